@@ -1,0 +1,87 @@
+// One lab run: prediction first, then the simulation with every event put beside the
+// closed-form prediction and the paper's printed formulas. Shared by the CLI, the ROS
+// node and the benchmarks, so all of them report the same numbers.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "collision_lab/core/analytic.h"
+#include "collision_lab/core/scene.h"
+#include "collision_lab/core/simulation.h"
+
+namespace collision_lab {
+
+/// What a run models. Values match the ROS message constants MODE_*.
+enum class RunMode : std::uint8_t {
+  kFull = 0,         ///< simulate, report every event
+  kPredictOnly = 1,  ///< closed form only, no simulation
+  kSummaryOnly = 2,  ///< simulate, report no per-collision output
+};
+
+/// Analytic predictions for a scene, computed before (and without) any simulation.
+struct Prediction {
+  std::uint64_t collision_count = 0;           ///< correct count, exact
+  std::optional<std::int64_t> paper_collision_count;  ///< eq. (3.22) as printed; empty if undefined
+  std::uint64_t max_possible_collision_count = 0;     ///< ceil(pi / alpha), exact
+  Angles angles;                               ///< alpha, theta, Omega [rad]
+  double phi_bc = 0.0;                         ///< the paper's phi_BC, eq. (3.21) [rad]
+  double psi = 0.0;                            ///< angle of u_perp from r_BC [rad]
+  std::optional<Pair> first_pair;
+  std::array<double, 3> final_velocities{};    ///< closed form after collision_count [m/s]
+};
+
+Prediction predict(const Scene& scene);
+
+/// One collision with everything a lab compares it to.
+struct LabEvent {
+  CollisionEvent event;
+  std::array<double, 3> predicted_velocities_after{};  ///< closed form [m/s]
+  std::array<double, 3> paper_velocities_after{};      ///< eqs. (2.15)/(2.16) as printed [m/s]
+  std::array<double, 3> predicted_energy_transfer{};   ///< closed form, gained by A,B,C [J]
+  std::array<double, 3> paper_energy_transfer{};       ///< eqs. (4.4)-(4.7) as printed [J]
+  std::array<double, 3> kinetic_energy_after{};        ///< per particle [J]; 0 for a wall
+};
+
+struct RunOptions {
+  std::uint64_t max_collisions = 10'000'000;
+  EventPolicy events = EventPolicy::all();  ///< which LabEvents RunResult keeps
+  RunMode mode = RunMode::kFull;
+  Precision precision = Precision::kDouble;
+  /// When the predicted count exceeds max_collisions, answer at once with the prediction
+  /// and a truncated summary instead of simulating up to the cap.
+  bool skip_simulation_over_cap = false;
+};
+
+struct RunSummary {
+  std::uint64_t collision_count = 0;
+  bool truncated = false;
+  std::string truncation_reason;            ///< empty unless truncated
+  bool simulated = false;                   ///< false for predict-only and skipped runs
+  std::array<double, 3> final_velocities{}; ///< [m/s]
+  /// max over reported states of max_i |v_sim - v_pred| / max_i |v_0| (dimensionless).
+  double max_prediction_error = 0.0;
+  double energy_relative_drift = 0.0;
+  double momentum_relative_drift = 0.0;     ///< NaN with a wall
+  double compute_time_s = 0.0;              ///< wall time of prediction + simulation [s]
+  EscalationStats escalation;
+};
+
+struct RunResult {
+  Prediction prediction;
+  RunSummary summary;
+  std::vector<LabEvent> events;  ///< as RunOptions::events says
+};
+
+using LabEventVisitor = std::function<void(const LabEvent&)>;
+
+/// Runs a validated scene. The visitor sees every event in order (none in predict-only
+/// or summary-only mode). Precondition: validate(scene) passed.
+RunResult runLab(const Scene& scene, const RunOptions& options,
+                 const LabEventVisitor& visitor = {});
+
+}  // namespace collision_lab

@@ -1,0 +1,39 @@
+// The paper's printed formulas, implemented exactly as printed (arXiv 2509.02628).
+// Several are wrong (shared/physics.md, Errata 1-4). They exist only so that a class can
+// put them beside the simulation and see where they disagree. Predictions elsewhere use
+// the correct formulas in analytic.h.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+
+#include "collision_lab/core/scene.h"
+
+namespace collision_lab {
+namespace paper {
+
+/// Velocities after n collisions by eq. (2.15) (n = 2k) and (2.16) (n = 2k+1), with the
+/// paper's c, d, nu^2 and the *initial* average vbar_AB. Written for AB first.
+std::array<double, 3> velocitiesAfter(const Scene& scene, std::uint64_t n);
+
+/// phi_BC of eq. (3.21): atan2(u1.n_BC, u1.l_BC) with u1 = u after the first AB impact [rad].
+double phiBC(const Scene& scene);
+
+/// Omega as printed: arccos(n_AB . n_BC) [rad].
+double omega(const std::array<double, 3>& masses);
+
+/// n_max of eq. (3.22): 1 + floor((Omega - phi_BC)/theta) + ceil((Omega - phi_BC)/theta).
+/// Empty when the printed expression is not a finite number for this scene.
+std::optional<std::int64_t> collisionCount(const Scene& scene);
+
+/// Energy gained by A, B, C [J] in collision n (1-based) by eqs. (4.4)-(4.7), with v_k
+/// read as the paper defines it (against the *initial* vbar_AB).
+/// state_before: velocities just before collision n; state_two_before: just before
+/// collision n-1 (used by the BC formulas 4.6, 4.7, which refer to v_{k-1}).
+std::array<double, 3> energyTransfer(const Scene& scene, std::uint64_t n, Pair pair,
+                                     const std::array<double, 3>& state_before,
+                                     const std::array<double, 3>& state_two_before);
+
+}  // namespace paper
+}  // namespace collision_lab
