@@ -1,0 +1,77 @@
+// Reports of lab runs for people (aligned table) and programs (JSON, CSV). ROS-free.
+// Used by collision_lab_cli; the JSON pieces are free functions so that other front ends
+// (the ROS node, scripts) print exactly the same keys.
+//
+// Conventions: SI units throughout (the JSON "units" object lists them); doubles are
+// printed so that they read back to the same double (JSON: shortest round-trip form,
+// CSV: the same via std::to_chars); NaN and infinities are JSON null, with walls named
+// in scene.walls. Values from the paper's printed formulas carry the prefix "paper_".
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "collision_lab/core/lab_run.h"
+#include "collision_lab/io/scenario_file.h"
+
+namespace collision_lab {
+namespace io {
+
+enum class ReportFormat { kTable, kJson, kCsv };
+
+/// Option spellings shared by the CLI's parser and the reports that echo them.
+std::optional<ReportFormat> parseReportFormat(const std::string& text);   ///< table|json|csv
+std::optional<RunMode> parseRunMode(const std::string& text);             ///< full|predict|summary
+std::optional<Precision> parsePrecisionOption(const std::string& text);   ///< double|long_double|high
+/// all | none | first:N (N a non-negative integer).
+std::optional<EventPolicy> parseEventPolicy(const std::string& text);
+std::string runModeText(RunMode mode);
+std::string precisionText(Precision precision);
+std::string eventPolicyText(const EventPolicy& policy);
+
+using Json = nlohmann::ordered_json;
+
+/// Compact JSON text; never throws (invalid UTF-8 in names or messages is replaced).
+std::string jsonText(const Json& json);
+
+Json unitsJson();
+/// name, description, masses, positions, velocities, walls (["A"], ["C"] or []).
+Json sceneJson(const NamedScene& scene);
+Json optionsJson(const RunOptions& options);
+/// One event: simulation, closed-form prediction and the paper's printed values.
+Json eventJson(const LabEvent& event);
+/// The summary of a run next to its predictions (see docs/cli_section.md for the keys).
+Json summaryJson(const RunResult& result);
+/// {"error": {"reason", "code", "field", "message"}}.
+Json errorJson(const std::string& reason, int code, const std::string& field, const std::string& message);
+
+/// Writes the report of one run while it runs, so that millions of events need no memory:
+/// begin(), then event() for each event to show, then end().
+class RunReportWriter {
+ public:
+  virtual ~RunReportWriter() = default;
+  virtual void begin(const NamedScene& scene, const RunOptions& options) = 0;
+  virtual void event(const LabEvent& event) = 0;
+  virtual void end(const RunResult& result) = 0;
+};
+
+std::unique_ptr<RunReportWriter> makeRunReportWriter(ReportFormat format, std::ostream& out);
+
+/// One scene of a batch and its finished run (events as its RunOptions kept them).
+struct SceneOutcome {
+  NamedScene scene;
+  RunOptions options;  ///< as run (a scene's own max_collisions applied)
+  RunResult result;
+};
+
+/// Several scenes: table and CSV give one summary row per scene; JSON gives
+/// {"units", "scenarios": [{"scene", "options", "events", "summary"}, ...]}.
+void writeBatchReport(ReportFormat format, const std::vector<SceneOutcome>& outcomes, std::ostream& out);
+
+}  // namespace io
+}  // namespace collision_lab

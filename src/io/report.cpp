@@ -1,0 +1,489 @@
+#include "collision_lab/io/report.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+
+#include "collision_lab/io/number_text.h"
+
+namespace collision_lab {
+namespace io {
+
+namespace {
+
+const char* const kParticleNames[3] = {"A", "B", "C"};
+
+/// Shortest text that reads back to the same double ("nan", "inf" as C writes them).
+std::string roundTripText(double value) {
+  char buffer[64];
+  const auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
+  return std::string(buffer, result.ptr);
+}
+
+/// Compact text for people, `digits` significant digits; -0 is shown as 0.
+std::string humanText(double value, int digits) {
+  if (value == 0.0) return "0";
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.*g", digits, value);
+  return buffer;
+}
+
+std::string padLeft(const std::string& text, std::size_t width) {
+  return text.size() >= width ? text : std::string(width - text.size(), ' ') + text;
+}
+
+std::string padRight(const std::string& text, std::size_t width) {
+  return text.size() >= width ? text : text + std::string(width - text.size(), ' ');
+}
+
+Json array3(const std::array<double, 3>& values) { return Json::array({values[0], values[1], values[2]}); }
+
+Json optionalPair(const std::optional<Pair>& pair) {
+  return pair ? Json(pairName(*pair)) : Json(nullptr);
+}
+
+double maxAbsDifference(const std::array<double, 3>& a, const std::array<double, 3>& b) {
+  double result = 0.0;
+  for (int i = 0; i < 3; ++i) result = std::max(result, std::fabs(a[i] - b[i]));
+  return result;
+}
+
+std::string paperCountText(const Prediction& prediction) {
+  return prediction.paper_collision_count ? std::to_string(*prediction.paper_collision_count)
+                                          : std::string("undefined");
+}
+
+// ---------------------------------------------------------------------------------------
+// Table: for people. Event rows use 7 significant digits, the summary 10; JSON and CSV
+// carry the full values.
+
+constexpr int kEventDigits = 7;
+constexpr int kSummaryDigits = 10;
+constexpr std::size_t kNumberWidth = 15;
+
+class TableWriter : public RunReportWriter {
+ public:
+  explicit TableWriter(std::ostream& out) : out_(out) {}
+
+  void begin(const NamedScene& named, const RunOptions& options) override {
+    out_ << "collision_lab: " << (named.name.empty() ? "scene from the command line" : named.name);
+    if (!named.description.empty()) out_ << " - " << named.description;
+    out_ << "\n\n" << padRight("", 16);
+    for (const char* name : kParticleNames) out_ << padLeft(name, kNumberWidth + 3);
+    out_ << "\n";
+    writeSceneRow("mass [kg]", named.scene.masses);
+    writeSceneRow("position [m]", named.scene.positions);
+    writeSceneRow("velocity [m/s]", named.scene.velocities);
+    out_ << "\nrun: mode " << runModeText(options.mode) << ", precision " << precisionText(options.precision)
+         << ", events " << eventPolicyText(options.events) << ", at most " << options.max_collisions
+         << " collisions\n";
+  }
+
+  void event(const LabEvent& lab) override {
+    if (!header_written_) writeEventHeader();
+    const CollisionEvent& e = lab.event;
+    out_ << padLeft(std::to_string(e.index), 9) << padLeft(pairName(e.pair), 5);
+    writeNumber(e.time);
+    writeNumber(e.position);
+    for (double v : e.velocities_after) writeNumber(v);
+    for (double de : e.energy_transfer) writeNumber(de);
+    writeNumber(maxAbsDifference(e.velocities_after, lab.predicted_velocities_after));
+    writeNumber(maxAbsDifference(e.velocities_after, lab.paper_velocities_after));
+    out_ << "\n";
+  }
+
+  void end(const RunResult& result) override {
+    const Prediction& p = result.prediction;
+    const RunSummary& s = result.summary;
+    const auto simulated = [&](const std::string& text) { return s.simulated ? text : std::string("-"); };
+    out_ << "\n";
+    writeSummaryRow("Summary", "simulation", "prediction", "paper, as printed");
+    writeSummaryRow("collisions", simulated(std::to_string(s.collision_count)), std::to_string(p.collision_count),
+                    paperCountText(p) + " by eq. 3.22");
+    writeSummaryRow("most possible collisions", "",
+                    std::to_string(p.max_possible_collision_count) + " = ceil(pi/alpha)", "");
+    writeSummaryRow("first pair", "", p.first_pair ? pairName(*p.first_pair) : "none", "");
+    for (int i = 0; i < 3; ++i) {
+      writeSummaryRow(std::string("final v_") + kParticleNames[i] + " [m/s]",
+                      simulated(humanText(s.final_velocities[i], kSummaryDigits)),
+                      humanText(p.final_velocities[i], kSummaryDigits), "");
+    }
+    out_ << "\nangles [rad]: alpha " << humanText(p.angles.alpha, kSummaryDigits) << ", theta = 2 alpha "
+         << humanText(p.angles.theta, kSummaryDigits) << ", Omega = pi - alpha "
+         << humanText(p.angles.omega, kSummaryDigits) << ", psi " << humanText(p.psi, kSummaryDigits)
+         << ", paper's phi_BC (eq. 3.21) " << humanText(p.phi_bc, kSummaryDigits) << "\n";
+    if (s.simulated) {
+      out_ << "checks: max prediction error " << humanText(s.max_prediction_error, 3)
+           << " (max |v_sim - v_pred| / max |v0|), energy drift " << humanText(s.energy_relative_drift, 3)
+           << ", momentum drift "
+           << (std::isnan(s.momentum_relative_drift) ? std::string("n/a (a wall)")
+                                                     : humanText(s.momentum_relative_drift, 3))
+           << " (relative)\n";
+    }
+    out_ << "truncated: " << (s.truncated ? "yes, " + s.truncation_reason : std::string("no")) << "\n";
+    out_ << "precision: " << s.escalation.decisions << " decisions, " << s.escalation.high_precision
+         << " taken at 50 digits, " << s.escalation.exact_rational << " by exact rationals; compute time "
+         << humanText(s.compute_time_s, 3) << " s\n";
+  }
+
+ private:
+  void writeSceneRow(const char* label, const std::array<double, 3>& values) {
+    out_ << padRight(label, 16);
+    for (double v : values) out_ << padLeft(humanText(v, kSummaryDigits), kNumberWidth + 3);
+    out_ << "\n";
+  }
+
+  void writeEventHeader() {
+    header_written_ = true;
+    out_ << "\nEvents (velocities after each impact; dv pred: max |v - closed form|, dv paper: max |v -"
+            " paper's eqs. 2.15/2.16|)\n"
+         << padLeft("#", 9) << padLeft("pair", 5);
+    for (const char* label : {"t [s]", "x [m]", "v_A [m/s]", "v_B [m/s]", "v_C [m/s]", "dE_A [J]", "dE_B [J]",
+                              "dE_C [J]", "dv pred [m/s]", "dv paper [m/s]"}) {
+      out_ << padLeft(label, kNumberWidth);
+    }
+    out_ << "\n";
+  }
+
+  void writeNumber(double value) { out_ << padLeft(humanText(value, kEventDigits), kNumberWidth); }
+
+  void writeSummaryRow(const std::string& label, const std::string& simulation, const std::string& prediction,
+                       const std::string& paper) {
+    constexpr std::size_t kLabelWidth = 26;
+    constexpr std::size_t kColumnWidth = 22;
+    std::string row = padRight(label, kLabelWidth) + padLeft(simulation, kColumnWidth) +
+                      padLeft(prediction, kColumnWidth) + padLeft(paper, kColumnWidth);
+    row.erase(row.find_last_not_of(' ') + 1);
+    out_ << row << "\n";
+  }
+
+  std::ostream& out_;
+  bool header_written_ = false;
+};
+
+// ---------------------------------------------------------------------------------------
+// JSON: one document, one event per line.
+
+class JsonWriter : public RunReportWriter {
+ public:
+  explicit JsonWriter(std::ostream& out) : out_(out) {}
+
+  void begin(const NamedScene& named, const RunOptions& options) override {
+    out_ << "{\"scene\": " << jsonText(sceneJson(named)) << ",\n\"options\": " << jsonText(optionsJson(options))
+         << ",\n\"units\": " << jsonText(unitsJson()) << ",\n\"events\": [";
+  }
+
+  void event(const LabEvent& lab) override {
+    out_ << (any_event_ ? ",\n" : "\n") << jsonText(eventJson(lab));
+    any_event_ = true;
+  }
+
+  void end(const RunResult& result) override {
+    out_ << (any_event_ ? "\n]" : "]") << ",\n\"summary\": " << jsonText(summaryJson(result)) << "}\n";
+  }
+
+ private:
+  std::ostream& out_;
+  bool any_event_ = false;
+};
+
+// ---------------------------------------------------------------------------------------
+// CSV: "# key,value..." comment lines for the scene and options, a header line, one row
+// per event, then "# key,value..." comment lines for the summary (the JSON summary keys,
+// nested keys joined by '.', null as an empty field).
+
+void writeCsvComments(std::ostream& out, const std::string& prefix, const Json& object) {
+  for (const auto& item : object.items()) {
+    const std::string key = prefix + item.key();
+    const Json& value = item.value();
+    if (value.is_object()) {
+      writeCsvComments(out, key + ".", value);
+      continue;
+    }
+    out << "# " << key;
+    const auto write_scalar = [&](const Json& scalar) {
+      out << ",";
+      if (scalar.is_string()) {
+        out << scalar.get<std::string>();
+      } else if (!scalar.is_null()) {
+        out << jsonText(scalar);
+      }
+    };
+    if (value.is_array()) {
+      for (const Json& element : value) write_scalar(element);
+    } else {
+      write_scalar(value);
+    }
+    out << "\n";
+  }
+}
+
+class CsvWriter : public RunReportWriter {
+ public:
+  explicit CsvWriter(std::ostream& out) : out_(out) {}
+
+  void begin(const NamedScene& named, const RunOptions& options) override {
+    out_ << "# scene," << named.name << "\n";
+    const std::pair<const char*, const std::array<double, 3>*> vectors[] = {
+        {"masses_kg", &named.scene.masses},
+        {"positions_m", &named.scene.positions},
+        {"velocities_m_s", &named.scene.velocities}};
+    for (const auto& [label, values] : vectors) {
+      out_ << "# " << label;
+      for (double v : *values) out_ << "," << roundTripText(v);
+      out_ << "\n";
+    }
+    writeCsvComments(out_, "", optionsJson(options));
+    out_ << "index,pair,time_s,position_m";
+    for (const char* group : {"x_%s_m", "v_%s_before_m_s", "v_%s_after_m_s", "energy_transfer_%s_J",
+                              "predicted_v_%s_after_m_s", "paper_v_%s_after_m_s", "predicted_energy_transfer_%s_J",
+                              "paper_energy_transfer_%s_J"}) {
+      for (const char* particle : kParticleNames) {
+        char column[64];
+        std::snprintf(column, sizeof column, group, particle);
+        out_ << "," << column;
+      }
+    }
+    out_ << ",total_energy_J,total_momentum_kg_m_s\n";
+  }
+
+  void event(const LabEvent& lab) override {
+    const CollisionEvent& e = lab.event;
+    out_ << e.index << "," << pairName(e.pair) << "," << roundTripText(e.time) << "," << roundTripText(e.position);
+    for (const auto* values : {&e.positions, &e.velocities_before, &e.velocities_after, &e.energy_transfer,
+                               &lab.predicted_velocities_after, &lab.paper_velocities_after,
+                               &lab.predicted_energy_transfer, &lab.paper_energy_transfer}) {
+      for (double v : *values) out_ << "," << roundTripText(v);
+    }
+    out_ << "," << roundTripText(e.total_energy) << "," << roundTripText(e.total_momentum) << "\n";
+  }
+
+  void end(const RunResult& result) override { writeCsvComments(out_, "summary.", summaryJson(result)); }
+
+ private:
+  std::ostream& out_;
+};
+
+// ---------------------------------------------------------------------------------------
+// Batches.
+
+void writeBatchTable(const std::vector<SceneOutcome>& outcomes, std::ostream& out) {
+  std::size_t name_width = 8;
+  for (const SceneOutcome& outcome : outcomes) name_width = std::max(name_width, outcome.scene.name.size());
+  out << padRight("scenario", name_width) << padLeft("collisions", 12) << padLeft("predicted", 12)
+      << padLeft("paper (3.22)", 14) << padLeft("most possible", 15) << padLeft("final v_A [m/s]", 18)
+      << padLeft("final v_B [m/s]", 18) << padLeft("final v_C [m/s]", 18) << padLeft("max pred err", 14)
+      << "  truncated\n";
+  for (const SceneOutcome& outcome : outcomes) {
+    const Prediction& p = outcome.result.prediction;
+    const RunSummary& s = outcome.result.summary;
+    out << padRight(outcome.scene.name, name_width)
+        << padLeft(s.simulated ? std::to_string(s.collision_count) : "-", 12)
+        << padLeft(std::to_string(p.collision_count), 12) << padLeft(paperCountText(p), 14)
+        << padLeft(std::to_string(p.max_possible_collision_count), 15);
+    const std::array<double, 3>& final_velocities = s.simulated ? s.final_velocities : p.final_velocities;
+    for (double v : final_velocities) out << padLeft(humanText(v, kSummaryDigits), 18);
+    out << padLeft(s.simulated ? humanText(s.max_prediction_error, 3) : "-", 14) << "  "
+        << (s.truncated ? "yes" : "no") << "\n";
+  }
+  out << "\ncollisions: simulated; predicted: the correct closed form; paper (3.22): the paper's printed n_max;"
+         "\nfinal velocities: simulated (predicted when not simulated); max pred err: max |v_sim - v_pred| / max |v0|\n";
+}
+
+void writeBatchCsv(const std::vector<SceneOutcome>& outcomes, std::ostream& out) {
+  out << "scenario,collision_count,truncated,predicted_collision_count,paper_predicted_collision_count,"
+         "max_possible_collision_count,final_v_A_m_s,final_v_B_m_s,final_v_C_m_s,predicted_final_v_A_m_s,"
+         "predicted_final_v_B_m_s,predicted_final_v_C_m_s,max_prediction_error,energy_relative_drift,"
+         "momentum_relative_drift\n";
+  for (const SceneOutcome& outcome : outcomes) {
+    const Prediction& p = outcome.result.prediction;
+    const RunSummary& s = outcome.result.summary;
+    out << outcome.scene.name << "," << s.collision_count << "," << (s.truncated ? "true" : "false") << ","
+        << p.collision_count << "," << (p.paper_collision_count ? std::to_string(*p.paper_collision_count) : "")
+        << "," << p.max_possible_collision_count;
+    for (double v : s.final_velocities) out << "," << roundTripText(v);
+    for (double v : p.final_velocities) out << "," << roundTripText(v);
+    out << "," << roundTripText(s.max_prediction_error) << "," << roundTripText(s.energy_relative_drift) << ","
+        << roundTripText(s.momentum_relative_drift) << "\n";
+  }
+}
+
+void writeBatchJson(const std::vector<SceneOutcome>& outcomes, std::ostream& out) {
+  out << "{\"units\": " << jsonText(unitsJson()) << ",\n\"scenarios\": [";
+  bool first = true;
+  for (const SceneOutcome& outcome : outcomes) {
+    Json events = Json::array();
+    for (const LabEvent& lab : outcome.result.events) events.push_back(eventJson(lab));
+    Json entry;
+    entry["scene"] = sceneJson(outcome.scene);
+    entry["options"] = optionsJson(outcome.options);
+    entry["events"] = std::move(events);
+    entry["summary"] = summaryJson(outcome.result);
+    out << (first ? "\n" : ",\n") << jsonText(entry);
+    first = false;
+  }
+  out << "\n]}\n";
+}
+
+}  // namespace
+
+std::optional<ReportFormat> parseReportFormat(const std::string& text) {
+  if (text == "table") return ReportFormat::kTable;
+  if (text == "json") return ReportFormat::kJson;
+  if (text == "csv") return ReportFormat::kCsv;
+  return std::nullopt;
+}
+
+std::optional<RunMode> parseRunMode(const std::string& text) {
+  if (text == "full") return RunMode::kFull;
+  if (text == "predict") return RunMode::kPredictOnly;
+  if (text == "summary") return RunMode::kSummaryOnly;
+  return std::nullopt;
+}
+
+std::optional<Precision> parsePrecisionOption(const std::string& text) {
+  if (text == "double") return Precision::kDouble;
+  if (text == "long_double") return Precision::kLongDouble;
+  if (text == "high") return Precision::kHigh;
+  return std::nullopt;
+}
+
+std::optional<EventPolicy> parseEventPolicy(const std::string& text) {
+  if (text == "all") return EventPolicy::all();
+  if (text == "none") return EventPolicy::none();
+  const std::string prefix = "first:";
+  if (text.compare(0, prefix.size(), prefix) == 0) {
+    if (const auto n = parseCount(text.substr(prefix.size()))) return EventPolicy::firstN(*n);
+  }
+  return std::nullopt;
+}
+
+std::string runModeText(RunMode mode) {
+  switch (mode) {
+    case RunMode::kFull: return "full";
+    case RunMode::kPredictOnly: return "predict";
+    case RunMode::kSummaryOnly: return "summary";
+  }
+  return "unknown";
+}
+
+std::string precisionText(Precision precision) {
+  switch (precision) {
+    case Precision::kDouble: return "double";
+    case Precision::kLongDouble: return "long_double";
+    case Precision::kHigh: return "high";
+  }
+  return "unknown";
+}
+
+std::string eventPolicyText(const EventPolicy& policy) {
+  switch (policy.kind) {
+    case EventPolicy::Kind::kAll: return "all";
+    case EventPolicy::Kind::kNone: return "none";
+    case EventPolicy::Kind::kFirstN: return "first:" + std::to_string(policy.first_n);
+  }
+  return "unknown";
+}
+
+std::string jsonText(const Json& json) {
+  return json.dump(-1, ' ', false, Json::error_handler_t::replace);
+}
+
+Json unitsJson() {
+  return Json{{"mass", "kg"},         {"position", "m"}, {"velocity", "m/s"},
+              {"time", "s"},          {"energy", "J"},   {"momentum", "kg m/s"},
+              {"angle", "rad"},       {"drift", "relative (dimensionless)"},
+              {"prediction_error", "relative to max |v0| (dimensionless)"}};
+}
+
+Json sceneJson(const NamedScene& named) {
+  Json walls = Json::array();
+  const int wall = named.scene.wallIndex();
+  if (wall >= 0) walls.push_back(kParticleNames[wall]);
+  return Json{{"name", named.name},
+              {"description", named.description},
+              {"masses", array3(named.scene.masses)},
+              {"walls", std::move(walls)},
+              {"positions", array3(named.scene.positions)},
+              {"velocities", array3(named.scene.velocities)}};
+}
+
+Json optionsJson(const RunOptions& options) {
+  return Json{{"max_collisions", options.max_collisions},
+              {"events", eventPolicyText(options.events)},
+              {"mode", runModeText(options.mode)},
+              {"precision", precisionText(options.precision)}};
+}
+
+Json eventJson(const LabEvent& lab) {
+  const CollisionEvent& e = lab.event;
+  return Json{{"index", e.index},
+              {"pair", pairName(e.pair)},
+              {"time", e.time},
+              {"position", e.position},
+              {"positions", array3(e.positions)},
+              {"velocities_before", array3(e.velocities_before)},
+              {"velocities_after", array3(e.velocities_after)},
+              {"energy_transfer", array3(e.energy_transfer)},
+              {"predicted_velocities_after", array3(lab.predicted_velocities_after)},
+              {"predicted_energy_transfer", array3(lab.predicted_energy_transfer)},
+              {"paper_velocities_after", array3(lab.paper_velocities_after)},
+              {"paper_energy_transfer", array3(lab.paper_energy_transfer)},
+              {"kinetic_energy_after", array3(lab.kinetic_energy_after)},
+              {"total_energy", e.total_energy},
+              {"total_momentum", e.total_momentum}};
+}
+
+Json summaryJson(const RunResult& result) {
+  const Prediction& p = result.prediction;
+  const RunSummary& s = result.summary;
+  return Json{{"collision_count", s.collision_count},
+              {"truncated", s.truncated},
+              {"truncation_reason", s.truncation_reason},
+              {"simulated", s.simulated},
+              {"final_velocities", array3(s.final_velocities)},
+              {"predicted_collision_count", p.collision_count},
+              {"paper_predicted_collision_count",
+               p.paper_collision_count ? Json(*p.paper_collision_count) : Json(nullptr)},
+              {"max_possible_collision_count", p.max_possible_collision_count},
+              {"predicted_first_pair", optionalPair(p.first_pair)},
+              {"predicted_final_velocities", array3(p.final_velocities)},
+              {"theta", p.angles.theta},
+              {"alpha", p.angles.alpha},
+              {"omega", p.angles.omega},
+              {"psi", p.psi},
+              {"paper_phi_bc", p.phi_bc},
+              {"max_prediction_error", s.max_prediction_error},
+              {"energy_relative_drift", s.energy_relative_drift},
+              {"momentum_relative_drift", s.momentum_relative_drift},
+              {"compute_time_s", s.compute_time_s},
+              {"escalation",
+               {{"decisions", s.escalation.decisions},
+                {"high_precision", s.escalation.high_precision},
+                {"exact_rational", s.escalation.exact_rational}}}};
+}
+
+Json errorJson(const std::string& reason, int code, const std::string& field, const std::string& message) {
+  return Json{{"error", {{"reason", reason}, {"code", code}, {"field", field}, {"message", message}}}};
+}
+
+std::unique_ptr<RunReportWriter> makeRunReportWriter(ReportFormat format, std::ostream& out) {
+  switch (format) {
+    case ReportFormat::kJson: return std::make_unique<JsonWriter>(out);
+    case ReportFormat::kCsv: return std::make_unique<CsvWriter>(out);
+    case ReportFormat::kTable: break;
+  }
+  return std::make_unique<TableWriter>(out);
+}
+
+void writeBatchReport(ReportFormat format, const std::vector<SceneOutcome>& outcomes, std::ostream& out) {
+  switch (format) {
+    case ReportFormat::kJson: writeBatchJson(outcomes, out); return;
+    case ReportFormat::kCsv: writeBatchCsv(outcomes, out); return;
+    case ReportFormat::kTable: writeBatchTable(outcomes, out); return;
+  }
+}
+
+}  // namespace io
+}  // namespace collision_lab
