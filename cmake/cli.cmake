@@ -1,0 +1,16 @@
+# collision_lab_cli: no ROS master needed. Placed in the devel space's package bin
+# folder so that `rosrun collision_lab collision_lab_cli` finds it.
+add_executable(collision_lab_cli
+  src/cli/main.cpp
+  src/cli/command_line.cpp
+  src/cli/progress.cpp)
+target_link_libraries(collision_lab_cli PRIVATE collision_lab_io CLI11::CLI11)
+# --name and --list without --scenario read the presets: the source tree's in the devel
+# space, the installed copy otherwise.
+target_compile_definitions(collision_lab_cli PRIVATE
+  COLLISION_LAB_SOURCE_SCENARIOS="${PROJECT_SOURCE_DIR}/config/scenarios.yaml"
+  COLLISION_LAB_INSTALLED_SCENARIOS="${CMAKE_INSTALL_PREFIX}/${CATKIN_PACKAGE_SHARE_DESTINATION}/config/scenarios.yaml")
+set_target_properties(collision_lab_cli PROPERTIES
+  RUNTIME_OUTPUT_DIRECTORY ${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_BIN_DESTINATION})
+
+install(TARGETS collision_lab_cli RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})

@@ -1,0 +1,209 @@
+#include "command_line.h"
+
+#include <algorithm>
+#include <array>
+
+#include <CLI/CLI.hpp>
+
+#include "collision_lab/io/number_text.h"
+
+namespace collision_lab {
+namespace cli {
+
+namespace {
+
+/// Options that take a value. A value may start with '-' (negative numbers, "-inf",
+/// "-.5"), which CLI11 would take for a flag; normalizeArguments() prevents that.
+const std::array<const char*, 10> kValueOptions = {"--masses",     "--positions", "--velocities", "--max-collisions",
+                                                  "--events",     "--format",    "--precision",  "--mode",
+                                                  "--scenario",   "--name"};
+
+/// "--velocities -1,0,0" -> "--velocities=-1,0,0": a value option takes the next
+/// argument as its value, as getopt does, unless that argument is itself a long option.
+std::vector<std::string> normalizeArguments(const std::vector<std::string>& args) {
+  std::vector<std::string> out;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const bool takes_value =
+        std::find(kValueOptions.begin(), kValueOptions.end(), args[i]) != kValueOptions.end();
+    if (takes_value && i + 1 < args.size() && args[i + 1].rfind("--", 0) != 0) {
+      out.push_back(args[i] + "=" + args[i + 1]);
+      ++i;
+    } else {
+      out.push_back(args[i]);
+    }
+  }
+  return out;
+}
+
+/// CLI11 messages may span lines; the CLI promises one line.
+std::string oneLine(std::string text) {
+  std::replace(text.begin(), text.end(), '\n', ' ');
+  while (!text.empty() && text.back() == ' ') text.pop_back();
+  return text;
+}
+
+/// "1,2,inf" -> three doubles; `field` is "masses", "positions" or "velocities".
+std::array<double, 3> parseTriple(const std::string& text, const std::string& field, const char* symbol) {
+  const std::vector<std::string> items = io::splitCommaList(text);
+  if (items.size() != 3) {
+    throw makeCliError(CliReason::kWrongCount, field,
+                       field + " needs 3 comma-separated numbers (" + symbol + "_A," + symbol + "_B," + symbol +
+                           "_C), got " + std::to_string(items.size()) + " in '" + text + "'");
+  }
+  std::array<double, 3> values{};
+  for (int i = 0; i < 3; ++i) {
+    const io::ParsedNumber parsed = io::parseNumber(items[i]);
+    if (!parsed.problem.empty()) {
+      const std::string item_field = field + "[" + std::to_string(i) + "]";
+      throw makeCliError(CliReason::kMalformedNumber, item_field,
+                         item_field + " '" + items[i] + "' " + parsed.problem);
+    }
+    values[i] = parsed.value;
+  }
+  return values;
+}
+
+struct RawOptions {
+  std::string masses, positions, velocities;
+  std::string max_collisions, events, format = "table", precision = "double", mode = "full";
+  std::string scenario, name;
+  bool list = false;
+};
+
+}  // namespace
+
+const char* cliReasonName(CliReason reason) {
+  switch (reason) {
+    case CliReason::kUsage: return "USAGE";
+    case CliReason::kMalformedNumber: return "MALFORMED_NUMBER";
+    case CliReason::kWrongCount: return "WRONG_COUNT";
+    case CliReason::kMissingInput: return "MISSING_INPUT";
+    case CliReason::kInvalidOption: return "INVALID_OPTION";
+    case CliReason::kUnknownScenario: return "UNKNOWN_SCENARIO";
+    case CliReason::kScenarioFile: return "SCENARIO_FILE";
+  }
+  return "UNKNOWN";
+}
+
+CliError makeCliError(CliReason reason, std::string field, std::string message) {
+  return CliError{cliReasonName(reason), static_cast<int>(reason), std::move(field), std::move(message)};
+}
+
+io::ReportFormat requestedFormat(const std::vector<std::string>& args) {
+  std::optional<io::ReportFormat> format;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    if (args[i] == "--format" && i + 1 < args.size()) format = io::parseReportFormat(args[i + 1]);
+    if (args[i].rfind("--format=", 0) == 0) format = io::parseReportFormat(args[i].substr(9));
+  }
+  return format.value_or(io::ReportFormat::kTable);
+}
+
+CliRequest parseCommandLine(std::vector<std::string> args, const std::string& default_scenario_path) {
+  RawOptions raw;
+  CLI::App app{
+      "collision_lab_cli: three elastic point masses on a line, simulated exactly, beside the correct "
+      "closed-form predictions and the paper's printed formulas (SI units).",
+      "collision_lab_cli"};
+  const CLI::Option* masses = app.add_option("--masses", raw.masses, "m_A,m_B,m_C [kg]; inf makes A or C a wall");
+  const CLI::Option* positions =
+      app.add_option("--positions", raw.positions, "x_A,x_B,x_C [m], strictly decreasing");
+  const CLI::Option* velocities =
+      app.add_option("--velocities", raw.velocities, "v_A,v_B,v_C [m/s]; negative values are fine");
+  const CLI::Option* max_collisions = app.add_option("--max-collisions", raw.max_collisions,
+                 "stop after N collisions and mark the run truncated (default 10000000)");
+  const CLI::Option* events_option = app.add_option("--events", raw.events,
+                 "events to print: all|none|first:N (default all; none when running every scenario)");
+  app.add_option("--format", raw.format, "table|json|csv (default table)");
+  app.add_option("--precision", raw.precision, "working precision: double|long_double|high (default double)");
+  app.add_option("--mode", raw.mode, "full|predict|summary (default full)");
+  const CLI::Option* scenario =
+      app.add_option("--scenario", raw.scenario, "scenario file (YAML); without --name runs every scene in it");
+  const CLI::Option* name = app.add_option("--name", raw.name, "scene of the scenario file (default file: the package's presets)");
+  app.add_flag("--list", raw.list, "list the scenes of the scenario file");
+
+  CliRequest request;
+  try {
+    // CLI11 wants the arguments in reverse order.
+    std::vector<std::string> normalized = normalizeArguments(args);
+    std::reverse(normalized.begin(), normalized.end());
+    app.parse(normalized);
+  } catch (const CLI::CallForHelp&) {
+    request.action = CliRequest::Action::kHelp;
+    request.help_text = app.help();
+    return request;
+  } catch (const CLI::ParseError& e) {
+    throw makeCliError(CliReason::kUsage, "arguments", oneLine(e.what()) + " (see --help)");
+  }
+
+  const auto format = io::parseReportFormat(raw.format);
+  if (!format) {
+    throw makeCliError(CliReason::kInvalidOption, "format", "format '" + raw.format + "' is not table, json or csv");
+  }
+  request.format = *format;
+  const auto precision = io::parsePrecisionOption(raw.precision);
+  if (!precision) {
+    throw makeCliError(CliReason::kInvalidOption, "precision",
+                       "precision '" + raw.precision + "' is not double, long_double or high");
+  }
+  request.options.precision = *precision;
+  const auto mode = io::parseRunMode(raw.mode);
+  if (!mode) {
+    throw makeCliError(CliReason::kInvalidOption, "mode", "mode '" + raw.mode + "' is not full, predict or summary");
+  }
+  request.options.mode = *mode;
+  if (max_collisions->count() > 0) {
+    const auto cap = io::parseCount(raw.max_collisions);
+    if (!cap) {
+      throw makeCliError(CliReason::kInvalidOption, "max-collisions",
+                         "max-collisions '" + raw.max_collisions + "' is not a non-negative integer");
+    }
+    request.options.max_collisions = *cap;
+    request.max_collisions_given = true;
+  }
+
+  const bool any_scene_value = masses->count() + positions->count() + velocities->count() > 0;
+  const bool from_file = scenario->count() + name->count() > 0 || raw.list;
+  if (any_scene_value && from_file) {
+    throw makeCliError(CliReason::kUsage, "scenario",
+                       "give either --masses/--positions/--velocities or --scenario/--name/--list, not both");
+  }
+  if (from_file) {
+    request.scenario_path = scenario->count() > 0 ? raw.scenario : default_scenario_path;
+    if (raw.list) {
+      request.action = CliRequest::Action::kList;
+    } else if (name->count() == 0) {
+      request.action = CliRequest::Action::kRunAll;
+    } else {
+      request.action = CliRequest::Action::kRunOne;
+      request.scenario_name = raw.name;
+    }
+  } else {
+    for (const auto& [option, field] : {std::pair{masses, "masses"}, std::pair{positions, "positions"},
+                                        std::pair{velocities, "velocities"}}) {
+      if (option->count() == 0) {
+        throw makeCliError(CliReason::kMissingInput, field,
+                           std::string(field) + " missing: give --masses, --positions and --velocities "
+                                                "(3 comma-separated numbers each), or --scenario FILE");
+      }
+    }
+    Scene scene;
+    scene.masses = parseTriple(raw.masses, "masses", "m");
+    scene.positions = parseTriple(raw.positions, "positions", "x");
+    scene.velocities = parseTriple(raw.velocities, "velocities", "v");
+    request.scene = scene;
+  }
+
+  // Every scene of a file at once: the summary rows are the point, not the events.
+  const std::string events_text =
+      events_option->count() == 0 ? (request.action == CliRequest::Action::kRunAll ? "none" : "all") : raw.events;
+  const auto events = io::parseEventPolicy(events_text);
+  if (!events) {
+    throw makeCliError(CliReason::kInvalidOption, "events",
+                       "events '" + events_text + "' is not all, none or first:N with N a non-negative integer");
+  }
+  request.options.events = *events;
+  return request;
+}
+
+}  // namespace cli
+}  // namespace collision_lab

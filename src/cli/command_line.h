@@ -1,0 +1,58 @@
+// collision_lab_cli's command line: argv -> a request, or one CliError naming the field.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "collision_lab/core/lab_run.h"
+#include "collision_lab/io/report.h"
+
+namespace collision_lab {
+namespace cli {
+
+/// Reason codes of input the CLI rejects before the core sees a scene. The core's
+/// validation reasons (scene.h, codes 0-8) are reported with their own names and codes.
+enum class CliReason {
+  kUsage = 100,            ///< unknown option, stray argument, conflicting options
+  kMalformedNumber = 101,  ///< a list item that is not a number, or beyond a double
+  kWrongCount = 102,       ///< a list without exactly 3 items
+  kMissingInput = 103,     ///< no --masses / --positions / --velocities and no --scenario
+  kInvalidOption = 104,    ///< a bad value for --max-collisions, --events, --format, ...
+  kUnknownScenario = 105,  ///< --name not in the scenario file
+  kScenarioFile = 106,     ///< unreadable or malformed scenario file
+};
+const char* cliReasonName(CliReason reason);
+
+/// One rejected input: what exits with code 2 and one line on stderr.
+struct CliError {
+  std::string reason;  ///< e.g. "MALFORMED_NUMBER", "NON_POSITIVE_MASS"
+  int code = 0;
+  std::string field;   ///< e.g. "masses[1]", "max-collisions", "name"
+  std::string message;
+};
+
+CliError makeCliError(CliReason reason, std::string field, std::string message);
+
+struct CliRequest {
+  enum class Action { kHelp, kList, kRunOne, kRunAll };
+  Action action = Action::kRunOne;
+  std::string help_text;
+  io::ReportFormat format = io::ReportFormat::kTable;
+  RunOptions options;
+  bool max_collisions_given = false;  ///< else a scenario's own cap applies, if it has one
+  std::string scenario_path;          ///< for kList, kRunAll, and kRunOne from a file
+  std::string scenario_name;          ///< kRunOne from a file
+  std::optional<Scene> scene;         ///< kRunOne from --masses/--positions/--velocities
+};
+
+/// The format asked for on the command line, found before full parsing so that even a
+/// parse error can be reported as JSON. Table when absent or not understood.
+io::ReportFormat requestedFormat(const std::vector<std::string>& args);
+
+/// Parses the arguments (without argv[0]). Throws CliError.
+/// `default_scenario_path` is used by --name and --list when --scenario is absent.
+CliRequest parseCommandLine(std::vector<std::string> args, const std::string& default_scenario_path);
+
+}  // namespace cli
+}  // namespace collision_lab

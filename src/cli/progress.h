@@ -1,0 +1,34 @@
+// A progress line on stderr for long runs, shown only when stderr is a terminal.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <cstdio>
+
+namespace collision_lab {
+namespace cli {
+
+class ProgressLine {
+ public:
+  /// `expected` is the predicted number of collisions (the cap, if lower).
+  ProgressLine(std::FILE* terminal, std::uint64_t expected);
+  ~ProgressLine();  ///< erases the line, if one was drawn
+
+  /// Called for every collision; reads the clock only every 2^16 collisions, and draws
+  /// from one second after the start, at most five times a second.
+  void onCollision(std::uint64_t index) {
+    if ((index & 0xFFFF) == 0) maybeDraw(index);
+  }
+
+ private:
+  void maybeDraw(std::uint64_t index);
+
+  std::FILE* terminal_;
+  std::uint64_t expected_;
+  std::chrono::steady_clock::time_point start_;
+  std::chrono::steady_clock::time_point last_draw_;
+  bool drawn_ = false;
+};
+
+}  // namespace cli
+}  // namespace collision_lab
