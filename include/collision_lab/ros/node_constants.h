@@ -1,0 +1,45 @@
+// Default topic names (relative: the launch files put them in namespace collision_lab;
+// remap as needed), queue sizes and parameter defaults of the collision_lab nodes.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+namespace collision_lab_ros {
+
+constexpr char kInitialConditionsTopic[] = "initial_conditions";
+constexpr char kPredictionsTopic[] = "predictions";
+constexpr char kCollisionEventsTopic[] = "collision_events";
+constexpr char kVelocitiesTopic[] = "velocities";
+constexpr char kEnergyTransfersTopic[] = "energy_transfers";
+constexpr char kRunSummariesTopic[] = "run_summaries";
+constexpr char kRejectedTopic[] = "rejected";
+constexpr char kMarkersTopic[] = "markers";
+
+/// Inputs arrive in bursts from scripts; the subscriber callback only queues them, so
+/// this covers bursts of up to 10,000 inputs between two spins.
+constexpr std::uint32_t kInputQueueSize = 10000;
+/// Per-run topics: a burst of runs may queue many messages per subscriber link before a
+/// slow subscriber reads them. roscpp drops the oldest beyond this, so it is sized for
+/// ~max_published_events per run times a burst of runs.
+constexpr std::uint32_t kOutputQueueSize = 100000;
+/// Markers are periodic snapshots: only the newest matters.
+constexpr std::uint32_t kMarkerQueueSize = 10;
+
+constexpr std::uint64_t kDefaultMaxCollisions = 10'000'000;
+/// Per run; beyond it, events go to the bag only. Keeps a 2-million-collision run from
+/// putting 6 million messages on the network.
+constexpr std::uint64_t kDefaultMaxPublishedEvents = 10'000;
+/// Relative to $ROS_HOME (default ~/.ros).
+constexpr char kDefaultBagSubdirectory[] = "collision_lab/runs";
+
+constexpr double kDefaultMarkerRate = 20.0;  ///< [Hz]
+/// Simulated seconds per wall second; 0 = choose so that one loop of the run's
+/// animation takes about kAutoLoopDuration.
+constexpr double kDefaultTimeScale = 0.0;
+constexpr double kAutoLoopDuration = 8.0;  ///< [s] wall time
+/// The marker view keeps the first this many collisions of a run for its plots.
+constexpr std::size_t kDefaultMaxPlottedEvents = 1000;
+constexpr char kMarkerFrame[] = "collision_lab";
+
+}  // namespace collision_lab_ros

@@ -1,0 +1,233 @@
+#include "collision_lab/ros/msg_conversion.h"
+
+namespace collision_lab_ros {
+
+using collision_lab::Rejected;
+
+static_assert(collision_lab::InitialConditions::MODE_FULL ==
+                  static_cast<std::uint8_t>(core::RunMode::kFull) &&
+              collision_lab::InitialConditions::MODE_PREDICT_ONLY ==
+                  static_cast<std::uint8_t>(core::RunMode::kPredictOnly) &&
+              collision_lab::InitialConditions::MODE_SUMMARY_ONLY ==
+                  static_cast<std::uint8_t>(core::RunMode::kSummaryOnly),
+              "InitialConditions::MODE_* must match collision_lab::RunMode");
+constexpr int kPairAB = static_cast<int>(core::Pair::AB);
+constexpr int kPairBC = static_cast<int>(core::Pair::BC);
+static_assert(collision_lab::CollisionEvent::PAIR_AB == kPairAB &&
+              collision_lab::CollisionEvent::PAIR_BC == kPairBC &&
+              collision_lab::Prediction::PAIR_AB == kPairAB &&
+              collision_lab::Prediction::PAIR_BC == kPairBC &&
+              collision_lab::EnergyTransfer::PAIR_AB == kPairAB &&
+              collision_lab::EnergyTransfer::PAIR_BC == kPairBC,
+              "PAIR_* must match collision_lab::Pair");
+static_assert(Rejected::NON_FINITE_VALUE == static_cast<std::uint8_t>(core::Reason::kNonFiniteValue) &&
+              Rejected::NON_POSITIVE_MASS == static_cast<std::uint8_t>(core::Reason::kNonPositiveMass) &&
+              Rejected::TWO_WALLS == static_cast<std::uint8_t>(core::Reason::kTwoWalls) &&
+              Rejected::INFINITE_MIDDLE_MASS ==
+                  static_cast<std::uint8_t>(core::Reason::kInfiniteMiddleMass) &&
+              Rejected::POSITIONS_NOT_ORDERED ==
+                  static_cast<std::uint8_t>(core::Reason::kPositionsNotOrdered) &&
+              Rejected::POSITIONS_COINCIDENT ==
+                  static_cast<std::uint8_t>(core::Reason::kPositionsCoincident) &&
+              Rejected::TRIPLE_COLLISION == static_cast<std::uint8_t>(core::Reason::kTripleCollision) &&
+              Rejected::OVERFLOW == static_cast<std::uint8_t>(core::Reason::kOverflow),
+              "Rejected reason codes must match collision_lab::Reason");
+
+const char* nodeReasonName(NodeReason reason) {
+  switch (reason) {
+    case NodeReason::kDuplicateRunId: return "DUPLICATE_RUN_ID";
+    case NodeReason::kInvalidRunId: return "INVALID_RUN_ID";
+    case NodeReason::kInvalidMode: return "INVALID_MODE";
+  }
+  return "UNKNOWN";
+}
+
+std::array<double, 3> toArray(const boost::array<double, 3>& values) {
+  return {values[0], values[1], values[2]};
+}
+
+boost::array<double, 3> toBoostArray(const std::array<double, 3>& values) {
+  return {{values[0], values[1], values[2]}};
+}
+
+core::Scene toScene(const collision_lab::InitialConditions& msg) {
+  core::Scene scene;
+  scene.masses = toArray(msg.masses);
+  scene.positions = toArray(msg.positions);
+  scene.velocities = toArray(msg.velocities);
+  return scene;
+}
+
+collision_lab::InitialConditions toInitialConditions(const core::Scene& scene,
+                                                     core::RunMode mode,
+                                                     std::uint64_t max_collisions) {
+  collision_lab::InitialConditions msg;
+  msg.mode = static_cast<std::uint8_t>(mode);
+  msg.masses = toBoostArray(scene.masses);
+  msg.positions = toBoostArray(scene.positions);
+  msg.velocities = toBoostArray(scene.velocities);
+  msg.max_collisions = max_collisions;
+  return msg;
+}
+
+std::optional<core::RunMode> toRunMode(std::uint8_t mode) {
+  switch (mode) {
+    case collision_lab::InitialConditions::MODE_FULL: return core::RunMode::kFull;
+    case collision_lab::InitialConditions::MODE_PREDICT_ONLY: return core::RunMode::kPredictOnly;
+    case collision_lab::InitialConditions::MODE_SUMMARY_ONLY: return core::RunMode::kSummaryOnly;
+    default: return std::nullopt;
+  }
+}
+
+std::uint8_t toPairCode(const std::optional<core::Pair>& pair) {
+  return pair ? static_cast<std::uint8_t>(*pair)
+              : static_cast<std::uint8_t>(collision_lab::Prediction::PAIR_NONE);
+}
+
+std::optional<core::Pair> toPair(std::uint8_t code) {
+  switch (code) {
+    case collision_lab::Prediction::PAIR_AB: return core::Pair::AB;
+    case collision_lab::Prediction::PAIR_BC: return core::Pair::BC;
+    default: return std::nullopt;
+  }
+}
+
+collision_lab::Prediction toPredictionMsg(const core::Prediction& prediction) {
+  collision_lab::Prediction msg;
+  msg.collision_count = prediction.collision_count;
+  msg.paper_count_defined = prediction.paper_collision_count.has_value();
+  msg.paper_collision_count = prediction.paper_collision_count.value_or(0);
+  msg.max_possible_collision_count = prediction.max_possible_collision_count;
+  msg.alpha = prediction.angles.alpha;
+  msg.theta = prediction.angles.theta;
+  msg.omega = prediction.angles.omega;
+  msg.phi_bc = prediction.phi_bc;
+  msg.psi = prediction.psi;
+  msg.first_pair = toPairCode(prediction.first_pair);
+  msg.final_velocities = toBoostArray(prediction.final_velocities);
+  return msg;
+}
+
+core::Prediction toPrediction(const collision_lab::Prediction& msg) {
+  core::Prediction prediction;
+  prediction.collision_count = msg.collision_count;
+  if (msg.paper_count_defined) prediction.paper_collision_count = msg.paper_collision_count;
+  prediction.max_possible_collision_count = msg.max_possible_collision_count;
+  prediction.angles.alpha = msg.alpha;
+  prediction.angles.theta = msg.theta;
+  prediction.angles.omega = msg.omega;
+  prediction.phi_bc = msg.phi_bc;
+  prediction.psi = msg.psi;
+  prediction.first_pair = toPair(msg.first_pair);
+  prediction.final_velocities = toArray(msg.final_velocities);
+  return prediction;
+}
+
+collision_lab::CollisionEvent toCollisionEventMsg(const core::LabEvent& event) {
+  const core::CollisionEvent& e = event.event;
+  collision_lab::CollisionEvent msg;
+  msg.index = e.index;
+  msg.pair = static_cast<std::uint8_t>(e.pair);
+  msg.time = e.time;
+  msg.position = e.position;
+  msg.positions = toBoostArray(e.positions);
+  msg.velocities_before = toBoostArray(e.velocities_before);
+  msg.velocities_after = toBoostArray(e.velocities_after);
+  msg.predicted_velocities_after = toBoostArray(event.predicted_velocities_after);
+  msg.paper_velocities_after = toBoostArray(event.paper_velocities_after);
+  msg.energy_transfer = toBoostArray(e.energy_transfer);
+  msg.total_energy = e.total_energy;
+  msg.total_momentum = e.total_momentum;
+  return msg;
+}
+
+core::LabEvent toLabEvent(const collision_lab::CollisionEvent& msg) {
+  core::LabEvent event;
+  core::CollisionEvent& e = event.event;
+  e.index = msg.index;
+  e.pair = toPair(msg.pair).value_or(core::Pair::AB);
+  e.time = msg.time;
+  e.position = msg.position;
+  e.positions = toArray(msg.positions);
+  e.velocities_before = toArray(msg.velocities_before);
+  e.velocities_after = toArray(msg.velocities_after);
+  e.energy_transfer = toArray(msg.energy_transfer);
+  e.total_energy = msg.total_energy;
+  e.total_momentum = msg.total_momentum;
+  event.predicted_velocities_after = toArray(msg.predicted_velocities_after);
+  event.paper_velocities_after = toArray(msg.paper_velocities_after);
+  return event;
+}
+
+collision_lab::Velocities toVelocitiesMsg(const core::LabEvent& event) {
+  collision_lab::Velocities msg;
+  msg.index = event.event.index;
+  msg.time = event.event.time;
+  msg.v_a = event.event.velocities_after[0];
+  msg.v_b = event.event.velocities_after[1];
+  msg.v_c = event.event.velocities_after[2];
+  msg.predicted_v_a = event.predicted_velocities_after[0];
+  msg.predicted_v_b = event.predicted_velocities_after[1];
+  msg.predicted_v_c = event.predicted_velocities_after[2];
+  return msg;
+}
+
+collision_lab::EnergyTransfer toEnergyTransferMsg(const core::LabEvent& event) {
+  collision_lab::EnergyTransfer msg;
+  msg.index = event.event.index;
+  msg.pair = static_cast<std::uint8_t>(event.event.pair);
+  msg.delta_a = event.event.energy_transfer[0];
+  msg.delta_b = event.event.energy_transfer[1];
+  msg.delta_c = event.event.energy_transfer[2];
+  msg.kinetic_a = event.kinetic_energy_after[0];
+  msg.kinetic_b = event.kinetic_energy_after[1];
+  msg.kinetic_c = event.kinetic_energy_after[2];
+  msg.predicted_delta_a = event.predicted_energy_transfer[0];
+  msg.predicted_delta_b = event.predicted_energy_transfer[1];
+  msg.predicted_delta_c = event.predicted_energy_transfer[2];
+  msg.paper_delta_a = event.paper_energy_transfer[0];
+  msg.paper_delta_b = event.paper_energy_transfer[1];
+  msg.paper_delta_c = event.paper_energy_transfer[2];
+  return msg;
+}
+
+collision_lab::RunSummary toRunSummaryMsg(const core::RunSummary& summary,
+                                          const core::Prediction& prediction,
+                                          core::RunMode mode) {
+  collision_lab::RunSummary msg;
+  msg.mode = static_cast<std::uint8_t>(mode);
+  msg.collision_count = summary.collision_count;
+  msg.truncated = summary.truncated;
+  msg.truncation_reason = summary.truncation_reason;
+  msg.simulated = summary.simulated;
+  msg.predicted_collision_count = prediction.collision_count;
+  msg.paper_prediction_defined = prediction.paper_collision_count.has_value();
+  msg.paper_predicted_collision_count = prediction.paper_collision_count.value_or(0);
+  msg.final_velocities = toBoostArray(summary.final_velocities);
+  msg.max_prediction_error = summary.max_prediction_error;
+  msg.energy_relative_drift = summary.energy_relative_drift;
+  msg.momentum_relative_drift = summary.momentum_relative_drift;
+  msg.compute_time = summary.compute_time_s;
+  return msg;
+}
+
+collision_lab::Rejected toRejectedMsg(const core::ValidationError& error) {
+  collision_lab::Rejected msg;
+  msg.reason = static_cast<std::uint8_t>(error.reason);
+  msg.reason_name = collision_lab::reasonName(error.reason);
+  msg.field = error.field;
+  msg.message = error.message;
+  return msg;
+}
+
+collision_lab::Rejected toRejectedMsg(NodeReason reason, const std::string& field,
+                                      const std::string& message) {
+  collision_lab::Rejected msg;
+  msg.reason = static_cast<std::uint8_t>(reason);
+  msg.reason_name = nodeReasonName(reason);
+  msg.field = field;
+  msg.message = message;
+  return msg;
+}
+
+}  // namespace collision_lab_ros
