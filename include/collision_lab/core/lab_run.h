@@ -63,7 +63,8 @@ struct RunSummary {
   std::string truncation_reason;            ///< empty unless truncated
   bool simulated = false;                   ///< false for predict-only and skipped runs
   std::array<double, 3> final_velocities{}; ///< [m/s]
-  /// max over reported states of max_i |v_sim - v_pred| / max_i |v_0| (dimensionless).
+  /// max over reported states of |S (v_sim - v_pred)| / |S v_0|, S = diag(sqrt(m)):
+  /// relative error in the energy norm, in the wall's frame (dimensionless).
   double max_prediction_error = 0.0;
   double energy_relative_drift = 0.0;
   double momentum_relative_drift = 0.0;     ///< NaN with a wall

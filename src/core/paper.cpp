@@ -1,0 +1,118 @@
+// Transcriptions of the paper's printed equations. Walls make the printed expressions
+// inf/inf; they come out as NaN ("not defined as printed"), never as a guessed limit.
+#include "collision_lab/core/paper.h"
+
+#include <cmath>
+#include <limits>
+
+#include <boost/math/constants/constants.hpp>
+
+namespace collision_lab {
+namespace paper {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+/// The paper's constants: c + d i of eq. (2.6), nu^2 = c^2 + d^2, theta = arg(lambda_+).
+struct Constants {
+  double c, d, nu_sq, theta;
+};
+
+Constants constantsOf(const std::array<double, 3>& masses) {
+  const double m_a = masses[kA], m_b = masses[kB], m_c = masses[kC];
+  const double m_ab = m_a + m_b, m_bc = m_b + m_c, m_total = m_a + m_b + m_c;
+  const double root = std::sqrt(m_a * m_b * m_c * m_total);
+  Constants k;
+  k.c = 2 * m_a * m_c / (m_a * m_ab);
+  k.d = root / (m_a * m_ab);
+  k.nu_sq = k.c * k.c + k.d * k.d;
+  // lambda_+ = (m_A m_C - m_B M + 2 i sqrt(m_A m_B m_C M)) / (M_AB M_BC), eq. (2.2).
+  k.theta = std::atan2(2 * root / (m_ab * m_bc), (m_a * m_c - m_b * m_total) / (m_ab * m_bc));
+  return k;
+}
+
+double dot(const std::array<double, 3>& a, const std::array<double, 3>& b) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+std::array<double, 3> normalized(std::array<double, 3> a) {
+  const double norm = std::sqrt(dot(a, a));
+  for (double& x : a) x /= norm;
+  return a;
+}
+
+}  // namespace
+
+std::array<double, 3> velocitiesAfter(const Scene& scene, std::uint64_t n) {
+  const auto& m = scene.masses;
+  const auto& v0 = scene.velocities;
+  const Constants k = constantsOf(m);
+  const double vbar = (v0[kA] + v0[kB]) / 2;  // the *initial* average (eq. 2.14)
+  const double half_ba = (v0[kB] - v0[kA]) / 2;
+  const double kth = static_cast<double>(n / 2) * k.theta;
+  const double s = std::sin(kth), co = std::cos(kth);
+  // The two brackets of eq. (2.15).
+  const double x = ((vbar - v0[kC]) * k.nu_sq + k.c * half_ba) * s - k.d * half_ba * co;
+  const double y = (-half_ba - k.c * (vbar - v0[kC])) * s - k.d * (vbar - v0[kC]) * co;
+  if (n % 2 == 0) return {x / k.d + vbar, -x / k.d + vbar, y / k.d + vbar};
+  const double m_ab = m[kA] + m[kB];
+  // Eq. (2.16).
+  return {(m[kA] - 3 * m[kB]) * x / (k.d * m_ab) + vbar, (m[kB] - 3 * m[kA]) * x / (k.d * m_ab) + vbar,
+          m_ab * y / (k.d * m_ab) + vbar};
+}
+
+double phiBC(const Scene& scene) {
+  const auto& m = scene.masses;
+  const auto& v = scene.velocities;
+  // u after the first AB impact (eq. 1.1, 1.2), in u = (sqrt(m_i) v_i).
+  const double m_ab = m[kA] + m[kB];
+  const double va = ((m[kA] - m[kB]) * v[kA] + 2 * m[kB] * v[kB]) / m_ab;
+  const double vb = (2 * m[kA] * v[kA] + (m[kB] - m[kA]) * v[kB]) / m_ab;
+  const std::array<double, 3> u1{std::sqrt(m[kA]) * va, std::sqrt(m[kB]) * vb, std::sqrt(m[kC]) * v[kC]};
+  const auto s_hat = normalized({std::sqrt(m[kA]), std::sqrt(m[kB]), std::sqrt(m[kC])});
+  const auto n_bc = normalized({0.0, 1 / std::sqrt(m[kB]), -1 / std::sqrt(m[kC])});
+  // l_BC = s_hat x n_BC / |s_hat x n_BC| (eq. 3.20).
+  const auto l_bc = normalized({s_hat[1] * n_bc[2] - s_hat[2] * n_bc[1], s_hat[2] * n_bc[0] - s_hat[0] * n_bc[2],
+                                s_hat[0] * n_bc[1] - s_hat[1] * n_bc[0]});
+  return std::atan2(dot(u1, n_bc), dot(u1, l_bc));  // eq. (3.21)
+}
+
+double omega(const std::array<double, 3>& m) {
+  const auto n_ab = normalized({1 / std::sqrt(m[kA]), -1 / std::sqrt(m[kB]), 0.0});
+  const auto n_bc = normalized({0.0, 1 / std::sqrt(m[kB]), -1 / std::sqrt(m[kC])});
+  return std::acos(dot(n_ab, n_bc));
+}
+
+std::optional<std::int64_t> collisionCount(const Scene& scene) {
+  const double x = (omega(scene.masses) - phiBC(scene)) / constantsOf(scene.masses).theta;
+  if (!std::isfinite(x) || std::fabs(x) > 1e15) return std::nullopt;
+  return 1 + static_cast<std::int64_t>(std::floor(x)) + static_cast<std::int64_t>(std::ceil(x));  // eq. (3.22)
+}
+
+std::array<double, 3> energyTransfer(const Scene& scene, std::uint64_t n, Pair pair,
+                                     const std::array<double, 3>& state_before,
+                                     const std::array<double, 3>& state_two_before) {
+  const auto& m = scene.masses;
+  const double vbar = (scene.velocities[kA] + scene.velocities[kB]) / 2;  // initial average
+  if (pair == Pair::AB) {
+    // Eqs. (4.4), (4.5): v_k from v_A2k = v_k + vbar_AB, P_AB2k the AB momentum before.
+    const double v_k = state_before[kA] - vbar;
+    const double p_ab = m[kA] * state_before[kA] + m[kB] * state_before[kB];
+    const double m_ab = m[kA] + m[kB];
+    const double gained_a = -4 * m[kA] * m[kB] * v_k / (m_ab * m_ab) * p_ab;
+    return {gained_a, -gained_a, 0.0};
+  }
+  // Eqs. (4.6), (4.7): v_{k-1}, v'_{k-1} from the state two impacts back (2k-2), and
+  // P_BC2k-1 from the state just before. The first impact has no such state.
+  if (n < 2) return {kNaN, kNaN, kNaN};
+  const double v_k1 = state_two_before[kA] - vbar;
+  const double v_k1_prime = state_two_before[kC] - vbar;
+  const double p_bc = m[kB] * state_before[kB] + m[kC] * state_before[kC];
+  const double m_bc = m[kB] + m[kC];
+  const double gained_c = -4 * m[kB] * m[kC] / (m_bc * m_bc) * (v_k1 + v_k1_prime) / 2 * p_bc;
+  return {0.0, -gained_c, gained_c};
+}
+
+}  // namespace paper
+}  // namespace collision_lab

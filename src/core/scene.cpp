@@ -1,0 +1,146 @@
+#include "collision_lab/core/scene.h"
+
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "collision_lab/core/exact.h"
+
+namespace collision_lab {
+
+namespace {
+
+const char* const kParticleNames[3] = {"A", "B", "C"};
+
+std::string indexedField(const char* vector_name, int i) {
+  return std::string(vector_name) + "[" + std::to_string(i) + "]";
+}
+
+std::string formatValue(double value) {
+  std::ostringstream out;
+  out.precision(17);
+  out << value;
+  return out.str();
+}
+
+ValidationError makeError(Reason reason, std::string field, std::string message) {
+  return ValidationError{reason, std::move(field), std::move(message)};
+}
+
+bool isFiniteProduct(double a, double b) { return std::isfinite(a * b); }
+
+}  // namespace
+
+bool Scene::isWall(int i) const { return masses[i] == std::numeric_limits<double>::infinity(); }
+
+int Scene::wallIndex() const {
+  if (isWall(kA)) return kA;
+  if (isWall(kC)) return kC;
+  return -1;
+}
+
+const char* reasonName(Reason r) {
+  switch (r) {
+    case Reason::kOk: return "OK";
+    case Reason::kNonFiniteValue: return "NON_FINITE_VALUE";
+    case Reason::kNonPositiveMass: return "NON_POSITIVE_MASS";
+    case Reason::kTwoWalls: return "TWO_WALLS";
+    case Reason::kInfiniteMiddleMass: return "INFINITE_MIDDLE_MASS";
+    case Reason::kPositionsNotOrdered: return "POSITIONS_NOT_ORDERED";
+    case Reason::kPositionsCoincident: return "POSITIONS_COINCIDENT";
+    case Reason::kTripleCollision: return "TRIPLE_COLLISION";
+    case Reason::kOverflow: return "OVERFLOW";
+  }
+  return "UNKNOWN";
+}
+
+std::optional<ValidationError> validate(const Scene& scene) {
+  for (int i = 0; i < 3; ++i) {
+    const double m = scene.masses[i];
+    const std::string field = indexedField("masses", i);
+    const std::string who = std::string(" (m_") + kParticleNames[i] + ")";
+    if (std::isnan(m)) {
+      return makeError(Reason::kNonFiniteValue, field,
+                       field + who + " is NaN; a mass must be a positive number in kg, or inf for a wall");
+    }
+    if (!(m > 0.0)) {
+      return makeError(Reason::kNonPositiveMass, field,
+                       field + who + " is " + formatValue(m) + " kg; a mass must be positive");
+    }
+  }
+  if (std::isinf(scene.masses[kB])) {
+    return makeError(Reason::kInfiniteMiddleMass, "masses[1]",
+                     "masses[1] (m_B) is inf; only A or C may be a wall, B must have a finite mass");
+  }
+  if (std::isinf(scene.masses[kA]) && std::isinf(scene.masses[kC])) {
+    return makeError(Reason::kTwoWalls, "masses",
+                     "masses[0] and masses[2] are both inf; at most one of A and C may be a wall");
+  }
+  for (int i = 0; i < 3; ++i) {
+    if (!std::isfinite(scene.positions[i])) {
+      const std::string field = indexedField("positions", i);
+      return makeError(Reason::kNonFiniteValue, field,
+                       field + " (x_" + kParticleNames[i] + ") is " + formatValue(scene.positions[i]) +
+                           "; a position must be a finite number in m");
+    }
+  }
+  for (int i = 0; i < 3; ++i) {
+    if (!std::isfinite(scene.velocities[i])) {
+      const std::string field = indexedField("velocities", i);
+      return makeError(Reason::kNonFiniteValue, field,
+                       field + " (v_" + kParticleNames[i] + ") is " + formatValue(scene.velocities[i]) +
+                           "; a velocity must be a finite number in m/s");
+    }
+  }
+  const auto& x = scene.positions;
+  for (int i = 0; i < 2; ++i) {
+    if (x[i] == x[i + 1]) {
+      return makeError(Reason::kPositionsCoincident, "positions",
+                       std::string("positions of ") + kParticleNames[i] + " and " + kParticleNames[i + 1] +
+                           " coincide at " + formatValue(x[i]) + " m; they must be distinct");
+    }
+  }
+  if (!(x[kA] > x[kB] && x[kB] > x[kC])) {
+    return makeError(Reason::kPositionsNotOrdered, "positions",
+                     "positions (" + formatValue(x[kA]) + ", " + formatValue(x[kB]) + ", " +
+                         formatValue(x[kC]) + ") m must be strictly decreasing: x_A > x_B > x_C");
+  }
+
+  // Everything the engine forms must be representable: momenta, energies in the wall's
+  // frame, relative velocities and gaps.
+  const int wall = scene.wallIndex();
+  const double frame_velocity = wall >= 0 ? scene.velocities[wall] : 0.0;
+  for (int i = 0; i < 3; ++i) {
+    if (i == wall) continue;
+    const double m = scene.masses[i];
+    const double v = scene.velocities[i];
+    const double relative = v - frame_velocity;
+    if (!std::isfinite(relative) || !isFiniteProduct(m, v) || !isFiniteProduct(m * relative, relative) ||
+        !isFiniteProduct(m, 4.0 * std::fabs(v) + 4.0 * std::fabs(frame_velocity))) {
+      const std::string field = indexedField("velocities", i);
+      return makeError(Reason::kOverflow, field,
+                       "momentum or kinetic energy of " + std::string(kParticleNames[i]) + " (m = " +
+                           formatValue(m) + " kg, v = " + formatValue(v) +
+                           " m/s) overflows a double; rescale the units");
+    }
+  }
+  for (int i = 0; i < 2; ++i) {
+    if (!std::isfinite(x[i] - x[i + 1]) || !std::isfinite(scene.velocities[i] - scene.velocities[i + 1]) ||
+        !std::isfinite(2.0 * (std::fabs(scene.velocities[i]) + std::fabs(scene.velocities[i + 1])))) {
+      return makeError(Reason::kOverflow, "positions",
+                       "the gap or relative velocity between " + std::string(kParticleNames[i]) + " and " +
+                           kParticleNames[i + 1] + " overflows a double; rescale the units");
+    }
+  }
+
+  const bool ab_approach = scene.velocities[kA] < scene.velocities[kB];
+  const bool bc_approach = scene.velocities[kB] < scene.velocities[kC];
+  if (ab_approach && bc_approach && exact::compareFirstContactTimes(scene) == 0) {
+    return makeError(Reason::kTripleCollision, "positions",
+                     "A, B and C would meet at the same instant (an exact triple collision), "
+                     "which three-body elastic collisions do not define");
+  }
+  return std::nullopt;
+}
+
+}  // namespace collision_lab
