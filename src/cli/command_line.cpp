@@ -19,18 +19,22 @@ const std::array<const char*, 10> kValueOptions = {"--masses",     "--positions"
                                                   "--scenario",   "--name"};
 
 /// "--velocities -1,0,0" -> "--velocities=-1,0,0": a value option takes the next
-/// argument as its value, as getopt does, unless that argument is itself a long option.
+/// argument as its value, as getopt does. A value option that is last, or followed by
+/// another long option, has no value (CLI11 would take "--format=json" as the value).
 std::vector<std::string> normalizeArguments(const std::vector<std::string>& args) {
   std::vector<std::string> out;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const bool takes_value =
         std::find(kValueOptions.begin(), kValueOptions.end(), args[i]) != kValueOptions.end();
-    if (takes_value && i + 1 < args.size() && args[i + 1].rfind("--", 0) != 0) {
-      out.push_back(args[i] + "=" + args[i + 1]);
-      ++i;
-    } else {
+    if (!takes_value) {
       out.push_back(args[i]);
+      continue;
     }
+    if (i + 1 == args.size() || args[i + 1].rfind("--", 0) == 0) {
+      throw makeCliError(CliReason::kMissingInput, args[i].substr(2), args[i] + " is given without a value");
+    }
+    out.push_back(args[i] + "=" + args[i + 1]);
+    ++i;
   }
   return out;
 }
@@ -120,11 +124,12 @@ CliRequest parseCommandLine(std::vector<std::string> args, const std::string& de
       app.add_option("--scenario", raw.scenario, "scenario file (YAML); without --name runs every scene in it");
   const CLI::Option* name = app.add_option("--name", raw.name, "scene of the scenario file (default file: the package's presets)");
   app.add_flag("--list", raw.list, "list the scenes of the scenario file");
+  app.allow_extras();  // reported below in the user's order, with a hint
 
   CliRequest request;
+  std::vector<std::string> normalized = normalizeArguments(args);
   try {
     // CLI11 wants the arguments in reverse order.
-    std::vector<std::string> normalized = normalizeArguments(args);
     std::reverse(normalized.begin(), normalized.end());
     app.parse(normalized);
   } catch (const CLI::CallForHelp&) {
@@ -133,6 +138,13 @@ CliRequest parseCommandLine(std::vector<std::string> args, const std::string& de
     return request;
   } catch (const CLI::ParseError& e) {
     throw makeCliError(CliReason::kUsage, "arguments", oneLine(e.what()) + " (see --help)");
+  }
+  if (!app.remaining().empty()) {
+    std::string unexpected;
+    for (const std::string& arg : app.remaining()) unexpected += " " + arg;
+    throw makeCliError(CliReason::kUsage, "arguments",
+                       "unexpected arguments:" + unexpected +
+                           " (lists are comma-separated without blanks, e.g. --velocities -1,0,0; see --help)");
   }
 
   const auto format = io::parseReportFormat(raw.format);

@@ -21,9 +21,10 @@ std::string roundTripText(double value) {
   return std::string(buffer, result.ptr);
 }
 
-/// Compact text for people, `digits` significant digits; -0 is shown as 0.
+/// Compact text for people, `digits` significant digits; -0 is shown as 0, any NaN as nan.
 std::string humanText(double value, int digits) {
   if (value == 0.0) return "0";
+  if (std::isnan(value)) return "nan";
   char buffer[64];
   std::snprintf(buffer, sizeof buffer, "%.*g", digits, value);
   return buffer;
@@ -100,7 +101,7 @@ class TableWriter : public RunReportWriter {
     out_ << "\n";
     writeSummaryRow("Summary", "simulation", "prediction", "paper, as printed");
     writeSummaryRow("collisions", simulated(std::to_string(s.collision_count)), std::to_string(p.collision_count),
-                    paperCountText(p) + " by eq. 3.22");
+                    "eq. 3.22: " + paperCountText(p));
     writeSummaryRow("most possible collisions", "",
                     std::to_string(p.max_possible_collision_count) + " = ceil(pi/alpha)", "");
     writeSummaryRow("first pair", "", p.first_pair ? pairName(*p.first_pair) : "none", "");
@@ -115,11 +116,11 @@ class TableWriter : public RunReportWriter {
          << ", paper's phi_BC (eq. 3.21) " << humanText(p.phi_bc, kSummaryDigits) << "\n";
     if (s.simulated) {
       out_ << "checks: max prediction error " << humanText(s.max_prediction_error, 3)
-           << " (max |v_sim - v_pred| / max |v0|), energy drift " << humanText(s.energy_relative_drift, 3)
-           << ", momentum drift "
-           << (std::isnan(s.momentum_relative_drift) ? std::string("n/a (a wall)")
+           << " (max |v_sim - v_pred| / max |v0|), relative energy drift " << humanText(s.energy_relative_drift, 3)
+           << ", relative momentum drift "
+           << (std::isnan(s.momentum_relative_drift) ? std::string("n/a (a wall does not conserve it)")
                                                      : humanText(s.momentum_relative_drift, 3))
-           << " (relative)\n";
+           << "\n";
     }
     out_ << "truncated: " << (s.truncated ? "yes, " + s.truncation_reason : std::string("no")) << "\n";
     out_ << "precision: " << s.escalation.decisions << " decisions, " << s.escalation.high_precision

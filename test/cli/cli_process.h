@@ -1,0 +1,22 @@
+// Runs the built collision_lab_cli as a child process and captures what it prints.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace collision_lab_test {
+
+struct CliOutput {
+  int exit_code = -1;  ///< the exit status, or 128 + signal number if it was killed
+  std::string out;
+  std::string err;
+};
+
+/// Runs COLLISION_LAB_CLI_PATH with `args` in the working directory `cwd`, stdin from
+/// /dev/null, stdout and stderr into unique temporary files.
+CliOutput runCli(const std::vector<std::string>& args, const std::string& cwd);
+
+/// The lines of `text` (a final newline does not start another line).
+std::vector<std::string> linesOf(const std::string& text);
+
+}  // namespace collision_lab_test

@@ -1,0 +1,262 @@
+// collision_lab_cli, run as a user runs it: a child process, its exit code and output.
+// Expected counts and velocities are exact (shared/physics.md).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_process.h"
+
+namespace {
+
+using collision_lab_test::CliOutput;
+using collision_lab_test::linesOf;
+using collision_lab_test::runCli;
+using Json = nlohmann::json;
+
+const std::string kPresets = COLLISION_LAB_SOURCE_DIR "/config/scenarios.yaml";
+
+CliOutput run(const std::vector<std::string>& args) { return runCli(args, COLLISION_LAB_SOURCE_DIR); }
+
+/// Runs with --format json and expects success and one JSON document on stdout.
+Json runJson(std::vector<std::string> args) {
+  args.insert(args.end(), {"--format", "json"});
+  const CliOutput result = run(args);
+  EXPECT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_EQ(result.err, "");
+  return Json::parse(result.out);
+}
+
+Json runPreset(const std::string& name, std::vector<std::string> extra = {}) {
+  std::vector<std::string> args = {"--scenario", kPresets, "--name", name};
+  args.insert(args.end(), extra.begin(), extra.end());
+  return runJson(args);
+}
+
+std::vector<double> doubles(const Json& array) { return array.get<std::vector<double>>(); }
+
+TEST(CliJson, EqualMassesGiveThreeCollisionsAndSwapOuterVelocities) {
+  const Json doc = runJson({"--masses", "1,1,1", "--positions", "2,1,-1", "--velocities", "-1,0,1"});
+
+  const Json& summary = doc.at("summary");
+  EXPECT_EQ(summary.at("collision_count"), 3);
+  EXPECT_EQ(summary.at("predicted_collision_count"), 3);
+  EXPECT_EQ(summary.at("max_possible_collision_count"), 3);
+  EXPECT_EQ(summary.at("truncated"), false);
+  // Equal masses exchange velocities: exact in double.
+  EXPECT_EQ(doubles(summary.at("final_velocities")), (std::vector<double>{1, 0, -1}));
+  EXPECT_NEAR(summary.at("alpha").get<double>(), M_PI / 3, 1e-15);
+  EXPECT_NEAR(summary.at("theta").get<double>(), 2 * M_PI / 3, 1e-15);
+  EXPECT_NEAR(summary.at("omega").get<double>(), 2 * M_PI / 3, 1e-15);
+  for (const char* key : {"paper_predicted_collision_count", "max_prediction_error", "energy_relative_drift",
+                          "momentum_relative_drift"}) {
+    EXPECT_TRUE(summary.contains(key)) << key;
+  }
+  EXPECT_LE(summary.at("max_prediction_error").get<double>(), 1e-12);
+
+  const Json& events = doc.at("events");
+  ASSERT_EQ(events.size(), 3u);
+  const std::vector<std::string> pairs = {"AB", "BC", "AB"};
+  const std::vector<std::vector<double>> after = {{0, -1, 1}, {0, 1, -1}, {1, 0, -1}};
+  for (std::size_t i = 0; i < 3; ++i) {
+    const Json& event = events[i];
+    EXPECT_EQ(event.at("index"), i + 1);
+    EXPECT_EQ(event.at("pair"), pairs[i]);
+    EXPECT_EQ(doubles(event.at("velocities_after")), after[i]);
+    EXPECT_EQ(event.at("velocities_before").size(), 3u);
+    EXPECT_EQ(event.at("positions").size(), 3u);
+    EXPECT_EQ(event.at("energy_transfer").size(), 3u);
+    EXPECT_EQ(event.at("paper_velocities_after").size(), 3u);
+    EXPECT_EQ(event.at("paper_energy_transfer").size(), 3u);
+    const std::vector<double> predicted = doubles(event.at("predicted_velocities_after"));
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(predicted[k], after[i][k], 1e-12);
+  }
+  // First impact: A (at rest after) hands its 0.5 J to B at t = 1 s, x = 1 m.
+  EXPECT_EQ(events[0].at("time"), 1.0);
+  EXPECT_EQ(events[0].at("position"), 1.0);
+  EXPECT_EQ(doubles(events[0].at("energy_transfer")), (std::vector<double>{-0.5, 0.5, 0}));
+
+  EXPECT_EQ(doc.at("units").at("energy"), "J");
+  EXPECT_EQ(doc.at("units").at("velocity"), "m/s");
+}
+
+TEST(CliJson, PiDigitsByPresets) {
+  EXPECT_EQ(runPreset("pi_digits_2", {"--events", "none"}).at("summary").at("collision_count"), 31);
+  EXPECT_EQ(runPreset("pi_digits_3", {"--events", "none"}).at("summary").at("collision_count"), 314);
+  const Json four = runPreset("pi_digits_4", {"--mode", "summary"}).at("summary");
+  EXPECT_EQ(four.at("collision_count"), 3141);
+  EXPECT_EQ(four.at("predicted_collision_count"), 3141);
+}
+
+TEST(CliJson, PiDigitsFromTheCommandLineWithAnInfiniteMass) {
+  const Json doc = runJson({"--masses", "100,1,inf", "--positions", "2,1,0", "--velocities", "-1,0,0"});
+  EXPECT_EQ(doc.at("summary").at("collision_count"), 31);
+  EXPECT_EQ(doc.at("events").size(), 31u);
+  // Infinities and NaN are null in JSON; the wall is named instead.
+  EXPECT_TRUE(doc.at("scene").at("masses")[2].is_null());
+  EXPECT_EQ(doc.at("scene").at("walls"), Json::array({"C"}));
+  EXPECT_TRUE(doc.at("summary").at("momentum_relative_drift").is_null());
+}
+
+TEST(CliJson, EveryPrecisionGivesTheExactCount) {
+  for (const char* precision : {"double", "long_double", "high"}) {
+    const Json doc = runPreset("pi_digits_3", {"--events", "none", "--precision", precision});
+    EXPECT_EQ(doc.at("summary").at("collision_count"), 314) << precision;
+    EXPECT_EQ(doc.at("options").at("precision"), precision);
+  }
+}
+
+TEST(CliJson, HardPresetsMatchExactArithmetic) {
+  EXPECT_EQ(runPreset("kaleidoscopic").at("summary").at("collision_count"), 3);
+  const Json grazing = runPreset("grazing").at("summary");
+  EXPECT_EQ(grazing.at("collision_count"), 2);
+  EXPECT_EQ(grazing.at("predicted_collision_count"), 2);
+  const std::vector<double> v = doubles(grazing.at("final_velocities"));
+  EXPECT_EQ(v[0], v[1]);  // ends with v_A = v_B exactly: the third contact grazes
+  EXPECT_EQ(runPreset("no_collision").at("summary").at("collision_count"), 0);
+  const Json bc_first = runPreset("bc_first");
+  EXPECT_EQ(bc_first.at("summary").at("predicted_first_pair"), "BC");
+  EXPECT_EQ(bc_first.at("events").at(0).at("pair"), "BC");
+}
+
+TEST(CliArguments, NegativeValuesRightAfterAFlag) {
+  const Json doc = runJson({"--masses", "1,1,1", "--positions", "0,-1,-2.5", "--velocities", "-1,-.5,-0"});
+  EXPECT_EQ(doubles(doc.at("scene").at("positions")), (std::vector<double>{0, -1, -2.5}));
+  EXPECT_EQ(doubles(doc.at("scene").at("velocities")), (std::vector<double>{-1, -0.5, 0}));
+  const Json with_equals = runJson({"--masses", "1,1,1", "--positions", "2,1,0", "--velocities=-1e-3,0,0"});
+  EXPECT_EQ(with_equals.at("scene").at("velocities")[0], -1e-3);
+  const Json scientific = runJson({"--velocities", "-2e+0,0,0", "--masses", "1,1,1", "--positions", "2,1,0"});
+  EXPECT_EQ(scientific.at("scene").at("velocities")[0], -2.0);
+}
+
+TEST(CliJson, DoublesReadBackExactly) {
+  const std::string text = "-0.30000000000000004";
+  const Json doc = runJson({"--masses", "1,2,3", "--positions", "2,0,-2", "--velocities", text + ",0.1,0.7"});
+  EXPECT_EQ(doc.at("scene").at("velocities")[0].get<double>(), std::strtod(text.c_str(), nullptr));
+  EXPECT_EQ(doc.at("scene").at("velocities")[1].get<double>(), 0.1);
+  // The last event's velocities are the summary's final velocities, bit for bit.
+  EXPECT_EQ(doc.at("events").back().at("velocities_after"), doc.at("summary").at("final_velocities"));
+}
+
+TEST(CliEvents, NoneStillReportsThePrediction) {
+  const Json doc = runPreset("pi_digits_3", {"--events", "none"});
+  EXPECT_TRUE(doc.at("events").empty());
+  EXPECT_EQ(doc.at("summary").at("predicted_collision_count"), 314);
+}
+
+TEST(CliEvents, FirstNKeepsTheFirstN) {
+  const Json doc = runPreset("pi_digits_2", {"--events", "first:4"});
+  ASSERT_EQ(doc.at("events").size(), 4u);
+  EXPECT_EQ(doc.at("events")[3].at("index"), 4);
+  EXPECT_EQ(doc.at("summary").at("collision_count"), 31);
+}
+
+TEST(CliEvents, CapTruncatesTheRunButNotThePrediction) {
+  const Json doc = runPreset("pi_digits_3", {"--max-collisions", "100", "--events", "none"});
+  const Json& summary = doc.at("summary");
+  EXPECT_EQ(summary.at("collision_count"), 100);
+  EXPECT_EQ(summary.at("truncated"), true);
+  EXPECT_NE(summary.at("truncation_reason"), "");
+  EXPECT_EQ(summary.at("predicted_collision_count"), 314);
+}
+
+TEST(CliModes, PredictOnlyDoesNotSimulate) {
+  const Json doc = runPreset("pi_digits_5", {"--mode", "predict"});
+  EXPECT_EQ(doc.at("summary").at("simulated"), false);
+  EXPECT_EQ(doc.at("summary").at("predicted_collision_count"), 31415);
+  EXPECT_TRUE(doc.at("events").empty());
+}
+
+TEST(CliTable, AlignedColumnsWithUnitsAndThePapersValuesLabelled) {
+  const CliOutput result =
+      run({"--masses", "1,1,1", "--positions", "2,1,-1", "--velocities", "-1,0,1"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  for (const char* text : {"mass [kg]", "velocity [m/s]", "t [s]", "dE_A [J]", "dv paper [m/s]",
+                           "paper, as printed", "eq. 3.22: 4", "3 = ceil(pi/alpha)"}) {
+    EXPECT_NE(result.out.find(text), std::string::npos) << text;
+  }
+  // Event rows line up under the header: every row is as long as the header row.
+  const std::vector<std::string> lines = linesOf(result.out);
+  std::size_t header = 0;
+  while (header < lines.size() && lines[header].find("pair") == std::string::npos) ++header;
+  ASSERT_LT(header + 3, lines.size());
+  for (std::size_t i = 1; i <= 3; ++i) EXPECT_EQ(lines[header + i].size(), lines[header].size());
+  // The summary row puts the simulated count beside the prediction and the paper's.
+  const auto row = std::find_if(lines.begin(), lines.end(),
+                                [](const std::string& line) { return line.rfind("collisions ", 0) == 0; });
+  ASSERT_NE(row, lines.end());
+  std::istringstream words(*row);
+  std::string label, simulated, predicted;
+  words >> label >> simulated >> predicted;
+  EXPECT_EQ(simulated, "3");
+  EXPECT_EQ(predicted, "3");
+  // Eq. (3.22) is even for every non-integer argument (physics.md, Errata 4).
+  EXPECT_NE(row->find("eq. 3.22: 4"), std::string::npos);
+}
+
+TEST(CliCsv, HeaderOneRowPerEventAndSummaryComments) {
+  const CliOutput result =
+      run({"--masses", "1,1,1", "--positions", "2,1,-1", "--velocities", "-1,0,1", "--format", "csv"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  std::vector<std::string> rows;
+  std::vector<std::string> comments;
+  for (const std::string& line : linesOf(result.out)) (line.rfind("# ", 0) == 0 ? comments : rows).push_back(line);
+  ASSERT_EQ(rows.size(), 4u);
+  EXPECT_EQ(rows[0].rfind("index,pair,time_s,position_m,", 0), 0u);
+  EXPECT_EQ(rows[1].rfind("1,AB,1,1,", 0), 0u);
+  EXPECT_EQ(rows[3].rfind("3,AB,2,1,", 0), 0u);
+  const auto count_columns = [](const std::string& row) { return std::count(row.begin(), row.end(), ','); };
+  for (const std::string& row : rows) EXPECT_EQ(count_columns(row), count_columns(rows[0]));
+  EXPECT_NE(std::find(comments.begin(), comments.end(), "# summary.collision_count,3"), comments.end());
+  EXPECT_NE(std::find(comments.begin(), comments.end(), "# summary.final_velocities,1.0,0.0,-1.0"), comments.end());
+}
+
+TEST(CliScenarioFile, ListNamesEveryPreset) {
+  const CliOutput result = run({"--scenario", kPresets, "--list"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const std::vector<std::string> lines = linesOf(result.out);
+  ASSERT_EQ(lines.size(), 12u);
+  EXPECT_EQ(lines[0].rfind("equal_masses ", 0), 0u);
+  EXPECT_EQ(lines[11].rfind("moving_wall ", 0), 0u);
+}
+
+TEST(CliScenarioFile, WithoutANameRunsEveryScene) {
+  const Json doc = runJson({"--scenario", kPresets});
+  const Json& scenarios = doc.at("scenarios");
+  ASSERT_EQ(scenarios.size(), 12u);
+  const std::vector<std::pair<std::string, int>> expected = {
+      {"equal_masses", 3}, {"no_collision", 0}, {"pi_digits_2", 31},  {"pi_digits_3", 314},
+      {"pi_digits_4", 3141}, {"pi_digits_5", 31415}, {"kaleidoscopic", 3}, {"grazing", 2}};
+  for (const auto& [name, count] : expected) {
+    const auto entry = std::find_if(scenarios.begin(), scenarios.end(),
+                                    [&](const Json& s) { return s.at("scene").at("name") == name; });
+    ASSERT_NE(entry, scenarios.end()) << name;
+    EXPECT_EQ(entry->at("summary").at("collision_count"), count) << name;
+    EXPECT_EQ(entry->at("summary").at("predicted_collision_count"), count) << name;
+    EXPECT_TRUE(entry->at("events").empty()) << name;  // a batch shows no events by default
+  }
+
+  const CliOutput table = run({"--scenario", kPresets});
+  ASSERT_EQ(table.exit_code, 0) << table.err;
+  EXPECT_NE(table.out.find("pi_digits_5"), std::string::npos);
+  EXPECT_NE(table.out.find("31415"), std::string::npos);
+}
+
+TEST(CliScenarioFile, NameAloneUsesThePackagePresets) {
+  EXPECT_EQ(runJson({"--name", "pi_digits_2"}).at("summary").at("collision_count"), 31);
+}
+
+TEST(CliHelp, HelpGoesToStdoutAndExitsZero) {
+  const CliOutput result = run({"--help"});
+  EXPECT_EQ(result.exit_code, 0);
+  EXPECT_EQ(result.err, "");
+  EXPECT_NE(result.out.find("--velocities"), std::string::npos);
+}
+
+}  // namespace
