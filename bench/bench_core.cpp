@@ -1,0 +1,171 @@
+// collision_lab_bench_core: speed of the core (issue 2, "Speed").
+//
+// Prints ns per collision for simulate<double> in count-only mode (EventPolicy::none(),
+// no visitor), with every event visited but not stored, and with every event kept
+// (EventPolicy::all()), next to a lean double event loop compiled into this binary
+// (times, positions, velocities, nothing stored) and a velocity-only loop. Methods run
+// round-robin, repeats are summarised by medians, and speeds are quoted as ratios to the
+// lean loop measured in the same process. Also times the closed form:
+// AnalyticModel<double>::velocitiesAfter(n) for n up to 1e12, and predictedCollisionCount.
+//
+// Usage: collision_lab_bench_core [--repeats N] [--quick]
+// Goals are printed as measured, never asserted.
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <functional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "collision_lab/core/analytic.h"
+#include "collision_lab/core/simulation.h"
+#include "closed_form_timing.h"
+#include "naive_loop.h"
+#include "timing.h"
+
+using namespace collision_lab;
+using namespace collision_lab::bench;
+
+namespace {
+
+struct Method {
+  Method(const char* n, std::function<std::uint64_t()> r) : name(n), run(std::move(r)) {}
+  const char* name;
+  std::function<std::uint64_t()> run;  // returns its collision count
+  std::vector<double> seconds;
+  std::uint64_t count = 0;
+};
+
+Scene heavyLightHeavy(double heavy) {
+  Scene scene;
+  scene.masses = {heavy, 1.0, heavy};
+  scene.positions = {1.0, 0.0, -1.0};
+  scene.velocities = {-1.0, 0.0, 0.0};
+  return scene;
+}
+
+/// Returns the core's count-only / lean ratio for this scene.
+double benchScene(double heavy, int repeats, bool keep_all) {
+  const Scene scene = heavyLightHeavy(heavy);
+  const std::uint64_t predicted = predictedCollisionCount(scene);
+  std::printf("\nScene: masses (%g, 1, %g), positions (1, 0, -1) m, v = (-1, 0, 0) m/s; "
+              "predicted collisions %llu\n", heavy, heavy, static_cast<unsigned long long>(predicted));
+  SimulationOptions count_only;
+  count_only.max_collisions = 1'000'000'000;
+  count_only.events = EventPolicy::none();
+  SimulationOptions all_events = count_only;
+  all_events.events = EventPolicy::all();
+
+  std::vector<Method> methods;
+  methods.emplace_back("lean double loop (t, x, v)", [&] {
+                       const auto run = naiveEventLoop<double, true>(scene, count_only.max_collisions);
+                       doNotOptimize(run.positions);
+                       return run.collision_count;
+                     });
+  methods.emplace_back("velocity-only double loop", [&] {
+                       const auto run = naiveEventLoop<double, false>(scene, count_only.max_collisions);
+                       doNotOptimize(run.velocities);
+                       return run.collision_count;
+                     });
+  methods.emplace_back("core count-only (events none)", [&] {
+                       const auto result = simulate<double>(scene, count_only);
+                       doNotOptimize(result.final_velocities);
+                       return result.collision_count;
+                     });
+  methods.emplace_back("core, every event visited", [&] {
+                       std::uint64_t seen = 0;
+                       const auto result =
+                           simulate<double>(scene, count_only, [&](const CollisionEvent&) { ++seen; });
+                       doNotOptimize(seen);
+                       return result.collision_count;
+                     });
+  if (keep_all) {
+    methods.emplace_back("core, every event kept (events all)", [&] {
+                         const auto result = simulate<double>(scene, all_events);
+                         doNotOptimize(result.events.data());
+                         return result.collision_count;
+                       });
+  }
+  for (int rep = 0; rep < repeats; ++rep) {
+    for (auto& method : methods) {
+      Stopwatch watch;
+      method.count = method.run();
+      method.seconds.push_back(watch.seconds());
+    }
+    std::fprintf(stderr, "  repeat %d/%d done\n", rep + 1, repeats);
+  }
+  const double lean_ns = median(methods[0].seconds) * 1e9 / static_cast<double>(methods[0].count);
+  std::printf("  %-38s %12s %10s %10s %14s\n", "method", "collisions", "median ns", "min ns", "ratio vs lean");
+  double core_ratio = 0.0;
+  for (const auto& method : methods) {
+    const double per = 1e9 / static_cast<double>(method.count);
+    const double med = median(method.seconds) * per;
+    double best = method.seconds.front();
+    for (double s : method.seconds) best = std::min(best, s);
+    std::printf("  %-38s %12llu %10.2f %10.2f %14.2f\n", method.name,
+                static_cast<unsigned long long>(method.count), med, best * per, med / lean_ns);
+    if (std::strncmp(method.name, "core count-only", 15) == 0) core_ratio = med / lean_ns;
+  }
+  std::printf("  (medians of %d round-robin repeats; ns per collision of each method's own count)\n", repeats);
+  return core_ratio;
+}
+
+double benchClosedForm(int repeats) {
+  std::printf("\nClosed form (AnalyticModel<double>, model built once)\n");
+  std::printf("  %-22s %16s %18s\n", "masses", "n", "median ns/query");
+  double worst = 0.0;
+  for (double heavy : {1e14, 1e30}) {
+    const Scene scene = heavyLightHeavy(heavy);
+    for (double n_double : {1e3, 1e6, 1e9, 1e12}) {
+      const auto n = static_cast<std::uint64_t>(n_double);
+      const double ns = velocitiesAfterNs(scene, n, repeats);
+      worst = std::max(worst, ns);
+      std::printf("  (%-6g, 1, %-6g)       %16llu %18.1f\n", heavy, heavy,
+                  static_cast<unsigned long long>(n), ns);
+    }
+  }
+  std::printf("\npredictedCollisionCount (exact count, includes building the model)\n");
+  std::printf("  %-22s %20s %18s\n", "masses", "count", "median ns/call");
+  for (double heavy : {1e12, 1e14, 1e16, 1e20, 1e30}) {
+    const Scene scene = heavyLightHeavy(heavy);
+    const std::uint64_t count = predictedCollisionCount(scene);
+    const double ns = predictedCountNs(scene, repeats);
+    std::printf("  (%-6g, 1, %-6g)       %20llu %18.1f\n", heavy, heavy,
+                static_cast<unsigned long long>(count), ns);
+  }
+  return worst;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int repeats = 5;
+  bool quick = false;
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--repeats") == 0 && i + 1 < argc) {
+      repeats = std::max(1, std::atoi(argv[++i]));
+    } else if (std::strcmp(argv[i], "--quick") == 0) {
+      quick = true;
+    } else {
+      std::fprintf(stderr, "usage: %s [--repeats N] [--quick]\n", argv[0]);
+      return 2;
+    }
+  }
+  if (quick) repeats = std::min(repeats, 3);
+  std::printf("collision_lab_bench_core: ns per collision, medians of %d repeats\n", repeats);
+  benchScene(1e12, repeats, true);
+  double main_ratio = 0.0;
+  if (!quick) main_ratio = benchScene(1e14, repeats, true);
+  const double worst_query_ns = benchClosedForm(repeats);
+
+  std::printf("\nGoals (measured, not asserted)\n");
+  if (!quick) {
+    std::printf("  core count-only / lean loop on (1e14, 1, 1e14): %.2fx  (target <= 1.5x: %s; "
+                "done-when <= 2x: %s)\n", main_ratio, main_ratio <= 1.5 ? "met" : "missed",
+                main_ratio <= 2.0 ? "met" : "missed");
+  }
+  std::printf("  slowest closed-form query for n <= 1e12: %.1f ns  (goal < 1 us: %s)\n",
+              worst_query_ns, worst_query_ns < 1000.0 ? "met" : "missed");
+  return 0;
+}

@@ -1,0 +1,34 @@
+// Small formatting helpers shared by the report-writing benchmarks.
+#pragma once
+
+#include <array>
+#include <string>
+
+#include "collision_lab/core/scene.h"
+
+namespace collision_lab {
+namespace bench {
+
+/// printf-style formatting into a std::string.
+std::string format(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
+
+/// A number for tables: "0" for exact zero, "nan" for NaN, else 3 significant digits.
+std::string sci(double value);
+
+/// "(a, b, c)" with %g, "inf" for walls.
+std::string triple(const std::array<double, 3>& values);
+
+/// max_i |a_i - b_i| / max_i |b_i| over the finite-mass bodies (walls are skipped);
+/// absolute when b is all zero.
+double relativeVelocityError(const Scene& scene, const std::array<double, 3>& a,
+                             const std::array<double, 3>& b);
+
+/// |E - E_0| / E_0 with E the kinetic energy of the finite masses (walls are at rest in
+/// every benchmark scene). Computed in long double.
+double energyRelativeDrift(const Scene& scene, const std::array<double, 3>& v);
+
+/// Writes `text` to `path`, creating nothing else; false (and a message on stderr) on failure.
+bool writeTextFile(const std::string& path, const std::string& text);
+
+}  // namespace bench
+}  // namespace collision_lab

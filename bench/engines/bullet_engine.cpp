@@ -1,0 +1,95 @@
+// Bullet (the double-precision build when CMake found bullet-float64), configured as
+// elastically as it allows (shared/physics.md, last section).
+#include <cmath>
+#include <memory>
+
+#include <btBulletDynamicsCommon.h>
+
+#include "engines.h"
+
+namespace collision_lab {
+namespace bench {
+
+namespace {
+
+SteppedRun runBullet(const Scene& scene, const StepConfig& config) {
+  btDefaultCollisionConfiguration collision_config;
+  btCollisionDispatcher dispatcher(&collision_config);
+  btDbvtBroadphase broadphase;
+  btSequentialImpulseConstraintSolver solver;
+  btDiscreteDynamicsWorld world(&dispatcher, &broadphase, &solver, &collision_config);
+  world.setGravity(btVector3(0, 0, 0));
+  btContactSolverInfo& info = world.getSolverInfo();
+  info.m_restitutionVelocityThreshold = 0;         // default 0.2 m/s: no bounce below it
+  info.m_solverMode &= ~SOLVER_USE_WARMSTARTING;  // no impulse carried between steps
+  info.m_splitImpulse = 1;                          // penetration fixed without adding velocity
+  info.m_splitImpulsePenetrationThreshold = 1e30;   // ... at every depth
+
+  btSphereShape sphere(kEngineRadius);
+  const double offset[3] = {2 * kEngineRadius, 0.0, -2 * kEngineRadius};
+  std::array<std::unique_ptr<btRigidBody>, 3> bodies;
+  for (int i = 0; i < 3; ++i) {
+    const bool wall = std::isinf(scene.masses[i]);
+    const btScalar mass = wall ? 0 : scene.masses[i];  // mass 0 = static: a wall is a static sphere
+    btVector3 inertia(0, 0, 0);
+    if (!wall) sphere.calculateLocalInertia(mass, inertia);
+    btRigidBody::btRigidBodyConstructionInfo body_info(mass, nullptr, &sphere, inertia);
+    body_info.m_startWorldTransform.setIdentity();
+    body_info.m_startWorldTransform.setOrigin(btVector3(scene.positions[i] + offset[i], 0, 0));
+    body_info.m_restitution = 1;  // combined as the product over the pair: 1 * 1
+    body_info.m_friction = 0;
+    body_info.m_rollingFriction = 0;
+    body_info.m_linearDamping = 0;
+    body_info.m_angularDamping = 0;
+    bodies[i] = std::make_unique<btRigidBody>(body_info);
+    btRigidBody& body = *bodies[i];
+    body.setLinearFactor(btVector3(1, 0, 0));  // motion on the x axis only
+    body.setAngularFactor(0);
+    body.setActivationState(DISABLE_DEACTIVATION);
+    if (!wall) body.setLinearVelocity(btVector3(scene.velocities[i], 0, 0));
+    world.addRigidBody(&body);
+  }
+
+  SteppedRun run;
+  auto read = [&] {
+    for (int i = 0; i < 3; ++i) {
+      run.positions[i] = bodies[i]->getWorldTransform().getOrigin().x() - offset[i];
+      run.velocities[i] = bodies[i]->getLinearVelocity().x();
+    }
+  };
+  read();
+  CollisionCounter counter(run.velocities);
+  run.steps = stepCount(config);
+  for (std::uint64_t step = 0; step < run.steps; ++step) {
+    world.stepSimulation(config.dt, 0);  // maxSubSteps 0: exactly one internal step of dt
+    read();
+    counter.update(run.velocities);
+  }
+  run.collisions = counter.count();
+  for (auto& body : bodies) world.removeRigidBody(body.get());
+  return run;
+}
+
+}  // namespace
+
+SteppedMethod bulletMethod() {
+#ifdef BT_USE_DOUBLE_PRECISION
+  const char* precision = "double-precision build (bullet-float64)";
+#else
+  const char* precision = "single-precision build";
+#endif
+  return {"bullet",
+          std::string("Bullet 3.24, ") + precision +
+              ", btDiscreteDynamicsWorld with btSequentialImpulseConstraintSolver and "
+              "btDbvtBroadphase, gravity 0, stepSimulation(dt, 0) (one step of dt). Spheres "
+              "of radius 0.01 m; a wall is a static sphere (mass 0). Every body: restitution "
+              "1 (Bullet multiplies the pair's restitutions), friction 0, rolling friction 0, "
+              "damping 0, setLinearFactor(1,0,0), setAngularFactor(0), DISABLE_DEACTIVATION. "
+              "Solver: m_restitutionVelocityThreshold = 0 (default 0.2 m/s), warm starting "
+              "off, m_splitImpulse = 1, m_splitImpulsePenetrationThreshold = 1e30; other "
+              "solver settings default (10 iterations).",
+          runBullet};
+}
+
+}  // namespace bench
+}  // namespace collision_lab

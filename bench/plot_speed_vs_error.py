@@ -1,0 +1,108 @@
+#!/usr/bin/env python3
+"""Plot docs/speed_vs_error.csv: wall time against error, log-log.
+
+One row of panels per scene: final-velocity relative error on the left, trajectory error
+(max |x - x_exact| at the common end time) on the right. One series per method; stepped
+methods are swept over dt (smaller dt = further right). Exact zeros sit on a floor line;
+runs that got the collision count wrong are crossed out.
+
+Usage: plot_speed_vs_error.py --csv FILE --out FILE.png [--title-suffix TEXT]
+Needs matplotlib (Debian: python3-matplotlib).
+"""
+import argparse
+import csv
+import math
+from collections import OrderedDict
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.lines import Line2D  # noqa: E402
+
+FLOOR = 1e-17  # where exact zeros are drawn
+STYLE = OrderedDict([
+    ("event_double", dict(color="#1b7837", marker="o", label="event_double (ours)")),
+    ("event_long_double", dict(color="#5aae61", marker="s", label="event_long_double (ours)")),
+    ("event_high", dict(color="#00441b", marker="D", label="event_high, 50 digits (ours)")),
+    ("closed_form", dict(color="#2166ac", marker="*", label="closed_form (ours, no positions)")),
+    ("fixed_step", dict(color="#636363", marker="v", label="fixed_step (hand-written), dt sweep")),
+    ("bullet", dict(color="#e66101", marker="^", label="Bullet, dt sweep")),
+    ("ode", dict(color="#b2182b", marker="<", label="ODE, dt sweep")),
+    ("box2d", dict(color="#762a83", marker=">", label="Box2D, dt sweep")),
+])
+METRICS = [
+    ("velocity_rel_error", "final-velocity relative error", 1e-12),
+    ("position_abs_error", "trajectory error max|x - x_exact| [m]", 1e-9),
+]
+
+
+def number(text):
+    try:
+        return float(text)
+    except ValueError:
+        return math.nan
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--csv", required=True)
+    parser.add_argument("--out", required=True)
+    parser.add_argument("--title-suffix", default="")
+    args = parser.parse_args()
+
+    with open(args.csv, newline="") as f:
+        rows = list(csv.DictReader(f))
+    scenes = list(OrderedDict.fromkeys(r["scene"] for r in rows))
+    methods = [m for m in STYLE if any(r["method"] == m for r in rows)]
+    methods += sorted({r["method"] for r in rows} - set(methods))
+
+    fig, axes = plt.subplots(len(scenes), 2, figsize=(13, 3.1 * len(scenes) + 1.3), squeeze=False)
+    for i, scene in enumerate(scenes):
+        for j, (metric, ylabel, goal) in enumerate(METRICS):
+            ax = axes[i][j]
+            for method in methods:
+                pts = [r for r in rows if r["scene"] == scene and r["method"] == method]
+                pts = [r for r in pts if not math.isnan(number(r[metric]))]
+                if not pts:
+                    continue
+                pts.sort(key=lambda r: number(r["wall_time_s"]))
+                x = [number(r["wall_time_s"]) for r in pts]
+                y = [max(number(r[metric]), FLOOR) for r in pts]
+                style = STYLE.get(method, dict(marker="o", label=method))
+                ax.plot(x, y, linestyle="-", linewidth=1.2, markersize=6, alpha=0.9,
+                        color=style.get("color"), marker=style["marker"])
+                bad = [(xx, yy) for xx, yy, r in zip(x, y, pts) if int(r["count_error"]) != 0]
+                if bad:
+                    ax.plot([b[0] for b in bad], [b[1] for b in bad], linestyle="none", marker="x",
+                            color="black", markersize=11, markeredgewidth=2)
+            ax.set_xscale("log")
+            ax.set_yscale("log")
+            ax.set_ylim(FLOOR / 5, 1e3)
+            ax.axhline(FLOOR, color="black", linestyle=":", linewidth=0.8)
+            ax.text(1.0, FLOOR, " exact (0)", transform=ax.get_yaxis_transform(), fontsize=7,
+                    va="bottom", ha="right")
+            ax.axhline(goal, color="#2166ac", linestyle="--", linewidth=0.8)
+            ax.text(0.0, goal, f" goal {goal:g}", transform=ax.get_yaxis_transform(), fontsize=7,
+                    va="bottom", ha="left", color="#2166ac")
+            ax.grid(True, which="major", linewidth=0.3)
+            ax.set_title(f"{scene}: {ylabel}", fontsize=10)
+            ax.set_ylabel(ylabel, fontsize=8)
+            if i == len(scenes) - 1:
+                ax.set_xlabel("wall time per run [s] (median)")
+
+    handles = [Line2D([], [], color=STYLE[m].get("color"), marker=STYLE[m]["marker"], label=STYLE[m]["label"])
+               for m in methods if m in STYLE]
+    handles.append(Line2D([], [], color="black", marker="x", linestyle="none", markersize=9,
+                          markeredgewidth=2, label="wrong collision count"))
+    fig.legend(handles=handles, loc="upper center", ncol=3, fontsize=9, frameon=False,
+               bbox_to_anchor=(0.5, 1.0 - 0.5 / fig.get_figheight()))
+    fig.suptitle("Speed against error: exact event-driven simulation vs time stepping"
+                 + args.title_suffix + "\nlower left is better; each stepped series goes right as dt shrinks "
+                 "(1e-2 ... 1e-6 s)", fontsize=12, y=1.0 - 0.02 / fig.get_figheight())
+    fig.tight_layout(rect=(0, 0, 1, 1.0 - 1.2 / fig.get_figheight()))
+    fig.savefig(args.out, dpi=110)
+
+
+if __name__ == "__main__":
+    main()
