@@ -20,12 +20,21 @@ const std::array<const char*, 10> kValueOptions = {"--masses",     "--positions"
 
 /// "--velocities -1,0,0" -> "--velocities=-1,0,0": a value option takes the next
 /// argument as its value, as getopt does. A value option that is last, or followed by
-/// another long option, has no value (CLI11 would take "--format=json" as the value).
+/// another long option, or written "--masses=", has no value (CLI11 would take the next
+/// argument, even "--format=json", as the value).
 std::vector<std::string> normalizeArguments(const std::vector<std::string>& args) {
   std::vector<std::string> out;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const bool takes_value =
         std::find(kValueOptions.begin(), kValueOptions.end(), args[i]) != kValueOptions.end();
+    const bool empty_after_equals =
+        args[i].size() > 1 && args[i].back() == '=' &&
+        std::find(kValueOptions.begin(), kValueOptions.end(), args[i].substr(0, args[i].size() - 1)) !=
+            kValueOptions.end();
+    if (empty_after_equals) {
+      const std::string option = args[i].substr(0, args[i].size() - 1);
+      throw makeCliError(CliReason::kMissingInput, option.substr(2), option + " is given without a value");
+    }
     if (!takes_value) {
       out.push_back(args[i]);
       continue;
@@ -39,9 +48,9 @@ std::vector<std::string> normalizeArguments(const std::vector<std::string>& args
   return out;
 }
 
-/// CLI11 messages may span lines; the CLI promises one line.
+/// CLI11 and YAML messages may span lines; the CLI promises one line.
 std::string oneLine(std::string text) {
-  std::replace(text.begin(), text.end(), '\n', ' ');
+  std::replace_if(text.begin(), text.end(), [](char c) { return c == '\n' || c == '\r'; }, ' ');
   while (!text.empty() && text.back() == ' ') text.pop_back();
   return text;
 }
@@ -90,7 +99,7 @@ const char* cliReasonName(CliReason reason) {
 }
 
 CliError makeCliError(CliReason reason, std::string field, std::string message) {
-  return CliError{cliReasonName(reason), static_cast<int>(reason), std::move(field), std::move(message)};
+  return CliError{cliReasonName(reason), static_cast<int>(reason), std::move(field), oneLine(std::move(message))};
 }
 
 io::ReportFormat requestedFormat(const std::vector<std::string>& args) {
@@ -137,7 +146,7 @@ CliRequest parseCommandLine(std::vector<std::string> args, const std::string& de
     request.help_text = app.help();
     return request;
   } catch (const CLI::ParseError& e) {
-    throw makeCliError(CliReason::kUsage, "arguments", oneLine(e.what()) + " (see --help)");
+    throw makeCliError(CliReason::kUsage, "arguments", std::string(e.what()) + " (see --help)");
   }
   if (!app.remaining().empty()) {
     std::string unexpected;

@@ -32,6 +32,7 @@ struct CliError {
   std::string message;
 };
 
+/// Line breaks in `message` (from CLI11 or yaml-cpp) become blanks: one line on stderr.
 CliError makeCliError(CliReason reason, std::string field, std::string message);
 
 struct CliRequest {

@@ -1,5 +1,6 @@
 #include "collision_lab/io/scenario_file.h"
 
+#include <filesystem>
 #include <set>
 
 #include <yaml-cpp/yaml.h>
@@ -68,6 +69,10 @@ NamedScene readEntry(const std::string& name, const YAML::Node& entry, const std
 }  // namespace
 
 std::vector<NamedScene> loadScenarioFile(const std::string& path) {
+  std::error_code ignored;
+  if (std::filesystem::is_directory(path, ignored)) {
+    throw ScenarioFileError(path + ": is a folder, not a scenario file");
+  }
   YAML::Node root;
   try {
     root = YAML::LoadFile(path);
@@ -77,6 +82,8 @@ std::vector<NamedScene> loadScenarioFile(const std::string& path) {
     // e.mark is 0-based; people count lines from 1.
     throw ScenarioFileError(path + ": YAML syntax error at line " + std::to_string(e.mark.line + 1) +
                             ", column " + std::to_string(e.mark.column + 1) + ": " + e.msg);
+  } catch (const std::exception& e) {  // read errors surface as std::ios_base::failure
+    throw ScenarioFileError(path + ": cannot read the scenario file (" + e.what() + ")");
   }
   if (!root.IsMap() || root.size() == 0) {
     throw ScenarioFileError(path + ": expected a map of named scenarios (name: {masses, positions, velocities})");

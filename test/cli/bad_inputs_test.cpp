@@ -32,6 +32,12 @@ struct CatalogueRow {
   std::string stderr_line;
 };
 
+/// gtest names a failing row by its arguments instead of dumping its bytes.
+void PrintTo(const CatalogueRow& row, std::ostream* out) {
+  *out << "row " << row.number << ":";
+  for (const std::string& arg : row.args) *out << " " << arg;
+}
+
 std::string trim(const std::string& text) {
   const auto first = text.find_first_not_of(' ');
   if (first == std::string::npos) return "";

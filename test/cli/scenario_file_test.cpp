@@ -122,6 +122,7 @@ TEST(ScenarioFile, ErrorsNameTheFileTheEntryAndTheField) {
   EXPECT_NE(loadError(kData + "bad_syntax.yaml").find("YAML syntax error at line"), std::string::npos);
   EXPECT_NE(loadError(kData + "not_a_map.yaml").find("expected a map of named scenarios"), std::string::npos);
   EXPECT_EQ(loadError(kData + "absent.yaml"), kData + "absent.yaml: cannot open the scenario file");
+  EXPECT_EQ(loadError(kData), kData + ": is a folder, not a scenario file");
   const TemporaryYaml empty("");
   EXPECT_NE(loadError(empty.path()).find("expected a map"), std::string::npos);
   const TemporaryYaml missing("a:\n  masses: [1, 1, 1]\n  positions: [2, 1, 0]\n");
