@@ -14,8 +14,9 @@ namespace {
 
 const char* const kParticleNames[3] = {"A", "B", "C"};
 
-/// Shortest text that reads back to the same double ("nan", "inf" as C writes them).
+/// Shortest text that reads back to the same double; "inf", "-inf", and "nan" for any NaN.
 std::string roundTripText(double value) {
+  if (std::isnan(value)) return "nan";
   char buffer[64];
   const auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
   return std::string(buffer, result.ptr);
@@ -192,7 +193,7 @@ class JsonWriter : public RunReportWriter {
 // ---------------------------------------------------------------------------------------
 // CSV: "# key,value..." comment lines for the scene and options, a header line, one row
 // per event, then "# key,value..." comment lines for the summary (the JSON summary keys,
-// nested keys joined by '.', null as an empty field).
+// nested keys joined by '.', doubles as in the rows, an absent value as an empty field).
 
 void writeCsvComments(std::ostream& out, const std::string& prefix, const Json& object) {
   for (const auto& item : object.items()) {
@@ -207,6 +208,8 @@ void writeCsvComments(std::ostream& out, const std::string& prefix, const Json& 
       out << ",";
       if (scalar.is_string()) {
         out << scalar.get<std::string>();
+      } else if (scalar.is_number_float()) {
+        out << roundTripText(scalar.get<double>());
       } else if (!scalar.is_null()) {
         out << jsonText(scalar);
       }
