@@ -9,6 +9,7 @@ endif()
 catkin_add_gtest(collision_lab_cli_test
   test/cli/cli_test.cpp
   test/cli/bad_inputs_test.cpp
+  test/cli/random_input_test.cpp
   test/cli/cli_process.cpp)
 if(TARGET collision_lab_cli_test)
   target_link_libraries(collision_lab_cli_test collision_lab_core nlohmann_json::nlohmann_json GTest::gtest_main)
