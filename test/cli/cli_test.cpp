@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -12,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_process.h"
+#include "collision_lab/core/exact.h"
 
 namespace {
 
@@ -123,6 +125,48 @@ TEST(CliJson, HardPresetsMatchExactArithmetic) {
   const Json bc_first = runPreset("bc_first");
   EXPECT_EQ(bc_first.at("summary").at("predicted_first_pair"), "BC");
   EXPECT_EQ(bc_first.at("events").at(0).at("pair"), "BC");
+}
+
+/// Hard scenes not in the presets: counts, pair sequences and final velocities printed by
+/// the CLI must be those of exact rational arithmetic on the same doubles.
+TEST(CliJson, AgreesWithExactArithmetic) {
+  struct Case {
+    std::string masses, positions, velocities;
+  };
+  const std::vector<Case> cases = {
+      {"5,1,9", "2,1,0", "-1,0,0"},                              // kaleidoscopic, last contact grazes
+      {"1,1,1", "1,0,-0.9999999999999999", "-1,0,1"},            // near-triple: BC first by one ulp
+      {"0.3,0.7,0.11", "0.9,0.2,-0.4", "-0.3,0.1,0.25"},         // general
+      {"inf,1,2", "3,1,0", "-0.7,0.1,0"},                        // moving wall at A
+      {"1e-100,2e-100,3e-100", "2e-100,0,-1e-100", "-1e100,0,1e100"},  // extreme scale
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.masses + " / " + c.positions + " / " + c.velocities);
+    const Json doc = runJson({"--masses", c.masses, "--positions", c.positions, "--velocities", c.velocities});
+    collision_lab::Scene scene;
+    for (int i = 0; i < 3; ++i) {
+      scene.masses[i] = doc.at("scene").at("masses")[i].is_null() ? std::numeric_limits<double>::infinity()
+                                                                  : doc.at("scene").at("masses")[i].get<double>();
+      scene.positions[i] = doc.at("scene").at("positions")[i].get<double>();
+      scene.velocities[i] = doc.at("scene").at("velocities")[i].get<double>();
+    }
+    const collision_lab::exact::Run truth = collision_lab::exact::simulate(scene, 100000);
+    ASSERT_FALSE(truth.truncated);
+    EXPECT_EQ(doc.at("summary").at("collision_count"), truth.collision_count);
+    EXPECT_EQ(doc.at("summary").at("predicted_collision_count"), truth.collision_count);
+    const Json& events = doc.at("events");
+    ASSERT_EQ(events.size(), truth.pairs.size());
+    for (std::size_t i = 0; i < events.size(); ++i) {
+      EXPECT_EQ(events[i].at("pair"), collision_lab::pairName(truth.pairs[i])) << "event " << i + 1;
+    }
+    const std::vector<double> final_velocities = doubles(doc.at("summary").at("final_velocities"));
+    double scale = 0.0;
+    for (double v : scene.velocities) scale = std::max(scale, std::fabs(v));
+    for (int i = 0; i < 3; ++i) {
+      const double exact = truth.final_velocities[i].convert_to<double>();
+      EXPECT_NEAR(final_velocities[i], exact, 1e-12 * scale) << "particle " << i;
+    }
+  }
 }
 
 TEST(CliArguments, NegativeValuesRightAfterAFlag) {
