@@ -23,8 +23,9 @@ std::string formatValue(double value) {
   return out.str();
 }
 
-ValidationError makeError(Reason reason, std::string field, std::string message) {
-  return ValidationError{reason, std::move(field), std::move(message)};
+/// The message always starts with the field, so one line tells the user where to look.
+ValidationError makeError(Reason reason, const std::string& field, const std::string& message) {
+  return ValidationError{reason, field, field + ": " + message};
 }
 
 bool isFiniteProduct(double a, double b) { return std::isfinite(a * b); }
@@ -58,29 +59,28 @@ std::optional<ValidationError> validate(const Scene& scene) {
   for (int i = 0; i < 3; ++i) {
     const double m = scene.masses[i];
     const std::string field = indexedField("masses", i);
-    const std::string who = std::string(" (m_") + kParticleNames[i] + ")";
     if (std::isnan(m)) {
       return makeError(Reason::kNonFiniteValue, field,
-                       field + who + " is NaN; a mass must be a positive number in kg, or inf for a wall");
+                       std::string("m_") + kParticleNames[i] + " is NaN; a mass must be a positive number in kg, or inf for a wall");
     }
     if (!(m > 0.0)) {
       return makeError(Reason::kNonPositiveMass, field,
-                       field + who + " is " + formatValue(m) + " kg; a mass must be positive");
+                       std::string("m_") + kParticleNames[i] + " is " + formatValue(m) + " kg; a mass must be positive");
     }
   }
   if (std::isinf(scene.masses[kB])) {
     return makeError(Reason::kInfiniteMiddleMass, "masses[1]",
-                     "masses[1] (m_B) is inf; only A or C may be a wall, B must have a finite mass");
+                     "m_B is inf; only A or C may be a wall, B must have a finite mass");
   }
   if (std::isinf(scene.masses[kA]) && std::isinf(scene.masses[kC])) {
     return makeError(Reason::kTwoWalls, "masses",
-                     "masses[0] and masses[2] are both inf; at most one of A and C may be a wall");
+                     "m_A and m_C are both inf; at most one of A and C may be a wall");
   }
   for (int i = 0; i < 3; ++i) {
     if (!std::isfinite(scene.positions[i])) {
       const std::string field = indexedField("positions", i);
       return makeError(Reason::kNonFiniteValue, field,
-                       field + " (x_" + kParticleNames[i] + ") is " + formatValue(scene.positions[i]) +
+                       std::string("x_") + kParticleNames[i] + " is " + formatValue(scene.positions[i]) +
                            "; a position must be a finite number in m");
     }
   }
@@ -88,7 +88,7 @@ std::optional<ValidationError> validate(const Scene& scene) {
     if (!std::isfinite(scene.velocities[i])) {
       const std::string field = indexedField("velocities", i);
       return makeError(Reason::kNonFiniteValue, field,
-                       field + " (v_" + kParticleNames[i] + ") is " + formatValue(scene.velocities[i]) +
+                       std::string("v_") + kParticleNames[i] + " is " + formatValue(scene.velocities[i]) +
                            "; a velocity must be a finite number in m/s");
     }
   }

@@ -279,8 +279,9 @@ class Trajectory {
       event.velocities_before[i] = toDouble(before[i]);
       event.velocities_after[i] = toDouble(after[i]);
     }
-    // The contact point is where the pair meets; take the body that is not a wall.
-    event.position = event.positions[left + 1 == wall ? left : left + 1];
+    // The contact point is where the pair meets: at the wall if there is one (its path is
+    // exact), else at the right-hand body.
+    event.position = event.positions[left == wall ? left : left + 1];
     event.positions[left] = event.positions[left + 1] = event.position;
     double gained_by_finite = 0.0;
     for (int i = 0; i < 3; ++i) {

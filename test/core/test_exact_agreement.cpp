@@ -1,0 +1,218 @@
+// The adaptive double engine against exact rational arithmetic on the same doubles.
+#include <gtest/gtest.h>
+
+#include <random>
+#include <vector>
+
+#include "collision_lab/core/analytic.h"
+#include "collision_lab/core/exact.h"
+#include "collision_lab/core/precision.h"
+#include "collision_lab/core/simulation.h"
+#include "scenes.h"
+
+namespace collision_lab {
+namespace {
+
+using testing_support::energyNormError;
+using testing_support::kInf;
+using testing_support::randomScene;
+
+struct Observed {
+  SimulationResult result;
+  std::vector<Pair> pairs;
+};
+
+template <class Scalar = double>
+Observed run(const Scene& scene, std::uint64_t max_collisions = 10'000'000) {
+  Observed observed;
+  SimulationOptions options;
+  options.max_collisions = max_collisions;
+  observed.result = simulate<Scalar>(scene, options, [&](const CollisionEvent& e) { observed.pairs.push_back(e.pair); });
+  return observed;
+}
+
+void expectMatchesExact(const Scene& scene, double tolerance = 1e-13) {
+  const exact::Run reference = exact::simulate(scene, 100000);
+  ASSERT_FALSE(reference.truncated);
+  const Observed observed = run(scene);
+  EXPECT_EQ(observed.result.collision_count, reference.collision_count);
+  EXPECT_EQ(observed.pairs, reference.pairs);
+  EXPECT_EQ(observed.result.first_pair, reference.first_pair);
+  EXPECT_LE(energyNormError(scene, observed.result.final_velocities, reference.final_velocities), tolerance);
+  // Count-only mode models velocities alone and must agree too.
+  EXPECT_EQ(simulate<double>(scene, {}).collision_count, reference.collision_count);
+  EXPECT_EQ(predictedCollisionCount(scene), reference.collision_count);
+}
+
+TEST(ExactAgreement, ThousandSeededRandomScenes) {
+  std::mt19937_64 rng(20261122);
+  int with_collisions = 0, bc_first = 0, walls = 0;
+  for (int i = 0; i < 1000; ++i) {
+    const Scene scene = randomScene(rng);
+    SCOPED_TRACE(::testing::Message() << "scene " << i);
+    expectMatchesExact(scene, 1e-12);
+    const auto first = firstPair(scene);
+    with_collisions += first.has_value();
+    bc_first += first == Pair::BC;
+    walls += scene.wallIndex() >= 0;
+  }
+  // The sample really covers the branches.
+  EXPECT_GT(with_collisions, 500);
+  EXPECT_GT(bc_first, 100);
+  EXPECT_GT(walls, 100);
+}
+
+TEST(ExactAgreement, WideMassRatiosWithLongerRuns) {
+  std::mt19937_64 rng(31);
+  for (int i = 0; i < 25; ++i) {
+    const Scene scene = randomScene(rng, 2.5);
+    SCOPED_TRACE(::testing::Message() << "scene " << i);
+    expectMatchesExact(scene, 1e-12);
+  }
+}
+
+TEST(ExactAgreement, KaleidoscopicMassesGrazeAtTheEnd) {
+  // pi / alpha is an integer (3, 4, 6); from v = (-1, 0, 0) the last contact grazes.
+  const std::vector<std::pair<std::array<double, 3>, std::uint64_t>> cases = {
+      {{1, 1, 1}, 2}, {{2, 1, 3}, 3}, {{5, 1, 9}, 5}};
+  for (const auto& [masses, expected] : cases) {
+    const Scene scene{masses, {2, 1, 0}, {-1, 0, 0}};
+    EXPECT_EQ(run(scene).result.collision_count, expected);
+    EXPECT_EQ(predictedCollisionCount(scene), expected);
+    expectMatchesExact(scene);
+  }
+}
+
+TEST(ExactAgreement, GrazingEndsWithEqualVelocities) {
+  const Scene scene{{3, 1, 0.5}, {2, 1, 0}, {-1, 0, 0}};
+  const Observed observed = run(scene);
+  EXPECT_EQ(observed.result.collision_count, 2u);
+  const auto& v = observed.result.final_velocities;
+  EXPECT_EQ(v[kA], v[kB]);  // exactly: the engine adopted the exact state
+  EXPECT_GE(observed.result.escalation.exact_rational, 1u);
+  expectMatchesExact(scene);
+}
+
+TEST(ExactAgreement, NearTripleCollisionsPickTheExactFirstPair) {
+  // t_AB and t_BC differ in the last bits of the positions or velocities.
+  for (int ulps = -3; ulps <= 3; ++ulps) {
+    if (ulps == 0) continue;
+    double x_a = 1.0;
+    for (int i = 0; i < std::abs(ulps); ++i) x_a = std::nextafter(x_a, ulps > 0 ? 2.0 : 0.0);
+    for (const auto& masses : {std::array<double, 3>{1, 1, 1}, std::array<double, 3>{3, 1, 7}}) {
+      const Scene scene{masses, {x_a, 0.0, -1.0}, {-1.0, 0.0, 1.0}};
+      ASSERT_FALSE(validate(scene));
+      const Pair expected = ulps > 0 ? Pair::BC : Pair::AB;
+      EXPECT_EQ(firstPair(scene), expected) << ulps;
+      expectMatchesExact(scene);
+    }
+  }
+  // Products that round to equal in double but differ exactly.
+  const Scene rounded{{1, 2, 3}, {0.3, 0.2, 0.1}, {-0.1, 0.0, 0.1}};
+  ASSERT_FALSE(validate(rounded));
+  EXPECT_EQ(firstPair(rounded), exact::compareFirstContactTimes(rounded) < 0 ? Pair::AB : Pair::BC);
+  expectMatchesExact(rounded);
+}
+
+TEST(ExactAgreement, ExtremeScalesDoNotOverflow) {
+  for (double scale : {1e-150, 1e150}) {
+    const Scene masses_scaled{{2 * scale, scale, 3 * scale}, {2, 1, 0}, {-1, 0.25, 1}};
+    expectMatchesExact(masses_scaled);
+    const Scene speeds_scaled{{2, 1, 3}, {2 * scale, scale, 0}, {-scale, 0.25 * scale, scale}};
+    expectMatchesExact(speeds_scaled);
+  }
+}
+
+TEST(ExactAgreement, WallsMovingAndResting) {
+  expectMatchesExact(Scene{{kInf, 1, 3}, {2, 1, 0}, {0.25, 0, 1}});
+  expectMatchesExact(Scene{{3, 1, kInf}, {2, 1, 0}, {-1, 0.5, -0.125}});
+}
+
+TEST(ExactAgreement, OtherPrecisionsAgreeOnCountsAndPairs) {
+  std::mt19937_64 rng(7);
+  for (int i = 0; i < 40; ++i) {
+    const Scene scene = randomScene(rng);
+    const exact::Run reference = exact::simulate(scene, 100000);
+    EXPECT_EQ(run<long double>(scene).pairs, reference.pairs);
+    const Observed high = run<HighPrecision>(scene);
+    EXPECT_EQ(high.pairs, reference.pairs);
+    EXPECT_LE(energyNormError(scene, high.result.final_velocities, reference.final_velocities), 1e-15);
+  }
+}
+
+TEST(Conservation, EnergyAndMomentumOverLongRuns) {
+  for (const Scene& scene : {Scene{{1e6, 1, 1e6}, {2, 1, 0}, {-1, 0, 0}}, Scene{{1e8, 3, 1e9}, {2, 1, 0}, {-1, 0.5, 0.25}}}) {
+    const SimulationResult result = simulate<double>(scene, {});
+    EXPECT_GT(result.collision_count, 1000u);
+    EXPECT_LE(result.energy_relative_drift, 1e-12);
+    EXPECT_LE(result.momentum_relative_drift, 1e-12);
+  }
+  // Every event's running totals stay on the initial values.
+  const Scene scene{{1, 2, 3}, {2, 1, 0}, {-1, 0.3, 0.7}};
+  const double energy = 0.5 * (1 * 1 + 2 * 0.09 + 3 * 0.49);
+  const double momentum = -1 + 2 * 0.3 + 3 * 0.7;
+  SimulationOptions options;
+  options.events = EventPolicy::all();
+  const SimulationResult result = simulate<double>(scene, options);
+  ASSERT_FALSE(result.events.empty());
+  for (const CollisionEvent& e : result.events) {
+    EXPECT_NEAR(e.total_energy, energy, 1e-14);
+    EXPECT_NEAR(e.total_momentum, momentum, 1e-14);
+    EXPECT_NEAR(e.energy_transfer[0] + e.energy_transfer[1] + e.energy_transfer[2], 0.0, 1e-14);
+  }
+}
+
+TEST(Events, PoliciesCapsAndTimes) {
+  const Scene scene{{100, 1, kInf}, {3, 2, 0}, {-1, 0, 0}};
+  SimulationOptions options;
+  options.events = EventPolicy::firstN(5);
+  std::uint64_t visited = 0;
+  const SimulationResult first5 = simulate<double>(scene, options, [&](const CollisionEvent&) { ++visited; });
+  EXPECT_EQ(first5.collision_count, 31u);
+  EXPECT_EQ(visited, 31u);
+  ASSERT_EQ(first5.events.size(), 5u);
+  // First impact: A (x = 3, v = -1) reaches B (x = 2, at rest) at t = 1, x = 2.
+  EXPECT_EQ(first5.events[0].pair, Pair::AB);
+  EXPECT_DOUBLE_EQ(first5.events[0].time, 1.0);
+  EXPECT_DOUBLE_EQ(first5.events[0].position, 2.0);
+  // Times increase; contacts with the wall happen at the wall.
+  for (std::size_t i = 1; i < first5.events.size(); ++i) EXPECT_GT(first5.events[i].time, first5.events[i - 1].time);
+  EXPECT_DOUBLE_EQ(first5.events[1].position, 0.0);
+
+  options.events = EventPolicy::none();
+  options.max_collisions = 10;
+  const SimulationResult capped = simulate<double>(scene, options);
+  EXPECT_TRUE(capped.truncated);
+  EXPECT_EQ(capped.collision_count, 10u);
+  EXPECT_TRUE(capped.events.empty());
+  options.max_collisions = 31;
+  EXPECT_FALSE(simulate<double>(scene, options).truncated);  // exactly the count is not truncation
+}
+
+TEST(PiDigits, BySimulation) {
+  const std::vector<std::pair<double, std::uint64_t>> digits = {{1e2, 31}, {1e4, 314}, {1e6, 3141}, {1e8, 31415}};
+  for (const auto& [ratio, expected] : digits) {
+    const Scene scene{{ratio, 1, kInf}, {2, 1, 0}, {-1, 0, 0}};
+    EXPECT_EQ(simulate<double>(scene, {}).collision_count, expected);
+    EXPECT_EQ(predictedCollisionCount(scene), expected);
+  }
+  const Scene small{{1e4, 1, kInf}, {2, 1, 0}, {-1, 0, 0}};
+  expectMatchesExact(small);
+}
+
+TEST(HeavyLightHeavy, MillionsOfCollisionsStayAccurate) {
+  const Scene scene{{1e12, 1, 1e12}, {2, 1, 0}, {-1, 0, 0}};
+  const SimulationResult fast = simulate<double>(scene, {});
+  EXPECT_EQ(fast.collision_count, 2221441u);
+  EXPECT_EQ(predictedCollisionCount(scene), 2221441u);
+  // Reference: the 50-digit closed form.
+  const AnalyticModel<HighPrecision> model(scene);
+  const auto reference = model.velocitiesAfter(fast.collision_count);
+  exact::RationalState reference_state;
+  for (int i = 0; i < 3; ++i) reference_state[i] = exact::Rational(static_cast<double>(reference(i)));
+  EXPECT_LE(energyNormError(scene, fast.final_velocities, reference_state), 1e-12);
+  EXPECT_LE(fast.energy_relative_drift, 1e-12);
+}
+
+}  // namespace
+}  // namespace collision_lab
