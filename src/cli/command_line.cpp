@@ -14,9 +14,17 @@ namespace {
 
 /// Options that take a value. A value may start with '-' (negative numbers, "-inf",
 /// "-.5"), which CLI11 would take for a flag; normalizeArguments() prevents that.
-const std::array<const char*, 10> kValueOptions = {"--masses",     "--positions", "--velocities", "--max-collisions",
-                                                  "--events",     "--format",    "--precision",  "--mode",
-                                                  "--scenario",   "--name"};
+const std::array<const char*, 10> kValueOptions = {"--masses",   "--positions", "--velocities", "--max-collisions",
+                                                  "--events",   "--format",    "--precision",  "--mode",
+                                                  "--scenario", "--name"};
+
+bool isValueOption(const std::string& arg) {
+  return std::find(kValueOptions.begin(), kValueOptions.end(), arg) != kValueOptions.end();
+}
+
+CliError missingValue(const std::string& option) {
+  return makeCliError(CliReason::kMissingInput, option.substr(2), option + " is given without a value");
+}
 
 /// "--velocities -1,0,0" -> "--velocities=-1,0,0": a value option takes the next
 /// argument as its value, as getopt does. A value option that is last, or followed by
@@ -25,24 +33,16 @@ const std::array<const char*, 10> kValueOptions = {"--masses",     "--positions"
 std::vector<std::string> normalizeArguments(const std::vector<std::string>& args) {
   std::vector<std::string> out;
   for (std::size_t i = 0; i < args.size(); ++i) {
-    const bool takes_value =
-        std::find(kValueOptions.begin(), kValueOptions.end(), args[i]) != kValueOptions.end();
-    const bool empty_after_equals =
-        args[i].size() > 1 && args[i].back() == '=' &&
-        std::find(kValueOptions.begin(), kValueOptions.end(), args[i].substr(0, args[i].size() - 1)) !=
-            kValueOptions.end();
-    if (empty_after_equals) {
-      const std::string option = args[i].substr(0, args[i].size() - 1);
-      throw makeCliError(CliReason::kMissingInput, option.substr(2), option + " is given without a value");
+    const std::string& arg = args[i];
+    if (arg.size() > 1 && arg.back() == '=' && isValueOption(arg.substr(0, arg.size() - 1))) {
+      throw missingValue(arg.substr(0, arg.size() - 1));
     }
-    if (!takes_value) {
-      out.push_back(args[i]);
+    if (!isValueOption(arg)) {
+      out.push_back(arg);
       continue;
     }
-    if (i + 1 == args.size() || args[i + 1].rfind("--", 0) == 0) {
-      throw makeCliError(CliReason::kMissingInput, args[i].substr(2), args[i] + " is given without a value");
-    }
-    out.push_back(args[i] + "=" + args[i + 1]);
+    if (i + 1 == args.size() || args[i + 1].rfind("--", 0) == 0) throw missingValue(arg);
+    out.push_back(arg + "=" + args[i + 1]);
     ++i;
   }
   return out;
@@ -76,12 +76,93 @@ std::array<double, 3> parseTriple(const std::string& text, const std::string& fi
   return values;
 }
 
+/// The options as typed, before their values are checked.
 struct RawOptions {
   std::string masses, positions, velocities;
   std::string max_collisions, events, format = "table", precision = "double", mode = "full";
   std::string scenario, name;
   bool list = false;
+  bool masses_given = false, positions_given = false, velocities_given = false;
+  bool max_collisions_given = false, events_given = false, scenario_given = false, name_given = false;
 };
+
+/// Format, precision, mode and collision cap.
+void readRunOptions(const RawOptions& raw, CliRequest& request) {
+  const auto format = io::parseReportFormat(raw.format);
+  if (!format) {
+    throw makeCliError(CliReason::kInvalidOption, "format", "format '" + raw.format + "' is not table, json or csv");
+  }
+  request.format = *format;
+  const auto precision = io::parsePrecisionOption(raw.precision);
+  if (!precision) {
+    throw makeCliError(CliReason::kInvalidOption, "precision",
+                       "precision '" + raw.precision + "' is not double, long_double or high");
+  }
+  request.options.precision = *precision;
+  const auto mode = io::parseRunMode(raw.mode);
+  if (!mode) {
+    throw makeCliError(CliReason::kInvalidOption, "mode", "mode '" + raw.mode + "' is not full, predict or summary");
+  }
+  request.options.mode = *mode;
+  if (raw.max_collisions_given) {
+    const auto cap = io::parseCount(raw.max_collisions);
+    if (!cap) {
+      throw makeCliError(CliReason::kInvalidOption, "max-collisions",
+                         "max-collisions '" + raw.max_collisions + "' is not a non-negative integer");
+    }
+    request.options.max_collisions = *cap;
+    request.max_collisions_given = true;
+  }
+}
+
+/// What to run: a scene from the three lists, or one scene, all scenes or the list of a file.
+void readSceneSource(const RawOptions& raw, const std::string& default_scenario_path, CliRequest& request) {
+  const bool any_scene_value = raw.masses_given || raw.positions_given || raw.velocities_given;
+  const bool from_file = raw.scenario_given || raw.name_given || raw.list;
+  if (any_scene_value && from_file) {
+    throw makeCliError(CliReason::kUsage, "scenario",
+                       "give either --masses/--positions/--velocities or --scenario/--name/--list, not both");
+  }
+  if (from_file) {
+    request.scenario_path = raw.scenario_given ? raw.scenario : default_scenario_path;
+    if (raw.list) {
+      request.action = CliRequest::Action::kList;
+    } else if (raw.name_given) {
+      request.action = CliRequest::Action::kRunOne;
+      request.scenario_name = raw.name;
+    } else {
+      request.action = CliRequest::Action::kRunAll;
+    }
+    return;
+  }
+  for (const auto& [given, field] : {std::pair{raw.masses_given, "masses"}, std::pair{raw.positions_given, "positions"},
+                                     std::pair{raw.velocities_given, "velocities"}}) {
+    if (!given) {
+      throw makeCliError(CliReason::kMissingInput, field,
+                         std::string(field) + " missing: give --masses, --positions and --velocities "
+                                              "(3 comma-separated numbers each), or --scenario FILE");
+    }
+  }
+  Scene scene;
+  scene.masses = parseTriple(raw.masses, "masses", "m");
+  scene.positions = parseTriple(raw.positions, "positions", "x");
+  scene.velocities = parseTriple(raw.velocities, "velocities", "v");
+  request.action = CliRequest::Action::kRunOne;
+  request.scene = scene;
+}
+
+/// Which events to show. Every scene of a file at once: the summary rows are the point,
+/// so none unless asked for.
+void readEventPolicy(const RawOptions& raw, CliRequest& request) {
+  const std::string text =
+      raw.events_given ? raw.events : (request.action == CliRequest::Action::kRunAll ? "none" : "all");
+  const auto events = io::parseEventPolicy(text);
+  if (!events) {
+    throw makeCliError(CliReason::kInvalidOption, "events",
+                       "events '" + text + "' is not all, none or first:N with N a non-negative integer");
+  }
+  request.options.events = *events;
+}
 
 }  // namespace
 
@@ -111,7 +192,7 @@ io::ReportFormat requestedFormat(const std::vector<std::string>& args) {
   return format.value_or(io::ReportFormat::kTable);
 }
 
-CliRequest parseCommandLine(std::vector<std::string> args, const std::string& default_scenario_path) {
+CliRequest parseCommandLine(const std::vector<std::string>& args, const std::string& default_scenario_path) {
   RawOptions raw;
   CLI::App app{
       "collision_lab_cli: three elastic point masses on a line, simulated exactly, beside the correct "
@@ -122,24 +203,24 @@ CliRequest parseCommandLine(std::vector<std::string> args, const std::string& de
       app.add_option("--positions", raw.positions, "x_A,x_B,x_C [m], strictly decreasing");
   const CLI::Option* velocities =
       app.add_option("--velocities", raw.velocities, "v_A,v_B,v_C [m/s]; negative values are fine");
-  const CLI::Option* max_collisions = app.add_option("--max-collisions", raw.max_collisions,
-                 "stop after N collisions and mark the run truncated (default 10000000)");
-  const CLI::Option* events_option = app.add_option("--events", raw.events,
-                 "events to print: all|none|first:N (default all; none when running every scenario)");
+  const CLI::Option* max_collisions = app.add_option(
+      "--max-collisions", raw.max_collisions, "stop after N collisions and mark the run truncated (default 10000000)");
+  const CLI::Option* events = app.add_option(
+      "--events", raw.events, "events to print: all|none|first:N (default all; none when running every scenario)");
   app.add_option("--format", raw.format, "table|json|csv (default table)");
   app.add_option("--precision", raw.precision, "working precision: double|long_double|high (default double)");
   app.add_option("--mode", raw.mode, "full|predict|summary (default full)");
   const CLI::Option* scenario =
       app.add_option("--scenario", raw.scenario, "scenario file (YAML); without --name runs every scene in it");
-  const CLI::Option* name = app.add_option("--name", raw.name, "scene of the scenario file (default file: the package's presets)");
+  const CLI::Option* name =
+      app.add_option("--name", raw.name, "scene of the scenario file (default file: the package's presets)");
   app.add_flag("--list", raw.list, "list the scenes of the scenario file");
   app.allow_extras();  // reported below in the user's order, with a hint
 
   CliRequest request;
   std::vector<std::string> normalized = normalizeArguments(args);
+  std::reverse(normalized.begin(), normalized.end());  // CLI11 takes them last first
   try {
-    // CLI11 wants the arguments in reverse order.
-    std::reverse(normalized.begin(), normalized.end());
     app.parse(normalized);
   } catch (const CLI::CallForHelp&) {
     request.action = CliRequest::Action::kHelp;
@@ -155,74 +236,17 @@ CliRequest parseCommandLine(std::vector<std::string> args, const std::string& de
                        "unexpected arguments:" + unexpected +
                            " (lists are comma-separated without blanks, e.g. --velocities -1,0,0; see --help)");
   }
+  raw.masses_given = masses->count() > 0;
+  raw.positions_given = positions->count() > 0;
+  raw.velocities_given = velocities->count() > 0;
+  raw.max_collisions_given = max_collisions->count() > 0;
+  raw.events_given = events->count() > 0;
+  raw.scenario_given = scenario->count() > 0;
+  raw.name_given = name->count() > 0;
 
-  const auto format = io::parseReportFormat(raw.format);
-  if (!format) {
-    throw makeCliError(CliReason::kInvalidOption, "format", "format '" + raw.format + "' is not table, json or csv");
-  }
-  request.format = *format;
-  const auto precision = io::parsePrecisionOption(raw.precision);
-  if (!precision) {
-    throw makeCliError(CliReason::kInvalidOption, "precision",
-                       "precision '" + raw.precision + "' is not double, long_double or high");
-  }
-  request.options.precision = *precision;
-  const auto mode = io::parseRunMode(raw.mode);
-  if (!mode) {
-    throw makeCliError(CliReason::kInvalidOption, "mode", "mode '" + raw.mode + "' is not full, predict or summary");
-  }
-  request.options.mode = *mode;
-  if (max_collisions->count() > 0) {
-    const auto cap = io::parseCount(raw.max_collisions);
-    if (!cap) {
-      throw makeCliError(CliReason::kInvalidOption, "max-collisions",
-                         "max-collisions '" + raw.max_collisions + "' is not a non-negative integer");
-    }
-    request.options.max_collisions = *cap;
-    request.max_collisions_given = true;
-  }
-
-  const bool any_scene_value = masses->count() + positions->count() + velocities->count() > 0;
-  const bool from_file = scenario->count() + name->count() > 0 || raw.list;
-  if (any_scene_value && from_file) {
-    throw makeCliError(CliReason::kUsage, "scenario",
-                       "give either --masses/--positions/--velocities or --scenario/--name/--list, not both");
-  }
-  if (from_file) {
-    request.scenario_path = scenario->count() > 0 ? raw.scenario : default_scenario_path;
-    if (raw.list) {
-      request.action = CliRequest::Action::kList;
-    } else if (name->count() == 0) {
-      request.action = CliRequest::Action::kRunAll;
-    } else {
-      request.action = CliRequest::Action::kRunOne;
-      request.scenario_name = raw.name;
-    }
-  } else {
-    for (const auto& [option, field] : {std::pair{masses, "masses"}, std::pair{positions, "positions"},
-                                        std::pair{velocities, "velocities"}}) {
-      if (option->count() == 0) {
-        throw makeCliError(CliReason::kMissingInput, field,
-                           std::string(field) + " missing: give --masses, --positions and --velocities "
-                                                "(3 comma-separated numbers each), or --scenario FILE");
-      }
-    }
-    Scene scene;
-    scene.masses = parseTriple(raw.masses, "masses", "m");
-    scene.positions = parseTriple(raw.positions, "positions", "x");
-    scene.velocities = parseTriple(raw.velocities, "velocities", "v");
-    request.scene = scene;
-  }
-
-  // Every scene of a file at once: the summary rows are the point, not the events.
-  const std::string events_text =
-      events_option->count() == 0 ? (request.action == CliRequest::Action::kRunAll ? "none" : "all") : raw.events;
-  const auto events = io::parseEventPolicy(events_text);
-  if (!events) {
-    throw makeCliError(CliReason::kInvalidOption, "events",
-                       "events '" + events_text + "' is not all, none or first:N with N a non-negative integer");
-  }
-  request.options.events = *events;
+  readRunOptions(raw, request);
+  readSceneSource(raw, default_scenario_path, request);
+  readEventPolicy(raw, request);
   return request;
 }
 

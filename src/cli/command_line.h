@@ -53,7 +53,7 @@ io::ReportFormat requestedFormat(const std::vector<std::string>& args);
 
 /// Parses the arguments (without argv[0]). Throws CliError.
 /// `default_scenario_path` is used by --name and --list when --scenario is absent.
-CliRequest parseCommandLine(std::vector<std::string> args, const std::string& default_scenario_path);
+CliRequest parseCommandLine(const std::vector<std::string>& args, const std::string& default_scenario_path);
 
 }  // namespace cli
 }  // namespace collision_lab
