@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# The main job: set up, build, and run launch/demo.launch on the shipped presets.
+# With a display, rviz opens; without one, every preset runs headless, a table of runs is
+# printed, one bag per run is left in the bag directory, and the launch ends by itself.
+# Usage: scripts/demo.sh [roslaunch args, e.g. scenarios:="pi_digits_3 grazing"]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+if [ -n "${DISPLAY:-}" ]; then
+  scripts/setup_debian.sh --with-rviz
+  rviz=true
+else
+  scripts/setup_debian.sh
+  rviz=false
+fi
+export PATH=/usr/bin:/bin:$PATH
+set +u
+source build/devel/setup.bash
+set -u
+exec roslaunch collision_lab demo.launch rviz:=$rviz "$@"
