@@ -1,8 +1,8 @@
 #include "collision_lab/core/scene.h"
 
+#include <charconv>
 #include <cmath>
 #include <limits>
-#include <sstream>
 
 #include "collision_lab/core/exact.h"
 
@@ -16,11 +16,11 @@ std::string indexedField(const char* vector_name, int i) {
   return std::string(vector_name) + "[" + std::to_string(i) + "]";
 }
 
+/// Shortest text that reads back as the same double.
 std::string formatValue(double value) {
-  std::ostringstream out;
-  out.precision(17);
-  out << value;
-  return out.str();
+  char buffer[32];
+  const auto end = std::to_chars(buffer, buffer + sizeof buffer, value).ptr;
+  return std::string(buffer, end);
 }
 
 /// The message always starts with the field, so one line tells the user where to look.

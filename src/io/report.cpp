@@ -117,7 +117,7 @@ class TableWriter : public RunReportWriter {
          << ", paper's phi_BC (eq. 3.21) " << humanText(p.phi_bc, kSummaryDigits) << "\n";
     if (s.simulated) {
       out_ << "checks: max prediction error " << humanText(s.max_prediction_error, 3)
-           << " (max |v_sim - v_pred| / max |v0|), relative energy drift " << humanText(s.energy_relative_drift, 3)
+           << " (|S (v_sim - v_pred)| / |S v0|, S = diag(sqrt m): energy norm), relative energy drift " << humanText(s.energy_relative_drift, 3)
            << ", relative momentum drift "
            << (std::isnan(s.momentum_relative_drift) ? std::string("n/a (a wall does not conserve it)")
                                                      : humanText(s.momentum_relative_drift, 3))
@@ -292,7 +292,7 @@ void writeBatchTable(const std::vector<SceneOutcome>& outcomes, std::ostream& ou
         << (s.truncated ? "yes" : "no") << "\n";
   }
   out << "\ncollisions: simulated; predicted: the correct closed form; paper (3.22): the paper's printed n_max;"
-         "\nfinal velocities: simulated (predicted when not simulated); max pred err: max |v_sim - v_pred| / max |v0|\n";
+         "\nfinal velocities: simulated (predicted when not simulated); max pred err: |S (v_sim - v_pred)| / |S v0|, S = diag(sqrt m) (energy norm)\n";
 }
 
 void writeBatchCsv(const std::vector<SceneOutcome>& outcomes, std::ostream& out) {
@@ -398,7 +398,7 @@ Json unitsJson() {
   return Json{{"mass", "kg"},         {"position", "m"}, {"velocity", "m/s"},
               {"time", "s"},          {"energy", "J"},   {"momentum", "kg m/s"},
               {"angle", "rad"},       {"drift", "relative (dimensionless)"},
-              {"prediction_error", "relative to max |v0| (dimensionless)"}};
+              {"prediction_error", "energy norm |S (v_sim - v_pred)| / |S v0|, S = diag(sqrt m) (dimensionless)"}};
 }
 
 Json sceneJson(const NamedScene& named) {
