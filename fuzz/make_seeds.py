@@ -1,0 +1,113 @@
+#!/usr/bin/env python3
+"""Writes the seed corpus of fuzz/core_fuzzer.cpp into fuzz/corpus/core (deterministic).
+
+Each seed is one scene from shared/physics.md's hard cases or the bad-input catalogue,
+in the byte layout documented at the top of core_fuzzer.cpp. Run from anywhere:
+    python3 fuzz/make_seeds.py
+"""
+import math
+import os
+import struct
+
+INF, NAN = math.inf, math.nan
+CAP = {0: 0, 1: 1, 2: 2, 3: 3, 5: 4, 10: 5, 100: 6, 1000: 7, 10000: 8, 100000: 9}
+PRECISION = {"double": 0, "long_double": 1, "high": 2}
+EVENTS = {"none": 0, "all": 1, "first3": 2}
+MODE = {"full": 0, "predict_only": 1, "summary_only": 2}
+
+
+def flags(precision="double", events="none", compact=False, skip_over_cap=False, mode="full"):
+    return (PRECISION[precision] | EVENTS[events] << 2 | int(compact) << 4 | int(skip_over_cap) << 5
+            | MODE[mode] << 6)
+
+
+def raw(masses, positions, velocities, cap=100000, **options):
+    """Any doubles, bit for bit."""
+    header = bytes([flags(**options), CAP[cap]])
+    return header + struct.pack("<9d", *masses, *positions, *velocities)
+
+
+def compact_value(value):
+    """(mantissa, exponent) with value == mantissa * 10^exponent as the fuzzer decodes it."""
+    if math.isnan(value):
+        return -32766, 0
+    if math.isinf(value):
+        return (-32768 if value > 0 else -32767), 0
+    for exponent in range(-30, 31):
+        mantissa = round(value / 10.0 ** exponent) if exponent >= 0 else round(value * 10 ** -exponent)
+        if -32765 <= mantissa <= 32767:
+            decoded = mantissa * 10.0 ** exponent if exponent >= 0 else mantissa / 10.0 ** -exponent
+            if decoded == value:
+                return mantissa, exponent
+    raise ValueError(f"{value} has no compact form; use raw()")
+
+
+def compact(masses, positions, velocities, cap=100000, **options):
+    """Short decimal values (mantissa * 10^exponent), the form mutations explore best."""
+    out = bytes([flags(compact=True, **options), CAP[cap]])
+    for value in (*masses, *positions, *velocities):
+        out += struct.pack("<hh", *compact_value(value))
+    return out
+
+
+SEEDS = {
+    # Galperin's billiard: m_A / m_B = 100^(d-1), C a wall at rest: the digits of pi.
+    "pi_31": compact((100, 1, INF), (2, 1, 0), (-1, 0, 0)),
+    "pi_314_events": compact((1e4, 1, INF), (2, 1, 0), (-1, 0, 0), events="all", cap=1000),
+    "pi_3141_high": compact((1e6, 1, INF), (2, 1, 0), (-1, 0, 0), precision="high", cap=10000),
+    "pi_31415": compact((1e8, 1, INF), (2, 1, 0), (-1, 0, 0)),
+    "pi_314159_truncated": compact((1e10, 1, INF), (2, 1, 0), (-1, 0, 0), skip_over_cap=True),
+    "pi_wall_A": compact((INF, 1, 100), (2, 1, 0), (0, 0, 1)),
+    "moving_wall": compact((INF, 1, 3), (5, 1, -2), (-2, 0, 1), events="first3"),
+    # Kaleidoscopic masses (pi / alpha an integer): grazing last contacts.
+    "kaleido_111": compact((1, 1, 1), (2, 1, 0), (-1, 0, 0), events="all"),
+    "kaleido_213": compact((2, 1, 3), (2, 1, 0), (-1, 0, 0), precision="long_double"),
+    "kaleido_519": compact((5, 1, 9), (2, 1, 0), (-1, 0, 0), precision="high", events="all"),
+    "grazing_3_1_half": compact((3, 1, 0.5), (2, 1, 0), (-1, 0, 0), events="all"),
+    "equal_three_collisions": compact((1, 1, 1), (3, 1, 0), (-1, 0, 1)),
+    "paper_errata2": compact((1, 1, 1), (2, 1, 0), (-1, 0.3, 0.7), events="all"),
+    "errata1_masses": compact((1, 2, 3), (1.5, 0.25, -4), (-2, 0.5, 1.5), mode="summary_only"),
+    "bc_first": compact((2, 7, 1), (10, 1, 0), (0, 0, 5), events="all"),
+    "nothing_collides": compact((1, 1, 1), (3, 2, 1), (3, 2, 1)),
+    "common_velocity": compact((1, 1, 1), (3, 2, 1), (7, 7, 7)),
+    # Near-triple: t_AB and t_BC differ in the last bit; and the exact triple (rejected).
+    "near_triple": raw((1, 1, 1), (1 + 2 ** -52, 0, -1), (-1, 0, 1), events="all"),
+    "near_triple_bc": raw((1, 3, 1), (1, 0, -1 - 2 ** -52), (-1, 0, 1)),
+    "triple_exact": compact((1, 1, 1), (1, 0, -1), (-1, 0, 1)),
+    # Extreme mass ratios and scales.
+    "mass_1e12": compact((1e12, 1, 1e12), (2, 1, 0), (-1, 0, 0)),
+    "mass_1e30": compact((1e30, 1, 1e30), (2, 1, 0), (-1, 0, 0), mode="predict_only"),
+    "mass_1e300": raw((1e300, 1, 1e300), (2, 1, 0), (-1, 0, 0), mode="predict_only"),
+    "mass_ratio_1e600": raw((1e300, 1e-300, 1e300), (2, 1, 0), (-1, 0, 0), mode="predict_only"),
+    "light_outer": compact((1e-12, 1, 1e-12), (2, 1, 0), (-1, 0, 1)),
+    "scale_1e150": raw((1e150, 1e150, 1e150), (3e150, 2e150, 1e150), (-1e-150, 0, 1e-150)),
+    "scale_small": raw((1e-300, 2e-300, 3e-300), (3e-300, 2e-300, 1e-300), (-5e-324, 0, 5e-324)),
+    "overflow_energy": raw((1e300, 1, 1), (2, 1, 0), (-1e10, 0, 0)),
+    "time_overflow": raw((1, 1, 1), (1e300, 0, -1), (-1e-300, 0, 0), events="all"),
+    "velocity_near_max": raw((1, 1, 1), (2, 1, 0), (-1e308, 0, 1e308)),
+    # Bad input: each is rejected by validate().
+    "nan_mass": compact((NAN, 1, 1), (2, 1, 0), (-1, 0, 0)),
+    "zero_mass": compact((1, 0, 1), (2, 1, 0), (-1, 0, 0)),
+    "negative_mass": compact((1, -1, 1), (2, 1, 0), (-1, 0, 0)),
+    "negative_zero_mass": raw((1, -0.0, 1), (2, 1, 0), (-1, 0, 0)),
+    "two_walls": compact((INF, 1, INF), (2, 1, 0), (-1, 0, 0)),
+    "infinite_b": compact((1, INF, 1), (2, 1, 0), (-1, 0, 0)),
+    "nan_position": compact((1, 1, 1), (2, NAN, 0), (-1, 0, 0)),
+    "inf_velocity": compact((1, 1, 1), (2, 1, 0), (-INF, 0, 0)),
+    "unordered": compact((1, 1, 1), (0, 1, 2), (-1, 0, 0)),
+    "coincident": compact((1, 1, 1), (1, 1, 0), (-1, 0, 0)),
+    "gap_overflow": raw((1, 1, 1), (1.7e308, 0, -1.7e308), (-1, 0, 0)),
+}
+
+
+def main():
+    folder = os.path.join(os.path.dirname(os.path.abspath(__file__)), "corpus", "core")
+    os.makedirs(folder, exist_ok=True)
+    for name, data in SEEDS.items():
+        with open(os.path.join(folder, name), "wb") as f:
+            f.write(data)
+    print(f"{len(SEEDS)} seeds in {folder}")
+
+
+if __name__ == "__main__":
+    main()
