@@ -68,8 +68,10 @@ double benchScene(double heavy, int repeats, bool keep_all) {
                        doNotOptimize(run.velocities);
                        return run.collision_count;
                      });
+  EscalationStats escalation;
   methods.emplace_back("core count-only (events none)", [&] {
                        const auto result = simulate<double>(scene, count_only);
+                       escalation = result.escalation;
                        doNotOptimize(result.final_velocities);
                        return result.collision_count;
                      });
@@ -108,6 +110,10 @@ double benchScene(double heavy, int repeats, bool keep_all) {
     if (std::strncmp(method.name, "core count-only", 15) == 0) core_ratio = med / lean_ns;
   }
   std::printf("  (medians of %d round-robin repeats; ns per collision of each method's own count)\n", repeats);
+  std::printf("  core escalations in count-only mode: %llu decisions, %llu to 50 digits, %llu to exact rationals\n",
+              static_cast<unsigned long long>(escalation.decisions),
+              static_cast<unsigned long long>(escalation.high_precision),
+              static_cast<unsigned long long>(escalation.exact_rational));
   return core_ratio;
 }
 

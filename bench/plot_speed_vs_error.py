@@ -57,7 +57,9 @@ def main():
     methods = [m for m in STYLE if any(r["method"] == m for r in rows)]
     methods += sorted({r["method"] for r in rows} - set(methods))
 
-    fig, axes = plt.subplots(len(scenes), 2, figsize=(13, 3.1 * len(scenes) + 1.3), squeeze=False)
+    header = 1.7  # inches above the panels for the title and the legend
+    height = 3.1 * len(scenes) + header
+    fig, axes = plt.subplots(len(scenes), 2, figsize=(13, height), squeeze=False)
     for i, scene in enumerate(scenes):
         for j, (metric, ylabel, goal) in enumerate(METRICS):
             ax = axes[i][j]
@@ -66,12 +68,18 @@ def main():
                 pts = [r for r in pts if not math.isnan(number(r[metric]))]
                 if not pts:
                     continue
-                pts.sort(key=lambda r: number(r["wall_time_s"]))
+                # Stepped methods in sweep order (dt falling); the others by time.
+                stepped = all(not math.isnan(number(r["parameter"])) for r in pts)
+                pts.sort(key=lambda r: -number(r["parameter"]) if stepped else number(r["wall_time_s"]))
                 x = [number(r["wall_time_s"]) for r in pts]
                 y = [max(number(r[metric]), FLOOR) for r in pts]
                 style = STYLE.get(method, dict(marker="o", label=method))
                 ax.plot(x, y, linestyle="-", linewidth=1.2, markersize=6, alpha=0.9,
                         color=style.get("color"), marker=style["marker"])
+                if method == "fixed_step":
+                    for xx, yy, r in zip(x, y, pts):
+                        ax.annotate("dt " + r["parameter"], (xx, yy), textcoords="offset points",
+                                    xytext=(0, 5), fontsize=6, color="#636363", ha="center")
                 bad = [(xx, yy) for xx, yy, r in zip(x, y, pts) if int(r["count_error"]) != 0]
                 if bad:
                     ax.plot([b[0] for b in bad], [b[1] for b in bad], linestyle="none", marker="x",
@@ -95,12 +103,13 @@ def main():
                for m in methods if m in STYLE]
     handles.append(Line2D([], [], color="black", marker="x", linestyle="none", markersize=9,
                           markeredgewidth=2, label="wrong collision count"))
-    fig.legend(handles=handles, loc="upper center", ncol=3, fontsize=9, frameon=False,
-               bbox_to_anchor=(0.5, 1.0 - 0.5 / fig.get_figheight()))
+    fig.tight_layout()
+    fig.subplots_adjust(top=1.0 - header / height)
     fig.suptitle("Speed against error: exact event-driven simulation vs time stepping"
                  + args.title_suffix + "\nlower left is better; each stepped series goes right as dt shrinks "
-                 "(1e-2 ... 1e-6 s)", fontsize=12, y=1.0 - 0.02 / fig.get_figheight())
-    fig.tight_layout(rect=(0, 0, 1, 1.0 - 1.2 / fig.get_figheight()))
+                 "(1e-2 ... 1e-6 s)", fontsize=12, y=1.0 - 0.05 / height, va="top")
+    fig.legend(handles=handles, loc="upper center", ncol=4, fontsize=9, frameon=False,
+               bbox_to_anchor=(0.5, 1.0 - 0.5 / height))
     fig.savefig(args.out, dpi=110)
 
 

@@ -2,6 +2,8 @@
 #   collision_lab_bench_core      ns per collision of the core vs a lean double loop (issue 2)
 #   collision_lab_speed_vs_error  speed against error vs fixed stepping and real engines (issue 4)
 #   collision_lab_hard_cases      adaptive precision on the hard cases of physics.md (issue 4)
+#   collision_lab_node_throughput, collision_lab_relay_node   the whole node over loopback
+#                                 (issue 4; built with the ROS layer; bench/node/node_throughput.launch)
 # Real engines are optional: each is compiled in only when found. GMP (exact reference
 # trajectories) is required by the last two; without it they are skipped with a message.
 
@@ -18,6 +20,15 @@ endif()
 add_executable(collision_lab_bench_core bench/bench_core.cpp)
 target_include_directories(collision_lab_bench_core PRIVATE bench/common)
 target_link_libraries(collision_lab_bench_core PRIVATE collision_lab_core)
+
+if(TARGET collision_lab_ros)
+  add_executable(collision_lab_relay_node bench/node/relay_node.cpp)
+  target_link_libraries(collision_lab_relay_node PRIVATE collision_lab_ros)
+  add_executable(collision_lab_node_throughput bench/node/node_throughput.cpp)
+  target_link_libraries(collision_lab_node_throughput PRIVATE collision_lab_ros)
+  set_target_properties(collision_lab_relay_node collision_lab_node_throughput PROPERTIES
+    RUNTIME_OUTPUT_DIRECTORY ${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_BIN_DESTINATION})
+endif()
 
 if(NOT (COLLISION_LAB_GMPXX_INCLUDE AND COLLISION_LAB_GMPXX_LIBRARY AND COLLISION_LAB_GMP_LIBRARY))
   message(STATUS "collision_lab bench: GMP (libgmp-dev) not found; speed_vs_error and hard_cases not built")

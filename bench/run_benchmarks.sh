@@ -1,0 +1,36 @@
+#!/usr/bin/env bash
+# Regenerates every benchmark output in docs/ with one command:
+#   docs/speed_vs_error.csv, docs/speed_vs_error.md, docs/speed_vs_error.png  (collision_lab_speed_vs_error)
+#   docs/hard_cases.md                                                        (collision_lab_hard_cases)
+# and prints the core speed benchmark (collision_lab_bench_core).
+#
+# Usage: bench/run_benchmarks.sh [--quick]
+#   --quick: fewer scenes, dt values and repeats (each program under a minute); outputs go
+#            to $BUILD_DIR/bench_quick/ instead of docs/.
+# Environment: BUILD_DIR (default: build_bench next to this repository's sources).
+# Needs: libgmp-dev; optional engines libbullet-dev, libode-dev, libbox2d-dev; python3-matplotlib.
+set -euo pipefail
+
+repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+build="${BUILD_DIR:-$repo/build_bench}"
+# catkin's CMake needs Debian's python3 (with catkin_pkg), not a pyenv one earlier on PATH.
+export PATH="/usr/bin:$PATH"
+
+cmake -S "$repo" -B "$build" -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build "$build" -j2 --target collision_lab_bench_core collision_lab_speed_vs_error collision_lab_hard_cases
+bin="$build/devel/lib/collision_lab"
+
+if [[ "${1:-}" == "--quick" ]]; then
+  out="$build/bench_quick"
+  mkdir -p "$out"
+  "$bin/collision_lab_speed_vs_error" --quick --csv "$out/speed_vs_error.csv" --md "$out/speed_vs_error.md" \
+    --plot "$out/speed_vs_error.png" >/dev/null
+  "$bin/collision_lab_hard_cases" --quick --md "$out/hard_cases.md" >/dev/null
+  "$bin/collision_lab_bench_core" --quick
+  echo "quick outputs in $out" >&2
+else
+  "$bin/collision_lab_speed_vs_error" >/dev/null
+  "$bin/collision_lab_hard_cases" >/dev/null
+  "$bin/collision_lab_bench_core"
+  echo "regenerated $repo/docs/speed_vs_error.{csv,md,png} and $repo/docs/hard_cases.md" >&2
+fi
