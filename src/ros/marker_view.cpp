@@ -55,48 +55,50 @@ void MarkerView::subscribe() {
       [this](const collision_lab::RunSummary::ConstPtr& m) { onRunSummary(*m); }));
 }
 
+RunRecord& MarkerView::select(const std::string& run_id) {
+  if (!has_run_ || run_id != current_run_id_) {
+    run_ = RunRecord{};
+    current_run_id_ = run_id;
+    has_run_ = true;
+    run_changed_ = true;
+    run_start_ = ros::WallTime::now();
+  }
+  static_dirty_ = true;
+  return run_;
+}
+
 void MarkerView::onInitialConditions(const collision_lab::InitialConditions& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
-  run_ = RunRecord{};
-  run_.input = msg;
-  has_run_ = true;
-  run_changed_ = true;
-  static_dirty_ = true;
+  select(msg.run_id).input = msg;
   run_start_ = ros::WallTime::now();
 }
 
 void MarkerView::onPrediction(const collision_lab::Prediction& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (!isCurrent(msg.run_id)) return;
-  run_.prediction = msg;
-  static_dirty_ = true;
+  select(msg.run_id).prediction = msg;
 }
 
 void MarkerView::onCollisionEvent(const collision_lab::CollisionEvent& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (!isCurrent(msg.run_id) || run_.events.size() >= params_.max_plotted_events) return;
-  run_.events.push_back(msg);
-  static_dirty_ = true;
+  auto& events = select(msg.run_id).events;
+  if (events.size() < params_.max_plotted_events) events.push_back(msg);
 }
 
 void MarkerView::onVelocities(const collision_lab::Velocities& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (!isCurrent(msg.run_id) || run_.velocities.size() >= params_.max_plotted_events) return;
-  run_.velocities.push_back(msg);
-  static_dirty_ = true;
+  auto& velocities = select(msg.run_id).velocities;
+  if (velocities.size() < params_.max_plotted_events) velocities.push_back(msg);
 }
 
 void MarkerView::onEnergyTransfer(const collision_lab::EnergyTransfer& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (!isCurrent(msg.run_id) || run_.energies.size() >= params_.max_plotted_events) return;
-  run_.energies.push_back(msg);
+  auto& energies = select(msg.run_id).energies;
+  if (energies.size() < params_.max_plotted_events) energies.push_back(msg);
 }
 
 void MarkerView::onRunSummary(const collision_lab::RunSummary& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (!isCurrent(msg.run_id)) return;
-  run_.summary = msg;
-  static_dirty_ = true;
+  select(msg.run_id).summary = msg;
 }
 
 void MarkerView::onTimer(const ros::WallTimerEvent&) {
@@ -104,7 +106,8 @@ void MarkerView::onTimer(const ros::WallTimerEvent&) {
   bool clear = false;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (!has_run_) return;
+    // Nothing to draw before the run's masses and start are known.
+    if (!has_run_ || run_.input.run_id != current_run_id_) return;
     const ros::WallTime now = ros::WallTime::now();
     clear = run_changed_;
     run_changed_ = false;

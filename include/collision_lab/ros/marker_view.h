@@ -32,7 +32,9 @@ class MarkerView {
   /// Subscribes to the run topics in nh's namespace (for replay).
   void subscribe();
 
-  /// A new run_id starts a new picture; messages of other runs are ignored. Thread-safe.
+  /// A message of a new run_id starts a new picture. Topics are not ordered against each
+  /// other, so a run's messages may arrive before its InitialConditions; it is drawn once
+  /// those arrive. Thread-safe.
   void onInitialConditions(const collision_lab::InitialConditions& msg);
   void onPrediction(const collision_lab::Prediction& msg);
   void onCollisionEvent(const collision_lab::CollisionEvent& msg);
@@ -42,7 +44,9 @@ class MarkerView {
 
  private:
   void onTimer(const ros::WallTimerEvent& event);
-  bool isCurrent(const std::string& run_id) const { return has_run_ && run_id == run_.input.run_id; }
+  /// The record of run_id, started afresh when run_id is not the current run. Call with
+  /// mutex_ held.
+  RunRecord& select(const std::string& run_id);
 
   ros::NodeHandle nh_;
   MarkerViewParams params_;
@@ -52,6 +56,7 @@ class MarkerView {
 
   std::mutex mutex_;
   RunRecord run_;
+  std::string current_run_id_;
   bool has_run_ = false;
   bool run_changed_ = false;     // the previous run's markers must be deleted
   bool static_dirty_ = false;    // the static markers must be rebuilt

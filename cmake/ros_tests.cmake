@@ -1,0 +1,16 @@
+# Tests of the ROS layer. Unit tests need no master; the rostests start the real node.
+catkin_add_gtest(ros_layer_unit_test
+  test/ros/msg_conversion_test.cpp
+  test/ros/run_recorder_test.cpp
+  test/ros/marker_builder_test.cpp)
+if(TARGET ros_layer_unit_test)
+  target_link_libraries(ros_layer_unit_test collision_lab_ros GTest::gtest_main)
+endif()
+
+find_package(rostest REQUIRED)
+foreach(name node_test burst_test demo_test)
+  add_rostest_gtest(${name} test/ros/${name}.test test/ros/${name}.cpp)
+  target_link_libraries(${name} collision_lab_ros ${catkin_LIBRARIES})
+  # The rostests start these nodes.
+  add_dependencies(${name} collision_lab_node collision_lab_markers scenario_publisher)
+endforeach()

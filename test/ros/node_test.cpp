@@ -1,0 +1,324 @@
+// collision_lab_node end to end (node_test.test): round trip against the core, bad
+// input, the collision cap, modes, the published-event cap, bags, and recording faults.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+
+#include "collision_lab/ros/msg_conversion.h"
+#include "run_collector.h"
+
+namespace {
+
+using collision_lab_test::makeInput;
+using collision_lab_test::RunCollector;
+using collision_lab_test::RunOutputs;
+namespace core = collision_lab_ros::core;
+namespace fs = std::filesystem;
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+std::string g_bag_directory;         // the node's ~bag_directory
+std::string g_faulty_bag_directory;  // the faulty node's: a regular file, not a folder
+RunCollector* g_node = nullptr;      // namespace collision_lab
+RunCollector* g_faulty = nullptr;    // namespace collision_lab_faulty
+
+template <class Message>
+std::vector<std::uint8_t> bytes(const Message& msg) {
+  std::vector<std::uint8_t> buffer(ros::serialization::serializationLength(msg));
+  ros::serialization::OStream stream(buffer.data(), buffer.size());
+  ros::serialization::serialize(stream, msg);
+  return buffer;
+}
+
+template <class Message>
+std::vector<Message> readTopic(const rosbag::Bag& bag, const std::string& topic) {
+  std::vector<Message> messages;
+  for (const rosbag::MessageInstance& m : rosbag::View(bag, rosbag::TopicQuery(topic))) {
+    const auto msg = m.instantiate<Message>();
+    EXPECT_TRUE(msg) << topic << " holds another type";
+    if (msg) messages.push_back(*msg);
+  }
+  return messages;
+}
+
+template <class Message>
+void expectSameMessages(const std::vector<Message>& published, const std::vector<Message>& bagged,
+                        const std::string& topic) {
+  ASSERT_EQ(published.size(), bagged.size()) << topic;
+  for (std::size_t i = 0; i < published.size(); ++i) {
+    // roscpp numbers header.seq while publishing; the bag holds the message as given.
+    Message received = published[i];
+    received.header.seq = 0;
+    EXPECT_EQ(bytes(received), bytes(bagged[i])) << topic << " message " << i;
+  }
+}
+
+void expectArrayEq(const boost::array<double, 3>& actual, const std::array<double, 3>& expected,
+                   const std::string& what) {
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(actual[i], expected[i]) << what << "[" << i << "]";
+}
+
+// ---- Round trip: every output, equal to the core's runLab ----
+
+TEST(LabNode, RoundTripMatchesCore) {
+  const auto input = makeInput("round_trip", {1, 2, 3}, {2, 0, -2}, {-1, 0.5, 1});
+  g_node->publish(input);
+  const RunOutputs& out = g_node->waitFor("round_trip");
+  ASSERT_TRUE(out.rejections.empty()) << out.rejections.front().message;
+
+  core::RunOptions options;
+  options.events = collision_lab::EventPolicy::all();
+  options.skip_simulation_over_cap = true;
+  const core::RunResult expected = collision_lab::runLab(collision_lab_ros::toScene(input), options);
+  ASSERT_GT(expected.events.size(), 0u);
+
+  ASSERT_EQ(out.predictions.size(), 1u);
+  ASSERT_EQ(out.summaries.size(), 1u);
+  ASSERT_EQ(out.events.size(), expected.events.size());
+  ASSERT_EQ(out.velocities.size(), expected.events.size());
+  ASSERT_EQ(out.energies.size(), expected.events.size());
+
+  const auto prediction = collision_lab_ros::toPredictionMsg(expected.prediction);
+  auto received_prediction = out.predictions.front();
+  received_prediction.header = prediction.header;
+  received_prediction.run_id = prediction.run_id;
+  EXPECT_EQ(bytes(received_prediction), bytes(prediction));
+
+  for (std::size_t k = 0; k < expected.events.size(); ++k) {
+    auto event = collision_lab_ros::toCollisionEventMsg(expected.events[k]);
+    auto velocities = collision_lab_ros::toVelocitiesMsg(expected.events[k]);
+    auto energy = collision_lab_ros::toEnergyTransferMsg(expected.events[k]);
+    event.header = out.events[k].header, event.run_id = "round_trip";
+    velocities.header = out.velocities[k].header, velocities.run_id = "round_trip";
+    energy.header = out.energies[k].header, energy.run_id = "round_trip";
+    EXPECT_EQ(bytes(out.events[k]), bytes(event)) << "collision " << k + 1;
+    EXPECT_EQ(bytes(out.velocities[k]), bytes(velocities)) << "collision " << k + 1;
+    EXPECT_EQ(bytes(out.energies[k]), bytes(energy)) << "collision " << k + 1;
+  }
+
+  const auto& summary = out.summaries.front();
+  EXPECT_EQ(summary.collision_count, expected.summary.collision_count);
+  EXPECT_EQ(summary.predicted_collision_count, expected.prediction.collision_count);
+  EXPECT_FALSE(summary.truncated);
+  EXPECT_TRUE(summary.simulated);
+  expectArrayEq(summary.final_velocities, expected.summary.final_velocities, "final_velocities");
+  EXPECT_EQ(summary.max_prediction_error, expected.summary.max_prediction_error);
+  EXPECT_EQ(summary.energy_relative_drift, expected.summary.energy_relative_drift);
+  EXPECT_EQ(summary.published_events, expected.events.size());
+  EXPECT_FALSE(summary.events_not_published);
+  EXPECT_TRUE(summary.recording_ok) << summary.recording_error;
+  EXPECT_EQ(summary.bag_path, g_bag_directory + "/round_trip.bag");
+
+  // Stamps follow the publishing order: prediction, collisions, summary.
+  ros::Time last = out.predictions.front().header.stamp;
+  EXPECT_GE(last, ros::TIME_MIN);
+  for (const auto& e : out.events) {
+    EXPECT_GE(e.header.stamp, last);
+    last = e.header.stamp;
+  }
+  EXPECT_GE(summary.header.stamp, last);
+}
+
+// ---- Bag: exactly the published messages ----
+
+TEST(LabNode, BagHoldsExactlyThePublishedMessages) {
+  const RunOutputs& out = g_node->waitFor("round_trip");
+  ASSERT_EQ(out.summaries.size(), 1u);
+  const std::string path = out.summaries.front().bag_path;
+  ASSERT_TRUE(fs::exists(path)) << path;
+  EXPECT_FALSE(fs::exists(path + ".active"));
+
+  rosbag::Bag bag(path, rosbag::bagmode::Read);
+  const std::string ns = "/collision_lab/";
+  const auto inputs = readTopic<collision_lab::InitialConditions>(bag, ns + "initial_conditions");
+  ASSERT_EQ(inputs.size(), 1u);
+  EXPECT_EQ(inputs.front().run_id, "round_trip");
+  expectArrayEq(inputs.front().velocities, {-1, 0.5, 1}, "bagged velocities");
+  expectSameMessages(out.predictions, readTopic<collision_lab::Prediction>(bag, ns + "predictions"),
+                     "predictions");
+  expectSameMessages(out.events, readTopic<collision_lab::CollisionEvent>(bag, ns + "collision_events"),
+                     "collision_events");
+  expectSameMessages(out.velocities, readTopic<collision_lab::Velocities>(bag, ns + "velocities"),
+                     "velocities");
+  expectSameMessages(out.energies, readTopic<collision_lab::EnergyTransfer>(bag, ns + "energy_transfers"),
+                     "energy_transfers");
+  expectSameMessages(out.summaries, readTopic<collision_lab::RunSummary>(bag, ns + "run_summaries"),
+                     "run_summaries");
+  EXPECT_EQ(rosbag::View(bag).size(), 3 + 3 * out.events.size());
+}
+
+// ---- Bad input: rejected with the right reason, then the next valid run is served ----
+
+struct BadCase {
+  collision_lab::InitialConditions input;
+  std::uint8_t reason;
+  std::string field_prefix;
+};
+
+TEST(LabNode, BadInputIsRejectedAndTheNextRunServed) {
+  using collision_lab::Rejected;
+  std::vector<BadCase> cases = {
+      {makeInput("bad_nan", {1, 1, 1}, {2, 1, 0}, {-1, kNaN, 0}), Rejected::NON_FINITE_VALUE, "velocities"},
+      {makeInput("bad_mass", {1, -2, 1}, {2, 1, 0}, {-1, 0, 0}), Rejected::NON_POSITIVE_MASS, "masses"},
+      {makeInput("bad_walls", {kInf, 1, kInf}, {2, 1, 0}, {-1, 0, 0}), Rejected::TWO_WALLS, "masses"},
+      {makeInput("bad_middle", {1, kInf, 1}, {2, 1, 0}, {-1, 0, 0}), Rejected::INFINITE_MIDDLE_MASS, "masses"},
+      {makeInput("bad_order", {1, 1, 1}, {0, 1, 2}, {-1, 0, 0}), Rejected::POSITIONS_NOT_ORDERED, "positions"},
+      {makeInput("bad_triple", {1, 1, 1}, {1, 0, -1}, {-1, 0, 1}), Rejected::TRIPLE_COLLISION, ""},
+      {makeInput("round_trip", {1, 1, 1}, {2, 1, 0}, {-1, 0, 0}), Rejected::DUPLICATE_RUN_ID, "run_id"},
+      {makeInput("../escape", {1, 1, 1}, {2, 1, 0}, {-1, 0, 0}), Rejected::INVALID_RUN_ID, "run_id"},
+      {makeInput("bad_mode", {1, 1, 1}, {2, 1, 0}, {-1, 0, 0}), Rejected::INVALID_MODE, "mode"},
+  };
+  cases.back().input.mode = 7;
+  g_node->waitFor("round_trip");  // the duplicate case needs the first bag on disk
+
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.input.run_id);
+    const std::size_t before = g_node->runs().count(c.input.run_id)
+                                   ? g_node->runs().at(c.input.run_id).rejections.size()
+                                   : 0;
+    g_node->publish(c.input);
+    const RunOutputs* out = &g_node->waitFor(c.input.run_id);
+    while (ros::ok() && out->rejections.size() == before) {
+      RunCollector::spinOnce();  // a duplicate's run_id already has a complete run
+    }
+    ASSERT_GT(out->rejections.size(), before);
+    const auto& rejected = out->rejections.back();
+    EXPECT_EQ(rejected.reason, c.reason) << rejected.reason_name << ": " << rejected.message;
+    EXPECT_EQ(rejected.field.rfind(c.field_prefix, 0), 0u) << rejected.field;
+    EXPECT_FALSE(rejected.message.empty());
+    EXPECT_FALSE(rejected.reason_name.empty());
+    if (c.reason != Rejected::DUPLICATE_RUN_ID) {
+      EXPECT_TRUE(out->summaries.empty());
+      EXPECT_TRUE(out->predictions.empty());
+      EXPECT_FALSE(fs::exists(g_bag_directory + "/" + c.input.run_id + ".bag"));
+    }
+
+    const std::string next = "after_" + std::to_string(&c - cases.data());
+    g_node->publish(makeInput(next, {1, 1, 1}, {2, 1, -1}, {-1, 0, 1}));
+    const RunOutputs& served = g_node->waitFor(next);
+    ASSERT_EQ(served.summaries.size(), 1u);
+    EXPECT_EQ(served.summaries.front().collision_count, 3u);
+  }
+  EXPECT_EQ(g_node->runs().at("round_trip").summaries.size(), 1u);
+}
+
+// ---- The collision cap: answered at once, never simulated up to the cap ----
+
+TEST(LabNode, OverCapRunIsAnsweredWithPredictionAndTruncatedSummary) {
+  auto input = makeInput("over_cap", {1e12, 1, 1e12}, {2, 1, 0}, {-1, 0, 0});
+  input.max_collisions = 1000;
+  g_node->publish(input);
+  const RunOutputs& out = g_node->waitFor("over_cap");
+  ASSERT_EQ(out.summaries.size(), 1u);
+  ASSERT_EQ(out.predictions.size(), 1u);
+  EXPECT_EQ(out.predictions.front().collision_count, 2221441u);
+  const auto& summary = out.summaries.front();
+  EXPECT_TRUE(summary.truncated);
+  EXPECT_FALSE(summary.truncation_reason.empty());
+  EXPECT_FALSE(summary.simulated);
+  EXPECT_EQ(summary.predicted_collision_count, 2221441u);
+  EXPECT_TRUE(out.events.empty());
+}
+
+// ---- Modes ----
+
+TEST(LabNode, PredictOnlyAndSummaryOnlyPublishNoCollisions) {
+  auto predict_only = makeInput("predict_only", {1, 2, 3}, {2, 0, -2}, {-1, 0.5, 1});
+  predict_only.mode = collision_lab::InitialConditions::MODE_PREDICT_ONLY;
+  auto summary_only = makeInput("summary_only", {1, 2, 3}, {2, 0, -2}, {-1, 0.5, 1});
+  summary_only.mode = collision_lab::InitialConditions::MODE_SUMMARY_ONLY;
+  g_node->publish(predict_only);
+  g_node->publish(summary_only);
+
+  const RunOutputs& p = g_node->waitFor("predict_only");
+  ASSERT_EQ(p.summaries.size(), 1u);
+  EXPECT_FALSE(p.summaries.front().simulated);
+  EXPECT_EQ(p.summaries.front().mode, collision_lab::InitialConditions::MODE_PREDICT_ONLY);
+  EXPECT_EQ(p.predictions.front().collision_count, 3u);
+  EXPECT_TRUE(p.events.empty());
+
+  const RunOutputs& s = g_node->waitFor("summary_only");
+  ASSERT_EQ(s.summaries.size(), 1u);
+  EXPECT_TRUE(s.summaries.front().simulated);
+  EXPECT_EQ(s.summaries.front().collision_count, 3u);
+  EXPECT_TRUE(s.events.empty());
+  EXPECT_TRUE(s.velocities.empty());
+  EXPECT_TRUE(s.energies.empty());
+}
+
+// ---- ~max_published_events (50 in node_test.test): the rest goes to the bag only ----
+
+TEST(LabNode, EventsBeyondThePublishCapAreRecordedOnly) {
+  g_node->publish(makeInput("pi_digits_3", {1e4, 1, kInf}, {2, 1, 0}, {-1, 0, 0}));
+  const RunOutputs& out = g_node->waitFor("pi_digits_3");
+  ASSERT_EQ(out.summaries.size(), 1u);
+  const auto& summary = out.summaries.front();
+  EXPECT_EQ(summary.collision_count, 314u);
+  EXPECT_EQ(summary.published_events, 50u);
+  EXPECT_TRUE(summary.events_not_published);
+  EXPECT_EQ(out.events.size(), 50u);
+  ASSERT_TRUE(summary.recording_ok) << summary.recording_error;
+
+  rosbag::Bag bag(summary.bag_path, rosbag::bagmode::Read);
+  const auto events = readTopic<collision_lab::CollisionEvent>(bag, "/collision_lab/collision_events");
+  ASSERT_EQ(events.size(), 314u);
+  for (std::size_t k = 0; k < events.size(); ++k) EXPECT_EQ(events[k].index, k + 1);
+  EXPECT_EQ(readTopic<collision_lab::Velocities>(bag, "/collision_lab/velocities").size(), 314u);
+  EXPECT_EQ(readTopic<collision_lab::EnergyTransfer>(bag, "/collision_lab/energy_transfers").size(), 314u);
+}
+
+// ---- Recording faults: everything is still published, the summary says why ----
+
+TEST(LabNode, UnwritableBagDirectoryStillPublishesEverything) {
+  g_faulty->publish(makeInput("no_disk", {1, 2, 3}, {2, 0, -2}, {-1, 0.5, 1}));
+  const RunOutputs& out = g_faulty->waitFor("no_disk");
+  ASSERT_EQ(out.summaries.size(), 1u);
+  const auto& summary = out.summaries.front();
+  EXPECT_FALSE(summary.recording_ok);
+  EXPECT_NE(summary.recording_error.find(g_faulty_bag_directory), std::string::npos)
+      << summary.recording_error;
+  EXPECT_EQ(summary.collision_count, 3u);
+  EXPECT_EQ(out.predictions.size(), 1u);
+  EXPECT_EQ(out.events.size(), 3u);
+  EXPECT_EQ(out.velocities.size(), 3u);
+  EXPECT_EQ(out.energies.size(), 3u);
+
+  // The node keeps serving.
+  g_faulty->publish(makeInput("no_disk_2", {1, 1, 1}, {2, 1, -1}, {-1, 0, 1}));
+  EXPECT_EQ(g_faulty->waitFor("no_disk_2").summaries.size(), 1u);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "node_test");
+  ros::NodeHandle private_nh("~");
+  if (!private_nh.getParam("bag_directory", g_bag_directory) ||
+      !private_nh.getParam("faulty_bag_directory", g_faulty_bag_directory)) {
+    ADD_FAILURE() << "~bag_directory and ~faulty_bag_directory must be set";
+    return 1;
+  }
+  // The faulty node's bag directory is a regular file: no bag can be created there.
+  fs::create_directories(fs::path(g_faulty_bag_directory).parent_path());
+  std::ofstream(g_faulty_bag_directory) << "not a directory\n";
+
+  RunCollector node("collision_lab"), faulty("collision_lab_faulty");
+  g_node = &node;
+  g_faulty = &faulty;
+  node.waitForConnection();
+  faulty.waitForConnection();
+  const int result = RUN_ALL_TESTS();
+  std::error_code ec;
+  fs::remove_all(fs::path(g_bag_directory).parent_path(), ec);
+  return result;
+}

@@ -1,0 +1,115 @@
+// Test client for collision_lab_node: publishes InitialConditions and collects every
+// output per run_id. Waits are event-driven (spinning the callback queue until a
+// condition holds); rostest's time-limit is the only timeout.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <ros/callback_queue.h>
+#include <ros/ros.h>
+
+#include "collision_lab/CollisionEvent.h"
+#include "collision_lab/EnergyTransfer.h"
+#include "collision_lab/InitialConditions.h"
+#include "collision_lab/Prediction.h"
+#include "collision_lab/Rejected.h"
+#include "collision_lab/RunSummary.h"
+#include "collision_lab/Velocities.h"
+#include "collision_lab/ros/node_constants.h"
+
+namespace collision_lab_test {
+
+struct RunOutputs {
+  std::vector<collision_lab::Prediction> predictions;
+  std::vector<collision_lab::CollisionEvent> events;
+  std::vector<collision_lab::Velocities> velocities;
+  std::vector<collision_lab::EnergyTransfer> energies;
+  std::vector<collision_lab::RunSummary> summaries;
+  std::vector<collision_lab::Rejected> rejections;
+
+  /// A rejection, or a summary with every per-collision message it announces.
+  bool complete() const {
+    if (!rejections.empty()) return true;
+    if (summaries.empty() || predictions.empty()) return false;
+    const std::uint64_t n = summaries.front().published_events;
+    return events.size() >= n && velocities.size() >= n && energies.size() >= n;
+  }
+};
+
+class RunCollector {
+ public:
+  /// Talks to the node whose topics are in namespace ns.
+  explicit RunCollector(const std::string& ns) : nh_(ns) {
+    using namespace collision_lab_ros;
+    input_pub_ = nh_.advertise<collision_lab::InitialConditions>(kInitialConditionsTopic,
+                                                                 kInputQueueSize);
+    subscribe<collision_lab::Prediction>(kPredictionsTopic, &RunOutputs::predictions);
+    subscribe<collision_lab::CollisionEvent>(kCollisionEventsTopic, &RunOutputs::events);
+    subscribe<collision_lab::Velocities>(kVelocitiesTopic, &RunOutputs::velocities);
+    subscribe<collision_lab::EnergyTransfer>(kEnergyTransfersTopic, &RunOutputs::energies);
+    subscribe<collision_lab::RunSummary>(kRunSummariesTopic, &RunOutputs::summaries);
+    subscribe<collision_lab::Rejected>(kRejectedTopic, &RunOutputs::rejections);
+  }
+
+  /// Returns once the node subscribes to our input and all its outputs reach us.
+  void waitForConnection() {
+    const auto connected = [this] {
+      if (input_pub_.getNumSubscribers() == 0) return false;
+      for (const auto& sub : subscribers_) {
+        if (sub.getNumPublishers() == 0) return false;
+      }
+      return true;
+    };
+    while (ros::ok() && !connected()) spinOnce();
+  }
+
+  void publish(const collision_lab::InitialConditions& input) { input_pub_.publish(input); }
+
+  /// Waits until the run is complete (see RunOutputs::complete) and returns its outputs.
+  const RunOutputs& waitFor(const std::string& run_id) {
+    while (ros::ok() && !runs_[run_id].complete()) spinOnce();
+    return runs_[run_id];
+  }
+
+  const std::map<std::string, RunOutputs>& runs() const { return runs_; }
+
+  static void spinOnce() {
+    ros::getGlobalCallbackQueue()->callAvailable(ros::WallDuration(0.1));
+  }
+
+ private:
+  template <class Message>
+  void subscribe(const std::string& topic, std::vector<Message> RunOutputs::*field) {
+    subscribers_.push_back(nh_.subscribe<Message>(
+        topic, collision_lab_ros::kOutputQueueSize,
+        [this, field](const typename Message::ConstPtr& msg) {
+          (runs_[msg->run_id].*field).push_back(*msg);
+        }));
+  }
+
+  ros::NodeHandle nh_;
+  ros::Publisher input_pub_;
+  std::vector<ros::Subscriber> subscribers_;
+  std::map<std::string, RunOutputs> runs_;
+};
+
+inline collision_lab::InitialConditions makeInput(const std::string& run_id,
+                                                  const std::array<double, 3>& masses,
+                                                  const std::array<double, 3>& positions,
+                                                  const std::array<double, 3>& velocities) {
+  collision_lab::InitialConditions input;
+  input.header.stamp = ros::Time::now();
+  input.run_id = run_id;
+  for (int i = 0; i < 3; ++i) {
+    input.masses[i] = masses[i];
+    input.positions[i] = positions[i];
+    input.velocities[i] = velocities[i];
+  }
+  return input;
+}
+
+}  // namespace collision_lab_test
