@@ -79,11 +79,13 @@ SEEDS = {
     "mass_1e30": compact((1e30, 1, 1e30), (2, 1, 0), (-1, 0, 0), mode="predict_only"),
     "mass_1e300": raw((1e300, 1, 1e300), (2, 1, 0), (-1, 0, 0), mode="predict_only"),
     "mass_ratio_1e600": raw((1e300, 1e-300, 1e300), (2, 1, 0), (-1, 0, 0), mode="predict_only"),
+    "mass_ratio_underflow": raw((1, 1e200, 1e-200), (2, 1, 0), (-1, 0, 0)),
     "light_outer": compact((1e-12, 1, 1e-12), (2, 1, 0), (-1, 0, 1)),
     "scale_1e150": raw((1e150, 1e150, 1e150), (3e150, 2e150, 1e150), (-1e-150, 0, 1e-150)),
     "scale_small": raw((1e-300, 2e-300, 3e-300), (3e-300, 2e-300, 1e-300), (-5e-324, 0, 5e-324)),
     "overflow_energy": raw((1e300, 1, 1), (2, 1, 0), (-1e10, 0, 0)),
     "time_overflow": raw((1, 1, 1), (1e300, 0, -1), (-1e-300, 0, 0), events="all"),
+    "position_overflow": raw((1, 1, 1), (1, 0, -1e300), (1e10, 0, 1), events="all"),
     "velocity_near_max": raw((1, 1, 1), (2, 1, 0), (-1e308, 0, 1e308)),
     # Bad input: each is rejected by validate().
     "nan_mass": compact((NAN, 1, 1), (2, 1, 0), (-1, 0, 0)),
