@@ -17,9 +17,9 @@ using visualization_msgs::MarkerArray;
 using Vec3 = std::array<double, 3>;
 
 // Layout of the three views in the marker frame [rviz units].
-constexpr double kSceneY = 7.6, kSceneLeft = -9.5, kSceneRight = 14.5;
-constexpr double kWedgeX = -5.6, kWedgeY = -2.0, kWedgeRadius = 3.2;
-constexpr double kPlotLeft = -0.6, kPlotRight = 9.4, kPlotBottom = -5.2, kPlotTop = 1.2;
+constexpr double kSceneY = 5.2, kSceneLeft = -9.5, kSceneRight = 14.5;
+constexpr double kWedgeX = -6.4, kWedgeY = -2.0, kWedgeRadius = 3.2;
+constexpr double kPlotLeft = 0.0, kPlotRight = 9.4, kPlotBottom = -5.2, kPlotTop = 1.2;
 constexpr double kBarsLeft = 11.6, kBarsPitch = 1.1, kBarsBottom = -5.2, kBarsHeight = 6.4;
 constexpr double kTitleY = 2.6;
 constexpr double kTextSize = 0.38, kSmallTextSize = 0.3, kTitleSize = 0.46;
@@ -294,8 +294,13 @@ MarkerArray buildStaticMarkers(const RunRecord& run, const std::string& frame_id
     Marker axis = lines(frame_id, "scene", 0, Marker::LINE_LIST, 0.03, kGrey);
     axis.points = {point(kSceneLeft, kSceneY), point(kSceneRight, kSceneY)};
     out.push_back(axis);
-    out.push_back(text(frame_id, "scene", 1, kSceneRight - 0.3, kSceneY - 1.2, "x [m]",
-                       kSmallTextSize, kGrey));
+    const SceneAxis scene_axis = sceneAxis(run);
+    out.push_back(text(frame_id, "scene", 1, kSceneLeft, kSceneY - 0.5,
+                       format("%.3g m", scene_axis.min), kSmallTextSize, kGrey));
+    out.push_back(text(frame_id, "scene", 2, kSceneRight, kSceneY - 0.5,
+                       format("%.3g m", scene_axis.max), kSmallTextSize, kGrey));
+    out.push_back(text(frame_id, "scene", 3, (kSceneLeft + kSceneRight) / 2, kSceneY - 1.2,
+                       "x [m] (to scale; bodies sized by log mass)", kSmallTextSize, kGrey));
   }
 
   // Wedge.
@@ -328,10 +333,6 @@ MarkerArray buildStaticMarkers(const RunRecord& run, const std::string& frame_id
     out.push_back(text(frame_id, "wedge", 3, kWedgeX + 1.12 * kWedgeRadius * std::cos(a),
                        kWedgeY + 1.12 * kWedgeRadius * std::sin(a) + (a < 0.3 ? 0.45 : 0.0),
                        "L_AB"));
-    out.push_back(text(frame_id, "wedge", 4, kWedgeX + 0.55 * kWedgeRadius * std::cos(a / 2),
-                       kWedgeY + 0.55 * kWedgeRadius * std::sin(a / 2) - 0.35,
-                       "escape cone, alpha = " + format("%.4g rad", a), kSmallTextSize,
-                       color(1.0, 0.85, 0.2)));
 
     Marker circle = lines(frame_id, "wedge", 5, Marker::LINE_STRIP, 0.015, kGrey);
     for (int k = 0; k <= 96; ++k) {
@@ -363,8 +364,11 @@ MarkerArray buildStaticMarkers(const RunRecord& run, const std::string& frame_id
     out.push_back(text(frame_id, "wedge", 9, s.x, s.y - 0.35, "start", kSmallTextSize));
     out.push_back(text(frame_id, "wedge", 10, kWedgeX, kTitleY,
                        "velocity space s-perp (u = S v): u_perp per collision", kTextSize));
-    out.push_back(text(frame_id, "wedge", 11, kWedgeX, kWedgeY - kWedgeRadius - 0.45,
-                       "orange: simulated   violet: predicted", kSmallTextSize));
+    out.push_back(text(frame_id, "wedge", 4, kWedgeX, kWedgeY - kWedgeRadius - 0.3,
+                       "yellow: escape cone, alpha = " + format("%.4g rad", a), kSmallTextSize,
+                       color(1.0, 0.85, 0.2)));
+    out.push_back(text(frame_id, "wedge", 11, kWedgeX, kWedgeY - kWedgeRadius - 0.75,
+                       "orange: simulated   violet: predicted   white: now", kSmallTextSize));
   }
 
   // Velocity plot.
@@ -405,9 +409,8 @@ MarkerArray buildStaticMarkers(const RunRecord& run, const std::string& frame_id
       if (line.points.size() == 1) line.points.push_back(point(kPlotRight, line.points[0].y));
       out.push_back(line);
       if (!dots.points.empty()) out.push_back(dots);
-      out.push_back(text(frame_id, "plot", 30 + i, kPlotRight + 0.45,
-                         line.points.back().y + (i - 1) * 0.3, std::string("v_") + kNames[i],
-                         kSmallTextSize, particleColor(i)));
+      out.push_back(text(frame_id, "plot", 30 + i, kPlotRight + 0.5, kPlotTop - 0.45 * i,
+                         std::string("v_") + kNames[i], kTextSize, particleColor(i)));
     }
   }
 
@@ -449,11 +452,17 @@ MarkerArray buildAnimatedMarkers(const RunRecord& run, double t, const std::stri
       body.color = particleColor(i);
       out.push_back(body);
     }
-    out.push_back(text(frame_id, "labels", i, x, kSceneY + (i == 1 ? -1.0 : 1.0) * 1.0,
-                       std::string(kNames[i]) + format(": %.4g m/s", state.velocities[i]),
+    // A short tag beside the body (walls: on their outer side), the value in a fixed row.
+    const double tag_x = isWall(run.input, i) ? x + (i == 0 ? 0.9 : -0.9) : x;
+    const double tag_y = isWall(run.input, i) ? kSceneY + 0.6 : kSceneY + (i == 1 ? -0.75 : 0.75);
+    out.push_back(text(frame_id, "labels", i, tag_x, tag_y,
+                       isWall(run.input, i) ? std::string(kNames[i]) + "\n(wall)" : kNames[i],
+                       kTextSize, particleColor(i, 0.3)));
+    out.push_back(text(frame_id, "labels", 10 + i, -3.0 + 5.2 * i, kSceneY + 1.5,
+                       std::string("v_") + kNames[i] + format(" = %.4g m/s", state.velocities[i]),
                        kTextSize, particleColor(i, 0.3)));
   }
-  out.push_back(text(frame_id, "labels", 3, kSceneLeft + 1.6, kSceneY + 1.4,
+  out.push_back(text(frame_id, "labels", 3, kSceneLeft + 1.8, kSceneY + 1.5,
                      format("t = %.4g s", t) + ",  collisions " + std::to_string(state.collisions),
                      kTextSize));
 
