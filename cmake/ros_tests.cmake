@@ -14,3 +14,5 @@ foreach(name node_test burst_test demo_test)
   # The rostests start these nodes.
   add_dependencies(${name} collision_lab_node collision_lab_markers scenario_publisher)
 endforeach()
+# node_test reads the bad-input catalogue, docs/bad_inputs.md.
+target_compile_definitions(node_test PRIVATE COLLISION_LAB_SOURCE_DIR="${PROJECT_SOURCE_DIR}")

@@ -1,11 +1,16 @@
 // collision_lab_node end to end (node_test.test): round trip against the core, bad
 // input, the collision cap, modes, the published-event cap, bags, and recording faults.
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <sstream>
 #include <string>
 #include <vector>
+
+#include <map>
+#include <optional>
 
 #include <gtest/gtest.h>
 #include <ros/ros.h>
@@ -209,6 +214,94 @@ TEST(LabNode, BadInputIsRejectedAndTheNextRunServed) {
     EXPECT_EQ(served.summaries.front().collision_count, 3u);
   }
   EXPECT_EQ(g_node->runs().at("round_trip").summaries.size(), 1u);
+}
+
+// ---- docs/bad_inputs.md: every catalogue row that is a scene, through the node ----
+
+/// Three comma-separated doubles, as the catalogue writes them; empty if not that.
+std::optional<std::array<double, 3>> parseTriple(const std::string& text) {
+  std::array<double, 3> values{};
+  std::istringstream in(text);
+  std::string item;
+  int n = 0;
+  while (std::getline(in, item, ',')) {
+    char* end = nullptr;
+    if (n == 3 || item.empty()) return std::nullopt;
+    values[n++] = std::strtod(item.c_str(), &end);
+    if (*end != '\0' || std::isinf(values[n - 1]) != (item.find("inf") != std::string::npos)) {
+      return std::nullopt;  // not a number, or out of a double's range
+    }
+  }
+  if (n != 3) return std::nullopt;
+  return values;
+}
+
+struct CatalogueRow {
+  std::string number;
+  collision_lab::InitialConditions input;
+  int code = 0;
+  std::string field;
+  std::string message;
+};
+
+/// The rows given as --masses/--positions/--velocities with a core reason (codes 1-8).
+std::vector<CatalogueRow> sceneRows(const std::string& path) {
+  std::vector<CatalogueRow> rows;
+  std::ifstream file(path);
+  std::string line;
+  while (std::getline(file, line)) {
+    std::vector<std::string> cells;
+    std::istringstream in(line);
+    std::string cell;
+    while (std::getline(in, cell, '|')) cells.push_back(cell);
+    if (cells.size() < 8 || line.rfind("| ", 0) != 0) continue;
+    const auto unquote = [](const std::string& c) {
+      const auto a = c.find('`'), b = c.rfind('`');
+      return a == std::string::npos || b <= a ? std::string() : c.substr(a + 1, b - a - 1);
+    };
+    std::istringstream args(unquote(cells[3]));
+    std::map<std::string, std::string> options;
+    std::string flag, value;
+    while (args >> flag) {
+      if (!(args >> value)) options.clear();
+      options[flag] = value;
+    }
+    const auto m = parseTriple(options["--masses"]);
+    const auto x = parseTriple(options["--positions"]);
+    const auto v = parseTriple(options["--velocities"]);
+    const int code = std::atoi(cells[5].c_str());
+    if (options.size() != 3 || !m || !x || !v || code < 1 || code > 8) continue;
+    CatalogueRow row;
+    row.number = cells[1].substr(1, cells[1].size() - 2);
+    row.input = makeInput("catalogue_" + row.number, *m, *x, *v);
+    row.code = code;
+    row.field = unquote(cells[6]);
+    const std::string seen = unquote(cells[7]);
+    const std::string reason = cells[4].substr(1, cells[4].size() - 2);
+    const auto start = seen.find("(" + reason + "): ");
+    row.message = start == std::string::npos ? seen : seen.substr(start + reason.size() + 4);
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+TEST(LabNode, EveryBadSceneOfTheCatalogueIsRejectedAsTheCliSays) {
+  const auto rows = sceneRows(COLLISION_LAB_SOURCE_DIR "/docs/bad_inputs.md");
+  ASSERT_GE(rows.size(), 15u) << "docs/bad_inputs.md lost its scene rows";
+  for (const auto& row : rows) {
+    SCOPED_TRACE("catalogue row " + row.number);
+    g_node->publish(row.input);
+    const RunOutputs& out = g_node->waitFor(row.input.run_id);
+    ASSERT_EQ(out.rejections.size(), 1u);
+    EXPECT_TRUE(out.summaries.empty());
+    EXPECT_EQ(out.rejections.front().reason, row.code);
+    EXPECT_EQ(out.rejections.front().field, row.field);
+    EXPECT_EQ(out.rejections.front().message, row.message);
+
+    const std::string next = "after_catalogue_" + row.number;
+    g_node->publish(makeInput(next, {1, 1, 1}, {2, 1, -1}, {-1, 0, 1}));
+    EXPECT_EQ(g_node->waitFor(next).summaries.size(), 1u);
+  }
 }
 
 // ---- The collision cap: answered at once, never simulated up to the cap ----
