@@ -158,8 +158,8 @@ int main(int argc, char** argv) {
                 "predicted", "paper (3.22)", "error", "bag");
   table << "\n" << header << "\n" << std::string(110, '-') << "\n";
   for (const auto& r : rows) table << r << "\n";
-  table << "(* truncated at the collision cap; n/s: not simulated; error: max |v_sim - v_pred| / "
-           "max |v_0|)\n";
+  table << "(* truncated at the collision cap; n/s: not simulated; error: max |S (v_sim - v_pred)| / "
+           "|S v_0|, S = diag(sqrt m))\n";
   std::cout << table.str() << std::flush;
 
   if (!exit_when_done) ros::spin();
