@@ -243,46 +243,68 @@ Frame measure(const Scene& scene, const std::array<Scalar, 3>& v) {
   return {toDouble(energy), toDouble(momentum), toDouble(magnitude)};
 }
 
-/// Time, position and event bookkeeping of a run that reports events.
+/// Run time as an unevaluated sum hi + lo: thousands of short flights add up without
+/// the rounding of each sum, which a fast light body would turn into position error.
+template <class T>
+struct CompensatedTime {
+  T hi = 0;
+  T lo = 0;
+
+  void advance(const T& delay) {
+    const T sum = hi + delay;
+    const T delay_part = sum - hi;
+    lo += (hi - (sum - delay_part)) + (delay - delay_part);
+    hi = sum;
+  }
+  T since(const CompensatedTime& earlier) const { return (hi - earlier.hi) + (lo - earlier.lo); }
+  T value() const { return hi + lo; }
+};
+
+/// Time, position and event bookkeeping of a run that reports events. Each body's path
+/// is anchored where its velocity last changed.
 template <class Scalar>
 class Trajectory {
  public:
   explicit Trajectory(const Scene& scene) : scene_(scene) {
-    for (int i = 0; i < 3; ++i) {
-      reference_position_[i] = Scalar(scene.positions[i]);
-      reference_time_[i] = Scalar(0);
-    }
+    for (int i = 0; i < 3; ++i) reference_position_[i] = Scalar(scene.positions[i]);
   }
 
-  Scalar positionAt(int i, const Scalar& t, const std::array<Scalar, 3>& v) const {
-    return reference_position_[i] + v[i] * (t - reference_time_[i]);
+  Scalar positionNow(int i, const std::array<Scalar, 3>& v) const {
+    return reference_position_[i] + v[i] * now_.since(reference_time_[i]);
   }
 
-  /// Time of the next impact of `pair`, which approaches with speed `approach` > 0.
-  Scalar nextImpactTime(Pair pair, const std::array<Scalar, 3>& v, const Scalar& approach) const {
+  /// Delay until the next impact of `pair`, which approaches with speed `approach` > 0.
+  Scalar delayToImpact(Pair pair, const std::array<Scalar, 3>& v, const Scalar& approach) const {
     const int left = pair == Pair::AB ? kA : kB;
-    Scalar gap = positionAt(left, now_, v) - positionAt(left + 1, now_, v);
+    Scalar gap = positionNow(left, v) - positionNow(left + 1, v);
     if (gap < 0) gap = 0;  // rounding can put touching bodies a hair out of order
-    return now_ + gap / approach;
+    return gap / approach;
   }
 
-  CollisionEvent makeEvent(std::uint64_t index, Pair pair, const Scalar& time, const std::array<Scalar, 3>& before,
+  CollisionEvent makeEvent(std::uint64_t index, Pair pair, const Scalar& delay, const std::array<Scalar, 3>& before,
                            const std::array<Scalar, 3>& after) {
+    now_.advance(delay);
     CollisionEvent event;
     event.index = index;
     event.pair = pair;
-    event.time = toDouble(time);
+    event.time = toDouble(now_.value());
     const int left = pair == Pair::AB ? kA : kB;
+    const int right = left + 1;
     const int wall = scene_.wallIndex();
+    std::array<Scalar, 3> positions;
     for (int i = 0; i < 3; ++i) {
-      event.positions[i] = toDouble(positionAt(i, time, before));
+      positions[i] = positionNow(i, before);
       event.velocities_before[i] = toDouble(before[i]);
       event.velocities_after[i] = toDouble(after[i]);
     }
-    // The contact point is where the pair meets: at the wall if there is one (its path is
-    // exact), else at the right-hand body.
-    event.position = event.positions[left == wall ? left : left + 1];
-    event.positions[left] = event.positions[left + 1] = event.position;
+    // The pair meets where the slower of the two is: a position extrapolated at speed v
+    // is off by v times the time's rounding, so the slow body's is the accurate one.
+    const Scalar speed_left = before[left] < 0 ? Scalar(-before[left]) : before[left];
+    const Scalar speed_right = before[right] < 0 ? Scalar(-before[right]) : before[right];
+    const Scalar contact = speed_left <= speed_right ? positions[left] : positions[right];
+    positions[left] = positions[right] = contact;
+    for (int i = 0; i < 3; ++i) event.positions[i] = toDouble(positions[i]);
+    event.position = toDouble(contact);
     double gained_by_finite = 0.0;
     for (int i = 0; i < 3; ++i) {
       if (i == wall) continue;
@@ -295,23 +317,22 @@ class Trajectory {
     }
     if (wall >= 0) event.energy_transfer[wall] = -gained_by_finite;
 
-    // Re-anchor the bodies whose velocity changed at the contact point (a wall's never does).
-    for (int i : {left, left + 1}) {
+    // Re-anchor the bodies whose velocity changed (a wall's never does).
+    for (int i : {left, right}) {
       if (i == wall) continue;
-      reference_position_[i] = Scalar(event.position);
-      reference_time_[i] = time;
+      reference_position_[i] = contact;
+      reference_time_[i] = now_;
     }
-    now_ = time;
     return event;
   }
 
-  const Scalar& now() const { return now_; }
+  Scalar now() const { return now_.value(); }
 
  private:
   const Scene& scene_;
   std::array<Scalar, 3> reference_position_;
-  std::array<Scalar, 3> reference_time_;
-  Scalar now_ = 0;
+  std::array<CompensatedTime<Scalar>, 3> reference_time_{};
+  CompensatedTime<Scalar> now_;
 };
 
 bool keepsEvent(const EventPolicy& policy, std::uint64_t index) {
@@ -384,19 +405,17 @@ SimulationResult simulate(const Scene& scene, const SimulationOptions& options, 
       const int left = pair == Pair::AB ? kA : kB;
       const std::array<Scalar, 3> before = v.values();
       const Scalar approach = before[left + 1] - before[left];
-      const Scalar time = trajectory.nextImpactTime(pair, before, approach > 0 ? approach : Scalar(0));
+      const Scalar delay = trajectory.delayToImpact(pair, before, approach > 0 ? approach : Scalar(0));
       v.impact(coefficients.of(pair), left);
       ++k;
-      const CollisionEvent event = trajectory.makeEvent(k, pair, time, before, v.values());
+      const CollisionEvent event = trajectory.makeEvent(k, pair, delay, before, v.values());
       if (visitor) visitor(event);
       if (keepsEvent(options.events, k)) result.events.push_back(event);
       pair = otherPair(pair);
     }
     result.final_time = toDouble(trajectory.now());
     const std::array<Scalar, 3> final_velocities = v.values();
-    for (int i = 0; i < 3; ++i) {
-      result.final_positions[i] = toDouble(trajectory.positionAt(i, trajectory.now(), final_velocities));
-    }
+    for (int i = 0; i < 3; ++i) result.final_positions[i] = toDouble(trajectory.positionNow(i, final_velocities));
   }
   if (!tracks_events || !result.first_pair) {
     for (int i = 0; i < 3; ++i) {
