@@ -43,8 +43,9 @@ constexpr std::uint64_t kSlowPathCap = 2000;
 /// cubically: 40 collisions of a scene mixing 1e30 kg and 1e-198 m/s take 0.2 s).
 constexpr std::uint64_t kExactCrossCheckLimit = 40;
 
-/// Known, reported core issues (issue 5 report; seeds mass_1e300, mass_ratio_1e600 and
-/// mass_1e30 reproduce them). While they are open the target steps around them so that
+/// Known, reported core issues (issue 5 report; seeds mass_1e300, mass_ratio_1e600,
+/// mass_ratio_underflow, mass_1e30, exact_escalation, time_overflow, position_overflow and
+/// max_possible_too_low reproduce them). While they are open the target steps around them so that
 /// fuzzing keeps looking for new ones; COLLISION_LAB_FUZZ_KNOWN_ISSUES=check turns the
 /// detours off. Remove them when the core is fixed.
 ///  - pi / alpha >= 2^64 (mass ratios beyond ~1e38), alpha == 0 (ratios beyond ~1e616),
@@ -52,14 +53,20 @@ constexpr std::uint64_t kExactCrossCheckLimit = 40;
 ///    predictedCollisionCount and maxPossibleCollisionCount convert an out-of-range
 ///    double (or NaN) to uint64_t, which is undefined behaviour.
 ///  - mass ratio beyond ~1e24: simulate's error bound exceeds the approach speeds, every
-///    decision escalates to a 100-digit replay from the start, and the run is quadratic
-///    in its length (release build, (1e30, 1, 1e30): 1,000 collisions 0.14 s, 10,000 in 10 s).
+///    decision escalates to a 100-digit replay from the start (or, for ratios like
+///    (1e40, 1e17, 1e273), to an exact rational replay), so a run's cost grows
+///    quadratically or worse with its length. Release build: (1e30, 1, 1e30) takes 10 s
+///    for 10,000 collisions; (1e40, 1e17, 1e273), x (3, 1, 0), v (-1, 0, 1) takes 1.6 s
+///    for 20 and 12 s for 40. Such runs are capped at kQuadraticCap collisions here.
 ///  - event times or positions beyond DBL_MAX: validate accepts a gap of 1e300 m closed
 ///    at 1e-300 m/s (time inf, positions NaN), or a body at 1e10 m/s while a contact
 ///    1e300 m away happens (positions inf); events then report non-finite values.
+///  - maxPossibleCollisionCount says 2 when m_B is so much heavier than A and C that
+///    pi / alpha exceeds 2 by less than 1e-50 (its 50-digit fallback rounds to 2), yet
+///    3 collisions happen: (1, 1e60, 1), x (1e80, 1, 0), v (-1e61, 0, 1) gives BC AB BC.
 constexpr double kCountOverflowQuotient = 1.8e19;
 constexpr double kQuadraticMassRatio = 1e24;
-constexpr std::uint64_t kQuadraticCap = 100;
+constexpr std::uint64_t kQuadraticCap = 5;
 
 bool skipKnownIssues() {
   static const bool skip = [] {
@@ -115,7 +122,14 @@ bool allFinite(const Eigen::Vector3d& v) { return v.allFinite(); }
 /// mass-weighted velocity in the wall's (or centre-of-mass) frame, whose norm every
 /// impact conserves. No velocity of particle i can exceed it in exact arithmetic.
 /// Computed without squaring a velocity, so 1e-200 m/s does not underflow.
-std::array<double, 3> velocityScales(const cl::Scene& scene) {
+/// floor: the absolute error [m/s] of a mass-weighted component that fell below DBL_MIN
+/// (subnormal, no relative precision left), seen as a velocity of particle i.
+struct VelocityScales {
+  std::array<double, 3> speed{};
+  std::array<double, 3> floor{};
+};
+
+VelocityScales velocityScales(const cl::Scene& scene) {
   const int wall = scene.wallIndex();
   double mass_max = 0.0;
   for (int i = 0; i < 3; ++i) {
@@ -138,24 +152,21 @@ std::array<double, 3> velocityScales(const cl::Scene& scene) {
     const double dv = (scene.velocities[i] - frame) / dv_max;
     u_sq += scene.masses[i] / mass_max * dv * dv;
   }
-  std::array<double, 3> scales{};
+  VelocityScales scales;
   for (int i = 0; i < 3; ++i) {
-    scales[i] = std::fabs(frame);
-    if (i != wall) scales[i] += dv_max * std::sqrt(u_sq) * (std::sqrt(mass_max) / std::sqrt(scene.masses[i]));
+    const double inverse_sqrt_mass = i == wall ? 0.0 : std::sqrt(mass_max) / std::sqrt(scene.masses[i]);
+    scales.speed[i] = std::fabs(frame) + dv_max * std::sqrt(u_sq) * inverse_sqrt_mass;
+    scales.floor[i] = std::numeric_limits<double>::min() * std::max(1.0, inverse_sqrt_mass);
   }
   return scales;
 }
 
-/// Absolute error floor [m/s]: subnormal velocities carry no relative precision.
-constexpr double kSubnormalFloor = std::numeric_limits<double>::min();
-
 /// After the last collision no pair approaches: v_A >= v_B >= v_C, up to `tolerance`
 /// relative to the pair's velocity scale.
-void checkEscaped(const std::array<double, 3>& v, const std::array<double, 3>& scale, double tolerance) {
-  FUZZ_CHECK(v[cl::kB] - v[cl::kA] <= tolerance * (scale[cl::kA] + scale[cl::kB]) + kSubnormalFloor,
-             "A and B still approach at the end");
-  FUZZ_CHECK(v[cl::kC] - v[cl::kB] <= tolerance * (scale[cl::kB] + scale[cl::kC]) + kSubnormalFloor,
-             "B and C still approach at the end");
+void checkEscaped(const std::array<double, 3>& v, const VelocityScales& scales, double tolerance) {
+  auto allowance = [&](int i) { return tolerance * scales.speed[i] + scales.floor[i]; };
+  FUZZ_CHECK(v[cl::kB] - v[cl::kA] <= allowance(cl::kA) + allowance(cl::kB), "A and B still approach at the end");
+  FUZZ_CHECK(v[cl::kC] - v[cl::kB] <= allowance(cl::kB) + allowance(cl::kC), "B and C still approach at the end");
 }
 
 /// The engine's own rounding bound: 64 eps per impact (simulation.cpp, kBoundFactor).
@@ -191,7 +202,7 @@ void checkModel(const cl::Scene& scene, const cl::Prediction& prediction) {
   FUZZ_CHECK(alpha > 0 && alpha <= M_PI / 2 + 1e-12, "alpha in (0, pi/2]");
   const double psi = model.psi();
   FUZZ_CHECK(psi >= 0 && psi < 2 * M_PI + 1e-12, "psi in [0, 2 pi)");
-  const std::array<double, 3> scale = velocityScales(scene);
+  const VelocityScales scales = velocityScales(scene);
   for (const std::uint64_t n : {std::uint64_t{0}, std::uint64_t{1}, prediction.collision_count}) {
     const Eigen::Vector3d after = model.velocitiesAfter(n);
     FUZZ_CHECK(allFinite(after), "finite closed-form velocities");
@@ -205,12 +216,12 @@ void checkModel(const cl::Scene& scene, const cl::Prediction& prediction) {
     // counts used here, so 1e-9 leaves a wide margin over O(eps) errors.
     const double tolerance = 1e-9;
     for (int i = 0; i < 3; ++i) {
-      FUZZ_CHECK(std::fabs(back(i) - scene.velocities[i]) <= tolerance * scale[i] + kSubnormalFloor,
+      FUZZ_CHECK(std::fabs(back(i) - scene.velocities[i]) <= tolerance * scales.speed[i] + scales.floor[i],
                  "initialVelocitiesFrom inverts velocitiesAfter");
     }
   }
   const Eigen::Vector3d last = model.velocitiesAfter(prediction.collision_count);
-  checkEscaped({last(0), last(1), last(2)}, scale, 1e-9);
+  checkEscaped({last(0), last(1), last(2)}, scales, 1e-9);
 }
 
 void exercisePaper(const cl::Scene& scene, std::uint64_t count) {
@@ -263,7 +274,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const cl::Prediction prediction = cl::predict(scene);
   const std::uint64_t max_possible = cl::maxPossibleCollisionCount(scene.masses);
   FUZZ_CHECK(prediction.max_possible_collision_count == max_possible, "predict reports maxPossibleCollisionCount");
-  FUZZ_CHECK(prediction.collision_count <= max_possible, "count <= ceil(pi / alpha)");
+  const bool max_possible_may_be_low = skipKnownIssues() && max_possible == 2;
+  FUZZ_CHECK(prediction.collision_count <= max_possible + (max_possible_may_be_low ? 1 : 0), "count <= ceil(pi / alpha)");
   FUZZ_CHECK(prediction.first_pair == cl::firstPair(scene), "predict reports firstPair");
   FUZZ_CHECK(prediction.first_pair.has_value() || prediction.collision_count == 0, "no first pair, no collisions");
   FUZZ_CHECK(allFinite(prediction.final_velocities), "finite predicted final velocities");
