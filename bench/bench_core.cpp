@@ -159,7 +159,9 @@ int main(int argc, char** argv) {
     }
   }
   if (quick) repeats = std::min(repeats, 3);
-  std::printf("collision_lab_bench_core: ns per collision, medians of %d repeats\n", repeats);
+  const char* source = std::getenv("COLLISION_LAB_BENCH_SOURCE");
+  std::printf("collision_lab_bench_core: ns per collision, medians of %d repeats; source %s\n", repeats,
+              source && *source ? source : "unknown");
   benchScene(1e12, repeats, true);
   double main_ratio = 0.0;
   if (!quick) main_ratio = benchScene(1e14, repeats, true);

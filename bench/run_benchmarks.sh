@@ -16,6 +16,13 @@ build="${BUILD_DIR:-$repo/build_bench}"
 # catkin's CMake needs Debian's python3 (with catkin_pkg), not a pyenv one earlier on PATH.
 export PATH="/usr/bin:$PATH"
 
+# Every output names the source it measured: the commit, marked when the core has local changes.
+COLLISION_LAB_BENCH_SOURCE="$(git -C "$repo" rev-parse --short HEAD 2>/dev/null || echo unknown)"
+if ! git -C "$repo" diff --quiet HEAD -- src include 2>/dev/null; then
+  COLLISION_LAB_BENCH_SOURCE+=" with local changes in src/ or include/"
+fi
+export COLLISION_LAB_BENCH_SOURCE
+
 cmake -S "$repo" -B "$build" -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build "$build" -j2 --target collision_lab_bench_core collision_lab_speed_vs_error collision_lab_hard_cases
 bin="$build/devel/lib/collision_lab"

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <vector>
 
@@ -53,6 +54,11 @@ double energyRelativeDrift(const Scene& scene, const std::array<double, 3>& v) {
     e += m * static_cast<long double>(v[i]) * v[i] / 2;
   }
   return static_cast<double>(std::fabs(e - e0) / e0);
+}
+
+std::string sourceVersion() {
+  const char* version = std::getenv("COLLISION_LAB_BENCH_SOURCE");
+  return version && *version ? version : "unknown (not run through bench/run_benchmarks.sh)";
 }
 
 bool writeTextFile(const std::string& path, const std::string& text) {

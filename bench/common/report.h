@@ -27,6 +27,10 @@ double relativeVelocityError(const Scene& scene, const std::array<double, 3>& a,
 /// every benchmark scene). Computed in long double.
 double energyRelativeDrift(const Scene& scene, const std::array<double, 3>& v);
 
+/// The source version the results belong to, from $COLLISION_LAB_BENCH_SOURCE (set by
+/// bench/run_benchmarks.sh to the commit, marked when src/ or include/ have local changes).
+std::string sourceVersion();
+
 /// Writes `text` to `path`, creating nothing else; false (and a message on stderr) on failure.
 bool writeTextFile(const std::string& path, const std::string& text);
 
