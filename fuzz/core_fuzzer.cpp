@@ -40,11 +40,11 @@ constexpr std::array<std::uint64_t, 10> kCaps = {0, 1, 2, 3, 5, 10, 100, 1000, 1
 /// Caps for the slower paths (events kept, higher precision, runLab's per-event model).
 constexpr std::uint64_t kSlowPathCap = 2000;
 /// Runs short enough to cross-check against exact rationals (their cost grows about
-/// cubically: 40 collisions of a scene mixing 1e30 kg and 1e-198 m/s take 0.2 s).
-constexpr std::uint64_t kExactCrossCheckLimit = 40;
+/// cubically: 40 collisions of a scene mixing 1e30 kg and 1e-139 m/s take 1.3 s).
+constexpr std::uint64_t kExactCrossCheckLimit = 20;
 
 /// Known, reported core issues (issue 5 report; seeds mass_1e300, mass_ratio_1e600,
-/// mass_ratio_underflow, mass_1e30, exact_escalation, time_overflow, position_overflow and
+/// mass_ratio_underflow, mass_1e30, exact_escalation, subnormal_count, time_overflow, position_overflow and
 /// max_possible_too_low reproduce them). While they are open the target steps around them so that
 /// fuzzing keeps looking for new ones; COLLISION_LAB_FUZZ_KNOWN_ISSUES=check turns the
 /// detours off. Remove them when the core is fixed.
@@ -64,6 +64,12 @@ constexpr std::uint64_t kExactCrossCheckLimit = 40;
 ///  - maxPossibleCollisionCount says 2 when m_B is so much heavier than A and C that
 ///    pi / alpha exceeds 2 by less than 1e-50 (its 50-digit fallback rounds to 2), yet
 ///    3 collisions happen: (1, 1e60, 1), x (1e80, 1, 0), v (-1e61, 0, 1) gives BC AB BC.
+///  - predictedCollisionCount is wrong when mass-weighted velocity differences fall into
+///    the subnormal range: (1, 2, 0.26542376078465163), x (3, 2, 1.5),
+///    v (-5e-324, 0, 5e-324) predicts 3 collisions, exact arithmetic and the simulation
+///    give 2 (BC AB). Its error bound assumes relative rounding, which subnormals lack.
+///    Count cross-checks are skipped below kSubnormalWeightedSpeed.
+constexpr double kSubnormalWeightedSpeed = std::numeric_limits<double>::min() / std::numeric_limits<double>::epsilon();
 constexpr double kCountOverflowQuotient = 1.8e19;
 constexpr double kQuadraticMassRatio = 1e24;
 constexpr std::uint64_t kQuadraticCap = 5;
@@ -173,11 +179,13 @@ void checkEscaped(const std::array<double, 3>& v, const VelocityScales& scales, 
 double engineTolerance(std::uint64_t count) { return 64 * std::numeric_limits<double>::epsilon() * double(count + 2); }
 
 void checkSimulation(const cl::Scene& scene, const cl::SimulationResult& sim, const cl::Prediction& prediction,
-                     std::uint64_t cap) {
+                     std::uint64_t cap, bool count_reliable) {
   FUZZ_CHECK(sim.first_pair == prediction.first_pair, "simulation and prediction disagree on the first pair");
-  FUZZ_CHECK(sim.truncated == (prediction.collision_count > cap), "truncated iff the predicted count exceeds the cap");
-  FUZZ_CHECK(sim.collision_count == std::min(prediction.collision_count, cap),
-             "simulated count == predictedCollisionCount (capped)");
+  if (count_reliable) {
+    FUZZ_CHECK(sim.truncated == (prediction.collision_count > cap), "truncated iff the predicted count exceeds the cap");
+    FUZZ_CHECK(sim.collision_count == std::min(prediction.collision_count, cap),
+               "simulated count == predictedCollisionCount (capped)");
+  }
   FUZZ_CHECK(allFinite(sim.final_velocities), "finite final velocities");
   FUZZ_CHECK(std::isfinite(sim.energy_relative_drift), "finite energy drift");
   const int wall = scene.wallIndex();
@@ -196,7 +204,7 @@ void checkSimulation(const cl::Scene& scene, const cl::SimulationResult& sim, co
   }
 }
 
-void checkModel(const cl::Scene& scene, const cl::Prediction& prediction) {
+void checkModel(const cl::Scene& scene, const cl::Prediction& prediction, bool count_reliable) {
   const cl::AnalyticModel<double> model(scene);
   const double alpha = model.alpha();
   FUZZ_CHECK(alpha > 0 && alpha <= M_PI / 2 + 1e-12, "alpha in (0, pi/2]");
@@ -220,6 +228,7 @@ void checkModel(const cl::Scene& scene, const cl::Prediction& prediction) {
                  "initialVelocitiesFrom inverts velocitiesAfter");
     }
   }
+  if (!count_reliable) return;
   const Eigen::Vector3d last = model.velocitiesAfter(prediction.collision_count);
   checkEscaped({last(0), last(1), last(2)}, scales, 1e-9);
 }
@@ -268,6 +277,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
                             !(mass_min / mass_max >= std::numeric_limits<double>::min()))) {
     return 0;
   }
+  double weighted_speed = std::numeric_limits<double>::infinity();  // smallest nonzero |v_i - v_j| sqrt(m_min / m_max)
+  for (int i = 0; i < 3; ++i) {
+    for (int j = i + 1; j < 3; ++j) {
+      const double dv = std::fabs(scene.velocities[i] - scene.velocities[j]);
+      if (dv > 0) weighted_speed = std::min(weighted_speed, dv * std::sqrt(mass_min / mass_max));
+    }
+  }
+  const bool count_reliable = !skipKnownIssues() || weighted_speed >= kSubnormalWeightedSpeed;
   const std::uint64_t known_issue_cap =
       skipKnownIssues() && mass_max / mass_min > kQuadraticMassRatio ? kQuadraticCap : kCaps.back();
 
@@ -275,11 +292,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::uint64_t max_possible = cl::maxPossibleCollisionCount(scene.masses);
   FUZZ_CHECK(prediction.max_possible_collision_count == max_possible, "predict reports maxPossibleCollisionCount");
   const bool max_possible_may_be_low = skipKnownIssues() && max_possible == 2;
-  FUZZ_CHECK(prediction.collision_count <= max_possible + (max_possible_may_be_low ? 1 : 0), "count <= ceil(pi / alpha)");
+  FUZZ_CHECK(!count_reliable || prediction.collision_count <= max_possible + (max_possible_may_be_low ? 1 : 0),
+             "count <= ceil(pi / alpha)");
   FUZZ_CHECK(prediction.first_pair == cl::firstPair(scene), "predict reports firstPair");
   FUZZ_CHECK(prediction.first_pair.has_value() || prediction.collision_count == 0, "no first pair, no collisions");
   FUZZ_CHECK(allFinite(prediction.final_velocities), "finite predicted final velocities");
-  checkModel(scene, prediction);
+  checkModel(scene, prediction, count_reliable);
   exercisePaper(scene, prediction.collision_count);
 
   const int precision_bits = flags & 0x3;  // Precision is kDouble, kLongDouble, kHigh = 0, 1, 2
@@ -290,9 +308,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const bool slow_path = precision != cl::Precision::kDouble || events == 1;
   options.max_collisions = std::min({cap, slow_path ? kSlowPathCap : cap, known_issue_cap});
   const cl::SimulationResult sim = cl::simulate(scene, options, precision);
-  checkSimulation(scene, sim, prediction, options.max_collisions);
+  checkSimulation(scene, sim, prediction, options.max_collisions, count_reliable);
 
-  if (prediction.collision_count <= kExactCrossCheckLimit) {
+  if (count_reliable && prediction.collision_count <= kExactCrossCheckLimit) {
     const cl::exact::Run truth = cl::exact::simulate(scene, kExactCrossCheckLimit + 1);
     FUZZ_CHECK(!truth.truncated && truth.collision_count == prediction.collision_count,
                "predictedCollisionCount == exact rational count");
@@ -306,7 +324,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   run_options.events = cl::EventPolicy::firstN(3);
   const cl::RunResult run = cl::runLab(scene, run_options);
   FUZZ_CHECK(allFinite(run.summary.final_velocities), "finite lab-run final velocities");
-  FUZZ_CHECK(run.summary.truncated == (run_options.mode != cl::RunMode::kPredictOnly &&
+  FUZZ_CHECK(!count_reliable || run.summary.truncated == (run_options.mode != cl::RunMode::kPredictOnly &&
                                        prediction.collision_count > run_options.max_collisions),
              "a lab run is truncated iff it simulates and the prediction exceeds the cap");
   return 0;
