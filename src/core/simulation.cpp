@@ -6,6 +6,7 @@
 
 #include <boost/multiprecision/cpp_bin_float.hpp>
 
+#include "collision_lab/core/analytic.h"
 #include "collision_lab/core/exact.h"
 #include "collision_lab/core/precision.h"
 
@@ -15,12 +16,13 @@ namespace {
 
 namespace mp = boost::multiprecision;
 
-/// Replay precision of the first escalation tier (100 digits) and of the last resort
-/// beyond the exact-rational limit (500 digits).
+/// Precision of the first escalation tier (100 digits) and of the last resort beyond the
+/// exact-rational limit (500 digits).
 using ReplayPrecision = mp::cpp_bin_float_100;
 using DeepReplayPrecision = mp::number<mp::cpp_bin_float<500>>;
 
 /// Longest run an exact rational replay is attempted for (its cost grows ~quadratically).
+/// Reached only when 100 digits cannot tell the approach speed from zero.
 constexpr std::uint64_t kExactReplayLimit = 20000;
 
 /// Safety factor of the forward error bound: a sign decision is trusted when
@@ -68,18 +70,6 @@ struct Coefficients {
       : ab(pairCoefficients<T>(m, kA)), bc(pairCoefficients<T>(m, kB)) {}
   const PairCoefficients<T>& of(Pair p) const { return p == Pair::AB ? ab : bc; }
 };
-
-template <class T>
-inline void applyImpact(const PairCoefficients<T>& c, T& v_left, T& v_right) {
-  const T approach = v_right - v_left;
-  if (c.heavy_is_left) {
-    v_left += c.heavy_gain * approach;
-    v_right = v_left - approach;
-  } else {
-    v_right -= c.heavy_gain * approach;
-    v_left = v_right + approach;
-  }
-}
 
 /// Velocities as unevaluated sums hi + lo. The heavy body's increment is added with an
 /// error-free TwoSum, so the rounding of millions of tiny increments to a heavy body's
@@ -136,19 +126,6 @@ struct CompensatedVelocities {
   }
 };
 
-template <class T>
-std::array<T, 3> replay(const Scene& scene, Pair first, std::uint64_t n) {
-  const Coefficients<T> c(scene.masses);
-  std::array<T, 3> v{T(scene.velocities[0]), T(scene.velocities[1]), T(scene.velocities[2])};
-  Pair pair = first;
-  for (std::uint64_t i = 0; i < n; ++i) {
-    const int left = pair == Pair::AB ? kA : kB;
-    applyImpact(c.of(pair), v[left], v[left + 1]);
-    pair = otherPair(pair);
-  }
-  return v;
-}
-
 /// Scales that bound rounding errors: in the wall's frame (or the lab frame without a
 /// wall) kinetic energy is conserved, so |u| = sqrt(sum m v^2) bounds every mass-weighted
 /// velocity, and a velocity error is at most |du| / sqrt(m).
@@ -195,31 +172,60 @@ T approachOf(Pair pair, const std::array<T, 3>& v) {
   return pair == Pair::AB ? T(v[kB] - v[kA]) : T(v[kC] - v[kB]);
 }
 
-/// Decides, as exact arithmetic would, whether `pair` approaches after k impacts, and
-/// refreshes `v` with the more accurate replayed state.
+/// Takes the sign decisions the working precision cannot: the closed-form state after k
+/// impacts at 100 digits (O(1) in k), then exact rationals for a zero to within that,
+/// then 500 digits beyond the rationals' reach. The closed form holds for any alternating
+/// sequence, which every run is, so no replay from the start is needed.
 template <class Scalar>
-bool escalateApproach(const Scene& scene, const ErrorScale& scale, Pair first, std::uint64_t k, Pair pair,
-                      CompensatedVelocities<Scalar>& v, EscalationStats& stats) {
-  ++stats.high_precision;
-  const auto precise = replay<ReplayPrecision>(scene, first, k);
-  const ReplayPrecision precise_approach = approachOf(pair, precise);
-  if (mp::abs(precise_approach) > scale.bound<ReplayPrecision>(pair, k)) {
-    v.adopt(precise);
-    return precise_approach > 0;
+class Escalation {
+ public:
+  Escalation(const Scene& scene, const ErrorScale& scale, Pair first) : scene_(scene), scale_(scale), first_(first) {}
+
+  /// Does `pair` approach after k impacts, as exact arithmetic says? Hands the accurate
+  /// state at k to `v`.
+  bool approaches(std::uint64_t k, Pair pair, CompensatedVelocities<Scalar>& v, EscalationStats& stats) {
+    ++stats.high_precision;
+    if (!precise_) precise_.emplace(scene_);
+    const auto precise = stateOf(*precise_, k);
+    const ReplayPrecision precise_approach = approachOf(pair, precise);
+    if (mp::abs(precise_approach) > bound<ReplayPrecision>(pair, k)) {
+      v.adopt(precise);
+      return precise_approach > 0;
+    }
+    if (k <= kExactReplayLimit) {
+      ++stats.exact_rational;
+      const exact::RationalState exact_state = exact::velocitiesAfter(scene_, first_, k);
+      v.adopt(exact_state);
+      return exact::approachSpeed(pair, exact_state) > 0;
+    }
+    // An exact zero this deep would need input doubles built for it over thousands of
+    // impacts; 500 digits separate everything else.
+    const AnalyticModel<DeepReplayPrecision> deep_model(scene_);
+    const auto deep = stateOf(deep_model, k);
+    v.adopt(deep);
+    return approachOf(pair, deep) > bound<DeepReplayPrecision>(pair, k);
   }
-  if (k <= kExactReplayLimit) {
-    ++stats.exact_rational;
-    const exact::RationalState exact_state = exact::velocitiesAfter(scene, first, k);
-    v.adopt(exact_state);
-    return exact::approachSpeed(pair, exact_state) > 0;
+
+ private:
+  template <class T>
+  static std::array<T, 3> stateOf(const AnalyticModel<T>& model, std::uint64_t k) {
+    const auto state = model.velocitiesAfter(k);
+    return {state(0), state(1), state(2)};
   }
-  // Beyond the exact limit an exact zero would need input doubles built for it over
-  // thousands of impacts; 500 digits separate everything else.
-  const auto deep = replay<DeepReplayPrecision>(scene, first, k);
-  v.adopt(deep);
-  const DeepReplayPrecision deep_approach = approachOf(pair, deep);
-  return deep_approach > scale.bound<DeepReplayPrecision>(pair, k);
-}
+
+  /// Rounding bound of the closed form: the rotation angle k theta carries k rounding
+  /// errors, and an angle error moves the state by up to 1/alpha times its scale.
+  template <class T>
+  T bound(Pair pair, std::uint64_t k) const {
+    const T alpha(anglesFor(scene_.masses).alpha);
+    return scale_.bound<T>(pair, k) * 16 * (1 + 1 / alpha);
+  }
+
+  const Scene& scene_;
+  const ErrorScale& scale_;
+  Pair first_;
+  std::optional<AnalyticModel<ReplayPrecision>> precise_;
+};
 
 struct Frame {
   double energy = 0.0;    // kinetic energy in the wall's frame (lab frame without a wall)
@@ -370,14 +376,21 @@ SimulationResult simulate(const Scene& scene, const SimulationOptions& options, 
   const Scalar step_bound_bc = scale.bound<Scalar>(Pair::BC, 0) / Scalar(2);
   EscalationStats& stats = result.escalation;
 
+  // The error bound grows with the impacts since v was last exact to working precision.
+  std::uint64_t exact_at = 0;
+  std::optional<Escalation<Scalar>> escalation;
+
   // Does `pair` approach after k impacts? Exact decision; may refresh v.
   auto approaches = [&](Pair pair, std::uint64_t k) {
     ++stats.decisions;
     const Scalar approach = v.approach(pair == Pair::AB ? kA : kB);
-    const Scalar bound = (pair == Pair::AB ? step_bound_ab : step_bound_bc) * Scalar(static_cast<double>(k + 2));
+    const Scalar bound =
+        (pair == Pair::AB ? step_bound_ab : step_bound_bc) * Scalar(static_cast<double>(k - exact_at + 2));
     if (approach > bound) return true;
     if (approach < -bound) return false;
-    return escalateApproach(scene, scale, *result.first_pair, k, pair, v, stats);
+    if (!escalation) escalation.emplace(scene, scale, *result.first_pair);
+    exact_at = k;
+    return escalation->approaches(k, pair, v, stats);
   };
 
   std::uint64_t k = 0;

@@ -2,9 +2,11 @@
 //
 // Every decision that changes the outcome (which pair hits first, does a pair still
 // approach) is taken as exact rational arithmetic on the input doubles would take it:
-// a fast path in the working precision with a forward error bound, escalating to a
-// high-precision replay and then to an exact rational replay only when a decision falls
-// inside the bound (adaptive precision, as in robust geometric predicates).
+// a fast path in the working precision with a forward error bound, escalating to the
+// closed-form state at 100 digits (O(1) in the collision index) and then to an exact
+// rational replay only when a decision falls inside the bound (adaptive precision, as in
+// robust geometric predicates). After an escalation the engine adopts the accurate state
+// and its error bound starts again from there.
 #pragma once
 
 #include <array>
@@ -54,8 +56,8 @@ using EventVisitor = std::function<void(const CollisionEvent&)>;
 /// How often the adaptive path had to leave the working precision.
 struct EscalationStats {
   std::uint64_t decisions = 0;        ///< sign decisions taken
-  std::uint64_t high_precision = 0;   ///< decided by a multiprecision replay
-  std::uint64_t exact_rational = 0;   ///< decided by an exact rational replay
+  std::uint64_t high_precision = 0;   ///< decisions sent to the 100-digit closed form
+  std::uint64_t exact_rational = 0;   ///< of those, decided by an exact rational replay
 };
 
 struct SimulationResult {
