@@ -124,9 +124,11 @@ bool allFinite(const std::array<double, 3>& v) {
 
 bool allFinite(const Eigen::Vector3d& v) { return v.allFinite(); }
 
-/// Per-particle velocity scale [m/s]: |frame| + |u| / sqrt(m_i), where u is the
-/// mass-weighted velocity in the wall's (or centre-of-mass) frame, whose norm every
-/// impact conserves. No velocity of particle i can exceed it in exact arithmetic.
+/// Per-particle velocity scale [m/s]: (|frame| + |u| / sqrt(m_max)) sqrt(m_max / m_i),
+/// where u is the mass-weighted velocity in the wall's (or centre-of-mass) frame, whose
+/// norm every impact conserves. It bounds |v_i| in exact arithmetic, and it is the
+/// conditioning of the closed form: the rounding of the frame velocity in a heavy
+/// body's component (eps |frame| sqrt(m_max)) reaches body i as eps |frame| sqrt(m_max / m_i).
 /// Computed without squaring a velocity, so 1e-200 m/s does not underflow.
 /// floor: the absolute error [m/s] of a mass-weighted component that fell below DBL_MIN
 /// (subnormal, no relative precision left), seen as a velocity of particle i.
@@ -161,7 +163,7 @@ VelocityScales velocityScales(const cl::Scene& scene) {
   VelocityScales scales;
   for (int i = 0; i < 3; ++i) {
     const double inverse_sqrt_mass = i == wall ? 0.0 : std::sqrt(mass_max) / std::sqrt(scene.masses[i]);
-    scales.speed[i] = std::fabs(frame) + dv_max * std::sqrt(u_sq) * inverse_sqrt_mass;
+    scales.speed[i] = std::fabs(frame) * std::max(1.0, inverse_sqrt_mass) + dv_max * std::sqrt(u_sq) * inverse_sqrt_mass;
     scales.floor[i] = std::numeric_limits<double>::min() * std::max(1.0, inverse_sqrt_mass);
   }
   return scales;
