@@ -67,6 +67,22 @@ struct Quotient {
   T error_bound;
 };
 
+double largest_mass(const Scene& scene) {
+  double mass = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    if (!scene.isWall(i)) mass = std::max(mass, scene.masses[i]);
+  }
+  return mass;
+}
+
+double smallest_mass(const Scene& scene) {
+  double mass = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < 3; ++i) {
+    if (!scene.isWall(i)) mass = std::min(mass, scene.masses[i]);
+  }
+  return mass;
+}
+
 template <class T>
 Quotient<T> countQuotient(const Scene& scene, Pair first) {
   using std::sqrt;
@@ -91,6 +107,11 @@ Quotient<T> countQuotient(const Scene& scene, Pair first) {
     if (wall >= 0) relative_speed = std::max(relative_speed, absOf(T(scene.velocities[i]) - T(scene.velocities[wall])));
   }
   const T eps = std::numeric_limits<T>::epsilon();
+  // Rounding is relative only above the normal range: closer to underflow, leave the
+  // decision to a type with a wider exponent.
+  if (relative_speed * sqrt(T(smallest_mass(scene)) / T(largest_mass(scene))) < std::numeric_limits<T>::min() / eps) {
+    return {T(0), std::numeric_limits<T>::infinity()};
+  }
   const T angular_error = 64 * eps * (1 + velocity_scale / relative_speed);
   const T q = angle / alpha;
   return {q, angular_error / alpha + 16 * eps * q};
@@ -332,8 +353,9 @@ std::uint64_t maxPossibleCollisionCount(const std::array<double, 3>& m) {
   if (std::fabs(quotient - std::round(quotient)) > 64 * std::numeric_limits<double>::epsilon() * quotient) {
     return static_cast<std::uint64_t>(std::ceil(quotient));
   }
+  // alpha < pi / 2 for finite masses, so pi / alpha > 2 even when it rounds to 2.
   const HighPrecision precise = pi<HighPrecision>() / alphaOf<HighPrecision>(m);
-  return static_cast<std::uint64_t>(static_cast<double>(ceil(precise)));
+  return std::max<std::uint64_t>(3, static_cast<std::uint64_t>(static_cast<double>(ceil(precise))));
 }
 
 }  // namespace collision_lab

@@ -1,5 +1,6 @@
 #include "collision_lab/core/scene.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <limits>
@@ -29,6 +30,9 @@ ValidationError makeError(Reason reason, const std::string& field, const std::st
 }
 
 bool isFiniteProduct(double a, double b) { return std::isfinite(a * b); }
+
+/// Collision counts are 64-bit; the count never exceeds ceil(pi / alpha).
+constexpr double kMaxCollisionCount = 9.2e18;
 
 }  // namespace
 
@@ -133,12 +137,44 @@ std::optional<ValidationError> validate(const Scene& scene) {
     }
   }
 
+  // The collision count is about pi / alpha; it must fit the 64-bit counters (mass
+  // ratios up to ~1e36), and the mass ratios themselves must stay representable.
+  double mass_min = std::numeric_limits<double>::infinity(), mass_max = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    if (scene.isWall(i)) continue;
+    mass_min = std::min(mass_min, scene.masses[i]);
+    mass_max = std::max(mass_max, scene.masses[i]);
+  }
+  const double b_over_a = scene.isWall(kA) ? 0.0 : scene.masses[kB] / scene.masses[kA];
+  const double b_over_c = scene.isWall(kC) ? 0.0 : scene.masses[kB] / scene.masses[kC];
+  const double alpha = std::atan(std::sqrt(b_over_a * (1 + b_over_c) + b_over_c));
+  if (!(mass_min / mass_max >= std::numeric_limits<double>::min()) || !(3.5 / alpha < kMaxCollisionCount)) {
+    return makeError(Reason::kOverflow, "masses",
+                     "the mass ratios (" + formatValue(mass_max) + " / " + formatValue(mass_min) +
+                         ") are too extreme: the collision count would not fit 2^63; keep ratios below 1e36");
+  }
+
   const bool ab_approach = scene.velocities[kA] < scene.velocities[kB];
   const bool bc_approach = scene.velocities[kB] < scene.velocities[kC];
   if (ab_approach && bc_approach && exact::compareFirstContactTimes(scene) == 0) {
     return makeError(Reason::kTripleCollision, "positions",
                      "A, B and C would meet at the same instant (an exact triple collision), "
                      "which three-body elastic collisions do not define");
+  }
+  // The first contact must happen at a representable time and place.
+  for (int left : {kA, kB}) {
+    const double approach = scene.velocities[left + 1] - scene.velocities[left];
+    if (!(approach > 0)) continue;
+    const double time = (x[left] - x[left + 1]) / approach;
+    bool representable = std::isfinite(time);
+    for (int i = 0; i < 3 && representable; ++i) {
+      representable = std::isfinite(x[i] + scene.velocities[i] * time);
+    }
+    if (!representable) {
+      return makeError(Reason::kOverflow, "positions",
+                       "the first contact would come at t = " + formatValue(time) +
+                           " s or beyond the range of a double in position; rescale the units");
+    }
   }
   return std::nullopt;
 }

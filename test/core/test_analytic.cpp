@@ -102,6 +102,9 @@ TEST(Count, MaxPossibleIsExactForKaleidoscopicMasses) {
   EXPECT_EQ(maxPossibleCollisionCount({2, 1, 3}), 4u);
   EXPECT_EQ(maxPossibleCollisionCount({5, 1, 9}), 6u);
   EXPECT_EQ(maxPossibleCollisionCount({1e12, 1, 1e12}), 2221442u);
+  // A heavy B: alpha -> pi/2, pi/alpha exceeds 2 by ~1e-60; 3 collisions are possible.
+  EXPECT_EQ(maxPossibleCollisionCount({1, 1e60, 1}), 3u);
+  EXPECT_EQ(predictedCollisionCount(Scene{{1, 1e60, 1}, {1e80, 1, 0}, {-1e61, 0, 1}}), 3u);
   // No start exceeds the bound.
   std::mt19937_64 rng(3);
   for (int i = 0; i < 300; ++i) {

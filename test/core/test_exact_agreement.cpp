@@ -123,6 +123,13 @@ TEST(ExactAgreement, ExtremeScalesDoNotOverflow) {
   }
 }
 
+TEST(ExactAgreement, SubnormalVelocityDifferences) {
+  // Found by the fuzzer: rounding is not relative down here.
+  const Scene scene{{1, 2, 0.26542376078465163}, {3e-16, 2e-16, 1.5e-16}, {-5e-324, 0, 5e-324}};
+  ASSERT_FALSE(validate(scene));
+  expectMatchesExact(scene);
+}
+
 TEST(ExactAgreement, WallsMovingAndResting) {
   expectMatchesExact(Scene{{kInf, 1, 3}, {2, 1, 0}, {0.25, 0, 1}});
   expectMatchesExact(Scene{{3, 1, kInf}, {2, 1, 0}, {-1, 0.5, -0.125}});

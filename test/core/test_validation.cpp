@@ -65,6 +65,18 @@ TEST(Validation, EveryReasonCode) {
   s = validScene();
   s.positions = {1.7e308, -1.7e308, -1.75e308};
   expectRejected(s, Reason::kOverflow, "positions");
+  // Counts beyond 64 bits (mass ratio 1e40) and mass ratios that underflow.
+  s = validScene();
+  s.masses = {1e40, 1, 1e40};
+  expectRejected(s, Reason::kOverflow, "masses");
+  s = validScene();
+  s.masses = {1e-300, 1, 1e300};
+  expectRejected(s, Reason::kOverflow, "masses");
+  // A first contact at t = 1e600 s.
+  s = validScene();
+  s.positions = {1e300, 0, -1};
+  s.velocities = {-1e-300, 0, -1};
+  expectRejected(s, Reason::kOverflow, "positions");
 }
 
 TEST(Validation, ExactTripleCollisionOnlyWhenTimesAreExactlyEqual) {
