@@ -18,8 +18,8 @@ export PATH="/usr/bin:$PATH"
 
 # Every output names the source it measured: the commit, marked when the core has local changes.
 COLLISION_LAB_BENCH_SOURCE="$(git -C "$repo" rev-parse --short HEAD 2>/dev/null || echo unknown)"
-if ! git -C "$repo" diff --quiet HEAD -- src include 2>/dev/null; then
-  COLLISION_LAB_BENCH_SOURCE+=" with local changes in src/ or include/"
+if ! git -C "$repo" diff --quiet HEAD -- src/core include/collision_lab/core 2>/dev/null; then
+  COLLISION_LAB_BENCH_SOURCE+=" with local changes in the core"
 fi
 export COLLISION_LAB_BENCH_SOURCE
 
