@@ -1,7 +1,7 @@
 // Box2D 2.4 (float only; b2_linearSlop is compiled in), configured as elastically as it
 // allows (shared/physics.md, last section).
+#include <array>
 #include <cmath>
-#include <vector>
 
 #include <box2d/box2d.h>
 

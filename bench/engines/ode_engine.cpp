@@ -1,8 +1,8 @@
 // ODE (double precision in Debian's build), configured as elastically as it allows
 // (shared/physics.md, last section).
+#include <array>
 #include <cmath>
 #include <mutex>
-#include <vector>
 
 #include <ode/ode.h>
 
