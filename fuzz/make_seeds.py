@@ -85,6 +85,7 @@ SEEDS = {
     "exact_escalation": raw((1e40, 1e17, 1e273), (3, 1, 0), (-1, 0, 1), mode="summary_only", cap=100),
     "subnormal_count": raw((1, 2, 0.26542376078465163), (3, 2, 1.5), (-5e-324, 0, 5e-324)),
     "light_count": raw((5, 1, 1e-200), (2, 1, 0), (-0.1, -0.1, 0), events="all"),
+    "energy_transfer_overflow": raw((INF, 1e308, 3), (5, 1, 0), (0, 0, 1), events="all"),
     "light_outer": compact((1e-12, 1, 1e-12), (2, 1, 0), (-1, 0, 1)),
     "scale_1e150": raw((1e150, 1e150, 1e150), (3e150, 2e150, 1e150), (-1e-150, 0, 1e-150)),
     "scale_small": raw((1e-300, 2e-300, 3e-300), (3e-300, 2e-300, 1e-300), (-5e-324, 0, 5e-324)),
