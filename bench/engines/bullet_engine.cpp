@@ -24,6 +24,10 @@ SteppedRun runBullet(const Scene& scene, const StepConfig& config) {
   info.m_solverMode &= ~SOLVER_USE_WARMSTARTING;  // no impulse carried between steps
   info.m_splitImpulse = 1;                          // penetration fixed without adding velocity
   info.m_splitImpulsePenetrationThreshold = 1e30;   // ... at every depth
+  // No split-impulse position correction either: with the default m_erp2 = 0.8 the
+  // pushes out of each overlap add up, and positions stop converging near 0.1-0.2 m on
+  // scenes with thousands of fast collisions.
+  info.m_erp2 = 0;
 
   btSphereShape sphere(kEngineRadius);
   const double offset[3] = {2 * kEngineRadius, 0.0, -2 * kEngineRadius};
@@ -86,8 +90,10 @@ SteppedMethod bulletMethod() {
               "1 (Bullet multiplies the pair's restitutions), friction 0, rolling friction 0, "
               "damping 0, setLinearFactor(1,0,0), setAngularFactor(0), DISABLE_DEACTIVATION. "
               "Solver: m_restitutionVelocityThreshold = 0 (default 0.2 m/s), warm starting "
-              "off, m_splitImpulse = 1, m_splitImpulsePenetrationThreshold = 1e30; other "
-              "solver settings default (10 iterations).",
+              "off, m_splitImpulse = 1, m_splitImpulsePenetrationThreshold = 1e30, m_erp2 = 0 "
+              "(no split-impulse position correction; with the default 0.8 the position error "
+              "stops converging near 0.1-0.2 m on the 10^6:1 scenes); other solver settings "
+              "default (10 iterations).",
           runBullet};
 }
 
