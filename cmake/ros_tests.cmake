@@ -8,7 +8,7 @@ if(TARGET ros_layer_unit_test)
 endif()
 
 find_package(rostest REQUIRED)
-foreach(name node_test burst_test demo_test)
+foreach(name node_test burst_test demo_test crash_test)
   add_rostest_gtest(${name} test/ros/${name}.test test/ros/${name}.cpp)
   target_link_libraries(${name} collision_lab_ros ${catkin_LIBRARIES})
   # The rostests start these nodes.
@@ -16,3 +16,5 @@ foreach(name node_test burst_test demo_test)
 endforeach()
 # node_test reads the bad-input catalogue, docs/bad_inputs.md.
 target_compile_definitions(node_test PRIVATE COLLISION_LAB_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+# crash_test starts and kills the node itself.
+target_compile_definitions(crash_test PRIVATE COLLISION_LAB_NODE_PATH="$<TARGET_FILE:collision_lab_node>")

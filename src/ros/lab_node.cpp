@@ -18,7 +18,8 @@ namespace {
 ros::Time stampNow() {
   const ros::Time now = ros::Time::now();
   if (now >= ros::TIME_MIN) return now;
-  return ros::Time(ros::WallTime::now().sec, ros::WallTime::now().nsec);
+  const ros::WallTime wall = ros::WallTime::now();
+  return ros::Time(wall.sec, wall.nsec);
 }
 
 std::string defaultBagDirectory() {
@@ -178,10 +179,7 @@ void LabNode::serve(collision_lab::InitialConditions input) {
   }
 
   std::optional<RunRecorder> recorder;
-  if (params_.record) {
-    recorder.emplace(params_.bag_directory, run_id);
-    if (!recorder->ok()) ROS_ERROR_STREAM("run " << run_id << ": " << recorder->error());
-  }
+  if (params_.record) recorder.emplace(params_.bag_directory, run_id);
   const auto publishAndRecord = [&](const ros::Publisher& pub, auto& msg) {
     msg.header.stamp = stampNow();
     msg.run_id = run_id;

@@ -1,0 +1,130 @@
+// kill -9 in the middle of a run (crash_test.test): the bags of finished runs stay
+// intact, the run in progress is left as <run_id>.bag.active and `rosbag reindex`
+// recovers it, and a restarted node never overwrites an existing bag.
+#include <signal.h>
+#include <stdlib.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+
+#include "run_collector.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using collision_lab_test::makeInput;
+using collision_lab_test::RunCollector;
+
+constexpr char kNamespace[] = "crash";
+
+/// Starts collision_lab_node in namespace `crash` with its bags in directory.
+pid_t startNode(const std::string& directory) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    // The binary itself (rosrun may find several in a source tree with many builds).
+    execl(COLLISION_LAB_NODE_PATH, COLLISION_LAB_NODE_PATH, "__ns:=crash",
+           ("_bag_directory:=" + directory).c_str(), "_publish_markers:=false",
+           static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  return pid;
+}
+
+void stop(pid_t pid, int signal) {
+  kill(pid, signal);
+  int status = 0;
+  waitpid(pid, &status, 0);
+}
+
+std::size_t messageCount(const std::string& path) {
+  rosbag::Bag bag(path, rosbag::bagmode::Read);
+  return rosbag::View(bag).size();
+}
+
+TEST(Crash, KillNineKeepsFinishedBagsAndNeverOverwrites) {
+  char pattern[] = "/tmp/collision_lab_crash_XXXXXX";
+  ASSERT_NE(mkdtemp(pattern), nullptr);
+  const std::string dir = pattern;
+
+  // A finished run, then a long one (2,221,441 collisions, under the default cap) that is
+  // killed mid-way.
+  const auto finished = makeInput("finished", {1, 2, 3}, {2, 0, -2}, {-1, 0.5, 1});
+  const auto long_run = makeInput("long_run", {1e12, 1, 1e12}, {2, 1, 0}, {-1, 0, 0});
+  {
+    const pid_t node = startNode(dir);
+    ASSERT_GT(node, 0);
+    RunCollector client(kNamespace);
+    client.waitForConnection();
+    client.publish(finished);
+    ASSERT_EQ(client.waitFor("finished").summaries.size(), 1u);
+    client.publish(long_run);
+    // In progress: 10,000 collisions published (the default ~max_published_events), so the
+    // bag has flushed its first chunks (768 kB each); the rest of the run goes on.
+    const auto inProgress = [&client] {
+      const auto run = client.runs().find("long_run");
+      return run != client.runs().end() && run->second.events.size() >= 10000;
+    };
+    const auto over = [&client] {
+      const auto run = client.runs().find("long_run");
+      return run != client.runs().end() && !run->second.summaries.empty();
+    };
+    while (ros::ok() && !inProgress() && !over()) RunCollector::spinOnce();
+    const bool killed_mid_run = fs::exists(dir + "/long_run.bag.active") && !over();
+    stop(node, SIGKILL);
+    ASSERT_TRUE(killed_mid_run);
+  }
+
+  const std::size_t finished_messages = messageCount(dir + "/finished.bag");
+  EXPECT_EQ(finished_messages, 3 + 3 * 3u);  // input, prediction, 3 x 3 per collision, summary
+  EXPECT_FALSE(fs::exists(dir + "/long_run.bag"));
+  ASSERT_TRUE(fs::exists(dir + "/long_run.bag.active"));
+
+  // The interrupted bag is recoverable up to its last flushed chunk: reindex a copy and
+  // read it.
+  const std::string recovered = dir + "/long_run_recovered.bag";
+  fs::copy_file(dir + "/long_run.bag.active", recovered);
+  ASSERT_EQ(std::system(("rosbag reindex -q " + recovered + " > /dev/null").c_str()), 0);
+  {
+    rosbag::Bag bag(recovered, rosbag::bagmode::Read);
+    EXPECT_EQ(rosbag::View(bag, rosbag::TopicQuery("/crash/initial_conditions")).size(), 1u);
+    EXPECT_EQ(rosbag::View(bag, rosbag::TopicQuery("/crash/predictions")).size(), 1u);
+    EXPECT_GT(rosbag::View(bag, rosbag::TopicQuery("/crash/collision_events")).size(), 0u);
+    EXPECT_EQ(rosbag::View(bag, rosbag::TopicQuery("/crash/run_summaries")).size(), 0u);
+  }
+
+  // A restarted node refuses both run_ids: a finished bag and an interrupted one.
+  {
+    const pid_t node = startNode(dir);
+    ASSERT_GT(node, 0);
+    RunCollector client(kNamespace);
+    client.waitForConnection();
+    for (const auto& input : {finished, long_run}) {
+      client.publish(input);
+      const auto& out = client.waitFor(input.run_id);
+      ASSERT_EQ(out.rejections.size(), 1u) << input.run_id;
+      EXPECT_EQ(out.rejections.front().reason, collision_lab::Rejected::DUPLICATE_RUN_ID);
+    }
+    stop(node, SIGINT);
+  }
+  EXPECT_EQ(messageCount(dir + "/finished.bag"), finished_messages);
+  fs::remove_all(dir);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "crash_test");
+  ros::NodeHandle nh;  // starts ROS for the whole test
+  return RUN_ALL_TESTS();
+}
