@@ -24,6 +24,8 @@ using DeepPrecision = mp::number<mp::cpp_bin_float<500>>;
 
 /// Longest replay the exact integer test of psi / alpha runs as rationals.
 constexpr std::uint64_t kExactReplayLimit = 20000;
+/// Longest run counted by exact simulation when no precision can place u_perp.
+constexpr std::uint64_t kExactCountLimit = 2000;
 
 template <class T>
 T pi() {
@@ -94,25 +96,39 @@ Quotient<T> countQuotient(const Scene& scene, Pair first) {
     if (angle < 0) angle += 2 * pi<T>();
   }
   // Rounding in w = S (v - V 1) is relative to the velocities, not to w itself, so a
-  // nearly common velocity makes psi inaccurate: bound the angular error by |dw| / |w|.
+  // nearly common velocity makes psi inaccurate: bound the angular error by |dw| / |w|,
+  // both weighted by sqrt(m_i / m_max) as w is.
   const int wall = scene.wallIndex();
+  const double mass_max = largest_mass(scene);
   T velocity_scale = 0;
   for (int i = 0; i < 3; ++i) velocity_scale = std::max(velocity_scale, absOf(T(scene.velocities[i])));
-  T relative_speed = 0;
+  const T frame = wall >= 0 ? T(scene.velocities[wall]) : T(0);
+  T centre = frame;
+  if (wall < 0) {
+    T mass_sum = 0, momentum = 0;
+    for (int i = 0; i < 3; ++i) {
+      mass_sum += T(scene.masses[i]) / T(mass_max);
+      momentum += T(scene.masses[i]) / T(mass_max) * T(scene.velocities[i]);
+    }
+    centre = momentum / mass_sum;
+  }
+  T w_norm_sq = 0, w_error = 0;
   for (int i = 0; i < 3; ++i) {
     if (i == wall) continue;
-    for (int j = 0; j < 3; ++j) {
-      if (j != wall) relative_speed = std::max(relative_speed, absOf(T(scene.velocities[i]) - T(scene.velocities[j])));
-    }
-    if (wall >= 0) relative_speed = std::max(relative_speed, absOf(T(scene.velocities[i]) - T(scene.velocities[wall])));
+    const T weight = sqrt(T(scene.masses[i]) / T(mass_max));
+    const T w = weight * (T(scene.velocities[i]) - centre);
+    w_norm_sq += w * w;
+    w_error += weight * (absOf(T(scene.velocities[i])) + velocity_scale);
   }
   const T eps = std::numeric_limits<T>::epsilon();
-  // Rounding is relative only above the normal range: closer to underflow, leave the
-  // decision to a type with a wider exponent.
-  if (relative_speed * sqrt(T(smallest_mass(scene)) / T(largest_mass(scene))) < std::numeric_limits<T>::min() / eps) {
+  const T w_norm = sqrt(w_norm_sq);
+  w_error *= 16 * eps;
+  // Rounding is relative only above the normal range: closer to underflow, or when the
+  // error may rival w itself, leave the decision to a type with more range or digits.
+  if (!(w_norm > 64 * w_error) || w_norm < std::numeric_limits<T>::min() / eps) {
     return {T(0), std::numeric_limits<T>::infinity()};
   }
-  const T angular_error = 64 * eps * (1 + velocity_scale / relative_speed);
+  const T angular_error = 4 * w_error / w_norm + 64 * eps;
   const T q = angle / alpha;
   return {q, angular_error / alpha + 16 * eps * q};
 }
@@ -278,7 +294,7 @@ std::array<Scalar, 3> AnalyticModel<Scalar>::energyTransfer(std::uint64_t n) con
   const Scalar approach = before(right) - before(left);
   const Scalar pair_centre_velocity = f_left * before(left) + f_right * before(right);
   // dE_left = 2 m_l m_r (v_r - v_l)(m_l v_l + m_r v_r) / (m_l + m_r)^2 (physics.md).
-  gained[left] = 2 * reduced * approach * pair_centre_velocity;
+  gained[left] = reduced * (2 * approach * pair_centre_velocity);  // this order cannot overflow first
   gained[right] = -gained[left];
   return gained;
 }
@@ -322,6 +338,14 @@ std::uint64_t predictedCollisionCount(const Scene& scene) {
   if (auto count = countIfSeparated(countQuotient<double>(scene, *first))) return *count;
   const Quotient<HighPrecision> precise = countQuotient<HighPrecision>(scene, *first);
   if (auto count = countIfSeparated(precise)) return *count;
+  if (!(precise.error_bound < 0.25)) {
+    // Even 50 digits cannot place u_perp (a body far lighter than the rest carries all the
+    // relative motion): count exactly when the run is short, else go to 500 digits.
+    if (maxPossibleCollisionCount(scene.masses) <= kExactCountLimit) {
+      return exact::simulate(scene, kExactCountLimit).collision_count;
+    }
+    if (auto count = countIfSeparated(countQuotient<DeepPrecision>(scene, *first))) return *count;
+  }
   // psi / alpha is an integer Q to 50 digits. If it is exactly Q, contact Q grazes with
   // zero approach speed and does not count: decide by the exact state before contact Q.
   using std::round;

@@ -417,7 +417,9 @@ SimulationResult simulate(const Scene& scene, const SimulationOptions& options, 
       }
       const int left = pair == Pair::AB ? kA : kB;
       const std::array<Scalar, 3> before = v.values();
-      const Scalar approach = before[left + 1] - before[left];
+      // The compensated approach speed: after an escalation it can be far below the
+      // rounding of the velocities themselves.
+      const Scalar approach = v.approach(left);
       const Scalar delay = trajectory.delayToImpact(pair, before, approach > 0 ? approach : Scalar(0));
       v.impact(coefficients.of(pair), left);
       ++k;

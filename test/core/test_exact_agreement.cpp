@@ -130,6 +130,17 @@ TEST(ExactAgreement, SubnormalVelocityDifferences) {
   expectMatchesExact(scene);
 }
 
+TEST(ExactAgreement, AFeatherweightCarriesAllTheRelativeMotion) {
+  // Found by the fuzzer: A and B share a velocity and C, far lighter, carries all the
+  // relative motion, below the rounding of the centre-of-mass velocity in double (and,
+  // at 1e-99, in 50 digits too).
+  for (double light : {1e-30, 1e-90, 1e-99}) {
+    const Scene scene{{5, 1, light}, {2, 1, 0}, {-0.1, -0.1, 0}};
+    ASSERT_FALSE(validate(scene));
+    expectMatchesExact(scene);
+  }
+}
+
 TEST(ExactAgreement, WallsMovingAndResting) {
   expectMatchesExact(Scene{{kInf, 1, 3}, {2, 1, 0}, {0.25, 0, 1}});
   expectMatchesExact(Scene{{3, 1, kInf}, {2, 1, 0}, {-1, 0.5, -0.125}});
