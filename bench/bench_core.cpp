@@ -78,7 +78,7 @@ double benchScene(double heavy, int repeats, bool keep_all) {
   methods.emplace_back("core, every event visited", [&] {
                        std::uint64_t seen = 0;
                        const auto result =
-                           simulate<double>(scene, count_only, [&](const CollisionEvent&) { ++seen; });
+                           simulate<double>(scene, count_only, [&](const ImpactEvent&) { ++seen; });
                        doNotOptimize(seen);
                        return result.collision_count;
                      });

@@ -163,7 +163,7 @@ Row runEvent(Precision precision, const BenchScene& s, const Reference& ref, boo
   options.events = EventPolicy::none();
   SimulationResult result;
   // A visitor makes the core track positions (final_positions at final_time).
-  auto work = [&] { result = simulate(s.scene, options, precision, [](const CollisionEvent&) {}); };
+  auto work = [&] { result = simulate(s.scene, options, precision, [](const ImpactEvent&) {}); };
   int runs = 0;
   const double time = medianTime(work, quick, &runs);
   std::array<double, 3> x_end{};

@@ -175,7 +175,7 @@ void checkEscaped(const std::array<double, 3>& v, const VelocityScales& scales, 
 /// The engine's own rounding bound: 64 eps per impact (simulation.cpp, kBoundFactor).
 double engineTolerance(std::uint64_t count) { return 64 * std::numeric_limits<double>::epsilon() * double(count + 2); }
 
-void checkSimulation(const cl::Scene& scene, const cl::SimulationResult& sim, const cl::Prediction& prediction,
+void checkSimulation(const cl::Scene& scene, const cl::SimulationResult& sim, const cl::AnalyticPrediction& prediction,
                      std::uint64_t cap, bool count_reliable) {
   FUZZ_CHECK(sim.first_pair == prediction.first_pair, "simulation and prediction disagree on the first pair");
   if (count_reliable) {
@@ -190,7 +190,7 @@ void checkSimulation(const cl::Scene& scene, const cl::SimulationResult& sim, co
   if (!sim.truncated) checkEscaped(sim.final_velocities, velocityScales(scene), engineTolerance(sim.collision_count));
   std::uint64_t index = 0;
   double time = 0.0;
-  for (const cl::CollisionEvent& event : sim.events) {
+  for (const cl::ImpactEvent& event : sim.events) {
     FUZZ_CHECK(event.index == ++index, "events numbered 1, 2, ...");
     FUZZ_CHECK(allFinite(event.velocities_after), "finite event velocities");
     if (skipKnownIssues() && !(std::isfinite(event.time) && allFinite(event.positions))) break;
@@ -201,7 +201,7 @@ void checkSimulation(const cl::Scene& scene, const cl::SimulationResult& sim, co
   }
 }
 
-void checkModel(const cl::Scene& scene, const cl::Prediction& prediction, bool count_reliable) {
+void checkModel(const cl::Scene& scene, const cl::AnalyticPrediction& prediction, bool count_reliable) {
   const cl::AnalyticModel<double> model(scene);
   const double alpha = model.alpha();
   FUZZ_CHECK(alpha > 0 && alpha <= M_PI / 2 + 1e-12, "alpha in (0, pi/2]");
@@ -286,7 +286,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::uint64_t known_issue_cap =
       skipKnownIssues() && mass_max / mass_min > kQuadraticMassRatio ? kQuadraticCap : kCaps.back();
 
-  const cl::Prediction prediction = cl::predict(scene);
+  const cl::AnalyticPrediction prediction = cl::predict(scene);
   const std::uint64_t max_possible = cl::maxPossibleCollisionCount(scene.masses);
   FUZZ_CHECK(prediction.max_possible_collision_count == max_possible, "predict reports maxPossibleCollisionCount");
   FUZZ_CHECK(!count_reliable || prediction.collision_count <= max_possible, "count <= ceil(pi / alpha)");

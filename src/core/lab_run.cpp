@@ -56,9 +56,9 @@ bool keeps(const EventPolicy& policy, std::uint64_t index) {
 
 }  // namespace
 
-Prediction predict(const Scene& scene) {
+AnalyticPrediction predict(const Scene& scene) {
   const AnalyticModel<double> model(scene);
-  Prediction prediction;
+  AnalyticPrediction prediction;
   prediction.collision_count = predictedCollisionCount(scene);
   prediction.paper_collision_count = paper::collisionCount(scene);
   prediction.max_possible_collision_count = maxPossibleCollisionCount(scene.masses);
@@ -72,9 +72,17 @@ Prediction predict(const Scene& scene) {
 
 RunResult runLab(const Scene& scene, const RunOptions& options, const LabEventVisitor& visitor) {
   const auto started = std::chrono::steady_clock::now();
+  RunResult result = runLab(scene, options, predict(scene), visitor);
+  result.summary.compute_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  return result;
+}
+
+RunResult runLab(const Scene& scene, const RunOptions& options, const AnalyticPrediction& prediction,
+                 const LabEventVisitor& visitor) {
+  const auto started = std::chrono::steady_clock::now();
   RunResult result;
-  result.prediction = predict(scene);
-  RunSummary& summary = result.summary;
+  result.prediction = prediction;
+  LabRunSummary& summary = result.summary;
   const EnergyNormError relative_error(scene);
 
   const bool over_cap = result.prediction.collision_count > options.max_collisions;
@@ -94,7 +102,7 @@ RunResult runLab(const Scene& scene, const RunOptions& options, const LabEventVi
     EventVisitor enrich;
     std::array<double, 3> previous_before = scene.velocities;
     if (options.mode == RunMode::kFull) {
-      enrich = [&](const CollisionEvent& event) {
+      enrich = [&](const ImpactEvent& event) {
         LabEvent lab;
         lab.event = event;
         lab.predicted_velocities_after = toArray(model.velocitiesAfter(event.index));

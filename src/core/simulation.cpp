@@ -287,10 +287,10 @@ class Trajectory {
     return gap / approach;
   }
 
-  CollisionEvent makeEvent(std::uint64_t index, Pair pair, const Scalar& delay, const std::array<Scalar, 3>& before,
+  ImpactEvent makeEvent(std::uint64_t index, Pair pair, const Scalar& delay, const std::array<Scalar, 3>& before,
                            const std::array<Scalar, 3>& after) {
     now_.advance(delay);
-    CollisionEvent event;
+    ImpactEvent event;
     event.index = index;
     event.pair = pair;
     event.time = toDouble(now_.value());
@@ -423,7 +423,7 @@ SimulationResult simulate(const Scene& scene, const SimulationOptions& options, 
       const Scalar delay = trajectory.delayToImpact(pair, before, approach > 0 ? approach : Scalar(0));
       v.impact(coefficients.of(pair), left);
       ++k;
-      const CollisionEvent event = trajectory.makeEvent(k, pair, delay, before, v.values());
+      const ImpactEvent event = trajectory.makeEvent(k, pair, delay, before, v.values());
       if (visitor) visitor(event);
       if (keepsEvent(options.events, k)) result.events.push_back(event);
       pair = otherPair(pair);

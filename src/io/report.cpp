@@ -51,7 +51,7 @@ double maxAbsDifference(const std::array<double, 3>& a, const std::array<double,
   return result;
 }
 
-std::string paperCountText(const Prediction& prediction) {
+std::string paperCountText(const AnalyticPrediction& prediction) {
   return prediction.paper_collision_count ? std::to_string(*prediction.paper_collision_count)
                                           : std::string("undefined");
 }
@@ -84,7 +84,7 @@ class TableWriter : public RunReportWriter {
 
   void event(const LabEvent& lab) override {
     if (!header_written_) writeEventHeader();
-    const CollisionEvent& e = lab.event;
+    const ImpactEvent& e = lab.event;
     out_ << padLeft(std::to_string(e.index), 9) << padLeft(pairName(e.pair), 5);
     writeNumber(e.time);
     writeNumber(e.position);
@@ -96,8 +96,8 @@ class TableWriter : public RunReportWriter {
   }
 
   void end(const RunResult& result) override {
-    const Prediction& p = result.prediction;
-    const RunSummary& s = result.summary;
+    const AnalyticPrediction& p = result.prediction;
+    const LabRunSummary& s = result.summary;
     const auto simulated = [&](const std::string& text) { return s.simulated ? text : std::string("-"); };
     out_ << "\n";
     writeSummaryRow("Summary", "simulation", "prediction", "paper, as printed");
@@ -253,7 +253,7 @@ class CsvWriter : public RunReportWriter {
   }
 
   void event(const LabEvent& lab) override {
-    const CollisionEvent& e = lab.event;
+    const ImpactEvent& e = lab.event;
     out_ << e.index << "," << pairName(e.pair) << "," << roundTripText(e.time) << "," << roundTripText(e.position);
     for (const auto* values : {&e.positions, &e.velocities_before, &e.velocities_after, &e.energy_transfer,
                                &lab.predicted_velocities_after, &lab.paper_velocities_after,
@@ -280,8 +280,8 @@ void writeBatchTable(const std::vector<SceneOutcome>& outcomes, std::ostream& ou
       << padLeft("final v_B [m/s]", 18) << padLeft("final v_C [m/s]", 18) << padLeft("max pred err", 14)
       << "  truncated\n";
   for (const SceneOutcome& outcome : outcomes) {
-    const Prediction& p = outcome.result.prediction;
-    const RunSummary& s = outcome.result.summary;
+    const AnalyticPrediction& p = outcome.result.prediction;
+    const LabRunSummary& s = outcome.result.summary;
     out << padRight(outcome.scene.name, name_width)
         << padLeft(s.simulated ? std::to_string(s.collision_count) : "-", 12)
         << padLeft(std::to_string(p.collision_count), 12) << padLeft(paperCountText(p), 14)
@@ -301,8 +301,8 @@ void writeBatchCsv(const std::vector<SceneOutcome>& outcomes, std::ostream& out)
          "predicted_final_v_B_m_s,predicted_final_v_C_m_s,max_prediction_error,energy_relative_drift,"
          "momentum_relative_drift\n";
   for (const SceneOutcome& outcome : outcomes) {
-    const Prediction& p = outcome.result.prediction;
-    const RunSummary& s = outcome.result.summary;
+    const AnalyticPrediction& p = outcome.result.prediction;
+    const LabRunSummary& s = outcome.result.summary;
     out << outcome.scene.name << "," << s.collision_count << "," << (s.truncated ? "true" : "false") << ","
         << p.collision_count << "," << (p.paper_collision_count ? std::to_string(*p.paper_collision_count) : "")
         << "," << p.max_possible_collision_count;
@@ -421,7 +421,7 @@ Json optionsJson(const RunOptions& options) {
 }
 
 Json eventJson(const LabEvent& lab) {
-  const CollisionEvent& e = lab.event;
+  const ImpactEvent& e = lab.event;
   return Json{{"index", e.index},
               {"pair", pairName(e.pair)},
               {"time", e.time},
@@ -440,8 +440,8 @@ Json eventJson(const LabEvent& lab) {
 }
 
 Json summaryJson(const RunResult& result) {
-  const Prediction& p = result.prediction;
-  const RunSummary& s = result.summary;
+  const AnalyticPrediction& p = result.prediction;
+  const LabRunSummary& s = result.summary;
   return Json{{"collision_count", s.collision_count},
               {"truncated", s.truncated},
               {"truncation_reason", s.truncation_reason},

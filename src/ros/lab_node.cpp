@@ -197,9 +197,9 @@ void LabNode::serve(collision_lab::InitialConditions input) {
   options.mode = *mode;
   options.skip_simulation_over_cap = true;
 
-  // The prediction goes out before the simulation starts; runLab computes it again,
-  // which costs O(1) next to the simulation.
-  collision_lab::Prediction prediction = toPredictionMsg(collision_lab::predict(scene));
+  // The prediction goes out before the simulation starts.
+  const core::Prediction core_prediction = collision_lab::predict(scene);
+  collision_lab::Prediction prediction = toPredictionMsg(core_prediction);
   publishAndRecord(predictions_pub_, prediction);
   if (marker_view_) marker_view_->onPrediction(prediction);
 
@@ -233,7 +233,7 @@ void LabNode::serve(collision_lab::InitialConditions input) {
       recorder->write(energy_pub_.getTopic(), stamp, energy_msg);
     }
   };
-  const core::RunResult result = collision_lab::runLab(scene, options, onEvent);
+  const core::RunResult result = collision_lab::runLab(scene, options, core_prediction, onEvent);
 
   collision_lab::RunSummary summary = toRunSummaryMsg(result.summary, result.prediction, *mode);
   summary.published_events = published_events;

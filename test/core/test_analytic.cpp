@@ -76,7 +76,7 @@ TEST(ClosedForm, AgreesWithSimulationUpToAMillionCollisions) {
   SimulationOptions options;
   double worst = 0.0;
   const AnalyticModel<long double> model(scene);
-  const SimulationResult result = simulate<double>(scene, options, [&](const CollisionEvent& e) {
+  const SimulationResult result = simulate<double>(scene, options, [&](const ImpactEvent& e) {
     if (e.index % 997 != 0) return;
     const auto predicted = model.velocitiesAfter(e.index);
     const exact::RationalState p{exact::Rational(static_cast<double>(predicted(0))),
@@ -170,7 +170,7 @@ TEST(EnergyTransfer, ClosedFormMatchesSimulatedEvents) {
     SimulationOptions options;
     options.events = EventPolicy::all();
     const SimulationResult result = simulate<double>(scene, options);
-    for (const CollisionEvent& e : result.events) {
+    for (const ImpactEvent& e : result.events) {
       const auto predicted = model.energyTransfer(e.index);
       for (int j = 0; j < 3; ++j) {
         EXPECT_NEAR(predicted[j], e.energy_transfer[j], 1e-10 * std::max(1.0, energy)) << i << " event " << e.index;

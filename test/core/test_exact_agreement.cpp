@@ -27,7 +27,7 @@ Observed run(const Scene& scene, std::uint64_t max_collisions = 10'000'000) {
   Observed observed;
   SimulationOptions options;
   options.max_collisions = max_collisions;
-  observed.result = simulate<Scalar>(scene, options, [&](const CollisionEvent& e) { observed.pairs.push_back(e.pair); });
+  observed.result = simulate<Scalar>(scene, options, [&](const ImpactEvent& e) { observed.pairs.push_back(e.pair); });
   return observed;
 }
 
@@ -173,7 +173,7 @@ TEST(Conservation, EnergyAndMomentumOverLongRuns) {
   options.events = EventPolicy::all();
   const SimulationResult result = simulate<double>(scene, options);
   ASSERT_FALSE(result.events.empty());
-  for (const CollisionEvent& e : result.events) {
+  for (const ImpactEvent& e : result.events) {
     EXPECT_NEAR(e.total_energy, energy, 1e-14);
     EXPECT_NEAR(e.total_momentum, momentum, 1e-14);
     EXPECT_NEAR(e.energy_transfer[0] + e.energy_transfer[1] + e.energy_transfer[2], 0.0, 1e-14);
@@ -185,7 +185,7 @@ TEST(Events, PoliciesCapsAndTimes) {
   SimulationOptions options;
   options.events = EventPolicy::firstN(5);
   std::uint64_t visited = 0;
-  const SimulationResult first5 = simulate<double>(scene, options, [&](const CollisionEvent&) { ++visited; });
+  const SimulationResult first5 = simulate<double>(scene, options, [&](const ImpactEvent&) { ++visited; });
   EXPECT_EQ(first5.collision_count, 31u);
   EXPECT_EQ(visited, 31u);
   ASSERT_EQ(first5.events.size(), 5u);

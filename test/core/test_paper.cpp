@@ -64,11 +64,11 @@ TEST(PaperErrata, EnergyTransfer44UsesTheWrongAverage) {
   options.events = EventPolicy::all();
   const SimulationResult result = simulate<double>(scene, options);
   ASSERT_GE(result.collision_count, 3u);
-  const CollisionEvent& first = result.events[0];
+  const ImpactEvent& first = result.events[0];
   const auto printed_first =
       paper::energyTransfer(scene, 1, first.pair, first.velocities_before, scene.velocities);
   EXPECT_NEAR(printed_first[0], first.energy_transfer[0], 1e-12);  // right at k = 0
-  const CollisionEvent& third = result.events[2];
+  const ImpactEvent& third = result.events[2];
   ASSERT_EQ(third.pair, Pair::AB);
   const auto printed_third =
       paper::energyTransfer(scene, 3, third.pair, third.velocities_before, result.events[1].velocities_before);

@@ -24,7 +24,7 @@ enum class RunMode : std::uint8_t {
 };
 
 /// Analytic predictions for a scene, computed before (and without) any simulation.
-struct Prediction {
+struct AnalyticPrediction {
   std::uint64_t collision_count = 0;           ///< correct count, exact
   std::optional<std::int64_t> paper_collision_count;  ///< eq. (3.22) as printed; empty if undefined
   std::uint64_t max_possible_collision_count = 0;     ///< ceil(pi / alpha), exact
@@ -35,11 +35,11 @@ struct Prediction {
   std::array<double, 3> final_velocities{};    ///< closed form after collision_count [m/s]
 };
 
-Prediction predict(const Scene& scene);
+AnalyticPrediction predict(const Scene& scene);
 
 /// One collision with everything a lab compares it to.
 struct LabEvent {
-  CollisionEvent event;
+  ImpactEvent event;
   std::array<double, 3> predicted_velocities_after{};  ///< closed form [m/s]
   std::array<double, 3> paper_velocities_after{};      ///< eqs. (2.15)/(2.16) as printed [m/s]
   std::array<double, 3> predicted_energy_transfer{};   ///< closed form, gained by A,B,C [J]
@@ -57,7 +57,7 @@ struct RunOptions {
   bool skip_simulation_over_cap = false;
 };
 
-struct RunSummary {
+struct LabRunSummary {
   std::uint64_t collision_count = 0;
   bool truncated = false;
   std::string truncation_reason;            ///< empty unless truncated
@@ -73,8 +73,8 @@ struct RunSummary {
 };
 
 struct RunResult {
-  Prediction prediction;
-  RunSummary summary;
+  AnalyticPrediction prediction;
+  LabRunSummary summary;
   std::vector<LabEvent> events;  ///< as RunOptions::events says
 };
 
@@ -83,6 +83,11 @@ using LabEventVisitor = std::function<void(const LabEvent&)>;
 /// Runs a validated scene. The visitor sees every event in order (none in predict-only
 /// or summary-only mode). Precondition: validate(scene) passed.
 RunResult runLab(const Scene& scene, const RunOptions& options,
+                 const LabEventVisitor& visitor = {});
+
+/// The same with the prediction already made (for callers that publish it first);
+/// `prediction` must be predict(scene).
+RunResult runLab(const Scene& scene, const RunOptions& options, const AnalyticPrediction& prediction,
                  const LabEventVisitor& visitor = {});
 
 }  // namespace collision_lab

@@ -20,7 +20,7 @@
 namespace collision_lab {
 
 /// One elastic two-body impact.
-struct CollisionEvent {
+struct ImpactEvent {
   std::uint64_t index = 0;                    ///< 1-based collision number
   Pair pair = Pair::AB;
   double time = 0.0;                          ///< [s] since the start of the run
@@ -51,7 +51,7 @@ struct SimulationOptions {
 };
 
 /// Called for every collision, in order. May be empty.
-using EventVisitor = std::function<void(const CollisionEvent&)>;
+using EventVisitor = std::function<void(const ImpactEvent&)>;
 
 /// How often the adaptive path had to leave the working precision.
 struct EscalationStats {
@@ -73,7 +73,7 @@ struct SimulationResult {
   /// |p_end - p_0| / sum |m v|; NaN with a wall, which does not conserve momentum.
   double momentum_relative_drift = 0.0;
   EscalationStats escalation;
-  std::vector<CollisionEvent> events;     ///< as EventPolicy says
+  std::vector<ImpactEvent> events;     ///< as EventPolicy says
 };
 
 /// Which pair collides first, exactly for the given doubles; empty when neither pair

@@ -1,21 +1,13 @@
 // The one way ROS-layer code includes the core.
 //
 // The generated messages live in namespace collision_lab (the package name), and so does
-// the core. Three core structs share a message's name (Prediction, RunSummary,
-// CollisionEvent), so a translation unit cannot declare both as they are. This header
-// includes the core with those three renamed to Core*, and exposes the core to the ROS
-// layer as collision_lab_ros::core. Include it instead of any collision_lab/core header.
-// Should the core move to its own namespace, only this header changes.
+// the core, whose structs are named apart from the messages (AnalyticPrediction vs the
+// Prediction message, and so on). This header exposes the core to the ROS layer as
+// collision_lab_ros::core, under the names the messages mirror.
 #pragma once
 
-#define Prediction CorePrediction
-#define RunSummary CoreRunSummary
-#define CollisionEvent CoreCollisionEvent
 #include "collision_lab/core/lab_run.h"
 #include "collision_lab/core/scene.h"
-#undef CollisionEvent
-#undef RunSummary
-#undef Prediction
 
 namespace collision_lab_ros {
 namespace core {
@@ -28,9 +20,9 @@ using collision_lab::RunOptions;
 using collision_lab::RunResult;
 using collision_lab::Scene;
 using collision_lab::ValidationError;
-using CollisionEvent = collision_lab::CoreCollisionEvent;
-using Prediction = collision_lab::CorePrediction;
-using RunSummary = collision_lab::CoreRunSummary;
+using CollisionEvent = collision_lab::ImpactEvent;
+using Prediction = collision_lab::AnalyticPrediction;
+using RunSummary = collision_lab::LabRunSummary;
 
 }  // namespace core
 }  // namespace collision_lab_ros
