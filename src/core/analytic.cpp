@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <type_traits>
 
 #include <Eigen/Eigenvalues>
 #include <boost/math/constants/constants.hpp>
@@ -294,7 +295,14 @@ std::array<Scalar, 3> AnalyticModel<Scalar>::energyTransfer(std::uint64_t n) con
   const Scalar approach = before(right) - before(left);
   const Scalar pair_centre_velocity = f_left * before(left) + f_right * before(right);
   // dE_left = 2 m_l m_r (v_r - v_l)(m_l v_l + m_r v_r) / (m_l + m_r)^2 (physics.md).
-  gained[left] = reduced * (2 * approach * pair_centre_velocity);  // this order cannot overflow first
+  // The factors can overflow a double on their way to a representable energy (a mass
+  // near 1e308, or speeds near 1e300): multiply with the exponent range of long double.
+  if constexpr (std::is_floating_point_v<Scalar>) {
+    gained[left] = static_cast<Scalar>(2.0L * static_cast<long double>(reduced) * static_cast<long double>(approach) *
+                                       static_cast<long double>(pair_centre_velocity));
+  } else {
+    gained[left] = 2 * reduced * approach * pair_centre_velocity;
+  }
   gained[right] = -gained[left];
   return gained;
 }

@@ -158,6 +158,21 @@ TEST(Inverse, RoundTripRecoversInitialVelocities) {
   }
 }
 
+TEST(EnergyTransfer, FiniteAtTheEdgesOfTheDoubleRange) {
+  // Found by the fuzzer: intermediate products overflowed though the energies do not.
+  const Scene tiny_masses{{2.6895203214236869e-306, 1.7765824089018436e-307, 1.7765824089018436e-307},
+                          {1.7800590868057611e-307, 1.7765824089018436e-307, 0},
+                          {5.1294921942786796e-305, -5.4861240687936887e+303, 1}};
+  const Scene huge_mass{{kInf, 1.7e308, 1.7e308}, {5, 1, 0}, {0, 0, 1e-10}};
+  for (const Scene& scene : {tiny_masses, huge_mass}) {
+    ASSERT_FALSE(validate(scene));
+    const AnalyticModel<double> model(scene);
+    for (std::uint64_t n = 1; n <= 3; ++n) {
+      for (double gained : model.energyTransfer(n)) EXPECT_TRUE(std::isfinite(gained)) << n;
+    }
+  }
+}
+
 TEST(EnergyTransfer, ClosedFormMatchesSimulatedEvents) {
   std::mt19937_64 rng(5);
   for (int i = 0; i < 100; ++i) {
