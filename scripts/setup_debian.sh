@@ -12,7 +12,7 @@ packages=(
   build-essential cmake
   ros-core-dev python3-rostopic python3-roslaunch python3-rosbag python3-rosmaster
   python3-rosmsg python3-rosnode rosout
-  libeigen3-dev libboost-dev libgmp-dev libvisualization-msgs-dev
+  libeigen3-dev libboost-dev libgmp-dev libvisualization-msgs-dev libdiagnostic-msgs-dev
   libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
 )
 for arg in "$@"; do

@@ -1,9 +1,13 @@
 #include "collision_lab/ros/lab_node.h"
 
+#include <sys/statvfs.h>
+
 #include <cstdlib>
 #include <ctime>
 #include <optional>
 #include <utility>
+
+#include <diagnostic_msgs/DiagnosticArray.h>
 
 #include "collision_lab/ros/msg_conversion.h"
 #include "collision_lab/ros/node_constants.h"
@@ -56,6 +60,7 @@ LabNodeParams LabNodeParams::load(const ros::NodeHandle& private_nh) {
   params.max_published_events =
       getUint64(private_nh, "max_published_events", kDefaultMaxPublishedEvents);
   private_nh.param("publish_markers", params.publish_markers, true);
+  private_nh.param("min_free_space_mb", params.min_free_space_mb, kDefaultMinFreeSpaceMb);
   return params;
 }
 
@@ -89,6 +94,10 @@ LabNode::LabNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   const std::time_t now = std::time(nullptr);
   std::strftime(start, sizeof start, "%Y%m%d_%H%M%S", std::gmtime(&now));
   run_id_prefix_ = std::string("run_") + start + "_";
+
+  diagnostics_pub_ = nh_.advertise<diagnostic_msgs::DiagnosticArray>(kDiagnosticsTopic, 10);
+  diagnostics_timer_ = nh_.createWallTimer(ros::WallDuration(kDiagnosticsPeriod),
+                                           [this](const ros::WallTimerEvent&) { publishDiagnostics(); });
 
   worker_ = std::thread(&LabNode::workerLoop, this);
   input_sub_ = nh_.subscribe(kInitialConditionsTopic, kInputQueueSize,
@@ -143,6 +152,7 @@ std::string LabNode::newRunId() {
 void LabNode::reject(collision_lab::Rejected msg, const std::string& run_id) {
   msg.header.stamp = stampNow();
   msg.run_id = run_id;
+  ++runs_rejected_;
   ROS_WARN_STREAM("rejected run '" << run_id << "': " << msg.reason_name << " in field "
                   << msg.field << ": " << msg.message);
   rejected_pub_.publish(msg);
@@ -255,11 +265,63 @@ void LabNode::serve(collision_lab::InitialConditions input) {
     summary.recording_error = recorder->error();
   }
   summaries_pub_.publish(summary);
+  ++runs_accepted_;
+  last_compute_time_ = summary.compute_time;
+  if (recorder) {
+    std::lock_guard<std::mutex> lock(recording_mutex_);
+    last_recording_error_ = summary.recording_error;
+  }
   if (marker_view_) marker_view_->onRunSummary(summary);
   ROS_INFO_STREAM("run " << run_id << ": " << summary.collision_count << " collisions"
                   << (summary.truncated ? " (truncated)" : "") << ", predicted "
                   << summary.predicted_collision_count << ", " << summary.compute_time
                   << " s" << (recorder ? ", bag " + summary.bag_path : std::string()));
+}
+
+void LabNode::publishDiagnostics() {
+  diagnostic_msgs::DiagnosticStatus status;
+  status.name = ros::this_node::getName() + ": lab runs";
+  status.hardware_id = "collision_lab";
+  status.level = diagnostic_msgs::DiagnosticStatus::OK;
+  status.message = "serving";
+  const auto add = [&status](const std::string& key, const std::string& value) {
+    diagnostic_msgs::KeyValue pair;
+    pair.key = key;
+    pair.value = value;
+    status.values.push_back(pair);
+  };
+  add("runs accepted", std::to_string(runs_accepted_.load()));
+  add("runs rejected", std::to_string(runs_rejected_.load()));
+  add("last run compute time [s]", std::to_string(last_compute_time_.load()));
+  add("recording", params_.record ? "on" : "off");
+  add("bag directory", params_.bag_directory);
+  if (params_.record) {
+    std::string recording_error;
+    {
+      std::lock_guard<std::mutex> lock(recording_mutex_);
+      recording_error = last_recording_error_;
+    }
+    add("last recording error", recording_error);
+    if (!recording_error.empty()) {
+      status.level = diagnostic_msgs::DiagnosticStatus::ERROR;
+      status.message = "recording failed: " + recording_error;
+    }
+    struct statvfs space {};
+    if (statvfs(params_.bag_directory.c_str(), &space) == 0) {
+      const double free_mb = static_cast<double>(space.f_bavail) * space.f_frsize / 1e6;
+      add("free space in bag directory [MB]", std::to_string(free_mb));
+      if (free_mb < params_.min_free_space_mb && status.level == diagnostic_msgs::DiagnosticStatus::OK) {
+        status.level = diagnostic_msgs::DiagnosticStatus::WARN;
+        status.message = "low free space for bags: " + std::to_string(free_mb) + " MB";
+      }
+    } else {
+      add("free space in bag directory [MB]", "unknown (directory not readable)");
+    }
+  }
+  diagnostic_msgs::DiagnosticArray array;
+  array.header.stamp = stampNow();
+  array.status.push_back(status);
+  diagnostics_pub_.publish(array);
 }
 
 }  // namespace collision_lab_ros

@@ -12,6 +12,7 @@
 #include <map>
 #include <optional>
 
+#include <diagnostic_msgs/DiagnosticArray.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <rosbag/bag.h>
@@ -391,6 +392,40 @@ TEST(LabNode, UnwritableBagDirectoryStillPublishesEverything) {
 }
 
 }  // namespace
+
+// ---- /diagnostics: counts, recording state, free space ----
+
+TEST(LabNode, DiagnosticsReportRunsAndRecordingState) {
+  g_node->waitFor("round_trip");
+  g_faulty->waitFor("no_disk");
+  using Status = diagnostic_msgs::DiagnosticStatus;
+  std::map<std::string, Status> latest;
+  ros::NodeHandle nh;
+  const ros::Subscriber sub = nh.subscribe<diagnostic_msgs::DiagnosticArray>(
+      "/diagnostics", 100, [&latest](const diagnostic_msgs::DiagnosticArray::ConstPtr& array) {
+        for (const Status& status : array->status) latest[status.name] = status;
+      });
+  const auto value = [](const Status& status, const std::string& key) {
+    for (const auto& pair : status.values) {
+      if (pair.key == key) return pair.value;
+    }
+    return std::string();
+  };
+  const std::string healthy = "/collision_lab/collision_lab_node: lab runs";
+  const std::string faulty = "/collision_lab_faulty/collision_lab_node: lab runs";
+  // Published once a second; wait for a report from each node after their runs.
+  const auto reported = [&] {
+    return latest.count(healthy) && latest.count(faulty) && value(latest[healthy], "runs accepted") != "0" &&
+           latest[faulty].level == Status::ERROR;
+  };
+  while (ros::ok() && !reported()) RunCollector::spinOnce();
+  EXPECT_GE(std::stoull(value(latest[healthy], "runs accepted")), 1u);
+  EXPECT_GE(std::stoull(value(latest[healthy], "runs rejected")), 1u);
+  EXPECT_NE(latest[healthy].level, Status::ERROR);
+  EXPECT_EQ(value(latest[healthy], "recording"), "on");
+  EXPECT_GT(std::stod(value(latest[healthy], "free space in bag directory [MB]")), 0.0);
+  EXPECT_NE(latest[faulty].message.find("recording failed"), std::string::npos);
+}
 
 int main(int argc, char** argv) {
   testing::InitGoogleTest(&argc, argv);

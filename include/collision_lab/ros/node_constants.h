@@ -15,6 +15,11 @@ constexpr char kEnergyTransfersTopic[] = "energy_transfers";
 constexpr char kRunSummariesTopic[] = "run_summaries";
 constexpr char kRejectedTopic[] = "rejected";
 constexpr char kMarkersTopic[] = "markers";
+/// Absolute by the ROS convention: the diagnostic aggregator listens there.
+constexpr char kDiagnosticsTopic[] = "/diagnostics";
+constexpr double kDiagnosticsPeriod = 1.0;  ///< [s]
+/// Below this much free space in bag_directory the diagnostics warn.
+constexpr double kDefaultMinFreeSpaceMb = 500.0;  ///< [MB]
 
 /// Inputs arrive in bursts from scripts; the subscriber callback only queues them, so
 /// this covers bursts of up to 10,000 inputs between two spins.
