@@ -21,6 +21,12 @@ namespace mp = boost::multiprecision;
 using ReplayPrecision = mp::cpp_bin_float_100;
 using DeepReplayPrecision = mp::number<mp::cpp_bin_float<500>>;
 
+/// Up to this many impacts a 100-digit replay is cheaper than building the closed form.
+constexpr std::uint64_t kShortReplay = 2000;
+/// Every this many impacts a long run adopts the 100-digit closed-form state (~0.1 ns per
+/// impact amortized), which keeps its velocities accurate over hundreds of millions.
+constexpr std::uint64_t kResynchronizeInterval = std::uint64_t{1} << 20;
+
 /// Longest run an exact rational replay is attempted for (its cost grows ~quadratically).
 /// Reached only when 100 digits cannot tell the approach speed from zero.
 constexpr std::uint64_t kExactReplayLimit = 20000;
@@ -126,6 +132,29 @@ struct CompensatedVelocities {
   }
 };
 
+/// Velocities after k alternating impacts, replayed in precision T with the engine's own
+/// impact formula. Cheaper than building the closed form when k is small.
+template <class T>
+std::array<T, 3> replay(const Scene& scene, Pair first, std::uint64_t k) {
+  const Coefficients<T> coefficients(scene.masses);
+  std::array<T, 3> v{T(scene.velocities[0]), T(scene.velocities[1]), T(scene.velocities[2])};
+  Pair pair = first;
+  for (std::uint64_t i = 0; i < k; ++i) {
+    const int left = pair == Pair::AB ? kA : kB;
+    const PairCoefficients<T>& c = coefficients.of(pair);
+    const T approach = v[left + 1] - v[left];
+    if (c.heavy_is_left) {
+      v[left] += c.heavy_gain * approach;
+      v[left + 1] = v[left] - approach;
+    } else {
+      v[left + 1] -= c.heavy_gain * approach;
+      v[left] = v[left + 1] + approach;
+    }
+    pair = otherPair(pair);
+  }
+  return v;
+}
+
 /// Scales that bound rounding errors: in the wall's frame (or the lab frame without a
 /// wall) kinetic energy is conserved, so |u| = sqrt(sum m v^2) bounds every mass-weighted
 /// velocity, and a velocity error is at most |du| / sqrt(m).
@@ -172,10 +201,10 @@ T approachOf(Pair pair, const std::array<T, 3>& v) {
   return pair == Pair::AB ? T(v[kB] - v[kA]) : T(v[kC] - v[kB]);
 }
 
-/// Takes the sign decisions the working precision cannot: the closed-form state after k
-/// impacts at 100 digits (O(1) in k), then exact rationals for a zero to within that,
-/// then 500 digits beyond the rationals' reach. The closed form holds for any alternating
-/// sequence, which every run is, so no replay from the start is needed.
+/// Takes the sign decisions the working precision cannot, at 100 digits: a replay for
+/// short runs, the closed-form state after k impacts (O(1) in k) for long ones; then
+/// exact rationals for a zero to within that, then 500 digits beyond the rationals' reach.
+/// The closed form holds for any alternating sequence, which every run is.
 template <class Scalar>
 class Escalation {
  public:
@@ -185,11 +214,10 @@ class Escalation {
   /// state at k to `v`.
   bool approaches(std::uint64_t k, Pair pair, CompensatedVelocities<Scalar>& v, EscalationStats& stats) {
     ++stats.high_precision;
-    if (!precise_) precise_.emplace(scene_);
-    const auto precise = stateOf(*precise_, k);
-    const ReplayPrecision precise_approach = approachOf(pair, precise);
-    if (mp::abs(precise_approach) > bound<ReplayPrecision>(pair, k)) {
-      v.adopt(precise);
+    const Precise precise = preciseState(k);
+    const ReplayPrecision precise_approach = approachOf(pair, precise.velocities);
+    if (mp::abs(precise_approach) > precise.bound_factor * scale_.bound<ReplayPrecision>(pair, k)) {
+      v.adopt(precise.velocities);
       return precise_approach > 0;
     }
     if (k <= kExactReplayLimit) {
@@ -203,28 +231,43 @@ class Escalation {
     const AnalyticModel<DeepReplayPrecision> deep_model(scene_);
     const auto deep = stateOf(deep_model, k);
     v.adopt(deep);
-    return approachOf(pair, deep) > bound<DeepReplayPrecision>(pair, k);
+    return approachOf(pair, deep) > closedFormFactor<DeepReplayPrecision>() * scale_.bound<DeepReplayPrecision>(pair, k);
   }
 
+  /// Replaces v by the 100-digit state after k impacts, so that rounding errors of very
+  /// long runs do not accumulate.
+  void resynchronize(std::uint64_t k, CompensatedVelocities<Scalar>& v) { v.adopt(preciseState(k).velocities); }
+
  private:
+  struct Precise {
+    std::array<ReplayPrecision, 3> velocities;
+    ReplayPrecision bound_factor;  ///< times the replay bound of ErrorScale
+  };
+
+  Precise preciseState(std::uint64_t k) {
+    if (k <= kShortReplay) return {replay<ReplayPrecision>(scene_, first_, k), ReplayPrecision(1)};
+    if (!closed_form_) closed_form_.emplace(scene_);
+    return {stateOf(*closed_form_, k), closedFormFactor<ReplayPrecision>()};
+  }
+
   template <class T>
   static std::array<T, 3> stateOf(const AnalyticModel<T>& model, std::uint64_t k) {
     const auto state = model.velocitiesAfter(k);
     return {state(0), state(1), state(2)};
   }
 
-  /// Rounding bound of the closed form: the rotation angle k theta carries k rounding
-  /// errors, and an angle error moves the state by up to 1/alpha times its scale.
+  /// The closed form's rotation angle k theta carries k rounding errors, and an angle
+  /// error moves the state by up to 1/alpha times its scale.
   template <class T>
-  T bound(Pair pair, std::uint64_t k) const {
+  T closedFormFactor() const {
     const T alpha(anglesFor(scene_.masses).alpha);
-    return scale_.bound<T>(pair, k) * 16 * (1 + 1 / alpha);
+    return 16 * (1 + 1 / alpha);
   }
 
   const Scene& scene_;
   const ErrorScale& scale_;
   Pair first_;
-  std::optional<AnalyticModel<ReplayPrecision>> precise_;
+  std::optional<AnalyticModel<ReplayPrecision>> closed_form_;
 };
 
 struct Frame {
@@ -383,6 +426,11 @@ SimulationResult simulate(const Scene& scene, const SimulationOptions& options, 
   // Does `pair` approach after k impacts? Exact decision; may refresh v.
   auto approaches = [&](Pair pair, std::uint64_t k) {
     ++stats.decisions;
+    if (k - exact_at >= kResynchronizeInterval) {
+      if (!escalation) escalation.emplace(scene, scale, *result.first_pair);
+      escalation->resynchronize(k, v);
+      exact_at = k;
+    }
     const Scalar approach = v.approach(pair == Pair::AB ? kA : kB);
     const Scalar bound =
         (pair == Pair::AB ? step_bound_ab : step_bound_bc) * Scalar(static_cast<double>(k - exact_at + 2));
