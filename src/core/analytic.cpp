@@ -70,18 +70,10 @@ struct Quotient {
   T error_bound;
 };
 
-double largest_mass(const Scene& scene) {
+double largestFiniteMass(const Scene& scene) {
   double mass = 0.0;
   for (int i = 0; i < 3; ++i) {
     if (!scene.isWall(i)) mass = std::max(mass, scene.masses[i]);
-  }
-  return mass;
-}
-
-double smallest_mass(const Scene& scene) {
-  double mass = std::numeric_limits<double>::infinity();
-  for (int i = 0; i < 3; ++i) {
-    if (!scene.isWall(i)) mass = std::min(mass, scene.masses[i]);
   }
   return mass;
 }
@@ -100,7 +92,7 @@ Quotient<T> countQuotient(const Scene& scene, Pair first) {
   // nearly common velocity makes psi inaccurate: bound the angular error by |dw| / |w|,
   // both weighted by sqrt(m_i / m_max) as w is.
   const int wall = scene.wallIndex();
-  const double mass_max = largest_mass(scene);
+  const double mass_max = largestFiniteMass(scene);
   T velocity_scale = 0;
   for (int i = 0; i < 3; ++i) velocity_scale = std::max(velocity_scale, absOf(T(scene.velocities[i])));
   const T frame = wall >= 0 ? T(scene.velocities[wall]) : T(0);
