@@ -101,19 +101,30 @@ struct CompensatedVelocities {
     hi[i] = sum;
   }
 
-  void set(int i, const T& value) {
-    hi[i] = value;
-    lo[i] = T(0);
+  /// Sets body i to (hi[from] + lo[from]) + sign * (speed_hi + speed_lo), keeping the
+  /// rounding error of the leading sum: the light body's velocity swings far above its
+  /// final value, and its rounding at the peak would otherwise stay in it.
+  void setFrom(int i, int from, const T& sign, const T& speed_hi, const T& speed_lo) {
+    const T term = sign * speed_hi;
+    const T sum = hi[from] + term;
+    const T term_part = sum - hi[from];
+    lo[i] = (hi[from] - (sum - term_part)) + (term - term_part) + lo[from] + sign * speed_lo;
+    hi[i] = sum;
   }
 
   void impact(const PairCoefficients<T>& c, int left) {
-    const T speed = approach(left);
+    const int right = left + 1;
+    // Approach speed as hi + lo, the leading difference split exactly (TwoSum).
+    const T speed_hi = hi[right] - hi[left];
+    const T right_part = speed_hi + hi[left];
+    const T speed_lo = ((hi[right] - right_part) + (right_part - speed_hi - hi[left])) + (lo[right] - lo[left]);
+    const T speed = speed_hi + speed_lo;
     if (c.heavy_is_left) {
       add(left, c.heavy_gain * speed);
-      set(left + 1, value(left) - speed);
+      setFrom(right, left, T(-1), speed_hi, speed_lo);
     } else {
-      add(left + 1, -(c.heavy_gain * speed));
-      set(left, value(left + 1) + speed);
+      add(right, -(c.heavy_gain * speed));
+      setFrom(left, right, T(1), speed_hi, speed_lo);
     }
   }
 
