@@ -9,7 +9,7 @@ cd "$(dirname "$0")/.."
 export PATH=/usr/bin:/bin:/usr/sbin:/sbin:$PATH
 
 packages=(
-  build-essential cmake
+  build-essential cmake libgtest-dev
   ros-core-dev python3-rostopic python3-roslaunch python3-rosbag python3-rosmaster
   python3-rosmsg python3-rosnode rosout
   libeigen3-dev libboost-dev libgmp-dev libvisualization-msgs-dev libdiagnostic-msgs-dev
