@@ -5,15 +5,10 @@
 # Usage: scripts/demo.sh [roslaunch args, e.g. scenarios:="pi_digits_3 grazing"]
 set -euo pipefail
 cd "$(dirname "$0")/.."
-if [ -n "${DISPLAY:-}" ]; then
-  scripts/setup_debian.sh --with-rviz
-  rviz=true
-else
-  scripts/setup_debian.sh
-  rviz=false
-fi
+scripts/setup_debian.sh
+if [ -n "${DISPLAY:-}" ]; then rviz=true; else rviz=false; fi
 export PATH=/usr/bin:/bin:$PATH
 set +u
-source build/devel/setup.bash
+source build_ros/devel/setup.bash
 set -u
 exec roslaunch collision_lab demo.launch rviz:=$rviz "$@"

@@ -1,23 +1,33 @@
 #!/usr/bin/env bash
-# Installs what collision_lab needs on Debian 12 (as root) and builds it into ./build.
+# Installs what collision_lab needs on Debian 12 (as root) and builds it into ./build_ros, a
+# standalone catkin devel space. Afterwards `source build_ros/devel/setup.bash` makes rosrun,
+# roslaunch, rostest and rosservice find the package and every executable. (rosrun skips
+# every path under <package>/build/, so the folder must not be called build.)
 # Idempotent: apt-get runs only when a package is missing; the build is incremental.
-# Usage: scripts/setup_debian.sh [--with-rviz] [--with-bench]
+# Usage: scripts/setup_debian.sh [--with-screenshots] [--with-bench]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 # catkin's CMake needs Debian's python3 (with catkin_pkg), not a pyenv one earlier on PATH.
 export PATH=/usr/bin:/bin:/usr/sbin:/sbin:$PATH
 
+# Every command that the README, the launch files and the tests use, on a bare machine:
+# rostest (python3-rostest) and rosrun (rosbash) are not part of ros-core-dev; rostopic
+# needs the Python messages of other packages to echo /diagnostics and the markers; rviz
+# is opened by the launch files whenever a display is set.
 packages=(
   build-essential cmake libgtest-dev
-  ros-core-dev python3-rostopic python3-roslaunch python3-rosbag python3-rosmaster
-  python3-rosmsg python3-rosnode rosout
+  ros-core-dev rosout rosbash python3-rostest
+  python3-rostopic python3-roslaunch python3-rosbag python3-rosmaster python3-rosmsg
+  python3-rosnode python3-rosservice python3-rosparam
   libeigen3-dev libboost-dev libgmp-dev libvisualization-msgs-dev libdiagnostic-msgs-dev
+  python3-visualization-msgs python3-diagnostic-msgs
   libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
+  rviz
 )
 for arg in "$@"; do
   case "$arg" in
-    --with-rviz) packages+=(rviz xvfb imagemagick) ;;
+    --with-screenshots) packages+=(xvfb imagemagick) ;;
     --with-bench) packages+=(libbullet-dev libode-dev libbox2d-dev gnuplot python3-matplotlib) ;;
     *) echo "setup_debian.sh: unknown option $arg" >&2; exit 2 ;;
   esac
@@ -34,7 +44,8 @@ if [ ${#missing[@]} -gt 0 ]; then
   apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
-echo "== building into ./build"
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DPYTHON_EXECUTABLE=/usr/bin/python3 > build.configure.log 2>&1 \
-  || { cat build.configure.log; exit 1; }
-cmake --build build -j"$(nproc)"
+echo "== building into ./build_ros (log in build_ros.log)"
+{ cmake -S . -B build_ros -DCMAKE_BUILD_TYPE=Release -DPYTHON_EXECUTABLE=/usr/bin/python3 \
+    && cmake --build build_ros -j"$(nproc)"; } > build_ros.log 2>&1 \
+  || { tail -n 60 build_ros.log; echo "setup_debian.sh: the build failed; whole log in build_ros.log" >&2; exit 1; }
+echo "== built: source build_ros/devel/setup.bash, then rosrun collision_lab collision_lab_cli --help"

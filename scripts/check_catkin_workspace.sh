@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# Checks the usual ROS way on this machine: a fresh catkin workspace with this checkout in
+# src/, built with catkin_make (or `catkin build` with --catkin-tools), then rosrun and
+# roslaunch find the package. Run after scripts/setup_debian.sh. The workspace is a
+# temporary folder, removed at the end.
+# Usage: scripts/check_catkin_workspace.sh [--catkin-tools]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+export PATH=/usr/bin:/bin:/usr/sbin:/sbin:$PATH
+repo=$PWD
+tool=catkin_make
+[ "${1:-}" = "--catkin-tools" ] && tool="catkin build"
+
+ws=$(mktemp -d /tmp/collision_lab_ws.XXXXXX)
+trap 'rm -rf "$ws"' EXIT
+mkdir -p "$ws/src"
+ln -s "$repo" "$ws/src/collision_lab"
+echo "== $tool in $ws (log in $ws/build.log)"
+(
+  cd "$ws"
+  if [ "$tool" = catkin_make ]; then
+    catkin_make -DCMAKE_BUILD_TYPE=Release -DPYTHON_EXECUTABLE=/usr/bin/python3 -j"$(nproc)"
+  else
+    catkin init && catkin config --cmake-args -DCMAKE_BUILD_TYPE=Release -DPYTHON_EXECUTABLE=/usr/bin/python3
+    catkin build --no-status -j"$(nproc)"
+  fi
+) > "$ws/build.log" 2>&1 || { tail -n 60 "$ws/build.log"; echo "check_catkin_workspace.sh: $tool failed" >&2; exit 1; }
+
+set +u
+# A clean environment: only the new workspace's devel space (and /usr underneath).
+unset ROS_PACKAGE_PATH CMAKE_PREFIX_PATH
+source "$ws/devel/setup.bash"
+set -u
+found=$(rospack find collision_lab)
+[ "$found" = "$ws/src/collision_lab" ] || { echo "rospack finds $found, not the workspace's copy" >&2; exit 1; }
+out=$(rosrun collision_lab collision_lab_cli --masses 100,1,inf --positions 2,1,0 --velocities -1,0,0 \
+  --mode predict --format json)
+echo "$out" | grep -Eq '"collision_count": ?31[,}]' || { echo "rosrun collision_lab_cli gave: $out" >&2; exit 1; }
+roslaunch --files collision_lab demo.launch > /dev/null
+echo "check_catkin_workspace.sh: $tool workspace OK (rospack, rosrun collision_lab_cli: 31 collisions, roslaunch finds demo.launch)"
