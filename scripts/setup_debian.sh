@@ -4,7 +4,8 @@
 # roslaunch, rostest and rosservice find the package and every executable. (rosrun skips
 # every path under <package>/build/, so the folder must not be called build.)
 # Idempotent: apt-get runs only when a package is missing; the build is incremental.
-# Usage: scripts/setup_debian.sh [--with-screenshots] [--with-bench]
+# Usage: scripts/setup_debian.sh [--no-build] [--with-screenshots] [--with-bench]
+#   --no-build: install the packages only (for a catkin workspace of your own).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -25,8 +26,10 @@ packages=(
   libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
   rviz
 )
+build=true
 for arg in "$@"; do
   case "$arg" in
+    --no-build) build=false ;;
     --with-screenshots) packages+=(xvfb imagemagick) ;;
     --with-bench) packages+=(libbullet-dev libode-dev libbox2d-dev gnuplot python3-matplotlib) ;;
     *) echo "setup_debian.sh: unknown option $arg" >&2; exit 2 ;;
@@ -44,6 +47,7 @@ if [ ${#missing[@]} -gt 0 ]; then
   apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
+$build || exit 0
 echo "== building into ./build_ros (log in build_ros.log)"
 { cmake -S . -B build_ros -DCMAKE_BUILD_TYPE=Release -DPYTHON_EXECUTABLE=/usr/bin/python3 \
     && cmake --build build_ros -j"$(nproc)"; } > build_ros.log 2>&1 \
