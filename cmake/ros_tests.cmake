@@ -7,6 +7,17 @@ if(TARGET ros_layer_unit_test)
   target_link_libraries(ros_layer_unit_test collision_lab_ros GTest::gtest_main)
 endif()
 
+# The run timeline and bag_to_csv (no master).
+catkin_add_gtest(ros_tools_unit_test
+  test/ros/run_timeline_test.cpp
+  test/ros/bag_csv_test.cpp)
+if(TARGET ros_tools_unit_test)
+  target_link_libraries(ros_tools_unit_test collision_lab_ros GTest::gtest_main)
+  add_dependencies(ros_tools_unit_test bag_to_csv)
+  target_compile_definitions(ros_tools_unit_test PRIVATE
+    COLLISION_LAB_BAG_TO_CSV="$<TARGET_FILE:bag_to_csv>")
+endif()
+
 find_package(rostest REQUIRED)
 foreach(name node_test burst_test demo_test crash_test)
   add_rostest_gtest(${name} test/ros/${name}.test test/ros/${name}.cpp)
