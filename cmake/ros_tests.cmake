@@ -25,7 +25,8 @@ foreach(name node_test burst_test demo_test crash_test)
   # The rostests start these nodes.
   add_dependencies(${name} collision_lab_node collision_lab_markers scenario_publisher)
 endforeach()
-# node_test reads the bad-input catalogue, docs/bad_inputs.md.
+# node_test reads the bad-input catalogue, docs/bad_inputs.md; demo_test runs scripts/play_run.
 target_compile_definitions(node_test PRIVATE COLLISION_LAB_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+target_compile_definitions(demo_test PRIVATE COLLISION_LAB_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
 # crash_test starts and kills the node itself.
 target_compile_definitions(crash_test PRIVATE COLLISION_LAB_NODE_PATH="$<TARGET_FILE:collision_lab_node>")
