@@ -126,7 +126,9 @@ std::vector<collision_lab::CollisionEvent> expectBagOnTimeline(const std::string
   for (std::size_t k = 0; k < events.size(); ++k) {
     EXPECT_NEAR(nsAfter(start, events[k].header.stamp), scale * events[k].time * 1e9, 1.0)
         << "collision " << k + 1;
-    if (k < velocities.size()) EXPECT_EQ(velocities[k].header.stamp, events[k].header.stamp);
+    if (k < velocities.size()) {
+      EXPECT_EQ(velocities[k].header.stamp, events[k].header.stamp);
+    }
   }
   // The bag's own times are the stamps: its duration is the run's scaled duration.
   rosbag::View all(bag);
