@@ -3,21 +3,27 @@
 add_library(collision_lab_ros
   src/ros/msg_conversion.cpp
   src/ros/run_recorder.cpp
+  src/ros/run_timeline.cpp
+  src/ros/bag_csv.cpp
   src/ros/lab_node.cpp
   src/ros/marker_builder.cpp
   src/ros/marker_view.cpp)
 target_include_directories(collision_lab_ros PUBLIC include ${catkin_INCLUDE_DIRS})
-target_link_libraries(collision_lab_ros PUBLIC collision_lab_core ${catkin_LIBRARIES})
+# collision_lab_io: the node reads the presets of ~run_preset.
+target_link_libraries(collision_lab_ros PUBLIC collision_lab_core collision_lab_io ${catkin_LIBRARIES})
 add_dependencies(collision_lab_ros ${PROJECT_NAME}_generate_messages_cpp ${catkin_EXPORTED_TARGETS})
 
 # Executables go to the devel space's package folder, where rosrun and roslaunch look.
-set(collision_lab_ROS_EXECUTABLES collision_lab_node collision_lab_markers scenario_publisher)
+set(collision_lab_ROS_EXECUTABLES
+  collision_lab_node collision_lab_markers scenario_publisher bag_to_csv)
 add_executable(collision_lab_node src/ros/lab_node_main.cpp)
 target_link_libraries(collision_lab_node PRIVATE collision_lab_ros)
 add_executable(collision_lab_markers src/ros/markers_main.cpp)
 target_link_libraries(collision_lab_markers PRIVATE collision_lab_ros)
 add_executable(scenario_publisher src/ros/scenario_publisher.cpp)
 target_link_libraries(scenario_publisher PRIVATE collision_lab_ros collision_lab_io)
+add_executable(bag_to_csv src/ros/bag_to_csv_main.cpp)
+target_link_libraries(bag_to_csv PRIVATE collision_lab_ros)
 set_target_properties(${collision_lab_ROS_EXECUTABLES} PROPERTIES
   RUNTIME_OUTPUT_DIRECTORY ${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_BIN_DESTINATION})
 
@@ -26,3 +32,6 @@ install(TARGETS collision_lab_ros
   LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION})
 install(TARGETS ${collision_lab_ROS_EXECUTABLES}
   RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
+# replay.launch's bag resolver (bag:=latest, a run_id or a path), found in the source
+# folder by rosrun and roslaunch, installed beside the executables.
+install(PROGRAMS scripts/play_run DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})

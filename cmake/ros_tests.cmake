@@ -7,6 +7,17 @@ if(TARGET ros_layer_unit_test)
   target_link_libraries(ros_layer_unit_test collision_lab_ros GTest::gtest_main)
 endif()
 
+# The run timeline and bag_to_csv (no master).
+catkin_add_gtest(ros_tools_unit_test
+  test/ros/run_timeline_test.cpp
+  test/ros/bag_csv_test.cpp)
+if(TARGET ros_tools_unit_test)
+  target_link_libraries(ros_tools_unit_test collision_lab_ros GTest::gtest_main)
+  add_dependencies(ros_tools_unit_test bag_to_csv)
+  target_compile_definitions(ros_tools_unit_test PRIVATE
+    COLLISION_LAB_BAG_TO_CSV="$<TARGET_FILE:bag_to_csv>")
+endif()
+
 find_package(rostest REQUIRED)
 foreach(name node_test burst_test demo_test crash_test)
   add_rostest_gtest(${name} test/ros/${name}.test test/ros/${name}.cpp)
@@ -14,7 +25,8 @@ foreach(name node_test burst_test demo_test crash_test)
   # The rostests start these nodes.
   add_dependencies(${name} collision_lab_node collision_lab_markers scenario_publisher)
 endforeach()
-# node_test reads the bad-input catalogue, docs/bad_inputs.md.
+# node_test reads the bad-input catalogue, docs/bad_inputs.md; demo_test runs scripts/play_run.
 target_compile_definitions(node_test PRIVATE COLLISION_LAB_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+target_compile_definitions(demo_test PRIVATE COLLISION_LAB_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
 # crash_test starts and kills the node itself.
 target_compile_definitions(crash_test PRIVATE COLLISION_LAB_NODE_PATH="$<TARGET_FILE:collision_lab_node>")

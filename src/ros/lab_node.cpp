@@ -5,13 +5,17 @@
 #include <cstdlib>
 #include <ctime>
 #include <optional>
+#include <sstream>
 #include <utility>
 
 #include <diagnostic_msgs/DiagnosticArray.h>
+#include <ros/package.h>
 
+#include "collision_lab/io/scenario_file.h"
 #include "collision_lab/ros/msg_conversion.h"
 #include "collision_lab/ros/node_constants.h"
 #include "collision_lab/ros/run_recorder.h"
+#include "collision_lab/ros/run_timeline.h"
 
 namespace collision_lab_ros {
 
@@ -24,6 +28,86 @@ ros::Time stampNow() {
   if (now >= ros::TIME_MIN) return now;
   const ros::WallTime wall = ros::WallTime::now();
   return ros::Time(wall.sec, wall.nsec);
+}
+
+std::string utcStamp(const char* format) {
+  char buffer[32];
+  const std::time_t now = std::time(nullptr);
+  std::strftime(buffer, sizeof buffer, format, std::gmtime(&now));
+  return buffer;
+}
+
+/// Stamps the messages of one run on its timeline, publishes them and records them.
+class RunWriter {
+ public:
+  /// recorder may be null (not recording).
+  RunWriter(std::string run_id, RunTimeline timeline, RunRecorder* recorder)
+      : run_id_(std::move(run_id)), timeline_(timeline), recorder_(recorder) {}
+
+  const RunTimeline& timeline() const { return timeline_; }
+
+  /// Sets run_id and header.stamp: the timeline's stamp of simulated time t [s].
+  template <class Message>
+  void stamp(Message& msg, double t) {
+    msg.run_id = run_id_;
+    msg.header.stamp = timeline_.stamp(t);
+  }
+  /// Records msg at its header.stamp.
+  template <class Message>
+  void record(const std::string& topic, const Message& msg) {
+    if (recorder_) recorder_->write(topic, msg.header.stamp, msg);
+  }
+  /// Stamps at t, records only (events beyond ~max_published_events).
+  template <class Message>
+  void record(const std::string& topic, Message& msg, double t) {
+    stamp(msg, t);
+    record(topic, msg);
+  }
+  /// Stamps at t, publishes and records.
+  template <class Message>
+  void publish(const ros::Publisher& pub, Message& msg, double t) {
+    stamp(msg, t);
+    pub.publish(msg);
+    record(pub.getTopic(), msg);
+  }
+
+ private:
+  std::string run_id_;
+  RunTimeline timeline_;
+  RunRecorder* recorder_;
+};
+
+/// Fills a RunScene or RunPreset response (their fields are the same).
+template <class Response>
+void fillResponse(const std::optional<ServeOutcome>& outcome, Response& response) {
+  if (!outcome) {
+    response.ok = false;
+    response.message = "collision_lab_node is shutting down; the input was not served";
+    return;
+  }
+  response.ok = outcome->summary.has_value();
+  if (!response.ok) {
+    const collision_lab::Rejected& r = outcome->rejected;
+    response.rejected = r;
+    response.message = "rejected run '" + r.run_id + "': " + r.reason_name + " in " + r.field +
+                       ": " + r.message;
+    return;
+  }
+  const collision_lab::RunSummary& s = *outcome->summary;
+  response.summary = s;
+  std::ostringstream line;
+  line << "run " << s.run_id << ": " << s.collision_count << " collisions, predicted "
+       << s.predicted_collision_count;
+  if (s.truncated) line << " (truncated: " << s.truncation_reason << ")";
+  if (!s.requested_run_id.empty()) line << "; run_id '" << s.requested_run_id << "' was taken";
+  if (s.bag_path.empty()) {
+    line << "; not recorded";
+  } else if (s.recording_ok) {
+    line << "; bag " << s.bag_path;
+  } else {
+    line << "; recording FAILED: " << s.recording_error;
+  }
+  response.message = line.str();
 }
 
 std::string defaultBagDirectory() {
@@ -61,6 +145,9 @@ LabNodeParams LabNodeParams::load(const ros::NodeHandle& private_nh) {
       getUint64(private_nh, "max_published_events", kDefaultMaxPublishedEvents);
   private_nh.param("publish_markers", params.publish_markers, true);
   private_nh.param("min_free_space_mb", params.min_free_space_mb, kDefaultMinFreeSpaceMb);
+  private_nh.param("scenario_file", params.scenario_file,
+                   ros::package::getPath("collision_lab") + "/" + kDefaultScenarioFile);
+  params.scenario_file = expandUser(params.scenario_file);
   return params;
 }
 
@@ -76,24 +163,25 @@ std::string runIdProblem(const std::string& run_id) {
 }
 
 LabNode::LabNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
-    : nh_(nh), params_(LabNodeParams::load(private_nh)) {
-  predictions_pub_ =
-      nh_.advertise<collision_lab::Prediction>(kPredictionsTopic, kOutputQueueSize);
+    : nh_(nh),
+      params_(LabNodeParams::load(private_nh)),
+      service_spinner_(kServiceThreads, &service_queue_) {
+  predictions_pub_ = nh_.advertise<collision_lab::Prediction>(kPredictionsTopic, kOutputQueueSize,
+                                                              kLatchPredictions);
   events_pub_ =
       nh_.advertise<collision_lab::CollisionEvent>(kCollisionEventsTopic, kOutputQueueSize);
   velocities_pub_ = nh_.advertise<collision_lab::Velocities>(kVelocitiesTopic, kOutputQueueSize);
   energy_pub_ =
       nh_.advertise<collision_lab::EnergyTransfer>(kEnergyTransfersTopic, kOutputQueueSize);
-  summaries_pub_ = nh_.advertise<collision_lab::RunSummary>(kRunSummariesTopic, kOutputQueueSize);
-  rejected_pub_ = nh_.advertise<collision_lab::Rejected>(kRejectedTopic, kOutputQueueSize);
+  summaries_pub_ = nh_.advertise<collision_lab::RunSummary>(kRunSummariesTopic, kOutputQueueSize,
+                                                            kLatchRunSummaries);
+  rejected_pub_ =
+      nh_.advertise<collision_lab::Rejected>(kRejectedTopic, kOutputQueueSize, kLatchRejected);
   if (params_.publish_markers) {
     marker_view_ = std::make_unique<MarkerView>(nh_, MarkerViewParams::load(private_nh));
   }
 
-  char start[32];
-  const std::time_t now = std::time(nullptr);
-  std::strftime(start, sizeof start, "%Y%m%d_%H%M%S", std::gmtime(&now));
-  run_id_prefix_ = std::string("run_") + start + "_";
+  run_id_prefix_ = std::string("run_") + utcStamp("%Y%m%d_%H%M%S") + "_";
 
   diagnostics_pub_ = nh_.advertise<diagnostic_msgs::DiagnosticArray>(kDiagnosticsTopic, 10);
   diagnostics_timer_ = nh_.createWallTimer(ros::WallDuration(kDiagnosticsPeriod),
@@ -102,42 +190,102 @@ LabNode::LabNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   worker_ = std::thread(&LabNode::workerLoop, this);
   input_sub_ = nh_.subscribe(kInitialConditionsTopic, kInputQueueSize,
                              &LabNode::onInitialConditions, this);
+  // The services' own queue: a waiting call never holds up the global queue.
+  ros::NodeHandle service_nh(private_nh);
+  service_nh.setCallbackQueue(&service_queue_);
+  run_scene_srv_ = service_nh.advertiseService(kRunSceneService, &LabNode::onRunScene, this);
+  run_preset_srv_ = service_nh.advertiseService(kRunPresetService, &LabNode::onRunPreset, this);
+  service_spinner_.start();
   ROS_INFO_STREAM("collision_lab_node: recording " << (params_.record ? "on" : "off")
                   << ", bags in " << params_.bag_directory << ", max_collisions "
                   << params_.max_collisions << ", max_published_events "
-                  << params_.max_published_events);
+                  << params_.max_published_events << ", presets from " << params_.scenario_file);
 }
 
 LabNode::~LabNode() {
   input_sub_.shutdown();
+  run_scene_srv_.shutdown();
+  run_preset_srv_.shutdown();
   {
     std::lock_guard<std::mutex> lock(mutex_);
     stopping_ = true;
-    inputs_.clear();
+    inputs_.clear();  // breaks the promises of waiting calls
   }
   wake_.notify_one();
   worker_.join();
+  service_spinner_.stop();
 }
 
 void LabNode::onInitialConditions(const collision_lab::InitialConditions::ConstPtr& msg) {
+  enqueue(Job{msg, nullptr});
+}
+
+void LabNode::enqueue(Job job) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    inputs_.push_back(msg);
+    if (stopping_) return;  // a call's promise breaks as job goes out of scope
+    inputs_.push_back(std::move(job));
   }
   wake_.notify_one();
+}
+
+std::optional<ServeOutcome> LabNode::serveAndWait(const collision_lab::InitialConditions& input) {
+  auto reply = std::make_shared<std::promise<ServeOutcome>>();
+  std::future<ServeOutcome> outcome = reply->get_future();
+  enqueue(Job{boost::make_shared<collision_lab::InitialConditions>(input), std::move(reply)});
+  try {
+    return outcome.get();
+  } catch (const std::future_error&) {
+    return std::nullopt;  // dropped: the node is shutting down
+  }
+}
+
+bool LabNode::onRunScene(collision_lab::RunScene::Request& request,
+                         collision_lab::RunScene::Response& response) {
+  collision_lab::InitialConditions input;
+  input.run_id = request.run_id;
+  input.mode = request.mode;
+  input.masses = request.masses;
+  input.positions = request.positions;
+  input.velocities = request.velocities;
+  input.max_collisions = request.max_collisions;
+  fillResponse(serveAndWait(input), response);
+  return true;
+}
+
+bool LabNode::onRunPreset(collision_lab::RunPreset::Request& request,
+                          collision_lab::RunPreset::Response& response) {
+  collision_lab::io::NamedScene preset;
+  try {
+    // Read on every call, so that an edited file counts at once.
+    preset = collision_lab::io::findScenario(
+        collision_lab::io::loadScenarioFile(params_.scenario_file), request.name);
+  } catch (const collision_lab::io::ScenarioFileError& e) {
+    response.ok = false;
+    response.message = e.what();
+    return true;
+  }
+  collision_lab::InitialConditions input =
+      toInitialConditions(preset.scene, core::RunMode::kFull, preset.max_collisions);
+  input.mode = request.mode;
+  input.run_id =
+      request.run_id.empty() ? preset.name + "_" + utcStamp("%Y%m%dT%H%M%SZ") : request.run_id;
+  fillResponse(serveAndWait(input), response);
+  return true;
 }
 
 void LabNode::workerLoop() {
   for (;;) {
-    collision_lab::InitialConditions::ConstPtr input;
+    Job job;
     {
       std::unique_lock<std::mutex> lock(mutex_);
       wake_.wait(lock, [this] { return stopping_ || !inputs_.empty(); });
       if (stopping_) return;
-      input = inputs_.front();
+      job = std::move(inputs_.front());
       inputs_.pop_front();
     }
-    serve(*input);
+    ServeOutcome outcome = serve(*job.input);
+    if (job.reply) job.reply->set_value(std::move(outcome));
   }
 }
 
@@ -145,137 +293,155 @@ std::string LabNode::newRunId() {
   std::string run_id;
   do {
     run_id = run_id_prefix_ + std::to_string(++run_counter_);
-  } while (params_.record && bagExists(params_.bag_directory, run_id));
+  } while (runIdTaken(run_id));
+  used_run_ids_.insert(run_id);
   return run_id;
 }
 
-void LabNode::reject(collision_lab::Rejected msg, const std::string& run_id) {
+bool LabNode::runIdTaken(const std::string& run_id) const {
+  return used_run_ids_.count(run_id) > 0 ||
+         (params_.record && bagExists(params_.bag_directory, run_id));
+}
+
+std::string LabNode::claimRunId(const std::string& requested) {
+  std::string run_id = requested;
+  for (std::uint64_t n = 2; runIdTaken(run_id); ++n) {
+    run_id = requested + "." + std::to_string(n);
+  }
+  used_run_ids_.insert(run_id);
+  return run_id;
+}
+
+ServeOutcome LabNode::reject(collision_lab::Rejected msg, const std::string& run_id) {
   msg.header.stamp = stampNow();
   msg.run_id = run_id;
   ++runs_rejected_;
   ROS_WARN_STREAM("rejected run '" << run_id << "': " << msg.reason_name << " in field "
                   << msg.field << ": " << msg.message);
   rejected_pub_.publish(msg);
+  return ServeOutcome{std::nullopt, msg};
 }
 
-void LabNode::serve(collision_lab::InitialConditions input) {
-  if (input.run_id.empty()) input.run_id = newRunId();
-  const std::string run_id = input.run_id;
-
-  if (const std::string problem = runIdProblem(run_id); !problem.empty()) {
-    reject(toRejectedMsg(NodeReason::kInvalidRunId, "run_id", "run_id '" + run_id + "' " + problem),
-           run_id);
-    return;
+ServeOutcome LabNode::serve(collision_lab::InitialConditions input) {
+  const std::string requested = input.run_id;
+  if (!requested.empty()) {
+    if (const std::string problem = runIdProblem(requested); !problem.empty()) {
+      return reject(toRejectedMsg(NodeReason::kInvalidRunId, "run_id",
+                                  "run_id '" + requested + "' " + problem),
+                    requested);
+    }
   }
   const std::optional<core::RunMode> mode = toRunMode(input.mode);
   if (!mode) {
-    reject(toRejectedMsg(NodeReason::kInvalidMode, "mode",
-                         "mode " + std::to_string(input.mode) + " is not one of MODE_FULL (0), "
-                         "MODE_PREDICT_ONLY (1), MODE_SUMMARY_ONLY (2)"),
-           run_id);
-    return;
+    return reject(toRejectedMsg(NodeReason::kInvalidMode, "mode",
+                                "mode " + std::to_string(input.mode) + " is not one of MODE_FULL (0), "
+                                "MODE_PREDICT_ONLY (1), MODE_SUMMARY_ONLY (2)"),
+                  requested);
   }
   const core::Scene scene = toScene(input);
   if (const auto error = collision_lab::validate(scene)) {
-    reject(toRejectedMsg(*error), run_id);
-    return;
-  }
-  if (params_.record && bagExists(params_.bag_directory, run_id)) {
-    reject(toRejectedMsg(NodeReason::kDuplicateRunId, "run_id",
-                         "a bag for run_id '" + run_id + "' already exists in " +
-                             params_.bag_directory + "; bags are never overwritten"),
-           run_id);
-    return;
+    return reject(toRejectedMsg(*error), requested);
   }
 
+  input.run_id = requested.empty() ? newRunId() : claimRunId(requested);
+  if (!requested.empty() && input.run_id != requested) {
+    ROS_WARN_STREAM("run_id '" << requested << "' is taken (its bag exists, or this node served "
+                    "it before); serving the run as '" << input.run_id << "'");
+  }
+  const collision_lab::RunSummary summary =
+      run(input, scene, *mode, input.run_id != requested ? requested : std::string());
+  ROS_INFO_STREAM("run " << summary.run_id << ": " << summary.collision_count << " collisions"
+                  << (summary.truncated ? " (truncated)" : "") << ", predicted "
+                  << summary.predicted_collision_count << ", " << summary.compute_time << " s"
+                  << (summary.bag_path.empty() ? std::string() : ", bag " + summary.bag_path));
+  return ServeOutcome{summary, {}};
+}
+
+collision_lab::RunSummary LabNode::run(collision_lab::InitialConditions& input,
+                                       const core::Scene& scene, core::RunMode mode,
+                                       const std::string& requested_run_id) {
+  const std::string& run_id = input.run_id;
+  const ros::Time start = stampNow();
+  // The prediction goes out before the simulation starts; it also fixes the timeline.
+  const core::Prediction core_prediction = collision_lab::predict(scene);
   std::optional<RunRecorder> recorder;
   if (params_.record) recorder.emplace(params_.bag_directory, run_id);
-  const auto publishAndRecord = [&](const ros::Publisher& pub, auto& msg) {
-    msg.header.stamp = stampNow();
-    msg.run_id = run_id;
-    pub.publish(msg);
-    if (recorder) recorder->write(pub.getTopic(), msg.header.stamp, msg);
-  };
+  RunWriter out(run_id, RunTimeline(start, chooseTimelineScale(firstContactTime(
+                                                scene, core_prediction.first_pair))),
+                recorder ? &*recorder : nullptr);
 
-  input.header.stamp = stampNow();
-  if (recorder) recorder->write(nh_.resolveName(kInitialConditionsTopic), input.header.stamp, input);
+  input.header.stamp = start;
+  out.record(nh_.resolveName(kInitialConditionsTopic), input);
   if (marker_view_) marker_view_->onInitialConditions(input);
+  collision_lab::Prediction prediction = toPredictionMsg(core_prediction);
+  prediction.timeline_scale = out.timeline().scale();
+  out.publish(predictions_pub_, prediction, 0.0);
+  if (marker_view_) marker_view_->onPrediction(prediction);
 
   core::RunOptions options;
   options.max_collisions = input.max_collisions ? input.max_collisions : params_.max_collisions;
   options.events = collision_lab::EventPolicy::none();
-  options.mode = *mode;
+  options.mode = mode;
   options.skip_simulation_over_cap = true;
-
-  // The prediction goes out before the simulation starts.
-  const core::Prediction core_prediction = collision_lab::predict(scene);
-  collision_lab::Prediction prediction = toPredictionMsg(core_prediction);
-  publishAndRecord(predictions_pub_, prediction);
-  if (marker_view_) marker_view_->onPrediction(prediction);
-
   std::uint64_t published_events = 0;
   bool events_not_published = false;
+  double last_event_time = 0.0;  // [s]
   const auto onEvent = [&](const core::LabEvent& event) {
     collision_lab::CollisionEvent event_msg = toCollisionEventMsg(event);
     collision_lab::Velocities velocities_msg = toVelocitiesMsg(event);
     collision_lab::EnergyTransfer energy_msg = toEnergyTransferMsg(event);
-    const bool publish = published_events < params_.max_published_events;
-    if (publish) {
-      publishAndRecord(events_pub_, event_msg);
-      publishAndRecord(velocities_pub_, velocities_msg);
-      publishAndRecord(energy_pub_, energy_msg);
-      ++published_events;
-      if (marker_view_) {
-        marker_view_->onCollisionEvent(event_msg);
-        marker_view_->onVelocities(velocities_msg);
-        marker_view_->onEnergyTransfer(energy_msg);
-      }
-    } else {
+    const double t = last_event_time = event.event.time;
+    if (published_events == params_.max_published_events) {  // the bag only
       events_not_published = true;
-      if (!recorder) return;
-      const ros::Time stamp = stampNow();
-      for (auto* header : {&event_msg.header, &velocities_msg.header, &energy_msg.header}) {
-        header->stamp = stamp;
-      }
-      event_msg.run_id = velocities_msg.run_id = energy_msg.run_id = run_id;
-      recorder->write(events_pub_.getTopic(), stamp, event_msg);
-      recorder->write(velocities_pub_.getTopic(), stamp, velocities_msg);
-      recorder->write(energy_pub_.getTopic(), stamp, energy_msg);
+      out.record(events_pub_.getTopic(), event_msg, t);
+      out.record(velocities_pub_.getTopic(), velocities_msg, t);
+      out.record(energy_pub_.getTopic(), energy_msg, t);
+      return;
+    }
+    out.publish(events_pub_, event_msg, t);
+    out.publish(velocities_pub_, velocities_msg, t);
+    out.publish(energy_pub_, energy_msg, t);
+    ++published_events;
+    if (marker_view_) {
+      marker_view_->onCollisionEvent(event_msg);
+      marker_view_->onVelocities(velocities_msg);
+      marker_view_->onEnergyTransfer(energy_msg);
     }
   };
   const core::RunResult result = collision_lab::runLab(scene, options, core_prediction, onEvent);
 
-  collision_lab::RunSummary summary = toRunSummaryMsg(result.summary, result.prediction, *mode);
+  collision_lab::RunSummary summary = toRunSummaryMsg(result.summary, result.prediction, mode);
   summary.published_events = published_events;
   summary.events_not_published = events_not_published;
+  summary.requested_run_id = requested_run_id;
+  summary.timeline_scale = out.timeline().scale();
+  out.stamp(summary, last_event_time);
+  summary.timeline_saturated = out.timeline().saturated();
+  if (summary.timeline_saturated) {
+    ROS_WARN_STREAM("run " << run_id << ": collisions after " << RunTimeline::kMaxOffset
+                    << " bag s are stamped at that limit (timeline_scale "
+                    << summary.timeline_scale << ")");
+  }
   if (recorder) {
     summary.bag_path = recorder->path();
     summary.recording_ok = recorder->ok();
     summary.recording_error = recorder->error();
-  }
-  summary.header.stamp = stampNow();
-  summary.run_id = run_id;
-  if (recorder) {
-    recorder->write(summaries_pub_.getTopic(), summary.header.stamp, summary);
+    out.record(summaries_pub_.getTopic(), summary);
     if (!recorder->close()) {
       ROS_ERROR_STREAM("run " << run_id << ": recording failed: " << recorder->error());
     }
     // The published summary reports the bag's final state, closing included.
     summary.recording_ok = recorder->ok();
     summary.recording_error = recorder->error();
-  }
-  summaries_pub_.publish(summary);
-  ++runs_accepted_;
-  last_compute_time_ = summary.compute_time;
-  if (recorder) {
     std::lock_guard<std::mutex> lock(recording_mutex_);
     last_recording_error_ = summary.recording_error;
   }
+  // The summary goes out last, after everything it counts.
+  summaries_pub_.publish(summary);
+  ++runs_accepted_;
+  last_compute_time_ = summary.compute_time;
   if (marker_view_) marker_view_->onRunSummary(summary);
-  ROS_INFO_STREAM("run " << run_id << ": " << summary.collision_count << " collisions"
-                  << (summary.truncated ? " (truncated)" : "") << ", predicted "
-                  << summary.predicted_collision_count << ", " << summary.compute_time
-                  << " s" << (recorder ? ", bag " + summary.bag_path : std::string()));
+  return summary;
 }
 
 void LabNode::publishDiagnostics() {

@@ -1,31 +1,41 @@
-// scenario_publisher: sends preset scenes to collision_lab_node one at a time, waits for
-// each run's summary (or rejection), matched by run_id, and prints a table.
+// scenario_publisher: serves preset scenes one at a time through collision_lab_node's
+// ~run_scene service (so each is published, recorded and drawn like any input), prints a
+// table, and ends with one plain line: "demo finished: N runs, bags in DIR", or
+// "demo FAILED: ..." naming the failed runs.
 //
 // Private parameters:
 //   ~scenario_file (string, required)  YAML file of named scenes (config/scenarios.yaml)
 //   ~scenarios (string, default "")    names to run, separated by spaces or commas; empty: all
 //   ~mode (int, default 0)             InitialConditions.MODE_* for every run
 //   ~run_id_suffix (string, default: UTC start time)  run_id = <scene name>_<suffix>
-//   ~exit_when_done (bool, default true)  shut down after the last run
+//   ~service (string, default "collision_lab_node/run_scene")  the node's service
+//   ~wait_timeout (double, default 60) [s]  how long to wait for that service to appear
+//   ~dwell (double, default 0) [s]     wall time each run stays on screen before the next
+//   ~exit_when_done (bool, default true)  exit after the last run; false: stay until shut down
+//   ~end_launch_when_done (bool, default false)  after a demo without failures, shut down the
+//       roslaunch that started this node as Ctrl-C does (SIGINT), so that a headless demo
+//       ends cleanly; after a failure, exit 1 instead, which roslaunch reports in red for a
+//       required node.
+#include <signal.h>
+#include <unistd.h>
+
 #include <cstdio>
 #include <ctime>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
-#include <map>
 #include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
 
-#include <ros/callback_queue.h>
 #include <ros/ros.h>
 
+#include "collision_lab/RunScene.h"
 #include "collision_lab/io/scenario_file.h"
 #include "collision_lab/ros/msg_conversion.h"
-#include "collision_lab/ros/node_constants.h"
 
 namespace {
-
-using collision_lab_ros::core::RunMode;
 
 std::vector<std::string> splitNames(const std::string& text) {
   std::vector<std::string> names;
@@ -48,21 +58,19 @@ std::string utcStamp() {
   return buffer;
 }
 
-/// The answer to one input: its summary or its rejection.
-struct Outcome {
-  std::optional<collision_lab::RunSummary> summary;
-  std::optional<collision_lab::Rejected> rejected;
-  bool done() const { return summary || rejected; }
+/// A run's row in the table, and whether it failed.
+struct Row {
+  std::string text;
+  bool failed = false;
 };
 
-std::string row(const std::string& scene, const Outcome& outcome) {
-  char buffer[512];
-  if (outcome.rejected) {
-    std::snprintf(buffer, sizeof buffer, "%-22s rejected: %s (%s)", scene.c_str(),
-                  outcome.rejected->reason_name.c_str(), outcome.rejected->message.c_str());
-    return buffer;
+Row row(const std::string& scene, const collision_lab::RunScene::Response& response) {
+  char buffer[768];
+  if (!response.ok) {
+    std::snprintf(buffer, sizeof buffer, "%-22s FAILED: %s", scene.c_str(), response.message.c_str());
+    return {buffer, true};
   }
-  const auto& s = *outcome.summary;
+  const auto& s = response.summary;
   const std::string collisions =
       std::to_string(s.collision_count) + (s.truncated ? "*" : "") + (s.simulated ? "" : " (n/s)");
   const std::string paper =
@@ -73,7 +81,54 @@ std::string row(const std::string& scene, const Outcome& outcome) {
   std::snprintf(buffer, sizeof buffer, "%-22s %12s %12llu %12s %10.2e  %s", scene.c_str(),
                 collisions.c_str(), static_cast<unsigned long long>(s.predicted_collision_count),
                 paper.c_str(), s.max_prediction_error, bag.c_str());
-  return buffer;
+  return {buffer, !s.bag_path.empty() && !s.recording_ok};
+}
+
+/// Sleeps seconds of wall time, or less when ROS shuts down.
+void sleepFor(double seconds) {
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(seconds);
+  while (ros::ok() && ros::WallTime::now() < end) ros::WallDuration(0.05).sleep();
+}
+
+/// True when our parent process is roslaunch (its command line names it).
+bool startedByRoslaunch() {
+  std::ifstream cmdline("/proc/" + std::to_string(getppid()) + "/cmdline");
+  const std::string text((std::istreambuf_iterator<char>(cmdline)), std::istreambuf_iterator<char>());
+  return text.find("roslaunch") != std::string::npos;
+}
+
+/// Asks the roslaunch that started us to shut down, as Ctrl-C does; roslaunch then stops
+/// every node (us too) and ends with plain lines. Returns false when not started by roslaunch.
+bool endLaunch() {
+  if (!startedByRoslaunch()) {
+    ROS_WARN("~end_launch_when_done: not started by roslaunch; just exiting");
+    return false;
+  }
+  kill(getppid(), SIGINT);
+  sleepFor(30.0);  // roslaunch stops us within its own ~15 s kill timeout
+  return true;
+}
+
+std::vector<collision_lab::io::NamedScene> selectScenes(const std::string& file,
+                                                        const std::string& selection) {
+  const auto all = collision_lab::io::loadScenarioFile(file);
+  const auto names = splitNames(selection);
+  if (names.empty()) return all;
+  std::vector<collision_lab::io::NamedScene> scenes;
+  for (const auto& name : names) scenes.push_back(collision_lab::io::findScenario(all, name));
+  return scenes;
+}
+
+void printTable(const std::vector<Row>& rows) {
+  std::ostringstream table;
+  char header[256];
+  std::snprintf(header, sizeof header, "%-22s %12s %12s %12s %10s  %s", "scene", "collisions",
+                "predicted", "paper (3.22)", "error", "bag");
+  table << "\n" << header << "\n" << std::string(110, '-') << "\n";
+  for (const auto& r : rows) table << r.text << "\n";
+  table << "(* truncated at the collision cap; n/s: not simulated; error: max |S (v_sim - v_pred)| / "
+           "|S v_0|, S = diag(sqrt m))\n";
+  std::cout << table.str() << std::flush;
 }
 
 }  // namespace
@@ -82,9 +137,10 @@ int main(int argc, char** argv) {
   ros::init(argc, argv, "scenario_publisher");
   ros::NodeHandle nh, private_nh("~");
 
-  std::string scenario_file, selection, suffix;
+  std::string scenario_file, selection, suffix, service;
   int mode = 0;
-  bool exit_when_done = true;
+  double wait_timeout = 60.0, dwell = 0.0;
+  bool exit_when_done = true, end_launch_when_done = false;
   if (!private_nh.getParam("scenario_file", scenario_file)) {
     ROS_FATAL("~scenario_file is not set");
     return 1;
@@ -92,76 +148,75 @@ int main(int argc, char** argv) {
   private_nh.param("scenarios", selection, std::string());
   private_nh.param("mode", mode, 0);
   private_nh.param("run_id_suffix", suffix, utcStamp());
+  private_nh.param("service", service, std::string("collision_lab_node/run_scene"));
+  private_nh.param("wait_timeout", wait_timeout, 60.0);
+  private_nh.param("dwell", dwell, 0.0);
   private_nh.param("exit_when_done", exit_when_done, true);
+  private_nh.param("end_launch_when_done", end_launch_when_done, false);
   const auto run_mode = collision_lab_ros::toRunMode(static_cast<std::uint8_t>(mode));
   if (mode < 0 || mode > 255 || !run_mode) {
     ROS_FATAL_STREAM("~mode = " << mode << " is not one of InitialConditions.MODE_*");
     return 1;
   }
-
   std::vector<collision_lab::io::NamedScene> scenes;
   try {
-    const auto all = collision_lab::io::loadScenarioFile(scenario_file);
-    const auto names = splitNames(selection);
-    if (names.empty()) {
-      scenes = all;
-    } else {
-      for (const auto& name : names) scenes.push_back(collision_lab::io::findScenario(all, name));
-    }
+    scenes = selectScenes(scenario_file, selection);
   } catch (const collision_lab::io::ScenarioFileError& e) {
     ROS_FATAL_STREAM(e.what());
     return 1;
   }
 
-  std::map<std::string, Outcome> outcomes;  // by run_id
-  ros::Publisher input_pub = nh.advertise<collision_lab::InitialConditions>(
-      collision_lab_ros::kInitialConditionsTopic, collision_lab_ros::kInputQueueSize);
-  ros::Subscriber summary_sub = nh.subscribe<collision_lab::RunSummary>(
-      collision_lab_ros::kRunSummariesTopic, collision_lab_ros::kOutputQueueSize,
-      [&outcomes](const collision_lab::RunSummary::ConstPtr& m) {
-        if (outcomes.count(m->run_id)) outcomes[m->run_id].summary = *m;
-      });
-  ros::Subscriber rejected_sub = nh.subscribe<collision_lab::Rejected>(
-      collision_lab_ros::kRejectedTopic, collision_lab_ros::kOutputQueueSize,
-      [&outcomes](const collision_lab::Rejected::ConstPtr& m) {
-        if (outcomes.count(m->run_id)) outcomes[m->run_id].rejected = *m;
-      });
-
-  // Wait until the node listens to us and we listen to it: a message published before
-  // the connection is up is lost.
-  const auto spinFor = [] { ros::getGlobalCallbackQueue()->callAvailable(ros::WallDuration(0.1)); };
-  ROS_INFO_STREAM("waiting for " << input_pub.getTopic() << " to be served");
-  while (ros::ok() && (input_pub.getNumSubscribers() == 0 || summary_sub.getNumPublishers() == 0 ||
-                       rejected_sub.getNumPublishers() == 0)) {
-    spinFor();
+  service = nh.resolveName(service);
+  ROS_INFO_STREAM("waiting up to " << wait_timeout << " s for " << service);
+  if (!ros::service::waitForService(service, ros::Duration(wait_timeout))) {
+    if (!ros::ok()) return 1;
+    ROS_FATAL_STREAM("no service " << service << " after " << wait_timeout
+                     << " s: is collision_lab_node running (rosnode list, rosservice list)?");
+    return 1;
   }
 
-  std::vector<std::string> rows;
-  for (const auto& scene : scenes) {
-    if (!ros::ok()) break;
-    collision_lab::InitialConditions input =
+  std::vector<Row> rows;
+  std::string bag_directory;
+  std::size_t failed = 0;
+  for (std::size_t i = 0; i < scenes.size() && ros::ok(); ++i) {
+    const auto& scene = scenes[i];
+    collision_lab::RunScene call;
+    call.request.run_id = scene.name + "_" + suffix;
+    const auto input =
         collision_lab_ros::toInitialConditions(scene.scene, *run_mode, scene.max_collisions);
-    input.header.stamp = ros::Time::now();
-    input.run_id = scene.name + "_" + suffix;
-    outcomes[input.run_id] = Outcome{};
-    ROS_INFO_STREAM("sending " << scene.name << " (" << scene.description << ") as run "
-                    << input.run_id);
-    input_pub.publish(input);
-    while (ros::ok() && !outcomes[input.run_id].done()) spinFor();
-    if (!ros::ok()) break;
-    rows.push_back(row(scene.name, outcomes[input.run_id]));
+    call.request.mode = input.mode;
+    call.request.masses = input.masses;
+    call.request.positions = input.positions;
+    call.request.velocities = input.velocities;
+    call.request.max_collisions = input.max_collisions;
+    ROS_INFO_STREAM("running " << scene.name << " (" << scene.description << ") as run "
+                    << call.request.run_id);
+    if (!ros::service::call(service, call)) {
+      call.response.ok = false;
+      call.response.message = "the call to " + service + " failed (did collision_lab_node die?)";
+    }
+    rows.push_back(row(scene.name, call.response));
+    failed += rows.back().failed;
+    if (bag_directory.empty() && !call.response.summary.bag_path.empty()) {
+      bag_directory = std::filesystem::path(call.response.summary.bag_path).parent_path().string();
+    }
+    if (dwell > 0 && i + 1 < scenes.size()) {
+      ROS_INFO_STREAM("showing " << scene.name << " for " << dwell << " s");
+      sleepFor(dwell);
+    }
   }
+  printTable(rows);
 
-  std::ostringstream table;
-  char header[256];
-  std::snprintf(header, sizeof header, "%-22s %12s %12s %12s %10s  %s", "scene", "collisions",
-                "predicted", "paper (3.22)", "error", "bag");
-  table << "\n" << header << "\n" << std::string(110, '-') << "\n";
-  for (const auto& r : rows) table << r << "\n";
-  table << "(* truncated at the collision cap; n/s: not simulated; error: max |S (v_sim - v_pred)| / "
-           "|S v_0|, S = diag(sqrt m))\n";
-  std::cout << table.str() << std::flush;
-
-  if (!exit_when_done) ros::spin();
-  return rows.size() == scenes.size() ? 0 : 1;
+  const bool complete = rows.size() == scenes.size();
+  if (failed > 0 || !complete) {
+    std::cout << "demo FAILED: " << failed << " of " << rows.size() << " runs failed"
+              << (complete ? "" : ", the demo was cut short") << " (see the table above)"
+              << std::endl;
+    return 1;
+  }
+  std::cout << "demo finished: " << rows.size() << " runs, bags in "
+            << (bag_directory.empty() ? std::string("(not recorded)") : bag_directory) << std::endl;
+  if (end_launch_when_done && endLaunch()) return 0;
+  if (!exit_when_done) ros::waitForShutdown();
+  return 0;
 }

@@ -1,6 +1,7 @@
 // kill -9 in the middle of a run (crash_test.test): the bags of finished runs stay
 // intact, the run in progress is left as <run_id>.bag.active and `rosbag reindex`
-// recovers it, and a restarted node never overwrites an existing bag.
+// recovers it, and a restarted node never overwrites an existing bag: it serves a taken
+// run_id as <run_id>.2.
 #include <signal.h>
 #include <stdlib.h>
 #include <sys/wait.h>
@@ -24,6 +25,7 @@ namespace {
 namespace fs = std::filesystem;
 using collision_lab_test::makeInput;
 using collision_lab_test::RunCollector;
+using collision_lab_test::waitUntil;
 
 constexpr char kNamespace[] = "crash";
 
@@ -78,7 +80,7 @@ TEST(Crash, KillNineKeepsFinishedBagsAndNeverOverwrites) {
       const auto run = client.runs().find("long_run");
       return run != client.runs().end() && !run->second.summaries.empty();
     };
-    while (ros::ok() && !inProgress() && !over()) RunCollector::spinOnce();
+    waitUntil([&] { return inProgress() || over(); }, "10,000 collisions of long_run");
     const bool killed_mid_run = fs::exists(dir + "/long_run.bag.active") && !over();
     stop(node, SIGKILL);
     ASSERT_TRUE(killed_mid_run);
@@ -102,21 +104,29 @@ TEST(Crash, KillNineKeepsFinishedBagsAndNeverOverwrites) {
     EXPECT_EQ(rosbag::View(bag, rosbag::TopicQuery("/crash/run_summaries")).size(), 0u);
   }
 
-  // A restarted node refuses both run_ids: a finished bag and an interrupted one.
+  // A restarted node serves both run_ids again under the next free suffix, and touches
+  // neither the finished bag nor the interrupted one.
+  const auto active_size = fs::file_size(dir + "/long_run.bag.active");
   {
     const pid_t node = startNode(dir);
     ASSERT_GT(node, 0);
     RunCollector client(kNamespace);
     client.waitForConnection();
-    for (const auto& input : {finished, long_run}) {
+    auto short_run = finished;
+    short_run.run_id = "long_run";
+    for (const auto& input : {finished, short_run}) {
       client.publish(input);
-      const auto& out = client.waitFor(input.run_id);
-      ASSERT_EQ(out.rejections.size(), 1u) << input.run_id;
-      EXPECT_EQ(out.rejections.front().reason, collision_lab::Rejected::DUPLICATE_RUN_ID);
+      const auto& out = client.waitFor(input.run_id + ".2");
+      ASSERT_EQ(out.summaries.size(), 1u) << input.run_id;
+      EXPECT_EQ(out.summaries.front().requested_run_id, input.run_id);
+      EXPECT_EQ(out.summaries.front().collision_count, 3u);
+      EXPECT_EQ(messageCount(dir + "/" + input.run_id + ".2.bag"), finished_messages);
     }
     stop(node, SIGINT);
   }
   EXPECT_EQ(messageCount(dir + "/finished.bag"), finished_messages);
+  EXPECT_EQ(fs::file_size(dir + "/long_run.bag.active"), active_size);
+  EXPECT_FALSE(fs::exists(dir + "/long_run.bag"));
   fs::remove_all(dir);
 }
 

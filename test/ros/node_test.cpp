@@ -1,16 +1,21 @@
 // collision_lab_node end to end (node_test.test): round trip against the core, bad
-// input, the collision cap, modes, the published-event cap, bags, and recording faults.
+// input, the collision cap, modes, the published-event cap, bags, the simulated
+// timeline, duplicate run_ids, the services, latching and recording faults. Every test
+// sends the runs it needs (runs shared between tests are sent once, by whichever test
+// asks first), so any subset runs alone.
+#include <atomic>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <limits>
-#include <sstream>
-#include <string>
-#include <vector>
-
 #include <map>
 #include <optional>
+#include <set>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
 
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <gtest/gtest.h>
@@ -18,6 +23,8 @@
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 
+#include "collision_lab/RunPreset.h"
+#include "collision_lab/RunScene.h"
 #include "collision_lab/ros/msg_conversion.h"
 #include "run_collector.h"
 
@@ -26,6 +33,7 @@ namespace {
 using collision_lab_test::makeInput;
 using collision_lab_test::RunCollector;
 using collision_lab_test::RunOutputs;
+using collision_lab_test::waitUntil;
 namespace core = collision_lab_ros::core;
 namespace fs = std::filesystem;
 
@@ -36,6 +44,23 @@ std::string g_bag_directory;         // the node's ~bag_directory
 std::string g_faulty_bag_directory;  // the faulty node's: a regular file, not a folder
 RunCollector* g_node = nullptr;      // namespace collision_lab
 RunCollector* g_faulty = nullptr;    // namespace collision_lab_faulty
+constexpr char kRunScene[] = "/collision_lab/collision_lab_node/run_scene";
+constexpr char kRunPreset[] = "/collision_lab/collision_lab_node/run_preset";
+
+/// Publishes input to node unless this run_id was sent before, and waits for the run.
+const RunOutputs& runOnce(RunCollector* node, const collision_lab::InitialConditions& input) {
+  static std::set<std::string> sent;
+  if (sent.insert(input.run_id).second) node->publish(input);
+  return node->waitFor(input.run_id);
+}
+
+const RunOutputs& roundTrip() {
+  return runOnce(g_node, makeInput("round_trip", {1, 2, 3}, {2, 0, -2}, {-1, 0.5, 1}));
+}
+
+const RunOutputs& noDisk() {
+  return runOnce(g_faulty, makeInput("no_disk", {1, 2, 3}, {2, 0, -2}, {-1, 0.5, 1}));
+}
 
 template <class Message>
 std::vector<std::uint8_t> bytes(const Message& msg) {
@@ -73,12 +98,52 @@ void expectArrayEq(const boost::array<double, 3>& actual, const std::array<doubl
   for (int i = 0; i < 3; ++i) EXPECT_EQ(actual[i], expected[i]) << what << "[" << i << "]";
 }
 
+/// [ns] from start to stamp.
+double nsAfter(const ros::Time& start, const ros::Time& stamp) {
+  return static_cast<double>(static_cast<std::int64_t>(stamp.toNSec()) -
+                             static_cast<std::int64_t>(start.toNSec()));
+}
+
+/// Every collision of the bag at start + scale * time, to the nanosecond; returns the bag.
+std::vector<collision_lab::CollisionEvent> expectBagOnTimeline(const std::string& path,
+                                                               double scale) {
+  rosbag::Bag bag(path, rosbag::bagmode::Read);
+  const std::string ns = "/collision_lab/";
+  const auto inputs = readTopic<collision_lab::InitialConditions>(bag, ns + "initial_conditions");
+  const auto predictions = readTopic<collision_lab::Prediction>(bag, ns + "predictions");
+  const auto events = readTopic<collision_lab::CollisionEvent>(bag, ns + "collision_events");
+  const auto velocities = readTopic<collision_lab::Velocities>(bag, ns + "velocities");
+  const auto summaries = readTopic<collision_lab::RunSummary>(bag, ns + "run_summaries");
+  if (inputs.size() != 1 || predictions.size() != 1 || summaries.size() != 1) {
+    ADD_FAILURE() << path << " lacks its input, prediction or summary";
+    return events;
+  }
+  const ros::Time start = inputs.front().header.stamp;
+  EXPECT_EQ(predictions.front().header.stamp, start);
+  EXPECT_EQ(predictions.front().timeline_scale, scale);
+  EXPECT_EQ(summaries.front().timeline_scale, scale);
+  EXPECT_EQ(velocities.size(), events.size());
+  for (std::size_t k = 0; k < events.size(); ++k) {
+    EXPECT_NEAR(nsAfter(start, events[k].header.stamp), scale * events[k].time * 1e9, 1.0)
+        << "collision " << k + 1;
+    if (k < velocities.size()) {
+      EXPECT_EQ(velocities[k].header.stamp, events[k].header.stamp);
+    }
+  }
+  // The bag's own times are the stamps: its duration is the run's scaled duration.
+  rosbag::View all(bag);
+  EXPECT_EQ(all.getBeginTime(), start);
+  const double last = events.empty() ? 0.0 : events.back().time;
+  EXPECT_NEAR(nsAfter(start, all.getEndTime()), scale * last * 1e9, 1.0);
+  EXPECT_EQ(summaries.front().header.stamp, all.getEndTime());
+  return events;
+}
+
 // ---- Round trip: every output, equal to the core's runLab ----
 
 TEST(LabNode, RoundTripMatchesCore) {
   const auto input = makeInput("round_trip", {1, 2, 3}, {2, 0, -2}, {-1, 0.5, 1});
-  g_node->publish(input);
-  const RunOutputs& out = g_node->waitFor("round_trip");
+  const RunOutputs& out = roundTrip();
   ASSERT_TRUE(out.rejections.empty()) << out.rejections.front().message;
 
   core::RunOptions options;
@@ -93,7 +158,8 @@ TEST(LabNode, RoundTripMatchesCore) {
   ASSERT_EQ(out.velocities.size(), expected.events.size());
   ASSERT_EQ(out.energies.size(), expected.events.size());
 
-  const auto prediction = collision_lab_ros::toPredictionMsg(expected.prediction);
+  auto prediction = collision_lab_ros::toPredictionMsg(expected.prediction);
+  prediction.timeline_scale = 1.0;  // the node's: first contact after 4/3 s, an ordinary scene
   auto received_prediction = out.predictions.front();
   received_prediction.header = prediction.header;
   received_prediction.run_id = prediction.run_id;
@@ -137,7 +203,7 @@ TEST(LabNode, RoundTripMatchesCore) {
 // ---- Bag: exactly the published messages ----
 
 TEST(LabNode, BagHoldsExactlyThePublishedMessages) {
-  const RunOutputs& out = g_node->waitFor("round_trip");
+  const RunOutputs& out = roundTrip();
   ASSERT_EQ(out.summaries.size(), 1u);
   const std::string path = out.summaries.front().bag_path;
   ASSERT_TRUE(fs::exists(path)) << path;
@@ -179,34 +245,24 @@ TEST(LabNode, BadInputIsRejectedAndTheNextRunServed) {
       {makeInput("bad_middle", {1, kInf, 1}, {2, 1, 0}, {-1, 0, 0}), Rejected::INFINITE_MIDDLE_MASS, "masses"},
       {makeInput("bad_order", {1, 1, 1}, {0, 1, 2}, {-1, 0, 0}), Rejected::POSITIONS_NOT_ORDERED, "positions"},
       {makeInput("bad_triple", {1, 1, 1}, {1, 0, -1}, {-1, 0, 1}), Rejected::TRIPLE_COLLISION, ""},
-      {makeInput("round_trip", {1, 1, 1}, {2, 1, 0}, {-1, 0, 0}), Rejected::DUPLICATE_RUN_ID, "run_id"},
       {makeInput("../escape", {1, 1, 1}, {2, 1, 0}, {-1, 0, 0}), Rejected::INVALID_RUN_ID, "run_id"},
       {makeInput("bad_mode", {1, 1, 1}, {2, 1, 0}, {-1, 0, 0}), Rejected::INVALID_MODE, "mode"},
   };
   cases.back().input.mode = 7;
-  g_node->waitFor("round_trip");  // the duplicate case needs the first bag on disk
 
   for (const auto& c : cases) {
     SCOPED_TRACE(c.input.run_id);
-    const std::size_t before = g_node->runs().count(c.input.run_id)
-                                   ? g_node->runs().at(c.input.run_id).rejections.size()
-                                   : 0;
     g_node->publish(c.input);
-    const RunOutputs* out = &g_node->waitFor(c.input.run_id);
-    while (ros::ok() && out->rejections.size() == before) {
-      RunCollector::spinOnce();  // a duplicate's run_id already has a complete run
-    }
-    ASSERT_GT(out->rejections.size(), before);
-    const auto& rejected = out->rejections.back();
+    const RunOutputs& out = g_node->waitFor(c.input.run_id);
+    ASSERT_EQ(out.rejections.size(), 1u);
+    const auto& rejected = out.rejections.back();
     EXPECT_EQ(rejected.reason, c.reason) << rejected.reason_name << ": " << rejected.message;
     EXPECT_EQ(rejected.field.rfind(c.field_prefix, 0), 0u) << rejected.field;
     EXPECT_FALSE(rejected.message.empty());
     EXPECT_FALSE(rejected.reason_name.empty());
-    if (c.reason != Rejected::DUPLICATE_RUN_ID) {
-      EXPECT_TRUE(out->summaries.empty());
-      EXPECT_TRUE(out->predictions.empty());
-      EXPECT_FALSE(fs::exists(g_bag_directory + "/" + c.input.run_id + ".bag"));
-    }
+    EXPECT_TRUE(out.summaries.empty());
+    EXPECT_TRUE(out.predictions.empty());
+    EXPECT_FALSE(fs::exists(g_bag_directory + "/" + c.input.run_id + ".bag"));
 
     const std::string next = "after_" + std::to_string(&c - cases.data());
     g_node->publish(makeInput(next, {1, 1, 1}, {2, 1, -1}, {-1, 0, 1}));
@@ -214,7 +270,6 @@ TEST(LabNode, BadInputIsRejectedAndTheNextRunServed) {
     ASSERT_EQ(served.summaries.size(), 1u);
     EXPECT_EQ(served.summaries.front().collision_count, 3u);
   }
-  EXPECT_EQ(g_node->runs().at("round_trip").summaries.size(), 1u);
 }
 
 // ---- docs/bad_inputs.md: every catalogue row that is a scene, through the node ----
@@ -368,13 +423,14 @@ TEST(LabNode, EventsBeyondThePublishCapAreRecordedOnly) {
   for (std::size_t k = 0; k < events.size(); ++k) EXPECT_EQ(events[k].index, k + 1);
   EXPECT_EQ(readTopic<collision_lab::Velocities>(bag, "/collision_lab/velocities").size(), 314u);
   EXPECT_EQ(readTopic<collision_lab::EnergyTransfer>(bag, "/collision_lab/energy_transfers").size(), 314u);
+  // The bag-only collisions sit on the run's timeline too.
+  expectBagOnTimeline(summary.bag_path, 1.0);
 }
 
 // ---- Recording faults: everything is still published, the summary says why ----
 
 TEST(LabNode, UnwritableBagDirectoryStillPublishesEverything) {
-  g_faulty->publish(makeInput("no_disk", {1, 2, 3}, {2, 0, -2}, {-1, 0.5, 1}));
-  const RunOutputs& out = g_faulty->waitFor("no_disk");
+  const RunOutputs& out = noDisk();
   ASSERT_EQ(out.summaries.size(), 1u);
   const auto& summary = out.summaries.front();
   EXPECT_FALSE(summary.recording_ok);
@@ -391,13 +447,239 @@ TEST(LabNode, UnwritableBagDirectoryStillPublishesEverything) {
   EXPECT_EQ(g_faulty->waitFor("no_disk_2").summaries.size(), 1u);
 }
 
+
+// ---- The simulated timeline: stamp = start + timeline_scale * time, live and in the bag ----
+
+TEST(Timeline, RunIsStampedOnItsSimulatedTimeLiveAndInTheBag) {
+  const RunOutputs& out = roundTrip();
+  ASSERT_EQ(out.summaries.size(), 1u);
+  ASSERT_EQ(out.events.size(), 3u);
+  // First contact AB after 2 m / 1.5 m/s: an ordinary scene, scale 1.
+  EXPECT_EQ(out.predictions.front().timeline_scale, 1.0);
+  const ros::Time start = out.predictions.front().header.stamp;
+  for (const auto& e : out.events) {
+    EXPECT_NEAR(nsAfter(start, e.header.stamp), e.time * 1e9, 1.0) << "collision " << e.index;
+  }
+  EXPECT_EQ(out.summaries.front().header.stamp, out.events.back().header.stamp);
+  EXPECT_GT(out.events.back().time, 1.0);  // a bag duration of more than a second
+  EXPECT_FALSE(out.summaries.front().timeline_saturated);
+  expectBagOnTimeline(out.summaries.front().bag_path, 1.0);
+}
+
+TEST(Timeline, NanosecondAndTerasecondScenesGetAPowerOfTen) {
+  struct Case {
+    std::string run_id;
+    double unit;  // [m] and [s]: equal masses, B and C at rest, A at -1 m/s
+    double scale;
+  };
+  for (const Case& c : {Case{"nano_scene", 1e-9, 1e9}, Case{"tera_scene", 1e12, 1e-12}}) {
+    SCOPED_TRACE(c.run_id);
+    // AB after 1 unit, BC after 2 units (A stops, B takes over, then C): 2 collisions,
+    // the first contact 1 bag second after the start.
+    const RunOutputs& out = runOnce(
+        g_node, makeInput(c.run_id, {1, 1, 1}, {2 * c.unit, c.unit, 0}, {-1, 0, 0}));
+    ASSERT_EQ(out.summaries.size(), 1u);
+    ASSERT_EQ(out.events.size(), 2u);
+    EXPECT_EQ(out.summaries.front().timeline_scale, c.scale);
+    const ros::Time start = out.predictions.front().header.stamp;
+    EXPECT_NEAR(nsAfter(start, out.events[0].header.stamp), 1e9, 1.0);
+    EXPECT_NEAR(nsAfter(start, out.events[1].header.stamp), 2e9, 1.0);
+    expectBagOnTimeline(out.summaries.front().bag_path, c.scale);
+  }
+}
+
+TEST(Timeline, CollisionsBeyondTheRangeSaturateAndTheSummarySaysSo) {
+  // AB at t = 1 s (scale 1), then B crosses 1e15 m to C: t = 1e15 + 2 s, beyond 1e9 bag s.
+  const RunOutputs& out =
+      runOnce(g_node, makeInput("saturated", {1, 1, 1}, {2, 1, -1e15}, {-1, 0, 0}));
+  ASSERT_EQ(out.summaries.size(), 1u);
+  ASSERT_EQ(out.events.size(), 2u);
+  const auto& summary = out.summaries.front();
+  EXPECT_EQ(summary.timeline_scale, 1.0);
+  EXPECT_TRUE(summary.timeline_saturated);
+  EXPECT_EQ(out.events[1].time, 1e15 + 2);  // the true time stays in the message
+  const ros::Time start = out.predictions.front().header.stamp;
+  EXPECT_NEAR(nsAfter(start, out.events[0].header.stamp), 1e9, 1.0);
+  EXPECT_EQ(out.events[1].header.stamp - start, ros::Duration(1e9));
+  EXPECT_EQ(summary.header.stamp, out.events[1].header.stamp);
+  ASSERT_TRUE(summary.recording_ok) << summary.recording_error;
+  rosbag::Bag bag(summary.bag_path, rosbag::bagmode::Read);
+  EXPECT_EQ(rosbag::View(bag).size(), 3 + 3 * 2u);
+}
+
+// ---- A taken run_id: served under the next free suffix, nothing overwritten ----
+
+TEST(DuplicateRunId, TwentyStudentsTypingTheSameRunIdAreAllServed) {
+  const auto input = makeInput("test", {1, 1, 1}, {2, 1, -1}, {-1, 0, 1});
+  for (int i = 0; i < 20; ++i) g_node->publish(input);
+  for (int i = 1; i <= 20; ++i) {
+    const std::string run_id = i == 1 ? "test" : "test." + std::to_string(i);
+    SCOPED_TRACE(run_id);
+    const RunOutputs& out = g_node->waitFor(run_id);
+    ASSERT_EQ(out.summaries.size(), 1u);
+    EXPECT_TRUE(out.rejections.empty());
+    EXPECT_EQ(out.summaries.front().collision_count, 3u);
+    EXPECT_EQ(out.summaries.front().requested_run_id, i == 1 ? "" : "test");
+    EXPECT_EQ(out.predictions.front().run_id, run_id);
+    EXPECT_EQ(out.summaries.front().bag_path, g_bag_directory + "/" + run_id + ".bag");
+    EXPECT_TRUE(fs::exists(out.summaries.front().bag_path));
+  }
+}
+
+TEST(DuplicateRunId, AnExistingBagIsNeverOverwritten) {
+  const std::string existing = g_bag_directory + "/from_last_week.bag";
+  fs::create_directories(g_bag_directory);
+  std::ofstream(existing) << "a bag of last week\n";
+  g_node->publish(makeInput("from_last_week", {1, 1, 1}, {2, 1, -1}, {-1, 0, 1}));
+  const RunOutputs& served = g_node->waitFor("from_last_week.2");
+  ASSERT_EQ(served.summaries.size(), 1u);
+  EXPECT_EQ(served.summaries.front().requested_run_id, "from_last_week");
+  EXPECT_EQ(g_node->runs().count("from_last_week"), 0u);  // nothing under the taken name
+  std::ifstream file(existing);
+  std::string line;
+  std::getline(file, line);
+  EXPECT_EQ(line, "a bag of last week");
+}
+
+// ---- Services: the same serve path as the topic ----
+
+TEST(Services, RunSceneAnswersWithTheSummaryOfAPublishedRecordedRun) {
+  collision_lab::RunScene call;
+  call.request.run_id = "by_service";
+  call.request.masses = {{1e4, 1, std::numeric_limits<double>::infinity()}};
+  call.request.positions = {{2, 1, 0}};
+  call.request.velocities = {{-1, 0, 0}};
+  ASSERT_TRUE(ros::service::call(kRunScene, call));
+  EXPECT_TRUE(call.response.ok) << call.response.message;
+  const auto& summary = call.response.summary;
+  EXPECT_EQ(summary.run_id, "by_service");
+  EXPECT_EQ(summary.collision_count, 314u);  // pi to 3 digits
+  EXPECT_NE(call.response.message.find("314 collisions"), std::string::npos) << call.response.message;
+
+  const RunOutputs& out = g_node->waitFor("by_service");  // published like a topic input
+  ASSERT_EQ(out.summaries.size(), 1u);
+  auto published = out.summaries.front();
+  published.header.seq = 0;
+  EXPECT_EQ(bytes(published), bytes(summary));
+  EXPECT_EQ(out.predictions.size(), 1u);
+  ASSERT_TRUE(summary.recording_ok) << summary.recording_error;
+  const auto bagged = expectBagOnTimeline(summary.bag_path, 1.0);
+  EXPECT_EQ(bagged.size(), 314u);
+}
+
+TEST(Services, RunSceneReportsARejection) {
+  collision_lab::RunScene call;
+  call.request.run_id = "bad_by_service";
+  call.request.masses = {{1, 1, 1}};
+  call.request.positions = {{0, 1, 2}};
+  call.request.velocities = {{-1, 0, 0}};
+  ASSERT_TRUE(ros::service::call(kRunScene, call));
+  EXPECT_FALSE(call.response.ok);
+  EXPECT_EQ(call.response.rejected.reason, collision_lab::Rejected::POSITIONS_NOT_ORDERED);
+  EXPECT_NE(call.response.message.find("POSITIONS_NOT_ORDERED"), std::string::npos);
+  const RunOutputs& out = g_node->waitFor("bad_by_service");  // published on `rejected` too
+  ASSERT_EQ(out.rejections.size(), 1u);
+  EXPECT_EQ(out.rejections.front().reason, collision_lab::Rejected::POSITIONS_NOT_ORDERED);
+}
+
+TEST(Services, RunPresetRunsANamedPresetAndListsTheNamesOfAnUnknownOne) {
+  collision_lab::RunPreset call;
+  call.request.name = "pi_digits_2";
+  call.request.run_id = "preset_run";
+  ASSERT_TRUE(ros::service::call(kRunPreset, call));
+  EXPECT_TRUE(call.response.ok) << call.response.message;
+  EXPECT_EQ(call.response.summary.collision_count, 31u);  // pi to 2 digits
+  EXPECT_EQ(g_node->waitFor("preset_run").events.size(), 31u);
+
+  collision_lab::RunPreset unnamed;
+  unnamed.request.name = "pi_digits_3";  // run_id: <name>_<UTC time>
+  ASSERT_TRUE(ros::service::call(kRunPreset, unnamed));
+  EXPECT_TRUE(unnamed.response.ok) << unnamed.response.message;
+  EXPECT_EQ(unnamed.response.summary.run_id.rfind("pi_digits_3_", 0), 0u);
+
+  collision_lab::RunPreset unknown;
+  unknown.request.name = "pi_digits_9";
+  ASSERT_TRUE(ros::service::call(kRunPreset, unknown));
+  EXPECT_FALSE(unknown.response.ok);
+  for (const char* name : {"pi_digits_9", "equal_masses", "pi_digits_3", "moving_wall"}) {
+    EXPECT_NE(unknown.response.message.find(name), std::string::npos) << unknown.response.message;
+  }
+}
+
+TEST(Services, ConcurrentCallsAndTopicInputsAreAllServedOnce) {
+  constexpr int kCalls = 6, kTopicInputs = 3;
+  std::atomic<int> done{0};
+  std::vector<collision_lab::RunScene> calls(kCalls);
+  std::vector<std::thread> threads;
+  for (auto& call : calls) {
+    call.request.run_id = "class";
+    call.request.masses = {{1, 2, 3}};
+    call.request.positions = {{2, 0, -2}};
+    call.request.velocities = {{-1, 0.5, 1}};
+    threads.emplace_back([&call, &done] {
+      if (!ros::service::call(kRunScene, call)) call.response.message = "call failed";
+      ++done;
+    });
+  }
+  for (int i = 0; i < kTopicInputs; ++i) {
+    g_node->publish(makeInput("class", {1, 2, 3}, {2, 0, -2}, {-1, 0.5, 1}));
+  }
+  // The main thread spins the collector while the calls wait for their runs.
+  const bool returned = waitUntil([&] { return done == kCalls; }, "6 concurrent run_scene calls");
+  for (auto& t : threads) t.join();
+  ASSERT_TRUE(returned);
+
+  std::set<std::string> expected, by_calls;
+  for (int i = 1; i <= kCalls + kTopicInputs; ++i) {
+    expected.insert(i == 1 ? "class" : "class." + std::to_string(i));
+  }
+  for (const auto& call : calls) {
+    ASSERT_TRUE(call.response.ok) << call.response.message;
+    EXPECT_EQ(expected.count(call.response.summary.run_id), 1u) << call.response.summary.run_id;
+    by_calls.insert(call.response.summary.run_id);
+  }
+  EXPECT_EQ(by_calls.size(), static_cast<std::size_t>(kCalls));  // each call its own run
+  for (const auto& run_id : expected) {
+    const RunOutputs& out = g_node->waitFor(run_id);
+    ASSERT_EQ(out.summaries.size(), 1u) << run_id;
+    EXPECT_EQ(out.events.size(), 3u) << run_id;
+  }
+  EXPECT_EQ(g_node->runs().count("class." + std::to_string(kCalls + kTopicInputs + 1)), 0u);
+}
+
+// ---- Latching: a late joiner gets the newest prediction, summary and rejection ----
+
+TEST(Latching, ALateJoinerGetsTheNewestPredictionSummaryAndRejection) {
+  runOnce(g_node, makeInput("latched_run", {1, 1, 1}, {2, 1, -1}, {-1, 0, 1}));
+  runOnce(g_node, makeInput("latched_bad", {1, -1, 1}, {2, 1, -1}, {-1, 0, 1}));
+  std::optional<collision_lab::Prediction> prediction;
+  std::optional<collision_lab::RunSummary> summary;
+  std::optional<collision_lab::Rejected> rejected;
+  ros::NodeHandle nh("collision_lab");
+  const auto keep = [](auto& slot) {
+    return [&slot](const auto& msg) { slot = *msg; };
+  };
+  const ros::Subscriber a = nh.subscribe<collision_lab::Prediction>(
+      "predictions", 1, boost::function<void(const collision_lab::Prediction::ConstPtr&)>(keep(prediction)));
+  const ros::Subscriber b = nh.subscribe<collision_lab::RunSummary>(
+      "run_summaries", 1, boost::function<void(const collision_lab::RunSummary::ConstPtr&)>(keep(summary)));
+  const ros::Subscriber c = nh.subscribe<collision_lab::Rejected>(
+      "rejected", 1, boost::function<void(const collision_lab::Rejected::ConstPtr&)>(keep(rejected)));
+  ASSERT_TRUE(waitUntil([&] { return prediction && summary && rejected; },
+                        "the latched prediction, summary and rejection"));
+  EXPECT_EQ(prediction->run_id, "latched_run");
+  EXPECT_EQ(summary->run_id, "latched_run");
+  EXPECT_EQ(rejected->run_id, "latched_bad");
+}
+
 }  // namespace
 
 // ---- /diagnostics: counts, recording state, free space ----
 
 TEST(LabNode, DiagnosticsReportRunsAndRecordingState) {
-  g_node->waitFor("round_trip");
-  g_faulty->waitFor("no_disk");
+  roundTrip();
+  noDisk();
+  runOnce(g_node, makeInput("diagnosed_bad", {1, -1, 1}, {2, 1, 0}, {-1, 0, 0}));
   using Status = diagnostic_msgs::DiagnosticStatus;
   std::map<std::string, Status> latest;
   ros::NodeHandle nh;
@@ -418,7 +700,7 @@ TEST(LabNode, DiagnosticsReportRunsAndRecordingState) {
     return latest.count(healthy) && latest.count(faulty) && value(latest[healthy], "runs accepted") != "0" &&
            latest[faulty].level == Status::ERROR;
   };
-  while (ros::ok() && !reported()) RunCollector::spinOnce();
+  ASSERT_TRUE(waitUntil(reported, "/diagnostics from both nodes after their runs"));
   EXPECT_GE(std::stoull(value(latest[healthy], "runs accepted")), 1u);
   EXPECT_GE(std::stoull(value(latest[healthy], "runs rejected")), 1u);
   EXPECT_NE(latest[healthy].level, Status::ERROR);
@@ -445,6 +727,11 @@ int main(int argc, char** argv) {
   g_faulty = &faulty;
   node.waitForConnection();
   faulty.waitForConnection();
+  for (const char* service : {kRunScene, kRunPreset}) {
+    if (!ros::service::waitForService(service, ros::Duration(collision_lab_test::kWaitTimeout))) {
+      ADD_FAILURE() << "no service " << service << " after " << collision_lab_test::kWaitTimeout << " s";
+    }
+  }
   const int result = RUN_ALL_TESTS();
   std::error_code ec;
   fs::remove_all(fs::path(g_bag_directory).parent_path(), ec);

@@ -1,14 +1,17 @@
 // Test client for collision_lab_node: publishes InitialConditions and collects every
 // output per run_id. Waits are event-driven (spinning the callback queue until a
-// condition holds); rostest's time-limit is the only timeout.
+// condition holds) and each gives up after kWaitTimeout with a gtest failure that says
+// what it waited for, so a regression fails instead of hanging until rostest's limit.
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include <gtest/gtest.h>
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
 
@@ -22,6 +25,25 @@
 #include "collision_lab/ros/node_constants.h"
 
 namespace collision_lab_test {
+
+/// Guards against hangs, not a performance limit: the slowest single wait in these tests
+/// (a 10,000-collision stretch of the crash test's long run) takes a few seconds.
+constexpr double kWaitTimeout = 120.0;  ///< [s] wall time
+
+/// Spins the global callback queue until done() holds; false (and a gtest failure naming
+/// what) after timeout seconds or when ROS shuts down.
+inline bool waitUntil(const std::function<bool()>& done, const std::string& what,
+                      double timeout = kWaitTimeout) {
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(timeout);
+  while (!done()) {
+    if (!ros::ok() || ros::WallTime::now() > end) {
+      ADD_FAILURE() << "gave up after " << timeout << " s waiting for " << what;
+      return false;
+    }
+    ros::getGlobalCallbackQueue()->callAvailable(ros::WallDuration(0.1));
+  }
+  return true;
+}
 
 struct RunOutputs {
   std::vector<collision_lab::Prediction> predictions;
@@ -64,22 +86,21 @@ class RunCollector {
       }
       return true;
     };
-    while (ros::ok() && !connected()) spinOnce();
+    waitUntil(connected, "the node in namespace '" + nh_.getNamespace() +
+                             "' to subscribe to our input and publish every output");
   }
 
   void publish(const collision_lab::InitialConditions& input) { input_pub_.publish(input); }
 
-  /// Waits until the run is complete (see RunOutputs::complete) and returns its outputs.
+  /// Waits until the run is complete (see RunOutputs::complete) and returns its outputs,
+  /// as far as they came when the wait gives up.
   const RunOutputs& waitFor(const std::string& run_id) {
-    while (ros::ok() && !runs_[run_id].complete()) spinOnce();
+    waitUntil([&] { return runs_[run_id].complete(); },
+              "run '" + run_id + "' to complete (a summary with its announced collisions, or a rejection)");
     return runs_[run_id];
   }
 
   const std::map<std::string, RunOutputs>& runs() const { return runs_; }
-
-  static void spinOnce() {
-    ros::getGlobalCallbackQueue()->callAvailable(ros::WallDuration(0.1));
-  }
 
  private:
   template <class Message>

@@ -1,25 +1,47 @@
 // collision_lab_node: serves InitialConditions with the core's runLab, publishes every
-// output, records one bag per run and feeds the marker view.
+// output, records one bag per run and feeds the marker view. Inputs come from the topic
+// `initial_conditions` and from the services ~run_scene and ~run_preset; all three take
+// the same path (served, published, recorded, drawn).
 //
-// Threading: the subscriber callback only queues the input; one worker thread serves the
-// inputs in arrival order and does all publishing, so a run's messages go out in the
-// order predictions, (collision_events, velocities, energy_transfers) per collision,
-// run_summaries, and runs never interleave.
+// Threading contract:
+// - One worker thread serves every input, from the topic and the services alike, in
+//   arrival order, and does all publishing and recording: a run's messages go out in the
+//   order predictions, (collision_events, velocities, energy_transfers) per collision,
+//   run_summaries, and runs never interleave.
+// - The topic callback (global callback queue, spun by main) only queues the input.
+// - The services run on their own callback queue, spun by kServiceThreads threads of an
+//   AsyncSpinner. A call queues its input like the topic does and blocks only its own
+//   service thread until the worker hands back the outcome (a promise): the worker, topic
+//   inputs, diagnostics and the marker animation (global queue) go on meanwhile. Further
+//   concurrent calls wait in roscpp for a free service thread.
+// - The diagnostics timer (global queue) reads the worker's counters through atomics and
+//   recording_mutex_.
+// - Destruction: the subscription and the services stop, queued inputs are dropped (a
+//   call waiting for one answers ok = false), the run in progress finishes and closes its
+//   bag, then the worker and the service threads are joined.
 #pragma once
 
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
+#include <future>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
+#include <unordered_set>
 
+#include <ros/callback_queue.h>
 #include <ros/ros.h>
 
 #include "collision_lab/InitialConditions.h"
 #include "collision_lab/Rejected.h"
+#include "collision_lab/RunPreset.h"
+#include "collision_lab/RunScene.h"
+#include "collision_lab/RunSummary.h"
+#include "collision_lab/ros/core.h"
 #include "collision_lab/ros/marker_view.h"
 
 namespace collision_lab_ros {
@@ -31,14 +53,22 @@ struct LabNodeParams {
   std::uint64_t max_published_events = 0;
   bool publish_markers = true;
   double min_free_space_mb = 0.0;  ///< [MB] diagnostics warn below it
+  std::string scenario_file;       ///< the presets of ~run_preset
 
   /// Reads ~record, ~bag_directory, ~max_collisions, ~max_published_events,
-  /// ~publish_markers and ~min_free_space_mb, with the defaults of node_constants.h.
+  /// ~publish_markers, ~min_free_space_mb and ~scenario_file (default: the package's
+  /// config/scenarios.yaml), with the defaults of node_constants.h.
   static LabNodeParams load(const ros::NodeHandle& private_nh);
 };
 
 /// Empty when run_id is safe as a bag file name; otherwise why not.
 std::string runIdProblem(const std::string& run_id);
+
+/// The answer to one input: its summary when served, else its rejection.
+struct ServeOutcome {
+  std::optional<collision_lab::RunSummary> summary;
+  collision_lab::Rejected rejected;
+};
 
 class LabNode {
  public:
@@ -47,11 +77,36 @@ class LabNode {
   ~LabNode();
 
  private:
+  struct Job {
+    collision_lab::InitialConditions::ConstPtr input;
+    std::shared_ptr<std::promise<ServeOutcome>> reply;  ///< null for topic inputs
+  };
+
   void onInitialConditions(const collision_lab::InitialConditions::ConstPtr& msg);
+  bool onRunScene(collision_lab::RunScene::Request& request,
+                  collision_lab::RunScene::Response& response);
+  bool onRunPreset(collision_lab::RunPreset::Request& request,
+                   collision_lab::RunPreset::Response& response);
+  /// Queues input for the worker and waits for its outcome; empty when the node stops
+  /// before serving it.
+  std::optional<ServeOutcome> serveAndWait(const collision_lab::InitialConditions& input);
+  void enqueue(Job job);
   void workerLoop();
-  void serve(collision_lab::InitialConditions input);
-  void reject(collision_lab::Rejected msg, const std::string& run_id);
+
+  // ---- The worker's (not thread-safe) ----
+  ServeOutcome serve(collision_lab::InitialConditions input);
+  /// Publishes, records and draws one validated run; returns its summary.
+  /// requested_run_id: RunSummary.requested_run_id.
+  collision_lab::RunSummary run(collision_lab::InitialConditions& input, const core::Scene& scene,
+                                core::RunMode mode, const std::string& requested_run_id);
+  ServeOutcome reject(collision_lab::Rejected msg, const std::string& run_id);
   std::string newRunId();
+  /// requested, or the first free requested.N (N = 2, 3, ...) when it is taken; marks the
+  /// result as taken.
+  std::string claimRunId(const std::string& requested);
+  /// A bag of that name exists, or this node served it.
+  bool runIdTaken(const std::string& run_id) const;
+
   /// Publishes one DiagnosticArray: runs accepted and rejected, the last run's compute
   /// time, the recording state and the free space in bag_directory.
   void publishDiagnostics();
@@ -66,6 +121,7 @@ class LabNode {
   std::unique_ptr<MarkerView> marker_view_;
   std::string run_id_prefix_;
   std::uint64_t run_counter_ = 0;
+  std::unordered_set<std::string> used_run_ids_;
 
   // Written by the worker, read by the diagnostics timer.
   std::atomic<std::uint64_t> runs_accepted_{0};
@@ -76,9 +132,13 @@ class LabNode {
 
   std::mutex mutex_;
   std::condition_variable wake_;
-  std::deque<collision_lab::InitialConditions::ConstPtr> inputs_;
+  std::deque<Job> inputs_;
   bool stopping_ = false;
   std::thread worker_;
+
+  ros::CallbackQueue service_queue_;
+  ros::AsyncSpinner service_spinner_;
+  ros::ServiceServer run_scene_srv_, run_preset_srv_;
 };
 
 }  // namespace collision_lab_ros

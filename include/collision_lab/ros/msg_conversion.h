@@ -1,7 +1,8 @@
 // Every conversion between collision_lab messages and the core's types, as free
 // functions (like cartographer_ros/msg_conversion.h). Conversions copy values only; the
-// caller fills header and run_id, and the node-only fields of RunSummary (bag and
-// publishing state).
+// caller fills header and run_id, the run's timeline (timeline_scale of Prediction and
+// RunSummary), and the node-only fields of RunSummary (bag and publishing state,
+// timeline_saturated, requested_run_id).
 #pragma once
 
 #include <array>
@@ -59,7 +60,8 @@ collision_lab::Velocities toVelocitiesMsg(const core::LabEvent& event);
 collision_lab::EnergyTransfer toEnergyTransferMsg(const core::LabEvent& event);
 
 /// The physics fields of a summary; published_events, events_not_published, bag_path,
-/// recording_ok and recording_error are the node's to fill.
+/// recording_ok, recording_error, timeline_scale, timeline_saturated and
+/// requested_run_id are the node's to fill.
 collision_lab::RunSummary toRunSummaryMsg(const core::RunSummary& summary,
                                           const core::Prediction& prediction,
                                           core::RunMode mode);

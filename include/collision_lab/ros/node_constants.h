@@ -15,6 +15,26 @@ constexpr char kEnergyTransfersTopic[] = "energy_transfers";
 constexpr char kRunSummariesTopic[] = "run_summaries";
 constexpr char kRejectedTopic[] = "rejected";
 constexpr char kMarkersTopic[] = "markers";
+
+/// Latched: a late joiner (rviz or `rostopic echo` started after a run, a second client)
+/// gets the newest of these at once. predictions and run_summaries: the newest run's
+/// prediction and result, what a late window needs to show it. rejected: the answer to
+/// "why did nothing happen?" for whoever looks after the fact; its stamp and run_id say
+/// whose it was. Not latched: the per-collision topics (their last message alone is a
+/// fragment of a run), initial_conditions (a late-joining node would serve a stale scene
+/// again) and /diagnostics (periodic).
+constexpr bool kLatchPredictions = true;
+constexpr bool kLatchRunSummaries = true;
+constexpr bool kLatchRejected = true;
+
+/// Private services of collision_lab_node (srv/RunScene.srv, srv/RunPreset.srv).
+constexpr char kRunSceneService[] = "run_scene";
+constexpr char kRunPresetService[] = "run_preset";
+/// Service calls served at once; each blocks its thread until its run is over (the runs
+/// themselves are served one at a time by the worker). Further calls wait in roscpp.
+constexpr std::uint32_t kServiceThreads = 4;
+/// ~scenario_file default, relative to the package folder.
+constexpr char kDefaultScenarioFile[] = "config/scenarios.yaml";
 /// Absolute by the ROS convention: the diagnostic aggregator listens there.
 constexpr char kDiagnosticsTopic[] = "/diagnostics";
 constexpr double kDiagnosticsPeriod = 1.0;  ///< [s]
