@@ -11,4 +11,8 @@ export PATH=/usr/bin:/bin:$PATH
 set +u
 source build_ros/devel/setup.bash
 set -u
-exec roslaunch collision_lab demo.launch rviz:=$rviz "$@"
+# roslaunch exits 0 even when the required publisher fails; its last line says which.
+log=$(mktemp /tmp/collision_lab_demo.XXXXXX.log)
+roslaunch collision_lab demo.launch rviz:=$rviz "$@" 2>&1 | tee "$log"
+if grep -q "demo FAILED" "$log"; then rm -f "$log"; exit 1; fi
+rm -f "$log"
