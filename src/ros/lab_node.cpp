@@ -156,6 +156,7 @@ void LabNode::reject(collision_lab::Rejected msg, const std::string& run_id) {
   ROS_WARN_STREAM("rejected run '" << run_id << "': " << msg.reason_name << " in field "
                   << msg.field << ": " << msg.message);
   rejected_pub_.publish(msg);
+  if (marker_view_) marker_view_->onRejected(msg);
 }
 
 void LabNode::serve(collision_lab::InitialConditions input) {
@@ -219,17 +220,14 @@ void LabNode::serve(collision_lab::InitialConditions input) {
     collision_lab::CollisionEvent event_msg = toCollisionEventMsg(event);
     collision_lab::Velocities velocities_msg = toVelocitiesMsg(event);
     collision_lab::EnergyTransfer energy_msg = toEnergyTransferMsg(event);
+    event_msg.run_id = run_id;
+    if (marker_view_) marker_view_->onCollisionEvent(event_msg);  // every event, published or not
     const bool publish = published_events < params_.max_published_events;
     if (publish) {
       publishAndRecord(events_pub_, event_msg);
       publishAndRecord(velocities_pub_, velocities_msg);
       publishAndRecord(energy_pub_, energy_msg);
       ++published_events;
-      if (marker_view_) {
-        marker_view_->onCollisionEvent(event_msg);
-        marker_view_->onVelocities(velocities_msg);
-        marker_view_->onEnergyTransfer(energy_msg);
-      }
     } else {
       events_not_published = true;
       if (!recorder) return;
