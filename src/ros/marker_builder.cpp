@@ -406,9 +406,9 @@ struct Box {
 // Layout [rviz units]. rviz/collision_lab.rviz looks down at (2.8, 0.85), 46 px per unit;
 // its 1248 x 708 pixel view shows x in [-10.7, 16.3] and y in [-6.8, 8.5].
 constexpr double kCentreX = 2.8;
-constexpr double kTitleY = 8.2, kStatusY = 7.68, kVelocityRowY = 7.18, kNoteY = 5.3;
-constexpr double kSceneY = 6.25, kSceneLeft = -10.2, kSceneRight = 15.8;
-constexpr double kPanelTitleY = 4.65, kLegendY = 4.25;
+constexpr double kTitleY = 8.25, kNoteY = 7.8, kStatusY = 7.35, kVelocityRowY = 6.9;
+constexpr double kSceneY = 6.05, kSceneLeft = -10.2, kSceneRight = 15.8, kZoomY = 5.05;
+constexpr double kPanelTitleY = 4.55, kLegendY = 4.2;
 constexpr Box kWedgeBox{-10.6, -4.6, -0.55, 3.65};
 constexpr double kWedgeRadius = 2.1;
 constexpr Box kBarsBox{-9.9, -5.3, -6.3, -2.6};
@@ -419,6 +419,8 @@ constexpr Box kWorldBox{8.3, 15.9, -6.1, 3.55};
 constexpr double kTextSize = 0.32, kSmallTextSize = 0.26, kTitleSize = 0.38;
 /// B gets its own panel when its largest speed exceeds A's and C's by this factor.
 constexpr double kOwnScaleFactor = 5.0;
+/// The paper's velocities widen a panel's scale at most this much; beyond, they are clipped.
+constexpr double kPaperScaleFactor = 4.0;
 /// At most this many closed-form dots per series (they sit on the simulated steps).
 constexpr std::size_t kMaxPredictedDots = 200;
 /// At most this many states per series in the wedge when not every collision is kept.
@@ -546,12 +548,16 @@ void addFrame(std::vector<Marker>& out, const std::string& frame_id, const std::
     frame.points.push_back(point(b.right, axes.toY(0.0)));
   }
   out.push_back(frame);
-  out.push_back(text(frame_id, ns, id + 1, b.left - 0.55, b.top, format("%.3g", axes.y1), kSmallTextSize));
-  out.push_back(text(frame_id, ns, id + 2, b.left - 0.55, b.bottom, format("%.3g", axes.y0), kSmallTextSize));
+  // Zero is labelled whenever it is inside; an end label too close to it gives way.
   const double zero = axes.toY(0.0);
-  if (axes.y0 < 0 && axes.y1 > 0 && zero - b.bottom > 0.3 && b.top - zero > 0.3) {
-    out.push_back(text(frame_id, ns, id + 3, b.left - 0.3, zero, "0", kSmallTextSize));
+  const bool zero_inside = axes.y0 < 0 && axes.y1 > 0;
+  if (!zero_inside || b.top - zero > 0.3) {
+    out.push_back(text(frame_id, ns, id + 1, b.left - 0.55, b.top, format("%.3g", axes.y1), kSmallTextSize));
   }
+  if (!zero_inside || zero - b.bottom > 0.3) {
+    out.push_back(text(frame_id, ns, id + 2, b.left - 0.55, b.bottom, format("%.3g", axes.y0), kSmallTextSize));
+  }
+  if (zero_inside) out.push_back(text(frame_id, ns, id + 3, b.left - 0.3, zero, "0", kSmallTextSize));
   out.push_back(text(frame_id, ns, id + 4, b.midX(), b.top + 0.22, label, kSmallTextSize));
 }
 
@@ -884,6 +890,13 @@ std::vector<VelocityPanel> velocityPanels(const RunRecord& run) {
         lo = std::min(lo, final_v->second[i]), hi = std::max(hi, final_v->second[i]);
       }
     }
+    // The paper's values join the scale unless they would squash the simulated ones.
+    double paper_lo = lo, paper_hi = hi;
+    for (int i : bodies) {
+      paper_lo = std::min(paper_lo, run.paperVelocity(i).minY());
+      paper_hi = std::max(paper_hi, run.paperVelocity(i).maxY());
+    }
+    if (paper_hi - paper_lo <= kPaperScaleFactor * (hi - lo)) lo = paper_lo, hi = paper_hi;
     return paddedRange(lo, hi);
   };
   const double x1 = indexAxisEnd(run);
@@ -1094,6 +1107,40 @@ void addBodies(std::vector<Marker>& out, const RunRecord& run, const SceneState&
   }
 }
 
+/// A magnifier under the scene while the bodies crowd together (less than 5 % of the axis
+/// apart): the three at their true separations, in a window a power of ten wide.
+void addZoom(std::vector<Marker>& out, const RunRecord& run, const SceneState& state, const std::string& frame_id) {
+  constexpr int kMarkers = 6;  // ids 0..5 of ns "zoom"
+  const SceneAxis axis = sceneAxis(run);
+  const auto [lo, hi] = std::minmax({state.positions[0], state.positions[1], state.positions[2]});
+  const double full = axis.max - axis.min;
+  if (!(hi - lo > 0) || hi - lo > 0.05 * full) {
+    for (int id = 0; id < kMarkers; ++id) out.push_back(deleteMarker("zoom", id, frame_id));
+    return;
+  }
+  const double window = std::pow(10.0, std::ceil(std::log10(1.6 * (hi - lo))));
+  const double left = kSceneLeft + 5.0, right = kSceneRight - 5.0, middle = (lo + hi) / 2;
+  const auto toX = [&](double x) { return left + ((x - middle) / window + 0.5) * (right - left); };
+  Marker line = lines(frame_id, "zoom", 0, Marker::LINE_LIST, 0.02, kGrey);
+  line.points = {point(left, kZoomY), point(right, kZoomY)};
+  out.push_back(line);
+  for (int i = 0; i < 3; ++i) {
+    Marker body = base(frame_id, "zoom", 1 + i, isWall(run.input(), i) ? Marker::CUBE : Marker::SPHERE);
+    // B, the light one, on top: at a collision it touches A or C.
+    body.pose.position = point(toX(state.positions[i]), kZoomY, i == 1 ? 0.3 : 0.05);
+    body.scale.x = isWall(run.input(), i) ? 0.08 : (i == 1 ? 0.16 : 0.26);
+    body.scale.y = isWall(run.input(), i) ? 0.6 : body.scale.x;
+    body.scale.z = body.scale.x;
+    body.color = isWall(run.input(), i) ? kGrey : particleColor(i);
+    out.push_back(body);
+  }
+  out.push_back(text(frame_id, "zoom", 4, left - 2.2, kZoomY, format("magnified x%.2g", full / window),
+                     kSmallTextSize, kGrey));
+  out.push_back(text(frame_id, "zoom", 5, right + 2.5, kZoomY,
+                     format("window %.2g m", window) + format(" from x = %.4g m", middle - window / 2), kSmallTextSize,
+                     kGrey));
+}
+
 std::string statusLine(const RunRecord& run, const SceneState& state, const FrameClock& clock) {
   std::string s = format("t = %.6g s", state.time) + "     collisions " + withSeparators(state.collisions);
   const std::uint64_t expected = expectedCollisions(run);
@@ -1158,6 +1205,7 @@ MarkerArray buildAnimatedMarkers(const RunRecord& run, const FrameClock& clock, 
   auto& out = array.markers;
   const SceneState state = stateAt(run, clock.t);
   addBodies(out, run, state, frame_id);
+  addZoom(out, run, state, frame_id);
   out.push_back(text(frame_id, "labels", 3, kCentreX, kStatusY, statusLine(run, state, clock), kTextSize));
   addCursors(out, run, state, frame_id);
   addBars(out, run, state, frame_id);
@@ -1191,7 +1239,7 @@ std::vector<Marker> framedText(const std::string& frame_id, const std::string& n
 
 std::vector<Marker> rejectedBanner(const collision_lab::Rejected& rejected, const std::string& frame_id) {
   const std::string run = rejected.run_id.empty() ? "an input" : "run '" + rejected.run_id + "'";
-  return framedText(frame_id, "rejected", kNoteY,
+  return framedText(frame_id, "rejected", kZoomY,
                     "REJECTED " + run + ": " + rejected.reason_name + " in " + rejected.field + "\n" +
                         rejected.message,
                     color(1.0, 0.35, 0.35));

@@ -54,9 +54,9 @@ constexpr double kMarkerEndHold = 2.5;
 constexpr double kRejectedShowTime = 6.0;
 /// What the marker view keeps of one run, whatever its count (RunRecord): exact states
 /// after this many selected collisions, and plotted series of at most this many vertices
-/// each (beyond it, min/max per column: 1024 columns, more than a plot's pixels).
+/// each (beyond it, min/max per column: 256 to 512 columns, about a plot's pixels).
 constexpr std::size_t kMarkerKeyframes = 4096;
-constexpr std::size_t kMarkerEnvelopeVertices = 4096;
+constexpr std::size_t kMarkerEnvelopeVertices = 2048;
 /// rviz draws LINE_STRIP and LINE_LIST markers with a BillboardLine whose chains hold at
 /// most 65536 / 4 = 16384 elements (rviz 1.14 src/rviz/ogre_helpers/billboard_line.cpp,
 /// MAX_ELEMENTS). A LINE_STRIP with more points is split over several lines, and the next
