@@ -416,7 +416,7 @@ constexpr Box kVelocityBox{-2.2, 5.2, -0.35, 3.55};
 constexpr Box kEnergyBox{-2.2, 5.2, -3.05, -1.55};
 constexpr Box kMomentumBox{-2.2, 5.2, -6.1, -4.6};
 constexpr Box kWorldBox{8.3, 15.9, -6.1, 3.55};
-constexpr double kTextSize = 0.32, kSmallTextSize = 0.26, kTitleSize = 0.38;
+constexpr double kTextSize = 0.32, kSmallTextSize = 0.29, kTitleSize = 0.38;
 /// B gets its own panel when its largest speed exceeds A's and C's by this factor.
 constexpr double kOwnScaleFactor = 5.0;
 /// The paper's velocities widen a panel's scale at most this much; beyond, they are clipped.
@@ -439,6 +439,8 @@ std_msgs::ColorRGBA particleColor(int i, double lighten = 0.0) {
 }
 const std_msgs::ColorRGBA kWhite = color(0.95, 0.95, 0.95);
 const std_msgs::ColorRGBA kGrey = color(0.6, 0.6, 0.6);
+/// Small grey text lighter than lines: rviz draws a minus sign one pixel thin.
+const std_msgs::ColorRGBA kLabelGrey = color(0.8, 0.8, 0.8);
 const std_msgs::ColorRGBA kAmber = color(1.0, 0.75, 0.2);
 const std_msgs::ColorRGBA kPaper = color(1.0, 0.55, 0.9);
 const std_msgs::ColorRGBA kPredicted = color(0.8, 0.5, 1.0);
@@ -718,10 +720,10 @@ void addSceneAxis(std::vector<Marker>& out, const RunRecord& run, const std::str
   axis.points = {point(kSceneLeft, kSceneY), point(kSceneRight, kSceneY)};
   out.push_back(axis);
   const SceneAxis scene = sceneAxis(run);
-  out.push_back(text(frame_id, "scene", 1, kSceneLeft + 0.3, kSceneY - 0.5, format("x = %.4g m", scene.min),
-                     kSmallTextSize, kGrey));
-  out.push_back(text(frame_id, "scene", 2, kSceneRight - 0.3, kSceneY - 0.5, format("x = %.4g m", scene.max),
-                     kSmallTextSize, kGrey));
+  out.push_back(text(frame_id, "scene", 1, kSceneLeft + 0.9, kSceneY - 0.5, format("x = %.4g m", scene.min),
+                     kSmallTextSize, kLabelGrey));
+  out.push_back(text(frame_id, "scene", 2, kSceneRight - 0.9, kSceneY - 0.5, format("x = %.4g m", scene.max),
+                     kSmallTextSize, kLabelGrey));
   const std::string note = runNote(run);
   if (!note.empty()) out.push_back(text(frame_id, "scene", 4, kCentreX, kNoteY, note, kTextSize, kAmber));
 }
@@ -970,7 +972,7 @@ void addVelocityPlot(std::vector<Marker>& out, const RunRecord& run, const std::
   if (paper_any) legend += "   pink: paper's eqs. (2.15)/(2.16) where they differ";
   if (paper_off_scale) legend += " (clipped)";
   if (!paper_any && (isWall(run.input(), 0) || isWall(run.input(), 2))) legend += "   paper's (2.15)/(2.16): undefined with a wall";
-  out.push_back(text(frame_id, "plot", 311, kVelocityBox.midX(), kLegendY, legend, kSmallTextSize, kGrey));
+  out.push_back(text(frame_id, "plot", 311, kVelocityBox.midX(), kLegendY, legend, kSmallTextSize, kLabelGrey));
   for (int i = 0; i < 3; ++i) {
     out.push_back(text(frame_id, "plot", 320 + i, kVelocityBox.right + 0.55, kVelocityBox.top - 0.4 * i,
                        std::string("v_") + kNames[i], kTextSize, particleColor(i)));
@@ -990,8 +992,8 @@ void addConservedPlot(std::vector<Marker>& out, const RunRecord& run, const Enve
 }
 
 void addEnergyPlot(std::vector<Marker>& out, const RunRecord& run, const std::string& frame_id) {
-  std::string energy = "energy E [J] (finite masses) vs collision index";
-  std::string p = "momentum p [kg m/s] (finite masses) vs collision index";
+  std::string energy = "E [J] of the finite masses vs collision index";
+  std::string p = "p [kg m/s] of the finite masses vs collision index";
   if (run.summary && run.summary->simulated) {
     energy += format(";  drift %.2g", run.summary->energy_relative_drift);
     const double drift = run.summary->momentum_relative_drift;
@@ -1042,7 +1044,7 @@ void addWorldlines(std::vector<Marker>& out, const RunRecord& run, const std::st
   label(6, kWorldBox.midX(), kWorldBox.bottom - 0.3, "x [m]");
   out.push_back(text(frame_id, "worldlines", 7, kWorldBox.midX(), kPanelTitleY, "x-t diagram (worldlines)", kTextSize));
   out.push_back(text(frame_id, "worldlines", 8, kWorldBox.midX(), kLegendY,
-                     run.worldline(1).exact() ? "exact" : "min/max of x per time column", kSmallTextSize, kGrey));
+                     run.worldline(1).exact() ? "exact" : "min/max of x per time column", kSmallTextSize, kLabelGrey));
 }
 
 // ---- energy bars ----
@@ -1135,10 +1137,10 @@ void addZoom(std::vector<Marker>& out, const RunRecord& run, const SceneState& s
     out.push_back(body);
   }
   out.push_back(text(frame_id, "zoom", 4, left - 2.2, kZoomY, format("magnified x%.2g", full / window),
-                     kSmallTextSize, kGrey));
+                     kSmallTextSize, kLabelGrey));
   out.push_back(text(frame_id, "zoom", 5, right + 2.5, kZoomY,
-                     format("window %.2g m", window) + format(" from x = %.4g m", middle - window / 2), kSmallTextSize,
-                     kGrey));
+                     format("window %.2g m", window) + format(" from %.3g m", middle - window / 2), kSmallTextSize,
+                     kLabelGrey));
 }
 
 std::string statusLine(const RunRecord& run, const SceneState& state, const FrameClock& clock) {
@@ -1217,7 +1219,7 @@ namespace {
 /// A text with a frame around it. The frame also makes rviz 1.14 draw a text that comes
 /// alone: an array of only TEXT_VIEW_FACING markers is received but not drawn.
 std::vector<Marker> framedText(const std::string& frame_id, const std::string& ns, double y, const std::string& s,
-                               const std_msgs::ColorRGBA& c) {
+                               const std_msgs::ColorRGBA& c, double size) {
   std::size_t longest = 0, lines_count = 1, start = 0;
   for (std::size_t end = s.find('\n'); ; end = s.find('\n', start)) {
     longest = std::max(longest, (end == std::string::npos ? s.size() : end) - start);
@@ -1226,13 +1228,13 @@ std::vector<Marker> framedText(const std::string& frame_id, const std::string& n
     ++lines_count;
   }
   // rviz's font is about 0.42 text heights wide per character, 1.25 high per line.
-  const double half_width = std::min(0.21 * kTextSize * static_cast<double>(longest) + 0.4, 13.0);
-  const double half_height = 0.62 * kTextSize * static_cast<double>(lines_count) + 0.2;
+  const double half_width = std::min(0.21 * size * static_cast<double>(longest) + 0.4, 13.0);
+  const double half_height = 0.62 * size * static_cast<double>(lines_count) + 0.2;
   Marker box = lines(frame_id, ns, 1, Marker::LINE_LIST, 0.03, c);
   const double l = kCentreX - half_width, r = kCentreX + half_width;
   const double b = y - half_height, t = y + half_height;
   box.points = {point(l, b), point(r, b), point(r, b), point(r, t), point(r, t), point(l, t), point(l, t), point(l, b)};
-  return {text(frame_id, ns, 0, kCentreX, y, s, kTextSize, c), box};
+  return {text(frame_id, ns, 0, kCentreX, y, s, size, c), box};
 }
 
 }  // namespace
@@ -1242,11 +1244,12 @@ std::vector<Marker> rejectedBanner(const collision_lab::Rejected& rejected, cons
   return framedText(frame_id, "rejected", kZoomY,
                     "REJECTED " + run + ": " + rejected.reason_name + " in " + rejected.field + "\n" +
                         rejected.message,
-                    color(1.0, 0.35, 0.35));
+                    color(1.0, 0.35, 0.35), kTextSize);
 }
 
 std::vector<Marker> hintMarkers(const std::string& command, const std::string& frame_id) {
-  return framedText(frame_id, "hint", 1.5, command, kWhite);
+  // Large: an underscore one pixel thin would vanish, and this is a command to copy.
+  return framedText(frame_id, "hint", 1.5, command, kWhite, 0.44);
 }
 
 Marker deleteMarker(const std::string& ns, int id, const std::string& frame_id) {
