@@ -133,7 +133,8 @@ std::optional<std::uint64_t> countIfSeparated(const Quotient<T>& quotient) {
   using std::ceil;
   using std::round;
   const T nearest = round(quotient.q);
-  if (absOf(T(quotient.q - nearest)) <= 2 * quotient.error_bound) return std::nullopt;
+  // Written so that a NaN (a precision without the range for these masses) is not separated.
+  if (!(absOf(T(quotient.q - nearest)) > 2 * quotient.error_bound)) return std::nullopt;
   const T count = ceil(quotient.q) - 1;
   return count < 0 ? 0 : static_cast<std::uint64_t>(count);  // never through a double: counts pass 2^53
 }
@@ -325,11 +326,11 @@ std::uint64_t predictedCollisionCount(const Scene& scene) {
   if (auto count = countIfSeparated(precise)) return *count;
   if (!(precise.error_bound < 0.25)) {
     // Even 50 digits cannot place u_perp (a body far lighter than the rest carries all the
-    // relative motion): count exactly when the run is short, else go to 500 digits.
+    // relative motion): 500 digits, else count exactly when the run is short.
+    if (auto count = countIfSeparated(countQuotient<DeepPrecision>(scene, *first))) return *count;
     if (maxPossibleCollisionCount(scene.masses) <= kExactCountLimit) {
       return exact::simulate(scene, kExactCountLimit).collision_count;
     }
-    if (auto count = countIfSeparated(countQuotient<DeepPrecision>(scene, *first))) return *count;
   }
   // psi / alpha is an integer Q to 50 digits. If it is exactly Q, contact Q grazes with
   // zero approach speed and does not count: decide by the exact state before contact Q.

@@ -239,8 +239,8 @@ T approachOf(Pair pair, const std::array<T, 3>& v) {
 }
 
 /// Takes the sign decisions the working precision cannot, at 100 digits: a replay for
-/// short runs, the closed-form state after k impacts (O(1) in k) for long ones; then
-/// exact rationals for a zero to within that, then 500 digits beyond the rationals' reach.
+/// short runs, the closed-form state after k impacts (O(1) in k) for long ones; then the
+/// closed form at 500 digits; then exact rationals for a zero to within that.
 /// The closed form holds for any alternating sequence, which every run is.
 template <class Scalar>
 class Escalation {
@@ -263,21 +263,24 @@ class Escalation {
       v.adopt(precise.velocities);
       return {precise_approach > 0, precise_approach};
     }
-    if (k <= kExactReplayLimit) {
-      ++stats.exact_rational;
-      const exact::RationalState exact_state = exact::velocitiesAfter(scene_, first_, k);
-      v.adopt(exact_state);
-      const exact::Rational approach = exact::approachSpeed(pair, exact_state);
-      return {approach > 0, ReplayPrecision(numerator(approach)) / ReplayPrecision(denominator(approach))};
+    // Masses that span more than ~1e100 defeat 100 digits; 500 digits decide all but an
+    // exact zero, in O(1) like the 100-digit closed form.
+    if (!deep_closed_form_) deep_closed_form_.emplace(scene_);
+    const auto deep = stateOf(*deep_closed_form_, k);
+    const DeepReplayPrecision deep_approach = approachOf(pair, deep);
+    const bool deep_decides =
+        mp::abs(deep_approach) > closedFormFactor<DeepReplayPrecision>() * scale_.bound<DeepReplayPrecision>(pair, k);
+    if (deep_decides || k > kExactReplayLimit) {
+      // Beyond the exact replay's reach, an exact zero would need input doubles built for
+      // it over thousands of impacts: within 500 digits of zero counts as not approaching.
+      v.adopt(deep);
+      return {deep_decides && deep_approach > 0, static_cast<ReplayPrecision>(deep_approach)};
     }
-    // An exact zero this deep would need input doubles built for it over thousands of
-    // impacts; 500 digits separate everything else.
-    const AnalyticModel<DeepReplayPrecision> deep_model(scene_);
-    const auto deep = stateOf(deep_model, k);
-    v.adopt(deep);
-    const DeepReplayPrecision approach = approachOf(pair, deep);
-    return {approach > closedFormFactor<DeepReplayPrecision>() * scale_.bound<DeepReplayPrecision>(pair, k),
-            static_cast<ReplayPrecision>(approach)};
+    ++stats.exact_rational;
+    const exact::RationalState exact_state = exact::velocitiesAfter(scene_, first_, k);
+    v.adopt(exact_state);
+    const exact::Rational approach = exact::approachSpeed(pair, exact_state);
+    return {approach > 0, ReplayPrecision(numerator(approach)) / ReplayPrecision(denominator(approach))};
   }
 
   /// Replaces v by the 100-digit state after k impacts, so that rounding errors of very
@@ -314,6 +317,7 @@ class Escalation {
   const ErrorScale& scale_;
   Pair first_;
   std::optional<AnalyticModel<ReplayPrecision>> closed_form_;
+  std::optional<AnalyticModel<DeepReplayPrecision>> deep_closed_form_;
 };
 
 template <class T>
