@@ -39,9 +39,10 @@ std::string formatShort(double value) {
   return buffer;
 }
 
-/// The message always starts with the field, so one line tells the user where to look.
+/// The field is its own value; the message names the quantity (m_B, x_A, ...) once, so a
+/// one-line report "field: message" never repeats itself.
 ValidationError makeError(Reason reason, const std::string& field, const std::string& message) {
-  return ValidationError{reason, field, field + ": " + message};
+  return ValidationError{reason, field, message};
 }
 
 bool isFiniteProduct(double a, double b) { return std::isfinite(a * b); }
