@@ -184,7 +184,6 @@ class TimeWarp {
   double timeAt(double phase) const;
   /// d(simulated time)/d(phase) at phase [s per loop].
   double rateAt(double phase) const;
-  double end() const { return end_; }
 
  private:
   std::vector<double> times_, phases_;  ///< increasing nodes of the piecewise-linear map
