@@ -250,7 +250,8 @@ class Escalation {
   /// A sign decision taken above the working precision.
   struct Decision {
     bool approaches;
-    ReplayPrecision approach;  ///< the approach speed it saw [m/s], to 100 digits or better
+    ReplayPrecision approach;                  ///< the approach speed it saw, to 100 digits or better
+    std::array<ReplayPrecision, 3> velocities;  ///< the state it saw (Scalar may not hold all of it)
   };
 
   /// Does `pair` approach after k impacts, as exact arithmetic says? Hands the accurate
@@ -261,7 +262,7 @@ class Escalation {
     const ReplayPrecision precise_approach = approachOf(pair, precise.velocities);
     if (mp::abs(precise_approach) > precise.bound_factor * scale_.bound<ReplayPrecision>(pair, k)) {
       v.adopt(precise.velocities);
-      return {precise_approach > 0, precise_approach};
+      return {precise_approach > 0, precise_approach, precise.velocities};
     }
     // Masses that span more than ~1e100 defeat 100 digits; 500 digits decide all but an
     // exact zero, in O(1) like the 100-digit closed form.
@@ -274,13 +275,13 @@ class Escalation {
       // Beyond the exact replay's reach, an exact zero would need input doubles built for
       // it over thousands of impacts: within 500 digits of zero counts as not approaching.
       v.adopt(deep);
-      return {deep_decides && deep_approach > 0, static_cast<ReplayPrecision>(deep_approach)};
+      return {deep_decides && deep_approach > 0, static_cast<ReplayPrecision>(deep_approach), narrowed(deep)};
     }
     ++stats.exact_rational;
     const exact::RationalState exact_state = exact::velocitiesAfter(scene_, first_, k);
     v.adopt(exact_state);
     const exact::Rational approach = exact::approachSpeed(pair, exact_state);
-    return {approach > 0, ReplayPrecision(numerator(approach)) / ReplayPrecision(denominator(approach))};
+    return {approach > 0, narrowed(approach), narrowed(exact_state)};
   }
 
   /// Replaces v by the 100-digit state after k impacts, so that rounding errors of very
@@ -297,6 +298,15 @@ class Escalation {
     if (k <= kShortReplay) return {replay<ReplayPrecision>(scene_, first_, k), ReplayPrecision(1)};
     if (!closed_form_) closed_form_.emplace(scene_);
     return {stateOf(*closed_form_, k), closedFormFactor<ReplayPrecision>()};
+  }
+
+  static ReplayPrecision narrowed(const exact::Rational& q) {
+    return ReplayPrecision(numerator(q)) / ReplayPrecision(denominator(q));
+  }
+  static ReplayPrecision narrowed(const DeepReplayPrecision& x) { return static_cast<ReplayPrecision>(x); }
+  template <class T>
+  static std::array<ReplayPrecision, 3> narrowed(const std::array<T, 3>& state) {
+    return {narrowed(state[0]), narrowed(state[1]), narrowed(state[2])};
   }
 
   template <class T>
@@ -440,6 +450,14 @@ struct CompensatedTime {
   T value() const { return hi + lo; }
 };
 
+/// Zero, or a finite magnitude in T's normal range with room to spare: no underflow has
+/// eaten digits, and no product of it can overflow.
+template <class T>
+bool inNormalRange(const T& x) {
+  const T smallest = std::numeric_limits<T>::min() / epsilonOf<T>();
+  return x == 0 || (absOf(x) >= smallest && absOf(x) <= 1 / smallest);
+}
+
 /// Time, position and event bookkeeping of a run that reports events, in working units
 /// and precision T. Each body's path is anchored where its velocity last changed.
 template <class T>
@@ -483,8 +501,8 @@ class Trajectory {
     // is off by v times the time's rounding, so the slow body's is the accurate one.
     const T contact = absOf(v[left]) <= absOf(v[right]) ? impact.positions[left] : impact.positions[right];
     impact.positions[left] = impact.positions[right] = contact;
-    impact.in_range = inRange(approach) && inRange(impact.time.value());
-    for (const T& x : impact.positions) impact.in_range = impact.in_range && inRange(x);
+    impact.in_range = inNormalRange(approach) && inNormalRange(impact.time.value());
+    for (const T& x : impact.positions) impact.in_range = impact.in_range && inNormalRange(x);
     return impact;
   }
 
@@ -536,13 +554,6 @@ class Trajectory {
   template <class Narrow>
   static CompensatedTime<T> widened(const CompensatedTime<Narrow>& time) {
     return {T(time.hi), T(time.lo)};
-  }
-
-  /// Zero, or a finite magnitude in T's normal range with room to spare: no underflow
-  /// has eaten digits, and no product of it can overflow.
-  static bool inRange(const T& x) {
-    const T smallest = std::numeric_limits<T>::min() / epsilonOf<T>();
-    return x == 0 || (absOf(x) >= smallest && absOf(x) <= 1 / smallest);
   }
 
   using Energy = detail::EnergyType<T>;
@@ -599,14 +610,16 @@ SimulationResult simulate(const Scene& scene, const SimulationOptions& options, 
   // The error bound grows with the impacts since v was last exact to working precision.
   std::uint64_t exact_at = 0;
   std::optional<Escalation<Scalar>> escalation;
-  // The approach speed seen by the last decision when it was taken above the working
-  // precision: an event's time and energy use it.
+  // The approach speed and state seen by the last decision when it was taken above the
+  // working precision: an event's time, positions and energy use them.
   std::optional<ReplayPrecision> precise_approach;
+  std::optional<std::array<ReplayPrecision, 3>> precise_state;
 
   // Does `pair` approach after k impacts? Exact decision; may refresh v.
   auto approaches = [&](Pair pair, std::uint64_t k) {
     ++stats.decisions;
     precise_approach.reset();
+    precise_state.reset();
     if (k - exact_at >= kResynchronizeInterval) {
       if (!escalation) escalation.emplace(working, scale, *result.first_pair);
       escalation->resynchronize(k, v);
@@ -621,6 +634,7 @@ SimulationResult simulate(const Scene& scene, const SimulationOptions& options, 
     exact_at = k;
     const auto decision = escalation->decide(k, pair, v, stats);
     precise_approach = decision.approach;
+    precise_state = decision.velocities;
     return decision.approaches;
   };
 
@@ -649,12 +663,20 @@ SimulationResult simulate(const Scene& scene, const SimulationOptions& options, 
     auto impactOn = [&](auto& trajectory) {
       using T = typename std::decay_t<decltype(trajectory)>::Value;
       const int left = pair == Pair::AB ? kA : kB;
-      const std::array<T, 3> before = v.template valuesAs<T>();
-      // The approach speed to the last digit the run knows: the precise one after an
-      // escalation, else the compensated one (never the difference of `before`).
+      // The state to the last digit the run knows: the precise one after an escalation
+      // (where even a velocity that Scalar cannot hold moves a body over a long flight),
+      // else the compensated one; never the approach speed as a difference of `before`.
+      std::array<T, 3> before = v.template valuesAs<T>();
+      bool held = true;
+      if (precise_state) {
+        for (int i = 0; i < 3; ++i) {
+          before[i] = static_cast<T>((*precise_state)[i]);
+          held = held && ((*precise_state)[i] == 0 || (before[i] != 0 && inNormalRange(before[i])));
+        }
+      }
       const T approach = precise_approach ? static_cast<T>(*precise_approach) : T(v.approach(left));
       const auto impact = trajectory.next(pair, before, approach);
-      if (!impact.in_range && !std::is_same_v<T, Wide>) return false;
+      if (!(impact.in_range && held) && !std::is_same_v<T, Wide>) return false;
       v.impact(coefficients.of(pair), left);
       ++k;
       event = trajectory.commit(k, pair, impact, before, v.template valuesAs<T>(), approach, units);
