@@ -23,7 +23,7 @@ bool isValueOption(const std::string& arg) {
 }
 
 CliError missingValue(const std::string& option) {
-  return makeCliError(CliReason::kMissingInput, option.substr(2), option + " is given without a value");
+  return makeCliError(CliReason::kMissingInput, option.substr(2), "the option is given without a value");
 }
 
 /// "--velocities -1,0,0" -> "--velocities=-1,0,0": a value option takes the next
@@ -55,21 +55,21 @@ std::string oneLine(std::string text) {
   return text;
 }
 
-/// "1,2,inf" -> three doubles; `field` is "masses", "positions" or "velocities".
+/// "1,2,inf" -> three doubles; `field` is "masses", "positions" or "velocities". Messages
+/// do not repeat the field, which the error line names already.
 std::array<double, 3> parseTriple(const std::string& text, const std::string& field, const char* symbol) {
   const std::vector<std::string> items = io::splitCommaList(text);
   if (items.size() != 3) {
     throw makeCliError(CliReason::kWrongCount, field,
-                       field + " needs 3 comma-separated numbers (" + symbol + "_A," + symbol + "_B," + symbol +
-                           "_C), got " + std::to_string(items.size()) + " in '" + text + "'");
+                       "3 comma-separated numbers are needed (" + std::string(symbol) + "_A," + symbol + "_B," +
+                           symbol + "_C), got " + std::to_string(items.size()) + " in '" + text + "'");
   }
   std::array<double, 3> values{};
   for (int i = 0; i < 3; ++i) {
     const io::ParsedNumber parsed = io::parseNumber(items[i]);
     if (!parsed.problem.empty()) {
-      const std::string item_field = field + "[" + std::to_string(i) + "]";
-      throw makeCliError(CliReason::kMalformedNumber, item_field,
-                         item_field + " '" + items[i] + "' " + parsed.problem);
+      throw makeCliError(CliReason::kMalformedNumber, field + "[" + std::to_string(i) + "]",
+                         "'" + items[i] + "' " + parsed.problem);
     }
     values[i] = parsed.value;
   }
@@ -90,27 +90,26 @@ struct RawOptions {
 void readRunOptions(const RawOptions& raw, CliRequest& request) {
   const auto format = io::parseReportFormat(raw.format);
   if (!format) {
-    throw makeCliError(CliReason::kInvalidOption, "format", "format '" + raw.format + "' is not table, json or csv");
+    throw makeCliError(CliReason::kInvalidOption, "format", "'" + raw.format + "' is not table, json or csv");
   }
   request.format = *format;
   const auto precision = io::parsePrecisionOption(raw.precision);
   if (!precision) {
     throw makeCliError(CliReason::kInvalidOption, "precision",
-                       "precision '" + raw.precision + "' is not double, long_double or high");
+                       "'" + raw.precision + "' is not double, long_double or high");
   }
   request.options.precision = *precision;
   const auto mode = io::parseRunMode(raw.mode);
   if (!mode) {
-    throw makeCliError(CliReason::kInvalidOption, "mode", "mode '" + raw.mode + "' is not full, predict or summary");
+    throw makeCliError(CliReason::kInvalidOption, "mode", "'" + raw.mode + "' is not full, predict or summary");
   }
   request.options.mode = *mode;
   if (raw.max_collisions_given) {
-    const auto cap = io::parseCount(raw.max_collisions);
-    if (!cap) {
-      throw makeCliError(CliReason::kInvalidOption, "max-collisions",
-                         "max-collisions '" + raw.max_collisions + "' is not a non-negative integer");
+    const io::ParsedCount cap = io::parseCount(raw.max_collisions);
+    if (!cap.problem.empty()) {
+      throw makeCliError(CliReason::kInvalidOption, "max-collisions", "'" + raw.max_collisions + "' " + cap.problem);
     }
-    request.options.max_collisions = *cap;
+    request.options.max_collisions = cap.value;
     request.max_collisions_given = true;
   }
 }
@@ -139,8 +138,8 @@ void readSceneSource(const RawOptions& raw, const std::string& default_scenario_
                                      std::pair{raw.velocities_given, "velocities"}}) {
     if (!given) {
       throw makeCliError(CliReason::kMissingInput, field,
-                         std::string(field) + " missing: give --masses, --positions and --velocities "
-                                              "(3 comma-separated numbers each), or --scenario FILE");
+                         "missing: give --masses, --positions and --velocities "
+                         "(3 comma-separated numbers each), or --scenario FILE");
     }
   }
   Scene scene;
@@ -158,8 +157,13 @@ void readEventPolicy(const RawOptions& raw, CliRequest& request) {
       raw.events_given ? raw.events : (request.action == CliRequest::Action::kRunAll ? "none" : "all");
   const auto events = io::parseEventPolicy(text);
   if (!events) {
+    const std::string prefix = "first:";
+    const std::string n_problem =
+        text.rfind(prefix, 0) == 0 ? io::parseCount(std::string_view(text).substr(prefix.size())).problem : "";
     throw makeCliError(CliReason::kInvalidOption, "events",
-                       "events '" + text + "' is not all, none or first:N with N a non-negative integer");
+                       n_problem.rfind("is too large", 0) == 0
+                           ? "'" + text + "': N " + n_problem
+                           : "'" + text + "' is not all, none or first:N with N a non-negative integer");
   }
   request.options.events = *events;
 }

@@ -13,6 +13,7 @@
 #include "collision_lab/core/exact.h"
 #include "collision_lab/core/precision.h"
 #include "collision_lab/core/simulation.h"
+#include "impact_energy.h"
 
 namespace collision_lab {
 
@@ -132,9 +133,10 @@ std::optional<std::uint64_t> countIfSeparated(const Quotient<T>& quotient) {
   using std::ceil;
   using std::round;
   const T nearest = round(quotient.q);
-  if (absOf(T(quotient.q - nearest)) <= 2 * quotient.error_bound) return std::nullopt;
+  // Written so that a NaN (a precision without the range for these masses) is not separated.
+  if (!(absOf(T(quotient.q - nearest)) > 2 * quotient.error_bound)) return std::nullopt;
   const T count = ceil(quotient.q) - 1;
-  return count < 0 ? 0 : static_cast<std::uint64_t>(static_cast<double>(count));
+  return count < 0 ? 0 : static_cast<std::uint64_t>(count);  // never through a double: counts pass 2^53
 }
 
 std::array<std::complex<double>, 3> sortedByArgument(std::array<std::complex<double>, 3> values) {
@@ -231,7 +233,7 @@ template <class Scalar>
 typename AnalyticModel<Scalar>::Vec3 AnalyticModel<Scalar>::rotate(std::int64_t direction, std::uint64_t k) const {
   using std::cos;
   using std::sin;
-  const Scalar angle = Scalar(direction) * Scalar(static_cast<double>(k)) * theta();
+  const Scalar angle = Scalar(direction) * Scalar(k) * theta();
   const Vec3 rotated = cos(angle) * w_ + sin(angle) * cross<Scalar>(s_hat_, w_);
   Vec3 v = centre_velocity_;
   for (int i = 0; i < 3; ++i) {
@@ -261,7 +263,7 @@ typename AnalyticModel<Scalar>::Vec3 AnalyticModel<Scalar>::initialVelocitiesFro
   const Scalar centre = centre_velocity_(0);
   Vec3 w_after;
   for (int i = 0; i < 3; ++i) w_after(i) = i == wall_ ? Scalar(0) : sqrt_mass_scaled_(i) * (even(i) - centre);
-  const Scalar angle = Scalar(first == Pair::AB ? 1 : -1) * Scalar(static_cast<double>(n / 2)) * theta();
+  const Scalar angle = Scalar(first == Pair::AB ? 1 : -1) * Scalar(n / 2) * theta();
   const Vec3 w0 = cos(angle) * w_after + sin(angle) * cross<Scalar>(s_hat_, w_after);
   Vec3 v = centre_velocity_;
   for (int i = 0; i < 3; ++i) {
@@ -276,26 +278,10 @@ std::array<Scalar, 3> AnalyticModel<Scalar>::energyTransfer(std::uint64_t n) con
   if (!first_pair_ || n == 0) return gained;
   const Pair pair = n % 2 == 1 ? *first_pair_ : otherPair(*first_pair_);
   const Vec3 before = velocitiesAfter(n - 1);
+  const std::array<Scalar, 3> v{before(0), before(1), before(2)};
   const int left = pair == Pair::AB ? kA : kB;
-  const int right = left + 1;
-  const Scalar f_left = pair == Pair::AB ? f_ab_a_ : f_bc_b_;
-  const Scalar f_right = pair == Pair::AB ? f_ab_b_ : f_bc_c_;
-  // Reduced mass m_l m_r / (m_l + m_r), and its wall limit (the finite mass).
-  const Scalar reduced = left == wall_ ? Scalar(masses_[right])
-                         : right == wall_ ? Scalar(masses_[left])
-                                          : Scalar(masses_[left]) * f_right;
-  const Scalar approach = before(right) - before(left);
-  const Scalar pair_centre_velocity = f_left * before(left) + f_right * before(right);
-  // dE_left = 2 m_l m_r (v_r - v_l)(m_l v_l + m_r v_r) / (m_l + m_r)^2 (physics.md).
-  // The factors can overflow a double on their way to a representable energy (a mass
-  // near 1e308, or speeds near 1e300): multiply with the exponent range of long double.
-  if constexpr (std::is_floating_point_v<Scalar>) {
-    gained[left] = static_cast<Scalar>(2.0L * static_cast<long double>(reduced) * static_cast<long double>(approach) *
-                                       static_cast<long double>(pair_centre_velocity));
-  } else {
-    gained[left] = 2 * reduced * approach * pair_centre_velocity;
-  }
-  gained[right] = -gained[left];
+  const auto energies = detail::ImpactEnergy<detail::EnergyType<Scalar>>(masses_).gained(pair, v, Scalar(v[left + 1] - v[left]));
+  for (int i = 0; i < 3; ++i) gained[i] = static_cast<Scalar>(energies[i]);
   return gained;
 }
 
@@ -340,16 +326,16 @@ std::uint64_t predictedCollisionCount(const Scene& scene) {
   if (auto count = countIfSeparated(precise)) return *count;
   if (!(precise.error_bound < 0.25)) {
     // Even 50 digits cannot place u_perp (a body far lighter than the rest carries all the
-    // relative motion): count exactly when the run is short, else go to 500 digits.
+    // relative motion): 500 digits, else count exactly when the run is short.
+    if (auto count = countIfSeparated(countQuotient<DeepPrecision>(scene, *first))) return *count;
     if (maxPossibleCollisionCount(scene.masses) <= kExactCountLimit) {
       return exact::simulate(scene, kExactCountLimit).collision_count;
     }
-    if (auto count = countIfSeparated(countQuotient<DeepPrecision>(scene, *first))) return *count;
   }
   // psi / alpha is an integer Q to 50 digits. If it is exactly Q, contact Q grazes with
   // zero approach speed and does not count: decide by the exact state before contact Q.
   using std::round;
-  const std::uint64_t nearest = static_cast<std::uint64_t>(static_cast<double>(round(precise.q)));
+  const auto nearest = static_cast<std::uint64_t>(round(precise.q));
   if (nearest == 0) return 0;
   const Pair contact_pair = (nearest - 1) % 2 == 0 ? *first : otherPair(*first);
   if (nearest - 1 <= kExactReplayLimit) {
@@ -361,8 +347,7 @@ std::uint64_t predictedCollisionCount(const Scene& scene) {
   return nearest - 1;  // an integer to 500 digits: a grazing last contact
 }
 
-std::uint64_t maxPossibleCollisionCount(const std::array<double, 3>& m) {
-  using std::ceil;
+std::optional<std::uint64_t> checkedMaxPossibleCollisionCount(const std::array<double, 3>& m) {
   // pi / alpha is an integer only for alpha = pi/3, pi/4, pi/6, where
   // cos^2 alpha = m_A m_C / ((m_A + m_B)(m_B + m_C)) is the rational 1/4, 1/2, 3/4.
   using exact::Rational;
@@ -373,13 +358,26 @@ std::uint64_t maxPossibleCollisionCount(const std::array<double, 3>& m) {
   if (cos_sq == Rational(1, 4)) return 3;
   if (cos_sq == Rational(1, 2)) return 4;
   if (cos_sq == Rational(3, 4)) return 6;
+  // Otherwise pi / alpha is irrational. In double, far enough below 2^53 and from an
+  // integer; else at 50 digits, or 500 when even 50 cannot tell the integer above it.
   const double quotient = pi<double>() / alphaOf<double>(m);
   if (std::fabs(quotient - std::round(quotient)) > 64 * std::numeric_limits<double>::epsilon() * quotient) {
     return static_cast<std::uint64_t>(std::ceil(quotient));
   }
+  using std::ceil;
+  using std::round;
+  HighPrecision precise = pi<HighPrecision>() / alphaOf<HighPrecision>(m);
+  if (absOf(HighPrecision(precise - round(precise))) < HighPrecision(1e-40) * precise) {
+    precise = static_cast<HighPrecision>(pi<DeepPrecision>() / alphaOf<DeepPrecision>(m));
+  }
+  const HighPrecision count = ceil(precise);
+  if (count > HighPrecision(std::numeric_limits<std::uint64_t>::max())) return std::nullopt;
   // alpha < pi / 2 for finite masses, so pi / alpha > 2 even when it rounds to 2.
-  const HighPrecision precise = pi<HighPrecision>() / alphaOf<HighPrecision>(m);
-  return std::max<std::uint64_t>(3, static_cast<std::uint64_t>(static_cast<double>(ceil(precise))));
+  return std::max<std::uint64_t>(3, static_cast<std::uint64_t>(count));
+}
+
+std::uint64_t maxPossibleCollisionCount(const std::array<double, 3>& m) {
+  return checkedMaxPossibleCollisionCount(m).value_or(std::numeric_limits<std::uint64_t>::max());
 }
 
 }  // namespace collision_lab

@@ -3,15 +3,64 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
+#include <optional>
 #include <string>
 
 #include "collision_lab/core/paper.h"
+#include "collision_lab/core/precision.h"
 
 namespace collision_lab {
 
 namespace {
 
-std::array<double, 3> toArray(const Eigen::Vector3d& v) { return {v(0), v(1), v(2)}; }
+/// What a run that was not simulated reports for the quantities it did not measure.
+constexpr double kNotMeasured = std::numeric_limits<double>::quiet_NaN();
+
+/// A zero is +0, never -0 (outputs must not show "-0").
+double plusZero(double value) { return value == 0 ? 0.0 : value; }
+
+template <class Vector>
+std::array<double, 3> toArray(const Vector& v) {
+  return {plusZero(static_cast<double>(v(0))), plusZero(static_cast<double>(v(1))), plusZero(static_cast<double>(v(2)))};
+}
+
+template <class T>
+std::array<double, 3> toArray(const std::array<T, 3>& v) {
+  return toArray(Eigen::Matrix<T, 3, 1>(v[0], v[1], v[2]));
+}
+
+/// The closed form in double; at 50 digits, whose exponent range has no end in sight,
+/// where a finite-mass ratio beyond 2^1000 would underflow the light body's share of the
+/// mass-weighted velocities (S = diag(sqrt(m / m_max))) in double.
+class ClosedForm {
+ public:
+  explicit ClosedForm(const Scene& scene) {
+    int smallest = std::numeric_limits<int>::max(), largest = std::numeric_limits<int>::min();
+    for (int i = 0; i < 3; ++i) {
+      if (scene.isWall(i)) continue;
+      smallest = std::min(smallest, std::ilogb(scene.masses[i]));
+      largest = std::max(largest, std::ilogb(scene.masses[i]));
+    }
+    if (largest - smallest <= 1000) {
+      fast_.emplace(scene);
+    } else {
+      wide_.emplace(scene);
+    }
+  }
+
+  std::array<double, 3> velocitiesAfter(std::uint64_t n) const {
+    return fast_ ? toArray(fast_->velocitiesAfter(n)) : toArray(wide_->velocitiesAfter(n));
+  }
+  std::array<double, 3> energyTransfer(std::uint64_t n) const {
+    return fast_ ? toArray(fast_->energyTransfer(n)) : toArray(wide_->energyTransfer(n));
+  }
+  double psi() const { return fast_ ? fast_->psi() : static_cast<double>(wide_->psi()); }
+
+ private:
+  std::optional<AnalyticModel<double>> fast_;
+  std::optional<AnalyticModel<HighPrecision>> wide_;
+};
 
 /// Relative error in the energy norm: |S (a - b)| / |S v_0| with S = diag(sqrt(m)), in
 /// the wall's frame. Scale-free, and the norm in which every impact is an isometry, so a
@@ -57,7 +106,7 @@ bool keeps(const EventPolicy& policy, std::uint64_t index) {
 }  // namespace
 
 AnalyticPrediction predict(const Scene& scene) {
-  const AnalyticModel<double> model(scene);
+  const ClosedForm model(scene);
   AnalyticPrediction prediction;
   prediction.collision_count = predictedCollisionCount(scene);
   prediction.paper_collision_count = paper::collisionCount(scene);
@@ -65,7 +114,7 @@ AnalyticPrediction predict(const Scene& scene) {
   prediction.angles = anglesFor(scene.masses);
   prediction.phi_bc = paper::phiBC(scene);
   prediction.psi = model.psi();
-  prediction.first_pair = model.firstPair();
+  prediction.first_pair = firstPair(scene);
   prediction.final_velocities = toArray(model.velocitiesAfter(prediction.collision_count));
   return prediction;
 }
@@ -86,17 +135,22 @@ RunResult runLab(const Scene& scene, const RunOptions& options, const AnalyticPr
   const EnergyNormError relative_error(scene);
 
   const bool over_cap = result.prediction.collision_count > options.max_collisions;
-  if (options.mode == RunMode::kPredictOnly) {
-    summary.collision_count = result.prediction.collision_count;
+  const bool skipped = options.mode != RunMode::kPredictOnly && over_cap && options.skip_simulation_over_cap;
+  if (options.mode == RunMode::kPredictOnly || skipped) {
+    // Not simulated: the closed form answers, and nothing was measured.
+    summary.collision_count = options.mode == RunMode::kPredictOnly ? result.prediction.collision_count : 0;
     summary.final_velocities = result.prediction.final_velocities;
-  } else if (over_cap && options.skip_simulation_over_cap) {
+    summary.max_prediction_error = kNotMeasured;
+    summary.energy_relative_drift = kNotMeasured;
+    summary.momentum_relative_drift = kNotMeasured;
+  }
+  if (skipped) {
     summary.truncated = true;
     summary.truncation_reason = "predicted " + std::to_string(result.prediction.collision_count) +
                                 " collisions exceed max_collisions = " + std::to_string(options.max_collisions) +
                                 "; not simulated";
-    summary.final_velocities = scene.velocities;
-  } else {
-    const AnalyticModel<double> model(scene);
+  } else if (options.mode != RunMode::kPredictOnly) {
+    const ClosedForm model(scene);
     SimulationOptions simulation_options;
     simulation_options.max_collisions = options.max_collisions;
     EventVisitor enrich;
@@ -107,8 +161,7 @@ RunResult runLab(const Scene& scene, const RunOptions& options, const AnalyticPr
         lab.event = event;
         lab.predicted_velocities_after = toArray(model.velocitiesAfter(event.index));
         lab.paper_velocities_after = paper::velocitiesAfter(scene, event.index);
-        const auto predicted_gain = model.energyTransfer(event.index);
-        std::copy(predicted_gain.begin(), predicted_gain.end(), lab.predicted_energy_transfer.begin());
+        lab.predicted_energy_transfer = model.energyTransfer(event.index);
         lab.paper_energy_transfer =
             paper::energyTransfer(scene, event.index, event.pair, event.velocities_before, previous_before);
         for (int i = 0; i < 3; ++i) {

@@ -14,6 +14,12 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
+/// A zero is +0, never -0 (outputs must not show "-0").
+std::array<double, 3> plusZeros(std::array<double, 3> values) {
+  for (double& x : values) x = x == 0 ? 0.0 : x;
+  return values;
+}
+
 /// The paper's constants: c + d i of eq. (2.6), nu^2 = c^2 + d^2, theta = arg(lambda_+).
 struct Constants {
   double c, d, nu_sq, theta;
@@ -55,11 +61,11 @@ std::array<double, 3> velocitiesAfter(const Scene& scene, std::uint64_t n) {
   // The two brackets of eq. (2.15).
   const double x = ((vbar - v0[kC]) * k.nu_sq + k.c * half_ba) * s - k.d * half_ba * co;
   const double y = (-half_ba - k.c * (vbar - v0[kC])) * s - k.d * (vbar - v0[kC]) * co;
-  if (n % 2 == 0) return {x / k.d + vbar, -x / k.d + vbar, y / k.d + vbar};
+  if (n % 2 == 0) return plusZeros({x / k.d + vbar, -x / k.d + vbar, y / k.d + vbar});
   const double m_ab = m[kA] + m[kB];
   // Eq. (2.16).
-  return {(m[kA] - 3 * m[kB]) * x / (k.d * m_ab) + vbar, (m[kB] - 3 * m[kA]) * x / (k.d * m_ab) + vbar,
-          m_ab * y / (k.d * m_ab) + vbar};
+  return plusZeros({(m[kA] - 3 * m[kB]) * x / (k.d * m_ab) + vbar, (m[kB] - 3 * m[kA]) * x / (k.d * m_ab) + vbar,
+                    m_ab * y / (k.d * m_ab) + vbar});
 }
 
 double phiBC(const Scene& scene) {
@@ -86,7 +92,8 @@ double omega(const std::array<double, 3>& m) {
 
 std::optional<std::int64_t> collisionCount(const Scene& scene) {
   const double x = (omega(scene.masses) - phiBC(scene)) / constantsOf(scene.masses).theta;
-  if (!std::isfinite(x) || std::fabs(x) > 1e15) return std::nullopt;
+  // Evaluated in double as printed; 1 + floor(x) + ceil(x) must fit the int64 it is reported in.
+  if (!std::isfinite(x) || std::fabs(x) > 4e18) return std::nullopt;
   return 1 + static_cast<std::int64_t>(std::floor(x)) + static_cast<std::int64_t>(std::ceil(x));  // eq. (3.22)
 }
 
@@ -101,17 +108,18 @@ std::array<double, 3> energyTransfer(const Scene& scene, std::uint64_t n, Pair p
     const double p_ab = m[kA] * state_before[kA] + m[kB] * state_before[kB];
     const double m_ab = m[kA] + m[kB];
     const double gained_a = -4 * m[kA] * m[kB] * v_k / (m_ab * m_ab) * p_ab;
-    return {gained_a, -gained_a, 0.0};
+    return plusZeros({gained_a, -gained_a, 0.0});
   }
   // Eqs. (4.6), (4.7): v_{k-1}, v'_{k-1} from the state two impacts back (2k-2), and
-  // P_BC2k-1 from the state just before. The first impact has no such state.
-  if (n < 2) return {kNaN, kNaN, kNaN};
+  // P_BC2k-1 from the state just before. The first impact has no such state, so they are
+  // undefined as printed; A, which they do not concern, still gains 0.
+  if (n < 2) return {0.0, kNaN, kNaN};
   const double v_k1 = state_two_before[kA] - vbar;
   const double v_k1_prime = state_two_before[kC] - vbar;
   const double p_bc = m[kB] * state_before[kB] + m[kC] * state_before[kC];
   const double m_bc = m[kB] + m[kC];
   const double gained_c = -4 * m[kB] * m[kC] / (m_bc * m_bc) * (v_k1 + v_k1_prime) / 2 * p_bc;
-  return {0.0, -gained_c, gained_c};
+  return plusZeros({0.0, -gained_c, gained_c});
 }
 
 }  // namespace paper

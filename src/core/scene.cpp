@@ -3,9 +3,14 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <limits>
+#include <tuple>
 
+#include "collision_lab/core/analytic.h"
 #include "collision_lab/core/exact.h"
+#include "collision_lab/core/precision.h"
+#include "collision_lab/core/simulation.h"
 
 namespace collision_lab {
 
@@ -17,25 +22,31 @@ std::string indexedField(const char* vector_name, int i) {
   return std::string(vector_name) + "[" + std::to_string(i) + "]";
 }
 
-/// Shortest text that reads back as the same double.
+/// Shortest text that reads back as the same double; any NaN is "NaN" and a zero is "0",
+/// never signed.
 std::string formatValue(double value) {
+  if (std::isnan(value)) return "NaN";
+  if (value == 0) return "0";
   char buffer[32];
   const auto end = std::to_chars(buffer, buffer + sizeof buffer, value).ptr;
   return std::string(buffer, end);
 }
 
-/// The message always starts with the field, so one line tells the user where to look.
+/// Three significant digits, for values that are approximate anyway.
+std::string formatShort(double value) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.3g", value);
+  return buffer;
+}
+
+/// The field is its own value; the message names the quantity (m_B, x_A, ...) once, so a
+/// one-line report "field: message" never repeats itself.
 ValidationError makeError(Reason reason, const std::string& field, const std::string& message) {
-  return ValidationError{reason, field, field + ": " + message};
+  return ValidationError{reason, field, message};
 }
 
 bool isFiniteProduct(double a, double b) { return std::isfinite(a * b); }
 
-/// Collision counts are 64-bit; the count never exceeds ceil(pi / alpha).
-constexpr double kMaxCollisionCount = 9.2e18;
-/// Beyond this finite-mass ratio the 100-digit decisions of the engine lose their margin;
-/// a body that much heavier is a wall to all digits that matter.
-constexpr double kMaxMassRatio = 1e100;
 
 }  // namespace
 
@@ -62,7 +73,9 @@ const char* reasonName(Reason r) {
   return "UNKNOWN";
 }
 
-std::optional<ValidationError> validate(const Scene& scene) {
+namespace {
+
+std::optional<ValidationError> checkMasses(const Scene& scene) {
   for (int i = 0; i < 3; ++i) {
     const double m = scene.masses[i];
     const std::string field = indexedField("masses", i);
@@ -83,38 +96,40 @@ std::optional<ValidationError> validate(const Scene& scene) {
     return makeError(Reason::kTwoWalls, "masses",
                      "m_A and m_C are both inf; at most one of A and C may be a wall");
   }
-  for (int i = 0; i < 3; ++i) {
-    if (!std::isfinite(scene.positions[i])) {
-      const std::string field = indexedField("positions", i);
-      return makeError(Reason::kNonFiniteValue, field,
-                       std::string("x_") + kParticleNames[i] + " is " + formatValue(scene.positions[i]) +
-                           "; a position must be a finite number in m");
-    }
-  }
-  for (int i = 0; i < 3; ++i) {
-    if (!std::isfinite(scene.velocities[i])) {
-      const std::string field = indexedField("velocities", i);
-      return makeError(Reason::kNonFiniteValue, field,
-                       std::string("v_") + kParticleNames[i] + " is " + formatValue(scene.velocities[i]) +
-                           "; a velocity must be a finite number in m/s");
+  return std::nullopt;
+}
+
+std::optional<ValidationError> checkFiniteAndOrdered(const Scene& scene) {
+  for (const auto& [values, name, symbol, unit] :
+       {std::tuple{&scene.positions, "positions", "x_", "position must be a finite number in m"},
+        std::tuple{&scene.velocities, "velocities", "v_", "velocity must be a finite number in m/s"}}) {
+    for (int i = 0; i < 3; ++i) {
+      if (!std::isfinite((*values)[i])) {
+        return makeError(Reason::kNonFiniteValue, indexedField(name, i),
+                         std::string(symbol) + kParticleNames[i] + " is " + formatValue((*values)[i]) + "; a " + unit);
+      }
     }
   }
   const auto& x = scene.positions;
   for (int i = 0; i < 2; ++i) {
     if (x[i] == x[i + 1]) {
       return makeError(Reason::kPositionsCoincident, "positions",
-                       std::string("positions of ") + kParticleNames[i] + " and " + kParticleNames[i + 1] +
-                           " coincide at " + formatValue(x[i]) + " m; they must be distinct");
+                       std::string("x_") + kParticleNames[i] + " = x_" + kParticleNames[i + 1] + " = " +
+                           formatValue(x[i]) + " m; " + kParticleNames[i] + " and " + kParticleNames[i + 1] +
+                           " must start apart");
     }
   }
   if (!(x[kA] > x[kB] && x[kB] > x[kC])) {
     return makeError(Reason::kPositionsNotOrdered, "positions",
-                     "positions (" + formatValue(x[kA]) + ", " + formatValue(x[kB]) + ", " +
-                         formatValue(x[kC]) + ") m must be strictly decreasing: x_A > x_B > x_C");
+                     "x_A = " + formatValue(x[kA]) + " m, x_B = " + formatValue(x[kB]) + " m, x_C = " +
+                         formatValue(x[kC]) + " m must be strictly decreasing: x_A > x_B > x_C");
   }
+  return std::nullopt;
+}
 
-  // Everything the engine forms must be representable: momenta, energies in the wall's
-  // frame, relative velocities and gaps.
+/// Everything the engine forms must be representable: momenta, energies in the wall's
+/// frame, relative velocities and gaps.
+std::optional<ValidationError> checkDoubleRange(const Scene& scene) {
   const int wall = scene.wallIndex();
   const double frame_velocity = wall >= 0 ? scene.velocities[wall] : 0.0;
   for (int i = 0; i < 3; ++i) {
@@ -124,13 +139,13 @@ std::optional<ValidationError> validate(const Scene& scene) {
     const double relative = v - frame_velocity;
     if (!std::isfinite(relative) || !isFiniteProduct(m, v) || !isFiniteProduct(m * relative, relative) ||
         !isFiniteProduct(m, 4.0 * std::fabs(v) + 4.0 * std::fabs(frame_velocity))) {
-      const std::string field = indexedField("velocities", i);
-      return makeError(Reason::kOverflow, field,
+      return makeError(Reason::kOverflow, indexedField("velocities", i),
                        "momentum or kinetic energy of " + std::string(kParticleNames[i]) + " (m = " +
                            formatValue(m) + " kg, v = " + formatValue(v) +
                            " m/s) overflows a double; rescale the units");
     }
   }
+  const auto& x = scene.positions;
   for (int i = 0; i < 2; ++i) {
     if (!std::isfinite(x[i] - x[i + 1]) || !std::isfinite(scene.velocities[i] - scene.velocities[i + 1]) ||
         !std::isfinite(2.0 * (std::fabs(scene.velocities[i]) + std::fabs(scene.velocities[i + 1])))) {
@@ -139,29 +154,60 @@ std::optional<ValidationError> validate(const Scene& scene) {
                            kParticleNames[i + 1] + " overflows a double; rescale the units");
     }
   }
+  return std::nullopt;
+}
 
-  // The collision count is about pi / alpha; it must fit the 64-bit counters (mass
-  // ratios up to ~1e36), and the mass ratios themselves must stay representable.
-  double mass_min = std::numeric_limits<double>::infinity(), mass_max = 0.0;
+/// Every count is reported as a 64-bit integer, and no start of these masses can have more
+/// collisions than ceil(pi / alpha). Only a light B makes that many: the count grows like
+/// pi sqrt(m / m_B) with m the lighter of A and C.
+std::optional<ValidationError> checkCountFits(const Scene& scene) {
+  if (checkedMaxPossibleCollisionCount(scene.masses)) return std::nullopt;
+  const double lighter_outer = std::min(scene.masses[kA], scene.masses[kC]);
+  return makeError(Reason::kOverflow, "masses",
+                   "these masses allow up to ceil(pi / alpha) = " + formatShort(M_PI / anglesFor(scene.masses).alpha) +
+                       " collisions, more than 2^64 - 1 = 18446744073709551615, the largest count collision_lab "
+                       "reports; the count grows like pi sqrt(m / m_B) with m = " + formatValue(lighter_outer) +
+                       " kg the lighter of A and C: make B heavier or that body lighter");
+}
+
+/// The first contact certainly happens: its time and the positions then must be doubles.
+/// (Later contacts beyond the range of a double are reported as inf.)
+std::optional<ValidationError> checkFirstContact(const Scene& scene) {
+  const std::optional<Pair> first = firstPair(scene);
+  if (!first) return std::nullopt;
+  const int left = *first == Pair::AB ? kA : kB;
+  using exact::Rational;
+  const auto& x = scene.positions;
+  const auto& v = scene.velocities;
+  const Rational time = (Rational(x[left]) - Rational(x[left + 1])) / (Rational(v[left + 1]) - Rational(v[left]));
+  const Rational largest(std::numeric_limits<double>::max());
+  const auto text = [](const Rational& q) { return HighPrecision(HighPrecision(numerator(q)) / HighPrecision(denominator(q))).str(3); };
+  const std::string contact = std::string("the first contact, of ") + kParticleNames[left] + " and " +
+                              kParticleNames[left + 1] + ", ";
+  if (time > largest) {
+    return makeError(Reason::kOverflow, "positions",
+                     contact + "would come at t = " + text(time) +
+                         " s, beyond the largest double (1.8e+308); a longer unit of time brings it into range");
+  }
   for (int i = 0; i < 3; ++i) {
-    if (scene.isWall(i)) continue;
-    mass_min = std::min(mass_min, scene.masses[i]);
-    mass_max = std::max(mass_max, scene.masses[i]);
+    const Rational position = Rational(x[i]) + Rational(v[i]) * time;
+    if (abs(position) > largest) {
+      return makeError(Reason::kOverflow, "positions",
+                       contact + "at t = " + text(time) + " s, would find " + kParticleNames[i] + " at " +
+                           text(position) +
+                           " m, beyond the largest double (1.8e+308); a longer unit of length brings it into range");
+    }
   }
-  const double b_over_a = scene.isWall(kA) ? 0.0 : scene.masses[kB] / scene.masses[kA];
-  const double b_over_c = scene.isWall(kC) ? 0.0 : scene.masses[kB] / scene.masses[kC];
-  const double alpha = std::atan(std::sqrt(b_over_a * (1 + b_over_c) + b_over_c));
-  if (!(3.5 / alpha < kMaxCollisionCount)) {
-    return makeError(Reason::kOverflow, "masses",
-                     "the mass ratios (largest / smallest = " + formatValue(mass_max / mass_min) +
-                         ") are too extreme: the collision count would not fit 2^63");
-  }
-  if (!(mass_max / mass_min <= kMaxMassRatio)) {
-    return makeError(Reason::kOverflow, "masses",
-                     "the ratio of the largest to the smallest finite mass exceeds 1e100 (" + formatValue(mass_max) +
-                         " / " + formatValue(mass_min) + "); make the heavy body a wall (inf) instead");
-  }
+  return std::nullopt;
+}
 
+}  // namespace
+
+std::optional<ValidationError> validate(const Scene& scene) {
+  if (auto error = checkMasses(scene)) return error;
+  if (auto error = checkFiniteAndOrdered(scene)) return error;
+  if (auto error = checkDoubleRange(scene)) return error;
+  if (auto error = checkCountFits(scene)) return error;
   const bool ab_approach = scene.velocities[kA] < scene.velocities[kB];
   const bool bc_approach = scene.velocities[kB] < scene.velocities[kC];
   if (ab_approach && bc_approach && exact::compareFirstContactTimes(scene) == 0) {
@@ -169,22 +215,7 @@ std::optional<ValidationError> validate(const Scene& scene) {
                      "A, B and C would meet at the same instant (an exact triple collision), "
                      "which three-body elastic collisions do not define");
   }
-  // The first contact must happen at a representable time and place.
-  for (int left : {kA, kB}) {
-    const double approach = scene.velocities[left + 1] - scene.velocities[left];
-    if (!(approach > 0)) continue;
-    const double time = (x[left] - x[left + 1]) / approach;
-    bool representable = std::isfinite(time);
-    for (int i = 0; i < 3 && representable; ++i) {
-      representable = std::isfinite(x[i] + scene.velocities[i] * time);
-    }
-    if (!representable) {
-      return makeError(Reason::kOverflow, "positions",
-                       "the first contact would come at t = " + formatValue(time) +
-                           " s or beyond the range of a double in position; rescale the units");
-    }
-  }
-  return std::nullopt;
+  return checkFirstContact(scene);
 }
 
 }  // namespace collision_lab

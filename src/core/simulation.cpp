@@ -1,7 +1,9 @@
 #include "collision_lab/core/simulation.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <type_traits>
 
 #include <boost/multiprecision/cpp_bin_float.hpp>
@@ -9,6 +11,7 @@
 #include "collision_lab/core/analytic.h"
 #include "collision_lab/core/exact.h"
 #include "collision_lab/core/precision.h"
+#include "impact_energy.h"
 
 namespace collision_lab {
 
@@ -37,10 +40,24 @@ constexpr std::uint64_t kExactReplayLimit = 20000;
 /// maps are orthogonal and do not amplify earlier errors.
 constexpr double kBoundFactor = 64.0;
 
+/// Rounds to double; a zero is always +0, so that no output shows "-0".
 template <class T>
 double toDouble(const T& value) {
-  return static_cast<double>(value);
+  const double rounded = static_cast<double>(value);
+  return rounded == 0 ? 0.0 : rounded;
 }
+
+constexpr bool kLongDoubleIsWide =
+    std::numeric_limits<long double>::max_exponent >= 4 * std::numeric_limits<double>::max_exponent;
+
+/// The type of a run's times and positions in working precision Scalar: long double for
+/// double and long double where its exponent range is far wider than double's, else
+/// 50 digits. Times and positions of doubles need that range: a gap of 1e-200 m closed at
+/// 1e150 m/s takes 1e-350 s, and one closed at a subnormal approach speed can take longer
+/// than the largest double; the positions at such times can still be ordinary numbers.
+template <class Scalar>
+using WideOf = std::conditional_t<!std::is_floating_point_v<Scalar>, Scalar,
+                                  std::conditional_t<kLongDoubleIsWide, long double, HighPrecision>>;
 
 template <class T>
 T epsilonOf() {
@@ -91,6 +108,14 @@ struct CompensatedVelocities {
   T value(int i) const { return hi[i] + lo[i]; }
   std::array<T, 3> values() const { return {value(0), value(1), value(2)}; }
 
+  /// The velocities in type W (hi + lo summed in W).
+  template <class W>
+  std::array<W, 3> valuesAs() const {
+    std::array<W, 3> out;
+    for (int i = 0; i < 3; ++i) out[i] = W(hi[i]) + W(lo[i]);
+    return out;
+  }
+
   /// Approach speed of the pair whose right-hand body is `left` (A for AB, B for BC).
   T approach(int left) const { return (hi[left + 1] - hi[left]) + (lo[left + 1] - lo[left]); }
 
@@ -133,8 +158,9 @@ struct CompensatedVelocities {
   void adopt(const std::array<Precise, 3>& precise) {
     for (int i = 0; i < 3; ++i) {
       if constexpr (std::is_floating_point_v<T>) {
-        hi[i] = T(static_cast<double>(precise[i]));
-        lo[i] = T(static_cast<double>(Precise(precise[i] - Precise(static_cast<double>(hi[i])))));
+        // Straight to T: a detour through double would round a long double's low part.
+        hi[i] = static_cast<T>(precise[i]);
+        lo[i] = static_cast<T>(Precise(precise[i] - Precise(hi[i])));
       } else {
         hi[i] = T(precise[i]);
         lo[i] = T(0);
@@ -213,36 +239,49 @@ T approachOf(Pair pair, const std::array<T, 3>& v) {
 }
 
 /// Takes the sign decisions the working precision cannot, at 100 digits: a replay for
-/// short runs, the closed-form state after k impacts (O(1) in k) for long ones; then
-/// exact rationals for a zero to within that, then 500 digits beyond the rationals' reach.
+/// short runs, the closed-form state after k impacts (O(1) in k) for long ones; then the
+/// closed form at 500 digits; then exact rationals for a zero to within that.
 /// The closed form holds for any alternating sequence, which every run is.
 template <class Scalar>
 class Escalation {
  public:
   Escalation(const Scene& scene, const ErrorScale& scale, Pair first) : scene_(scene), scale_(scale), first_(first) {}
 
+  /// A sign decision taken above the working precision.
+  struct Decision {
+    bool approaches;
+    ReplayPrecision approach;                  ///< the approach speed it saw, to 100 digits or better
+    std::array<ReplayPrecision, 3> velocities;  ///< the state it saw (Scalar may not hold all of it)
+  };
+
   /// Does `pair` approach after k impacts, as exact arithmetic says? Hands the accurate
   /// state at k to `v`.
-  bool approaches(std::uint64_t k, Pair pair, CompensatedVelocities<Scalar>& v, EscalationStats& stats) {
+  Decision decide(std::uint64_t k, Pair pair, CompensatedVelocities<Scalar>& v, EscalationStats& stats) {
     ++stats.high_precision;
     const Precise precise = preciseState(k);
     const ReplayPrecision precise_approach = approachOf(pair, precise.velocities);
     if (mp::abs(precise_approach) > precise.bound_factor * scale_.bound<ReplayPrecision>(pair, k)) {
       v.adopt(precise.velocities);
-      return precise_approach > 0;
+      return {precise_approach > 0, precise_approach, precise.velocities};
     }
-    if (k <= kExactReplayLimit) {
-      ++stats.exact_rational;
-      const exact::RationalState exact_state = exact::velocitiesAfter(scene_, first_, k);
-      v.adopt(exact_state);
-      return exact::approachSpeed(pair, exact_state) > 0;
+    // Masses that span more than ~1e100 defeat 100 digits; 500 digits decide all but an
+    // exact zero, in O(1) like the 100-digit closed form.
+    if (!deep_closed_form_) deep_closed_form_.emplace(scene_);
+    const auto deep = stateOf(*deep_closed_form_, k);
+    const DeepReplayPrecision deep_approach = approachOf(pair, deep);
+    const bool deep_decides =
+        mp::abs(deep_approach) > closedFormFactor<DeepReplayPrecision>() * scale_.bound<DeepReplayPrecision>(pair, k);
+    if (deep_decides || k > kExactReplayLimit) {
+      // Beyond the exact replay's reach, an exact zero would need input doubles built for
+      // it over thousands of impacts: within 500 digits of zero counts as not approaching.
+      v.adopt(deep);
+      return {deep_decides && deep_approach > 0, static_cast<ReplayPrecision>(deep_approach), narrowed(deep)};
     }
-    // An exact zero this deep would need input doubles built for it over thousands of
-    // impacts; 500 digits separate everything else.
-    const AnalyticModel<DeepReplayPrecision> deep_model(scene_);
-    const auto deep = stateOf(deep_model, k);
-    v.adopt(deep);
-    return approachOf(pair, deep) > closedFormFactor<DeepReplayPrecision>() * scale_.bound<DeepReplayPrecision>(pair, k);
+    ++stats.exact_rational;
+    const exact::RationalState exact_state = exact::velocitiesAfter(scene_, first_, k);
+    v.adopt(exact_state);
+    const exact::Rational approach = exact::approachSpeed(pair, exact_state);
+    return {approach > 0, narrowed(approach), narrowed(exact_state)};
   }
 
   /// Replaces v by the 100-digit state after k impacts, so that rounding errors of very
@@ -259,6 +298,15 @@ class Escalation {
     if (k <= kShortReplay) return {replay<ReplayPrecision>(scene_, first_, k), ReplayPrecision(1)};
     if (!closed_form_) closed_form_.emplace(scene_);
     return {stateOf(*closed_form_, k), closedFormFactor<ReplayPrecision>()};
+  }
+
+  static ReplayPrecision narrowed(const exact::Rational& q) {
+    return ReplayPrecision(numerator(q)) / ReplayPrecision(denominator(q));
+  }
+  static ReplayPrecision narrowed(const DeepReplayPrecision& x) { return static_cast<ReplayPrecision>(x); }
+  template <class T>
+  static std::array<ReplayPrecision, 3> narrowed(const std::array<T, 3>& state) {
+    return {narrowed(state[0]), narrowed(state[1]), narrowed(state[2])};
   }
 
   template <class T>
@@ -279,28 +327,110 @@ class Escalation {
   const ErrorScale& scale_;
   Pair first_;
   std::optional<AnalyticModel<ReplayPrecision>> closed_form_;
+  std::optional<AnalyticModel<DeepReplayPrecision>> deep_closed_form_;
 };
 
+template <class T>
+T absOf(const T& x) {
+  return x < 0 ? T(-x) : x;
+}
+
+/// Energy and momentum of the finite masses [J, kg m/s], in the wide type of the run.
+template <class Wide>
 struct Frame {
-  double energy = 0.0;    // kinetic energy in the wall's frame (lab frame without a wall)
-  double momentum = 0.0;  // lab-frame momentum of the finite masses
-  double momentum_magnitude = 0.0;  // sum |m v|
+  Wide energy = 0;              // kinetic energy in the wall's frame (lab frame without a wall)
+  Wide momentum = 0;            // lab-frame momentum
+  Wide momentum_magnitude = 0;  // sum |m v|
 };
 
-template <class Scalar>
-Frame measure(const Scene& scene, const std::array<Scalar, 3>& v) {
+template <class Wide>
+Frame<Wide> measure(const Scene& scene, const std::array<Wide, 3>& v) {
   const int wall = scene.wallIndex();
-  const Scalar frame = wall >= 0 ? v[wall] : Scalar(0);
-  Scalar energy = 0, momentum = 0, magnitude = 0;
+  const Wide frame = wall >= 0 ? v[wall] : Wide(0);
+  Frame<Wide> measured;
   for (int i = 0; i < 3; ++i) {
     if (i == wall) continue;
-    const Scalar m(scene.masses[i]);
-    const Scalar dv = v[i] - frame;
-    energy += m * dv * dv / 2;
-    momentum += m * v[i];
-    magnitude += m * (v[i] < 0 ? Scalar(-v[i]) : v[i]);
+    const Wide m(scene.masses[i]);
+    const Wide dv = v[i] - frame;
+    measured.energy += m * dv * dv / 2;
+    measured.momentum += m * v[i];
+    measured.momentum_magnitude += m * absOf(v[i]);
   }
-  return {toDouble(energy), toDouble(momentum), toDouble(magnitude)};
+  return measured;
+}
+
+/// Gives working-unit values back in SI units as doubles: times 2^-shift, one rounding.
+class ToSi {
+ public:
+  explicit ToSi(int shift)
+      : shift_(shift),
+        double_factor_(std::ldexp(1.0, -shift)),
+        double_factor_exact_(shift >= 1 - std::numeric_limits<double>::max_exponent &&
+                             shift <= std::numeric_limits<double>::digits - std::numeric_limits<double>::min_exponent),
+        long_double_factor_(std::ldexp(1.0L, -shift)) {}
+
+  template <class T>
+  double operator()(const T& value) const {
+    // A product with a power of two is rounded once, into the subnormals too.
+    if constexpr (std::is_same_v<T, double>) {
+      if (double_factor_exact_) return toDouble(value * double_factor_);
+    }
+    if constexpr (std::is_floating_point_v<T> && kLongDoubleIsWide) {
+      return toDouble(static_cast<long double>(value) * long_double_factor_);
+    } else {
+      using std::ldexp;
+      return toDouble(ldexp(value, -shift_));
+    }
+  }
+
+ private:
+  int shift_;
+  double double_factor_;
+  bool double_factor_exact_;  // 2^-shift is a double
+  long double long_double_factor_;
+};
+
+/// Exact power-of-two units of a run: the engine works on velocities times 2^velocity
+/// and positions times 2^position, so that both are near 1 and rounding stays relative
+/// where tiny (even subnormal) values would meet underflow. The physics is invariant:
+/// times scale by 2^(position - velocity), energies by 2^(2 velocity).
+struct WorkingUnits {
+  int velocity = 0;
+  int position = 0;
+  ToSi velocity_si{0}, position_si{0}, time_si{0}, energy_si{0};
+};
+
+bool scalesExactly(const std::array<double, 3>& values, int shift) {
+  for (double x : values) {
+    if (std::ldexp(std::ldexp(x, shift), -shift) != x) return false;
+  }
+  return true;
+}
+
+/// The shift that brings the largest |value| to [1/2, 1), or as close as it goes without
+/// rounding any value (scaling down can push low bits below the smallest subnormal).
+int shiftTowardsOne(const std::array<double, 3>& values) {
+  double largest = 0.0;
+  for (double x : values) largest = std::max(largest, std::fabs(x));
+  if (largest == 0.0) return 0;
+  int exponent = 0;
+  std::frexp(largest, &exponent);  // largest = f 2^exponent, f in [1/2, 1)
+  int shift = -exponent;
+  while (shift < 0 && !scalesExactly(values, shift)) ++shift;
+  return shift;
+}
+
+Scene inWorkingUnits(const Scene& scene, WorkingUnits& units) {
+  units.velocity = shiftTowardsOne(scene.velocities);
+  units.position = shiftTowardsOne(scene.positions);
+  units.velocity_si = ToSi(units.velocity);
+  units.position_si = ToSi(units.position);
+  units.time_si = ToSi(units.position - units.velocity);
+  units.energy_si = ToSi(2 * units.velocity);
+  Scene working = scene;
+  for (double& v : working.velocities) v = std::ldexp(v, units.velocity);
+  for (double& x : working.positions) x = std::ldexp(x, units.position);
+  return working;
 }
 
 /// Run time as an unevaluated sum hi + lo: thousands of short flights add up without
@@ -320,79 +450,120 @@ struct CompensatedTime {
   T value() const { return hi + lo; }
 };
 
-/// Time, position and event bookkeeping of a run that reports events. Each body's path
-/// is anchored where its velocity last changed.
-template <class Scalar>
+/// Zero, or a finite magnitude in T's normal range with room to spare: no underflow has
+/// eaten digits, and no product of it can overflow.
+template <class T>
+bool inNormalRange(const T& x) {
+  const T smallest = std::numeric_limits<T>::min() / epsilonOf<T>();
+  return x == 0 || (absOf(x) >= smallest && absOf(x) <= 1 / smallest);
+}
+
+/// Time, position and event bookkeeping of a run that reports events, in working units
+/// and precision T. Each body's path is anchored where its velocity last changed.
+template <class T>
 class Trajectory {
  public:
-  explicit Trajectory(const Scene& scene) : scene_(scene) {
-    for (int i = 0; i < 3; ++i) reference_position_[i] = Scalar(scene.positions[i]);
+  using Value = T;
+
+  /// One impact, computed but not yet committed.
+  struct Impact {
+    CompensatedTime<T> time;
+    std::array<T, 3> positions;  ///< A, B, C; the pair at its contact point
+    bool in_range = true;        ///< every time and position in T's normal range
+  };
+
+  explicit Trajectory(const Scene& working) : masses_(working.masses), wall_(working.wallIndex()), energy_(masses_) {
+    for (int i = 0; i < 3; ++i) reference_position_[i] = T(working.positions[i]);
   }
 
-  Scalar positionNow(int i, const std::array<Scalar, 3>& v) const {
-    return reference_position_[i] + v[i] * now_.since(reference_time_[i]);
+  /// The same state in a wider type, to go on where T's range ends.
+  template <class Narrow>
+  explicit Trajectory(const Trajectory<Narrow>& narrow)
+      : masses_(narrow.masses_), wall_(narrow.wall_), energy_(masses_) {
+    now_ = widened(narrow.now_);
+    for (int i = 0; i < 3; ++i) {
+      reference_position_[i] = T(narrow.reference_position_[i]);
+      reference_time_[i] = widened(narrow.reference_time_[i]);
+    }
   }
 
-  /// Delay until the next impact of `pair`, which approaches with speed `approach` > 0.
-  Scalar delayToImpact(Pair pair, const std::array<Scalar, 3>& v, const Scalar& approach) const {
+  /// The next impact, of `pair` approaching at `approach` > 0 with the bodies at `v`.
+  Impact next(Pair pair, const std::array<T, 3>& v, const T& approach) const {
     const int left = pair == Pair::AB ? kA : kB;
-    Scalar gap = positionNow(left, v) - positionNow(left + 1, v);
+    const int right = left + 1;
+    Impact impact;
+    T gap = positionAt(left, v, now_) - positionAt(right, v, now_);
     if (gap < 0) gap = 0;  // rounding can put touching bodies a hair out of order
-    return gap / approach;
+    impact.time = now_;
+    impact.time.advance(gap / approach);
+    for (int i = 0; i < 3; ++i) impact.positions[i] = positionAt(i, v, impact.time);
+    // The pair meets where the slower of the two is: a position extrapolated at speed v
+    // is off by v times the time's rounding, so the slow body's is the accurate one.
+    const T contact = absOf(v[left]) <= absOf(v[right]) ? impact.positions[left] : impact.positions[right];
+    impact.positions[left] = impact.positions[right] = contact;
+    impact.in_range = inNormalRange(approach) && inNormalRange(impact.time.value());
+    for (const T& x : impact.positions) impact.in_range = impact.in_range && inNormalRange(x);
+    return impact;
   }
 
-  ImpactEvent makeEvent(std::uint64_t index, Pair pair, const Scalar& delay, const std::array<Scalar, 3>& before,
-                           const std::array<Scalar, 3>& after) {
-    now_.advance(delay);
+  /// Commits `impact` of `pair` (velocities `before` -> `after`, approach speed
+  /// `approach`, all in working units) and describes it in SI units.
+  ImpactEvent commit(std::uint64_t index, Pair pair, const Impact& impact, const std::array<T, 3>& before,
+                     const std::array<T, 3>& after, const T& approach, const WorkingUnits& units) {
+    now_ = impact.time;
     ImpactEvent event;
     event.index = index;
     event.pair = pair;
-    event.time = toDouble(now_.value());
+    event.time = units.time_si(now_.value());
     const int left = pair == Pair::AB ? kA : kB;
-    const int right = left + 1;
-    const int wall = scene_.wallIndex();
-    std::array<Scalar, 3> positions;
+    event.position = units.position_si(impact.positions[left]);
+    for (int i = 0; i < 3; ++i) event.positions[i] = units.position_si(impact.positions[i]);
+    const auto gained = energy_.gained(pair, before, approach);
+    Energy energy = 0, momentum = 0;
     for (int i = 0; i < 3; ++i) {
-      positions[i] = positionNow(i, before);
-      event.velocities_before[i] = toDouble(before[i]);
-      event.velocities_after[i] = toDouble(after[i]);
+      event.energy_transfer[i] = units.energy_si(gained[i]);
+      if (i == wall_) continue;
+      const Energy m(masses_[i]);
+      energy += m * Energy(after[i]) * Energy(after[i]) / 2;
+      momentum += m * Energy(after[i]);
     }
-    // The pair meets where the slower of the two is: a position extrapolated at speed v
-    // is off by v times the time's rounding, so the slow body's is the accurate one.
-    const Scalar speed_left = before[left] < 0 ? Scalar(-before[left]) : before[left];
-    const Scalar speed_right = before[right] < 0 ? Scalar(-before[right]) : before[right];
-    const Scalar contact = speed_left <= speed_right ? positions[left] : positions[right];
-    positions[left] = positions[right] = contact;
-    for (int i = 0; i < 3; ++i) event.positions[i] = toDouble(positions[i]);
-    event.position = toDouble(contact);
-    double gained_by_finite = 0.0;
-    for (int i = 0; i < 3; ++i) {
-      if (i == wall) continue;
-      const Scalar m(scene_.masses[i]);
-      const double gained = toDouble(m * (after[i] - before[i]) * (after[i] + before[i]) / 2);
-      event.energy_transfer[i] = gained;
-      gained_by_finite += gained;
-      event.total_energy += toDouble(m * after[i] * after[i] / 2);
-      event.total_momentum += toDouble(m * after[i]);
-    }
-    if (wall >= 0) event.energy_transfer[wall] = -gained_by_finite;
-
+    event.total_energy = units.energy_si(energy);
+    event.total_momentum = units.velocity_si(momentum);
     // Re-anchor the bodies whose velocity changed (a wall's never does).
-    for (int i : {left, right}) {
-      if (i == wall) continue;
-      reference_position_[i] = contact;
+    for (int i : {left, left + 1}) {
+      if (i == wall_) continue;
+      reference_position_[i] = impact.positions[left];
       reference_time_[i] = now_;
     }
     return event;
   }
 
-  Scalar now() const { return now_.value(); }
+  /// Time [working units] of the last impact (0 before any).
+  T now() const { return now_.value(); }
+  /// Position of body i [working units] at the last impact, moving at v.
+  T positionNow(int i, const std::array<T, 3>& v) const { return positionAt(i, v, now_); }
 
  private:
-  const Scene& scene_;
-  std::array<Scalar, 3> reference_position_;
-  std::array<CompensatedTime<Scalar>, 3> reference_time_{};
-  CompensatedTime<Scalar> now_;
+  template <class U>
+  friend class Trajectory;
+
+  T positionAt(int i, const std::array<T, 3>& v, const CompensatedTime<T>& time) const {
+    return reference_position_[i] + v[i] * time.since(reference_time_[i]);
+  }
+
+  template <class Narrow>
+  static CompensatedTime<T> widened(const CompensatedTime<Narrow>& time) {
+    return {T(time.hi), T(time.lo)};
+  }
+
+  using Energy = detail::EnergyType<T>;
+
+  std::array<double, 3> masses_;
+  int wall_;
+  detail::ImpactEnergy<Energy> energy_;
+  std::array<T, 3> reference_position_;
+  std::array<CompensatedTime<T>, 3> reference_time_{};
+  CompensatedTime<T> now_;
 };
 
 bool keepsEvent(const EventPolicy& policy, std::uint64_t index) {
@@ -418,38 +589,53 @@ std::optional<Pair> firstPair(const Scene& scene) {
 
 template <class Scalar>
 SimulationResult simulate(const Scene& scene, const SimulationOptions& options, const EventVisitor& visitor) {
+  using Wide = WideOf<Scalar>;
   SimulationResult result;
   result.first_pair = firstPair(scene);
-  CompensatedVelocities<Scalar> v(scene.velocities);
-  const Frame start = measure(scene, v.values());
+  WorkingUnits units;
+  const Scene working = inWorkingUnits(scene, units);
+  CompensatedVelocities<Scalar> v(working.velocities);
+  const Frame<Wide> start = measure(working, v.template valuesAs<Wide>());
   const bool tracks_events = options.events.kind != EventPolicy::Kind::kNone || static_cast<bool>(visitor);
 
   const Coefficients<Scalar> coefficients(scene.masses);
-  const ErrorScale scale(scene);
+  const ErrorScale scale(working);
   const Scalar step_bound_ab = scale.bound<Scalar>(Pair::AB, 0) / Scalar(2);  // bound(k) = (k+2) * step
   const Scalar step_bound_bc = scale.bound<Scalar>(Pair::BC, 0) / Scalar(2);
+  // Below this a positive approach speed may have lost digits to underflow, which an
+  // event's time would inherit.
+  const Scalar resolution = std::numeric_limits<Scalar>::min() / epsilonOf<Scalar>();
   EscalationStats& stats = result.escalation;
 
   // The error bound grows with the impacts since v was last exact to working precision.
   std::uint64_t exact_at = 0;
   std::optional<Escalation<Scalar>> escalation;
+  // The approach speed and state seen by the last decision when it was taken above the
+  // working precision: an event's time, positions and energy use them.
+  std::optional<ReplayPrecision> precise_approach;
+  std::optional<std::array<ReplayPrecision, 3>> precise_state;
 
   // Does `pair` approach after k impacts? Exact decision; may refresh v.
   auto approaches = [&](Pair pair, std::uint64_t k) {
     ++stats.decisions;
+    precise_approach.reset();
+    precise_state.reset();
     if (k - exact_at >= kResynchronizeInterval) {
-      if (!escalation) escalation.emplace(scene, scale, *result.first_pair);
+      if (!escalation) escalation.emplace(working, scale, *result.first_pair);
       escalation->resynchronize(k, v);
       exact_at = k;
     }
     const Scalar approach = v.approach(pair == Pair::AB ? kA : kB);
     const Scalar bound =
         (pair == Pair::AB ? step_bound_ab : step_bound_bc) * Scalar(static_cast<double>(k - exact_at + 2));
-    if (approach > bound) return true;
+    if (approach > bound && !(tracks_events && approach < resolution)) return true;
     if (approach < -bound) return false;
-    if (!escalation) escalation.emplace(scene, scale, *result.first_pair);
+    if (!escalation) escalation.emplace(working, scale, *result.first_pair);
     exact_at = k;
-    return escalation->approaches(k, pair, v, stats);
+    const auto decision = escalation->decide(k, pair, v, stats);
+    precise_approach = decision.approach;
+    precise_state = decision.velocities;
+    return decision.approaches;
   };
 
   std::uint64_t k = 0;
@@ -467,46 +653,76 @@ SimulationResult simulate(const Scene& scene, const SimulationOptions& options, 
       pair = otherPair(pair);
     }
   } else if (result.first_pair) {
-    Trajectory<Scalar> trajectory(scene);
+    // Times and positions in Scalar while they stay in its range, in Wide from there on.
+    Trajectory<Scalar> narrow(working);
+    std::optional<Trajectory<Wide>> wide;
     Pair pair = *result.first_pair;
+    ImpactEvent event;
+    // One impact on `trajectory`; false, with nothing changed, when it leaves the range of
+    // a narrow trajectory's type.
+    auto impactOn = [&](auto& trajectory) {
+      using T = typename std::decay_t<decltype(trajectory)>::Value;
+      const int left = pair == Pair::AB ? kA : kB;
+      // The state to the last digit the run knows: the precise one after an escalation
+      // (where even a velocity that Scalar cannot hold moves a body over a long flight),
+      // else the compensated one; never the approach speed as a difference of `before`.
+      std::array<T, 3> before = v.template valuesAs<T>();
+      bool held = true;
+      if (precise_state) {
+        for (int i = 0; i < 3; ++i) {
+          before[i] = static_cast<T>((*precise_state)[i]);
+          held = held && ((*precise_state)[i] == 0 || (before[i] != 0 && inNormalRange(before[i])));
+        }
+      }
+      const T approach = precise_approach ? static_cast<T>(*precise_approach) : T(v.approach(left));
+      const auto impact = trajectory.next(pair, before, approach);
+      if (!(impact.in_range && held) && !std::is_same_v<T, Wide>) return false;
+      v.impact(coefficients.of(pair), left);
+      ++k;
+      event = trajectory.commit(k, pair, impact, before, v.template valuesAs<T>(), approach, units);
+      return true;
+    };
     while (approaches(pair, k)) {
       if (k == options.max_collisions) {
         result.truncated = true;
         break;
       }
-      const int left = pair == Pair::AB ? kA : kB;
-      const std::array<Scalar, 3> before = v.values();
-      // The compensated approach speed: after an escalation it can be far below the
-      // rounding of the velocities themselves.
-      const Scalar approach = v.approach(left);
-      const Scalar delay = trajectory.delayToImpact(pair, before, approach > 0 ? approach : Scalar(0));
-      v.impact(coefficients.of(pair), left);
-      ++k;
-      const ImpactEvent event = trajectory.makeEvent(k, pair, delay, before, v.values());
+      // Velocities as the run reports them everywhere, whichever type timed the impact.
+      std::array<double, 3> before;
+      for (int i = 0; i < 3; ++i) before[i] = units.velocity_si(v.value(i));
+      if (wide || !impactOn(narrow)) {
+        if (!wide) wide.emplace(narrow);
+        impactOn(*wide);
+      }
+      event.velocities_before = before;
+      for (int i = 0; i < 3; ++i) event.velocities_after[i] = units.velocity_si(v.value(i));
       if (visitor) visitor(event);
       if (keepsEvent(options.events, k)) result.events.push_back(event);
       pair = otherPair(pair);
     }
-    result.final_time = toDouble(trajectory.now());
-    const std::array<Scalar, 3> final_velocities = v.values();
-    for (int i = 0; i < 3; ++i) result.final_positions[i] = toDouble(trajectory.positionNow(i, final_velocities));
+    for (int i = 0; i < 3; ++i) {
+      result.final_positions[i] = wide ? units.position_si(wide->positionNow(i, v.template valuesAs<Wide>()))
+                                       : units.position_si(narrow.positionNow(i, v.values()));
+    }
+    result.final_time = wide ? units.time_si(wide->now()) : units.time_si(narrow.now());
   }
   if (!tracks_events || !result.first_pair) {
     for (int i = 0; i < 3; ++i) {
-      result.final_positions[i] = tracks_events ? scene.positions[i] : std::numeric_limits<double>::quiet_NaN();
+      result.final_positions[i] = tracks_events ? toDouble(scene.positions[i]) : std::numeric_limits<double>::quiet_NaN();
     }
   }
 
   result.collision_count = k;
-  const std::array<Scalar, 3> final_velocities = v.values();
-  for (int i = 0; i < 3; ++i) result.final_velocities[i] = toDouble(final_velocities[i]);
-  const Frame end = measure(scene, final_velocities);
-  result.energy_relative_drift = start.energy > 0 ? std::fabs(end.energy - start.energy) / start.energy : 0.0;
+  for (int i = 0; i < 3; ++i) result.final_velocities[i] = units.velocity_si(v.value(i));
+  const Frame<Wide> end = measure(working, v.template valuesAs<Wide>());
+  result.energy_relative_drift = start.energy > 0 ? toDouble(absOf(Wide(end.energy - start.energy)) / start.energy) : 0.0;
   if (scene.wallIndex() >= 0) {
     result.momentum_relative_drift = std::numeric_limits<double>::quiet_NaN();
   } else {
     result.momentum_relative_drift =
-        start.momentum_magnitude > 0 ? std::fabs(end.momentum - start.momentum) / start.momentum_magnitude : 0.0;
+        start.momentum_magnitude > 0
+            ? toDouble(absOf(Wide(end.momentum - start.momentum)) / start.momentum_magnitude)
+            : 0.0;
   }
   return result;
 }

@@ -1,5 +1,6 @@
 #include "collision_lab/io/number_text.h"
 
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cmath>
@@ -11,12 +12,7 @@ namespace io {
 
 namespace {
 
-std::string_view trimBlanks(std::string_view text) {
-  const auto is_blank = [](char c) { return std::isspace(static_cast<unsigned char>(c)) != 0; };
-  while (!text.empty() && is_blank(text.front())) text.remove_prefix(1);
-  while (!text.empty() && is_blank(text.back())) text.remove_suffix(1);
-  return text;
-}
+bool isBlank(char c) { return std::isspace(static_cast<unsigned char>(c)) != 0; }
 
 std::string lowerCase(std::string_view text) {
   std::string out(text);
@@ -36,9 +32,9 @@ std::optional<double> yamlSpecialValue(const std::string& lower) {
 }  // namespace
 
 ParsedNumber parseNumber(std::string_view text) {
-  const std::string_view trimmed = trimBlanks(text);
-  if (trimmed.empty()) return {0.0, "is empty"};
-  const std::string lower = lowerCase(trimmed);
+  if (text.empty()) return {0.0, "is empty"};
+  if (std::any_of(text.begin(), text.end(), isBlank)) return {0.0, "contains a blank; numbers are written without blanks"};
+  const std::string lower = lowerCase(text);
   if (const auto special = yamlSpecialValue(lower)) return {*special, ""};
 
   // strtod also reads inf, infinity, nan and hex floats; the C locale is in force.
@@ -48,19 +44,27 @@ ParsedNumber parseNumber(std::string_view text) {
   const double value = std::strtod(begin, &end);
   if (end == begin || *end != '\0') return {0.0, "is not a number"};
   if (errno == ERANGE && std::isinf(value)) return {0.0, "is too large for a double"};
+  // A subnormal result is the nearest double and is kept; only a nonzero number that
+  // would be read as 0 is refused.
+  if (errno == ERANGE && value == 0) {
+    return {0.0, "is too small for a double (it would be read as 0; the smallest is 4.9e-324); write 0 for zero"};
+  }
   return {value, ""};
 }
 
-std::optional<std::uint64_t> parseCount(std::string_view text) {
-  if (text.empty() || text.size() > 20) return std::nullopt;
+ParsedCount parseCount(std::string_view text) {
+  if (text.empty() || !std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; })) {
+    return {0, "is not a non-negative integer"};
+  }
   std::uint64_t value = 0;
   for (char c : text) {
-    if (c < '0' || c > '9') return std::nullopt;
     const std::uint64_t digit = static_cast<std::uint64_t>(c - '0');
-    if (value > (std::numeric_limits<std::uint64_t>::max() - digit) / 10) return std::nullopt;
+    if (value > (std::numeric_limits<std::uint64_t>::max() - digit) / 10) {
+      return {0, "is too large: the largest is 2^64 - 1 = 18446744073709551615"};
+    }
     value = value * 10 + digit;
   }
-  return value;
+  return {value, ""};
 }
 
 std::vector<std::string> splitCommaList(std::string_view text) {

@@ -14,9 +14,11 @@ namespace {
 
 const char* const kParticleNames[3] = {"A", "B", "C"};
 
-/// Shortest text that reads back to the same double; "inf", "-inf", and "nan" for any NaN.
+/// Shortest text that reads back to the same double; "inf", "-inf", "nan" for any NaN,
+/// and "0" for either zero.
 std::string roundTripText(double value) {
   if (std::isnan(value)) return "nan";
+  if (value == 0) return "0";
   char buffer[64];
   const auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
   return std::string(buffer, result.ptr);
@@ -39,7 +41,12 @@ std::string padRight(const std::string& text, std::size_t width) {
   return text.size() >= width ? text : text + std::string(width - text.size(), ' ');
 }
 
-Json array3(const std::array<double, 3>& values) { return Json::array({values[0], values[1], values[2]}); }
+/// A double for JSON: never a negative zero (NaN and infinities become null when dumped).
+Json number(double value) { return Json(value == 0 ? 0.0 : value); }
+
+Json array3(const std::array<double, 3>& values) {
+  return Json::array({number(values[0]), number(values[1]), number(values[2])});
+}
 
 Json optionalPair(const std::optional<Pair>& pair) {
   return pair ? Json(pairName(*pair)) : Json(nullptr);
@@ -358,7 +365,8 @@ std::optional<EventPolicy> parseEventPolicy(const std::string& text) {
   if (text == "none") return EventPolicy::none();
   const std::string prefix = "first:";
   if (text.compare(0, prefix.size(), prefix) == 0) {
-    if (const auto n = parseCount(text.substr(prefix.size()))) return EventPolicy::firstN(*n);
+    const ParsedCount n = parseCount(std::string_view(text).substr(prefix.size()));
+    if (n.problem.empty()) return EventPolicy::firstN(n.value);
   }
   return std::nullopt;
 }
@@ -424,8 +432,8 @@ Json eventJson(const LabEvent& lab) {
   const ImpactEvent& e = lab.event;
   return Json{{"index", e.index},
               {"pair", pairName(e.pair)},
-              {"time", e.time},
-              {"position", e.position},
+              {"time", number(e.time)},
+              {"position", number(e.position)},
               {"positions", array3(e.positions)},
               {"velocities_before", array3(e.velocities_before)},
               {"velocities_after", array3(e.velocities_after)},
@@ -435,8 +443,8 @@ Json eventJson(const LabEvent& lab) {
               {"paper_velocities_after", array3(lab.paper_velocities_after)},
               {"paper_energy_transfer", array3(lab.paper_energy_transfer)},
               {"kinetic_energy_after", array3(lab.kinetic_energy_after)},
-              {"total_energy", e.total_energy},
-              {"total_momentum", e.total_momentum}};
+              {"total_energy", number(e.total_energy)},
+              {"total_momentum", number(e.total_momentum)}};
 }
 
 Json summaryJson(const RunResult& result) {
@@ -453,15 +461,15 @@ Json summaryJson(const RunResult& result) {
               {"max_possible_collision_count", p.max_possible_collision_count},
               {"predicted_first_pair", optionalPair(p.first_pair)},
               {"predicted_final_velocities", array3(p.final_velocities)},
-              {"theta", p.angles.theta},
-              {"alpha", p.angles.alpha},
-              {"omega", p.angles.omega},
-              {"psi", p.psi},
-              {"paper_phi_bc", p.phi_bc},
-              {"max_prediction_error", s.max_prediction_error},
-              {"energy_relative_drift", s.energy_relative_drift},
-              {"momentum_relative_drift", s.momentum_relative_drift},
-              {"compute_time_s", s.compute_time_s},
+              {"theta", number(p.angles.theta)},
+              {"alpha", number(p.angles.alpha)},
+              {"omega", number(p.angles.omega)},
+              {"psi", number(p.psi)},
+              {"paper_phi_bc", number(p.phi_bc)},
+              {"max_prediction_error", number(s.max_prediction_error)},
+              {"energy_relative_drift", number(s.energy_relative_drift)},
+              {"momentum_relative_drift", number(s.momentum_relative_drift)},
+              {"compute_time_s", number(s.compute_time_s)},
               {"escalation",
                {{"decisions", s.escalation.decisions},
                 {"high_precision", s.escalation.high_precision},

@@ -57,11 +57,14 @@ NamedScene readEntry(const std::string& name, const YAML::Node& entry, const std
   readTriple(entry, kVectorKeys[1], where, named.scene.positions);
   readTriple(entry, kVectorKeys[2], where, named.scene.velocities);
   if (const YAML::Node cap = entry["max_collisions"]) {
-    const std::optional<std::uint64_t> value = cap.IsScalar() ? parseCount(cap.Scalar()) : std::nullopt;
-    if (!value || *value == 0) {
+    const ParsedCount value = cap.IsScalar() ? parseCount(cap.Scalar()) : ParsedCount{0, "is not a number"};
+    if (value.problem.rfind("is too large", 0) == 0) {
+      throw ScenarioFileError(where + ": 'max_collisions' " + cap.Scalar() + " " + value.problem);
+    }
+    if (!value.problem.empty() || value.value == 0) {
       throw ScenarioFileError(where + ": 'max_collisions' must be a positive integer");
     }
-    named.max_collisions = *value;
+    named.max_collisions = value.value;
   }
   return named;
 }

@@ -319,6 +319,7 @@ ServeOutcome LabNode::reject(collision_lab::Rejected msg, const std::string& run
   ROS_WARN_STREAM("rejected run '" << run_id << "': " << msg.reason_name << " in field "
                   << msg.field << ": " << msg.message);
   rejected_pub_.publish(msg);
+  if (marker_view_) marker_view_->onRejected(msg);
   return ServeOutcome{std::nullopt, msg};
 }
 
@@ -391,6 +392,8 @@ collision_lab::RunSummary LabNode::run(collision_lab::InitialConditions& input,
     collision_lab::Velocities velocities_msg = toVelocitiesMsg(event);
     collision_lab::EnergyTransfer energy_msg = toEnergyTransferMsg(event);
     const double t = last_event_time = event.event.time;
+    event_msg.run_id = run_id;
+    if (marker_view_) marker_view_->onCollisionEvent(event_msg);  // every event, published or not
     if (published_events == params_.max_published_events) {  // the bag only
       events_not_published = true;
       out.record(events_pub_.getTopic(), event_msg, t);
@@ -402,11 +405,6 @@ collision_lab::RunSummary LabNode::run(collision_lab::InitialConditions& input,
     out.publish(velocities_pub_, velocities_msg, t);
     out.publish(energy_pub_, energy_msg, t);
     ++published_events;
-    if (marker_view_) {
-      marker_view_->onCollisionEvent(event_msg);
-      marker_view_->onVelocities(velocities_msg);
-      marker_view_->onEnergyTransfer(energy_msg);
-    }
   };
   const core::RunResult result = collision_lab::runLab(scene, options, core_prediction, onEvent);
 

@@ -1,134 +1,211 @@
 #include "collision_lab/ros/marker_view.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 
+#include "collision_lab/EnergyTransfer.h"
+#include "collision_lab/Velocities.h"
 #include "collision_lab/ros/node_constants.h"
 
 namespace collision_lab_ros {
 
 namespace {
-constexpr double kStaticRepublishPeriod = 1.0;  ///< [s], for rviz instances that join late
-}
+/// Collisions of a run held while its InitialConditions has not arrived (a replay's topics
+/// are not ordered against each other). Beyond, they count as missed.
+constexpr std::size_t kMaxPendingEvents = 100000;
+
+template <class Message>
+void ignore(const boost::shared_ptr<const Message>&) {}
+}  // namespace
 
 MarkerViewParams MarkerViewParams::load(const ros::NodeHandle& private_nh) {
   MarkerViewParams params;
   private_nh.param("time_scale", params.time_scale, kDefaultTimeScale);
   private_nh.param("marker_rate", params.marker_rate, kDefaultMarkerRate);
-  int max_plotted = static_cast<int>(kDefaultMaxPlottedEvents);
-  private_nh.param("max_plotted_events", max_plotted, max_plotted);
-  params.max_plotted_events = static_cast<std::size_t>(std::max(max_plotted, 0));
   private_nh.param("frame_id", params.frame_id, std::string(kMarkerFrame));
   if (!(params.marker_rate > 0)) {
     ROS_WARN_STREAM("~marker_rate = " << params.marker_rate << " Hz is not positive; using "
                     << kDefaultMarkerRate << " Hz");
     params.marker_rate = kDefaultMarkerRate;
   }
+  const std::string fallback = ros::Time::isSimTime() ? "ros" : "wall";
+  std::string clock;
+  private_nh.param("clock", clock, fallback);
+  if (clock != "wall" && clock != "ros") {
+    ROS_WARN_STREAM("~clock = '" << clock << "' is neither 'wall' nor 'ros'; using '" << fallback << "'");
+    clock = fallback;
+  }
+  params.clock = clock == "ros" ? Clock::kRos : Clock::kWall;
   return params;
 }
 
-MarkerView::MarkerView(ros::NodeHandle nh, const MarkerViewParams& params)
-    : nh_(nh), params_(params) {
-  markers_pub_ = nh_.advertise<visualization_msgs::MarkerArray>(kMarkersTopic, kMarkerQueueSize);
-  timer_ = nh_.createWallTimer(ros::WallDuration(1.0 / params_.marker_rate), &MarkerView::onTimer,
-                               this);
+MarkerView::MarkerView(ros::NodeHandle nh, const MarkerViewParams& params) : nh_(nh), params_(params) {
+  markers_pub_ = nh_.advertise<visualization_msgs::MarkerArray>(kMarkersTopic, kMarkerQueueSize, true);
+  animated_pub_ = nh_.advertise<visualization_msgs::MarkerArray>(kAnimatedMarkersTopic, kMarkerQueueSize, true);
+  timer_ = nh_.createWallTimer(ros::WallDuration(1.0 / params_.marker_rate), &MarkerView::onTimer, this);
 }
 
 void MarkerView::subscribe() {
+  replay_ = true;
   // Queues as deep as the node's, so a replayed burst is not thinned out.
   subscribers_.push_back(nh_.subscribe<collision_lab::InitialConditions>(
       kInitialConditionsTopic, kOutputQueueSize,
       [this](const collision_lab::InitialConditions::ConstPtr& m) { onInitialConditions(*m); }));
   subscribers_.push_back(nh_.subscribe<collision_lab::Prediction>(
-      kPredictionsTopic, kOutputQueueSize,
-      [this](const collision_lab::Prediction::ConstPtr& m) { onPrediction(*m); }));
+      kPredictionsTopic, kOutputQueueSize, [this](const collision_lab::Prediction::ConstPtr& m) { onPrediction(*m); }));
   subscribers_.push_back(nh_.subscribe<collision_lab::CollisionEvent>(
       kCollisionEventsTopic, kOutputQueueSize,
       [this](const collision_lab::CollisionEvent::ConstPtr& m) { onCollisionEvent(*m); }));
-  subscribers_.push_back(nh_.subscribe<collision_lab::Velocities>(
-      kVelocitiesTopic, kOutputQueueSize,
-      [this](const collision_lab::Velocities::ConstPtr& m) { onVelocities(*m); }));
-  subscribers_.push_back(nh_.subscribe<collision_lab::EnergyTransfer>(
-      kEnergyTransfersTopic, kOutputQueueSize,
-      [this](const collision_lab::EnergyTransfer::ConstPtr& m) { onEnergyTransfer(*m); }));
   subscribers_.push_back(nh_.subscribe<collision_lab::RunSummary>(
-      kRunSummariesTopic, kOutputQueueSize,
-      [this](const collision_lab::RunSummary::ConstPtr& m) { onRunSummary(*m); }));
+      kRunSummariesTopic, kOutputQueueSize, [this](const collision_lab::RunSummary::ConstPtr& m) { onRunSummary(*m); }));
+  subscribers_.push_back(nh_.subscribe<collision_lab::Rejected>(
+      kRejectedTopic, kOutputQueueSize, [this](const collision_lab::Rejected::ConstPtr& m) { onRejected(*m); }));
+  // The view needs nothing from these two (a CollisionEvent carries it all), but
+  // `rosbag play --wait-for-subscribers` (replay.launch) waits for a subscriber on every
+  // recorded topic.
+  subscribers_.push_back(nh_.subscribe(kVelocitiesTopic, 1, &ignore<collision_lab::Velocities>));
+  subscribers_.push_back(nh_.subscribe(kEnergyTransfersTopic, 1, &ignore<collision_lab::EnergyTransfer>));
 }
 
-RunRecord& MarkerView::select(const std::string& run_id) {
-  if (!has_run_ || run_id != current_run_id_) {
-    run_ = RunRecord{};
-    current_run_id_ = run_id;
-    has_run_ = true;
-    run_changed_ = true;
-    run_start_ = ros::WallTime::now();
-  }
-  static_dirty_ = true;
-  return run_;
+void MarkerView::select(const std::string& run_id) {
+  if (has_run_id_ && run_id == run_id_) return;
+  run_id_ = run_id;
+  has_run_id_ = true;
+  run_.reset();
+  pending_ = Pending{};
+  run_changed_ = true;
 }
 
 void MarkerView::onInitialConditions(const collision_lab::InitialConditions& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
-  select(msg.run_id).input = msg;
+  if (run_ && msg.run_id == run_id_) has_run_id_ = false;  // the same run again: start afresh
+  select(msg.run_id);
+  run_.emplace(msg);
+  run_->prediction = pending_.prediction;
+  run_->summary = pending_.summary;
+  for (const auto& event : pending_.events) run_->add(event);
+  pending_ = Pending{};
   run_start_ = ros::WallTime::now();
+  static_dirty_ = true;
 }
 
 void MarkerView::onPrediction(const collision_lab::Prediction& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
-  select(msg.run_id).prediction = msg;
+  select(msg.run_id);
+  (run_ ? run_->prediction : pending_.prediction) = msg;
+  static_dirty_ = true;
 }
 
 void MarkerView::onCollisionEvent(const collision_lab::CollisionEvent& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
-  auto& events = select(msg.run_id).events;
-  if (events.size() < params_.max_plotted_events) events.push_back(msg);
-}
-
-void MarkerView::onVelocities(const collision_lab::Velocities& msg) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  auto& velocities = select(msg.run_id).velocities;
-  if (velocities.size() < params_.max_plotted_events) velocities.push_back(msg);
-}
-
-void MarkerView::onEnergyTransfer(const collision_lab::EnergyTransfer& msg) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  auto& energies = select(msg.run_id).energies;
-  if (energies.size() < params_.max_plotted_events) energies.push_back(msg);
+  select(msg.run_id);
+  if (run_) {
+    run_->add(msg);
+  } else if (pending_.events.size() < kMaxPendingEvents) {
+    pending_.events.push_back(msg);
+  }
+  static_dirty_ = true;
 }
 
 void MarkerView::onRunSummary(const collision_lab::RunSummary& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
-  select(msg.run_id).summary = msg;
+  select(msg.run_id);
+  (run_ ? run_->summary : pending_.summary) = msg;
+  static_dirty_ = true;
+}
+
+void MarkerView::onRejected(const collision_lab::Rejected& msg) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  rejected_ = msg;
+  rejected_at_ = ros::WallTime::now();
+}
+
+FrameClock MarkerView::frameClock(const RunRecord& run, const ros::WallTime& now) const {
+  FrameClock clock;
+  if (params_.clock == MarkerViewParams::Clock::kRos) {
+    const double scale = run.prediction ? run.prediction->timeline_scale : 0.0;
+    clock.t = std::min(simulatedTimeOnTimeline(ros::Time::now(), run.input().header.stamp, scale), endTime(run));
+    clock.description = "ROS clock" + std::string(ros::Time::isSimTime() ? " (bag)" : "");
+    return clock;
+  }
+  const double elapsed = (now - run_start_).toSec();
+  if (params_.time_scale > 0) {
+    const double end = endTime(run);
+    const double into = std::fmod(elapsed, end / params_.time_scale + kMarkerEndHold);
+    clock.t = std::min(into * params_.time_scale, end);
+    clock.description = "sim time x" + std::to_string(params_.time_scale);
+    return clock;
+  }
+  const TimeWarp warp(run);
+  const double loop = autoLoopDuration(run.collisions());
+  const double phase = std::min(std::fmod(elapsed, loop + kMarkerEndHold) / loop, 1.0);
+  clock.t = warp.timeAt(phase);
+  char rate[64];
+  std::snprintf(rate, sizeof rate, "sim time x%.2g", warp.rateAt(phase) / loop);
+  clock.description = rate;
+  return clock;
+}
+
+std::string MarkerView::hintText() const {
+  if (replay_) {
+    return "Waiting for a run. Replay one:\nroslaunch collision_lab replay.launch bag:=<run>.bag";
+  }
+  return "No run yet. Send one, e.g.:\nrostopic pub -1 " + nh_.resolveName(kInitialConditionsTopic) +
+         " collision_lab/InitialConditions\n'{masses: [100.0, 1.0, .inf], positions: [2.0, 1.0, 0.0], "
+         "velocities: [-1.0, 0.0, 0.0]}'\n(numbers as 1.0e+8, not 1e8; .inf is a wall)";
+}
+
+void MarkerView::addOverlays(visualization_msgs::MarkerArray& animated, const ros::WallTime& now) {
+  auto& out = animated.markers;
+  const auto show = [&](bool shown, bool& was_shown, const std::string& ns,
+                        const std::vector<visualization_msgs::Marker>& markers) {
+    if (shown) out.insert(out.end(), markers.begin(), markers.end());
+    if (was_shown && !shown) {
+      for (int id : {0, 1}) out.push_back(deleteMarker(ns, id, params_.frame_id));
+    }
+    was_shown = shown;
+  };
+  const bool banner = rejected_ && (now - rejected_at_).toSec() < kRejectedShowTime;
+  show(banner, banner_shown_, "rejected",
+       banner ? rejectedBanner(*rejected_, params_.frame_id) : std::vector<visualization_msgs::Marker>{});
+  const bool hint = !has_run_id_;
+  show(hint, hint_shown_, "hint", hint ? hintMarkers(hintText(), params_.frame_id) : std::vector<visualization_msgs::Marker>{});
 }
 
 void MarkerView::onTimer(const ros::WallTimerEvent&) {
   visualization_msgs::MarkerArray static_markers, animated;
-  bool clear = false;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    // Nothing to draw before the run's masses and start are known.
-    if (!has_run_ || run_.input.run_id != current_run_id_) return;
     const ros::WallTime now = ros::WallTime::now();
-    clear = run_changed_;
-    run_changed_ = false;
-    if (static_dirty_ || (now - last_static_publish_).toSec() >= kStaticRepublishPeriod) {
-      static_markers = buildStaticMarkers(run_, params_.frame_id);
-      static_dirty_ = false;
-      last_static_publish_ = now;
+    // A deletion goes in the same message as the new picture, so rviz never shows the
+    // two together, and every static message (the latched one too) is a whole picture.
+    if (run_changed_) {
+      animated = deleteAllMarkers(params_.frame_id);
+      banner_shown_ = hint_shown_ = false;
     }
-    const double loop = loopDuration(run_);
-    const double time_scale =
-        params_.time_scale > 0 ? params_.time_scale : loop / kAutoLoopDuration;
-    const double t = std::fmod((now - run_start_).toSec() * time_scale, loop);
-    animated = buildAnimatedMarkers(run_, t, params_.frame_id);
+    if (run_changed_ || (run_ && static_dirty_)) {
+      static_markers = deleteAllMarkers(params_.frame_id);
+      if (run_) {
+        const auto built = buildStaticMarkers(*run_, params_.frame_id);
+        static_markers.markers.insert(static_markers.markers.end(), built.markers.begin(), built.markers.end());
+        static_dirty_ = false;
+      }
+    }
+    run_changed_ = false;
+    if (run_) {
+      const auto built = buildAnimatedMarkers(*run_, frameClock(*run_, now), params_.frame_id);
+      animated.markers.insert(animated.markers.end(), built.markers.begin(), built.markers.end());
+    }
+    addOverlays(animated, now);
   }
-  if (clear) {
-    // In the same message, so rviz never sees the new run drawn over the old one.
-    auto& markers = static_markers.markers;
-    markers.insert(markers.begin(), deleteAllMarkers(params_.frame_id).markers.front());
+  for (auto* array : {&static_markers, &animated}) {
+    if (const std::size_t changed = enforceRvizLimits(*array)) {
+      ROS_WARN_STREAM_THROTTLE(10, changed << " markers did not fit rviz's limits and were thinned or dropped");
+    }
   }
   if (!static_markers.markers.empty()) markers_pub_.publish(static_markers);
-  markers_pub_.publish(animated);
+  if (!animated.markers.empty()) animated_pub_.publish(animated);
 }
 
 }  // namespace collision_lab_ros

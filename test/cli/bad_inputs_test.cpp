@@ -8,7 +8,6 @@
 #include <cctype>
 #include <fstream>
 #include <set>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -50,6 +49,29 @@ std::string unquote(const std::string& cell) {
   return text.size() >= 2 && text.front() == '`' && text.back() == '`' ? text.substr(1, text.size() - 2) : text;
 }
 
+/// Splits the Arguments cell as a shell would for these rows: at blanks, except inside
+/// single quotes ('1, 1,1' is one argument).
+std::vector<std::string> splitArguments(const std::string& text) {
+  std::vector<std::string> args;
+  std::string current;
+  bool quoted = false, any = false;
+  for (char c : text) {
+    if (c == '\'') {
+      quoted = !quoted;
+      any = true;
+    } else if (c == ' ' && !quoted) {
+      if (any) args.push_back(current);
+      current.clear();
+      any = false;
+    } else {
+      current += c;
+      any = true;
+    }
+  }
+  if (any) args.push_back(current);
+  return args;
+}
+
 /// Table rows "| n | what | `args` | REASON | code | `field` | `stderr line` |".
 std::vector<CatalogueRow> loadCatalogue() {
   std::ifstream in(COLLISION_LAB_SOURCE_DIR "/docs/bad_inputs.md");
@@ -65,8 +87,7 @@ std::vector<CatalogueRow> loadCatalogue() {
     if (cells.size() != 7 || number.empty() || !std::isdigit(static_cast<unsigned char>(number[0]))) continue;
     CatalogueRow row;
     row.number = std::stoi(number);
-    std::istringstream words(unquote(cells[2]));
-    for (std::string word; words >> word;) row.args.push_back(word);
+    row.args = splitArguments(unquote(cells[2]));
     row.reason = trim(cells[3]);
     row.code = std::stoi(trim(cells[4]));
     row.field = unquote(cells[5]);

@@ -1,6 +1,9 @@
 #!/usr/bin/env python3
 """Refreshes the catalogue table of docs/bad_inputs.md from the real CLI.
 
+The catalogue's expected texts are written by hand (a changed message is a decision);
+use this only to see what the CLI prints now, and review the diff before keeping any of it.
+
 The rows' "Bad input" and "Arguments" columns are the source; reason, code, field and
 message are rewritten from what collision_lab_cli prints when run from the repository root
 (bad_inputs_test.cpp then checks them). To add a row, append it with any placeholder in
@@ -10,6 +13,7 @@ the last four columns and run:
 """
 import json
 import pathlib
+import shlex
 import subprocess
 import sys
 
@@ -22,7 +26,7 @@ def run(cli, args):
 
 
 def refreshed_row(cli, number, label, args_text):
-    args = args_text.split()
+    args = shlex.split(args_text)
     plain = run(cli, args)
     line = plain.stderr.rstrip("\n")
     if plain.returncode != 2 or plain.stdout or "\n" in line:

@@ -18,7 +18,9 @@ void expectRejected(const Scene& scene, Reason reason, const std::string& field)
   ASSERT_TRUE(error.has_value()) << "expected " << reasonName(reason);
   EXPECT_EQ(error->reason, reason) << error->message;
   EXPECT_EQ(error->field, field) << error->message;
-  EXPECT_NE(error->message.find(field.substr(0, field.find('['))), std::string::npos) << error->message;
+  // One sentence that does not repeat its field: reports print "field: message".
+  EXPECT_NE(error->message.rfind(field, 0), 0u) << error->message;
+  EXPECT_FALSE(error->message.empty());
 }
 
 TEST(Validation, AcceptsOrdinaryScenesAndWalls) {
@@ -65,12 +67,9 @@ TEST(Validation, EveryReasonCode) {
   s = validScene();
   s.positions = {1.7e308, -1.7e308, -1.75e308};
   expectRejected(s, Reason::kOverflow, "positions");
-  // Counts beyond 64 bits (mass ratio 1e40) and mass ratios that underflow.
+  // Counts beyond 64 bits (mass ratio 1e40).
   s = validScene();
   s.masses = {1e40, 1, 1e40};
-  expectRejected(s, Reason::kOverflow, "masses");
-  s = validScene();
-  s.masses = {1e-300, 1, 1e300};
   expectRejected(s, Reason::kOverflow, "masses");
   // A first contact at t = 1e600 s.
   s = validScene();

@@ -94,12 +94,16 @@ EigenCheck eigenCheck(const std::array<double, 3>& masses);
 /// first (psi' = (alpha - psi) mod 2 pi for BC first); 0 when nothing collides. A last
 /// contact with exactly zero approach speed (psi / alpha an exact integer) does not count.
 /// Exact for the given doubles: double, then 50 digits, then exact rationals where the
-/// integer test needs them.
+/// integer test needs them. Never rounded through a double: counts pass 2^53.
 std::uint64_t predictedCollisionCount(const Scene& scene);
 
 /// The most collisions any start can give for these masses, ceil(pi / alpha)
 /// (Galperin & Zemlyakov; OEIS A119661). Exact, including the kaleidoscopic masses where
-/// pi / alpha is an integer.
+/// pi / alpha is an integer. Empty when it exceeds 2^64 - 1, the largest count the lab
+/// reports (validate() rejects such masses).
+std::optional<std::uint64_t> checkedMaxPossibleCollisionCount(const std::array<double, 3>& masses);
+
+/// checkedMaxPossibleCollisionCount for masses that validate() accepts.
 std::uint64_t maxPossibleCollisionCount(const std::array<double, 3>& masses);
 
 }  // namespace collision_lab

@@ -57,17 +57,20 @@ struct RunOptions {
   bool skip_simulation_over_cap = false;
 };
 
+/// A run that was not simulated (predict-only, or skipped over the cap) measured nothing:
+/// its max_prediction_error, energy_relative_drift and momentum_relative_drift are NaN,
+/// "not measured", and its final_velocities are the predicted ones.
 struct LabRunSummary {
-  std::uint64_t collision_count = 0;
+  std::uint64_t collision_count = 0;        ///< simulated; the predicted count in predict-only mode
   bool truncated = false;
   std::string truncation_reason;            ///< empty unless truncated
   bool simulated = false;                   ///< false for predict-only and skipped runs
-  std::array<double, 3> final_velocities{}; ///< [m/s]
+  std::array<double, 3> final_velocities{}; ///< simulated, else the closed form's after the predicted count [m/s]
   /// max over reported states of |S (v_sim - v_pred)| / |S v_0|, S = diag(sqrt(m)):
   /// relative error in the energy norm, in the wall's frame (dimensionless).
   double max_prediction_error = 0.0;
-  double energy_relative_drift = 0.0;
-  double momentum_relative_drift = 0.0;     ///< NaN with a wall
+  double energy_relative_drift = 0.0;       ///< |E_end - E_0| / E_0, in the wall's frame
+  double momentum_relative_drift = 0.0;     ///< |p_end - p_0| / sum |m v|; NaN with a wall
   double compute_time_s = 0.0;              ///< wall time of prediction + simulation [s]
   EscalationStats escalation;
 };

@@ -24,11 +24,15 @@ double phiBC(const Scene& scene);
 double omega(const std::array<double, 3>& masses);
 
 /// n_max of eq. (3.22): 1 + floor((Omega - phi_BC)/theta) + ceil((Omega - phi_BC)/theta).
-/// Empty when the printed expression is not a finite number for this scene.
+/// Empty when the printed expression is not a finite number for this scene, or when it
+/// does not fit an int64.
 std::optional<std::int64_t> collisionCount(const Scene& scene);
 
 /// Energy gained by A, B, C [J] in collision n (1-based) by eqs. (4.4)-(4.7), with v_k
-/// read as the paper defines it (against the *initial* vbar_AB).
+/// read as the paper defines it (against the *initial* vbar_AB). The equations give the
+/// colliding pair's entries only; the third body, which the paper's impact does not touch,
+/// gains 0. A wall in the pair makes its printed entries NaN (inf / inf), as does an
+/// impact BC that comes first (4.6 and 4.7 refer to the impact before).
 /// state_before: velocities just before collision n; state_two_before: just before
 /// collision n-1 (used by the BC formulas 4.6, 4.7, which refer to v_{k-1}).
 std::array<double, 3> energyTransfer(const Scene& scene, std::uint64_t n, Pair pair,

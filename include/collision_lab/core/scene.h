@@ -50,7 +50,7 @@ const char* reasonName(Reason r);
 struct ValidationError {
   Reason reason = Reason::kOk;
   std::string field;    ///< e.g. "velocities[1]", "masses", "positions"
-  std::string message;  ///< one human-readable sentence naming field and value
+  std::string message;  ///< one sentence naming the quantity (m_B, x_A, ...), its value and unit, and what is allowed; not prefixed with the field
 };
 
 /// Checks a scene. Returns nothing when the scene is valid. Never throws for any input.

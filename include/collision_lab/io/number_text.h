@@ -17,15 +17,23 @@ struct ParsedNumber {
   std::string problem;
 };
 
-/// Reads one decimal (or hexadecimal) floating-point number. Surrounding blanks are
-/// ignored. Accepts inf / infinity / nan in any case, with an optional sign, and YAML's
-/// .inf / .nan. Rejects empty text, trailing characters, and magnitudes beyond a double
-/// (1e400 is an error, never silently inf). Underflow rounds towards zero, as C does.
+/// Reads one decimal (or hexadecimal) floating-point number, as the nearest double.
+/// Accepts inf / infinity / nan in any case, with an optional sign, and YAML's .inf / .nan.
+/// Rejects empty text, any blank (lists are written without blanks: "1,1,1"), trailing
+/// characters, magnitudes beyond a double (1e400 is an error, never silently inf) and
+/// nonzero numbers below the smallest subnormal (1e-400 is an error, never silently 0).
 ParsedNumber parseNumber(std::string_view text);
 
-/// Reads a non-negative decimal integer that fits in 64 bits ("10000000"). Returns empty
-/// for anything else (signs, fractions, exponents, blanks inside, overflow).
-std::optional<std::uint64_t> parseCount(std::string_view text);
+/// A count read from text, or why it could not be read.
+struct ParsedCount {
+  std::uint64_t value = 0;
+  /// Empty on success, else "is not a non-negative integer" or "is too large: ...".
+  std::string problem;
+};
+
+/// Reads a non-negative decimal integer ("10000000"); signs, fractions, exponents and
+/// blanks are not integers, and more than 2^64 - 1 is too large (and says so).
+ParsedCount parseCount(std::string_view text);
 
 /// Splits "a,b,c" at commas. Items are not trimmed; "1,,2" gives an empty middle item.
 std::vector<std::string> splitCommaList(std::string_view text);

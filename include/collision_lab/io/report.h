@@ -4,8 +4,9 @@
 //
 // Conventions: SI units throughout (the JSON "units" object lists them); doubles are
 // printed so that they read back to the same double (JSON: shortest round-trip form,
-// CSV: the same via std::to_chars); NaN and infinities are JSON null, with walls named
-// in scene.walls. Values from the paper's printed formulas carry the prefix "paper_".
+// CSV: the same via std::to_chars), a zero always as 0, never -0; NaN and infinities are
+// JSON null, with walls named in scene.walls; counts are integers (uint64), never doubles.
+// A NaN summary value means "not measured" (a run that was not simulated). Values from the paper's printed formulas carry the prefix "paper_".
 #pragma once
 
 #include <memory>

@@ -1,11 +1,18 @@
 // rviz markers for one run, built from the run's messages alone (so a live node and a
-// bag replay draw the same picture). Three views in one frame, side by side:
-//   1. the scene: bodies sized by mass, walls as walls, animated along the exact
-//      trajectory, with velocity labels;
-//   2. the wedge in velocity space s-perp (the paper's Figure 1): lines L_AB and L_BC, the
-//      escape cone, u_perp after each collision (simulated path) and as predicted;
-//   3. plots: v_A, v_B, v_C against collision index (simulated lines, predicted points),
-//      and kinetic energy per particle as bars, with axis labels.
+// bag replay draw the same picture). The views:
+//   - the scene: bodies sized by mass, walls as walls, animated along the exact trajectory
+//     (never extrapolated), with the time, the collision counter and the velocities;
+//   - the wedge in velocity space s-perp (the paper's Figure 1): lines L_AB and L_BC, the
+//     escape cone, u_perp after the collisions (simulated and by the closed form);
+//   - v_A, v_B, v_C against collision index as steps (constant between impacts), with the
+//     paper's printed eqs. (2.15)/(2.16) as a third series where they differ, and B on its
+//     own scale when it dwarfs A and C;
+//   - the x-t diagram (worldlines);
+//   - total energy and momentum of the finite masses against collision index;
+//   - kinetic energy per body as bars.
+//
+// Memory is bounded whatever the count: a RunRecord keeps a decimated set of exact states
+// (Keyframes) and per-pixel-column min/max envelopes of every plotted series (Envelope).
 #pragma once
 
 #include <array>
@@ -15,47 +22,208 @@
 #include <string>
 #include <vector>
 
+#include <ros/time.h>
 #include <visualization_msgs/MarkerArray.h>
 
 #include "collision_lab/CollisionEvent.h"
-#include "collision_lab/EnergyTransfer.h"
 #include "collision_lab/InitialConditions.h"
 #include "collision_lab/Prediction.h"
+#include "collision_lab/Rejected.h"
 #include "collision_lab/RunSummary.h"
-#include "collision_lab/Velocities.h"
+#include "collision_lab/ros/node_constants.h"
 
 namespace collision_lab_ros {
 
-/// What the marker view keeps of one run: everything up to the first N collisions.
-struct RunRecord {
-  collision_lab::InitialConditions input;
-  std::optional<collision_lab::Prediction> prediction;
-  std::vector<collision_lab::CollisionEvent> events;
-  std::vector<collision_lab::Velocities> velocities;
-  std::vector<collision_lab::EnergyTransfer> energies;
-  std::optional<collision_lab::RunSummary> summary;
+/// A polyline y(x), appended to with x never decreasing, in bounded memory. While it has
+/// at most max_vertices vertices it is kept exactly; beyond, it is kept per column of
+/// x (a power of two wide, at most max_vertices / 4 columns): the first and last vertex
+/// and the min and max of y over the column, which is all a pixel column can show. Each
+/// vertex carries a mark (e.g. a deviation); a column keeps the largest.
+class Envelope {
+ public:
+  struct Vertex {
+    double x = 0.0, y = 0.0, mark = 0.0;
+  };
+
+  explicit Envelope(std::size_t max_vertices = kMarkerEnvelopeVertices);
+
+  /// Appends a vertex; x >= 0 and x >= the previous x. NaN y is kept (a gap) and ignored
+  /// by the bounds.
+  void add(double x, double y, double mark = 0.0);
+  /// Appends a step: holds the last y up to x, then jumps to y (no jump when y and mark
+  /// are unchanged; the first call just adds).
+  void step(double x, double y, double mark = 0.0);
+
+  /// The polyline to draw: the exact vertices, or per column first, min/max, last. At
+  /// most max_vertices points.
+  std::vector<Vertex> polyline() const;
+  bool empty() const { return count_ == 0; }
+  bool exact() const { return columns_.empty(); }
+  const Vertex& last() const { return last_; }
+  /// Bounds of y over every vertex ever added (+inf / -inf when none is finite).
+  double minY() const { return min_y_; }
+  double maxY() const { return max_y_; }
+
+ private:
+  struct Column {
+    bool used = false;
+    Vertex first, last;
+    double lo = 0.0, hi = 0.0, mark = 0.0;
+  };
+  void addToColumns(const Vertex& v);
+  void addToColumn(std::size_t c, const Vertex& v);
+  void switchToColumns(double x);
+  void widenColumns();
+
+  std::size_t max_vertices_;
+  std::size_t count_ = 0;
+  std::vector<Vertex> vertices_;  ///< exact mode
+  std::vector<Column> columns_;   ///< column mode (empty in exact mode)
+  double width_ = 0.0;            ///< column width [x units], a power of two
+  Vertex last_;
+  double min_y_, max_y_;
 };
 
-/// Positions [m] and velocities [m/s] at simulated time t [s], and how many of the kept
-/// collisions have happened by then.
+/// The exact state just after one collision.
+struct Keyframe {
+  std::uint64_t index = 0;  ///< collision number [1]
+  double time = 0.0;        ///< [s]
+  /// Up to this time [s] the free flight from this state is exact: the next collision's
+  /// time once it is known, +inf while this is the newest collision.
+  double valid_until = 0.0;
+  double previous_time = 0.0;  ///< the previous collision's time [s] (0 for the first)
+  std::array<double, 3> positions{};   ///< [m]
+  std::array<double, 3> velocities{};  ///< after the collision [m/s]
+  std::array<double, 3> predicted{};   ///< closed form after the collision [m/s]
+};
+
+/// Bounds of a RunRecord's memory, whatever the count.
+struct RecordLimits {
+  std::size_t keyframes = kMarkerKeyframes;
+  std::size_t envelope_vertices = kMarkerEnvelopeVertices;
+};
+
+/// What the marker view keeps of one run. Collisions are added in index order; the record
+/// keeps the first and the newest collision, every collision whose index is a multiple of
+/// a power-of-two stride, and the first collision in every time bucket (a power of two
+/// wide), doubling stride or bucket as needed to stay within limits.keyframes. So both
+/// the sparse phases (uniform in time) and the dense bursts (uniform in index) keep exact
+/// states close together.
+class RunRecord {
+ public:
+  explicit RunRecord(const collision_lab::InitialConditions& input, const RecordLimits& limits = {});
+
+  /// Collisions must come in index order; an index already added is ignored, and a
+  /// skipped index is counted in missedCollisions().
+  void add(const collision_lab::CollisionEvent& event);
+
+  const collision_lab::InitialConditions& input() const { return input_; }
+  std::optional<collision_lab::Prediction> prediction;
+  std::optional<collision_lab::RunSummary> summary;
+
+  /// Index of the newest collision added [1].
+  std::uint64_t collisions() const { return keyframes_.empty() ? 0 : keyframes_.back().index; }
+  std::uint64_t missedCollisions() const { return missed_; }
+  const std::vector<Keyframe>& keyframes() const { return keyframes_; }
+  /// True when every collision of the run is here: the summary (or, before it, the exact
+  /// predicted count) says the simulated run ended with the newest collision.
+  bool finished() const;
+
+  /// Steps against collision index: velocities [m/s] (simulated, and the paper's with
+  /// mark |paper - simulated|), total energy [J] and momentum [kg m/s] of the finite
+  /// masses. Worldlines: positions [m] against time [s].
+  const Envelope& velocity(int i) const { return velocity_[i]; }
+  const Envelope& paperVelocity(int i) const { return paper_velocity_[i]; }
+  const Envelope& energy() const { return energy_; }
+  const Envelope& momentum() const { return momentum_; }
+  const Envelope& worldline(int i) const { return worldline_[i]; }
+
+ private:
+  bool keeps(const Keyframe& frame) const;
+  void prune();
+
+  collision_lab::InitialConditions input_;
+  RecordLimits limits_;
+  std::vector<Keyframe> keyframes_;
+  std::uint64_t stride_ = 1;   ///< keeps indices that are multiples of it
+  double bucket_ = 0.0;        ///< [s]; 0 until the first collision at t > 0
+  std::uint64_t missed_ = 0;
+  std::array<Envelope, 3> velocity_, paper_velocity_, worldline_;
+  Envelope energy_, momentum_;
+};
+
+/// Kinetic energy [J] and momentum [kg m/s] of the finite masses (walls excluded).
+double kineticEnergy(const collision_lab::InitialConditions& input, const std::array<double, 3>& v);
+double momentum(const collision_lab::InitialConditions& input, const std::array<double, 3>& v);
+
+/// How long bodies at positions x [m] with velocities v [m/s] fly freely before two
+/// touch [s]: +inf when no pair approaches. Bounds the animation of an unfinished run.
+double freeFlightHorizon(const std::array<double, 3>& x, const std::array<double, 3>& v);
+
+/// What the scene shows at simulated time t [s].
 struct SceneState {
-  std::array<double, 3> positions{};
-  std::array<double, 3> velocities{};
-  std::size_t collisions = 0;
+  /// The simulated time shown [s]: t itself when its exact state is known, otherwise the
+  /// nearest instant whose exact state is known (never an extrapolation).
+  double time = 0.0;
+  std::array<double, 3> positions{};   ///< [m]
+  std::array<double, 3> velocities{};  ///< [m/s]
+  std::uint64_t collisions = 0;        ///< collisions before `time` [1]
 };
 SceneState stateAt(const RunRecord& run, double t);
 
-/// One loop of the animation in simulated time [s]: past the last kept collision by a
-/// quarter, so the bodies are seen flying apart.
-double loopDuration(const RunRecord& run);
+/// The simulated time [s] the animation runs to: 25 % past the last collision of a
+/// finished run, or past the bodies' closest approach when nothing collides; for an
+/// unfinished run, as far as its known trajectory goes.
+double endTime(const RunRecord& run);
 
-/// The parts that change only when a message arrives (axes, lines, paths, titles).
-visualization_msgs::MarkerArray buildStaticMarkers(const RunRecord& run,
-                                                   const std::string& frame_id);
-/// The parts that move with simulated time t [s] (bodies, labels, cursors, bars).
-visualization_msgs::MarkerArray buildAnimatedMarkers(const RunRecord& run, double t,
+/// The animation's time warp: phase in [0, 1] (one loop) -> simulated time [s], a blend of
+/// uniform time and uniform collision index, so dense bursts play in slow motion.
+class TimeWarp {
+ public:
+  explicit TimeWarp(const RunRecord& run);
+  double timeAt(double phase) const;
+  /// d(simulated time)/d(phase) at phase [s per loop].
+  double rateAt(double phase) const;
+
+ private:
+  std::vector<double> times_, phases_;  ///< increasing nodes of the piecewise-linear map
+  double end_ = 0.0;
+};
+
+/// Wall seconds of one auto-timed loop of a run with this many collisions.
+double autoLoopDuration(std::uint64_t collisions);
+
+/// Simulated time [s] of a replayed run at ROS time `now`, on the run's timeline stamped
+/// from `start` (its InitialConditions) at timeline_scale bag s per simulated s; a scale
+/// <= 0 or not finite counts as 1. Never negative.
+double simulatedTimeOnTimeline(const ros::Time& now, const ros::Time& start, double timeline_scale);
+
+/// One frame's time line for the status text.
+struct FrameClock {
+  double t = 0.0;           ///< simulated time requested [s]
+  std::string description;  ///< e.g. "slow motion: sim time x0.001", "bag clock"
+};
+
+/// The parts that change only when a message arrives (axes, plots, paths, titles).
+visualization_msgs::MarkerArray buildStaticMarkers(const RunRecord& run, const std::string& frame_id);
+/// The parts that move with simulated time (bodies, labels, cursors, bars).
+visualization_msgs::MarkerArray buildAnimatedMarkers(const RunRecord& run, const FrameClock& clock,
                                                      const std::string& frame_id);
+/// A banner for a rejected input: its reason, field and message (ns "rejected", ids 0, 1).
+std::vector<visualization_msgs::Marker> rejectedBanner(const collision_lab::Rejected& rejected,
+                                                       const std::string& frame_id);
+/// Before the first run: how to send one, `command` (ns "hint", ids 0, 1).
+std::vector<visualization_msgs::Marker> hintMarkers(const std::string& command, const std::string& frame_id);
+/// Deletes the marker ns/id (when a banner or hint is no longer shown).
+visualization_msgs::Marker deleteMarker(const std::string& ns, int id, const std::string& frame_id);
 /// Clears every marker of earlier runs.
 visualization_msgs::MarkerArray deleteAllMarkers(const std::string& frame_id);
+
+/// rviz's limits (rviz 1.14, Debian 12), applied to every array the view publishes as a
+/// last guard (the builders already stay within them): a LINE_STRIP or LINE_LIST longer
+/// than kRvizMaxLinePoints is thinned, a list with too few points for its type, a
+/// TRIANGLE_LIST not in threes, an odd LINE_LIST, a blank text or a non-finite value is
+/// dropped (rviz rejects those with an error). Returns how many markers it changed.
+std::size_t enforceRvizLimits(visualization_msgs::MarkerArray& array);
 
 }  // namespace collision_lab_ros

@@ -1,10 +1,21 @@
-// Publishes `markers` (visualization_msgs/MarkerArray) for the newest run. Fed either
-// directly by collision_lab_node, or from the node's topics (collision_lab_markers, used
-// on bag replay): markers are not recorded in bags, replay regenerates them.
+// Publishes the newest run's picture on `markers` (static: axes, plots, titles) and its
+// animation on `markers_animated`, both latched, so an rviz opened late shows the last run
+// and its last frame. Fed either directly by collision_lab_node (every collision, whether
+// published or not), or from the node's topics (collision_lab_markers, on bag replay):
+// markers are not recorded in bags, replay regenerates them.
+//
+// The animation's clock (~clock):
+//   "wall": loops over the run in wall time, at ~time_scale simulated s per wall s, or
+//           (time_scale <= 0) auto-timed with dense bursts in slow motion (TimeWarp);
+//   "ros":  follows ROS time on the run's timeline, simulated t =
+//           (ros::Time::now() - InitialConditions stamp) / Prediction.timeline_scale, so
+//           that rosbag play --clock drives it: rate (-r), pause (space) and step (s).
+// The default is "ros" under use_sim_time, "wall" otherwise.
 #pragma once
 
 #include <cstddef>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -15,12 +26,14 @@
 namespace collision_lab_ros {
 
 struct MarkerViewParams {
-  double time_scale = 0.0;   ///< simulated s per wall s; <= 0: auto
-  double marker_rate = 0.0;  ///< [Hz]
-  std::size_t max_plotted_events = 0;
-  std::string frame_id;
+  enum class Clock { kWall, kRos };
 
-  /// Reads ~time_scale, ~marker_rate, ~max_plotted_events and ~frame_id, with the
+  double time_scale = 0.0;   ///< simulated s per wall s; <= 0: auto (wall clock only)
+  double marker_rate = 0.0;  ///< [Hz]
+  std::string frame_id;
+  Clock clock = Clock::kWall;
+
+  /// Reads ~time_scale, ~marker_rate, ~frame_id and ~clock ("wall" or "ros"), with the
   /// defaults of node_constants.h.
   static MarkerViewParams load(const ros::NodeHandle& private_nh);
 };
@@ -29,39 +42,53 @@ class MarkerView {
  public:
   MarkerView(ros::NodeHandle nh, const MarkerViewParams& params);
 
-  /// Subscribes to the run topics in nh's namespace (for replay).
+  /// Subscribes to the run topics and `rejected` in nh's namespace (for replay).
   void subscribe();
 
-  /// A message of a new run_id starts a new picture. Topics are not ordered against each
-  /// other, so a run's messages may arrive before its InitialConditions; it is drawn once
-  /// those arrive. Thread-safe.
+  /// A message of a new run_id starts a new picture; so does a second InitialConditions
+  /// of the current run (a bag played again). A run's other messages may arrive before
+  /// its InitialConditions: they wait for it. Thread-safe.
   void onInitialConditions(const collision_lab::InitialConditions& msg);
   void onPrediction(const collision_lab::Prediction& msg);
   void onCollisionEvent(const collision_lab::CollisionEvent& msg);
-  void onVelocities(const collision_lab::Velocities& msg);
-  void onEnergyTransfer(const collision_lab::EnergyTransfer& msg);
   void onRunSummary(const collision_lab::RunSummary& msg);
+  /// Shown for kRejectedShowTime (wall time) over whatever run is on screen.
+  void onRejected(const collision_lab::Rejected& msg);
 
  private:
+  /// Messages of the current run that came before its InitialConditions.
+  struct Pending {
+    std::optional<collision_lab::Prediction> prediction;
+    std::optional<collision_lab::RunSummary> summary;
+    std::vector<collision_lab::CollisionEvent> events;
+  };
+
   void onTimer(const ros::WallTimerEvent& event);
-  /// The record of run_id, started afresh when run_id is not the current run. Call with
-  /// mutex_ held.
-  RunRecord& select(const std::string& run_id);
+  /// Switches to run_id when it is not the current run. Call with mutex_ held.
+  void select(const std::string& run_id);
+  FrameClock frameClock(const RunRecord& run, const ros::WallTime& now) const;
+  std::string hintText() const;
+  /// The banner and hint markers of this frame (adds, or deletes of ones shown before).
+  void addOverlays(visualization_msgs::MarkerArray& animated, const ros::WallTime& now);
 
   ros::NodeHandle nh_;
   MarkerViewParams params_;
-  ros::Publisher markers_pub_;
+  ros::Publisher markers_pub_, animated_pub_;
   ros::WallTimer timer_;
   std::vector<ros::Subscriber> subscribers_;
+  bool replay_ = false;  ///< fed by subscriptions rather than by the node
 
   std::mutex mutex_;
-  RunRecord run_;
-  std::string current_run_id_;
-  bool has_run_ = false;
-  bool run_changed_ = false;     // the previous run's markers must be deleted
-  bool static_dirty_ = false;    // the static markers must be rebuilt
+  std::string run_id_;
+  bool has_run_id_ = false;
+  std::optional<RunRecord> run_;
+  Pending pending_;
+  bool run_changed_ = false;   // the previous run's markers must be deleted
+  bool static_dirty_ = false;  // the static markers must be rebuilt
   ros::WallTime run_start_;
-  ros::WallTime last_static_publish_;
+  std::optional<collision_lab::Rejected> rejected_;
+  ros::WallTime rejected_at_;
+  bool banner_shown_ = false, hint_shown_ = false;
 };
 
 }  // namespace collision_lab_ros

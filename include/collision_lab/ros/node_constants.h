@@ -14,7 +14,11 @@ constexpr char kVelocitiesTopic[] = "velocities";
 constexpr char kEnergyTransfersTopic[] = "energy_transfers";
 constexpr char kRunSummariesTopic[] = "run_summaries";
 constexpr char kRejectedTopic[] = "rejected";
+/// The run's picture that changes only when a message arrives (axes, plots, titles), and
+/// the animation's frames (bodies, counter, cursors, banners). Both are latched, so an
+/// rviz opened late shows the last run and its last frame at once.
 constexpr char kMarkersTopic[] = "markers";
+constexpr char kAnimatedMarkersTopic[] = "markers_animated";
 
 /// Latched: a late joiner (rviz or `rostopic echo` started after a run, a second client)
 /// gets the newest of these at once. predictions and run_summaries: the newest run's
@@ -48,7 +52,7 @@ constexpr std::uint32_t kInputQueueSize = 10000;
 /// slow subscriber reads them. roscpp drops the oldest beyond this, so it is sized for
 /// ~max_published_events per run times a burst of runs.
 constexpr std::uint32_t kOutputQueueSize = 100000;
-/// Markers are periodic snapshots: only the newest matters.
+/// Markers are snapshots: only the newest matters.
 constexpr std::uint32_t kMarkerQueueSize = 10;
 
 constexpr std::uint64_t kDefaultMaxCollisions = 10'000'000;
@@ -59,12 +63,27 @@ constexpr std::uint64_t kDefaultMaxPublishedEvents = 10'000;
 constexpr char kDefaultBagSubdirectory[] = "collision_lab/runs";
 
 constexpr double kDefaultMarkerRate = 20.0;  ///< [Hz]
-/// Simulated seconds per wall second; 0 = choose so that one loop of the run's
-/// animation takes about kAutoLoopDuration.
+/// Simulated seconds per wall second; 0 = auto: one loop of the run's animation takes
+/// kAutoLoopDuration for a few collisions, up to about twice that for millions, with
+/// dense bursts in slow motion (see TimeWarp).
 constexpr double kDefaultTimeScale = 0.0;
 constexpr double kAutoLoopDuration = 8.0;  ///< [s] wall time
-/// The marker view keeps the first this many collisions of a run for its plots.
-constexpr std::size_t kDefaultMaxPlottedEvents = 1000;
+/// Each loop ends by holding its last frame (the final count) this long [s] wall time.
+constexpr double kMarkerEndHold = 2.5;
+/// A rejected input stays on screen this long [s] wall time.
+constexpr double kRejectedShowTime = 6.0;
+/// What the marker view keeps of one run, whatever its count (RunRecord): exact states
+/// after this many selected collisions, and plotted series of at most this many vertices
+/// each (beyond it, min/max per column: 256 to 512 columns, about a plot's pixels).
+constexpr std::size_t kMarkerKeyframes = 4096;
+constexpr std::size_t kMarkerEnvelopeVertices = 2048;
+/// rviz draws LINE_STRIP and LINE_LIST markers with a BillboardLine whose chains hold at
+/// most 65536 / 4 = 16384 elements (rviz 1.14 src/rviz/ogre_helpers/billboard_line.cpp,
+/// MAX_ELEMENTS). A LINE_STRIP with more points is split over several lines, and the next
+/// message for the same marker then fails ROS_ASSERT(num_lines_ == 1) (billboard_line.cpp
+/// line 178) and aborts rviz. No line marker we publish has more points than this; the
+/// builders stay far below it (Envelope), and enforceRvizLimits() guards the output.
+constexpr std::size_t kRvizMaxLinePoints = 16384;
 constexpr char kMarkerFrame[] = "collision_lab";
 
 }  // namespace collision_lab_ros

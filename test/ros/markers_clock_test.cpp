@@ -1,0 +1,123 @@
+// collision_lab_markers under use_sim_time (markers_clock_test.test): simulated time is
+// (ROS time - the run's InitialConditions stamp) / Prediction.timeline_scale, so what
+// rosbag play does to /clock (rate, pause, step) the animation does too.
+//
+// The run: equal masses at x = (2, 1, -1) m with v = (-1, 0, 1) m/s. Equal masses swap
+// velocities, so by hand: AB meet at t = 1 s; then B (-1 m/s from 1 m) and C (+1 m/s from
+// 0 m) meet at t = 1.5 s; then B (+1 m/s from 0.5 m) reaches A (at rest at 1 m) at t = 2 s.
+// Three collisions; the view runs 25 % past the last one, to t = 2.5 s.
+#include <string>
+
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+#include <rosgraph_msgs/Clock.h>
+
+#include "collision_lab/ros/msg_conversion.h"
+#include "marker_test_client.h"
+
+namespace {
+
+using namespace collision_lab_test;
+using namespace collision_lab_ros;
+
+constexpr double kTimeout = 60.0;  ///< [s] wall time for any one expected frame
+constexpr double kScale = 2.0;     ///< bag s per simulated s
+const ros::Time kStart(1000, 0);   ///< the run's InitialConditions stamp
+
+class Player {
+ public:
+  explicit Player(ros::NodeHandle nh)
+      : clock_(ros::NodeHandle().advertise<rosgraph_msgs::Clock>("/clock", 10)),
+        input_(nh.advertise<collision_lab::InitialConditions>(kInitialConditionsTopic, 10)),
+        prediction_(nh.advertise<collision_lab::Prediction>(kPredictionsTopic, 10)),
+        events_(nh.advertise<collision_lab::CollisionEvent>(kCollisionEventsTopic, 100)),
+        summary_(nh.advertise<collision_lab::RunSummary>(kRunSummariesTopic, 10)) {}
+
+  bool connected() const {
+    for (const auto* pub : {&clock_, &input_, &prediction_, &events_, &summary_}) {
+      if (pub->getNumSubscribers() == 0) return false;
+    }
+    return true;
+  }
+
+  void setClock(const ros::Time& t) {
+    rosgraph_msgs::Clock msg;
+    msg.clock = t;
+    clock_.publish(msg);
+  }
+
+  /// The whole run, each message stamped on the timeline.
+  void publishRun() {
+    core::Scene scene;
+    scene.masses = {1, 1, 1};
+    scene.positions = {2, 1, -1};
+    scene.velocities = {-1, 0, 1};
+    auto input = toInitialConditions(scene, core::RunMode::kFull, 0);
+    input.run_id = "clock_run";
+    input.header.stamp = kStart;
+    input_.publish(input);
+    core::RunOptions options;
+    options.events = collision_lab::EventPolicy::all();
+    const core::RunResult result = collision_lab::runLab(scene, options);
+    auto prediction = toPredictionMsg(result.prediction);
+    prediction.run_id = input.run_id;
+    prediction.header.stamp = kStart;
+    prediction.timeline_scale = kScale;
+    prediction_.publish(prediction);
+    for (const auto& e : result.events) {
+      auto msg = toCollisionEventMsg(e);
+      msg.run_id = input.run_id;
+      msg.header.stamp = kStart + ros::Duration(kScale * e.event.time);
+      events_.publish(msg);
+    }
+    auto summary = toRunSummaryMsg(result.summary, result.prediction, core::RunMode::kFull);
+    summary.run_id = input.run_id;
+    summary.header.stamp = kStart + ros::Duration(kScale * result.events.back().event.time);
+    summary_.publish(summary);
+  }
+
+ private:
+  ros::Publisher clock_, input_, prediction_, events_, summary_;
+};
+
+std::string timeShown(const std::string& status) { return status.substr(0, status.find(" s ")); }
+
+TEST(MarkersClock, AnimationFollowsTheBagClock) {
+  ros::NodeHandle nh("collision_lab");
+  AnimationWatcher watcher(nh);
+  Player player(nh);
+  ASSERT_TRUE(spinUntil([&] { return player.connected(); }, kTimeout)) << "collision_lab_markers never subscribed";
+  player.setClock(kStart);
+  player.publishRun();
+
+  // Simulated t = 1.25 s: after the first collision, before the second.
+  player.setClock(kStart + ros::Duration(kScale * 1.25));
+  ASSERT_TRUE(spinUntil([&] { return timeShown(watcher.status) == "t = 1.25"; }, kTimeout))
+      << "last shown: " << watcher.status;
+  EXPECT_EQ(numberAfter(watcher.status, "collisions "), 1);
+
+  // Paused: the clock stands still, and so does the picture, frame after frame.
+  const std::uint64_t paused_at = watcher.frames;
+  ASSERT_TRUE(spinUntil([&] { return watcher.frames >= paused_at + 10; }, kTimeout)) << "frames stopped coming";
+  EXPECT_EQ(timeShown(watcher.status), "t = 1.25");
+
+  // A step forward to t = 1.75 s: two collisions done.
+  player.setClock(kStart + ros::Duration(kScale * 1.75));
+  ASSERT_TRUE(spinUntil([&] { return timeShown(watcher.status) == "t = 1.75"; }, kTimeout))
+      << "last shown: " << watcher.status;
+  EXPECT_EQ(numberAfter(watcher.status, "collisions "), 2);
+
+  // Long after the end: all three, held at the end of the run's picture (2.5 s).
+  player.setClock(kStart + ros::Duration(kScale * 100.0));
+  ASSERT_TRUE(spinUntil([&] { return timeShown(watcher.status) == "t = 2.5"; }, kTimeout))
+      << "last shown: " << watcher.status;
+  EXPECT_NE(watcher.status.find("collisions 3 of 3"), std::string::npos) << watcher.status;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "markers_clock_test");
+  return RUN_ALL_TESTS();
+}
