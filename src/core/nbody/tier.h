@@ -1,0 +1,459 @@
+// One arithmetic tier of the N-body event engine (internal; not installed).
+//
+// State. Body k moves on the line x = b_k + v_k t between its impacts; the tier keeps the
+// intercepts b [m] and velocities v [m/s] in its number type S. An impact of pair p maps
+// (b, v) of its two bodies by the same linear impact map (impact_rule.h), so no body ever
+// needs a time of its own, and the impact time t_p = (b_p - b_{p+1}) / (v_{p+1} - v_p)
+// serves only to order the events.
+//
+// Error bounds. In mass-weighted coordinates B = sqrt(m) b and U = sqrt(m) v an impact
+// applies the same linear map F = I - (1+e) n n^T (norm 1) to B and to U, in the exact
+// process and in the computed one alike, as long as both see the same sequence of impacts.
+// So the 2-norm of the error vector only grows by each impact's own rounding:
+// ||U_computed - U_exact|| <= eu_, ||B_computed - B_exact|| <= eb_, with eu_, eb_ summed
+// from a bound on each impact's rounding (rho()). A body's velocity is then off by at most
+// eu_ / sqrt(m_k), and a pair's approach speed by eu_ (1/sqrt(m_p) + 1/sqrt(m_{p+1})).
+// Walls are exact and take no part. In the exact tier every bound is 0.
+//
+// Decisions. The events are processed in the canonical order (exact time, then pair
+// index). Each pair's leaf in the tournament tree holds a lower bound of its next impact
+// time and upper_ an upper bound. The root is next when its upper bound is below every
+// other lower bound; otherwise the candidates are compared with precise times (S
+// arithmetic, tight bounds). What a tier cannot decide it reports as kAmbiguous: the
+// caller then replays the run in a more precise tier and adopts that tier's state.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "arithmetic.h"
+#include "collision_lab/core/nbody/engine.h"
+#include "collision_lab/core/nbody/impact_rule.h"
+#include "collision_lab/core/nbody/scene.h"
+#include "tournament_tree.h"
+
+namespace collision_lab {
+namespace core {
+namespace nbody_detail {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kUnit = 0x1p-53;           // unit roundoff of double
+constexpr double kSlack = 1.0 + 0x1p-40;    // covers the rounding of evaluating a bound in double
+constexpr double kTiny = 0x1p-1000;         // covers underflow in double-double, per operation
+constexpr double kMaxMagnitude = 0x1p900;   // beyond this the engine stops: out of range
+
+/// What does not change during a run, shared by the tiers (doubles, exact inputs).
+struct SceneTables {
+  explicit SceneTables(const Scene& scene);
+  const Scene& scene;
+  std::size_t pairs = 0;
+  std::vector<double> sqrt_mass;      ///< sqrt(m) [kg^0.5]; 0 for a wall (it carries no error)
+  std::vector<double> inv_sqrt_mass;  ///< 1 / sqrt(m) [kg^-0.5]; 0 for a wall
+  std::vector<double> loss_factor;    ///< (1 - e^2) mu / 2 per pair [kg]
+};
+
+enum class StepKind { kImpact, kFinished, kMultipleCollision, kAmbiguous, kOutOfRange, kInconsistent };
+
+struct StepResult {
+  StepKind kind = StepKind::kImpact;
+  std::size_t pair = 0;  ///< the impact's pair, or the lower pair of a multiple collision
+  double time = 0.0;     ///< [s]
+};
+
+template <class S>
+class Tier {
+ public:
+  using Ar = Arithmetic<S>;
+
+  explicit Tier(const SceneTables& tables) : tables_(tables), tree_(tables.pairs), upper_(tables.pairs, kInf) {
+    const Scene& scene = tables.scene;
+    for (std::size_t k = 0; k < scene.size(); ++k) {
+      b_.push_back(S(scene.positions[k]));
+      v_.push_back(S(scene.velocities[k]));
+    }
+    for (std::size_t p = 0; p < tables.pairs; ++p) {
+      maps_.push_back(makeImpactMap<S>(scene.masses[p], scene.masses[p + 1], scene.restitutionOf(p)));
+    }
+  }
+
+  /// Schedules every pair from the initial state.
+  StepResult start() {
+    for (std::size_t p = 0; p < tables_.pairs; ++p) {
+      const StepResult r = schedule(p);
+      if (r.kind != StepKind::kImpact) return r;
+    }
+    tree_.rebuild();
+    return {};
+  }
+
+  bool pending() const { return tree_.minKey() < kInf; }
+  std::uint64_t count() const { return count_; }
+  std::uint64_t refinements() const { return refinements_; }
+  double energyLost() const { return lost_ + lost_compensation_; }
+  /// Time of the last impact [s] (0 before the first).
+  double lastTime() const { return count_ == 0 ? 0.0 : 0.5 * (now_.lower + now_.upper); }
+
+  /// Finds and performs the next impact (or reports why not). `record` may be null.
+  StepResult step(ImpactRecord* record) {
+    std::size_t next = tree_.minLeaf();
+    if (!(tree_.minKey() < kInf)) return {StepKind::kFinished, 0, lastTime()};
+    if (!(upper_[next] < tree_.minKeyExcluding(next))) {
+      const StepResult r = resolveNext(next);
+      if (r.kind != StepKind::kImpact) return r;
+      next = r.pair;
+    }
+    return impact(next, record);
+  }
+
+  /// Takes over the state of a more precise tier at the same impact count.
+  template <class From>
+  void adopt(const Tier<From>& from) {
+    constexpr double conversion = conversionError<S>();
+    eu_ = from.eu_;
+    eb_ = from.eb_;
+    for (std::size_t k = 0; k < b_.size(); ++k) {
+      b_[k] = convertTo<S>(from.b_[k]);
+      v_[k] = convertTo<S>(from.v_[k]);
+      eu_ += 2 * conversion * tables_.sqrt_mass[k] * std::fabs(Ar::toDouble(v_[k]));
+      eb_ += 2 * conversion * tables_.sqrt_mass[k] * std::fabs(Ar::toDouble(b_[k]));
+    }
+    tree_ = from.tree_;
+    upper_ = from.upper_;
+    count_ = from.count_;
+    lost_ = from.lost_;
+    lost_compensation_ = from.lost_compensation_;
+    now_.pair = from.now_.pair;
+    now_.G = convertTo<S>(from.now_.G);
+    now_.A = convertTo<S>(from.now_.A);
+    now_.eG = from.now_.eG + 2 * conversion * std::fabs(Ar::toDouble(now_.G));
+    now_.eA = from.now_.eA + 2 * conversion * std::fabs(Ar::toDouble(now_.A));
+    now_.lower = from.now_.lower;
+    now_.upper = from.now_.upper;
+  }
+
+  /// Positions [m] at time t [s] and velocities [m/s], rounded to double.
+  void state(double t, std::vector<double>& positions, std::vector<double>& velocities) const {
+    positions.resize(b_.size());
+    velocities.resize(b_.size());
+    for (std::size_t k = 0; k < b_.size(); ++k) {
+      positions[k] = Ar::toDouble(S(b_[k] + S(v_[k] * t)));
+      velocities[k] = Ar::toDouble(v_[k]);
+    }
+  }
+
+ private:
+  template <class>
+  friend class Tier;
+
+  enum class Decision { kYes, kNo, kUnknown };
+  enum class Order { kLess, kEqual, kGreater, kUnknown };
+
+  /// A double approximation of an exact-process quantity and a bound on its error.
+  struct Approx {
+    double value;
+    double error;
+  };
+  /// A time in S and a bound on its distance to the exact time [s].
+  struct Precise {
+    S value;
+    double error;
+    bool ok;
+  };
+  /// The last impact: its gap G = b_p - b_{p+1} and approach speed A before it, with
+  /// bounds (so its precise time can be formed later), and its time bounds.
+  struct Now {
+    std::size_t pair = 0;
+    S G{}, A{};
+    double eG = 0.0, eA = 0.0;
+    double lower = 0.0, upper = 0.0;
+  };
+
+  double pairScale(std::size_t p) const { return tables_.inv_sqrt_mass[p] + tables_.inv_sqrt_mass[p + 1]; }
+
+  /// x - y as a double, with a bound on its distance to the exact difference of x and y.
+  static Approx approxDifference(const S& x, const S& y) {
+    if constexpr (std::is_same_v<S, DD>) {
+      const double value = (x.hi - y.hi) + (x.lo - y.lo);
+      return {value, 2.01 * kUnit * std::fabs(value) + 3 * kUnit * kUnit * (std::fabs(x.hi) + std::fabs(y.hi)) + kTiny};
+    } else {
+      const double value = Ar::toDouble(S(x - y));
+      return {value, 1.01 * (Ar::kOpError + Ar::kToDoubleError) * std::fabs(value)};
+    }
+  }
+
+  /// Approach speed v_{p+1} - v_p [m/s] in double, its error bound including the state's.
+  Approx approach(std::size_t p) const {
+    Approx a = approxDifference(v_[p + 1], v_[p]);
+    a.error = (a.error + eu_ * pairScale(p)) * kSlack;
+    return a;
+  }
+  /// Gap at t = 0 of the two lines, G = b_p - b_{p+1} [m], likewise.
+  Approx gap(std::size_t p) const {
+    Approx g = approxDifference(b_[p], b_[p + 1]);
+    g.error = (g.error + eb_ * pairScale(p)) * kSlack;
+    return g;
+  }
+
+  /// Sign decision on an S value known to within `error` of the exact one.
+  static Decision positive(const S& value, double error) {
+    if (Ar::sign(S(value - S(error))) > 0) return Decision::kYes;
+    if (Ar::sign(S(value + S(error))) <= 0) return Decision::kNo;
+    return Decision::kUnknown;
+  }
+
+  Decision decideApproach(std::size_t p) {
+    const Approx a = approach(p);
+    if (a.value - a.error > 0) return Decision::kYes;
+    if (a.value + a.error <= 0) return Decision::kNo;
+    ++refinements_;
+    const S precise = v_[p + 1] - v_[p];
+    const double error = (eu_ * pairScale(p) + 1.01 * Ar::kOpError * std::fabs(Ar::toDouble(precise))) * kSlack;
+    return positive(precise, error);
+  }
+
+  /// The exact time t = G / A from S values with error bounds eG, eA; !ok when A is not
+  /// clearly positive at this precision.
+  static Precise preciseTime(const S& G, double eG, const S& A, double eA) {
+    const double a = Ar::toDouble(A) * (1 - 2 * Ar::kToDoubleError) - eA;
+    if (!(a > 0.5 * Ar::toDouble(A))) return {S(), kInf, Ar::kExact && Ar::sign(A) > 0};
+    const S t = G / A;
+    const double td = std::fabs(Ar::toDouble(t)) * (1 + 2 * Ar::kToDoubleError);
+    double error = (eG + td * eA) / a + 2 * Ar::kOpError * td;
+    if (!Ar::kExact) error = error * kSlack + kTiny;
+    return {t, error, true};
+  }
+
+  Precise preciseTime(std::size_t p) {
+    ++refinements_;
+    const S G = b_[p] - b_[p + 1];
+    const S A = v_[p + 1] - v_[p];
+    const double eG = (eb_ * pairScale(p) + 1.01 * Ar::kOpError * std::fabs(Ar::toDouble(G))) * kSlack;
+    const double eA = (eu_ * pairScale(p) + 1.01 * Ar::kOpError * std::fabs(Ar::toDouble(A))) * kSlack;
+    if constexpr (Ar::kExact) return {G / A, 0.0, true};
+    return preciseTime(G, eG, A, eA);
+  }
+
+  Precise preciseNow() const { return preciseTime(now_.G, now_.eG, now_.A, now_.eA); }
+
+  static Order compare(const Precise& x, const Precise& y) {
+    if (!x.ok || !y.ok) return Order::kUnknown;
+    const S difference = y.value - x.value;
+    if constexpr (Ar::kExact) {
+      const int s = Ar::sign(difference);
+      return s > 0 ? Order::kLess : (s < 0 ? Order::kGreater : Order::kEqual);
+    }
+    const double error = (x.error + y.error + 2 * Ar::kOpError * std::fabs(Ar::toDouble(difference))) * kSlack;
+    switch (positive(difference, error)) {
+      case Decision::kYes: return Order::kLess;
+      case Decision::kNo: return positive(S(-difference), error) == Decision::kYes ? Order::kGreater : Order::kUnknown;
+      case Decision::kUnknown: break;
+    }
+    return Order::kUnknown;
+  }
+
+  /// Lower and upper bounds [s] of an approaching pair's next impact time. False when
+  /// even the precise time cannot be bounded at this precision.
+  bool timeBounds(std::size_t p, double& lower, double& upper) {
+    const Approx a = approach(p);
+    const Approx g = gap(p);
+    double estimate = 0.0, error = kInf;
+    if (a.value - a.error >= 0.5 * a.value && std::is_same_v<S, DD>) {
+      estimate = g.value / a.value;
+      const double t = std::fabs(estimate);
+      error = (kUnit * t + (g.error + t * (1 + 2 * kUnit) * a.error) / (a.value - a.error)) * kSlack;
+    } else {
+      const Precise precise = preciseTime(p);
+      if (!precise.ok) return false;
+      estimate = Ar::toDouble(precise.value);
+      error = precise.error + Ar::kToDoubleError * std::fabs(estimate);
+    }
+    const double widen = error * kSlack + std::fabs(estimate) * 0x1p-50 + 0x1p-1070;
+    lower = estimate - widen;
+    upper = estimate + widen;
+    return true;
+  }
+
+  /// Decides whether pair p approaches and bounds its next impact time.
+  StepResult schedule(std::size_t p) {
+    double lower = kInf, upper = kInf;
+    switch (decideApproach(p)) {
+      case Decision::kUnknown: return {StepKind::kAmbiguous, p, lastTime()};
+      case Decision::kNo: break;
+      case Decision::kYes:
+        if (!timeBounds(p, lower, upper)) return {StepKind::kAmbiguous, p, lastTime()};
+        if (!(upper < kMaxMagnitude)) return {StepKind::kOutOfRange, p, lastTime()};
+        break;
+    }
+    tree_.set(p, lower);
+    upper_[p] = upper;
+    return {};
+  }
+
+  /// After an impact of pair m: pair q (a neighbour) gets its new schedule, which must
+  /// come strictly after the impact; exactly at it is a multiple collision.
+  StepResult reschedule(std::size_t q, std::size_t m) {
+    const StepResult r = schedule(q);
+    if (r.kind != StepKind::kImpact || !(tree_.key(q) <= now_.upper)) return r;
+    switch (compare(preciseNow(), preciseTime(q))) {
+      case Order::kLess: return {};
+      case Order::kEqual: return {StepKind::kMultipleCollision, std::min(q, m), lastTime()};
+      case Order::kGreater: return {StepKind::kInconsistent, q, lastTime()};
+      case Order::kUnknown: break;
+    }
+    return {StepKind::kAmbiguous, q, lastTime()};
+  }
+
+  /// The root's bounds overlap others: compare the candidates' precise times. Exact ties
+  /// of disjoint pairs go in pair order; of pairs sharing a body, they are a multiple collision.
+  StepResult resolveNext(std::size_t root) {
+    std::vector<std::size_t> candidates;
+    tree_.forEachAtMost(upper_[root], [&](std::size_t p) { candidates.push_back(p); });
+    std::vector<Precise> times;
+    std::size_t best = 0;
+    for (std::size_t k = 0; k < candidates.size(); ++k) {
+      times.push_back(preciseTime(candidates[k]));
+      if (!times.back().ok) return {StepKind::kAmbiguous, candidates[k], lastTime()};
+      if (times[k].value < times[best].value) best = k;
+    }
+    std::vector<std::size_t> tied{candidates[best]};
+    for (std::size_t k = 0; k < candidates.size(); ++k) {
+      if (k == best) continue;
+      const Order order = compare(times[best], times[k]);
+      if (order == Order::kUnknown || order == Order::kGreater) return {StepKind::kAmbiguous, candidates[k], lastTime()};
+      if (order == Order::kEqual) tied.push_back(candidates[k]);
+    }
+    std::sort(tied.begin(), tied.end());
+    for (std::size_t k = 0; k + 1 < tied.size(); ++k) {
+      if (tied[k + 1] == tied[k] + 1) {
+        return {StepKind::kMultipleCollision, tied[k], Ar::toDouble(times[best].value)};
+      }
+    }
+    return {StepKind::kImpact, tied.front(), 0.0};
+  }
+
+  /// Bound on the mass-weighted rounding error of one impact (see the header comment):
+  /// 2 eta [ s_h (|q_h'| + 8 |inc|) + s_l (|q_l'| + |q_h'| + 8 |inc| + 2 |d|) ].
+  double rho(std::size_t m, const ImpactChange<S>& change, const S& q_i, const S& q_j) const {
+    if constexpr (Ar::kExact) return 0.0;
+    const bool heavy_is_i = maps_[m].heavy_is_i;
+    const double s_h = tables_.sqrt_mass[heavy_is_i ? m : m + 1];
+    const double s_l = tables_.sqrt_mass[heavy_is_i ? m + 1 : m];
+    const double q_h = std::fabs(Ar::toDouble(heavy_is_i ? q_i : q_j));
+    const double q_l = std::fabs(Ar::toDouble(heavy_is_i ? q_j : q_i));
+    const double inc = std::fabs(Ar::toDouble(change.heavy_increment));
+    const double d = std::fabs(Ar::toDouble(change.difference));
+    return 2 * Ar::kOpError * (s_h * (q_h + 8 * inc) + s_l * (q_l + q_h + 8 * inc + 2 * d)) + (s_h + s_l) * kTiny;
+  }
+
+  void recordBefore(std::size_t m, double time, ImpactRecord& record) const {
+    const std::size_t slow = std::fabs(Ar::toDouble(v_[m])) <= std::fabs(Ar::toDouble(v_[m + 1])) ? m : m + 1;
+    record.pair_index = m;
+    record.time = time;
+    record.position = Ar::toDouble(S(b_[slow] + S(v_[slow] * time)));
+    record.velocities_before = {Ar::toDouble(v_[m]), Ar::toDouble(v_[m + 1])};
+  }
+
+  void recordAfter(std::size_t m, const S& before_i, const S& before_j, double lost, ImpactRecord& record) const {
+    record.velocities_after = {Ar::toDouble(v_[m]), Ar::toDouble(v_[m + 1])};
+    record.energy_lost = lost;
+    const S* before[2] = {&before_i, &before_j};
+    const Scene& scene = tables_.scene;
+    for (int k = 0; k < 2; ++k) {
+      if (scene.isWall(m + k)) continue;
+      const double dv = Ar::toDouble(S(v_[m + k] - *before[k]));
+      const double sum = record.velocities_after[k] + record.velocities_before[k];
+      record.energy_gained[k] = 0.5 * scene.masses[m + k] * dv * sum;
+    }
+    // A wall takes what the finite body gave up minus the heat.
+    for (int k = 0; k < 2; ++k) {
+      if (scene.isWall(m + k)) record.energy_gained[k] = -record.energy_gained[1 - k] - lost;
+    }
+  }
+
+  void addLoss(double loss) {
+    // Neumaier summation: the total of many small losses keeps its digits.
+    const double sum = lost_ + loss;
+    lost_compensation_ += std::fabs(lost_) >= std::fabs(loss) ? (lost_ - sum) + loss : (loss - sum) + lost_;
+    lost_ = sum;
+  }
+
+  /// Performs the impact of pair m. When a neighbour then hits at the same instant (a
+  /// multiple collision, or a decision this tier cannot take), the impact is undone.
+  StepResult impact(std::size_t m, ImpactRecord* record) {
+    const Undo undo{b_[m], b_[m + 1], v_[m], v_[m + 1], eu_, eb_, lost_, lost_compensation_, now_};
+    const StepResult r = apply(m, record);
+    if (r.kind != StepKind::kImpact) {
+      b_[m] = undo.b_i, b_[m + 1] = undo.b_j, v_[m] = undo.v_i, v_[m + 1] = undo.v_j;
+      eu_ = undo.eu, eb_ = undo.eb, lost_ = undo.lost, lost_compensation_ = undo.lost_compensation;
+      now_ = undo.now;
+    }
+    return r;
+  }
+
+  StepResult apply(std::size_t m, ImpactRecord* record) {
+    now_.pair = m;
+    now_.lower = tree_.key(m);
+    now_.upper = upper_[m];
+    const double time = 0.5 * (now_.lower + now_.upper);
+    const S before_i = v_[m], before_j = v_[m + 1];
+    if (record) recordBefore(m, time, *record);
+    const double eu_before = eu_, eb_before = eb_;
+    const ImpactChange<S> dv = applyImpactMap(maps_[m], v_[m], v_[m + 1]);
+    const ImpactChange<S> db = applyImpactMap(maps_[m], b_[m], b_[m + 1]);
+    eu_ += rho(m, dv, v_[m], v_[m + 1]);
+    eb_ += rho(m, db, b_[m], b_[m + 1]);
+    now_.A = dv.difference;
+    now_.G = -db.difference;
+    now_.eA = (eu_before * pairScale(m) + 1.01 * Ar::kOpError * std::fabs(Ar::toDouble(now_.A))) * kSlack;
+    now_.eG = (eb_before * pairScale(m) + 1.01 * Ar::kOpError * std::fabs(Ar::toDouble(now_.G))) * kSlack;
+    const double approach_speed = Ar::toDouble(now_.A);
+    const double lost = tables_.loss_factor[m] * approach_speed * approach_speed;
+    if (lost != 0.0) addLoss(lost);
+    if (record) recordAfter(m, before_i, before_j, lost, *record);
+    for (std::size_t k = m; k <= m + 1; ++k) {
+      if (!(std::fabs(Ar::toDouble(b_[k])) < kMaxMagnitude && std::fabs(Ar::toDouble(v_[k])) < kMaxMagnitude)) {
+        return {StepKind::kOutOfRange, m, time};
+      }
+    }
+    tree_.set(m, kInf);  // e > 0: the pair separates; e = 0: it moves together, no impact
+    upper_[m] = kInf;
+    if (m > 0) {
+      const StepResult r = reschedule(m - 1, m);
+      if (r.kind != StepKind::kImpact) return r;
+    }
+    if (m + 1 < tables_.pairs) {
+      const StepResult r = reschedule(m + 1, m);
+      if (r.kind != StepKind::kImpact) return r;
+    }
+    tree_.update(m > 0 ? m - 1 : m, std::min(m + 1, tables_.pairs - 1));
+    ++count_;
+    return {StepKind::kImpact, m, time};
+  }
+
+  /// What an impact changes besides the tree (which is no longer used after a failure).
+  struct Undo {
+    S b_i, b_j, v_i, v_j;
+    double eu, eb, lost, lost_compensation;
+    Now now;
+  };
+
+  const SceneTables& tables_;
+  std::vector<S> b_;  ///< intercepts [m]: body k is at b_k + v_k t
+  std::vector<S> v_;  ///< velocities [m/s]
+  std::vector<ImpactMap<S>> maps_;
+  TournamentTree tree_;        ///< per pair: lower bound of the next impact time [s]
+  std::vector<double> upper_;  ///< per pair: upper bound of the next impact time [s]
+  double eu_ = 0.0;            ///< bound on ||U_computed - U_exact|| [kg^0.5 m/s]
+  double eb_ = 0.0;            ///< bound on ||B_computed - B_exact|| [kg^0.5 m]
+  std::uint64_t count_ = 0;
+  std::uint64_t refinements_ = 0;
+  double lost_ = 0.0, lost_compensation_ = 0.0;  ///< kinetic energy lost so far [J]
+  Now now_;
+};
+
+}  // namespace nbody_detail
+}  // namespace core
+}  // namespace collision_lab
