@@ -12,6 +12,13 @@
 
 #include <cmath>
 
+// The operations are small and sit on the engine's hot path: always inline them.
+#if defined(__GNUC__)
+#define CL_DD_INLINE inline __attribute__((always_inline))
+#else
+#define CL_DD_INLINE inline
+#endif
+
 namespace collision_lab {
 namespace core {
 namespace nbody_detail {
@@ -28,19 +35,19 @@ struct DD {
   DD(double h, double l, int /*normalized*/) : hi(h), lo(l) {}
 };
 
-inline DD twoSum(double a, double b) {
+CL_DD_INLINE DD twoSum(double a, double b) {
   const double s = a + b;
   const double bb = s - a;
   return DD(s, (a - (s - bb)) + (b - bb), 0);
 }
 
 /// Precondition: |a| >= |b| or a == 0.
-inline DD fastTwoSum(double a, double b) {
+CL_DD_INLINE DD fastTwoSum(double a, double b) {
   const double s = a + b;
   return DD(s, b - (s - a), 0);
 }
 
-inline DD twoProd(double a, double b) {
+CL_DD_INLINE DD twoProd(double a, double b) {
   const double p = a * b;
 #if defined(__FMA__) || defined(FP_FAST_FMA)
   return DD(p, std::fma(a, b, -p), 0);
@@ -54,23 +61,23 @@ inline DD twoProd(double a, double b) {
 #endif
 }
 
-inline DD operator+(const DD& x, const DD& y) {
+CL_DD_INLINE DD operator+(const DD& x, const DD& y) {
   const DD s = twoSum(x.hi, y.hi);
   const DD t = twoSum(x.lo, y.lo);
   const DD v = fastTwoSum(s.hi, s.lo + t.hi);
   return fastTwoSum(v.hi, t.lo + v.lo);
 }
 
-inline DD operator-(const DD& x) { return DD(-x.hi, -x.lo, 0); }
-inline DD operator-(const DD& x, const DD& y) { return x + (-y); }
+CL_DD_INLINE DD operator-(const DD& x) { return DD(-x.hi, -x.lo, 0); }
+CL_DD_INLINE DD operator-(const DD& x, const DD& y) { return x + (-y); }
 
-inline DD operator*(const DD& x, double y) {
+CL_DD_INLINE DD operator*(const DD& x, double y) {
   const DD c = twoProd(x.hi, y);
   const DD t = fastTwoSum(c.hi, x.lo * y);
   return fastTwoSum(t.hi, t.lo + c.lo);
 }
 
-inline DD operator*(const DD& x, const DD& y) {
+CL_DD_INLINE DD operator*(const DD& x, const DD& y) {
   const DD c = twoProd(x.hi, y.hi);
 #if defined(__FMA__) || defined(FP_FAST_FMA)
   const double cross = std::fma(x.lo, y.hi, std::fma(x.hi, y.lo, x.lo * y.lo));
@@ -80,7 +87,7 @@ inline DD operator*(const DD& x, const DD& y) {
   return fastTwoSum(c.hi, c.lo + cross);
 }
 
-inline DD operator/(const DD& x, const DD& y) {
+CL_DD_INLINE DD operator/(const DD& x, const DD& y) {
   const double th = x.hi / y.hi;
   const DD r = y * th;
   const DD pi = twoSum(x.hi, -r.hi);
@@ -88,9 +95,9 @@ inline DD operator/(const DD& x, const DD& y) {
   return fastTwoSum(th, delta / y.hi);
 }
 
-inline bool operator<(const DD& x, const DD& y) { return x.hi < y.hi || (x.hi == y.hi && x.lo < y.lo); }
-inline bool operator>(const DD& x, const DD& y) { return y < x; }
-inline bool operator==(const DD& x, const DD& y) { return x.hi == y.hi && x.lo == y.lo; }
+CL_DD_INLINE bool operator<(const DD& x, const DD& y) { return x.hi < y.hi || (x.hi == y.hi && x.lo < y.lo); }
+CL_DD_INLINE bool operator>(const DD& x, const DD& y) { return y < x; }
+CL_DD_INLINE bool operator==(const DD& x, const DD& y) { return x.hi == y.hi && x.lo == y.lo; }
 
 }  // namespace nbody_detail
 }  // namespace core

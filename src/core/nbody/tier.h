@@ -17,7 +17,7 @@
 //
 // Decisions. The events are processed in the canonical order (exact time, then pair
 // index). Each pair's leaf in the tournament tree holds a lower bound of its next impact
-// time and upper_ an upper bound. The root is next when its upper bound is below every
+// time and PairState::upper an upper bound. The root is next when its upper bound is below every
 // other lower bound; otherwise the candidates are compared with precise times (S
 // arithmetic, tight bounds). What a tier cannot decide it reports as kAmbiguous: the
 // caller then replays the run in a more precise tier and adopts that tier's state.
@@ -68,14 +68,18 @@ class Tier {
  public:
   using Ar = Arithmetic<S>;
 
-  explicit Tier(const SceneTables& tables) : tables_(tables), tree_(tables.pairs), upper_(tables.pairs, kInf) {
+  explicit Tier(const SceneTables& tables) : tables_(tables), tree_(tables.pairs) {
     const Scene& scene = tables.scene;
     for (std::size_t k = 0; k < scene.size(); ++k) {
-      b_.push_back(S(scene.positions[k]));
-      v_.push_back(S(scene.velocities[k]));
+      bodies_.push_back({S(scene.positions[k]), S(scene.velocities[k])});
     }
     for (std::size_t p = 0; p < tables.pairs; ++p) {
-      maps_.push_back(makeImpactMap<S>(scene.masses[p], scene.masses[p + 1], scene.restitutionOf(p)));
+      PairState pair;
+      pair.map = makeImpactMap<S>(scene.masses[p], scene.masses[p + 1], scene.restitutionOf(p));
+      pair.scale = tables.inv_sqrt_mass[p] + tables.inv_sqrt_mass[p + 1];
+      pair.sqrt_heavy = tables.sqrt_mass[pair.map.heavy_is_i ? p : p + 1];
+      pair.sqrt_light = tables.sqrt_mass[pair.map.heavy_is_i ? p + 1 : p];
+      pairs_.push_back(pair);
     }
   }
 
@@ -100,7 +104,7 @@ class Tier {
   StepResult step(ImpactRecord* record) {
     std::size_t next = tree_.minLeaf();
     if (!(tree_.minKey() < kInf)) return {StepKind::kFinished, 0, lastTime()};
-    if (!(upper_[next] < tree_.minKeyExcluding(next))) {
+    if (!(pairs_[next].upper < tree_.minKeyExcluding(next))) {
       const StepResult r = resolveNext(next);
       if (r.kind != StepKind::kImpact) return r;
       next = r.pair;
@@ -114,39 +118,57 @@ class Tier {
     constexpr double conversion = conversionError<S>();
     eu_ = from.eu_;
     eb_ = from.eb_;
-    for (std::size_t k = 0; k < b_.size(); ++k) {
-      b_[k] = convertTo<S>(from.b_[k]);
-      v_[k] = convertTo<S>(from.v_[k]);
-      eu_ += 2 * conversion * tables_.sqrt_mass[k] * std::fabs(Ar::toDouble(v_[k]));
-      eb_ += 2 * conversion * tables_.sqrt_mass[k] * std::fabs(Ar::toDouble(b_[k]));
+    for (std::size_t k = 0; k < bodies_.size(); ++k) {
+      BodyState& body = bodies_[k];
+      body.b = convertTo<S>(from.bodies_[k].b);
+      body.v = convertTo<S>(from.bodies_[k].v);
+      eu_ += 2 * conversion * tables_.sqrt_mass[k] * std::fabs(Ar::toDouble(body.v));
+      eb_ += 2 * conversion * tables_.sqrt_mass[k] * std::fabs(Ar::toDouble(body.b));
     }
     tree_ = from.tree_;
-    upper_ = from.upper_;
+    for (std::size_t p = 0; p < pairs_.size(); ++p) pairs_[p].upper = from.pairs_[p].upper;
     count_ = from.count_;
     lost_ = from.lost_;
     lost_compensation_ = from.lost_compensation_;
     now_.pair = from.now_.pair;
     now_.G = convertTo<S>(from.now_.G);
     now_.A = convertTo<S>(from.now_.A);
-    now_.eG = from.now_.eG + 2 * conversion * std::fabs(Ar::toDouble(now_.G));
-    now_.eA = from.now_.eA + 2 * conversion * std::fabs(Ar::toDouble(now_.A));
+    now_.eb = from.now_.eb;
+    now_.eu = from.now_.eu;
+    // The conversion of G and A; the other tier's rounding of them is below this tier's,
+    // which preciseNow() counts.
+    now_.extra = from.now_.extra + 2 * conversion * (std::fabs(Ar::toDouble(now_.G)) + std::fabs(Ar::toDouble(now_.A)));
     now_.lower = from.now_.lower;
     now_.upper = from.now_.upper;
   }
 
   /// Positions [m] at time t [s] and velocities [m/s], rounded to double.
   void state(double t, std::vector<double>& positions, std::vector<double>& velocities) const {
-    positions.resize(b_.size());
-    velocities.resize(b_.size());
-    for (std::size_t k = 0; k < b_.size(); ++k) {
-      positions[k] = Ar::toDouble(S(b_[k] + S(v_[k] * t)));
-      velocities[k] = Ar::toDouble(v_[k]);
+    positions.resize(bodies_.size());
+    velocities.resize(bodies_.size());
+    for (std::size_t k = 0; k < bodies_.size(); ++k) {
+      positions[k] = Ar::toDouble(S(bodies_[k].b + S(bodies_[k].v * S(t))));
+      velocities[k] = Ar::toDouble(bodies_[k].v);
     }
   }
 
  private:
   template <class>
   friend class Tier;
+
+  /// Body k is at b + v t [m] at time t [s], between its impacts.
+  struct BodyState {
+    S b;  ///< intercept [m]
+    S v;  ///< velocity [m/s]
+  };
+  /// What an impact needs of pair p (bodies p, p+1), in one cache line for double-double.
+  struct alignas(64) PairState {
+    ImpactMap<S> map;
+    double upper = kInf;      ///< upper bound of the next impact time [s]
+    double scale = 0.0;       ///< 1/sqrt(m_p) + 1/sqrt(m_p+1) [kg^-0.5], a wall counting 0
+    double sqrt_heavy = 0.0;  ///< sqrt of the heavier mass [kg^0.5], 0 for a wall
+    double sqrt_light = 0.0;  ///< sqrt of the lighter mass [kg^0.5]
+  };
 
   enum class Decision { kYes, kNo, kUnknown };
   enum class Order { kLess, kEqual, kGreater, kUnknown };
@@ -167,11 +189,12 @@ class Tier {
   struct Now {
     std::size_t pair = 0;
     S G{}, A{};
-    double eG = 0.0, eA = 0.0;
+    double eb = 0.0, eu = 0.0;  ///< the state's bounds before the impact
+    double extra = 0.0;         ///< what adoption added to the bounds of G and A
     double lower = 0.0, upper = 0.0;
   };
 
-  double pairScale(std::size_t p) const { return tables_.inv_sqrt_mass[p] + tables_.inv_sqrt_mass[p + 1]; }
+  double pairScale(std::size_t p) const { return pairs_[p].scale; }
 
   /// x - y as a double, with a bound on its distance to the exact difference of x and y.
   static Approx approxDifference(const S& x, const S& y) {
@@ -186,13 +209,13 @@ class Tier {
 
   /// Approach speed v_{p+1} - v_p [m/s] in double, its error bound including the state's.
   Approx approach(std::size_t p) const {
-    Approx a = approxDifference(v_[p + 1], v_[p]);
+    Approx a = approxDifference(bodies_[p + 1].v, bodies_[p].v);
     a.error = (a.error + eu_ * pairScale(p)) * kSlack;
     return a;
   }
   /// Gap at t = 0 of the two lines, G = b_p - b_{p+1} [m], likewise.
   Approx gap(std::size_t p) const {
-    Approx g = approxDifference(b_[p], b_[p + 1]);
+    Approx g = approxDifference(bodies_[p].b, bodies_[p + 1].b);
     g.error = (g.error + eb_ * pairScale(p)) * kSlack;
     return g;
   }
@@ -204,12 +227,12 @@ class Tier {
     return Decision::kUnknown;
   }
 
-  Decision decideApproach(std::size_t p) {
-    const Approx a = approach(p);
+  /// Does pair p approach? `a` is approach(p).
+  Decision decideApproach(std::size_t p, const Approx& a) {
     if (a.value - a.error > 0) return Decision::kYes;
     if (a.value + a.error <= 0) return Decision::kNo;
     ++refinements_;
-    const S precise = v_[p + 1] - v_[p];
+    const S precise = bodies_[p + 1].v - bodies_[p].v;
     const double error = (eu_ * pairScale(p) + 1.01 * Ar::kOpError * std::fabs(Ar::toDouble(precise))) * kSlack;
     return positive(precise, error);
   }
@@ -228,15 +251,21 @@ class Tier {
 
   Precise preciseTime(std::size_t p) {
     ++refinements_;
-    const S G = b_[p] - b_[p + 1];
-    const S A = v_[p + 1] - v_[p];
+    const S G = bodies_[p].b - bodies_[p + 1].b;
+    const S A = bodies_[p + 1].v - bodies_[p].v;
     const double eG = (eb_ * pairScale(p) + 1.01 * Ar::kOpError * std::fabs(Ar::toDouble(G))) * kSlack;
     const double eA = (eu_ * pairScale(p) + 1.01 * Ar::kOpError * std::fabs(Ar::toDouble(A))) * kSlack;
     if constexpr (Ar::kExact) return {G / A, 0.0, true};
     return preciseTime(G, eG, A, eA);
   }
 
-  Precise preciseNow() const { return preciseTime(now_.G, now_.eG, now_.A, now_.eA); }
+  Precise preciseNow() const {
+    if constexpr (Ar::kExact) return {now_.G / now_.A, 0.0, true};
+    const double scale = pairs_[now_.pair].scale;
+    const double eG = (now_.eb * scale + 1.01 * Ar::kOpError * std::fabs(Ar::toDouble(now_.G)) + now_.extra) * kSlack;
+    const double eA = (now_.eu * scale + 1.01 * Ar::kOpError * std::fabs(Ar::toDouble(now_.A)) + now_.extra) * kSlack;
+    return preciseTime(now_.G, eG, now_.A, eA);
+  }
 
   static Order compare(const Precise& x, const Precise& y) {
     if (!x.ok || !y.ok) return Order::kUnknown;
@@ -254,41 +283,60 @@ class Tier {
     return Order::kUnknown;
   }
 
-  /// Lower and upper bounds [s] of an approaching pair's next impact time. False when
-  /// even the precise time cannot be bounded at this precision.
-  bool timeBounds(std::size_t p, double& lower, double& upper) {
-    const Approx a = approach(p);
-    const Approx g = gap(p);
-    double estimate = 0.0, error = kInf;
-    if (a.value - a.error >= 0.5 * a.value && std::is_same_v<S, DD>) {
-      estimate = g.value / a.value;
-      const double t = std::fabs(estimate);
-      error = (kUnit * t + (g.error + t * (1 + 2 * kUnit) * a.error) / (a.value - a.error)) * kSlack;
-    } else {
-      const Precise precise = preciseTime(p);
-      if (!precise.ok) return false;
-      estimate = Ar::toDouble(precise.value);
-      error = precise.error + Ar::kToDoubleError * std::fabs(estimate);
-    }
+  /// Outward-rounded bounds [s] of a time known to within `error` of `estimate`.
+  static void widenBounds(double estimate, double error, double& lower, double& upper) {
     const double widen = error * kSlack + std::fabs(estimate) * 0x1p-50 + 0x1p-1070;
     lower = estimate - widen;
     upper = estimate + widen;
-    return true;
   }
 
-  /// Decides whether pair p approaches and bounds its next impact time.
+  /// Bounds [s] of the time G / A from double approximations, with one division:
+  /// 1 / (a - e) <= (1/a)(1 + 2 e/a) for e <= a/2. Meaningful when a.value - a.error > a.value / 2.
+  static void coarseBounds(const Approx& a, const Approx& g, double& lower, double& upper) {
+    const double inverse = 1.0 / a.value;
+    const double estimate = g.value * inverse;
+    const double t = std::fabs(estimate);
+    const double error =
+        (2 * kUnit * t + (g.error + t * (1 + 4 * kUnit) * a.error) * inverse * (1 + 2 * a.error * inverse)) * kSlack;
+    widenBounds(estimate, error, lower, upper);
+  }
+
+  void setSchedule(std::size_t p, double lower, double upper) {
+    tree_.set(p, lower);
+    pairs_[p].upper = upper;
+  }
+
+  /// Decides whether pair p approaches and bounds its next impact time. The common cases
+  /// take no branch on the answer, which is unpredictable.
   StepResult schedule(std::size_t p) {
+    const Approx a = approach(p);
+    const Approx g = gap(p);
+    const bool yes = a.value - a.error > 0.5 * a.value;  // false for a.value <= 0
+    const bool no = a.value + a.error <= 0;
+    if (!(yes || no)) return scheduleCarefully(p, a);
+    double bounds[2][2] = {{kInf, kInf}, {0.0, 0.0}};  // [yes][lower, upper]
+    coarseBounds(a, g, bounds[1][0], bounds[1][1]);
+    if (yes && !(bounds[1][1] < kMaxMagnitude)) return {StepKind::kOutOfRange, p, lastTime()};
+    setSchedule(p, bounds[yes][0], bounds[yes][1]);
+    return {};
+  }
+
+  /// The rare case: the approach speed or the time is too close to call in double.
+  StepResult scheduleCarefully(std::size_t p, const Approx& a) {
     double lower = kInf, upper = kInf;
-    switch (decideApproach(p)) {
+    switch (decideApproach(p, a)) {
       case Decision::kUnknown: return {StepKind::kAmbiguous, p, lastTime()};
       case Decision::kNo: break;
-      case Decision::kYes:
-        if (!timeBounds(p, lower, upper)) return {StepKind::kAmbiguous, p, lastTime()};
+      case Decision::kYes: {
+        const Precise precise = preciseTime(p);
+        if (!precise.ok) return {StepKind::kAmbiguous, p, lastTime()};
+        const double estimate = Ar::toDouble(precise.value);
+        widenBounds(estimate, precise.error + Ar::kToDoubleError * std::fabs(estimate), lower, upper);
         if (!(upper < kMaxMagnitude)) return {StepKind::kOutOfRange, p, lastTime()};
         break;
+      }
     }
-    tree_.set(p, lower);
-    upper_[p] = upper;
+    setSchedule(p, lower, upper);
     return {};
   }
 
@@ -310,7 +358,7 @@ class Tier {
   /// of disjoint pairs go in pair order; of pairs sharing a body, they are a multiple collision.
   StepResult resolveNext(std::size_t root) {
     std::vector<std::size_t> candidates;
-    tree_.forEachAtMost(upper_[root], [&](std::size_t p) { candidates.push_back(p); });
+    tree_.forEachAtMost(pairs_[root].upper, [&](std::size_t p) { candidates.push_back(p); });
     std::vector<Precise> times;
     std::size_t best = 0;
     for (std::size_t k = 0; k < candidates.size(); ++k) {
@@ -338,9 +386,9 @@ class Tier {
   /// 2 eta [ s_h (|q_h'| + 8 |inc|) + s_l (|q_l'| + |q_h'| + 8 |inc| + 2 |d|) ].
   double rho(std::size_t m, const ImpactChange<S>& change, const S& q_i, const S& q_j) const {
     if constexpr (Ar::kExact) return 0.0;
-    const bool heavy_is_i = maps_[m].heavy_is_i;
-    const double s_h = tables_.sqrt_mass[heavy_is_i ? m : m + 1];
-    const double s_l = tables_.sqrt_mass[heavy_is_i ? m + 1 : m];
+    const PairState& pair = pairs_[m];
+    const bool heavy_is_i = pair.map.heavy_is_i;
+    const double s_h = pair.sqrt_heavy, s_l = pair.sqrt_light;
     const double q_h = std::fabs(Ar::toDouble(heavy_is_i ? q_i : q_j));
     const double q_l = std::fabs(Ar::toDouble(heavy_is_i ? q_j : q_i));
     const double inc = std::fabs(Ar::toDouble(change.heavy_increment));
@@ -349,21 +397,23 @@ class Tier {
   }
 
   void recordBefore(std::size_t m, double time, ImpactRecord& record) const {
-    const std::size_t slow = std::fabs(Ar::toDouble(v_[m])) <= std::fabs(Ar::toDouble(v_[m + 1])) ? m : m + 1;
+    const BodyState& i = bodies_[m];
+    const BodyState& j = bodies_[m + 1];
+    const BodyState& slow = std::fabs(Ar::toDouble(i.v)) <= std::fabs(Ar::toDouble(j.v)) ? i : j;
     record.pair_index = m;
     record.time = time;
-    record.position = Ar::toDouble(S(b_[slow] + S(v_[slow] * time)));
-    record.velocities_before = {Ar::toDouble(v_[m]), Ar::toDouble(v_[m + 1])};
+    record.position = Ar::toDouble(S(slow.b + S(slow.v * S(time))));
+    record.velocities_before = {Ar::toDouble(i.v), Ar::toDouble(j.v)};
   }
 
   void recordAfter(std::size_t m, const S& before_i, const S& before_j, double lost, ImpactRecord& record) const {
-    record.velocities_after = {Ar::toDouble(v_[m]), Ar::toDouble(v_[m + 1])};
+    record.velocities_after = {Ar::toDouble(bodies_[m].v), Ar::toDouble(bodies_[m + 1].v)};
     record.energy_lost = lost;
     const S* before[2] = {&before_i, &before_j};
     const Scene& scene = tables_.scene;
     for (int k = 0; k < 2; ++k) {
       if (scene.isWall(m + k)) continue;
-      const double dv = Ar::toDouble(S(v_[m + k] - *before[k]));
+      const double dv = Ar::toDouble(S(bodies_[m + k].v - *before[k]));
       const double sum = record.velocities_after[k] + record.velocities_before[k];
       record.energy_gained[k] = 0.5 * scene.masses[m + k] * dv * sum;
     }
@@ -383,10 +433,10 @@ class Tier {
   /// Performs the impact of pair m. When a neighbour then hits at the same instant (a
   /// multiple collision, or a decision this tier cannot take), the impact is undone.
   StepResult impact(std::size_t m, ImpactRecord* record) {
-    const Undo undo{b_[m], b_[m + 1], v_[m], v_[m + 1], eu_, eb_, lost_, lost_compensation_, now_};
+    const Undo undo{bodies_[m], bodies_[m + 1], eu_, eb_, lost_, lost_compensation_, now_};
     const StepResult r = apply(m, record);
     if (r.kind != StepKind::kImpact) {
-      b_[m] = undo.b_i, b_[m + 1] = undo.b_j, v_[m] = undo.v_i, v_[m + 1] = undo.v_j;
+      bodies_[m] = undo.i, bodies_[m + 1] = undo.j;
       eu_ = undo.eu, eb_ = undo.eb, lost_ = undo.lost, lost_compensation_ = undo.lost_compensation;
       now_ = undo.now;
     }
@@ -394,58 +444,60 @@ class Tier {
   }
 
   StepResult apply(std::size_t m, ImpactRecord* record) {
+    PairState& pair = pairs_[m];
+    BodyState& i = bodies_[m];
+    BodyState& j = bodies_[m + 1];
     now_.pair = m;
     now_.lower = tree_.key(m);
-    now_.upper = upper_[m];
+    now_.upper = pair.upper;
     const double time = 0.5 * (now_.lower + now_.upper);
-    const S before_i = v_[m], before_j = v_[m + 1];
+    const S before_i = i.v, before_j = j.v;
     if (record) recordBefore(m, time, *record);
-    const double eu_before = eu_, eb_before = eb_;
-    const ImpactChange<S> dv = applyImpactMap(maps_[m], v_[m], v_[m + 1]);
-    const ImpactChange<S> db = applyImpactMap(maps_[m], b_[m], b_[m + 1]);
-    eu_ += rho(m, dv, v_[m], v_[m + 1]);
-    eb_ += rho(m, db, b_[m], b_[m + 1]);
+    now_.eu = eu_;
+    now_.eb = eb_;
+    now_.extra = 0.0;
+    const ImpactChange<S> dv = applyImpactMap(pair.map, i.v, j.v);
+    const ImpactChange<S> db = applyImpactMap(pair.map, i.b, j.b);
+    eu_ += rho(m, dv, i.v, j.v);
+    eb_ += rho(m, db, i.b, j.b);
     now_.A = dv.difference;
     now_.G = -db.difference;
-    now_.eA = (eu_before * pairScale(m) + 1.01 * Ar::kOpError * std::fabs(Ar::toDouble(now_.A))) * kSlack;
-    now_.eG = (eb_before * pairScale(m) + 1.01 * Ar::kOpError * std::fabs(Ar::toDouble(now_.G))) * kSlack;
-    const double approach_speed = Ar::toDouble(now_.A);
-    const double lost = tables_.loss_factor[m] * approach_speed * approach_speed;
-    if (lost != 0.0) addLoss(lost);
-    if (record) recordAfter(m, before_i, before_j, lost, *record);
-    for (std::size_t k = m; k <= m + 1; ++k) {
-      if (!(std::fabs(Ar::toDouble(b_[k])) < kMaxMagnitude && std::fabs(Ar::toDouble(v_[k])) < kMaxMagnitude)) {
-        return {StepKind::kOutOfRange, m, time};
-      }
+    double lost = 0.0;
+    if (std::fabs(pair.map.light_factor) != 1.0) {  // e < 1
+      const double approach_speed = Ar::toDouble(now_.A);
+      lost = tables_.loss_factor[m] * approach_speed * approach_speed;
+      addLoss(lost);
     }
+    if (record) recordAfter(m, before_i, before_j, lost, *record);
+    const double magnitude = std::fabs(Ar::toDouble(i.b)) + std::fabs(Ar::toDouble(j.b)) +
+                             std::fabs(Ar::toDouble(i.v)) + std::fabs(Ar::toDouble(j.v));
+    if (!(magnitude < kMaxMagnitude)) return {StepKind::kOutOfRange, m, time};
     tree_.set(m, kInf);  // e > 0: the pair separates; e = 0: it moves together, no impact
-    upper_[m] = kInf;
+    pair.upper = kInf;
     if (m > 0) {
       const StepResult r = reschedule(m - 1, m);
       if (r.kind != StepKind::kImpact) return r;
     }
-    if (m + 1 < tables_.pairs) {
+    if (m + 1 < pairs_.size()) {
       const StepResult r = reschedule(m + 1, m);
       if (r.kind != StepKind::kImpact) return r;
     }
-    tree_.update(m > 0 ? m - 1 : m, std::min(m + 1, tables_.pairs - 1));
+    tree_.update(m > 0 ? m - 1 : m, std::min(m + 1, pairs_.size() - 1));
     ++count_;
     return {StepKind::kImpact, m, time};
   }
 
   /// What an impact changes besides the tree (which is no longer used after a failure).
   struct Undo {
-    S b_i, b_j, v_i, v_j;
+    BodyState i, j;
     double eu, eb, lost, lost_compensation;
     Now now;
   };
 
   const SceneTables& tables_;
-  std::vector<S> b_;  ///< intercepts [m]: body k is at b_k + v_k t
-  std::vector<S> v_;  ///< velocities [m/s]
-  std::vector<ImpactMap<S>> maps_;
-  TournamentTree tree_;        ///< per pair: lower bound of the next impact time [s]
-  std::vector<double> upper_;  ///< per pair: upper bound of the next impact time [s]
+  std::vector<BodyState> bodies_;
+  std::vector<PairState> pairs_;
+  TournamentTree tree_;  ///< per pair: lower bound of the next impact time [s]
   double eu_ = 0.0;            ///< bound on ||U_computed - U_exact|| [kg^0.5 m/s]
   double eb_ = 0.0;            ///< bound on ||B_computed - B_exact|| [kg^0.5 m]
   std::uint64_t count_ = 0;

@@ -22,12 +22,13 @@ namespace core {
 /// (d = q_j - q_i) and the lighter body's value from the scaled reversal
 /// q_i' - q_j' = e d: the heavy body, whose error costs the most energy, gets the small
 /// coefficient, and e = 0 leaves both bodies with bit-identical values (they move together).
+/// The signs are folded into the coefficients, so applying the map takes no branch on
+/// which body is heavier.
 template <class T>
 struct ImpactMap {
-  bool heavy_is_i = true;   ///< the right body of the pair is the heavier (or equal) one
-  bool heavy_is_wall = false;
-  T heavy_gain{};           ///< c_h = (1 + e) m_light / (m_i + m_j) [1]; 0 for a wall
-  double restitution = 1.0;  ///< e [1]
+  bool heavy_is_i = true;     ///< the right body of the pair is the heavier (or equal) one
+  T heavy_gain{};             ///< +-c_h, c_h = (1 + e) m_light / (m_i + m_j) [1]; 0 for a wall
+  double light_factor = -1.0;  ///< -+e [1]: q_light' = q_heavy' + light_factor d
 };
 
 /// Coefficients for masses m_i, m_j [kg] (+inf = wall; not both) and e in [0, 1].
@@ -36,11 +37,12 @@ template <class T>
 ImpactMap<T> makeImpactMap(double m_i, double m_j, double e) {
   ImpactMap<T> map;
   map.heavy_is_i = m_i >= m_j;
-  map.restitution = e;
   const double heavy = map.heavy_is_i ? m_i : m_j;
   const double light = map.heavy_is_i ? m_j : m_i;
-  map.heavy_is_wall = std::isinf(heavy);
-  if (!map.heavy_is_wall) map.heavy_gain = (T(1) + T(e)) * T(light) / (T(heavy) + T(light));
+  if (!std::isinf(heavy)) map.heavy_gain = (T(1) + T(e)) * T(light) / (T(heavy) + T(light));
+  // q_h' = q_h + c_h d when h = i, q_h - c_h d when h = j; q_i' - q_j' = e d.
+  if (!map.heavy_is_i) map.heavy_gain = -map.heavy_gain;
+  map.light_factor = map.heavy_is_i ? -e : e;
   return map;
 }
 
@@ -51,27 +53,24 @@ struct ImpactChange {
   T heavy_increment{};  ///< q_h' - q_h of the heavier body; 0 for a wall
 };
 
-/// Applies the map to q_i, q_j (velocities [m/s] or intercepts [m]). A wall's value is
-/// never written. Never throws (for double, double-double, 100-digit float, rational).
+/// Applies the map to q_i, q_j (velocities [m/s] or intercepts [m]). A wall gets an
+/// increment of exactly 0. Never throws (for double, double-double, 100-digit float,
+/// rational).
 template <class T>
 ImpactChange<T> applyImpactMap(const ImpactMap<T>& map, T& q_i, T& q_j) {
   ImpactChange<T> change;
   change.difference = q_j - q_i;
-  const T& d = change.difference;
   T& heavy = map.heavy_is_i ? q_i : q_j;
   T& light = map.heavy_is_i ? q_j : q_i;
-  if (!map.heavy_is_wall) {
-    const T increment = map.heavy_gain * d;
-    change.heavy_increment = map.heavy_is_i ? increment : T(-increment);
-    heavy = map.heavy_is_i ? T(heavy + increment) : T(heavy - increment);
-  }
-  // q_i' - q_j' = e d, solved for the light body.
-  const double e = map.restitution;
-  if (e == 0.0) {
-    light = heavy;
+  change.heavy_increment = map.heavy_gain * change.difference;
+  heavy = heavy + change.heavy_increment;
+  // e = 1 (the common case) needs no product; e = 0 gives light = heavy exactly.
+  if (map.light_factor == -1.0) {
+    light = heavy - change.difference;
+  } else if (map.light_factor == 1.0) {
+    light = heavy + change.difference;
   } else {
-    const T scaled = e == 1.0 ? d : T(d * e);
-    light = map.heavy_is_i ? T(heavy - scaled) : T(heavy + scaled);
+    light = heavy + T(change.difference * map.light_factor);
   }
   return change;
 }
