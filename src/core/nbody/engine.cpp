@@ -243,7 +243,7 @@ EngineResult runEngine(const Scene& scene, const EngineOptions& options, const I
       if (count <= options.keep_events) result.events.push_back(record);
     }
     if (progress && options.progress_interval > 0 && count % options.progress_interval == 0) {
-      progress(EngineProgress{count, r.time});
+      progress(EngineProgress{count, driver.fast().lastTime()});
     }
   }
   if (result.stop == StopReason::kFinished) finish(r, result);

@@ -163,11 +163,14 @@ std::optional<ValidationError> checkFirstContact(const Scene& scene) {
   const auto& v = scene.velocities;
   std::vector<double> time(scene.pairCount(), kInf);
   double first = kInf;
+  bool approaching = false;
   for (std::size_t p = 0; p < time.size(); ++p) {
-    if (v[p] < v[p + 1]) time[p] = (x[p] - x[p + 1]) / (v[p + 1] - v[p]);
+    if (!(v[p] < v[p + 1])) continue;
+    approaching = true;
+    time[p] = (x[p] - x[p + 1]) / (v[p + 1] - v[p]);
     first = std::min(first, time[p]);
   }
-  if (first == kInf) return std::nullopt;
+  if (!approaching) return std::nullopt;
   // Each double time is within 3 ulps of the truth; exact rationals settle the near-ties.
   const double window = first * (1.0 + 0x1p-48) + 4.0 * std::numeric_limits<double>::denorm_min();
   std::vector<std::size_t> candidates;

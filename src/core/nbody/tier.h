@@ -60,7 +60,7 @@ enum class StepKind { kImpact, kFinished, kMultipleCollision, kAmbiguous, kOutOf
 struct StepResult {
   StepKind kind = StepKind::kImpact;
   std::size_t pair = 0;  ///< the impact's pair, or the lower pair of a multiple collision
-  double time = 0.0;     ///< [s]
+  double time = 0.0;     ///< of a multiple collision [s]
 };
 
 template <class S>
@@ -98,7 +98,8 @@ class Tier {
   std::uint64_t refinements() const { return refinements_; }
   double energyLost() const { return lost_ + lost_compensation_; }
   /// Time of the last impact [s] (0 before the first).
-  double lastTime() const { return count_ == 0 ? 0.0 : 0.5 * (now_.lower + now_.upper); }
+  /// Time of the last impact [s], or of the one in progress (0 before the first).
+  double lastTime() const { return Ar::sign(now_.A) > 0 ? Ar::toDouble(S(now_.G / now_.A)) : 0.0; }
 
   /// Finds and performs the next impact (or reports why not). `record` may be null.
   StepResult step(ImpactRecord* record) {
@@ -396,13 +397,15 @@ class Tier {
     return 2 * Ar::kOpError * (s_h * (q_h + 8 * inc) + s_l * (q_l + q_h + 8 * inc + 2 * d)) + (s_h + s_l) * kTiny;
   }
 
-  void recordBefore(std::size_t m, double time, ImpactRecord& record) const {
+  void recordBefore(std::size_t m, ImpactRecord& record) const {
     const BodyState& i = bodies_[m];
     const BodyState& j = bodies_[m + 1];
+    // The contact point is best extrapolated along the slower body's line.
     const BodyState& slow = std::fabs(Ar::toDouble(i.v)) <= std::fabs(Ar::toDouble(j.v)) ? i : j;
+    const S time = (i.b - j.b) / (j.v - i.v);
     record.pair_index = m;
-    record.time = time;
-    record.position = Ar::toDouble(S(slow.b + S(slow.v * S(time))));
+    record.time = Ar::toDouble(time);
+    record.position = Ar::toDouble(S(slow.b + S(slow.v * time)));
     record.velocities_before = {Ar::toDouble(i.v), Ar::toDouble(j.v)};
   }
 
@@ -450,9 +453,8 @@ class Tier {
     now_.pair = m;
     now_.lower = tree_.key(m);
     now_.upper = pair.upper;
-    const double time = 0.5 * (now_.lower + now_.upper);
     const S before_i = i.v, before_j = j.v;
-    if (record) recordBefore(m, time, *record);
+    if (record) recordBefore(m, *record);
     now_.eu = eu_;
     now_.eb = eb_;
     now_.extra = 0.0;
@@ -471,7 +473,7 @@ class Tier {
     if (record) recordAfter(m, before_i, before_j, lost, *record);
     const double magnitude = std::fabs(Ar::toDouble(i.b)) + std::fabs(Ar::toDouble(j.b)) +
                              std::fabs(Ar::toDouble(i.v)) + std::fabs(Ar::toDouble(j.v));
-    if (!(magnitude < kMaxMagnitude)) return {StepKind::kOutOfRange, m, time};
+    if (!(magnitude < kMaxMagnitude)) return {StepKind::kOutOfRange, m, lastTime()};
     tree_.set(m, kInf);  // e > 0: the pair separates; e = 0: it moves together, no impact
     pair.upper = kInf;
     if (m > 0) {
@@ -484,7 +486,7 @@ class Tier {
     }
     tree_.update(m > 0 ? m - 1 : m, std::min(m + 1, pairs_.size() - 1));
     ++count_;
-    return {StepKind::kImpact, m, time};
+    return {StepKind::kImpact, m, 0.0};
   }
 
   /// What an impact changes besides the tree (which is no longer used after a failure).

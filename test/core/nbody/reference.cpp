@@ -109,7 +109,7 @@ Run simulate(const Scene& scene, std::uint64_t max_impacts) {
       break;
     }
     run.energy_lost += lost;
-    run.events.push_back({p, s.now});
+    run.events.push_back({p, s.now, s.x[p], lost});
     run.last_time = s.now;
   }
   run.velocities = s.v;

@@ -21,7 +21,9 @@ using Rational = boost::multiprecision::cpp_rational;
 
 struct Event {
   std::size_t pair = 0;
-  Rational time;
+  Rational time;      ///< [s]
+  Rational position;  ///< contact point [m]
+  Rational lost;      ///< kinetic energy lost [J]
 };
 
 struct Run {
