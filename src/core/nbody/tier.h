@@ -44,6 +44,7 @@ constexpr double kUnit = 0x1p-53;           // unit roundoff of double
 constexpr double kSlack = 1.0 + 0x1p-40;    // covers the rounding of evaluating a bound in double
 constexpr double kTiny = 0x1p-1000;         // covers underflow in double-double, per operation
 constexpr double kMaxMagnitude = 0x1p900;   // beyond this the engine stops: out of range
+constexpr double kTimePrecision = 0x1p-42;  // relative precision of the published impact times
 
 /// What does not change during a run, shared by the tiers (doubles, exact inputs).
 struct SceneTables {
@@ -426,6 +427,15 @@ class Tier {
     }
   }
 
+  /// Precision guard: an impact's time t = G / A is published to about 1e-12. When this
+  /// tier's state pins G or A down less well than 2^-42 of their size (tiny approach speeds,
+  /// as on the way to an inelastic collapse), a more precise tier takes the step.
+  bool timeIsPrecise(double scale) const {
+    if constexpr (Ar::kExact) return true;
+    return now_.eb * scale <= kTimePrecision * std::fabs(Ar::toDouble(now_.G)) &&
+           now_.eu * scale <= kTimePrecision * std::fabs(Ar::toDouble(now_.A));
+  }
+
   void addLoss(double loss) {
     // Neumaier summation: the total of many small losses keeps its digits.
     const double sum = lost_ + loss;
@@ -464,6 +474,7 @@ class Tier {
     eb_ += rho(m, db, i.b, j.b);
     now_.A = dv.difference;
     now_.G = -db.difference;
+    if (!timeIsPrecise(pair.scale)) return {StepKind::kAmbiguous, m, 0.0};
     double lost = 0.0;
     if (std::fabs(pair.map.light_factor) != 1.0) {  // e < 1
       const double approach_speed = Ar::toDouble(now_.A);
