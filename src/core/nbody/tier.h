@@ -98,7 +98,6 @@ class Tier {
   std::uint64_t count() const { return count_; }
   std::uint64_t refinements() const { return refinements_; }
   double energyLost() const { return lost_ + lost_compensation_; }
-  /// Time of the last impact [s] (0 before the first).
   /// Time of the last impact [s], or of the one in progress (0 before the first).
   double lastTime() const { return Ar::sign(now_.A) > 0 ? Ar::toDouble(S(now_.G / now_.A)) : 0.0; }
 
@@ -140,7 +139,6 @@ class Tier {
     // The conversion of G and A; the other tier's rounding of them is below this tier's,
     // which preciseNow() counts.
     now_.extra = from.now_.extra + 2 * conversion * (std::fabs(Ar::toDouble(now_.G)) + std::fabs(Ar::toDouble(now_.A)));
-    now_.lower = from.now_.lower;
     now_.upper = from.now_.upper;
   }
 
@@ -187,13 +185,13 @@ class Tier {
     bool ok;
   };
   /// The last impact: its gap G = b_p - b_{p+1} and approach speed A before it, with
-  /// bounds (so its precise time can be formed later), and its time bounds.
+  /// bounds (so its precise time can be formed later), and the upper bound of its time.
   struct Now {
     std::size_t pair = 0;
     S G{}, A{};
     double eb = 0.0, eu = 0.0;  ///< the state's bounds before the impact
     double extra = 0.0;         ///< what adoption added to the bounds of G and A
-    double lower = 0.0, upper = 0.0;
+    double upper = 0.0;         ///< [s]
   };
 
   double pairScale(std::size_t p) const { return pairs_[p].scale; }
@@ -239,25 +237,25 @@ class Tier {
     return positive(precise, error);
   }
 
-  /// The exact time t = G / A from S values with error bounds eG, eA; !ok when A is not
-  /// clearly positive at this precision.
+  /// The time t = G / A [s] from S values with error bounds eG, eA (an inexact tier); !ok
+  /// when A is not clearly positive at this precision.
   static Precise preciseTime(const S& G, double eG, const S& A, double eA) {
     const double a = Ar::toDouble(A) * (1 - 2 * Ar::kToDoubleError) - eA;
-    if (!(a > 0.5 * Ar::toDouble(A))) return {S(), kInf, Ar::kExact && Ar::sign(A) > 0};
+    if (!(a > 0.5 * Ar::toDouble(A))) return {S(), kInf, false};
     const S t = G / A;
     const double td = std::fabs(Ar::toDouble(t)) * (1 + 2 * Ar::kToDoubleError);
-    double error = (eG + td * eA) / a + 2 * Ar::kOpError * td;
-    if (!Ar::kExact) error = error * kSlack + kTiny;
+    const double error = ((eG + td * eA) / a + 2 * Ar::kOpError * td) * kSlack + kTiny;
     return {t, error, true};
   }
 
+  /// Pair p's next impact time in S (p approaches).
   Precise preciseTime(std::size_t p) {
     ++refinements_;
     const S G = bodies_[p].b - bodies_[p + 1].b;
     const S A = bodies_[p + 1].v - bodies_[p].v;
+    if constexpr (Ar::kExact) return {G / A, 0.0, true};
     const double eG = (eb_ * pairScale(p) + 1.01 * Ar::kOpError * std::fabs(Ar::toDouble(G))) * kSlack;
     const double eA = (eu_ * pairScale(p) + 1.01 * Ar::kOpError * std::fabs(Ar::toDouble(A))) * kSlack;
-    if constexpr (Ar::kExact) return {G / A, 0.0, true};
     return preciseTime(G, eG, A, eA);
   }
 
@@ -461,7 +459,6 @@ class Tier {
     BodyState& i = bodies_[m];
     BodyState& j = bodies_[m + 1];
     now_.pair = m;
-    now_.lower = tree_.key(m);
     now_.upper = pair.upper;
     const S before_i = i.v, before_j = j.v;
     if (record) recordBefore(m, *record);
