@@ -83,16 +83,30 @@ class Driver {
     const std::uint64_t count = t.count();
     StepResult r = t.step(record);
     if constexpr (Arithmetic<S>::kExact) {
-      if (r.kind == StepKind::kAmbiguous) r.kind = StepKind::kInconsistent;  // cannot happen
+      if (r.kind == StepKind::kAmbiguous || r.kind == StepKind::kImprecise) r.kind = StepKind::kInconsistent;  // cannot happen
       return r;
     } else {
-      if (r.kind != StepKind::kAmbiguous) return r;
-      using H = typename NextTier<S>::type;
-      ++(std::is_same_v<H, Float100> ? escalations_.high_precision : escalations_.exact_rational);
-      r = advanceAndStep<H>(count, record);
-      t.adopt(*tier<H>());
-      return r;
+      if (r.kind != StepKind::kAmbiguous && r.kind != StepKind::kImprecise) return r;
+      // A value exactly 0 in double-double is in practice an exact tie, which 100 digits
+      // cannot settle either: go straight to the rationals.
+      if constexpr (std::is_same_v<S, DD>) {
+        if (r.at_zero) return escalate<S, Rational>(r, count, record);
+      }
+      return escalate<S, typename NextTier<S>::type>(r, count, record);
     }
+  }
+
+  /// Tier H takes the step that tier S could not; S then follows it in O(1), or adopts H's
+  /// state when its own is too imprecise.
+  template <class S, class H>
+  StepResult escalate(const StepResult& r, std::uint64_t count, ImpactRecord* record) {
+    ++(std::is_same_v<H, Float100> ? escalations_.high_precision : escalations_.exact_rational);
+    const StepResult higher = advanceAndStep<H>(count, record);
+    Tier<S>& t = *tier<S>();
+    const bool followed =
+        r.kind == StepKind::kAmbiguous && higher.kind == StepKind::kImpact && t.follow(*tier<H>(), higher.pair);
+    if (!followed) t.adopt(*tier<H>());
+    return higher;
   }
 
   /// Brings tier S to `target` impacts (creating it from the scene on first use), then
@@ -196,6 +210,7 @@ void finish(const StepResult& r, EngineResult& result) {
       break;
     case StepKind::kOutOfRange: result.stop = StopReason::kOutOfRange; break;
     case StepKind::kAmbiguous:
+    case StepKind::kImprecise:
     case StepKind::kInconsistent: result.stop = StopReason::kInternalError; break;
   }
 }

@@ -56,12 +56,15 @@ struct SceneTables {
   std::vector<double> loss_factor;    ///< (1 - e^2) mu / 2 per pair [kg]
 };
 
-enum class StepKind { kImpact, kFinished, kMultipleCollision, kAmbiguous, kOutOfRange, kInconsistent };
+/// kAmbiguous: a decision this tier cannot take; kImprecise: its state no longer pins down
+/// the time of the impact it was about to perform (the precision guard).
+enum class StepKind { kImpact, kFinished, kMultipleCollision, kAmbiguous, kImprecise, kOutOfRange, kInconsistent };
 
 struct StepResult {
   StepKind kind = StepKind::kImpact;
   std::size_t pair = 0;  ///< the impact's pair, or the lower pair of a multiple collision
   double time = 0.0;     ///< of a multiple collision [s]
+  bool at_zero = false;  ///< kAmbiguous on a value exactly 0 at this precision: likely an exact tie
 };
 
 template <class S>
@@ -142,6 +145,25 @@ class Tier {
     now_.upper = from.now_.upper;
   }
 
+  /// Performs, in this tier's arithmetic, the impact of pair m that a more precise tier at
+  /// the same count has just taken, and takes that tier's schedules of the three pairs it
+  /// changed (bounds on exact times, whoever computed them): O(1), where adopt() is O(N).
+  /// Returns false, changing nothing, when this tier's state cannot pin down the impact's
+  /// time; adopt() then refreshes it.
+  template <class From>
+  bool follow(const Tier<From>& from, std::size_t m) {
+    const Undo undo = saveFor(m);
+    if (collide(m, nullptr).kind != StepKind::kImpact) {
+      restore(m, undo);
+      return false;
+    }
+    const std::size_t first = m > 0 ? m - 1 : m, last = std::min(m + 1, pairs_.size() - 1);
+    for (std::size_t q = first; q <= last; ++q) setSchedule(q, from.tree_.key(q), from.pairs_[q].upper);
+    tree_.update(first, last);
+    ++count_;
+    return true;
+  }
+
   /// Positions [m] at time t [s] and velocities [m/s], rounded to double.
   void state(double t, std::vector<double>& positions, std::vector<double>& velocities) const {
     positions.resize(bodies_.size());
@@ -170,8 +192,10 @@ class Tier {
     double sqrt_light = 0.0;  ///< sqrt of the lighter mass [kg^0.5]
   };
 
-  enum class Decision { kYes, kNo, kUnknown };
-  enum class Order { kLess, kEqual, kGreater, kUnknown };
+  /// kUnknownAtZero: undecided, and the value is exactly 0 at this precision, which in
+  /// practice means an exact tie (equal velocities or times from structured inputs).
+  enum class Decision { kYes, kNo, kUnknown, kUnknownAtZero };
+  enum class Order { kLess, kEqual, kGreater, kUnknown, kUnknownAtZero };
 
   /// A double approximation of an exact-process quantity and a bound on its error.
   struct Approx {
@@ -192,6 +216,13 @@ class Tier {
     double eb = 0.0, eu = 0.0;  ///< the state's bounds before the impact
     double extra = 0.0;         ///< what adoption added to the bounds of G and A
     double upper = 0.0;         ///< [s]
+  };
+
+  /// What an impact changes besides the tree (a failed step leaves the tree to be rebuilt by adopt()).
+  struct Undo {
+    BodyState i, j;
+    double eu, eb, lost, lost_compensation;
+    Now now;
   };
 
   double pairScale(std::size_t p) const { return pairs_[p].scale; }
@@ -224,7 +255,7 @@ class Tier {
   static Decision positive(const S& value, double error) {
     if (Ar::sign(S(value - S(error))) > 0) return Decision::kYes;
     if (Ar::sign(S(value + S(error))) <= 0) return Decision::kNo;
-    return Decision::kUnknown;
+    return Ar::sign(value) == 0 ? Decision::kUnknownAtZero : Decision::kUnknown;
   }
 
   /// Does pair p approach? `a` is approach(p).
@@ -278,6 +309,7 @@ class Tier {
     switch (positive(difference, error)) {
       case Decision::kYes: return Order::kLess;
       case Decision::kNo: return positive(S(-difference), error) == Decision::kYes ? Order::kGreater : Order::kUnknown;
+      case Decision::kUnknownAtZero: return Order::kUnknownAtZero;
       case Decision::kUnknown: break;
     }
     return Order::kUnknown;
@@ -326,6 +358,7 @@ class Tier {
     double lower = kInf, upper = kInf;
     switch (decideApproach(p, a)) {
       case Decision::kUnknown: return {StepKind::kAmbiguous, p, lastTime()};
+      case Decision::kUnknownAtZero: return {StepKind::kAmbiguous, p, lastTime(), true};
       case Decision::kNo: break;
       case Decision::kYes: {
         const Precise precise = preciseTime(p);
@@ -349,6 +382,7 @@ class Tier {
       case Order::kLess: return {};
       case Order::kEqual: return {StepKind::kMultipleCollision, std::min(q, m), lastTime()};
       case Order::kGreater: return {StepKind::kInconsistent, q, lastTime()};
+      case Order::kUnknownAtZero: return {StepKind::kAmbiguous, q, lastTime(), true};
       case Order::kUnknown: break;
     }
     return {StepKind::kAmbiguous, q, lastTime()};
@@ -370,7 +404,9 @@ class Tier {
     for (std::size_t k = 0; k < candidates.size(); ++k) {
       if (k == best) continue;
       const Order order = compare(times[best], times[k]);
-      if (order == Order::kUnknown || order == Order::kGreater) return {StepKind::kAmbiguous, candidates[k], lastTime()};
+      if (order == Order::kUnknown || order == Order::kGreater || order == Order::kUnknownAtZero) {
+        return {StepKind::kAmbiguous, candidates[k], lastTime(), order == Order::kUnknownAtZero};
+      }
       if (order == Order::kEqual) tied.push_back(candidates[k]);
     }
     std::sort(tied.begin(), tied.end());
@@ -387,6 +423,7 @@ class Tier {
   double rho(std::size_t m, const ImpactChange<S>& change, const S& q_i, const S& q_j) const {
     if constexpr (Ar::kExact) return 0.0;
     const PairState& pair = pairs_[m];
+    if (pair.map.exchange) return 0.0;  // a swap rounds nothing
     const bool heavy_is_i = pair.map.heavy_is_i;
     const double s_h = pair.sqrt_heavy, s_l = pair.sqrt_light;
     const double q_h = std::fabs(Ar::toDouble(heavy_is_i ? q_i : q_j));
@@ -444,17 +481,23 @@ class Tier {
   /// Performs the impact of pair m. When a neighbour then hits at the same instant (a
   /// multiple collision, or a decision this tier cannot take), the impact is undone.
   StepResult impact(std::size_t m, ImpactRecord* record) {
-    const Undo undo{bodies_[m], bodies_[m + 1], eu_, eb_, lost_, lost_compensation_, now_};
-    const StepResult r = apply(m, record);
-    if (r.kind != StepKind::kImpact) {
-      bodies_[m] = undo.i, bodies_[m + 1] = undo.j;
-      eu_ = undo.eu, eb_ = undo.eb, lost_ = undo.lost, lost_compensation_ = undo.lost_compensation;
-      now_ = undo.now;
-    }
+    const Undo undo = saveFor(m);
+    StepResult r = collide(m, record);
+    if (r.kind == StepKind::kImpact) r = scheduleAfter(m);
+    if (r.kind != StepKind::kImpact) restore(m, undo);
     return r;
   }
 
-  StepResult apply(std::size_t m, ImpactRecord* record) {
+  Undo saveFor(std::size_t m) const { return {bodies_[m], bodies_[m + 1], eu_, eb_, lost_, lost_compensation_, now_}; }
+
+  void restore(std::size_t m, const Undo& undo) {
+    bodies_[m] = undo.i, bodies_[m + 1] = undo.j;
+    eu_ = undo.eu, eb_ = undo.eb, lost_ = undo.lost, lost_compensation_ = undo.lost_compensation;
+    now_ = undo.now;
+  }
+
+  /// The impact of pair m on its two bodies, with the error bounds, the heat and the record.
+  StepResult collide(std::size_t m, ImpactRecord* record) {
     PairState& pair = pairs_[m];
     BodyState& i = bodies_[m];
     BodyState& j = bodies_[m + 1];
@@ -471,7 +514,7 @@ class Tier {
     eb_ += rho(m, db, i.b, j.b);
     now_.A = dv.difference;
     now_.G = -db.difference;
-    if (!timeIsPrecise(pair.scale)) return {StepKind::kAmbiguous, m, 0.0};
+    if (!timeIsPrecise(pair.scale)) return {StepKind::kImprecise, m, 0.0};
     double lost = 0.0;
     if (std::fabs(pair.map.light_factor) != 1.0) {  // e < 1
       const double approach_speed = Ar::toDouble(now_.A);
@@ -482,8 +525,13 @@ class Tier {
     const double magnitude = std::fabs(Ar::toDouble(i.b)) + std::fabs(Ar::toDouble(j.b)) +
                              std::fabs(Ar::toDouble(i.v)) + std::fabs(Ar::toDouble(j.v));
     if (!(magnitude < kMaxMagnitude)) return {StepKind::kOutOfRange, m, lastTime()};
-    tree_.set(m, kInf);  // e > 0: the pair separates; e = 0: it moves together, no impact
-    pair.upper = kInf;
+    return {StepKind::kImpact, m, 0.0};
+  }
+
+  /// Pair m separates (e > 0) or moves on together (e = 0): no impact; its neighbours get
+  /// new schedules.
+  StepResult scheduleAfter(std::size_t m) {
+    setSchedule(m, kInf, kInf);
     if (m > 0) {
       const StepResult r = reschedule(m - 1, m);
       if (r.kind != StepKind::kImpact) return r;
@@ -496,13 +544,6 @@ class Tier {
     ++count_;
     return {StepKind::kImpact, m, 0.0};
   }
-
-  /// What an impact changes besides the tree (which is no longer used after a failure).
-  struct Undo {
-    BodyState i, j;
-    double eu, eb, lost, lost_compensation;
-    Now now;
-  };
 
   const SceneTables& tables_;
   std::vector<BodyState> bodies_;

@@ -46,9 +46,10 @@ TEST(NBodyEngineHard, CradleWithGaps) {
   EXPECT_EQ(run.final_positions, (std::vector<double>{3, 2, 1, 0, 0}));  // at t = 4 s
   EXPECT_EQ(run.final_time, 4.0);
   EXPECT_EQ(run.stop, StopReason::kFinished);
-  // The bodies left at rest touch with exactly zero approach speed: exact ties, which the
-  // double-double state cannot see and the exact tier settles.
-  EXPECT_GT(run.escalations.exact_rational, 0u);
+  // The bodies left at rest touch with exactly zero approach speed. Equal masses swap
+  // their velocities without rounding, so the working precision sees those zeros exactly
+  // and needs no replay.
+  EXPECT_EQ(run.escalations.high_precision + run.escalations.exact_rational, 0u);
   EXPECT_EQ(*predictGhosts(s).impact_count, 4u);
 }
 
@@ -77,11 +78,28 @@ TEST(NBodyEngineHard, DisjointImpactsAtTheSameInstantBothHappen) {
   const std::vector<double> times{1, 1, 1.5, 2, 2};
   for (std::size_t k = 0; k < run.events.size(); ++k) EXPECT_EQ(run.events[k].time, times[k]);
   EXPECT_EQ(run.final_velocities, (std::vector<double>{1, 0, 0, -1}));
+  EXPECT_GT(run.escalations.exact_rational, 0u);  // exactly equal times: the exact tier orders them
   // One ulp later for D: CD is strictly after AB, and the order is still exact.
   Scene later = s;
   later.positions[3] = std::nextafter(0.0, -1.0);
   ASSERT_FALSE(validate(later));
   expectMatchesReference(later, kCap, "CD one ulp later");
+}
+
+TEST(NBodyEngineHard, GrazingContactsAreNoImpacts) {
+  // physics.md: from v = (-1, 0, 0) m/s, masses (3, 1, 0.5) kg give exactly 2 impacts and
+  // end with v_A = v_B; the kaleidoscopic masses (1, 1, 1), (2, 1, 3), (5, 1, 9) graze
+  // too, with 2, 3 and 5 impacts. The last contact has approach speed exactly 0.
+  const std::pair<std::vector<double>, std::uint64_t> cases[] = {
+      {{3, 1, 0.5}, 2}, {{1, 1, 1}, 2}, {{2, 1, 3}, 3}, {{5, 1, 9}, 5}};
+  for (const auto& [masses, count] : cases) {
+    const Scene s{masses, {2, 1, 0}, {-1, 0, 0}, {}};
+    const EngineResult run = expectMatchesReference(s, kCap, "grazing");
+    EXPECT_EQ(run.impact_count, count) << masses[0] << ", " << masses[1] << ", " << masses[2];
+  }
+  const EngineResult run = runEngine(Scene{{3, 1, 0.5}, {2, 1, 0}, {-1, 0, 0}, {}});
+  EXPECT_EQ(run.final_velocities[0], run.final_velocities[1]);
+  EXPECT_GT(run.escalations.exact_rational, 0u);  // an exact zero after rounded impacts
 }
 
 TEST(NBodyEngineHard, TwoStrikers) {

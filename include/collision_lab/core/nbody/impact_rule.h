@@ -12,6 +12,7 @@
 #pragma once
 
 #include <cmath>
+#include <utility>
 
 namespace collision_lab {
 namespace core {
@@ -27,6 +28,7 @@ namespace core {
 template <class T>
 struct ImpactMap {
   bool heavy_is_i = true;     ///< the right body of the pair is the heavier (or equal) one
+  bool exchange = false;      ///< equal masses and e = 1: the two bodies swap values, exactly
   T heavy_gain{};             ///< +-c_h, c_h = (1 + e) m_light / (m_i + m_j) [1]; 0 for a wall
   double light_factor = -1.0;  ///< -+e [1]: q_light' = q_heavy' + light_factor d
 };
@@ -37,6 +39,7 @@ template <class T>
 ImpactMap<T> makeImpactMap(double m_i, double m_j, double e) {
   ImpactMap<T> map;
   map.heavy_is_i = m_i >= m_j;
+  map.exchange = m_i == m_j && !std::isinf(m_i) && e == 1.0;
   const double heavy = map.heavy_is_i ? m_i : m_j;
   const double light = map.heavy_is_i ? m_j : m_i;
   if (!std::isinf(heavy)) map.heavy_gain = (T(1) + T(e)) * T(light) / (T(heavy) + T(light));
@@ -60,6 +63,11 @@ template <class T>
 ImpactChange<T> applyImpactMap(const ImpactMap<T>& map, T& q_i, T& q_j) {
   ImpactChange<T> change;
   change.difference = q_j - q_i;
+  if (map.exchange) {  // what the general form gives in exact arithmetic, without rounding
+    change.heavy_increment = change.difference;
+    std::swap(q_i, q_j);
+    return change;
+  }
   T& heavy = map.heavy_is_i ? q_i : q_j;
   T& light = map.heavy_is_i ? q_j : q_i;
   change.heavy_increment = map.heavy_gain * change.difference;
