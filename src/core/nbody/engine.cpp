@@ -2,7 +2,10 @@
 
 #include <charconv>
 #include <cmath>
+#include <limits>
 #include <memory>
+#include <optional>
+#include <string>
 
 #include "tier.h"
 

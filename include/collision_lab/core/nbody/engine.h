@@ -6,10 +6,17 @@
 // predicates):
 //   0. double-double state (about 106 bits) with a rigorous forward error bound, and double
 //      time keys; a key too close to call is first re-taken from the double-double state;
-//   1. what that cannot decide is replayed from the start (or from its last replay) in
-//      100-digit floats with their own bound, and the engine adopts the accurate state;
-//   2. what 100 digits cannot decide (in practice an exact tie, which comes from inputs
-//      such as small integers, where rationals stay small) is replayed in exact rationals.
+//   1. what that cannot decide, a tier of 100-digit floats with its own bound decides: it
+//      replays the run from the start (or from where it last stopped) to that impact and
+//      takes the step; the working tier then follows that step in O(1);
+//   2. what 100 digits cannot decide, exact rationals decide the same way. A value exactly
+//      0 in double-double (in practice an exact tie: equal velocities or simultaneous
+//      impacts, from inputs such as small integers, where rationals stay small) goes
+//      straight to this tier.
+// Equal masses with e = 1 swap their velocities without rounding, so scenes of equal
+// masses keep an exact state. A tier whose state can no longer pin an impact's published
+// time to 2^-42 (tiny approach speeds, as on the way to an inelastic collapse) hands that
+// step to the next tier too and adopts its state.
 // Impacts happen in the canonical order: exact time, then pair index. Impacts of disjoint
 // pairs at the same instant are all performed; two impacts sharing a body at the same
 // instant are a multiple collision, which ends the run (its outcome is undefined for
