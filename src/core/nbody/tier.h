@@ -234,7 +234,8 @@ class Tier {
       return {value, 2.01 * kUnit * std::fabs(value) + 3 * kUnit * kUnit * (std::fabs(x.hi) + std::fabs(y.hi)) + kTiny};
     } else {
       const double value = Ar::toDouble(S(x - y));
-      return {value, 1.01 * (Ar::kOpError + Ar::kToDoubleError) * std::fabs(value)};
+      // kTiny: a difference that underflows in double must not read as exactly 0.
+      return {value, 1.01 * (Ar::kOpError + Ar::kToDoubleError) * std::fabs(value) + kTiny};
     }
   }
 
