@@ -8,3 +8,15 @@ catkin_add_gtest(collision_lab_core_tests
 if(TARGET collision_lab_core_tests)
   target_link_libraries(collision_lab_core_tests collision_lab_core GTest::gtest_main)
 endif()
+
+# N-body core (issue 10): scene, models, exact event engine, against an exact rational
+# reference written in the test directory.
+catkin_add_gtest(collision_lab_nbody_tests
+  test/core/nbody/reference.cpp
+  test/core/nbody/test_scene.cpp
+  test/core/nbody/test_models.cpp
+  test/core/nbody/test_engine_hard.cpp
+  test/core/nbody/test_engine_random.cpp)
+if(TARGET collision_lab_nbody_tests)
+  target_link_libraries(collision_lab_nbody_tests collision_lab_core GTest::gtest_main)
+endif()

@@ -1,0 +1,127 @@
+// The exact event engine for N bodies on a line: impact by impact, no time stepping.
+//
+// Every decision that changes the outcome (which pair is next, whether a pair approaches,
+// whether two impacts are simultaneous) is taken as exact rational arithmetic on the input
+// doubles would take it, in three tiers (adaptive precision, as in robust geometric
+// predicates):
+//   0. double-double state (about 106 bits) with a rigorous forward error bound, and double
+//      time keys; a key too close to call is first re-taken from the double-double state;
+//   1. what that cannot decide, a tier of 100-digit floats with its own bound decides: it
+//      replays the run from the start (or from where it last stopped) to that impact and
+//      takes the step; the working tier then follows that step in O(1);
+//   2. what 100 digits cannot decide, exact rationals decide the same way. A value exactly
+//      0 in double-double (in practice an exact tie: equal velocities or simultaneous
+//      impacts, from inputs such as small integers, where rationals stay small) goes
+//      straight to this tier.
+// Equal masses with e = 1 swap their velocities without rounding, so scenes of equal
+// masses keep an exact state. A tier whose state can no longer pin an impact's published
+// time to 2^-42 (tiny approach speeds, as on the way to an inelastic collapse) hands that
+// step to the next tier too and adopts its state.
+// Impacts happen in the canonical order: exact time, then pair index. Impacts of disjoint
+// pairs at the same instant are all performed; two impacts sharing a body at the same
+// instant are a multiple collision, which ends the run (its outcome is undefined for
+// point masses). Nothing is stored per impact unless asked, so memory is O(N).
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "collision_lab/core/nbody/scene.h"
+
+namespace collision_lab {
+namespace core {
+
+/// One impact of pair p (bodies p and p+1).
+struct ImpactRecord {
+  std::uint64_t index = 0;                    ///< 1-based impact number
+  std::size_t pair_index = 0;                 ///< p; its name is pairName(p)
+  double time = 0.0;                          ///< [s] since the start of the run
+  double position = 0.0;                      ///< contact point [m]
+  std::array<double, 2> velocities_before{};  ///< bodies p, p+1 [m/s]
+  std::array<double, 2> velocities_after{};   ///< bodies p, p+1 [m/s]
+  /// Kinetic energy gained by bodies p, p+1 [J]. A wall's entry is minus what the other
+  /// body gained and the heat, so the two entries and energy_lost sum to zero.
+  std::array<double, 2> energy_gained{};
+  double energy_lost = 0.0;  ///< kinetic energy turned into heat, (1 - e^2) mu A^2 / 2 [J]
+};
+
+/// Why a run ended. Values are stable: append only.
+enum class StopReason : std::uint8_t {
+  kFinished = 0,           ///< no pair approaches any more
+  kCap = 1,                ///< max_impacts reached (truncated)
+  kCancelled = 2,          ///< the cancel flag was set (truncated)
+  kMultipleCollision = 3,  ///< two impacts sharing a body at the same instant
+  kOutOfRange = 4,         ///< a time, position or velocity left the safe range of a double
+  kInternalError = 5,      ///< the tiers disagreed (a bug; reported, never hidden)
+};
+
+/// Machine-readable name, e.g. "MULTIPLE_COLLISION".
+const char* stopReasonName(StopReason reason);
+
+/// Progress of a long run.
+struct EngineProgress {
+  std::uint64_t impacts = 0;  ///< impacts so far
+  double time = 0.0;          ///< time of the last impact [s]
+};
+
+struct EngineOptions {
+  std::uint64_t max_impacts = 10'000'000;  ///< the run stops here, marked truncated
+  std::uint64_t keep_events = 0;           ///< keep the first this many records in the result
+  std::uint64_t progress_interval = std::uint64_t{1} << 20;  ///< impacts between progress calls (0: never)
+  /// When set (by another thread or a signal handler), the run stops within 1024 impacts,
+  /// marked truncated, with the summary of what was done.
+  const std::atomic<bool>* cancel = nullptr;
+};
+
+/// How often the engine had to leave its working precision.
+struct Escalations {
+  std::uint64_t refinements = 0;       ///< decisions re-taken from the double-double state
+  std::uint64_t high_precision = 0;    ///< replays in 100-digit floats
+  std::uint64_t exact_rational = 0;    ///< replays in exact rationals
+  std::uint64_t replayed_impacts = 0;  ///< impacts simulated by those replays
+};
+
+/// Three bodies that meet at one instant.
+struct MultipleCollision {
+  std::size_t first_body = 0;  ///< bodies first_body, first_body + 1, first_body + 2
+  double time = 0.0;           ///< [s]
+};
+
+struct EngineResult {
+  std::uint64_t impact_count = 0;
+  bool truncated = false;  ///< stopped by the cap or by cancellation: more impacts were due
+  StopReason stop = StopReason::kFinished;
+  std::string stop_message;  ///< one sentence: why the run ended
+  std::optional<MultipleCollision> multiple_collision;
+  double final_time = 0.0;               ///< time of the last impact [s] (0 without any)
+  std::vector<double> final_positions;   ///< at final_time [m]
+  std::vector<double> final_velocities;  ///< [m/s]
+  double energy_lost = 0.0;              ///< total kinetic energy lost to heat [J]
+  /// |E_end + energy_lost - E_0| / E_0, kinetic energies in the walls' frame (the lab frame
+  /// without walls); NaN when two walls move at different velocities (not conserved).
+  double energy_relative_drift = 0.0;
+  /// |p_end - p_0| / sum |m v_0| over the finite masses; NaN with a wall (not conserved).
+  double momentum_relative_drift = 0.0;
+  Escalations escalations;
+  std::vector<ImpactRecord> events;  ///< the first options.keep_events impacts
+};
+
+/// Called for every impact, in order. May be empty.
+using ImpactVisitor = std::function<void(const ImpactRecord&)>;
+/// Called every options.progress_interval impacts. May be empty.
+using ProgressCallback = std::function<void(const EngineProgress&)>;
+
+/// Runs the scene to its end, the cap, cancellation or a multiple collision.
+/// Precondition: validate(scene) passed. Never throws for a valid scene (short of running
+/// out of memory); the visitor and the progress callback may throw, which ends the run.
+EngineResult runEngine(const Scene& scene, const EngineOptions& options = {}, const ImpactVisitor& visitor = {},
+                       const ProgressCallback& progress = {});
+
+}  // namespace core
+}  // namespace collision_lab

@@ -1,0 +1,75 @@
+// The model each scene needs: the cheapest one that is exact for it, and why.
+//   no_collisions        N = 1, or no pair approaches: nothing happens, O(N)
+//   two_walls_infinite   walls at both ends that do not move apart, every e > 0: the bodies
+//                        between them collide forever (the run stops at its cap)
+//   two_body             N = 2: at most one impact, closed form
+//   three_body_rotation  N = 3, elastic: the paper's rotation model (the three-body analytic
+//                        core answers; nothing is predicted here)
+//   ghosts               equal masses, elastic, no walls: the bodies exchange velocities, so
+//                        they move like ghosts passing through each other; the count is the
+//                        number of inversions, O(N log N), and the final velocities are the
+//                        initial ones sorted
+//   event_engine         anything else: no count formula exists; the exact event engine
+//                        simulates every impact
+// ROS-free; every function here never throws for a validated scene (short of memory).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "collision_lab/core/nbody/scene.h"
+
+namespace collision_lab {
+namespace core {
+
+/// Values are stable: append only.
+enum class ModelKind : std::uint8_t {
+  kNoCollisions = 0,
+  kTwoWallsInfinite = 1,
+  kTwoBody = 2,
+  kThreeBodyRotation = 3,
+  kGhosts = 4,
+  kEventEngine = 5,
+};
+
+/// Machine-readable name, e.g. "three_body_rotation".
+const char* modelKindName(ModelKind kind);
+
+struct ModelChoice {
+  ModelKind kind = ModelKind::kEventEngine;
+  std::string reason;  ///< one line: why this model answers this scene
+};
+
+/// Precondition: validate(scene) passed.
+ModelChoice chooseModel(const Scene& scene);
+
+/// What a closed-form model predicts. Fields a model does not give stay empty.
+struct Prediction {
+  ModelKind kind = ModelKind::kNoCollisions;
+  std::string reason;
+  bool infinite = false;                      ///< infinitely many impacts
+  std::optional<std::uint64_t> impact_count;  ///< the exact number of impacts
+  std::vector<double> final_velocities;       ///< [m/s], listed like the bodies
+  std::optional<double> impact_time;          ///< two_body: time of the impact [s]
+  std::optional<double> impact_position;      ///< two_body: contact point [m]
+  double energy_lost = 0.0;                   ///< kinetic energy turned into heat [J]
+};
+
+/// Each requires the scene its model is chosen for (chooseModel) and validate() passed.
+Prediction predictNoCollisions(const Scene& scene);
+Prediction predictTwoWalls(const Scene& scene);
+Prediction predictTwoBody(const Scene& scene);
+Prediction predictGhosts(const Scene& scene);
+
+/// The prediction of chooseModel(scene)'s model. Empty for three_body_rotation (the
+/// three-body analytic model answers) and for event_engine (no formula: run the engine).
+std::optional<Prediction> predict(const Scene& scene);
+
+/// Number of pairs i < j with v_i < v_j (equal values are not inversions), by merge sort:
+/// O(N log N) time, O(N) memory; exact in 64 bits for N up to 6e9.
+std::uint64_t countInversions(const std::vector<double>& velocities);
+
+}  // namespace core
+}  // namespace collision_lab

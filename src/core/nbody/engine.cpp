@@ -1,0 +1,279 @@
+#include "collision_lab/core/nbody/engine.h"
+
+#include <charconv>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "tier.h"
+
+namespace collision_lab {
+namespace core {
+
+namespace nbody_detail {
+
+SceneTables::SceneTables(const Scene& s) : scene(s), pairs(s.pairCount()) {
+  for (std::size_t k = 0; k < s.size(); ++k) {
+    const bool wall = s.isWall(k);
+    sqrt_mass.push_back(wall ? 0.0 : std::sqrt(s.masses[k]));
+    inv_sqrt_mass.push_back(wall ? 0.0 : 1.0 / std::sqrt(s.masses[k]));
+  }
+  for (std::size_t p = 0; p < pairs; ++p) {
+    // The loss at unit approach speed, (1 - e^2) mu / 2: one home for the formula.
+    loss_factor.push_back(impactEnergyLost(s.masses[p], s.masses[p + 1], 1.0, s.restitutionOf(p)));
+  }
+}
+
+namespace {
+
+template <class S>
+struct NextTier;
+template <>
+struct NextTier<DD> {
+  using type = Float100;
+};
+template <>
+struct NextTier<Float100> {
+  using type = Rational;
+};
+
+/// Owns the tiers: the double-double one always, the others from their first use on. A
+/// higher tier keeps its state between escalations, so each replays every impact at most
+/// once over the whole run.
+class Driver {
+ public:
+  explicit Driver(const Scene& scene) : tables_(scene) {}
+
+  StepResult start() { return startOrEscalate<DD>(); }
+  StepResult step(ImpactRecord* record) { return stepOrEscalate<DD>(record); }
+
+  const Tier<DD>& fast() const { return *fast_; }
+  Escalations escalations() const {
+    Escalations e = escalations_;
+    e.refinements = fast_->refinements();
+    return e;
+  }
+
+ private:
+  template <class S>
+  std::unique_ptr<Tier<S>>& tier() {
+    if constexpr (std::is_same_v<S, DD>) return fast_;
+    if constexpr (std::is_same_v<S, Float100>) return high_;
+    if constexpr (std::is_same_v<S, Rational>) return exact_;
+  }
+
+  template <class S>
+  StepResult startOrEscalate() {
+    auto& t = tier<S>();
+    t = std::make_unique<Tier<S>>(tables_);
+    StepResult r = t->start();
+    if constexpr (!Arithmetic<S>::kExact) {
+      if (r.kind == StepKind::kAmbiguous) {
+        using H = typename NextTier<S>::type;
+        r = startOrEscalate<H>();
+        t->adopt(*tier<H>());
+      }
+    }
+    return r;
+  }
+
+  /// One step of tier S; what it cannot decide, the next tier decides.
+  template <class S>
+  StepResult stepOrEscalate(ImpactRecord* record) {
+    Tier<S>& t = *tier<S>();
+    const std::uint64_t count = t.count();
+    StepResult r = t.step(record);
+    if constexpr (Arithmetic<S>::kExact) {
+      if (r.kind == StepKind::kAmbiguous || r.kind == StepKind::kImprecise) r.kind = StepKind::kInconsistent;  // cannot happen
+      return r;
+    } else {
+      if (r.kind != StepKind::kAmbiguous && r.kind != StepKind::kImprecise) return r;
+      // A value exactly 0 in double-double is in practice an exact tie, which 100 digits
+      // cannot settle either: go straight to the rationals.
+      if constexpr (std::is_same_v<S, DD>) {
+        if (r.at_zero) return escalate<S, Rational>(r, count, record);
+      }
+      return escalate<S, typename NextTier<S>::type>(r, count, record);
+    }
+  }
+
+  /// Tier H takes the step that tier S could not; S then follows it in O(1), or adopts H's
+  /// state when its own is too imprecise.
+  template <class S, class H>
+  StepResult escalate(const StepResult& r, std::uint64_t count, ImpactRecord* record) {
+    ++(std::is_same_v<H, Float100> ? escalations_.high_precision : escalations_.exact_rational);
+    const StepResult higher = advanceAndStep<H>(count, record);
+    Tier<S>& t = *tier<S>();
+    const bool followed =
+        r.kind == StepKind::kAmbiguous && higher.kind == StepKind::kImpact && t.follow(*tier<H>(), higher.pair);
+    if (!followed) t.adopt(*tier<H>());
+    return higher;
+  }
+
+  /// Brings tier S to `target` impacts (creating it from the scene on first use), then
+  /// takes the next step there.
+  template <class S>
+  StepResult advanceAndStep(std::uint64_t target, ImpactRecord* record) {
+    if (!tier<S>()) {
+      const StepResult r = startOrEscalate<S>();
+      if (r.kind != StepKind::kImpact) return {StepKind::kInconsistent, r.pair, r.time};
+    }
+    if (tier<S>()->count() > target) return {StepKind::kInconsistent, 0, 0.0};
+    while (tier<S>()->count() < target) {
+      const StepResult r = stepOrEscalate<S>(nullptr);
+      if (r.kind != StepKind::kImpact) return {StepKind::kInconsistent, r.pair, r.time};
+      ++escalations_.replayed_impacts;
+    }
+    return stepOrEscalate<S>(record);
+  }
+
+  SceneTables tables_;
+  std::unique_ptr<Tier<DD>> fast_;
+  std::unique_ptr<Tier<Float100>> high_;
+  std::unique_ptr<Tier<Rational>> exact_;
+  Escalations escalations_;
+};
+
+std::string formatValue(double value) {
+  char buffer[32];
+  const auto end = std::to_chars(buffer, buffer + sizeof buffer, value).ptr;
+  return std::string(buffer, end);
+}
+
+/// The frame in which kinetic energy is conserved: the walls' (the lab without walls).
+/// Empty when two walls move at different velocities.
+std::optional<double> energyFrame(const Scene& scene) {
+  const std::size_t last = scene.size() - 1;
+  const bool right = scene.isWall(0), left = scene.size() > 1 && scene.isWall(last);
+  if (right && left && scene.velocities[0] != scene.velocities[last]) return std::nullopt;
+  if (right) return scene.velocities[0];
+  if (left) return scene.velocities[last];
+  return 0.0;
+}
+
+void fillDrift(const Scene& scene, EngineResult& result) {
+  long double e0 = 0, e1 = 0, p0 = 0, p1 = 0, magnitude = 0;
+  const std::optional<double> frame = energyFrame(scene);
+  for (std::size_t k = 0; k < scene.size(); ++k) {
+    if (scene.isWall(k)) continue;
+    const long double m = scene.masses[k];
+    const long double v0 = scene.velocities[k], v1 = result.final_velocities[k];
+    const long double w = frame.value_or(0.0);
+    e0 += m * (v0 - w) * (v0 - w) / 2;
+    e1 += m * (v1 - w) * (v1 - w) / 2;
+    p0 += m * v0;
+    p1 += m * v1;
+    magnitude += m * std::fabs(v0);
+  }
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  if (!frame) {
+    result.energy_relative_drift = kNaN;
+  } else {
+    const long double error = std::fabs(e1 + result.energy_lost - e0);
+    result.energy_relative_drift = static_cast<double>(e0 > 0 ? error / e0 : error);
+  }
+  result.momentum_relative_drift =
+      scene.wallCount() > 0 ? kNaN : static_cast<double>(magnitude > 0 ? std::fabs(p1 - p0) / magnitude : 0.0L);
+}
+
+std::string stopMessage(const Scene& scene, const EngineResult& result) {
+  const std::string count = std::to_string(result.impact_count);
+  switch (result.stop) {
+    case StopReason::kFinished: return "no pair approaches any more after " + count + " impacts: the run is complete";
+    case StopReason::kCap:
+      return "stopped at the cap of " + count + " impacts (truncated)" +
+             (scene.wallCount() == 2 ? "; two walls keep the bodies between them colliding forever" : "");
+    case StopReason::kCancelled: return "cancelled after " + count + " impacts (truncated)";
+    case StopReason::kMultipleCollision: {
+      const MultipleCollision& c = *result.multiple_collision;
+      return bodyName(c.first_body) + ", " + bodyName(c.first_body + 1) + " and " + bodyName(c.first_body + 2) +
+             " meet at the same instant t = " + formatValue(c.time) + " s after " + count +
+             " impacts: a multiple collision, whose outcome point masses do not define, so the run ends here";
+    }
+    case StopReason::kOutOfRange:
+      return "after " + count + " impacts the next one would leave the safe range of a double (above 2^900 in m, s "
+             "or m/s); rescale the units";
+    case StopReason::kInternalError:
+      return "the engine's precision tiers disagreed after " + count + " impacts (a bug, please report it); "
+             "the run ends here";
+  }
+  return "";
+}
+
+/// Maps a step that did not produce an impact to the way the run ends.
+void finish(const StepResult& r, EngineResult& result) {
+  switch (r.kind) {
+    case StepKind::kImpact:
+    case StepKind::kFinished: result.stop = StopReason::kFinished; break;
+    case StepKind::kMultipleCollision:
+      result.stop = StopReason::kMultipleCollision;
+      result.multiple_collision = MultipleCollision{r.pair, r.time};
+      break;
+    case StepKind::kOutOfRange: result.stop = StopReason::kOutOfRange; break;
+    case StepKind::kAmbiguous:
+    case StepKind::kImprecise:
+    case StepKind::kInconsistent: result.stop = StopReason::kInternalError; break;
+  }
+}
+
+}  // namespace
+}  // namespace nbody_detail
+
+const char* stopReasonName(StopReason reason) {
+  switch (reason) {
+    case StopReason::kFinished: return "FINISHED";
+    case StopReason::kCap: return "CAP";
+    case StopReason::kCancelled: return "CANCELLED";
+    case StopReason::kMultipleCollision: return "MULTIPLE_COLLISION";
+    case StopReason::kOutOfRange: return "OUT_OF_RANGE";
+    case StopReason::kInternalError: return "INTERNAL_ERROR";
+  }
+  return "UNKNOWN";
+}
+
+EngineResult runEngine(const Scene& scene, const EngineOptions& options, const ImpactVisitor& visitor,
+                       const ProgressCallback& progress) {
+  using namespace nbody_detail;
+  EngineResult result;
+  Driver driver(scene);
+  StepResult r = driver.start();
+  const bool wants_records = static_cast<bool>(visitor) || options.keep_events > 0;
+  ImpactRecord record;
+  std::uint64_t& count = result.impact_count;
+  while (r.kind == StepKind::kImpact) {
+    if (!driver.fast().pending()) break;
+    if (count == options.max_impacts) {
+      result.stop = StopReason::kCap;
+      break;
+    }
+    if (options.cancel && count % 1024 == 0 && options.cancel->load(std::memory_order_relaxed)) {
+      result.stop = StopReason::kCancelled;
+      break;
+    }
+    r = driver.step(wants_records ? &record : nullptr);
+    if (r.kind != StepKind::kImpact) break;
+    ++count;
+    if (wants_records) {
+      record.index = count;
+      if (visitor) visitor(record);
+      if (count <= options.keep_events) result.events.push_back(record);
+    }
+    if (progress && options.progress_interval > 0 && count % options.progress_interval == 0) {
+      progress(EngineProgress{count, driver.fast().lastTime()});
+    }
+  }
+  if (result.stop == StopReason::kFinished) finish(r, result);
+  result.truncated = result.stop == StopReason::kCap || result.stop == StopReason::kCancelled;
+  result.final_time = driver.fast().lastTime();
+  driver.fast().state(result.final_time, result.final_positions, result.final_velocities);
+  result.energy_lost = driver.fast().energyLost();
+  result.escalations = driver.escalations();
+  fillDrift(scene, result);
+  result.stop_message = stopMessage(scene, result);
+  return result;
+}
+
+}  // namespace core
+}  // namespace collision_lab

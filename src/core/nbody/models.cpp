@@ -1,0 +1,179 @@
+#include "collision_lab/core/nbody/models.h"
+
+#include <algorithm>
+#include <functional>
+
+#include "collision_lab/core/nbody/impact_rule.h"
+#include "double_double.h"
+
+namespace collision_lab {
+namespace core {
+
+namespace {
+
+bool anyApproaching(const Scene& scene) {
+  for (std::size_t p = 0; p < scene.pairCount(); ++p) {
+    if (scene.velocities[p] < scene.velocities[p + 1]) return true;
+  }
+  return false;
+}
+
+/// Walls at both ends that do not move apart, and no pair that can stick (e = 0).
+bool confinedForever(const Scene& scene) {
+  if (scene.size() < 3 || scene.wallCount() != 2) return false;
+  if (scene.velocities.back() < scene.velocities.front()) return false;  // the walls separate
+  for (std::size_t p = 0; p < scene.pairCount(); ++p) {
+    if (scene.restitutionOf(p) == 0.0) return false;
+  }
+  return true;
+}
+
+bool equalFiniteMasses(const Scene& scene) {
+  if (scene.wallCount() > 0) return false;
+  return std::all_of(scene.masses.begin(), scene.masses.end(), [&](double m) { return m == scene.masses[0]; });
+}
+
+/// The one-line reason of each model.
+std::string modelReason(ModelKind kind, const Scene& scene) {
+  switch (kind) {
+    case ModelKind::kNoCollisions:
+      return scene.size() == 1 ? "a single body never collides"
+                               : "no pair approaches (v_p >= v_p+1 for every pair), so the bodies only move apart";
+    case ModelKind::kTwoWallsInfinite:
+      return "two walls that do not move apart confine the bodies, and with every e > 0 they collide forever: "
+             "infinitely many impacts (a run stops at its cap)";
+    case ModelKind::kTwoBody: return "two bodies meet at most once: one impact in closed form";
+    case ModelKind::kThreeBodyRotation:
+      return "three elastic bodies: the paper's rotation model gives the exact count and state in O(1)";
+    case ModelKind::kGhosts:
+      return "equal masses exchange velocities, so the bodies move like ghosts passing through each other: "
+             "the count is the number of inversions and the final velocities are the initial ones sorted";
+    case ModelKind::kEventEngine: break;
+  }
+  return "no count formula exists for " + std::to_string(scene.size()) +
+         " bodies with these masses, walls and restitution: the exact event engine simulates every impact";
+}
+
+ModelKind chooseKind(const Scene& scene) {
+  const std::size_t n = scene.size();
+  if (n == 1 || !anyApproaching(scene)) return ModelKind::kNoCollisions;
+  if (confinedForever(scene)) return ModelKind::kTwoWallsInfinite;
+  if (n == 2) return ModelKind::kTwoBody;
+  if (n == 3 && scene.isElastic() && scene.wallCount() < 2) return ModelKind::kThreeBodyRotation;
+  if (equalFiniteMasses(scene) && scene.isElastic()) return ModelKind::kGhosts;
+  return ModelKind::kEventEngine;
+}
+
+Prediction base(ModelKind kind, const Scene& scene) {
+  Prediction prediction;
+  prediction.kind = kind;
+  prediction.reason = modelReason(kind, scene);
+  return prediction;
+}
+
+/// Merges two descending runs of `from` into `to`, counting the inversions between them.
+std::uint64_t mergeCounting(const double* from, std::size_t begin, std::size_t middle, std::size_t end, double* to) {
+  std::uint64_t inversions = 0;
+  std::size_t i = begin, j = middle, out = begin;
+  while (i < middle && j < end) {
+    if (from[i] >= from[j]) {
+      to[out++] = from[i++];
+    } else {
+      inversions += middle - i;  // every remaining earlier value is below this later one
+      to[out++] = from[j++];
+    }
+  }
+  while (i < middle) to[out++] = from[i++];
+  while (j < end) to[out++] = from[j++];
+  return inversions;
+}
+
+}  // namespace
+
+const char* modelKindName(ModelKind kind) {
+  switch (kind) {
+    case ModelKind::kNoCollisions: return "no_collisions";
+    case ModelKind::kTwoWallsInfinite: return "two_walls_infinite";
+    case ModelKind::kTwoBody: return "two_body";
+    case ModelKind::kThreeBodyRotation: return "three_body_rotation";
+    case ModelKind::kGhosts: return "ghosts";
+    case ModelKind::kEventEngine: return "event_engine";
+  }
+  return "unknown";
+}
+
+ModelChoice chooseModel(const Scene& scene) {
+  const ModelKind kind = chooseKind(scene);
+  return {kind, modelReason(kind, scene)};
+}
+
+Prediction predictNoCollisions(const Scene& scene) {
+  Prediction prediction = base(ModelKind::kNoCollisions, scene);
+  prediction.impact_count = 0;
+  prediction.final_velocities = scene.velocities;
+  return prediction;
+}
+
+Prediction predictTwoWalls(const Scene& scene) {
+  Prediction prediction = base(ModelKind::kTwoWallsInfinite, scene);
+  prediction.infinite = true;
+  return prediction;
+}
+
+Prediction predictTwoBody(const Scene& scene) {
+  using nbody_detail::DD;
+  Prediction prediction = base(ModelKind::kTwoBody, scene);
+  const auto& x = scene.positions;
+  const auto& v = scene.velocities;
+  prediction.final_velocities = v;
+  prediction.impact_count = 0;
+  if (!(v[0] < v[1])) return prediction;
+  // Differences of doubles are exact in double-double, so time and place round once or twice.
+  const DD time = (DD(x[0]) - DD(x[1])) / (DD(v[1]) - DD(v[0]));
+  const std::size_t slow = std::fabs(v[0]) <= std::fabs(v[1]) ? 0 : 1;
+  const ImpactOutcome outcome = impact(scene.masses[0], scene.masses[1], v[0], v[1], scene.restitutionOf(0));
+  prediction.impact_count = 1;
+  prediction.impact_time = time.hi;
+  prediction.impact_position = (DD(x[slow]) + time * v[slow]).hi;
+  prediction.final_velocities = {outcome.velocity_i, outcome.velocity_j};
+  prediction.energy_lost = outcome.energy_lost;
+  return prediction;
+}
+
+Prediction predictGhosts(const Scene& scene) {
+  Prediction prediction = base(ModelKind::kGhosts, scene);
+  prediction.impact_count = countInversions(scene.velocities);
+  prediction.final_velocities = scene.velocities;
+  // The fastest rightward ends on the right, at index 0.
+  std::sort(prediction.final_velocities.begin(), prediction.final_velocities.end(), std::greater<double>());
+  return prediction;
+}
+
+std::optional<Prediction> predict(const Scene& scene) {
+  switch (chooseKind(scene)) {
+    case ModelKind::kNoCollisions: return predictNoCollisions(scene);
+    case ModelKind::kTwoWallsInfinite: return predictTwoWalls(scene);
+    case ModelKind::kTwoBody: return predictTwoBody(scene);
+    case ModelKind::kGhosts: return predictGhosts(scene);
+    case ModelKind::kThreeBodyRotation:
+    case ModelKind::kEventEngine: break;
+  }
+  return std::nullopt;
+}
+
+std::uint64_t countInversions(const std::vector<double>& velocities) {
+  const std::size_t n = velocities.size();
+  std::vector<double> a = velocities, b(n);
+  std::uint64_t inversions = 0;
+  for (std::size_t width = 1; width < n; width *= 2) {
+    for (std::size_t begin = 0; begin < n; begin += 2 * width) {
+      const std::size_t middle = std::min(begin + width, n), end = std::min(begin + 2 * width, n);
+      inversions += mergeCounting(a.data(), begin, middle, end, b.data());
+    }
+    a.swap(b);
+  }
+  return inversions;
+}
+
+}  // namespace core
+}  // namespace collision_lab

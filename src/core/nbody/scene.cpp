@@ -1,0 +1,264 @@
+#include "collision_lab/core/nbody/scene.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <limits>
+
+#include <boost/multiprecision/cpp_int.hpp>
+
+namespace collision_lab {
+namespace core {
+
+namespace {
+
+using Rational = boost::multiprecision::cpp_rational;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+/// Beyond this finite-mass ratio the engine's 100-digit tier loses its margin; a body
+/// that much heavier is a wall to every digit that matters.
+constexpr double kMaxMassRatio = 1e100;
+
+/// Shortest text that reads back as the same double.
+std::string formatValue(double value) {
+  char buffer[32];
+  const auto end = std::to_chars(buffer, buffer + sizeof buffer, value).ptr;
+  return std::string(buffer, end);
+}
+
+std::string indexedField(const char* list, std::size_t i) { return std::string(list) + "[" + std::to_string(i) + "]"; }
+
+/// The message always starts with the field, so one line tells the user where to look.
+ValidationError makeError(Reason reason, const std::string& field, const std::string& message) {
+  return ValidationError{reason, field, field + ": " + message};
+}
+
+std::optional<ValidationError> checkShape(const Scene& scene) {
+  const std::size_t n = scene.masses.size();
+  if (scene.positions.size() != n || scene.velocities.size() != n) {
+    return makeError(Reason::kUnequalLengths, "masses",
+                     "the lists have different lengths (masses " + std::to_string(n) + ", positions " +
+                         std::to_string(scene.positions.size()) + ", velocities " +
+                         std::to_string(scene.velocities.size()) + "); give one mass, position and velocity per body");
+  }
+  if (n == 0) {
+    return makeError(Reason::kEmptyScene, "masses", "the scene has no bodies; give at least one mass, position and velocity");
+  }
+  const std::size_t count = scene.restitution.size();
+  if (count != 0 && count != 1 && count != n - 1) {
+    return makeError(Reason::kRestitutionCount, "restitution",
+                     std::to_string(count) + " values for " + std::to_string(n - 1) +
+                         " pairs; give none (elastic), one for every pair, or one per pair (N-1 = " +
+                         std::to_string(n - 1) + ")");
+  }
+  for (std::size_t i = 0; i < count; ++i) {
+    const double e = scene.restitution[i];
+    if (!(e >= 0.0 && e <= 1.0)) {
+      return makeError(Reason::kRestitutionOutOfRange, indexedField("restitution", i),
+                       "e = " + formatValue(e) + " is not a coefficient of restitution; it must lie in [0, 1] (1 = elastic)");
+    }
+  }
+  return std::nullopt;
+}
+
+std::optional<ValidationError> checkMasses(const Scene& scene) {
+  const std::size_t n = scene.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const double m = scene.masses[i];
+    if (std::isnan(m)) {
+      return makeError(Reason::kNonFiniteValue, indexedField("masses", i),
+                       "the mass of " + bodyName(i) + " is NaN; a mass must be a positive number in kg, or inf for a wall");
+    }
+    if (!(m > 0.0)) {
+      return makeError(Reason::kNonPositiveMass, indexedField("masses", i),
+                       "the mass of " + bodyName(i) + " is " + formatValue(m) + " kg; a mass must be positive");
+    }
+    if (std::isinf(m) && i != 0 && i + 1 != n) {
+      return makeError(Reason::kWallNotAtEnd, indexedField("masses", i),
+                       "the mass of " + bodyName(i) + " is inf, but a wall may only be the first or the last body; "
+                       "give it a finite mass in kg");
+    }
+  }
+  if (n == 2 && scene.isWall(0) && scene.isWall(1)) {
+    return makeError(Reason::kTwoWalls, "masses", "both bodies are walls (inf) with no body between them; give one a finite mass");
+  }
+  double lightest = kInf, heaviest = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (scene.isWall(i)) continue;
+    lightest = std::min(lightest, scene.masses[i]);
+    heaviest = std::max(heaviest, scene.masses[i]);
+  }
+  if (heaviest > 0.0 && !(heaviest / lightest <= kMaxMassRatio)) {
+    return makeError(Reason::kOverflow, "masses",
+                     "the ratio of the largest to the smallest finite mass exceeds 1e100 (" + formatValue(heaviest) +
+                         " / " + formatValue(lightest) + " kg); make the heavy body a wall (inf) instead");
+  }
+  return std::nullopt;
+}
+
+std::optional<ValidationError> checkFinite(const std::vector<double>& values, const char* list, const char* what,
+                                           const char* unit) {
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    if (!std::isfinite(values[i])) {
+      return makeError(Reason::kNonFiniteValue, indexedField(list, i),
+                       std::string("the ") + what + " of " + bodyName(i) + " is " + formatValue(values[i]) + "; a " +
+                           what + " must be a finite number in " + unit);
+    }
+  }
+  return std::nullopt;
+}
+
+std::optional<ValidationError> checkOrder(const Scene& scene) {
+  const auto& x = scene.positions;
+  for (std::size_t i = 0; i + 1 < x.size(); ++i) {
+    if (x[i] == x[i + 1]) {
+      return makeError(Reason::kPositionsCoincident, "positions",
+                       "the positions of " + bodyName(i) + " and " + bodyName(i + 1) + " coincide at " + formatValue(x[i]) +
+                           " m; touching point masses are a multiple collision, so they must be distinct");
+    }
+    if (!(x[i] > x[i + 1])) {
+      return makeError(Reason::kPositionsNotOrdered, "positions",
+                       "x_" + bodyName(i) + " = " + formatValue(x[i]) + " m is not greater than x_" + bodyName(i + 1) +
+                           " = " + formatValue(x[i + 1]) + " m; list the bodies right to left (strictly decreasing positions)");
+    }
+  }
+  return std::nullopt;
+}
+
+/// Everything the engine forms must be representable: momenta, kinetic energies, gaps,
+/// relative velocities and their sums.
+std::optional<ValidationError> checkRange(const Scene& scene) {
+  const auto& m = scene.masses;
+  const auto& x = scene.positions;
+  const auto& v = scene.velocities;
+  double energy = 0.0, momentum = 0.0;
+  for (std::size_t i = 0; i < scene.size(); ++i) {
+    if (scene.isWall(i)) continue;
+    energy += m[i] * v[i] * v[i];
+    momentum += m[i] * std::fabs(v[i]);
+    if (!std::isfinite(energy) || !std::isfinite(momentum) || !std::isfinite(8.0 * v[i])) {
+      return makeError(Reason::kOverflow, indexedField("velocities", i),
+                       "the momentum or kinetic energy of " + bodyName(i) + " (m = " + formatValue(m[i]) + " kg, v = " +
+                           formatValue(v[i]) + " m/s), or the total, overflows a double; rescale the units");
+    }
+  }
+  for (std::size_t i = 0; i + 1 < scene.size(); ++i) {
+    if (!std::isfinite(x[i] - x[i + 1]) || !std::isfinite(4.0 * (std::fabs(v[i]) + std::fabs(v[i + 1])))) {
+      return makeError(Reason::kOverflow, "positions",
+                       "the gap or relative velocity between " + bodyName(i) + " and " + bodyName(i + 1) +
+                           " overflows a double; rescale the units");
+    }
+  }
+  return std::nullopt;
+}
+
+Rational exactTime(const Scene& scene, std::size_t p) {
+  const Rational gap = Rational(scene.positions[p]) - Rational(scene.positions[p + 1]);
+  return gap / (Rational(scene.velocities[p + 1]) - Rational(scene.velocities[p]));
+}
+
+/// The first contact: representable, and not two contacts sharing a body at once.
+std::optional<ValidationError> checkFirstContact(const Scene& scene) {
+  const auto& x = scene.positions;
+  const auto& v = scene.velocities;
+  std::vector<double> time(scene.pairCount(), kInf);
+  double first = kInf;
+  bool approaching = false;
+  for (std::size_t p = 0; p < time.size(); ++p) {
+    if (!(v[p] < v[p + 1])) continue;
+    approaching = true;
+    time[p] = (x[p] - x[p + 1]) / (v[p + 1] - v[p]);
+    first = std::min(first, time[p]);
+  }
+  if (!approaching) return std::nullopt;
+  // Each double time is within 3 ulps of the truth; exact rationals settle the near-ties.
+  const double window = first * (1.0 + 0x1p-48) + 4.0 * std::numeric_limits<double>::denorm_min();
+  std::vector<std::size_t> candidates;
+  for (std::size_t p = 0; p < time.size(); ++p) {
+    if (time[p] <= window) candidates.push_back(p);
+  }
+  if (candidates.size() > 1) {
+    std::vector<Rational> exact;
+    for (std::size_t p : candidates) exact.push_back(exactTime(scene, p));
+    const Rational earliest = *std::min_element(exact.begin(), exact.end());
+    for (std::size_t k = 0; k + 1 < candidates.size(); ++k) {
+      const std::size_t p = candidates[k];
+      if (candidates[k + 1] == p + 1 && exact[k] == earliest && exact[k + 1] == earliest) {
+        return makeError(Reason::kTripleCollision, "positions",
+                         bodyName(p) + ", " + bodyName(p + 1) + " and " + bodyName(p + 2) + " would meet at the same instant (t = " +
+                             formatValue(time[p]) + " s), a multiple collision whose outcome point masses do not define; "
+                             "move one of them");
+      }
+    }
+  }
+  for (std::size_t i = 0; i < scene.size(); ++i) {
+    if (!std::isfinite(first) || !std::isfinite(x[i] + v[i] * first)) {
+      return makeError(Reason::kOverflow, "positions",
+                       "the first contact would come at t = " + formatValue(first) +
+                           " s or beyond the range of a double in position; rescale the units");
+    }
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+bool Scene::isWall(std::size_t body) const { return masses[body] == kInf; }
+
+std::size_t Scene::wallCount() const {
+  if (masses.empty()) return 0;
+  if (masses.size() == 1) return isWall(0) ? 1 : 0;
+  return (isWall(0) ? 1 : 0) + (isWall(masses.size() - 1) ? 1 : 0);
+}
+
+double Scene::restitutionOf(std::size_t pair) const {
+  if (restitution.empty()) return 1.0;
+  return restitution.size() == 1 ? restitution[0] : restitution[pair];
+}
+
+bool Scene::isElastic() const {
+  return std::all_of(restitution.begin(), restitution.end(), [](double e) { return e == 1.0; });
+}
+
+std::string bodyName(std::size_t body) {
+  if (body < 26) return std::string(1, static_cast<char>('A' + body));
+  return "#" + std::to_string(body);
+}
+
+std::string pairName(std::size_t pair) {
+  if (pair + 1 < 26) return bodyName(pair) + bodyName(pair + 1);
+  return bodyName(pair) + "-" + bodyName(pair + 1);
+}
+
+const char* reasonName(Reason reason) {
+  switch (reason) {
+    case Reason::kOk: return "OK";
+    case Reason::kNonFiniteValue: return "NON_FINITE_VALUE";
+    case Reason::kNonPositiveMass: return "NON_POSITIVE_MASS";
+    case Reason::kTwoWalls: return "TWO_WALLS";
+    case Reason::kInfiniteMiddleMass: return "INFINITE_MIDDLE_MASS";
+    case Reason::kPositionsNotOrdered: return "POSITIONS_NOT_ORDERED";
+    case Reason::kPositionsCoincident: return "POSITIONS_COINCIDENT";
+    case Reason::kTripleCollision: return "TRIPLE_COLLISION";
+    case Reason::kOverflow: return "OVERFLOW";
+    case Reason::kUnequalLengths: return "UNEQUAL_LENGTHS";
+    case Reason::kEmptyScene: return "EMPTY_SCENE";
+    case Reason::kRestitutionOutOfRange: return "RESTITUTION_OUT_OF_RANGE";
+    case Reason::kRestitutionCount: return "RESTITUTION_COUNT";
+    case Reason::kWallNotAtEnd: return "WALL_NOT_AT_END";
+  }
+  return "UNKNOWN";
+}
+
+std::optional<ValidationError> validate(const Scene& scene) {
+  if (auto error = checkShape(scene)) return error;
+  if (auto error = checkMasses(scene)) return error;
+  if (auto error = checkFinite(scene.positions, "positions", "position", "m")) return error;
+  if (auto error = checkFinite(scene.velocities, "velocities", "velocity", "m/s")) return error;
+  if (auto error = checkOrder(scene)) return error;
+  if (auto error = checkRange(scene)) return error;
+  return checkFirstContact(scene);
+}
+
+}  // namespace core
+}  // namespace collision_lab

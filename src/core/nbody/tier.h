@@ -1,0 +1,563 @@
+// One arithmetic tier of the N-body event engine (internal; not installed).
+//
+// State. Body k moves on the line x = b_k + v_k t between its impacts; the tier keeps the
+// intercepts b [m] and velocities v [m/s] in its number type S. An impact of pair p maps
+// (b, v) of its two bodies by the same linear impact map (impact_rule.h), so no body ever
+// needs a time of its own, and the impact time t_p = (b_p - b_{p+1}) / (v_{p+1} - v_p)
+// serves only to order the events.
+//
+// Error bounds. In mass-weighted coordinates B = sqrt(m) b and U = sqrt(m) v an impact
+// applies the same linear map F = I - (1+e) n n^T (norm 1) to B and to U, in the exact
+// process and in the computed one alike, as long as both see the same sequence of impacts.
+// So the 2-norm of the error vector only grows by each impact's own rounding:
+// ||U_computed - U_exact|| <= eu_, ||B_computed - B_exact|| <= eb_, with eu_, eb_ summed
+// from a bound on each impact's rounding (rho()). A body's velocity is then off by at most
+// eu_ / sqrt(m_k), and a pair's approach speed by eu_ (1/sqrt(m_p) + 1/sqrt(m_{p+1})).
+// Walls are exact and take no part. In the exact tier every bound is 0.
+//
+// Decisions. The events are processed in the canonical order (exact time, then pair
+// index). Each pair's leaf in the tournament tree holds a lower bound of its next impact
+// time and PairState::upper an upper bound. The root is next when its upper bound is below every
+// other lower bound; otherwise the candidates are compared with precise times (S
+// arithmetic, tight bounds). What a tier cannot decide it reports as kAmbiguous: the
+// caller then replays the run in a more precise tier and adopts that tier's state.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "arithmetic.h"
+#include "collision_lab/core/nbody/engine.h"
+#include "collision_lab/core/nbody/impact_rule.h"
+#include "collision_lab/core/nbody/scene.h"
+#include "tournament_tree.h"
+
+namespace collision_lab {
+namespace core {
+namespace nbody_detail {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kUnit = 0x1p-53;           // unit roundoff of double
+constexpr double kSlack = 1.0 + 0x1p-40;    // covers the rounding of evaluating a bound in double
+constexpr double kTiny = 0x1p-1000;         // covers underflow in double-double, per operation
+constexpr double kMaxMagnitude = 0x1p900;   // beyond this the engine stops: out of range
+constexpr double kTimePrecision = 0x1p-42;  // relative precision of the published impact times
+
+/// What does not change during a run, shared by the tiers (doubles, exact inputs).
+struct SceneTables {
+  explicit SceneTables(const Scene& scene);
+  const Scene& scene;
+  std::size_t pairs = 0;
+  std::vector<double> sqrt_mass;      ///< sqrt(m) [kg^0.5]; 0 for a wall (it carries no error)
+  std::vector<double> inv_sqrt_mass;  ///< 1 / sqrt(m) [kg^-0.5]; 0 for a wall
+  std::vector<double> loss_factor;    ///< (1 - e^2) mu / 2 per pair [kg]
+};
+
+/// kAmbiguous: a decision this tier cannot take; kImprecise: its state no longer pins down
+/// the time of the impact it was about to perform (the precision guard).
+enum class StepKind { kImpact, kFinished, kMultipleCollision, kAmbiguous, kImprecise, kOutOfRange, kInconsistent };
+
+struct StepResult {
+  StepKind kind = StepKind::kImpact;
+  std::size_t pair = 0;  ///< the impact's pair, or the lower pair of a multiple collision
+  double time = 0.0;     ///< of a multiple collision [s]
+  bool at_zero = false;  ///< kAmbiguous on a value exactly 0 at this precision: likely an exact tie
+};
+
+template <class S>
+class Tier {
+ public:
+  using Ar = Arithmetic<S>;
+
+  explicit Tier(const SceneTables& tables) : tables_(tables), tree_(tables.pairs) {
+    const Scene& scene = tables.scene;
+    for (std::size_t k = 0; k < scene.size(); ++k) {
+      bodies_.push_back({S(scene.positions[k]), S(scene.velocities[k])});
+    }
+    for (std::size_t p = 0; p < tables.pairs; ++p) {
+      PairState pair;
+      pair.map = makeImpactMap<S>(scene.masses[p], scene.masses[p + 1], scene.restitutionOf(p));
+      pair.scale = tables.inv_sqrt_mass[p] + tables.inv_sqrt_mass[p + 1];
+      pair.sqrt_heavy = tables.sqrt_mass[pair.map.heavy_is_i ? p : p + 1];
+      pair.sqrt_light = tables.sqrt_mass[pair.map.heavy_is_i ? p + 1 : p];
+      pairs_.push_back(pair);
+    }
+  }
+
+  /// Schedules every pair from the initial state.
+  StepResult start() {
+    for (std::size_t p = 0; p < tables_.pairs; ++p) {
+      const StepResult r = schedule(p);
+      if (r.kind != StepKind::kImpact) return r;
+    }
+    tree_.rebuild();
+    return {};
+  }
+
+  bool pending() const { return tree_.minKey() < kInf; }
+  std::uint64_t count() const { return count_; }
+  std::uint64_t refinements() const { return refinements_; }
+  double energyLost() const { return lost_ + lost_compensation_; }
+  /// Time of the last impact [s], or of the one in progress (0 before the first).
+  double lastTime() const { return Ar::sign(now_.A) > 0 ? Ar::toDouble(S(now_.G / now_.A)) : 0.0; }
+
+  /// Finds and performs the next impact (or reports why not). `record` may be null.
+  StepResult step(ImpactRecord* record) {
+    std::size_t next = tree_.minLeaf();
+    if (!(tree_.minKey() < kInf)) return {StepKind::kFinished, 0, lastTime()};
+    if (!(pairs_[next].upper < tree_.minKeyExcluding(next))) {
+      const StepResult r = resolveNext(next);
+      if (r.kind != StepKind::kImpact) return r;
+      next = r.pair;
+    }
+    return impact(next, record);
+  }
+
+  /// Takes over the state of a more precise tier at the same impact count.
+  template <class From>
+  void adopt(const Tier<From>& from) {
+    constexpr double conversion = conversionError<S>();
+    eu_ = from.eu_;
+    eb_ = from.eb_;
+    for (std::size_t k = 0; k < bodies_.size(); ++k) {
+      BodyState& body = bodies_[k];
+      body.b = convertTo<S>(from.bodies_[k].b);
+      body.v = convertTo<S>(from.bodies_[k].v);
+      eu_ += 2 * conversion * tables_.sqrt_mass[k] * std::fabs(Ar::toDouble(body.v));
+      eb_ += 2 * conversion * tables_.sqrt_mass[k] * std::fabs(Ar::toDouble(body.b));
+    }
+    tree_ = from.tree_;
+    for (std::size_t p = 0; p < pairs_.size(); ++p) pairs_[p].upper = from.pairs_[p].upper;
+    count_ = from.count_;
+    lost_ = from.lost_;
+    lost_compensation_ = from.lost_compensation_;
+    now_.pair = from.now_.pair;
+    now_.G = convertTo<S>(from.now_.G);
+    now_.A = convertTo<S>(from.now_.A);
+    now_.eb = from.now_.eb;
+    now_.eu = from.now_.eu;
+    // The conversion of G and A; the other tier's rounding of them is below this tier's,
+    // which preciseNow() counts.
+    now_.extra = from.now_.extra + 2 * conversion * (std::fabs(Ar::toDouble(now_.G)) + std::fabs(Ar::toDouble(now_.A)));
+    now_.upper = from.now_.upper;
+  }
+
+  /// Performs, in this tier's arithmetic, the impact of pair m that a more precise tier at
+  /// the same count has just taken, and takes that tier's schedules of the three pairs it
+  /// changed (bounds on exact times, whoever computed them): O(1), where adopt() is O(N).
+  /// Returns false, changing nothing, when this tier's state cannot pin down the impact's
+  /// time; adopt() then refreshes it.
+  template <class From>
+  bool follow(const Tier<From>& from, std::size_t m) {
+    const Undo undo = saveFor(m);
+    if (collide(m, nullptr).kind != StepKind::kImpact) {
+      restore(m, undo);
+      return false;
+    }
+    const std::size_t first = m > 0 ? m - 1 : m, last = std::min(m + 1, pairs_.size() - 1);
+    for (std::size_t q = first; q <= last; ++q) setSchedule(q, from.tree_.key(q), from.pairs_[q].upper);
+    tree_.update(first, last);
+    ++count_;
+    return true;
+  }
+
+  /// Positions [m] at time t [s] and velocities [m/s], rounded to double.
+  void state(double t, std::vector<double>& positions, std::vector<double>& velocities) const {
+    positions.resize(bodies_.size());
+    velocities.resize(bodies_.size());
+    for (std::size_t k = 0; k < bodies_.size(); ++k) {
+      positions[k] = Ar::toDouble(S(bodies_[k].b + S(bodies_[k].v * S(t))));
+      velocities[k] = Ar::toDouble(bodies_[k].v);
+    }
+  }
+
+ private:
+  template <class>
+  friend class Tier;
+
+  /// Body k is at b + v t [m] at time t [s], between its impacts.
+  struct BodyState {
+    S b;  ///< intercept [m]
+    S v;  ///< velocity [m/s]
+  };
+  /// What an impact needs of pair p (bodies p, p+1), in one cache line for double-double.
+  struct alignas(64) PairState {
+    ImpactMap<S> map;
+    double upper = kInf;      ///< upper bound of the next impact time [s]
+    double scale = 0.0;       ///< 1/sqrt(m_p) + 1/sqrt(m_p+1) [kg^-0.5], a wall counting 0
+    double sqrt_heavy = 0.0;  ///< sqrt of the heavier mass [kg^0.5], 0 for a wall
+    double sqrt_light = 0.0;  ///< sqrt of the lighter mass [kg^0.5]
+  };
+
+  /// kUnknownAtZero: undecided, and the value is exactly 0 at this precision, which in
+  /// practice means an exact tie (equal velocities or times from structured inputs).
+  enum class Decision { kYes, kNo, kUnknown, kUnknownAtZero };
+  enum class Order { kLess, kEqual, kGreater, kUnknown, kUnknownAtZero };
+
+  /// A double approximation of an exact-process quantity and a bound on its error.
+  struct Approx {
+    double value;
+    double error;
+  };
+  /// A time in S and a bound on its distance to the exact time [s].
+  struct Precise {
+    S value;
+    double error;
+    bool ok;
+  };
+  /// The last impact: its gap G = b_p - b_{p+1} and approach speed A before it, with
+  /// bounds (so its precise time can be formed later), and the upper bound of its time.
+  struct Now {
+    std::size_t pair = 0;
+    S G{}, A{};
+    double eb = 0.0, eu = 0.0;  ///< the state's bounds before the impact
+    double extra = 0.0;         ///< what adoption added to the bounds of G and A
+    double upper = 0.0;         ///< [s]
+  };
+
+  /// What an impact changes besides the tree (a failed step leaves the tree to be rebuilt by adopt()).
+  struct Undo {
+    BodyState i, j;
+    double eu, eb, lost, lost_compensation;
+    Now now;
+  };
+
+  double pairScale(std::size_t p) const { return pairs_[p].scale; }
+
+  /// x - y as a double, with a bound on its distance to the exact difference of x and y.
+  static Approx approxDifference(const S& x, const S& y) {
+    if constexpr (std::is_same_v<S, DD>) {
+      const double value = (x.hi - y.hi) + (x.lo - y.lo);
+      return {value, 2.01 * kUnit * std::fabs(value) + 3 * kUnit * kUnit * (std::fabs(x.hi) + std::fabs(y.hi)) + kTiny};
+    } else {
+      const double value = Ar::toDouble(S(x - y));
+      // kTiny: a difference that underflows in double must not read as exactly 0.
+      return {value, 1.01 * (Ar::kOpError + Ar::kToDoubleError) * std::fabs(value) + kTiny};
+    }
+  }
+
+  /// Approach speed v_{p+1} - v_p [m/s] in double, its error bound including the state's.
+  Approx approach(std::size_t p) const {
+    Approx a = approxDifference(bodies_[p + 1].v, bodies_[p].v);
+    a.error = (a.error + eu_ * pairScale(p)) * kSlack;
+    return a;
+  }
+  /// Gap at t = 0 of the two lines, G = b_p - b_{p+1} [m], likewise.
+  Approx gap(std::size_t p) const {
+    Approx g = approxDifference(bodies_[p].b, bodies_[p + 1].b);
+    g.error = (g.error + eb_ * pairScale(p)) * kSlack;
+    return g;
+  }
+
+  /// Sign decision on an S value known to within `error` of the exact one.
+  static Decision positive(const S& value, double error) {
+    if (Ar::sign(S(value - S(error))) > 0) return Decision::kYes;
+    if (Ar::sign(S(value + S(error))) <= 0) return Decision::kNo;
+    return Ar::sign(value) == 0 ? Decision::kUnknownAtZero : Decision::kUnknown;
+  }
+
+  /// Does pair p approach? `a` is approach(p).
+  Decision decideApproach(std::size_t p, const Approx& a) {
+    if (a.value - a.error > 0) return Decision::kYes;
+    if (a.value + a.error <= 0) return Decision::kNo;
+    ++refinements_;
+    const S precise = bodies_[p + 1].v - bodies_[p].v;
+    const double error = (eu_ * pairScale(p) + 1.01 * Ar::kOpError * std::fabs(Ar::toDouble(precise))) * kSlack;
+    return positive(precise, error);
+  }
+
+  /// The time t = G / A [s] from S values with error bounds eG, eA (an inexact tier); !ok
+  /// when A is not clearly positive at this precision.
+  static Precise preciseTime(const S& G, double eG, const S& A, double eA) {
+    const double a = Ar::toDouble(A) * (1 - 2 * Ar::kToDoubleError) - eA;
+    if (!(a > 0.5 * Ar::toDouble(A))) return {S(), kInf, false};
+    const S t = G / A;
+    const double td = std::fabs(Ar::toDouble(t)) * (1 + 2 * Ar::kToDoubleError);
+    const double error = ((eG + td * eA) / a + 2 * Ar::kOpError * td) * kSlack + kTiny;
+    return {t, error, true};
+  }
+
+  /// Pair p's next impact time in S (p approaches).
+  Precise preciseTime(std::size_t p) {
+    ++refinements_;
+    const S G = bodies_[p].b - bodies_[p + 1].b;
+    const S A = bodies_[p + 1].v - bodies_[p].v;
+    if constexpr (Ar::kExact) return {G / A, 0.0, true};
+    const double eG = (eb_ * pairScale(p) + 1.01 * Ar::kOpError * std::fabs(Ar::toDouble(G))) * kSlack;
+    const double eA = (eu_ * pairScale(p) + 1.01 * Ar::kOpError * std::fabs(Ar::toDouble(A))) * kSlack;
+    return preciseTime(G, eG, A, eA);
+  }
+
+  Precise preciseNow() const {
+    if constexpr (Ar::kExact) return {now_.G / now_.A, 0.0, true};
+    const double scale = pairs_[now_.pair].scale;
+    const double eG = (now_.eb * scale + 1.01 * Ar::kOpError * std::fabs(Ar::toDouble(now_.G)) + now_.extra) * kSlack;
+    const double eA = (now_.eu * scale + 1.01 * Ar::kOpError * std::fabs(Ar::toDouble(now_.A)) + now_.extra) * kSlack;
+    return preciseTime(now_.G, eG, now_.A, eA);
+  }
+
+  static Order compare(const Precise& x, const Precise& y) {
+    if (!x.ok || !y.ok) return Order::kUnknown;
+    const S difference = y.value - x.value;
+    if constexpr (Ar::kExact) {
+      const int s = Ar::sign(difference);
+      return s > 0 ? Order::kLess : (s < 0 ? Order::kGreater : Order::kEqual);
+    }
+    const double error = (x.error + y.error + 2 * Ar::kOpError * std::fabs(Ar::toDouble(difference))) * kSlack;
+    switch (positive(difference, error)) {
+      case Decision::kYes: return Order::kLess;
+      case Decision::kNo: return positive(S(-difference), error) == Decision::kYes ? Order::kGreater : Order::kUnknown;
+      case Decision::kUnknownAtZero: return Order::kUnknownAtZero;
+      case Decision::kUnknown: break;
+    }
+    return Order::kUnknown;
+  }
+
+  /// Outward-rounded bounds [s] of a time known to within `error` of `estimate`.
+  static void widenBounds(double estimate, double error, double& lower, double& upper) {
+    const double widen = error * kSlack + std::fabs(estimate) * 0x1p-50 + 0x1p-1070;
+    lower = estimate - widen;
+    upper = estimate + widen;
+  }
+
+  /// Bounds [s] of the time G / A from double approximations, with one division:
+  /// 1 / (a - e) <= (1/a)(1 + 2 e/a) for e <= a/2. Meaningful when a.value - a.error > a.value / 2.
+  static void coarseBounds(const Approx& a, const Approx& g, double& lower, double& upper) {
+    const double inverse = 1.0 / a.value;
+    const double estimate = g.value * inverse;
+    const double t = std::fabs(estimate);
+    const double error =
+        (2 * kUnit * t + (g.error + t * (1 + 4 * kUnit) * a.error) * inverse * (1 + 2 * a.error * inverse)) * kSlack;
+    widenBounds(estimate, error, lower, upper);
+  }
+
+  void setSchedule(std::size_t p, double lower, double upper) {
+    tree_.set(p, lower);
+    pairs_[p].upper = upper;
+  }
+
+  /// Decides whether pair p approaches and bounds its next impact time. The common cases
+  /// take no branch on the answer, which is unpredictable.
+  StepResult schedule(std::size_t p) {
+    const Approx a = approach(p);
+    const Approx g = gap(p);
+    const bool yes = a.value - a.error > 0.5 * a.value;  // false for a.value <= 0
+    const bool no = a.value + a.error <= 0;
+    if (!(yes || no)) return scheduleCarefully(p, a);
+    double bounds[2][2] = {{kInf, kInf}, {0.0, 0.0}};  // [yes][lower, upper]
+    coarseBounds(a, g, bounds[1][0], bounds[1][1]);
+    if (yes && !(bounds[1][1] < kMaxMagnitude)) return {StepKind::kOutOfRange, p, lastTime()};
+    setSchedule(p, bounds[yes][0], bounds[yes][1]);
+    return {};
+  }
+
+  /// The rare case: the approach speed or the time is too close to call in double.
+  StepResult scheduleCarefully(std::size_t p, const Approx& a) {
+    double lower = kInf, upper = kInf;
+    switch (decideApproach(p, a)) {
+      case Decision::kUnknown: return {StepKind::kAmbiguous, p, lastTime()};
+      case Decision::kUnknownAtZero: return {StepKind::kAmbiguous, p, lastTime(), true};
+      case Decision::kNo: break;
+      case Decision::kYes: {
+        const Precise precise = preciseTime(p);
+        if (!precise.ok) return {StepKind::kAmbiguous, p, lastTime()};
+        const double estimate = Ar::toDouble(precise.value);
+        widenBounds(estimate, precise.error + Ar::kToDoubleError * std::fabs(estimate), lower, upper);
+        if (!(upper < kMaxMagnitude)) return {StepKind::kOutOfRange, p, lastTime()};
+        break;
+      }
+    }
+    setSchedule(p, lower, upper);
+    return {};
+  }
+
+  /// After an impact of pair m: pair q (a neighbour) gets its new schedule, which must
+  /// come strictly after the impact; exactly at it is a multiple collision.
+  StepResult reschedule(std::size_t q, std::size_t m) {
+    const StepResult r = schedule(q);
+    if (r.kind != StepKind::kImpact || !(tree_.key(q) <= now_.upper)) return r;
+    switch (compare(preciseNow(), preciseTime(q))) {
+      case Order::kLess: return {};
+      case Order::kEqual: return {StepKind::kMultipleCollision, std::min(q, m), lastTime()};
+      case Order::kGreater: return {StepKind::kInconsistent, q, lastTime()};
+      case Order::kUnknownAtZero: return {StepKind::kAmbiguous, q, lastTime(), true};
+      case Order::kUnknown: break;
+    }
+    return {StepKind::kAmbiguous, q, lastTime()};
+  }
+
+  /// The root's bounds overlap others: compare the candidates' precise times. Exact ties
+  /// of disjoint pairs go in pair order; of pairs sharing a body, they are a multiple collision.
+  StepResult resolveNext(std::size_t root) {
+    std::vector<std::size_t> candidates;
+    tree_.forEachAtMost(pairs_[root].upper, [&](std::size_t p) { candidates.push_back(p); });
+    std::vector<Precise> times;
+    std::size_t best = 0;
+    for (std::size_t k = 0; k < candidates.size(); ++k) {
+      times.push_back(preciseTime(candidates[k]));
+      if (!times.back().ok) return {StepKind::kAmbiguous, candidates[k], lastTime()};
+      if (times[k].value < times[best].value) best = k;
+    }
+    std::vector<std::size_t> tied{candidates[best]};
+    for (std::size_t k = 0; k < candidates.size(); ++k) {
+      if (k == best) continue;
+      const Order order = compare(times[best], times[k]);
+      if (order == Order::kUnknown || order == Order::kGreater || order == Order::kUnknownAtZero) {
+        return {StepKind::kAmbiguous, candidates[k], lastTime(), order == Order::kUnknownAtZero};
+      }
+      if (order == Order::kEqual) tied.push_back(candidates[k]);
+    }
+    std::sort(tied.begin(), tied.end());
+    for (std::size_t k = 0; k + 1 < tied.size(); ++k) {
+      if (tied[k + 1] == tied[k] + 1) {
+        return {StepKind::kMultipleCollision, tied[k], Ar::toDouble(times[best].value)};
+      }
+    }
+    return {StepKind::kImpact, tied.front(), 0.0};
+  }
+
+  /// Bound on the mass-weighted rounding error of one impact (see the header comment):
+  /// 2 eta [ s_h (|q_h'| + 8 |inc|) + s_l (|q_l'| + |q_h'| + 8 |inc| + 2 |d|) ].
+  double rho(std::size_t m, const ImpactChange<S>& change, const S& q_i, const S& q_j) const {
+    if constexpr (Ar::kExact) return 0.0;
+    const PairState& pair = pairs_[m];
+    if (pair.map.exchange) return 0.0;  // a swap rounds nothing
+    const bool heavy_is_i = pair.map.heavy_is_i;
+    const double s_h = pair.sqrt_heavy, s_l = pair.sqrt_light;
+    const double q_h = std::fabs(Ar::toDouble(heavy_is_i ? q_i : q_j));
+    const double q_l = std::fabs(Ar::toDouble(heavy_is_i ? q_j : q_i));
+    const double inc = std::fabs(Ar::toDouble(change.heavy_increment));
+    const double d = std::fabs(Ar::toDouble(change.difference));
+    return 2 * Ar::kOpError * (s_h * (q_h + 8 * inc) + s_l * (q_l + q_h + 8 * inc + 2 * d)) + (s_h + s_l) * kTiny;
+  }
+
+  void recordBefore(std::size_t m, ImpactRecord& record) const {
+    const BodyState& i = bodies_[m];
+    const BodyState& j = bodies_[m + 1];
+    // The contact point is best extrapolated along the slower body's line.
+    const BodyState& slow = std::fabs(Ar::toDouble(i.v)) <= std::fabs(Ar::toDouble(j.v)) ? i : j;
+    const S time = (i.b - j.b) / (j.v - i.v);
+    record.pair_index = m;
+    record.time = Ar::toDouble(time);
+    record.position = Ar::toDouble(S(slow.b + S(slow.v * time)));
+    record.velocities_before = {Ar::toDouble(i.v), Ar::toDouble(j.v)};
+  }
+
+  void recordAfter(std::size_t m, const S& before_i, const S& before_j, double lost, ImpactRecord& record) const {
+    record.velocities_after = {Ar::toDouble(bodies_[m].v), Ar::toDouble(bodies_[m + 1].v)};
+    record.energy_lost = lost;
+    const S* before[2] = {&before_i, &before_j};
+    const Scene& scene = tables_.scene;
+    for (int k = 0; k < 2; ++k) {
+      if (scene.isWall(m + k)) continue;
+      const double dv = Ar::toDouble(S(bodies_[m + k].v - *before[k]));
+      const double sum = record.velocities_after[k] + record.velocities_before[k];
+      record.energy_gained[k] = 0.5 * scene.masses[m + k] * dv * sum;
+    }
+    // A wall takes what the finite body gave up minus the heat.
+    for (int k = 0; k < 2; ++k) {
+      if (scene.isWall(m + k)) record.energy_gained[k] = -record.energy_gained[1 - k] - lost;
+    }
+  }
+
+  /// Precision guard: an impact's time t = G / A is published to about 1e-12. When this
+  /// tier's state pins G or A down less well than 2^-42 of their size (tiny approach speeds,
+  /// as on the way to an inelastic collapse), a more precise tier takes the step.
+  bool timeIsPrecise(double scale) const {
+    if constexpr (Ar::kExact) return true;
+    return now_.eb * scale <= kTimePrecision * std::fabs(Ar::toDouble(now_.G)) &&
+           now_.eu * scale <= kTimePrecision * std::fabs(Ar::toDouble(now_.A));
+  }
+
+  void addLoss(double loss) {
+    // Neumaier summation: the total of many small losses keeps its digits.
+    const double sum = lost_ + loss;
+    lost_compensation_ += std::fabs(lost_) >= std::fabs(loss) ? (lost_ - sum) + loss : (loss - sum) + lost_;
+    lost_ = sum;
+  }
+
+  /// Performs the impact of pair m. When a neighbour then hits at the same instant (a
+  /// multiple collision, or a decision this tier cannot take), the impact is undone.
+  StepResult impact(std::size_t m, ImpactRecord* record) {
+    const Undo undo = saveFor(m);
+    StepResult r = collide(m, record);
+    if (r.kind == StepKind::kImpact) r = scheduleAfter(m);
+    if (r.kind != StepKind::kImpact) restore(m, undo);
+    return r;
+  }
+
+  Undo saveFor(std::size_t m) const { return {bodies_[m], bodies_[m + 1], eu_, eb_, lost_, lost_compensation_, now_}; }
+
+  void restore(std::size_t m, const Undo& undo) {
+    bodies_[m] = undo.i, bodies_[m + 1] = undo.j;
+    eu_ = undo.eu, eb_ = undo.eb, lost_ = undo.lost, lost_compensation_ = undo.lost_compensation;
+    now_ = undo.now;
+  }
+
+  /// The impact of pair m on its two bodies, with the error bounds, the heat and the record.
+  StepResult collide(std::size_t m, ImpactRecord* record) {
+    PairState& pair = pairs_[m];
+    BodyState& i = bodies_[m];
+    BodyState& j = bodies_[m + 1];
+    now_.pair = m;
+    now_.upper = pair.upper;
+    const S before_i = i.v, before_j = j.v;
+    if (record) recordBefore(m, *record);
+    now_.eu = eu_;
+    now_.eb = eb_;
+    now_.extra = 0.0;
+    const ImpactChange<S> dv = applyImpactMap(pair.map, i.v, j.v);
+    const ImpactChange<S> db = applyImpactMap(pair.map, i.b, j.b);
+    eu_ += rho(m, dv, i.v, j.v);
+    eb_ += rho(m, db, i.b, j.b);
+    now_.A = dv.difference;
+    now_.G = -db.difference;
+    if (!timeIsPrecise(pair.scale)) return {StepKind::kImprecise, m, 0.0};
+    double lost = 0.0;
+    if (std::fabs(pair.map.light_factor) != 1.0) {  // e < 1
+      const double approach_speed = Ar::toDouble(now_.A);
+      lost = tables_.loss_factor[m] * approach_speed * approach_speed;
+      addLoss(lost);
+    }
+    if (record) recordAfter(m, before_i, before_j, lost, *record);
+    const double magnitude = std::fabs(Ar::toDouble(i.b)) + std::fabs(Ar::toDouble(j.b)) +
+                             std::fabs(Ar::toDouble(i.v)) + std::fabs(Ar::toDouble(j.v));
+    if (!(magnitude < kMaxMagnitude)) return {StepKind::kOutOfRange, m, lastTime()};
+    return {StepKind::kImpact, m, 0.0};
+  }
+
+  /// Pair m separates (e > 0) or moves on together (e = 0): no impact; its neighbours get
+  /// new schedules.
+  StepResult scheduleAfter(std::size_t m) {
+    setSchedule(m, kInf, kInf);
+    if (m > 0) {
+      const StepResult r = reschedule(m - 1, m);
+      if (r.kind != StepKind::kImpact) return r;
+    }
+    if (m + 1 < pairs_.size()) {
+      const StepResult r = reschedule(m + 1, m);
+      if (r.kind != StepKind::kImpact) return r;
+    }
+    tree_.update(m > 0 ? m - 1 : m, std::min(m + 1, pairs_.size() - 1));
+    ++count_;
+    return {StepKind::kImpact, m, 0.0};
+  }
+
+  const SceneTables& tables_;
+  std::vector<BodyState> bodies_;
+  std::vector<PairState> pairs_;
+  TournamentTree tree_;  ///< per pair: lower bound of the next impact time [s]
+  double eu_ = 0.0;            ///< bound on ||U_computed - U_exact|| [kg^0.5 m/s]
+  double eb_ = 0.0;            ///< bound on ||B_computed - B_exact|| [kg^0.5 m]
+  std::uint64_t count_ = 0;
+  std::uint64_t refinements_ = 0;
+  double lost_ = 0.0, lost_compensation_ = 0.0;  ///< kinetic energy lost so far [J]
+  Now now_;
+};
+
+}  // namespace nbody_detail
+}  // namespace core
+}  // namespace collision_lab

@@ -1,0 +1,52 @@
+// Exact N-body reference for the tests: cpp_rational positions and velocities, advanced
+// event by event with a plain O(N) scan for the next contact. Written from physics.md
+// independently of the engine (no shared code, a different state: positions at the
+// current time instead of line intercepts, the centre-of-mass form of the impact rule).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <boost/multiprecision/cpp_int.hpp>
+
+#include "collision_lab/core/nbody/scene.h"
+
+namespace collision_lab {
+namespace core {
+namespace reference {
+
+using Rational = boost::multiprecision::cpp_rational;
+
+struct Event {
+  std::size_t pair = 0;
+  Rational time;      ///< [s]
+  Rational position;  ///< contact point [m]
+  Rational lost;      ///< kinetic energy lost [J]
+};
+
+struct Run {
+  std::vector<Event> events;
+  bool truncated = false;                     ///< stopped at the cap with an impact due
+  std::optional<std::size_t> multiple_first;  ///< a multiple collision of bodies first..first+2
+  Rational multiple_time;                     ///< [s]
+  std::vector<Rational> velocities;           ///< at the end [m/s]
+  std::vector<Rational> positions;            ///< at the time of the last impact [m]
+  Rational last_time;                         ///< of the last impact [s] (0 without any)
+  Rational energy_lost;                       ///< [J]
+};
+
+/// Events in the order exact time, then pair index; a tie of two pairs sharing a body, or
+/// a pair that approaches at zero gap right after an impact next to it, is a multiple
+/// collision: the run ends before it. Precondition: validate(scene) passed.
+Run simulate(const Scene& scene, std::uint64_t max_impacts);
+
+/// sqrt(sum m (v - reference)^2) / sqrt(sum m v0^2) over the finite bodies, in the frame of
+/// the walls (the lab frame without walls): the scale-free energy norm.
+double energyNormError(const Scene& scene, const std::vector<double>& velocities,
+                       const std::vector<Rational>& reference);
+
+}  // namespace reference
+}  // namespace core
+}  // namespace collision_lab
