@@ -1,0 +1,218 @@
+// Issue 8, section 4, in the core: what a lab run reports for a run over the cap, the
+// energy each body gains per impact, negative zeros, and the wording of rejections.
+// References: exact rationals (rational_reference.h), conservation, hand-derived numbers.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "collision_lab/core/lab_run.h"
+#include "collision_lab/core/paper.h"
+#include "rational_reference.h"
+
+namespace collision_lab {
+namespace {
+
+using reference::Q;
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+bool isNegativeZero(double x) { return x == 0 && std::signbit(x); }
+
+RunResult runAll(const Scene& scene, RunOptions options = {}) {
+  options.events = EventPolicy::all();
+  return runLab(scene, options);
+}
+
+// ---------------------------------------------------------------------------------------
+// An over-cap run answered by the closed form.
+
+TEST(LabRunOverCap, ReportsThePredictedFinalVelocitiesAndMeasuresNothing) {
+  // Masses (1e30, 1, inf): 3.1e15 collisions, far over a cap of 10.
+  const Scene scene{{1e30, 1, kInf}, {2, 1, 0}, {-1, 0, 0}};
+  RunOptions options;
+  options.max_collisions = 10;
+  options.skip_simulation_over_cap = true;
+  const RunResult result = runLab(scene, options);
+  ASSERT_FALSE(result.summary.simulated);
+  ASSERT_TRUE(result.summary.truncated);
+  EXPECT_EQ(result.summary.final_velocities, result.prediction.final_velocities);
+  // The closed form's end state, checked by physics: energy m_A v_A^2 + m_B v_B^2 = m_A
+  // (the wall at rest) and no further impact, v_A >= v_B >= 0 (it was (-1, 0, 0)).
+  const auto& v = result.summary.final_velocities;
+  EXPECT_NEAR((1e30 * v[kA] * v[kA] + v[kB] * v[kB]) / 1e30, 1.0, 1e-12);
+  EXPECT_GE(v[kA], v[kB]);
+  EXPECT_GE(v[kB], 0.0);
+  EXPECT_EQ(v[kC], 0.0);
+  // Nothing was measured: NaN, as a simulated wall run gives for momentum.
+  EXPECT_TRUE(std::isnan(result.summary.momentum_relative_drift));
+  EXPECT_TRUE(std::isnan(result.summary.energy_relative_drift));
+  EXPECT_TRUE(std::isnan(result.summary.max_prediction_error));
+}
+
+TEST(LabRunOverCap, WithoutAWallMomentumIsNotMeasuredEither) {
+  const Scene scene{{1e30, 1, 1e30}, {2, 1, 0}, {-1, 0, 0}};
+  RunOptions options;
+  options.max_collisions = 10;
+  options.skip_simulation_over_cap = true;
+  const RunResult skipped = runLab(scene, options);
+  EXPECT_TRUE(std::isnan(skipped.summary.momentum_relative_drift));
+  options.mode = RunMode::kPredictOnly;
+  const RunResult predicted = runLab(scene, options);
+  EXPECT_TRUE(std::isnan(predicted.summary.momentum_relative_drift));
+  EXPECT_EQ(predicted.summary.final_velocities, predicted.prediction.final_velocities);
+  // A simulated run still measures: 0 drift to rounding, no wall.
+  const RunResult simulated = runLab(Scene{{1, 2, 3}, {2, 1, 0}, {-1, 0, 1}}, {});
+  EXPECT_LE(simulated.summary.momentum_relative_drift, 1e-15);
+}
+
+// ---------------------------------------------------------------------------------------
+// Energy transfer per impact.
+
+/// The kinetic energy body i gains in impact k, exactly.
+double exactGain(const Scene& scene, const reference::Run& truth, std::size_t k, int i) {
+  const Q before = k == 0 ? Q(scene.velocities[i]) : truth.impacts[k - 1].velocities[i];
+  const Q after = truth.impacts[k].velocities[i];
+  return static_cast<double>(reference::toWide(Q(scene.masses[i]) * (after * after - before * before) / 2));
+}
+
+TEST(EnergyTransferPerImpact, NonParticipantsAndRestingWallsGainExactlyZero) {
+  // A pi billiard against a resting wall C, equal masses, and a general scene.
+  for (const Scene& scene : {Scene{{1e4, 1, kInf}, {2, 1, 0}, {-1, 0, 0}}, Scene{{1, 1, 1}, {2, 1, -1}, {-1, 0, 1}},
+                             Scene{{0.3, 0.7, 0.11}, {0.9, 0.2, -0.4}, {-0.3, 0.1, 0.25}}}) {
+    const RunResult result = runAll(scene);
+    ASSERT_FALSE(result.events.empty());
+    for (const LabEvent& lab : result.events) {
+      const int outsider = lab.event.pair == Pair::AB ? kC : kA;
+      for (const auto* gains : {&lab.event.energy_transfer, &lab.predicted_energy_transfer, &lab.paper_energy_transfer}) {
+        EXPECT_EQ((*gains)[outsider], 0.0) << lab.event.index;
+        EXPECT_FALSE(std::signbit((*gains)[outsider])) << lab.event.index;
+      }
+      if (scene.isWall(kC) && lab.event.pair == Pair::BC) {
+        // The ball bounces off a resting wall with its speed: nobody gains anything.
+        for (double gained : lab.event.energy_transfer) EXPECT_EQ(gained, 0.0) << lab.event.index;
+        for (double gained : lab.predicted_energy_transfer) EXPECT_EQ(gained, 0.0) << lab.event.index;
+      }
+    }
+  }
+}
+
+TEST(EnergyTransferPerImpact, ThePairsEntriesAreExactOppositesAndExact) {
+  for (const Scene& scene : {Scene{{1, 2, 3}, {2, 1, 0}, {-1, 0.3, 0.7}}, Scene{{1e4, 1, 1e4}, {2, 1, 0}, {-1, 0, 0}},
+                             Scene{{0.3, 0.7, 0.11}, {0.9, 0.2, -0.4}, {-0.3, 0.1, 0.25}}}) {
+    const reference::Run truth = reference::simulate(scene, 5000);
+    const RunResult result = runAll(scene);
+    ASSERT_EQ(result.events.size(), truth.impacts.size());
+    double energy = 0;
+    for (int i = 0; i < 3; ++i) energy += scene.masses[i] * scene.velocities[i] * scene.velocities[i] / 2;
+    for (std::size_t k = 0; k < truth.impacts.size(); ++k) {
+      const LabEvent& lab = result.events[k];
+      const int left = lab.event.pair == Pair::AB ? kA : kB;
+      EXPECT_EQ(lab.event.energy_transfer[left], -lab.event.energy_transfer[left + 1]) << k;
+      EXPECT_EQ(lab.predicted_energy_transfer[left], -lab.predicted_energy_transfer[left + 1]) << k;
+      for (int i : {left, left + 1}) {
+        EXPECT_NEAR(lab.event.energy_transfer[i], exactGain(scene, truth, k, i), 1e-12 * energy) << k;
+      }
+    }
+  }
+}
+
+TEST(EnergyTransferPerImpact, AMovingWallsEntryIsMinusWhatTheBallGains) {
+  // A wall at A moving at 0.25 m/s: the ball's gain is exact, the wall's is its opposite.
+  const Scene scene{{kInf, 1, 3}, {2, 1, 0}, {0.25, 0, 1}};
+  const reference::Run truth = reference::simulate(scene, 100);
+  const RunResult result = runAll(scene);
+  ASSERT_EQ(result.events.size(), truth.impacts.size());
+  int wall_impacts = 0;
+  for (std::size_t k = 0; k < truth.impacts.size(); ++k) {
+    const LabEvent& lab = result.events[k];
+    if (lab.event.pair != Pair::AB) continue;
+    ++wall_impacts;
+    const double ball = exactGain(scene, truth, k, kB);
+    EXPECT_NE(ball, 0.0);
+    EXPECT_NEAR(lab.event.energy_transfer[kB], ball, 1e-15 * std::fabs(ball) + 1e-300) << k;
+    EXPECT_EQ(lab.event.energy_transfer[kA], -lab.event.energy_transfer[kB]) << k;
+    EXPECT_EQ(lab.predicted_energy_transfer[kA], -lab.predicted_energy_transfer[kB]) << k;
+  }
+  EXPECT_GE(wall_impacts, 1);
+}
+
+TEST(EnergyTransferPerImpact, ThePapersFormulasLeaveTheThirdBodyAtZero) {
+  // BC first: (4.6)/(4.7) refer to the impact before, undefined here; A still gains 0.
+  const Scene bc_first{{1, 1, 1}, {3, 1, 0}, {0, 0, -1}};
+  const auto gained = paper::energyTransfer(bc_first, 1, Pair::BC, bc_first.velocities, bc_first.velocities);
+  EXPECT_EQ(gained[kA], 0.0);
+  EXPECT_TRUE(std::isnan(gained[kB]));
+  EXPECT_TRUE(std::isnan(gained[kC]));
+}
+
+// ---------------------------------------------------------------------------------------
+// No negative zeros anywhere in a lab run.
+
+void expectNoNegativeZero(const std::array<double, 3>& values, const char* what, std::uint64_t index) {
+  for (int i = 0; i < 3; ++i) EXPECT_FALSE(isNegativeZero(values[i])) << what << "[" << i << "] of event " << index;
+}
+
+TEST(NegativeZeros, NoneInEventsPredictionsOrSummaries) {
+  // Resting walls, bodies at rest and -0 inputs are where -0 comes from.
+  for (const Scene& scene : {Scene{{100, 1, kInf}, {2, 1, 0}, {-1, -0.0, -0.0}}, Scene{{1, 1, 1}, {2, 1, 0}, {-1, 0, 0}},
+                             Scene{{kInf, 1, 1}, {2, 1, 0}, {-0.0, 0.5, -1}}, Scene{{3, 1, 0.5}, {2, 1, 0}, {-1, 0, 0}}}) {
+    const RunResult result = runAll(scene);
+    for (const LabEvent& lab : result.events) {
+      const std::uint64_t k = lab.event.index;
+      EXPECT_FALSE(isNegativeZero(lab.event.time)) << k;
+      EXPECT_FALSE(isNegativeZero(lab.event.position)) << k;
+      EXPECT_FALSE(isNegativeZero(lab.event.total_energy)) << k;
+      EXPECT_FALSE(isNegativeZero(lab.event.total_momentum)) << k;
+      expectNoNegativeZero(lab.event.positions, "positions", k);
+      expectNoNegativeZero(lab.event.velocities_before, "velocities_before", k);
+      expectNoNegativeZero(lab.event.velocities_after, "velocities_after", k);
+      expectNoNegativeZero(lab.event.energy_transfer, "energy_transfer", k);
+      expectNoNegativeZero(lab.predicted_velocities_after, "predicted_velocities_after", k);
+      expectNoNegativeZero(lab.paper_velocities_after, "paper_velocities_after", k);
+      expectNoNegativeZero(lab.predicted_energy_transfer, "predicted_energy_transfer", k);
+      expectNoNegativeZero(lab.paper_energy_transfer, "paper_energy_transfer", k);
+      expectNoNegativeZero(lab.kinetic_energy_after, "kinetic_energy_after", k);
+    }
+    expectNoNegativeZero(result.summary.final_velocities, "summary final_velocities", 0);
+    expectNoNegativeZero(result.prediction.final_velocities, "predicted final_velocities", 0);
+  }
+}
+
+// ---------------------------------------------------------------------------------------
+// Wording of rejections.
+
+TEST(RejectionWording, NaNIsNaNWithoutASign) {
+  Scene scene{{1, 1, 1}, {2, 1, 0}, {-std::numeric_limits<double>::quiet_NaN(), 0, 0}};
+  ASSERT_TRUE(std::signbit(scene.velocities[0]));
+  EXPECT_EQ(validate(scene)->message, "velocities[0]: v_A is NaN; a velocity must be a finite number in m/s");
+  scene.velocities[0] = -1;
+  scene.positions[1] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(validate(scene)->message, "positions[1]: x_B is NaN; a position must be a finite number in m");
+}
+
+TEST(RejectionWording, NoMessageRepeatsItsField) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const std::vector<Scene> rejected = {
+      {{nan, 1, 1}, {2, 1, 0}, {-1, 0, 0}},           {{0, 1, 1}, {2, 1, 0}, {-1, 0, 0}},
+      {{kInf, 1, kInf}, {2, 1, 0}, {-1, 0, 0}},       {{1, kInf, 1}, {2, 1, 0}, {-1, 0, 0}},
+      {{1, 1, 1}, {0, 1, 2}, {-1, 0, 0}},             {{1, 1, 1}, {1, 1, 0}, {-1, 0, 0}},
+      {{1, 1, 1}, {1, 0, -1}, {-1, 0, 1}},            {{1e300, 1, 1}, {2, 1, 0}, {-1e10, 0, 0}},
+      {{1, 1, 1}, {1e308, -1e308, -1.5e308}, {-1, 0, 1}}, {{1e40, 1, 1e40}, {2, 1, 0}, {-1, 0, 0}},
+      {{1, 1, 1}, {1e300, 0, -1}, {-1e-300, 0, -1}},  {{1, 1, 1}, {kInf, 1, 0}, {-1, 0, 0}}};
+  for (const Scene& scene : rejected) {
+    const auto error = validate(scene);
+    ASSERT_TRUE(error);
+    const std::string base = error->field.substr(0, error->field.find('['));
+    const std::string prefix = error->field + ": ";
+    ASSERT_EQ(error->message.rfind(prefix, 0), 0u) << error->message;
+    // "positions: positions (0, 1, 2) m ..." said its field twice.
+    EXPECT_NE(error->message.substr(prefix.size()).rfind(base, 0), 0u) << error->message;
+    EXPECT_EQ(error->message.find("nan"), std::string::npos) << error->message;
+  }
+}
+
+}  // namespace
+}  // namespace collision_lab
