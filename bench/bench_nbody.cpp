@@ -2,7 +2,8 @@
 // lean double event loop with an indexed binary heap and no exactness, on random masses in
 // [1, 2] kg, velocities in [-1, 1] m/s and spacing 1 m. Prints ns per impact of both,
 // medians of several repeats run round-robin in one process, their ratio (the goal:
-// at most 1.5x, and beat it if we can), and the peak memory of a run on 10^5 bodies.
+// at most 1.5x, and beat it if we can), the same lean loop on the engine's queue (which
+// isolates the queue choice), and the peak memory of a run on 10^5 bodies.
 //
 //   collision_lab_bench_nbody [--quick] [--repeats R] [--long]
 //     --quick   first 2e6 impacts instead of 2e7 for N = 10^4 and 10^5; 3 repeats
@@ -23,6 +24,7 @@
 #include <vector>
 
 #include "collision_lab/core/nbody/engine.h"
+#include "tournament_tree.h"  // the engine's event queue (src/core/nbody), for the queue comparison
 
 namespace {
 
@@ -122,6 +124,50 @@ class LeanLoop {
   std::vector<std::uint32_t> heap_, where_;
 };
 
+// ---- The same lean loop on the engine's event queue (blocked tournament tree) ----
+// Identical arithmetic to LeanLoop; only the queue differs, which isolates what the queue
+// choice is worth from what exactness costs.
+class LeanTreeLoop {
+ public:
+  explicit LeanTreeLoop(const Scene& s)
+      : m_(s.masses), x_(s.positions), v_(s.velocities), t_(s.size(), 0.0), tree_(s.size() - 1) {
+    for (std::size_t p = 0; p + 1 < m_.size(); ++p) tree_.set(p, timeOf(p, 0.0));
+    tree_.rebuild();
+  }
+
+  std::uint64_t run(std::uint64_t max_impacts) {
+    std::uint64_t count = 0;
+    const std::size_t pairs = m_.size() - 1;
+    while (count < max_impacts && tree_.minKey() < kInf) {
+      const std::size_t p = tree_.minLeaf();
+      const double now = tree_.minKey();
+      for (std::size_t k : {p, p + 1}) {
+        x_[k] += v_[k] * (now - t_[k]);
+        t_[k] = now;
+      }
+      const double centre = (m_[p] * v_[p] + m_[p + 1] * v_[p + 1]) / (m_[p] + m_[p + 1]);
+      v_[p] = 2 * centre - v_[p];
+      v_[p + 1] = 2 * centre - v_[p + 1];
+      const std::size_t first = p > 0 ? p - 1 : p, last = std::min(p + 1, pairs - 1);
+      for (std::size_t q = first; q <= last; ++q) tree_.set(q, timeOf(q, now));
+      tree_.update(first, last);
+      ++count;
+    }
+    return count;
+  }
+
+ private:
+  double timeOf(std::size_t p, double now) const {
+    const double approach = v_[p + 1] - v_[p];
+    if (!(approach > 0)) return kInf;
+    const double gap = (x_[p] + v_[p] * (now - t_[p])) - (x_[p + 1] + v_[p + 1] * (now - t_[p + 1]));
+    return now + std::max(gap, 0.0) / approach;
+  }
+
+  std::vector<double> m_, x_, v_, t_;
+  collision_lab::core::nbody_detail::TournamentTree tree_;
+};
+
 // ---- Measurement ----
 struct Timed {
   std::uint64_t impacts = 0;
@@ -154,8 +200,8 @@ struct Case {
   std::size_t n;
   std::uint64_t max_impacts;
   Scene scene;
-  std::vector<double> anchor_ns, engine_ns;
-  std::uint64_t anchor_impacts = 0, engine_impacts = 0, escalations = 0;
+  std::vector<double> anchor_ns, tree_ns, engine_ns;
+  std::uint64_t anchor_impacts = 0, tree_impacts = 0, engine_impacts = 0, escalations = 0;
 };
 
 /// Peak resident memory [MB] of an engine run in a child process (so that the parent's
@@ -194,14 +240,16 @@ int main(int argc, char** argv) {
   }
   const std::uint64_t budget = quick ? 2'000'000 : 20'000'000;
   std::vector<Case> cases;
-  cases.push_back({1'000, std::numeric_limits<std::uint64_t>::max(), gasScene(1'000, 1), {}, {}});
-  cases.push_back({10'000, budget, gasScene(10'000, 2), {}, {}});
-  cases.push_back({100'000, budget, gasScene(100'000, 3), {}, {}});
+  cases.push_back({1'000, std::numeric_limits<std::uint64_t>::max(), gasScene(1'000, 1), {}, {}, {}});
+  cases.push_back({10'000, budget, gasScene(10'000, 2), {}, {}, {}});
+  cases.push_back({100'000, budget, gasScene(100'000, 3), {}, {}, {}});
 
   for (int r = 0; r < repeats; ++r) {
     for (Case& c : cases) {
       LeanLoop anchor(c.scene);
       const Timed a = timeRun([&] { return anchor.run(c.max_impacts); });
+      LeanTreeLoop tree(c.scene);
+      const Timed t = timeRun([&] { return tree.run(c.max_impacts); });
       collision_lab::core::EngineOptions options;
       options.max_impacts = c.max_impacts;
       collision_lab::core::EngineResult result;
@@ -210,8 +258,10 @@ int main(int argc, char** argv) {
         return result.impact_count;
       });
       c.anchor_ns.push_back(a.ns_per_impact);
+      c.tree_ns.push_back(t.ns_per_impact);
       c.engine_ns.push_back(e.ns_per_impact);
       c.anchor_impacts = a.impacts;
+      c.tree_impacts = t.impacts;
       c.engine_impacts = e.impacts;
       c.escalations = result.escalations.refinements + result.escalations.high_precision + result.escalations.exact_rational;
     }
@@ -221,16 +271,18 @@ int main(int argc, char** argv) {
   std::printf("random masses [1, 2] kg, velocities [-1, 1] m/s, spacing 1 m; CPU time per impact, medians of %d\n"
               "repeats run round-robin in this process\n\n",
               repeats);
-  std::printf("%9s %12s %12s %14s %14s %8s %12s\n", "N", "impacts", "anchor ns", "engine ns", "engine/anchor",
-              "same", "escalations");
+  std::printf("%9s %12s %11s %11s %11s %15s %6s %12s\n", "N", "impacts", "anchor ns", "tree ns", "engine ns",
+              "engine/anchor", "same", "escalations");
   for (const Case& c : cases) {
-    const double anchor = median(c.anchor_ns), engine = median(c.engine_ns);
-    std::printf("%9zu %12llu %12.1f %14.1f %14.2f %8s %12llu\n", c.n, static_cast<unsigned long long>(c.engine_impacts),
-                anchor, engine, engine / anchor, c.anchor_impacts == c.engine_impacts ? "yes" : "NO",
+    const double anchor = median(c.anchor_ns), tree = median(c.tree_ns), engine = median(c.engine_ns);
+    const bool same = c.anchor_impacts == c.engine_impacts && c.tree_impacts == c.engine_impacts;
+    std::printf("%9zu %12llu %11.1f %11.1f %11.1f %15.2f %6s %12llu\n", c.n,
+                static_cast<unsigned long long>(c.engine_impacts), anchor, tree, engine, engine / anchor, same ? "yes" : "NO",
                 static_cast<unsigned long long>(c.escalations));
   }
-  std::printf("\n'same': the anchor made as many impacts (it is not exact, but agrees on these scenes).\n");
-
+  std::printf("\nanchor: the lean double loop on an indexed binary heap; tree: the same loop on the engine's\n"
+              "blocked tournament tree (what the queue choice is worth); engine: the exact engine.\n"
+              "'same': both lean loops made as many impacts (they are not exact, but agree on these scenes).\n");
   const std::uint64_t memory_impacts = long_run ? 100'000'000 : budget;
   const double rss = engineMaxRssMb(cases.back().scene, memory_impacts);
   std::printf("peak memory (max RSS) of one engine run on 10^5 bodies, %llu impacts, no events kept: %.1f MB\n",

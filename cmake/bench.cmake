@@ -23,6 +23,7 @@ target_include_directories(collision_lab_bench_core PRIVATE bench/common)
 target_link_libraries(collision_lab_bench_core PRIVATE collision_lab_core)
 
 add_executable(collision_lab_bench_nbody bench/bench_nbody.cpp)
+target_include_directories(collision_lab_bench_nbody PRIVATE src/core/nbody)  # the engine's queue, compared
 target_link_libraries(collision_lab_bench_nbody PRIVATE collision_lab_core)
 
 if(TARGET collision_lab_ros)
