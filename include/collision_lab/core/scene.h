@@ -41,7 +41,9 @@ enum class Reason : std::uint8_t {
   kPositionsNotOrdered = 5, ///< not x_A > x_B > x_C
   kPositionsCoincident = 6, ///< two positions are equal
   kTripleCollision = 7,     ///< the first two contacts happen at exactly the same time
-  kOverflow = 8,            ///< momentum or kinetic energy overflows a double
+  kOverflow = 8,            ///< a momentum, energy, gap or relative velocity overflows a double; the
+                            ///< first contact comes after, or puts a body beyond, the largest double;
+                            ///< or the masses allow more than 2^64 - 1 collisions
 };
 
 /// Machine-readable name of a reason, e.g. "TRIPLE_COLLISION".
