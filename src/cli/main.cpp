@@ -31,16 +31,11 @@ std::string defaultScenarioPath() {
   return COLLISION_LAB_SOURCE_SCENARIOS;
 }
 
-/// The core's message starts with its field ("positions: ..."), which the CLI's error line
-/// names already: the line gives it once.
 void validateOrThrow(const io::NamedScene& named) {
   if (const auto error = validate(named.scene)) {
     const std::string where = named.name.empty() ? "" : "scenario '" + named.name + "': ";
-    const std::string field_prefix = error->field + ": ";
-    const std::string message = error->message.rfind(field_prefix, 0) == 0
-                                    ? error->message.substr(field_prefix.size())
-                                    : error->message;
-    throw CliError{reasonName(error->reason), static_cast<int>(error->reason), error->field, where + message};
+    throw CliError{reasonName(error->reason), static_cast<int>(error->reason), error->field,
+                   where + error->message};
   }
 }
 

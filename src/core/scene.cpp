@@ -39,9 +39,10 @@ std::string formatShort(double value) {
   return buffer;
 }
 
-/// The message always starts with the field, so one line tells the user where to look.
+/// `field` says where; the message says what is wrong there without repeating it (a
+/// front end shows both, the CLI as "invalid <field> (<REASON>): <message>").
 ValidationError makeError(Reason reason, const std::string& field, const std::string& message) {
-  return ValidationError{reason, field, field + ": " + message};
+  return ValidationError{reason, field, message};
 }
 
 bool isFiniteProduct(double a, double b) { return std::isfinite(a * b); }

@@ -145,7 +145,7 @@ TEST(DoubleRange, OnlyTheFirstContactMustBeRepresentable) {
   ASSERT_TRUE(error);
   EXPECT_EQ(error->reason, Reason::kOverflow);
   EXPECT_EQ(error->message,
-            "positions: the first contact, of A and B, would come at t = 1e+600 s, beyond the largest double "
+            "the first contact, of A and B, would come at t = 1e+600 s, beyond the largest double "
             "(1.8e+308); a longer unit of time brings it into range");
 }
 

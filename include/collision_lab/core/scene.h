@@ -52,7 +52,9 @@ const char* reasonName(Reason r);
 struct ValidationError {
   Reason reason = Reason::kOk;
   std::string field;    ///< e.g. "velocities[1]", "masses", "positions"
-  std::string message;  ///< one human-readable sentence naming field and value
+  /// One sentence for people about the value in `field` ("v_B is NaN; ..."), which it does
+  /// not repeat: front ends show field and message side by side.
+  std::string message;
 };
 
 /// Checks a scene. Returns nothing when the scene is valid. Never throws for any input.
