@@ -280,8 +280,20 @@ std::array<Scalar, 3> AnalyticModel<Scalar>::energyTransfer(std::uint64_t n) con
   const Vec3 before = velocitiesAfter(n - 1);
   const std::array<Scalar, 3> v{before(0), before(1), before(2)};
   const int left = pair == Pair::AB ? kA : kB;
-  const auto energies = detail::ImpactEnergy<detail::EnergyType<Scalar>>(masses_).gained(pair, v, Scalar(v[left + 1] - v[left]));
-  for (int i = 0; i < 3; ++i) gained[i] = static_cast<Scalar>(energies[i]);
+  const int right = left + 1;
+  const Scalar f_left = pair == Pair::AB ? f_ab_a_ : f_bc_b_;
+  const Scalar f_right = pair == Pair::AB ? f_ab_b_ : f_bc_c_;
+  // Reduced mass m_l m_r / (m_l + m_r), and its wall limit (the finite mass).
+  const Scalar reduced = left == wall_    ? Scalar(masses_[right])
+                         : right == wall_ ? Scalar(masses_[left])
+                                          : Scalar(masses_[left]) * f_right;
+  using Energy = detail::EnergyType<Scalar>;
+  const auto wide = detail::ImpactEnergy<Energy>::impactGains(pair, Energy(reduced), Energy(f_left), Energy(f_right), v,
+                                                              Scalar(v[right] - v[left]));
+  for (int i = 0; i < 3; ++i) {
+    gained[i] = static_cast<Scalar>(wide[i]);
+    if (gained[i] == 0) gained[i] = Scalar(0);  // an underflow keeps no sign
+  }
   return gained;
 }
 

@@ -39,8 +39,8 @@ std::string formatShort(double value) {
   return buffer;
 }
 
-/// The field is its own value; the message names the quantity (m_B, x_A, ...) once, so a
-/// one-line report "field: message" never repeats itself.
+/// `field` says where; the message says what is wrong there without repeating it (a
+/// front end shows both, the CLI as "invalid <field> (<REASON>): <message>").
 ValidationError makeError(Reason reason, const std::string& field, const std::string& message) {
   return ValidationError{reason, field, message};
 }

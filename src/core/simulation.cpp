@@ -472,14 +472,15 @@ class Trajectory {
     bool in_range = true;        ///< every time and position in T's normal range
   };
 
-  explicit Trajectory(const Scene& working) : masses_(working.masses), wall_(working.wallIndex()), energy_(masses_) {
+  explicit Trajectory(const Scene& working)
+      : masses_(working.masses), wall_(working.wallIndex()), energy_(masses_), wide_energy_(masses_) {
     for (int i = 0; i < 3; ++i) reference_position_[i] = T(working.positions[i]);
   }
 
   /// The same state in a wider type, to go on where T's range ends.
   template <class Narrow>
   explicit Trajectory(const Trajectory<Narrow>& narrow)
-      : masses_(narrow.masses_), wall_(narrow.wall_), energy_(masses_) {
+      : masses_(narrow.masses_), wall_(narrow.wall_), energy_(masses_), wide_energy_(masses_) {
     now_ = widened(narrow.now_);
     for (int i = 0; i < 3; ++i) {
       reference_position_[i] = T(narrow.reference_position_[i]);
@@ -518,17 +519,9 @@ class Trajectory {
     const int left = pair == Pair::AB ? kA : kB;
     event.position = units.position_si(impact.positions[left]);
     for (int i = 0; i < 3; ++i) event.positions[i] = units.position_si(impact.positions[i]);
-    const auto gained = energy_.gained(pair, before, approach);
-    Energy energy = 0, momentum = 0;
-    for (int i = 0; i < 3; ++i) {
-      event.energy_transfer[i] = units.energy_si(gained[i]);
-      if (i == wall_) continue;
-      const Energy m(masses_[i]);
-      energy += m * Energy(after[i]) * Energy(after[i]) / 2;
-      momentum += m * Energy(after[i]);
+    if (!describeEnergies(energy_, pair, before, after, approach, units, event)) {
+      describeEnergies(wide_energy_, pair, before, after, approach, units, event);
     }
-    event.total_energy = units.energy_si(energy);
-    event.total_momentum = units.velocity_si(momentum);
     // Re-anchor the bodies whose velocity changed (a wall's never does).
     for (int i : {left, left + 1}) {
       if (i == wall_) continue;
@@ -551,16 +544,39 @@ class Trajectory {
     return reference_position_[i] + v[i] * time.since(reference_time_[i]);
   }
 
+  /// The energies of an impact in precision E: the gains and the totals after it. False,
+  /// with nothing written, when E is narrower than EnergyType<T> and a value leaves its
+  /// normal range (a mass near 1e308, say): then the wider type answers.
+  template <class E>
+  bool describeEnergies(const detail::ImpactEnergy<E>& model, Pair pair, const std::array<T, 3>& before,
+                        const std::array<T, 3>& after, const T& approach, const WorkingUnits& units,
+                        ImpactEvent& event) const {
+    const std::array<E, 3> gained = model.gained(pair, before, approach);
+    E energy = 0, momentum = 0;
+    for (int i = 0; i < 3; ++i) {
+      if (i == wall_) continue;
+      const E m(masses_[i]);
+      energy += m * E(after[i]) * E(after[i]) / 2;
+      momentum += m * E(after[i]);
+    }
+    bool in_range = inNormalRange(energy) && inNormalRange(momentum);
+    for (const E& x : gained) in_range = in_range && inNormalRange(x);
+    if (!in_range && !std::is_same_v<E, detail::EnergyType<T>>) return false;
+    for (int i = 0; i < 3; ++i) event.energy_transfer[i] = units.energy_si(gained[i]);
+    event.total_energy = units.energy_si(energy);
+    event.total_momentum = units.velocity_si(momentum);
+    return true;
+  }
+
   template <class Narrow>
   static CompensatedTime<T> widened(const CompensatedTime<Narrow>& time) {
     return {T(time.hi), T(time.lo)};
   }
 
-  using Energy = detail::EnergyType<T>;
-
   std::array<double, 3> masses_;
   int wall_;
-  detail::ImpactEnergy<Energy> energy_;
+  detail::ImpactEnergy<T> energy_;
+  detail::ImpactEnergy<detail::EnergyType<T>> wide_energy_;
   std::array<T, 3> reference_position_;
   std::array<CompensatedTime<T>, 3> reference_time_{};
   CompensatedTime<T> now_;

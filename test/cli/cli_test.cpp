@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -301,6 +302,89 @@ TEST(CliHelp, HelpGoesToStdoutAndExitsZero) {
   EXPECT_EQ(result.exit_code, 0);
   EXPECT_EQ(result.err, "");
   EXPECT_NE(result.out.find("--velocities"), std::string::npos);
+}
+
+// ---------------------------------------------------------------------------------------
+// Issue 14 as a user meets it: the issue's own commands and exact figures.
+
+TEST(CliDoubleRange, ASubnormalSpeedOfTheOtherPairIsNoReasonToReject) {
+  const Json doc = runJson({"--masses", "1,2,3", "--positions", "2,1,0", "--velocities", "-1,0,5e-324"});
+  EXPECT_EQ(doc.at("summary").at("collision_count"), 2);
+  const std::vector<double> v = doubles(doc.at("summary").at("final_velocities"));
+  EXPECT_NEAR(v[0], 1.0 / 3, 1e-15);    // exact: 1/3
+  EXPECT_NEAR(v[1], 2.0 / 15, 1e-15);   // 2/15
+  EXPECT_NEAR(v[2], -8.0 / 15, 1e-15);  // -8/15 + 1e-324
+  const Json three = runJson({"--masses", "1,1,1", "--positions", "2,1,0", "--velocities=-1,-5e-324,0"});
+  EXPECT_EQ(three.at("summary").at("collision_count"), 3);
+  EXPECT_TRUE(three.at("events")[2].at("time").is_null());  // 2.02e323 s: beyond a double
+  EXPECT_NEAR(three.at("events")[2].at("position").get<double>(), 0.0, 2e-9);  // where B rests (length scale 2 m)
+}
+
+TEST(CliDoubleRange, CountsPast2To53AreJsonIntegers) {
+  const Json pi = runJson({"--masses", "1e32,1,inf", "--positions", "2,1,0", "--velocities", "-1,0,0", "--mode", "predict"})
+                      .at("summary");
+  ASSERT_TRUE(pi.at("predicted_collision_count").is_number_unsigned());
+  EXPECT_EQ(pi.at("predicted_collision_count").get<std::uint64_t>(), 31415926535897933u);
+  EXPECT_EQ(pi.at("max_possible_collision_count").get<std::uint64_t>(), 31415926535897934u);
+  const Json heavy = runJson({"--masses", "1e36,1,1e36", "--positions", "2,1,0", "--velocities", "-1,0,0", "--mode",
+                              "predict"})
+                         .at("summary");
+  EXPECT_EQ(heavy.at("predicted_collision_count").get<std::uint64_t>(), 2221441469079183170u);
+  EXPECT_EQ(heavy.at("max_possible_collision_count").get<std::uint64_t>(), 2221441469079183171u);
+  const Json inside = runJson({"--masses", "8e36,1,inf", "--positions", "2,1,0", "--velocities", "-1,0,0", "--mode",
+                               "predict"})
+                          .at("summary");
+  EXPECT_EQ(inside.at("predicted_collision_count").get<std::uint64_t>(), 8885765876316732682u);
+  // The table prints the integer too.
+  const CliOutput table =
+      run({"--masses", "1e36,1,1e36", "--positions", "2,1,0", "--velocities", "-1,0,0", "--mode", "predict"});
+  EXPECT_NE(table.out.find("2221441469079183170"), std::string::npos) << table.out;
+}
+
+TEST(CliDoubleRange, PositionsOfImpactsShorterThanTheSmallestDouble) {
+  const Json doc = runJson({"--masses", "1,2,3", "--positions", "3e-200,1e-200,0", "--velocities", "-1e150,0,1e150"});
+  const Json& events = doc.at("events");
+  ASSERT_EQ(events.size(), 3u);
+  EXPECT_NEAR(events[1].at("position").get<double>(), 1.5454545454545453e-200, 1e-209);
+  EXPECT_NEAR(events[2].at("position").get<double>(), 1.2857142857142857e-200, 1e-209);
+  EXPECT_EQ(events[2].at("time"), 0.0);  // 1e-350 s rounds to 0
+}
+
+TEST(CliDoubleRange, SubnormalApproachSpeedInEveryPrecision) {
+  for (const char* precision : {"double", "long_double", "high"}) {
+    const Json doc = runJson({"--masses", "3e-300,1e-300,5e-301", "--positions", "2e-200,1e-200,0", "--velocities",
+                              "-1e-300,0,0", "--precision", precision});
+    const Json& third = doc.at("events").at(2);
+    EXPECT_NEAR(third.at("time").get<double>() / 4.8256457640483526e+116, 1.0, 1e-9) << precision;
+    EXPECT_NEAR(third.at("position").get<double>() / -2.4128228820241767e-184, 1.0, 1e-9) << precision;
+  }
+}
+
+TEST(CliDoubleRange, ExtremeMassRatiosAreRun) {
+  const Json doc = runJson({"--masses", "1e-300,1,inf", "--positions", "2,1,0", "--velocities", "-1e-140,0,0"});
+  EXPECT_EQ(doc.at("summary").at("collision_count"), 2);
+  EXPECT_EQ(doc.at("summary").at("predicted_collision_count"), 2);
+}
+
+// ---------------------------------------------------------------------------------------
+// Issue 8, section 4: no output shows a negative zero.
+
+TEST(CliOutputs, NeverPrintANegativeZero) {
+  // -0 inputs, a resting wall, bodies at rest: every format.
+  const std::regex negative_zero(R"((^|[^0-9.eE])-0(\.0*)?([^0-9.eE]|$))");
+  for (const char* format : {"table", "json", "csv"}) {
+    for (const std::vector<std::string>& scene :
+         {std::vector<std::string>{"--masses", "100,1,inf", "--positions", "2,1,0", "--velocities=-1,-0,-0"},
+          std::vector<std::string>{"--masses", "inf,1,1", "--positions", "2,1,0", "--velocities=-0,0.5,-1"}}) {
+      std::vector<std::string> args = scene;
+      args.insert(args.end(), {"--format", format});
+      const CliOutput result = run(args);
+      ASSERT_EQ(result.exit_code, 0) << result.err;
+      for (const std::string& line : linesOf(result.out)) {
+        EXPECT_FALSE(std::regex_search(line, negative_zero)) << format << ": " << line;
+      }
+    }
+  }
 }
 
 }  // namespace

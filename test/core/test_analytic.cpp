@@ -17,10 +17,6 @@ using testing_support::energyNormError;
 using testing_support::kInf;
 using testing_support::randomScene;
 
-exact::RationalState toRational(const Eigen::Vector3d& v) {
-  return {exact::Rational(v(0)), exact::Rational(v(1)), exact::Rational(v(2))};
-}
-
 TEST(Angles, AtanFormIsWellConditioned) {
   // physics.md: for (1e12, 1, 1e12) pi / alpha is 2221441.469 (the acos form is off).
   const Angles angles = anglesFor({1e12, 1, 1e12});

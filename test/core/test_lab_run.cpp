@@ -205,9 +205,10 @@ TEST(RejectionWording, NoMessageRepeatsItsField) {
   for (const Scene& scene : rejected) {
     const auto error = validate(scene);
     ASSERT_TRUE(error);
-    // A report prints "field: message"; "positions: positions (0, 1, 2) m ..." said its
-    // field twice, so the message must not start with the field's name.
+    // "positions: positions (0, 1, 2) m ..." said its field twice; front ends show the
+    // field beside the message, which therefore names neither the field nor its prefix.
     const std::string base = error->field.substr(0, error->field.find('['));
+    EXPECT_EQ(error->message.find(error->field + ":"), std::string::npos) << error->message;
     EXPECT_NE(error->message.rfind(base, 0), 0u) << error->message;
     EXPECT_EQ(error->message.find("nan"), std::string::npos) << error->message;
   }

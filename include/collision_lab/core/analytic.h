@@ -24,7 +24,9 @@ struct Angles {
 };
 
 /// Closed-form model of one scene in working precision Scalar (double, long double or
-/// HighPrecision). Precondition: validate(scene) passed.
+/// HighPrecision). Precondition: validate(scene) passed. In double it needs finite-mass
+/// ratios up to about 2^1000, beyond which the light body's share of the mass-weighted
+/// velocities underflows; predict() and runLab() go to HighPrecision there.
 template <class Scalar>
 class AnalyticModel {
  public:

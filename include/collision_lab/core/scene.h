@@ -41,7 +41,9 @@ enum class Reason : std::uint8_t {
   kPositionsNotOrdered = 5, ///< not x_A > x_B > x_C
   kPositionsCoincident = 6, ///< two positions are equal
   kTripleCollision = 7,     ///< the first two contacts happen at exactly the same time
-  kOverflow = 8,            ///< momentum or kinetic energy overflows a double
+  kOverflow = 8,            ///< a momentum, energy, gap or relative velocity overflows a double; the
+                            ///< first contact comes after, or puts a body beyond, the largest double;
+                            ///< or the masses allow more than 2^64 - 1 collisions
 };
 
 /// Machine-readable name of a reason, e.g. "TRIPLE_COLLISION".
@@ -50,7 +52,9 @@ const char* reasonName(Reason r);
 struct ValidationError {
   Reason reason = Reason::kOk;
   std::string field;    ///< e.g. "velocities[1]", "masses", "positions"
-  std::string message;  ///< one sentence naming the quantity (m_B, x_A, ...), its value and unit, and what is allowed; not prefixed with the field
+  /// One sentence for people about the value in `field` ("v_B is NaN; ..."), which it does
+  /// not repeat: front ends show field and message side by side.
+  std::string message;
 };
 
 /// Checks a scene. Returns nothing when the scene is valid. Never throws for any input.

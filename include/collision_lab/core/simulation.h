@@ -19,7 +19,10 @@
 
 namespace collision_lab {
 
-/// One elastic two-body impact.
+/// One elastic two-body impact. Every value is the double nearest to the exact one (and
+/// never -0): a time beyond the largest double is +inf (only the first contact is
+/// validated to be representable), one below the smallest rounds to 0, while positions
+/// keep their digits.
 struct ImpactEvent {
   std::uint64_t index = 0;                    ///< 1-based collision number
   Pair pair = Pair::AB;
