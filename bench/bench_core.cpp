@@ -25,6 +25,7 @@
 #include "timing.h"
 
 using namespace collision_lab;
+using namespace collision_lab::core;
 using namespace collision_lab::bench;
 
 namespace {
@@ -37,8 +38,8 @@ struct Method {
   std::uint64_t count = 0;
 };
 
-Scene heavyLightHeavy(double heavy) {
-  Scene scene;
+ThreeBodyScene heavyLightHeavy(double heavy) {
+  ThreeBodyScene scene;
   scene.masses = {heavy, 1.0, heavy};
   scene.positions = {1.0, 0.0, -1.0};
   scene.velocities = {-1.0, 0.0, 0.0};
@@ -47,7 +48,7 @@ Scene heavyLightHeavy(double heavy) {
 
 /// Returns the core's count-only / lean ratio for this scene.
 double benchScene(double heavy, int repeats, bool keep_all) {
-  const Scene scene = heavyLightHeavy(heavy);
+  const ThreeBodyScene scene = heavyLightHeavy(heavy);
   const std::uint64_t predicted = predictedCollisionCount(scene);
   std::printf("\nScene: masses (%g, 1, %g), positions (1, 0, -1) m, v = (-1, 0, 0) m/s; "
               "predicted collisions %llu\n", heavy, heavy, static_cast<unsigned long long>(predicted));
@@ -122,7 +123,7 @@ double benchClosedForm(int repeats) {
   std::printf("  %-22s %16s %18s\n", "masses", "n", "median ns/query");
   double worst = 0.0;
   for (double heavy : {1e14, 1e30}) {
-    const Scene scene = heavyLightHeavy(heavy);
+    const ThreeBodyScene scene = heavyLightHeavy(heavy);
     for (double n_double : {1e3, 1e6, 1e9, 1e12}) {
       const auto n = static_cast<std::uint64_t>(n_double);
       const double ns = velocitiesAfterNs(scene, n, repeats);
@@ -134,7 +135,7 @@ double benchClosedForm(int repeats) {
   std::printf("\npredictedCollisionCount (exact count, includes building the model)\n");
   std::printf("  %-22s %20s %18s\n", "masses", "count", "median ns/call");
   for (double heavy : {1e12, 1e14, 1e16, 1e20, 1e30}) {
-    const Scene scene = heavyLightHeavy(heavy);
+    const ThreeBodyScene scene = heavyLightHeavy(heavy);
     const std::uint64_t count = predictedCollisionCount(scene);
     const double ns = predictedCountNs(scene, repeats);
     std::printf("  (%-6g, 1, %-6g)       %20llu %18.1f\n", heavy, heavy,

@@ -40,6 +40,7 @@
 #include "timing.h"
 
 using namespace collision_lab;
+using namespace collision_lab::core;
 using namespace collision_lab::bench;
 
 namespace {
@@ -51,11 +52,11 @@ constexpr std::uint64_t kIsolateAbove = 1'000'000;  // longer runs go to a child
 
 struct HardCase {
   std::string name;
-  Scene scene;
+  ThreeBodyScene scene;
 };
 
-Scene makeScene(std::array<double, 3> m, std::array<double, 3> x, std::array<double, 3> v) {
-  Scene s;
+ThreeBodyScene makeScene(std::array<double, 3> m, std::array<double, 3> x, std::array<double, 3> v) {
+  ThreeBodyScene s;
   s.masses = m;
   s.positions = x;
   s.velocities = v;
@@ -91,7 +92,7 @@ struct Reference {
   std::string kind;
 };
 
-Reference makeReference(const Scene& scene) {
+Reference makeReference(const ThreeBodyScene& scene) {
   Reference ref;
   ref.first_pair = ExactTrajectory(scene, 0).firstPair();  // exact, stops before any collision
   const std::uint64_t predicted = predictedCollisionCount(scene);
@@ -127,11 +128,11 @@ struct Method {
   std::string name;
   bool multiprecision;
   bool adaptive;  ///< the core in double: the column the goals are about
-  std::function<Outcome(const Scene&)> run;
+  std::function<Outcome(const ThreeBodyScene&)> run;
 };
 
 template <class Scalar, ImpulseForm kForm = ImpulseForm::kMassFraction>
-Outcome naiveOutcome(const Scene& scene) {
+Outcome naiveOutcome(const ThreeBodyScene& scene) {
   const auto run = naiveEventLoop<Scalar, false, kForm>(scene, kSimulationLimit);
   Outcome out;
   out.ran = true;
@@ -149,7 +150,7 @@ SimulationOptions countOnly() {
 }
 
 template <class Scalar>
-Outcome coreOutcome(const Scene& scene) {
+Outcome coreOutcome(const ThreeBodyScene& scene) {
   const SimulationResult result = simulate<Scalar>(scene, countOnly());
   Outcome out;
   out.ran = true;
@@ -183,7 +184,7 @@ std::size_t adaptiveIndex(const std::vector<Method>& list) {
 /// Runs `method` once in a forked child and returns its outcome, or an outcome saying it
 /// did not finish within `limit` seconds (the child is then killed). Keeps a run whose
 /// cost cannot be predicted (escalation replays) from holding up the whole table.
-Outcome runIsolated(const Method& method, const Scene& scene, double limit) {
+Outcome runIsolated(const Method& method, const ThreeBodyScene& scene, double limit) {
   struct Wire {
     std::uint64_t count;
     int first_pair;  // -1: none
@@ -248,7 +249,7 @@ double medianSeconds(Work&& work, int repeats) {
   return median(samples) / batch;
 }
 
-std::string cell(const Outcome& out, const Reference& ref, const Scene& scene) {
+std::string cell(const Outcome& out, const Reference& ref, const ThreeBodyScene& scene) {
   if (!out.ran) return out.why_not;
   const long long err = static_cast<long long>(out.count) - static_cast<long long>(ref.count);
   std::string text = format("%+lld / %s", err, sci(relativeVelocityError(scene, out.velocities, ref.velocities)).c_str());
@@ -263,7 +264,7 @@ bool outcomeExact(const Outcome& out, const Reference& ref) {
 struct RandomFamily {
   std::string name;
   std::string how;
-  std::function<Scene(std::mt19937_64&)> draw;
+  std::function<ThreeBodyScene(std::mt19937_64&)> draw;
 };
 
 std::vector<RandomFamily> randomFamilies() {
@@ -271,7 +272,7 @@ std::vector<RandomFamily> randomFamilies() {
       {"random generic", "masses 10^U(-3,3), velocities U(-1,1), gaps U(0.1,1) m",
        [](std::mt19937_64& rng) {
          std::uniform_real_distribution<double> u(0.0, 1.0);
-         Scene s;
+         ThreeBodyScene s;
          for (auto& m : s.masses) m = std::pow(10.0, -3.0 + 6.0 * u(rng));
          for (auto& v : s.velocities) v = -1.0 + 2.0 * u(rng);
          s.positions[2] = 0.0;
@@ -283,7 +284,7 @@ std::vector<RandomFamily> randomFamilies() {
                                 "(ties and grazing contacts are common)",
        [](std::mt19937_64& rng) {
          std::uniform_int_distribution<int> mass(1, 9), vel(-4, 4);
-         Scene s;
+         ThreeBodyScene s;
          for (auto& m : s.masses) m = mass(rng);
          for (auto& v : s.velocities) v = vel(rng) / 4.0;
          s.positions = {2.0, 1.0, 0.0};
@@ -327,7 +328,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> adaptive_failures;
   Stopwatch total;
   for (const auto& hard : hardCases(quick)) {
-    const Scene& scene = hard.scene;
+    const ThreeBodyScene& scene = hard.scene;
     std::fprintf(stderr, "[%5.0f s] %s\n", total.seconds(), hard.name.c_str());
     errors << "| " << hard.name << " | " << triple(scene.masses) << " | " << triple(scene.velocities) << " | ";
     if (const auto invalid = validate(scene)) {
@@ -387,9 +388,9 @@ int main(int argc, char** argv) {
   std::vector<double> escalation_costs;
   for (const auto& family : randomFamilies()) {
     std::mt19937_64 rng(seed);
-    std::vector<Scene> scenes;
+    std::vector<ThreeBodyScene> scenes;
     while (static_cast<int>(scenes.size()) < random_scenes) {
-      const Scene s = family.draw(rng);
+      const ThreeBodyScene s = family.draw(rng);
       if (!validate(s)) scenes.push_back(s);
     }
     std::fprintf(stderr, "[%5.0f s] %s: %d scenes\n", total.seconds(), family.name.c_str(), random_scenes);
@@ -470,7 +471,7 @@ int main(int argc, char** argv) {
   closed << "| masses [kg] | n | velocitiesAfter(n) [ns] |\n|---|---|---|\n";
   double worst_query = 0.0;
   for (double heavy : {1e12, 1e30}) {
-    const Scene s = makeScene({heavy, 1, heavy}, {1, 0, -1}, {-1, 0, 0});
+    const ThreeBodyScene s = makeScene({heavy, 1, heavy}, {1, 0, -1}, {-1, 0, 0});
     for (double n : {1e3, 1e6, 1e9, 1e12}) {
       const double ns = velocitiesAfterNs(s, static_cast<std::uint64_t>(n), repeats);
       worst_query = std::max(worst_query, ns);
@@ -479,7 +480,7 @@ int main(int argc, char** argv) {
   }
   closed << "\n| masses [kg] | predictedCollisionCount | time per call [ns] |\n|---|---|---|\n";
   for (double heavy : {1e12, 1e16, 1e20, 1e30}) {
-    const Scene s = makeScene({heavy, 1, heavy}, {1, 0, -1}, {-1, 0, 0});
+    const ThreeBodyScene s = makeScene({heavy, 1, heavy}, {1, 0, -1}, {-1, 0, 0});
     closed << "| " << triple(s.masses) << " | " << predictedCollisionCount(s) << " | "
            << format("%.0f", predictedCountNs(s, repeats)) << " |\n";
   }

@@ -31,6 +31,7 @@
 #include "timing.h"
 
 using namespace collision_lab;
+using namespace collision_lab::core;
 using namespace collision_lab::bench;
 
 namespace {
@@ -42,7 +43,7 @@ constexpr double kEndTime = 3.0;
 struct BenchScene {
   std::string name;
   std::string description;
-  Scene scene;
+  ThreeBodyScene scene;
   bool in_quick;
 };
 

@@ -31,7 +31,7 @@
 #include "collision_lab/core/scene.h"
 #include "collision_lab/core/simulation.h"
 
-namespace cl = collision_lab;
+namespace cl = collision_lab::core;
 
 namespace {
 
@@ -122,7 +122,7 @@ struct VelocityScales {
   std::array<double, 3> floor{};
 };
 
-VelocityScales velocityScales(const cl::Scene& scene) {
+VelocityScales velocityScales(const cl::ThreeBodyScene& scene) {
   const int wall = scene.wallIndex();
   double mass_max = 0.0;
   for (int i = 0; i < 3; ++i) {
@@ -165,7 +165,7 @@ void checkEscaped(const std::array<double, 3>& v, const VelocityScales& scales, 
 /// The engine's own rounding bound: 64 eps per impact (simulation.cpp, kBoundFactor).
 double engineTolerance(std::uint64_t count) { return 64 * std::numeric_limits<double>::epsilon() * double(count + 2); }
 
-void checkSimulation(const cl::Scene& scene, const cl::SimulationResult& sim, const cl::AnalyticPrediction& prediction,
+void checkSimulation(const cl::ThreeBodyScene& scene, const cl::SimulationResult& sim, const cl::AnalyticPrediction& prediction,
                      std::uint64_t cap) {
   FUZZ_CHECK(sim.first_pair == prediction.first_pair, "simulation and prediction disagree on the first pair");
   FUZZ_CHECK(sim.truncated == (prediction.collision_count > cap), "truncated iff the predicted count exceeds the cap");
@@ -189,7 +189,7 @@ void checkSimulation(const cl::Scene& scene, const cl::SimulationResult& sim, co
   }
 }
 
-void checkModel(const cl::Scene& scene, const cl::AnalyticPrediction& prediction) {
+void checkModel(const cl::ThreeBodyScene& scene, const cl::AnalyticPrediction& prediction) {
   const cl::AnalyticModel<double> model(scene);
   const double alpha = model.alpha();
   FUZZ_CHECK(alpha > 0 && alpha <= M_PI / 2 + 1e-12, "alpha in (0, pi/2]");
@@ -217,7 +217,7 @@ void checkModel(const cl::Scene& scene, const cl::AnalyticPrediction& prediction
   checkEscaped({last(0), last(1), last(2)}, scales, 1e-9);
 }
 
-void exercisePaper(const cl::Scene& scene, std::uint64_t count) {
+void exercisePaper(const cl::ThreeBodyScene& scene, std::uint64_t count) {
   // Printed formulas may be NaN or wrong by design (physics.md, Errata); they must only
   // answer without crashing or undefined behaviour.
   (void)cl::paper::velocitiesAfter(scene, count);
@@ -239,7 +239,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::uint64_t cap = kCaps[in.byte() % kCaps.size()];
   const bool compact = flags & 0x10;
   if (!in.has(compact ? 9 * 4 : 9 * 8)) return 0;
-  cl::Scene scene;
+  cl::ThreeBodyScene scene;
   for (auto* values : {&scene.masses, &scene.positions, &scene.velocities}) {
     for (double& value : *values) value = compact ? in.compactDouble() : in.rawDouble();
   }

@@ -10,8 +10,8 @@ namespace collision_lab {
 namespace bench {
 
 /// Median ns per AnalyticModel<double>::velocitiesAfter(n) query (model built once).
-inline double velocitiesAfterNs(const Scene& scene, std::uint64_t n, int repeats) {
-  const AnalyticModel<double> model(scene);
+inline double velocitiesAfterNs(const core::ThreeBodyScene& scene, std::uint64_t n, int repeats) {
+  const core::AnalyticModel<double> model(scene);
   constexpr int kBatch = 100'000;
   const auto samples = timeRepeats(repeats, [&] {
     // Alternate n so the query cannot be hoisted out of the loop.
@@ -21,10 +21,10 @@ inline double velocitiesAfterNs(const Scene& scene, std::uint64_t n, int repeats
 }
 
 /// Median ns per predictedCollisionCount(scene) call (builds its model every call).
-inline double predictedCountNs(const Scene& scene, int repeats) {
+inline double predictedCountNs(const core::ThreeBodyScene& scene, int repeats) {
   constexpr int kBatch = 200;
   const auto samples = timeRepeats(repeats, [&] {
-    for (int i = 0; i < kBatch; ++i) doNotOptimize(predictedCollisionCount(scene));
+    for (int i = 0; i < kBatch; ++i) doNotOptimize(core::predictedCollisionCount(scene));
   });
   return median(samples) * 1e9 / kBatch;
 }

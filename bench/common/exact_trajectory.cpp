@@ -26,7 +26,7 @@ mpq_class massFraction(double m_i, double m_j) {
 
 }  // namespace
 
-ExactTrajectory::ExactTrajectory(const Scene& scene, std::uint64_t max_collisions)
+ExactTrajectory::ExactTrajectory(const core::ThreeBodyScene& scene, std::uint64_t max_collisions)
     : state_(std::make_unique<State>()) {
   auto& x = state_->x;
   auto& v = state_->v;
@@ -37,25 +37,25 @@ ExactTrajectory::ExactTrajectory(const Scene& scene, std::uint64_t max_collision
   }
   t = 0;
   const auto& m = scene.masses;
-  const std::array<mpq_class, 2> f_left = {massFraction(m[kA], m[kB]), massFraction(m[kB], m[kC])};
-  const std::array<mpq_class, 2> f_right = {massFraction(m[kB], m[kA]), massFraction(m[kC], m[kB])};
+  const std::array<mpq_class, 2> f_left = {massFraction(m[core::kA], m[core::kB]), massFraction(m[core::kB], m[core::kC])};
+  const std::array<mpq_class, 2> f_right = {massFraction(m[core::kB], m[core::kA]), massFraction(m[core::kC], m[core::kB])};
 
-  const bool ab = v[kB] > v[kA];
-  const bool bc = v[kC] > v[kB];
+  const bool ab = v[core::kB] > v[core::kA];
+  const bool bc = v[core::kC] > v[core::kB];
   if (ab && bc) {
     // t_AB < t_BC  <=>  (x_A - x_B)(v_C - v_B) < (x_B - x_C)(v_B - v_A); triple excluded.
-    const mpq_class lhs = (x[kA] - x[kB]) * (v[kC] - v[kB]);
-    const mpq_class rhs = (x[kB] - x[kC]) * (v[kB] - v[kA]);
+    const mpq_class lhs = (x[core::kA] - x[core::kB]) * (v[core::kC] - v[core::kB]);
+    const mpq_class rhs = (x[core::kB] - x[core::kC]) * (v[core::kB] - v[core::kA]);
     if (lhs == rhs) throw std::invalid_argument("exact reference: triple collision");
-    first_pair_ = lhs < rhs ? Pair::AB : Pair::BC;
+    first_pair_ = lhs < rhs ? core::Pair::AB : core::Pair::BC;
   } else if (ab) {
-    first_pair_ = Pair::AB;
+    first_pair_ = core::Pair::AB;
   } else if (bc) {
-    first_pair_ = Pair::BC;
+    first_pair_ = core::Pair::BC;
   }
   if (!first_pair_) return;
 
-  int pair = *first_pair_ == Pair::AB ? 0 : 1;
+  int pair = *first_pair_ == core::Pair::AB ? 0 : 1;
   mpq_class approach, dt;
   for (;;) {
     const int left = pair;  // AB: A=0, B=1; BC: B=1, C=2

@@ -17,14 +17,14 @@ namespace bench {
 class ExactTrajectory {
  public:
   /// Runs a validated scene exactly, to its end or to max_collisions.
-  ExactTrajectory(const Scene& scene, std::uint64_t max_collisions);
+  ExactTrajectory(const core::ThreeBodyScene& scene, std::uint64_t max_collisions);
   ~ExactTrajectory();
   ExactTrajectory(ExactTrajectory&&) noexcept;
   ExactTrajectory& operator=(ExactTrajectory&&) noexcept;
 
   std::uint64_t collisionCount() const { return collision_count_; }
   bool truncated() const { return truncated_; }
-  std::optional<Pair> firstPair() const { return first_pair_; }
+  std::optional<core::Pair> firstPair() const { return first_pair_; }
   /// After the last collision, rounded to double [m/s].
   std::array<double, 3> finalVelocities() const;
   /// Time of the last collision, rounded to double (0 without any) [s].
@@ -37,7 +37,7 @@ class ExactTrajectory {
   std::unique_ptr<State> state_;
   std::uint64_t collision_count_ = 0;
   bool truncated_ = false;
-  std::optional<Pair> first_pair_;
+  std::optional<core::Pair> first_pair_;
 };
 
 }  // namespace bench

@@ -19,7 +19,7 @@ template <class Scalar>
 struct NaiveRun {
   std::uint64_t collision_count = 0;
   bool truncated = false;
-  std::optional<Pair> first_pair;
+  std::optional<core::Pair> first_pair;
   std::array<Scalar, 3> velocities{};  ///< after the last collision [m/s]
   std::array<Scalar, 3> positions{};   ///< at `time` (only with position tracking) [m]
   Scalar time = 0;                     ///< of the last collision (only with tracking) [s]
@@ -46,37 +46,37 @@ enum class ImpulseForm {
 /// loop": times, positions, velocities, nothing stored); without it only velocities
 /// change after the first pair is chosen.
 template <class Scalar, bool kTrackPositions, ImpulseForm kForm = ImpulseForm::kMassFraction>
-NaiveRun<Scalar> naiveEventLoop(const Scene& scene, std::uint64_t max_collisions) {
+NaiveRun<Scalar> naiveEventLoop(const core::ThreeBodyScene& scene, std::uint64_t max_collisions) {
   NaiveRun<Scalar> run;
   const auto& m = scene.masses;
   // Per pair: fraction of the left body (A of AB, B of BC) and of the right body.
-  const Scalar f_ab_a = naiveMassFraction<Scalar>(m[kA], m[kB]);
-  const Scalar f_ab_b = naiveMassFraction<Scalar>(m[kB], m[kA]);
-  const Scalar f_bc_b = naiveMassFraction<Scalar>(m[kB], m[kC]);
-  const Scalar f_bc_c = naiveMassFraction<Scalar>(m[kC], m[kB]);
+  const Scalar f_ab_a = naiveMassFraction<Scalar>(m[core::kA], m[core::kB]);
+  const Scalar f_ab_b = naiveMassFraction<Scalar>(m[core::kB], m[core::kA]);
+  const Scalar f_bc_b = naiveMassFraction<Scalar>(m[core::kB], m[core::kC]);
+  const Scalar f_bc_c = naiveMassFraction<Scalar>(m[core::kC], m[core::kB]);
   auto& v = run.velocities;
   auto& x = run.positions;
   for (int i = 0; i < 3; ++i) {
     v[i] = Scalar(scene.velocities[i]);
     x[i] = Scalar(scene.positions[i]);
   }
-  const bool ab = v[kB] - v[kA] > 0;
-  const bool bc = v[kC] - v[kB] > 0;
+  const bool ab = v[core::kB] - v[core::kA] > 0;
+  const bool bc = v[core::kC] - v[core::kB] > 0;
   if (ab && bc) {
-    const Scalar t_ab = (x[kA] - x[kB]) / (v[kB] - v[kA]);
-    const Scalar t_bc = (x[kB] - x[kC]) / (v[kC] - v[kB]);
-    run.first_pair = t_ab <= t_bc ? Pair::AB : Pair::BC;
+    const Scalar t_ab = (x[core::kA] - x[core::kB]) / (v[core::kB] - v[core::kA]);
+    const Scalar t_bc = (x[core::kB] - x[core::kC]) / (v[core::kC] - v[core::kB]);
+    run.first_pair = t_ab <= t_bc ? core::Pair::AB : core::Pair::BC;
   } else if (ab) {
-    run.first_pair = Pair::AB;
+    run.first_pair = core::Pair::AB;
   } else if (bc) {
-    run.first_pair = Pair::BC;
+    run.first_pair = core::Pair::BC;
   } else {
     return run;
   }
-  bool is_ab = *run.first_pair == Pair::AB;
+  bool is_ab = *run.first_pair == core::Pair::AB;
   std::uint64_t count = 0;
   for (;;) {
-    const int left = is_ab ? kA : kB;
+    const int left = is_ab ? core::kA : core::kB;
     const int right = left + 1;
     const Scalar approach = v[right] - v[left];
     if (!(approach > 0)) break;
@@ -87,9 +87,9 @@ NaiveRun<Scalar> naiveEventLoop(const Scene& scene, std::uint64_t max_collisions
     if constexpr (kTrackPositions) {
       const Scalar dt = (x[left] - x[right]) / approach;
       run.time += dt;
-      x[kA] += v[kA] * dt;
-      x[kB] += v[kB] * dt;
-      x[kC] += v[kC] * dt;
+      x[core::kA] += v[core::kA] * dt;
+      x[core::kB] += v[core::kB] * dt;
+      x[core::kC] += v[core::kC] * dt;
     }
     const Scalar f_left = is_ab ? f_ab_a : f_bc_b;
     const Scalar f_right = is_ab ? f_ab_b : f_bc_c;

@@ -33,7 +33,7 @@ std::string triple(const std::array<double, 3>& values) {
   return format("(%g, %g, %g)", values[0], values[1], values[2]);
 }
 
-double relativeVelocityError(const Scene& scene, const std::array<double, 3>& a,
+double relativeVelocityError(const core::ThreeBodyScene& scene, const std::array<double, 3>& a,
                              const std::array<double, 3>& b) {
   double diff = 0.0, scale = 0.0;
   for (int i = 0; i < 3; ++i) {
@@ -45,7 +45,7 @@ double relativeVelocityError(const Scene& scene, const std::array<double, 3>& a,
   return scale > 0.0 ? diff / scale : diff;
 }
 
-double energyRelativeDrift(const Scene& scene, const std::array<double, 3>& v) {
+double energyRelativeDrift(const core::ThreeBodyScene& scene, const std::array<double, 3>& v) {
   long double e0 = 0, e = 0;
   for (int i = 0; i < 3; ++i) {
     if (scene.isWall(i)) continue;

@@ -20,12 +20,12 @@ std::string triple(const std::array<double, 3>& values);
 
 /// max_i |a_i - b_i| / max_i |b_i| over the finite-mass bodies (walls are skipped);
 /// absolute when b is all zero.
-double relativeVelocityError(const Scene& scene, const std::array<double, 3>& a,
+double relativeVelocityError(const core::ThreeBodyScene& scene, const std::array<double, 3>& a,
                              const std::array<double, 3>& b);
 
 /// |E - E_0| / E_0 with E the kinetic energy of the finite masses (walls are at rest in
 /// every benchmark scene). Computed in long double.
-double energyRelativeDrift(const Scene& scene, const std::array<double, 3>& v);
+double energyRelativeDrift(const core::ThreeBodyScene& scene, const std::array<double, 3>& v);
 
 /// The source version the results belong to, from $COLLISION_LAB_BENCH_SOURCE (set by
 /// bench/run_benchmarks.sh to the commit, marked when src/ or include/ have local changes).

@@ -15,7 +15,7 @@ namespace {
 constexpr int kVelocityIterations = 8;
 constexpr int kPositionIterations = 3;
 
-SteppedRun runBox2d(const Scene& scene, const StepConfig& config) {
+SteppedRun runBox2d(const core::ThreeBodyScene& scene, const StepConfig& config) {
   b2World world(b2Vec2(0.0f, 0.0f));
   world.SetAllowSleeping(false);
   world.SetWarmStarting(false);

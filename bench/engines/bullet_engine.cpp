@@ -12,7 +12,7 @@ namespace bench {
 
 namespace {
 
-SteppedRun runBullet(const Scene& scene, const StepConfig& config) {
+SteppedRun runBullet(const core::ThreeBodyScene& scene, const StepConfig& config) {
   btDefaultCollisionConfiguration collision_config;
   btCollisionDispatcher dispatcher(&collision_config);
   btDbvtBroadphase broadphase;

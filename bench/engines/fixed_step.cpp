@@ -18,10 +18,10 @@ double fraction(double m_i, double m_j) {
   return m_i / (m_i + m_j);
 }
 
-SteppedRun runFixedStep(const Scene& scene, const StepConfig& config) {
+SteppedRun runFixedStep(const core::ThreeBodyScene& scene, const StepConfig& config) {
   const auto& m = scene.masses;
-  const double f_left[2] = {fraction(m[kA], m[kB]), fraction(m[kB], m[kC])};
-  const double f_right[2] = {fraction(m[kB], m[kA]), fraction(m[kC], m[kB])};
+  const double f_left[2] = {fraction(m[core::kA], m[core::kB]), fraction(m[core::kB], m[core::kC])};
+  const double f_right[2] = {fraction(m[core::kB], m[core::kA]), fraction(m[core::kC], m[core::kB])};
   SteppedRun run;
   auto& x = run.positions;
   auto& v = run.velocities;

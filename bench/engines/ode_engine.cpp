@@ -36,7 +36,7 @@ void nearCallback(void* data, dGeomID a, dGeomID b) {
   }
 }
 
-SteppedRun runOde(const Scene& scene, const StepConfig& config) {
+SteppedRun runOde(const core::ThreeBodyScene& scene, const StepConfig& config) {
   static std::once_flag init;
   std::call_once(init, [] { dInitODE2(0); });
   OdeWorld w{dWorldCreate(), dJointGroupCreate(0)};
@@ -50,7 +50,7 @@ SteppedRun runOde(const Scene& scene, const StepConfig& config) {
   for (int i = 0; i < 3; ++i) {
     if (std::isinf(scene.masses[i])) {
       // A wall is a plane touching B's surface exactly when x_B reaches the wall.
-      if (i == kC) dCreatePlane(space, 1, 0, 0, scene.positions[i] - r);
+      if (i == core::kC) dCreatePlane(space, 1, 0, 0, scene.positions[i] - r);
       else dCreatePlane(space, -1, 0, 0, -(scene.positions[i] + r));
       continue;
     }

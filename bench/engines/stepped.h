@@ -35,8 +35,8 @@ class CollisionCounter {
  public:
   explicit CollisionCounter(const std::array<double, 3>& v) { update(v); }
   void update(const std::array<double, 3>& v) {
-    const bool ab = v[kB] > v[kA];
-    const bool bc = v[kC] > v[kB];
+    const bool ab = v[core::kB] > v[core::kA];
+    const bool bc = v[core::kC] > v[core::kB];
     count_ += (approach_ab_ && !ab) + (approach_bc_ && !bc);
     approach_ab_ = ab;
     approach_bc_ = bc;
@@ -54,7 +54,7 @@ class CollisionCounter {
 struct SteppedMethod {
   std::string name;
   std::string settings;  ///< every setting, as prose for docs/speed_vs_error.md
-  std::function<SteppedRun(const Scene&, const StepConfig&)> run;
+  std::function<SteppedRun(const core::ThreeBodyScene&, const StepConfig&)> run;
 };
 
 /// Radius of the spheres/circles the engines use [m]. Centres are shifted by the radii

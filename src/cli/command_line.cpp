@@ -142,7 +142,7 @@ void readSceneSource(const RawOptions& raw, const std::string& default_scenario_
                          "(3 comma-separated numbers each), or --scenario FILE");
     }
   }
-  Scene scene;
+  core::ThreeBodyScene scene;
   scene.masses = parseTriple(raw.masses, "masses", "m");
   scene.positions = parseTriple(raw.positions, "positions", "x");
   scene.velocities = parseTriple(raw.velocities, "velocities", "v");

@@ -40,11 +40,11 @@ struct CliRequest {
   Action action = Action::kRunOne;
   std::string help_text;
   io::ReportFormat format = io::ReportFormat::kTable;
-  RunOptions options;
+  core::RunOptions options;
   bool max_collisions_given = false;  ///< else a scenario's own cap applies, if it has one
   std::string scenario_path;          ///< for kList, kRunAll, and kRunOne from a file
   std::string scenario_name;          ///< kRunOne from a file
-  std::optional<Scene> scene;         ///< kRunOne from --masses/--positions/--velocities
+  std::optional<core::ThreeBodyScene> scene;         ///< kRunOne from --masses/--positions/--velocities
 };
 
 /// The format asked for on the command line, found before full parsing so that even a

@@ -32,9 +32,9 @@ std::string defaultScenarioPath() {
 }
 
 void validateOrThrow(const io::NamedScene& named) {
-  if (const auto error = validate(named.scene)) {
+  if (const auto error = core::validate(named.scene)) {
     const std::string where = named.name.empty() ? "" : "scenario '" + named.name + "': ";
-    throw CliError{reasonName(error->reason), static_cast<int>(error->reason), error->field,
+    throw CliError{core::reasonName(error->reason), static_cast<int>(error->reason), error->field,
                    where + error->message};
   }
 }
@@ -48,30 +48,30 @@ std::vector<io::NamedScene> loadScenes(const std::string& path) {
 }
 
 /// The request's options, with a scene's own collision cap unless --max-collisions was given.
-RunOptions optionsFor(const CliRequest& request, const io::NamedScene& named) {
-  RunOptions options = request.options;
+core::RunOptions optionsFor(const CliRequest& request, const io::NamedScene& named) {
+  core::RunOptions options = request.options;
   if (!request.max_collisions_given && named.max_collisions > 0) options.max_collisions = named.max_collisions;
   return options;
 }
 
-bool isShown(const EventPolicy& policy, std::uint64_t index) {
+bool isShown(const core::EventPolicy& policy, std::uint64_t index) {
   switch (policy.kind) {
-    case EventPolicy::Kind::kAll: return true;
-    case EventPolicy::Kind::kNone: return false;
-    case EventPolicy::Kind::kFirstN: return index <= policy.first_n;
+    case core::EventPolicy::Kind::kAll: return true;
+    case core::EventPolicy::Kind::kNone: return false;
+    case core::EventPolicy::Kind::kFirstN: return index <= policy.first_n;
   }
   return false;
 }
 
 /// Runs one validated scene. `on_event` (may be empty) sees every event; a progress line
 /// is drawn on a terminal.
-RunResult runWithProgress(const Scene& scene, const RunOptions& options, const LabEventVisitor& on_event) {
+core::RunResult runWithProgress(const core::ThreeBodyScene& scene, const core::RunOptions& options, const core::LabEventVisitor& on_event) {
   std::optional<ProgressLine> progress;
-  if (options.mode == RunMode::kFull && isatty(STDERR_FILENO)) {
-    progress.emplace(stderr, std::min(predict(scene).collision_count, options.max_collisions));
+  if (options.mode == core::RunMode::kFull && isatty(STDERR_FILENO)) {
+    progress.emplace(stderr, std::min(core::predict(scene).collision_count, options.max_collisions));
   }
-  if (!progress) return runLab(scene, options, on_event);
-  return runLab(scene, options, [&](const LabEvent& event) {
+  if (!progress) return core::runLab(scene, options, on_event);
+  return core::runLab(scene, options, [&](const core::LabEvent& event) {
     if (on_event) on_event(event);
     progress->onCollision(event.event.index);
   });
@@ -80,15 +80,15 @@ RunResult runWithProgress(const Scene& scene, const RunOptions& options, const L
 /// One scene, its events streamed to the report as they happen: nothing is kept.
 void runOne(const CliRequest& request, const io::NamedScene& named) {
   validateOrThrow(named);
-  const RunOptions shown_options = optionsFor(request, named);
-  RunOptions run_options = shown_options;
-  run_options.events = EventPolicy::none();
+  const core::RunOptions shown_options = optionsFor(request, named);
+  core::RunOptions run_options = shown_options;
+  run_options.events = core::EventPolicy::none();
 
   const std::unique_ptr<io::RunReportWriter> writer = io::makeRunReportWriter(request.format, std::cout);
   writer->begin(named, shown_options);
-  LabEventVisitor show_event;
-  if (shown_options.events.kind != EventPolicy::Kind::kNone) {
-    show_event = [&](const LabEvent& event) {
+  core::LabEventVisitor show_event;
+  if (shown_options.events.kind != core::EventPolicy::Kind::kNone) {
+    show_event = [&](const core::LabEvent& event) {
       if (isShown(shown_options.events, event.event.index)) writer->event(event);
     };
   }
@@ -100,7 +100,7 @@ void runAll(const CliRequest& request, const std::vector<io::NamedScene>& scenes
   for (const io::NamedScene& named : scenes) validateOrThrow(named);
   std::vector<io::SceneOutcome> outcomes;
   for (const io::NamedScene& named : scenes) {
-    const RunOptions options = optionsFor(request, named);
+    const core::RunOptions options = optionsFor(request, named);
     outcomes.push_back({named, options, runWithProgress(named.scene, options, {})});
   }
   io::writeBatchReport(request.format, outcomes, std::cout);

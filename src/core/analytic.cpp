@@ -16,6 +16,7 @@
 #include "impact_energy.h"
 
 namespace collision_lab {
+namespace core {
 
 namespace {
 
@@ -71,7 +72,7 @@ struct Quotient {
   T error_bound;
 };
 
-double largestFiniteMass(const Scene& scene) {
+double largestFiniteMass(const ThreeBodyScene& scene) {
   double mass = 0.0;
   for (int i = 0; i < 3; ++i) {
     if (!scene.isWall(i)) mass = std::max(mass, scene.masses[i]);
@@ -80,7 +81,7 @@ double largestFiniteMass(const Scene& scene) {
 }
 
 template <class T>
-Quotient<T> countQuotient(const Scene& scene, Pair first) {
+Quotient<T> countQuotient(const ThreeBodyScene& scene, Pair first) {
   using std::sqrt;
   const AnalyticModel<T> model(scene);
   const T alpha = model.alpha();
@@ -148,7 +149,7 @@ std::array<std::complex<double>, 3> sortedByArgument(std::array<std::complex<dou
 }  // namespace
 
 template <class Scalar>
-AnalyticModel<Scalar>::AnalyticModel(const Scene& scene) : masses_(scene.masses), wall_(scene.wallIndex()) {
+AnalyticModel<Scalar>::AnalyticModel(const ThreeBodyScene& scene) : masses_(scene.masses), wall_(scene.wallIndex()) {
   using std::atan2;
   using std::sqrt;
   f_ab_a_ = fraction<Scalar>(masses_[kA], masses_[kB]);
@@ -156,7 +157,7 @@ AnalyticModel<Scalar>::AnalyticModel(const Scene& scene) : masses_(scene.masses)
   f_bc_b_ = fraction<Scalar>(masses_[kB], masses_[kC]);
   f_bc_c_ = fraction<Scalar>(masses_[kC], masses_[kB]);
   alpha_ = alphaOf<Scalar>(masses_);
-  first_pair_ = collision_lab::firstPair(scene);
+  first_pair_ = core::firstPair(scene);
 
   double mass_max = 0.0;
   for (int i = 0; i < 3; ++i) {
@@ -312,7 +313,7 @@ Angles anglesFor(const std::array<double, 3>& masses) {
 }
 
 EigenCheck eigenCheck(const std::array<double, 3>& masses) {
-  Scene scene;
+  ThreeBodyScene scene;
   scene.masses = masses;
   scene.positions = {2, 1, 0};
   const AnalyticModel<double> model(scene);
@@ -330,7 +331,7 @@ EigenCheck eigenCheck(const std::array<double, 3>& masses) {
   return check;
 }
 
-std::uint64_t predictedCollisionCount(const Scene& scene) {
+std::uint64_t predictedCollisionCount(const ThreeBodyScene& scene) {
   const std::optional<Pair> first = firstPair(scene);
   if (!first) return 0;
   if (auto count = countIfSeparated(countQuotient<double>(scene, *first))) return *count;
@@ -392,4 +393,5 @@ std::uint64_t maxPossibleCollisionCount(const std::array<double, 3>& m) {
   return checkedMaxPossibleCollisionCount(m).value_or(std::numeric_limits<std::uint64_t>::max());
 }
 
+}  // namespace core
 }  // namespace collision_lab

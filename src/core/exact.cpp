@@ -4,6 +4,7 @@
 #include <limits>
 
 namespace collision_lab {
+namespace core {
 namespace exact {
 
 namespace {
@@ -18,7 +19,7 @@ Rational massFraction(double m_i, double m_j) {
 
 }  // namespace
 
-RationalState initialVelocities(const Scene& scene) {
+RationalState initialVelocities(const ThreeBodyScene& scene) {
   return {Rational(scene.velocities[0]), Rational(scene.velocities[1]), Rational(scene.velocities[2])};
 }
 
@@ -36,7 +37,7 @@ Rational approachSpeed(Pair pair, const RationalState& v) {
   return pair == Pair::AB ? Rational(v[kB] - v[kA]) : Rational(v[kC] - v[kB]);
 }
 
-int compareFirstContactTimes(const Scene& scene) {
+int compareFirstContactTimes(const ThreeBodyScene& scene) {
   const auto& x = scene.positions;
   const auto& v = scene.velocities;
   // t_AB - t_BC has the sign of (x_A - x_B)(v_C - v_B) - (x_B - x_C)(v_B - v_A), both
@@ -53,7 +54,7 @@ int compareFirstContactTimes(const Scene& scene) {
   return exact_ab < exact_bc ? -1 : (exact_ab > exact_bc ? 1 : 0);
 }
 
-RationalState velocitiesAfter(const Scene& scene, Pair first, std::uint64_t n) {
+RationalState velocitiesAfter(const ThreeBodyScene& scene, Pair first, std::uint64_t n) {
   RationalState v = initialVelocities(scene);
   Pair pair = first;
   for (std::uint64_t i = 0; i < n; ++i) {
@@ -63,7 +64,7 @@ RationalState velocitiesAfter(const Scene& scene, Pair first, std::uint64_t n) {
   return v;
 }
 
-Run simulate(const Scene& scene, std::uint64_t max_collisions) {
+Run simulate(const ThreeBodyScene& scene, std::uint64_t max_collisions) {
   Run run;
   RationalState v = initialVelocities(scene);
   const bool ab = approachSpeed(Pair::AB, v) > 0;
@@ -93,4 +94,5 @@ Run simulate(const Scene& scene, std::uint64_t max_collisions) {
 }
 
 }  // namespace exact
+}  // namespace core
 }  // namespace collision_lab

@@ -9,6 +9,7 @@
 #include "collision_lab/core/scene.h"
 
 namespace collision_lab {
+namespace core {
 namespace detail {
 
 /// A type in which the energies of velocities in T cannot overflow on the way.
@@ -73,4 +74,5 @@ class ImpactEnergy {
 };
 
 }  // namespace detail
+}  // namespace core
 }  // namespace collision_lab

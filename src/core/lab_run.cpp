@@ -11,6 +11,7 @@
 #include "collision_lab/core/precision.h"
 
 namespace collision_lab {
+namespace core {
 
 namespace {
 
@@ -35,7 +36,7 @@ std::array<double, 3> toArray(const std::array<T, 3>& v) {
 /// mass-weighted velocities (S = diag(sqrt(m / m_max))) in double.
 class ClosedForm {
  public:
-  explicit ClosedForm(const Scene& scene) {
+  explicit ClosedForm(const ThreeBodyScene& scene) {
     int smallest = std::numeric_limits<int>::max(), largest = std::numeric_limits<int>::min();
     for (int i = 0; i < 3; ++i) {
       if (scene.isWall(i)) continue;
@@ -67,7 +68,7 @@ class ClosedForm {
 /// light body's rounding is weighed by the energy it carries.
 class EnergyNormError {
  public:
-  explicit EnergyNormError(const Scene& scene) : scene_(scene) {
+  explicit EnergyNormError(const ThreeBodyScene& scene) : scene_(scene) {
     for (int i = 0; i < 3; ++i) {
       if (!scene.isWall(i)) mass_max_ = std::max(mass_max_, scene.masses[i]);
     }
@@ -93,7 +94,7 @@ class EnergyNormError {
   }
 
  private:
-  const Scene& scene_;
+  const ThreeBodyScene& scene_;
   double mass_max_ = 0.0;
   double initial_norm_ = 1.0;
 };
@@ -105,7 +106,7 @@ bool keeps(const EventPolicy& policy, std::uint64_t index) {
 
 }  // namespace
 
-AnalyticPrediction predict(const Scene& scene) {
+AnalyticPrediction predict(const ThreeBodyScene& scene) {
   const ClosedForm model(scene);
   AnalyticPrediction prediction;
   prediction.collision_count = predictedCollisionCount(scene);
@@ -119,14 +120,14 @@ AnalyticPrediction predict(const Scene& scene) {
   return prediction;
 }
 
-RunResult runLab(const Scene& scene, const RunOptions& options, const LabEventVisitor& visitor) {
+RunResult runLab(const ThreeBodyScene& scene, const RunOptions& options, const LabEventVisitor& visitor) {
   const auto started = std::chrono::steady_clock::now();
   RunResult result = runLab(scene, options, predict(scene), visitor);
   result.summary.compute_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return result;
 }
 
-RunResult runLab(const Scene& scene, const RunOptions& options, const AnalyticPrediction& prediction,
+RunResult runLab(const ThreeBodyScene& scene, const RunOptions& options, const AnalyticPrediction& prediction,
                  const LabEventVisitor& visitor) {
   const auto started = std::chrono::steady_clock::now();
   RunResult result;
@@ -194,4 +195,5 @@ RunResult runLab(const Scene& scene, const RunOptions& options, const AnalyticPr
   return result;
 }
 
+}  // namespace core
 }  // namespace collision_lab

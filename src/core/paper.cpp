@@ -8,6 +8,7 @@
 #include <boost/math/constants/constants.hpp>
 
 namespace collision_lab {
+namespace core {
 namespace paper {
 
 namespace {
@@ -50,7 +51,7 @@ std::array<double, 3> normalized(std::array<double, 3> a) {
 
 }  // namespace
 
-std::array<double, 3> velocitiesAfter(const Scene& scene, std::uint64_t n) {
+std::array<double, 3> velocitiesAfter(const ThreeBodyScene& scene, std::uint64_t n) {
   const auto& m = scene.masses;
   const auto& v0 = scene.velocities;
   const Constants k = constantsOf(m);
@@ -68,7 +69,7 @@ std::array<double, 3> velocitiesAfter(const Scene& scene, std::uint64_t n) {
                     m_ab * y / (k.d * m_ab) + vbar});
 }
 
-double phiBC(const Scene& scene) {
+double phiBC(const ThreeBodyScene& scene) {
   const auto& m = scene.masses;
   const auto& v = scene.velocities;
   // u after the first AB impact (eq. 1.1, 1.2), in u = (sqrt(m_i) v_i).
@@ -90,14 +91,14 @@ double omega(const std::array<double, 3>& m) {
   return std::acos(dot(n_ab, n_bc));
 }
 
-std::optional<std::int64_t> collisionCount(const Scene& scene) {
+std::optional<std::int64_t> collisionCount(const ThreeBodyScene& scene) {
   const double x = (omega(scene.masses) - phiBC(scene)) / constantsOf(scene.masses).theta;
   // Evaluated in double as printed; 1 + floor(x) + ceil(x) must fit the int64 it is reported in.
   if (!std::isfinite(x) || std::fabs(x) > 4e18) return std::nullopt;
   return 1 + static_cast<std::int64_t>(std::floor(x)) + static_cast<std::int64_t>(std::ceil(x));  // eq. (3.22)
 }
 
-std::array<double, 3> energyTransfer(const Scene& scene, std::uint64_t n, Pair pair,
+std::array<double, 3> energyTransfer(const ThreeBodyScene& scene, std::uint64_t n, Pair pair,
                                      const std::array<double, 3>& state_before,
                                      const std::array<double, 3>& state_two_before) {
   const auto& m = scene.masses;
@@ -123,4 +124,5 @@ std::array<double, 3> energyTransfer(const Scene& scene, std::uint64_t n, Pair p
 }
 
 }  // namespace paper
+}  // namespace core
 }  // namespace collision_lab

@@ -13,6 +13,7 @@
 #include "collision_lab/core/simulation.h"
 
 namespace collision_lab {
+namespace core {
 
 namespace {
 
@@ -50,32 +51,17 @@ bool isFiniteProduct(double a, double b) { return std::isfinite(a * b); }
 
 }  // namespace
 
-bool Scene::isWall(int i) const { return masses[i] == std::numeric_limits<double>::infinity(); }
+bool ThreeBodyScene::isWall(int i) const { return masses[i] == std::numeric_limits<double>::infinity(); }
 
-int Scene::wallIndex() const {
+int ThreeBodyScene::wallIndex() const {
   if (isWall(kA)) return kA;
   if (isWall(kC)) return kC;
   return -1;
 }
 
-const char* reasonName(Reason r) {
-  switch (r) {
-    case Reason::kOk: return "OK";
-    case Reason::kNonFiniteValue: return "NON_FINITE_VALUE";
-    case Reason::kNonPositiveMass: return "NON_POSITIVE_MASS";
-    case Reason::kTwoWalls: return "TWO_WALLS";
-    case Reason::kInfiniteMiddleMass: return "INFINITE_MIDDLE_MASS";
-    case Reason::kPositionsNotOrdered: return "POSITIONS_NOT_ORDERED";
-    case Reason::kPositionsCoincident: return "POSITIONS_COINCIDENT";
-    case Reason::kTripleCollision: return "TRIPLE_COLLISION";
-    case Reason::kOverflow: return "OVERFLOW";
-  }
-  return "UNKNOWN";
-}
-
 namespace {
 
-std::optional<ValidationError> checkMasses(const Scene& scene) {
+std::optional<ValidationError> checkMasses(const ThreeBodyScene& scene) {
   for (int i = 0; i < 3; ++i) {
     const double m = scene.masses[i];
     const std::string field = indexedField("masses", i);
@@ -99,7 +85,7 @@ std::optional<ValidationError> checkMasses(const Scene& scene) {
   return std::nullopt;
 }
 
-std::optional<ValidationError> checkFiniteAndOrdered(const Scene& scene) {
+std::optional<ValidationError> checkFiniteAndOrdered(const ThreeBodyScene& scene) {
   for (const auto& [values, name, symbol, unit] :
        {std::tuple{&scene.positions, "positions", "x_", "position must be a finite number in m"},
         std::tuple{&scene.velocities, "velocities", "v_", "velocity must be a finite number in m/s"}}) {
@@ -129,7 +115,7 @@ std::optional<ValidationError> checkFiniteAndOrdered(const Scene& scene) {
 
 /// Everything the engine forms must be representable: momenta, energies in the wall's
 /// frame, relative velocities and gaps.
-std::optional<ValidationError> checkDoubleRange(const Scene& scene) {
+std::optional<ValidationError> checkDoubleRange(const ThreeBodyScene& scene) {
   const int wall = scene.wallIndex();
   const double frame_velocity = wall >= 0 ? scene.velocities[wall] : 0.0;
   for (int i = 0; i < 3; ++i) {
@@ -160,7 +146,7 @@ std::optional<ValidationError> checkDoubleRange(const Scene& scene) {
 /// Every count is reported as a 64-bit integer, and no start of these masses can have more
 /// collisions than ceil(pi / alpha). Only a light B makes that many: the count grows like
 /// pi sqrt(m / m_B) with m the lighter of A and C.
-std::optional<ValidationError> checkCountFits(const Scene& scene) {
+std::optional<ValidationError> checkCountFits(const ThreeBodyScene& scene) {
   if (checkedMaxPossibleCollisionCount(scene.masses)) return std::nullopt;
   const double lighter_outer = std::min(scene.masses[kA], scene.masses[kC]);
   return makeError(Reason::kOverflow, "masses",
@@ -172,7 +158,7 @@ std::optional<ValidationError> checkCountFits(const Scene& scene) {
 
 /// The first contact certainly happens: its time and the positions then must be doubles.
 /// (Later contacts beyond the range of a double are reported as inf.)
-std::optional<ValidationError> checkFirstContact(const Scene& scene) {
+std::optional<ValidationError> checkFirstContact(const ThreeBodyScene& scene) {
   const std::optional<Pair> first = firstPair(scene);
   if (!first) return std::nullopt;
   const int left = *first == Pair::AB ? kA : kB;
@@ -203,7 +189,7 @@ std::optional<ValidationError> checkFirstContact(const Scene& scene) {
 
 }  // namespace
 
-std::optional<ValidationError> validate(const Scene& scene) {
+std::optional<ValidationError> validate(const ThreeBodyScene& scene) {
   if (auto error = checkMasses(scene)) return error;
   if (auto error = checkFiniteAndOrdered(scene)) return error;
   if (auto error = checkDoubleRange(scene)) return error;
@@ -218,4 +204,5 @@ std::optional<ValidationError> validate(const Scene& scene) {
   return checkFirstContact(scene);
 }
 
+}  // namespace core
 }  // namespace collision_lab

@@ -14,6 +14,7 @@
 #include "impact_energy.h"
 
 namespace collision_lab {
+namespace core {
 
 namespace {
 
@@ -172,7 +173,7 @@ struct CompensatedVelocities {
 /// Velocities after k alternating impacts, replayed in precision T with the engine's own
 /// impact formula. Cheaper than building the closed form when k is small.
 template <class T>
-std::array<T, 3> replay(const Scene& scene, Pair first, std::uint64_t k) {
+std::array<T, 3> replay(const ThreeBodyScene& scene, Pair first, std::uint64_t k) {
   const Coefficients<T> coefficients(scene.masses);
   std::array<T, 3> v{T(scene.velocities[0]), T(scene.velocities[1]), T(scene.velocities[2])};
   Pair pair = first;
@@ -197,7 +198,7 @@ std::array<T, 3> replay(const Scene& scene, Pair first, std::uint64_t k) {
 /// velocity, and a velocity error is at most |du| / sqrt(m).
 class ErrorScale {
  public:
-  explicit ErrorScale(const Scene& scene) {
+  explicit ErrorScale(const ThreeBodyScene& scene) {
     const int wall = scene.wallIndex();
     const long double frame = wall >= 0 ? scene.velocities[wall] : 0.0L;
     long double energy_norm_sq = 0.0L;
@@ -245,7 +246,7 @@ T approachOf(Pair pair, const std::array<T, 3>& v) {
 template <class Scalar>
 class Escalation {
  public:
-  Escalation(const Scene& scene, const ErrorScale& scale, Pair first) : scene_(scene), scale_(scale), first_(first) {}
+  Escalation(const ThreeBodyScene& scene, const ErrorScale& scale, Pair first) : scene_(scene), scale_(scale), first_(first) {}
 
   /// A sign decision taken above the working precision.
   struct Decision {
@@ -323,7 +324,7 @@ class Escalation {
     return 16 * (1 + 1 / alpha);
   }
 
-  const Scene& scene_;
+  const ThreeBodyScene& scene_;
   const ErrorScale& scale_;
   Pair first_;
   std::optional<AnalyticModel<ReplayPrecision>> closed_form_;
@@ -344,7 +345,7 @@ struct Frame {
 };
 
 template <class Wide>
-Frame<Wide> measure(const Scene& scene, const std::array<Wide, 3>& v) {
+Frame<Wide> measure(const ThreeBodyScene& scene, const std::array<Wide, 3>& v) {
   const int wall = scene.wallIndex();
   const Wide frame = wall >= 0 ? v[wall] : Wide(0);
   Frame<Wide> measured;
@@ -420,14 +421,14 @@ int shiftTowardsOne(const std::array<double, 3>& values) {
   return shift;
 }
 
-Scene inWorkingUnits(const Scene& scene, WorkingUnits& units) {
+ThreeBodyScene inWorkingUnits(const ThreeBodyScene& scene, WorkingUnits& units) {
   units.velocity = shiftTowardsOne(scene.velocities);
   units.position = shiftTowardsOne(scene.positions);
   units.velocity_si = ToSi(units.velocity);
   units.position_si = ToSi(units.position);
   units.time_si = ToSi(units.position - units.velocity);
   units.energy_si = ToSi(2 * units.velocity);
-  Scene working = scene;
+  ThreeBodyScene working = scene;
   for (double& v : working.velocities) v = std::ldexp(v, units.velocity);
   for (double& x : working.positions) x = std::ldexp(x, units.position);
   return working;
@@ -472,7 +473,7 @@ class Trajectory {
     bool in_range = true;        ///< every time and position in T's normal range
   };
 
-  explicit Trajectory(const Scene& working)
+  explicit Trajectory(const ThreeBodyScene& working)
       : masses_(working.masses), wall_(working.wallIndex()), energy_(masses_), wide_energy_(masses_) {
     for (int i = 0; i < 3; ++i) reference_position_[i] = T(working.positions[i]);
   }
@@ -593,7 +594,7 @@ bool keepsEvent(const EventPolicy& policy, std::uint64_t index) {
 
 }  // namespace
 
-std::optional<Pair> firstPair(const Scene& scene) {
+std::optional<Pair> firstPair(const ThreeBodyScene& scene) {
   const auto& v = scene.velocities;
   const bool ab = v[kA] < v[kB];
   const bool bc = v[kB] < v[kC];
@@ -604,12 +605,12 @@ std::optional<Pair> firstPair(const Scene& scene) {
 }
 
 template <class Scalar>
-SimulationResult simulate(const Scene& scene, const SimulationOptions& options, const EventVisitor& visitor) {
+SimulationResult simulate(const ThreeBodyScene& scene, const SimulationOptions& options, const EventVisitor& visitor) {
   using Wide = WideOf<Scalar>;
   SimulationResult result;
   result.first_pair = firstPair(scene);
   WorkingUnits units;
-  const Scene working = inWorkingUnits(scene, units);
+  const ThreeBodyScene working = inWorkingUnits(scene, units);
   CompensatedVelocities<Scalar> v(working.velocities);
   const Frame<Wide> start = measure(working, v.template valuesAs<Wide>());
   const bool tracks_events = options.events.kind != EventPolicy::Kind::kNone || static_cast<bool>(visitor);
@@ -743,9 +744,9 @@ SimulationResult simulate(const Scene& scene, const SimulationOptions& options, 
   return result;
 }
 
-template SimulationResult simulate<double>(const Scene&, const SimulationOptions&, const EventVisitor&);
-template SimulationResult simulate<long double>(const Scene&, const SimulationOptions&, const EventVisitor&);
-template SimulationResult simulate<HighPrecision>(const Scene&, const SimulationOptions&, const EventVisitor&);
+template SimulationResult simulate<double>(const ThreeBodyScene&, const SimulationOptions&, const EventVisitor&);
+template SimulationResult simulate<long double>(const ThreeBodyScene&, const SimulationOptions&, const EventVisitor&);
+template SimulationResult simulate<HighPrecision>(const ThreeBodyScene&, const SimulationOptions&, const EventVisitor&);
 
 const char* precisionName(Precision p) {
   switch (p) {
@@ -763,7 +764,7 @@ std::optional<Precision> parsePrecision(const std::string& name) {
   return std::nullopt;
 }
 
-SimulationResult simulate(const Scene& scene, const SimulationOptions& options, Precision precision,
+SimulationResult simulate(const ThreeBodyScene& scene, const SimulationOptions& options, Precision precision,
                           const EventVisitor& visitor) {
   switch (precision) {
     case Precision::kLongDouble: return simulate<long double>(scene, options, visitor);
@@ -773,4 +774,5 @@ SimulationResult simulate(const Scene& scene, const SimulationOptions& options, 
   return simulate<double>(scene, options, visitor);
 }
 
+}  // namespace core
 }  // namespace collision_lab

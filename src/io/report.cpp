@@ -48,8 +48,8 @@ Json array3(const std::array<double, 3>& values) {
   return Json::array({number(values[0]), number(values[1]), number(values[2])});
 }
 
-Json optionalPair(const std::optional<Pair>& pair) {
-  return pair ? Json(pairName(*pair)) : Json(nullptr);
+Json optionalPair(const std::optional<core::Pair>& pair) {
+  return pair ? Json(core::pairName(*pair)) : Json(nullptr);
 }
 
 double maxAbsDifference(const std::array<double, 3>& a, const std::array<double, 3>& b) {
@@ -58,7 +58,7 @@ double maxAbsDifference(const std::array<double, 3>& a, const std::array<double,
   return result;
 }
 
-std::string paperCountText(const AnalyticPrediction& prediction) {
+std::string paperCountText(const core::AnalyticPrediction& prediction) {
   return prediction.paper_collision_count ? std::to_string(*prediction.paper_collision_count)
                                           : std::string("undefined");
 }
@@ -75,7 +75,7 @@ class TableWriter : public RunReportWriter {
  public:
   explicit TableWriter(std::ostream& out) : out_(out) {}
 
-  void begin(const NamedScene& named, const RunOptions& options) override {
+  void begin(const NamedScene& named, const core::RunOptions& options) override {
     out_ << "collision_lab: " << (named.name.empty() ? "scene from the command line" : named.name);
     if (!named.description.empty()) out_ << " - " << named.description;
     out_ << "\n\n" << padRight("", 16);
@@ -89,10 +89,10 @@ class TableWriter : public RunReportWriter {
          << " collisions\n";
   }
 
-  void event(const LabEvent& lab) override {
+  void event(const core::LabEvent& lab) override {
     if (!header_written_) writeEventHeader();
-    const ImpactEvent& e = lab.event;
-    out_ << padLeft(std::to_string(e.index), 9) << padLeft(pairName(e.pair), 5);
+    const core::ImpactEvent& e = lab.event;
+    out_ << padLeft(std::to_string(e.index), 9) << padLeft(core::pairName(e.pair), 5);
     writeNumber(e.time);
     writeNumber(e.position);
     for (double v : e.velocities_after) writeNumber(v);
@@ -102,9 +102,9 @@ class TableWriter : public RunReportWriter {
     out_ << "\n";
   }
 
-  void end(const RunResult& result) override {
-    const AnalyticPrediction& p = result.prediction;
-    const LabRunSummary& s = result.summary;
+  void end(const core::RunResult& result) override {
+    const core::AnalyticPrediction& p = result.prediction;
+    const core::LabRunSummary& s = result.summary;
     const auto simulated = [&](const std::string& text) { return s.simulated ? text : std::string("-"); };
     out_ << "\n";
     writeSummaryRow("Summary", "simulation", "prediction", "paper, as printed");
@@ -112,7 +112,7 @@ class TableWriter : public RunReportWriter {
                     "eq. 3.22: " + paperCountText(p));
     writeSummaryRow("most possible collisions", "",
                     std::to_string(p.max_possible_collision_count) + " = ceil(pi/alpha)", "");
-    writeSummaryRow("first pair", "", p.first_pair ? pairName(*p.first_pair) : "none", "");
+    writeSummaryRow("first pair", "", p.first_pair ? core::pairName(*p.first_pair) : "none", "");
     for (int i = 0; i < 3; ++i) {
       writeSummaryRow(std::string("final v_") + kParticleNames[i] + " [m/s]",
                       simulated(humanText(s.final_velocities[i], kSummaryDigits)),
@@ -178,17 +178,17 @@ class JsonWriter : public RunReportWriter {
  public:
   explicit JsonWriter(std::ostream& out) : out_(out) {}
 
-  void begin(const NamedScene& named, const RunOptions& options) override {
+  void begin(const NamedScene& named, const core::RunOptions& options) override {
     out_ << "{\"scene\": " << jsonText(sceneJson(named)) << ",\n\"options\": " << jsonText(optionsJson(options))
          << ",\n\"units\": " << jsonText(unitsJson()) << ",\n\"events\": [";
   }
 
-  void event(const LabEvent& lab) override {
+  void event(const core::LabEvent& lab) override {
     out_ << (any_event_ ? ",\n" : "\n") << jsonText(eventJson(lab));
     any_event_ = true;
   }
 
-  void end(const RunResult& result) override {
+  void end(const core::RunResult& result) override {
     out_ << (any_event_ ? "\n]" : "]") << ",\n\"summary\": " << jsonText(summaryJson(result)) << "}\n";
   }
 
@@ -234,7 +234,7 @@ class CsvWriter : public RunReportWriter {
  public:
   explicit CsvWriter(std::ostream& out) : out_(out) {}
 
-  void begin(const NamedScene& named, const RunOptions& options) override {
+  void begin(const NamedScene& named, const core::RunOptions& options) override {
     out_ << "# scene," << named.name << "\n";
     const std::pair<const char*, const std::array<double, 3>*> vectors[] = {
         {"masses_kg", &named.scene.masses},
@@ -259,9 +259,9 @@ class CsvWriter : public RunReportWriter {
     out_ << ",total_energy_J,total_momentum_kg_m_s\n";
   }
 
-  void event(const LabEvent& lab) override {
-    const ImpactEvent& e = lab.event;
-    out_ << e.index << "," << pairName(e.pair) << "," << roundTripText(e.time) << "," << roundTripText(e.position);
+  void event(const core::LabEvent& lab) override {
+    const core::ImpactEvent& e = lab.event;
+    out_ << e.index << "," << core::pairName(e.pair) << "," << roundTripText(e.time) << "," << roundTripText(e.position);
     for (const auto* values : {&e.positions, &e.velocities_before, &e.velocities_after, &e.energy_transfer,
                                &lab.predicted_velocities_after, &lab.paper_velocities_after,
                                &lab.predicted_energy_transfer, &lab.paper_energy_transfer}) {
@@ -270,7 +270,7 @@ class CsvWriter : public RunReportWriter {
     out_ << "," << roundTripText(e.total_energy) << "," << roundTripText(e.total_momentum) << "\n";
   }
 
-  void end(const RunResult& result) override { writeCsvComments(out_, "summary.", summaryJson(result)); }
+  void end(const core::RunResult& result) override { writeCsvComments(out_, "summary.", summaryJson(result)); }
 
  private:
   std::ostream& out_;
@@ -287,8 +287,8 @@ void writeBatchTable(const std::vector<SceneOutcome>& outcomes, std::ostream& ou
       << padLeft("final v_B [m/s]", 18) << padLeft("final v_C [m/s]", 18) << padLeft("max pred err", 14)
       << "  truncated\n";
   for (const SceneOutcome& outcome : outcomes) {
-    const AnalyticPrediction& p = outcome.result.prediction;
-    const LabRunSummary& s = outcome.result.summary;
+    const core::AnalyticPrediction& p = outcome.result.prediction;
+    const core::LabRunSummary& s = outcome.result.summary;
     out << padRight(outcome.scene.name, name_width)
         << padLeft(s.simulated ? std::to_string(s.collision_count) : "-", 12)
         << padLeft(std::to_string(p.collision_count), 12) << padLeft(paperCountText(p), 14)
@@ -308,8 +308,8 @@ void writeBatchCsv(const std::vector<SceneOutcome>& outcomes, std::ostream& out)
          "predicted_final_v_B_m_s,predicted_final_v_C_m_s,max_prediction_error,energy_relative_drift,"
          "momentum_relative_drift\n";
   for (const SceneOutcome& outcome : outcomes) {
-    const AnalyticPrediction& p = outcome.result.prediction;
-    const LabRunSummary& s = outcome.result.summary;
+    const core::AnalyticPrediction& p = outcome.result.prediction;
+    const core::LabRunSummary& s = outcome.result.summary;
     out << outcome.scene.name << "," << s.collision_count << "," << (s.truncated ? "true" : "false") << ","
         << p.collision_count << "," << (p.paper_collision_count ? std::to_string(*p.paper_collision_count) : "")
         << "," << p.max_possible_collision_count;
@@ -325,7 +325,7 @@ void writeBatchJson(const std::vector<SceneOutcome>& outcomes, std::ostream& out
   bool first = true;
   for (const SceneOutcome& outcome : outcomes) {
     Json events = Json::array();
-    for (const LabEvent& lab : outcome.result.events) events.push_back(eventJson(lab));
+    for (const core::LabEvent& lab : outcome.result.events) events.push_back(eventJson(lab));
     Json entry;
     entry["scene"] = sceneJson(outcome.scene);
     entry["options"] = optionsJson(outcome.options);
@@ -346,54 +346,54 @@ std::optional<ReportFormat> parseReportFormat(const std::string& text) {
   return std::nullopt;
 }
 
-std::optional<RunMode> parseRunMode(const std::string& text) {
-  if (text == "full") return RunMode::kFull;
-  if (text == "predict") return RunMode::kPredictOnly;
-  if (text == "summary") return RunMode::kSummaryOnly;
+std::optional<core::RunMode> parseRunMode(const std::string& text) {
+  if (text == "full") return core::RunMode::kFull;
+  if (text == "predict") return core::RunMode::kPredictOnly;
+  if (text == "summary") return core::RunMode::kSummaryOnly;
   return std::nullopt;
 }
 
-std::optional<Precision> parsePrecisionOption(const std::string& text) {
-  if (text == "double") return Precision::kDouble;
-  if (text == "long_double") return Precision::kLongDouble;
-  if (text == "high") return Precision::kHigh;
+std::optional<core::Precision> parsePrecisionOption(const std::string& text) {
+  if (text == "double") return core::Precision::kDouble;
+  if (text == "long_double") return core::Precision::kLongDouble;
+  if (text == "high") return core::Precision::kHigh;
   return std::nullopt;
 }
 
-std::optional<EventPolicy> parseEventPolicy(const std::string& text) {
-  if (text == "all") return EventPolicy::all();
-  if (text == "none") return EventPolicy::none();
+std::optional<core::EventPolicy> parseEventPolicy(const std::string& text) {
+  if (text == "all") return core::EventPolicy::all();
+  if (text == "none") return core::EventPolicy::none();
   const std::string prefix = "first:";
   if (text.compare(0, prefix.size(), prefix) == 0) {
     const ParsedCount n = parseCount(std::string_view(text).substr(prefix.size()));
-    if (n.problem.empty()) return EventPolicy::firstN(n.value);
+    if (n.problem.empty()) return core::EventPolicy::firstN(n.value);
   }
   return std::nullopt;
 }
 
-std::string runModeText(RunMode mode) {
+std::string runModeText(core::RunMode mode) {
   switch (mode) {
-    case RunMode::kFull: return "full";
-    case RunMode::kPredictOnly: return "predict";
-    case RunMode::kSummaryOnly: return "summary";
+    case core::RunMode::kFull: return "full";
+    case core::RunMode::kPredictOnly: return "predict";
+    case core::RunMode::kSummaryOnly: return "summary";
   }
   return "unknown";
 }
 
-std::string precisionText(Precision precision) {
+std::string precisionText(core::Precision precision) {
   switch (precision) {
-    case Precision::kDouble: return "double";
-    case Precision::kLongDouble: return "long_double";
-    case Precision::kHigh: return "high";
+    case core::Precision::kDouble: return "double";
+    case core::Precision::kLongDouble: return "long_double";
+    case core::Precision::kHigh: return "high";
   }
   return "unknown";
 }
 
-std::string eventPolicyText(const EventPolicy& policy) {
+std::string eventPolicyText(const core::EventPolicy& policy) {
   switch (policy.kind) {
-    case EventPolicy::Kind::kAll: return "all";
-    case EventPolicy::Kind::kNone: return "none";
-    case EventPolicy::Kind::kFirstN: return "first:" + std::to_string(policy.first_n);
+    case core::EventPolicy::Kind::kAll: return "all";
+    case core::EventPolicy::Kind::kNone: return "none";
+    case core::EventPolicy::Kind::kFirstN: return "first:" + std::to_string(policy.first_n);
   }
   return "unknown";
 }
@@ -421,17 +421,17 @@ Json sceneJson(const NamedScene& named) {
               {"velocities", array3(named.scene.velocities)}};
 }
 
-Json optionsJson(const RunOptions& options) {
+Json optionsJson(const core::RunOptions& options) {
   return Json{{"max_collisions", options.max_collisions},
               {"events", eventPolicyText(options.events)},
               {"mode", runModeText(options.mode)},
               {"precision", precisionText(options.precision)}};
 }
 
-Json eventJson(const LabEvent& lab) {
-  const ImpactEvent& e = lab.event;
+Json eventJson(const core::LabEvent& lab) {
+  const core::ImpactEvent& e = lab.event;
   return Json{{"index", e.index},
-              {"pair", pairName(e.pair)},
+              {"pair", core::pairName(e.pair)},
               {"time", number(e.time)},
               {"position", number(e.position)},
               {"positions", array3(e.positions)},
@@ -447,9 +447,9 @@ Json eventJson(const LabEvent& lab) {
               {"total_momentum", number(e.total_momentum)}};
 }
 
-Json summaryJson(const RunResult& result) {
-  const AnalyticPrediction& p = result.prediction;
-  const LabRunSummary& s = result.summary;
+Json summaryJson(const core::RunResult& result) {
+  const core::AnalyticPrediction& p = result.prediction;
+  const core::LabRunSummary& s = result.summary;
   return Json{{"collision_count", s.collision_count},
               {"truncated", s.truncated},
               {"truncation_reason", s.truncation_reason},

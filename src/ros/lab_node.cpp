@@ -266,7 +266,7 @@ bool LabNode::onRunPreset(collision_lab::RunPreset::Request& request,
     return true;
   }
   collision_lab::InitialConditions input =
-      toInitialConditions(preset.scene, core::RunMode::kFull, preset.max_collisions);
+      toInitialConditions(preset.scene, collision_lab::core::RunMode::kFull, preset.max_collisions);
   input.mode = request.mode;
   input.run_id =
       request.run_id.empty() ? preset.name + "_" + utcStamp("%Y%m%dT%H%M%SZ") : request.run_id;
@@ -332,15 +332,15 @@ ServeOutcome LabNode::serve(collision_lab::InitialConditions input) {
                     requested);
     }
   }
-  const std::optional<core::RunMode> mode = toRunMode(input.mode);
+  const std::optional<collision_lab::core::RunMode> mode = toRunMode(input.mode);
   if (!mode) {
     return reject(toRejectedMsg(NodeReason::kInvalidMode, "mode",
                                 "mode " + std::to_string(input.mode) + " is not one of MODE_FULL (0), "
                                 "MODE_PREDICT_ONLY (1), MODE_SUMMARY_ONLY (2)"),
                   requested);
   }
-  const core::Scene scene = toScene(input);
-  if (const auto error = collision_lab::validate(scene)) {
+  const collision_lab::core::ThreeBodyScene scene = toScene(input);
+  if (const auto error = collision_lab::core::validate(scene)) {
     return reject(toRejectedMsg(*error), requested);
   }
 
@@ -359,12 +359,12 @@ ServeOutcome LabNode::serve(collision_lab::InitialConditions input) {
 }
 
 collision_lab::RunSummary LabNode::run(collision_lab::InitialConditions& input,
-                                       const core::Scene& scene, core::RunMode mode,
+                                       const collision_lab::core::ThreeBodyScene& scene, collision_lab::core::RunMode mode,
                                        const std::string& requested_run_id) {
   const std::string& run_id = input.run_id;
   const ros::Time start = stampNow();
   // The prediction goes out before the simulation starts; it also fixes the timeline.
-  const core::Prediction core_prediction = collision_lab::predict(scene);
+  const collision_lab::core::AnalyticPrediction core_prediction = collision_lab::core::predict(scene);
   std::optional<RunRecorder> recorder;
   if (params_.record) recorder.emplace(params_.bag_directory, run_id);
   RunWriter out(run_id, RunTimeline(start, chooseTimelineScale(firstContactTime(
@@ -379,15 +379,15 @@ collision_lab::RunSummary LabNode::run(collision_lab::InitialConditions& input,
   out.publish(predictions_pub_, prediction, 0.0);
   if (marker_view_) marker_view_->onPrediction(prediction);
 
-  core::RunOptions options;
+  collision_lab::core::RunOptions options;
   options.max_collisions = input.max_collisions ? input.max_collisions : params_.max_collisions;
-  options.events = collision_lab::EventPolicy::none();
+  options.events = collision_lab::core::EventPolicy::none();
   options.mode = mode;
   options.skip_simulation_over_cap = true;
   std::uint64_t published_events = 0;
   bool events_not_published = false;
   double last_event_time = 0.0;  // [s]
-  const auto onEvent = [&](const core::LabEvent& event) {
+  const auto onEvent = [&](const collision_lab::core::LabEvent& event) {
     collision_lab::CollisionEvent event_msg = toCollisionEventMsg(event);
     collision_lab::Velocities velocities_msg = toVelocitiesMsg(event);
     collision_lab::EnergyTransfer energy_msg = toEnergyTransferMsg(event);
@@ -406,7 +406,7 @@ collision_lab::RunSummary LabNode::run(collision_lab::InitialConditions& input,
     out.publish(energy_pub_, energy_msg, t);
     ++published_events;
   };
-  const core::RunResult result = collision_lab::runLab(scene, options, core_prediction, onEvent);
+  const collision_lab::core::RunResult result = collision_lab::core::runLab(scene, options, core_prediction, onEvent);
 
   collision_lab::RunSummary summary = toRunSummaryMsg(result.summary, result.prediction, mode);
   summary.published_events = published_events;

@@ -5,33 +5,33 @@ namespace collision_lab_ros {
 using collision_lab::Rejected;
 
 static_assert(collision_lab::InitialConditions::MODE_FULL ==
-                  static_cast<std::uint8_t>(core::RunMode::kFull) &&
+                  static_cast<std::uint8_t>(collision_lab::core::RunMode::kFull) &&
               collision_lab::InitialConditions::MODE_PREDICT_ONLY ==
-                  static_cast<std::uint8_t>(core::RunMode::kPredictOnly) &&
+                  static_cast<std::uint8_t>(collision_lab::core::RunMode::kPredictOnly) &&
               collision_lab::InitialConditions::MODE_SUMMARY_ONLY ==
-                  static_cast<std::uint8_t>(core::RunMode::kSummaryOnly),
-              "InitialConditions::MODE_* must match collision_lab::RunMode");
-constexpr int kPairAB = static_cast<int>(core::Pair::AB);
-constexpr int kPairBC = static_cast<int>(core::Pair::BC);
+                  static_cast<std::uint8_t>(collision_lab::core::RunMode::kSummaryOnly),
+              "InitialConditions::MODE_* must match collision_lab::core::RunMode");
+constexpr int kPairAB = static_cast<int>(collision_lab::core::Pair::AB);
+constexpr int kPairBC = static_cast<int>(collision_lab::core::Pair::BC);
 static_assert(collision_lab::CollisionEvent::PAIR_AB == kPairAB &&
               collision_lab::CollisionEvent::PAIR_BC == kPairBC &&
               collision_lab::Prediction::PAIR_AB == kPairAB &&
               collision_lab::Prediction::PAIR_BC == kPairBC &&
               collision_lab::EnergyTransfer::PAIR_AB == kPairAB &&
               collision_lab::EnergyTransfer::PAIR_BC == kPairBC,
-              "PAIR_* must match collision_lab::Pair");
-static_assert(Rejected::NON_FINITE_VALUE == static_cast<std::uint8_t>(core::Reason::kNonFiniteValue) &&
-              Rejected::NON_POSITIVE_MASS == static_cast<std::uint8_t>(core::Reason::kNonPositiveMass) &&
-              Rejected::TWO_WALLS == static_cast<std::uint8_t>(core::Reason::kTwoWalls) &&
+              "PAIR_* must match collision_lab::core::Pair");
+static_assert(Rejected::NON_FINITE_VALUE == static_cast<std::uint8_t>(collision_lab::core::Reason::kNonFiniteValue) &&
+              Rejected::NON_POSITIVE_MASS == static_cast<std::uint8_t>(collision_lab::core::Reason::kNonPositiveMass) &&
+              Rejected::TWO_WALLS == static_cast<std::uint8_t>(collision_lab::core::Reason::kTwoWalls) &&
               Rejected::INFINITE_MIDDLE_MASS ==
-                  static_cast<std::uint8_t>(core::Reason::kInfiniteMiddleMass) &&
+                  static_cast<std::uint8_t>(collision_lab::core::Reason::kInfiniteMiddleMass) &&
               Rejected::POSITIONS_NOT_ORDERED ==
-                  static_cast<std::uint8_t>(core::Reason::kPositionsNotOrdered) &&
+                  static_cast<std::uint8_t>(collision_lab::core::Reason::kPositionsNotOrdered) &&
               Rejected::POSITIONS_COINCIDENT ==
-                  static_cast<std::uint8_t>(core::Reason::kPositionsCoincident) &&
-              Rejected::TRIPLE_COLLISION == static_cast<std::uint8_t>(core::Reason::kTripleCollision) &&
-              Rejected::OVERFLOW == static_cast<std::uint8_t>(core::Reason::kOverflow),
-              "Rejected reason codes must match collision_lab::Reason");
+                  static_cast<std::uint8_t>(collision_lab::core::Reason::kPositionsCoincident) &&
+              Rejected::TRIPLE_COLLISION == static_cast<std::uint8_t>(collision_lab::core::Reason::kTripleCollision) &&
+              Rejected::OVERFLOW == static_cast<std::uint8_t>(collision_lab::core::Reason::kOverflow),
+              "Rejected reason codes must match collision_lab::core::Reason");
 
 const char* nodeReasonName(NodeReason reason) {
   switch (reason) {
@@ -50,16 +50,16 @@ boost::array<double, 3> toBoostArray(const std::array<double, 3>& values) {
   return {{values[0], values[1], values[2]}};
 }
 
-core::Scene toScene(const collision_lab::InitialConditions& msg) {
-  core::Scene scene;
+collision_lab::core::ThreeBodyScene toScene(const collision_lab::InitialConditions& msg) {
+  collision_lab::core::ThreeBodyScene scene;
   scene.masses = toArray(msg.masses);
   scene.positions = toArray(msg.positions);
   scene.velocities = toArray(msg.velocities);
   return scene;
 }
 
-collision_lab::InitialConditions toInitialConditions(const core::Scene& scene,
-                                                     core::RunMode mode,
+collision_lab::InitialConditions toInitialConditions(const collision_lab::core::ThreeBodyScene& scene,
+                                                     collision_lab::core::RunMode mode,
                                                      std::uint64_t max_collisions) {
   collision_lab::InitialConditions msg;
   msg.mode = static_cast<std::uint8_t>(mode);
@@ -70,29 +70,29 @@ collision_lab::InitialConditions toInitialConditions(const core::Scene& scene,
   return msg;
 }
 
-std::optional<core::RunMode> toRunMode(std::uint8_t mode) {
+std::optional<collision_lab::core::RunMode> toRunMode(std::uint8_t mode) {
   switch (mode) {
-    case collision_lab::InitialConditions::MODE_FULL: return core::RunMode::kFull;
-    case collision_lab::InitialConditions::MODE_PREDICT_ONLY: return core::RunMode::kPredictOnly;
-    case collision_lab::InitialConditions::MODE_SUMMARY_ONLY: return core::RunMode::kSummaryOnly;
+    case collision_lab::InitialConditions::MODE_FULL: return collision_lab::core::RunMode::kFull;
+    case collision_lab::InitialConditions::MODE_PREDICT_ONLY: return collision_lab::core::RunMode::kPredictOnly;
+    case collision_lab::InitialConditions::MODE_SUMMARY_ONLY: return collision_lab::core::RunMode::kSummaryOnly;
     default: return std::nullopt;
   }
 }
 
-std::uint8_t toPairCode(const std::optional<core::Pair>& pair) {
+std::uint8_t toPairCode(const std::optional<collision_lab::core::Pair>& pair) {
   return pair ? static_cast<std::uint8_t>(*pair)
               : static_cast<std::uint8_t>(collision_lab::Prediction::PAIR_NONE);
 }
 
-std::optional<core::Pair> toPair(std::uint8_t code) {
+std::optional<collision_lab::core::Pair> toPair(std::uint8_t code) {
   switch (code) {
-    case collision_lab::Prediction::PAIR_AB: return core::Pair::AB;
-    case collision_lab::Prediction::PAIR_BC: return core::Pair::BC;
+    case collision_lab::Prediction::PAIR_AB: return collision_lab::core::Pair::AB;
+    case collision_lab::Prediction::PAIR_BC: return collision_lab::core::Pair::BC;
     default: return std::nullopt;
   }
 }
 
-collision_lab::Prediction toPredictionMsg(const core::Prediction& prediction) {
+collision_lab::Prediction toPredictionMsg(const collision_lab::core::AnalyticPrediction& prediction) {
   collision_lab::Prediction msg;
   msg.collision_count = prediction.collision_count;
   msg.paper_count_defined = prediction.paper_collision_count.has_value();
@@ -108,8 +108,8 @@ collision_lab::Prediction toPredictionMsg(const core::Prediction& prediction) {
   return msg;
 }
 
-core::Prediction toPrediction(const collision_lab::Prediction& msg) {
-  core::Prediction prediction;
+collision_lab::core::AnalyticPrediction toPrediction(const collision_lab::Prediction& msg) {
+  collision_lab::core::AnalyticPrediction prediction;
   prediction.collision_count = msg.collision_count;
   if (msg.paper_count_defined) prediction.paper_collision_count = msg.paper_collision_count;
   prediction.max_possible_collision_count = msg.max_possible_collision_count;
@@ -123,8 +123,8 @@ core::Prediction toPrediction(const collision_lab::Prediction& msg) {
   return prediction;
 }
 
-collision_lab::CollisionEvent toCollisionEventMsg(const core::LabEvent& event) {
-  const core::CollisionEvent& e = event.event;
+collision_lab::CollisionEvent toCollisionEventMsg(const collision_lab::core::LabEvent& event) {
+  const collision_lab::core::ImpactEvent& e = event.event;
   collision_lab::CollisionEvent msg;
   msg.index = e.index;
   msg.pair = static_cast<std::uint8_t>(e.pair);
@@ -141,11 +141,11 @@ collision_lab::CollisionEvent toCollisionEventMsg(const core::LabEvent& event) {
   return msg;
 }
 
-core::LabEvent toLabEvent(const collision_lab::CollisionEvent& msg) {
-  core::LabEvent event;
-  core::CollisionEvent& e = event.event;
+collision_lab::core::LabEvent toLabEvent(const collision_lab::CollisionEvent& msg) {
+  collision_lab::core::LabEvent event;
+  collision_lab::core::ImpactEvent& e = event.event;
   e.index = msg.index;
-  e.pair = toPair(msg.pair).value_or(core::Pair::AB);
+  e.pair = toPair(msg.pair).value_or(collision_lab::core::Pair::AB);
   e.time = msg.time;
   e.position = msg.position;
   e.positions = toArray(msg.positions);
@@ -159,7 +159,7 @@ core::LabEvent toLabEvent(const collision_lab::CollisionEvent& msg) {
   return event;
 }
 
-collision_lab::Velocities toVelocitiesMsg(const core::LabEvent& event) {
+collision_lab::Velocities toVelocitiesMsg(const collision_lab::core::LabEvent& event) {
   collision_lab::Velocities msg;
   msg.index = event.event.index;
   msg.time = event.event.time;
@@ -172,7 +172,7 @@ collision_lab::Velocities toVelocitiesMsg(const core::LabEvent& event) {
   return msg;
 }
 
-collision_lab::EnergyTransfer toEnergyTransferMsg(const core::LabEvent& event) {
+collision_lab::EnergyTransfer toEnergyTransferMsg(const collision_lab::core::LabEvent& event) {
   collision_lab::EnergyTransfer msg;
   msg.index = event.event.index;
   msg.pair = static_cast<std::uint8_t>(event.event.pair);
@@ -191,9 +191,9 @@ collision_lab::EnergyTransfer toEnergyTransferMsg(const core::LabEvent& event) {
   return msg;
 }
 
-collision_lab::RunSummary toRunSummaryMsg(const core::RunSummary& summary,
-                                          const core::Prediction& prediction,
-                                          core::RunMode mode) {
+collision_lab::RunSummary toRunSummaryMsg(const collision_lab::core::LabRunSummary& summary,
+                                          const collision_lab::core::AnalyticPrediction& prediction,
+                                          collision_lab::core::RunMode mode) {
   collision_lab::RunSummary msg;
   msg.mode = static_cast<std::uint8_t>(mode);
   msg.collision_count = summary.collision_count;
@@ -211,10 +211,10 @@ collision_lab::RunSummary toRunSummaryMsg(const core::RunSummary& summary,
   return msg;
 }
 
-collision_lab::Rejected toRejectedMsg(const core::ValidationError& error) {
+collision_lab::Rejected toRejectedMsg(const collision_lab::core::ValidationError& error) {
   collision_lab::Rejected msg;
   msg.reason = static_cast<std::uint8_t>(error.reason);
-  msg.reason_name = collision_lab::reasonName(error.reason);
+  msg.reason_name = collision_lab::core::reasonName(error.reason);
   msg.field = error.field;
   msg.message = error.message;
   return msg;

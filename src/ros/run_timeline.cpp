@@ -14,10 +14,10 @@ constexpr int kMaxExponent = 300;      ///< 10^+-300 are normal doubles
 constexpr std::uint64_t kNsPerS = 1'000'000'000;
 }  // namespace
 
-std::optional<double> firstContactTime(const core::Scene& scene,
-                                       const std::optional<core::Pair>& first_pair) {
+std::optional<double> firstContactTime(const collision_lab::core::ThreeBodyScene& scene,
+                                       const std::optional<collision_lab::core::Pair>& first_pair) {
   if (!first_pair) return std::nullopt;
-  const int right = *first_pair == core::Pair::AB ? 0 : 1;  // the pair (right, right + 1)
+  const int right = *first_pair == collision_lab::core::Pair::AB ? 0 : 1;  // the pair (right, right + 1)
   const double gap = scene.positions[right] - scene.positions[right + 1];
   const double closing = scene.velocities[right + 1] - scene.velocities[right];
   return gap / closing;

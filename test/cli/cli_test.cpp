@@ -144,21 +144,21 @@ TEST(CliJson, AgreesWithExactArithmetic) {
   for (const Case& c : cases) {
     SCOPED_TRACE(c.masses + " / " + c.positions + " / " + c.velocities);
     const Json doc = runJson({"--masses", c.masses, "--positions", c.positions, "--velocities", c.velocities});
-    collision_lab::Scene scene;
+    collision_lab::core::ThreeBodyScene scene;
     for (int i = 0; i < 3; ++i) {
       scene.masses[i] = doc.at("scene").at("masses")[i].is_null() ? std::numeric_limits<double>::infinity()
                                                                   : doc.at("scene").at("masses")[i].get<double>();
       scene.positions[i] = doc.at("scene").at("positions")[i].get<double>();
       scene.velocities[i] = doc.at("scene").at("velocities")[i].get<double>();
     }
-    const collision_lab::exact::Run truth = collision_lab::exact::simulate(scene, 100000);
+    const collision_lab::core::exact::Run truth = collision_lab::core::exact::simulate(scene, 100000);
     ASSERT_FALSE(truth.truncated);
     EXPECT_EQ(doc.at("summary").at("collision_count"), truth.collision_count);
     EXPECT_EQ(doc.at("summary").at("predicted_collision_count"), truth.collision_count);
     const Json& events = doc.at("events");
     ASSERT_EQ(events.size(), truth.pairs.size());
     for (std::size_t i = 0; i < events.size(); ++i) {
-      EXPECT_EQ(events[i].at("pair"), collision_lab::pairName(truth.pairs[i])) << "event " << i + 1;
+      EXPECT_EQ(events[i].at("pair"), collision_lab::core::pairName(truth.pairs[i])) << "event " << i + 1;
     }
     const std::vector<double> final_velocities = doubles(doc.at("summary").at("final_velocities"));
     double scale = 0.0;

@@ -13,7 +13,7 @@
 
 namespace {
 
-using collision_lab::validate;
+using collision_lab::core::validate;
 using collision_lab::io::findScenario;
 using collision_lab::io::loadScenarioFile;
 using collision_lab::io::NamedScene;
@@ -158,7 +158,7 @@ TEST(ScenarioFile, PhysicsIsLeftToValidate) {
   const std::vector<NamedScene> scenes = loadScenarioFile(kData + "invalid_physics.yaml");
   ASSERT_EQ(scenes.size(), 2u);
   EXPECT_FALSE(validate(scenes[0].scene).has_value());
-  EXPECT_EQ(validate(scenes[1].scene)->reason, collision_lab::Reason::kPositionsNotOrdered);
+  EXPECT_EQ(validate(scenes[1].scene)->reason, collision_lab::core::Reason::kPositionsNotOrdered);
 }
 
 TEST(ScenarioFile, UnknownNameListsTheKnownOnes) {

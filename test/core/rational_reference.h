@@ -20,6 +20,7 @@
 #include "collision_lab/core/scene.h"
 
 namespace collision_lab {
+namespace core {
 namespace reference {
 
 using Q = boost::multiprecision::cpp_rational;
@@ -45,7 +46,7 @@ inline Wide toWide(const Q& q) {
 }
 
 /// The run of `scene`, at most `max_impacts` impacts. Throws on a triple collision.
-inline Run simulate(const Scene& scene, std::size_t max_impacts) {
+inline Run simulate(const ThreeBodyScene& scene, std::size_t max_impacts) {
   std::array<Q, 3> x, v;
   for (int i = 0; i < 3; ++i) {
     x[i] = Q(scene.positions[i]);
@@ -109,4 +110,5 @@ inline bool closeOnScale(double value, const Q& truth, const Wide& length_scale,
 }
 
 }  // namespace reference
+}  // namespace core
 }  // namespace collision_lab

@@ -9,6 +9,7 @@
 #include "collision_lab/core/scene.h"
 
 namespace collision_lab {
+namespace core {
 namespace testing_support {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -16,12 +17,12 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 /// A valid random scene: masses within 10^(+-decades), about one in six with a wall,
 /// positions in order, velocities in [-1, 1]. Deterministic for a given generator.
 /// Wider mass ranges mean longer runs and much larger exact rationals.
-inline Scene randomScene(std::mt19937_64& rng, double decades_each_way = 1.0) {
+inline ThreeBodyScene randomScene(std::mt19937_64& rng, double decades_each_way = 1.0) {
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   std::uniform_real_distribution<double> decades(-decades_each_way, decades_each_way);
   std::uniform_int_distribution<int> wall_choice(0, 11);
   while (true) {
-    Scene scene;
+    ThreeBodyScene scene;
     for (double& m : scene.masses) m = std::pow(10.0, decades(rng));
     const int wall = wall_choice(rng);
     if (wall == 0) scene.masses[kA] = kInf;
@@ -34,7 +35,7 @@ inline Scene randomScene(std::mt19937_64& rng, double decades_each_way = 1.0) {
 
 /// |S (v - exact)| / |S v0| with S = diag(sqrt(m)) in the wall's frame: the scale-free
 /// norm in which every impact is an isometry.
-inline double energyNormError(const Scene& scene, const std::array<double, 3>& v,
+inline double energyNormError(const ThreeBodyScene& scene, const std::array<double, 3>& v,
                               const exact::RationalState& reference) {
   double mass_max = 0.0;
   for (int i = 0; i < 3; ++i) {
@@ -54,4 +55,5 @@ inline double energyNormError(const Scene& scene, const std::array<double, 3>& v
 }
 
 }  // namespace testing_support
+}  // namespace core
 }  // namespace collision_lab

@@ -11,6 +11,7 @@
 #include "scenes.h"
 
 namespace collision_lab {
+namespace core {
 namespace {
 
 using testing_support::energyNormError;
@@ -36,7 +37,7 @@ TEST(Matrices, EigenSolverAgreesWithClosedFormEigenvalues) {
     for (const auto& lambda : check.eigen_solver) EXPECT_NEAR(std::abs(lambda), 1.0, 1e-12);
   }
   // D = D_BC D_AB equals the paper's explicit matrix (1.8), which is correct.
-  const Scene scene{{1, 2, 3}, {2, 1, 0}, {-1, 0, 1}};
+  const ThreeBodyScene scene{{1, 2, 3}, {2, 1, 0}, {-1, 0, 1}};
   const AnalyticModel<double> model(scene);
   const double m_a = 1, m_b = 2, m_c = 3, m_ab = 3, m_bc = 5;
   Eigen::Matrix3d paper;
@@ -49,7 +50,7 @@ TEST(Matrices, EigenSolverAgreesWithClosedFormEigenvalues) {
 TEST(ClosedForm, MatchesExactStateAfterEveryCollision) {
   std::mt19937_64 rng(99);
   for (int i = 0; i < 200; ++i) {
-    const Scene scene = randomScene(rng);
+    const ThreeBodyScene scene = randomScene(rng);
     const exact::Run reference = exact::simulate(scene, 100000);
     const AnalyticModel<double> model(scene);
     if (!reference.first_pair) continue;
@@ -68,7 +69,7 @@ TEST(ClosedForm, MatchesExactStateAfterEveryCollision) {
 }
 
 TEST(ClosedForm, AgreesWithSimulationUpToAMillionCollisions) {
-  const Scene scene{{2e11, 1, 3e11}, {2, 1, 0}, {-1, 0.5, 0.2}};
+  const ThreeBodyScene scene{{2e11, 1, 3e11}, {2, 1, 0}, {-1, 0.5, 0.2}};
   SimulationOptions options;
   double worst = 0.0;
   const AnalyticModel<long double> model(scene);
@@ -88,7 +89,7 @@ TEST(ClosedForm, AgreesWithSimulationUpToAMillionCollisions) {
 
 TEST(Count, PiBilliardByClosedForm) {
   // m_A / m_B = 100^8 with a wall: the first nine digits of pi.
-  const Scene scene{{1e16, 1, kInf}, {2, 1, 0}, {-1, 0, 0}};
+  const ThreeBodyScene scene{{1e16, 1, kInf}, {2, 1, 0}, {-1, 0, 0}};
   EXPECT_EQ(predictedCollisionCount(scene), 314159265u);
   EXPECT_EQ(maxPossibleCollisionCount({1e2, 1, kInf}), 32u);
 }
@@ -100,11 +101,11 @@ TEST(Count, MaxPossibleIsExactForKaleidoscopicMasses) {
   EXPECT_EQ(maxPossibleCollisionCount({1e12, 1, 1e12}), 2221442u);
   // A heavy B: alpha -> pi/2, pi/alpha exceeds 2 by ~1e-60; 3 collisions are possible.
   EXPECT_EQ(maxPossibleCollisionCount({1, 1e60, 1}), 3u);
-  EXPECT_EQ(predictedCollisionCount(Scene{{1, 1e60, 1}, {1e80, 1, 0}, {-1e61, 0, 1}}), 3u);
+  EXPECT_EQ(predictedCollisionCount(ThreeBodyScene{{1, 1e60, 1}, {1e80, 1, 0}, {-1e61, 0, 1}}), 3u);
   // No start exceeds the bound.
   std::mt19937_64 rng(3);
   for (int i = 0; i < 300; ++i) {
-    const Scene scene = randomScene(rng);
+    const ThreeBodyScene scene = randomScene(rng);
     EXPECT_LE(predictedCollisionCount(scene), maxPossibleCollisionCount(scene.masses));
   }
 }
@@ -114,7 +115,7 @@ TEST(Count, ExactUpToMassRatio1e20) {
   using Precise = boost::multiprecision::cpp_bin_float_100;
   for (double ratio : {1e12, 1e14, 1e16, 1e18, 1e20}) {
     for (const auto& v : {std::array<double, 3>{-1, 0, 0}, std::array<double, 3>{-1, 0.3, 0.2}}) {
-      const Scene scene{{ratio, 1, 0.5 * ratio}, {2, 1, 0}, v};
+      const ThreeBodyScene scene{{ratio, 1, 0.5 * ratio}, {2, 1, 0}, v};
       const AnalyticModel<Precise> model(scene);
       Precise q = model.psi() / model.alpha();
       if (*model.firstPair() == Pair::BC) {
@@ -126,24 +127,24 @@ TEST(Count, ExactUpToMassRatio1e20) {
       EXPECT_EQ(predictedCollisionCount(scene), expected) << ratio;
     }
   }
-  const Scene simulated{{1e12, 1, 0.5e12}, {2, 1, 0}, {-1, 0, 0}};
+  const ThreeBodyScene simulated{{1e12, 1, 0.5e12}, {2, 1, 0}, {-1, 0, 0}};
   EXPECT_EQ(predictedCollisionCount(simulated), simulate<double>(simulated, {}).collision_count);
 }
 
 TEST(Count, FloorExceptWhenPsiOverAlphaIsAnInteger) {
   // (3, 1, 0.5) from (-1, 0, 0): q = 3 exactly, the third contact grazes, N = 2.
-  const Scene grazing{{3, 1, 0.5}, {2, 1, 0}, {-1, 0, 0}};
+  const ThreeBodyScene grazing{{3, 1, 0.5}, {2, 1, 0}, {-1, 0, 0}};
   const AnalyticModel<double> model(grazing);
   EXPECT_NEAR(model.psi() / model.alpha(), 3.0, 1e-12);
   EXPECT_EQ(predictedCollisionCount(grazing), 2u);
   // Equal masses, (-1, 0, 1), AB first: 3 collisions (the paper's formula says even).
-  EXPECT_EQ(predictedCollisionCount(Scene{{1, 1, 1}, {3, 2, 0}, {-1, 0, 1}}), 3u);
+  EXPECT_EQ(predictedCollisionCount(ThreeBodyScene{{1, 1, 1}, {3, 2, 0}, {-1, 0, 1}}), 3u);
 }
 
 TEST(Inverse, RoundTripRecoversInitialVelocities) {
   std::mt19937_64 rng(11);
   for (int i = 0; i < 300; ++i) {
-    const Scene scene = randomScene(rng);
+    const ThreeBodyScene scene = randomScene(rng);
     const AnalyticModel<double> model(scene);
     const std::uint64_t count = predictedCollisionCount(scene);
     for (std::uint64_t n : {std::uint64_t{0}, std::uint64_t{1}, count / 2, count}) {
@@ -156,11 +157,11 @@ TEST(Inverse, RoundTripRecoversInitialVelocities) {
 
 TEST(EnergyTransfer, FiniteAtTheEdgesOfTheDoubleRange) {
   // Found by the fuzzer: intermediate products overflowed though the energies do not.
-  const Scene tiny_masses{{2.6895203214236869e-306, 1.7765824089018436e-307, 1.7765824089018436e-307},
+  const ThreeBodyScene tiny_masses{{2.6895203214236869e-306, 1.7765824089018436e-307, 1.7765824089018436e-307},
                           {1.7800590868057611e-307, 1.7765824089018436e-307, 0},
                           {5.1294921942786796e-305, -5.4861240687936887e+303, 1}};
-  const Scene huge_mass{{kInf, 1.7e308, 1.7e308}, {5, 1, 0}, {0, 0, 1e-10}};
-  for (const Scene& scene : {tiny_masses, huge_mass}) {
+  const ThreeBodyScene huge_mass{{kInf, 1.7e308, 1.7e308}, {5, 1, 0}, {0, 0, 1e-10}};
+  for (const ThreeBodyScene& scene : {tiny_masses, huge_mass}) {
     ASSERT_FALSE(validate(scene));
     const AnalyticModel<double> model(scene);
     for (std::uint64_t n = 1; n <= 3; ++n) {
@@ -172,7 +173,7 @@ TEST(EnergyTransfer, FiniteAtTheEdgesOfTheDoubleRange) {
 TEST(EnergyTransfer, ClosedFormMatchesSimulatedEvents) {
   std::mt19937_64 rng(5);
   for (int i = 0; i < 100; ++i) {
-    const Scene scene = randomScene(rng);
+    const ThreeBodyScene scene = randomScene(rng);
     const AnalyticModel<double> model(scene);
     double energy = 0.0;
     for (int j = 0; j < 3; ++j) {
@@ -191,4 +192,5 @@ TEST(EnergyTransfer, ClosedFormMatchesSimulatedEvents) {
 }
 
 }  // namespace
+}  // namespace core
 }  // namespace collision_lab

@@ -22,6 +22,7 @@
 #include "rational_reference.h"
 
 namespace collision_lab {
+namespace core {
 namespace {
 
 using reference::Q;
@@ -35,7 +36,7 @@ struct Observed {
   std::vector<ImpactEvent> events;
 };
 
-Observed run(const Scene& scene, Precision precision) {
+Observed run(const ThreeBodyScene& scene, Precision precision) {
   Observed observed;
   observed.result = simulate(scene, {}, precision, [&](const ImpactEvent& e) { observed.events.push_back(e); });
   return observed;
@@ -43,7 +44,7 @@ Observed run(const Scene& scene, Precision precision) {
 
 /// |S (v - exact)| / |S v0| with S = diag(sqrt(m / m_max)), in the wall's frame, allowing
 /// each component the spacing of subnormal doubles (a subnormal result has no more digits).
-bool velocitiesClose(const Scene& scene, const std::array<double, 3>& v, const std::array<Q, 3>& exact) {
+bool velocitiesClose(const ThreeBodyScene& scene, const std::array<double, 3>& v, const std::array<Q, 3>& exact) {
   double mass_max = 0.0;
   for (int i = 0; i < 3; ++i) {
     if (!scene.isWall(i)) mass_max = std::max(mass_max, scene.masses[i]);
@@ -63,7 +64,7 @@ bool velocitiesClose(const Scene& scene, const std::array<double, 3>& v, const s
   return error_sq <= Wide(1e-24) * norm_sq + 4 * floor_sq;
 }
 
-std::string describe(const Scene& scene) {
+std::string describe(const ThreeBodyScene& scene) {
   char text[256];
   const auto& m = scene.masses;
   const auto& x = scene.positions;
@@ -74,7 +75,7 @@ std::string describe(const Scene& scene) {
 }
 
 /// The run of `scene` in `precision` against the exact reference `truth`, impact by impact.
-void expectExactRun(const Scene& scene, Precision precision, const reference::Run& truth) {
+void expectExactRun(const ThreeBodyScene& scene, Precision precision, const reference::Run& truth) {
   SCOPED_TRACE(describe(scene) + " " + precisionName(precision));
   ASSERT_FALSE(truth.truncated);
   const Observed observed = run(scene, precision);
@@ -99,7 +100,7 @@ void expectExactRun(const Scene& scene, Precision precision, const reference::Ru
 }
 
 /// The same in every working precision.
-void expectExactRuns(const Scene& scene) {
+void expectExactRuns(const ThreeBodyScene& scene) {
   const reference::Run truth = reference::simulate(scene, 1000);
   for (Precision p : kPrecisions) expectExactRun(scene, p, truth);
 }
@@ -109,7 +110,7 @@ void expectExactRuns(const Scene& scene) {
 
 TEST(DoubleRange, OtherPairApproachingAtASubnormalSpeedIsAccepted) {
   // AB meets at t = 1; B then reaches C, which creeps at 5e-324 m/s, at t = 2.5 - 1e-323.
-  const Scene scene{{1, 2, 3}, {2, 1, 0}, {-1, 0, 5e-324}};
+  const ThreeBodyScene scene{{1, 2, 3}, {2, 1, 0}, {-1, 0, 5e-324}};
   ASSERT_FALSE(validate(scene)) << validate(scene)->message;
   expectExactRuns(scene);
   const Observed observed = run(scene, Precision::kDouble);
@@ -126,7 +127,7 @@ TEST(DoubleRange, OtherPairApproachingAtASubnormalSpeedIsAccepted) {
 TEST(DoubleRange, AContactAfterTheLargestDoubleIsReportedAsInfinity) {
   // Equal masses swap velocities: the third impact comes when A, creeping at 5e-324 m/s,
   // has covered 1 m to B at rest at 0: at t = 2 + 1/5e-324 = 2.02e323 s, beyond any double.
-  const Scene scene{{1, 1, 1}, {2, 1, 0}, {-1, -5e-324, 0}};
+  const ThreeBodyScene scene{{1, 1, 1}, {2, 1, 0}, {-1, -5e-324, 0}};
   ASSERT_FALSE(validate(scene)) << validate(scene)->message;
   expectExactRuns(scene);
   for (Precision p : kPrecisions) {
@@ -140,7 +141,7 @@ TEST(DoubleRange, AContactAfterTheLargestDoubleIsReportedAsInfinity) {
 
 TEST(DoubleRange, OnlyTheFirstContactMustBeRepresentable) {
   // The first contact itself at t = 1e600 s is still out of range, and says how to fix it.
-  const Scene late{{1, 1, 1}, {1e300, 0, -1}, {-1e-300, 0, -1}};
+  const ThreeBodyScene late{{1, 1, 1}, {1e300, 0, -1}, {-1e-300, 0, -1}};
   const auto error = validate(late);
   ASSERT_TRUE(error);
   EXPECT_EQ(error->reason, Reason::kOverflow);
@@ -161,7 +162,7 @@ struct CountGeometry {
   Float pi_over_alpha;
 };
 
-CountGeometry countGeometry(const Scene& scene) {
+CountGeometry countGeometry(const ThreeBodyScene& scene) {
   using Float = CountGeometry::Float;
   using Vec = std::array<Float, 3>;
   auto dot = [](const Vec& a, const Vec& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; };
@@ -212,7 +213,7 @@ TEST(DoubleRange, TheIndependentCountGeometryAgreesWithExactSimulation) {
   std::uniform_real_distribution<double> unit(-1, 1), decade(-2, 2);
   int checked = 0;
   while (checked < 200) {
-    Scene scene{{std::pow(10.0, decade(rng)), std::pow(10.0, decade(rng)), std::pow(10.0, decade(rng))},
+    ThreeBodyScene scene{{std::pow(10.0, decade(rng)), std::pow(10.0, decade(rng)), std::pow(10.0, decade(rng))},
                 {2 + unit(rng), 0.5 * unit(rng), -2 + unit(rng)},
                 {unit(rng), unit(rng), unit(rng)}};
     if (checked % 5 == 0) scene.masses[kC] = kInf;
@@ -227,10 +228,10 @@ TEST(DoubleRange, TheIndependentCountGeometryAgreesWithExactSimulation) {
 
 TEST(DoubleRange, CountsPast2To53AreExact) {
   // The issue's exact figures.
-  const Scene pi_1e32{{1e32, 1, kInf}, {2, 1, 0}, {-1, 0, 0}};
+  const ThreeBodyScene pi_1e32{{1e32, 1, kInf}, {2, 1, 0}, {-1, 0, 0}};
   EXPECT_EQ(predictedCollisionCount(pi_1e32), 31415926535897933u);
   EXPECT_EQ(maxPossibleCollisionCount(pi_1e32.masses), 31415926535897934u);
-  const Scene heavy_light_heavy{{1e36, 1, 1e36}, {2, 1, 0}, {-1, 0, 0}};
+  const ThreeBodyScene heavy_light_heavy{{1e36, 1, 1e36}, {2, 1, 0}, {-1, 0, 0}};
   EXPECT_EQ(predictedCollisionCount(heavy_light_heavy), 2221441469079183170u);
   EXPECT_EQ(maxPossibleCollisionCount(heavy_light_heavy.masses), 2221441469079183171u);
   const AnalyticPrediction prediction = predict(heavy_light_heavy);
@@ -243,7 +244,7 @@ TEST(DoubleRange, CountsPast2To53AreExact) {
     for (int exponent = 32; exponent <= 37; ++exponent) {
       for (bool wall : {true, false}) {
         const double heavy = mantissa * std::pow(10.0, exponent);
-        const Scene scene{{heavy, 1, wall ? kInf : heavy}, {2, 1, 0}, {-1, 0, 0}};
+        const ThreeBodyScene scene{{heavy, 1, wall ? kInf : heavy}, {2, 1, 0}, {-1, 0, 0}};
         if (validate(scene)) continue;  // beyond 2^64 - 1: rejected, tested below
         const CountGeometry g = countGeometry(scene);
         const auto expected = static_cast<std::uint64_t>(ceil(g.quotient)) - 1;
@@ -257,13 +258,13 @@ TEST(DoubleRange, CountsPast2To53AreExact) {
 }
 
 TEST(DoubleRange, ACountBeyond64BitsIsAClearError) {
-  const auto error = validate(Scene{{1e40, 1, 1e40}, {2, 1, 0}, {-1, 0, 0}});
+  const auto error = validate(ThreeBodyScene{{1e40, 1, 1e40}, {2, 1, 0}, {-1, 0, 0}});
   ASSERT_TRUE(error);
   EXPECT_EQ(error->reason, Reason::kOverflow);
   EXPECT_NE(error->message.find("more than 2^64 - 1 = 18446744073709551615"), std::string::npos) << error->message;
   EXPECT_NE(error->message.find("make B heavier"), std::string::npos) << error->message;
   // Just inside: 8e36 with a wall has 8885765876316732682 collisions (issue 14), which fit.
-  const Scene inside{{8e36, 1, kInf}, {2, 1, 0}, {-1, 0, 0}};
+  const ThreeBodyScene inside{{8e36, 1, kInf}, {2, 1, 0}, {-1, 0, 0}};
   ASSERT_FALSE(validate(inside));
   EXPECT_EQ(predictedCollisionCount(inside), 8885765876316732682u);
   EXPECT_EQ(static_cast<std::uint64_t>(ceil(countGeometry(inside).quotient)) - 1, 8885765876316732682u);
@@ -274,9 +275,9 @@ TEST(DoubleRange, ACountBeyond64BitsIsAClearError) {
 
 TEST(DoubleRange, TimesBelowTheSmallestDoubleKeepPositionsRight) {
   // Impacts 1e-350 s apart: times round to 0, positions must not.
-  const Scene fast{{1, 2, 3}, {3e-200, 1e-200, 0}, {-1e150, 0, 1e150}};
-  const Scene light{{5e-300, 1e-300, 9e-300}, {2e-200, 1e-200, 0}, {-1e150, 0, 0}};
-  for (const Scene& scene : {fast, light}) {
+  const ThreeBodyScene fast{{1, 2, 3}, {3e-200, 1e-200, 0}, {-1e150, 0, 1e150}};
+  const ThreeBodyScene light{{5e-300, 1e-300, 9e-300}, {2e-200, 1e-200, 0}, {-1e150, 0, 0}};
+  for (const ThreeBodyScene& scene : {fast, light}) {
     ASSERT_FALSE(validate(scene));
     expectExactRuns(scene);
   }
@@ -290,7 +291,7 @@ TEST(DoubleRange, TimesBelowTheSmallestDoubleKeepPositionsRight) {
 
 TEST(DoubleRange, ASubnormalApproachSpeedKeepsTheEventTimeExact) {
   // After two impacts A and B drift apart at ~1.4e-317 m/s (subnormal).
-  const Scene scene{{3e-300, 1e-300, 5e-301}, {2e-200, 1e-200, 0}, {-1e-300, 0, 0}};
+  const ThreeBodyScene scene{{3e-300, 1e-300, 5e-301}, {2e-200, 1e-200, 0}, {-1e-300, 0, 0}};
   ASSERT_FALSE(validate(scene));
   expectExactRuns(scene);
   for (Precision p : kPrecisions) {
@@ -303,8 +304,8 @@ TEST(DoubleRange, ASubnormalApproachSpeedKeepsTheEventTimeExact) {
 
 TEST(DoubleRange, SubnormalVelocitiesThroughLongRuns) {
   // Every velocity subnormal: rounding must stay relative over 314 impacts.
-  for (const Scene& scene : {Scene{{1e4, 1, kInf}, {2e-10, 1e-10, 0}, {-1e-310, 0, 0}},
-                             Scene{{1e2, 1, 1e2}, {2e-10, 1e-10, 0}, {-1e-315, 0, 0}}}) {
+  for (const ThreeBodyScene& scene : {ThreeBodyScene{{1e4, 1, kInf}, {2e-10, 1e-10, 0}, {-1e-310, 0, 0}},
+                             ThreeBodyScene{{1e2, 1, 1e2}, {2e-10, 1e-10, 0}, {-1e-315, 0, 0}}}) {
     ASSERT_FALSE(validate(scene));
     expectExactRun(scene, Precision::kDouble, reference::simulate(scene, 1000));
   }
@@ -316,7 +317,7 @@ TEST(DoubleRange, SubnormalVelocitiesThroughLongRuns) {
 TEST(DoubleRange, ExtremeMassRatiosAreAcceptedAndExact) {
   // The issue's scene: 2 collisions, the second after the largest double (B creeps at
   // 2e-440 m/s towards the wall), with finite positions.
-  const Scene feather{{1e-300, 1, kInf}, {2, 1, 0}, {-1e-140, 0, 0}};
+  const ThreeBodyScene feather{{1e-300, 1, kInf}, {2, 1, 0}, {-1e-140, 0, 0}};
   ASSERT_FALSE(validate(feather)) << validate(feather)->message;
   expectExactRuns(feather);
   const Observed observed = run(feather, Precision::kDouble);
@@ -325,9 +326,9 @@ TEST(DoubleRange, ExtremeMassRatiosAreAcceptedAndExact) {
   EXPECT_EQ(observed.events[1].position, 0.0);
   // A heavy B (it cannot be a wall), ratios past the double range (1e300 / 1e-310), and a
   // light B between bodies 1e200 apart in mass (31 impacts).
-  for (const Scene& scene : {Scene{{1e-300, 1e300, 1}, {3, 1, 0}, {-1, 0, 1}},
-                             Scene{{1e300, 1e-300, 1e-310}, {2, 1, 0}, {-1, 0, 0.5}},
-                             Scene{{1e200, 1e-2, 1}, {2, 1, 0}, {-1, 0, 0}}}) {
+  for (const ThreeBodyScene& scene : {ThreeBodyScene{{1e-300, 1e300, 1}, {3, 1, 0}, {-1, 0, 1}},
+                             ThreeBodyScene{{1e300, 1e-300, 1e-310}, {2, 1, 0}, {-1, 0, 0.5}},
+                             ThreeBodyScene{{1e200, 1e-2, 1}, {2, 1, 0}, {-1, 0, 0}}}) {
     ASSERT_FALSE(validate(scene)) << validate(scene)->message;
     const reference::Run truth = reference::simulate(scene, 1000);
     expectExactRun(scene, Precision::kDouble, truth);
@@ -352,7 +353,7 @@ TEST(DoubleRange, SeededScenesAcrossTheDoubleRange) {
   };
   int accepted = 0, extreme_masses = 0;
   for (int attempt = 0; attempt < 6000 && accepted < 300; ++attempt) {
-    Scene scene;
+    ThreeBodyScene scene;
     for (double& m : scene.masses) m = mantissa(rng) * std::pow(10.0, std::round(exponent(rng)));
     if (kind(rng) == 0) scene.masses[kind(rng) % 2 == 0 ? kA : kC] = kInf;
     const double top = value();
@@ -378,4 +379,5 @@ TEST(DoubleRange, SeededScenesAcrossTheDoubleRange) {
 }
 
 }  // namespace
+}  // namespace core
 }  // namespace collision_lab

@@ -11,6 +11,7 @@
 #include "scenes.h"
 
 namespace collision_lab {
+namespace core {
 namespace {
 
 using testing_support::energyNormError;
@@ -23,7 +24,7 @@ struct Observed {
 };
 
 template <class Scalar = double>
-Observed run(const Scene& scene, std::uint64_t max_collisions = 10'000'000) {
+Observed run(const ThreeBodyScene& scene, std::uint64_t max_collisions = 10'000'000) {
   Observed observed;
   SimulationOptions options;
   options.max_collisions = max_collisions;
@@ -31,7 +32,7 @@ Observed run(const Scene& scene, std::uint64_t max_collisions = 10'000'000) {
   return observed;
 }
 
-void expectMatchesExact(const Scene& scene, double tolerance = 1e-13) {
+void expectMatchesExact(const ThreeBodyScene& scene, double tolerance = 1e-13) {
   const exact::Run reference = exact::simulate(scene, 100000);
   ASSERT_FALSE(reference.truncated);
   const Observed observed = run(scene);
@@ -48,7 +49,7 @@ TEST(ExactAgreement, ThousandSeededRandomScenes) {
   std::mt19937_64 rng(20261122);
   int with_collisions = 0, bc_first = 0, walls = 0;
   for (int i = 0; i < 1000; ++i) {
-    const Scene scene = randomScene(rng);
+    const ThreeBodyScene scene = randomScene(rng);
     SCOPED_TRACE(::testing::Message() << "scene " << i);
     expectMatchesExact(scene, 1e-12);
     const auto first = firstPair(scene);
@@ -65,7 +66,7 @@ TEST(ExactAgreement, ThousandSeededRandomScenes) {
 TEST(ExactAgreement, WideMassRatiosWithLongerRuns) {
   std::mt19937_64 rng(31);
   for (int i = 0; i < 25; ++i) {
-    const Scene scene = randomScene(rng, 2.5);
+    const ThreeBodyScene scene = randomScene(rng, 2.5);
     SCOPED_TRACE(::testing::Message() << "scene " << i);
     expectMatchesExact(scene, 1e-12);
   }
@@ -76,7 +77,7 @@ TEST(ExactAgreement, KaleidoscopicMassesGrazeAtTheEnd) {
   const std::vector<std::pair<std::array<double, 3>, std::uint64_t>> cases = {
       {{1, 1, 1}, 2}, {{2, 1, 3}, 3}, {{5, 1, 9}, 5}};
   for (const auto& [masses, expected] : cases) {
-    const Scene scene{masses, {2, 1, 0}, {-1, 0, 0}};
+    const ThreeBodyScene scene{masses, {2, 1, 0}, {-1, 0, 0}};
     EXPECT_EQ(run(scene).result.collision_count, expected);
     EXPECT_EQ(predictedCollisionCount(scene), expected);
     expectMatchesExact(scene);
@@ -84,7 +85,7 @@ TEST(ExactAgreement, KaleidoscopicMassesGrazeAtTheEnd) {
 }
 
 TEST(ExactAgreement, GrazingEndsWithEqualVelocities) {
-  const Scene scene{{3, 1, 0.5}, {2, 1, 0}, {-1, 0, 0}};
+  const ThreeBodyScene scene{{3, 1, 0.5}, {2, 1, 0}, {-1, 0, 0}};
   const Observed observed = run(scene);
   EXPECT_EQ(observed.result.collision_count, 2u);
   const auto& v = observed.result.final_velocities;
@@ -100,7 +101,7 @@ TEST(ExactAgreement, NearTripleCollisionsPickTheExactFirstPair) {
     double x_a = 1.0;
     for (int i = 0; i < std::abs(ulps); ++i) x_a = std::nextafter(x_a, ulps > 0 ? 2.0 : 0.0);
     for (const auto& masses : {std::array<double, 3>{1, 1, 1}, std::array<double, 3>{3, 1, 7}}) {
-      const Scene scene{masses, {x_a, 0.0, -1.0}, {-1.0, 0.0, 1.0}};
+      const ThreeBodyScene scene{masses, {x_a, 0.0, -1.0}, {-1.0, 0.0, 1.0}};
       ASSERT_FALSE(validate(scene));
       const Pair expected = ulps > 0 ? Pair::BC : Pair::AB;
       EXPECT_EQ(firstPair(scene), expected) << ulps;
@@ -108,7 +109,7 @@ TEST(ExactAgreement, NearTripleCollisionsPickTheExactFirstPair) {
     }
   }
   // Products that round to equal in double but differ exactly.
-  const Scene rounded{{1, 2, 3}, {0.3, 0.2, 0.1}, {-0.1, 0.0, 0.1}};
+  const ThreeBodyScene rounded{{1, 2, 3}, {0.3, 0.2, 0.1}, {-0.1, 0.0, 0.1}};
   ASSERT_FALSE(validate(rounded));
   EXPECT_EQ(firstPair(rounded), exact::compareFirstContactTimes(rounded) < 0 ? Pair::AB : Pair::BC);
   expectMatchesExact(rounded);
@@ -116,16 +117,16 @@ TEST(ExactAgreement, NearTripleCollisionsPickTheExactFirstPair) {
 
 TEST(ExactAgreement, ExtremeScalesDoNotOverflow) {
   for (double scale : {1e-150, 1e150}) {
-    const Scene masses_scaled{{2 * scale, scale, 3 * scale}, {2, 1, 0}, {-1, 0.25, 1}};
+    const ThreeBodyScene masses_scaled{{2 * scale, scale, 3 * scale}, {2, 1, 0}, {-1, 0.25, 1}};
     expectMatchesExact(masses_scaled);
-    const Scene speeds_scaled{{2, 1, 3}, {2 * scale, scale, 0}, {-scale, 0.25 * scale, scale}};
+    const ThreeBodyScene speeds_scaled{{2, 1, 3}, {2 * scale, scale, 0}, {-scale, 0.25 * scale, scale}};
     expectMatchesExact(speeds_scaled);
   }
 }
 
 TEST(ExactAgreement, SubnormalVelocityDifferences) {
   // Found by the fuzzer: rounding is not relative down here.
-  const Scene scene{{1, 2, 0.26542376078465163}, {3e-16, 2e-16, 1.5e-16}, {-5e-324, 0, 5e-324}};
+  const ThreeBodyScene scene{{1, 2, 0.26542376078465163}, {3e-16, 2e-16, 1.5e-16}, {-5e-324, 0, 5e-324}};
   ASSERT_FALSE(validate(scene));
   expectMatchesExact(scene);
 }
@@ -135,21 +136,21 @@ TEST(ExactAgreement, AFeatherweightCarriesAllTheRelativeMotion) {
   // relative motion, below the rounding of the centre-of-mass velocity in double (and,
   // at 1e-99, in 50 digits too).
   for (double light : {1e-30, 1e-90, 1e-99}) {
-    const Scene scene{{5, 1, light}, {2, 1, 0}, {-0.1, -0.1, 0}};
+    const ThreeBodyScene scene{{5, 1, light}, {2, 1, 0}, {-0.1, -0.1, 0}};
     ASSERT_FALSE(validate(scene));
     expectMatchesExact(scene);
   }
 }
 
 TEST(ExactAgreement, WallsMovingAndResting) {
-  expectMatchesExact(Scene{{kInf, 1, 3}, {2, 1, 0}, {0.25, 0, 1}});
-  expectMatchesExact(Scene{{3, 1, kInf}, {2, 1, 0}, {-1, 0.5, -0.125}});
+  expectMatchesExact(ThreeBodyScene{{kInf, 1, 3}, {2, 1, 0}, {0.25, 0, 1}});
+  expectMatchesExact(ThreeBodyScene{{3, 1, kInf}, {2, 1, 0}, {-1, 0.5, -0.125}});
 }
 
 TEST(ExactAgreement, OtherPrecisionsAgreeOnCountsAndPairs) {
   std::mt19937_64 rng(7);
   for (int i = 0; i < 40; ++i) {
-    const Scene scene = randomScene(rng);
+    const ThreeBodyScene scene = randomScene(rng);
     const exact::Run reference = exact::simulate(scene, 100000);
     EXPECT_EQ(run<long double>(scene).pairs, reference.pairs);
     const Observed high = run<HighPrecision>(scene);
@@ -159,14 +160,14 @@ TEST(ExactAgreement, OtherPrecisionsAgreeOnCountsAndPairs) {
 }
 
 TEST(Conservation, EnergyAndMomentumOverLongRuns) {
-  for (const Scene& scene : {Scene{{1e6, 1, 1e6}, {2, 1, 0}, {-1, 0, 0}}, Scene{{1e8, 3, 1e9}, {2, 1, 0}, {-1, 0.5, 0.25}}}) {
+  for (const ThreeBodyScene& scene : {ThreeBodyScene{{1e6, 1, 1e6}, {2, 1, 0}, {-1, 0, 0}}, ThreeBodyScene{{1e8, 3, 1e9}, {2, 1, 0}, {-1, 0.5, 0.25}}}) {
     const SimulationResult result = simulate<double>(scene, {});
     EXPECT_GT(result.collision_count, 1000u);
     EXPECT_LE(result.energy_relative_drift, 1e-12);
     EXPECT_LE(result.momentum_relative_drift, 1e-12);
   }
   // Every event's running totals stay on the initial values.
-  const Scene scene{{1, 2, 3}, {2, 1, 0}, {-1, 0.3, 0.7}};
+  const ThreeBodyScene scene{{1, 2, 3}, {2, 1, 0}, {-1, 0.3, 0.7}};
   const double energy = 0.5 * (1 * 1 + 2 * 0.09 + 3 * 0.49);
   const double momentum = -1 + 2 * 0.3 + 3 * 0.7;
   SimulationOptions options;
@@ -181,7 +182,7 @@ TEST(Conservation, EnergyAndMomentumOverLongRuns) {
 }
 
 TEST(Events, PoliciesCapsAndTimes) {
-  const Scene scene{{100, 1, kInf}, {3, 2, 0}, {-1, 0, 0}};
+  const ThreeBodyScene scene{{100, 1, kInf}, {3, 2, 0}, {-1, 0, 0}};
   SimulationOptions options;
   options.events = EventPolicy::firstN(5);
   std::uint64_t visited = 0;
@@ -210,21 +211,21 @@ TEST(Events, PoliciesCapsAndTimes) {
 TEST(PiDigits, BySimulation) {
   const std::vector<std::pair<double, std::uint64_t>> digits = {{1e2, 31}, {1e4, 314}, {1e6, 3141}, {1e8, 31415}};
   for (const auto& [ratio, expected] : digits) {
-    const Scene scene{{ratio, 1, kInf}, {2, 1, 0}, {-1, 0, 0}};
+    const ThreeBodyScene scene{{ratio, 1, kInf}, {2, 1, 0}, {-1, 0, 0}};
     EXPECT_EQ(simulate<double>(scene, {}).collision_count, expected);
     EXPECT_EQ(predictedCollisionCount(scene), expected);
   }
-  const Scene small{{1e4, 1, kInf}, {2, 1, 0}, {-1, 0, 0}};
+  const ThreeBodyScene small{{1e4, 1, kInf}, {2, 1, 0}, {-1, 0, 0}};
   expectMatchesExact(small);
   // 3141 impacts with a light body 1000 times faster at its peak than at the end.
-  const Scene pi_1e6{{1e6, 1, kInf}, {2, 1, 0}, {-1, 0, 0}};
+  const ThreeBodyScene pi_1e6{{1e6, 1, kInf}, {2, 1, 0}, {-1, 0, 0}};
   const SimulationResult high = simulate<HighPrecision>(pi_1e6, {});
   const SimulationResult fast = simulate<double>(pi_1e6, {});
   for (int i = 0; i < 3; ++i) EXPECT_NEAR(fast.final_velocities[i], high.final_velocities[i], 1e-12) << i;
 }
 
 TEST(HeavyLightHeavy, MillionsOfCollisionsStayAccurate) {
-  const Scene scene{{1e12, 1, 1e12}, {2, 1, 0}, {-1, 0, 0}};
+  const ThreeBodyScene scene{{1e12, 1, 1e12}, {2, 1, 0}, {-1, 0, 0}};
   const SimulationResult fast = simulate<double>(scene, {});
   EXPECT_EQ(fast.collision_count, 2221441u);
   EXPECT_EQ(predictedCollisionCount(scene), 2221441u);
@@ -240,4 +241,5 @@ TEST(HeavyLightHeavy, MillionsOfCollisionsStayAccurate) {
 }
 
 }  // namespace
+}  // namespace core
 }  // namespace collision_lab

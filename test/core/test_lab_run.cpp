@@ -13,6 +13,7 @@
 #include "rational_reference.h"
 
 namespace collision_lab {
+namespace core {
 namespace {
 
 using reference::Q;
@@ -21,7 +22,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 
 bool isNegativeZero(double x) { return x == 0 && std::signbit(x); }
 
-RunResult runAll(const Scene& scene, RunOptions options = {}) {
+RunResult runAll(const ThreeBodyScene& scene, RunOptions options = {}) {
   options.events = EventPolicy::all();
   return runLab(scene, options);
 }
@@ -31,7 +32,7 @@ RunResult runAll(const Scene& scene, RunOptions options = {}) {
 
 TEST(LabRunOverCap, ReportsThePredictedFinalVelocitiesAndMeasuresNothing) {
   // Masses (1e30, 1, inf): 3.1e15 collisions, far over a cap of 10.
-  const Scene scene{{1e30, 1, kInf}, {2, 1, 0}, {-1, 0, 0}};
+  const ThreeBodyScene scene{{1e30, 1, kInf}, {2, 1, 0}, {-1, 0, 0}};
   RunOptions options;
   options.max_collisions = 10;
   options.skip_simulation_over_cap = true;
@@ -53,7 +54,7 @@ TEST(LabRunOverCap, ReportsThePredictedFinalVelocitiesAndMeasuresNothing) {
 }
 
 TEST(LabRunOverCap, WithoutAWallMomentumIsNotMeasuredEither) {
-  const Scene scene{{1e30, 1, 1e30}, {2, 1, 0}, {-1, 0, 0}};
+  const ThreeBodyScene scene{{1e30, 1, 1e30}, {2, 1, 0}, {-1, 0, 0}};
   RunOptions options;
   options.max_collisions = 10;
   options.skip_simulation_over_cap = true;
@@ -64,7 +65,7 @@ TEST(LabRunOverCap, WithoutAWallMomentumIsNotMeasuredEither) {
   EXPECT_TRUE(std::isnan(predicted.summary.momentum_relative_drift));
   EXPECT_EQ(predicted.summary.final_velocities, predicted.prediction.final_velocities);
   // A simulated run still measures: 0 drift to rounding, no wall.
-  const RunResult simulated = runLab(Scene{{1, 2, 3}, {2, 1, 0}, {-1, 0, 1}}, {});
+  const RunResult simulated = runLab(ThreeBodyScene{{1, 2, 3}, {2, 1, 0}, {-1, 0, 1}}, {});
   EXPECT_LE(simulated.summary.momentum_relative_drift, 1e-15);
 }
 
@@ -72,7 +73,7 @@ TEST(LabRunOverCap, WithoutAWallMomentumIsNotMeasuredEither) {
 // Energy transfer per impact.
 
 /// The kinetic energy body i gains in impact k, exactly.
-double exactGain(const Scene& scene, const reference::Run& truth, std::size_t k, int i) {
+double exactGain(const ThreeBodyScene& scene, const reference::Run& truth, std::size_t k, int i) {
   const Q before = k == 0 ? Q(scene.velocities[i]) : truth.impacts[k - 1].velocities[i];
   const Q after = truth.impacts[k].velocities[i];
   return static_cast<double>(reference::toWide(Q(scene.masses[i]) * (after * after - before * before) / 2));
@@ -80,8 +81,8 @@ double exactGain(const Scene& scene, const reference::Run& truth, std::size_t k,
 
 TEST(EnergyTransferPerImpact, NonParticipantsAndRestingWallsGainExactlyZero) {
   // A pi billiard against a resting wall C, equal masses, and a general scene.
-  for (const Scene& scene : {Scene{{1e4, 1, kInf}, {2, 1, 0}, {-1, 0, 0}}, Scene{{1, 1, 1}, {2, 1, -1}, {-1, 0, 1}},
-                             Scene{{0.3, 0.7, 0.11}, {0.9, 0.2, -0.4}, {-0.3, 0.1, 0.25}}}) {
+  for (const ThreeBodyScene& scene : {ThreeBodyScene{{1e4, 1, kInf}, {2, 1, 0}, {-1, 0, 0}}, ThreeBodyScene{{1, 1, 1}, {2, 1, -1}, {-1, 0, 1}},
+                             ThreeBodyScene{{0.3, 0.7, 0.11}, {0.9, 0.2, -0.4}, {-0.3, 0.1, 0.25}}}) {
     const RunResult result = runAll(scene);
     ASSERT_FALSE(result.events.empty());
     for (const LabEvent& lab : result.events) {
@@ -100,8 +101,8 @@ TEST(EnergyTransferPerImpact, NonParticipantsAndRestingWallsGainExactlyZero) {
 }
 
 TEST(EnergyTransferPerImpact, ThePairsEntriesAreExactOppositesAndExact) {
-  for (const Scene& scene : {Scene{{1, 2, 3}, {2, 1, 0}, {-1, 0.3, 0.7}}, Scene{{1e4, 1, 1e4}, {2, 1, 0}, {-1, 0, 0}},
-                             Scene{{0.3, 0.7, 0.11}, {0.9, 0.2, -0.4}, {-0.3, 0.1, 0.25}}}) {
+  for (const ThreeBodyScene& scene : {ThreeBodyScene{{1, 2, 3}, {2, 1, 0}, {-1, 0.3, 0.7}}, ThreeBodyScene{{1e4, 1, 1e4}, {2, 1, 0}, {-1, 0, 0}},
+                             ThreeBodyScene{{0.3, 0.7, 0.11}, {0.9, 0.2, -0.4}, {-0.3, 0.1, 0.25}}}) {
     const reference::Run truth = reference::simulate(scene, 5000);
     const RunResult result = runAll(scene);
     ASSERT_EQ(result.events.size(), truth.impacts.size());
@@ -121,7 +122,7 @@ TEST(EnergyTransferPerImpact, ThePairsEntriesAreExactOppositesAndExact) {
 
 TEST(EnergyTransferPerImpact, AMovingWallsEntryIsMinusWhatTheBallGains) {
   // A wall at A moving at 0.25 m/s: the ball's gain is exact, the wall's is its opposite.
-  const Scene scene{{kInf, 1, 3}, {2, 1, 0}, {0.25, 0, 1}};
+  const ThreeBodyScene scene{{kInf, 1, 3}, {2, 1, 0}, {0.25, 0, 1}};
   const reference::Run truth = reference::simulate(scene, 100);
   const RunResult result = runAll(scene);
   ASSERT_EQ(result.events.size(), truth.impacts.size());
@@ -141,7 +142,7 @@ TEST(EnergyTransferPerImpact, AMovingWallsEntryIsMinusWhatTheBallGains) {
 
 TEST(EnergyTransferPerImpact, ThePapersFormulasLeaveTheThirdBodyAtZero) {
   // BC first: (4.6)/(4.7) refer to the impact before, undefined here; A still gains 0.
-  const Scene bc_first{{1, 1, 1}, {3, 1, 0}, {0, 0, -1}};
+  const ThreeBodyScene bc_first{{1, 1, 1}, {3, 1, 0}, {0, 0, -1}};
   const auto gained = paper::energyTransfer(bc_first, 1, Pair::BC, bc_first.velocities, bc_first.velocities);
   EXPECT_EQ(gained[kA], 0.0);
   EXPECT_TRUE(std::isnan(gained[kB]));
@@ -157,8 +158,8 @@ void expectNoNegativeZero(const std::array<double, 3>& values, const char* what,
 
 TEST(NegativeZeros, NoneInEventsPredictionsOrSummaries) {
   // Resting walls, bodies at rest and -0 inputs are where -0 comes from.
-  for (const Scene& scene : {Scene{{100, 1, kInf}, {2, 1, 0}, {-1, -0.0, -0.0}}, Scene{{1, 1, 1}, {2, 1, 0}, {-1, 0, 0}},
-                             Scene{{kInf, 1, 1}, {2, 1, 0}, {-0.0, 0.5, -1}}, Scene{{3, 1, 0.5}, {2, 1, 0}, {-1, 0, 0}}}) {
+  for (const ThreeBodyScene& scene : {ThreeBodyScene{{100, 1, kInf}, {2, 1, 0}, {-1, -0.0, -0.0}}, ThreeBodyScene{{1, 1, 1}, {2, 1, 0}, {-1, 0, 0}},
+                             ThreeBodyScene{{kInf, 1, 1}, {2, 1, 0}, {-0.0, 0.5, -1}}, ThreeBodyScene{{3, 1, 0.5}, {2, 1, 0}, {-1, 0, 0}}}) {
     const RunResult result = runAll(scene);
     for (const LabEvent& lab : result.events) {
       const std::uint64_t k = lab.event.index;
@@ -185,7 +186,7 @@ TEST(NegativeZeros, NoneInEventsPredictionsOrSummaries) {
 // Wording of rejections.
 
 TEST(RejectionWording, NaNIsNaNWithoutASign) {
-  Scene scene{{1, 1, 1}, {2, 1, 0}, {-std::numeric_limits<double>::quiet_NaN(), 0, 0}};
+  ThreeBodyScene scene{{1, 1, 1}, {2, 1, 0}, {-std::numeric_limits<double>::quiet_NaN(), 0, 0}};
   ASSERT_TRUE(std::signbit(scene.velocities[0]));
   EXPECT_EQ(validate(scene)->message, "v_A is NaN; a velocity must be a finite number in m/s");
   scene.velocities[0] = -1;
@@ -195,14 +196,14 @@ TEST(RejectionWording, NaNIsNaNWithoutASign) {
 
 TEST(RejectionWording, NoMessageRepeatsItsField) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  const std::vector<Scene> rejected = {
+  const std::vector<ThreeBodyScene> rejected = {
       {{nan, 1, 1}, {2, 1, 0}, {-1, 0, 0}},           {{0, 1, 1}, {2, 1, 0}, {-1, 0, 0}},
       {{kInf, 1, kInf}, {2, 1, 0}, {-1, 0, 0}},       {{1, kInf, 1}, {2, 1, 0}, {-1, 0, 0}},
       {{1, 1, 1}, {0, 1, 2}, {-1, 0, 0}},             {{1, 1, 1}, {1, 1, 0}, {-1, 0, 0}},
       {{1, 1, 1}, {1, 0, -1}, {-1, 0, 1}},            {{1e300, 1, 1}, {2, 1, 0}, {-1e10, 0, 0}},
       {{1, 1, 1}, {1e308, -1e308, -1.5e308}, {-1, 0, 1}}, {{1e40, 1, 1e40}, {2, 1, 0}, {-1, 0, 0}},
       {{1, 1, 1}, {1e300, 0, -1}, {-1e-300, 0, -1}},  {{1, 1, 1}, {kInf, 1, 0}, {-1, 0, 0}}};
-  for (const Scene& scene : rejected) {
+  for (const ThreeBodyScene& scene : rejected) {
     const auto error = validate(scene);
     ASSERT_TRUE(error);
     // "positions: positions (0, 1, 2) m ..." said its field twice; front ends show the
@@ -215,4 +216,5 @@ TEST(RejectionWording, NoMessageRepeatsItsField) {
 }
 
 }  // namespace
+}  // namespace core
 }  // namespace collision_lab

@@ -11,11 +11,12 @@
 #include "scenes.h"
 
 namespace collision_lab {
+namespace core {
 namespace {
 
 TEST(PaperErrata, ClosedFormVelocities215AreWrong) {
   // physics.md Erratum 2: masses (1,1,1), v0 = (-1, 0.3, 0.7), k = 1.
-  const Scene scene{{1, 1, 1}, {3, 2, 0}, {-1, 0.3, 0.7}};
+  const ThreeBodyScene scene{{1, 1, 1}, {3, 2, 0}, {-1, 0.3, 0.7}};
   const auto printed = paper::velocitiesAfter(scene, 2);
   EXPECT_NEAR(printed[0], -1.2125, 1e-12);
   EXPECT_NEAR(printed[1], 0.5125, 1e-12);
@@ -35,7 +36,7 @@ TEST(PaperErrata, ClosedFormVelocities215AreWrong) {
 
 TEST(PaperErrata, CollisionCount322IsEvenForNonIntegerArguments) {
   // Equal masses (-1, 0, 1) with AB first: 3 collisions; (3.22) cannot give an odd number.
-  const Scene scene{{1, 1, 1}, {3, 2, 0}, {-1, 0, 1}};
+  const ThreeBodyScene scene{{1, 1, 1}, {3, 2, 0}, {-1, 0, 1}};
   ASSERT_EQ(simulate<double>(scene, {}).collision_count, 3u);
   const auto printed = paper::collisionCount(scene);
   ASSERT_TRUE(printed.has_value());
@@ -44,7 +45,7 @@ TEST(PaperErrata, CollisionCount322IsEvenForNonIntegerArguments) {
   std::mt19937_64 rng(2025);
   int matches = 0, ab_first = 0;
   for (int i = 0; i < 500; ++i) {
-    const Scene s = testing_support::randomScene(rng);
+    const ThreeBodyScene s = testing_support::randomScene(rng);
     if (s.wallIndex() >= 0 || firstPair(s) != Pair::AB) continue;
     ++ab_first;
     const std::uint64_t truth = exact::simulate(s, 100000).collision_count;
@@ -59,7 +60,7 @@ TEST(PaperErrata, CollisionCount322IsEvenForNonIntegerArguments) {
 TEST(PaperErrata, EnergyTransfer44UsesTheWrongAverage) {
   // (4.4) with v_k against the initial vbar_AB differs from the true change once
   // v_A + v_B has changed, i.e. from the second AB impact on (collision 3).
-  const Scene scene{{1, 2, 3}, {3, 2, 0}, {-1, 0.3, 0.7}};
+  const ThreeBodyScene scene{{1, 2, 3}, {3, 2, 0}, {-1, 0.3, 0.7}};
   SimulationOptions options;
   options.events = EventPolicy::all();
   const SimulationResult result = simulate<double>(scene, options);
@@ -81,4 +82,5 @@ TEST(PaperErrata, OmegaAsPrintedIsPiMinusAlpha) {
 }
 
 }  // namespace
+}  // namespace core
 }  // namespace collision_lab

@@ -6,14 +6,15 @@
 #include "collision_lab/core/scene.h"
 
 namespace collision_lab {
+namespace core {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-Scene validScene() { return Scene{{1, 2, 3}, {3, 1, 0}, {-1, 0, 1}}; }
+ThreeBodyScene validScene() { return ThreeBodyScene{{1, 2, 3}, {3, 1, 0}, {-1, 0, 1}}; }
 
-void expectRejected(const Scene& scene, Reason reason, const std::string& field) {
+void expectRejected(const ThreeBodyScene& scene, Reason reason, const std::string& field) {
   const auto error = validate(scene);
   ASSERT_TRUE(error.has_value()) << "expected " << reasonName(reason);
   EXPECT_EQ(error->reason, reason) << error->message;
@@ -25,12 +26,12 @@ void expectRejected(const Scene& scene, Reason reason, const std::string& field)
 
 TEST(Validation, AcceptsOrdinaryScenesAndWalls) {
   EXPECT_FALSE(validate(validScene()));
-  EXPECT_FALSE(validate(Scene{{100, 1, kInf}, {2, 1, 0}, {-1, 0, 0}}));
-  EXPECT_FALSE(validate(Scene{{kInf, 1, 1}, {2, 1, 0}, {0.5, 0, 1}}));  // moving wall
+  EXPECT_FALSE(validate(ThreeBodyScene{{100, 1, kInf}, {2, 1, 0}, {-1, 0, 0}}));
+  EXPECT_FALSE(validate(ThreeBodyScene{{kInf, 1, 1}, {2, 1, 0}, {0.5, 0, 1}}));  // moving wall
 }
 
 TEST(Validation, EveryReasonCode) {
-  Scene s = validScene();
+  ThreeBodyScene s = validScene();
   s.velocities[1] = kNaN;
   expectRejected(s, Reason::kNonFiniteValue, "velocities[1]");
   s = validScene();
@@ -80,13 +81,13 @@ TEST(Validation, EveryReasonCode) {
 
 TEST(Validation, ExactTripleCollisionOnlyWhenTimesAreExactlyEqual) {
   // t_AB = 1 / 1 and t_BC = 1 / 1: all three meet at x = 0 at t = 1.
-  Scene triple{{1, 2, 3}, {1, 0, -1}, {-1, 0, 1}};
+  ThreeBodyScene triple{{1, 2, 3}, {1, 0, -1}, {-1, 0, 1}};
   expectRejected(triple, Reason::kTripleCollision, "positions");
   // One ulp apart is a valid (near-triple) scene.
   triple.positions[0] = std::nextafter(1.0, 2.0);
   EXPECT_FALSE(validate(triple));
   // Equal only after rounding: 0.1 + 0.2 and 0.3 are different doubles, so not a triple.
-  Scene near{{1, 1, 1}, {0.1 + 0.2, 0.0, -0.3}, {-1, 0, 1}};
+  ThreeBodyScene near{{1, 1, 1}, {0.1 + 0.2, 0.0, -0.3}, {-1, 0, 1}};
   EXPECT_FALSE(validate(near));
 }
 
@@ -94,11 +95,12 @@ TEST(Validation, NeverThrowsOnHostileInput) {
   const double values[] = {0.0, -0.0, 1.0, -1.0, kInf, -kInf, kNaN, 1e-320, 1e308, -1e308};
   for (double a : values) {
     for (double b : values) {
-      Scene s{{a, 1, b}, {b, 0, a}, {a, b, a}};
+      ThreeBodyScene s{{a, 1, b}, {b, 0, a}, {a, b, a}};
       EXPECT_NO_THROW(validate(s));
     }
   }
 }
 
 }  // namespace
+}  // namespace core
 }  // namespace collision_lab

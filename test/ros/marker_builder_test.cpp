@@ -42,22 +42,22 @@ FeedOptions withMode(std::uint8_t mode) {
 }
 
 Fed feed(const Array3& masses, const Array3& positions, const Array3& velocities, const FeedOptions& o = {}) {
-  core::Scene scene;
+  collision_lab::core::ThreeBodyScene scene;
   scene.masses = masses;
   scene.positions = positions;
   scene.velocities = velocities;
-  const core::RunMode run_mode = *toRunMode(o.mode);
+  const collision_lab::core::RunMode run_mode = *toRunMode(o.mode);
   collision_lab::InitialConditions input = toInitialConditions(scene, run_mode, o.max_collisions);
   input.run_id = "markers";
   Fed fed{RunRecord(input, o.limits), {}};
-  core::RunOptions options;
+  collision_lab::core::RunOptions options;
   options.mode = run_mode;
   options.max_collisions = o.max_collisions;
-  options.events = collision_lab::EventPolicy::none();
+  options.events = collision_lab::core::EventPolicy::none();
   options.skip_simulation_over_cap = o.skip_simulation_over_cap;
-  const core::Prediction prediction = collision_lab::predict(scene);
+  const collision_lab::core::AnalyticPrediction prediction = collision_lab::core::predict(scene);
   fed.run.prediction = toPredictionMsg(prediction);
-  const core::RunResult result = collision_lab::runLab(scene, options, prediction, [&](const core::LabEvent& e) {
+  const collision_lab::core::RunResult result = collision_lab::core::runLab(scene, options, prediction, [&](const collision_lab::core::LabEvent& e) {
     const auto msg = toCollisionEventMsg(e);
     fed.run.add(msg);
     if (o.keep_events) fed.events.push_back(msg);

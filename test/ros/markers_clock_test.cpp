@@ -48,17 +48,17 @@ class Player {
 
   /// The whole run, each message stamped on the timeline.
   void publishRun() {
-    core::Scene scene;
+    collision_lab::core::ThreeBodyScene scene;
     scene.masses = {1, 1, 1};
     scene.positions = {2, 1, -1};
     scene.velocities = {-1, 0, 1};
-    auto input = toInitialConditions(scene, core::RunMode::kFull, 0);
+    auto input = toInitialConditions(scene, collision_lab::core::RunMode::kFull, 0);
     input.run_id = "clock_run";
     input.header.stamp = kStart;
     input_.publish(input);
-    core::RunOptions options;
-    options.events = collision_lab::EventPolicy::all();
-    const core::RunResult result = collision_lab::runLab(scene, options);
+    collision_lab::core::RunOptions options;
+    options.events = collision_lab::core::EventPolicy::all();
+    const collision_lab::core::RunResult result = collision_lab::core::runLab(scene, options);
     auto prediction = toPredictionMsg(result.prediction);
     prediction.run_id = input.run_id;
     prediction.header.stamp = kStart;
@@ -70,7 +70,7 @@ class Player {
       msg.header.stamp = kStart + ros::Duration(kScale * e.event.time);
       events_.publish(msg);
     }
-    auto summary = toRunSummaryMsg(result.summary, result.prediction, core::RunMode::kFull);
+    auto summary = toRunSummaryMsg(result.summary, result.prediction, collision_lab::core::RunMode::kFull);
     summary.run_id = input.run_id;
     summary.header.stamp = kStart + ros::Duration(kScale * result.events.back().event.time);
     summary_.publish(summary);

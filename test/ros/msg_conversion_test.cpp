@@ -13,46 +13,46 @@ using namespace collision_lab_ros;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 TEST(MsgConversion, SceneRoundTripKeepsWallsAndValues) {
-  core::Scene scene;
+  collision_lab::core::ThreeBodyScene scene;
   scene.masses = {kInf, 2.5, 1e-300};
   scene.positions = {3, 1, -0.1};
   scene.velocities = {-0.5, 0, 1e150};
-  const auto msg = toInitialConditions(scene, core::RunMode::kSummaryOnly, 77);
+  const auto msg = toInitialConditions(scene, collision_lab::core::RunMode::kSummaryOnly, 77);
   EXPECT_EQ(msg.mode, collision_lab::InitialConditions::MODE_SUMMARY_ONLY);
   EXPECT_EQ(msg.max_collisions, 77u);
-  const core::Scene back = toScene(msg);
+  const collision_lab::core::ThreeBodyScene back = toScene(msg);
   EXPECT_EQ(back.masses, scene.masses);
   EXPECT_EQ(back.positions, scene.positions);
   EXPECT_EQ(back.velocities, scene.velocities);
 }
 
 TEST(MsgConversion, RunModes) {
-  EXPECT_EQ(toRunMode(0), core::RunMode::kFull);
-  EXPECT_EQ(toRunMode(1), core::RunMode::kPredictOnly);
-  EXPECT_EQ(toRunMode(2), core::RunMode::kSummaryOnly);
+  EXPECT_EQ(toRunMode(0), collision_lab::core::RunMode::kFull);
+  EXPECT_EQ(toRunMode(1), collision_lab::core::RunMode::kPredictOnly);
+  EXPECT_EQ(toRunMode(2), collision_lab::core::RunMode::kSummaryOnly);
   EXPECT_FALSE(toRunMode(3));
   EXPECT_FALSE(toRunMode(255));
 }
 
 TEST(MsgConversion, PairCodes) {
-  EXPECT_EQ(toPairCode(core::Pair::AB), collision_lab::Prediction::PAIR_AB);
-  EXPECT_EQ(toPairCode(core::Pair::BC), collision_lab::Prediction::PAIR_BC);
+  EXPECT_EQ(toPairCode(collision_lab::core::Pair::AB), collision_lab::Prediction::PAIR_AB);
+  EXPECT_EQ(toPairCode(collision_lab::core::Pair::BC), collision_lab::Prediction::PAIR_BC);
   EXPECT_EQ(toPairCode(std::nullopt), collision_lab::Prediction::PAIR_NONE);
-  EXPECT_EQ(toPair(collision_lab::Prediction::PAIR_BC), core::Pair::BC);
+  EXPECT_EQ(toPair(collision_lab::Prediction::PAIR_BC), collision_lab::core::Pair::BC);
   EXPECT_FALSE(toPair(collision_lab::Prediction::PAIR_NONE));
 }
 
 TEST(MsgConversion, PredictionRoundTrip) {
-  core::Prediction p;
+  collision_lab::core::AnalyticPrediction p;
   p.collision_count = 2221441;
   p.paper_collision_count = -3;
   p.max_possible_collision_count = 2221442;
   p.angles = {0.1, 0.2, M_PI - 0.1};
   p.phi_bc = 0.3;
   p.psi = 4.5;
-  p.first_pair = core::Pair::BC;
+  p.first_pair = collision_lab::core::Pair::BC;
   p.final_velocities = {1, -2, 3};
-  const core::Prediction back = toPrediction(toPredictionMsg(p));
+  const collision_lab::core::AnalyticPrediction back = toPrediction(toPredictionMsg(p));
   EXPECT_EQ(back.collision_count, p.collision_count);
   EXPECT_EQ(back.paper_collision_count, p.paper_collision_count);
   EXPECT_EQ(back.max_possible_collision_count, p.max_possible_collision_count);
@@ -73,10 +73,10 @@ TEST(MsgConversion, PredictionRoundTrip) {
   EXPECT_FALSE(toPrediction(msg).first_pair);
 }
 
-core::LabEvent sampleEvent() {
-  core::LabEvent e;
+collision_lab::core::LabEvent sampleEvent() {
+  collision_lab::core::LabEvent e;
   e.event.index = 42;
-  e.event.pair = core::Pair::BC;
+  e.event.pair = collision_lab::core::Pair::BC;
   e.event.time = 1.5;
   e.event.position = -0.25;
   e.event.positions = {1, -0.25, -0.25};
@@ -94,10 +94,10 @@ core::LabEvent sampleEvent() {
 }
 
 TEST(MsgConversion, CollisionEventRoundTrip) {
-  const core::LabEvent e = sampleEvent();
+  const collision_lab::core::LabEvent e = sampleEvent();
   const auto msg = toCollisionEventMsg(e);
   EXPECT_EQ(msg.pair, collision_lab::CollisionEvent::PAIR_BC);
-  const core::LabEvent back = toLabEvent(msg);
+  const collision_lab::core::LabEvent back = toLabEvent(msg);
   EXPECT_EQ(back.event.index, e.event.index);
   EXPECT_EQ(back.event.pair, e.event.pair);
   EXPECT_EQ(back.event.time, e.event.time);
@@ -113,7 +113,7 @@ TEST(MsgConversion, CollisionEventRoundTrip) {
 }
 
 TEST(MsgConversion, VelocitiesAndEnergyTransferFields) {
-  const core::LabEvent e = sampleEvent();
+  const collision_lab::core::LabEvent e = sampleEvent();
   const auto v = toVelocitiesMsg(e);
   EXPECT_EQ(v.index, 42u);
   EXPECT_EQ(v.time, 1.5);
@@ -130,7 +130,7 @@ TEST(MsgConversion, VelocitiesAndEnergyTransferFields) {
 }
 
 TEST(MsgConversion, RunSummaryPhysicsFields) {
-  core::RunSummary s;
+  collision_lab::core::LabRunSummary s;
   s.collision_count = 10;
   s.truncated = true;
   s.truncation_reason = "cap";
@@ -140,9 +140,9 @@ TEST(MsgConversion, RunSummaryPhysicsFields) {
   s.energy_relative_drift = 2e-16;
   s.momentum_relative_drift = std::nan("");
   s.compute_time_s = 0.5;
-  core::Prediction p;
+  collision_lab::core::AnalyticPrediction p;
   p.collision_count = 11;
-  const auto msg = toRunSummaryMsg(s, p, core::RunMode::kFull);
+  const auto msg = toRunSummaryMsg(s, p, collision_lab::core::RunMode::kFull);
   EXPECT_EQ(msg.collision_count, 10u);
   EXPECT_TRUE(msg.truncated);
   EXPECT_EQ(msg.truncation_reason, "cap");
@@ -155,7 +155,7 @@ TEST(MsgConversion, RunSummaryPhysicsFields) {
 }
 
 TEST(MsgConversion, Rejections) {
-  core::ValidationError error{core::Reason::kTripleCollision, "positions", "a triple collision"};
+  collision_lab::core::ValidationError error{collision_lab::core::Reason::kTripleCollision, "positions", "a triple collision"};
   const auto msg = toRejectedMsg(error);
   EXPECT_EQ(msg.reason, collision_lab::Rejected::TRIPLE_COLLISION);
   EXPECT_EQ(msg.reason_name, "TRIPLE_COLLISION");

@@ -34,7 +34,7 @@ using collision_lab_test::makeInput;
 using collision_lab_test::RunCollector;
 using collision_lab_test::RunOutputs;
 using collision_lab_test::waitUntil;
-namespace core = collision_lab_ros::core;
+namespace core = collision_lab::core;
 namespace fs = std::filesystem;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -146,10 +146,10 @@ TEST(LabNode, RoundTripMatchesCore) {
   const RunOutputs& out = roundTrip();
   ASSERT_TRUE(out.rejections.empty()) << out.rejections.front().message;
 
-  core::RunOptions options;
-  options.events = collision_lab::EventPolicy::all();
+  collision_lab::core::RunOptions options;
+  options.events = collision_lab::core::EventPolicy::all();
   options.skip_simulation_over_cap = true;
-  const core::RunResult expected = collision_lab::runLab(collision_lab_ros::toScene(input), options);
+  const collision_lab::core::RunResult expected = collision_lab::core::runLab(collision_lab_ros::toScene(input), options);
   ASSERT_GT(expected.events.size(), 0u);
 
   ASSERT_EQ(out.predictions.size(), 1u);

@@ -12,11 +12,11 @@ namespace {
 using collision_lab_ros::chooseTimelineScale;
 using collision_lab_ros::firstContactTime;
 using collision_lab_ros::RunTimeline;
-namespace core = collision_lab_ros::core;
+namespace core = collision_lab::core;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-core::Scene scene(std::array<double, 3> x, std::array<double, 3> v) {
-  core::Scene s;
+collision_lab::core::ThreeBodyScene scene(std::array<double, 3> x, std::array<double, 3> v) {
+  collision_lab::core::ThreeBodyScene s;
   s.masses = {1, 1, 1};
   s.positions = x;
   s.velocities = v;
@@ -24,8 +24,8 @@ core::Scene scene(std::array<double, 3> x, std::array<double, 3> v) {
 }
 
 TEST(FirstContactTime, GapOverClosingSpeedOfTheFirstPair) {
-  EXPECT_EQ(firstContactTime(scene({2, 0, -2}, {-1, 0.5, 1}), core::Pair::AB), 2.0 / 1.5);
-  EXPECT_EQ(firstContactTime(scene({3, 1, 0}, {-0.5, 0, 2}), core::Pair::BC), 0.5);
+  EXPECT_EQ(firstContactTime(scene({2, 0, -2}, {-1, 0.5, 1}), collision_lab::core::Pair::AB), 2.0 / 1.5);
+  EXPECT_EQ(firstContactTime(scene({3, 1, 0}, {-0.5, 0, 2}), collision_lab::core::Pair::BC), 0.5);
   EXPECT_FALSE(firstContactTime(scene({2, 1, 0}, {1, 0, -1}), std::nullopt));
 }
 

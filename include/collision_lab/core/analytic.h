@@ -15,6 +15,7 @@
 #include "collision_lab/core/scene.h"
 
 namespace collision_lab {
+namespace core {
 
 /// Angles fixed by the masses alone [rad].
 struct Angles {
@@ -33,7 +34,7 @@ class AnalyticModel {
   using Vec3 = Eigen::Matrix<Scalar, 3, 1>;
   using Mat3 = Eigen::Matrix<Scalar, 3, 3>;
 
-  explicit AnalyticModel(const Scene& scene);
+  explicit AnalyticModel(const ThreeBodyScene& scene);
 
   Scalar alpha() const { return alpha_; }
   Scalar theta() const { return 2 * alpha_; }
@@ -97,7 +98,7 @@ EigenCheck eigenCheck(const std::array<double, 3>& masses);
 /// contact with exactly zero approach speed (psi / alpha an exact integer) does not count.
 /// Exact for the given doubles: double, then 50 digits, then exact rationals where the
 /// integer test needs them. Never rounded through a double: counts pass 2^53.
-std::uint64_t predictedCollisionCount(const Scene& scene);
+std::uint64_t predictedCollisionCount(const ThreeBodyScene& scene);
 
 /// The most collisions any start can give for these masses, ceil(pi / alpha)
 /// (Galperin & Zemlyakov; OEIS A119661). Exact, including the kaleidoscopic masses where
@@ -108,4 +109,5 @@ std::optional<std::uint64_t> checkedMaxPossibleCollisionCount(const std::array<d
 /// checkedMaxPossibleCollisionCount for masses that validate() accepts.
 std::uint64_t maxPossibleCollisionCount(const std::array<double, 3>& masses);
 
+}  // namespace core
 }  // namespace collision_lab

@@ -15,6 +15,7 @@
 #include "collision_lab/core/simulation.h"
 
 namespace collision_lab {
+namespace core {
 
 /// What a run models. Values match the ROS message constants MODE_*.
 enum class RunMode : std::uint8_t {
@@ -35,7 +36,7 @@ struct AnalyticPrediction {
   std::array<double, 3> final_velocities{};    ///< closed form after collision_count [m/s]
 };
 
-AnalyticPrediction predict(const Scene& scene);
+AnalyticPrediction predict(const ThreeBodyScene& scene);
 
 /// One collision with everything a lab compares it to.
 struct LabEvent {
@@ -85,12 +86,13 @@ using LabEventVisitor = std::function<void(const LabEvent&)>;
 
 /// Runs a validated scene. The visitor sees every event in order (none in predict-only
 /// or summary-only mode). Precondition: validate(scene) passed.
-RunResult runLab(const Scene& scene, const RunOptions& options,
+RunResult runLab(const ThreeBodyScene& scene, const RunOptions& options,
                  const LabEventVisitor& visitor = {});
 
 /// The same with the prediction already made (for callers that publish it first);
 /// `prediction` must be predict(scene).
-RunResult runLab(const Scene& scene, const RunOptions& options, const AnalyticPrediction& prediction,
+RunResult runLab(const ThreeBodyScene& scene, const RunOptions& options, const AnalyticPrediction& prediction,
                  const LabEventVisitor& visitor = {});
 
+}  // namespace core
 }  // namespace collision_lab

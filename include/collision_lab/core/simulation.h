@@ -18,6 +18,7 @@
 #include "collision_lab/core/scene.h"
 
 namespace collision_lab {
+namespace core {
 
 /// One elastic two-body impact. Every value is the double nearest to the exact one (and
 /// never -0): a time beyond the largest double is +inf (only the first contact is
@@ -81,12 +82,12 @@ struct SimulationResult {
 
 /// Which pair collides first, exactly for the given doubles; empty when neither pair
 /// approaches. Precondition: validate(scene) passed (so the times are not tied).
-std::optional<Pair> firstPair(const Scene& scene);
+std::optional<Pair> firstPair(const ThreeBodyScene& scene);
 
 /// Runs the scene to the end (or to max_collisions). Scalar is double, long double or
 /// HighPrecision. Precondition: validate(scene) passed. Never throws for a valid scene.
 template <class Scalar>
-SimulationResult simulate(const Scene& scene, const SimulationOptions& options,
+SimulationResult simulate(const ThreeBodyScene& scene, const SimulationOptions& options,
                           const EventVisitor& visitor = {});
 
 /// Runtime choice of the working precision.
@@ -94,7 +95,8 @@ enum class Precision { kDouble, kLongDouble, kHigh };
 const char* precisionName(Precision p);
 std::optional<Precision> parsePrecision(const std::string& name);
 
-SimulationResult simulate(const Scene& scene, const SimulationOptions& options,
+SimulationResult simulate(const ThreeBodyScene& scene, const SimulationOptions& options,
                           Precision precision, const EventVisitor& visitor = {});
 
+}  // namespace core
 }  // namespace collision_lab

@@ -27,13 +27,13 @@ enum class ReportFormat { kTable, kJson, kCsv };
 
 /// Option spellings shared by the CLI's parser and the reports that echo them.
 std::optional<ReportFormat> parseReportFormat(const std::string& text);   ///< table|json|csv
-std::optional<RunMode> parseRunMode(const std::string& text);             ///< full|predict|summary
-std::optional<Precision> parsePrecisionOption(const std::string& text);   ///< double|long_double|high
+std::optional<core::RunMode> parseRunMode(const std::string& text);             ///< full|predict|summary
+std::optional<core::Precision> parsePrecisionOption(const std::string& text);   ///< double|long_double|high
 /// all | none | first:N (N a non-negative integer).
-std::optional<EventPolicy> parseEventPolicy(const std::string& text);
-std::string runModeText(RunMode mode);
-std::string precisionText(Precision precision);
-std::string eventPolicyText(const EventPolicy& policy);
+std::optional<core::EventPolicy> parseEventPolicy(const std::string& text);
+std::string runModeText(core::RunMode mode);
+std::string precisionText(core::Precision precision);
+std::string eventPolicyText(const core::EventPolicy& policy);
 
 using Json = nlohmann::ordered_json;
 
@@ -43,11 +43,11 @@ std::string jsonText(const Json& json);
 Json unitsJson();
 /// name, description, masses, positions, velocities, walls (["A"], ["C"] or []).
 Json sceneJson(const NamedScene& scene);
-Json optionsJson(const RunOptions& options);
+Json optionsJson(const core::RunOptions& options);
 /// One event: simulation, closed-form prediction and the paper's printed values.
-Json eventJson(const LabEvent& event);
+Json eventJson(const core::LabEvent& event);
 /// The summary of a run next to its predictions (see docs/cli_section.md for the keys).
-Json summaryJson(const RunResult& result);
+Json summaryJson(const core::RunResult& result);
 /// {"error": {"reason", "code", "field", "message"}}.
 Json errorJson(const std::string& reason, int code, const std::string& field, const std::string& message);
 
@@ -56,9 +56,9 @@ Json errorJson(const std::string& reason, int code, const std::string& field, co
 class RunReportWriter {
  public:
   virtual ~RunReportWriter() = default;
-  virtual void begin(const NamedScene& scene, const RunOptions& options) = 0;
-  virtual void event(const LabEvent& event) = 0;
-  virtual void end(const RunResult& result) = 0;
+  virtual void begin(const NamedScene& scene, const core::RunOptions& options) = 0;
+  virtual void event(const core::LabEvent& event) = 0;
+  virtual void end(const core::RunResult& result) = 0;
 };
 
 std::unique_ptr<RunReportWriter> makeRunReportWriter(ReportFormat format, std::ostream& out);
@@ -66,8 +66,8 @@ std::unique_ptr<RunReportWriter> makeRunReportWriter(ReportFormat format, std::o
 /// One scene of a batch and its finished run (events as its RunOptions kept them).
 struct SceneOutcome {
   NamedScene scene;
-  RunOptions options;  ///< as run (a scene's own max_collisions applied)
-  RunResult result;
+  core::RunOptions options;  ///< as run (a scene's own max_collisions applied)
+  core::RunResult result;
 };
 
 /// Several scenes: table and CSV give one summary row per scene; JSON gives

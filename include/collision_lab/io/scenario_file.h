@@ -14,7 +14,7 @@ namespace io {
 struct NamedScene {
   std::string name;         ///< unique key, e.g. "pi_digits_3"
   std::string description;  ///< one line for people
-  Scene scene;              ///< masses may be written inf / .inf in the file
+  core::ThreeBodyScene scene;              ///< masses may be written inf / .inf in the file
   std::uint64_t max_collisions = 0;  ///< 0: the caller's default
 };
 

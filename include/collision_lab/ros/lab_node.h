@@ -41,7 +41,8 @@
 #include "collision_lab/RunPreset.h"
 #include "collision_lab/RunScene.h"
 #include "collision_lab/RunSummary.h"
-#include "collision_lab/ros/core.h"
+#include "collision_lab/core/lab_run.h"
+#include "collision_lab/core/scene.h"
 #include "collision_lab/ros/marker_view.h"
 
 namespace collision_lab_ros {
@@ -97,8 +98,8 @@ class LabNode {
   ServeOutcome serve(collision_lab::InitialConditions input);
   /// Publishes, records and draws one validated run; returns its summary.
   /// requested_run_id: RunSummary.requested_run_id.
-  collision_lab::RunSummary run(collision_lab::InitialConditions& input, const core::Scene& scene,
-                                core::RunMode mode, const std::string& requested_run_id);
+  collision_lab::RunSummary run(collision_lab::InitialConditions& input, const collision_lab::core::ThreeBodyScene& scene,
+                                collision_lab::core::RunMode mode, const std::string& requested_run_id);
   ServeOutcome reject(collision_lab::Rejected msg, const std::string& run_id);
   std::string newRunId();
   /// requested, or the first free requested.N (N = 2, 3, ...) when it is taken; marks the

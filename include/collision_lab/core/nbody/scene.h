@@ -61,7 +61,9 @@ const char* reasonName(Reason reason);
 struct ValidationError {
   Reason reason = Reason::kOk;
   std::string field;    ///< e.g. "velocities[1]", "masses", "restitution"
-  std::string message;  ///< one sentence starting with the field: the value, its unit, advice
+  /// One sentence for people about the value in `field` ("v_B is NaN; ..."), which it does
+  /// not repeat: front ends show field and message side by side.
+  std::string message;
 };
 
 /// Checks a scene. Returns nothing when the scene is valid. Never throws for any input
