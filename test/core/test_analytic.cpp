@@ -1,6 +1,7 @@
 // The closed-form model against the simulation and exact arithmetic.
 #include <gtest/gtest.h>
 
+#include <boost/math/constants/constants.hpp>
 #include <boost/multiprecision/cpp_bin_float.hpp>
 #include <cmath>
 #include <random>
@@ -110,23 +111,56 @@ TEST(Count, MaxPossibleIsExactForKaleidoscopicMasses) {
   }
 }
 
-TEST(Count, ExactUpToMassRatio1e20) {
-  // Reference: floor(psi / alpha) evaluated independently at 100 digits.
+/// The count from physics.md (Erratum 4), computed here from first principles at 100 digits
+/// and sharing no code with AnalyticModel: u = S v, the escape cone's boundary rays
+/// r_BC = s x n_BC and r_AB = s x n_AB (oriented into the cone), psi the angle of u from r_BC
+/// towards r_AB, alpha the cone's opening angle, N = ceil(psi / alpha) - 1 (AB first).
+/// Preconditions: finite masses, only AB approaches (so AB is first).
+std::uint64_t countFromFirstPrinciples(const ThreeBodyScene& scene) {
   using Precise = boost::multiprecision::cpp_bin_float_100;
+  using Vec = std::array<Precise, 3>;
+  const auto dot = [](const Vec& a, const Vec& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; };
+  const auto cross = [](const Vec& a, const Vec& b) {
+    return Vec{a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+  };
+  Vec root_m, u;
+  for (int i = 0; i < 3; ++i) {
+    root_m[i] = sqrt(Precise(scene.masses[i]));
+    u[i] = root_m[i] * Precise(scene.velocities[i]);
+  }
+  const Vec n_ab{1 / root_m[0], -1 / root_m[1], Precise(0)};
+  const Vec n_bc{Precise(0), 1 / root_m[1], -1 / root_m[2]};
+  Vec r_bc = cross(root_m, n_bc);
+  if (dot(n_ab, r_bc) < 0) r_bc = Vec{-r_bc[0], -r_bc[1], -r_bc[2]};
+  Vec r_ab = cross(root_m, n_ab);
+  if (dot(n_bc, r_ab) < 0) r_ab = Vec{-r_ab[0], -r_ab[1], -r_ab[2]};
+  // Orthonormal basis of the plane s-perp: e1 along r_BC, e2 towards r_AB.
+  const Precise r_bc_norm = sqrt(dot(r_bc, r_bc));
+  const Vec e1{r_bc[0] / r_bc_norm, r_bc[1] / r_bc_norm, r_bc[2] / r_bc_norm};
+  const Precise along = dot(r_ab, e1);
+  Vec e2{r_ab[0] - along * e1[0], r_ab[1] - along * e1[1], r_ab[2] - along * e1[2]};
+  const Precise e2_norm = sqrt(dot(e2, e2));
+  for (Precise& c : e2) c /= e2_norm;
+  const Precise two_pi = 2 * boost::math::constants::pi<Precise>();
+  const Precise alpha = atan2(dot(r_ab, e2), dot(r_ab, e1));
+  Precise psi = atan2(dot(u, e2), dot(u, e1));  // u's component along s drops out
+  if (psi < 0) psi += two_pi;
+  return static_cast<std::uint64_t>(ceil(psi / alpha)) - 1;
+}
+
+TEST(Count, ExactUpToMassRatio1e20) {
   for (double ratio : {1e12, 1e14, 1e16, 1e18, 1e20}) {
+    // Both starts have only AB approaching, and q = psi / alpha far from an integer.
     for (const auto& v : {std::array<double, 3>{-1, 0, 0}, std::array<double, 3>{-1, 0.3, 0.2}}) {
       const ThreeBodyScene scene{{ratio, 1, 0.5 * ratio}, {2, 1, 0}, v};
-      const AnalyticModel<Precise> model(scene);
-      Precise q = model.psi() / model.alpha();
-      if (*model.firstPair() == Pair::BC) {
-        Precise psi_bc = model.alpha() - model.psi();
-        if (psi_bc < 0) psi_bc += 2 * boost::math::constants::pi<Precise>();
-        q = psi_bc / model.alpha();
-      }
-      const auto expected = static_cast<std::uint64_t>(static_cast<double>(floor(q)));
-      EXPECT_EQ(predictedCollisionCount(scene), expected) << ratio;
+      EXPECT_EQ(predictedCollisionCount(scene), countFromFirstPrinciples(scene)) << ratio;
     }
   }
+  // The reference itself against known counts: equal masses exchange velocities, so
+  // (-1, 0.3, 0.2) gives 2 by hand (AB, then BC, then (0.3, 0.2, -1) separates), and
+  // (1e12, 1, 1e12) from (-1, 0, 0) gives physics.md's 2,221,441.
+  EXPECT_EQ(countFromFirstPrinciples(ThreeBodyScene{{1, 1, 1}, {2, 1, 0}, {-1, 0.3, 0.2}}), 2u);
+  EXPECT_EQ(countFromFirstPrinciples(ThreeBodyScene{{1e12, 1, 1e12}, {2, 1, 0}, {-1, 0, 0}}), 2221441u);
   const ThreeBodyScene simulated{{1e12, 1, 0.5e12}, {2, 1, 0}, {-1, 0, 0}};
   EXPECT_EQ(predictedCollisionCount(simulated), simulate<double>(simulated, {}).collision_count);
 }

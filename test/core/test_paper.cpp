@@ -2,7 +2,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <complex>
 #include <random>
+
+#include <Eigen/Dense>
 
 #include "collision_lab/core/analytic.h"
 #include "collision_lab/core/exact.h"
@@ -13,6 +16,36 @@
 namespace collision_lab {
 namespace core {
 namespace {
+
+TEST(PaperErrata, Eigenvectors24AreNotEigenvectors) {
+  // physics.md Erratum 1: with masses (1, 2, 3), the printed v_+ of eq. (2.4) misses
+  // D v_+ = lambda_+ v_+ by 4.9, while the printed lambda_+ (2.2) is an eigenvalue.
+  // D is eq. (1.8) as printed (correct), checked here against D_BC D_AB built from the
+  // textbook impact rule.
+  using Complex = std::complex<double>;
+  const double ma = 1, mb = 2, mc = 3, mab = ma + mb, mbc = mb + mc, m = ma + mb + mc;
+  Eigen::Matrix3d printed_d;
+  printed_d << mbc * (ma - mb), 2 * mbc * mb, 0,  //
+      2 * ma * (mb - mc), (mb - ma) * (mb - mc), 2 * mc * mab,  //
+      4 * ma * mb, 2 * mb * (mb - ma), mab * (mc - mb);
+  printed_d /= mab * mbc;
+  Eigen::Matrix3d d_ab = Eigen::Matrix3d::Identity(), d_bc = Eigen::Matrix3d::Identity();
+  d_ab.block<2, 2>(0, 0) << (ma - mb) / mab, 2 * mb / mab, 2 * ma / mab, (mb - ma) / mab;
+  d_bc.block<2, 2>(1, 1) << (mb - mc) / mbc, 2 * mc / mbc, 2 * mb / mbc, (mc - mb) / mbc;
+  EXPECT_LE((printed_d - d_bc * d_ab).norm(), 1e-15);
+
+  const double root = std::sqrt(ma * mb * mc * m);
+  const Complex lambda_plus = Complex(ma * mc - mb * m, 2 * root) / (mab * mbc);
+  EXPECT_NEAR(std::abs(lambda_plus), 1.0, 1e-15);
+  const Eigen::Matrix3cd shifted = printed_d.cast<Complex>() - lambda_plus * Eigen::Matrix3cd::Identity();
+  EXPECT_LE(std::abs(shifted.determinant()), 1e-14);  // lambda_+ is right
+
+  Eigen::Vector3cd v_plus;
+  v_plus << Complex(-2 * ma * mc, root) / (ma * mab), Complex(2 * ma * mc, -root) / (ma * mab), 1.0;
+  const double residual = (shifted * v_plus).norm();
+  // 4.88 against |v_+| = 4.12 (physics.md: "about 4"): v_+ is not an eigenvector, nor close.
+  EXPECT_GT(residual, 0.5 * v_plus.norm());
+}
 
 TEST(PaperErrata, ClosedFormVelocities215AreWrong) {
   // physics.md Erratum 2: masses (1,1,1), v0 = (-1, 0.3, 0.7), k = 1.
