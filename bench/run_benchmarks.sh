@@ -4,7 +4,7 @@
 #   docs/hard_cases.md                                                        (collision_lab_hard_cases)
 # and prints the core speed benchmark (collision_lab_bench_core).
 #
-# Usage: bench/run_benchmarks.sh [--quick]
+# Usage: bash bench/run_benchmarks.sh [--quick]
 #   --quick: fewer scenes, dt values and repeats (each program under a minute); outputs go
 #            to $BUILD_DIR/bench_quick/ instead of docs/.
 # Environment: BUILD_DIR (default: build_bench next to this repository's sources).

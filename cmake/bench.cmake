@@ -25,6 +25,9 @@ target_link_libraries(collision_lab_bench_core PRIVATE collision_lab_core)
 add_executable(collision_lab_bench_nbody bench/bench_nbody.cpp)
 target_include_directories(collision_lab_bench_nbody PRIVATE src/core/nbody)  # the engine's queue, compared
 target_link_libraries(collision_lab_bench_nbody PRIVATE collision_lab_core)
+# Installed too, so that an install space can be benchmarked with rosrun.
+install(TARGETS collision_lab_bench_core collision_lab_bench_nbody
+  RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 
 if(TARGET collision_lab_ros)
   add_executable(collision_lab_relay_node bench/node/relay_node.cpp)
@@ -33,6 +36,8 @@ if(TARGET collision_lab_ros)
   target_link_libraries(collision_lab_node_throughput PRIVATE collision_lab_ros)
   set_target_properties(collision_lab_relay_node collision_lab_node_throughput PROPERTIES
     RUNTIME_OUTPUT_DIRECTORY ${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_BIN_DESTINATION})
+  install(TARGETS collision_lab_relay_node collision_lab_node_throughput
+    RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 endif()
 
 if(NOT (COLLISION_LAB_GMPXX_INCLUDE AND COLLISION_LAB_GMPXX_LIBRARY AND COLLISION_LAB_GMP_LIBRARY))
@@ -44,8 +49,8 @@ add_library(collision_lab_bench_common STATIC
   bench/common/exact_trajectory.cpp
   bench/engines/fixed_step.cpp
   bench/engines/stepped_methods.cpp)
-target_include_directories(collision_lab_bench_common PUBLIC bench/common bench/engines
-  ${COLLISION_LAB_GMPXX_INCLUDE})
+target_include_directories(collision_lab_bench_common PUBLIC bench/common bench/engines)
+target_include_directories(collision_lab_bench_common PRIVATE ${COLLISION_LAB_GMPXX_INCLUDE})
 target_link_libraries(collision_lab_bench_common PUBLIC collision_lab_core
   ${COLLISION_LAB_GMPXX_LIBRARY} ${COLLISION_LAB_GMP_LIBRARY})
 
@@ -101,3 +106,5 @@ add_executable(collision_lab_hard_cases bench/hard_cases.cpp bench/common/report
 target_link_libraries(collision_lab_hard_cases PRIVATE collision_lab_bench_common)
 target_compile_definitions(collision_lab_hard_cases PRIVATE
   COLLISION_LAB_DOCS_DIR="${PROJECT_SOURCE_DIR}/docs")
+install(TARGETS collision_lab_speed_vs_error collision_lab_hard_cases
+  RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})

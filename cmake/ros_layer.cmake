@@ -1,5 +1,8 @@
 # Thin ROS layer: message <-> core conversion, the lab node, per-run bags, rviz markers,
 # and the scenario publisher. Links the core (and collision_lab_io for scenario files).
+# ROS headers for this layer and everything built after it (nodes, ROS tests, the node
+# benchmarks); the core, built before, never sees them.
+include_directories(SYSTEM ${catkin_INCLUDE_DIRS})
 add_library(collision_lab_ros
   src/ros/msg_conversion.cpp
   src/ros/run_recorder.cpp
@@ -8,7 +11,7 @@ add_library(collision_lab_ros
   src/ros/lab_node.cpp
   src/ros/marker_builder.cpp
   src/ros/marker_view.cpp)
-target_include_directories(collision_lab_ros PUBLIC include ${catkin_INCLUDE_DIRS})
+target_include_directories(collision_lab_ros PUBLIC include)
 # collision_lab_io: the node reads the presets of ~run_preset.
 target_link_libraries(collision_lab_ros PUBLIC collision_lab_core collision_lab_io ${catkin_LIBRARIES})
 add_dependencies(collision_lab_ros ${PROJECT_NAME}_generate_messages_cpp ${catkin_EXPORTED_TARGETS})

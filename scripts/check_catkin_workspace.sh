@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # Checks the usual ROS way on this machine: a fresh catkin workspace with this checkout in
 # src/, built with catkin_make (or `catkin build` with --catkin-tools), then rosrun and
-# roslaunch find the package. Run after scripts/setup_debian.sh. The workspace is a
+# roslaunch find the package. Run after bash scripts/setup_debian.sh. The workspace is a
 # temporary folder, removed at the end.
-# Usage: scripts/check_catkin_workspace.sh [--catkin-tools]
+# Usage: bash scripts/check_catkin_workspace.sh [--catkin-tools]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 export PATH=/usr/bin:/bin:/usr/sbin:/sbin:$PATH

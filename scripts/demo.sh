@@ -2,10 +2,10 @@
 # The main job: set up, build, and run launch/demo.launch on the shipped presets.
 # With a display, rviz opens; without one, every preset runs headless, a table of runs is
 # printed, one bag per run is left in the bag directory, and the launch ends by itself.
-# Usage: scripts/demo.sh [roslaunch args, e.g. scenarios:="pi_digits_3 grazing"]
+# Usage: bash scripts/demo.sh [roslaunch args, e.g. scenarios:="pi_digits_3 grazing"]
 set -euo pipefail
 cd "$(dirname "$0")/.."
-scripts/setup_debian.sh
+bash scripts/setup_debian.sh
 if [ -n "${DISPLAY:-}" ]; then rviz=true; else rviz=false; fi
 export PATH=/usr/bin:/bin:$PATH
 set +u

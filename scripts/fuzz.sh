@@ -4,7 +4,7 @@
 # corpus fuzz/corpus/core. New inputs go to build_fuzz/corpus, crashes, timeouts and
 # inputs slower than 1 s to build_fuzz/artifacts. Prints the number of executions.
 # Exits non-zero when the fuzzer found a crash, a timeout or a sanitizer error.
-# Usage: scripts/fuzz.sh [seconds] [extra libFuzzer flags...]
+# Usage: bash scripts/fuzz.sh [seconds] [extra libFuzzer flags...]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 # catkin's CMake needs Debian's python3 (with catkin_pkg), not a pyenv one earlier on PATH.

@@ -3,7 +3,7 @@
 # (-DCOLLISION_LAB_SANITIZE=ON) in ./build_sanitize, runs every test (core, CLI, ROS unit
 # tests and rostests), prints catkin's summary and the wall time. Exits non-zero when the
 # build fails, a test fails, or a sanitizer reports an error.
-# Usage: scripts/sanitize.sh [jobs]   (default 2)
+# Usage: bash scripts/sanitize.sh [jobs]   (default 2)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 # catkin's CMake needs Debian's python3 (with catkin_pkg), not a pyenv one earlier on PATH.

@@ -4,7 +4,7 @@
 # roslaunch, rostest and rosservice find the package and every executable. (rosrun skips
 # every path under <package>/build/, so the folder must not be called build.)
 # Idempotent: apt-get runs only when a package is missing; the build is incremental.
-# Usage: scripts/setup_debian.sh [--no-build] [--with-screenshots] [--with-bench]
+# Usage: bash scripts/setup_debian.sh [--no-build] [--with-screenshots] [--with-bench]
 #   --no-build: install the packages only (for a catkin workspace of your own).
 set -euo pipefail
 cd "$(dirname "$0")/.."

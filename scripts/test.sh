@@ -3,9 +3,9 @@
 # tests, rostests), then prints catkin's summary. Exits non-zero when any test fails.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-scripts/setup_debian.sh
+bash scripts/setup_debian.sh
 # The usual ROS way works too: a fresh catkin workspace, catkin_make, rosrun, roslaunch.
-scripts/check_catkin_workspace.sh
+bash scripts/check_catkin_workspace.sh
 export PATH=/usr/bin:/bin:$PATH
 set +u
 source build_ros/devel/setup.bash
