@@ -163,12 +163,23 @@ collision_lab::core::LabEvent toLabEvent(const collision_lab::CollisionEvent& ms
   return event;
 }
 
-collision_lab::Velocities toVelocitiesMsg(const collision_lab::CollisionEvent& event) {
-  collision_lab::Velocities msg;
+namespace {
+
+/// A plot message of event, its scalar fields left for the caller.
+template <class PlotMessage>
+PlotMessage plotMessageOf(const collision_lab::CollisionEvent& event) {
+  PlotMessage msg;
   msg.header = event.header;
   msg.run_id = event.run_id;
   msg.index = event.index;
   msg.time = event.time;
+  return msg;
+}
+
+}  // namespace
+
+collision_lab::Velocities toVelocitiesMsg(const collision_lab::CollisionEvent& event) {
+  auto msg = plotMessageOf<collision_lab::Velocities>(event);
   msg.v_a = event.velocities_after[0];
   msg.v_b = event.velocities_after[1];
   msg.v_c = event.velocities_after[2];
@@ -176,11 +187,7 @@ collision_lab::Velocities toVelocitiesMsg(const collision_lab::CollisionEvent& e
 }
 
 collision_lab::EnergyTransfer toEnergyTransferMsg(const collision_lab::CollisionEvent& event) {
-  collision_lab::EnergyTransfer msg;
-  msg.header = event.header;
-  msg.run_id = event.run_id;
-  msg.index = event.index;
-  msg.time = event.time;
+  auto msg = plotMessageOf<collision_lab::EnergyTransfer>(event);
   msg.delta_a = event.energy_transfer[0];
   msg.delta_b = event.energy_transfer[1];
   msg.delta_c = event.energy_transfer[2];
