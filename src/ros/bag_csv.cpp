@@ -93,10 +93,11 @@ class Table {
     add({"stamp_s", "header"}, [](std::ostream& o, const M& m) { writeStamp(o, m.header.stamp); });
     add({"run_id", "run_id"}, [](std::ostream& o, const M& m) { writeCell(o, m.run_id); });
   }
-  /// A number or string field, written as it is.
+  /// A number or string field, written as it is; its column is the field's name and unit
+  /// (e.g. "_s"; empty for [1] and strings).
   template <class T>
-  Table& field(const std::string& column, const std::string& field, T M::*member) {
-    return add({column, field}, [member](std::ostream& o, const M& m) {
+  Table& field(const std::string& field, T M::*member, const std::string& unit = "") {
+    return add({field + unit, field}, [member](std::ostream& o, const M& m) {
       if constexpr (std::is_same_v<T, std::uint8_t>) {
         o << static_cast<int>(m.*member);
       } else {
@@ -104,11 +105,11 @@ class Table {
       }
     });
   }
-  Table& flag(const std::string& column, const std::string& field, std::uint8_t M::*member) {
-    return add({column, field}, [member](std::ostream& o, const M& m) { writeBool(o, m.*member); });
+  Table& flag(const std::string& field, std::uint8_t M::*member) {
+    return add({field, field}, [member](std::ostream& o, const M& m) { writeBool(o, m.*member); });
   }
-  Table& pair(const std::string& column, const std::string& field, std::uint8_t M::*member) {
-    return add({column, field}, [member](std::ostream& o, const M& m) { writePair(o, m.*member); });
+  Table& pair(const std::string& field, std::uint8_t M::*member) {
+    return add({field, field}, [member](std::ostream& o, const M& m) { writePair(o, m.*member); });
   }
   Table& mode(std::uint8_t M::*member) {
     return add({"mode", "mode"}, [member](std::ostream& o, const M& m) { writeMode(o, m.*member); });
@@ -128,7 +129,7 @@ class Table {
                  const std::array<double M::*, 3>& members) {
     for (int i = 0; i < 3; ++i) {
       const std::string name = abc(pattern, i);
-      field(name + unit, name, members[i]);
+      field(name, members[i], unit);
     }
     return *this;
   }
@@ -153,67 +154,66 @@ Table<collision_lab::InitialConditions> initialConditionsTable() {
       .triple("m_{}_kg", "masses", &M::masses)
       .triple("x_{}_m", "positions", &M::positions)
       .triple("v_{}_m_s", "velocities", &M::velocities)
-      .field("max_collisions", "max_collisions", &M::max_collisions);
+      .field("max_collisions", &M::max_collisions);
   return t;
 }
 
 Table<collision_lab::Prediction> predictionTable() {
   using M = collision_lab::Prediction;
   Table<M> t;
-  t.field("collision_count", "collision_count", &M::collision_count)
-      .field("paper_collision_count", "paper_collision_count", &M::paper_collision_count)
-      .flag("paper_count_defined", "paper_count_defined", &M::paper_count_defined)
-      .field("max_possible_collision_count", "max_possible_collision_count",
-             &M::max_possible_collision_count)
-      .field("alpha_rad", "alpha", &M::alpha)
-      .field("theta_rad", "theta", &M::theta)
-      .field("omega_rad", "omega", &M::omega)
-      .field("phi_bc_rad", "phi_bc", &M::phi_bc)
-      .field("psi_rad", "psi", &M::psi)
-      .pair("first_pair", "first_pair", &M::first_pair)
+  t.field("collision_count", &M::collision_count)
+      .field("paper_collision_count", &M::paper_collision_count)
+      .flag("paper_collision_count_defined", &M::paper_collision_count_defined)
+      .field("max_possible_collision_count", &M::max_possible_collision_count)
+      .field("alpha", &M::alpha, "_rad")
+      .field("theta", &M::theta, "_rad")
+      .field("omega", &M::omega, "_rad")
+      .field("phi_bc", &M::phi_bc, "_rad")
+      .field("psi", &M::psi, "_rad")
+      .pair("first_pair_index", &M::first_pair_index)
       .triple("v_{}_final_m_s", "final_velocities", &M::final_velocities)
-      .field("timeline_scale_bag_s_per_s", "timeline_scale", &M::timeline_scale);
+      .field("timeline_scale", &M::timeline_scale, "_bag_s_per_s");
   return t;
 }
 
 Table<collision_lab::CollisionEvent> collisionEventTable() {
   using M = collision_lab::CollisionEvent;
   Table<M> t;
-  t.field("index", "index", &M::index)
-      .pair("pair", "pair", &M::pair)
-      .field("time_s", "time", &M::time)
-      .field("position_m", "position", &M::position)
+  t.field("index", &M::index)
+      .pair("pair_index", &M::pair_index)
+      .field("time", &M::time, "_s")
+      .field("position", &M::position, "_m")
       .triple("x_{}_m", "positions", &M::positions)
       .triple("v_{}_before_m_s", "velocities_before", &M::velocities_before)
       .triple("v_{}_after_m_s", "velocities_after", &M::velocities_after)
       .triple("predicted_v_{}_after_m_s", "predicted_velocities_after", &M::predicted_velocities_after)
       .triple("paper_v_{}_after_m_s", "paper_velocities_after", &M::paper_velocities_after)
       .triple("energy_transfer_{}_J", "energy_transfer", &M::energy_transfer)
-      .field("total_energy_J", "total_energy", &M::total_energy)
-      .field("total_momentum_kg_m_s", "total_momentum", &M::total_momentum);
+      .triple("predicted_energy_transfer_{}_J", "predicted_energy_transfer",
+              &M::predicted_energy_transfer)
+      .triple("paper_energy_transfer_{}_J", "paper_energy_transfer", &M::paper_energy_transfer)
+      .triple("kinetic_energy_{}_after_J", "kinetic_energy_after", &M::kinetic_energy_after)
+      .field("total_energy", &M::total_energy, "_J")
+      .field("total_momentum", &M::total_momentum, "_kg_m_s");
   return t;
 }
 
 Table<collision_lab::Velocities> velocitiesTable() {
   using M = collision_lab::Velocities;
   Table<M> t;
-  t.field("index", "index", &M::index)
-      .field("time_s", "time", &M::time)
-      .scalars("v_{}", "_m_s", {&M::v_a, &M::v_b, &M::v_c})
-      .scalars("predicted_v_{}", "_m_s", {&M::predicted_v_a, &M::predicted_v_b, &M::predicted_v_c});
+  t.field("index", &M::index)
+      .field("time", &M::time, "_s")
+      .scalars("v_{}", "_m_s", {&M::v_a, &M::v_b, &M::v_c});
   return t;
 }
 
 Table<collision_lab::EnergyTransfer> energyTransferTable() {
   using M = collision_lab::EnergyTransfer;
   Table<M> t;
-  t.field("index", "index", &M::index)
-      .pair("pair", "pair", &M::pair)
+  t.field("index", &M::index)
+      .field("time", &M::time, "_s")
       .scalars("delta_{}", "_J", {&M::delta_a, &M::delta_b, &M::delta_c})
-      .scalars("kinetic_{}", "_J", {&M::kinetic_a, &M::kinetic_b, &M::kinetic_c})
-      .scalars("predicted_delta_{}", "_J",
-               {&M::predicted_delta_a, &M::predicted_delta_b, &M::predicted_delta_c})
-      .scalars("paper_delta_{}", "_J", {&M::paper_delta_a, &M::paper_delta_b, &M::paper_delta_c});
+      .scalars("kinetic_{}", "_J", {&M::kinetic_a, &M::kinetic_b, &M::kinetic_c});
   return t;
 }
 
@@ -221,37 +221,36 @@ Table<collision_lab::RunSummary> runSummaryTable() {
   using M = collision_lab::RunSummary;
   Table<M> t;
   t.mode(&M::mode)
-      .field("collision_count", "collision_count", &M::collision_count)
-      .flag("truncated", "truncated", &M::truncated)
-      .field("truncation_reason", "truncation_reason", &M::truncation_reason)
-      .flag("simulated", "simulated", &M::simulated)
-      .field("predicted_collision_count", "predicted_collision_count", &M::predicted_collision_count)
-      .field("paper_predicted_collision_count", "paper_predicted_collision_count",
-             &M::paper_predicted_collision_count)
-      .flag("paper_prediction_defined", "paper_prediction_defined", &M::paper_prediction_defined)
+      .field("collision_count", &M::collision_count)
+      .flag("truncated", &M::truncated)
+      .field("truncation_reason", &M::truncation_reason)
+      .flag("simulated", &M::simulated)
+      .field("predicted_collision_count", &M::predicted_collision_count)
+      .field("paper_predicted_collision_count", &M::paper_predicted_collision_count)
+      .flag("paper_predicted_collision_count_defined", &M::paper_predicted_collision_count_defined)
       .triple("v_{}_final_m_s", "final_velocities", &M::final_velocities)
-      .field("max_prediction_error", "max_prediction_error", &M::max_prediction_error)
-      .field("energy_relative_drift", "energy_relative_drift", &M::energy_relative_drift)
-      .field("momentum_relative_drift", "momentum_relative_drift", &M::momentum_relative_drift)
-      .field("compute_time_s", "compute_time", &M::compute_time)
-      .field("published_events", "published_events", &M::published_events)
-      .flag("events_not_published", "events_not_published", &M::events_not_published)
-      .field("bag_path", "bag_path", &M::bag_path)
-      .flag("recording_ok", "recording_ok", &M::recording_ok)
-      .field("recording_error", "recording_error", &M::recording_error)
-      .field("timeline_scale_bag_s_per_s", "timeline_scale", &M::timeline_scale)
-      .flag("timeline_saturated", "timeline_saturated", &M::timeline_saturated)
-      .field("requested_run_id", "requested_run_id", &M::requested_run_id);
+      .field("max_prediction_error", &M::max_prediction_error)
+      .field("energy_relative_drift", &M::energy_relative_drift)
+      .field("momentum_relative_drift", &M::momentum_relative_drift)
+      .field("compute_time", &M::compute_time, "_s")
+      .field("published_events", &M::published_events)
+      .flag("events_not_published", &M::events_not_published)
+      .field("bag_path", &M::bag_path)
+      .flag("recording_ok", &M::recording_ok)
+      .field("recording_error", &M::recording_error)
+      .field("timeline_scale", &M::timeline_scale, "_bag_s_per_s")
+      .flag("timeline_saturated", &M::timeline_saturated)
+      .field("requested_run_id", &M::requested_run_id);
   return t;
 }
 
 Table<collision_lab::Rejected> rejectedTable() {
   using M = collision_lab::Rejected;
   Table<M> t;
-  t.field("reason", "reason", &M::reason)
-      .field("reason_name", "reason_name", &M::reason_name)
-      .field("field", "field", &M::field)
-      .field("message", "message", &M::message);
+  t.field("reason", &M::reason)
+      .field("reason_name", &M::reason_name)
+      .field("field", &M::field)
+      .field("message", &M::message);
   return t;
 }
 

@@ -19,6 +19,41 @@
 
 namespace collision_lab_ros {
 
+/// Stamps the messages of one run on its timeline, publishes them and records them.
+class RunWriter {
+ public:
+  /// recorder may be null (not recording).
+  RunWriter(std::string run_id, RunTimeline timeline, RunRecorder* recorder)
+      : run_id_(std::move(run_id)), timeline_(timeline), recorder_(recorder) {}
+
+  const RunTimeline& timeline() const { return timeline_; }
+  RunRecorder* recorder() const { return recorder_; }
+
+  /// Sets run_id and header.stamp: the timeline's stamp of simulated time t [s].
+  template <class Message>
+  void stamp(Message& msg, double t) {
+    msg.run_id = run_id_;
+    msg.header.stamp = timeline_.stamp(t);
+  }
+  /// Records msg at its header.stamp.
+  template <class Message>
+  void record(const std::string& topic, const Message& msg) {
+    if (recorder_) recorder_->write(topic, msg.header.stamp, msg);
+  }
+  /// Stamps at t, publishes and records.
+  template <class Message>
+  void publish(const ros::Publisher& pub, Message& msg, double t) {
+    stamp(msg, t);
+    pub.publish(msg);
+    record(pub.getTopic(), msg);
+  }
+
+ private:
+  std::string run_id_;
+  RunTimeline timeline_;
+  RunRecorder* recorder_;
+};
+
 namespace {
 
 /// Message stamps double as bag times, which must be >= ros::TIME_MIN: under
@@ -37,45 +72,94 @@ std::string utcStamp(const char* format) {
   return buffer;
 }
 
-/// Stamps the messages of one run on its timeline, publishes them and records them.
-class RunWriter {
+/// The per-collision messages of one run. Every CollisionEvent is recorded and drawn;
+/// the first max_published also go out on collision_events and, as their plot
+/// projections (live only, never recorded: docs/messages.md), on velocities and
+/// energy_transfers.
+class EventStream {
  public:
-  /// recorder may be null (not recording).
-  RunWriter(std::string run_id, RunTimeline timeline, RunRecorder* recorder)
-      : run_id_(std::move(run_id)), timeline_(timeline), recorder_(recorder) {}
+  EventStream(const RunTopics& topics, RunWriter& out, MarkerView* markers,
+              std::uint64_t max_published)
+      : topics_(topics), out_(out), markers_(markers), max_published_(max_published) {}
 
-  const RunTimeline& timeline() const { return timeline_; }
+  void operator()(const collision_lab::core::LabEvent& event) {
+    collision_lab::CollisionEvent msg = toCollisionEventMsg(event);
+    last_time_ = event.event.time;
+    out_.stamp(msg, last_time_);
+    if (markers_) markers_->onCollisionEvent(msg);
+    if (published_ == max_published_) {
+      cut_ = true;
+      out_.record(topics_.events.getTopic(), msg);
+      return;
+    }
+    out_.publish(topics_.events, msg, last_time_);
+    topics_.velocities.publish(toVelocitiesMsg(msg));
+    topics_.energies.publish(toEnergyTransferMsg(msg));
+    ++published_;
+  }
 
-  /// Sets run_id and header.stamp: the timeline's stamp of simulated time t [s].
-  template <class Message>
-  void stamp(Message& msg, double t) {
-    msg.run_id = run_id_;
-    msg.header.stamp = timeline_.stamp(t);
-  }
-  /// Records msg at its header.stamp.
-  template <class Message>
-  void record(const std::string& topic, const Message& msg) {
-    if (recorder_) recorder_->write(topic, msg.header.stamp, msg);
-  }
-  /// Stamps at t, records only (events beyond ~max_published_events).
-  template <class Message>
-  void record(const std::string& topic, Message& msg, double t) {
-    stamp(msg, t);
-    record(topic, msg);
-  }
-  /// Stamps at t, publishes and records.
-  template <class Message>
-  void publish(const ros::Publisher& pub, Message& msg, double t) {
-    stamp(msg, t);
-    pub.publish(msg);
-    record(pub.getTopic(), msg);
-  }
+  std::uint64_t published() const { return published_; }
+  /// True when ~max_published_events cut the published stream.
+  bool cut() const { return cut_; }
+  /// Simulated time of the last collision [s]; 0 before any.
+  double lastTime() const { return last_time_; }
 
  private:
-  std::string run_id_;
-  RunTimeline timeline_;
-  RunRecorder* recorder_;
+  const RunTopics& topics_;
+  RunWriter& out_;
+  MarkerView* markers_;
+  std::uint64_t max_published_;
+  std::uint64_t published_ = 0;
+  bool cut_ = false;
+  double last_time_ = 0.0;
 };
+
+/// Fills summary's recording fields from recorder and closes the bag: the recorded
+/// summary tells the state before closing, the returned one (published) after it.
+void closeRecording(RunWriter& out, const std::string& topic, collision_lab::RunSummary& summary) {
+  RunRecorder* recorder = out.recorder();
+  summary.bag_path = recorder->path();
+  summary.recording_ok = recorder->ok();
+  summary.recording_error = recorder->error();
+  out.record(topic, summary);
+  if (!recorder->close()) {
+    ROS_ERROR_STREAM("run " << summary.run_id << ": recording failed: " << recorder->error());
+  }
+  summary.recording_ok = recorder->ok();
+  summary.recording_error = recorder->error();
+}
+
+/// The reason to refuse input before simulating it (run_id, mode, then the scene), if any.
+std::optional<collision_lab::Rejected> checkInput(const collision_lab::InitialConditions& input) {
+  if (!input.run_id.empty()) {
+    if (const std::string problem = runIdProblem(input.run_id); !problem.empty()) {
+      return toRejectedMsg(NodeReason::kInvalidRunId, "run_id",
+                           "run_id '" + input.run_id + "' " + problem);
+    }
+  }
+  if (!toRunMode(input.mode)) {
+    return toRejectedMsg(NodeReason::kInvalidMode, "mode",
+                         "mode " + std::to_string(input.mode) + " is not one of MODE_FULL (0), "
+                         "MODE_PREDICT_ONLY (1), MODE_SUMMARY_ONLY (2)");
+  }
+  if (const auto error = collision_lab::core::validate(toScene(input))) return toRejectedMsg(*error);
+  return std::nullopt;
+}
+
+void addValue(diagnostic_msgs::DiagnosticStatus& status, const std::string& key,
+              const std::string& value) {
+  diagnostic_msgs::KeyValue pair;
+  pair.key = key;
+  pair.value = value;
+  status.values.push_back(pair);
+}
+
+void logRun(const collision_lab::RunSummary& summary) {
+  ROS_INFO_STREAM("run " << summary.run_id << ": " << summary.collision_count << " collisions"
+                  << (summary.truncated ? " (truncated)" : "") << ", predicted "
+                  << summary.predicted_collision_count << ", " << summary.compute_time << " s"
+                  << (summary.bag_path.empty() ? std::string() : ", bag " + summary.bag_path));
+}
 
 /// Fills a RunScene or RunPreset response (their fields are the same).
 template <class Response>
@@ -166,15 +250,16 @@ LabNode::LabNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
     : nh_(nh),
       params_(LabNodeParams::load(private_nh)),
       service_spinner_(kServiceThreads, &service_queue_) {
-  predictions_pub_ = nh_.advertise<collision_lab::Prediction>(kPredictionsTopic, kOutputQueueSize,
-                                                              kLatchPredictions);
-  events_pub_ =
+  topics_.predictions = nh_.advertise<collision_lab::Prediction>(
+      kPredictionsTopic, kOutputQueueSize, kLatchPredictions);
+  topics_.events =
       nh_.advertise<collision_lab::CollisionEvent>(kCollisionEventsTopic, kOutputQueueSize);
-  velocities_pub_ = nh_.advertise<collision_lab::Velocities>(kVelocitiesTopic, kOutputQueueSize);
-  energy_pub_ =
+  topics_.velocities =
+      nh_.advertise<collision_lab::Velocities>(kVelocitiesTopic, kOutputQueueSize);
+  topics_.energies =
       nh_.advertise<collision_lab::EnergyTransfer>(kEnergyTransfersTopic, kOutputQueueSize);
-  summaries_pub_ = nh_.advertise<collision_lab::RunSummary>(kRunSummariesTopic, kOutputQueueSize,
-                                                            kLatchRunSummaries);
+  topics_.summaries = nh_.advertise<collision_lab::RunSummary>(
+      kRunSummariesTopic, kOutputQueueSize, kLatchRunSummaries);
   rejected_pub_ =
       nh_.advertise<collision_lab::Rejected>(kRejectedTopic, kOutputQueueSize, kLatchRejected);
   if (params_.publish_markers) {
@@ -325,121 +410,79 @@ ServeOutcome LabNode::reject(collision_lab::Rejected msg, const std::string& run
 
 ServeOutcome LabNode::serve(collision_lab::InitialConditions input) {
   const std::string requested = input.run_id;
-  if (!requested.empty()) {
-    if (const std::string problem = runIdProblem(requested); !problem.empty()) {
-      return reject(toRejectedMsg(NodeReason::kInvalidRunId, "run_id",
-                                  "run_id '" + requested + "' " + problem),
-                    requested);
-    }
-  }
-  const std::optional<collision_lab::core::RunMode> mode = toRunMode(input.mode);
-  if (!mode) {
-    return reject(toRejectedMsg(NodeReason::kInvalidMode, "mode",
-                                "mode " + std::to_string(input.mode) + " is not one of MODE_FULL (0), "
-                                "MODE_PREDICT_ONLY (1), MODE_SUMMARY_ONLY (2)"),
-                  requested);
-  }
-  const collision_lab::core::ThreeBodyScene scene = toScene(input);
-  if (const auto error = collision_lab::core::validate(scene)) {
-    return reject(toRejectedMsg(*error), requested);
-  }
-
+  if (auto rejection = checkInput(input)) return reject(std::move(*rejection), requested);
   input.run_id = requested.empty() ? newRunId() : claimRunId(requested);
   if (!requested.empty() && input.run_id != requested) {
     ROS_WARN_STREAM("run_id '" << requested << "' is taken (its bag exists, or this node served "
                     "it before); serving the run as '" << input.run_id << "'");
   }
   const collision_lab::RunSummary summary =
-      run(input, scene, *mode, input.run_id != requested ? requested : std::string());
-  ROS_INFO_STREAM("run " << summary.run_id << ": " << summary.collision_count << " collisions"
-                  << (summary.truncated ? " (truncated)" : "") << ", predicted "
-                  << summary.predicted_collision_count << ", " << summary.compute_time << " s"
-                  << (summary.bag_path.empty() ? std::string() : ", bag " + summary.bag_path));
+      run(input, input.run_id != requested ? requested : std::string());
+  logRun(summary);
   return ServeOutcome{summary, {}};
 }
 
 collision_lab::RunSummary LabNode::run(collision_lab::InitialConditions& input,
-                                       const collision_lab::core::ThreeBodyScene& scene, collision_lab::core::RunMode mode,
                                        const std::string& requested_run_id) {
-  const std::string& run_id = input.run_id;
   const ros::Time start = stampNow();
+  const collision_lab::core::ThreeBodyScene scene = toScene(input);
+  const collision_lab::core::RunMode mode = *toRunMode(input.mode);
   // The prediction goes out before the simulation starts; it also fixes the timeline.
-  const collision_lab::core::AnalyticPrediction core_prediction = collision_lab::core::predict(scene);
+  const collision_lab::core::AnalyticPrediction prediction = collision_lab::core::predict(scene);
   std::optional<RunRecorder> recorder;
-  if (params_.record) recorder.emplace(params_.bag_directory, run_id);
-  RunWriter out(run_id, RunTimeline(start, chooseTimelineScale(firstContactTime(
-                                                scene, core_prediction.first_pair))),
+  if (params_.record) recorder.emplace(params_.bag_directory, input.run_id);
+  RunWriter out(input.run_id,
+                RunTimeline(start, chooseTimelineScale(firstContactTime(scene, prediction.first_pair))),
                 recorder ? &*recorder : nullptr);
-
   input.header.stamp = start;
-  out.record(nh_.resolveName(kInitialConditionsTopic), input);
-  if (marker_view_) marker_view_->onInitialConditions(input);
-  collision_lab::Prediction prediction = toPredictionMsg(core_prediction);
-  prediction.timeline_scale = out.timeline().scale();
-  out.publish(predictions_pub_, prediction, 0.0);
-  if (marker_view_) marker_view_->onPrediction(prediction);
+  publishStart(out, input, prediction);
 
   collision_lab::core::RunOptions options;
   options.max_collisions = input.max_collisions ? input.max_collisions : params_.max_collisions;
   options.events = collision_lab::core::EventPolicy::none();
   options.mode = mode;
   options.skip_simulation_over_cap = true;
-  std::uint64_t published_events = 0;
-  bool events_not_published = false;
-  double last_event_time = 0.0;  // [s]
-  const auto onEvent = [&](const collision_lab::core::LabEvent& event) {
-    collision_lab::CollisionEvent event_msg = toCollisionEventMsg(event);
-    collision_lab::Velocities velocities_msg = toVelocitiesMsg(event);
-    collision_lab::EnergyTransfer energy_msg = toEnergyTransferMsg(event);
-    const double t = last_event_time = event.event.time;
-    event_msg.run_id = run_id;
-    if (marker_view_) marker_view_->onCollisionEvent(event_msg);  // every event, published or not
-    if (published_events == params_.max_published_events) {  // the bag only
-      events_not_published = true;
-      out.record(events_pub_.getTopic(), event_msg, t);
-      out.record(velocities_pub_.getTopic(), velocities_msg, t);
-      out.record(energy_pub_.getTopic(), energy_msg, t);
-      return;
-    }
-    out.publish(events_pub_, event_msg, t);
-    out.publish(velocities_pub_, velocities_msg, t);
-    out.publish(energy_pub_, energy_msg, t);
-    ++published_events;
-  };
-  const collision_lab::core::RunResult result = collision_lab::core::runLab(scene, options, core_prediction, onEvent);
+  EventStream events(topics_, out, marker_view_.get(), params_.max_published_events);
+  const collision_lab::core::RunResult result = collision_lab::core::runLab(
+      scene, options, prediction, [&events](const collision_lab::core::LabEvent& e) { events(e); });
 
   collision_lab::RunSummary summary = toRunSummaryMsg(result.summary, result.prediction, mode);
-  summary.published_events = published_events;
-  summary.events_not_published = events_not_published;
+  summary.published_events = events.published();
+  summary.events_not_published = events.cut();
   summary.requested_run_id = requested_run_id;
+  publishEnd(out, summary, events.lastTime());
+  return summary;
+}
+
+void LabNode::publishStart(RunWriter& out, const collision_lab::InitialConditions& input,
+                           const collision_lab::core::AnalyticPrediction& core_prediction) {
+  out.record(nh_.resolveName(kInitialConditionsTopic), input);
+  if (marker_view_) marker_view_->onInitialConditions(input);
+  collision_lab::Prediction prediction = toPredictionMsg(core_prediction);
+  prediction.timeline_scale = out.timeline().scale();
+  out.publish(topics_.predictions, prediction, 0.0);
+  if (marker_view_) marker_view_->onPrediction(prediction);
+}
+
+void LabNode::publishEnd(RunWriter& out, collision_lab::RunSummary& summary, double last_event_time) {
   summary.timeline_scale = out.timeline().scale();
   out.stamp(summary, last_event_time);
   summary.timeline_saturated = out.timeline().saturated();
   if (summary.timeline_saturated) {
-    ROS_WARN_STREAM("run " << run_id << ": collisions after " << RunTimeline::kMaxOffset
+    ROS_WARN_STREAM("run " << summary.run_id << ": collisions after " << RunTimeline::kMaxOffset
                     << " bag s are stamped at that limit (timeline_scale "
                     << summary.timeline_scale << ")");
   }
-  if (recorder) {
-    summary.bag_path = recorder->path();
-    summary.recording_ok = recorder->ok();
-    summary.recording_error = recorder->error();
-    out.record(summaries_pub_.getTopic(), summary);
-    if (!recorder->close()) {
-      ROS_ERROR_STREAM("run " << run_id << ": recording failed: " << recorder->error());
-    }
-    // The published summary reports the bag's final state, closing included.
-    summary.recording_ok = recorder->ok();
-    summary.recording_error = recorder->error();
+  if (out.recorder()) {
+    closeRecording(out, topics_.summaries.getTopic(), summary);
     std::lock_guard<std::mutex> lock(recording_mutex_);
     last_recording_error_ = summary.recording_error;
   }
   // The summary goes out last, after everything it counts.
-  summaries_pub_.publish(summary);
+  topics_.summaries.publish(summary);
   ++runs_accepted_;
   last_compute_time_ = summary.compute_time;
   if (marker_view_) marker_view_->onRunSummary(summary);
-  return summary;
 }
 
 void LabNode::publishDiagnostics() {
@@ -448,44 +491,40 @@ void LabNode::publishDiagnostics() {
   status.hardware_id = "collision_lab";
   status.level = diagnostic_msgs::DiagnosticStatus::OK;
   status.message = "serving";
-  const auto add = [&status](const std::string& key, const std::string& value) {
-    diagnostic_msgs::KeyValue pair;
-    pair.key = key;
-    pair.value = value;
-    status.values.push_back(pair);
-  };
-  add("runs accepted", std::to_string(runs_accepted_.load()));
-  add("runs rejected", std::to_string(runs_rejected_.load()));
-  add("last run compute time [s]", std::to_string(last_compute_time_.load()));
-  add("recording", params_.record ? "on" : "off");
-  add("bag directory", params_.bag_directory);
-  if (params_.record) {
-    std::string recording_error;
-    {
-      std::lock_guard<std::mutex> lock(recording_mutex_);
-      recording_error = last_recording_error_;
-    }
-    add("last recording error", recording_error);
-    if (!recording_error.empty()) {
-      status.level = diagnostic_msgs::DiagnosticStatus::ERROR;
-      status.message = "recording failed: " + recording_error;
-    }
-    struct statvfs space {};
-    if (statvfs(params_.bag_directory.c_str(), &space) == 0) {
-      const double free_mb = static_cast<double>(space.f_bavail) * space.f_frsize / 1e6;
-      add("free space in bag directory [MB]", std::to_string(free_mb));
-      if (free_mb < params_.min_free_space_mb && status.level == diagnostic_msgs::DiagnosticStatus::OK) {
-        status.level = diagnostic_msgs::DiagnosticStatus::WARN;
-        status.message = "low free space for bags: " + std::to_string(free_mb) + " MB";
-      }
-    } else {
-      add("free space in bag directory [MB]", "unknown (directory not readable)");
-    }
-  }
+  addValue(status, "runs accepted", std::to_string(runs_accepted_.load()));
+  addValue(status, "runs rejected", std::to_string(runs_rejected_.load()));
+  addValue(status, "last run compute time [s]", std::to_string(last_compute_time_.load()));
+  addValue(status, "recording", params_.record ? "on" : "off");
+  addValue(status, "bag directory", params_.bag_directory);
+  if (params_.record) addRecordingStatus(status);
   diagnostic_msgs::DiagnosticArray array;
   array.header.stamp = stampNow();
   array.status.push_back(status);
   diagnostics_pub_.publish(array);
+}
+
+void LabNode::addRecordingStatus(diagnostic_msgs::DiagnosticStatus& status) {
+  std::string recording_error;
+  {
+    std::lock_guard<std::mutex> lock(recording_mutex_);
+    recording_error = last_recording_error_;
+  }
+  addValue(status, "last recording error", recording_error);
+  if (!recording_error.empty()) {
+    status.level = diagnostic_msgs::DiagnosticStatus::ERROR;
+    status.message = "recording failed: " + recording_error;
+  }
+  struct statvfs space {};
+  if (statvfs(params_.bag_directory.c_str(), &space) != 0) {
+    addValue(status, "free space in bag directory [MB]", "unknown (directory not readable)");
+    return;
+  }
+  const double free_mb = static_cast<double>(space.f_bavail) * space.f_frsize / 1e6;
+  addValue(status, "free space in bag directory [MB]", std::to_string(free_mb));
+  if (free_mb < params_.min_free_space_mb && status.level == diagnostic_msgs::DiagnosticStatus::OK) {
+    status.level = diagnostic_msgs::DiagnosticStatus::WARN;
+    status.message = "low free space for bags: " + std::to_string(free_mb) + " MB";
+  }
 }
 
 }  // namespace collision_lab_ros

@@ -653,7 +653,7 @@ std::string runTitle(const RunRecord& run) {
   std::string title = "run " + run.input().run_id;
   if (run.prediction) {
     title += ":  predicted " + withSeparators(run.prediction->collision_count) + " collisions";
-    title += run.prediction->paper_count_defined
+    title += run.prediction->paper_collision_count_defined
                  ? "  (paper's eq. 3.22: " + std::to_string(run.prediction->paper_collision_count) + ")"
                  : "  (paper's eq. 3.22: undefined)";
   }

@@ -16,9 +16,7 @@ constexpr int kPairBC = static_cast<int>(collision_lab::core::Pair::BC);
 static_assert(collision_lab::CollisionEvent::PAIR_AB == kPairAB &&
               collision_lab::CollisionEvent::PAIR_BC == kPairBC &&
               collision_lab::Prediction::PAIR_AB == kPairAB &&
-              collision_lab::Prediction::PAIR_BC == kPairBC &&
-              collision_lab::EnergyTransfer::PAIR_AB == kPairAB &&
-              collision_lab::EnergyTransfer::PAIR_BC == kPairBC,
+              collision_lab::Prediction::PAIR_BC == kPairBC,
               "PAIR_* must match collision_lab::core::Pair");
 static_assert(Rejected::NON_FINITE_VALUE == static_cast<std::uint8_t>(collision_lab::core::Reason::kNonFiniteValue) &&
               Rejected::NON_POSITIVE_MASS == static_cast<std::uint8_t>(collision_lab::core::Reason::kNonPositiveMass) &&
@@ -95,7 +93,7 @@ std::optional<collision_lab::core::Pair> toPair(std::uint8_t code) {
 collision_lab::Prediction toPredictionMsg(const collision_lab::core::AnalyticPrediction& prediction) {
   collision_lab::Prediction msg;
   msg.collision_count = prediction.collision_count;
-  msg.paper_count_defined = prediction.paper_collision_count.has_value();
+  msg.paper_collision_count_defined = prediction.paper_collision_count.has_value();
   msg.paper_collision_count = prediction.paper_collision_count.value_or(0);
   msg.max_possible_collision_count = prediction.max_possible_collision_count;
   msg.alpha = prediction.angles.alpha;
@@ -103,7 +101,7 @@ collision_lab::Prediction toPredictionMsg(const collision_lab::core::AnalyticPre
   msg.omega = prediction.angles.omega;
   msg.phi_bc = prediction.phi_bc;
   msg.psi = prediction.psi;
-  msg.first_pair = toPairCode(prediction.first_pair);
+  msg.first_pair_index = toPairCode(prediction.first_pair);
   msg.final_velocities = toBoostArray(prediction.final_velocities);
   return msg;
 }
@@ -111,14 +109,14 @@ collision_lab::Prediction toPredictionMsg(const collision_lab::core::AnalyticPre
 collision_lab::core::AnalyticPrediction toPrediction(const collision_lab::Prediction& msg) {
   collision_lab::core::AnalyticPrediction prediction;
   prediction.collision_count = msg.collision_count;
-  if (msg.paper_count_defined) prediction.paper_collision_count = msg.paper_collision_count;
+  if (msg.paper_collision_count_defined) prediction.paper_collision_count = msg.paper_collision_count;
   prediction.max_possible_collision_count = msg.max_possible_collision_count;
   prediction.angles.alpha = msg.alpha;
   prediction.angles.theta = msg.theta;
   prediction.angles.omega = msg.omega;
   prediction.phi_bc = msg.phi_bc;
   prediction.psi = msg.psi;
-  prediction.first_pair = toPair(msg.first_pair);
+  prediction.first_pair = toPair(msg.first_pair_index);
   prediction.final_velocities = toArray(msg.final_velocities);
   return prediction;
 }
@@ -127,7 +125,7 @@ collision_lab::CollisionEvent toCollisionEventMsg(const collision_lab::core::Lab
   const collision_lab::core::ImpactEvent& e = event.event;
   collision_lab::CollisionEvent msg;
   msg.index = e.index;
-  msg.pair = static_cast<std::uint8_t>(e.pair);
+  msg.pair_index = static_cast<std::uint8_t>(e.pair);
   msg.time = e.time;
   msg.position = e.position;
   msg.positions = toBoostArray(e.positions);
@@ -136,6 +134,9 @@ collision_lab::CollisionEvent toCollisionEventMsg(const collision_lab::core::Lab
   msg.predicted_velocities_after = toBoostArray(event.predicted_velocities_after);
   msg.paper_velocities_after = toBoostArray(event.paper_velocities_after);
   msg.energy_transfer = toBoostArray(e.energy_transfer);
+  msg.predicted_energy_transfer = toBoostArray(event.predicted_energy_transfer);
+  msg.paper_energy_transfer = toBoostArray(event.paper_energy_transfer);
+  msg.kinetic_energy_after = toBoostArray(event.kinetic_energy_after);
   msg.total_energy = e.total_energy;
   msg.total_momentum = e.total_momentum;
   return msg;
@@ -145,7 +146,7 @@ collision_lab::core::LabEvent toLabEvent(const collision_lab::CollisionEvent& ms
   collision_lab::core::LabEvent event;
   collision_lab::core::ImpactEvent& e = event.event;
   e.index = msg.index;
-  e.pair = toPair(msg.pair).value_or(collision_lab::core::Pair::AB);
+  e.pair = toPair(msg.pair_index).value_or(collision_lab::core::Pair::AB);
   e.time = msg.time;
   e.position = msg.position;
   e.positions = toArray(msg.positions);
@@ -156,38 +157,43 @@ collision_lab::core::LabEvent toLabEvent(const collision_lab::CollisionEvent& ms
   e.total_momentum = msg.total_momentum;
   event.predicted_velocities_after = toArray(msg.predicted_velocities_after);
   event.paper_velocities_after = toArray(msg.paper_velocities_after);
+  event.predicted_energy_transfer = toArray(msg.predicted_energy_transfer);
+  event.paper_energy_transfer = toArray(msg.paper_energy_transfer);
+  event.kinetic_energy_after = toArray(msg.kinetic_energy_after);
   return event;
 }
 
-collision_lab::Velocities toVelocitiesMsg(const collision_lab::core::LabEvent& event) {
-  collision_lab::Velocities msg;
-  msg.index = event.event.index;
-  msg.time = event.event.time;
-  msg.v_a = event.event.velocities_after[0];
-  msg.v_b = event.event.velocities_after[1];
-  msg.v_c = event.event.velocities_after[2];
-  msg.predicted_v_a = event.predicted_velocities_after[0];
-  msg.predicted_v_b = event.predicted_velocities_after[1];
-  msg.predicted_v_c = event.predicted_velocities_after[2];
+namespace {
+
+/// A plot message of event, its scalar fields left for the caller.
+template <class PlotMessage>
+PlotMessage plotMessageOf(const collision_lab::CollisionEvent& event) {
+  PlotMessage msg;
+  msg.header = event.header;
+  msg.run_id = event.run_id;
+  msg.index = event.index;
+  msg.time = event.time;
   return msg;
 }
 
-collision_lab::EnergyTransfer toEnergyTransferMsg(const collision_lab::core::LabEvent& event) {
-  collision_lab::EnergyTransfer msg;
-  msg.index = event.event.index;
-  msg.pair = static_cast<std::uint8_t>(event.event.pair);
-  msg.delta_a = event.event.energy_transfer[0];
-  msg.delta_b = event.event.energy_transfer[1];
-  msg.delta_c = event.event.energy_transfer[2];
+}  // namespace
+
+collision_lab::Velocities toVelocitiesMsg(const collision_lab::CollisionEvent& event) {
+  auto msg = plotMessageOf<collision_lab::Velocities>(event);
+  msg.v_a = event.velocities_after[0];
+  msg.v_b = event.velocities_after[1];
+  msg.v_c = event.velocities_after[2];
+  return msg;
+}
+
+collision_lab::EnergyTransfer toEnergyTransferMsg(const collision_lab::CollisionEvent& event) {
+  auto msg = plotMessageOf<collision_lab::EnergyTransfer>(event);
+  msg.delta_a = event.energy_transfer[0];
+  msg.delta_b = event.energy_transfer[1];
+  msg.delta_c = event.energy_transfer[2];
   msg.kinetic_a = event.kinetic_energy_after[0];
   msg.kinetic_b = event.kinetic_energy_after[1];
   msg.kinetic_c = event.kinetic_energy_after[2];
-  msg.predicted_delta_a = event.predicted_energy_transfer[0];
-  msg.predicted_delta_b = event.predicted_energy_transfer[1];
-  msg.predicted_delta_c = event.predicted_energy_transfer[2];
-  msg.paper_delta_a = event.paper_energy_transfer[0];
-  msg.paper_delta_b = event.paper_energy_transfer[1];
-  msg.paper_delta_c = event.paper_energy_transfer[2];
   return msg;
 }
 
@@ -201,7 +207,7 @@ collision_lab::RunSummary toRunSummaryMsg(const collision_lab::core::LabRunSumma
   msg.truncation_reason = summary.truncation_reason;
   msg.simulated = summary.simulated;
   msg.predicted_collision_count = prediction.collision_count;
-  msg.paper_prediction_defined = prediction.paper_collision_count.has_value();
+  msg.paper_predicted_collision_count_defined = prediction.paper_collision_count.has_value();
   msg.paper_predicted_collision_count = prediction.paper_collision_count.value_or(0);
   msg.final_velocities = toBoostArray(summary.final_velocities);
   msg.max_prediction_error = summary.max_prediction_error;

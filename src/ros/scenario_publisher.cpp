@@ -74,7 +74,7 @@ Row row(const std::string& scene, const collision_lab::RunScene::Response& respo
   const std::string collisions =
       std::to_string(s.collision_count) + (s.truncated ? "*" : "") + (s.simulated ? "" : " (n/s)");
   const std::string paper =
-      s.paper_prediction_defined ? std::to_string(s.paper_predicted_collision_count) : "undef.";
+      s.paper_predicted_collision_count_defined ? std::to_string(s.paper_predicted_collision_count) : "undef.";
   const std::string bag = s.bag_path.empty()     ? std::string("(not recorded)")
                           : s.recording_ok        ? s.bag_path
                                                   : "FAILED: " + s.recording_error;
@@ -131,59 +131,63 @@ void printTable(const std::vector<Row>& rows) {
   std::cout << table.str() << std::flush;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  ros::init(argc, argv, "scenario_publisher");
-  ros::NodeHandle nh, private_nh("~");
-
+/// The publisher's private parameters (see the top of this file).
+struct Options {
   std::string scenario_file, selection, suffix, service;
-  int mode = 0;
-  double wait_timeout = 60.0, dwell = 0.0;
+  collision_lab::core::RunMode mode = collision_lab::core::RunMode::kFull;
+  double wait_timeout = 60.0;  ///< [s]
+  double dwell = 0.0;          ///< [s]
   bool exit_when_done = true, end_launch_when_done = false;
-  if (!private_nh.getParam("scenario_file", scenario_file)) {
-    ROS_FATAL("~scenario_file is not set");
-    return 1;
+
+  /// Empty with a ROS_FATAL when ~scenario_file is missing or ~mode is not a MODE_*.
+  static std::optional<Options> load(const ros::NodeHandle& private_nh) {
+    Options o;
+    if (!private_nh.getParam("scenario_file", o.scenario_file)) {
+      ROS_FATAL("~scenario_file is not set");
+      return std::nullopt;
+    }
+    int mode = 0;
+    private_nh.param("scenarios", o.selection, std::string());
+    private_nh.param("mode", mode, 0);
+    private_nh.param("run_id_suffix", o.suffix, utcStamp());
+    private_nh.param("service", o.service, std::string("collision_lab_node/run_scene"));
+    private_nh.param("wait_timeout", o.wait_timeout, 60.0);
+    private_nh.param("dwell", o.dwell, 0.0);
+    private_nh.param("exit_when_done", o.exit_when_done, true);
+    private_nh.param("end_launch_when_done", o.end_launch_when_done, false);
+    const auto run_mode = collision_lab_ros::toRunMode(static_cast<std::uint8_t>(mode));
+    if (mode < 0 || mode > 255 || !run_mode) {
+      ROS_FATAL_STREAM("~mode = " << mode << " is not one of InitialConditions.MODE_*");
+      return std::nullopt;
+    }
+    o.mode = *run_mode;
+    return o;
   }
-  private_nh.param("scenarios", selection, std::string());
-  private_nh.param("mode", mode, 0);
-  private_nh.param("run_id_suffix", suffix, utcStamp());
-  private_nh.param("service", service, std::string("collision_lab_node/run_scene"));
-  private_nh.param("wait_timeout", wait_timeout, 60.0);
-  private_nh.param("dwell", dwell, 0.0);
-  private_nh.param("exit_when_done", exit_when_done, true);
-  private_nh.param("end_launch_when_done", end_launch_when_done, false);
-  const auto run_mode = collision_lab_ros::toRunMode(static_cast<std::uint8_t>(mode));
-  if (mode < 0 || mode > 255 || !run_mode) {
-    ROS_FATAL_STREAM("~mode = " << mode << " is not one of InitialConditions.MODE_*");
-    return 1;
-  }
-  std::vector<collision_lab::io::NamedScene> scenes;
-  try {
-    scenes = selectScenes(scenario_file, selection);
-  } catch (const collision_lab::io::ScenarioFileError& e) {
-    ROS_FATAL_STREAM(e.what());
-    return 1;
+};
+
+/// A client of collision_lab_node's ~run_scene service: waits for it, sends scenes one at
+/// a time, and keeps the table of their outcomes.
+class RunSceneClient {
+ public:
+  RunSceneClient(std::string service, collision_lab::core::RunMode mode, std::string suffix)
+      : service_(std::move(service)), mode_(mode), suffix_(std::move(suffix)) {}
+
+  /// Waits up to timeout [s] for the service; false (with a ROS_FATAL) when it is not there.
+  bool connect(double timeout) const {
+    ROS_INFO_STREAM("waiting up to " << timeout << " s for " << service_);
+    if (ros::service::waitForService(service_, ros::Duration(timeout))) return true;
+    if (ros::ok()) {
+      ROS_FATAL_STREAM("no service " << service_ << " after " << timeout
+                       << " s: is collision_lab_node running (rosnode list, rosservice list)?");
+    }
+    return false;
   }
 
-  service = nh.resolveName(service);
-  ROS_INFO_STREAM("waiting up to " << wait_timeout << " s for " << service);
-  if (!ros::service::waitForService(service, ros::Duration(wait_timeout))) {
-    if (!ros::ok()) return 1;
-    ROS_FATAL_STREAM("no service " << service << " after " << wait_timeout
-                     << " s: is collision_lab_node running (rosnode list, rosservice list)?");
-    return 1;
-  }
-
-  std::vector<Row> rows;
-  std::string bag_directory;
-  std::size_t failed = 0;
-  for (std::size_t i = 0; i < scenes.size() && ros::ok(); ++i) {
-    const auto& scene = scenes[i];
+  /// Serves scene as run <name>_<suffix> and adds its row to the table.
+  void send(const collision_lab::io::NamedScene& scene) {
     collision_lab::RunScene call;
-    call.request.run_id = scene.name + "_" + suffix;
-    const auto input =
-        collision_lab_ros::toInitialConditions(scene.scene, *run_mode, scene.max_collisions);
+    call.request.run_id = scene.name + "_" + suffix_;
+    const auto input = collision_lab_ros::toInitialConditions(scene.scene, mode_, scene.max_collisions);
     call.request.mode = input.mode;
     call.request.masses = input.masses;
     call.request.positions = input.positions;
@@ -191,32 +195,68 @@ int main(int argc, char** argv) {
     call.request.max_collisions = input.max_collisions;
     ROS_INFO_STREAM("running " << scene.name << " (" << scene.description << ") as run "
                     << call.request.run_id);
-    if (!ros::service::call(service, call)) {
+    if (!ros::service::call(service_, call)) {
       call.response.ok = false;
-      call.response.message = "the call to " + service + " failed (did collision_lab_node die?)";
+      call.response.message = "the call to " + service_ + " failed (did collision_lab_node die?)";
     }
-    rows.push_back(row(scene.name, call.response));
-    failed += rows.back().failed;
-    if (bag_directory.empty() && !call.response.summary.bag_path.empty()) {
-      bag_directory = std::filesystem::path(call.response.summary.bag_path).parent_path().string();
-    }
-    if (dwell > 0 && i + 1 < scenes.size()) {
-      ROS_INFO_STREAM("showing " << scene.name << " for " << dwell << " s");
-      sleepFor(dwell);
+    rows_.push_back(row(scene.name, call.response));
+    failed_ += rows_.back().failed;
+    if (bag_directory_.empty() && !call.response.summary.bag_path.empty()) {
+      bag_directory_ = std::filesystem::path(call.response.summary.bag_path).parent_path().string();
     }
   }
-  printTable(rows);
 
-  const bool complete = rows.size() == scenes.size();
-  if (failed > 0 || !complete) {
-    std::cout << "demo FAILED: " << failed << " of " << rows.size() << " runs failed"
-              << (complete ? "" : ", the demo was cut short") << " (see the table above)"
+  /// Prints the table and the last line; true when all of expected runs were served
+  /// without failure.
+  bool finish(std::size_t expected) const {
+    printTable(rows_);
+    const bool complete = rows_.size() == expected;
+    if (failed_ > 0 || !complete) {
+      std::cout << "demo FAILED: " << failed_ << " of " << rows_.size() << " runs failed"
+                << (complete ? "" : ", the demo was cut short") << " (see the table above)"
+                << std::endl;
+      return false;
+    }
+    std::cout << "demo finished: " << rows_.size() << " runs, bags in "
+              << (bag_directory_.empty() ? std::string("(not recorded)") : bag_directory_)
               << std::endl;
+    return true;
+  }
+
+ private:
+  std::string service_;
+  collision_lab::core::RunMode mode_;
+  std::string suffix_;
+  std::vector<Row> rows_;
+  std::size_t failed_ = 0;
+  std::string bag_directory_;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  ros::init(argc, argv, "scenario_publisher");
+  ros::NodeHandle nh, private_nh("~");
+  const std::optional<Options> options = Options::load(private_nh);
+  if (!options) return 1;
+  std::vector<collision_lab::io::NamedScene> scenes;
+  try {
+    scenes = selectScenes(options->scenario_file, options->selection);
+  } catch (const collision_lab::io::ScenarioFileError& e) {
+    ROS_FATAL_STREAM(e.what());
     return 1;
   }
-  std::cout << "demo finished: " << rows.size() << " runs, bags in "
-            << (bag_directory.empty() ? std::string("(not recorded)") : bag_directory) << std::endl;
-  if (end_launch_when_done && endLaunch()) return 0;
-  if (!exit_when_done) ros::waitForShutdown();
+  RunSceneClient client(nh.resolveName(options->service), options->mode, options->suffix);
+  if (!client.connect(options->wait_timeout)) return 1;
+  for (std::size_t i = 0; i < scenes.size() && ros::ok(); ++i) {
+    client.send(scenes[i]);
+    if (options->dwell > 0 && i + 1 < scenes.size()) {
+      ROS_INFO_STREAM("showing " << scenes[i].name << " for " << options->dwell << " s");
+      sleepFor(options->dwell);
+    }
+  }
+  if (!client.finish(scenes.size())) return 1;
+  if (options->end_launch_when_done && endLaunch()) return 0;
+  if (!options->exit_when_done) ros::waitForShutdown();
   return 0;
 }

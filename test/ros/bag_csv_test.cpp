@@ -122,7 +122,7 @@ class BagCsvTest : public testing::Test {
     prediction.collision_count = 314;
     prediction.alpha = 1.0 / 3.0;
     prediction.phi_bc = std::nan("");
-    prediction.first_pair = collision_lab::Prediction::PAIR_AB;
+    prediction.first_pair_index = collision_lab::Prediction::PAIR_AB;
     prediction.final_velocities = {{0.1, -kInf, 1e-300}};
     prediction.timeline_scale = 1e9;
     bag.write("/collision_lab/predictions", start, prediction);
@@ -132,9 +132,10 @@ class BagCsvTest : public testing::Test {
       event.header.stamp = start + ros::Duration(0, 250'000'000 * k);
       event.run_id = "csv_run";
       event.index = k;
-      event.pair = k == 1 ? collision_lab::CollisionEvent::PAIR_AB : collision_lab::CollisionEvent::PAIR_BC;
+      event.pair_index = k == 1 ? collision_lab::CollisionEvent::PAIR_AB : collision_lab::CollisionEvent::PAIR_BC;
       event.time = 0.25 * k;
       event.velocities_after = {{-0.1 * k, 2.0 / 3.0, 0}};
+      event.kinetic_energy_after = {{0.005 * k, 2.0 / 9.0, 0}};
       event.total_momentum = -10000;
       bag.write("/collision_lab/collision_events", event.header.stamp, event);
       collision_lab::Velocities velocities;
@@ -193,8 +194,7 @@ TEST_F(BagCsvTest, OneCsvPerTopicWithUnitsAndExactNumbers) {
 
   const Table velocities = readCsv(dir_ + "/csv/velocities.csv");
   ASSERT_EQ(velocities.size(), 3u);
-  EXPECT_EQ(velocities[0], split("stamp_s,run_id,index,time_s,v_a_m_s,v_b_m_s,v_c_m_s,"
-                                 "predicted_v_a_m_s,predicted_v_b_m_s,predicted_v_c_m_s"));
+  EXPECT_EQ(velocities[0], split("stamp_s,run_id,index,time_s,v_a_m_s,v_b_m_s,v_c_m_s"));
   EXPECT_EQ(cell(velocities, 1, "stamp_s"), "1700000000.250000005");
   EXPECT_EQ(cell(velocities, 2, "stamp_s"), "1700000000.500000005");
   EXPECT_EQ(number(velocities, 2, "time_s"), 0.5);
@@ -209,15 +209,17 @@ TEST_F(BagCsvTest, OneCsvPerTopicWithUnitsAndExactNumbers) {
   const Table prediction = readCsv(dir_ + "/csv/predictions.csv");
   EXPECT_EQ(number(prediction, 1, "alpha_rad"), 1.0 / 3.0);
   EXPECT_EQ(cell(prediction, 1, "phi_bc_rad"), "nan");
-  EXPECT_EQ(cell(prediction, 1, "first_pair"), "AB");
+  EXPECT_EQ(cell(prediction, 1, "first_pair_index"), "AB");
   EXPECT_EQ(cell(prediction, 1, "v_b_final_m_s"), "-inf");
   EXPECT_EQ(number(prediction, 1, "v_c_final_m_s"), 1e-300);
   EXPECT_EQ(number(prediction, 1, "timeline_scale_bag_s_per_s"), 1e9);
-  EXPECT_EQ(cell(prediction, 1, "paper_count_defined"), "false");
+  EXPECT_EQ(cell(prediction, 1, "paper_collision_count_defined"), "false");
 
   const Table events = readCsv(dir_ + "/csv/collision_events.csv");
   ASSERT_EQ(events.size(), 3u);
-  EXPECT_EQ(cell(events, 2, "pair"), "BC");
+  EXPECT_EQ(cell(events, 2, "pair_index"), "BC");
+  EXPECT_EQ(number(events, 2, "kinetic_energy_a_after_J"), 0.005 * 2);
+  EXPECT_EQ(number(events, 1, "kinetic_energy_b_after_J"), 2.0 / 9.0);
   EXPECT_EQ(number(events, 2, "v_a_after_m_s"), -0.1 * 2);
   EXPECT_EQ(number(events, 1, "total_momentum_kg_m_s"), -10000);
   const Table energy = readCsv(dir_ + "/csv/energy_transfers.csv");

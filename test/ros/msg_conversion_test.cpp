@@ -67,8 +67,8 @@ TEST(MsgConversion, PredictionRoundTrip) {
   p.paper_collision_count.reset();
   p.first_pair.reset();
   const auto msg = toPredictionMsg(p);
-  EXPECT_FALSE(msg.paper_count_defined);
-  EXPECT_EQ(msg.first_pair, collision_lab::Prediction::PAIR_NONE);
+  EXPECT_FALSE(msg.paper_collision_count_defined);
+  EXPECT_EQ(msg.first_pair_index, collision_lab::Prediction::PAIR_NONE);
   EXPECT_FALSE(toPrediction(msg).paper_collision_count);
   EXPECT_FALSE(toPrediction(msg).first_pair);
 }
@@ -96,7 +96,7 @@ collision_lab::core::LabEvent sampleEvent() {
 TEST(MsgConversion, CollisionEventRoundTrip) {
   const collision_lab::core::LabEvent e = sampleEvent();
   const auto msg = toCollisionEventMsg(e);
-  EXPECT_EQ(msg.pair, collision_lab::CollisionEvent::PAIR_BC);
+  EXPECT_EQ(msg.pair_index, collision_lab::CollisionEvent::PAIR_BC);
   const collision_lab::core::LabEvent back = toLabEvent(msg);
   EXPECT_EQ(back.event.index, e.event.index);
   EXPECT_EQ(back.event.pair, e.event.pair);
@@ -110,23 +110,34 @@ TEST(MsgConversion, CollisionEventRoundTrip) {
   EXPECT_EQ(back.event.total_momentum, e.event.total_momentum);
   EXPECT_EQ(back.predicted_velocities_after, e.predicted_velocities_after);
   EXPECT_EQ(back.paper_velocities_after, e.paper_velocities_after);
+  EXPECT_EQ(back.predicted_energy_transfer, e.predicted_energy_transfer);
+  EXPECT_EQ(back.paper_energy_transfer, e.paper_energy_transfer);
+  EXPECT_EQ(back.kinetic_energy_after, e.kinetic_energy_after);
 }
 
-TEST(MsgConversion, VelocitiesAndEnergyTransferFields) {
-  const collision_lab::core::LabEvent e = sampleEvent();
-  const auto v = toVelocitiesMsg(e);
+TEST(MsgConversion, PlotTopicsAreTheEventsSimulatedValues) {
+  collision_lab::CollisionEvent event = toCollisionEventMsg(sampleEvent());
+  event.header.stamp = ros::Time(1700000000, 5);
+  event.run_id = "plotted";
+  const auto v = toVelocitiesMsg(event);
+  EXPECT_EQ(v.header.stamp, event.header.stamp);
+  EXPECT_EQ(v.run_id, "plotted");
   EXPECT_EQ(v.index, 42u);
   EXPECT_EQ(v.time, 1.5);
+  EXPECT_EQ(v.v_a, -1.0);
   EXPECT_EQ(v.v_b, 0.9);
-  EXPECT_EQ(v.predicted_v_b, 0.9000001);
   EXPECT_EQ(v.v_c, 0.2);
-  const auto t = toEnergyTransferMsg(e);
-  EXPECT_EQ(t.pair, collision_lab::EnergyTransfer::PAIR_BC);
+  const auto t = toEnergyTransferMsg(event);
+  EXPECT_EQ(t.header.stamp, event.header.stamp);
+  EXPECT_EQ(t.run_id, "plotted");
+  EXPECT_EQ(t.index, 42u);
+  EXPECT_EQ(t.time, 1.5);
+  EXPECT_EQ(t.delta_a, 0.0);
   EXPECT_EQ(t.delta_b, 0.1);
   EXPECT_EQ(t.delta_c, -0.1);
+  EXPECT_EQ(t.kinetic_a, 0.5);
   EXPECT_EQ(t.kinetic_b, 0.81);
-  EXPECT_EQ(t.predicted_delta_c, -0.11);
-  EXPECT_EQ(t.paper_delta_b, 0.2);
+  EXPECT_EQ(t.kinetic_c, 0.06);
 }
 
 TEST(MsgConversion, RunSummaryPhysicsFields) {
@@ -147,7 +158,7 @@ TEST(MsgConversion, RunSummaryPhysicsFields) {
   EXPECT_TRUE(msg.truncated);
   EXPECT_EQ(msg.truncation_reason, "cap");
   EXPECT_EQ(msg.predicted_collision_count, 11u);
-  EXPECT_FALSE(msg.paper_prediction_defined);
+  EXPECT_FALSE(msg.paper_predicted_collision_count_defined);
   EXPECT_EQ(msg.final_velocities[2], 3.0);
   EXPECT_TRUE(std::isnan(msg.momentum_relative_drift));
   EXPECT_EQ(msg.compute_time, 0.5);

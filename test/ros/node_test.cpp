@@ -47,6 +47,26 @@ RunCollector* g_faulty = nullptr;    // namespace collision_lab_faulty
 constexpr char kRunScene[] = "/collision_lab/collision_lab_node/run_scene";
 constexpr char kRunPreset[] = "/collision_lab/collision_lab_node/run_preset";
 
+/// Calls service like ros::service::call, but gives up after kWaitTimeout with a failure
+/// naming the service (the call then finishes, unseen, in its own thread).
+template <class Service>
+bool callService(const std::string& service, Service& call) {
+  struct Shared {
+    Service call;
+    std::atomic<bool> done{false};
+    bool ok = false;
+  };
+  auto shared = std::make_shared<Shared>();
+  shared->call = call;
+  std::thread([shared, service] {
+    shared->ok = ros::service::call(service, shared->call);
+    shared->done = true;
+  }).detach();
+  if (!waitUntil([&] { return shared->done.load(); }, "an answer from " + service)) return false;
+  call = shared->call;
+  return shared->ok;
+}
+
 /// Publishes input to node unless this run_id was sent before, and waits for the run.
 const RunOutputs& runOnce(RunCollector* node, const collision_lab::InitialConditions& input) {
   static std::set<std::string> sent;
@@ -112,7 +132,6 @@ std::vector<collision_lab::CollisionEvent> expectBagOnTimeline(const std::string
   const auto inputs = readTopic<collision_lab::InitialConditions>(bag, ns + "initial_conditions");
   const auto predictions = readTopic<collision_lab::Prediction>(bag, ns + "predictions");
   const auto events = readTopic<collision_lab::CollisionEvent>(bag, ns + "collision_events");
-  const auto velocities = readTopic<collision_lab::Velocities>(bag, ns + "velocities");
   const auto summaries = readTopic<collision_lab::RunSummary>(bag, ns + "run_summaries");
   if (inputs.size() != 1 || predictions.size() != 1 || summaries.size() != 1) {
     ADD_FAILURE() << path << " lacks its input, prediction or summary";
@@ -122,13 +141,9 @@ std::vector<collision_lab::CollisionEvent> expectBagOnTimeline(const std::string
   EXPECT_EQ(predictions.front().header.stamp, start);
   EXPECT_EQ(predictions.front().timeline_scale, scale);
   EXPECT_EQ(summaries.front().timeline_scale, scale);
-  EXPECT_EQ(velocities.size(), events.size());
   for (std::size_t k = 0; k < events.size(); ++k) {
     EXPECT_NEAR(nsAfter(start, events[k].header.stamp), scale * events[k].time * 1e9, 1.0)
         << "collision " << k + 1;
-    if (k < velocities.size()) {
-      EXPECT_EQ(velocities[k].header.stamp, events[k].header.stamp);
-    }
   }
   // The bag's own times are the stamps: its duration is the run's scaled duration.
   rosbag::View all(bag);
@@ -166,15 +181,23 @@ TEST(LabNode, RoundTripMatchesCore) {
   EXPECT_EQ(bytes(received_prediction), bytes(prediction));
 
   for (std::size_t k = 0; k < expected.events.size(); ++k) {
-    auto event = collision_lab_ros::toCollisionEventMsg(expected.events[k]);
-    auto velocities = collision_lab_ros::toVelocitiesMsg(expected.events[k]);
-    auto energy = collision_lab_ros::toEnergyTransferMsg(expected.events[k]);
+    const core::LabEvent& e = expected.events[k];
+    auto event = collision_lab_ros::toCollisionEventMsg(e);
     event.header = out.events[k].header, event.run_id = "round_trip";
-    velocities.header = out.velocities[k].header, velocities.run_id = "round_trip";
-    energy.header = out.energies[k].header, energy.run_id = "round_trip";
     EXPECT_EQ(bytes(out.events[k]), bytes(event)) << "collision " << k + 1;
-    EXPECT_EQ(bytes(out.velocities[k]), bytes(velocities)) << "collision " << k + 1;
-    EXPECT_EQ(bytes(out.energies[k]), bytes(energy)) << "collision " << k + 1;
+    // The plot topics: the simulated values of the same collision, at the same stamp.
+    const collision_lab::Velocities& v = out.velocities[k];
+    EXPECT_EQ(v.header.stamp, out.events[k].header.stamp) << "collision " << k + 1;
+    EXPECT_EQ(v.run_id, "round_trip");
+    EXPECT_EQ(v.index, e.event.index);
+    EXPECT_EQ(v.time, e.event.time);
+    expectArrayEq({{v.v_a, v.v_b, v.v_c}}, e.event.velocities_after, "v after collision " + std::to_string(k + 1));
+    const collision_lab::EnergyTransfer& t = out.energies[k];
+    EXPECT_EQ(t.header.stamp, out.events[k].header.stamp) << "collision " << k + 1;
+    EXPECT_EQ(t.index, e.event.index);
+    EXPECT_EQ(t.time, e.event.time);
+    expectArrayEq({{t.delta_a, t.delta_b, t.delta_c}}, e.event.energy_transfer, "delta " + std::to_string(k + 1));
+    expectArrayEq({{t.kinetic_a, t.kinetic_b, t.kinetic_c}}, e.kinetic_energy_after, "kinetic " + std::to_string(k + 1));
   }
 
   const auto& summary = out.summaries.front();
@@ -200,9 +223,9 @@ TEST(LabNode, RoundTripMatchesCore) {
   EXPECT_GE(summary.header.stamp, last);
 }
 
-// ---- Bag: exactly the published messages ----
+// ---- Bag: exactly the published messages, one per collision (docs/messages.md) ----
 
-TEST(LabNode, BagHoldsExactlyThePublishedMessages) {
+TEST(LabNode, BagHoldsExactlyThePublishedMessagesAndOneMessagePerCollision) {
   const RunOutputs& out = roundTrip();
   ASSERT_EQ(out.summaries.size(), 1u);
   const std::string path = out.summaries.front().bag_path;
@@ -219,13 +242,12 @@ TEST(LabNode, BagHoldsExactlyThePublishedMessages) {
                      "predictions");
   expectSameMessages(out.events, readTopic<collision_lab::CollisionEvent>(bag, ns + "collision_events"),
                      "collision_events");
-  expectSameMessages(out.velocities, readTopic<collision_lab::Velocities>(bag, ns + "velocities"),
-                     "velocities");
-  expectSameMessages(out.energies, readTopic<collision_lab::EnergyTransfer>(bag, ns + "energy_transfers"),
-                     "energy_transfers");
+  // The plot topics are live only: a CollisionEvent holds all they carry.
+  EXPECT_TRUE(readTopic<collision_lab::Velocities>(bag, ns + "velocities").empty());
+  EXPECT_TRUE(readTopic<collision_lab::EnergyTransfer>(bag, ns + "energy_transfers").empty());
   expectSameMessages(out.summaries, readTopic<collision_lab::RunSummary>(bag, ns + "run_summaries"),
                      "run_summaries");
-  EXPECT_EQ(rosbag::View(bag).size(), 3 + 3 * out.events.size());
+  EXPECT_EQ(rosbag::View(bag).size(), 3 + out.events.size());
 }
 
 // ---- Bad input: rejected with the right reason, then the next valid run is served ----
@@ -407,22 +429,21 @@ TEST(LabNode, PredictOnlyAndSummaryOnlyPublishNoCollisions) {
 // ---- ~max_published_events (50 in node_test.test): the rest goes to the bag only ----
 
 TEST(LabNode, EventsBeyondThePublishCapAreRecordedOnly) {
-  g_node->publish(makeInput("pi_digits_3", {1e4, 1, kInf}, {2, 1, 0}, {-1, 0, 0}));
-  const RunOutputs& out = g_node->waitFor("pi_digits_3");
+  const RunOutputs& out = runOnce(g_node, makeInput("pi_digits_3", {1e4, 1, kInf}, {2, 1, 0}, {-1, 0, 0}));
   ASSERT_EQ(out.summaries.size(), 1u);
   const auto& summary = out.summaries.front();
   EXPECT_EQ(summary.collision_count, 314u);
   EXPECT_EQ(summary.published_events, 50u);
   EXPECT_TRUE(summary.events_not_published);
   EXPECT_EQ(out.events.size(), 50u);
+  EXPECT_EQ(out.velocities.size(), 50u);
+  EXPECT_EQ(out.energies.size(), 50u);
   ASSERT_TRUE(summary.recording_ok) << summary.recording_error;
 
   rosbag::Bag bag(summary.bag_path, rosbag::bagmode::Read);
   const auto events = readTopic<collision_lab::CollisionEvent>(bag, "/collision_lab/collision_events");
   ASSERT_EQ(events.size(), 314u);
   for (std::size_t k = 0; k < events.size(); ++k) EXPECT_EQ(events[k].index, k + 1);
-  EXPECT_EQ(readTopic<collision_lab::Velocities>(bag, "/collision_lab/velocities").size(), 314u);
-  EXPECT_EQ(readTopic<collision_lab::EnergyTransfer>(bag, "/collision_lab/energy_transfers").size(), 314u);
   // The bag-only collisions sit on the run's timeline too.
   expectBagOnTimeline(summary.bag_path, 1.0);
 }
@@ -504,7 +525,7 @@ TEST(Timeline, CollisionsBeyondTheRangeSaturateAndTheSummarySaysSo) {
   EXPECT_EQ(summary.header.stamp, out.events[1].header.stamp);
   ASSERT_TRUE(summary.recording_ok) << summary.recording_error;
   rosbag::Bag bag(summary.bag_path, rosbag::bagmode::Read);
-  EXPECT_EQ(rosbag::View(bag).size(), 3 + 3 * 2u);
+  EXPECT_EQ(rosbag::View(bag).size(), 3 + 2u);  // input, prediction, 2 events, summary
 }
 
 // ---- A taken run_id: served under the next free suffix, nothing overwritten ----
@@ -549,7 +570,7 @@ TEST(Services, RunSceneAnswersWithTheSummaryOfAPublishedRecordedRun) {
   call.request.masses = {{1e4, 1, std::numeric_limits<double>::infinity()}};
   call.request.positions = {{2, 1, 0}};
   call.request.velocities = {{-1, 0, 0}};
-  ASSERT_TRUE(ros::service::call(kRunScene, call));
+  ASSERT_TRUE(callService(kRunScene, call));
   EXPECT_TRUE(call.response.ok) << call.response.message;
   const auto& summary = call.response.summary;
   EXPECT_EQ(summary.run_id, "by_service");
@@ -573,7 +594,7 @@ TEST(Services, RunSceneReportsARejection) {
   call.request.masses = {{1, 1, 1}};
   call.request.positions = {{0, 1, 2}};
   call.request.velocities = {{-1, 0, 0}};
-  ASSERT_TRUE(ros::service::call(kRunScene, call));
+  ASSERT_TRUE(callService(kRunScene, call));
   EXPECT_FALSE(call.response.ok);
   EXPECT_EQ(call.response.rejected.reason, collision_lab::Rejected::POSITIONS_NOT_ORDERED);
   EXPECT_NE(call.response.message.find("POSITIONS_NOT_ORDERED"), std::string::npos);
@@ -586,20 +607,20 @@ TEST(Services, RunPresetRunsANamedPresetAndListsTheNamesOfAnUnknownOne) {
   collision_lab::RunPreset call;
   call.request.name = "pi_digits_2";
   call.request.run_id = "preset_run";
-  ASSERT_TRUE(ros::service::call(kRunPreset, call));
+  ASSERT_TRUE(callService(kRunPreset, call));
   EXPECT_TRUE(call.response.ok) << call.response.message;
   EXPECT_EQ(call.response.summary.collision_count, 31u);  // pi to 2 digits
   EXPECT_EQ(g_node->waitFor("preset_run").events.size(), 31u);
 
   collision_lab::RunPreset unnamed;
   unnamed.request.name = "pi_digits_3";  // run_id: <name>_<UTC time>
-  ASSERT_TRUE(ros::service::call(kRunPreset, unnamed));
+  ASSERT_TRUE(callService(kRunPreset, unnamed));
   EXPECT_TRUE(unnamed.response.ok) << unnamed.response.message;
   EXPECT_EQ(unnamed.response.summary.run_id.rfind("pi_digits_3_", 0), 0u);
 
   collision_lab::RunPreset unknown;
   unknown.request.name = "pi_digits_9";
-  ASSERT_TRUE(ros::service::call(kRunPreset, unknown));
+  ASSERT_TRUE(callService(kRunPreset, unknown));
   EXPECT_FALSE(unknown.response.ok);
   for (const char* name : {"pi_digits_9", "equal_masses", "pi_digits_3", "moving_wall"}) {
     EXPECT_NE(unknown.response.message.find(name), std::string::npos) << unknown.response.message;

@@ -33,6 +33,7 @@
 #include <thread>
 #include <unordered_set>
 
+#include <diagnostic_msgs/DiagnosticStatus.h>
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
 
@@ -65,6 +66,14 @@ struct LabNodeParams {
 /// Empty when run_id is safe as a bag file name; otherwise why not.
 std::string runIdProblem(const std::string& run_id);
 
+/// The publishers of a run's outputs, in the order a run uses them.
+struct RunTopics {
+  ros::Publisher predictions, events, velocities, energies, summaries;
+};
+
+/// Stamps, publishes and records the messages of one run (lab_node.cpp).
+class RunWriter;
+
 /// The answer to one input: its summary when served, else its rejection.
 struct ServeOutcome {
   std::optional<collision_lab::RunSummary> summary;
@@ -95,11 +104,17 @@ class LabNode {
   void workerLoop();
 
   // ---- The worker's (not thread-safe) ----
+  /// Validates input, assigns its run_id, then runs it or rejects it.
   ServeOutcome serve(collision_lab::InitialConditions input);
-  /// Publishes, records and draws one validated run; returns its summary.
-  /// requested_run_id: RunSummary.requested_run_id.
-  collision_lab::RunSummary run(collision_lab::InitialConditions& input, const collision_lab::core::ThreeBodyScene& scene,
-                                collision_lab::core::RunMode mode, const std::string& requested_run_id);
+  /// Publishes, records and draws one validated run (its run_id assigned); returns its
+  /// summary. requested_run_id: RunSummary.requested_run_id.
+  collision_lab::RunSummary run(collision_lab::InitialConditions& input,
+                                const std::string& requested_run_id);
+  /// Records the input (stamped at the run's start) and publishes the prediction.
+  void publishStart(RunWriter& out, const collision_lab::InitialConditions& input,
+                    const collision_lab::core::AnalyticPrediction& prediction);
+  /// Stamps, records and publishes the summary last, closes the bag, counts the run.
+  void publishEnd(RunWriter& out, collision_lab::RunSummary& summary, double last_event_time);
   ServeOutcome reject(collision_lab::Rejected msg, const std::string& run_id);
   std::string newRunId();
   /// requested, or the first free requested.N (N = 2, 3, ...) when it is taken; marks the
@@ -111,12 +126,14 @@ class LabNode {
   /// Publishes one DiagnosticArray: runs accepted and rejected, the last run's compute
   /// time, the recording state and the free space in bag_directory.
   void publishDiagnostics();
+  /// Adds the last recording error and the free space in bag_directory to status.
+  void addRecordingStatus(diagnostic_msgs::DiagnosticStatus& status);
 
   ros::NodeHandle nh_;
   LabNodeParams params_;
   ros::Subscriber input_sub_;
-  ros::Publisher predictions_pub_, events_pub_, velocities_pub_, energy_pub_,
-      summaries_pub_, rejected_pub_;
+  RunTopics topics_;
+  ros::Publisher rejected_pub_;
   ros::Publisher diagnostics_pub_;
   ros::WallTimer diagnostics_timer_;
   std::unique_ptr<MarkerView> marker_view_;

@@ -53,12 +53,13 @@ collision_lab::Prediction toPredictionMsg(const collision_lab::core::AnalyticPre
 collision_lab::core::AnalyticPrediction toPrediction(const collision_lab::Prediction& msg);
 
 collision_lab::CollisionEvent toCollisionEventMsg(const collision_lab::core::LabEvent& event);
-/// Inverse of toCollisionEventMsg for the fields that message carries (not the energy
-/// predictions and kinetic energies, which live in EnergyTransfer).
+/// Inverse of toCollisionEventMsg: the message carries every field of a LabEvent.
 collision_lab::core::LabEvent toLabEvent(const collision_lab::CollisionEvent& msg);
 
-collision_lab::Velocities toVelocitiesMsg(const collision_lab::core::LabEvent& event);
-collision_lab::EnergyTransfer toEnergyTransferMsg(const collision_lab::core::LabEvent& event);
+/// The plot topics' projections of a CollisionEvent (header and run_id included): each
+/// field copies one element of the event's arrays (docs/messages.md).
+collision_lab::Velocities toVelocitiesMsg(const collision_lab::CollisionEvent& event);
+collision_lab::EnergyTransfer toEnergyTransferMsg(const collision_lab::CollisionEvent& event);
 
 /// The physics fields of a summary; published_events, events_not_published, bag_path,
 /// recording_ok, recording_error, timeline_scale, timeline_saturated and
