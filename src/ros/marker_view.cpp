@@ -6,6 +6,7 @@
 
 #include "collision_lab/EnergyTransfer.h"
 #include "collision_lab/Velocities.h"
+#include "collision_lab/ros/markers/ids.h"
 #include "collision_lab/ros/node_constants.h"
 
 namespace collision_lab_ros {
@@ -162,15 +163,15 @@ void MarkerView::addOverlays(visualization_msgs::MarkerArray& animated, const ro
                         const std::vector<visualization_msgs::Marker>& markers) {
     if (shown) out.insert(out.end(), markers.begin(), markers.end());
     if (was_shown && !shown) {
-      for (int id : {0, 1}) out.push_back(deleteMarker(ns, id, params_.frame_id));
+      for (int id : {markers::kFramedText, markers::kFramedBox}) out.push_back(deleteMarker(ns, id, params_.frame_id));
     }
     was_shown = shown;
   };
   const bool banner = rejected_ && (now - rejected_at_).toSec() < kRejectedShowTime;
-  show(banner, banner_shown_, "rejected",
+  show(banner, banner_shown_, markers::ns::kRejected,
        banner ? rejectedBanner(*rejected_, params_.frame_id) : std::vector<visualization_msgs::Marker>{});
   const bool hint = !has_run_id_;
-  show(hint, hint_shown_, "hint", hint ? hintMarkers(hintText(), params_.frame_id) : std::vector<visualization_msgs::Marker>{});
+  show(hint, hint_shown_, markers::ns::kHint, hint ? hintMarkers(hintText(), params_.frame_id) : std::vector<visualization_msgs::Marker>{});
 }
 
 void MarkerView::onTimer(const ros::WallTimerEvent&) {
