@@ -11,6 +11,13 @@ namespace collision_lab_ros {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+/// A finished run plays on to this multiple of its last collision's time.
+constexpr double kEndMargin = 1.25;
+/// The collision index's weight in the time warp: n / (n + kIndexWeightHalf) for n
+/// collisions, at most kMaxIndexWeight.
+constexpr double kIndexWeightHalf = 50.0, kMaxIndexWeight = 0.85;
+/// An auto-timed loop lasts kAutoLoopDuration (1 + log10(1 + n) / kLoopDecades).
+constexpr double kLoopDecades = 6.0;
 
 /// Smallest power of two >= value (value > 0 and finite), else 1.
 double powerOfTwoAtLeast(double value) {
@@ -324,7 +331,7 @@ SceneState stateAt(const RunRecord& run, double t) {
 double endTime(const RunRecord& run) {
   const auto& frames = run.keyframes();
   const SceneState newest = frames.empty() ? initialState(run) : stateOf(frames.back());
-  if (run.finished() && newest.time > 0) return 1.25 * newest.time;
+  if (run.finished() && newest.time > 0) return kEndMargin * newest.time;
   const double horizon = run.finished() ? kInf : freeFlightHorizon(newest.positions, newest.velocities);
   const double end = newest.time + (std::isfinite(horizon) ? horizon : flyApartTime(run.input()));
   return std::max(end, std::numeric_limits<double>::min());
@@ -334,7 +341,7 @@ TimeWarp::TimeWarp(const RunRecord& run) : end_(collision_lab_ros::endTime(run))
   // Weight of the collision index in the warp: none for a handful of collisions, most of
   // the loop for thousands, but never all of it (the sparse phases keep some time).
   const double n = static_cast<double>(run.collisions());
-  const double index_weight = std::min(0.85, n / (n + 50.0));
+  const double index_weight = std::min(kMaxIndexWeight, n / (n + kIndexWeightHalf));
   times_.push_back(0.0);
   std::vector<double> counts{0.0};
   for (const Keyframe& f : run.keyframes()) {
@@ -368,7 +375,7 @@ double TimeWarp::rateAt(double phase) const {
 }
 
 double autoLoopDuration(std::uint64_t collisions) {
-  return kAutoLoopDuration * (1.0 + std::log10(1.0 + static_cast<double>(collisions)) / 6.0);
+  return kAutoLoopDuration * (1.0 + std::log10(1.0 + static_cast<double>(collisions)) / kLoopDecades);
 }
 
 double simulatedTimeOnTimeline(const ros::Time& now, const ros::Time& start, double timeline_scale) {

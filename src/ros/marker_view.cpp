@@ -91,11 +91,16 @@ void MarkerView::onInitialConditions(const collision_lab::InitialConditions& msg
   static_dirty_ = true;
 }
 
-void MarkerView::onPrediction(const collision_lab::Prediction& msg) {
+template <typename Msg>
+void MarkerView::keep(const Msg& msg, std::optional<Msg> RunRecord::*in_run, std::optional<Msg> Pending::*pending) {
   std::lock_guard<std::mutex> lock(mutex_);
   select(msg.run_id);
-  (run_ ? run_->prediction : pending_.prediction) = msg;
+  (run_ ? (*run_).*in_run : pending_.*pending) = msg;
   static_dirty_ = true;
+}
+
+void MarkerView::onPrediction(const collision_lab::Prediction& msg) {
+  keep(msg, &RunRecord::prediction, &Pending::prediction);
 }
 
 void MarkerView::onCollisionEvent(const collision_lab::CollisionEvent& msg) {
@@ -110,10 +115,7 @@ void MarkerView::onCollisionEvent(const collision_lab::CollisionEvent& msg) {
 }
 
 void MarkerView::onRunSummary(const collision_lab::RunSummary& msg) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  select(msg.run_id);
-  (run_ ? run_->summary : pending_.summary) = msg;
-  static_dirty_ = true;
+  keep(msg, &RunRecord::summary, &Pending::summary);
 }
 
 void MarkerView::onRejected(const collision_lab::Rejected& msg) {

@@ -9,24 +9,24 @@ namespace collision_lab_ros::markers {
 /// The namespaces. rviz/collision_lab.rviz shows them all (two MarkerArray displays).
 namespace ns {
 // static: rebuilt when a message arrives (topic `markers`)
-constexpr char kTitle[] = "title";
-constexpr char kScene[] = "scene";
-constexpr char kWedge[] = "wedge";
-constexpr char kPlot[] = "plot";            // velocity steps and the paper's series
-constexpr char kConserved[] = "conserved";  // energy and momentum steps
-constexpr char kWorldlines[] = "worldlines";
-constexpr char kEnergy[] = "energy";        // the kinetic energy bars' axis
+constexpr const char* kTitle = "title";
+constexpr const char* kScene = "scene";
+constexpr const char* kWedge = "wedge";
+constexpr const char* kPlot = "plot";            // velocity steps and the paper's series
+constexpr const char* kConserved = "conserved";  // energy and momentum steps
+constexpr const char* kWorldlines = "worldlines";
+constexpr const char* kEnergy = "energy";        // the kinetic energy bars' axis
 // animated: every frame (topic `markers_animated`)
-constexpr char kBodies[] = "bodies";
-constexpr char kLabels[] = "labels";
-constexpr char kZoom[] = "zoom";  // the magnifier
-constexpr char kWedgeNow[] = "wedge_now";
-constexpr char kPlotCursor[] = "plot_cursor";
-constexpr char kWorldlinesNow[] = "worldlines_now";
-constexpr char kEnergyBars[] = "energy_bars";
+constexpr const char* kBodies = "bodies";
+constexpr const char* kLabels = "labels";
+constexpr const char* kZoom = "zoom";  // the magnifier
+constexpr const char* kWedgeNow = "wedge_now";
+constexpr const char* kPlotCursor = "plot_cursor";
+constexpr const char* kWorldlinesNow = "worldlines_now";
+constexpr const char* kEnergyBars = "energy_bars";
 // overlays, also on `markers_animated`
-constexpr char kRejected[] = "rejected";
-constexpr char kHint[] = "hint";
+constexpr const char* kRejected = "rejected";
+constexpr const char* kHint = "hint";
 }  // namespace ns
 
 enum MarkerId : int {
