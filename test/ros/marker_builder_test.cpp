@@ -6,6 +6,7 @@
 #include <limits>
 #include <set>
 #include <string>
+#include <utility>
 
 #include <gtest/gtest.h>
 
@@ -322,6 +323,13 @@ void expectFitForRviz(const MarkerArray& array) {
   EXPECT_EQ(enforceRvizLimits(copy), 0u);
 }
 
+/// rviz keeps one marker per namespace and id: a second one in the same array would
+/// replace the first, and a view would lose a part without a word.
+void expectOneMarkerPerId(const MarkerArray& array) {
+  std::set<std::pair<std::string, int>> seen;
+  for (const auto& m : array.markers) EXPECT_TRUE(seen.insert({m.ns, m.id}).second) << m.ns << "/" << m.id;
+}
+
 TEST(MarkerBuilder, EveryViewFitsRvizForEveryCount) {
   const std::vector<Fed> runs = {
       feed({1, 1, 1}, {2, 1, 0}, {1, 0, -1}),                  // 0 collisions
@@ -349,10 +357,12 @@ TEST(MarkerBuilder, EveryViewFitsRvizForEveryCount) {
                            markers::ns::kConserved, markers::ns::kWorldlines, markers::ns::kEnergy}) {
       EXPECT_TRUE(namespaces.count(ns)) << ns;
     }
+    expectOneMarkerPerId(fixed);
     const double end = endTime(run);
     for (double t : {0.0, 0.3 * end, end, 2 * end}) {
       const auto animated = buildAnimatedMarkers(run, FrameClock{t, "test"}, "f");
       expectFitForRviz(animated);
+      expectOneMarkerPerId(animated);
     }
   }
 }
