@@ -10,7 +10,18 @@ add_library(collision_lab_ros
   src/ros/bag_csv.cpp
   src/ros/lab_node.cpp
   src/ros/marker_builder.cpp
-  src/ros/marker_view.cpp)
+  src/ros/marker_view.cpp
+  # the rviz views, one file each, and what they share (include/.../ros/markers/)
+  src/ros/markers/draw.cpp
+  src/ros/markers/run_facts.cpp
+  src/ros/markers/scene.cpp
+  src/ros/markers/magnifier.cpp
+  src/ros/markers/wedge.cpp
+  src/ros/markers/steps.cpp
+  src/ros/markers/worldlines.cpp
+  src/ros/markers/energy_bars.cpp
+  src/ros/markers/overlays.cpp
+  src/ros/markers/rviz_limits.cpp)
 target_include_directories(collision_lab_ros PUBLIC include)
 # collision_lab_io: the node reads the presets of ~run_preset.
 target_link_libraries(collision_lab_ros PUBLIC collision_lab_core collision_lab_io ${catkin_LIBRARIES})

@@ -4,8 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "collision_lab/EnergyTransfer.h"
-#include "collision_lab/Velocities.h"
+#include "collision_lab/ros/markers/ids.h"
 #include "collision_lab/ros/node_constants.h"
 
 namespace collision_lab_ros {
@@ -14,9 +13,6 @@ namespace {
 /// Collisions of a run held while its InitialConditions has not arrived (a replay's topics
 /// are not ordered against each other). Beyond, they count as missed.
 constexpr std::size_t kMaxPendingEvents = 100000;
-
-template <class Message>
-void ignore(const boost::shared_ptr<const Message>&) {}
 }  // namespace
 
 MarkerViewParams MarkerViewParams::load(const ros::NodeHandle& private_nh) {
@@ -61,11 +57,6 @@ void MarkerView::subscribe() {
       kRunSummariesTopic, kOutputQueueSize, [this](const collision_lab::RunSummary::ConstPtr& m) { onRunSummary(*m); }));
   subscribers_.push_back(nh_.subscribe<collision_lab::Rejected>(
       kRejectedTopic, kOutputQueueSize, [this](const collision_lab::Rejected::ConstPtr& m) { onRejected(*m); }));
-  // The view needs nothing from these two (a CollisionEvent carries it all), but
-  // `rosbag play --wait-for-subscribers` (replay.launch) waits for a subscriber on every
-  // recorded topic.
-  subscribers_.push_back(nh_.subscribe(kVelocitiesTopic, 1, &ignore<collision_lab::Velocities>));
-  subscribers_.push_back(nh_.subscribe(kEnergyTransfersTopic, 1, &ignore<collision_lab::EnergyTransfer>));
 }
 
 void MarkerView::select(const std::string& run_id) {
@@ -90,11 +81,16 @@ void MarkerView::onInitialConditions(const collision_lab::InitialConditions& msg
   static_dirty_ = true;
 }
 
-void MarkerView::onPrediction(const collision_lab::Prediction& msg) {
+template <typename Msg>
+void MarkerView::keep(const Msg& msg, std::optional<Msg> RunRecord::*in_run, std::optional<Msg> Pending::*pending) {
   std::lock_guard<std::mutex> lock(mutex_);
   select(msg.run_id);
-  (run_ ? run_->prediction : pending_.prediction) = msg;
+  (run_ ? (*run_).*in_run : pending_.*pending) = msg;
   static_dirty_ = true;
+}
+
+void MarkerView::onPrediction(const collision_lab::Prediction& msg) {
+  keep(msg, &RunRecord::prediction, &Pending::prediction);
 }
 
 void MarkerView::onCollisionEvent(const collision_lab::CollisionEvent& msg) {
@@ -109,10 +105,7 @@ void MarkerView::onCollisionEvent(const collision_lab::CollisionEvent& msg) {
 }
 
 void MarkerView::onRunSummary(const collision_lab::RunSummary& msg) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  select(msg.run_id);
-  (run_ ? run_->summary : pending_.summary) = msg;
-  static_dirty_ = true;
+  keep(msg, &RunRecord::summary, &Pending::summary);
 }
 
 void MarkerView::onRejected(const collision_lab::Rejected& msg) {
@@ -162,15 +155,15 @@ void MarkerView::addOverlays(visualization_msgs::MarkerArray& animated, const ro
                         const std::vector<visualization_msgs::Marker>& markers) {
     if (shown) out.insert(out.end(), markers.begin(), markers.end());
     if (was_shown && !shown) {
-      for (int id : {0, 1}) out.push_back(deleteMarker(ns, id, params_.frame_id));
+      for (int id : {markers::kFramedText, markers::kFramedBox}) out.push_back(deleteMarker(ns, id, params_.frame_id));
     }
     was_shown = shown;
   };
   const bool banner = rejected_ && (now - rejected_at_).toSec() < kRejectedShowTime;
-  show(banner, banner_shown_, "rejected",
+  show(banner, banner_shown_, markers::ns::kRejected,
        banner ? rejectedBanner(*rejected_, params_.frame_id) : std::vector<visualization_msgs::Marker>{});
   const bool hint = !has_run_id_;
-  show(hint, hint_shown_, "hint", hint ? hintMarkers(hintText(), params_.frame_id) : std::vector<visualization_msgs::Marker>{});
+  show(hint, hint_shown_, markers::ns::kHint, hint ? hintMarkers(hintText(), params_.frame_id) : std::vector<visualization_msgs::Marker>{});
 }
 
 void MarkerView::onTimer(const ros::WallTimerEvent&) {

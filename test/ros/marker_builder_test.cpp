@@ -6,10 +6,12 @@
 #include <limits>
 #include <set>
 #include <string>
+#include <utility>
 
 #include <gtest/gtest.h>
 
 #include "collision_lab/ros/marker_builder.h"
+#include "collision_lab/ros/markers/ids.h"
 #include "collision_lab/ros/msg_conversion.h"
 
 namespace {
@@ -321,6 +323,13 @@ void expectFitForRviz(const MarkerArray& array) {
   EXPECT_EQ(enforceRvizLimits(copy), 0u);
 }
 
+/// rviz keeps one marker per namespace and id: a second one in the same array would
+/// replace the first, and a view would lose a part without a word.
+void expectOneMarkerPerId(const MarkerArray& array) {
+  std::set<std::pair<std::string, int>> seen;
+  for (const auto& m : array.markers) EXPECT_TRUE(seen.insert({m.ns, m.id}).second) << m.ns << "/" << m.id;
+}
+
 TEST(MarkerBuilder, EveryViewFitsRvizForEveryCount) {
   const std::vector<Fed> runs = {
       feed({1, 1, 1}, {2, 1, 0}, {1, 0, -1}),                  // 0 collisions
@@ -344,13 +353,16 @@ TEST(MarkerBuilder, EveryViewFitsRvizForEveryCount) {
     expectFitForRviz(fixed);
     std::set<std::string> namespaces;
     for (const auto& m : fixed.markers) namespaces.insert(m.ns);
-    for (const char* ns : {"title", "scene", "wedge", "plot", "conserved", "worldlines", "energy"}) {
+    for (const char* ns : {markers::ns::kTitle, markers::ns::kScene, markers::ns::kWedge, markers::ns::kPlot,
+                           markers::ns::kConserved, markers::ns::kWorldlines, markers::ns::kEnergy}) {
       EXPECT_TRUE(namespaces.count(ns)) << ns;
     }
+    expectOneMarkerPerId(fixed);
     const double end = endTime(run);
     for (double t : {0.0, 0.3 * end, end, 2 * end}) {
       const auto animated = buildAnimatedMarkers(run, FrameClock{t, "test"}, "f");
       expectFitForRviz(animated);
+      expectOneMarkerPerId(animated);
     }
   }
 }
@@ -396,7 +408,7 @@ TEST(MarkerBuilder, VelocitiesArePlottedAsSteps) {
   // On screen every segment of every velocity line is horizontal or vertical.
   const auto fixed = buildStaticMarkers(fed.run, "f");
   for (int i = 0; i < 3; ++i) {
-    const Marker* line = find(fixed, "plot", 10 + i);
+    const Marker* line = find(fixed, markers::ns::kPlot, markers::kPlotSeries + i);
     ASSERT_TRUE(line);
     ASSERT_EQ(line->type, Marker::LINE_STRIP);
     for (std::size_t k = 1; k < line->points.size(); ++k) {
@@ -421,15 +433,15 @@ TEST(MarkerBuilder, PaperSeriesShownWhereItDiffers) {
       }
     }
     EXPECT_TRUE(seen) << i;
-    const Marker* segments = find(buildStaticMarkers(fed.run, "f"), "plot", 30 + i);
+    const Marker* segments = find(buildStaticMarkers(fed.run, "f"), markers::ns::kPlot, markers::kPlotPaper + i);
     ASSERT_TRUE(segments) << i;
     EXPECT_EQ(segments->type, Marker::LINE_LIST);
   }
   // With a wall the printed formulas are undefined: no series, and the legend says so.
   const Fed wall = feed({100, 1, kInf}, {2, 1, 0}, {-1, 0, 0});
   const auto fixed = buildStaticMarkers(wall.run, "f");
-  for (int i = 0; i < 3; ++i) EXPECT_FALSE(find(fixed, "plot", 30 + i));
-  const Marker* legend = find(fixed, "plot", 311);
+  for (int i = 0; i < 3; ++i) EXPECT_FALSE(find(fixed, markers::ns::kPlot, markers::kPlotPaper + i));
+  const Marker* legend = find(fixed, markers::ns::kPlot, markers::kPlotLegend);
   ASSERT_TRUE(legend);
   EXPECT_NE(legend->text.find("undefined with a wall"), std::string::npos);
 }
@@ -439,7 +451,7 @@ TEST(MarkerBuilder, BGetsItsOwnScaleWhenItDwarfsAandC) {
   const auto labels = [](const MarkerArray& array) {
     std::set<std::string> texts;
     for (const auto& m : array.markers) {
-      if (m.ns == "plot") texts.insert(m.text);
+      if (m.ns == markers::ns::kPlot) texts.insert(m.text);
     }
     return texts;
   };
@@ -454,8 +466,8 @@ TEST(MarkerBuilder, WedgePathStaysOnItsCircle) {
   // on one circle around the wedge's centre.
   const Fed fed = feed({1e4, 1, kInf}, {2, 1, 0}, {-1, 0, 0});
   const auto fixed = buildStaticMarkers(fed.run, "f");
-  const Marker* path = find(fixed, "wedge", 7);
-  const Marker* circle = find(fixed, "wedge", 5);
+  const Marker* path = find(fixed, markers::ns::kWedge, markers::kWedgeSimulated);
+  const Marker* circle = find(fixed, markers::ns::kWedge, markers::kWedgeCircle);
   ASSERT_TRUE(path && circle);
   ASSERT_EQ(path->points.size(), fed.events.size() + 1);
   const double cx = (circle->points[0].x + circle->points[48].x) / 2;

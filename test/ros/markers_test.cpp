@@ -11,6 +11,7 @@
 #include <ros/ros.h>
 
 #include "collision_lab/InitialConditions.h"
+#include "collision_lab/ros/markers/ids.h"
 #include "marker_test_client.h"
 
 namespace {
@@ -73,7 +74,7 @@ TEST(Markers, HintRejectionAndTheTrueCountOnALongRun) {
       late.subscribe<visualization_msgs::MarkerArray, const MarkerEvent&>(collision_lab_ros::kMarkersTopic, 1, MarkerEventCallback([&](const MarkerEvent& event) {
                        late_latched = latched(event);
                        for (const auto& m : event.getMessage()->markers) {
-                         if (m.ns == "title") late_title = m.text;
+                         if (m.ns == collision_lab_ros::markers::ns::kTitle) late_title = m.text;
                        }
                      }));
   ASSERT_TRUE(spinUntil([&] { return !late_title.empty(); }, kTimeout)) << "a late subscriber got no picture";

@@ -10,6 +10,8 @@
 //   - the x-t diagram (worldlines);
 //   - total energy and momentum of the finite masses against collision index;
 //   - kinetic energy per body as bars.
+// Each view is drawn by its own functions in src/ros/markers/<view>.cpp; their marker
+// namespaces and ids are in markers/ids.h, their layout in markers/layout.h.
 //
 // Memory is bounded whatever the count: a RunRecord keeps a decimated set of exact states
 // (Keyframes) and per-pixel-column min/max envelopes of every plotted series (Envelope).
@@ -209,10 +211,11 @@ visualization_msgs::MarkerArray buildStaticMarkers(const RunRecord& run, const s
 /// The parts that move with simulated time (bodies, labels, cursors, bars).
 visualization_msgs::MarkerArray buildAnimatedMarkers(const RunRecord& run, const FrameClock& clock,
                                                      const std::string& frame_id);
-/// A banner for a rejected input: its reason, field and message (ns "rejected", ids 0, 1).
+/// A banner for a rejected input: its reason, field and message (markers/ids.h: ns kRejected,
+/// ids kFramedText, kFramedBox).
 std::vector<visualization_msgs::Marker> rejectedBanner(const collision_lab::Rejected& rejected,
                                                        const std::string& frame_id);
-/// Before the first run: how to send one, `command` (ns "hint", ids 0, 1).
+/// Before the first run: how to send one, `command` (ns kHint, the same ids).
 std::vector<visualization_msgs::Marker> hintMarkers(const std::string& command, const std::string& frame_id);
 /// Deletes the marker ns/id (when a banner or hint is no longer shown).
 visualization_msgs::Marker deleteMarker(const std::string& ns, int id, const std::string& frame_id);

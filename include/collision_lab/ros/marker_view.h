@@ -63,6 +63,10 @@ class MarkerView {
     std::vector<collision_lab::CollisionEvent> events;
   };
 
+  /// Keeps a run's Prediction or RunSummary: in the run, or pending until its
+  /// InitialConditions comes.
+  template <typename Msg>
+  void keep(const Msg& msg, std::optional<Msg> RunRecord::*in_run, std::optional<Msg> Pending::*pending);
   void onTimer(const ros::WallTimerEvent& event);
   /// Switches to run_id when it is not the current run. Call with mutex_ held.
   void select(const std::string& run_id);

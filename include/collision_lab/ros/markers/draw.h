@@ -1,0 +1,130 @@
+// What the views share (internal to the marker builders): marker primitives, plot axes
+// and frames, the facts of a run that several views show, and one function per view.
+// The views draw into a Canvas; the order of their calls is the order of the markers.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <geometry_msgs/Point.h>
+#include <std_msgs/ColorRGBA.h>
+#include <visualization_msgs/Marker.h>
+
+#include "collision_lab/ros/marker_builder.h"
+#include "collision_lab/ros/markers/ids.h"
+#include "collision_lab/ros/markers/layout.h"
+
+namespace collision_lab_ros::markers {
+
+using visualization_msgs::Marker;
+using Vec3 = std::array<double, 3>;
+using Polyline = std::vector<Envelope::Vertex>;
+
+constexpr const char* kNames[3] = {"A", "B", "C"};
+
+// ---- primitives ----
+std_msgs::ColorRGBA color(const Rgba& c);
+/// Body i's colour, lightened towards white by `lighten` (0..1).
+std_msgs::ColorRGBA particleColor(int i, double lighten = 0.0);
+geometry_msgs::Point point(double x, double y, double z = 0.0);
+std::string format(const char* fmt, double value);
+/// 31415 -> "31,415".
+std::string withSeparators(std::uint64_t n);
+std::array<double, 3> toArray3(const boost::array<double, 3>& a);
+bool isWall(const collision_lab::InitialConditions& input, int i);
+
+/// Where a view draws: the run, the frame of its markers, and the array it appends to.
+struct Canvas {
+  const RunRecord& run;
+  const std::string& frame_id;
+  std::vector<Marker>& out;
+
+  Marker base(const std::string& ns, int id, int type) const;
+  Marker text(const std::string& ns, int id, double x, double y, const std::string& s,
+              double size = layout::kTextSize, const std_msgs::ColorRGBA& c = color(layout::kWhite)) const;
+  Marker lines(const std::string& ns, int id, int type, double width, const std_msgs::ColorRGBA& c) const;
+  Marker dots(const std::string& ns, int id, double size, const std_msgs::ColorRGBA& c) const;
+  void add(Marker m) const { out.push_back(std::move(m)); }
+  /// Line markers go out only with enough points for rviz (>= 2; LINE_LIST in pairs).
+  void addLines(Marker m) const;
+};
+/// A text and a line marker without a run (the overlays draw over any run).
+Marker textMarker(const std::string& frame_id, const std::string& ns, int id, double x, double y,
+                  const std::string& s, double size, const std_msgs::ColorRGBA& c);
+Marker lineMarker(const std::string& frame_id, const std::string& ns, int id, int type, double width,
+                  const std_msgs::ColorRGBA& c);
+
+// ---- plots ----
+/// A linear map from data (x in [x0, x1], y in [y0, y1]) into a box; values outside are
+/// drawn at its edges.
+struct Axes {
+  Box box;
+  double x0 = 0.0, x1 = 1.0, y0 = 0.0, y1 = 1.0;
+  double toX(double x) const;
+  double toY(double y) const;
+  bool contains(double y) const { return y >= y0 && y <= y1; }
+};
+/// [lo, hi] widened to include `always` and padded; [-1, 1] around it when empty.
+std::pair<double, double> paddedRange(double lo, double hi, double always = 0.0);
+/// The frame, a zero line when 0 is inside, values at the bottom, top and zero, and a
+/// label over the panel (ids base + kFrame*).
+void addFrame(const Canvas& c, const std::string& ns, int base, const Axes& axes, const std::string& label);
+/// A series' steps as a LINE_STRIP, plus a dot at its start (id + kSeriesStartDot) when
+/// the known part is too short to see on the axis.
+void addSeries(const Canvas& c, const std::string& ns, int id, const Polyline& poly, const Axes& axes,
+               const std_msgs::ColorRGBA& colour, double width = layout::kSeriesWidth);
+/// The segments of a series whose mark exceeds `tolerance`, as a LINE_LIST.
+Marker markedSegments(const Canvas& c, const std::string& ns, int id, const Polyline& poly, const Axes& axes,
+                      double tolerance, const std_msgs::ColorRGBA& colour);
+/// The series' polyline held at its last value up to x_end.
+Polyline withTail(const Envelope& e, double x_end);
+/// Evenly thinned keyframes, at most `n`.
+std::vector<const Keyframe*> thinned(const std::vector<Keyframe>& frames, std::size_t n);
+/// Labels of the collision index axis under a box (ids base + label number).
+void addIndexAxisLabels(const Canvas& c, const std::string& ns, int base, const Axes& axes);
+
+// ---- facts of the run ----
+/// Collisions the run is known to have, as far as the messages tell [1].
+std::uint64_t expectedCollisions(const RunRecord& run);
+/// The collision index axis runs to this [1]: one past the last drawn step, or past the
+/// predicted count when the collisions are not shown one by one.
+double indexAxisEnd(const RunRecord& run);
+/// Velocities after all the collisions when the steps do not get there: the summary's
+/// (simulated or, when not simulated, predicted) or the prediction's, at index n.
+std::optional<std::pair<std::uint64_t, Vec3>> finalVelocitiesNotDrawn(const RunRecord& run);
+std::string runTitle(const RunRecord& run);
+/// What the picture does not show, in one line (empty when it shows the whole run).
+std::string runNote(const RunRecord& run);
+/// The status line: time, collisions, the clock.
+std::string statusLine(const RunRecord& run, const SceneState& state, const FrameClock& clock);
+
+/// The scene's position axis [m] on screen.
+struct SceneAxis {
+  double min = 0.0, max = 1.0;
+  double toX(double position) const;
+};
+/// Every position the animation can show: the worldlines and the end state.
+SceneAxis sceneAxis(const RunRecord& run);
+
+// ---- the views (static: when a message arrives; animated: every frame) ----
+void drawTitle(const Canvas& c);
+void drawSceneAxis(const Canvas& c);
+void drawWedge(const Canvas& c);
+void drawVelocitySteps(const Canvas& c);
+void drawConservedSteps(const Canvas& c);
+void drawWorldlines(const Canvas& c);
+void drawEnergyBarsAxis(const Canvas& c);
+
+void drawBodies(const Canvas& c, const SceneState& state);
+void drawMagnifier(const Canvas& c, const SceneState& state);
+void drawStatus(const Canvas& c, const SceneState& state, const FrameClock& clock);
+void drawWedgeCursor(const Canvas& c, const SceneState& state);
+void drawStepsCursor(const Canvas& c, const SceneState& state);
+void drawWorldlinesCursor(const Canvas& c, const SceneState& state);
+void drawEnergyBars(const Canvas& c, const SceneState& state);
+
+}  // namespace collision_lab_ros::markers

@@ -1,0 +1,130 @@
+// Every rviz marker of the views by namespace (Marker.ns) and id (Marker.id): one enum,
+// grouped by namespace. rviz replaces a marker of the same ns and id, so each name below is
+// one thing on screen. Where a name is a base, the marker's id is base + an offset (a
+// body's index i: 0 A, 1 B, 2 C; a frame part; a label's position), as its comment says.
+#pragma once
+
+namespace collision_lab_ros::markers {
+
+/// The namespaces. rviz/collision_lab.rviz shows them all (two MarkerArray displays).
+namespace ns {
+// static: rebuilt when a message arrives (topic `markers`)
+constexpr const char* kTitle = "title";
+constexpr const char* kScene = "scene";
+constexpr const char* kWedge = "wedge";
+constexpr const char* kPlot = "plot";            // velocity steps and the paper's series
+constexpr const char* kConserved = "conserved";  // energy and momentum steps
+constexpr const char* kWorldlines = "worldlines";
+constexpr const char* kEnergy = "energy";        // the kinetic energy bars' axis
+// animated: every frame (topic `markers_animated`)
+constexpr const char* kBodies = "bodies";
+constexpr const char* kLabels = "labels";
+constexpr const char* kZoom = "zoom";  // the magnifier
+constexpr const char* kWedgeNow = "wedge_now";
+constexpr const char* kPlotCursor = "plot_cursor";
+constexpr const char* kWorldlinesNow = "worldlines_now";
+constexpr const char* kEnergyBars = "energy_bars";
+// overlays, also on `markers_animated`
+constexpr const char* kRejected = "rejected";
+constexpr const char* kHint = "hint";
+}  // namespace ns
+
+enum MarkerId : int {
+  // ns "title"
+  kTitleText = 0,
+
+  // ns "scene"
+  kSceneAxis = 0,
+  kSceneMinLabel = 1,
+  kSceneMaxLabel = 2,
+  kSceneNote = 4,  ///< what the picture does not show
+
+  // a plot frame (addFrame): base + these
+  kFrameLines = 0,
+  kFrameTopValue = 1,
+  kFrameBottomValue = 2,
+  kFrameZeroLabel = 3,
+  kFrameLabel = 4,
+  /// A series' start dot (when its known part is too short to see): the series' id + this.
+  kSeriesStartDot = 1000,
+
+  // ns "wedge"
+  kWedgeCone = 0,
+  kWedgeLines = 1,  ///< L_BC and L_AB
+  kWedgeBcLabel = 2,
+  kWedgeAbLabel = 3,
+  kWedgeCaption = 4,  ///< the cone's colour and alpha
+  kWedgeCircle = 5,   ///< |u_perp| is conserved: the path lies on it
+  kWedgePath = 6,
+  kWedgeSimulated = 7,
+  kWedgePredicted = 8,
+  kWedgeStartLabel = 9,
+  kWedgeTitle = 10,
+  kWedgeLegend = 11,
+
+  // ns "plot": panel p (0, or 1 for A and C when B has its own) at p * kPlotPanelStride
+  kPlotPanelStride = 100,
+  kPlotFrame = 0,       ///< + kFrame*
+  kPlotSeries = 10,     ///< + body index
+  kPlotPredicted = 20,  ///< + body index: the closed form's dots
+  kPlotPaper = 30,      ///< + body index: the paper's series where it differs
+  kPlotTitle = 310,
+  kPlotLegend = 311,
+  kPlotSeriesNames = 320,  ///< + body index
+  kPlotIndexLabels = 400,  ///< + label number
+
+  // ns "conserved"
+  kConservedEnergy = 0,     ///< base of the energy plot
+  kConservedMomentum = 100, ///< base of the momentum plot
+  kConservedSeries = 10,    ///< base + this
+  kConservedIndexLabels = 20,  ///< base + this + label number
+
+  // ns "worldlines"
+  kWorldFrame = 0,
+  kWorldTimeZero = 1,
+  kWorldTimeEnd = 2,
+  kWorldTimeUnit = 3,
+  kWorldPositionMin = 4,
+  kWorldPositionMax = 5,
+  kWorldPositionUnit = 6,
+  kWorldTitle = 7,
+  kWorldLegend = 8,
+  kWorldLines = 10,  ///< + body index
+
+  // ns "energy"
+  kEnergyAxis = 0,
+  kEnergyBodyNames = 1,  ///< + body index
+  kEnergyTitle = 4,
+
+  // ns "bodies"
+  kBody = 0,  ///< + body index
+
+  // ns "labels"
+  kBodyTag = 0,  ///< + body index
+  kStatus = 3,
+  kVelocityRow = 10,  ///< + body index
+
+  // ns "zoom"
+  kZoomLine = 0,
+  kZoomBody = 1,  ///< + body index
+  kZoomMagnification = 4,
+  kZoomWindow = 5,
+  kZoomCount = 6,  ///< ids 0 .. kZoomCount - 1
+
+  // ns "wedge_now", "plot_cursor"
+  kCursor = 0,
+
+  // ns "worldlines_now"
+  kWorldNowLine = 0,
+  kWorldNowBodies = 1,
+
+  // ns "energy_bars"
+  kEnergyBar = 0,       ///< + body index
+  kEnergyBarValue = 10, ///< + body index
+
+  // ns "rejected" and "hint": a framed text
+  kFramedText = 0,
+  kFramedBox = 1,
+};
+
+}  // namespace collision_lab_ros::markers

@@ -1,0 +1,140 @@
+// Where the views sit and how they look: every position, size, line width, colour and
+// scale of the rviz markers, in one place [rviz units unless stated].
+// rviz/collision_lab.rviz looks down at (2.8, 0.85), 46 px per unit; its 1248 x 708 pixel
+// view shows x in [-10.7, 16.3] and y in [-6.8, 8.5].
+#pragma once
+
+#include <cstddef>
+
+namespace collision_lab_ros::markers {
+
+/// A rectangle in the marker frame [rviz units].
+struct Box {
+  double left, right, bottom, top;
+  constexpr double midX() const { return (left + right) / 2; }
+  constexpr double midY() const { return (bottom + top) / 2; }
+};
+
+/// A colour, 0..1 per channel.
+struct Rgba {
+  double r, g, b, a = 1.0;
+};
+
+namespace layout {
+
+// ---- rows and panels ----
+constexpr double kCentreX = 2.8;
+constexpr double kTitleY = 8.25, kNoteY = 7.8, kStatusY = 7.35, kVelocityRowY = 6.9;
+constexpr double kSceneY = 6.05, kSceneLeft = -10.2, kSceneRight = 15.8, kZoomY = 5.05;
+constexpr double kPanelTitleY = 4.55, kLegendY = 4.2;
+constexpr Box kWedgeBox{-10.6, -4.6, -0.55, 3.65};
+constexpr Box kBarsBox{-9.9, -5.3, -6.3, -2.6};
+constexpr Box kVelocityBox{-2.2, 5.2, -0.35, 3.55};
+constexpr Box kEnergyBox{-2.2, 5.2, -3.05, -1.55};
+constexpr Box kMomentumBox{-2.2, 5.2, -6.1, -4.6};
+constexpr Box kWorldBox{8.3, 15.9, -6.1, 3.55};
+constexpr double kHintY = 1.5;
+
+// ---- text heights, depths ----
+constexpr double kTextSize = 0.32, kSmallTextSize = 0.29, kTitleSize = 0.38;
+/// Large: an underscore one pixel thin would vanish, and the hint is a command to copy.
+constexpr double kHintTextSize = 0.44;
+constexpr double kTextZ = 0.2;  ///< texts over everything
+constexpr double kDotZ = 0.05;  ///< dots over lines
+
+// ---- colours ----
+constexpr Rgba kParticleRgb[3] = {{0.95, 0.25, 0.25}, {0.25, 0.8, 0.3}, {0.3, 0.55, 1.0}};
+constexpr Rgba kWhite{0.95, 0.95, 0.95};
+constexpr Rgba kGrey{0.6, 0.6, 0.6};
+/// Small grey text lighter than lines: rviz draws a minus sign one pixel thin.
+constexpr Rgba kLabelGrey{0.8, 0.8, 0.8};
+constexpr Rgba kAmber{1.0, 0.75, 0.2};
+constexpr Rgba kPaper{1.0, 0.55, 0.9};
+constexpr Rgba kPredicted{0.8, 0.5, 1.0};
+constexpr Rgba kCursorWhite{1, 1, 1, 0.5};
+constexpr Rgba kConeFill{1.0, 0.85, 0.2, 0.3};
+constexpr Rgba kConeYellow{1.0, 0.85, 0.2};
+constexpr Rgba kPathOrange{1.0, 0.55, 0.1, 0.8};
+constexpr Rgba kSimulatedOrange{1.0, 0.55, 0.1};
+constexpr Rgba kBannerRed{1.0, 0.35, 0.35};
+/// How much lighter than its body a body's text is (0: same, 1: white).
+constexpr double kTagLighten = 0.3;
+/// How much lighter than its series a closed form's dot is.
+constexpr double kDotLighten = 0.6;
+
+// ---- line widths ----
+constexpr double kFrameWidth = 0.025, kAxisWidth = 0.03, kSeriesWidth = 0.035, kConservedWidth = 0.03;
+constexpr double kCursorWidth = 0.02;
+
+// ---- plots (frames, steps, index axis) ----
+constexpr double kValueLabelDx = -0.55;  ///< a frame's top and bottom values, left of it
+constexpr double kZeroLabelDx = -0.3;
+constexpr double kFrameLabelDy = 0.22;  ///< a frame's label, over it
+constexpr double kLabelClearance = 0.3;  ///< an end value closer than this to zero gives way
+constexpr double kRangePadding = 0.06;  ///< of the data's range, at each end
+constexpr double kStartDotSize = 0.16;
+constexpr double kShortestSeries = 0.1;  ///< shorter series get a start dot
+constexpr double kMarkedWidth = 0.025, kMarkedZ = 0.02;
+constexpr double kIndexLabelDy = -0.28;
+constexpr unsigned kAllIndexLabelsUpTo = 12;  ///< beyond: the first and the last step only
+constexpr double kPredictedDotSize = 0.09;
+constexpr double kOwnPanelGap = 0.45;  ///< between B's panel and A's and C's
+constexpr double kSeriesNameDx = 0.55, kSeriesNamePitch = 0.4;
+/// The paper's series is drawn where it differs by more than this share of the panel.
+constexpr double kPaperTolerance = 1e-6;
+/// B gets its own panel when its largest speed exceeds A's and C's by this factor.
+constexpr double kOwnScaleFactor = 5.0;
+/// The paper's velocities widen a panel's scale at most this much; beyond, they are clipped.
+constexpr double kPaperScaleFactor = 4.0;
+/// At most this many closed-form dots per series (they sit on the simulated steps).
+constexpr std::size_t kMaxPredictedDots = 200;
+
+// ---- the scene and its magnifier ----
+constexpr double kSceneLabelDx = 0.9, kSceneLabelDy = -0.5;
+constexpr double kSmallestBody = 0.35, kBodyGrowth = 0.55;  ///< diameter over the mass decades
+constexpr double kWallWidth = 0.2, kWallHeight = 1.8, kWallDepth = 0.3;
+constexpr double kWallTagDx = 0.8, kTagDy = 0.5;
+constexpr double kVelocityRowPitch = 6.8;
+/// The magnifier shows while the bodies are closer than this share of the scene's axis.
+constexpr double kCrowded = 0.05;
+constexpr double kZoomMargin = 1.6;   ///< the window is a power of ten >= this x their spread
+constexpr double kZoomInset = 5.0;    ///< from each end of the scene's axis
+constexpr double kZoomLightSize = 0.16, kZoomHeavySize = 0.26, kZoomWallWidth = 0.08, kZoomWallHeight = 0.6;
+constexpr double kZoomLightZ = 0.3;  ///< B, the light one, on top: at a collision it touches A or C
+constexpr double kZoomMagnificationDx = -2.2, kZoomWindowDx = 2.5;
+
+// ---- the wedge in velocity space ----
+constexpr double kWedgeRadius = 2.1;
+constexpr double kWedgeX = kWedgeBox.midX(), kWedgeY = kWedgeBox.midY();
+constexpr int kConeSegments = 32, kCircleSegments = 96;
+constexpr double kConeZ = -0.01;
+constexpr double kWedgeLineWidth = 0.03, kCircleWidth = 0.012, kPathWidth = 0.025;
+constexpr double kLineLabelRadius = 1.14 * kWedgeRadius;
+/// L_AB's label moves up by kNarrowConeDy when the cone is narrower than this [rad].
+constexpr double kNarrowCone = 0.3, kNarrowConeDy = 0.35;
+/// The path's circle: |u_perp| at this share of the wedge's radius.
+constexpr double kPathRadius = 0.8 * kWedgeRadius;
+constexpr double kSimulatedDotSize = 0.16, kPredictedWedgeDotSize = 0.08, kCursorSize = 0.3, kCursorZ = 0.1;
+constexpr double kStartLabelDy = -0.3, kCaptionDy = -0.1, kWedgeLegendDy = -0.65;
+/// At most this many states per series in the wedge when not every collision is kept.
+constexpr std::size_t kMaxWedgeDots = 600;
+
+// ---- the x-t diagram ----
+constexpr double kWallLineWidth = 0.08, kBodyLineWidth = 0.03;
+constexpr double kWorldZeroDx = -0.3, kWorldEndDx = -0.55, kWorldUnitDx = -0.45, kWorldUnitDy = 0.3;
+constexpr double kWorldPositionDy = -0.3;
+constexpr double kWorldNowDotSize = 0.16;
+
+// ---- the kinetic energy bars ----
+constexpr double kBarNameDy = -0.3, kBarsTitleDy = 0.75;
+constexpr double kBarWidth = 0.6;  ///< share of the pitch
+constexpr double kBarMinHeight = 0.01, kBarDepth = 0.1, kBarValueDy = 0.25;
+
+// ---- framed texts (banner, hint) ----
+/// rviz's font is about 0.42 text heights wide per character, 1.25 high per line.
+constexpr double kHalfCharWidth = 0.21, kHalfLineHeight = 0.62;
+constexpr double kFrameMarginX = 0.4, kFrameMarginY = 0.2, kMaxHalfFrameWidth = 13.0;
+constexpr double kFramedBoxWidth = 0.03;
+
+}  // namespace layout
+}  // namespace collision_lab_ros::markers

@@ -1,0 +1,204 @@
+// Marker primitives and plot parts shared by the views (see markers/draw.h).
+#include "collision_lab/ros/markers/draw.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace collision_lab_ros::markers {
+
+using namespace layout;
+
+std_msgs::ColorRGBA color(const Rgba& c) {
+  std_msgs::ColorRGBA out;
+  out.r = c.r; out.g = c.g; out.b = c.b; out.a = c.a;
+  return out;
+}
+
+std_msgs::ColorRGBA particleColor(int i, double lighten) {
+  const Rgba& c = kParticleRgb[i];
+  return color({c.r + (1 - c.r) * lighten, c.g + (1 - c.g) * lighten, c.b + (1 - c.b) * lighten});
+}
+
+geometry_msgs::Point point(double x, double y, double z) {
+  geometry_msgs::Point p;
+  p.x = x; p.y = y; p.z = z;
+  return p;
+}
+
+std::string format(const char* fmt, double value) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, fmt, value);
+  return buffer;
+}
+
+std::string withSeparators(std::uint64_t n) {
+  std::string digits = std::to_string(n), out;
+  for (std::size_t k = 0; k < digits.size(); ++k) {
+    if (k > 0 && (digits.size() - k) % 3 == 0) out += ',';
+    out += digits[k];
+  }
+  return out;
+}
+
+std::array<double, 3> toArray3(const boost::array<double, 3>& a) { return {a[0], a[1], a[2]}; }
+
+bool isWall(const collision_lab::InitialConditions& input, int i) { return std::isinf(input.masses[i]); }
+
+namespace {
+
+Marker baseMarker(const std::string& frame_id, const std::string& ns, int id, int type) {
+  Marker m;
+  m.header.frame_id = frame_id;  // stamp 0: rviz uses the latest transform
+  m.ns = ns;
+  m.id = id;
+  m.type = type;
+  m.action = Marker::ADD;
+  m.pose.orientation.w = 1.0;
+  m.scale.x = m.scale.y = m.scale.z = 1.0;
+  m.color = color(kWhite);
+  return m;
+}
+
+}  // namespace
+
+Marker textMarker(const std::string& frame_id, const std::string& ns, int id, double x, double y,
+                  const std::string& s, double size, const std_msgs::ColorRGBA& c) {
+  Marker m = baseMarker(frame_id, ns, id, Marker::TEXT_VIEW_FACING);
+  m.pose.position = point(x, y, kTextZ);
+  m.scale.z = size;
+  m.color = c;
+  m.text = s;
+  return m;
+}
+
+Marker lineMarker(const std::string& frame_id, const std::string& ns, int id, int type, double width,
+                  const std_msgs::ColorRGBA& c) {
+  Marker m = baseMarker(frame_id, ns, id, type);
+  m.scale.x = width;
+  m.color = c;
+  return m;
+}
+
+Marker Canvas::base(const std::string& ns, int id, int type) const { return baseMarker(frame_id, ns, id, type); }
+
+Marker Canvas::text(const std::string& ns, int id, double x, double y, const std::string& s, double size,
+                    const std_msgs::ColorRGBA& c) const {
+  return textMarker(frame_id, ns, id, x, y, s, size, c);
+}
+
+Marker Canvas::lines(const std::string& ns, int id, int type, double width, const std_msgs::ColorRGBA& c) const {
+  return lineMarker(frame_id, ns, id, type, width, c);
+}
+
+Marker Canvas::dots(const std::string& ns, int id, double size, const std_msgs::ColorRGBA& c) const {
+  Marker m = base(ns, id, Marker::SPHERE_LIST);
+  m.scale.x = m.scale.y = m.scale.z = size;
+  m.color = c;
+  return m;
+}
+
+void Canvas::addLines(Marker m) const {
+  if (m.points.size() >= 2) out.push_back(std::move(m));
+}
+
+// ---- plots ----
+
+double Axes::toX(double x) const {
+  return box.left + std::clamp((x - x0) / (x1 - x0), 0.0, 1.0) * (box.right - box.left);
+}
+
+double Axes::toY(double y) const {
+  return box.bottom + std::clamp((y - y0) / (y1 - y0), 0.0, 1.0) * (box.top - box.bottom);
+}
+
+std::pair<double, double> paddedRange(double lo, double hi, double always) {
+  lo = std::min(lo, always);
+  hi = std::max(hi, always);
+  if (!(hi > lo) || !std::isfinite(hi - lo)) {
+    const double centre = std::isfinite(lo) ? lo : 0.0;
+    return {centre - 1.0, centre + 1.0};
+  }
+  const double pad = kRangePadding * (hi - lo);
+  return {lo - pad, hi + pad};
+}
+
+void addFrame(const Canvas& c, const std::string& ns, int base, const Axes& axes, const std::string& label) {
+  const Box& b = axes.box;
+  const bool zero_inside = axes.y0 < 0 && axes.y1 > 0;
+  const double zero = axes.toY(0.0);
+  Marker frame = c.lines(ns, base + kFrameLines, Marker::LINE_LIST, kFrameWidth, color(kGrey));
+  frame.points = {point(b.left, b.bottom), point(b.right, b.bottom), point(b.left, b.bottom), point(b.left, b.top)};
+  if (zero_inside) {
+    frame.points.push_back(point(b.left, zero));
+    frame.points.push_back(point(b.right, zero));
+  }
+  c.add(frame);
+  // Zero is labelled whenever it is inside; an end label too close to it gives way.
+  if (!zero_inside || b.top - zero > kLabelClearance) {
+    c.add(c.text(ns, base + kFrameTopValue, b.left + kValueLabelDx, b.top, format("%.3g", axes.y1), kSmallTextSize));
+  }
+  if (!zero_inside || zero - b.bottom > kLabelClearance) {
+    c.add(c.text(ns, base + kFrameBottomValue, b.left + kValueLabelDx, b.bottom, format("%.3g", axes.y0),
+                 kSmallTextSize));
+  }
+  if (zero_inside) c.add(c.text(ns, base + kFrameZeroLabel, b.left + kZeroLabelDx, zero, "0", kSmallTextSize));
+  c.add(c.text(ns, base + kFrameLabel, b.midX(), b.top + kFrameLabelDy, label, kSmallTextSize));
+}
+
+void addSeries(const Canvas& c, const std::string& ns, int id, const Polyline& poly, const Axes& axes,
+               const std_msgs::ColorRGBA& colour, double width) {
+  // One LINE_STRIP; non-finite vertices are skipped.
+  Marker m = c.lines(ns, id, Marker::LINE_STRIP, width, colour);
+  for (const auto& v : poly) {
+    if (std::isfinite(v.x) && std::isfinite(v.y)) m.points.push_back(point(axes.toX(v.x), axes.toY(v.y)));
+  }
+  c.addLines(m);
+  if (!poly.empty() && axes.toX(poly.back().x) - axes.toX(poly.front().x) < kShortestSeries) {
+    Marker dot = c.dots(ns, id + kSeriesStartDot, kStartDotSize, colour);
+    dot.points.push_back(point(axes.toX(poly.front().x), axes.toY(poly.front().y), kDotZ));
+    c.add(dot);
+  }
+}
+
+Marker markedSegments(const Canvas& c, const std::string& ns, int id, const Polyline& poly, const Axes& axes,
+                      double tolerance, const std_msgs::ColorRGBA& colour) {
+  Marker m = c.lines(ns, id, Marker::LINE_LIST, kMarkedWidth, colour);
+  for (std::size_t k = 1; k < poly.size(); ++k) {
+    const auto& a = poly[k - 1];
+    const auto& b = poly[k];
+    if (!(std::isfinite(a.y) && std::isfinite(b.y))) continue;
+    if (!(std::max(a.mark, b.mark) > tolerance)) continue;
+    m.points.push_back(point(axes.toX(a.x), axes.toY(a.y), kMarkedZ));
+    m.points.push_back(point(axes.toX(b.x), axes.toY(b.y), kMarkedZ));
+  }
+  return m;
+}
+
+Polyline withTail(const Envelope& e, double x_end) {
+  Polyline poly = e.polyline();
+  if (!poly.empty() && x_end > poly.back().x) poly.push_back({x_end, e.last().y, e.last().mark});
+  return poly;
+}
+
+std::vector<const Keyframe*> thinned(const std::vector<Keyframe>& frames, std::size_t n) {
+  std::vector<const Keyframe*> out;
+  const std::size_t stride = std::max<std::size_t>(1, (frames.size() + n - 1) / n);
+  for (std::size_t k = 0; k < frames.size(); k += stride) out.push_back(&frames[k]);
+  return out;
+}
+
+void addIndexAxisLabels(const Canvas& c, const std::string& ns, int base, const Axes& axes) {
+  // Step k (the velocities after k collisions) spans [k, k+1] of the axis; its label sits
+  // under its middle: every step while there are few, else the first and the last. (The
+  // panels' titles name the axis.)
+  const auto last = static_cast<std::uint64_t>(axes.x1) - 1;
+  std::vector<std::uint64_t> ticks{0};
+  for (std::uint64_t k = last <= kAllIndexLabelsUpTo ? 1 : last; k <= last && k > 0; ++k) ticks.push_back(k);
+  for (std::size_t j = 0; j < ticks.size(); ++j) {
+    c.add(c.text(ns, base + static_cast<int>(j), axes.toX(ticks[j] + 0.5), axes.box.bottom + kIndexLabelDy,
+                 withSeparators(ticks[j]), kSmallTextSize));
+  }
+}
+
+}  // namespace collision_lab_ros::markers

@@ -1,0 +1,84 @@
+// What kind of run it is, and the texts that say so (title, note, status line).
+#include <algorithm>
+
+#include "collision_lab/ros/markers/draw.h"
+
+namespace collision_lab_ros::markers {
+
+namespace {
+
+bool simulatedStepByStep(const RunRecord& run) {
+  return run.input().mode == collision_lab::InitialConditions::MODE_FULL &&
+         !(run.summary && !run.summary->simulated);
+}
+
+}  // namespace
+
+std::uint64_t expectedCollisions(const RunRecord& run) {
+  if (run.summary && run.summary->simulated && !run.summary->truncated) return run.summary->collision_count;
+  if (run.prediction) return std::max<std::uint64_t>(run.prediction->collision_count, run.collisions());
+  return run.collisions();
+}
+
+double indexAxisEnd(const RunRecord& run) {
+  const std::uint64_t n = simulatedStepByStep(run) ? run.collisions() : expectedCollisions(run);
+  return static_cast<double>(n) + 1.0;
+}
+
+std::optional<std::pair<std::uint64_t, Vec3>> finalVelocitiesNotDrawn(const RunRecord& run) {
+  if (simulatedStepByStep(run) && !(run.summary && run.summary->truncated)) return std::nullopt;
+  if (run.summary && run.summary->simulated && !run.summary->truncated) {
+    return std::make_pair(run.summary->collision_count, toArray3(run.summary->final_velocities));
+  }
+  if (run.prediction && run.prediction->collision_count > run.collisions()) {
+    return std::make_pair(run.prediction->collision_count, toArray3(run.prediction->final_velocities));
+  }
+  return std::nullopt;
+}
+
+std::string runTitle(const RunRecord& run) {
+  std::string title = "run " + run.input().run_id;
+  if (run.prediction) {
+    title += ":  predicted " + withSeparators(run.prediction->collision_count) + " collisions";
+    title += run.prediction->paper_collision_count_defined
+                 ? "  (paper's eq. 3.22: " + std::to_string(run.prediction->paper_collision_count) + ")"
+                 : "  (paper's eq. 3.22: undefined)";
+  }
+  if (run.summary) {
+    title += run.summary->simulated ? ",  simulated " + withSeparators(run.summary->collision_count)
+                                    : ",  not simulated";
+    if (run.summary->truncated) title += " (truncated)";
+  }
+  return title;
+}
+
+std::string runNote(const RunRecord& run) {
+  std::string note;
+  if (run.missedCollisions() > 0) {
+    note += withSeparators(run.missedCollisions()) + " collision messages missing; ";
+  }
+  if (run.summary && run.summary->truncated) {
+    note += "stopped: " + run.summary->truncation_reason + ". Shown up to the last known state.";
+  } else if (run.input().mode == collision_lab::InitialConditions::MODE_PREDICT_ONLY) {
+    note += "predict-only run: shown up to the first contact; the plots show the closed form's final velocities.";
+  } else if (run.input().mode == collision_lab::InitialConditions::MODE_SUMMARY_ONLY) {
+    note += "summary-only run: shown up to the first contact; the plots show the final velocities.";
+  } else if (!run.finished()) {
+    note += "run in progress: shown up to the last collision received.";
+  }
+  return note;
+}
+
+std::string statusLine(const RunRecord& run, const SceneState& state, const FrameClock& clock) {
+  std::string s = format("t = %.6g s", state.time) + "     collisions " + withSeparators(state.collisions);
+  const std::uint64_t expected = expectedCollisions(run);
+  if (run.finished()) {
+    s += " of " + withSeparators(run.collisions());
+  } else if (expected > state.collisions) {
+    s += " (" + withSeparators(expected) + " predicted)";
+  }
+  if (!clock.description.empty()) s += "     " + clock.description;
+  return s;
+}
+
+}  // namespace collision_lab_ros::markers

@@ -1,0 +1,162 @@
+// The steps plots against collision index: v_A, v_B, v_C (simulated steps, closed-form
+// dots, the paper's printed eqs. (2.15)/(2.16) where they differ, B on its own scale when
+// it dwarfs A and C), the total energy and momentum of the finite masses, and the cursor
+// on the current step.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "collision_lab/ros/markers/draw.h"
+
+namespace collision_lab_ros::markers {
+
+using namespace layout;
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+struct VelocityPanel {
+  Axes axes;
+  std::vector<int> bodies;
+};
+
+double largestSpeed(const Envelope& e) { return std::max(std::abs(e.minY()), std::abs(e.maxY())); }
+
+/// The scale of a panel of these bodies: their steps and final velocities, and the
+/// paper's values unless they would squash the simulated ones.
+std::pair<double, double> velocityRange(const RunRecord& run, const std::vector<int>& bodies) {
+  const auto final_v = finalVelocitiesNotDrawn(run);
+  double lo = kInf, hi = -kInf;
+  for (int i : bodies) {
+    lo = std::min(lo, run.velocity(i).minY());
+    hi = std::max(hi, run.velocity(i).maxY());
+    if (final_v && std::isfinite(final_v->second[i])) {
+      lo = std::min(lo, final_v->second[i]), hi = std::max(hi, final_v->second[i]);
+    }
+  }
+  double paper_lo = lo, paper_hi = hi;
+  for (int i : bodies) {
+    paper_lo = std::min(paper_lo, run.paperVelocity(i).minY());
+    paper_hi = std::max(paper_hi, run.paperVelocity(i).maxY());
+  }
+  if (paper_hi - paper_lo <= kPaperScaleFactor * (hi - lo)) lo = paper_lo, hi = paper_hi;
+  return paddedRange(lo, hi);
+}
+
+/// One panel for all three, or B on its own (top) when it dwarfs A and C.
+std::vector<VelocityPanel> velocityPanels(const RunRecord& run) {
+  const double x1 = indexAxisEnd(run);
+  const auto panel = [&](const Box& box, const std::vector<int>& bodies) {
+    const auto [y0, y1] = velocityRange(run, bodies);
+    return VelocityPanel{Axes{box, 0.0, x1, y0, y1}, bodies};
+  };
+  const double others = std::max(largestSpeed(run.velocity(0)), largestSpeed(run.velocity(2)));
+  if (largestSpeed(run.velocity(1)) > kOwnScaleFactor * others) {
+    const double middle = kVelocityBox.midY();
+    return {panel({kVelocityBox.left, kVelocityBox.right, middle + kOwnPanelGap / 2, kVelocityBox.top}, {1}),
+            panel({kVelocityBox.left, kVelocityBox.right, kVelocityBox.bottom, middle - kOwnPanelGap / 2}, {0, 2})};
+  }
+  return {panel(kVelocityBox, {0, 1, 2})};
+}
+
+/// The paper's series of body i where it differs from the simulated one; true when some
+/// of it lies off the panel's scale.
+bool addPaperSeries(const Canvas& c, const Axes& axes, int i, int id) {
+  const Envelope& paper = c.run.paperVelocity(i);
+  if (paper.empty()) return false;
+  const double tolerance = kPaperTolerance * (axes.y1 - axes.y0);
+  c.addLines(markedSegments(c, ns::kPlot, id, withTail(paper, static_cast<double>(c.run.collisions()) + 1), axes,
+                            tolerance, color(kPaper)));
+  return !(axes.contains(paper.minY()) && axes.contains(paper.maxY()));
+}
+
+/// The closed form's velocities of body i after each kept collision (and the final ones
+/// when the steps do not get there), as dots on the steps.
+void addPredictedDots(const Canvas& c, const Axes& axes, int i, int id) {
+  const auto final_v = finalVelocitiesNotDrawn(c.run);
+  Marker predicted = c.dots(ns::kPlot, id, kPredictedDotSize, particleColor(i, kDotLighten));
+  for (const Keyframe* f : thinned(c.run.keyframes(), kMaxPredictedDots)) {
+    predicted.points.push_back(point(axes.toX(f->index + 0.5), axes.toY(f->predicted[i]), kDotZ));
+  }
+  if (final_v) predicted.points.push_back(point(axes.toX(final_v->first + 0.5), axes.toY(final_v->second[i]), kDotZ));
+  if (!predicted.points.empty()) c.add(predicted);
+}
+
+struct PaperShown {
+  bool any = false, off_scale = false;
+};
+
+void addVelocityPanel(const Canvas& c, const VelocityPanel& panel, int p, std::size_t panels, PaperShown& paper) {
+  const int base = kPlotPanelStride * p;
+  const std::string label = panels == 1 ? "v [m/s]" : p == 0 ? "v_B [m/s]" : "v_A, v_C [m/s]";
+  addFrame(c, ns::kPlot, base + kPlotFrame, panel.axes, label);
+  const double tail = static_cast<double>(c.run.collisions()) + 1;
+  for (int i : panel.bodies) {
+    addSeries(c, ns::kPlot, base + kPlotSeries + i, withTail(c.run.velocity(i), tail), panel.axes, particleColor(i));
+    addPredictedDots(c, panel.axes, i, base + kPlotPredicted + i);
+    paper.any = paper.any || !c.run.paperVelocity(i).empty();
+    paper.off_scale = addPaperSeries(c, panel.axes, i, base + kPlotPaper + i) || paper.off_scale;
+  }
+}
+
+/// The plot's title, the legend (what the paper's series shows) and the series' names.
+void addVelocityLegend(const Canvas& c, bool own_scale, const PaperShown& paper) {
+  c.add(c.text(ns::kPlot, kPlotTitle, kVelocityBox.midX(), kPanelTitleY,
+               own_scale ? "velocity vs collision index (B on its own scale)" : "velocity vs collision index",
+               kTextSize));
+  std::string legend = "steps: simulated   dots: closed form";
+  if (paper.any) legend += "   pink: paper's eqs. (2.15)/(2.16) where they differ";
+  if (paper.off_scale) legend += " (clipped)";
+  if (!paper.any && (isWall(c.run.input(), 0) || isWall(c.run.input(), 2))) {
+    legend += "   paper's (2.15)/(2.16): undefined with a wall";
+  }
+  c.add(c.text(ns::kPlot, kPlotLegend, kVelocityBox.midX(), kLegendY, legend, kSmallTextSize, color(kLabelGrey)));
+  for (int i = 0; i < 3; ++i) {
+    c.add(c.text(ns::kPlot, kPlotSeriesNames + i, kVelocityBox.right + kSeriesNameDx,
+                 kVelocityBox.top - kSeriesNamePitch * i, std::string("v_") + kNames[i], kTextSize, particleColor(i)));
+  }
+}
+
+void addConservedPlot(const Canvas& c, const Envelope& series, const Box& box, int base, const std::string& label) {
+  const auto [y0, y1] = paddedRange(series.minY(), series.maxY());
+  const Axes axes{box, 0.0, indexAxisEnd(c.run), y0, y1};
+  addFrame(c, ns::kConserved, base, axes, label);
+  addSeries(c, ns::kConserved, base + kConservedSeries, withTail(series, static_cast<double>(c.run.collisions()) + 1),
+            axes, color(kWhite), kConservedWidth);
+  addIndexAxisLabels(c, ns::kConserved, base + kConservedIndexLabels, axes);
+}
+
+}  // namespace
+
+void drawVelocitySteps(const Canvas& c) {
+  const auto panels = velocityPanels(c.run);
+  PaperShown paper;
+  for (std::size_t p = 0; p < panels.size(); ++p) addVelocityPanel(c, panels[p], static_cast<int>(p), panels.size(), paper);
+  addIndexAxisLabels(c, ns::kPlot, kPlotIndexLabels, panels.back().axes);
+  addVelocityLegend(c, panels.size() > 1, paper);
+}
+
+void drawConservedSteps(const Canvas& c) {
+  std::string energy = "E [J] of the finite masses vs collision index";
+  std::string p = "p [kg m/s] of the finite masses vs collision index";
+  if (c.run.summary && c.run.summary->simulated) {
+    energy += format(";  drift %.2g", c.run.summary->energy_relative_drift);
+    const double drift = c.run.summary->momentum_relative_drift;
+    p += std::isnan(drift) ? "; a wall takes some" : format(";  drift %.2g", drift);
+  }
+  addConservedPlot(c, c.run.energy(), kEnergyBox, kConservedEnergy, energy);
+  addConservedPlot(c, c.run.momentum(), kMomentumBox, kConservedMomentum, p);
+}
+
+void drawStepsCursor(const Canvas& c, const SceneState& state) {
+  // The current step [k, k+1] of the index plots, across the velocity, energy and momentum plots.
+  const Axes index{kVelocityBox, 0.0, indexAxisEnd(c.run), 0.0, 1.0};
+  const double cx = index.toX(static_cast<double>(state.collisions) + 0.5);
+  Marker cursor = c.lines(ns::kPlotCursor, kCursor, Marker::LINE_LIST, kCursorWidth, color(kCursorWhite));
+  cursor.points = {point(cx, kVelocityBox.bottom), point(cx, kVelocityBox.top), point(cx, kMomentumBox.bottom),
+                   point(cx, kEnergyBox.top)};
+  c.add(cursor);
+}
+
+}  // namespace collision_lab_ros::markers
