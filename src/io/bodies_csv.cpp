@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <fstream>
 #include <iostream>
-#include <iterator>
+#include <sstream>
 #include <string_view>
 
 #include "collision_lab/io/number_text.h"
@@ -53,9 +53,13 @@ void readBody(std::string_view line, std::size_t line_number, core::Scene& scene
 }  // namespace
 
 core::Scene readBodiesCsv(std::istream& in) {
-  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  std::ostringstream buffer;
+  if (in.peek() != std::char_traits<char>::eof()) buffer << in.rdbuf();
   if (in.bad()) throw BodiesFileError(BodiesFileError::Kind::kUnreadable, "bodies", "cannot read the bodies file");
+  const std::string text = std::move(buffer).str();
   core::Scene scene;
+  const std::size_t lines = static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')) + 1;
+  for (auto* column : {&scene.masses, &scene.positions, &scene.velocities}) column->reserve(lines);
   bool header_seen = false;
   std::size_t line_number = 0;
   for (std::size_t start = 0; start < text.size();) {

@@ -145,6 +145,7 @@ std::vector<SceneEntry> loadScenes(const std::string& path) {
 bool isThreeBodyEntry(const SceneEntry& entry) {
   const core::Scene& scene = entry.scene;
   return scene.masses.size() == 3 && scene.positions.size() == 3 && scene.velocities.size() == 3 &&
+         !(scene.isWall(0) && scene.isWall(2)) &&
          std::all_of(scene.restitution.begin(), scene.restitution.end(), [](double e) { return e == 1.0; });
 }
 

@@ -43,7 +43,8 @@ struct ScenarioFileError : std::runtime_error {
 /// Does not validate the physics (call core::validateForRun() on each scene).
 std::vector<SceneEntry> loadScenes(const std::string& path);
 
-/// True for an entry that the three-body path takes: three bodies, elastic.
+/// True for an entry that the three-body path takes: three bodies, elastic, not walls at
+/// both ends (that scene is answered by the N-body models).
 bool isThreeBodyEntry(const SceneEntry& entry);
 /// The entry as a three-body scene. Precondition: isThreeBodyEntry(entry).
 NamedScene toNamedScene(const SceneEntry& entry);
