@@ -83,7 +83,8 @@ struct SceneVisitors {
 
 /// Checks a scene for runScene. Three elastic bodies get the three-body validation (its
 /// reasons and messages, as today), except that walls at both ends around a body are now
-/// valid; every other scene gets validate(scene). Returns nothing when the scene is valid.
+/// valid; every other scene gets validate(scene). The message never repeats the field.
+/// Returns nothing when the scene is valid.
 /// Never throws for any input (short of memory).
 std::optional<ValidationError> validateForRun(const Scene& scene);
 
