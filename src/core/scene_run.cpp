@@ -78,7 +78,9 @@ SceneSimulation simulateScene(const Scene& scene, const SceneRunOptions& options
     return prediction && !prediction->infinite ? fromPrediction(*prediction) : notSimulated(prediction);
   }
   const bool wants_events = lab.mode == RunMode::kFull && lab.events.kind != EventPolicy::Kind::kNone;
-  if (prediction && !prediction->infinite && !wants_events) return fromPrediction(*prediction);
+  // Nothing approaching: there is nothing to simulate, events or not.
+  const bool nothing_happens = prediction && prediction->kind == ModelKind::kNoCollisions;
+  if (prediction && !prediction->infinite && (!wants_events || nothing_happens)) return fromPrediction(*prediction);
 
   EngineOptions engine_options;
   engine_options.max_impacts = lab.max_collisions;

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <fstream>
 #include <iostream>
-#include <sstream>
 #include <string_view>
 
 #include "collision_lab/io/number_text.h"
@@ -50,13 +49,21 @@ void readBody(std::string_view line, std::size_t line_number, core::Scene& scene
   }
 }
 
+/// The whole stream, in chunks (standard input has no size to ask for).
+std::string readAll(std::istream& in) {
+  std::string text;
+  std::vector<char> chunk(std::size_t{1} << 20);
+  while (in.read(chunk.data(), static_cast<std::streamsize>(chunk.size())) || in.gcount() > 0) {
+    text.append(chunk.data(), static_cast<std::size_t>(in.gcount()));
+  }
+  if (in.bad()) throw BodiesFileError(BodiesFileError::Kind::kUnreadable, "bodies", "cannot read the bodies file");
+  return text;
+}
+
 }  // namespace
 
 core::Scene readBodiesCsv(std::istream& in) {
-  std::ostringstream buffer;
-  if (in.peek() != std::char_traits<char>::eof()) buffer << in.rdbuf();
-  if (in.bad()) throw BodiesFileError(BodiesFileError::Kind::kUnreadable, "bodies", "cannot read the bodies file");
-  const std::string text = std::move(buffer).str();
+  const std::string text = readAll(in);
   core::Scene scene;
   const std::size_t lines = static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')) + 1;
   for (auto* column : {&scene.masses, &scene.positions, &scene.velocities}) column->reserve(lines);

@@ -232,13 +232,7 @@ void writeSceneJson(std::ostream& out, const SceneEntry& entry) {
   out << "}";
 }
 
-/// The summary without its velocity lists, which writeSummaryJson streams.
-Json summaryScalars(const core::SceneRunResult& result) {
-  Json json = sceneSummaryJson(result);
-  json.erase("final_velocities");
-  json.erase("predicted_final_velocities");
-  return json;
-}
+Json summaryScalars(const core::SceneRunResult& result);
 
 void writeSummaryJson(std::ostream& out, const core::SceneRunResult& result) {
   std::string scalars = jsonText(summaryScalars(result));
@@ -502,7 +496,9 @@ Json impactJson(const core::ImpactRecord& r) {
               {"energy_lost", number(r.energy_lost)}};
 }
 
-Json sceneSummaryJson(const core::SceneRunResult& result) {
+namespace {
+/// The summary without its velocity lists (10^6 numbers are streamed, not built).
+Json summaryScalars(const core::SceneRunResult& result) {
   const core::SceneSimulation& s = result.simulation;
   const auto& p = result.prediction;
   const bool has_formula = p && (p->impact_count || p->infinite);
@@ -519,8 +515,6 @@ Json sceneSummaryJson(const core::SceneRunResult& result) {
             {"matches_prediction", s.matches_prediction ? Json(*s.matches_prediction) : Json(nullptr)},
             {"max_prediction_error", number(s.max_prediction_error)},
             {"final_time", number(s.final_time)},
-            {"final_velocities", s.final_velocities},
-            {"predicted_final_velocities", p && !p->final_velocities.empty() ? Json(p->final_velocities) : Json(nullptr)},
             {"energy_lost", number(s.energy_lost)},
             {"energy_relative_drift", number(s.energy_relative_drift)},
             {"momentum_relative_drift", number(s.momentum_relative_drift)},
@@ -537,6 +531,16 @@ Json sceneSummaryJson(const core::SceneRunResult& result) {
                         {"high_precision", s.escalations.high_precision},
                         {"exact_rational", s.escalations.exact_rational},
                         {"replayed_impacts", s.escalations.replayed_impacts}};
+  return json;
+}
+}  // namespace
+
+Json sceneSummaryJson(const core::SceneRunResult& result) {
+  Json json = summaryScalars(result);
+  const auto& p = result.prediction;
+  json["final_velocities"] = result.simulation.final_velocities;
+  json["predicted_final_velocities"] =
+      p && !p->final_velocities.empty() ? Json(p->final_velocities) : Json(nullptr);
   return json;
 }
 

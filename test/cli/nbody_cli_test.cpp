@@ -300,12 +300,19 @@ TEST(NBodyCli, ALaterMultipleCollisionEndsTheRunNamingBodiesAndTime) {
   EXPECT_TRUE(summary.at("matches_prediction").is_null());
 }
 
-TEST(NBodyCli, OneBodySimulatesNothing) {
-  const Json doc = runJson({"--masses", "2", "--positions", "0", "--velocities", "1", "--events", "none"});
-  EXPECT_EQ(doc.at("summary").at("model"), "no_collisions");
-  EXPECT_EQ(doc.at("summary").at("predicted_collision_count"), 0);
-  EXPECT_EQ(doc.at("summary").at("simulated"), false);
-  EXPECT_EQ(doubles(doc.at("summary").at("final_velocities")), std::vector<double>{1});
+TEST(NBodyCli, OneBodyAndBodiesMovingApartSimulateNothing) {
+  for (const Json& doc : {runJson({"--masses", "2", "--positions", "0", "--velocities", "1"}),
+                          runJson({"--masses", "2", "--positions", "0", "--velocities", "1", "--events", "none"})}) {
+    EXPECT_EQ(doc.at("summary").at("model"), "no_collisions");
+    EXPECT_EQ(doc.at("summary").at("predicted_collision_count"), 0);
+    EXPECT_EQ(doc.at("summary").at("simulated"), false);
+    EXPECT_EQ(doubles(doc.at("summary").at("final_velocities")), std::vector<double>{1});
+  }
+  // Four bodies, each pair separating (v_p >= v_p+1): nothing approaches.
+  const Json apart = runJson({"--masses", "1,2,3,4", "--positions", "3,2,1,0", "--velocities", "2,1,1,-1"});
+  EXPECT_EQ(apart.at("summary").at("model"), "no_collisions");
+  EXPECT_EQ(apart.at("summary").at("simulated"), false);
+  EXPECT_TRUE(apart.at("events").empty());
 }
 
 TEST(NBodyCli, UnequalLengthsNameTheThreeLengths) {
