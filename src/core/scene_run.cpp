@@ -35,6 +35,7 @@ SceneSimulation fromPrediction(const Prediction& prediction) {
 /// Predict-only mode with no finite closed form: nothing is known beyond the model.
 SceneSimulation notSimulated(const std::optional<Prediction>& prediction) {
   SceneSimulation simulation;
+  simulation.energy_lost = std::numeric_limits<double>::quiet_NaN();  // not known
   simulation.energy_relative_drift = std::numeric_limits<double>::quiet_NaN();
   simulation.momentum_relative_drift = std::numeric_limits<double>::quiet_NaN();
   simulation.truncated = prediction && prediction->infinite;

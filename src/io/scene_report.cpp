@@ -161,7 +161,7 @@ class SceneTableWriter : public SceneReportWriter {
          << ", predicted " << predictedCountText(p) << "\n";
     if (!p || (!p->impact_count && !p->infinite)) out_ << "count formula: " << kNoCountFormula << "\n";
     out_ << "truncated: " << (s.truncated ? "yes" : "no") << "; end of run: " << s.stop_message << "\n";
-    out_ << "energy lost [J]: " << humanText(s.energy_lost, kDigits) << "\n";
+    if (!std::isnan(s.energy_lost)) out_ << "energy lost [J]: " << humanText(s.energy_lost, kDigits) << "\n";
     if (s.simulated) writeChecks(s);
     if (!s.final_velocities.empty()) {
       const std::vector<double>* predicted =

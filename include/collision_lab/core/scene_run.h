@@ -50,7 +50,7 @@ struct SceneSimulation {
   std::optional<MultipleCollision> multiple_collision;
   double final_time = 0.0;               ///< time of the last impact [s]
   std::vector<double> final_velocities;  ///< [m/s]; the predicted ones when not simulated
-  double energy_lost = 0.0;              ///< total kinetic energy turned into heat [J]
+  double energy_lost = 0.0;              ///< total kinetic energy turned into heat [J]; NaN: not known
   double energy_relative_drift = 0.0;    ///< as EngineResult; NaN when not simulated
   double momentum_relative_drift = 0.0;  ///< as EngineResult; NaN when not simulated or with a wall
   /// Simulated and predicted with a finite count: the engine's count equals it and
