@@ -21,9 +21,9 @@ std::atomic<bool> g_cancel{false};
 
 extern "C" void onInterrupt(int) { g_cancel.store(true); }
 
-/// SIGINT sets the cancel flag while an event-engine run lasts; the previous handler
-/// (the default: end the process) is back afterwards, e.g. for the three-body path, which
-/// has no cancel flag.
+/// SIGINT sets the cancel flag while an N-body run lasts; the previous handler (the
+/// default: end the process) is back afterwards. The three-body path has no cancel flag,
+/// so it runs without the guard and Ctrl-C ends it as before.
 class InterruptGuard {
  public:
   InterruptGuard() {
@@ -90,6 +90,7 @@ core::SceneRunResult runWithProgress(const core::Scene& scene, const core::RunOp
       progress->onCollision(event.event.index);
     };
   }
+  if (core::usesThreeBodyPath(scene)) return core::runScene(scene, options, visitors);  // Ctrl-C ends it
   const InterruptGuard interrupt_guard;
   return core::runScene(scene, options, visitors);
 }
