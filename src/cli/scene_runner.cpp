@@ -29,6 +29,7 @@ class InterruptGuard {
   InterruptGuard() {
     g_cancel.store(false);
     previous_ = std::signal(SIGINT, onInterrupt);
+    if (previous_ == SIG_IGN) std::signal(SIGINT, SIG_IGN);  // ignored by the parent: stay so
   }
   ~InterruptGuard() { std::signal(SIGINT, previous_); }
   InterruptGuard(const InterruptGuard&) = delete;
