@@ -232,7 +232,42 @@ void writeSceneJson(std::ostream& out, const SceneEntry& entry) {
   out << "}";
 }
 
-Json summaryScalars(const core::SceneRunResult& result);
+/// The summary without its velocity lists (10^6 numbers are streamed, not built).
+Json summaryScalars(const core::SceneRunResult& result) {
+  const core::SceneSimulation& s = result.simulation;
+  const auto& p = result.prediction;
+  const bool has_formula = p && (p->impact_count || p->infinite);
+  Json json{{"model", core::modelKindName(result.model.kind)},
+            {"model_reason", result.model.reason},
+            {"collision_count", s.simulated ? Json(s.impact_count) : Json(nullptr)},
+            {"simulated", s.simulated},
+            {"truncated", s.truncated},
+            {"stop_reason", stopReasonText(s)},
+            {"stop_message", s.stop_message},
+            {"predicted_collision_count", p && p->impact_count ? Json(*p->impact_count) : Json(nullptr)},
+            {"predicted_infinite", p && p->infinite},
+            {"count_formula", has_formula ? Json(core::modelKindName(p->kind)) : Json(kNoCountFormula)},
+            {"matches_prediction", s.matches_prediction ? Json(*s.matches_prediction) : Json(nullptr)},
+            {"max_prediction_error", number(s.max_prediction_error)},
+            {"final_time", number(s.final_time)},
+            {"energy_lost", number(s.energy_lost)},
+            {"energy_relative_drift", number(s.energy_relative_drift)},
+            {"momentum_relative_drift", number(s.momentum_relative_drift)},
+            {"compute_time_s", number(result.compute_time_s)}};
+  json["multiple_collision"] = nullptr;
+  if (s.multiple_collision) {
+    const std::size_t b = s.multiple_collision->first_body;
+    json["multiple_collision"] = {
+        {"bodies", Json::array({core::bodyName(b), core::bodyName(b + 1), core::bodyName(b + 2)})},
+        {"first_body_index", b},
+        {"time", number(s.multiple_collision->time)}};
+  }
+  json["escalation"] = {{"refinements", s.escalations.refinements},
+                        {"high_precision", s.escalations.high_precision},
+                        {"exact_rational", s.escalations.exact_rational},
+                        {"replayed_impacts", s.escalations.replayed_impacts}};
+  return json;
+}
 
 void writeSummaryJson(std::ostream& out, const core::SceneRunResult& result) {
   std::string scalars = jsonText(summaryScalars(result));
@@ -495,45 +530,6 @@ Json impactJson(const core::ImpactRecord& r) {
               {"energy_gained", Json::array({number(r.energy_gained[0]), number(r.energy_gained[1])})},
               {"energy_lost", number(r.energy_lost)}};
 }
-
-namespace {
-/// The summary without its velocity lists (10^6 numbers are streamed, not built).
-Json summaryScalars(const core::SceneRunResult& result) {
-  const core::SceneSimulation& s = result.simulation;
-  const auto& p = result.prediction;
-  const bool has_formula = p && (p->impact_count || p->infinite);
-  Json json{{"model", core::modelKindName(result.model.kind)},
-            {"model_reason", result.model.reason},
-            {"collision_count", s.simulated ? Json(s.impact_count) : Json(nullptr)},
-            {"simulated", s.simulated},
-            {"truncated", s.truncated},
-            {"stop_reason", stopReasonText(s)},
-            {"stop_message", s.stop_message},
-            {"predicted_collision_count", p && p->impact_count ? Json(*p->impact_count) : Json(nullptr)},
-            {"predicted_infinite", p && p->infinite},
-            {"count_formula", has_formula ? Json(core::modelKindName(p->kind)) : Json(kNoCountFormula)},
-            {"matches_prediction", s.matches_prediction ? Json(*s.matches_prediction) : Json(nullptr)},
-            {"max_prediction_error", number(s.max_prediction_error)},
-            {"final_time", number(s.final_time)},
-            {"energy_lost", number(s.energy_lost)},
-            {"energy_relative_drift", number(s.energy_relative_drift)},
-            {"momentum_relative_drift", number(s.momentum_relative_drift)},
-            {"compute_time_s", number(result.compute_time_s)}};
-  json["multiple_collision"] = nullptr;
-  if (s.multiple_collision) {
-    const std::size_t b = s.multiple_collision->first_body;
-    json["multiple_collision"] = {
-        {"bodies", Json::array({core::bodyName(b), core::bodyName(b + 1), core::bodyName(b + 2)})},
-        {"first_body_index", b},
-        {"time", number(s.multiple_collision->time)}};
-  }
-  json["escalation"] = {{"refinements", s.escalations.refinements},
-                        {"high_precision", s.escalations.high_precision},
-                        {"exact_rational", s.escalations.exact_rational},
-                        {"replayed_impacts", s.escalations.replayed_impacts}};
-  return json;
-}
-}  // namespace
 
 Json sceneSummaryJson(const core::SceneRunResult& result) {
   Json json = summaryScalars(result);
