@@ -3,7 +3,8 @@
 add_executable(collision_lab_cli
   src/cli/main.cpp
   src/cli/command_line.cpp
-  src/cli/progress.cpp)
+  src/cli/progress.cpp
+  src/cli/scene_runner.cpp)
 target_link_libraries(collision_lab_cli PRIVATE collision_lab_io CLI11::CLI11)
 # --name and --list without --scenario read the presets: the source tree's in the devel
 # space, the installed copy otherwise.

@@ -1,6 +1,6 @@
 # Tests of collision_lab_io and collision_lab_cli (gtest, no master). The CLI tests run
 # the built binary as a child process, from the source folder.
-catkin_add_gtest(collision_lab_io_test test/cli/scenario_file_test.cpp)
+catkin_add_gtest(collision_lab_io_test test/cli/scenario_file_test.cpp test/cli/scene_run_test.cpp)
 if(TARGET collision_lab_io_test)
   target_link_libraries(collision_lab_io_test collision_lab_io GTest::gtest_main)
   target_compile_definitions(collision_lab_io_test PRIVATE COLLISION_LAB_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
@@ -10,6 +10,7 @@ catkin_add_gtest(collision_lab_cli_test
   test/cli/cli_test.cpp
   test/cli/bad_inputs_test.cpp
   test/cli/random_input_test.cpp
+  test/cli/nbody_cli_test.cpp
   test/cli/cli_process.cpp)
 if(TARGET collision_lab_cli_test)
   target_link_libraries(collision_lab_cli_test collision_lab_core nlohmann_json::nlohmann_json GTest::gtest_main)

@@ -3,6 +3,8 @@
 add_library(collision_lab_io
   src/io/number_text.cpp
   src/io/scenario_file.cpp
+  src/io/bodies_csv.cpp
+  src/io/scene_report.cpp
   src/io/report.cpp)
 target_link_libraries(collision_lab_io PUBLIC collision_lab_core yaml-cpp nlohmann_json::nlohmann_json)
 

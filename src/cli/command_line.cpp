@@ -5,6 +5,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "collision_lab/io/bodies_csv.h"
 #include "collision_lab/io/number_text.h"
 
 namespace collision_lab {
@@ -14,9 +15,9 @@ namespace {
 
 /// Options that take a value. A value may start with '-' (negative numbers, "-inf",
 /// "-.5"), which CLI11 would take for a flag; normalizeArguments() prevents that.
-const std::array<const char*, 10> kValueOptions = {"--masses",   "--positions", "--velocities", "--max-collisions",
-                                                  "--events",   "--format",    "--precision",  "--mode",
-                                                  "--scenario", "--name"};
+const std::array<const char*, 12> kValueOptions = {
+    "--masses", "--positions", "--velocities", "--bodies",   "--restitution", "--max-collisions",
+    "--events", "--format",    "--precision",  "--mode",     "--scenario",    "--name"};
 
 bool isValueOption(const std::string& arg) {
   return std::find(kValueOptions.begin(), kValueOptions.end(), arg) != kValueOptions.end();
@@ -55,34 +56,48 @@ std::string oneLine(std::string text) {
   return text;
 }
 
-/// "1,2,inf" -> three doubles; `field` is "masses", "positions" or "velocities". Messages
-/// do not repeat the field, which the error line names already.
-std::array<double, 3> parseTriple(const std::string& text, const std::string& field, const char* symbol) {
+/// "1,2,inf" -> its doubles, any number of them; `field` is "masses", "positions",
+/// "velocities" or "restitution". Messages do not repeat the field, which the error line
+/// names already.
+std::vector<double> parseList(const std::string& text, const std::string& field) {
   const std::vector<std::string> items = io::splitCommaList(text);
-  if (items.size() != 3) {
-    throw makeCliError(CliReason::kWrongCount, field,
-                       "3 comma-separated numbers are needed (" + std::string(symbol) + "_A," + symbol + "_B," +
-                           symbol + "_C), got " + std::to_string(items.size()) + " in '" + text + "'");
-  }
-  std::array<double, 3> values{};
-  for (int i = 0; i < 3; ++i) {
+  std::vector<double> values;
+  values.reserve(items.size());
+  for (std::size_t i = 0; i < items.size(); ++i) {
     const io::ParsedNumber parsed = io::parseNumber(items[i]);
     if (!parsed.problem.empty()) {
       throw makeCliError(CliReason::kMalformedNumber, field + "[" + std::to_string(i) + "]",
                          "'" + items[i] + "' " + parsed.problem);
     }
-    values[i] = parsed.value;
+    values.push_back(parsed.value);
   }
   return values;
 }
 
+/// The bodies of --bodies FILE ("-": standard input).
+core::Scene readBodies(const std::string& path) {
+  try {
+    return io::readBodiesFile(path);
+  } catch (const io::BodiesFileError& e) {
+    switch (e.kind) {
+      case io::BodiesFileError::Kind::kWrongCount: throw makeCliError(CliReason::kWrongCount, e.field, e.what());
+      case io::BodiesFileError::Kind::kMalformedNumber:
+        throw makeCliError(CliReason::kMalformedNumber, e.field, e.what());
+      case io::BodiesFileError::Kind::kUnreadable:
+      case io::BodiesFileError::Kind::kHeader: break;
+    }
+    throw makeCliError(CliReason::kBodiesFile, e.field, e.what());
+  }
+}
+
 /// The options as typed, before their values are checked.
 struct RawOptions {
-  std::string masses, positions, velocities;
+  std::string masses, positions, velocities, bodies, restitution;
   std::string max_collisions, events, format = "table", precision = "double", mode = "full";
   std::string scenario, name;
   bool list = false;
-  bool masses_given = false, positions_given = false, velocities_given = false;
+  bool masses_given = false, positions_given = false, velocities_given = false, bodies_given = false;
+  bool restitution_given = false;
   bool max_collisions_given = false, events_given = false, scenario_given = false, name_given = false;
 };
 
@@ -116,11 +131,15 @@ void readRunOptions(const RawOptions& raw, CliRequest& request) {
 
 /// What to run: a scene from the three lists, or one scene, all scenes or the list of a file.
 void readSceneSource(const RawOptions& raw, const std::string& default_scenario_path, CliRequest& request) {
-  const bool any_scene_value = raw.masses_given || raw.positions_given || raw.velocities_given;
+  const bool any_list = raw.masses_given || raw.positions_given || raw.velocities_given;
   const bool from_file = raw.scenario_given || raw.name_given || raw.list;
-  if (any_scene_value && from_file) {
+  if ((any_list || raw.bodies_given) && from_file) {
     throw makeCliError(CliReason::kUsage, "scenario",
                        "give either --masses/--positions/--velocities or --scenario/--name/--list, not both");
+  }
+  if (any_list && raw.bodies_given) {
+    throw makeCliError(CliReason::kUsage, "bodies",
+                       "give either --bodies FILE or --masses/--positions/--velocities, not both");
   }
   if (from_file) {
     request.scenario_path = raw.scenario_given ? raw.scenario : default_scenario_path;
@@ -134,20 +153,24 @@ void readSceneSource(const RawOptions& raw, const std::string& default_scenario_
     }
     return;
   }
+  request.action = CliRequest::Action::kRunOne;
+  if (raw.bodies_given) {
+    request.scene = readBodies(raw.bodies);
+    return;
+  }
   for (const auto& [given, field] : {std::pair{raw.masses_given, "masses"}, std::pair{raw.positions_given, "positions"},
                                      std::pair{raw.velocities_given, "velocities"}}) {
     if (!given) {
       throw makeCliError(CliReason::kMissingInput, field,
-                         "missing: give --masses, --positions and --velocities "
-                         "(3 comma-separated numbers each), or --scenario FILE");
+                         "missing: give --masses, --positions and --velocities (one comma-separated number per "
+                         "body each), or --bodies FILE, or --scenario FILE");
     }
   }
-  core::ThreeBodyScene scene;
-  scene.masses = parseTriple(raw.masses, "masses", "m");
-  scene.positions = parseTriple(raw.positions, "positions", "x");
-  scene.velocities = parseTriple(raw.velocities, "velocities", "v");
-  request.action = CliRequest::Action::kRunOne;
-  request.scene = scene;
+  core::Scene scene;
+  scene.masses = parseList(raw.masses, "masses");
+  scene.positions = parseList(raw.positions, "positions");
+  scene.velocities = parseList(raw.velocities, "velocities");
+  request.scene = std::move(scene);
 }
 
 /// Which events to show. Every scene of a file at once: the summary rows are the point,
@@ -179,6 +202,7 @@ const char* cliReasonName(CliReason reason) {
     case CliReason::kInvalidOption: return "INVALID_OPTION";
     case CliReason::kUnknownScenario: return "UNKNOWN_SCENARIO";
     case CliReason::kScenarioFile: return "SCENARIO_FILE";
+    case CliReason::kBodiesFile: return "BODIES_FILE";
   }
   return "UNKNOWN";
 }
@@ -199,14 +223,20 @@ io::ReportFormat requestedFormat(const std::vector<std::string>& args) {
 CliRequest parseCommandLine(const std::vector<std::string>& args, const std::string& default_scenario_path) {
   RawOptions raw;
   CLI::App app{
-      "collision_lab_cli: three elastic point masses on a line, simulated exactly, beside the correct "
-      "closed-form predictions and the paper's printed formulas (SI units).",
+      "collision_lab_cli: point masses on a line (any number, walls allowed), simulated exactly by the model "
+      "each scene needs; three elastic bodies beside the correct closed-form predictions and the paper's "
+      "printed formulas (SI units).",
       "collision_lab_cli"};
-  const CLI::Option* masses = app.add_option("--masses", raw.masses, "m_A,m_B,m_C [kg]; inf makes A or C a wall");
+  const CLI::Option* masses =
+      app.add_option("--masses", raw.masses, "m_A,m_B,... [kg], one per body, right to left; inf makes an end body a wall");
   const CLI::Option* positions =
-      app.add_option("--positions", raw.positions, "x_A,x_B,x_C [m], strictly decreasing");
+      app.add_option("--positions", raw.positions, "x_A,x_B,... [m], strictly decreasing");
   const CLI::Option* velocities =
-      app.add_option("--velocities", raw.velocities, "v_A,v_B,v_C [m/s]; negative values are fine");
+      app.add_option("--velocities", raw.velocities, "v_A,v_B,... [m/s]; negative values are fine");
+  const CLI::Option* bodies = app.add_option(
+      "--bodies", raw.bodies, "CSV file with the header mass,position,velocity, one body per line, right to left; - reads stdin");
+  const CLI::Option* restitution = app.add_option(
+      "--restitution", raw.restitution, "e in [0,1] for every pair, or e_AB,e_BC,... one per pair (default 1: elastic)");
   const CLI::Option* max_collisions = app.add_option(
       "--max-collisions", raw.max_collisions, "stop after N collisions and mark the run truncated (default 10000000)");
   const CLI::Option* events = app.add_option(
@@ -243,6 +273,8 @@ CliRequest parseCommandLine(const std::vector<std::string>& args, const std::str
   raw.masses_given = masses->count() > 0;
   raw.positions_given = positions->count() > 0;
   raw.velocities_given = velocities->count() > 0;
+  raw.bodies_given = bodies->count() > 0;
+  raw.restitution_given = restitution->count() > 0;
   raw.max_collisions_given = max_collisions->count() > 0;
   raw.events_given = events->count() > 0;
   raw.scenario_given = scenario->count() > 0;
@@ -250,6 +282,7 @@ CliRequest parseCommandLine(const std::vector<std::string>& args, const std::str
 
   readRunOptions(raw, request);
   readSceneSource(raw, default_scenario_path, request);
+  if (raw.restitution_given) request.restitution = parseList(raw.restitution, "restitution");
   readEventPolicy(raw, request);
   return request;
 }

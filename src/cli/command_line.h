@@ -12,15 +12,16 @@ namespace collision_lab {
 namespace cli {
 
 /// Reason codes of input the CLI rejects before the core sees a scene. The core's
-/// validation reasons (scene.h, codes 0-8) are reported with their own names and codes.
+/// validation reasons (nbody/scene.h, codes 0-13) are reported with their own names and codes.
 enum class CliReason {
   kUsage = 100,            ///< unknown option, stray argument, conflicting options
   kMalformedNumber = 101,  ///< a list item that is not a number, or beyond a double
-  kWrongCount = 102,       ///< a list without exactly 3 items
+  kWrongCount = 102,       ///< a --bodies line without exactly 3 values
   kMissingInput = 103,     ///< no --masses / --positions / --velocities and no --scenario
   kInvalidOption = 104,    ///< a bad value for --max-collisions, --events, --format, ...
   kUnknownScenario = 105,  ///< --name not in the scenario file
   kScenarioFile = 106,     ///< unreadable or malformed scenario file
+  kBodiesFile = 107,       ///< --bodies: unreadable file, or no header mass,position,velocity
 };
 const char* cliReasonName(CliReason reason);
 
@@ -44,7 +45,9 @@ struct CliRequest {
   bool max_collisions_given = false;  ///< else a scenario's own cap applies, if it has one
   std::string scenario_path;          ///< for kList, kRunAll, and kRunOne from a file
   std::string scenario_name;          ///< kRunOne from a file
-  std::optional<core::ThreeBodyScene> scene;         ///< kRunOne from --masses/--positions/--velocities
+  std::optional<core::Scene> scene;   ///< kRunOne from --masses/--positions/--velocities or --bodies
+  /// --restitution: replaces every scene's restitution (one value, or one per pair).
+  std::optional<std::vector<double>> restitution;
 };
 
 /// The format asked for on the command line, found before full parsing so that even a

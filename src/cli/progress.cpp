@@ -18,15 +18,20 @@ ProgressLine::~ProgressLine() {
   }
 }
 
-void ProgressLine::maybeDraw(std::uint64_t index) {
+void ProgressLine::maybeDraw(std::uint64_t index, double time) {
   const auto now = std::chrono::steady_clock::now();
   if (now - start_ < kQuietStart || now - last_draw_ < kRedrawInterval) return;
   last_draw_ = now;
   drawn_ = true;
   const double seconds = std::chrono::duration<double>(now - start_).count();
-  const double percent = expected_ > 0 ? 100.0 * static_cast<double>(index) / static_cast<double>(expected_) : 0.0;
-  std::fprintf(terminal_, "\rcollision_lab_cli: %llu of %llu collisions (%.1f %%), %.1f s",
-               static_cast<unsigned long long>(index), static_cast<unsigned long long>(expected_), percent, seconds);
+  if (expected_ == 0) {  // the event engine: no count known in advance
+    std::fprintf(terminal_, "\rcollision_lab_cli: %llu impacts, simulated t = %.6g s, %.3g impacts/s, %.1f s (Ctrl-C stops)\033[K",
+                 static_cast<unsigned long long>(index), time, static_cast<double>(index) / seconds, seconds);
+  } else {
+    const double percent = 100.0 * static_cast<double>(index) / static_cast<double>(expected_);
+    std::fprintf(terminal_, "\rcollision_lab_cli: %llu of %llu collisions (%.1f %%), %.1f s",
+                 static_cast<unsigned long long>(index), static_cast<unsigned long long>(expected_), percent, seconds);
+  }
   std::fflush(terminal_);
 }
 

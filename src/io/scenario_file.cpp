@@ -1,10 +1,12 @@
 #include "collision_lab/io/scenario_file.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <set>
 
 #include <yaml-cpp/yaml.h>
 
+#include "collision_lab/io/bodies_csv.h"
 #include "collision_lab/io/number_text.h"
 
 namespace collision_lab {
@@ -13,49 +15,87 @@ namespace io {
 namespace {
 
 const char* const kVectorKeys[3] = {"masses", "positions", "velocities"};
-const std::set<std::string> kKnownKeys = {"description", "masses", "positions", "velocities",
-                                          "max_collisions"};
+const std::set<std::string> kKnownKeys = {"description", "masses",      "positions",     "velocities",
+                                          "bodies",      "restitution", "max_collisions"};
 
-/// Reads the three numbers of `key` into `out`; `where` is "file: entry 'name'".
-void readTriple(const YAML::Node& entry, const char* key, const std::string& where,
-                std::array<double, 3>& out) {
+double readNumber(const YAML::Node& node, const std::string& where, const std::string& field) {
+  if (!node.IsScalar()) throw ScenarioFileError(where + ": " + field + " is not a number");
+  const ParsedNumber parsed = parseNumber(node.Scalar());
+  if (!parsed.problem.empty()) {
+    throw ScenarioFileError(where + ": " + field + " '" + node.Scalar() + "' " + parsed.problem);
+  }
+  return parsed.value;
+}
+
+/// Reads the list `key` (one number per body, N >= 1) into `out`; `where` is "file: entry 'name'".
+void readList(const YAML::Node& entry, const char* key, const std::string& where, std::vector<double>& out) {
   const YAML::Node list = entry[key];
   if (!list) throw ScenarioFileError(where + ": '" + key + "' is missing");
-  if (!list.IsSequence() || list.size() != 3) {
-    throw ScenarioFileError(where + ": '" + key + "' must be a list of 3 numbers [A, B, C]");
+  if (!list.IsSequence() || list.size() == 0) {
+    throw ScenarioFileError(where + ": '" + key + "' must be a list of numbers, one per body, right to left");
   }
-  for (std::size_t i = 0; i < 3; ++i) {
-    const std::string field = std::string(key) + "[" + std::to_string(i) + "]";
-    if (!list[i].IsScalar()) throw ScenarioFileError(where + ": " + field + " is not a number");
-    const ParsedNumber parsed = parseNumber(list[i].Scalar());
-    if (!parsed.problem.empty()) {
-      throw ScenarioFileError(where + ": " + field + " '" + list[i].Scalar() + "' " + parsed.problem);
-    }
-    out[i] = parsed.value;
+  out.reserve(list.size());
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    out.push_back(readNumber(list[i], where, std::string(key) + "[" + std::to_string(i) + "]"));
   }
 }
 
-NamedScene readEntry(const std::string& name, const YAML::Node& entry, const std::string& path) {
+/// `restitution: e` (every pair) or `restitution: [e_0, ..., e_N-2]`.
+std::vector<double> readRestitution(const YAML::Node& node, const std::string& where) {
+  if (node.IsScalar()) return {readNumber(node, where, "restitution")};
+  if (!node.IsSequence()) throw ScenarioFileError(where + ": 'restitution' must be a number or a list of numbers");
+  std::vector<double> values;
+  for (std::size_t i = 0; i < node.size(); ++i) {
+    values.push_back(readNumber(node[i], where, "restitution[" + std::to_string(i) + "]"));
+  }
+  return values;
+}
+
+/// The bodies of `bodies: FILE`, the path relative to the scenario file's folder.
+core::Scene readBodiesEntry(const YAML::Node& node, const std::string& where, const std::string& path) {
+  if (!node.IsScalar()) throw ScenarioFileError(where + ": 'bodies' must be a file name");
+  const std::filesystem::path file = std::filesystem::path(path).parent_path() / node.Scalar();
+  try {
+    return readBodiesFile(file.string());
+  } catch (const BodiesFileError& e) {
+    throw ScenarioFileError(where + ": bodies file '" + file.string() + "', " + e.field + ": " + e.what());
+  }
+}
+
+void readScene(const YAML::Node& entry, const std::string& where, const std::string& path, core::Scene& scene) {
+  if (const YAML::Node bodies = entry["bodies"]) {
+    for (const char* key : kVectorKeys) {
+      if (entry[key]) throw ScenarioFileError(where + ": give either 'bodies' or '" + key + "', not both");
+    }
+    scene = readBodiesEntry(bodies, where, path);
+  } else {
+    readList(entry, kVectorKeys[0], where, scene.masses);
+    readList(entry, kVectorKeys[1], where, scene.positions);
+    readList(entry, kVectorKeys[2], where, scene.velocities);
+  }
+  if (const YAML::Node restitution = entry["restitution"]) scene.restitution = readRestitution(restitution, where);
+}
+
+SceneEntry readEntry(const std::string& name, const YAML::Node& entry, const std::string& path) {
   const std::string where = path + ": entry '" + name + "'";
   if (!entry.IsMap()) {
-    throw ScenarioFileError(where + " must be a map with masses, positions and velocities");
+    throw ScenarioFileError(where + " must be a map with masses, positions and velocities (or bodies)");
   }
   for (const auto& item : entry) {
     const std::string key = item.first.Scalar();
     if (kKnownKeys.count(key) == 0) {
       throw ScenarioFileError(where + ": unknown key '" + key +
-                              "' (known: description, masses, positions, velocities, max_collisions)");
+                              "' (known: description, masses, positions, velocities, bodies, restitution, "
+                              "max_collisions)");
     }
   }
-  NamedScene named;
+  SceneEntry named;
   named.name = name;
   if (const YAML::Node description = entry["description"]) {
     if (!description.IsScalar()) throw ScenarioFileError(where + ": 'description' must be text");
     named.description = description.Scalar();
   }
-  readTriple(entry, kVectorKeys[0], where, named.scene.masses);
-  readTriple(entry, kVectorKeys[1], where, named.scene.positions);
-  readTriple(entry, kVectorKeys[2], where, named.scene.velocities);
+  readScene(entry, where, path, named.scene);
   if (const YAML::Node cap = entry["max_collisions"]) {
     const ParsedCount value = cap.IsScalar() ? parseCount(cap.Scalar()) : ParsedCount{0, "is not a number"};
     if (value.problem.rfind("is too large", 0) == 0) {
@@ -71,7 +111,7 @@ NamedScene readEntry(const std::string& name, const YAML::Node& entry, const std
 
 }  // namespace
 
-std::vector<NamedScene> loadScenarioFile(const std::string& path) {
+std::vector<SceneEntry> loadScenes(const std::string& path) {
   std::error_code ignored;
   if (std::filesystem::is_directory(path, ignored)) {
     throw ScenarioFileError(path + ": is a folder, not a scenario file");
@@ -91,7 +131,7 @@ std::vector<NamedScene> loadScenarioFile(const std::string& path) {
   if (!root.IsMap() || root.size() == 0) {
     throw ScenarioFileError(path + ": expected a map of named scenarios (name: {masses, positions, velocities})");
   }
-  std::vector<NamedScene> scenes;
+  std::vector<SceneEntry> scenes;
   std::set<std::string> seen;
   for (const auto& item : root) {
     if (!item.first.IsScalar()) throw ScenarioFileError(path + ": a scenario name must be plain text");
@@ -102,13 +142,53 @@ std::vector<NamedScene> loadScenarioFile(const std::string& path) {
   return scenes;
 }
 
-NamedScene findScenario(const std::vector<NamedScene>& scenes, const std::string& name) {
+bool isThreeBodyEntry(const SceneEntry& entry) {
+  const core::Scene& scene = entry.scene;
+  return scene.masses.size() == 3 && scene.positions.size() == 3 && scene.velocities.size() == 3 &&
+         !(scene.isWall(0) && scene.isWall(2)) &&
+         std::all_of(scene.restitution.begin(), scene.restitution.end(), [](double e) { return e == 1.0; });
+}
+
+NamedScene toNamedScene(const SceneEntry& entry) {
+  NamedScene named{entry.name, entry.description, {}, entry.max_collisions};
+  for (int i = 0; i < 3; ++i) {
+    named.scene.masses[i] = entry.scene.masses[i];
+    named.scene.positions[i] = entry.scene.positions[i];
+    named.scene.velocities[i] = entry.scene.velocities[i];
+  }
+  return named;
+}
+
+std::vector<NamedScene> loadScenarioFile(const std::string& path, std::vector<std::string>* skipped) {
+  std::vector<NamedScene> scenes;
+  for (const SceneEntry& entry : loadScenes(path)) {
+    if (isThreeBodyEntry(entry)) {
+      scenes.push_back(toNamedScene(entry));
+    } else if (skipped) {
+      skipped->push_back(entry.name);
+    }
+  }
+  return scenes;
+}
+
+namespace {
+template <class Entry>
+Entry findByName(const std::vector<Entry>& scenes, const std::string& name) {
   std::string known;
-  for (const NamedScene& scene : scenes) {
+  for (const Entry& scene : scenes) {
     if (scene.name == name) return scene;
     known += (known.empty() ? "" : ", ") + scene.name;
   }
   throw ScenarioFileError("no scenario named '" + name + "' (known: " + known + ")");
+}
+}  // namespace
+
+NamedScene findScenario(const std::vector<NamedScene>& scenes, const std::string& name) {
+  return findByName(scenes, name);
+}
+
+SceneEntry findScene(const std::vector<SceneEntry>& scenes, const std::string& name) {
+  return findByName(scenes, name);
 }
 
 }  // namespace io

@@ -2,6 +2,7 @@
 
 #include <sys/statvfs.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <ctime>
 #include <optional>
@@ -343,8 +344,16 @@ bool LabNode::onRunPreset(collision_lab::RunPreset::Request& request,
   collision_lab::io::NamedScene preset;
   try {
     // Read on every call, so that an edited file counts at once.
-    preset = collision_lab::io::findScenario(
-        collision_lab::io::loadScenarioFile(params_.scenario_file), request.name);
+    std::vector<std::string> skipped;
+    const auto presets = collision_lab::io::loadScenarioFile(params_.scenario_file, &skipped);
+    if (std::find(skipped.begin(), skipped.end(), request.name) != skipped.end()) {
+      response.ok = false;
+      response.message = "preset '" + request.name + "' is not a three-body elastic scene; the node runs three "
+                         "bodies only until the N-body node (issue 12); collision_lab_cli runs it";
+      ROS_INFO_STREAM(response.message);
+      return true;
+    }
+    preset = collision_lab::io::findScenario(presets, request.name);
   } catch (const collision_lab::io::ScenarioFileError& e) {
     response.ok = false;
     response.message = e.what();

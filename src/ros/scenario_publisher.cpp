@@ -111,7 +111,12 @@ bool endLaunch() {
 
 std::vector<collision_lab::io::NamedScene> selectScenes(const std::string& file,
                                                         const std::string& selection) {
-  const auto all = collision_lab::io::loadScenarioFile(file);
+  std::vector<std::string> skipped;
+  const auto all = collision_lab::io::loadScenarioFile(file, &skipped);
+  for (const auto& name : skipped) {
+    ROS_INFO_STREAM("skipping preset '" << name << "': not a three-body elastic scene, and this node runs "
+                                           "three bodies only until the N-body node (issue 12)");
+  }
   const auto names = splitNames(selection);
   if (names.empty()) return all;
   std::vector<collision_lab::io::NamedScene> scenes;

@@ -132,16 +132,16 @@ TEST(BadInputCatalogue, HasTwentyRowsAndEveryReasonCode) {
   EXPECT_GE(rows.size(), 20u);
   std::set<std::string> reasons;
   for (const CatalogueRow& row : rows) reasons.insert(row.reason);
-  // Every core validation reason that a three-body scene can meet (nbody/scene.h, codes 1-8;
-  // the N-body codes 9-13 get their rows when the CLI takes N-body scenes, issue 10) ...
+  // Every core validation reason (nbody/scene.h, codes 1-13: the CLI takes scenes of any
+  // size, issue 10) ...
   namespace core = collision_lab::core;
-  for (int code = 1; code <= static_cast<int>(core::Reason::kOverflow); ++code) {
+  for (int code = 1; code <= static_cast<int>(core::Reason::kWallNotAtEnd); ++code) {
     const std::string name = core::reasonName(static_cast<core::Reason>(code));
     EXPECT_EQ(reasons.count(name), 1u) << "no catalogue row for " << name;
   }
   // ... and every reason of the CLI itself (src/cli/command_line.h).
   for (const char* name : {"USAGE", "MALFORMED_NUMBER", "WRONG_COUNT", "MISSING_INPUT", "INVALID_OPTION",
-                           "UNKNOWN_SCENARIO", "SCENARIO_FILE"}) {
+                           "UNKNOWN_SCENARIO", "SCENARIO_FILE", "BODIES_FILE"}) {
     EXPECT_EQ(reasons.count(name), 1u) << "no catalogue row for " << name;
   }
 }

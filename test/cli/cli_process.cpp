@@ -22,7 +22,7 @@ std::string readWhole(const std::string& path) {
 
 }  // namespace
 
-CliOutput runCli(const std::vector<std::string>& args, const std::string& cwd) {
+CliOutput runCli(const std::vector<std::string>& args, const std::string& cwd, const std::string& stdin_path) {
   char dir_template[] = "/tmp/collision_lab_cli_test_XXXXXX";
   const char* dir = mkdtemp(dir_template);
   if (dir == nullptr) throw std::runtime_error("mkdtemp failed");
@@ -39,7 +39,7 @@ CliOutput runCli(const std::vector<std::string>& args, const std::string& cwd) {
   const pid_t pid = fork();
   if (pid < 0) throw std::runtime_error("fork failed");
   if (pid == 0) {
-    const int in_fd = open("/dev/null", O_RDONLY);
+    const int in_fd = open(stdin_path.c_str(), O_RDONLY);
     const int out_fd = open(out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
     const int err_fd = open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
     if (in_fd < 0 || out_fd < 0 || err_fd < 0 || dup2(in_fd, 0) < 0 || dup2(out_fd, 1) < 0 ||

@@ -13,8 +13,9 @@ struct CliOutput {
 };
 
 /// Runs COLLISION_LAB_CLI_PATH with `args` in the working directory `cwd`, stdin from
-/// /dev/null, stdout and stderr into unique temporary files.
-CliOutput runCli(const std::vector<std::string>& args, const std::string& cwd);
+/// `stdin_path` (default /dev/null), stdout and stderr into unique temporary files.
+CliOutput runCli(const std::vector<std::string>& args, const std::string& cwd,
+                 const std::string& stdin_path = "/dev/null");
 
 /// The lines of `text` (a final newline does not start another line).
 std::vector<std::string> linesOf(const std::string& text);

@@ -9,6 +9,7 @@
 #include <regex>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -266,15 +267,16 @@ TEST(CliScenarioFile, ListNamesEveryPreset) {
   const CliOutput result = run({"--scenario", kPresets, "--list"});
   ASSERT_EQ(result.exit_code, 0) << result.err;
   const std::vector<std::string> lines = linesOf(result.out);
-  ASSERT_EQ(lines.size(), 12u);
+  ASSERT_EQ(lines.size(), 18u);
   EXPECT_EQ(lines[0].rfind("equal_masses ", 0), 0u);
   EXPECT_EQ(lines[11].rfind("moving_wall ", 0), 0u);
+  EXPECT_EQ(lines[17].rfind("gas_1000 ", 0), 0u);
 }
 
 TEST(CliScenarioFile, WithoutANameRunsEveryScene) {
   const Json doc = runJson({"--scenario", kPresets});
   const Json& scenarios = doc.at("scenarios");
-  ASSERT_EQ(scenarios.size(), 12u);
+  ASSERT_EQ(scenarios.size(), 18u);
   const std::vector<std::pair<std::string, int>> expected = {
       {"equal_masses", 3}, {"no_collision", 0}, {"pi_digits_2", 31},  {"pi_digits_3", 314},
       {"pi_digits_4", 3141}, {"pi_digits_5", 31415}, {"kaleidoscopic", 3}, {"grazing", 2}};
@@ -285,6 +287,18 @@ TEST(CliScenarioFile, WithoutANameRunsEveryScene) {
     EXPECT_EQ(entry->at("summary").at("collision_count"), count) << name;
     EXPECT_EQ(entry->at("summary").at("predicted_collision_count"), count) << name;
     EXPECT_TRUE(entry->at("events").empty()) << name;  // a batch shows no events by default
+    EXPECT_EQ(entry->at("summary").at("model"), name == "no_collision" ? "no_collisions" : "three_body_rotation");
+  }
+  // Scenes of other sizes sit in the same batch, each with its model (counts by hand:
+  // shared/physics.md and config/scenarios.yaml).
+  const std::vector<std::tuple<std::string, std::string, int>> nbody = {
+      {"two_carts", "two_body", 1}, {"cradle_5", "ghosts", 4}, {"equal_masses_100", "ghosts", 2441}};
+  for (const auto& [name, model, count] : nbody) {
+    const auto entry = std::find_if(scenarios.begin(), scenarios.end(),
+                                    [&](const Json& s) { return s.at("scene").at("name") == name; });
+    ASSERT_NE(entry, scenarios.end()) << name;
+    EXPECT_EQ(entry->at("summary").at("model"), model) << name;
+    EXPECT_EQ(entry->at("summary").at("predicted_collision_count"), count) << name;
   }
 
   const CliOutput table = run({"--scenario", kPresets});

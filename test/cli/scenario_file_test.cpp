@@ -9,12 +9,16 @@
 #include <unistd.h>
 
 #include "collision_lab/io/number_text.h"
+#include "collision_lab/core/scene_run.h"
 #include "collision_lab/io/scenario_file.h"
 
 namespace {
 
 using collision_lab::core::validate;
 using collision_lab::io::findScenario;
+using collision_lab::io::findScene;
+using collision_lab::io::loadScenes;
+using collision_lab::io::SceneEntry;
 using collision_lab::io::loadScenarioFile;
 using collision_lab::io::NamedScene;
 using collision_lab::io::parseCount;
@@ -122,6 +126,39 @@ TEST(ScenarioFile, PresetsLoadInFileOrderAndAreValid) {
   EXPECT_EQ(pi.max_collisions, 0u);
 }
 
+TEST(ScenarioFile, PresetsOfAnySizeLoadAndAreValid) {
+  const std::vector<SceneEntry> scenes = loadScenes(COLLISION_LAB_SOURCE_DIR "/config/scenarios.yaml");
+  ASSERT_EQ(scenes.size(), 18u);
+  for (const SceneEntry& entry : scenes) {
+    EXPECT_FALSE(collision_lab::core::validateForRun(entry.scene).has_value()) << entry.name;
+    EXPECT_FALSE(entry.description.empty()) << entry.name;
+  }
+  const SceneEntry gas = findScene(scenes, "gas_1000");  // from config/gas_1000.csv
+  ASSERT_EQ(gas.scene.size(), 1000u);
+  EXPECT_EQ(gas.scene.positions.front(), 999.0);
+  EXPECT_EQ(gas.scene.positions.back(), 0.0);
+  for (std::size_t i = 0; i < gas.scene.size(); ++i) {
+    EXPECT_TRUE(gas.scene.masses[i] >= 1.0 && gas.scene.masses[i] <= 2.0) << i;
+    EXPECT_TRUE(gas.scene.velocities[i] >= -1.0 && gas.scene.velocities[i] <= 1.0) << i;
+  }
+  EXPECT_EQ(findScene(scenes, "inelastic_carts").scene.restitution, std::vector<double>{0.5});
+  // The three-body view (the ROS node's) skips the others and names them.
+  std::vector<std::string> skipped;
+  EXPECT_EQ(loadScenarioFile(COLLISION_LAB_SOURCE_DIR "/config/scenarios.yaml", &skipped).size(), 12u);
+  EXPECT_EQ(skipped, (std::vector<std::string>{"two_carts", "inelastic_carts", "cradle_5", "ball_between_walls",
+                                               "equal_masses_100", "gas_1000"}));
+}
+
+TEST(ScenarioFile, RestitutionAndBodiesKeys) {
+  const TemporaryYaml list("a:\n  masses: [1, 1, 1]\n  positions: [2, 1, 0]\n  velocities: [-1, 0, 0]\n"
+                           "  restitution: [0.5, 1]\n");
+  EXPECT_EQ(loadScenes(list.path()).at(0).scene.restitution, (std::vector<double>{0.5, 1}));
+  const TemporaryYaml both("a:\n  bodies: x.csv\n  masses: [1]\n");
+  EXPECT_NE(loadError(both.path()).find("give either 'bodies' or 'masses', not both"), std::string::npos);
+  const TemporaryYaml absent("a:\n  bodies: no_such_file.csv\n");
+  EXPECT_NE(loadError(absent.path()).find("cannot open"), std::string::npos);
+}
+
 TEST(ScenarioFile, OptionalCollisionCap) {
   const TemporaryYaml file("capped:\n  masses: [1, 1, 1]\n  positions: [2, 1, 0]\n  velocities: [-1, 0, 0]\n"
                            "  max_collisions: 5\n");
@@ -136,8 +173,14 @@ TEST(ScenarioFile, OptionalCollisionCap) {
 }
 
 TEST(ScenarioFile, ErrorsNameTheFileTheEntryAndTheField) {
-  EXPECT_EQ(loadError(kData + "wrong_count.yaml"),
-            kData + "wrong_count.yaml: entry 'two_masses': 'masses' must be a list of 3 numbers [A, B, C]");
+  // Lists of any length load; different lengths are the physics' to reject (UNEQUAL_LENGTHS).
+  const std::vector<SceneEntry> two_masses = loadScenes(kData + "wrong_count.yaml");
+  ASSERT_EQ(two_masses.size(), 1u);
+  EXPECT_EQ(collision_lab::core::validateForRun(two_masses[0].scene)->reason,
+            collision_lab::core::Reason::kUnequalLengths);
+  const TemporaryYaml empty_list("a:\n  masses: []\n  positions: []\n  velocities: []\n");
+  EXPECT_EQ(loadError(empty_list.path()),
+            empty_list.path() + ": entry 'a': 'masses' must be a list of numbers, one per body, right to left");
   EXPECT_EQ(loadError(kData + "bad_number.yaml"),
             kData + "bad_number.yaml: entry 'heavy': masses[1] 'heavy' is not a number");
   EXPECT_NE(loadError(kData + "unknown_key.yaml").find("entry 'typo': unknown key 'velocity'"), std::string::npos);

@@ -1,4 +1,10 @@
 // Named scenes from YAML files (config/scenarios.yaml). ROS-free; uses yaml-cpp.
+//
+// An entry holds a scene of any size N >= 1: either the lists masses, positions and
+// velocities (N items each, listed right to left), or `bodies: FILE`, a CSV file in the
+// format of --bodies (see bodies_csv.h), its path relative to the YAML file's folder.
+// Optional keys: description, restitution (one number for every pair, or a list of N-1),
+// max_collisions (a positive integer).
 #pragma once
 
 #include <cstdint>
@@ -6,11 +12,21 @@
 #include <string>
 #include <vector>
 
+#include "collision_lab/core/nbody/scene.h"
 #include "collision_lab/core/scene.h"
 
 namespace collision_lab {
 namespace io {
 
+/// A scene of any size from a scenario file.
+struct SceneEntry {
+  std::string name;         ///< unique key, e.g. "cradle_5"
+  std::string description;  ///< one line for people
+  core::Scene scene;        ///< masses may be written inf / .inf in the file
+  std::uint64_t max_collisions = 0;  ///< 0: the caller's default
+};
+
+/// A three-body entry, as the three-body path (and the ROS node) takes it.
 struct NamedScene {
   std::string name;         ///< unique key, e.g. "pi_digits_3"
   std::string description;  ///< one line for people
@@ -24,11 +40,23 @@ struct ScenarioFileError : std::runtime_error {
 };
 
 /// Loads every scene of a scenario file, in file order. Throws ScenarioFileError.
-/// Does not validate the physics (call validate() on each scene).
-std::vector<NamedScene> loadScenarioFile(const std::string& path);
+/// Does not validate the physics (call core::validateForRun() on each scene).
+std::vector<SceneEntry> loadScenes(const std::string& path);
+
+/// True for an entry that the three-body path takes: three bodies, elastic, not walls at
+/// both ends (that scene is answered by the N-body models).
+bool isThreeBodyEntry(const SceneEntry& entry);
+/// The entry as a three-body scene. Precondition: isThreeBodyEntry(entry).
+NamedScene toNamedScene(const SceneEntry& entry);
+
+/// The three-body entries of a scenario file, in file order (for front ends that take only
+/// three bodies, such as the ROS node until issue 12). The names of the other entries go to
+/// `skipped` when given. Throws ScenarioFileError.
+std::vector<NamedScene> loadScenarioFile(const std::string& path, std::vector<std::string>* skipped = nullptr);
 
 /// The entry called `name`; throws ScenarioFileError listing the known names if absent.
 NamedScene findScenario(const std::vector<NamedScene>& scenes, const std::string& name);
+SceneEntry findScene(const std::vector<SceneEntry>& scenes, const std::string& name);
 
 }  // namespace io
 }  // namespace collision_lab

@@ -1,0 +1,96 @@
+// One run of a scene of any size: the model that the scene needs (chooseModel), its
+// closed-form prediction where one exists, and the simulation summary. The front ends'
+// single entry point (the CLI today; the ROS node with issue 12). ROS-free.
+//
+// Three elastic bodies that the three-body path accepts (validate(ThreeBodyScene)) are
+// handed to runLab unchanged, so their output stays that of the paper's rotation model.
+// Every other scene is answered by its model (models.h): a closed form alone when no event
+// is asked for and the prediction is finite; otherwise the exact event engine, whose
+// summary is put beside the prediction.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "collision_lab/core/lab_run.h"
+#include "collision_lab/core/nbody/engine.h"
+#include "collision_lab/core/nbody/models.h"
+#include "collision_lab/core/nbody/scene.h"
+
+namespace collision_lab {
+namespace core {
+
+struct SceneRunOptions {
+  /// Cap, event policy, mode and precision. The precision applies to the three-body path
+  /// only (the event engine decides everything exactly); max_collisions caps the engine.
+  /// When lab.events asks for any event (in full mode), a closed-form scene is simulated
+  /// too, and the simulation is checked against the prediction.
+  RunOptions lab;
+  /// False: the three-body path keeps no event in RunResult::events (the visitor still sees
+  /// them all), for front ends that stream. The event engine never keeps any.
+  bool keep_events = true;
+  /// When set (by a signal handler or another thread), the event engine stops within 1024
+  /// impacts, marked truncated. The three-body path has no cancel flag and ignores it.
+  const std::atomic<bool>* cancel = nullptr;
+  std::uint64_t progress_interval = std::uint64_t{1} << 20;  ///< impacts between progress calls
+};
+
+/// The simulation of an N-body scene (not filled for the three-body path).
+struct SceneSimulation {
+  bool simulated = false;          ///< false: answered by the closed form alone (or predict-only)
+  std::uint64_t impact_count = 0;  ///< simulated; the predicted count when not simulated
+  bool truncated = false;          ///< the cap or a cancellation stopped it: more impacts were due
+  StopReason stop = StopReason::kFinished;
+  std::string stop_message;  ///< one sentence: why the run ended
+  std::optional<MultipleCollision> multiple_collision;
+  double final_time = 0.0;               ///< time of the last impact [s]
+  std::vector<double> final_velocities;  ///< [m/s]; the predicted ones when not simulated
+  double energy_lost = 0.0;              ///< total kinetic energy turned into heat [J]; NaN: not known
+  double energy_relative_drift = 0.0;    ///< as EngineResult; NaN when not simulated
+  double momentum_relative_drift = 0.0;  ///< as EngineResult; NaN when not simulated or with a wall
+  /// Simulated and predicted with a finite count: the engine's count equals it and
+  /// max |v_sim - v_pred| / max |v_0| is max_prediction_error. Empty otherwise.
+  std::optional<bool> matches_prediction;
+  double max_prediction_error = std::numeric_limits<double>::quiet_NaN();  ///< [1], NaN: not compared
+  Escalations escalations;
+};
+
+struct SceneRunResult {
+  ModelChoice model;                       ///< which model answered, and why (one line)
+  std::optional<Prediction> prediction;    ///< closed-form models (not three_body_rotation, event_engine)
+  std::optional<RunResult> three_body;     ///< set when the three-body path answered
+  SceneSimulation simulation;              ///< the N-body summary (unset for the three-body path)
+  double compute_time_s = 0.0;             ///< wall time of choice, prediction and simulation [s]
+};
+
+/// True when runScene hands this scene to runLab: three elastic bodies that
+/// validate(ThreeBodyScene) accepts. Precondition: validate(scene) passed.
+bool usesThreeBodyPath(const Scene& scene);
+/// The three-body scene of a three-body scene. Precondition: scene.size() == 3.
+ThreeBodyScene toThreeBodyScene(const Scene& scene);
+
+/// What runScene calls back. Each may be empty.
+struct SceneVisitors {
+  LabEventVisitor three_body_event;  ///< every event of the three-body path (full mode)
+  ImpactVisitor impact;              ///< every impact of the event engine (full mode)
+  ProgressCallback progress;         ///< the event engine's progress
+};
+
+/// Checks a scene for runScene. Three elastic bodies get the three-body validation (its
+/// reasons and messages, as today), except that walls at both ends around a body are now
+/// valid; every other scene gets validate(scene). The message never repeats the field.
+/// Returns nothing when the scene is valid.
+/// Never throws for any input (short of memory).
+std::optional<ValidationError> validateForRun(const Scene& scene);
+
+/// Runs a scene. Precondition: validateForRun(scene) returned nothing. Never throws (short
+/// of memory); the visitors may throw, which ends the run.
+SceneRunResult runScene(const Scene& scene, const SceneRunOptions& options, const SceneVisitors& visitors = {});
+
+}  // namespace core
+}  // namespace collision_lab

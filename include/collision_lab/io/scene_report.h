@@ -1,0 +1,64 @@
+// Reports of scenes of any size (N bodies): the aligned table, JSON and CSV, with the model
+// that answered and why. ROS-free. Conventions as report.h: SI units, doubles that read
+// back to the same double, never -0, null for NaN and infinities (walls are named).
+//
+// Three-body scenes that the three-body path answers keep report.h's output, with the
+// model added (makeThreeBodyReportWriter). Large scenes: the table shows the first and last
+// kTableBodies bodies and says how many it leaves out; JSON and CSV carry every body.
+#pragma once
+
+#include <cstddef>
+#include <memory>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "collision_lab/core/scene_run.h"
+#include "collision_lab/io/report.h"
+#include "collision_lab/io/scenario_file.h"
+
+namespace collision_lab {
+namespace io {
+
+/// Bodies shown at each end of the table's body lists.
+constexpr std::size_t kTableBodies = 5;
+
+/// Writes the report of one N-body run while it runs: begin(), impact() for each impact to
+/// show, then end(). Nothing is kept per impact.
+class SceneReportWriter {
+ public:
+  virtual ~SceneReportWriter() = default;
+  virtual void begin(const SceneEntry& entry, const core::RunOptions& options, const core::ModelChoice& model) = 0;
+  virtual void impact(const core::ImpactRecord& impact) = 0;
+  virtual void end(const core::SceneRunResult& result) = 0;
+};
+
+std::unique_ptr<SceneReportWriter> makeSceneReportWriter(ReportFormat format, std::ostream& out);
+
+/// report.h's three-body writer, which also states the model: the JSON summary gets
+/// "model" and "model_reason", CSV two "# summary.model..." lines, the table a "model:" line.
+std::unique_ptr<RunReportWriter> makeThreeBodyReportWriter(ReportFormat format, std::ostream& out,
+                                                           const core::ModelChoice& model);
+
+/// name, description, bodies (N), masses, positions, velocities, restitution, walls (names).
+Json sceneEntryJson(const SceneEntry& entry);
+/// One impact: pair (name) and pair_index, bodies, time, position, velocities, energies.
+Json impactJson(const core::ImpactRecord& impact);
+/// The summary of an N-body run (see docs/cli.md for the keys).
+Json sceneSummaryJson(const core::SceneRunResult& result);
+
+/// One scene of a batch and its finished run.
+struct SceneBatchOutcome {
+  SceneEntry entry;
+  core::RunOptions options;  ///< as run (a scene's own max_collisions applied)
+  core::SceneRunResult result;
+};
+
+/// Several scenes of any size. When every scene took the three-body path, this is
+/// writeBatchReport's output; otherwise table and CSV give one row per scene (bodies,
+/// model, collisions simulated and predicted, truncated, energy lost) and JSON gives
+/// {"units", "scenarios": [{"scene", "options", "events", "summary"}, ...]}.
+void writeSceneBatchReport(ReportFormat format, const std::vector<SceneBatchOutcome>& outcomes, std::ostream& out);
+
+}  // namespace io
+}  // namespace collision_lab

@@ -1,0 +1,153 @@
+#include "scene_runner.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <csignal>
+#include <iostream>
+#include <optional>
+
+#include "collision_lab/core/scene_run.h"
+#include "collision_lab/io/scene_report.h"
+#include "progress.h"
+
+namespace collision_lab {
+namespace cli {
+
+namespace {
+
+std::atomic<bool> g_cancel{false};
+
+extern "C" void onInterrupt(int) { g_cancel.store(true); }
+
+/// SIGINT sets the cancel flag while an N-body run lasts; the previous handler (the
+/// default: end the process) is back afterwards. The three-body path has no cancel flag,
+/// so it runs without the guard and Ctrl-C ends it as before.
+class InterruptGuard {
+ public:
+  InterruptGuard() {
+    g_cancel.store(false);
+    previous_ = std::signal(SIGINT, onInterrupt);
+    if (previous_ == SIG_IGN) std::signal(SIGINT, SIG_IGN);  // ignored by the parent: stay so
+  }
+  ~InterruptGuard() { std::signal(SIGINT, previous_); }
+  InterruptGuard(const InterruptGuard&) = delete;
+  InterruptGuard& operator=(const InterruptGuard&) = delete;
+
+ private:
+  void (*previous_)(int) = SIG_DFL;
+};
+
+/// The scene with --restitution applied.
+io::SceneEntry withRequestRestitution(const CliRequest& request, io::SceneEntry entry) {
+  if (request.restitution) entry.scene.restitution = *request.restitution;
+  return entry;
+}
+
+void validateOrThrow(const io::SceneEntry& entry) {
+  if (const auto error = core::validateForRun(entry.scene)) {
+    const std::string where = entry.name.empty() ? "" : "scenario '" + entry.name + "': ";
+    throw CliError{core::reasonName(error->reason), static_cast<int>(error->reason), error->field,
+                   where + error->message};
+  }
+}
+
+/// The request's options, with a scene's own collision cap unless --max-collisions was given.
+core::RunOptions optionsFor(const CliRequest& request, const io::SceneEntry& entry) {
+  core::RunOptions options = request.options;
+  if (!request.max_collisions_given && entry.max_collisions > 0) options.max_collisions = entry.max_collisions;
+  return options;
+}
+
+bool isShown(const core::EventPolicy& policy, std::uint64_t index) {
+  switch (policy.kind) {
+    case core::EventPolicy::Kind::kAll: return true;
+    case core::EventPolicy::Kind::kNone: return false;
+    case core::EventPolicy::Kind::kFirstN: return index <= policy.first_n;
+  }
+  return false;
+}
+
+/// Runs a validated scene with a progress line on a terminal and Ctrl-C for the engine.
+/// `visitors` see the shown events; the run itself keeps none.
+core::SceneRunResult runWithProgress(const core::Scene& scene, const core::RunOptions& shown,
+                                     core::SceneVisitors visitors) {
+  core::SceneRunOptions options;
+  options.lab = shown;
+  options.keep_events = false;  // streamed to the report, not kept
+  options.cancel = &g_cancel;
+  std::optional<ProgressLine> progress;
+  if (shown.mode != core::RunMode::kPredictOnly && isatty(STDERR_FILENO)) {
+    const bool three_body = core::usesThreeBodyPath(scene);
+    progress.emplace(stderr, three_body ? std::min(core::predict(core::toThreeBodyScene(scene)).collision_count,
+                                                   shown.max_collisions)
+                                        : 0);
+    options.progress_interval = std::uint64_t{1} << 16;
+    visitors.progress = [&](const core::EngineProgress& p) { progress->onEngineProgress(p.impacts, p.time); };
+    const core::LabEventVisitor on_event = visitors.three_body_event;
+    visitors.three_body_event = [&, on_event](const core::LabEvent& event) {
+      if (on_event) on_event(event);
+      progress->onCollision(event.event.index);
+    };
+  }
+  if (core::usesThreeBodyPath(scene)) return core::runScene(scene, options, visitors);  // Ctrl-C ends it
+  const InterruptGuard interrupt_guard;
+  return core::runScene(scene, options, visitors);
+}
+
+/// The visitors that hand the shown events to the writer of their path.
+core::SceneVisitors showEvents(const core::RunOptions& shown, io::RunReportWriter& three_body,
+                               io::SceneReportWriter& nbody) {
+  core::SceneVisitors visitors;
+  if (shown.events.kind == core::EventPolicy::Kind::kNone) return visitors;
+  const core::EventPolicy policy = shown.events;
+  visitors.three_body_event = [&three_body, policy](const core::LabEvent& event) {
+    if (isShown(policy, event.event.index)) three_body.event(event);
+  };
+  visitors.impact = [&nbody, policy](const core::ImpactRecord& impact) {
+    if (isShown(policy, impact.index)) nbody.impact(impact);
+  };
+  // The event engine runs to the end even when only the first N impacts are shown.
+  return visitors;
+}
+
+}  // namespace
+
+void runEntry(const CliRequest& request, const io::SceneEntry& given) {
+  const io::SceneEntry entry = withRequestRestitution(request, given);
+  validateOrThrow(entry);
+  const core::RunOptions shown = optionsFor(request, entry);
+  const core::ModelChoice model = core::chooseModel(entry.scene);
+  const auto three_body = io::makeThreeBodyReportWriter(request.format, std::cout, model);
+  const auto nbody = io::makeSceneReportWriter(request.format, std::cout);
+  const bool is_three_body = core::usesThreeBodyPath(entry.scene);
+  if (is_three_body) {
+    three_body->begin(io::toNamedScene(entry), shown);
+  } else {
+    nbody->begin(entry, shown, model);
+  }
+  const core::SceneRunResult result = runWithProgress(entry.scene, shown, showEvents(shown, *three_body, *nbody));
+  if (is_three_body) {
+    three_body->end(*result.three_body);
+  } else {
+    nbody->end(result);
+  }
+}
+
+void runEntries(const CliRequest& request, const std::vector<io::SceneEntry>& given) {
+  std::vector<io::SceneEntry> entries;
+  for (const io::SceneEntry& entry : given) entries.push_back(withRequestRestitution(request, entry));
+  for (const io::SceneEntry& entry : entries) validateOrThrow(entry);
+  std::vector<io::SceneBatchOutcome> outcomes;
+  for (const io::SceneEntry& entry : entries) {
+    const core::RunOptions options = optionsFor(request, entry);
+    core::SceneRunOptions run_options;
+    run_options.lab = options;  // the three-body path keeps the events that the options ask for
+    outcomes.push_back({entry, options, core::runScene(entry.scene, run_options)});
+  }
+  io::writeSceneBatchReport(request.format, outcomes, std::cout);
+}
+
+}  // namespace cli
+}  // namespace collision_lab

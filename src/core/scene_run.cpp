@@ -1,0 +1,152 @@
+#include "collision_lab/core/scene_run.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+namespace collision_lab {
+namespace core {
+
+namespace {
+
+bool allOnes(const std::vector<double>& restitution) {
+  return std::all_of(restitution.begin(), restitution.end(), [](double e) { return e == 1.0; });
+}
+
+/// Three bodies with e = 1 throughout, as the three-body path takes them.
+bool isElasticTriple(const Scene& scene) {
+  return scene.masses.size() == 3 && scene.positions.size() == 3 && scene.velocities.size() == 3 &&
+         scene.restitution.size() <= 2 && allOnes(scene.restitution);
+}
+
+/// What the closed form alone says, for a finite prediction that no event needs checking.
+SceneSimulation fromPrediction(const Prediction& prediction) {
+  SceneSimulation simulation;
+  simulation.impact_count = prediction.impact_count.value_or(0);
+  simulation.final_velocities = prediction.final_velocities;
+  simulation.energy_lost = prediction.energy_lost;
+  simulation.energy_relative_drift = std::numeric_limits<double>::quiet_NaN();
+  simulation.momentum_relative_drift = std::numeric_limits<double>::quiet_NaN();
+  simulation.stop_message = std::string("answered by the closed form of ") + modelKindName(prediction.kind) +
+                            ": nothing simulated";
+  return simulation;
+}
+
+/// Predict-only mode with no finite closed form: nothing is known beyond the model.
+SceneSimulation notSimulated(const std::optional<Prediction>& prediction) {
+  SceneSimulation simulation;
+  simulation.energy_lost = std::numeric_limits<double>::quiet_NaN();  // not known
+  simulation.energy_relative_drift = std::numeric_limits<double>::quiet_NaN();
+  simulation.momentum_relative_drift = std::numeric_limits<double>::quiet_NaN();
+  simulation.truncated = prediction && prediction->infinite;
+  simulation.stop_message = simulation.truncated
+                                ? "predict-only: infinitely many impacts, nothing simulated"
+                                : "predict-only: no closed form gives this scene's count, nothing simulated";
+  return simulation;
+}
+
+/// max |v_sim - v_pred| / max |v_0| (1 when every v_0 is 0 and any differs).
+double relativeVelocityError(const std::vector<double>& simulated, const std::vector<double>& predicted,
+                             const std::vector<double>& initial) {
+  double error = 0.0, scale = 0.0;
+  for (std::size_t i = 0; i < simulated.size(); ++i) error = std::max(error, std::fabs(simulated[i] - predicted[i]));
+  for (double v : initial) scale = std::max(scale, std::fabs(v));
+  return scale > 0.0 ? error / scale : error;
+}
+
+SceneSimulation fromEngine(EngineResult&& engine) {
+  SceneSimulation simulation;
+  simulation.simulated = true;
+  simulation.impact_count = engine.impact_count;
+  simulation.truncated = engine.truncated;
+  simulation.stop = engine.stop;
+  simulation.stop_message = std::move(engine.stop_message);
+  simulation.multiple_collision = engine.multiple_collision;
+  simulation.final_time = engine.final_time;
+  simulation.final_velocities = std::move(engine.final_velocities);
+  simulation.energy_lost = engine.energy_lost;
+  simulation.energy_relative_drift = engine.energy_relative_drift;
+  simulation.momentum_relative_drift = engine.momentum_relative_drift;
+  simulation.escalations = engine.escalations;
+  return simulation;
+}
+
+/// The engine's run of an N-body scene, compared with a finite prediction when it finished.
+SceneSimulation simulateScene(const Scene& scene, const SceneRunOptions& options,
+                              const std::optional<Prediction>& prediction, const SceneVisitors& visitors) {
+  const RunOptions& lab = options.lab;
+  if (lab.mode == RunMode::kPredictOnly) {
+    return prediction && !prediction->infinite ? fromPrediction(*prediction) : notSimulated(prediction);
+  }
+  const bool wants_events = lab.mode == RunMode::kFull && lab.events.kind != EventPolicy::Kind::kNone;
+  // Nothing approaching: there is nothing to simulate, events or not.
+  const bool nothing_happens = prediction && prediction->kind == ModelKind::kNoCollisions;
+  if (prediction && !prediction->infinite && (!wants_events || nothing_happens)) return fromPrediction(*prediction);
+
+  EngineOptions engine_options;
+  engine_options.max_impacts = lab.max_collisions;
+  engine_options.progress_interval = options.progress_interval;
+  engine_options.cancel = options.cancel;
+  const ImpactVisitor visitor = lab.mode == RunMode::kFull ? visitors.impact : ImpactVisitor{};
+  SceneSimulation simulation = fromEngine(runEngine(scene, engine_options, visitor, visitors.progress));
+  if (prediction && prediction->impact_count && simulation.stop == StopReason::kFinished) {
+    simulation.max_prediction_error =
+        relativeVelocityError(simulation.final_velocities, prediction->final_velocities, scene.velocities);
+    simulation.matches_prediction = simulation.impact_count == *prediction->impact_count;
+  }
+  return simulation;
+}
+
+}  // namespace
+
+ThreeBodyScene toThreeBodyScene(const Scene& scene) {
+  ThreeBodyScene triple;
+  for (int i = 0; i < 3; ++i) {
+    triple.masses[i] = scene.masses[i];
+    triple.positions[i] = scene.positions[i];
+    triple.velocities[i] = scene.velocities[i];
+  }
+  return triple;
+}
+
+/// The message without a leading "<field>: ": front ends show field and message side by
+/// side (ValidationError's contract), and N-body validation may still start with it.
+std::optional<ValidationError> withoutRepeatedField(std::optional<ValidationError> error) {
+  if (!error) return error;
+  const std::string prefix = error->field + ": ";
+  if (error->message.compare(0, prefix.size(), prefix) == 0) error->message.erase(0, prefix.size());
+  return error;
+}
+
+std::optional<ValidationError> validateForRun(const Scene& scene) {
+  if (isElasticTriple(scene)) {
+    auto error = validate(toThreeBodyScene(scene));
+    if (!error) return error;  // the three-body path takes it, whatever N-body limits say
+    // Walls at both ends around a body are an N-body scene now (two_walls_infinite).
+    if (error->reason != Reason::kTwoWalls) return error;
+  }
+  return withoutRepeatedField(validate(scene));
+}
+
+bool usesThreeBodyPath(const Scene& scene) {
+  return isElasticTriple(scene) && !validate(toThreeBodyScene(scene));
+}
+
+SceneRunResult runScene(const Scene& scene, const SceneRunOptions& options, const SceneVisitors& visitors) {
+  const auto start = std::chrono::steady_clock::now();
+  SceneRunResult result;
+  result.model = chooseModel(scene);
+  if (usesThreeBodyPath(scene)) {
+    RunOptions lab = options.lab;
+    if (!options.keep_events) lab.events = EventPolicy::none();
+    result.three_body = runLab(toThreeBodyScene(scene), lab, visitors.three_body_event);
+  } else {
+    result.prediction = predict(scene);
+    result.simulation = simulateScene(scene, options, result.prediction, visitors);
+  }
+  result.compute_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+}  // namespace core
+}  // namespace collision_lab

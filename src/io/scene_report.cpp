@@ -1,0 +1,573 @@
+#include "collision_lab/io/scene_report.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+
+namespace collision_lab {
+namespace io {
+
+namespace {
+
+/// Shortest text that reads back to the same double; 0 for either zero; `non_finite` for
+/// NaN and infinities.
+std::string exactText(double value, const char* non_finite) {
+  if (!std::isfinite(value)) return non_finite;
+  if (value == 0) return "0";
+  char buffer[64];
+  const auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
+  return std::string(buffer, result.ptr);
+}
+
+/// Text for CSV cells: inf, -inf and nan spelled out.
+std::string csvNumber(double value) {
+  if (std::isnan(value)) return "nan";
+  if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
+  return exactText(value, "nan");
+}
+
+/// Compact text for people, `digits` significant digits; never -0.
+std::string humanText(double value, int digits) {
+  if (value == 0.0) return "0";
+  if (std::isnan(value)) return "nan";
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.*g", digits, value);
+  return buffer;
+}
+
+std::string padLeft(const std::string& text, std::size_t width) {
+  return text.size() >= width ? text : std::string(width - text.size(), ' ') + text;
+}
+
+std::string padRight(const std::string& text, std::size_t width) {
+  return text.size() >= width ? text : text + std::string(width - text.size(), ' ');
+}
+
+/// A double for JSON: never -0; NaN and infinities become null when dumped.
+Json number(double value) { return Json(value == 0 ? 0.0 : value); }
+
+/// A JSON array of doubles, streamed without building a document (10^6 bodies).
+void writeJsonNumbers(std::ostream& out, const std::vector<double>& values) {
+  out << '[';
+  for (std::size_t i = 0; i < values.size(); ++i) out << (i ? "," : "") << exactText(values[i], "null");
+  out << ']';
+}
+
+/// A CSV field: quoted when it holds a comma, quote or line break.
+std::string csvField(const std::string& text) {
+  if (text.find_first_of(",\"\n") == std::string::npos) return text;
+  std::string quoted = "\"";
+  for (char c : text) quoted += (c == '"') ? std::string("\"\"") : std::string(1, c);
+  return quoted + "\"";
+}
+
+Json wallNames(const core::Scene& scene) {
+  Json walls = Json::array();
+  for (std::size_t i = 0; i < scene.size(); ++i) {
+    if (scene.isWall(i)) walls.push_back(core::bodyName(i));
+  }
+  return walls;
+}
+
+std::string restitutionText(const core::Scene& scene) {
+  if (scene.isElastic()) return "elastic (e = 1)";
+  if (scene.restitution.size() == 1) return "e = " + humanText(scene.restitution[0], 10) + " for every pair";
+  return "e per pair, from " + humanText(*std::min_element(scene.restitution.begin(), scene.restitution.end()), 10) +
+         " to " + humanText(*std::max_element(scene.restitution.begin(), scene.restitution.end()), 10);
+}
+
+/// Why no count formula is printed for a scene without a closed form.
+const char* const kNoCountFormula =
+    "none: no closed form gives the number of impacts of this scene; the count is the exact event engine's";
+
+std::string stopReasonText(const core::SceneSimulation& s) {
+  return s.simulated ? core::stopReasonName(s.stop) : "NOT_SIMULATED";
+}
+
+// ---------------------------------------------------------------------------------------
+// Table: for people. The bodies' lists show the first and last kTableBodies entries.
+
+constexpr int kDigits = 10;
+constexpr int kEventDigits = 7;
+constexpr std::size_t kWidth = 17;
+
+/// The body indices the table shows, with SIZE_MAX marking the gap.
+std::vector<std::size_t> shownBodies(std::size_t n) {
+  std::vector<std::size_t> shown;
+  if (n <= 2 * kTableBodies + 1) {
+    for (std::size_t i = 0; i < n; ++i) shown.push_back(i);
+    return shown;
+  }
+  for (std::size_t i = 0; i < kTableBodies; ++i) shown.push_back(i);
+  shown.push_back(SIZE_MAX);
+  for (std::size_t i = n - kTableBodies; i < n; ++i) shown.push_back(i);
+  return shown;
+}
+
+/// Rows "body | column 1 | column 2 ..." for the shown bodies; a line for the left-out ones.
+void writeBodyRows(std::ostream& out, std::size_t n, const std::vector<std::string>& headers,
+                   const std::vector<const std::vector<double>*>& columns) {
+  out << padLeft("body", 8);
+  for (const std::string& header : headers) out << padLeft(header, kWidth);
+  out << "\n";
+  for (std::size_t i : shownBodies(n)) {
+    if (i == SIZE_MAX) {
+      out << padLeft("...", 8) << "  (" << n - 2 * kTableBodies
+          << " bodies left out here; JSON and CSV list every body)\n";
+      continue;
+    }
+    out << padLeft(core::bodyName(i), 8);
+    for (const auto* column : columns) {
+      out << padLeft(i < column->size() ? humanText((*column)[i], kDigits) : "-", kWidth);
+    }
+    out << "\n";
+  }
+}
+
+class SceneTableWriter : public SceneReportWriter {
+ public:
+  explicit SceneTableWriter(std::ostream& out) : out_(out) {}
+
+  void begin(const SceneEntry& entry, const core::RunOptions& options, const core::ModelChoice& model) override {
+    const core::Scene& scene = entry.scene;
+    out_ << "collision_lab: " << (entry.name.empty() ? "scene from the command line" : entry.name);
+    if (!entry.description.empty()) out_ << " - " << entry.description;
+    const Json walls = wallNames(scene);
+    out_ << "\n\n" << scene.size() << (scene.size() == 1 ? " body" : " bodies") << ", right to left; walls: "
+         << (walls.empty() ? std::string("none") : jsonText(walls)) << "; " << restitutionText(scene) << "\n";
+    writeBodyRows(out_, scene.size(), {"mass [kg]", "position [m]", "velocity [m/s]"},
+                  {&scene.masses, &scene.positions, &scene.velocities});
+    out_ << "\nmodel: " << core::modelKindName(model.kind) << " - " << model.reason << "\n";
+    out_ << "run: mode " << runModeText(options.mode) << ", events " << eventPolicyText(options.events)
+         << ", at most " << options.max_collisions << " impacts\n";
+  }
+
+  void impact(const core::ImpactRecord& r) override {
+    if (!header_written_) writeImpactHeader();
+    out_ << padLeft(std::to_string(r.index), 9) << padLeft(core::pairName(r.pair_index), 8);
+    for (double value : {r.time, r.position, r.velocities_after[0], r.velocities_after[1], r.energy_lost}) {
+      out_ << padLeft(humanText(value, kEventDigits), 15);
+    }
+    out_ << "\n";
+  }
+
+  void end(const core::SceneRunResult& result) override {
+    const core::SceneSimulation& s = result.simulation;
+    const auto& p = result.prediction;
+    out_ << "\nSummary\n";
+    out_ << "collisions: " << (s.simulated ? "simulated " + std::to_string(s.impact_count) : "not simulated")
+         << ", predicted " << predictedCountText(p) << "\n";
+    if (!p || (!p->impact_count && !p->infinite)) out_ << "count formula: " << kNoCountFormula << "\n";
+    out_ << "truncated: " << (s.truncated ? "yes" : "no") << "; end of run: " << s.stop_message << "\n";
+    if (!std::isnan(s.energy_lost)) out_ << "energy lost [J]: " << humanText(s.energy_lost, kDigits) << "\n";
+    if (s.simulated) writeChecks(s);
+    if (!s.final_velocities.empty()) {
+      const std::vector<double>* predicted =
+          p && s.simulated && !p->final_velocities.empty() ? &p->final_velocities : nullptr;
+      out_ << "\nfinal velocities"
+           << (!s.simulated ? " (predicted)" : predicted ? " (simulated; predicted beside them)" : " (simulated)")
+           << "\n";
+      writeBodyRows(out_, s.final_velocities.size(),
+                    predicted ? std::vector<std::string>{"v [m/s]", "predicted [m/s]"}
+                              : std::vector<std::string>{"v [m/s]"},
+                    predicted ? std::vector<const std::vector<double>*>{&s.final_velocities, predicted}
+                              : std::vector<const std::vector<double>*>{&s.final_velocities});
+    }
+    out_ << "compute time " << humanText(result.compute_time_s, 3) << " s\n";
+  }
+
+ private:
+  static std::string predictedCountText(const std::optional<core::Prediction>& p) {
+    if (!p) return "- (no closed form)";
+    if (p->infinite) return "infinitely many";
+    return p->impact_count ? std::to_string(*p->impact_count) : "-";
+  }
+
+  void writeChecks(const core::SceneSimulation& s) {
+    out_ << "checks: relative energy drift " << humanText(s.energy_relative_drift, 3) << ", relative momentum drift "
+         << (std::isnan(s.momentum_relative_drift) ? std::string("n/a (a wall does not conserve it)")
+                                                   : humanText(s.momentum_relative_drift, 3));
+    if (s.matches_prediction) {
+      out_ << ", simulation " << (*s.matches_prediction ? "matches" : "DIFFERS FROM") << " the prediction (max |dv| / max |v0| "
+           << humanText(s.max_prediction_error, 3) << ")";
+    }
+    out_ << "\n";
+    if (s.multiple_collision) {
+      const core::MultipleCollision& m = *s.multiple_collision;
+      out_ << "multiple collision: " << core::bodyName(m.first_body) << ", " << core::bodyName(m.first_body + 1)
+           << " and " << core::bodyName(m.first_body + 2) << " at t = " << humanText(m.time, kDigits) << " s\n";
+    }
+  }
+
+  void writeImpactHeader() {
+    header_written_ = true;
+    out_ << "\nImpacts (velocities of the pair's two bodies after it, right body first; energy turned into heat)\n"
+         << padLeft("#", 9) << padLeft("pair", 8);
+    for (const char* label : {"t [s]", "x [m]", "v_right [m/s]", "v_left [m/s]", "lost [J]"}) {
+      out_ << padLeft(label, 15);
+    }
+    out_ << "\n";
+  }
+
+  std::ostream& out_;
+  bool header_written_ = false;
+};
+
+// ---------------------------------------------------------------------------------------
+// JSON: one document, one impact per line; the bodies' lists are streamed.
+
+void writeSceneJson(std::ostream& out, const SceneEntry& entry) {
+  const core::Scene& s = entry.scene;
+  out << "{\"name\":" << jsonText(Json(entry.name)) << ",\"description\":" << jsonText(Json(entry.description))
+      << ",\"bodies\":" << s.size() << ",\"walls\":" << jsonText(wallNames(s)) << ",\"masses\":";
+  writeJsonNumbers(out, s.masses);
+  out << ",\"positions\":";
+  writeJsonNumbers(out, s.positions);
+  out << ",\"velocities\":";
+  writeJsonNumbers(out, s.velocities);
+  out << ",\"restitution\":";
+  writeJsonNumbers(out, s.restitution);
+  out << "}";
+}
+
+/// The summary without its velocity lists (10^6 numbers are streamed, not built).
+Json summaryScalars(const core::SceneRunResult& result) {
+  const core::SceneSimulation& s = result.simulation;
+  const auto& p = result.prediction;
+  const bool has_formula = p && (p->impact_count || p->infinite);
+  Json json{{"model", core::modelKindName(result.model.kind)},
+            {"model_reason", result.model.reason},
+            {"collision_count", s.simulated ? Json(s.impact_count) : Json(nullptr)},
+            {"simulated", s.simulated},
+            {"truncated", s.truncated},
+            {"stop_reason", stopReasonText(s)},
+            {"stop_message", s.stop_message},
+            {"predicted_collision_count", p && p->impact_count ? Json(*p->impact_count) : Json(nullptr)},
+            {"predicted_infinite", p && p->infinite},
+            {"count_formula", has_formula ? Json(core::modelKindName(p->kind)) : Json(kNoCountFormula)},
+            {"matches_prediction", s.matches_prediction ? Json(*s.matches_prediction) : Json(nullptr)},
+            {"max_prediction_error", number(s.max_prediction_error)},
+            {"final_time", number(s.final_time)},
+            {"energy_lost", number(s.energy_lost)},
+            {"energy_relative_drift", number(s.energy_relative_drift)},
+            {"momentum_relative_drift", number(s.momentum_relative_drift)},
+            {"compute_time_s", number(result.compute_time_s)}};
+  json["multiple_collision"] = nullptr;
+  if (s.multiple_collision) {
+    const std::size_t b = s.multiple_collision->first_body;
+    json["multiple_collision"] = {
+        {"bodies", Json::array({core::bodyName(b), core::bodyName(b + 1), core::bodyName(b + 2)})},
+        {"first_body_index", b},
+        {"time", number(s.multiple_collision->time)}};
+  }
+  json["escalation"] = {{"refinements", s.escalations.refinements},
+                        {"high_precision", s.escalations.high_precision},
+                        {"exact_rational", s.escalations.exact_rational},
+                        {"replayed_impacts", s.escalations.replayed_impacts}};
+  return json;
+}
+
+void writeSummaryJson(std::ostream& out, const core::SceneRunResult& result) {
+  std::string scalars = jsonText(summaryScalars(result));
+  scalars.pop_back();  // the closing brace: the velocity lists follow
+  out << scalars << ",\"final_velocities\":";
+  writeJsonNumbers(out, result.simulation.final_velocities);
+  out << ",\"predicted_final_velocities\":";
+  if (result.prediction && !result.prediction->final_velocities.empty()) {
+    writeJsonNumbers(out, result.prediction->final_velocities);
+  } else {
+    out << "null";
+  }
+  out << "}";
+}
+
+class SceneJsonWriter : public SceneReportWriter {
+ public:
+  explicit SceneJsonWriter(std::ostream& out) : out_(out) {}
+
+  void begin(const SceneEntry& entry, const core::RunOptions& options, const core::ModelChoice&) override {
+    out_ << "{\"scene\": ";
+    writeSceneJson(out_, entry);
+    out_ << ",\n\"options\": " << jsonText(optionsJson(options)) << ",\n\"units\": " << jsonText(unitsJson())
+         << ",\n\"events\": [";
+  }
+
+  void impact(const core::ImpactRecord& impact) override {
+    out_ << (any_event_ ? ",\n" : "\n") << jsonText(impactJson(impact));
+    any_event_ = true;
+  }
+
+  void end(const core::SceneRunResult& result) override {
+    out_ << (any_event_ ? "\n]" : "]") << ",\n\"summary\": ";
+    writeSummaryJson(out_, result);
+    out_ << "}\n";
+  }
+
+ private:
+  std::ostream& out_;
+  bool any_event_ = false;
+};
+
+// ---------------------------------------------------------------------------------------
+// CSV: "# key,value..." comment lines for the scene, options and model, a header line, one
+// row per impact, then "# summary.key,value..." lines (the JSON summary's keys).
+
+void writeCsvComment(std::ostream& out, const std::string& key, const Json& value) {
+  if (value.is_object()) {
+    for (const auto& item : value.items()) writeCsvComment(out, key + "." + item.key(), item.value());
+    return;
+  }
+  out << "# " << key;
+  const auto scalar = [&](const Json& v) {
+    out << ",";
+    if (v.is_string()) {
+      out << csvField(v.get<std::string>());
+    } else if (v.is_number_float()) {
+      out << csvNumber(v.get<double>());
+    } else if (!v.is_null()) {
+      out << jsonText(v);
+    }
+  };
+  if (value.is_array()) {
+    for (const Json& element : value) scalar(element);
+  } else {
+    scalar(value);
+  }
+  out << "\n";
+}
+
+void writeCsvNumbers(std::ostream& out, const char* key, const std::vector<double>& values) {
+  out << "# " << key;
+  for (double v : values) out << "," << csvNumber(v);
+  out << "\n";
+}
+
+class SceneCsvWriter : public SceneReportWriter {
+ public:
+  explicit SceneCsvWriter(std::ostream& out) : out_(out) {}
+
+  void begin(const SceneEntry& entry, const core::RunOptions& options, const core::ModelChoice& model) override {
+    const core::Scene& s = entry.scene;
+    out_ << "# scene," << csvField(entry.name) << "\n# bodies," << s.size() << "\n";
+    writeCsvNumbers(out_, "masses_kg", s.masses);
+    writeCsvNumbers(out_, "positions_m", s.positions);
+    writeCsvNumbers(out_, "velocities_m_s", s.velocities);
+    writeCsvNumbers(out_, "restitution", s.restitution);
+    const Json options_json = optionsJson(options);
+    for (const auto& item : options_json.items()) writeCsvComment(out_, item.key(), item.value());
+    writeCsvComment(out_, "model", core::modelKindName(model.kind));
+    writeCsvComment(out_, "model_reason", model.reason);
+    out_ << "index,pair,pair_index,time_s,position_m,v_right_before_m_s,v_left_before_m_s,v_right_after_m_s,"
+            "v_left_after_m_s,energy_gained_right_J,energy_gained_left_J,energy_lost_J\n";
+  }
+
+  void impact(const core::ImpactRecord& r) override {
+    out_ << r.index << "," << core::pairName(r.pair_index) << "," << r.pair_index;
+    for (double v : {r.time, r.position, r.velocities_before[0], r.velocities_before[1], r.velocities_after[0],
+                     r.velocities_after[1], r.energy_gained[0], r.energy_gained[1], r.energy_lost}) {
+      out_ << "," << csvNumber(v);
+    }
+    out_ << "\n";
+  }
+
+  void end(const core::SceneRunResult& result) override {
+    const Json summary = summaryScalars(result);
+    for (const auto& item : summary.items()) {
+      writeCsvComment(out_, "summary." + item.key(), item.value());
+    }
+    writeCsvNumbers(out_, "summary.final_velocities", result.simulation.final_velocities);
+    if (result.prediction) writeCsvNumbers(out_, "summary.predicted_final_velocities", result.prediction->final_velocities);
+  }
+
+ private:
+  std::ostream& out_;
+};
+
+// ---------------------------------------------------------------------------------------
+// Three-body reports with the model.
+
+class ThreeBodyModelWriter : public RunReportWriter {
+ public:
+  ThreeBodyModelWriter(ReportFormat format, std::ostream& out, const core::ModelChoice& model)
+      : format_(format), out_(out), model_(model), inner_(makeRunReportWriter(format, out)) {}
+
+  void begin(const NamedScene& scene, const core::RunOptions& options) override {
+    if (format_ != ReportFormat::kJson) return inner_->begin(scene, options);
+    out_ << "{\"scene\": " << jsonText(sceneJson(scene)) << ",\n\"options\": " << jsonText(optionsJson(options))
+         << ",\n\"units\": " << jsonText(unitsJson()) << ",\n\"events\": [";
+  }
+
+  void event(const core::LabEvent& event) override {
+    if (format_ != ReportFormat::kJson) return inner_->event(event);
+    out_ << (any_event_ ? ",\n" : "\n") << jsonText(eventJson(event));
+    any_event_ = true;
+  }
+
+  void end(const core::RunResult& result) override {
+    if (format_ == ReportFormat::kJson) {
+      Json summary = summaryJson(result);
+      summary["model"] = core::modelKindName(model_.kind);
+      summary["model_reason"] = model_.reason;
+      out_ << (any_event_ ? "\n]" : "]") << ",\n\"summary\": " << jsonText(summary) << "}\n";
+      return;
+    }
+    inner_->end(result);
+    if (format_ == ReportFormat::kCsv) {
+      writeCsvComment(out_, "summary.model", core::modelKindName(model_.kind));
+      writeCsvComment(out_, "summary.model_reason", model_.reason);
+    } else {
+      out_ << "model: " << core::modelKindName(model_.kind) << " - " << model_.reason << "\n";
+    }
+  }
+
+ private:
+  ReportFormat format_;
+  std::ostream& out_;
+  core::ModelChoice model_;
+  std::unique_ptr<RunReportWriter> inner_;
+  bool any_event_ = false;
+};
+
+// ---------------------------------------------------------------------------------------
+// Batches of scenes of any size.
+
+struct BatchRow {
+  std::string name, model;
+  std::size_t bodies = 0;
+  std::string simulated, predicted;
+  bool truncated = false;
+  double energy_lost = 0.0;
+};
+
+BatchRow batchRow(const SceneBatchOutcome& outcome) {
+  const core::SceneRunResult& r = outcome.result;
+  BatchRow row{outcome.entry.name, core::modelKindName(r.model.kind), outcome.entry.scene.size(), "-", "-", false, 0.0};
+  if (r.three_body) {
+    const core::LabRunSummary& s = r.three_body->summary;
+    if (s.simulated) row.simulated = std::to_string(s.collision_count);
+    row.predicted = std::to_string(r.three_body->prediction.collision_count);
+    row.truncated = s.truncated;
+    return row;
+  }
+  const core::SceneSimulation& s = r.simulation;
+  if (s.simulated) row.simulated = std::to_string(s.impact_count);
+  if (r.prediction && r.prediction->infinite) row.predicted = "inf";
+  if (r.prediction && r.prediction->impact_count) row.predicted = std::to_string(*r.prediction->impact_count);
+  row.truncated = s.truncated;
+  row.energy_lost = s.energy_lost;
+  return row;
+}
+
+void writeSceneBatchTable(const std::vector<SceneBatchOutcome>& outcomes, std::ostream& out) {
+  std::size_t name_width = 8;
+  for (const auto& outcome : outcomes) name_width = std::max(name_width, outcome.entry.name.size());
+  out << padRight("scenario", name_width) << padLeft("bodies", 9) << "  " << padRight("model", 20)
+      << padLeft("collisions", 12) << padLeft("predicted", 12) << padLeft("energy lost [J]", 17) << "  truncated\n";
+  for (const auto& outcome : outcomes) {
+    const BatchRow row = batchRow(outcome);
+    out << padRight(row.name, name_width) << padLeft(std::to_string(row.bodies), 9) << "  " << padRight(row.model, 20)
+        << padLeft(row.simulated, 12) << padLeft(row.predicted, 12) << padLeft(humanText(row.energy_lost, 6), 17)
+        << "  " << (row.truncated ? "yes" : "no") << "\n";
+  }
+  out << "\ncollisions: simulated (- when a closed form answered alone); predicted: the model's closed form "
+         "(- when none exists, inf for infinitely many)\n";
+}
+
+void writeSceneBatchCsv(const std::vector<SceneBatchOutcome>& outcomes, std::ostream& out) {
+  out << "scenario,bodies,model,collision_count,predicted_collision_count,truncated,energy_lost_J\n";
+  for (const auto& outcome : outcomes) {
+    const BatchRow row = batchRow(outcome);
+    out << csvField(row.name) << "," << row.bodies << "," << row.model << ","
+        << (row.simulated == "-" ? "" : row.simulated) << "," << (row.predicted == "-" ? "" : row.predicted) << ","
+        << (row.truncated ? "true" : "false") << "," << csvNumber(row.energy_lost) << "\n";
+  }
+}
+
+void writeSceneBatchJson(const std::vector<SceneBatchOutcome>& outcomes, std::ostream& out) {
+  out << "{\"units\": " << jsonText(unitsJson()) << ",\n\"scenarios\": [";
+  bool first = true;
+  for (const auto& outcome : outcomes) {
+    const core::SceneRunResult& r = outcome.result;
+    Json entry;
+    entry["scene"] = r.three_body ? sceneJson(toNamedScene(outcome.entry)) : sceneEntryJson(outcome.entry);
+    entry["options"] = optionsJson(outcome.options);
+    entry["events"] = Json::array();
+    if (r.three_body) {
+      for (const core::LabEvent& lab : r.three_body->events) entry["events"].push_back(eventJson(lab));
+      entry["summary"] = summaryJson(*r.three_body);
+      entry["summary"]["model"] = core::modelKindName(r.model.kind);
+      entry["summary"]["model_reason"] = r.model.reason;
+    } else {
+      entry["summary"] = sceneSummaryJson(r);
+    }
+    out << (first ? "\n" : ",\n") << jsonText(entry);
+    first = false;
+  }
+  out << "\n]}\n";
+}
+
+}  // namespace
+
+Json sceneEntryJson(const SceneEntry& entry) {
+  const core::Scene& s = entry.scene;
+  return Json{{"name", entry.name},           {"description", entry.description},
+              {"bodies", s.size()},           {"walls", wallNames(s)},
+              {"masses", s.masses},           {"positions", s.positions},
+              {"velocities", s.velocities},   {"restitution", s.restitution}};
+}
+
+Json impactJson(const core::ImpactRecord& r) {
+  return Json{{"index", r.index},
+              {"pair", core::pairName(r.pair_index)},
+              {"pair_index", r.pair_index},
+              {"bodies", Json::array({core::bodyName(r.pair_index), core::bodyName(r.pair_index + 1)})},
+              {"time", number(r.time)},
+              {"position", number(r.position)},
+              {"velocities_before", Json::array({number(r.velocities_before[0]), number(r.velocities_before[1])})},
+              {"velocities_after", Json::array({number(r.velocities_after[0]), number(r.velocities_after[1])})},
+              {"energy_gained", Json::array({number(r.energy_gained[0]), number(r.energy_gained[1])})},
+              {"energy_lost", number(r.energy_lost)}};
+}
+
+Json sceneSummaryJson(const core::SceneRunResult& result) {
+  Json json = summaryScalars(result);
+  const auto& p = result.prediction;
+  json["final_velocities"] = result.simulation.final_velocities;
+  json["predicted_final_velocities"] =
+      p && !p->final_velocities.empty() ? Json(p->final_velocities) : Json(nullptr);
+  return json;
+}
+
+std::unique_ptr<SceneReportWriter> makeSceneReportWriter(ReportFormat format, std::ostream& out) {
+  switch (format) {
+    case ReportFormat::kJson: return std::make_unique<SceneJsonWriter>(out);
+    case ReportFormat::kCsv: return std::make_unique<SceneCsvWriter>(out);
+    case ReportFormat::kTable: break;
+  }
+  return std::make_unique<SceneTableWriter>(out);
+}
+
+std::unique_ptr<RunReportWriter> makeThreeBodyReportWriter(ReportFormat format, std::ostream& out,
+                                                           const core::ModelChoice& model) {
+  return std::make_unique<ThreeBodyModelWriter>(format, out, model);
+}
+
+void writeSceneBatchReport(ReportFormat format, const std::vector<SceneBatchOutcome>& outcomes, std::ostream& out) {
+  const bool all_three_body = std::all_of(outcomes.begin(), outcomes.end(),
+                                          [](const SceneBatchOutcome& o) { return o.result.three_body.has_value(); });
+  if (all_three_body) {
+    std::vector<SceneOutcome> three_body;
+    for (const auto& o : outcomes) three_body.push_back({toNamedScene(o.entry), o.options, *o.result.three_body});
+    return writeBatchReport(format, three_body, out);
+  }
+  switch (format) {
+    case ReportFormat::kJson: writeSceneBatchJson(outcomes, out); return;
+    case ReportFormat::kCsv: writeSceneBatchCsv(outcomes, out); return;
+    case ReportFormat::kTable: writeSceneBatchTable(outcomes, out); return;
+  }
+}
+
+}  // namespace io
+}  // namespace collision_lab

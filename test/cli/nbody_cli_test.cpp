@@ -1,0 +1,358 @@
+// collision_lab_cli on scenes of any size (issue 10), run as a user runs it. Expected values
+// are derived by hand (in the comments), from conservation laws computed here, or from an
+// inversion count by a plain O(N^2) loop: none shares code with the program.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <fstream>
+#include <functional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_process.h"
+
+namespace {
+
+using collision_lab_test::CliOutput;
+using collision_lab_test::linesOf;
+using collision_lab_test::runCli;
+using Json = nlohmann::json;
+
+const std::string kPresets = COLLISION_LAB_SOURCE_DIR "/config/scenarios.yaml";
+
+CliOutput run(const std::vector<std::string>& args, const std::string& stdin_path = "/dev/null") {
+  return runCli(args, COLLISION_LAB_SOURCE_DIR, stdin_path);
+}
+
+Json runJson(std::vector<std::string> args, const std::string& stdin_path = "/dev/null") {
+  args.insert(args.end(), {"--format", "json"});
+  const CliOutput result = run(args, stdin_path);
+  EXPECT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_EQ(result.err, "");
+  return Json::parse(result.out);
+}
+
+Json runPreset(const std::string& name, std::vector<std::string> extra = {}) {
+  std::vector<std::string> args = {"--scenario", kPresets, "--name", name};
+  args.insert(args.end(), extra.begin(), extra.end());
+  return runJson(args);
+}
+
+std::vector<double> doubles(const Json& array) { return array.get<std::vector<double>>(); }
+
+/// A unique temporary file holding `text`; removed when the object goes.
+class TempFile {
+ public:
+  explicit TempFile(const std::string& text) {
+    char name[] = "/tmp/collision_lab_bodies_XXXXXX";
+    const int fd = mkstemp(name);
+    if (fd < 0) throw std::runtime_error("mkstemp failed");
+    close(fd);
+    path_ = name;
+    std::ofstream(path_) << text;
+  }
+  ~TempFile() { unlink(path_.c_str()); }
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+};
+
+struct Bodies {
+  std::vector<double> masses, positions, velocities;
+};
+
+/// N bodies 1 m apart (x = N-1, ..., 0), velocities uniform in [-1, 1) from a seeded
+/// generator, masses from `mass(i)`. Uses its own mapping of 53 random bits, so the
+/// scene is the same with every standard library.
+Bodies seededBodies(std::size_t n, std::uint64_t seed, const std::function<double(std::mt19937_64&)>& mass) {
+  std::mt19937_64 rng(seed);
+  const auto unit = [&] { return static_cast<double>(rng() >> 11) * 0x1p-53; };
+  Bodies bodies;
+  for (std::size_t i = 0; i < n; ++i) {
+    bodies.masses.push_back(mass(rng));
+    bodies.positions.push_back(static_cast<double>(n - 1 - i));
+    bodies.velocities.push_back(2.0 * unit() - 1.0);
+  }
+  return bodies;
+}
+
+std::string bodiesCsv(const Bodies& bodies) {
+  std::string text = "mass,position,velocity\n";
+  char line[128];
+  for (std::size_t i = 0; i < bodies.masses.size(); ++i) {
+    std::snprintf(line, sizeof line, "%.17g,%.17g,%.17g\n", bodies.masses[i], bodies.positions[i],
+                  bodies.velocities[i]);
+    text += line;
+  }
+  return text;
+}
+
+/// Pairs i < j with v_i < v_j, by the plain O(N^2) loop.
+std::uint64_t inversionsByLoop(const std::vector<double>& v) {
+  std::uint64_t count = 0;
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    for (std::size_t j = i + 1; j < v.size(); ++j) count += v[i] < v[j] ? 1 : 0;
+  }
+  return count;
+}
+
+// Two carts, by hand: m = (3, 1) kg, x = (1, 0) m, v = (-1, 1) m/s. They close at 2 m/s over
+// 1 m: t = 0.5 s at x = 0.5 m. V = (3*(-1) + 1*1)/4 = -0.5 m/s, v' = 2V - v = (0, -2) m/s.
+// A's energy goes from 1.5 J to 0, B's from 0.5 J to 2 J.
+TEST(NBodyCli, TwoCartsMeetOnceAsComputedByHand) {
+  for (const Json& doc : {runJson({"--masses", "3,1", "--positions", "1,0", "--velocities", "-1,1"}),
+                          runPreset("two_carts")}) {
+    const Json& summary = doc.at("summary");
+    EXPECT_EQ(summary.at("model"), "two_body");
+    EXPECT_FALSE(summary.at("model_reason").get<std::string>().empty());
+    EXPECT_EQ(summary.at("collision_count"), 1);
+    EXPECT_EQ(summary.at("predicted_collision_count"), 1);
+    EXPECT_EQ(summary.at("matches_prediction"), true);
+    EXPECT_EQ(doubles(summary.at("final_velocities")), (std::vector<double>{0, -2}));
+    EXPECT_EQ(summary.at("energy_lost"), 0.0);
+    ASSERT_EQ(doc.at("events").size(), 1u);
+    const Json& event = doc.at("events")[0];
+    EXPECT_EQ(event.at("pair"), "AB");
+    EXPECT_EQ(event.at("pair_index"), 0);
+    EXPECT_EQ(event.at("time"), 0.5);
+    EXPECT_EQ(event.at("position"), 0.5);
+    EXPECT_EQ(doubles(event.at("velocities_after")), (std::vector<double>{0, -2}));
+    EXPECT_EQ(doubles(event.at("energy_gained")), (std::vector<double>{-1.5, 1.5}));
+    EXPECT_EQ(event.at("energy_lost"), 0.0);
+  }
+}
+
+// Restitution, by hand: equal carts at -1 and +1 m/s, V = 0. With e the relative velocity
+// 2 m/s becomes -2e: v' = (e, -e). Energy 1 J before, e^2 J after: 1 - e^2 J lost.
+TEST(NBodyCli, RestitutionScalesTheRelativeVelocityAndLosesEnergy) {
+  for (const auto& [e, lost] : {std::pair{"0.5", 0.75}, std::pair{"0", 1.0}}) {
+    const Json doc =
+        runJson({"--masses", "1,1", "--positions", "1,0", "--velocities", "-1,1", "--restitution", e});
+    const double ev = std::stod(e);
+    const Json& summary = doc.at("summary");
+    EXPECT_EQ(doubles(summary.at("final_velocities")), (std::vector<double>{ev, -ev})) << e;
+    EXPECT_DOUBLE_EQ(summary.at("energy_lost").get<double>(), lost) << e;
+    ASSERT_EQ(doc.at("events").size(), 1u);
+    EXPECT_DOUBLE_EQ(doc.at("events")[0].at("energy_lost").get<double>(), lost) << e;
+    EXPECT_EQ(doubles(doc.at("scene").at("restitution")), std::vector<double>{ev});
+  }
+  const Json preset = runPreset("inelastic_carts");
+  EXPECT_EQ(doubles(preset.at("summary").at("final_velocities")), (std::vector<double>{0.5, -0.5}));
+  EXPECT_DOUBLE_EQ(preset.at("summary").at("energy_lost").get<double>(), 0.75);
+}
+
+// Newton's cradle with gaps (shared/physics.md): the pulse runs down the chain, one impact
+// per pair at t = 1, 2, 3, 4 s at x = 3, 2, 1, 0 m; the last ball leaves at -1 m/s.
+TEST(NBodyCli, CradleGivesFourImpactsAndTheLastBallLeaves) {
+  const Json doc = runPreset("cradle_5");
+  const Json& summary = doc.at("summary");
+  EXPECT_EQ(summary.at("model"), "ghosts");
+  EXPECT_EQ(summary.at("collision_count"), 4);
+  EXPECT_EQ(summary.at("predicted_collision_count"), 4);
+  EXPECT_EQ(doubles(summary.at("final_velocities")), (std::vector<double>{0, 0, 0, 0, -1}));
+  const std::vector<std::string> pairs = {"AB", "BC", "CD", "DE"};
+  ASSERT_EQ(doc.at("events").size(), 4u);
+  for (std::size_t k = 0; k < 4; ++k) {
+    const Json& event = doc.at("events")[k];
+    EXPECT_EQ(event.at("pair"), pairs[k]);
+    EXPECT_EQ(event.at("pair_index"), k);
+    EXPECT_EQ(event.at("time"), k + 1.0);
+    EXPECT_EQ(event.at("position"), 3.0 - k);
+    EXPECT_EQ(doubles(event.at("velocities_after")), (std::vector<double>{0, -1}));
+  }
+}
+
+// A ball at x = 0.5 m between walls at 1 m and 0 m, at +1 m/s: impacts at t = 0.5, 1.5,
+// 2.5, ... s, alternately on A and C. After an odd number it moves at -1 m/s, after an
+// even number at +1 m/s. The run never ends by itself: it stops at the cap, truncated.
+TEST(NBodyCli, BallBetweenWallsStopsAtTheCapMarkedTruncated) {
+  const Json preset = runPreset("ball_between_walls", {"--events", "none"});
+  const Json& summary = preset.at("summary");
+  EXPECT_EQ(summary.at("model"), "two_walls_infinite");
+  EXPECT_EQ(summary.at("predicted_infinite"), true);
+  EXPECT_EQ(summary.at("truncated"), true);
+  EXPECT_EQ(summary.at("stop_reason"), "CAP");
+  EXPECT_EQ(summary.at("collision_count"), 1000);  // the preset's own cap
+  EXPECT_EQ(summary.at("final_time"), 999.5);
+  EXPECT_EQ(doubles(summary.at("final_velocities")), (std::vector<double>{0, 1, 0}));
+
+  const Json odd = runPreset("ball_between_walls", {"--max-collisions", "7", "--events", "none"});
+  EXPECT_EQ(odd.at("summary").at("collision_count"), 7);
+  EXPECT_EQ(odd.at("summary").at("final_time"), 6.5);
+  EXPECT_EQ(doubles(odd.at("summary").at("final_velocities")), (std::vector<double>{0, -1, 0}));
+}
+
+// Three bodies with walls at both ends were rejected (TWO_WALLS) and are valid now: B at
+// 1 m, +1 m/s, between walls at 2 m and 0 m hits A at t = 1 s, C at t = 3 s, A at t = 5 s.
+TEST(NBodyCli, ThreeBodiesBetweenTwoWallsAreAnsweredNotRejected) {
+  const Json doc = runJson(
+      {"--masses", "inf,1,inf", "--positions", "2,1,0", "--velocities", "0,1,0", "--max-collisions", "3"});
+  const Json& summary = doc.at("summary");
+  EXPECT_EQ(summary.at("model"), "two_walls_infinite");
+  EXPECT_EQ(summary.at("truncated"), true);
+  EXPECT_EQ(summary.at("collision_count"), 3);
+  ASSERT_EQ(doc.at("events").size(), 3u);
+  EXPECT_EQ(doc.at("events")[1].at("pair"), "BC");
+  EXPECT_EQ(doc.at("events")[2].at("time"), 5.0);
+  EXPECT_EQ(doubles(summary.at("final_velocities")), (std::vector<double>{0, -1, 0}));
+  EXPECT_EQ(doc.at("scene").at("walls"), (Json{"A", "C"}));
+}
+
+// Equal masses: the count is the number of inversions (counted here by a plain loop) and
+// the final velocities are the initial ones sorted, fastest rightward first. Without
+// events the closed form answers alone; with events the engine runs and must agree.
+TEST(NBodyCli, EqualMassesCountInversionsFromABodiesFile) {
+  const Bodies bodies = seededBodies(1500, 20261123, [](std::mt19937_64&) { return 2.5; });
+  const TempFile file(bodiesCsv(bodies));
+  const std::uint64_t inversions = inversionsByLoop(bodies.velocities);
+  std::vector<double> sorted = bodies.velocities;
+  std::sort(sorted.begin(), sorted.end(), std::greater<double>());
+
+  const Json closed = runJson({"--bodies", file.path(), "--events", "none"});
+  EXPECT_EQ(closed.at("summary").at("model"), "ghosts");
+  EXPECT_EQ(closed.at("summary").at("simulated"), false);
+  EXPECT_EQ(closed.at("summary").at("predicted_collision_count"), inversions);
+  EXPECT_EQ(doubles(closed.at("summary").at("final_velocities")), sorted);
+
+  const Json simulated = runJson({"--bodies", file.path(), "--events", "first:0"});
+  EXPECT_EQ(simulated.at("summary").at("simulated"), true);
+  EXPECT_EQ(simulated.at("summary").at("collision_count"), inversions);
+  EXPECT_EQ(simulated.at("summary").at("matches_prediction"), true);
+  EXPECT_EQ(doubles(simulated.at("summary").at("final_velocities")), sorted);
+  EXPECT_TRUE(simulated.at("events").empty());
+}
+
+TEST(NBodyCli, EqualMasses100PresetCountsItsInversions) {
+  const Json doc = runPreset("equal_masses_100", {"--events", "none"});
+  const std::vector<double> velocities = doubles(doc.at("scene").at("velocities"));
+  ASSERT_EQ(velocities.size(), 100u);
+  EXPECT_EQ(inversionsByLoop(velocities), 2441u);  // as the preset's description says
+  EXPECT_EQ(doc.at("summary").at("predicted_collision_count"), 2441);
+  EXPECT_EQ(runPreset("equal_masses_100", {"--events", "first:1"}).at("summary").at("collision_count"), 2441);
+}
+
+TEST(NBodyCli, BodiesFromStandardInputEqualBodiesFromAFile) {
+  const TempFile file("mass,position,velocity\n1,4,-1\n1,3,0\n1,2,0\r\n# a comment\n\n1,1,0\n1,0,0\n");
+  const Json from_file = runJson({"--bodies", file.path()});
+  const Json from_stdin = runJson({"--bodies", "-"}, file.path());
+  EXPECT_EQ(from_file.at("summary").at("collision_count"), 4);
+  EXPECT_EQ(from_stdin.at("summary").at("collision_count"), 4);
+  EXPECT_EQ(from_file.at("events"), from_stdin.at("events"));
+  EXPECT_EQ(from_stdin.at("scene").at("bodies"), 5);
+}
+
+TEST(NBodyCli, BadBodiesFilesNameTheLine) {
+  const TempFile no_header("1,4,-1\n");
+  const CliOutput header = run({"--bodies", no_header.path()});
+  EXPECT_EQ(header.exit_code, 2);
+  EXPECT_NE(header.err.find("(BODIES_FILE)"), std::string::npos) << header.err;
+  const TempFile two_values("mass,position,velocity\n1,4,-1\n1,3\n");
+  const CliOutput count = run({"--bodies", two_values.path()});
+  EXPECT_EQ(count.exit_code, 2);
+  EXPECT_NE(count.err.find("invalid bodies:3 (WRONG_COUNT)"), std::string::npos) << count.err;
+}
+
+// 10^5 bodies of random masses: the engine runs up to the cap. Momentum and kinetic energy
+// are recomputed here from the input and the printed final velocities.
+TEST(NBodyCli, HundredThousandBodiesKeepMomentumAndEnergy) {
+  const Bodies bodies = seededBodies(100000, 7, [](std::mt19937_64& rng) {
+    return 1.0 + static_cast<double>(rng() >> 11) * 0x1p-53;
+  });
+  const TempFile file(bodiesCsv(bodies));
+  const Json doc = runJson({"--bodies", file.path(), "--events", "none", "--max-collisions", "200000"});
+  const Json& summary = doc.at("summary");
+  EXPECT_EQ(summary.at("model"), "event_engine");
+  EXPECT_EQ(summary.at("count_formula").get<std::string>().rfind("none", 0), 0u);
+  EXPECT_EQ(summary.at("collision_count"), 200000);
+  EXPECT_EQ(summary.at("truncated"), true);
+  const std::vector<double> after = doubles(summary.at("final_velocities"));
+  ASSERT_EQ(after.size(), bodies.masses.size());
+  double p0 = 0, p1 = 0, scale = 0, e0 = 0, e1 = 0;
+  for (std::size_t i = 0; i < after.size(); ++i) {
+    const double m = bodies.masses[i], v = bodies.velocities[i];
+    p0 += m * v;
+    p1 += m * after[i];
+    scale += m * std::fabs(v);
+    e0 += 0.5 * m * v * v;
+    e1 += 0.5 * m * after[i] * after[i];
+  }
+  EXPECT_LT(std::fabs(p1 - p0) / scale, 1e-12);
+  EXPECT_LT(std::fabs(e1 - e0) / e0, 1e-12);
+}
+
+// A(3 m, -1 m/s) hits B(2 m) at t = 1 s; B then reaches C(1 m) at t = 2 s, just as D(-1 m,
+// +1 m/s) does: two impacts sharing C at one instant, whose outcome is undefined for point
+// masses. The run ends there (not a rejected input: it happens later in the run).
+TEST(NBodyCli, ALaterMultipleCollisionEndsTheRunNamingBodiesAndTime) {
+  const Json doc = runJson({"--masses", "1,1,1,1", "--positions", "3,2,1,-1", "--velocities", "-1,0,0,1"});
+  const Json& summary = doc.at("summary");
+  EXPECT_EQ(summary.at("stop_reason"), "MULTIPLE_COLLISION");
+  EXPECT_EQ(summary.at("collision_count"), 1);
+  EXPECT_EQ(summary.at("multiple_collision").at("bodies"), (Json{"B", "C", "D"}));
+  EXPECT_EQ(summary.at("multiple_collision").at("time"), 2.0);
+  EXPECT_TRUE(summary.at("matches_prediction").is_null());
+}
+
+TEST(NBodyCli, OneBodyAndBodiesMovingApartSimulateNothing) {
+  for (const Json& doc : {runJson({"--masses", "2", "--positions", "0", "--velocities", "1"}),
+                          runJson({"--masses", "2", "--positions", "0", "--velocities", "1", "--events", "none"})}) {
+    EXPECT_EQ(doc.at("summary").at("model"), "no_collisions");
+    EXPECT_EQ(doc.at("summary").at("predicted_collision_count"), 0);
+    EXPECT_EQ(doc.at("summary").at("simulated"), false);
+    EXPECT_EQ(doubles(doc.at("summary").at("final_velocities")), std::vector<double>{1});
+  }
+  // Four bodies, each pair separating (v_p >= v_p+1): nothing approaches.
+  const Json apart = runJson({"--masses", "1,2,3,4", "--positions", "3,2,1,0", "--velocities", "2,1,1,-1"});
+  EXPECT_EQ(apart.at("summary").at("model"), "no_collisions");
+  EXPECT_EQ(apart.at("summary").at("simulated"), false);
+  EXPECT_TRUE(apart.at("events").empty());
+}
+
+TEST(NBodyCli, UnequalLengthsNameTheThreeLengths) {
+  const CliOutput result = run({"--masses", "1,1", "--positions", "1,0,-1", "--velocities", "0,0", "--format", "json"});
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_NE(result.err.find("masses 2, positions 3, velocities 2"), std::string::npos) << result.err;
+  const Json error = Json::parse(result.out).at("error");
+  EXPECT_EQ(error.at("reason"), "UNEQUAL_LENGTHS");
+  EXPECT_EQ(error.at("code"), 9);
+}
+
+// Three elastic bodies keep the paper's report, now naming the model in every format.
+TEST(NBodyCli, ThreeBodyReportsStateTheirModel) {
+  const std::vector<std::string> scene = {"--masses", "1,1,1", "--positions", "2,1,-1", "--velocities", "-1,0,1"};
+  const Json doc = runJson(scene);
+  EXPECT_EQ(doc.at("summary").at("model"), "three_body_rotation");
+  EXPECT_EQ(doc.at("summary").at("collision_count"), 3);
+  EXPECT_EQ(doc.at("summary").at("max_possible_collision_count"), 3);  // the three-body keys stay
+  std::vector<std::string> csv = scene;
+  csv.insert(csv.end(), {"--format", "csv"});
+  EXPECT_NE(run(csv).out.find("\n# summary.model,three_body_rotation\n"), std::string::npos);
+  EXPECT_NE(run(scene).out.find("\nmodel: three_body_rotation - "), std::string::npos);
+}
+
+TEST(NBodyCli, TableOfManyBodiesShowsTheEndsAndSaysHowManyItLeavesOut) {
+  std::string masses, positions, velocities;
+  for (int i = 0; i < 30; ++i) {
+    masses += (i ? "," : "") + std::to_string(1 + i % 3);
+    positions += (i ? "," : "") + std::to_string(30 - i);
+    velocities += std::string(i ? "," : "") + (i == 0 ? "-1" : "0");
+  }
+  const CliOutput table = run({"--masses", masses, "--positions", positions, "--velocities", velocities});
+  ASSERT_EQ(table.exit_code, 0) << table.err;
+  EXPECT_NE(table.out.find("(20 bodies left out here; JSON and CSV list every body)"), std::string::npos);
+  EXPECT_NE(table.out.find(" #29 "), std::string::npos);
+  EXPECT_NE(table.out.find("count formula: none"), std::string::npos);
+  EXPECT_NE(table.out.find("model: event_engine - "), std::string::npos);
+  const Json doc = runJson({"--masses", masses, "--positions", positions, "--velocities", velocities});
+  EXPECT_EQ(doc.at("scene").at("masses").size(), 30u);
+  EXPECT_EQ(doc.at("summary").at("final_velocities").size(), 30u);
+}
+
+}  // namespace
