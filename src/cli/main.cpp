@@ -54,15 +54,6 @@ core::RunOptions optionsFor(const CliRequest& request, const io::NamedScene& nam
   return options;
 }
 
-bool isShown(const core::EventPolicy& policy, std::uint64_t index) {
-  switch (policy.kind) {
-    case core::EventPolicy::Kind::kAll: return true;
-    case core::EventPolicy::Kind::kNone: return false;
-    case core::EventPolicy::Kind::kFirstN: return index <= policy.first_n;
-  }
-  return false;
-}
-
 /// Runs one validated scene. `on_event` (may be empty) sees every event; a progress line
 /// is drawn on a terminal.
 core::RunResult runWithProgress(const core::ThreeBodyScene& scene, const core::RunOptions& options, const core::LabEventVisitor& on_event) {
@@ -89,7 +80,7 @@ void runOne(const CliRequest& request, const io::NamedScene& named) {
   core::LabEventVisitor show_event;
   if (shown_options.events.kind != core::EventPolicy::Kind::kNone) {
     show_event = [&](const core::LabEvent& event) {
-      if (isShown(shown_options.events, event.event.index)) writer->event(event);
+      if (shown_options.events.keeps(event.event.index)) writer->event(event);
     };
   }
   writer->end(runWithProgress(named.scene, run_options, show_event));

@@ -12,6 +12,7 @@
 #include "collision_lab/core/exact.h"
 #include "collision_lab/core/precision.h"
 #include "impact_energy.h"
+#include "two_sum.h"
 
 namespace collision_lab {
 namespace core {
@@ -20,20 +21,11 @@ namespace {
 
 namespace mp = boost::multiprecision;
 
-/// Precision of the first escalation tier (100 digits) and of the last resort beyond the
-/// exact-rational limit (500 digits).
-using ReplayPrecision = mp::cpp_bin_float_100;
-using DeepReplayPrecision = mp::number<mp::cpp_bin_float<500>>;
-
 /// Up to this many impacts a 100-digit replay is cheaper than building the closed form.
 constexpr std::uint64_t kShortReplay = 2000;
 /// Every this many impacts a long run adopts the 100-digit closed-form state (~0.1 ns per
 /// impact amortized), which keeps its velocities accurate over hundreds of millions.
 constexpr std::uint64_t kResynchronizeInterval = std::uint64_t{1} << 20;
-
-/// Longest run an exact rational replay is attempted for (its cost grows ~quadratically).
-/// Reached only when 100 digits cannot tell the approach speed from zero.
-constexpr std::uint64_t kExactReplayLimit = 20000;
 
 /// Safety factor of the forward error bound: a sign decision is trusted when
 /// |approach speed| > (k + 2) * kBoundFactor * eps * velocity scale of the pair.
@@ -65,34 +57,35 @@ T epsilonOf() {
   return std::numeric_limits<T>::epsilon();
 }
 
-/// Per-pair impact coefficients in precision T. An impact with approach speed
-/// r = v_right - v_left changes the heavier body by its small gain, 2 m_light / (m_l + m_r)
-/// times r, and then sets the lighter one from the exact reversal v_r' - v_l' = -r. The
-/// reversal keeps the relative speed exact, so rounded coefficients do not bias the
-/// energy, and the heavy body, whose error costs the most energy, gets the smallest one.
+/// Impact coefficients of pair i (bodies i and i + 1) in precision T. An impact with
+/// approach speed r = v[i + 1] - v[i] changes the heavier body by its small gain,
+/// 2 m_light / (m_i + m_i+1) times r, and then sets the lighter one from the exact reversal
+/// v'[i + 1] - v'[i] = -r. The reversal keeps the relative speed exact, so rounded
+/// coefficients do not bias the energy, and the heavy body, whose error costs the most
+/// energy, gets the smallest one.
 template <class T>
 struct PairCoefficients {
-  bool heavy_is_left;
+  int heavy;  ///< index of the heavier body (i on a tie)
+  int light;  ///< index of the other one
   T heavy_gain;
+  /// +1 when the heavy body is i, -1 when it is i + 1: the sign of r in its velocity.
+  T sign;
 };
 
 template <class T>
-PairCoefficients<T> pairCoefficients(const std::array<double, 3>& m, int left) {
-  const int right = left + 1;
-  const bool heavy_is_left = m[left] >= m[right];
-  const double heavy = heavy_is_left ? m[left] : m[right];
-  const double light = heavy_is_left ? m[right] : m[left];
-  if (std::isinf(heavy)) return {heavy_is_left, T(0)};
-  return {heavy_is_left, T(2) / (T(1) + T(heavy) / T(light))};
+PairCoefficients<T> pairCoefficients(const std::array<double, 3>& m, int i) {
+  const int heavy = m[i] >= m[i + 1] ? i : i + 1;
+  const int light = heavy == i ? i + 1 : i;
+  const T sign = heavy == i ? T(1) : T(-1);
+  if (std::isinf(m[heavy])) return {heavy, light, T(0), sign};
+  return {heavy, light, T(2) / (T(1) + T(m[heavy]) / T(m[light])), sign};
 }
 
 template <class T>
 struct Coefficients {
-  PairCoefficients<T> ab;
-  PairCoefficients<T> bc;
-  explicit Coefficients(const std::array<double, 3>& m)
-      : ab(pairCoefficients<T>(m, kA)), bc(pairCoefficients<T>(m, kB)) {}
-  const PairCoefficients<T>& of(Pair p) const { return p == Pair::AB ? ab : bc; }
+  std::array<PairCoefficients<T>, 2> pairs;  ///< by pair index
+  explicit Coefficients(const std::array<double, 3>& m) : pairs{pairCoefficients<T>(m, 0), pairCoefficients<T>(m, 1)} {}
+  const PairCoefficients<T>& of(Pair p) const { return pairs[pairIndex(p)]; }
 };
 
 /// Velocities as unevaluated sums hi + lo. The heavy body's increment is added with an
@@ -117,41 +110,33 @@ struct CompensatedVelocities {
     return out;
   }
 
-  /// Approach speed of the pair whose right-hand body is `left` (A for AB, B for BC).
-  T approach(int left) const { return (hi[left + 1] - hi[left]) + (lo[left + 1] - lo[left]); }
+  /// Approach speed v[i + 1] - v[i] of pair i.
+  T approach(int i) const { return (hi[i + 1] - hi[i]) + (lo[i + 1] - lo[i]); }
 
   void add(int i, const T& increment) {
-    const T sum = hi[i] + increment;
-    const T increment_part = sum - hi[i];
-    lo[i] += (hi[i] - (sum - increment_part)) + (increment - increment_part);
-    hi[i] = sum;
+    const detail::TwoSum<T> sum = detail::twoSum(hi[i], increment);
+    lo[i] += sum.error;
+    hi[i] = sum.sum;
   }
 
   /// Sets body i to (hi[from] + lo[from]) + sign * (speed_hi + speed_lo), keeping the
   /// rounding error of the leading sum: the light body's velocity swings far above its
   /// final value, and its rounding at the peak would otherwise stay in it.
   void setFrom(int i, int from, const T& sign, const T& speed_hi, const T& speed_lo) {
-    const T term = sign * speed_hi;
-    const T sum = hi[from] + term;
-    const T term_part = sum - hi[from];
-    lo[i] = (hi[from] - (sum - term_part)) + (term - term_part) + lo[from] + sign * speed_lo;
-    hi[i] = sum;
+    const detail::TwoSum<T> sum = detail::twoSum(hi[from], T(sign * speed_hi));
+    lo[i] = sum.error + lo[from] + sign * speed_lo;
+    hi[i] = sum.sum;
   }
 
-  void impact(const PairCoefficients<T>& c, int left) {
-    const int right = left + 1;
-    // Approach speed as hi + lo, the leading difference split exactly (TwoSum).
-    const T speed_hi = hi[right] - hi[left];
-    const T right_part = speed_hi + hi[left];
-    const T speed_lo = ((hi[right] - right_part) + (right_part - speed_hi - hi[left])) + (lo[right] - lo[left]);
+  /// One impact of pair i (bodies i and i + 1) with coefficients c.
+  void impact(const PairCoefficients<T>& c, int i) {
+    // Approach speed as hi + lo, the leading difference split exactly.
+    const detail::TwoSum<T> split = detail::twoSum(T(-hi[i]), hi[i + 1]);
+    const T speed_hi = split.sum;
+    const T speed_lo = split.error + (lo[i + 1] - lo[i]);
     const T speed = speed_hi + speed_lo;
-    if (c.heavy_is_left) {
-      add(left, c.heavy_gain * speed);
-      setFrom(right, left, T(-1), speed_hi, speed_lo);
-    } else {
-      add(right, -(c.heavy_gain * speed));
-      setFrom(left, right, T(1), speed_hi, speed_lo);
-    }
+    add(c.heavy, c.sign * (c.heavy_gain * speed));
+    setFrom(c.light, c.heavy, -c.sign, speed_hi, speed_lo);
   }
 
   /// Takes over a more accurate state (a replay in higher precision or exact rationals).
@@ -177,17 +162,12 @@ std::array<T, 3> replay(const ThreeBodyScene& scene, Pair first, std::uint64_t k
   const Coefficients<T> coefficients(scene.masses);
   std::array<T, 3> v{T(scene.velocities[0]), T(scene.velocities[1]), T(scene.velocities[2])};
   Pair pair = first;
-  for (std::uint64_t i = 0; i < k; ++i) {
-    const int left = pair == Pair::AB ? kA : kB;
+  for (std::uint64_t n = 0; n < k; ++n) {
+    const int i = pairIndex(pair);
     const PairCoefficients<T>& c = coefficients.of(pair);
-    const T approach = v[left + 1] - v[left];
-    if (c.heavy_is_left) {
-      v[left] += c.heavy_gain * approach;
-      v[left + 1] = v[left] - approach;
-    } else {
-      v[left + 1] -= c.heavy_gain * approach;
-      v[left] = v[left + 1] + approach;
-    }
+    const T approach = v[i + 1] - v[i];
+    v[c.heavy] += c.sign * (c.heavy_gain * approach);
+    v[c.light] = v[c.heavy] - c.sign * approach;
     pair = otherPair(pair);
   }
   return v;
@@ -215,12 +195,13 @@ class ErrorScale {
       inverse_sqrt_mass_[i] = i == wall ? 0.0L : 1.0L / std::sqrt(static_cast<long double>(scene.masses[i]));
     }
     const long double min_scale = std::numeric_limits<double>::min();
-    ab_ = std::max(min_scale, u * (inverse_sqrt_mass_[kA] + inverse_sqrt_mass_[kB]));
-    bc_ = std::max(min_scale, u * (inverse_sqrt_mass_[kB] + inverse_sqrt_mass_[kC]));
+    for (int i = 0; i < 2; ++i) {
+      pair_scale_[i] = std::max(min_scale, u * (inverse_sqrt_mass_[i] + inverse_sqrt_mass_[i + 1]));
+    }
   }
 
   /// Velocity scale [m/s] of the approach speed of `pair`.
-  long double of(Pair pair) const { return pair == Pair::AB ? ab_ : bc_; }
+  long double of(Pair pair) const { return pair_scale_[pairIndex(pair)]; }
 
   /// Bound on the rounding error of an approach speed after k impacts in precision T.
   template <class T>
@@ -230,13 +211,13 @@ class ErrorScale {
 
  private:
   long double inverse_sqrt_mass_[3]{};
-  long double ab_ = 0.0L;
-  long double bc_ = 0.0L;
+  long double pair_scale_[2]{};  // by pair index
 };
 
 template <class T>
 T approachOf(Pair pair, const std::array<T, 3>& v) {
-  return pair == Pair::AB ? T(v[kB] - v[kA]) : T(v[kC] - v[kB]);
+  const int i = pairIndex(pair);
+  return T(v[i + 1] - v[i]);
 }
 
 /// Takes the sign decisions the working precision cannot, at 100 digits: a replay for
@@ -269,9 +250,9 @@ class Escalation {
     // exact zero, in O(1) like the 100-digit closed form.
     if (!deep_closed_form_) deep_closed_form_.emplace(scene_);
     const auto deep = stateOf(*deep_closed_form_, k);
-    const DeepReplayPrecision deep_approach = approachOf(pair, deep);
+    const DeepPrecision deep_approach = approachOf(pair, deep);
     const bool deep_decides =
-        mp::abs(deep_approach) > closedFormFactor<DeepReplayPrecision>() * scale_.bound<DeepReplayPrecision>(pair, k);
+        mp::abs(deep_approach) > closedFormFactor<DeepPrecision>() * scale_.bound<DeepPrecision>(pair, k);
     if (deep_decides || k > kExactReplayLimit) {
       // Beyond the exact replay's reach, an exact zero would need input doubles built for
       // it over thousands of impacts: within 500 digits of zero counts as not approaching.
@@ -304,7 +285,7 @@ class Escalation {
   static ReplayPrecision narrowed(const exact::Rational& q) {
     return ReplayPrecision(numerator(q)) / ReplayPrecision(denominator(q));
   }
-  static ReplayPrecision narrowed(const DeepReplayPrecision& x) { return static_cast<ReplayPrecision>(x); }
+  static ReplayPrecision narrowed(const DeepPrecision& x) { return static_cast<ReplayPrecision>(x); }
   template <class T>
   static std::array<ReplayPrecision, 3> narrowed(const std::array<T, 3>& state) {
     return {narrowed(state[0]), narrowed(state[1]), narrowed(state[2])};
@@ -328,7 +309,7 @@ class Escalation {
   const ErrorScale& scale_;
   Pair first_;
   std::optional<AnalyticModel<ReplayPrecision>> closed_form_;
-  std::optional<AnalyticModel<DeepReplayPrecision>> deep_closed_form_;
+  std::optional<AnalyticModel<DeepPrecision>> deep_closed_form_;
 };
 
 template <class T>
@@ -442,10 +423,9 @@ struct CompensatedTime {
   T lo = 0;
 
   void advance(const T& delay) {
-    const T sum = hi + delay;
-    const T delay_part = sum - hi;
-    lo += (hi - (sum - delay_part)) + (delay - delay_part);
-    hi = sum;
+    const detail::TwoSum<T> sum = detail::twoSum(hi, delay);
+    lo += sum.error;
+    hi = sum.sum;
   }
   T since(const CompensatedTime& earlier) const { return (hi - earlier.hi) + (lo - earlier.lo); }
   T value() const { return hi + lo; }
@@ -491,18 +471,17 @@ class Trajectory {
 
   /// The next impact, of `pair` approaching at `approach` > 0 with the bodies at `v`.
   Impact next(Pair pair, const std::array<T, 3>& v, const T& approach) const {
-    const int left = pair == Pair::AB ? kA : kB;
-    const int right = left + 1;
+    const int i = pairIndex(pair);
     Impact impact;
-    T gap = positionAt(left, v, now_) - positionAt(right, v, now_);
+    T gap = positionAt(i, v, now_) - positionAt(i + 1, v, now_);
     if (gap < 0) gap = 0;  // rounding can put touching bodies a hair out of order
     impact.time = now_;
     impact.time.advance(gap / approach);
-    for (int i = 0; i < 3; ++i) impact.positions[i] = positionAt(i, v, impact.time);
+    for (int body = 0; body < 3; ++body) impact.positions[body] = positionAt(body, v, impact.time);
     // The pair meets where the slower of the two is: a position extrapolated at speed v
     // is off by v times the time's rounding, so the slow body's is the accurate one.
-    const T contact = absOf(v[left]) <= absOf(v[right]) ? impact.positions[left] : impact.positions[right];
-    impact.positions[left] = impact.positions[right] = contact;
+    const T contact = absOf(v[i]) <= absOf(v[i + 1]) ? impact.positions[i] : impact.positions[i + 1];
+    impact.positions[i] = impact.positions[i + 1] = contact;
     impact.in_range = inNormalRange(approach) && inNormalRange(impact.time.value());
     for (const T& x : impact.positions) impact.in_range = impact.in_range && inNormalRange(x);
     return impact;
@@ -517,16 +496,16 @@ class Trajectory {
     event.index = index;
     event.pair = pair;
     event.time = units.time_si(now_.value());
-    const int left = pair == Pair::AB ? kA : kB;
-    event.position = units.position_si(impact.positions[left]);
+    const int pair_index = pairIndex(pair);
+    event.position = units.position_si(impact.positions[pair_index]);
     for (int i = 0; i < 3; ++i) event.positions[i] = units.position_si(impact.positions[i]);
     if (!describeEnergies(energy_, pair, before, after, approach, units, event)) {
       describeEnergies(wide_energy_, pair, before, after, approach, units, event);
     }
     // Re-anchor the bodies whose velocity changed (a wall's never does).
-    for (int i : {left, left + 1}) {
+    for (int i : {pair_index, pair_index + 1}) {
       if (i == wall_) continue;
-      reference_position_[i] = impact.positions[left];
+      reference_position_[i] = impact.positions[pair_index];
       reference_time_[i] = now_;
     }
     return event;
@@ -583,26 +562,7 @@ class Trajectory {
   CompensatedTime<T> now_;
 };
 
-bool keepsEvent(const EventPolicy& policy, std::uint64_t index) {
-  switch (policy.kind) {
-    case EventPolicy::Kind::kNone: return false;
-    case EventPolicy::Kind::kAll: return true;
-    case EventPolicy::Kind::kFirstN: return index <= policy.first_n;
-  }
-  return false;
-}
-
 }  // namespace
-
-std::optional<Pair> firstPair(const ThreeBodyScene& scene) {
-  const auto& v = scene.velocities;
-  const bool ab = v[kA] < v[kB];
-  const bool bc = v[kB] < v[kC];
-  if (ab && bc) return exact::compareFirstContactTimes(scene) < 0 ? Pair::AB : Pair::BC;
-  if (ab) return Pair::AB;
-  if (bc) return Pair::BC;
-  return std::nullopt;
-}
 
 template <class Scalar>
 SimulationResult simulate(const ThreeBodyScene& scene, const SimulationOptions& options, const EventVisitor& visitor) {
@@ -617,8 +577,9 @@ SimulationResult simulate(const ThreeBodyScene& scene, const SimulationOptions& 
 
   const Coefficients<Scalar> coefficients(scene.masses);
   const ErrorScale scale(working);
-  const Scalar step_bound_ab = scale.bound<Scalar>(Pair::AB, 0) / Scalar(2);  // bound(k) = (k+2) * step
-  const Scalar step_bound_bc = scale.bound<Scalar>(Pair::BC, 0) / Scalar(2);
+  // By pair index: bound(k) = (k + 2) * step.
+  const std::array<Scalar, 2> step_bound{scale.bound<Scalar>(Pair::AB, 0) / Scalar(2),
+                                         scale.bound<Scalar>(Pair::BC, 0) / Scalar(2)};
   // Below this a positive approach speed may have lost digits to underflow, which an
   // event's time would inherit.
   const Scalar resolution = std::numeric_limits<Scalar>::min() / epsilonOf<Scalar>();
@@ -642,9 +603,9 @@ SimulationResult simulate(const ThreeBodyScene& scene, const SimulationOptions& 
       escalation->resynchronize(k, v);
       exact_at = k;
     }
-    const Scalar approach = v.approach(pair == Pair::AB ? kA : kB);
+    const Scalar approach = v.approach(pairIndex(pair));
     const Scalar bound =
-        (pair == Pair::AB ? step_bound_ab : step_bound_bc) * Scalar(static_cast<double>(k - exact_at + 2));
+        step_bound[pairIndex(pair)] * Scalar(static_cast<double>(k - exact_at + 2));
     if (approach > bound && !(tracks_events && approach < resolution)) return true;
     if (approach < -bound) return false;
     if (!escalation) escalation.emplace(working, scale, *result.first_pair);
@@ -665,7 +626,7 @@ SimulationResult simulate(const ThreeBodyScene& scene, const SimulationOptions& 
         result.truncated = true;
         break;
       }
-      v.impact(coefficients.of(pair), pair == Pair::AB ? kA : kB);
+      v.impact(coefficients.of(pair), pairIndex(pair));
       ++k;
       pair = otherPair(pair);
     }
@@ -679,7 +640,7 @@ SimulationResult simulate(const ThreeBodyScene& scene, const SimulationOptions& 
     // a narrow trajectory's type.
     auto impactOn = [&](auto& trajectory) {
       using T = typename std::decay_t<decltype(trajectory)>::Value;
-      const int left = pair == Pair::AB ? kA : kB;
+      const int i = pairIndex(pair);
       // The state to the last digit the run knows: the precise one after an escalation
       // (where even a velocity that Scalar cannot hold moves a body over a long flight),
       // else the compensated one; never the approach speed as a difference of `before`.
@@ -691,10 +652,10 @@ SimulationResult simulate(const ThreeBodyScene& scene, const SimulationOptions& 
           held = held && ((*precise_state)[i] == 0 || (before[i] != 0 && inNormalRange(before[i])));
         }
       }
-      const T approach = precise_approach ? static_cast<T>(*precise_approach) : T(v.approach(left));
+      const T approach = precise_approach ? static_cast<T>(*precise_approach) : T(v.approach(i));
       const auto impact = trajectory.next(pair, before, approach);
       if (!(impact.in_range && held) && !std::is_same_v<T, Wide>) return false;
-      v.impact(coefficients.of(pair), left);
+      v.impact(coefficients.of(pair), i);
       ++k;
       event = trajectory.commit(k, pair, impact, before, v.template valuesAs<T>(), approach, units);
       return true;
@@ -714,7 +675,7 @@ SimulationResult simulate(const ThreeBodyScene& scene, const SimulationOptions& 
       event.velocities_before = before;
       for (int i = 0; i < 3; ++i) event.velocities_after[i] = units.velocity_si(v.value(i));
       if (visitor) visitor(event);
-      if (keepsEvent(options.events, k)) result.events.push_back(event);
+      if (options.events.keeps(k)) result.events.push_back(event);
       pair = otherPair(pair);
     }
     for (int i = 0; i < 3; ++i) {
@@ -747,22 +708,6 @@ SimulationResult simulate(const ThreeBodyScene& scene, const SimulationOptions& 
 template SimulationResult simulate<double>(const ThreeBodyScene&, const SimulationOptions&, const EventVisitor&);
 template SimulationResult simulate<long double>(const ThreeBodyScene&, const SimulationOptions&, const EventVisitor&);
 template SimulationResult simulate<HighPrecision>(const ThreeBodyScene&, const SimulationOptions&, const EventVisitor&);
-
-const char* precisionName(Precision p) {
-  switch (p) {
-    case Precision::kDouble: return "double";
-    case Precision::kLongDouble: return "long_double";
-    case Precision::kHigh: return "high";
-  }
-  return "unknown";
-}
-
-std::optional<Precision> parsePrecision(const std::string& name) {
-  for (Precision p : {Precision::kDouble, Precision::kLongDouble, Precision::kHigh}) {
-    if (name == precisionName(p)) return p;
-  }
-  return std::nullopt;
-}
 
 SimulationResult simulate(const ThreeBodyScene& scene, const SimulationOptions& options, Precision precision,
                           const EventVisitor& visitor) {
