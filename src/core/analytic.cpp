@@ -165,16 +165,21 @@ typename AnalyticModel<Scalar>::Vec3 AnalyticModel<Scalar>::applyPairMap(Pair pa
 
 /// V 1 + S^-1 R(angle) w, where R rotates about s_hat: cos w + sin (s_hat x w).
 template <class Scalar>
-typename AnalyticModel<Scalar>::Vec3 AnalyticModel<Scalar>::rotate(std::int64_t direction, std::uint64_t k) const {
+typename AnalyticModel<Scalar>::Vec3 AnalyticModel<Scalar>::velocitiesOfRotated(const Vec3& w,
+                                                                               const Scalar& angle) const {
   using std::cos;
   using std::sin;
-  const Scalar angle = Scalar(direction) * Scalar(k) * theta();
-  const Vec3 rotated = cos(angle) * w_ + sin(angle) * cross<Scalar>(s_hat_, w_);
+  const Vec3 rotated = cos(angle) * w + sin(angle) * cross<Scalar>(s_hat_, w);
   Vec3 v = centre_velocity_;
   for (int i = 0; i < 3; ++i) {
     if (i != wall_) v(i) += rotated(i) / sqrt_mass_scaled_(i);
   }
   return v;
+}
+
+template <class Scalar>
+typename AnalyticModel<Scalar>::Vec3 AnalyticModel<Scalar>::rotate(std::int64_t direction, std::uint64_t k) const {
+  return velocitiesOfRotated(w_, Scalar(direction) * Scalar(k) * theta());
 }
 
 template <class Scalar>
@@ -190,21 +195,13 @@ typename AnalyticModel<Scalar>::Vec3 AnalyticModel<Scalar>::velocitiesAfter(std:
 template <class Scalar>
 typename AnalyticModel<Scalar>::Vec3 AnalyticModel<Scalar>::initialVelocitiesFrom(const Vec3& after,
                                                                                  std::uint64_t n) const {
-  using std::cos;
-  using std::sin;
   if (!first_pair_ || n == 0) return after;
   const Pair first = *first_pair_;
   const Vec3 even = n % 2 == 0 ? after : applyPairMap(first, after);  // the maps are involutions
   const Scalar centre = centre_velocity_(0);
   Vec3 w_after;
   for (int i = 0; i < 3; ++i) w_after(i) = i == wall_ ? Scalar(0) : sqrt_mass_scaled_(i) * (even(i) - centre);
-  const Scalar angle = Scalar(first == Pair::AB ? 1 : -1) * Scalar(n / 2) * theta();
-  const Vec3 w0 = cos(angle) * w_after + sin(angle) * cross<Scalar>(s_hat_, w_after);
-  Vec3 v = centre_velocity_;
-  for (int i = 0; i < 3; ++i) {
-    if (i != wall_) v(i) += w0(i) / sqrt_mass_scaled_(i);
-  }
-  return v;
+  return velocitiesOfRotated(w_after, Scalar(first == Pair::AB ? 1 : -1) * Scalar(n / 2) * theta());
 }
 
 template <class Scalar>

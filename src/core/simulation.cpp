@@ -562,147 +562,214 @@ class Trajectory {
   CompensatedTime<T> now_;
 };
 
-}  // namespace
-
+/// The sign decisions of one run: the fast path in Scalar with a forward error bound that
+/// grows with the impacts since v was last exact to working precision, and an Escalation
+/// where the bound cannot decide.
 template <class Scalar>
-SimulationResult simulate(const ThreeBodyScene& scene, const SimulationOptions& options, const EventVisitor& visitor) {
-  using Wide = WideOf<Scalar>;
-  SimulationResult result;
-  result.first_pair = firstPair(scene);
-  WorkingUnits units;
-  const ThreeBodyScene working = inWorkingUnits(scene, units);
-  CompensatedVelocities<Scalar> v(working.velocities);
-  const Frame<Wide> start = measure(working, v.template valuesAs<Wide>());
-  const bool tracks_events = options.events.kind != EventPolicy::Kind::kNone || static_cast<bool>(visitor);
+class Decider {
+ public:
+  Decider(const ThreeBodyScene& working, Pair first, bool tracks_events)
+      : working_(working),
+        scale_(working),
+        step_bound_{scale_.template bound<Scalar>(Pair::AB, 0) / Scalar(2),  // bound(k) = (k + 2) * step
+                    scale_.template bound<Scalar>(Pair::BC, 0) / Scalar(2)},
+        tracks_events_(tracks_events),
+        first_(first) {}
 
-  const Coefficients<Scalar> coefficients(scene.masses);
-  const ErrorScale scale(working);
-  // By pair index: bound(k) = (k + 2) * step.
-  const std::array<Scalar, 2> step_bound{scale.bound<Scalar>(Pair::AB, 0) / Scalar(2),
-                                         scale.bound<Scalar>(Pair::BC, 0) / Scalar(2)};
-  // Below this a positive approach speed may have lost digits to underflow, which an
-  // event's time would inherit.
-  const Scalar resolution = std::numeric_limits<Scalar>::min() / epsilonOf<Scalar>();
-  EscalationStats& stats = result.escalation;
-
-  // The error bound grows with the impacts since v was last exact to working precision.
-  std::uint64_t exact_at = 0;
-  std::optional<Escalation<Scalar>> escalation;
-  // The approach speed and state seen by the last decision when it was taken above the
-  // working precision: an event's time, positions and energy use them.
-  std::optional<ReplayPrecision> precise_approach;
-  std::optional<std::array<ReplayPrecision, 3>> precise_state;
-
-  // Does `pair` approach after k impacts? Exact decision; may refresh v.
-  auto approaches = [&](Pair pair, std::uint64_t k) {
+  /// Does `pair` approach after k impacts? Exact decision; may refresh v.
+  bool approaches(Pair pair, std::uint64_t k, CompensatedVelocities<Scalar>& v, EscalationStats& stats) {
     ++stats.decisions;
-    precise_approach.reset();
-    precise_state.reset();
-    if (k - exact_at >= kResynchronizeInterval) {
-      if (!escalation) escalation.emplace(working, scale, *result.first_pair);
-      escalation->resynchronize(k, v);
-      exact_at = k;
+    precise_approach_.reset();
+    precise_state_.reset();
+    if (k - exact_at_ >= kResynchronizeInterval) {
+      escalation().resynchronize(k, v);
+      exact_at_ = k;
     }
     const Scalar approach = v.approach(pairIndex(pair));
-    const Scalar bound =
-        step_bound[pairIndex(pair)] * Scalar(static_cast<double>(k - exact_at + 2));
-    if (approach > bound && !(tracks_events && approach < resolution)) return true;
+    const Scalar bound = step_bound_[pairIndex(pair)] * Scalar(static_cast<double>(k - exact_at_ + 2));
+    if (approach > bound && !(tracks_events_ && approach < resolution_)) return true;
     if (approach < -bound) return false;
-    if (!escalation) escalation.emplace(working, scale, *result.first_pair);
-    exact_at = k;
-    const auto decision = escalation->decide(k, pair, v, stats);
-    precise_approach = decision.approach;
-    precise_state = decision.velocities;
+    exact_at_ = k;
+    const auto decision = escalation().decide(k, pair, v, stats);
+    precise_approach_ = decision.approach;
+    precise_state_ = decision.velocities;
     return decision.approaches;
-  };
+  }
 
-  std::uint64_t k = 0;
-  if (result.first_pair && !tracks_events) {
-    // Count-only: after the first impact the pairs alternate and positions no longer
-    // matter, so only velocities are modelled.
-    Pair pair = *result.first_pair;
-    while (approaches(pair, k)) {
-      if (k == options.max_collisions) {
-        result.truncated = true;
+  /// The approach speed and state seen by the last decision when it was taken above the
+  /// working precision (else empty): an event's time, positions and energy use them.
+  const std::optional<ReplayPrecision>& preciseApproach() const { return precise_approach_; }
+  const std::optional<std::array<ReplayPrecision, 3>>& preciseState() const { return precise_state_; }
+
+ private:
+  Escalation<Scalar>& escalation() {
+    if (!escalation_) escalation_.emplace(working_, scale_, first_);
+    return *escalation_;
+  }
+
+  const ThreeBodyScene& working_;
+  const ErrorScale scale_;
+  const std::array<Scalar, 2> step_bound_;  // by pair index
+  // Below this a positive approach speed may have lost digits to underflow, which an
+  // event's time would inherit.
+  const Scalar resolution_ = std::numeric_limits<Scalar>::min() / epsilonOf<Scalar>();
+  const bool tracks_events_;
+  const Pair first_;
+  std::uint64_t exact_at_ = 0;
+  std::optional<Escalation<Scalar>> escalation_;
+  std::optional<ReplayPrecision> precise_approach_;
+  std::optional<std::array<ReplayPrecision, 3>> precise_state_;
+};
+
+/// One call of simulate(): the run's state, and one member function per phase.
+template <class Scalar>
+class EngineRun {
+ public:
+  using Wide = WideOf<Scalar>;
+
+  EngineRun(const ThreeBodyScene& scene, const SimulationOptions& options, const EventVisitor& visitor)
+      : scene_(scene),
+        options_(options),
+        visitor_(visitor),
+        working_(inWorkingUnits(scene, units_)),
+        v_(working_.velocities),
+        coefficients_(scene.masses),
+        tracks_events_(options.events.kind != EventPolicy::Kind::kNone || static_cast<bool>(visitor)) {
+    result_.first_pair = firstPair(scene);
+  }
+
+  SimulationResult run() {
+    const Frame<Wide> start = measure(working_, v_.template valuesAs<Wide>());
+    if (result_.first_pair) {
+      Decider<Scalar> decider(working_, *result_.first_pair, tracks_events_);
+      if (tracks_events_) {
+        runWithEvents(decider);
+      } else {
+        countImpacts(decider);
+      }
+    } else {
+      for (int i = 0; i < 3; ++i) result_.final_positions[i] = notModelled(scene_.positions[i]);
+    }
+    finish(start);
+    return std::move(result_);
+  }
+
+ private:
+  /// Count-only: after the first impact the pairs alternate and positions no longer
+  /// matter, so only velocities are modelled.
+  void countImpacts(Decider<Scalar>& decider) {
+    Pair pair = *result_.first_pair;
+    while (decider.approaches(pair, k_, v_, result_.escalation)) {
+      if (k_ == options_.max_collisions) {
+        result_.truncated = true;
         break;
       }
-      v.impact(coefficients.of(pair), pairIndex(pair));
-      ++k;
+      v_.impact(coefficients_.of(pair), pairIndex(pair));
+      ++k_;
       pair = otherPair(pair);
     }
-  } else if (result.first_pair) {
-    // Times and positions in Scalar while they stay in its range, in Wide from there on.
-    Trajectory<Scalar> narrow(working);
+    for (int i = 0; i < 3; ++i) result_.final_positions[i] = notModelled(scene_.positions[i]);
+  }
+
+  /// Every impact with its event: times and positions in Scalar while they stay in its
+  /// range, in Wide from there on.
+  void runWithEvents(Decider<Scalar>& decider) {
+    Trajectory<Scalar> narrow(working_);
     std::optional<Trajectory<Wide>> wide;
-    Pair pair = *result.first_pair;
-    ImpactEvent event;
-    // One impact on `trajectory`; false, with nothing changed, when it leaves the range of
-    // a narrow trajectory's type.
-    auto impactOn = [&](auto& trajectory) {
-      using T = typename std::decay_t<decltype(trajectory)>::Value;
-      const int i = pairIndex(pair);
-      // The state to the last digit the run knows: the precise one after an escalation
-      // (where even a velocity that Scalar cannot hold moves a body over a long flight),
-      // else the compensated one; never the approach speed as a difference of `before`.
-      std::array<T, 3> before = v.template valuesAs<T>();
-      bool held = true;
-      if (precise_state) {
-        for (int i = 0; i < 3; ++i) {
-          before[i] = static_cast<T>((*precise_state)[i]);
-          held = held && ((*precise_state)[i] == 0 || (before[i] != 0 && inNormalRange(before[i])));
-        }
-      }
-      const T approach = precise_approach ? static_cast<T>(*precise_approach) : T(v.approach(i));
-      const auto impact = trajectory.next(pair, before, approach);
-      if (!(impact.in_range && held) && !std::is_same_v<T, Wide>) return false;
-      v.impact(coefficients.of(pair), i);
-      ++k;
-      event = trajectory.commit(k, pair, impact, before, v.template valuesAs<T>(), approach, units);
-      return true;
-    };
-    while (approaches(pair, k)) {
-      if (k == options.max_collisions) {
-        result.truncated = true;
+    Pair pair = *result_.first_pair;
+    while (decider.approaches(pair, k_, v_, result_.escalation)) {
+      if (k_ == options_.max_collisions) {
+        result_.truncated = true;
         break;
       }
       // Velocities as the run reports them everywhere, whichever type timed the impact.
       std::array<double, 3> before;
-      for (int i = 0; i < 3; ++i) before[i] = units.velocity_si(v.value(i));
-      if (wide || !impactOn(narrow)) {
+      for (int i = 0; i < 3; ++i) before[i] = units_.velocity_si(v_.value(i));
+      ImpactEvent event;
+      if (wide || !impactOn(narrow, pair, decider, event)) {
         if (!wide) wide.emplace(narrow);
-        impactOn(*wide);
+        impactOn(*wide, pair, decider, event);
       }
       event.velocities_before = before;
-      for (int i = 0; i < 3; ++i) event.velocities_after[i] = units.velocity_si(v.value(i));
-      if (visitor) visitor(event);
-      if (options.events.keeps(k)) result.events.push_back(event);
+      for (int i = 0; i < 3; ++i) event.velocities_after[i] = units_.velocity_si(v_.value(i));
+      if (visitor_) visitor_(event);
+      if (options_.events.keeps(k_)) result_.events.push_back(event);
       pair = otherPair(pair);
     }
     for (int i = 0; i < 3; ++i) {
-      result.final_positions[i] = wide ? units.position_si(wide->positionNow(i, v.template valuesAs<Wide>()))
-                                       : units.position_si(narrow.positionNow(i, v.values()));
+      result_.final_positions[i] = wide ? units_.position_si(wide->positionNow(i, v_.template valuesAs<Wide>()))
+                                        : units_.position_si(narrow.positionNow(i, v_.values()));
     }
-    result.final_time = wide ? units.time_si(wide->now()) : units.time_si(narrow.now());
+    result_.final_time = wide ? units_.time_si(wide->now()) : units_.time_si(narrow.now());
   }
-  if (!tracks_events || !result.first_pair) {
-    for (int i = 0; i < 3; ++i) {
-      result.final_positions[i] = tracks_events ? toDouble(scene.positions[i]) : std::numeric_limits<double>::quiet_NaN();
+
+  /// One impact of `pair` on `path`, described in `event`; false, with nothing changed,
+  /// when it leaves the range of a narrow path's type.
+  template <class Path>
+  bool impactOn(Path& path, Pair pair, const Decider<Scalar>& decider, ImpactEvent& event) {
+    using T = typename Path::Value;
+    const int i = pairIndex(pair);
+    // The state to the last digit the run knows: the precise one after an escalation
+    // (where even a velocity that Scalar cannot hold moves a body over a long flight),
+    // else the compensated one; never the approach speed as a difference of `before`.
+    std::array<T, 3> before = v_.template valuesAs<T>();
+    bool held = true;
+    if (const auto& precise_state = decider.preciseState()) {
+      for (int body = 0; body < 3; ++body) {
+        before[body] = static_cast<T>((*precise_state)[body]);
+        held = held && ((*precise_state)[body] == 0 || (before[body] != 0 && inNormalRange(before[body])));
+      }
+    }
+    const auto& precise_approach = decider.preciseApproach();
+    const T approach = precise_approach ? static_cast<T>(*precise_approach) : T(v_.approach(i));
+    const auto impact = path.next(pair, before, approach);
+    if (!(impact.in_range && held) && !std::is_same_v<T, Wide>) return false;
+    v_.impact(coefficients_.of(pair), i);
+    ++k_;
+    event = path.commit(k_, pair, impact, before, v_.template valuesAs<T>(), approach, units_);
+    return true;
+  }
+
+  /// A position the run did not model: the start's when events are tracked (nothing
+  /// moved), else NaN.
+  double notModelled(double start) const {
+    return tracks_events_ ? toDouble(start) : std::numeric_limits<double>::quiet_NaN();
+  }
+
+  /// Count, final velocities and the drifts of energy and momentum since `start`.
+  void finish(const Frame<Wide>& start) {
+    result_.collision_count = k_;
+    for (int i = 0; i < 3; ++i) result_.final_velocities[i] = units_.velocity_si(v_.value(i));
+    const Frame<Wide> end = measure(working_, v_.template valuesAs<Wide>());
+    result_.energy_relative_drift =
+        start.energy > 0 ? toDouble(absOf(Wide(end.energy - start.energy)) / start.energy) : 0.0;
+    if (scene_.wallIndex() >= 0) {
+      result_.momentum_relative_drift = std::numeric_limits<double>::quiet_NaN();
+    } else {
+      result_.momentum_relative_drift =
+          start.momentum_magnitude > 0
+              ? toDouble(absOf(Wide(end.momentum - start.momentum)) / start.momentum_magnitude)
+              : 0.0;
     }
   }
 
-  result.collision_count = k;
-  for (int i = 0; i < 3; ++i) result.final_velocities[i] = units.velocity_si(v.value(i));
-  const Frame<Wide> end = measure(working, v.template valuesAs<Wide>());
-  result.energy_relative_drift = start.energy > 0 ? toDouble(absOf(Wide(end.energy - start.energy)) / start.energy) : 0.0;
-  if (scene.wallIndex() >= 0) {
-    result.momentum_relative_drift = std::numeric_limits<double>::quiet_NaN();
-  } else {
-    result.momentum_relative_drift =
-        start.momentum_magnitude > 0
-            ? toDouble(absOf(Wide(end.momentum - start.momentum)) / start.momentum_magnitude)
-            : 0.0;
-  }
-  return result;
+  const ThreeBodyScene& scene_;
+  const SimulationOptions& options_;
+  const EventVisitor& visitor_;
+  WorkingUnits units_;
+  const ThreeBodyScene working_;
+  CompensatedVelocities<Scalar> v_;
+  const Coefficients<Scalar> coefficients_;
+  const bool tracks_events_;
+  SimulationResult result_;
+  std::uint64_t k_ = 0;  // impacts so far
+};
+
+}  // namespace
+
+template <class Scalar>
+SimulationResult simulate(const ThreeBodyScene& scene, const SimulationOptions& options, const EventVisitor& visitor) {
+  return EngineRun<Scalar>(scene, options, visitor).run();
 }
 
 template SimulationResult simulate<double>(const ThreeBodyScene&, const SimulationOptions&, const EventVisitor&);

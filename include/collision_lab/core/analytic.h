@@ -67,7 +67,8 @@ class AnalyticModel {
   Scalar psi() const { return psi_; }
 
  private:
-  Vec3 rotate(std::int64_t k_signed_steps, std::uint64_t k) const;
+  Vec3 rotate(std::int64_t direction, std::uint64_t k) const;
+  Vec3 velocitiesOfRotated(const Vec3& w, const Scalar& angle) const;
   Mat3 pairMap(Pair pair) const;
   Vec3 applyPairMap(Pair pair, const Vec3& v) const;
 
