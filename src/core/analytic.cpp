@@ -13,15 +13,13 @@
 #include "collision_lab/core/exact.h"
 #include "collision_lab/core/precision.h"
 #include "collision_lab/core/wedge.h"
+#include "float_ops.h"
 #include "impact_energy.h"
 
 namespace collision_lab {
 namespace core {
 
 namespace {
-
-/// Longest run counted by exact simulation when no precision can place u_perp.
-constexpr std::uint64_t kExactCountLimit = 2000;
 
 template <class T>
 T pi() {
@@ -36,10 +34,7 @@ T fraction(double m_i, double m_j) {
   return T(1) / (T(1) + T(m_j) / T(m_i));
 }
 
-template <class T>
-T absOf(const T& x) {
-  return x < 0 ? T(-x) : x;
-}
+using detail::absOf;
 
 /// q = psi / alpha (psi' / alpha for BC first) in precision T, with a bound on its
 /// rounding error. The count is ceil(q) - 1.

@@ -9,6 +9,7 @@
 
 #include "collision_lab/core/paper.h"
 #include "collision_lab/core/precision.h"
+#include "float_ops.h"
 
 namespace collision_lab {
 namespace core {
@@ -18,12 +19,10 @@ namespace {
 /// What a run that was not simulated reports for the quantities it did not measure.
 constexpr double kNotMeasured = std::numeric_limits<double>::quiet_NaN();
 
-/// A zero is +0, never -0 (outputs must not show "-0").
-double plusZero(double value) { return value == 0 ? 0.0 : value; }
-
+/// In double, a zero always +0 (outputs must not show "-0").
 template <class Vector>
 std::array<double, 3> toArray(const Vector& v) {
-  return {plusZero(static_cast<double>(v(0))), plusZero(static_cast<double>(v(1))), plusZero(static_cast<double>(v(2)))};
+  return {detail::toDouble(v(0)), detail::toDouble(v(1)), detail::toDouble(v(2))};
 }
 
 template <class T>

@@ -8,6 +8,7 @@
 #include <boost/math/constants/constants.hpp>
 
 #include "collision_lab/core/wedge.h"
+#include "float_ops.h"
 
 namespace collision_lab {
 namespace core {
@@ -19,7 +20,7 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 /// A zero is +0, never -0 (outputs must not show "-0").
 std::array<double, 3> plusZeros(std::array<double, 3> values) {
-  for (double& x : values) x = x == 0 ? 0.0 : x;
+  for (double& x : values) x = detail::toDouble(x);
   return values;
 }
 

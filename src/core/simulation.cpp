@@ -11,8 +11,8 @@
 #include "collision_lab/core/analytic.h"
 #include "collision_lab/core/exact.h"
 #include "collision_lab/core/precision.h"
+#include "float_ops.h"
 #include "impact_energy.h"
-#include "two_sum.h"
 
 namespace collision_lab {
 namespace core {
@@ -33,12 +33,8 @@ constexpr std::uint64_t kResynchronizeInterval = std::uint64_t{1} << 20;
 /// maps are orthogonal and do not amplify earlier errors.
 constexpr double kBoundFactor = 64.0;
 
-/// Rounds to double; a zero is always +0, so that no output shows "-0".
-template <class T>
-double toDouble(const T& value) {
-  const double rounded = static_cast<double>(value);
-  return rounded == 0 ? 0.0 : rounded;
-}
+using detail::absOf;
+using detail::toDouble;
 
 constexpr bool kLongDoubleIsWide =
     std::numeric_limits<long double>::max_exponent >= 4 * std::numeric_limits<double>::max_exponent;
@@ -311,11 +307,6 @@ class Escalation {
   std::optional<AnalyticModel<ReplayPrecision>> closed_form_;
   std::optional<AnalyticModel<DeepPrecision>> deep_closed_form_;
 };
-
-template <class T>
-T absOf(const T& x) {
-  return x < 0 ? T(-x) : x;
-}
 
 /// Energy and momentum of the finite masses [J, kg m/s], in the wide type of the run.
 template <class Wide>
@@ -655,15 +646,22 @@ class EngineRun {
   }
 
  private:
+  /// Does `pair` collide next? False when it does not approach, and when max_collisions
+  /// stops the run (marked truncated).
+  bool nextImpact(Decider<Scalar>& decider, Pair pair) {
+    if (!decider.approaches(pair, k_, v_, result_.escalation)) return false;
+    if (k_ == options_.max_collisions) {
+      result_.truncated = true;
+      return false;
+    }
+    return true;
+  }
+
   /// Count-only: after the first impact the pairs alternate and positions no longer
   /// matter, so only velocities are modelled.
   void countImpacts(Decider<Scalar>& decider) {
     Pair pair = *result_.first_pair;
-    while (decider.approaches(pair, k_, v_, result_.escalation)) {
-      if (k_ == options_.max_collisions) {
-        result_.truncated = true;
-        break;
-      }
+    while (nextImpact(decider, pair)) {
       v_.impact(coefficients_.of(pair), pairIndex(pair));
       ++k_;
       pair = otherPair(pair);
@@ -677,11 +675,7 @@ class EngineRun {
     Trajectory<Scalar> narrow(working_);
     std::optional<Trajectory<Wide>> wide;
     Pair pair = *result_.first_pair;
-    while (decider.approaches(pair, k_, v_, result_.escalation)) {
-      if (k_ == options_.max_collisions) {
-        result_.truncated = true;
-        break;
-      }
+    while (nextImpact(decider, pair)) {
       // Velocities as the run reports them everywhere, whichever type timed the impact.
       std::array<double, 3> before;
       for (int i = 0; i < 3; ++i) before[i] = units_.velocity_si(v_.value(i));

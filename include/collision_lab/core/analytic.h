@@ -28,9 +28,10 @@ struct Angles {
 
 /// Closed-form model of one scene in precision Scalar: a working precision (double, long
 /// double, HighPrecision) or an escalation tier (ReplayPrecision, DeepPrecision), the
-/// scalars analytic.cpp instantiates (declared below). Precondition: validate(scene) passed. In double it needs finite-mass
-/// ratios up to about 2^1000, beyond which the light body's share of the mass-weighted
-/// velocities underflows; predict() and runLab() go to HighPrecision there.
+/// scalars analytic.cpp instantiates (declared below). Precondition: validate(scene)
+/// passed. In double it needs finite-mass ratios up to about 2^1000, beyond which the
+/// light body's share of the mass-weighted velocities underflows; predict() and runLab()
+/// go to HighPrecision there.
 template <class Scalar>
 class AnalyticModel {
  public:

@@ -54,5 +54,9 @@ using DeepPrecision = boost::multiprecision::number<boost::multiprecision::cpp_b
 /// zero.
 constexpr std::uint64_t kExactReplayLimit = 20000;
 
+/// Longest run (collisions) the predicted count is found by exact simulation for, when
+/// not even 500 digits can place the start in the wedge (analytic.h).
+constexpr std::uint64_t kExactCountLimit = 2000;
+
 }  // namespace core
 }  // namespace collision_lab
