@@ -58,26 +58,14 @@ Quotient<T> countQuotient(const ThreeBodyScene& scene, Pair first) {
   // nearly common velocity makes psi inaccurate: bound the angular error by |dw| / |w|,
   // both weighted by sqrt(m_i / m_max) as w is.
   const int wall = scene.wallIndex();
-  const double mass_max = largestFiniteMass(scene.masses);
   T velocity_scale = 0;
   for (int i = 0; i < 3; ++i) velocity_scale = std::max(velocity_scale, absOf(T(scene.velocities[i])));
-  const T frame = wall >= 0 ? T(scene.velocities[wall]) : T(0);
-  T centre = frame;
-  if (wall < 0) {
-    T mass_sum = 0, momentum = 0;
-    for (int i = 0; i < 3; ++i) {
-      mass_sum += T(scene.masses[i]) / T(mass_max);
-      momentum += T(scene.masses[i]) / T(mass_max) * T(scene.velocities[i]);
-    }
-    centre = momentum / mass_sum;
-  }
   T w_norm_sq = 0, w_error = 0;
   for (int i = 0; i < 3; ++i) {
     if (i == wall) continue;
-    const T weight = sqrt(T(scene.masses[i]) / T(mass_max));
-    const T w = weight * (T(scene.velocities[i]) - centre);
+    const T w = model.uPerp()(i);
     w_norm_sq += w * w;
-    w_error += weight * (absOf(T(scene.velocities[i])) + velocity_scale);
+    w_error += model.sqrtMassScaled()(i) * (absOf(T(scene.velocities[i])) + velocity_scale);
   }
   const T eps = std::numeric_limits<T>::epsilon();
   const T w_norm = sqrt(w_norm_sq);

@@ -67,6 +67,11 @@ class AnalyticModel {
   /// Angle of u_perp from the escape cone's ray r_BC towards r_AB, in [0, 2 pi) [rad].
   Scalar psi() const { return psi_; }
 
+  /// The start's u_perp = S (v0 - V 1) with S = diag(sqrt(m_i / m_max)) (0 for a wall),
+  /// mass-weighted velocity scaled by 1/sqrt(m_max) [m/s]; and that S [1].
+  const Vec3& uPerp() const { return w_; }
+  const Vec3& sqrtMassScaled() const { return sqrt_mass_scaled_; }
+
  private:
   Vec3 rotate(std::int64_t direction, std::uint64_t k) const;
   Vec3 velocitiesOfRotated(const Vec3& w, const Scalar& angle) const;
