@@ -108,7 +108,7 @@ void readRunOptions(const RawOptions& raw, CliRequest& request) {
     throw makeCliError(CliReason::kInvalidOption, "format", "'" + raw.format + "' is not table, json or csv");
   }
   request.format = *format;
-  const auto precision = io::parsePrecisionOption(raw.precision);
+  const auto precision = core::parsePrecision(raw.precision);
   if (!precision) {
     throw makeCliError(CliReason::kInvalidOption, "precision",
                        "'" + raw.precision + "' is not double, long_double or high");

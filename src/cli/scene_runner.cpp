@@ -60,15 +60,6 @@ core::RunOptions optionsFor(const CliRequest& request, const io::SceneEntry& ent
   return options;
 }
 
-bool isShown(const core::EventPolicy& policy, std::uint64_t index) {
-  switch (policy.kind) {
-    case core::EventPolicy::Kind::kAll: return true;
-    case core::EventPolicy::Kind::kNone: return false;
-    case core::EventPolicy::Kind::kFirstN: return index <= policy.first_n;
-  }
-  return false;
-}
-
 /// Runs a validated scene with a progress line on a terminal and Ctrl-C for the engine.
 /// `visitors` see the shown events; the run itself keeps none.
 core::SceneRunResult runWithProgress(const core::Scene& scene, const core::RunOptions& shown,
@@ -103,10 +94,10 @@ core::SceneVisitors showEvents(const core::RunOptions& shown, io::RunReportWrite
   if (shown.events.kind == core::EventPolicy::Kind::kNone) return visitors;
   const core::EventPolicy policy = shown.events;
   visitors.three_body_event = [&three_body, policy](const core::LabEvent& event) {
-    if (isShown(policy, event.event.index)) three_body.event(event);
+    if (policy.keeps(event.event.index)) three_body.event(event);
   };
   visitors.impact = [&nbody, policy](const core::ImpactRecord& impact) {
-    if (isShown(policy, impact.index)) nbody.impact(impact);
+    if (policy.keeps(impact.index)) nbody.impact(impact);
   };
   // The event engine runs to the end even when only the first N impacts are shown.
   return visitors;

@@ -12,23 +12,14 @@
 
 #include "collision_lab/core/exact.h"
 #include "collision_lab/core/precision.h"
-#include "collision_lab/core/simulation.h"
+#include "collision_lab/core/wedge.h"
+#include "float_ops.h"
 #include "impact_energy.h"
 
 namespace collision_lab {
 namespace core {
 
 namespace {
-
-namespace mp = boost::multiprecision;
-
-/// Precision of the last closed-form check, for counts too long to replay exactly.
-using DeepPrecision = mp::number<mp::cpp_bin_float<500>>;
-
-/// Longest replay the exact integer test of psi / alpha runs as rationals.
-constexpr std::uint64_t kExactReplayLimit = 20000;
-/// Longest run counted by exact simulation when no precision can place u_perp.
-constexpr std::uint64_t kExactCountLimit = 2000;
 
 template <class T>
 T pi() {
@@ -43,26 +34,7 @@ T fraction(double m_i, double m_j) {
   return T(1) / (T(1) + T(m_j) / T(m_i));
 }
 
-/// alpha = atan(sqrt(m_B M / (m_A m_C))) written as ratios so that walls (inf) and
-/// extreme masses stay finite: m_B M/(m_A m_C) = (m_B/m_A)(1 + m_B/m_C) + m_B/m_C.
-template <class T>
-T alphaOf(const std::array<double, 3>& m) {
-  using std::atan;
-  using std::sqrt;
-  const T b_over_a = std::isinf(m[kA]) ? T(0) : T(m[kB]) / T(m[kA]);
-  const T b_over_c = std::isinf(m[kC]) ? T(0) : T(m[kB]) / T(m[kC]);
-  return atan(sqrt(b_over_a * (1 + b_over_c) + b_over_c));
-}
-
-template <class T>
-Eigen::Matrix<T, 3, 1> cross(const Eigen::Matrix<T, 3, 1>& a, const Eigen::Matrix<T, 3, 1>& b) {
-  return Eigen::Matrix<T, 3, 1>(a(1) * b(2) - a(2) * b(1), a(2) * b(0) - a(0) * b(2), a(0) * b(1) - a(1) * b(0));
-}
-
-template <class T>
-T absOf(const T& x) {
-  return x < 0 ? T(-x) : x;
-}
+using detail::absOf;
 
 /// q = psi / alpha (psi' / alpha for BC first) in precision T, with a bound on its
 /// rounding error. The count is ceil(q) - 1.
@@ -71,14 +43,6 @@ struct Quotient {
   T q;
   T error_bound;
 };
-
-double largestFiniteMass(const ThreeBodyScene& scene) {
-  double mass = 0.0;
-  for (int i = 0; i < 3; ++i) {
-    if (!scene.isWall(i)) mass = std::max(mass, scene.masses[i]);
-  }
-  return mass;
-}
 
 template <class T>
 Quotient<T> countQuotient(const ThreeBodyScene& scene, Pair first) {
@@ -94,26 +58,14 @@ Quotient<T> countQuotient(const ThreeBodyScene& scene, Pair first) {
   // nearly common velocity makes psi inaccurate: bound the angular error by |dw| / |w|,
   // both weighted by sqrt(m_i / m_max) as w is.
   const int wall = scene.wallIndex();
-  const double mass_max = largestFiniteMass(scene);
   T velocity_scale = 0;
   for (int i = 0; i < 3; ++i) velocity_scale = std::max(velocity_scale, absOf(T(scene.velocities[i])));
-  const T frame = wall >= 0 ? T(scene.velocities[wall]) : T(0);
-  T centre = frame;
-  if (wall < 0) {
-    T mass_sum = 0, momentum = 0;
-    for (int i = 0; i < 3; ++i) {
-      mass_sum += T(scene.masses[i]) / T(mass_max);
-      momentum += T(scene.masses[i]) / T(mass_max) * T(scene.velocities[i]);
-    }
-    centre = momentum / mass_sum;
-  }
   T w_norm_sq = 0, w_error = 0;
   for (int i = 0; i < 3; ++i) {
     if (i == wall) continue;
-    const T weight = sqrt(T(scene.masses[i]) / T(mass_max));
-    const T w = weight * (T(scene.velocities[i]) - centre);
+    const T w = model.uPerp()(i);
     w_norm_sq += w * w;
-    w_error += weight * (absOf(T(scene.velocities[i])) + velocity_scale);
+    w_error += model.sqrtMassScaled()(i) * (absOf(T(scene.velocities[i])) + velocity_scale);
   }
   const T eps = std::numeric_limits<T>::epsilon();
   const T w_norm = sqrt(w_norm_sq);
@@ -151,51 +103,24 @@ std::array<std::complex<double>, 3> sortedByArgument(std::array<std::complex<dou
 template <class Scalar>
 AnalyticModel<Scalar>::AnalyticModel(const ThreeBodyScene& scene) : masses_(scene.masses), wall_(scene.wallIndex()) {
   using std::atan2;
-  using std::sqrt;
-  f_ab_a_ = fraction<Scalar>(masses_[kA], masses_[kB]);
-  f_ab_b_ = fraction<Scalar>(masses_[kB], masses_[kA]);
-  f_bc_b_ = fraction<Scalar>(masses_[kB], masses_[kC]);
-  f_bc_c_ = fraction<Scalar>(masses_[kC], masses_[kB]);
-  alpha_ = alphaOf<Scalar>(masses_);
+  for (int i = 0; i < 2; ++i) {
+    fractions_[i] = {fraction<Scalar>(masses_[i], masses_[i + 1]), fraction<Scalar>(masses_[i + 1], masses_[i])};
+  }
   first_pair_ = core::firstPair(scene);
-
-  double mass_max = 0.0;
+  const Wedge<Scalar> wedge = wedgeOf<Scalar>(masses_);
+  alpha_ = wedge.alpha;
+  sqrt_mass_scaled_ = wedge.sqrt_mass;
+  s_hat_ = wedge.s_hat;
+  const double mass_max = largestFiniteMass(masses_);
+  Scalar momentum = 0;
   for (int i = 0; i < 3; ++i) {
-    if (i != wall_) mass_max = std::max(mass_max, masses_[i]);
+    if (i != wall_) momentum += Scalar(masses_[i]) / Scalar(mass_max) * Scalar(scene.velocities[i]);
   }
-  Scalar total = 0, momentum = 0;
-  for (int i = 0; i < 3; ++i) {
-    if (i == wall_) {
-      sqrt_mass_scaled_(i) = 0;
-      continue;
-    }
-    const Scalar scaled = Scalar(masses_[i]) / Scalar(mass_max);
-    sqrt_mass_scaled_(i) = sqrt(scaled);
-    total += scaled;
-    momentum += scaled * Scalar(scene.velocities[i]);
-  }
-  const Scalar centre = wall_ >= 0 ? Scalar(scene.velocities[wall_]) : Scalar(momentum / total);
+  const Scalar centre = wall_ >= 0 ? Scalar(scene.velocities[wall_]) : Scalar(momentum / wedge.mass_sum);
   centre_velocity_ = Vec3::Constant(centre);
-  if (wall_ >= 0) {
-    s_hat_ = Vec3::Zero();
-    s_hat_(wall_) = 1;
-  } else {
-    s_hat_ = sqrt_mass_scaled_ / sqrt(total);
-  }
   for (int i = 0; i < 3; ++i) w_(i) = sqrt_mass_scaled_(i) * (Scalar(scene.velocities[i]) - centre);
-
-  // The escape cone's ray r_BC lies on L_BC (orthogonal to n_BC within s-perp), on the
-  // side where n_AB . u >= 0; psi is measured from it towards r_AB, which has a positive
-  // n_BC component.
-  auto inverse_sqrt = [this](int i) { return i == wall_ ? Scalar(0) : Scalar(1) / sqrt_mass_scaled_(i); };
-  Vec3 n_ab(inverse_sqrt(kA), -inverse_sqrt(kB), Scalar(0));
-  Vec3 n_bc(Scalar(0), inverse_sqrt(kB), -inverse_sqrt(kC));
-  n_ab /= sqrt(n_ab.squaredNorm());
-  n_bc /= sqrt(n_bc.squaredNorm());
-  Vec3 ray_bc = cross<Scalar>(s_hat_, n_bc);
-  ray_bc /= sqrt(ray_bc.squaredNorm());
-  if (n_ab.dot(ray_bc) < 0) ray_bc = -ray_bc;
-  psi_ = atan2(Scalar(w_.dot(n_bc)), Scalar(w_.dot(ray_bc)));
+  const std::array<Scalar, 2> u_perp = wedge.coordinates(w_);
+  psi_ = atan2(u_perp[1], u_perp[0]);
   if (psi_ < 0) psi_ += 2 * pi<Scalar>();
 }
 
@@ -205,42 +130,39 @@ Scalar AnalyticModel<Scalar>::omega() const {
 }
 
 template <class Scalar>
-typename AnalyticModel<Scalar>::Mat3 AnalyticModel<Scalar>::dAB() const {
+typename AnalyticModel<Scalar>::Mat3 AnalyticModel<Scalar>::pairMap(Pair pair) const {
+  const int i = pairIndex(pair);
+  const auto& [f_i, f_j] = fractions_[i];
   Mat3 d = Mat3::Identity();
-  d(0, 0) = f_ab_a_ - f_ab_b_;
-  d(0, 1) = 2 * f_ab_b_;
-  d(1, 0) = 2 * f_ab_a_;
-  d(1, 1) = f_ab_b_ - f_ab_a_;
-  return d;
-}
-
-template <class Scalar>
-typename AnalyticModel<Scalar>::Mat3 AnalyticModel<Scalar>::dBC() const {
-  Mat3 d = Mat3::Identity();
-  d(1, 1) = f_bc_b_ - f_bc_c_;
-  d(1, 2) = 2 * f_bc_c_;
-  d(2, 1) = 2 * f_bc_b_;
-  d(2, 2) = f_bc_c_ - f_bc_b_;
+  d(i, i) = f_i - f_j;
+  d(i, i + 1) = 2 * f_j;
+  d(i + 1, i) = 2 * f_i;
+  d(i + 1, i + 1) = f_j - f_i;
   return d;
 }
 
 template <class Scalar>
 typename AnalyticModel<Scalar>::Vec3 AnalyticModel<Scalar>::applyPairMap(Pair pair, const Vec3& v) const {
-  return (pair == Pair::AB ? dAB() : dBC()) * v;
+  return pairMap(pair) * v;
 }
 
 /// V 1 + S^-1 R(angle) w, where R rotates about s_hat: cos w + sin (s_hat x w).
 template <class Scalar>
-typename AnalyticModel<Scalar>::Vec3 AnalyticModel<Scalar>::rotate(std::int64_t direction, std::uint64_t k) const {
+typename AnalyticModel<Scalar>::Vec3 AnalyticModel<Scalar>::velocitiesOfRotated(const Vec3& w,
+                                                                               const Scalar& angle) const {
   using std::cos;
   using std::sin;
-  const Scalar angle = Scalar(direction) * Scalar(k) * theta();
-  const Vec3 rotated = cos(angle) * w_ + sin(angle) * cross<Scalar>(s_hat_, w_);
+  const Vec3 rotated = cos(angle) * w + sin(angle) * cross<Scalar>(s_hat_, w);
   Vec3 v = centre_velocity_;
   for (int i = 0; i < 3; ++i) {
     if (i != wall_) v(i) += rotated(i) / sqrt_mass_scaled_(i);
   }
   return v;
+}
+
+template <class Scalar>
+typename AnalyticModel<Scalar>::Vec3 AnalyticModel<Scalar>::rotate(std::int64_t direction, std::uint64_t k) const {
+  return velocitiesOfRotated(w_, Scalar(direction) * Scalar(k) * theta());
 }
 
 template <class Scalar>
@@ -256,21 +178,13 @@ typename AnalyticModel<Scalar>::Vec3 AnalyticModel<Scalar>::velocitiesAfter(std:
 template <class Scalar>
 typename AnalyticModel<Scalar>::Vec3 AnalyticModel<Scalar>::initialVelocitiesFrom(const Vec3& after,
                                                                                  std::uint64_t n) const {
-  using std::cos;
-  using std::sin;
   if (!first_pair_ || n == 0) return after;
   const Pair first = *first_pair_;
   const Vec3 even = n % 2 == 0 ? after : applyPairMap(first, after);  // the maps are involutions
   const Scalar centre = centre_velocity_(0);
   Vec3 w_after;
   for (int i = 0; i < 3; ++i) w_after(i) = i == wall_ ? Scalar(0) : sqrt_mass_scaled_(i) * (even(i) - centre);
-  const Scalar angle = Scalar(first == Pair::AB ? 1 : -1) * Scalar(n / 2) * theta();
-  const Vec3 w0 = cos(angle) * w_after + sin(angle) * cross<Scalar>(s_hat_, w_after);
-  Vec3 v = centre_velocity_;
-  for (int i = 0; i < 3; ++i) {
-    if (i != wall_) v(i) += w0(i) / sqrt_mass_scaled_(i);
-  }
-  return v;
+  return velocitiesOfRotated(w_after, Scalar(first == Pair::AB ? 1 : -1) * Scalar(n / 2) * theta());
 }
 
 template <class Scalar>
@@ -280,28 +194,28 @@ std::array<Scalar, 3> AnalyticModel<Scalar>::energyTransfer(std::uint64_t n) con
   const Pair pair = n % 2 == 1 ? *first_pair_ : otherPair(*first_pair_);
   const Vec3 before = velocitiesAfter(n - 1);
   const std::array<Scalar, 3> v{before(0), before(1), before(2)};
-  const int left = pair == Pair::AB ? kA : kB;
-  const int right = left + 1;
-  const Scalar f_left = pair == Pair::AB ? f_ab_a_ : f_bc_b_;
-  const Scalar f_right = pair == Pair::AB ? f_ab_b_ : f_bc_c_;
-  // Reduced mass m_l m_r / (m_l + m_r), and its wall limit (the finite mass).
-  const Scalar reduced = left == wall_    ? Scalar(masses_[right])
-                         : right == wall_ ? Scalar(masses_[left])
-                                          : Scalar(masses_[left]) * f_right;
+  const int i = pairIndex(pair);
+  const int j = i + 1;
+  const auto& [f_i, f_j] = fractions_[i];
+  // Reduced mass m_i m_j / (m_i + m_j), and its wall limit (the finite mass).
+  const Scalar reduced = i == wall_   ? Scalar(masses_[j])
+                         : j == wall_ ? Scalar(masses_[i])
+                                      : Scalar(masses_[i]) * f_j;
   using Energy = detail::EnergyType<Scalar>;
-  const auto wide = detail::ImpactEnergy<Energy>::impactGains(pair, Energy(reduced), Energy(f_left), Energy(f_right), v,
-                                                              Scalar(v[right] - v[left]));
-  for (int i = 0; i < 3; ++i) {
-    gained[i] = static_cast<Scalar>(wide[i]);
-    if (gained[i] == 0) gained[i] = Scalar(0);  // an underflow keeps no sign
+  const auto wide = detail::ImpactEnergy<Energy>::impactGains(pair, Energy(reduced), Energy(f_i), Energy(f_j), v,
+                                                              Scalar(v[j] - v[i]));
+  for (int body = 0; body < 3; ++body) {
+    gained[body] = static_cast<Scalar>(wide[body]);
+    if (gained[body] == 0) gained[body] = Scalar(0);  // an underflow keeps no sign
   }
   return gained;
 }
 
+// The scalars analytic.h promises.
 template class AnalyticModel<double>;
 template class AnalyticModel<long double>;
 template class AnalyticModel<HighPrecision>;
-template class AnalyticModel<mp::cpp_bin_float_100>;
+template class AnalyticModel<ReplayPrecision>;
 template class AnalyticModel<DeepPrecision>;
 
 Angles anglesFor(const std::array<double, 3>& masses) {

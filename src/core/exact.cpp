@@ -24,17 +24,16 @@ RationalState initialVelocities(const ThreeBodyScene& scene) {
 }
 
 void applyCollision(const std::array<double, 3>& masses, Pair pair, RationalState& v) {
-  const int left = pair == Pair::AB ? kA : kB;  // the right-hand body of the pair
-  const int right = left + 1;
-  const Rational approach = v[right] - v[left];
-  const Rational f_left = massFraction(masses[left], masses[right]);
-  const Rational f_right = 1 - f_left;
-  v[left] += 2 * f_right * approach;
-  v[right] -= 2 * f_left * approach;
+  const int i = pairIndex(pair);  // the pair's bodies are i and i + 1
+  const Rational approach = approachSpeed(pair, v);
+  const Rational f_i = massFraction(masses[i], masses[i + 1]);
+  v[i] += 2 * (1 - f_i) * approach;
+  v[i + 1] -= 2 * f_i * approach;
 }
 
 Rational approachSpeed(Pair pair, const RationalState& v) {
-  return pair == Pair::AB ? Rational(v[kB] - v[kA]) : Rational(v[kC] - v[kB]);
+  const int i = pairIndex(pair);
+  return v[i + 1] - v[i];
 }
 
 int compareFirstContactTimes(const ThreeBodyScene& scene) {

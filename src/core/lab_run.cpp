@@ -9,6 +9,7 @@
 
 #include "collision_lab/core/paper.h"
 #include "collision_lab/core/precision.h"
+#include "float_ops.h"
 
 namespace collision_lab {
 namespace core {
@@ -18,12 +19,10 @@ namespace {
 /// What a run that was not simulated reports for the quantities it did not measure.
 constexpr double kNotMeasured = std::numeric_limits<double>::quiet_NaN();
 
-/// A zero is +0, never -0 (outputs must not show "-0").
-double plusZero(double value) { return value == 0 ? 0.0 : value; }
-
+/// In double, a zero always +0 (outputs must not show "-0").
 template <class Vector>
 std::array<double, 3> toArray(const Vector& v) {
-  return {plusZero(static_cast<double>(v(0))), plusZero(static_cast<double>(v(1))), plusZero(static_cast<double>(v(2)))};
+  return {detail::toDouble(v(0)), detail::toDouble(v(1)), detail::toDouble(v(2))};
 }
 
 template <class T>
@@ -68,10 +67,7 @@ class ClosedForm {
 /// light body's rounding is weighed by the energy it carries.
 class EnergyNormError {
  public:
-  explicit EnergyNormError(const ThreeBodyScene& scene) : scene_(scene) {
-    for (int i = 0; i < 3; ++i) {
-      if (!scene.isWall(i)) mass_max_ = std::max(mass_max_, scene.masses[i]);
-    }
+  explicit EnergyNormError(const ThreeBodyScene& scene) : scene_(scene), mass_max_(largestFiniteMass(scene.masses)) {
     const int wall = scene.wallIndex();
     const double frame = wall >= 0 ? scene.velocities[wall] : 0.0;
     double norm_sq = 0.0;
@@ -95,13 +91,82 @@ class EnergyNormError {
 
  private:
   const ThreeBodyScene& scene_;
-  double mass_max_ = 0.0;
+  double mass_max_;
   double initial_norm_ = 1.0;
 };
 
-bool keeps(const EventPolicy& policy, std::uint64_t index) {
-  return policy.kind == EventPolicy::Kind::kAll ||
-         (policy.kind == EventPolicy::Kind::kFirstN && index <= policy.first_n);
+/// The summary of a run that was not simulated: the closed form answers, and nothing was
+/// measured. `skipped`: over the cap, rather than predict-only.
+void describeNotSimulated(const RunOptions& options, bool skipped, RunResult& result) {
+  LabRunSummary& summary = result.summary;
+  summary.collision_count = skipped ? 0 : result.prediction.collision_count;
+  summary.final_velocities = result.prediction.final_velocities;
+  summary.max_prediction_error = kNotMeasured;
+  summary.energy_relative_drift = kNotMeasured;
+  summary.momentum_relative_drift = kNotMeasured;
+  if (skipped) {
+    summary.truncated = true;
+    summary.truncation_reason = "predicted " + std::to_string(result.prediction.collision_count) +
+                                " collisions exceed max_collisions = " + std::to_string(options.max_collisions) +
+                                "; not simulated";
+  }
+}
+
+/// One simulated collision beside the closed form and the paper's printed formulas.
+/// `previous_before`: the velocities before the collision before it (the paper's BC
+/// energy formulas refer to them).
+LabEvent labEvent(const ThreeBodyScene& scene, const ClosedForm& model, const ImpactEvent& event,
+                  const std::array<double, 3>& previous_before) {
+  LabEvent lab;
+  lab.event = event;
+  lab.predicted_velocities_after = model.velocitiesAfter(event.index);
+  lab.paper_velocities_after = paper::velocitiesAfter(scene, event.index);
+  lab.predicted_energy_transfer = model.energyTransfer(event.index);
+  lab.paper_energy_transfer =
+      paper::energyTransfer(scene, event.index, event.pair, event.velocities_before, previous_before);
+  for (int i = 0; i < 3; ++i) {
+    const double v = event.velocities_after[i];
+    lab.kinetic_energy_after[i] = scene.isWall(i) ? 0.0 : scene.masses[i] * v * v / 2;
+  }
+  return lab;
+}
+
+/// Simulates, in full mode with every event put beside the prediction, and measures how
+/// far the simulation is from the closed form.
+void simulateBesidePrediction(const ThreeBodyScene& scene, const RunOptions& options, const LabEventVisitor& visitor,
+                              RunResult& result) {
+  LabRunSummary& summary = result.summary;
+  const EnergyNormError relative_error(scene);
+  const ClosedForm model(scene);
+  SimulationOptions simulation_options;
+  simulation_options.max_collisions = options.max_collisions;
+  EventVisitor enrich;
+  std::array<double, 3> previous_before = scene.velocities;
+  if (options.mode == RunMode::kFull) {
+    enrich = [&](const ImpactEvent& event) {
+      LabEvent lab = labEvent(scene, model, event, previous_before);
+      previous_before = event.velocities_before;
+      summary.max_prediction_error = std::max(summary.max_prediction_error,
+                                              relative_error(event.velocities_after, lab.predicted_velocities_after));
+      if (visitor) visitor(lab);
+      if (options.events.keeps(event.index)) result.events.push_back(std::move(lab));
+    };
+  }
+  const SimulationResult simulation = simulate(scene, simulation_options, options.precision, enrich);
+  summary.simulated = true;
+  summary.collision_count = simulation.collision_count;
+  summary.truncated = simulation.truncated;
+  if (simulation.truncated) {
+    summary.truncation_reason = "stopped at max_collisions = " + std::to_string(options.max_collisions) + " of " +
+                                std::to_string(result.prediction.collision_count) + " predicted";
+  }
+  summary.final_velocities = simulation.final_velocities;
+  summary.energy_relative_drift = simulation.energy_relative_drift;
+  summary.momentum_relative_drift = simulation.momentum_relative_drift;
+  summary.escalation = simulation.escalation;
+  const auto predicted_final = model.velocitiesAfter(simulation.collision_count);
+  summary.max_prediction_error =
+      std::max(summary.max_prediction_error, relative_error(simulation.final_velocities, predicted_final));
 }
 
 }  // namespace
@@ -132,66 +197,14 @@ RunResult runLab(const ThreeBodyScene& scene, const RunOptions& options, const A
   const auto started = std::chrono::steady_clock::now();
   RunResult result;
   result.prediction = prediction;
-  LabRunSummary& summary = result.summary;
-  const EnergyNormError relative_error(scene);
-
   const bool over_cap = result.prediction.collision_count > options.max_collisions;
   const bool skipped = options.mode != RunMode::kPredictOnly && over_cap && options.skip_simulation_over_cap;
   if (options.mode == RunMode::kPredictOnly || skipped) {
-    // Not simulated: the closed form answers, and nothing was measured.
-    summary.collision_count = options.mode == RunMode::kPredictOnly ? result.prediction.collision_count : 0;
-    summary.final_velocities = result.prediction.final_velocities;
-    summary.max_prediction_error = kNotMeasured;
-    summary.energy_relative_drift = kNotMeasured;
-    summary.momentum_relative_drift = kNotMeasured;
+    describeNotSimulated(options, skipped, result);
+  } else {
+    simulateBesidePrediction(scene, options, visitor, result);
   }
-  if (skipped) {
-    summary.truncated = true;
-    summary.truncation_reason = "predicted " + std::to_string(result.prediction.collision_count) +
-                                " collisions exceed max_collisions = " + std::to_string(options.max_collisions) +
-                                "; not simulated";
-  } else if (options.mode != RunMode::kPredictOnly) {
-    const ClosedForm model(scene);
-    SimulationOptions simulation_options;
-    simulation_options.max_collisions = options.max_collisions;
-    EventVisitor enrich;
-    std::array<double, 3> previous_before = scene.velocities;
-    if (options.mode == RunMode::kFull) {
-      enrich = [&](const ImpactEvent& event) {
-        LabEvent lab;
-        lab.event = event;
-        lab.predicted_velocities_after = toArray(model.velocitiesAfter(event.index));
-        lab.paper_velocities_after = paper::velocitiesAfter(scene, event.index);
-        lab.predicted_energy_transfer = model.energyTransfer(event.index);
-        lab.paper_energy_transfer =
-            paper::energyTransfer(scene, event.index, event.pair, event.velocities_before, previous_before);
-        for (int i = 0; i < 3; ++i) {
-          const double v = event.velocities_after[i];
-          lab.kinetic_energy_after[i] = scene.isWall(i) ? 0.0 : scene.masses[i] * v * v / 2;
-        }
-        previous_before = event.velocities_before;
-        summary.max_prediction_error = std::max(summary.max_prediction_error, relative_error(event.velocities_after, lab.predicted_velocities_after));
-        if (visitor) visitor(lab);
-        if (keeps(options.events, event.index)) result.events.push_back(std::move(lab));
-      };
-    }
-    const SimulationResult simulation = simulate(scene, simulation_options, options.precision, enrich);
-    summary.simulated = true;
-    summary.collision_count = simulation.collision_count;
-    summary.truncated = simulation.truncated;
-    if (simulation.truncated) {
-      summary.truncation_reason = "stopped at max_collisions = " + std::to_string(options.max_collisions) +
-                                  " of " + std::to_string(result.prediction.collision_count) + " predicted";
-    }
-    summary.final_velocities = simulation.final_velocities;
-    summary.energy_relative_drift = simulation.energy_relative_drift;
-    summary.momentum_relative_drift = simulation.momentum_relative_drift;
-    summary.escalation = simulation.escalation;
-    const auto predicted_final = toArray(model.velocitiesAfter(simulation.collision_count));
-    summary.max_prediction_error =
-        std::max(summary.max_prediction_error, relative_error(simulation.final_velocities, predicted_final));
-  }
-  summary.compute_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  result.summary.compute_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return result;
 }
 

@@ -7,6 +7,9 @@
 
 #include <boost/math/constants/constants.hpp>
 
+#include "collision_lab/core/wedge.h"
+#include "float_ops.h"
+
 namespace collision_lab {
 namespace core {
 namespace paper {
@@ -17,7 +20,7 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 /// A zero is +0, never -0 (outputs must not show "-0").
 std::array<double, 3> plusZeros(std::array<double, 3> values) {
-  for (double& x : values) x = x == 0 ? 0.0 : x;
+  for (double& x : values) x = detail::toDouble(x);
   return values;
 }
 
@@ -37,16 +40,6 @@ Constants constantsOf(const std::array<double, 3>& masses) {
   // lambda_+ = (m_A m_C - m_B M + 2 i sqrt(m_A m_B m_C M)) / (M_AB M_BC), eq. (2.2).
   k.theta = std::atan2(2 * root / (m_ab * m_bc), (m_a * m_c - m_b * m_total) / (m_ab * m_bc));
   return k;
-}
-
-double dot(const std::array<double, 3>& a, const std::array<double, 3>& b) {
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-std::array<double, 3> normalized(std::array<double, 3> a) {
-  const double norm = std::sqrt(dot(a, a));
-  for (double& x : a) x /= norm;
-  return a;
 }
 
 }  // namespace
@@ -70,25 +63,24 @@ std::array<double, 3> velocitiesAfter(const ThreeBodyScene& scene, std::uint64_t
 }
 
 double phiBC(const ThreeBodyScene& scene) {
+  // As printed, with s = (sqrt m_i) unscaled: a wall makes it inf / inf.
+  if (scene.wallIndex() >= 0) return kNaN;
   const auto& m = scene.masses;
   const auto& v = scene.velocities;
   // u after the first AB impact (eq. 1.1, 1.2), in u = (sqrt(m_i) v_i).
   const double m_ab = m[kA] + m[kB];
   const double va = ((m[kA] - m[kB]) * v[kA] + 2 * m[kB] * v[kB]) / m_ab;
   const double vb = (2 * m[kA] * v[kA] + (m[kB] - m[kA]) * v[kB]) / m_ab;
-  const std::array<double, 3> u1{std::sqrt(m[kA]) * va, std::sqrt(m[kB]) * vb, std::sqrt(m[kC]) * v[kC]};
-  const auto s_hat = normalized({std::sqrt(m[kA]), std::sqrt(m[kB]), std::sqrt(m[kC])});
-  const auto n_bc = normalized({0.0, 1 / std::sqrt(m[kB]), -1 / std::sqrt(m[kC])});
-  // l_BC = s_hat x n_BC / |s_hat x n_BC| (eq. 3.20).
-  const auto l_bc = normalized({s_hat[1] * n_bc[2] - s_hat[2] * n_bc[1], s_hat[2] * n_bc[0] - s_hat[0] * n_bc[2],
-                                s_hat[0] * n_bc[1] - s_hat[1] * n_bc[0]});
-  return std::atan2(dot(u1, n_bc), dot(u1, l_bc));  // eq. (3.21)
+  const Eigen::Vector3d u1(std::sqrt(m[kA]) * va, std::sqrt(m[kB]) * vb, std::sqrt(m[kC]) * v[kC]);
+  const Wedge<double> wedge = wedgeOf<double>(m);
+  // l_BC = s_hat x n_BC / |s_hat x n_BC| (eq. 3.20): the line of r_BC, its orientation as printed.
+  const Eigen::Vector3d l_bc = cross<double>(wedge.s_hat, wedge.n_bc).normalized();
+  return std::atan2(u1.dot(wedge.n_bc), u1.dot(l_bc));  // eq. (3.21)
 }
 
 double omega(const std::array<double, 3>& m) {
-  const auto n_ab = normalized({1 / std::sqrt(m[kA]), -1 / std::sqrt(m[kB]), 0.0});
-  const auto n_bc = normalized({0.0, 1 / std::sqrt(m[kB]), -1 / std::sqrt(m[kC])});
-  return std::acos(dot(n_ab, n_bc));
+  const Wedge<double> wedge = wedgeOf<double>(m);
+  return std::acos(wedge.n_ab.dot(wedge.n_bc));
 }
 
 std::optional<std::int64_t> collisionCount(const ThreeBodyScene& scene) {

@@ -10,7 +10,6 @@
 #include "collision_lab/core/analytic.h"
 #include "collision_lab/core/exact.h"
 #include "collision_lab/core/precision.h"
-#include "collision_lab/core/simulation.h"
 
 namespace collision_lab {
 namespace core {
@@ -52,6 +51,14 @@ bool isFiniteProduct(double a, double b) { return std::isfinite(a * b); }
 }  // namespace
 
 bool ThreeBodyScene::isWall(int i) const { return masses[i] == std::numeric_limits<double>::infinity(); }
+
+double largestFiniteMass(const std::array<double, 3>& masses) {
+  double largest = 0.0;
+  for (double m : masses) {
+    if (!std::isinf(m)) largest = std::max(largest, m);
+  }
+  return largest;
+}
 
 int ThreeBodyScene::wallIndex() const {
   if (isWall(kA)) return kA;
@@ -161,15 +168,16 @@ std::optional<ValidationError> checkCountFits(const ThreeBodyScene& scene) {
 std::optional<ValidationError> checkFirstContact(const ThreeBodyScene& scene) {
   const std::optional<Pair> first = firstPair(scene);
   if (!first) return std::nullopt;
-  const int left = *first == Pair::AB ? kA : kB;
+  const int pair_index = pairIndex(*first);
   using exact::Rational;
   const auto& x = scene.positions;
   const auto& v = scene.velocities;
-  const Rational time = (Rational(x[left]) - Rational(x[left + 1])) / (Rational(v[left + 1]) - Rational(v[left]));
+  const Rational time = (Rational(x[pair_index]) - Rational(x[pair_index + 1])) /
+                        (Rational(v[pair_index + 1]) - Rational(v[pair_index]));
   const Rational largest(std::numeric_limits<double>::max());
   const auto text = [](const Rational& q) { return HighPrecision(HighPrecision(numerator(q)) / HighPrecision(denominator(q))).str(3); };
-  const std::string contact = std::string("the first contact, of ") + kParticleNames[left] + " and " +
-                              kParticleNames[left + 1] + ", ";
+  const std::string contact = std::string("the first contact, of ") + kParticleNames[pair_index] + " and " +
+                              kParticleNames[pair_index + 1] + ", ";
   if (time > largest) {
     return makeError(Reason::kOverflow, "positions",
                      contact + "would come at t = " + text(time) +
@@ -202,6 +210,16 @@ std::optional<ValidationError> validate(const ThreeBodyScene& scene) {
                      "which three-body elastic collisions do not define");
   }
   return checkFirstContact(scene);
+}
+
+std::optional<Pair> firstPair(const ThreeBodyScene& scene) {
+  const auto& v = scene.velocities;
+  const bool ab = v[kA] < v[kB];
+  const bool bc = v[kB] < v[kC];
+  if (ab && bc) return exact::compareFirstContactTimes(scene) < 0 ? Pair::AB : Pair::BC;
+  if (ab) return Pair::AB;
+  if (bc) return Pair::BC;
+  return std::nullopt;
 }
 
 }  // namespace core

@@ -11,6 +11,7 @@
 #include "collision_lab/core/analytic.h"
 #include "collision_lab/core/exact.h"
 #include "collision_lab/core/precision.h"
+#include "float_ops.h"
 #include "impact_energy.h"
 
 namespace collision_lab {
@@ -20,20 +21,11 @@ namespace {
 
 namespace mp = boost::multiprecision;
 
-/// Precision of the first escalation tier (100 digits) and of the last resort beyond the
-/// exact-rational limit (500 digits).
-using ReplayPrecision = mp::cpp_bin_float_100;
-using DeepReplayPrecision = mp::number<mp::cpp_bin_float<500>>;
-
 /// Up to this many impacts a 100-digit replay is cheaper than building the closed form.
 constexpr std::uint64_t kShortReplay = 2000;
 /// Every this many impacts a long run adopts the 100-digit closed-form state (~0.1 ns per
 /// impact amortized), which keeps its velocities accurate over hundreds of millions.
 constexpr std::uint64_t kResynchronizeInterval = std::uint64_t{1} << 20;
-
-/// Longest run an exact rational replay is attempted for (its cost grows ~quadratically).
-/// Reached only when 100 digits cannot tell the approach speed from zero.
-constexpr std::uint64_t kExactReplayLimit = 20000;
 
 /// Safety factor of the forward error bound: a sign decision is trusted when
 /// |approach speed| > (k + 2) * kBoundFactor * eps * velocity scale of the pair.
@@ -41,12 +33,8 @@ constexpr std::uint64_t kExactReplayLimit = 20000;
 /// maps are orthogonal and do not amplify earlier errors.
 constexpr double kBoundFactor = 64.0;
 
-/// Rounds to double; a zero is always +0, so that no output shows "-0".
-template <class T>
-double toDouble(const T& value) {
-  const double rounded = static_cast<double>(value);
-  return rounded == 0 ? 0.0 : rounded;
-}
+using detail::absOf;
+using detail::toDouble;
 
 constexpr bool kLongDoubleIsWide =
     std::numeric_limits<long double>::max_exponent >= 4 * std::numeric_limits<double>::max_exponent;
@@ -65,34 +53,35 @@ T epsilonOf() {
   return std::numeric_limits<T>::epsilon();
 }
 
-/// Per-pair impact coefficients in precision T. An impact with approach speed
-/// r = v_right - v_left changes the heavier body by its small gain, 2 m_light / (m_l + m_r)
-/// times r, and then sets the lighter one from the exact reversal v_r' - v_l' = -r. The
-/// reversal keeps the relative speed exact, so rounded coefficients do not bias the
-/// energy, and the heavy body, whose error costs the most energy, gets the smallest one.
+/// Impact coefficients of pair i (bodies i and i + 1) in precision T. An impact with
+/// approach speed r = v[i + 1] - v[i] changes the heavier body by its small gain,
+/// 2 m_light / (m_i + m_i+1) times r, and then sets the lighter one from the exact reversal
+/// v'[i + 1] - v'[i] = -r. The reversal keeps the relative speed exact, so rounded
+/// coefficients do not bias the energy, and the heavy body, whose error costs the most
+/// energy, gets the smallest one.
 template <class T>
 struct PairCoefficients {
-  bool heavy_is_left;
+  int heavy;  ///< index of the heavier body (i on a tie)
+  int light;  ///< index of the other one
   T heavy_gain;
+  /// +1 when the heavy body is i, -1 when it is i + 1: the sign of r in its velocity.
+  T sign;
 };
 
 template <class T>
-PairCoefficients<T> pairCoefficients(const std::array<double, 3>& m, int left) {
-  const int right = left + 1;
-  const bool heavy_is_left = m[left] >= m[right];
-  const double heavy = heavy_is_left ? m[left] : m[right];
-  const double light = heavy_is_left ? m[right] : m[left];
-  if (std::isinf(heavy)) return {heavy_is_left, T(0)};
-  return {heavy_is_left, T(2) / (T(1) + T(heavy) / T(light))};
+PairCoefficients<T> pairCoefficients(const std::array<double, 3>& m, int i) {
+  const int heavy = m[i] >= m[i + 1] ? i : i + 1;
+  const int light = heavy == i ? i + 1 : i;
+  const T sign = heavy == i ? T(1) : T(-1);
+  if (std::isinf(m[heavy])) return {heavy, light, T(0), sign};
+  return {heavy, light, T(2) / (T(1) + T(m[heavy]) / T(m[light])), sign};
 }
 
 template <class T>
 struct Coefficients {
-  PairCoefficients<T> ab;
-  PairCoefficients<T> bc;
-  explicit Coefficients(const std::array<double, 3>& m)
-      : ab(pairCoefficients<T>(m, kA)), bc(pairCoefficients<T>(m, kB)) {}
-  const PairCoefficients<T>& of(Pair p) const { return p == Pair::AB ? ab : bc; }
+  std::array<PairCoefficients<T>, 2> pairs;  ///< by pair index
+  explicit Coefficients(const std::array<double, 3>& m) : pairs{pairCoefficients<T>(m, 0), pairCoefficients<T>(m, 1)} {}
+  const PairCoefficients<T>& of(Pair p) const { return pairs[pairIndex(p)]; }
 };
 
 /// Velocities as unevaluated sums hi + lo. The heavy body's increment is added with an
@@ -117,41 +106,33 @@ struct CompensatedVelocities {
     return out;
   }
 
-  /// Approach speed of the pair whose right-hand body is `left` (A for AB, B for BC).
-  T approach(int left) const { return (hi[left + 1] - hi[left]) + (lo[left + 1] - lo[left]); }
+  /// Approach speed v[i + 1] - v[i] of pair i.
+  T approach(int i) const { return (hi[i + 1] - hi[i]) + (lo[i + 1] - lo[i]); }
 
   void add(int i, const T& increment) {
-    const T sum = hi[i] + increment;
-    const T increment_part = sum - hi[i];
-    lo[i] += (hi[i] - (sum - increment_part)) + (increment - increment_part);
-    hi[i] = sum;
+    const detail::TwoSum<T> sum = detail::twoSum(hi[i], increment);
+    lo[i] += sum.error;
+    hi[i] = sum.sum;
   }
 
   /// Sets body i to (hi[from] + lo[from]) + sign * (speed_hi + speed_lo), keeping the
   /// rounding error of the leading sum: the light body's velocity swings far above its
   /// final value, and its rounding at the peak would otherwise stay in it.
   void setFrom(int i, int from, const T& sign, const T& speed_hi, const T& speed_lo) {
-    const T term = sign * speed_hi;
-    const T sum = hi[from] + term;
-    const T term_part = sum - hi[from];
-    lo[i] = (hi[from] - (sum - term_part)) + (term - term_part) + lo[from] + sign * speed_lo;
-    hi[i] = sum;
+    const detail::TwoSum<T> sum = detail::twoSum(hi[from], T(sign * speed_hi));
+    lo[i] = sum.error + lo[from] + sign * speed_lo;
+    hi[i] = sum.sum;
   }
 
-  void impact(const PairCoefficients<T>& c, int left) {
-    const int right = left + 1;
-    // Approach speed as hi + lo, the leading difference split exactly (TwoSum).
-    const T speed_hi = hi[right] - hi[left];
-    const T right_part = speed_hi + hi[left];
-    const T speed_lo = ((hi[right] - right_part) + (right_part - speed_hi - hi[left])) + (lo[right] - lo[left]);
+  /// One impact of pair i (bodies i and i + 1) with coefficients c.
+  void impact(const PairCoefficients<T>& c, int i) {
+    // Approach speed as hi + lo, the leading difference split exactly.
+    const detail::TwoSum<T> split = detail::twoSum(T(-hi[i]), hi[i + 1]);
+    const T speed_hi = split.sum;
+    const T speed_lo = split.error + (lo[i + 1] - lo[i]);
     const T speed = speed_hi + speed_lo;
-    if (c.heavy_is_left) {
-      add(left, c.heavy_gain * speed);
-      setFrom(right, left, T(-1), speed_hi, speed_lo);
-    } else {
-      add(right, -(c.heavy_gain * speed));
-      setFrom(left, right, T(1), speed_hi, speed_lo);
-    }
+    add(c.heavy, c.sign * (c.heavy_gain * speed));
+    setFrom(c.light, c.heavy, -c.sign, speed_hi, speed_lo);
   }
 
   /// Takes over a more accurate state (a replay in higher precision or exact rationals).
@@ -177,17 +158,12 @@ std::array<T, 3> replay(const ThreeBodyScene& scene, Pair first, std::uint64_t k
   const Coefficients<T> coefficients(scene.masses);
   std::array<T, 3> v{T(scene.velocities[0]), T(scene.velocities[1]), T(scene.velocities[2])};
   Pair pair = first;
-  for (std::uint64_t i = 0; i < k; ++i) {
-    const int left = pair == Pair::AB ? kA : kB;
+  for (std::uint64_t n = 0; n < k; ++n) {
+    const int i = pairIndex(pair);
     const PairCoefficients<T>& c = coefficients.of(pair);
-    const T approach = v[left + 1] - v[left];
-    if (c.heavy_is_left) {
-      v[left] += c.heavy_gain * approach;
-      v[left + 1] = v[left] - approach;
-    } else {
-      v[left + 1] -= c.heavy_gain * approach;
-      v[left] = v[left + 1] + approach;
-    }
+    const T approach = v[i + 1] - v[i];
+    v[c.heavy] += c.sign * (c.heavy_gain * approach);
+    v[c.light] = v[c.heavy] - c.sign * approach;
     pair = otherPair(pair);
   }
   return v;
@@ -215,12 +191,13 @@ class ErrorScale {
       inverse_sqrt_mass_[i] = i == wall ? 0.0L : 1.0L / std::sqrt(static_cast<long double>(scene.masses[i]));
     }
     const long double min_scale = std::numeric_limits<double>::min();
-    ab_ = std::max(min_scale, u * (inverse_sqrt_mass_[kA] + inverse_sqrt_mass_[kB]));
-    bc_ = std::max(min_scale, u * (inverse_sqrt_mass_[kB] + inverse_sqrt_mass_[kC]));
+    for (int i = 0; i < 2; ++i) {
+      pair_scale_[i] = std::max(min_scale, u * (inverse_sqrt_mass_[i] + inverse_sqrt_mass_[i + 1]));
+    }
   }
 
   /// Velocity scale [m/s] of the approach speed of `pair`.
-  long double of(Pair pair) const { return pair == Pair::AB ? ab_ : bc_; }
+  long double of(Pair pair) const { return pair_scale_[pairIndex(pair)]; }
 
   /// Bound on the rounding error of an approach speed after k impacts in precision T.
   template <class T>
@@ -230,13 +207,13 @@ class ErrorScale {
 
  private:
   long double inverse_sqrt_mass_[3]{};
-  long double ab_ = 0.0L;
-  long double bc_ = 0.0L;
+  long double pair_scale_[2]{};  // by pair index
 };
 
 template <class T>
 T approachOf(Pair pair, const std::array<T, 3>& v) {
-  return pair == Pair::AB ? T(v[kB] - v[kA]) : T(v[kC] - v[kB]);
+  const int i = pairIndex(pair);
+  return T(v[i + 1] - v[i]);
 }
 
 /// Takes the sign decisions the working precision cannot, at 100 digits: a replay for
@@ -269,9 +246,9 @@ class Escalation {
     // exact zero, in O(1) like the 100-digit closed form.
     if (!deep_closed_form_) deep_closed_form_.emplace(scene_);
     const auto deep = stateOf(*deep_closed_form_, k);
-    const DeepReplayPrecision deep_approach = approachOf(pair, deep);
+    const DeepPrecision deep_approach = approachOf(pair, deep);
     const bool deep_decides =
-        mp::abs(deep_approach) > closedFormFactor<DeepReplayPrecision>() * scale_.bound<DeepReplayPrecision>(pair, k);
+        mp::abs(deep_approach) > closedFormFactor<DeepPrecision>() * scale_.bound<DeepPrecision>(pair, k);
     if (deep_decides || k > kExactReplayLimit) {
       // Beyond the exact replay's reach, an exact zero would need input doubles built for
       // it over thousands of impacts: within 500 digits of zero counts as not approaching.
@@ -304,7 +281,7 @@ class Escalation {
   static ReplayPrecision narrowed(const exact::Rational& q) {
     return ReplayPrecision(numerator(q)) / ReplayPrecision(denominator(q));
   }
-  static ReplayPrecision narrowed(const DeepReplayPrecision& x) { return static_cast<ReplayPrecision>(x); }
+  static ReplayPrecision narrowed(const DeepPrecision& x) { return static_cast<ReplayPrecision>(x); }
   template <class T>
   static std::array<ReplayPrecision, 3> narrowed(const std::array<T, 3>& state) {
     return {narrowed(state[0]), narrowed(state[1]), narrowed(state[2])};
@@ -328,13 +305,8 @@ class Escalation {
   const ErrorScale& scale_;
   Pair first_;
   std::optional<AnalyticModel<ReplayPrecision>> closed_form_;
-  std::optional<AnalyticModel<DeepReplayPrecision>> deep_closed_form_;
+  std::optional<AnalyticModel<DeepPrecision>> deep_closed_form_;
 };
-
-template <class T>
-T absOf(const T& x) {
-  return x < 0 ? T(-x) : x;
-}
 
 /// Energy and momentum of the finite masses [J, kg m/s], in the wide type of the run.
 template <class Wide>
@@ -442,10 +414,9 @@ struct CompensatedTime {
   T lo = 0;
 
   void advance(const T& delay) {
-    const T sum = hi + delay;
-    const T delay_part = sum - hi;
-    lo += (hi - (sum - delay_part)) + (delay - delay_part);
-    hi = sum;
+    const detail::TwoSum<T> sum = detail::twoSum(hi, delay);
+    lo += sum.error;
+    hi = sum.sum;
   }
   T since(const CompensatedTime& earlier) const { return (hi - earlier.hi) + (lo - earlier.lo); }
   T value() const { return hi + lo; }
@@ -491,18 +462,17 @@ class Trajectory {
 
   /// The next impact, of `pair` approaching at `approach` > 0 with the bodies at `v`.
   Impact next(Pair pair, const std::array<T, 3>& v, const T& approach) const {
-    const int left = pair == Pair::AB ? kA : kB;
-    const int right = left + 1;
+    const int i = pairIndex(pair);
     Impact impact;
-    T gap = positionAt(left, v, now_) - positionAt(right, v, now_);
+    T gap = positionAt(i, v, now_) - positionAt(i + 1, v, now_);
     if (gap < 0) gap = 0;  // rounding can put touching bodies a hair out of order
     impact.time = now_;
     impact.time.advance(gap / approach);
-    for (int i = 0; i < 3; ++i) impact.positions[i] = positionAt(i, v, impact.time);
+    for (int body = 0; body < 3; ++body) impact.positions[body] = positionAt(body, v, impact.time);
     // The pair meets where the slower of the two is: a position extrapolated at speed v
     // is off by v times the time's rounding, so the slow body's is the accurate one.
-    const T contact = absOf(v[left]) <= absOf(v[right]) ? impact.positions[left] : impact.positions[right];
-    impact.positions[left] = impact.positions[right] = contact;
+    const T contact = absOf(v[i]) <= absOf(v[i + 1]) ? impact.positions[i] : impact.positions[i + 1];
+    impact.positions[i] = impact.positions[i + 1] = contact;
     impact.in_range = inNormalRange(approach) && inNormalRange(impact.time.value());
     for (const T& x : impact.positions) impact.in_range = impact.in_range && inNormalRange(x);
     return impact;
@@ -517,16 +487,16 @@ class Trajectory {
     event.index = index;
     event.pair = pair;
     event.time = units.time_si(now_.value());
-    const int left = pair == Pair::AB ? kA : kB;
-    event.position = units.position_si(impact.positions[left]);
+    const int pair_index = pairIndex(pair);
+    event.position = units.position_si(impact.positions[pair_index]);
     for (int i = 0; i < 3; ++i) event.positions[i] = units.position_si(impact.positions[i]);
     if (!describeEnergies(energy_, pair, before, after, approach, units, event)) {
       describeEnergies(wide_energy_, pair, before, after, approach, units, event);
     }
     // Re-anchor the bodies whose velocity changed (a wall's never does).
-    for (int i : {left, left + 1}) {
+    for (int i : {pair_index, pair_index + 1}) {
       if (i == wall_) continue;
-      reference_position_[i] = impact.positions[left];
+      reference_position_[i] = impact.positions[pair_index];
       reference_time_[i] = now_;
     }
     return event;
@@ -583,186 +553,222 @@ class Trajectory {
   CompensatedTime<T> now_;
 };
 
-bool keepsEvent(const EventPolicy& policy, std::uint64_t index) {
-  switch (policy.kind) {
-    case EventPolicy::Kind::kNone: return false;
-    case EventPolicy::Kind::kAll: return true;
-    case EventPolicy::Kind::kFirstN: return index <= policy.first_n;
+/// The sign decisions of one run: the fast path in Scalar with a forward error bound that
+/// grows with the impacts since v was last exact to working precision, and an Escalation
+/// where the bound cannot decide.
+template <class Scalar>
+class Decider {
+ public:
+  Decider(const ThreeBodyScene& working, Pair first, bool tracks_events)
+      : working_(working),
+        scale_(working),
+        step_bound_{scale_.template bound<Scalar>(Pair::AB, 0) / Scalar(2),  // bound(k) = (k + 2) * step
+                    scale_.template bound<Scalar>(Pair::BC, 0) / Scalar(2)},
+        tracks_events_(tracks_events),
+        first_(first) {}
+
+  /// Does `pair` approach after k impacts? Exact decision; may refresh v.
+  bool approaches(Pair pair, std::uint64_t k, CompensatedVelocities<Scalar>& v, EscalationStats& stats) {
+    ++stats.decisions;
+    precise_approach_.reset();
+    precise_state_.reset();
+    if (k - exact_at_ >= kResynchronizeInterval) {
+      escalation().resynchronize(k, v);
+      exact_at_ = k;
+    }
+    const Scalar approach = v.approach(pairIndex(pair));
+    const Scalar bound = step_bound_[pairIndex(pair)] * Scalar(static_cast<double>(k - exact_at_ + 2));
+    if (approach > bound && !(tracks_events_ && approach < resolution_)) return true;
+    if (approach < -bound) return false;
+    exact_at_ = k;
+    const auto decision = escalation().decide(k, pair, v, stats);
+    precise_approach_ = decision.approach;
+    precise_state_ = decision.velocities;
+    return decision.approaches;
   }
-  return false;
-}
+
+  /// The approach speed and state seen by the last decision when it was taken above the
+  /// working precision (else empty): an event's time, positions and energy use them.
+  const std::optional<ReplayPrecision>& preciseApproach() const { return precise_approach_; }
+  const std::optional<std::array<ReplayPrecision, 3>>& preciseState() const { return precise_state_; }
+
+ private:
+  Escalation<Scalar>& escalation() {
+    if (!escalation_) escalation_.emplace(working_, scale_, first_);
+    return *escalation_;
+  }
+
+  const ThreeBodyScene& working_;
+  const ErrorScale scale_;
+  const std::array<Scalar, 2> step_bound_;  // by pair index
+  // Below this a positive approach speed may have lost digits to underflow, which an
+  // event's time would inherit.
+  const Scalar resolution_ = std::numeric_limits<Scalar>::min() / epsilonOf<Scalar>();
+  const bool tracks_events_;
+  const Pair first_;
+  std::uint64_t exact_at_ = 0;
+  std::optional<Escalation<Scalar>> escalation_;
+  std::optional<ReplayPrecision> precise_approach_;
+  std::optional<std::array<ReplayPrecision, 3>> precise_state_;
+};
+
+/// One call of simulate(): the run's state, and one member function per phase.
+template <class Scalar>
+class EngineRun {
+ public:
+  using Wide = WideOf<Scalar>;
+
+  EngineRun(const ThreeBodyScene& scene, const SimulationOptions& options, const EventVisitor& visitor)
+      : scene_(scene),
+        options_(options),
+        visitor_(visitor),
+        working_(inWorkingUnits(scene, units_)),
+        v_(working_.velocities),
+        coefficients_(scene.masses),
+        tracks_events_(options.events.kind != EventPolicy::Kind::kNone || static_cast<bool>(visitor)) {
+    result_.first_pair = firstPair(scene);
+  }
+
+  SimulationResult run() {
+    const Frame<Wide> start = measure(working_, v_.template valuesAs<Wide>());
+    if (result_.first_pair) {
+      Decider<Scalar> decider(working_, *result_.first_pair, tracks_events_);
+      if (tracks_events_) {
+        runWithEvents(decider);
+      } else {
+        countImpacts(decider);
+      }
+    } else {
+      for (int i = 0; i < 3; ++i) result_.final_positions[i] = notModelled(scene_.positions[i]);
+    }
+    finish(start);
+    return std::move(result_);
+  }
+
+ private:
+  /// Does `pair` collide next? False when it does not approach, and when max_collisions
+  /// stops the run (marked truncated).
+  bool nextImpact(Decider<Scalar>& decider, Pair pair) {
+    if (!decider.approaches(pair, k_, v_, result_.escalation)) return false;
+    if (k_ == options_.max_collisions) {
+      result_.truncated = true;
+      return false;
+    }
+    return true;
+  }
+
+  /// Count-only: after the first impact the pairs alternate and positions no longer
+  /// matter, so only velocities are modelled.
+  void countImpacts(Decider<Scalar>& decider) {
+    Pair pair = *result_.first_pair;
+    while (nextImpact(decider, pair)) {
+      v_.impact(coefficients_.of(pair), pairIndex(pair));
+      ++k_;
+      pair = otherPair(pair);
+    }
+    for (int i = 0; i < 3; ++i) result_.final_positions[i] = notModelled(scene_.positions[i]);
+  }
+
+  /// Every impact with its event: times and positions in Scalar while they stay in its
+  /// range, in Wide from there on.
+  void runWithEvents(Decider<Scalar>& decider) {
+    Trajectory<Scalar> narrow(working_);
+    std::optional<Trajectory<Wide>> wide;
+    Pair pair = *result_.first_pair;
+    while (nextImpact(decider, pair)) {
+      // Velocities as the run reports them everywhere, whichever type timed the impact.
+      std::array<double, 3> before;
+      for (int i = 0; i < 3; ++i) before[i] = units_.velocity_si(v_.value(i));
+      ImpactEvent event;
+      if (wide || !impactOn(narrow, pair, decider, event)) {
+        if (!wide) wide.emplace(narrow);
+        impactOn(*wide, pair, decider, event);
+      }
+      event.velocities_before = before;
+      for (int i = 0; i < 3; ++i) event.velocities_after[i] = units_.velocity_si(v_.value(i));
+      if (visitor_) visitor_(event);
+      if (options_.events.keeps(k_)) result_.events.push_back(event);
+      pair = otherPair(pair);
+    }
+    for (int i = 0; i < 3; ++i) {
+      result_.final_positions[i] = wide ? units_.position_si(wide->positionNow(i, v_.template valuesAs<Wide>()))
+                                        : units_.position_si(narrow.positionNow(i, v_.values()));
+    }
+    result_.final_time = wide ? units_.time_si(wide->now()) : units_.time_si(narrow.now());
+  }
+
+  /// One impact of `pair` on `path`, described in `event`; false, with nothing changed,
+  /// when it leaves the range of a narrow path's type.
+  template <class Path>
+  bool impactOn(Path& path, Pair pair, const Decider<Scalar>& decider, ImpactEvent& event) {
+    using T = typename Path::Value;
+    const int i = pairIndex(pair);
+    // The state to the last digit the run knows: the precise one after an escalation
+    // (where even a velocity that Scalar cannot hold moves a body over a long flight),
+    // else the compensated one; never the approach speed as a difference of `before`.
+    std::array<T, 3> before = v_.template valuesAs<T>();
+    bool held = true;
+    if (const auto& precise_state = decider.preciseState()) {
+      for (int body = 0; body < 3; ++body) {
+        before[body] = static_cast<T>((*precise_state)[body]);
+        held = held && ((*precise_state)[body] == 0 || (before[body] != 0 && inNormalRange(before[body])));
+      }
+    }
+    const auto& precise_approach = decider.preciseApproach();
+    const T approach = precise_approach ? static_cast<T>(*precise_approach) : T(v_.approach(i));
+    const auto impact = path.next(pair, before, approach);
+    if (!(impact.in_range && held) && !std::is_same_v<T, Wide>) return false;
+    v_.impact(coefficients_.of(pair), i);
+    ++k_;
+    event = path.commit(k_, pair, impact, before, v_.template valuesAs<T>(), approach, units_);
+    return true;
+  }
+
+  /// A position the run did not model: the start's when events are tracked (nothing
+  /// moved), else NaN.
+  double notModelled(double start) const {
+    return tracks_events_ ? toDouble(start) : std::numeric_limits<double>::quiet_NaN();
+  }
+
+  /// Count, final velocities and the drifts of energy and momentum since `start`.
+  void finish(const Frame<Wide>& start) {
+    result_.collision_count = k_;
+    for (int i = 0; i < 3; ++i) result_.final_velocities[i] = units_.velocity_si(v_.value(i));
+    const Frame<Wide> end = measure(working_, v_.template valuesAs<Wide>());
+    result_.energy_relative_drift =
+        start.energy > 0 ? toDouble(absOf(Wide(end.energy - start.energy)) / start.energy) : 0.0;
+    if (scene_.wallIndex() >= 0) {
+      result_.momentum_relative_drift = std::numeric_limits<double>::quiet_NaN();
+    } else {
+      result_.momentum_relative_drift =
+          start.momentum_magnitude > 0
+              ? toDouble(absOf(Wide(end.momentum - start.momentum)) / start.momentum_magnitude)
+              : 0.0;
+    }
+  }
+
+  const ThreeBodyScene& scene_;
+  const SimulationOptions& options_;
+  const EventVisitor& visitor_;
+  WorkingUnits units_;
+  const ThreeBodyScene working_;
+  CompensatedVelocities<Scalar> v_;
+  const Coefficients<Scalar> coefficients_;
+  const bool tracks_events_;
+  SimulationResult result_;
+  std::uint64_t k_ = 0;  // impacts so far
+};
 
 }  // namespace
 
-std::optional<Pair> firstPair(const ThreeBodyScene& scene) {
-  const auto& v = scene.velocities;
-  const bool ab = v[kA] < v[kB];
-  const bool bc = v[kB] < v[kC];
-  if (ab && bc) return exact::compareFirstContactTimes(scene) < 0 ? Pair::AB : Pair::BC;
-  if (ab) return Pair::AB;
-  if (bc) return Pair::BC;
-  return std::nullopt;
-}
-
 template <class Scalar>
 SimulationResult simulate(const ThreeBodyScene& scene, const SimulationOptions& options, const EventVisitor& visitor) {
-  using Wide = WideOf<Scalar>;
-  SimulationResult result;
-  result.first_pair = firstPair(scene);
-  WorkingUnits units;
-  const ThreeBodyScene working = inWorkingUnits(scene, units);
-  CompensatedVelocities<Scalar> v(working.velocities);
-  const Frame<Wide> start = measure(working, v.template valuesAs<Wide>());
-  const bool tracks_events = options.events.kind != EventPolicy::Kind::kNone || static_cast<bool>(visitor);
-
-  const Coefficients<Scalar> coefficients(scene.masses);
-  const ErrorScale scale(working);
-  const Scalar step_bound_ab = scale.bound<Scalar>(Pair::AB, 0) / Scalar(2);  // bound(k) = (k+2) * step
-  const Scalar step_bound_bc = scale.bound<Scalar>(Pair::BC, 0) / Scalar(2);
-  // Below this a positive approach speed may have lost digits to underflow, which an
-  // event's time would inherit.
-  const Scalar resolution = std::numeric_limits<Scalar>::min() / epsilonOf<Scalar>();
-  EscalationStats& stats = result.escalation;
-
-  // The error bound grows with the impacts since v was last exact to working precision.
-  std::uint64_t exact_at = 0;
-  std::optional<Escalation<Scalar>> escalation;
-  // The approach speed and state seen by the last decision when it was taken above the
-  // working precision: an event's time, positions and energy use them.
-  std::optional<ReplayPrecision> precise_approach;
-  std::optional<std::array<ReplayPrecision, 3>> precise_state;
-
-  // Does `pair` approach after k impacts? Exact decision; may refresh v.
-  auto approaches = [&](Pair pair, std::uint64_t k) {
-    ++stats.decisions;
-    precise_approach.reset();
-    precise_state.reset();
-    if (k - exact_at >= kResynchronizeInterval) {
-      if (!escalation) escalation.emplace(working, scale, *result.first_pair);
-      escalation->resynchronize(k, v);
-      exact_at = k;
-    }
-    const Scalar approach = v.approach(pair == Pair::AB ? kA : kB);
-    const Scalar bound =
-        (pair == Pair::AB ? step_bound_ab : step_bound_bc) * Scalar(static_cast<double>(k - exact_at + 2));
-    if (approach > bound && !(tracks_events && approach < resolution)) return true;
-    if (approach < -bound) return false;
-    if (!escalation) escalation.emplace(working, scale, *result.first_pair);
-    exact_at = k;
-    const auto decision = escalation->decide(k, pair, v, stats);
-    precise_approach = decision.approach;
-    precise_state = decision.velocities;
-    return decision.approaches;
-  };
-
-  std::uint64_t k = 0;
-  if (result.first_pair && !tracks_events) {
-    // Count-only: after the first impact the pairs alternate and positions no longer
-    // matter, so only velocities are modelled.
-    Pair pair = *result.first_pair;
-    while (approaches(pair, k)) {
-      if (k == options.max_collisions) {
-        result.truncated = true;
-        break;
-      }
-      v.impact(coefficients.of(pair), pair == Pair::AB ? kA : kB);
-      ++k;
-      pair = otherPair(pair);
-    }
-  } else if (result.first_pair) {
-    // Times and positions in Scalar while they stay in its range, in Wide from there on.
-    Trajectory<Scalar> narrow(working);
-    std::optional<Trajectory<Wide>> wide;
-    Pair pair = *result.first_pair;
-    ImpactEvent event;
-    // One impact on `trajectory`; false, with nothing changed, when it leaves the range of
-    // a narrow trajectory's type.
-    auto impactOn = [&](auto& trajectory) {
-      using T = typename std::decay_t<decltype(trajectory)>::Value;
-      const int left = pair == Pair::AB ? kA : kB;
-      // The state to the last digit the run knows: the precise one after an escalation
-      // (where even a velocity that Scalar cannot hold moves a body over a long flight),
-      // else the compensated one; never the approach speed as a difference of `before`.
-      std::array<T, 3> before = v.template valuesAs<T>();
-      bool held = true;
-      if (precise_state) {
-        for (int i = 0; i < 3; ++i) {
-          before[i] = static_cast<T>((*precise_state)[i]);
-          held = held && ((*precise_state)[i] == 0 || (before[i] != 0 && inNormalRange(before[i])));
-        }
-      }
-      const T approach = precise_approach ? static_cast<T>(*precise_approach) : T(v.approach(left));
-      const auto impact = trajectory.next(pair, before, approach);
-      if (!(impact.in_range && held) && !std::is_same_v<T, Wide>) return false;
-      v.impact(coefficients.of(pair), left);
-      ++k;
-      event = trajectory.commit(k, pair, impact, before, v.template valuesAs<T>(), approach, units);
-      return true;
-    };
-    while (approaches(pair, k)) {
-      if (k == options.max_collisions) {
-        result.truncated = true;
-        break;
-      }
-      // Velocities as the run reports them everywhere, whichever type timed the impact.
-      std::array<double, 3> before;
-      for (int i = 0; i < 3; ++i) before[i] = units.velocity_si(v.value(i));
-      if (wide || !impactOn(narrow)) {
-        if (!wide) wide.emplace(narrow);
-        impactOn(*wide);
-      }
-      event.velocities_before = before;
-      for (int i = 0; i < 3; ++i) event.velocities_after[i] = units.velocity_si(v.value(i));
-      if (visitor) visitor(event);
-      if (keepsEvent(options.events, k)) result.events.push_back(event);
-      pair = otherPair(pair);
-    }
-    for (int i = 0; i < 3; ++i) {
-      result.final_positions[i] = wide ? units.position_si(wide->positionNow(i, v.template valuesAs<Wide>()))
-                                       : units.position_si(narrow.positionNow(i, v.values()));
-    }
-    result.final_time = wide ? units.time_si(wide->now()) : units.time_si(narrow.now());
-  }
-  if (!tracks_events || !result.first_pair) {
-    for (int i = 0; i < 3; ++i) {
-      result.final_positions[i] = tracks_events ? toDouble(scene.positions[i]) : std::numeric_limits<double>::quiet_NaN();
-    }
-  }
-
-  result.collision_count = k;
-  for (int i = 0; i < 3; ++i) result.final_velocities[i] = units.velocity_si(v.value(i));
-  const Frame<Wide> end = measure(working, v.template valuesAs<Wide>());
-  result.energy_relative_drift = start.energy > 0 ? toDouble(absOf(Wide(end.energy - start.energy)) / start.energy) : 0.0;
-  if (scene.wallIndex() >= 0) {
-    result.momentum_relative_drift = std::numeric_limits<double>::quiet_NaN();
-  } else {
-    result.momentum_relative_drift =
-        start.momentum_magnitude > 0
-            ? toDouble(absOf(Wide(end.momentum - start.momentum)) / start.momentum_magnitude)
-            : 0.0;
-  }
-  return result;
+  return EngineRun<Scalar>(scene, options, visitor).run();
 }
 
 template SimulationResult simulate<double>(const ThreeBodyScene&, const SimulationOptions&, const EventVisitor&);
 template SimulationResult simulate<long double>(const ThreeBodyScene&, const SimulationOptions&, const EventVisitor&);
 template SimulationResult simulate<HighPrecision>(const ThreeBodyScene&, const SimulationOptions&, const EventVisitor&);
-
-const char* precisionName(Precision p) {
-  switch (p) {
-    case Precision::kDouble: return "double";
-    case Precision::kLongDouble: return "long_double";
-    case Precision::kHigh: return "high";
-  }
-  return "unknown";
-}
-
-std::optional<Precision> parsePrecision(const std::string& name) {
-  for (Precision p : {Precision::kDouble, Precision::kLongDouble, Precision::kHigh}) {
-    if (name == precisionName(p)) return p;
-  }
-  return std::nullopt;
-}
 
 SimulationResult simulate(const ThreeBodyScene& scene, const SimulationOptions& options, Precision precision,
                           const EventVisitor& visitor) {

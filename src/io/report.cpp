@@ -84,7 +84,7 @@ class TableWriter : public RunReportWriter {
     writeSceneRow("mass [kg]", named.scene.masses);
     writeSceneRow("position [m]", named.scene.positions);
     writeSceneRow("velocity [m/s]", named.scene.velocities);
-    out_ << "\nrun: mode " << runModeText(options.mode) << ", precision " << precisionText(options.precision)
+    out_ << "\nrun: mode " << runModeText(options.mode) << ", precision " << core::precisionName(options.precision)
          << ", events " << eventPolicyText(options.events) << ", at most " << options.max_collisions
          << " collisions\n";
   }
@@ -132,7 +132,7 @@ class TableWriter : public RunReportWriter {
     }
     out_ << "truncated: " << (s.truncated ? "yes, " + s.truncation_reason : std::string("no")) << "\n";
     out_ << "precision: " << s.escalation.decisions << " decisions, " << s.escalation.high_precision
-         << " taken at 50 digits, " << s.escalation.exact_rational << " by exact rationals; compute time "
+         << " taken at 100 digits or more, " << s.escalation.exact_rational << " by exact rationals; compute time "
          << humanText(s.compute_time_s, 3) << " s\n";
   }
 
@@ -353,13 +353,6 @@ std::optional<core::RunMode> parseRunMode(const std::string& text) {
   return std::nullopt;
 }
 
-std::optional<core::Precision> parsePrecisionOption(const std::string& text) {
-  if (text == "double") return core::Precision::kDouble;
-  if (text == "long_double") return core::Precision::kLongDouble;
-  if (text == "high") return core::Precision::kHigh;
-  return std::nullopt;
-}
-
 std::optional<core::EventPolicy> parseEventPolicy(const std::string& text) {
   if (text == "all") return core::EventPolicy::all();
   if (text == "none") return core::EventPolicy::none();
@@ -376,15 +369,6 @@ std::string runModeText(core::RunMode mode) {
     case core::RunMode::kFull: return "full";
     case core::RunMode::kPredictOnly: return "predict";
     case core::RunMode::kSummaryOnly: return "summary";
-  }
-  return "unknown";
-}
-
-std::string precisionText(core::Precision precision) {
-  switch (precision) {
-    case core::Precision::kDouble: return "double";
-    case core::Precision::kLongDouble: return "long_double";
-    case core::Precision::kHigh: return "high";
   }
   return "unknown";
 }
@@ -425,7 +409,7 @@ Json optionsJson(const core::RunOptions& options) {
   return Json{{"max_collisions", options.max_collisions},
               {"events", eventPolicyText(options.events)},
               {"mode", runModeText(options.mode)},
-              {"precision", precisionText(options.precision)}};
+              {"precision", core::precisionName(options.precision)}};
 }
 
 Json eventJson(const core::LabEvent& lab) {

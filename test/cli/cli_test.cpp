@@ -246,6 +246,20 @@ TEST(CliTable, AlignedColumnsWithUnitsAndThePapersValuesLabelled) {
   EXPECT_NE(row->find("eq. 3.22: 4"), std::string::npos);
 }
 
+TEST(CliTable, NamesTheTierItsEscalatedDecisionsAreTakenAt) {
+  // Masses (3, 1, 0.5), v = (-1, 0, 0): psi / alpha is exactly 3, so after 2 collisions the
+  // pair AB touches at exactly zero approach speed (physics.md), a decision that double
+  // cannot take: it goes to the first escalation tier, 100 digits (simulation.h).
+  const std::vector<std::string> scene = {"--masses", "3,1,0.5", "--positions", "2,1,0", "--velocities", "-1,0,0"};
+  const Json json = runJson(scene);
+  ASSERT_EQ(json["summary"]["collision_count"], 2);
+  ASSERT_GE(json["summary"]["escalation"]["high_precision"].get<int>(), 1);
+  const CliOutput table = run(scene);
+  ASSERT_EQ(table.exit_code, 0) << table.err;
+  EXPECT_NE(table.out.find(" taken at 100 digits or more, "), std::string::npos) << table.out;
+  EXPECT_EQ(table.out.find("50 digits"), std::string::npos) << table.out;
+}
+
 TEST(CliCsv, HeaderOneRowPerEventAndSummaryComments) {
   const CliOutput result =
       run({"--masses", "1,1,1", "--positions", "2,1,-1", "--velocities", "-1,0,1", "--format", "csv"});

@@ -11,7 +11,9 @@
 #include <optional>
 
 #include <Eigen/Core>
+#include <boost/multiprecision/eigen.hpp>  // Eigen traits of the multiprecision scalars
 
+#include "collision_lab/core/precision.h"
 #include "collision_lab/core/scene.h"
 
 namespace collision_lab {
@@ -24,10 +26,12 @@ struct Angles {
   double omega = 0.0;  ///< angle between the normals n_AB and n_BC, pi - alpha
 };
 
-/// Closed-form model of one scene in working precision Scalar (double, long double or
-/// HighPrecision). Precondition: validate(scene) passed. In double it needs finite-mass
-/// ratios up to about 2^1000, beyond which the light body's share of the mass-weighted
-/// velocities underflows; predict() and runLab() go to HighPrecision there.
+/// Closed-form model of one scene in precision Scalar: a working precision (double, long
+/// double, HighPrecision) or an escalation tier (ReplayPrecision, DeepPrecision), the
+/// scalars analytic.cpp instantiates (declared below). Precondition: validate(scene)
+/// passed. In double it needs finite-mass ratios up to about 2^1000, beyond which the
+/// light body's share of the mass-weighted velocities underflows; predict() and runLab()
+/// go to HighPrecision there.
 template <class Scalar>
 class AnalyticModel {
  public:
@@ -41,8 +45,8 @@ class AnalyticModel {
   Scalar omega() const;
 
   /// Velocity maps of one impact (eq. 1.5, 1.6) and of one AB-then-BC cycle (eq. 1.8).
-  Mat3 dAB() const;
-  Mat3 dBC() const;
+  Mat3 dAB() const { return pairMap(Pair::AB); }
+  Mat3 dBC() const { return pairMap(Pair::BC); }
   Mat3 D() const { return dBC() * dAB(); }
 
   /// Which pair hits first (exact); empty when nothing collides.
@@ -63,23 +67,35 @@ class AnalyticModel {
   /// Angle of u_perp from the escape cone's ray r_BC towards r_AB, in [0, 2 pi) [rad].
   Scalar psi() const { return psi_; }
 
+  /// The start's u_perp = S (v0 - V 1) with S = diag(sqrt(m_i / m_max)) (0 for a wall),
+  /// mass-weighted velocity scaled by 1/sqrt(m_max) [m/s]; and that S [1].
+  const Vec3& uPerp() const { return w_; }
+  const Vec3& sqrtMassScaled() const { return sqrt_mass_scaled_; }
+
  private:
-  Vec3 rotate(std::int64_t k_signed_steps, std::uint64_t k) const;
+  Vec3 rotate(std::int64_t direction, std::uint64_t k) const;
+  Vec3 velocitiesOfRotated(const Vec3& w, const Scalar& angle) const;
+  Mat3 pairMap(Pair pair) const;
   Vec3 applyPairMap(Pair pair, const Vec3& v) const;
 
   std::array<double, 3> masses_{};
   int wall_ = -1;
-  Scalar wall_velocity_ = 0;
-  Scalar f_ab_a_ = 0, f_ab_b_ = 0;  // m_A/M_AB, m_B/M_AB (wall-safe)
-  Scalar f_bc_b_ = 0, f_bc_c_ = 0;  // m_B/M_BC, m_C/M_BC
+  // By pair index i: {m_i, m_i+1} / (m_i + m_i+1), wall-safe.
+  std::array<std::array<Scalar, 2>, 2> fractions_{};
   Scalar alpha_ = 0;
   Scalar psi_ = 0;
   Vec3 centre_velocity_;    // V 1: centre-of-mass velocity, or the wall's velocity
-  Vec3 sqrt_mass_scaled_;   // sqrt(m_i / m_max); 1 for a wall, others 0 in that limit
+  Vec3 sqrt_mass_scaled_;   // sqrt(m_i / m_max); 0 for a wall
   Vec3 s_hat_;              // unit s = S 1 (the limit (1,0,0) or (0,0,1) with a wall)
   Vec3 w_;                  // S (v0 - V 1) / sqrt(m_max), orthogonal to s_hat_
   std::optional<Pair> first_pair_;
 };
+
+extern template class AnalyticModel<double>;
+extern template class AnalyticModel<long double>;
+extern template class AnalyticModel<HighPrecision>;
+extern template class AnalyticModel<ReplayPrecision>;
+extern template class AnalyticModel<DeepPrecision>;
 
 /// Angles in double, atan form (well conditioned for extreme mass ratios).
 Angles anglesFor(const std::array<double, 3>& masses);

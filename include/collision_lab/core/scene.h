@@ -18,6 +18,10 @@ enum Particle : int { kA = 0, kB = 1, kC = 2 };
 /// The colliding pair. Values match the ROS message constants PAIR_AB / PAIR_BC.
 enum class Pair : std::uint8_t { AB = 0, BC = 1 };
 
+/// Pairs by index: pair i joins bodies i and i + 1 (AB: A and B, BC: B and C). Body i is
+/// to the right of body i + 1, so pair i approaches when v[i + 1] > v[i].
+inline int pairIndex(Pair p) { return static_cast<int>(p); }
+
 inline Pair otherPair(Pair p) { return p == Pair::AB ? Pair::BC : Pair::AB; }
 inline const char* pairName(Pair p) { return p == Pair::AB ? "AB" : "BC"; }
 
@@ -33,9 +37,17 @@ struct ThreeBodyScene {
   int wallIndex() const;
 };
 
+/// The largest finite mass [kg]; walls (+inf) left out. The scale of mass-weighted
+/// velocities throughout the core.
+double largestFiniteMass(const std::array<double, 3>& masses);
+
 /// Checks a scene. Returns nothing when the scene is valid. Never throws for any input.
 /// The triple-collision test is exact for the given doubles.
 std::optional<ValidationError> validate(const ThreeBodyScene& scene);
+
+/// Which pair collides first, exactly for the given doubles; empty when neither pair
+/// approaches. Precondition: validate(scene) passed (so the times are not tied).
+std::optional<Pair> firstPair(const ThreeBodyScene& scene);
 
 }  // namespace core
 }  // namespace collision_lab

@@ -15,6 +15,7 @@
 #include <optional>
 #include <vector>
 
+#include "collision_lab/core/precision.h"
 #include "collision_lab/core/scene.h"
 
 namespace collision_lab {
@@ -47,6 +48,16 @@ struct EventPolicy {
   static EventPolicy none() { return {Kind::kNone, 0}; }
   static EventPolicy all() { return {Kind::kAll, 0}; }
   static EventPolicy firstN(std::uint64_t n) { return {Kind::kFirstN, n}; }
+
+  /// Is the event of collision `index` (1-based) kept? The one place this is decided.
+  bool keeps(std::uint64_t index) const {
+    switch (kind) {
+      case Kind::kNone: return false;
+      case Kind::kAll: return true;
+      case Kind::kFirstN: return index <= first_n;
+    }
+    return false;
+  }
 };
 
 struct SimulationOptions {
@@ -80,21 +91,13 @@ struct SimulationResult {
   std::vector<ImpactEvent> events;     ///< as EventPolicy says
 };
 
-/// Which pair collides first, exactly for the given doubles; empty when neither pair
-/// approaches. Precondition: validate(scene) passed (so the times are not tied).
-std::optional<Pair> firstPair(const ThreeBodyScene& scene);
-
 /// Runs the scene to the end (or to max_collisions). Scalar is double, long double or
 /// HighPrecision. Precondition: validate(scene) passed. Never throws for a valid scene.
 template <class Scalar>
 SimulationResult simulate(const ThreeBodyScene& scene, const SimulationOptions& options,
                           const EventVisitor& visitor = {});
 
-/// Runtime choice of the working precision.
-enum class Precision { kDouble, kLongDouble, kHigh };
-const char* precisionName(Precision p);
-std::optional<Precision> parsePrecision(const std::string& name);
-
+/// The same with the working precision chosen at run time (precision.h).
 SimulationResult simulate(const ThreeBodyScene& scene, const SimulationOptions& options,
                           Precision precision, const EventVisitor& visitor = {});
 

@@ -25,14 +25,13 @@ namespace io {
 
 enum class ReportFormat { kTable, kJson, kCsv };
 
-/// Option spellings shared by the CLI's parser and the reports that echo them.
+/// Option spellings shared by the CLI's parser and the reports that echo them (a
+/// precision's are core::precisionName and core::parsePrecision).
 std::optional<ReportFormat> parseReportFormat(const std::string& text);   ///< table|json|csv
 std::optional<core::RunMode> parseRunMode(const std::string& text);             ///< full|predict|summary
-std::optional<core::Precision> parsePrecisionOption(const std::string& text);   ///< double|long_double|high
 /// all | none | first:N (N a non-negative integer).
 std::optional<core::EventPolicy> parseEventPolicy(const std::string& text);
 std::string runModeText(core::RunMode mode);
-std::string precisionText(core::Precision precision);
 std::string eventPolicyText(const core::EventPolicy& policy);
 
 using Json = nlohmann::ordered_json;

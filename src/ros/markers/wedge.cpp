@@ -3,6 +3,9 @@
 // cursor at u_perp now.
 #include <cmath>
 
+#include <Eigen/Core>
+
+#include "collision_lab/core/wedge.h"
 #include "collision_lab/ros/markers/draw.h"
 
 namespace collision_lab_ros::markers {
@@ -11,43 +14,19 @@ using namespace layout;
 
 namespace {
 
-double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-Vec3 cross(const Vec3& a, const Vec3& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-Vec3 scaled(const Vec3& a, double s) { return {a[0] * s, a[1] * s, a[2] * s}; }
-Vec3 normalized(const Vec3& a) {
-  const double n = std::sqrt(dot(a, a));
-  return n > 0 ? scaled(a, 1.0 / n) : a;
-}
-
-/// The plane s-perp of mass-weighted velocity space u = S v, seen in the basis (e1, e2)
-/// with e1 along the escape cone's ray r_BC and r_AB on the side of +e2, so that the
-/// angle of a point is the paper's psi. A wall is the m -> inf limit: its axis is s.
+/// The plane s-perp of mass-weighted velocity space u = S v, seen in the core's wedge
+/// basis (r_BC, n_BC) (core/wedge.h), so that the angle of a point is the paper's psi and
+/// the ray r_AB lies at +alpha. A wall is the m -> inf limit: its axis is s.
 class WedgeFrame {
  public:
-  explicit WedgeFrame(const collision_lab::InitialConditions& input) : input_(input) {
-    Vec3 inv_sqrt{}, s{};
+  explicit WedgeFrame(const collision_lab::InitialConditions& input)
+      : input_(input), wedge_(collision_lab::core::wedgeOf<double>(toArray3(input.masses))) {
     for (int i = 0; i < 3; ++i) {
-      inv_sqrt[i] = isWall(input, i) ? 0.0 : 1.0 / std::sqrt(input.masses[i]);
-      s[i] = isWall(input, i) ? 0.0 : std::sqrt(input.masses[i]);
       if (isWall(input, i)) wall_ = i;
     }
-    if (wall_ >= 0) s = Vec3{}, s[wall_] = 1.0;
-    s_hat_ = normalized(s);
-    const Vec3 n_ab{inv_sqrt[0], -inv_sqrt[1], 0.0};
-    const Vec3 n_bc{0.0, inv_sqrt[1], -inv_sqrt[2]};
-    Vec3 r_bc = normalized(cross(s_hat_, n_bc));
-    if (dot(n_ab, r_bc) < 0) r_bc = scaled(r_bc, -1.0);
-    Vec3 r_ab = normalized(cross(s_hat_, n_ab));
-    if (dot(n_bc, r_ab) < 0) r_ab = scaled(r_ab, -1.0);
-    e1_ = r_bc;
-    e2_ = cross(s_hat_, e1_);
-    if (dot(r_ab, e2_) < 0) e2_ = scaled(e2_, -1.0);
-    ab_angle_ = std::atan2(dot(r_ab, e2_), dot(r_ab, e1_));
   }
 
-  /// u_perp of velocities v [m/s] as (e1, e2) coordinates [sqrt(kg) m/s].
+  /// u_perp of velocities v [m/s] as (r_BC, n_BC) coordinates [sqrt(kg) m/s].
   std::array<double, 2> project(const Vec3& v) const {
     double reference = 0.0;
     if (wall_ >= 0) {
@@ -57,19 +36,18 @@ class WedgeFrame {
       for (int i = 0; i < 3; ++i) p += input_.masses[i] * v[i], m += input_.masses[i];
       reference = p / m;
     }
-    Vec3 u{};
+    Eigen::Vector3d u = Eigen::Vector3d::Zero();
     for (int i = 0; i < 3; ++i) u[i] = i == wall_ ? 0.0 : std::sqrt(input_.masses[i]) * (v[i] - reference);
-    return {dot(u, e1_), dot(u, e2_)};
+    return wedge_.coordinates(u);
   }
 
   /// Angle of r_AB from r_BC: the cone's opening, alpha [rad].
-  double abAngle() const { return ab_angle_; }
+  double abAngle() const { return wedge_.alpha; }
 
  private:
   const collision_lab::InitialConditions& input_;
+  collision_lab::core::Wedge<double> wedge_;
   int wall_ = -1;
-  Vec3 s_hat_{}, e1_{}, e2_{};
-  double ab_angle_ = 0.0;
 };
 
 /// Scale from u_perp to rviz units: |u_perp| is conserved, so the path lies on a circle.
