@@ -33,10 +33,13 @@ using Rational = boost::multiprecision::cpp_rational;
 constexpr std::uint64_t kWalkLimit = std::uint64_t{1} << 26;  ///< impacts; beyond: undecided
 constexpr std::uint64_t kRationalLimit = 3000;              ///< impacts walked in rationals
 
-/// Masses [kg] (finite) and e [1] of a three-body scene; the cycle's invariants.
+/// Masses [kg] (finite) and restitution [1] of three bodies (or clusters); the cycle's
+/// invariants. e_bc < 0 means e_bc = e (the model's case: one e for both pairs).
 struct Cycle {
   double m[3];
   double e;
+  double e_bc = -1.0;
+  double eBC() const { return e_bc < 0 ? e : e_bc; }
   double cos2_alpha() const { return m[0] * m[2] / ((m[0] + m[1]) * (m[1] + m[2])); }
   /// T^2 - 4 e^2 > 0 exactly (real, distinct eigenvalues), decided in rationals.
   bool realEigenvalues() const {
@@ -54,24 +57,24 @@ struct Cycle {
   double kappa() const {
     const double t = trace(), gap = std::sqrt(std::fabs(t * t - 4 * e * e));
     const double spread = std::sqrt(std::max(m[0], std::max(m[1], m[2])) / std::min(m[0], std::min(m[1], m[2])));
-    return (1 + 2 * e / std::max(gap, 1e-300)) * spread;
+    return (1 + 2 * std::max(e, eBC()) / std::max(gap, 1e-300)) * spread;
   }
 };
 
 /// The two impact maps on (a, c) in arithmetic T.
 template <class T>
 struct Maps {
-  T e, k_a, k_c;
+  T e_ab, e_bc, k_a, k_c;
   explicit Maps(const Cycle& c)
-      : e(T(c.e)), k_a((1 + T(c.e)) * T(c.m[0]) / (T(c.m[0]) + T(c.m[1]))),
-        k_c((1 + T(c.e)) * T(c.m[2]) / (T(c.m[1]) + T(c.m[2]))) {}
+      : e_ab(T(c.e)), e_bc(T(c.eBC())), k_a((1 + T(c.e)) * T(c.m[0]) / (T(c.m[0]) + T(c.m[1]))),
+        k_c((1 + T(c.eBC())) * T(c.m[2]) / (T(c.m[1]) + T(c.m[2]))) {}
   void apply(int pair, T& a, T& c) const {
     if (pair == 0) {
       c = c + k_a * a;
-      a = -e * a;
+      a = -e_ab * a;
     } else {
       a = a + k_c * c;
-      c = -e * c;
+      c = -e_bc * c;
     }
   }
 };
