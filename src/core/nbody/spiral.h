@@ -9,10 +9,11 @@
 // b = x - v t, which gives the collapse time in closed form (collapseTime()).
 //
 // Decisions. The walk runs in double, then in 100-digit floats, then in exact rationals.
-// A sign is taken when it exceeds a forward error estimate, 64 (k+1) u kappa |d|_inf after
+// A sign is taken when it exceeds a forward error estimate, 64 (k+1) u kappa^2 |d|_1 after
 // k impacts, with u the unit roundoff and kappa the conditioning of the cycle's eigenbasis
-// (about 2e / sqrt|T^2 - 4e^2|, which grows near r_c); otherwise the next tier walks again
-// from the start. The rationals are exact and decide every borderline case (a graze, e
+// (about 2e / sqrt|T^2 - 4e^2| times the mass spread, which grows near r_c): an error made
+// at one impact is carried by the same maps as the state, and relative to the state it can
+// grow by kappa^2 at most. Otherwise the next tier walks again from the start. The rationals are exact and decide every borderline case (a graze, e
 // within rounding of r_c); they are used only while the count stays below kRationalLimit.
 #pragma once
 
@@ -144,7 +145,7 @@ template <class T>
 Walk walk(const Cycle& cy, int first, const T& a0, const T& c0, std::uint64_t limit) {
   const Maps<T> mp(cy);
   const bool may_collapse = cy.realEigenvalues();
-  const double tolerance = 64 * roundoff<T>() * cy.kappa();
+  const double tolerance = 64 * roundoff<T>() * cy.kappa() * cy.kappa();
   T a = a0, c = c0;
   Walk w;
   int pair = first;
