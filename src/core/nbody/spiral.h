@@ -8,7 +8,8 @@
 // and on the first pair. The same maps act on the differences of the intercepts
 // b = x - v t, which gives the collapse time in closed form (collapseTime()).
 //
-// Decisions. The walk runs in double, then in 100-digit floats, then in exact rationals.
+// Decisions. The walk runs in double, then double-double, then 100-digit floats, then in
+// exact rationals.
 // A sign is taken when it exceeds a forward error estimate, 64 (k+1) u kappa^2 |d|_1 after
 // k impacts, with u the unit roundoff and kappa the conditioning of the cycle's eigenbasis
 // (about 2e / sqrt|T^2 - 4e^2| times the mass spread, which grows near r_c): an error made
@@ -24,10 +25,13 @@
 #include <boost/multiprecision/cpp_bin_float.hpp>
 #include <boost/multiprecision/cpp_int.hpp>
 
+#include "double_double.h"
+
 namespace collision_lab {
 namespace core {
 namespace spiral_detail {
 
+using DD = nbody_detail::DD;
 using Float100 = boost::multiprecision::cpp_bin_float_100;
 using Rational = boost::multiprecision::cpp_rational;
 
@@ -92,12 +96,17 @@ struct Walk {
 
 template <class T>
 double toDouble(const T& x) {
-  return static_cast<double>(x);
+  if constexpr (std::is_same_v<T, DD>) {
+    return x.hi;
+  } else {
+    return static_cast<double>(x);
+  }
 }
 
 template <class T>
 constexpr double roundoff() {
   if constexpr (std::is_same_v<T, double>) return 0x1p-53;
+  if constexpr (std::is_same_v<T, DD>) return 0x1p-104;
   if constexpr (std::is_same_v<T, Float100>) return 0x1p-320;
   return 0.0;
 }
@@ -167,11 +176,12 @@ Walk walk(const Cycle& cy, int first, const T& a0, const T& c0, std::uint64_t li
     mp.apply(pair, a, c);
     ++w.count;
     pair = 1 - pair;
-    if constexpr (std::is_same_v<T, double>) {  // keep (a, c) normal: scale by a power of two, exactly
+    if constexpr (std::is_same_v<T, double> || std::is_same_v<T, DD>) {  // keep (a, c) normal: scale by 2^-shift, exactly
       int shift = 0;
-      std::frexp(std::fabs(a) + std::fabs(c), &shift);
-      if (shift < -500) {
-        a = std::ldexp(a, -shift), c = std::ldexp(c, -shift);
+      std::frexp(std::fabs(toDouble(a)) + std::fabs(toDouble(c)), &shift);
+      if (shift < -400) {
+        const double factor = std::ldexp(1.0, -shift);
+        a = a * factor, c = c * factor;
         w.exponent += shift;
       }
     }
@@ -181,6 +191,8 @@ Walk walk(const Cycle& cy, int first, const T& a0, const T& c0, std::uint64_t li
     T s = abs(a) + abs(c);
     while (s != 0 && s < 1) a *= big, c *= big, s *= big, w.exponent -= 900;
     w.a = static_cast<double>(a), w.c = static_cast<double>(c);
+  } else if constexpr (std::is_same_v<T, double> || std::is_same_v<T, DD>) {  // already normal
+    w.a = toDouble(a), w.c = toDouble(c);
   } else {
     using std::abs;
     using std::frexp;
@@ -198,6 +210,12 @@ Walk walk(const Cycle& cy, int first, const T& a0, const T& c0, std::uint64_t li
 /// kRationalLimit). kUndecided only beyond kWalkLimit impacts or the rational limit.
 inline Walk walkExactly(const Cycle& cy, int first, const Rational& a0, const Rational& c0) {
   Walk w = walk<double>(cy, first, static_cast<double>(a0), static_cast<double>(c0), kWalkLimit);
+  if (w.end != WalkEnd::kUndecided) return w;
+  const auto dd = [](const Rational& r) {  // to double-double: the double and the rest
+    const double hi = static_cast<double>(r);
+    return DD(hi) + DD(static_cast<double>(Rational(r - hi)));
+  };
+  w = walk<DD>(cy, first, dd(a0), dd(c0), kWalkLimit);
   if (w.end != WalkEnd::kUndecided) return w;
   w = walk<Float100>(cy, first, Float100(numerator(a0)) / Float100(denominator(a0)),
                      Float100(numerator(c0)) / Float100(denominator(c0)), kWalkLimit);
