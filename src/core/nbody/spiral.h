@@ -176,12 +176,20 @@ Walk walk(const Cycle& cy, int first, const T& a0, const T& c0, std::uint64_t li
     mp.apply(pair, a, c);
     ++w.count;
     pair = 1 - pair;
-    if constexpr (std::is_same_v<T, double> || std::is_same_v<T, DD>) {  // keep (a, c) normal: scale by 2^-shift, exactly
+    if constexpr (!std::is_same_v<T, Rational>) {  // keep (a, c) normal: scale by 2^-shift, exactly
       int shift = 0;
-      std::frexp(std::fabs(toDouble(a)) + std::fabs(toDouble(c)), &shift);
+      if constexpr (std::is_same_v<T, Float100>) {
+        frexp(T(abs(a) + abs(c)), &shift);
+      } else {
+        std::frexp(std::fabs(toDouble(a)) + std::fabs(toDouble(c)), &shift);
+      }
       if (shift < -400) {
-        const double factor = std::ldexp(1.0, -shift);
-        a = a * factor, c = c * factor;
+        if constexpr (std::is_same_v<T, Float100>) {
+          a = ldexp(a, -shift), c = ldexp(c, -shift);
+        } else {
+          const double factor = std::ldexp(1.0, -shift);
+          a = a * factor, c = c * factor;
+        }
         w.exponent += shift;
       }
     }
@@ -191,17 +199,8 @@ Walk walk(const Cycle& cy, int first, const T& a0, const T& c0, std::uint64_t li
     T s = abs(a) + abs(c);
     while (s != 0 && s < 1) a *= big, c *= big, s *= big, w.exponent -= 900;
     w.a = static_cast<double>(a), w.c = static_cast<double>(c);
-  } else if constexpr (std::is_same_v<T, double> || std::is_same_v<T, DD>) {  // already normal
+  } else {  // already normal
     w.a = toDouble(a), w.c = toDouble(c);
-  } else {
-    using std::abs;
-    using std::frexp;
-    using std::ldexp;
-    int shift = 0;
-    const T s = abs(a) + abs(c);
-    if (s != 0) frexp(s, &shift);
-    w.a = toDouble(T(ldexp(a, -shift))), w.c = toDouble(T(ldexp(c, -shift)));
-    w.exponent += shift;
   }
   return w;
 }
