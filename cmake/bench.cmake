@@ -1,6 +1,7 @@
 # Benchmarks (not tests). Included by the top-level CMakeLists.txt.
 #   collision_lab_bench_core      ns per collision of the core vs a lean double loop (issue 2)
 #   collision_lab_bench_nbody     ns per impact of the N-body engine vs a lean heap loop, memory (issue 10)
+#   collision_lab_bench_restitution  count against e across r_c, three equal masses (issue 11)
 #   collision_lab_speed_vs_error  speed against error vs fixed stepping and real engines (issue 4)
 #   collision_lab_hard_cases      adaptive precision on the hard cases of physics.md (issue 4)
 #   collision_lab_node_throughput, collision_lab_relay_node   the whole node over loopback
@@ -28,6 +29,10 @@ target_link_libraries(collision_lab_bench_nbody PRIVATE collision_lab_core)
 # Installed too, so that an install space can be benchmarked with rosrun.
 install(TARGETS collision_lab_bench_core collision_lab_bench_nbody
   RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
+
+add_executable(collision_lab_bench_restitution bench/bench_restitution.cpp)
+target_link_libraries(collision_lab_bench_restitution PRIVATE collision_lab_core)
+target_compile_definitions(collision_lab_bench_restitution PRIVATE COLLISION_LAB_DOCS_DIR="${PROJECT_SOURCE_DIR}/docs")
 
 if(TARGET collision_lab_ros)
   add_executable(collision_lab_relay_node bench/node/relay_node.cpp)

@@ -1,5 +1,6 @@
 #include "collision_lab/core/nbody/engine.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <limits>
@@ -50,6 +51,24 @@ class Driver {
   StepResult step(ImpactRecord* record) { return stepOrEscalate<DD>(record); }
 
   const Tier<DD>& fast() const { return *fast_; }
+
+  /// After the impact of `pair`: when two pairs have alternated for 8 impacts, asks the
+  /// working tier whether their three clusters collapse, and resolves a collapse in every
+  /// tier (each applies it when it reaches this impact count, replays included).
+  StepResult afterImpact(std::size_t pair, EngineResult& result) {
+    alternating_ = pair != last_ && pair == before_last_ ? alternating_ + 1 : 2;
+    before_last_ = last_;
+    last_ = pair;
+    if (alternating_ < 8) return {};
+    const std::size_t p = std::min(last_, before_last_), q = std::max(last_, before_last_);
+    const auto found = fast_->collapseCandidate(p, q, last_ == p);
+    if (!found) return {};
+    collapses_.push_back({fast_->count(), found->first, found->last});
+    result.collapses.push_back({found->first, found->last, found->time, found->position, fast_->count()});
+    alternating_ = 0;
+    last_ = before_last_ = kNone;
+    return catchUp<DD>();
+  }
   Escalations escalations() const {
     Escalations e = escalations_;
     e.refinements = fast_->refinements();
@@ -116,19 +135,59 @@ class Driver {
   /// takes the next step there.
   template <class S>
   StepResult advanceAndStep(std::uint64_t target, ImpactRecord* record) {
+    const StepResult r = advanceTo<S>(target);
+    if (r.kind != StepKind::kImpact) return r;
+    return stepOrEscalate<S>(record);
+  }
+
+  /// Brings tier S to `target` impacts and applies the collapses due there.
+  template <class S>
+  StepResult advanceTo(std::uint64_t target) {
     if (!tier<S>()) {
       const StepResult r = startOrEscalate<S>();
       if (r.kind != StepKind::kImpact) return {StepKind::kInconsistent, r.pair, r.time};
     }
     if (tier<S>()->count() > target) return {StepKind::kInconsistent, 0, 0.0};
-    while (tier<S>()->count() < target) {
+    for (;;) {
+      const StepResult c = catchUp<S>();
+      if (c.kind != StepKind::kImpact) return {StepKind::kInconsistent, c.pair, c.time};
+      if (tier<S>()->count() == target) return {};
       const StepResult r = stepOrEscalate<S>(nullptr);
       if (r.kind != StepKind::kImpact) return {StepKind::kInconsistent, r.pair, r.time};
       ++escalations_.replayed_impacts;
     }
-    return stepOrEscalate<S>(record);
   }
 
+  /// Applies to tier S the collapses due at its count; a neighbour's schedule it cannot
+  /// decide there, the next tier decides (tier S then adopts its state).
+  template <class S>
+  StepResult catchUp() {
+    Tier<S>& t = *tier<S>();
+    while (t.merged() < collapses_.size() && collapses_[t.merged()].count == t.count()) {
+      const CollapseEvent& c = collapses_[t.merged()];
+      const StepResult r = t.merge(c.first, c.last);
+      if (r.kind == StepKind::kImpact) continue;
+      if constexpr (Arithmetic<S>::kExact) {
+        return {StepKind::kInconsistent, r.pair, r.time};
+      } else {
+        const StepResult h = advanceTo<typename NextTier<S>::type>(t.count());
+        if (h.kind != StepKind::kImpact) return h;
+        t.adopt(*tier<typename NextTier<S>::type>());
+      }
+    }
+    return {};
+  }
+
+  /// A collapse of bodies first..last, applied after `count` impacts.
+  struct CollapseEvent {
+    std::uint64_t count;
+    std::size_t first, last;
+  };
+  static constexpr std::size_t kNone = static_cast<std::size_t>(-1);
+
+  std::vector<CollapseEvent> collapses_;
+  std::size_t last_ = kNone, before_last_ = kNone;  ///< pairs of the last two impacts
+  std::uint64_t alternating_ = 0;                   ///< impacts alternating between them
   SceneTables tables_;
   std::unique_ptr<Tier<DD>> fast_;
   std::unique_ptr<Tier<Float100>> high_;
@@ -181,7 +240,18 @@ void fillDrift(const Scene& scene, EngineResult& result) {
 std::string stopMessage(const Scene& scene, const EngineResult& result) {
   const std::string count = std::to_string(result.impact_count);
   switch (result.stop) {
-    case StopReason::kFinished: return "no pair approaches any more after " + count + " impacts: the run is complete";
+    case StopReason::kFinished: {
+      std::string text = "no pair approaches any more after " + count + " impacts: the run is complete";
+      for (const Collapse& c : result.collapses) {
+        text += "; bodies " + bodyName(c.first_body) + " to " + bodyName(c.last_body) +
+                " collapsed (infinitely many impacts) at t = " + formatValue(c.time) + " s, x = " +
+                formatValue(c.position) + " m, and move on as one";
+      }
+      if (result.cluster_impacts > 0) {
+        text += "; " + std::to_string(result.cluster_impacts) + " impacts hit a cluster as one body of its total mass";
+      }
+      return text;
+    }
     case StopReason::kCap:
       return "stopped at the cap of " + count + " impacts (truncated)" +
              (scene.wallCount() == 2 ? "; two walls keep the bodies between them colliding forever" : "");
@@ -260,6 +330,11 @@ EngineResult runEngine(const Scene& scene, const EngineOptions& options, const I
       if (visitor) visitor(record);
       if (count <= options.keep_events) result.events.push_back(record);
     }
+    const StepResult collapse = driver.afterImpact(r.pair, result);
+    if (collapse.kind != StepKind::kImpact) {
+      r = collapse;
+      break;
+    }
     if (progress && options.progress_interval > 0 && count % options.progress_interval == 0) {
       progress(EngineProgress{count, driver.fast().lastTime()});
     }
@@ -267,6 +342,13 @@ EngineResult runEngine(const Scene& scene, const EngineOptions& options, const I
   if (result.stop == StopReason::kFinished) finish(r, result);
   result.truncated = result.stop == StopReason::kCap || result.stop == StopReason::kCancelled;
   result.final_time = driver.fast().lastTime();
+  result.collapsed = !result.collapses.empty();
+  if (result.collapsed) {
+    result.collapse_time = result.collapses.front().time;
+    result.collapse_position = result.collapses.front().position;
+    result.final_time = std::max(result.final_time, result.collapses.back().time);
+  }
+  result.cluster_impacts = driver.fast().clusterImpacts();
   driver.fast().state(result.final_time, result.final_positions, result.final_velocities);
   result.energy_lost = driver.fast().energyLost();
   result.escalations = driver.escalations();

@@ -1,10 +1,12 @@
 #include "collision_lab/core/nbody/models.h"
 
 #include <algorithm>
+#include <cmath>
 #include <functional>
 
 #include "collision_lab/core/nbody/impact_rule.h"
 #include "double_double.h"
+#include "spiral.h"
 
 namespace collision_lab {
 namespace core {
@@ -48,7 +50,14 @@ std::string modelReason(ModelKind kind, const Scene& scene) {
     case ModelKind::kGhosts:
       return "equal masses exchange velocities, so the bodies move like ghosts passing through each other: "
              "the count is the number of inversions and the final velocities are the initial ones sorted";
+    case ModelKind::kThreeBodySpiral:
+      return "three bodies with one e < 1: the AB/BC cycle is a spiral (e > r_c) or may collapse (e <= r_c); "
+             "count, state and collapse from the 2x2 cycle map";
     case ModelKind::kEventEngine: break;
+  }
+  if (scene.size() == 3 && scene.wallCount() == 0 && scene.restitutionOf(0) != scene.restitutionOf(1)) {
+    return "three bodies with two different e: the spiral model (r_c, phi) is defined for one e, so the exact "
+           "event engine simulates every impact";
   }
   return "no count formula exists for " + std::to_string(scene.size()) +
          " bodies with these masses, walls and restitution: the exact event engine simulates every impact";
@@ -60,6 +69,9 @@ ModelKind chooseKind(const Scene& scene) {
   if (confinedForever(scene)) return ModelKind::kTwoWallsInfinite;
   if (n == 2) return ModelKind::kTwoBody;
   if (n == 3 && scene.isElastic() && scene.wallCount() < 2) return ModelKind::kThreeBodyRotation;
+  if (n == 3 && scene.wallCount() == 0 && scene.restitutionOf(0) == scene.restitutionOf(1)) {
+    return ModelKind::kThreeBodySpiral;
+  }
   if (equalFiniteMasses(scene) && scene.isElastic()) return ModelKind::kGhosts;
   return ModelKind::kEventEngine;
 }
@@ -88,6 +100,36 @@ std::uint64_t mergeCounting(const double* from, std::size_t begin, std::size_t m
   return inversions;
 }
 
+using spiral_detail::Rational;
+
+/// Which pair hits first (0 = AB, 1 = BC), exactly; -1 when none approaches.
+int firstPair(const Scene& scene, const Rational& a, const Rational& c) {
+  if (a > 0 && c > 0) {  // both approach: the earlier contact (a tie is rejected by validate())
+    const Rational t_ab = (Rational(scene.positions[0]) - scene.positions[1]) / a;
+    const Rational t_bc = (Rational(scene.positions[1]) - scene.positions[2]) / c;
+    return t_ab < t_bc ? 0 : 1;
+  }
+  return a > 0 ? 0 : (c > 0 ? 1 : -1);
+}
+
+/// Velocities [m/s] relative to the centre of mass from approach speeds (a, c) * 2^exponent.
+std::vector<double> relativeVelocities(const double m[3], double a, double c, long exponent) {
+  const double total = m[0] + m[1] + m[2];
+  const double w_a = -(m[1] * a + m[2] * (a + c)) / total;
+  std::vector<double> w{w_a, w_a + a, w_a + a + c};
+  for (double& x : w) x = std::ldexp(x, static_cast<int>(std::max(-2000L, std::min(2000L, exponent))));
+  return w;
+}
+
+double kineticEnergy(const double m[3], const std::vector<double>& v) {
+  return 0.5 * (m[0] * v[0] * v[0] + m[1] * v[1] * v[1] + m[2] * v[2] * v[2]);
+}
+
+Rational weightedMean(const double m[3], const std::vector<double>& q) {
+  return (Rational(m[0]) * q[0] + Rational(m[1]) * q[1] + Rational(m[2]) * q[2]) /
+         (Rational(m[0]) + Rational(m[1]) + Rational(m[2]));
+}
+
 }  // namespace
 
 const char* modelKindName(ModelKind kind) {
@@ -98,6 +140,7 @@ const char* modelKindName(ModelKind kind) {
     case ModelKind::kThreeBodyRotation: return "three_body_rotation";
     case ModelKind::kGhosts: return "ghosts";
     case ModelKind::kEventEngine: return "event_engine";
+    case ModelKind::kThreeBodySpiral: return "three_body_spiral";
   }
   return "unknown";
 }
@@ -149,12 +192,67 @@ Prediction predictGhosts(const Scene& scene) {
   return prediction;
 }
 
+Prediction predictThreeBodySpiral(const Scene& scene) {
+  using namespace spiral_detail;
+  Prediction prediction = base(ModelKind::kThreeBodySpiral, scene);
+  const Cycle cycle{{scene.masses[0], scene.masses[1], scene.masses[2]}, scene.restitutionOf(0)};
+  const double* m = cycle.m;
+  const double alpha = std::atan(std::sqrt(m[1] * (m[0] + m[1] + m[2]) / (m[0] * m[2])));
+  const double root = std::tan(M_PI / 4 - alpha / 2);
+  prediction.critical_restitution = root * root;
+  if (cycle.complexEigenvalues()) prediction.spiral_angle = std::acos(cycle.trace() / (2 * cycle.e));
+  const auto& v = scene.velocities;
+  const Rational a0 = Rational(v[1]) - v[0], c0 = Rational(v[2]) - v[1];
+  const double centre = static_cast<double>(weightedMean(m, v));
+  const double heat0 = kineticEnergy(m, relativeVelocities(m, static_cast<double>(a0), static_cast<double>(c0), 0));
+  const int first = firstPair(scene, a0, c0);
+  Walk walked;
+  if (first < 0) {
+    walked = {WalkEnd::kFinished, 0, static_cast<double>(a0), static_cast<double>(c0), 0};
+  } else if (cycle.e == 0.0) {  // the first pair sticks; a hit on that cluster makes all three one
+    Rational a = a0, c = c0;
+    Maps<Rational>(cycle).apply(first, a, c);
+    walked = {WalkEnd::kFinished, 1, static_cast<double>(a), static_cast<double>(c), 0};
+    if ((first == 0 ? c : a) > 0) {  // the third body hits the cluster and sticks: all three move at V
+      prediction.impact_count = 2;
+      prediction.final_velocities.assign(3, centre);
+      prediction.energy_lost = heat0;
+      return prediction;
+    }
+  } else {
+    walked = walkExactly(cycle, first, a0, c0);
+  }
+  if (walked.end == WalkEnd::kUndecided) {
+    prediction.reason += "; undecided: the walk needs more impacts than it may take exactly (run the engine)";
+    return prediction;
+  }
+  if (walked.end == WalkEnd::kCollapse) {
+    prediction.collapsed = true;
+    prediction.final_velocities.assign(3, centre);
+    prediction.energy_lost = heat0;
+    prediction.infinite = true;
+    const Rational dv[2] = {a0, c0};
+    const Rational db[2] = {Rational(scene.positions[1]) - scene.positions[0],
+                            Rational(scene.positions[2]) - scene.positions[1]};
+    const double t = collapseTime(cycle, first, dv, db);
+    prediction.collapse_time = t;
+    prediction.collapse_position = static_cast<double>(weightedMean(m, scene.positions) + Rational(centre) * t);
+    return prediction;
+  }
+  prediction.impact_count = walked.count;
+  const std::vector<double> w = relativeVelocities(m, walked.a, walked.c, walked.exponent);
+  for (double x : w) prediction.final_velocities.push_back(centre + x);
+  prediction.energy_lost = heat0 - kineticEnergy(m, w);
+  return prediction;
+}
+
 std::optional<Prediction> predict(const Scene& scene) {
   switch (chooseKind(scene)) {
     case ModelKind::kNoCollisions: return predictNoCollisions(scene);
     case ModelKind::kTwoWallsInfinite: return predictTwoWalls(scene);
     case ModelKind::kTwoBody: return predictTwoBody(scene);
     case ModelKind::kGhosts: return predictGhosts(scene);
+    case ModelKind::kThreeBodySpiral: return predictThreeBodySpiral(scene);
     case ModelKind::kThreeBodyRotation:
     case ModelKind::kEventEngine: break;
   }

@@ -30,6 +30,7 @@
 #include <vector>
 
 #include "arithmetic.h"
+#include "spiral.h"
 #include "collision_lab/core/nbody/engine.h"
 #include "collision_lab/core/nbody/impact_rule.h"
 #include "collision_lab/core/nbody/scene.h"
@@ -85,6 +86,7 @@ class Tier {
       pair.sqrt_light = tables.sqrt_mass[pair.map.heavy_is_i ? p + 1 : p];
       pairs_.push_back(pair);
     }
+    bonded_.assign(tables.pairs, 0);
   }
 
   /// Schedules every pair from the initial state.
@@ -100,6 +102,8 @@ class Tier {
   bool pending() const { return tree_.minKey() < kInf; }
   std::uint64_t count() const { return count_; }
   std::uint64_t refinements() const { return refinements_; }
+  std::uint64_t clusterImpacts() const { return cluster_impacts_; }
+  std::size_t merged() const { return merged_; }
   double energyLost() const { return lost_ + lost_compensation_; }
   /// Time of the last impact [s], or of the one in progress (0 before the first).
   double lastTime() const { return Ar::sign(now_.A) > 0 ? Ar::toDouble(S(now_.G / now_.A)) : 0.0; }
@@ -132,6 +136,9 @@ class Tier {
     tree_ = from.tree_;
     for (std::size_t p = 0; p < pairs_.size(); ++p) pairs_[p].upper = from.pairs_[p].upper;
     count_ = from.count_;
+    bonded_ = from.bonded_;
+    cluster_impacts_ = from.cluster_impacts_;
+    merged_ = from.merged_;
     lost_ = from.lost_;
     lost_compensation_ = from.lost_compensation_;
     now_.pair = from.now_.pair;
@@ -157,11 +164,91 @@ class Tier {
       restore(m, undo);
       return false;
     }
-    const std::size_t first = m > 0 ? m - 1 : m, last = std::min(m + 1, pairs_.size() - 1);
+    const std::size_t lo = clusterLow(m), hi = clusterHigh(m + 1);
+    const std::size_t first = lo > 0 ? lo - 1 : lo, last = std::min(hi, pairs_.size() - 1);
     for (std::size_t q = first; q <= last; ++q) setSchedule(q, from.tree_.key(q), from.pairs_[q].upper);
     tree_.update(first, last);
     ++count_;
     return true;
+  }
+
+  /// A resolved collapse: bodies first..last meet at `position` [m] at `time` [s].
+  struct CollapseFound {
+    std::size_t first = 0, last = 0;
+    double time = 0.0, position = 0.0;
+  };
+
+  /// Pairs p < q alternate with a cluster between them: do the three clusters collapse
+  /// (spiral.h, dominates(): every later check provably stays positive), and does nothing
+  /// outside reach them before the collapse time? `q_next`: q hits next (else p). Only
+  /// finite masses and e < 1 on both pairs; conservative: "no" just lets the run go on.
+  std::optional<CollapseFound> collapseCandidate(std::size_t p, std::size_t q, bool q_next) const {
+    const Scene& scene = tables_.scene;
+    const std::size_t lo = clusterLow(p), hi = clusterHigh(q + 1);
+    if (clusterHigh(p + 1) != q || scene.restitutionOf(p) == 1.0 || scene.restitutionOf(q) == 1.0) return {};
+    spiral_detail::Cycle cycle{{0.0, 0.0, 0.0}, scene.restitutionOf(p), scene.restitutionOf(q)};
+    for (std::size_t k = lo; k <= hi; ++k) {
+      if (scene.isWall(k)) return {};
+      cycle.m[k <= p ? 0 : (k <= q ? 1 : 2)] += scene.masses[k];
+    }
+    const Approx a = approach(p), c = approach(q);
+    const double size = std::fabs(a.value) + std::fabs(c.value);
+    if (!(a.error + c.error <= 0x1p-30 * size)) return {};
+    if (!spiral_detail::dominates(cycle, q_next ? 1 : 0, a.value, c.value)) return {};
+    using spiral_detail::Rational;
+    const auto exact = [](const S& x) {  // the tier's value as a rational (to within its bound)
+      if constexpr (std::is_same_v<S, DD>) return Rational(x.hi) + Rational(x.lo);
+      else if constexpr (std::is_same_v<S, Rational>) return x;
+      else return Rational(Float100(x));
+    };
+    const Rational dv[2] = {exact(S(bodies_[p + 1].v - bodies_[p].v)), exact(S(bodies_[q + 1].v - bodies_[q].v))};
+    const Rational db[2] = {exact(S(bodies_[p + 1].b - bodies_[p].b)), exact(S(bodies_[q + 1].b - bodies_[q].b))};
+    CollapseFound found{lo, hi, spiral_detail::collapseTime(cycle, q_next ? 1 : 0, dv, db), 0.0};
+    const double now = lastTime();
+    if (!(found.time >= now) || !clearOfNeighbours(lo, hi, now, found.time)) return {};
+    double mass = 0.0, momentum = 0.0, intercept = 0.0;
+    for (std::size_t k = lo; k <= hi; ++k) {
+      mass += scene.masses[k];
+      momentum += scene.masses[k] * Ar::toDouble(bodies_[k].v);
+      intercept += scene.masses[k] * Ar::toDouble(bodies_[k].b);
+    }
+    found.position = (intercept + momentum * found.time) / mass;
+    return found;
+  }
+
+  /// Bodies lo..hi become one cluster at their centre of mass: b and v projected onto the
+  /// mass-weighted mean (the limit of the collapse; an orthogonal projection in mass-weighted
+  /// coordinates, so the error bounds only gain the rounding). The heat of the remaining
+  /// impacts, the group's kinetic energy about its centre, is added to the loss.
+  StepResult merge(std::size_t lo, std::size_t hi) {
+    const Scene& scene = tables_.scene;
+    S mass = S(0), momentum = S(0), intercept = S(0);
+    for (std::size_t k = lo; k <= hi; ++k) {
+      mass = mass + S(scene.masses[k]);
+      momentum = momentum + S(scene.masses[k]) * bodies_[k].v;
+      intercept = intercept + S(scene.masses[k]) * bodies_[k].b;
+    }
+    const S v = momentum / mass, b = intercept / mass;
+    double heat = 0.0, sqrt_mass = 0.0;
+    for (std::size_t k = lo; k <= hi; ++k) {
+      const double dv = Ar::toDouble(S(bodies_[k].v - v));
+      heat += 0.5 * scene.masses[k] * dv * dv;
+      sqrt_mass += tables_.sqrt_mass[k];
+      bodies_[k] = {b, v};
+    }
+    addLoss(heat);
+    const double ops = 4.0 * static_cast<double>(hi - lo + 3) * Ar::kOpError * sqrt_mass;
+    eu_ += ops * std::fabs(Ar::toDouble(v)) + kTiny;
+    eb_ += ops * std::fabs(Ar::toDouble(b)) + kTiny;
+    for (std::size_t k = lo; k < hi; ++k) bonded_[k] = 1, setSchedule(k, kInf, kInf);
+    for (std::size_t r : {lo, hi + 1}) {
+      if (r == 0 || r > pairs_.size()) continue;
+      const StepResult res = schedule(r - 1);
+      if (res.kind != StepKind::kImpact) return res;
+    }
+    tree_.update(lo > 0 ? lo - 1 : lo, std::min(hi, pairs_.size() - 1));
+    ++merged_;
+    return {};
   }
 
   /// Positions [m] at time t [s] and velocities [m/s], rounded to double.
@@ -223,9 +310,49 @@ class Tier {
     BodyState i, j;
     double eu, eb, lost, lost_compensation;
     Now now;
+    char bonded;
+    std::uint64_t cluster_impacts;
+    std::size_t lo;
+    std::vector<BodyState> cluster;  ///< bodies lo..hi, only when a cluster takes part
   };
 
   double pairScale(std::size_t p) const { return pairs_[p].scale; }
+
+  /// Nothing outside bodies lo..hi can reach them in [now, until]: the group stays within
+  /// its extent at `now` widened by the fastest speed its energy about its centre allows,
+  /// the outer neighbours move freely (their other pairs have no impact before `until`).
+  bool clearOfNeighbours(std::size_t lo, std::size_t hi, double now, double until) const {
+    const Scene& scene = tables_.scene;
+    double mass = 0.0, momentum = 0.0, lightest = kInf;
+    for (std::size_t k = lo; k <= hi; ++k) {
+      mass += scene.masses[k], momentum += scene.masses[k] * Ar::toDouble(bodies_[k].v);
+      lightest = std::min(lightest, scene.masses[k]);
+    }
+    const double centre = momentum / mass;
+    double heat = 0.0;
+    for (std::size_t k = lo; k <= hi; ++k) {
+      const double dv = Ar::toDouble(bodies_[k].v) - centre;
+      heat += 0.5 * scene.masses[k] * dv * dv;
+    }
+    const double spread = std::sqrt(2 * heat / lightest) * (1 + 0x1p-20), span = until - now;
+    const auto at = [&](std::size_t k) { return Ar::toDouble(S(bodies_[k].b + S(bodies_[k].v * S(now)))); };
+    const auto slack = [&](double x, double y, double v) {
+      return 0x1p-30 * (std::fabs(x) + std::fabs(y) + span * (std::fabs(v) + std::fabs(centre) + spread));
+    };
+    if (lo > 0) {
+      const std::size_t far = clusterLow(lo - 1);  // the neighbour may be a cluster
+      if (far > 0 && !(tree_.key(far - 1) > until)) return false;
+      const double x = at(lo - 1), v = Ar::toDouble(bodies_[lo - 1].v), y = at(lo);
+      if (!(x + std::min(0.0, v) * span - (y + std::max(0.0, centre + spread) * span) > slack(x, y, v))) return false;
+    }
+    if (hi + 1 < bodies_.size()) {
+      const std::size_t far = clusterHigh(hi + 1);
+      if (far < pairs_.size() && !(tree_.key(far) > until)) return false;
+      const double x = at(hi + 1), v = Ar::toDouble(bodies_[hi + 1].v), y = at(hi);
+      if (!((y + std::min(0.0, centre - spread) * span) - (x + std::max(0.0, v) * span) > slack(x, y, v))) return false;
+    }
+    return true;
+  }
 
   /// x - y as a double, with a bound on its distance to the exact difference of x and y.
   static Approx approxDifference(const S& x, const S& y) {
@@ -422,11 +549,14 @@ class Tier {
   /// Bound on the mass-weighted rounding error of one impact (see the header comment):
   /// 2 eta [ s_h (|q_h'| + 8 |inc|) + s_l (|q_l'| + |q_h'| + 8 |inc| + 2 |d|) ].
   double rho(std::size_t m, const ImpactChange<S>& change, const S& q_i, const S& q_j) const {
-    if constexpr (Ar::kExact) return 0.0;
     const PairState& pair = pairs_[m];
     if (pair.map.exchange) return 0.0;  // a swap rounds nothing
-    const bool heavy_is_i = pair.map.heavy_is_i;
-    const double s_h = pair.sqrt_heavy, s_l = pair.sqrt_light;
+    return rhoWith(pair.map.heavy_is_i, pair.sqrt_heavy, pair.sqrt_light, change, q_i, q_j);
+  }
+  /// rho() for square roots s_h, s_l of the heavier and lighter (total) masses.
+  static double rhoWith(bool heavy_is_i, double s_h, double s_l, const ImpactChange<S>& change, const S& q_i,
+                        const S& q_j) {
+    if constexpr (Ar::kExact) return 0.0;
     const double q_h = std::fabs(Ar::toDouble(heavy_is_i ? q_i : q_j));
     const double q_l = std::fabs(Ar::toDouble(heavy_is_i ? q_j : q_i));
     const double inc = std::fabs(Ar::toDouble(change.heavy_increment));
@@ -489,16 +619,100 @@ class Tier {
     return r;
   }
 
-  Undo saveFor(std::size_t m) const { return {bodies_[m], bodies_[m + 1], eu_, eb_, lost_, lost_compensation_, now_}; }
+  Undo saveFor(std::size_t m) const {
+    Undo undo{bodies_[m], bodies_[m + 1], eu_, eb_, lost_, lost_compensation_, now_, bonded_[m], cluster_impacts_, m, {}};
+    const std::size_t lo = clusterLow(m), hi = clusterHigh(m + 1);
+    if (lo != m || hi != m + 1) undo.cluster.assign(bodies_.begin() + lo, bodies_.begin() + hi + 1), undo.lo = lo;
+    return undo;
+  }
 
   void restore(std::size_t m, const Undo& undo) {
     bodies_[m] = undo.i, bodies_[m + 1] = undo.j;
+    std::copy(undo.cluster.begin(), undo.cluster.end(), bodies_.begin() + undo.lo);
     eu_ = undo.eu, eb_ = undo.eb, lost_ = undo.lost, lost_compensation_ = undo.lost_compensation;
     now_ = undo.now;
+    bonded_[m] = undo.bonded;
+    cluster_impacts_ = undo.cluster_impacts;
+  }
+
+  /// The first and last body of the cluster holding `body` (bodies stuck together by e = 0
+  /// or by a collapse move as one).
+  std::size_t clusterLow(std::size_t body) const {
+    while (body > 0 && bonded_[body - 1]) --body;
+    return body;
+  }
+  std::size_t clusterHigh(std::size_t body) const {
+    while (body < bonded_.size() && bonded_[body]) ++body;
+    return body;
   }
 
   /// The impact of pair m on its two bodies, with the error bounds, the heat and the record.
   StepResult collide(std::size_t m, ImpactRecord* record) {
+    const std::size_t lo = clusterLow(m), hi = clusterHigh(m + 1);
+    const StepResult r = lo == m && hi == m + 1 ? collideBodies(m, record) : collideClusters(m, lo, hi, record);
+    if (r.kind == StepKind::kImpact && pairs_[m].map.light_factor == 0.0) bonded_[m] = 1;  // e = 0: they stick
+    return r;
+  }
+
+  /// The cluster rule: clusters lo..m and m+1..hi meet as two bodies of their total masses,
+  /// with pair m's restitution; every member takes its cluster's new line.
+  StepResult collideClusters(std::size_t m, std::size_t lo, std::size_t hi, ImpactRecord* record) {
+    const Scene& scene = tables_.scene;
+    S mass[2] = {S(0), S(0)};
+    bool wall[2] = {false, false};
+    double mass_d[2] = {0.0, 0.0};
+    for (std::size_t k = lo; k <= hi; ++k) {
+      const int side = k <= m ? 0 : 1;
+      wall[side] = wall[side] || scene.isWall(k);
+      if (!scene.isWall(k)) mass[side] = mass[side] + S(scene.masses[k]), mass_d[side] += scene.masses[k];
+    }
+    for (int side = 0; side < 2; ++side) {
+      if (wall[side]) mass_d[side] = kInf;
+    }
+    const double e = scene.restitutionOf(m);
+    const ImpactMap<S> map = makeClusterImpactMap<S>(mass[0], wall[0], mass[1], wall[1], e, mass_d[0] >= mass_d[1]);
+    BodyState& i = bodies_[m];
+    BodyState& j = bodies_[m + 1];
+    now_.pair = m;
+    now_.upper = pairs_[m].upper;
+    const S before_i = i.v, before_j = j.v;
+    if (record) recordBefore(m, *record);
+    now_.eu = eu_, now_.eb = eb_, now_.extra = 0.0;
+    const ImpactChange<S> dv = applyImpactMap(map, i.v, j.v);
+    const ImpactChange<S> db = applyImpactMap(map, i.b, j.b);
+    const double s_h = wall[map.heavy_is_i ? 0 : 1] ? 0.0 : std::sqrt(mass_d[map.heavy_is_i ? 0 : 1]);
+    const double s_l = std::sqrt(mass_d[map.heavy_is_i ? 1 : 0]);
+    // The sums of the masses round too: (hi - lo) more operations on the increment.
+    const double sums = static_cast<double>(hi - lo) * 4 * Ar::kOpError * (s_h + s_l);
+    eu_ += rhoWith(map.heavy_is_i, s_h, s_l, dv, i.v, j.v) + sums * std::fabs(Ar::toDouble(dv.heavy_increment));
+    eb_ += rhoWith(map.heavy_is_i, s_h, s_l, db, i.b, j.b) + sums * std::fabs(Ar::toDouble(db.heavy_increment));
+    for (std::size_t k = lo; k <= hi; ++k) bodies_[k] = k <= m ? i : j;
+    now_.A = dv.difference;
+    now_.G = -db.difference;
+    if (!timeIsPrecise(pairs_[m].scale)) return {StepKind::kImprecise, m, 0.0};
+    const double lost = impactEnergyLost(mass_d[0], mass_d[1], Ar::toDouble(now_.A), e);
+    if (lost != 0.0) addLoss(lost);
+    if (record) {
+      record->velocities_after = {Ar::toDouble(i.v), Ar::toDouble(j.v)};
+      record->energy_lost = lost;
+      const S* before[2] = {&before_i, &before_j};
+      for (int k = 0; k < 2; ++k) {
+        const double dvk = Ar::toDouble(S(bodies_[m + k].v - *before[k]));
+        record->energy_gained[k] = 0.5 * mass_d[k] * dvk * (record->velocities_after[k] + record->velocities_before[k]);
+      }
+      for (int k = 0; k < 2; ++k) {
+        if (wall[k]) record->energy_gained[k] = -record->energy_gained[1 - k] - lost;
+      }
+    }
+    ++cluster_impacts_;
+    const double magnitude = std::fabs(Ar::toDouble(i.b)) + std::fabs(Ar::toDouble(j.b)) +
+                             std::fabs(Ar::toDouble(i.v)) + std::fabs(Ar::toDouble(j.v));
+    if (!(magnitude < kMaxMagnitude)) return {StepKind::kOutOfRange, m, lastTime()};
+    return {StepKind::kImpact, m, 0.0};
+  }
+
+  /// The impact of pair m on its two single bodies.
+  StepResult collideBodies(std::size_t m, ImpactRecord* record) {
     PairState& pair = pairs_[m];
     BodyState& i = bodies_[m];
     BodyState& j = bodies_[m + 1];
@@ -533,15 +747,17 @@ class Tier {
   /// new schedules.
   StepResult scheduleAfter(std::size_t m) {
     setSchedule(m, kInf, kInf);
-    if (m > 0) {
-      const StepResult r = reschedule(m - 1, m);
+    // The pairs at the outer ends of the two clusters (m - 1 and m + 1 for single bodies).
+    const std::size_t lo = clusterLow(m), hi = clusterHigh(m + 1);
+    if (lo > 0) {
+      const StepResult r = reschedule(lo - 1, m);
       if (r.kind != StepKind::kImpact) return r;
     }
-    if (m + 1 < pairs_.size()) {
-      const StepResult r = reschedule(m + 1, m);
+    if (hi < pairs_.size()) {
+      const StepResult r = reschedule(hi, m);
       if (r.kind != StepKind::kImpact) return r;
     }
-    tree_.update(m > 0 ? m - 1 : m, std::min(m + 1, pairs_.size() - 1));
+    tree_.update(lo > 0 ? lo - 1 : lo, std::min(hi, pairs_.size() - 1));
     ++count_;
     return {StepKind::kImpact, m, 0.0};
   }
@@ -550,6 +766,9 @@ class Tier {
   std::vector<BodyState> bodies_;
   std::vector<PairState> pairs_;
   TournamentTree tree_;  ///< per pair: lower bound of the next impact time [s]
+  std::vector<char> bonded_;           ///< per pair: its two bodies move as one (a cluster)
+  std::uint64_t cluster_impacts_ = 0;  ///< impacts in which a cluster met a body as one body
+  std::size_t merged_ = 0;             ///< collapses applied (the driver's list, in order)
   double eu_ = 0.0;            ///< bound on ||U_computed - U_exact|| [kg^0.5 m/s]
   double eb_ = 0.0;            ///< bound on ||B_computed - B_exact|| [kg^0.5 m]
   std::uint64_t count_ = 0;

@@ -14,6 +14,7 @@ struct State {
   std::vector<Rational> mass;  // unused for walls
   std::vector<Rational> e;     // per pair
   std::vector<Rational> x, v;
+  std::vector<bool> stuck;  // per pair: stuck together by e = 0 (one cluster)
   Rational now;
 };
 
@@ -31,31 +32,52 @@ State initial(const Scene& scene) {
                                                : (scene.restitution.size() == 1 ? scene.restitution[0] : scene.restitution[p]);
     s.e.emplace_back(e);
   }
+  s.stuck.assign(n - 1, false);
   return s;
 }
 
-bool approaches(const State& s, std::size_t p) { return s.v[p] < s.v[p + 1]; }
+bool approaches(const State& s, std::size_t p) { return !s.stuck[p] && s.v[p] < s.v[p + 1]; }
+
+/// The bodies stuck to `body` on each side: [first, last].
+std::pair<std::size_t, std::size_t> clusterOf(const State& s, std::size_t body) {
+  std::size_t first = body, last = body;
+  while (first > 0 && s.stuck[first - 1]) --first;
+  while (last < s.stuck.size() && s.stuck[last]) ++last;
+  return {first, last};
+}
 
 /// physics.md: v_i' = V - e m_j (v_i - v_j)/M, v_j' = V + e m_i (v_i - v_j)/M; against a
-/// wall i: v_j' = v_i - e (v_j - v_i).
+/// wall i: v_j' = v_i - e (v_j - v_i). A stuck cluster (e = 0 earlier) takes part as one body
+/// of its total mass (a wall in it makes it a wall); e = 0 sticks the two sides.
 Rational collide(State& s, std::size_t p) {
-  const std::size_t i = p, j = p + 1;
-  const Rational relative = s.v[i] - s.v[j];
-  const Rational& e = s.e[p];
-  Rational lost = 0;
-  if (s.wall[i]) {
-    lost = (1 - e * e) * s.mass[j] * relative * relative / 2;
-    s.v[j] = s.v[i] - e * (s.v[j] - s.v[i]);
-  } else if (s.wall[j]) {
-    lost = (1 - e * e) * s.mass[i] * relative * relative / 2;
-    s.v[i] = s.v[j] - e * (s.v[i] - s.v[j]);
-  } else {
-    const Rational total = s.mass[i] + s.mass[j];
-    const Rational centre = (s.mass[i] * s.v[i] + s.mass[j] * s.v[j]) / total;
-    lost = (1 - e * e) * (s.mass[i] * s.mass[j] / total) * relative * relative / 2;
-    s.v[i] = centre - e * s.mass[j] * relative / total;
-    s.v[j] = centre + e * s.mass[i] * relative / total;
+  const auto [first, p_last] = clusterOf(s, p);
+  const auto [p_first, last] = clusterOf(s, p + 1);
+  (void)p_last, (void)p_first;
+  Rational mass_i = 0, mass_j = 0;
+  bool wall_i = false, wall_j = false;
+  for (std::size_t k = first; k <= last; ++k) {
+    (k <= p ? wall_i : wall_j) = (k <= p ? wall_i : wall_j) || s.wall[k];
+    (k <= p ? mass_i : mass_j) += s.mass[k];
   }
+  const Rational v_i = s.v[p], v_j = s.v[p + 1];
+  const Rational relative = v_i - v_j;
+  const Rational& e = s.e[p];
+  Rational lost = 0, after_i = v_i, after_j = v_j;
+  if (wall_i) {
+    lost = (1 - e * e) * mass_j * relative * relative / 2;
+    after_j = v_i - e * (v_j - v_i);
+  } else if (wall_j) {
+    lost = (1 - e * e) * mass_i * relative * relative / 2;
+    after_i = v_j - e * (v_i - v_j);
+  } else {
+    const Rational total = mass_i + mass_j;
+    const Rational centre = (mass_i * v_i + mass_j * v_j) / total;
+    lost = (1 - e * e) * (mass_i * mass_j / total) * relative * relative / 2;
+    after_i = centre - e * mass_j * relative / total;
+    after_j = centre + e * mass_i * relative / total;
+  }
+  for (std::size_t k = first; k <= last; ++k) s.v[k] = k <= p ? after_i : after_j;
+  if (e == 0) s.stuck[p] = true;
   return lost;
 }
 
@@ -98,7 +120,8 @@ Run simulate(const Scene& scene, std::uint64_t max_impacts) {
     const Rational lost = collide(s, p);
     // A neighbour that now approaches at zero gap hits in the same instant: the two impacts
     // form one multiple collision, which does not happen (the state stays as before it).
-    for (std::size_t q : {p - 1, p + 1}) {
+    const std::size_t outer_first = clusterOf(s, p).first, outer_last = clusterOf(s, p + 1).second;
+    for (std::size_t q : {outer_first - 1, outer_last}) {
       if (!run.multiple_first && q < pairs && approaches(s, q) && s.x[q] == s.x[q + 1]) {
         run.multiple_first = std::min(p, q);
         run.multiple_time = s.now;

@@ -182,12 +182,25 @@ TEST(NBodyEngineHard, StickingWithZeroRestitution) {
   EXPECT_EQ(run.final_velocities, (std::vector<double>{-0.5, -0.5, -2}));
   EXPECT_DOUBLE_EQ(run.energy_lost, 0.25);
   EXPECT_EQ(run.stop, StopReason::kFinished);
-  // When the stuck pair reaches C at 3 s, three bodies meet: a multiple collision.
+  // When the stuck pair reaches C at 3 s, C hits the cluster AB as one body of 2 kg (the
+  // cluster rule), and all three stick: -1/3 m/s each, 1/4 + 1/12 J lost.
   const Scene onto{{1, 1, 1}, {2, 1, 0}, {-1, 0, 0}, {0.0}};
   const EngineResult hit = expectMatchesReference(onto, kCap, "stuck pair hits C");
-  EXPECT_EQ(hit.impact_count, 1u);
-  ASSERT_TRUE(hit.multiple_collision);
-  EXPECT_EQ(hit.multiple_collision->time, 3.0);
+  EXPECT_EQ(hit.impact_count, 2u);
+  EXPECT_EQ(hit.cluster_impacts, 1u);
+  EXPECT_FALSE(hit.multiple_collision);
+  EXPECT_FALSE(hit.collapsed);
+  for (double v : hit.final_velocities) EXPECT_DOUBLE_EQ(v, -1.0 / 3);
+  EXPECT_DOUBLE_EQ(hit.energy_lost, 1.0 / 3);
+  EXPECT_NE(hit.stop_message.find("1 impacts hit a cluster"), std::string::npos) << hit.stop_message;
+  // A cluster with e = 0.5 towards C bounces: AB (2 kg, -0.5 m/s) on C (1 kg, 0) at 3 s.
+  const Scene bounce{{1, 1, 1}, {2, 1, 0}, {-1, 0, 0}, {0.0, 0.5}};
+  const EngineResult bounced = expectMatchesReference(bounce, kCap, "cluster bounces off C");
+  EXPECT_EQ(bounced.impact_count, 2u);
+  EXPECT_EQ(bounced.cluster_impacts, 1u);
+  // By hand: M = 3 kg, V = -1/3 m/s, v_AB - v_C = -0.5 m/s, so
+  // v_AB' = V - e m_C (v_AB - v_C)/M = -1/3 + 1/12 = -1/4 and v_C' = V + e m_AB (v_AB - v_C)/M = -1/2.
+  EXPECT_EQ(bounced.final_velocities, (std::vector<double>{-0.25, -0.25, -0.5}));
 }
 
 TEST(NBodyEngineHard, ThreeEqualMassesWithRestitution) {
@@ -206,16 +219,21 @@ TEST(NBodyEngineHard, ThreeEqualMassesWithRestitution) {
     }
   }
   expectMatchesReference(Scene{{1, 1, 1}, {2, 1, 0}, {-1, 0, 0}, {0.072}}, 100, "e = 0.072");
-  // Below it the bodies collapse: infinitely many impacts before a finite time, which the
-  // impact times approach; the cap ends the run (resolving the collapse is issue 11).
+  // Below it the bodies collapse: infinitely many impacts before a finite time, resolved
+  // to its limit; afterwards the three move together at the centre-of-mass velocity.
   const std::pair<double, double> collapses[] = {{0.06, 3.7313542986536}, {0.07, 4.2578666486407}};
   for (const auto& [e, time] : collapses) {
-    EngineOptions options;
-    options.max_impacts = 300;
-    const EngineResult run = runEngine(Scene{{1, 1, 1}, {2, 1, 0}, {-1, 0, 0}, {e}}, options);
-    EXPECT_EQ(run.stop, StopReason::kCap) << run.stop_message;
-    EXPECT_NEAR(run.final_time, time, 1e-12) << "e = " << e;
-    EXPECT_GT(run.escalations.exact_rational, 0u);
+    const EngineResult run = runEngine(Scene{{1, 1, 1}, {2, 1, 0}, {-1, 0, 0}, {e}});
+    EXPECT_EQ(run.stop, StopReason::kFinished) << run.stop_message;
+    ASSERT_TRUE(run.collapsed) << run.stop_message;
+    EXPECT_NEAR(*run.collapse_time, time, 1e-12) << "e = " << e;
+    ASSERT_EQ(run.collapses.size(), 1u);
+    EXPECT_EQ(run.collapses[0].first_body, 0u);
+    EXPECT_EQ(run.collapses[0].last_body, 2u);
+    // The meeting point: the centre of mass (1 m at t = 0) moving at -1/3 m/s.
+    EXPECT_NEAR(*run.collapse_position, 1.0 - time / 3, 1e-12) << "e = " << e;
+    for (double v : run.final_velocities) EXPECT_NEAR(v, -1.0 / 3, 1e-15);
+    EXPECT_NEAR(run.energy_lost, 1.0 / 3, 1e-15);  // all the energy about the centre of mass
   }
 }
 

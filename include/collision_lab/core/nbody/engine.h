@@ -17,6 +17,16 @@
 // masses keep an exact state. A tier whose state can no longer pin an impact's published
 // time to 2^-42 (tiny approach speeds, as on the way to an inelastic collapse) hands that
 // step to the next tier too and adopts its state.
+// Restitution and clusters. An impact with e = 0 makes its two bodies one cluster at
+// once; a recognised inelastic collapse (see Collapse) makes its bodies one cluster at the
+// collapse time. A cluster is hit as ONE body of its total mass, with the restitution of the
+// pair that touches. Why: its members are point masses at zero separation, so an impulse at
+// its surface reaches all of them in the same instant, and the only outcome that keeps
+// momentum, respects the pair's e and leaves no body inside another is the two-body rule
+// with the total mass (the usual choice for aggregates). The alternative, resolving the
+// internal impacts one after the other, is ill-defined for point masses: at zero separation
+// every internal impact is simultaneous with the next, so its result depends on an
+// arbitrary order (a multiple collision). The run counts these impacts (cluster_impacts).
 // Impacts happen in the canonical order: exact time, then pair index. Impacts of disjoint
 // pairs at the same instant are all performed; two impacts sharing a body at the same
 // instant are a multiple collision, which ends the run (its outcome is undefined for
@@ -93,6 +103,19 @@ struct MultipleCollision {
   double time = 0.0;           ///< [s]
 };
 
+/// An inelastic collapse, resolved to its limit: infinitely many impacts of bodies
+/// first_body..last_body before `time`, after which they move as one cluster at their
+/// centre-of-mass velocity. Recognised for three bodies or clusters whose two pairs
+/// alternate (the three-body closed form, src/core/nbody/spiral.h, decides that the impacts
+/// never stop and gives the limit time); larger groups are not recognised (the cap ends them).
+struct Collapse {
+  std::size_t first_body = 0;
+  std::size_t last_body = 0;
+  double time = 0.0;                 ///< [s], the limit of the impact times
+  double position = 0.0;             ///< where the bodies meet [m]
+  std::uint64_t impacts_before = 0;  ///< impacts performed (and counted) before it was resolved
+};
+
 struct EngineResult {
   std::uint64_t impact_count = 0;
   bool truncated = false;  ///< stopped by the cap or by cancellation: more impacts were due
@@ -109,6 +132,14 @@ struct EngineResult {
   /// |p_end - p_0| / sum |m v_0| over the finite masses; NaN with a wall (not conserved).
   double momentum_relative_drift = 0.0;
   Escalations escalations;
+  /// Collapses resolved, in order (their infinitely many impacts are not in impact_count).
+  std::vector<Collapse> collapses;
+  bool collapsed = false;                   ///< collapses is not empty
+  std::optional<double> collapse_time;      ///< of the first collapse [s]
+  std::optional<double> collapse_position;  ///< of the first collapse [m]
+  /// Impacts in which a cluster (stuck by e = 0 or left by a collapse) met its neighbour as
+  /// ONE body of its total mass, with the restitution of the pair that touches (the cluster rule).
+  std::uint64_t cluster_impacts = 0;
   std::vector<ImpactRecord> events;  ///< the first options.keep_events impacts
 };
 

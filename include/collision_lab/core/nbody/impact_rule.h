@@ -49,6 +49,22 @@ ImpactMap<T> makeImpactMap(double m_i, double m_j, double e) {
   return map;
 }
 
+/// Coefficients for two clusters of total masses m_i, m_j [kg] in arithmetic T (sums need
+/// not be doubles); wall_i / wall_j: that side holds a wall (infinite mass; not both).
+/// i_heavier: side i is the heavier (a rounded comparison is fine: it only picks which
+/// side gets the small coefficient).
+template <class T>
+ImpactMap<T> makeClusterImpactMap(const T& m_i, bool wall_i, const T& m_j, bool wall_j, double e, bool i_heavier) {
+  ImpactMap<T> map;
+  map.heavy_is_i = wall_i || (!wall_j && i_heavier);
+  const T& heavy = map.heavy_is_i ? m_i : m_j;
+  const T& light = map.heavy_is_i ? m_j : m_i;
+  if (!wall_i && !wall_j) map.heavy_gain = (T(1) + T(e)) * light / (heavy + light);
+  if (!map.heavy_is_i) map.heavy_gain = -map.heavy_gain;
+  map.light_factor = map.heavy_is_i ? -e : e;
+  return map;
+}
+
 /// What an impact did to one pair of quantities, in arithmetic T.
 template <class T>
 struct ImpactChange {

@@ -9,6 +9,13 @@
 //                        they move like ghosts passing through each other; the count is the
 //                        number of inversions, O(N log N), and the final velocities are the
 //                        initial ones sorted
+//   three_body_spiral    N = 3 finite masses, one e < 1 for both pairs: the AB/BC cycle is a
+//                        2x2 map of trace T = (1+e)^2 cos^2(alpha) - 2e and determinant e^2;
+//                        a spiral for e > r_c = tan^2(pi/4 - alpha/2), possibly an inelastic
+//                        collapse for e <= r_c. The count is walked in O(count) with exact
+//                        decisions (src/core/nbody/spiral.h), the collapse time is closed form.
+//                        e = 0: the first pair sticks, and the third body hits that cluster as
+//                        one body (engine.h, the cluster rule). Two different e: event_engine.
 //   event_engine         anything else: no count formula exists; the exact event engine
 //                        simulates every impact
 // ROS-free; every function here never throws for a validated scene (short of memory).
@@ -32,6 +39,7 @@ enum class ModelKind : std::uint8_t {
   kThreeBodyRotation = 3,
   kGhosts = 4,
   kEventEngine = 5,
+  kThreeBodySpiral = 6,
 };
 
 /// Machine-readable name, e.g. "three_body_rotation".
@@ -55,6 +63,12 @@ struct Prediction {
   std::optional<double> impact_time;          ///< two_body: time of the impact [s]
   std::optional<double> impact_position;      ///< two_body: contact point [m]
   double energy_lost = 0.0;                   ///< kinetic energy turned into heat [J]
+  // three_body_spiral only:
+  std::optional<double> critical_restitution;  ///< r_c = tan^2(pi/4 - alpha/2) [1]
+  std::optional<double> spiral_angle;          ///< phi, cos(phi) = T / (2e), when e > r_c [rad]
+  bool collapsed = false;                      ///< inelastic collapse (then infinite is true)
+  std::optional<double> collapse_time;         ///< [s] since the start
+  std::optional<double> collapse_position;     ///< where the three meet [m]
 };
 
 /// Each requires the scene its model is chosen for (chooseModel) and validate() passed.
@@ -62,6 +76,9 @@ Prediction predictNoCollisions(const Scene& scene);
 Prediction predictTwoWalls(const Scene& scene);
 Prediction predictTwoBody(const Scene& scene);
 Prediction predictGhosts(const Scene& scene);
+/// No impact_count when the walk cannot decide within 2^26 impacts (or, for a borderline
+/// decision, within the 3000 impacts walked in rationals); the reason then says so.
+Prediction predictThreeBodySpiral(const Scene& scene);
 
 /// The prediction of chooseModel(scene)'s model. Empty for three_body_rotation (the
 /// three-body analytic model answers) and for event_engine (no formula: run the engine).

@@ -1,0 +1,126 @@
+// Issue 11: the three-body spiral model and the resolved collapse, against the reference
+// points of physics.md, hand-derived values and the exact rational reference.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "collision_lab/core/nbody/engine.h"
+#include "collision_lab/core/nbody/models.h"
+#include "reference.h"
+
+namespace collision_lab {
+namespace core {
+namespace {
+
+Scene equalMasses(double e) { return Scene{{1, 1, 1}, {2, 1, 0}, {-1, 0, 0}, {e}}; }
+
+TEST(Restitution, ReferencePointsOfTheSpiralModelAndTheEngine) {
+  // physics.md, "Reference points": exact counts for x = (2, 1, 0) m, v = (-1, 0, 0) m/s.
+  const std::pair<double, std::uint64_t> counts[] = {{0.5, 3},  {0.25, 3},   {0.17, 4},  {0.1, 6},
+                                                     {0.08, 10}, {0.075, 16}, {0.072, 63}};
+  for (const auto& [e, count] : counts) {
+    const Prediction p = *predict(equalMasses(e));
+    EXPECT_EQ(p.kind, ModelKind::kThreeBodySpiral);
+    EXPECT_EQ(p.impact_count, count) << "e = " << e;
+    EXPECT_FALSE(p.collapsed);
+    ASSERT_TRUE(p.spiral_angle) << "e = " << e;
+    const EngineResult run = runEngine(equalMasses(e));
+    EXPECT_EQ(run.impact_count, count) << "e = " << e;
+    for (std::size_t k = 0; k < 3; ++k) EXPECT_NEAR(p.final_velocities[k], run.final_velocities[k], 1e-15);
+    EXPECT_NEAR(p.energy_lost, run.energy_lost, 1e-15);
+  }
+  EXPECT_EQ(chooseModel(equalMasses(1.0)).kind, ModelKind::kThreeBodyRotation);  // e = 1 stays the paper's
+  const std::pair<double, double> collapses[] = {{0.06, 3.7313542986536}, {0.07, 4.2578666486407}, {0.071, 4.40}};
+  for (const auto& [e, time] : collapses) {
+    const Prediction p = *predict(equalMasses(e));
+    EXPECT_TRUE(p.collapsed) << "e = " << e;
+    EXPECT_TRUE(p.infinite);
+    EXPECT_FALSE(p.impact_count);
+    EXPECT_FALSE(p.spiral_angle);  // real eigenvalues below r_c
+    EXPECT_NEAR(*p.collapse_time, time, e == 0.071 ? 0.005 : 1e-12) << "e = " << e;
+    // Centre of mass: 1 m at t = 0, moving at -1/3 m/s; all the energy about it is lost.
+    EXPECT_NEAR(*p.collapse_position, 1.0 - *p.collapse_time / 3, 1e-13);
+    EXPECT_NEAR(p.energy_lost, 1.0 / 3, 1e-15);
+    const EngineResult run = runEngine(equalMasses(e));
+    ASSERT_TRUE(run.collapsed) << run.stop_message;
+    EXPECT_NEAR(*run.collapse_time, *p.collapse_time, 1e-12 * *p.collapse_time);
+    EXPECT_NEAR(*run.collapse_position, *p.collapse_position, 1e-12);
+  }
+}
+
+TEST(Restitution, CriticalRestitutionAndSpiralAngle) {
+  const auto rc = [](std::vector<double> m) {
+    return *predict(Scene{m, {2, 1, 0}, {-1, 0, 0}, {0.5}})->critical_restitution;
+  };
+  EXPECT_NEAR(rc({1, 1, 1}), 7 - 4 * std::sqrt(3.0), 1e-15);
+  EXPECT_NEAR(rc({3, 1, 2}), 3 - 2 * std::sqrt(2.0), 1e-15);
+  EXPECT_NEAR(rc({1, 2, 1}), 0.029437, 5e-7);
+  EXPECT_NEAR(rc({1, 1, 5}), 0.133939, 5e-7);
+  // The spiral angle: e exp(+-i phi) are the eigenvalues of the AB-then-BC map on the
+  // approach speeds (a, c), built here by hand for equal masses: AB (a, c) -> (-e a, c + (1+e)/2 a),
+  // BC (a, c) -> (a + (1+e)/2 c, -e c). Its trace is 2 e cos(phi) and its determinant e^2.
+  for (double e : {0.1, 0.3, 0.5, 0.8, 0.95}) {
+    const double k = (1 + e) / 2;
+    // M = BC * AB = [[1, k], [0, -e]] [[-e, 0], [k, 1]] = [[-e + k^2, k], [-e k, -e]].
+    const double trace = -e + k * k - e, det = (-e + k * k) * (-e) + e * k * k;
+    EXPECT_NEAR(det, e * e, 1e-15);
+    const double phi = *predict(equalMasses(e))->spiral_angle;
+    EXPECT_NEAR(2 * e * std::cos(phi), trace, 1e-14) << "e = " << e;
+  }
+}
+
+TEST(Restitution, CollapseTimesAreTheLimitOfTheExactImpactTimes) {
+  struct Case {
+    std::vector<double> m;
+    double e;
+  };
+  // Below r_c: equal masses (0.0718), (3, 1, 2) (0.1716), (1, 2, 1) (0.0294), (1, 1, 5) (0.1339).
+  const Case cases[] = {{{1, 1, 1}, 0.06}, {{1, 1, 1}, 0.07}, {{1, 1, 1}, 0.05},
+                        {{3, 1, 2}, 0.12}, {{1, 2, 1}, 0.02}, {{1, 1, 5}, 0.1}};
+  for (const Case& c : cases) {
+    const Scene s{c.m, {2, 1, 0}, {-1, 0, 0}, {c.e}};
+    const Prediction p = *predict(s);
+    ASSERT_TRUE(p.collapsed) << "e = " << c.e;
+    const EngineResult run = runEngine(s);
+    ASSERT_TRUE(run.collapsed) << run.stop_message;
+    EXPECT_NEAR(*run.collapse_time, *p.collapse_time, 1e-13 * *p.collapse_time);
+    // The exact impact times (rationals, every impact) converge geometrically to the limit.
+    const reference::Run exact = reference::simulate(s, 120);
+    ASSERT_TRUE(exact.truncated);
+    const auto& ev = exact.events;
+    const std::size_t n = ev.size();
+    // Aitken's limit, in rationals, of every second impact time (one pair's impacts).
+    const reference::Rational t1 = ev[n - 5].time, t2 = ev[n - 3].time, t3 = ev[n - 1].time;
+    const double limit = static_cast<double>(reference::Rational(t3 - (t3 - t2) * (t3 - t2) / ((t3 - t2) - (t2 - t1))));
+    EXPECT_NEAR(*run.collapse_time, limit, 1e-12 * limit) << "m = " << c.m[0] << "," << c.m[1] << "," << c.m[2];
+    EXPECT_LE(static_cast<double>(ev[n - 1].time), *run.collapse_time);
+  }
+}
+
+TEST(Restitution, ZeroRestitutionSticksAndTheClusterIsHitAsOneBody) {
+  // A sticks to B at 1 s, the pair (2 kg, -0.5 m/s) sticks to C at 3 s: two impacts, all
+  // three at -1/3 m/s, by the model and by the engine.
+  const Prediction p = *predict(equalMasses(0.0));
+  EXPECT_EQ(p.impact_count, 2u);
+  EXPECT_FALSE(p.collapsed);
+  for (double v : p.final_velocities) EXPECT_DOUBLE_EQ(v, -1.0 / 3);
+  const EngineResult run = runEngine(equalMasses(0.0));
+  EXPECT_EQ(run.impact_count, 2u);
+  EXPECT_EQ(run.cluster_impacts, 1u);
+  EXPECT_EQ(run.stop, StopReason::kFinished);
+  // A collapse leaves a cluster that a fourth body then hits as one body of 3 kg: D at
+  // -3 m, 1 m/s reaches the cluster (at -1/3 m/s) well after the collapse (t = 3.73 s).
+  const Scene four{{1, 1, 1, 1}, {2, 1, 0, -30}, {-1, 0, 0, 1}, {0.06}};
+  const EngineResult hit = runEngine(four);
+  ASSERT_TRUE(hit.collapsed) << hit.stop_message;
+  EXPECT_EQ(hit.cluster_impacts, 1u);
+  // By hand, e = 0.06, cluster 3 kg at -1/3, D 1 kg at 1: V = 0, relative -4/3:
+  // v_cluster' = 0 - 0.06 * 1 * (-4/3) / 4 = 0.02, v_D' = 0 + 0.06 * 3 * (-4/3) / 4 = -0.06.
+  for (std::size_t k = 0; k < 3; ++k) EXPECT_NEAR(hit.final_velocities[k], 0.02, 1e-15);
+  EXPECT_NEAR(hit.final_velocities[3], -0.06, 1e-15);
+  EXPECT_NEAR(hit.energy_lost + 0.5 * 3 * 0.02 * 0.02 + 0.5 * 0.06 * 0.06, 0.5 + 0.5, 1e-14);
+}
+
+}  // namespace
+}  // namespace core
+}  // namespace collision_lab
