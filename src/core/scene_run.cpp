@@ -25,6 +25,9 @@ SceneSimulation fromPrediction(const Prediction& prediction) {
   simulation.impact_count = prediction.impact_count.value_or(0);
   simulation.final_velocities = prediction.final_velocities;
   simulation.energy_lost = prediction.energy_lost;
+  simulation.collapsed = prediction.collapsed;
+  simulation.collapse_time = prediction.collapse_time;
+  simulation.collapse_position = prediction.collapse_position;
   simulation.energy_relative_drift = std::numeric_limits<double>::quiet_NaN();
   simulation.momentum_relative_drift = std::numeric_limits<double>::quiet_NaN();
   simulation.stop_message = std::string("answered by the closed form of ") + modelKindName(prediction.kind) +
@@ -65,6 +68,11 @@ SceneSimulation fromEngine(EngineResult&& engine) {
   simulation.final_time = engine.final_time;
   simulation.final_velocities = std::move(engine.final_velocities);
   simulation.energy_lost = engine.energy_lost;
+  simulation.collapsed = engine.collapsed;
+  simulation.collapse_time = engine.collapse_time;
+  simulation.collapse_position = engine.collapse_position;
+  simulation.collapses = std::move(engine.collapses);
+  simulation.cluster_impacts = engine.cluster_impacts;
   simulation.energy_relative_drift = engine.energy_relative_drift;
   simulation.momentum_relative_drift = engine.momentum_relative_drift;
   simulation.escalations = engine.escalations;

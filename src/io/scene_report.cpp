@@ -162,6 +162,7 @@ class SceneTableWriter : public SceneReportWriter {
     if (!p || (!p->impact_count && !p->infinite)) out_ << "count formula: " << kNoCountFormula << "\n";
     out_ << "truncated: " << (s.truncated ? "yes" : "no") << "; end of run: " << s.stop_message << "\n";
     if (!std::isnan(s.energy_lost)) out_ << "energy lost [J]: " << humanText(s.energy_lost, kDigits) << "\n";
+    writeRestitution(s, p);
     if (s.simulated) writeChecks(s);
     if (!s.final_velocities.empty()) {
       const std::vector<double>* predicted =
@@ -183,6 +184,25 @@ class SceneTableWriter : public SceneReportWriter {
     if (!p) return "- (no closed form)";
     if (p->infinite) return "infinitely many";
     return p->impact_count ? std::to_string(*p->impact_count) : "-";
+  }
+
+  /// The three-body spiral's constants, a collapse and the cluster rule, when they apply.
+  void writeRestitution(const core::SceneSimulation& s, const std::optional<core::Prediction>& p) {
+    if (p && p->critical_restitution) {
+      out_ << "three-body spiral: critical restitution r_c = tan^2(pi/4 - alpha/2) = "
+           << humanText(*p->critical_restitution, kDigits);
+      if (p->spiral_angle) out_ << ", spiral angle phi = " << humanText(*p->spiral_angle, kDigits) << " rad";
+      out_ << "\n";
+    }
+    if (s.collapsed && s.collapse_time && s.collapse_position) {
+      out_ << "inelastic collapse" << (s.simulated ? "" : " (predicted)") << ": infinitely many impacts before t = "
+           << humanText(*s.collapse_time, kDigits) << " s, the bodies meet at x = "
+           << humanText(*s.collapse_position, kDigits) << " m and move on as one\n";
+    }
+    if (s.cluster_impacts > 0) {
+      out_ << "cluster rule: " << s.cluster_impacts
+           << " impacts hit a cluster (stuck or collapsed) as one body of its total mass\n";
+    }
   }
 
   void writeChecks(const core::SceneSimulation& s) {
@@ -254,6 +274,12 @@ Json summaryScalars(const core::SceneRunResult& result) {
             {"energy_relative_drift", number(s.energy_relative_drift)},
             {"momentum_relative_drift", number(s.momentum_relative_drift)},
             {"compute_time_s", number(result.compute_time_s)}};
+  json["collapsed"] = s.collapsed;
+  json["collapse_time"] = s.collapse_time ? number(*s.collapse_time) : Json(nullptr);
+  json["collapse_position"] = s.collapse_position ? number(*s.collapse_position) : Json(nullptr);
+  json["cluster_impacts"] = s.cluster_impacts;
+  json["critical_restitution"] = p && p->critical_restitution ? number(*p->critical_restitution) : Json(nullptr);
+  json["spiral_angle"] = p && p->spiral_angle ? number(*p->spiral_angle) : Json(nullptr);
   json["multiple_collision"] = nullptr;
   if (s.multiple_collision) {
     const std::size_t b = s.multiple_collision->first_body;

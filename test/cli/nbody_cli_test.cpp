@@ -3,6 +3,8 @@
 // inversion count by a plain O(N^2) loop: none shares code with the program.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <unistd.h>
 
 #include <algorithm>
@@ -143,9 +145,10 @@ TEST(NBodyCli, RestitutionScalesTheRelativeVelocityAndLosesEnergy) {
     EXPECT_DOUBLE_EQ(doc.at("events")[0].at("energy_lost").get<double>(), lost) << e;
     EXPECT_EQ(doubles(doc.at("scene").at("restitution")), std::vector<double>{ev});
   }
-  const Json preset = runPreset("inelastic_carts");
-  EXPECT_EQ(doubles(preset.at("summary").at("final_velocities")), (std::vector<double>{0.5, -0.5}));
-  EXPECT_DOUBLE_EQ(preset.at("summary").at("energy_lost").get<double>(), 0.75);
+  // The preset: e = 0.8 on a relative speed of 2 m/s, so +-0.8 m/s after; heat 1 J - 0.64 J.
+  const Json preset = runPreset("two_carts_inelastic");
+  EXPECT_EQ(doubles(preset.at("summary").at("final_velocities")), (std::vector<double>{0.8, -0.8}));
+  EXPECT_NEAR(preset.at("summary").at("energy_lost").get<double>(), 0.36, 1e-15);
 }
 
 // Newton's cradle with gaps (shared/physics.md): the pulse runs down the chain, one impact
@@ -353,6 +356,52 @@ TEST(NBodyCli, TableOfManyBodiesShowsTheEndsAndSaysHowManyItLeavesOut) {
   const Json doc = runJson({"--masses", masses, "--positions", positions, "--velocities", velocities});
   EXPECT_EQ(doc.at("scene").at("masses").size(), 30u);
   EXPECT_EQ(doc.at("summary").at("final_velocities").size(), 30u);
+}
+
+// Restitution presets (issue 11), each against numbers derived by hand or in physics.md.
+
+// A ball between two walls 1 m apart, e = 0.9, starting at 0.5 m moving at 1 m/s: after k
+// bounces its speed is 0.9^k m/s, so bounce k + 1 comes 1 / 0.9^k s after bounce k.
+TEST(NBodyCli, BouncingBallTimesFormAGeometricSeries) {
+  const Json doc = runPreset("bouncing_ball_wall", {"--events", "all"});
+  const Json& summary = doc.at("summary");
+  EXPECT_EQ(summary.at("model"), "two_walls_infinite");
+  EXPECT_EQ(summary.at("truncated"), true);
+  ASSERT_EQ(doc.at("events").size(), 50u);
+  long double time = 0.5L, speed = 1.0L;
+  for (std::size_t k = 0; k < 50; ++k) {
+    const Json& event = doc.at("events")[k];
+    EXPECT_NEAR(event.at("time").get<double>(), static_cast<double>(time), 1e-12 * static_cast<double>(time)) << k;
+    speed *= 0.9L;
+    time += 1.0L / speed;
+  }
+  // Heat: the kinetic energy 1/2 m v^2 lost over 50 bounces, 1/2 (1 - 0.81^50) J.
+  EXPECT_NEAR(summary.at("energy_lost").get<double>(), 0.5 * (1 - std::pow(0.81, 50)), 1e-14);
+}
+
+// Three equal masses from x = (2, 1, 0) m, v = (-1, 0, 0) m/s (physics.md, Restitution):
+// e = 0.072 gives 63 impacts; e = 0.05 < r_c = 7 - 4 sqrt 3 collapses, after which all three
+// move at the centre-of-mass velocity -1/3 m/s, and 1/2 - 3/2 (1/3)^2 = 1/3 J is heat.
+TEST(NBodyCli, NearCollapseAndCollapseOfThreeEqualMasses) {
+  const Json near = runPreset("near_collapse").at("summary");
+  EXPECT_EQ(near.at("model"), "three_body_spiral");
+  EXPECT_EQ(near.at("predicted_collision_count"), 63);
+  EXPECT_EQ(near.at("collapsed"), false);
+  EXPECT_NEAR(near.at("critical_restitution").get<double>(), 7 - 4 * std::sqrt(3.0), 1e-15);
+
+  const Json collapse = runPreset("collapse_equal", {"--events", "all"});
+  const Json& summary = collapse.at("summary");
+  EXPECT_EQ(summary.at("model"), "three_body_spiral");
+  EXPECT_EQ(summary.at("collapsed"), true);
+  EXPECT_EQ(summary.at("truncated"), false);
+  for (double v : doubles(summary.at("final_velocities"))) EXPECT_NEAR(v, -1.0 / 3, 1e-15);
+  EXPECT_NEAR(summary.at("energy_lost").get<double>(), 1.0 / 3, 1e-15);
+  // The collapse comes after the last impact the engine performed, and the bodies meet at
+  // the centre of mass then: x_cm(t) = 1 - t / 3.
+  const double t_c = summary.at("collapse_time").get<double>();
+  EXPECT_GT(t_c, collapse.at("events").back().at("time").get<double>());
+  EXPECT_NEAR(summary.at("collapse_position").get<double>(), 1 - t_c / 3, 1e-12);
+  EXPECT_TRUE(summary.at("spiral_angle").is_null());  // real eigenvalues: no spiral
 }
 
 }  // namespace

@@ -128,7 +128,7 @@ TEST(ScenarioFile, PresetsLoadInFileOrderAndAreValid) {
 
 TEST(ScenarioFile, PresetsOfAnySizeLoadAndAreValid) {
   const std::vector<SceneEntry> scenes = loadScenes(COLLISION_LAB_SOURCE_DIR "/config/scenarios.yaml");
-  ASSERT_EQ(scenes.size(), 18u);
+  ASSERT_EQ(scenes.size(), 21u);
   for (const SceneEntry& entry : scenes) {
     EXPECT_FALSE(collision_lab::core::validateForRun(entry.scene).has_value()) << entry.name;
     EXPECT_FALSE(entry.description.empty()) << entry.name;
@@ -141,11 +141,12 @@ TEST(ScenarioFile, PresetsOfAnySizeLoadAndAreValid) {
     EXPECT_TRUE(gas.scene.masses[i] >= 1.0 && gas.scene.masses[i] <= 2.0) << i;
     EXPECT_TRUE(gas.scene.velocities[i] >= -1.0 && gas.scene.velocities[i] <= 1.0) << i;
   }
-  EXPECT_EQ(findScene(scenes, "inelastic_carts").scene.restitution, std::vector<double>{0.5});
+  EXPECT_EQ(findScene(scenes, "two_carts_inelastic").scene.restitution, std::vector<double>{0.8});
   // The three-body view (the ROS node's) skips the others and names them.
   std::vector<std::string> skipped;
   EXPECT_EQ(loadScenarioFile(COLLISION_LAB_SOURCE_DIR "/config/scenarios.yaml", &skipped).size(), 12u);
-  EXPECT_EQ(skipped, (std::vector<std::string>{"two_carts", "inelastic_carts", "cradle_5", "ball_between_walls",
+  EXPECT_EQ(skipped, (std::vector<std::string>{"two_carts", "two_carts_inelastic", "cradle_5", "ball_between_walls",
+                                               "bouncing_ball_wall", "collapse_equal", "near_collapse",
                                                "equal_masses_100", "gas_1000"}));
 }
 

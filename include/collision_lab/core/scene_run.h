@@ -51,6 +51,15 @@ struct SceneSimulation {
   double final_time = 0.0;               ///< time of the last impact [s]
   std::vector<double> final_velocities;  ///< [m/s]; the predicted ones when not simulated
   double energy_lost = 0.0;              ///< total kinetic energy turned into heat [J]; NaN: not known
+  /// An inelastic collapse was resolved (simulated) or is predicted (closed form alone):
+  /// infinitely many impacts before collapse_time, then the bodies move as one cluster.
+  bool collapsed = false;
+  std::optional<double> collapse_time;      ///< of the first collapse [s]
+  std::optional<double> collapse_position;  ///< where its bodies meet [m]
+  std::vector<Collapse> collapses;          ///< every collapse the engine resolved, in order
+  /// Impacts in which a cluster (stuck by e = 0 or left by a collapse) was hit as one body
+  /// of its total mass (the cluster rule, nbody/engine.h).
+  std::uint64_t cluster_impacts = 0;
   double energy_relative_drift = 0.0;    ///< as EngineResult; NaN when not simulated
   double momentum_relative_drift = 0.0;  ///< as EngineResult; NaN when not simulated or with a wall
   /// Simulated and predicted with a finite count: the engine's count equals it and
