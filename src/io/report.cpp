@@ -7,6 +7,8 @@
 
 #include "collision_lab/io/number_text.h"
 
+#include "report_text.h"
+
 namespace collision_lab {
 namespace io {
 
@@ -24,25 +26,10 @@ std::string roundTripText(double value) {
   return std::string(buffer, result.ptr);
 }
 
-/// Compact text for people, `digits` significant digits; -0 is shown as 0, any NaN as nan.
-std::string humanText(double value, int digits) {
-  if (value == 0.0) return "0";
-  if (std::isnan(value)) return "nan";
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, "%.*g", digits, value);
-  return buffer;
-}
-
-std::string padLeft(const std::string& text, std::size_t width) {
-  return text.size() >= width ? text : std::string(width - text.size(), ' ') + text;
-}
-
-std::string padRight(const std::string& text, std::size_t width) {
-  return text.size() >= width ? text : text + std::string(width - text.size(), ' ');
-}
-
-/// A double for JSON: never a negative zero (NaN and infinities become null when dumped).
-Json number(double value) { return Json(value == 0 ? 0.0 : value); }
+using report_text::humanText;
+using report_text::number;
+using report_text::padLeft;
+using report_text::padRight;
 
 Json array3(const std::array<double, 3>& values) {
   return Json::array({number(values[0]), number(values[1]), number(values[2])});

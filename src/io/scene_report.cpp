@@ -6,6 +6,8 @@
 #include <cstdint>
 #include <cstdio>
 
+#include "report_text.h"
+
 namespace collision_lab {
 namespace io {
 
@@ -28,25 +30,10 @@ std::string csvNumber(double value) {
   return exactText(value, "nan");
 }
 
-/// Compact text for people, `digits` significant digits; never -0.
-std::string humanText(double value, int digits) {
-  if (value == 0.0) return "0";
-  if (std::isnan(value)) return "nan";
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, "%.*g", digits, value);
-  return buffer;
-}
-
-std::string padLeft(const std::string& text, std::size_t width) {
-  return text.size() >= width ? text : std::string(width - text.size(), ' ') + text;
-}
-
-std::string padRight(const std::string& text, std::size_t width) {
-  return text.size() >= width ? text : text + std::string(width - text.size(), ' ');
-}
-
-/// A double for JSON: never -0; NaN and infinities become null when dumped.
-Json number(double value) { return Json(value == 0 ? 0.0 : value); }
+using report_text::humanText;
+using report_text::number;
+using report_text::padLeft;
+using report_text::padRight;
 
 /// A JSON array of doubles, streamed without building a document (10^6 bodies).
 void writeJsonNumbers(std::ostream& out, const std::vector<double>& values) {

@@ -1,0 +1,37 @@
+// Text helpers shared by the three-body report (report.cpp) and the N-body report
+// (scene_report.cpp). Internal to collision_lab_io.
+#pragma once
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "collision_lab/io/report.h"  // Json
+
+namespace collision_lab {
+namespace io {
+namespace report_text {
+
+/// Compact text for people, `digits` significant digits; -0 is shown as 0, any NaN as nan.
+inline std::string humanText(double value, int digits) {
+  if (value == 0.0) return "0";
+  if (std::isnan(value)) return "nan";
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.*g", digits, value);
+  return buffer;
+}
+
+inline std::string padLeft(const std::string& text, std::size_t width) {
+  return text.size() >= width ? text : std::string(width - text.size(), ' ') + text;
+}
+
+inline std::string padRight(const std::string& text, std::size_t width) {
+  return text.size() >= width ? text : text + std::string(width - text.size(), ' ');
+}
+
+/// A double for JSON: never a negative zero (NaN and infinities become null when dumped).
+inline Json number(double value) { return Json(value == 0 ? 0.0 : value); }
+
+}  // namespace report_text
+}  // namespace io
+}  // namespace collision_lab
