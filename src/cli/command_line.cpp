@@ -220,6 +220,40 @@ io::ReportFormat requestedFormat(const std::vector<std::string>& args) {
   return format.value_or(io::ReportFormat::kTable);
 }
 
+/// The options and their help texts, read into `raw`.
+void declareOptions(CLI::App& app, RawOptions& raw) {
+  app.add_option("--masses", raw.masses, "m_A,m_B,... [kg], one per body, right to left; inf makes an end body a wall");
+  app.add_option("--positions", raw.positions, "x_A,x_B,... [m], strictly decreasing");
+  app.add_option("--velocities", raw.velocities, "v_A,v_B,... [m/s]; negative values are fine");
+  app.add_option(
+      "--bodies", raw.bodies, "CSV file with the header mass,position,velocity, one body per line, right to left; - reads stdin");
+  app.add_option(
+      "--restitution", raw.restitution, "e in [0,1] for every pair, or e_AB,e_BC,... one per pair (default 1: elastic)");
+  app.add_option(
+      "--max-collisions", raw.max_collisions, "stop after N collisions and mark the run truncated (default 10000000)");
+  app.add_option(
+      "--events", raw.events, "events to print: all|none|first:N (default all; none when running every scenario)");
+  app.add_option("--format", raw.format, "table|json|csv (default table)");
+  app.add_option("--precision", raw.precision, "working precision: double|long_double|high (default double)");
+  app.add_option("--mode", raw.mode, "full|predict|summary (default full)");
+  app.add_option("--scenario", raw.scenario, "scenario file (YAML); without --name runs every scene in it");
+  app.add_option("--name", raw.name, "scene of the scenario file (default file: the package's presets)");
+  app.add_flag("--list", raw.list, "list the scenes of the scenario file");
+}
+
+/// Which options the user gave (a default value is not a choice).
+void markGiven(const CLI::App& app, RawOptions& raw) {
+  raw.masses_given = app.count("--masses") > 0;
+  raw.positions_given = app.count("--positions") > 0;
+  raw.velocities_given = app.count("--velocities") > 0;
+  raw.bodies_given = app.count("--bodies") > 0;
+  raw.restitution_given = app.count("--restitution") > 0;
+  raw.max_collisions_given = app.count("--max-collisions") > 0;
+  raw.events_given = app.count("--events") > 0;
+  raw.scenario_given = app.count("--scenario") > 0;
+  raw.name_given = app.count("--name") > 0;
+}
+
 CliRequest parseCommandLine(const std::vector<std::string>& args, const std::string& default_scenario_path) {
   RawOptions raw;
   CLI::App app{
@@ -227,28 +261,7 @@ CliRequest parseCommandLine(const std::vector<std::string>& args, const std::str
       "each scene needs; three elastic bodies beside the correct closed-form predictions and the paper's "
       "printed formulas (SI units).",
       "collision_lab_cli"};
-  const CLI::Option* masses =
-      app.add_option("--masses", raw.masses, "m_A,m_B,... [kg], one per body, right to left; inf makes an end body a wall");
-  const CLI::Option* positions =
-      app.add_option("--positions", raw.positions, "x_A,x_B,... [m], strictly decreasing");
-  const CLI::Option* velocities =
-      app.add_option("--velocities", raw.velocities, "v_A,v_B,... [m/s]; negative values are fine");
-  const CLI::Option* bodies = app.add_option(
-      "--bodies", raw.bodies, "CSV file with the header mass,position,velocity, one body per line, right to left; - reads stdin");
-  const CLI::Option* restitution = app.add_option(
-      "--restitution", raw.restitution, "e in [0,1] for every pair, or e_AB,e_BC,... one per pair (default 1: elastic)");
-  const CLI::Option* max_collisions = app.add_option(
-      "--max-collisions", raw.max_collisions, "stop after N collisions and mark the run truncated (default 10000000)");
-  const CLI::Option* events = app.add_option(
-      "--events", raw.events, "events to print: all|none|first:N (default all; none when running every scenario)");
-  app.add_option("--format", raw.format, "table|json|csv (default table)");
-  app.add_option("--precision", raw.precision, "working precision: double|long_double|high (default double)");
-  app.add_option("--mode", raw.mode, "full|predict|summary (default full)");
-  const CLI::Option* scenario =
-      app.add_option("--scenario", raw.scenario, "scenario file (YAML); without --name runs every scene in it");
-  const CLI::Option* name =
-      app.add_option("--name", raw.name, "scene of the scenario file (default file: the package's presets)");
-  app.add_flag("--list", raw.list, "list the scenes of the scenario file");
+  declareOptions(app, raw);
   app.allow_extras();  // reported below in the user's order, with a hint
 
   CliRequest request;
@@ -270,15 +283,7 @@ CliRequest parseCommandLine(const std::vector<std::string>& args, const std::str
                        "unexpected arguments:" + unexpected +
                            " (lists are comma-separated without blanks, e.g. --velocities -1,0,0; see --help)");
   }
-  raw.masses_given = masses->count() > 0;
-  raw.positions_given = positions->count() > 0;
-  raw.velocities_given = velocities->count() > 0;
-  raw.bodies_given = bodies->count() > 0;
-  raw.restitution_given = restitution->count() > 0;
-  raw.max_collisions_given = max_collisions->count() > 0;
-  raw.events_given = events->count() > 0;
-  raw.scenario_given = scenario->count() > 0;
-  raw.name_given = name->count() > 0;
+  markGiven(app, raw);
 
   readRunOptions(raw, request);
   readSceneSource(raw, default_scenario_path, request);
