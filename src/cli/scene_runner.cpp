@@ -21,9 +21,8 @@ std::atomic<bool> g_cancel{false};
 
 extern "C" void onInterrupt(int) { g_cancel.store(true); }
 
-/// SIGINT sets the cancel flag while an N-body run lasts; the previous handler (the
-/// default: end the process) is back afterwards. The three-body path has no cancel flag,
-/// so it runs without the guard and Ctrl-C ends it as before.
+/// SIGINT sets the cancel flag while a report is made; the previous handler (the default:
+/// end the process) is back afterwards.
 class InterruptGuard {
  public:
   InterruptGuard() {
@@ -82,8 +81,6 @@ core::SceneRunResult runWithProgress(const core::Scene& scene, const core::RunOp
       progress->onCollision(event.event.index);
     };
   }
-  if (core::usesThreeBodyPath(scene)) return core::runScene(scene, options, visitors);  // Ctrl-C ends it
-  const InterruptGuard interrupt_guard;
   return core::runScene(scene, options, visitors);
 }
 
@@ -106,6 +103,7 @@ core::SceneVisitors showEvents(const core::RunOptions& shown, io::RunReportWrite
 }  // namespace
 
 void runEntry(const CliRequest& request, const io::SceneEntry& given) {
+  const InterruptGuard interrupt_guard;  // from the first byte out, so Ctrl-C never cuts a report
   const io::SceneEntry entry = withRequestRestitution(request, given);
   validateOrThrow(entry);
   const core::RunOptions shown = optionsFor(request, entry);
@@ -127,6 +125,7 @@ void runEntry(const CliRequest& request, const io::SceneEntry& given) {
 }
 
 void runEntries(const CliRequest& request, const std::vector<io::SceneEntry>& given) {
+  const InterruptGuard interrupt_guard;  // Ctrl-C cuts every remaining run short; the report is whole
   std::vector<io::SceneEntry> entries;
   for (const io::SceneEntry& entry : given) entries.push_back(withRequestRestitution(request, entry));
   for (const io::SceneEntry& entry : entries) validateOrThrow(entry);
@@ -135,6 +134,7 @@ void runEntries(const CliRequest& request, const std::vector<io::SceneEntry>& gi
     const core::RunOptions options = optionsFor(request, entry);
     core::SceneRunOptions run_options;
     run_options.lab = options;  // the three-body path keeps the events that the options ask for
+    run_options.cancel = &g_cancel;
     outcomes.push_back({entry, options, core::runScene(entry.scene, run_options)});
   }
   io::writeSceneBatchReport(request.format, outcomes, std::cout);

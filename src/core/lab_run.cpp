@@ -140,6 +140,7 @@ void simulateBesidePrediction(const ThreeBodyScene& scene, const RunOptions& opt
   const ClosedForm model(scene);
   SimulationOptions simulation_options;
   simulation_options.max_collisions = options.max_collisions;
+  simulation_options.cancel = options.cancel;
   EventVisitor enrich;
   std::array<double, 3> previous_before = scene.velocities;
   if (options.mode == RunMode::kFull) {
@@ -156,7 +157,11 @@ void simulateBesidePrediction(const ThreeBodyScene& scene, const RunOptions& opt
   summary.simulated = true;
   summary.collision_count = simulation.collision_count;
   summary.truncated = simulation.truncated;
-  if (simulation.truncated) {
+  summary.cancelled = simulation.cancelled;
+  if (simulation.cancelled) {
+    summary.truncation_reason = "cancelled after " + std::to_string(simulation.collision_count) + " of " +
+                                std::to_string(result.prediction.collision_count) + " predicted";
+  } else if (simulation.truncated) {
     summary.truncation_reason = "stopped at max_collisions = " + std::to_string(options.max_collisions) + " of " +
                                 std::to_string(result.prediction.collision_count) + " predicted";
   }

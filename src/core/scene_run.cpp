@@ -147,6 +147,7 @@ SceneRunResult runScene(const Scene& scene, const SceneRunOptions& options, cons
   if (usesThreeBodyPath(scene)) {
     RunOptions lab = options.lab;
     if (!options.keep_events) lab.events = EventPolicy::none();
+    lab.cancel = options.cancel;
     result.three_body = runLab(toThreeBodyScene(scene), lab, visitors.three_body_event);
   } else {
     result.prediction = predict(scene);

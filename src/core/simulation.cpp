@@ -647,11 +647,15 @@ class EngineRun {
 
  private:
   /// Does `pair` collide next? False when it does not approach, and when max_collisions
-  /// stops the run (marked truncated).
+  /// or the cancel flag (read every 1024 collisions) stops the run (marked truncated).
   bool nextImpact(Decider<Scalar>& decider, Pair pair) {
     if (!decider.approaches(pair, k_, v_, result_.escalation)) return false;
     if (k_ == options_.max_collisions) {
       result_.truncated = true;
+      return false;
+    }
+    if (options_.cancel && (k_ & 1023) == 1023 && options_.cancel->load(std::memory_order_relaxed)) {
+      result_.truncated = result_.cancelled = true;
       return false;
     }
     return true;

@@ -423,6 +423,7 @@ Json summaryJson(const core::RunResult& result) {
   const core::LabRunSummary& s = result.summary;
   return Json{{"collision_count", s.collision_count},
               {"truncated", s.truncated},
+              {"cancelled", s.cancelled},
               {"truncation_reason", s.truncation_reason},
               {"simulated", s.simulated},
               {"final_velocities", array3(s.final_velocities)},

@@ -3,6 +3,9 @@
 // References: exact rationals (rational_reference.h), conservation, hand-derived numbers.
 #include <gtest/gtest.h>
 
+#include <boost/multiprecision/cpp_bin_float.hpp>
+
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -77,6 +80,39 @@ double exactGain(const ThreeBodyScene& scene, const reference::Run& truth, std::
   const Q before = k == 0 ? Q(scene.velocities[i]) : truth.impacts[k - 1].velocities[i];
   const Q after = truth.impacts[k].velocities[i];
   return static_cast<double>(reference::toWide(Q(scene.masses[i]) * (after * after - before * before) / 2));
+}
+
+// Ctrl-C: a set cancel flag stops the run at the next check (every 1024 collisions), with
+// the summary of what was done: 1023 collisions, the state the closed form gives after
+// them, and truncated + cancelled. (1e12, 1, 1e12) would give 2,221,441 (physics.md).
+TEST(LabRunCancel, ASetFlagStopsAtTheNextCheckWithThePartialSummary) {
+  const ThreeBodyScene scene{{1e12, 1, 1e12}, {2, 1, 0}, {-1, 0, 0}};
+  const std::atomic<bool> cancel{true};
+  for (const bool events : {false, true}) {
+    RunOptions options;
+    options.cancel = &cancel;
+    options.events = events ? EventPolicy::all() : EventPolicy::none();
+    const RunResult result = runLab(scene, options);
+    EXPECT_EQ(result.summary.collision_count, 1023u) << events;
+    EXPECT_TRUE(result.summary.truncated);
+    EXPECT_TRUE(result.summary.cancelled);
+    EXPECT_NE(result.summary.truncation_reason.find("cancelled after 1023 of 2221441"), std::string::npos)
+        << result.summary.truncation_reason;
+    // Reference: the textbook impact rule applied 1023 times at 50 digits.
+    using Fifty = boost::multiprecision::cpp_bin_float_50;
+    std::array<Fifty, 3> v{Fifty(-1), Fifty(0), Fifty(0)};
+    const Fifty ma(1e12), mb(1), mc(1e12);
+    for (int k = 0; k < 1023; ++k) {
+      const int l = k % 2;  // AB first, then alternating
+      const Fifty m_l = l == 0 ? ma : mb, m_r = l == 0 ? mb : mc;
+      const Fifty left = v[l], right = v[l + 1];
+      v[l] = ((m_l - m_r) * left + 2 * m_r * right) / (m_l + m_r);
+      v[l + 1] = (2 * m_l * left + (m_r - m_l) * right) / (m_l + m_r);
+    }
+    for (int i = 0; i < 3; ++i) {
+      EXPECT_NEAR(result.summary.final_velocities[i], static_cast<double>(v[i]), 1e-12) << i;
+    }
+  }
 }
 
 TEST(EnergyTransferPerImpact, NonParticipantsAndRestingWallsGainExactlyZero) {

@@ -56,6 +56,9 @@ struct RunOptions {
   /// When the predicted count exceeds max_collisions, answer at once with the prediction
   /// and a truncated summary instead of simulating up to the cap.
   bool skip_simulation_over_cap = false;
+  /// When set (by a signal handler or another thread), the simulation stops within 1024
+  /// collisions, marked truncated and cancelled.
+  const std::atomic<bool>* cancel = nullptr;
 };
 
 /// A run that was not simulated (predict-only, or skipped over the cap) measured nothing:
@@ -65,6 +68,7 @@ struct LabRunSummary {
   std::uint64_t collision_count = 0;        ///< simulated; the predicted count in predict-only mode
   bool truncated = false;
   std::string truncation_reason;            ///< empty unless truncated
+  bool cancelled = false;                   ///< truncated by RunOptions::cancel
   bool simulated = false;                   ///< false for predict-only and skipped runs
   std::array<double, 3> final_velocities{}; ///< simulated, else the closed form's after the predicted count [m/s]
   /// max over reported states of |S (v_sim - v_pred)| / |S v_0|, S = diag(sqrt(m)):

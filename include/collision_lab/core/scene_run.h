@@ -34,8 +34,9 @@ struct SceneRunOptions {
   /// False: the three-body path keeps no event in RunResult::events (the visitor still sees
   /// them all), for front ends that stream. The event engine never keeps any.
   bool keep_events = true;
-  /// When set (by a signal handler or another thread), the event engine stops within 1024
-  /// impacts, marked truncated. The three-body path has no cancel flag and ignores it.
+  /// When set (by a signal handler or another thread), the run stops within 1024 impacts,
+  /// marked truncated (the event engine's stop reason CANCELLED, the three-body summary's
+  /// cancelled flag).
   const std::atomic<bool>* cancel = nullptr;
   std::uint64_t progress_interval = std::uint64_t{1} << 20;  ///< impacts between progress calls
 };

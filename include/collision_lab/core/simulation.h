@@ -10,6 +10,7 @@
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -63,6 +64,9 @@ struct EventPolicy {
 struct SimulationOptions {
   std::uint64_t max_collisions = 10'000'000;  ///< stops the run cleanly; marks it truncated
   EventPolicy events = EventPolicy::none();
+  /// When set (by a signal handler or another thread), the run stops within 1024
+  /// collisions, marked truncated and cancelled, with the summary of what was done.
+  const std::atomic<bool>* cancel = nullptr;
 };
 
 /// Called for every collision, in order. May be empty.
@@ -77,7 +81,8 @@ struct EscalationStats {
 
 struct SimulationResult {
   std::uint64_t collision_count = 0;
-  bool truncated = false;                 ///< stopped by max_collisions
+  bool truncated = false;                 ///< stopped by max_collisions or cancelled
+  bool cancelled = false;                 ///< stopped by SimulationOptions::cancel
   std::optional<Pair> first_pair;         ///< empty when nothing ever collides
   std::array<double, 3> final_velocities{};  ///< [m/s]
   /// Positions [m] at final_time [s]: the time of the last collision (0 without any).
