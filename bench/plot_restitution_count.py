@@ -6,7 +6,7 @@ drawn as crosses at the top). Right: the count against e - r_c > 0 on a log axis
 grows like 1/sqrt(e - r_c) (the spiral angle phi shrinks), with the engine's count where an
 exact simulation reaches the end.
 
-Usage: plot_restitution_count.py --csv FILE --out FILE.png
+Usage: python3 bench/plot_restitution_count.py --csv FILE --out FILE.png
 Needs matplotlib (Debian: python3-matplotlib).
 """
 import argparse

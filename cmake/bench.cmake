@@ -26,13 +26,13 @@ target_link_libraries(collision_lab_bench_core PRIVATE collision_lab_core)
 add_executable(collision_lab_bench_nbody bench/bench_nbody.cpp)
 target_include_directories(collision_lab_bench_nbody PRIVATE src/core/nbody)  # the engine's queue, compared
 target_link_libraries(collision_lab_bench_nbody PRIVATE collision_lab_core)
-# Installed too, so that an install space can be benchmarked with rosrun.
-install(TARGETS collision_lab_bench_core collision_lab_bench_nbody
-  RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 
 add_executable(collision_lab_bench_restitution bench/bench_restitution.cpp)
 target_link_libraries(collision_lab_bench_restitution PRIVATE collision_lab_core)
 target_compile_definitions(collision_lab_bench_restitution PRIVATE COLLISION_LAB_DOCS_DIR="${PROJECT_SOURCE_DIR}/docs")
+# Installed too, so that an install space can be benchmarked with rosrun.
+install(TARGETS collision_lab_bench_core collision_lab_bench_nbody collision_lab_bench_restitution
+  RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 
 if(TARGET collision_lab_ros)
   add_executable(collision_lab_relay_node bench/node/relay_node.cpp)

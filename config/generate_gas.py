@@ -6,7 +6,7 @@ Twister, stable across versions): masses uniform in [1, 2] kg, velocities unifor
 [-1, 1] m/s, spacing 1 m, listed right to left (x = 999, 998, ..., 0 m). Numbers are
 written in their shortest round-trip form, so the file holds the exact doubles.
 
-    config/generate_gas.py > config/gas_1000.csv
+    python3 config/generate_gas.py > config/gas_1000.csv
 """
 import random
 
