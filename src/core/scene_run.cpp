@@ -117,15 +117,6 @@ ThreeBodyScene toThreeBodyScene(const Scene& scene) {
   return triple;
 }
 
-/// The message without a leading "<field>: ": front ends show field and message side by
-/// side (ValidationError's contract), and N-body validation may still start with it.
-std::optional<ValidationError> withoutRepeatedField(std::optional<ValidationError> error) {
-  if (!error) return error;
-  const std::string prefix = error->field + ": ";
-  if (error->message.compare(0, prefix.size(), prefix) == 0) error->message.erase(0, prefix.size());
-  return error;
-}
-
 std::optional<ValidationError> validateForRun(const Scene& scene) {
   if (isElasticTriple(scene)) {
     auto error = validate(toThreeBodyScene(scene));
@@ -133,7 +124,7 @@ std::optional<ValidationError> validateForRun(const Scene& scene) {
     // Walls at both ends around a body are an N-body scene now (two_walls_infinite).
     if (error->reason != Reason::kTwoWalls) return error;
   }
-  return withoutRepeatedField(validate(scene));
+  return validate(scene);
 }
 
 bool usesThreeBodyPath(const Scene& scene) {

@@ -28,9 +28,9 @@ std::string formatValue(double value) {
 
 std::string indexedField(const char* list, std::size_t i) { return std::string(list) + "[" + std::to_string(i) + "]"; }
 
-/// The message always starts with the field, so one line tells the user where to look.
+/// `field` says where; the message says what is wrong there without repeating it.
 ValidationError makeError(Reason reason, const std::string& field, const std::string& message) {
-  return ValidationError{reason, field, field + ": " + message};
+  return ValidationError{reason, field, message};
 }
 
 std::optional<ValidationError> checkShape(const Scene& scene) {

@@ -20,7 +20,9 @@ void expectRejected(const Scene& scene, Reason reason, const std::string& field)
   ASSERT_TRUE(error.has_value()) << "expected " << reasonName(reason);
   EXPECT_EQ(error->reason, reason) << error->message;
   EXPECT_EQ(error->field, field) << error->message;
-  EXPECT_EQ(error->message.rfind(field + ": ", 0), 0u) << error->message;  // starts with the field
+  // Front ends show the field beside the message, which therefore does not repeat it.
+  EXPECT_NE(error->message.rfind(field.substr(0, field.find('[')), 0), 0u) << error->message;
+  EXPECT_FALSE(error->message.empty());
 }
 
 TEST(NBodyNames, LettersThenIndices) {
