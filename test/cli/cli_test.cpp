@@ -14,36 +14,13 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cli_json.h"
 #include "cli_process.h"
 #include "collision_lab/core/exact.h"
 
 namespace {
 
-using collision_lab_test::CliOutput;
-using collision_lab_test::linesOf;
-using collision_lab_test::runCli;
-using Json = nlohmann::json;
-
-const std::string kPresets = COLLISION_LAB_SOURCE_DIR "/config/scenarios.yaml";
-
-CliOutput run(const std::vector<std::string>& args) { return runCli(args, COLLISION_LAB_SOURCE_DIR); }
-
-/// Runs with --format json and expects success and one JSON document on stdout.
-Json runJson(std::vector<std::string> args) {
-  args.insert(args.end(), {"--format", "json"});
-  const CliOutput result = run(args);
-  EXPECT_EQ(result.exit_code, 0) << result.err;
-  EXPECT_EQ(result.err, "");
-  return Json::parse(result.out);
-}
-
-Json runPreset(const std::string& name, std::vector<std::string> extra = {}) {
-  std::vector<std::string> args = {"--scenario", kPresets, "--name", name};
-  args.insert(args.end(), extra.begin(), extra.end());
-  return runJson(args);
-}
-
-std::vector<double> doubles(const Json& array) { return array.get<std::vector<double>>(); }
+using namespace collision_lab_test;  // run, runJson, runPreset, doubles, Json, kPresets
 
 TEST(CliJson, EqualMassesGiveThreeCollisionsAndSwapOuterVelocities) {
   const Json doc = runJson({"--masses", "1,1,1", "--positions", "2,1,-1", "--velocities", "-1,0,1"});

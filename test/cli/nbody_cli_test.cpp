@@ -17,36 +17,12 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cli_json.h"
 #include "cli_process.h"
 
 namespace {
 
-using collision_lab_test::CliOutput;
-using collision_lab_test::linesOf;
-using collision_lab_test::runCli;
-using Json = nlohmann::json;
-
-const std::string kPresets = COLLISION_LAB_SOURCE_DIR "/config/scenarios.yaml";
-
-CliOutput run(const std::vector<std::string>& args, const std::string& stdin_path = "/dev/null") {
-  return runCli(args, COLLISION_LAB_SOURCE_DIR, stdin_path);
-}
-
-Json runJson(std::vector<std::string> args, const std::string& stdin_path = "/dev/null") {
-  args.insert(args.end(), {"--format", "json"});
-  const CliOutput result = run(args, stdin_path);
-  EXPECT_EQ(result.exit_code, 0) << result.err;
-  EXPECT_EQ(result.err, "");
-  return Json::parse(result.out);
-}
-
-Json runPreset(const std::string& name, std::vector<std::string> extra = {}) {
-  std::vector<std::string> args = {"--scenario", kPresets, "--name", name};
-  args.insert(args.end(), extra.begin(), extra.end());
-  return runJson(args);
-}
-
-std::vector<double> doubles(const Json& array) { return array.get<std::vector<double>>(); }
+using namespace collision_lab_test;  // run, runJson, runPreset, doubles, Json, kPresets
 
 /// A unique temporary file holding `text`; removed when the object goes.
 class TempFile {
