@@ -58,7 +58,7 @@ void writeStamp(std::ostream& out, const ros::Time& stamp) {
   out << buffer;
 }
 void writeBool(std::ostream& out, std::uint8_t value) { out << (value ? "true" : "false"); }
-void writePair(std::ostream& out, std::uint8_t pair) {
+void writePair(std::ostream& out, std::uint32_t pair) {
   static_assert(collision_lab::CollisionEvent::PAIR_AB == collision_lab::Prediction::PAIR_AB &&
                     collision_lab::CollisionEvent::PAIR_BC == collision_lab::Prediction::PAIR_BC,
                 "one pair code for every message");
@@ -66,7 +66,7 @@ void writePair(std::ostream& out, std::uint8_t pair) {
     case collision_lab::Prediction::PAIR_AB: out << "AB"; return;
     case collision_lab::Prediction::PAIR_BC: out << "BC"; return;
     case collision_lab::Prediction::PAIR_NONE: out << "none"; return;
-    default: out << static_cast<int>(pair);
+    default: out << pair;
   }
 }
 void writeMode(std::ostream& out, std::uint8_t mode) {
@@ -108,18 +108,20 @@ class Table {
   Table& flag(const std::string& field, std::uint8_t M::*member) {
     return add({field, field}, [member](std::ostream& o, const M& m) { writeBool(o, m.*member); });
   }
-  Table& pair(const std::string& field, std::uint8_t M::*member) {
+  Table& pair(const std::string& field, std::uint32_t M::*member) {
     return add({field, field}, [member](std::ostream& o, const M& m) { writePair(o, m.*member); });
   }
   Table& mode(std::uint8_t M::*member) {
     return add({"mode", "mode"}, [member](std::ostream& o, const M& m) { writeMode(o, m.*member); });
   }
-  /// Three columns for A, B, C: pattern with "{}" replaced by a, b, c.
+  /// Three columns for A, B, C (bodies 0, 1, 2): pattern with "{}" replaced by a, b, c;
+  /// an empty cell for a body the array does not have.
   Table& triple(const std::string& pattern, const std::string& field,
-                boost::array<double, 3> M::*member) {
-    for (int i = 0; i < 3; ++i) {
-      add({abc(pattern, i), field},
-          [member, i](std::ostream& o, const M& m) { writeCell(o, (m.*member)[i]); });
+                std::vector<double> M::*member) {
+    for (std::size_t i = 0; i < 3; ++i) {
+      add({abc(pattern, i), field}, [member, i](std::ostream& o, const M& m) {
+        if (i < (m.*member).size()) writeCell(o, (m.*member)[i]);
+      });
     }
     return *this;
   }

@@ -95,7 +95,7 @@ class EventStream {
     }
     out_.publish(topics_.events, msg, last_time_);
     topics_.velocities.publish(toVelocitiesMsg(msg));
-    topics_.energies.publish(toEnergyTransferMsg(msg));
+    topics_.energies.publish(toEnergyTransferMsg(msg, 0.0));
     ++published_;
   }
 

@@ -1,8 +1,20 @@
 #include "collision_lab/ros/msg_conversion.h"
 
+#include <limits>
+
+#include "collision_lab/core/nbody/models.h"
+#include "collision_lab/core/wedge.h"
+
 namespace collision_lab_ros {
 
 using collision_lab::Rejected;
+
+namespace {
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+// The interim node serves three elastic bodies only (issue 12 serves any scene).
+constexpr char kThreeBodyRotationReason[] =
+    "three elastic bodies: the paper's rotation by 2 alpha per AB+BC cycle, corrected";
+}  // namespace
 
 static_assert(collision_lab::InitialConditions::MODE_FULL ==
                   static_cast<std::uint8_t>(collision_lab::core::RunMode::kFull) &&
@@ -40,12 +52,14 @@ const char* nodeReasonName(NodeReason reason) {
   return "UNKNOWN";
 }
 
-std::array<double, 3> toArray(const boost::array<double, 3>& values) {
-  return {values[0], values[1], values[2]};
+std::array<double, 3> toArray(const std::vector<double>& values) {
+  std::array<double, 3> result;
+  for (std::size_t i = 0; i < result.size(); ++i) result[i] = i < values.size() ? values[i] : kNaN;
+  return result;
 }
 
-boost::array<double, 3> toBoostArray(const std::array<double, 3>& values) {
-  return {{values[0], values[1], values[2]}};
+std::vector<double> toVector(const std::array<double, 3>& values) {
+  return {values.begin(), values.end()};
 }
 
 collision_lab::core::ThreeBodyScene toScene(const collision_lab::InitialConditions& msg) {
@@ -61,9 +75,9 @@ collision_lab::InitialConditions toInitialConditions(const collision_lab::core::
                                                      std::uint64_t max_collisions) {
   collision_lab::InitialConditions msg;
   msg.mode = static_cast<std::uint8_t>(mode);
-  msg.masses = toBoostArray(scene.masses);
-  msg.positions = toBoostArray(scene.positions);
-  msg.velocities = toBoostArray(scene.velocities);
+  msg.masses = toVector(scene.masses);
+  msg.positions = toVector(scene.positions);
+  msg.velocities = toVector(scene.velocities);
   msg.max_collisions = max_collisions;
   return msg;
 }
@@ -77,12 +91,11 @@ std::optional<collision_lab::core::RunMode> toRunMode(std::uint8_t mode) {
   }
 }
 
-std::uint8_t toPairCode(const std::optional<collision_lab::core::Pair>& pair) {
-  return pair ? static_cast<std::uint8_t>(*pair)
-              : static_cast<std::uint8_t>(collision_lab::Prediction::PAIR_NONE);
+std::uint32_t toPairCode(const std::optional<collision_lab::core::Pair>& pair) {
+  return pair ? static_cast<std::uint32_t>(*pair) : collision_lab::Prediction::PAIR_NONE;
 }
 
-std::optional<collision_lab::core::Pair> toPair(std::uint8_t code) {
+std::optional<collision_lab::core::Pair> toPair(std::uint32_t code) {
   switch (code) {
     case collision_lab::Prediction::PAIR_AB: return collision_lab::core::Pair::AB;
     case collision_lab::Prediction::PAIR_BC: return collision_lab::core::Pair::BC;
@@ -92,7 +105,13 @@ std::optional<collision_lab::core::Pair> toPair(std::uint8_t code) {
 
 collision_lab::Prediction toPredictionMsg(const collision_lab::core::AnalyticPrediction& prediction) {
   collision_lab::Prediction msg;
+  msg.model = collision_lab::Prediction::MODEL_THREE_BODY_ROTATION;
+  msg.model_name = collision_lab::core::modelKindName(collision_lab::core::ModelKind::kThreeBodyRotation);
+  msg.model_reason = kThreeBodyRotationReason;
+  msg.body_count = 3;
   msg.collision_count = prediction.collision_count;
+  msg.collision_count_defined = true;
+  msg.infinite_collisions = false;
   msg.paper_collision_count_defined = prediction.paper_collision_count.has_value();
   msg.paper_collision_count = prediction.paper_collision_count.value_or(0);
   msg.max_possible_collision_count = prediction.max_possible_collision_count;
@@ -102,7 +121,13 @@ collision_lab::Prediction toPredictionMsg(const collision_lab::core::AnalyticPre
   msg.phi_bc = prediction.phi_bc;
   msg.psi = prediction.psi;
   msg.first_pair_index = toPairCode(prediction.first_pair);
-  msg.final_velocities = toBoostArray(prediction.final_velocities);
+  msg.final_velocities = toVector(prediction.final_velocities);
+  msg.energy_lost = 0.0;
+  msg.collapsed = false;
+  msg.collapse_time = kNaN;
+  msg.collapse_position = kNaN;
+  msg.critical_restitution = collision_lab::core::criticalRestitution(prediction.angles.alpha);
+  msg.spiral_angle = prediction.angles.theta;
   return msg;
 }
 
@@ -124,19 +149,31 @@ collision_lab::core::AnalyticPrediction toPrediction(const collision_lab::Predic
 collision_lab::CollisionEvent toCollisionEventMsg(const collision_lab::core::LabEvent& event) {
   const collision_lab::core::ImpactEvent& e = event.event;
   collision_lab::CollisionEvent msg;
+  msg.kind = collision_lab::CollisionEvent::KIND_IMPACT;
   msg.index = e.index;
-  msg.pair_index = static_cast<std::uint8_t>(e.pair);
+  msg.pair_index = static_cast<std::uint32_t>(e.pair);
   msg.time = e.time;
   msg.position = e.position;
-  msg.positions = toBoostArray(e.positions);
-  msg.velocities_before = toBoostArray(e.velocities_before);
-  msg.velocities_after = toBoostArray(e.velocities_after);
-  msg.predicted_velocities_after = toBoostArray(event.predicted_velocities_after);
-  msg.paper_velocities_after = toBoostArray(event.paper_velocities_after);
-  msg.energy_transfer = toBoostArray(e.energy_transfer);
-  msg.predicted_energy_transfer = toBoostArray(event.predicted_energy_transfer);
-  msg.paper_energy_transfer = toBoostArray(event.paper_energy_transfer);
-  msg.kinetic_energy_after = toBoostArray(event.kinetic_energy_after);
+  msg.restitution = 1.0;
+  msg.first_moved = msg.pair_index;
+  msg.last_moved = msg.pair_index + 1;
+  msg.cluster_impact = false;
+  for (std::size_t side = 0; side < 2; ++side) {
+    const std::size_t body = msg.pair_index + side;
+    msg.pair_velocities_before[side] = e.velocities_before[body];
+    msg.pair_velocities_after[side] = e.velocities_after[body];
+    msg.pair_energy_transfer[side] = e.energy_transfer[body];
+  }
+  msg.energy_lost = 0.0;
+  msg.positions = toVector(e.positions);
+  msg.velocities_before = toVector(e.velocities_before);
+  msg.velocities_after = toVector(e.velocities_after);
+  msg.predicted_velocities_after = toVector(event.predicted_velocities_after);
+  msg.paper_velocities_after = toVector(event.paper_velocities_after);
+  msg.energy_transfer = toVector(e.energy_transfer);
+  msg.predicted_energy_transfer = toVector(event.predicted_energy_transfer);
+  msg.paper_energy_transfer = toVector(event.paper_energy_transfer);
+  msg.kinetic_energy_after = toVector(event.kinetic_energy_after);
   msg.total_energy = e.total_energy;
   msg.total_momentum = e.total_momentum;
   return msg;
@@ -180,20 +217,28 @@ PlotMessage plotMessageOf(const collision_lab::CollisionEvent& event) {
 
 collision_lab::Velocities toVelocitiesMsg(const collision_lab::CollisionEvent& event) {
   auto msg = plotMessageOf<collision_lab::Velocities>(event);
-  msg.v_a = event.velocities_after[0];
-  msg.v_b = event.velocities_after[1];
-  msg.v_c = event.velocities_after[2];
+  msg.v = event.velocities_after;
+  const std::array<double, 3> first_three = toArray(msg.v);
+  msg.v_a = first_three[0];
+  msg.v_b = first_three[1];
+  msg.v_c = first_three[2];
   return msg;
 }
 
-collision_lab::EnergyTransfer toEnergyTransferMsg(const collision_lab::CollisionEvent& event) {
+collision_lab::EnergyTransfer toEnergyTransferMsg(const collision_lab::CollisionEvent& event,
+                                                  double cumulative_energy_lost) {
   auto msg = plotMessageOf<collision_lab::EnergyTransfer>(event);
-  msg.delta_a = event.energy_transfer[0];
-  msg.delta_b = event.energy_transfer[1];
-  msg.delta_c = event.energy_transfer[2];
-  msg.kinetic_a = event.kinetic_energy_after[0];
-  msg.kinetic_b = event.kinetic_energy_after[1];
-  msg.kinetic_c = event.kinetic_energy_after[2];
+  msg.delta = event.energy_transfer;
+  msg.kinetic = event.kinetic_energy_after;
+  msg.energy_lost = event.energy_lost;
+  msg.cumulative_energy_lost = cumulative_energy_lost;
+  const std::array<double, 3> delta = toArray(msg.delta), kinetic = toArray(msg.kinetic);
+  msg.delta_a = delta[0];
+  msg.delta_b = delta[1];
+  msg.delta_c = delta[2];
+  msg.kinetic_a = kinetic[0];
+  msg.kinetic_b = kinetic[1];
+  msg.kinetic_c = kinetic[2];
   return msg;
 }
 
@@ -202,14 +247,32 @@ collision_lab::RunSummary toRunSummaryMsg(const collision_lab::core::LabRunSumma
                                           collision_lab::core::RunMode mode) {
   collision_lab::RunSummary msg;
   msg.mode = static_cast<std::uint8_t>(mode);
+  msg.model = collision_lab::Prediction::MODEL_THREE_BODY_ROTATION;
+  msg.model_name = collision_lab::core::modelKindName(collision_lab::core::ModelKind::kThreeBodyRotation);
+  msg.model_reason = kThreeBodyRotationReason;
+  msg.body_count = 3;
   msg.collision_count = summary.collision_count;
   msg.truncated = summary.truncated;
   msg.truncation_reason = summary.truncation_reason;
+  msg.cancelled = summary.cancelled;
+  msg.stop_reason = !summary.simulated ? "NOT_SIMULATED"
+                    : summary.cancelled ? "CANCELLED"
+                    : summary.truncated ? "CAP"
+                                        : "FINISHED";
   msg.simulated = summary.simulated;
   msg.predicted_collision_count = prediction.collision_count;
+  msg.predicted_collision_count_defined = true;
   msg.paper_predicted_collision_count_defined = prediction.paper_collision_count.has_value();
   msg.paper_predicted_collision_count = prediction.paper_collision_count.value_or(0);
-  msg.final_velocities = toBoostArray(summary.final_velocities);
+  msg.final_velocities = toVector(summary.final_velocities);
+  msg.energy_lost = 0.0;
+  msg.collapsed = false;
+  msg.collapse_time = kNaN;
+  msg.collapse_position = kNaN;
+  msg.collapse_count = 0;
+  msg.cluster_impacts = 0;
+  msg.critical_restitution = collision_lab::core::criticalRestitution(prediction.angles.alpha);
+  msg.spiral_angle = prediction.angles.theta;
   msg.max_prediction_error = summary.max_prediction_error;
   msg.energy_relative_drift = summary.energy_relative_drift;
   msg.momentum_relative_drift = summary.momentum_relative_drift;

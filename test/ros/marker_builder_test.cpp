@@ -68,7 +68,7 @@ Fed feed(const Array3& masses, const Array3& positions, const Array3& velocities
   return fed;
 }
 
-Array3 toArray(const boost::array<double, 3>& a) { return {a[0], a[1], a[2]}; }
+Array3 toArray(const std::vector<double>& a) { return {a.at(0), a.at(1), a.at(2)}; }
 
 // ---- Envelope ----
 

@@ -127,7 +127,7 @@ TEST(MsgConversion, PlotTopicsAreTheEventsSimulatedValues) {
   EXPECT_EQ(v.v_a, -1.0);
   EXPECT_EQ(v.v_b, 0.9);
   EXPECT_EQ(v.v_c, 0.2);
-  const auto t = toEnergyTransferMsg(event);
+  const auto t = toEnergyTransferMsg(event, 0.0);
   EXPECT_EQ(t.header.stamp, event.header.stamp);
   EXPECT_EQ(t.run_id, "plotted");
   EXPECT_EQ(t.index, 42u);

@@ -113,8 +113,9 @@ void expectSameMessages(const std::vector<Message>& published, const std::vector
   }
 }
 
-void expectArrayEq(const boost::array<double, 3>& actual, const std::array<double, 3>& expected,
+void expectArrayEq(const std::vector<double>& actual, const std::array<double, 3>& expected,
                    const std::string& what) {
+  ASSERT_EQ(actual.size(), 3u) << what;
   for (int i = 0; i < 3; ++i) EXPECT_EQ(actual[i], expected[i]) << what << "[" << i << "]";
 }
 

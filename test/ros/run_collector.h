@@ -125,11 +125,9 @@ inline collision_lab::InitialConditions makeInput(const std::string& run_id,
   collision_lab::InitialConditions input;
   input.header.stamp = ros::Time::now();
   input.run_id = run_id;
-  for (int i = 0; i < 3; ++i) {
-    input.masses[i] = masses[i];
-    input.positions[i] = positions[i];
-    input.velocities[i] = velocities[i];
-  }
+  input.masses.assign(masses.begin(), masses.end());
+  input.positions.assign(positions.begin(), positions.end());
+  input.velocities.assign(velocities.begin(), velocities.end());
   return input;
 }
 

@@ -10,7 +10,7 @@
 #include <optional>
 #include <string>
 
-#include <boost/array.hpp>
+#include <vector>
 
 #include "collision_lab/CollisionEvent.h"
 #include "collision_lab/EnergyTransfer.h"
@@ -33,8 +33,9 @@ enum class NodeReason : std::uint8_t {
 
 const char* nodeReasonName(NodeReason reason);
 
-std::array<double, 3> toArray(const boost::array<double, 3>& values);
-boost::array<double, 3> toBoostArray(const std::array<double, 3>& values);
+/// The first three values (bodies A, B, C); NaN for a body the list does not have.
+std::array<double, 3> toArray(const std::vector<double>& values);
+std::vector<double> toVector(const std::array<double, 3>& values);
 
 collision_lab::core::ThreeBodyScene toScene(const collision_lab::InitialConditions& msg);
 /// mode and max_collisions as given; header and run_id left for the caller.
@@ -46,8 +47,8 @@ collision_lab::InitialConditions toInitialConditions(const collision_lab::core::
 std::optional<collision_lab::core::RunMode> toRunMode(std::uint8_t mode);
 
 /// Prediction::PAIR_NONE for an empty pair.
-std::uint8_t toPairCode(const std::optional<collision_lab::core::Pair>& pair);
-std::optional<collision_lab::core::Pair> toPair(std::uint8_t code);
+std::uint32_t toPairCode(const std::optional<collision_lab::core::Pair>& pair);
+std::optional<collision_lab::core::Pair> toPair(std::uint32_t code);
 
 collision_lab::Prediction toPredictionMsg(const collision_lab::core::AnalyticPrediction& prediction);
 collision_lab::core::AnalyticPrediction toPrediction(const collision_lab::Prediction& msg);
@@ -59,7 +60,9 @@ collision_lab::core::LabEvent toLabEvent(const collision_lab::CollisionEvent& ms
 /// The plot topics' projections of a CollisionEvent (header and run_id included): each
 /// field copies one element of the event's arrays (docs/messages.md).
 collision_lab::Velocities toVelocitiesMsg(const collision_lab::CollisionEvent& event);
-collision_lab::EnergyTransfer toEnergyTransferMsg(const collision_lab::CollisionEvent& event);
+/// cumulative_energy_lost: the run's heat up to and including this event [J].
+collision_lab::EnergyTransfer toEnergyTransferMsg(const collision_lab::CollisionEvent& event,
+                                                  double cumulative_energy_lost);
 
 /// The physics fields of a summary; published_events, events_not_published, bag_path,
 /// recording_ok, recording_error, timeline_scale, timeline_saturated and

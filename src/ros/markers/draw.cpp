@@ -41,7 +41,11 @@ std::string withSeparators(std::uint64_t n) {
   return out;
 }
 
-std::array<double, 3> toArray3(const boost::array<double, 3>& a) { return {a[0], a[1], a[2]}; }
+std::array<double, 3> toArray3(const std::vector<double>& a) {
+  std::array<double, 3> result;
+  for (std::size_t i = 0; i < result.size(); ++i) result[i] = i < a.size() ? a[i] : std::nan("");
+  return result;
+}
 
 bool isWall(const collision_lab::InitialConditions& input, int i) { return std::isinf(input.masses[i]); }
 

@@ -34,7 +34,8 @@ geometry_msgs::Point point(double x, double y, double z = 0.0);
 std::string format(const char* fmt, double value);
 /// 31415 -> "31,415".
 std::string withSeparators(std::uint64_t n);
-std::array<double, 3> toArray3(const boost::array<double, 3>& a);
+/// Bodies A, B, C (0, 1, 2) of a per-body array; NaN for a body it does not have.
+std::array<double, 3> toArray3(const std::vector<double>& a);
 bool isWall(const collision_lab::InitialConditions& input, int i);
 
 /// Where a view draws: the run, the frame of its markers, and the array it appends to.
