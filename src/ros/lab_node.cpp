@@ -79,25 +79,22 @@ std::string utcStamp(const char* format) {
 /// energy_transfers.
 class EventStream {
  public:
-  EventStream(const RunTopics& topics, RunWriter& out, MarkerView* markers,
-              std::uint64_t max_published)
-      : topics_(topics), out_(out), markers_(markers), max_published_(max_published) {}
+  EventStream(const RunTopics& topics, RunWriter& out, MarkerView* markers, std::uint64_t max_published,
+              const collision_lab::core::Scene& scene)
+      : topics_(topics), out_(out), markers_(markers), max_published_(max_published), converter_(scene) {}
 
+  /// An event of the three-body path.
   void operator()(const collision_lab::core::LabEvent& event) {
     collision_lab::CollisionEvent msg = toCollisionEventMsg(event);
-    last_time_ = event.event.time;
-    out_.stamp(msg, last_time_);
-    if (markers_) markers_->onCollisionEvent(msg);
-    if (published_ == max_published_) {
-      cut_ = true;
-      out_.record(topics_.events.getTopic(), msg);
-      return;
+    if (send(msg)) {
+      topics_.velocities.publish(toVelocitiesMsg(msg));
+      topics_.energies.publish(toEnergyTransferMsg(msg, 0.0));  // elastic: no heat
     }
-    out_.publish(topics_.events, msg, last_time_);
-    topics_.velocities.publish(toVelocitiesMsg(msg));
-    topics_.energies.publish(toEnergyTransferMsg(msg, 0.0));
-    ++published_;
   }
+  /// An impact of the event engine.
+  void operator()(const collision_lab::core::ImpactRecord& impact) { sendWithPlots(converter_.impact(impact)); }
+  /// A collapse the event engine resolved.
+  void operator()(const collision_lab::core::Collapse& collapse) { sendWithPlots(converter_.collapse(collapse)); }
 
   std::uint64_t published() const { return published_; }
   /// True when ~max_published_events cut the published stream.
@@ -106,10 +103,31 @@ class EventStream {
   double lastTime() const { return last_time_; }
 
  private:
+  void sendWithPlots(collision_lab::CollisionEvent msg) {
+    if (!send(msg)) return;
+    topics_.velocities.publish(converter_.velocitiesMsg(msg));
+    topics_.energies.publish(converter_.energyTransferMsg(msg));
+  }
+  /// Stamps, draws and records msg, and publishes it unless the cap is reached; true when published.
+  bool send(collision_lab::CollisionEvent& msg) {
+    last_time_ = msg.time;
+    out_.stamp(msg, last_time_);
+    if (markers_) markers_->onCollisionEvent(msg);
+    if (published_ == max_published_) {
+      cut_ = true;
+      out_.record(topics_.events.getTopic(), msg);
+      return false;
+    }
+    out_.publish(topics_.events, msg, last_time_);
+    ++published_;
+    return true;
+  }
+
   const RunTopics& topics_;
   RunWriter& out_;
   MarkerView* markers_;
   std::uint64_t max_published_;
+  SceneEventConverter converter_;
   std::uint64_t published_ = 0;
   bool cut_ = false;
   double last_time_ = 0.0;
@@ -130,8 +148,9 @@ void closeRecording(RunWriter& out, const std::string& topic, collision_lab::Run
   summary.recording_error = recorder->error();
 }
 
-/// The reason to refuse input before simulating it (run_id, mode, then the scene), if any.
-std::optional<collision_lab::Rejected> checkInput(const collision_lab::InitialConditions& input) {
+/// The reason to refuse input before simulating it (run_id, mode, size, then the scene), if any.
+std::optional<collision_lab::Rejected> checkInput(const collision_lab::InitialConditions& input,
+                                                  std::size_t max_bodies) {
   if (!input.run_id.empty()) {
     if (const std::string problem = runIdProblem(input.run_id); !problem.empty()) {
       return toRejectedMsg(NodeReason::kInvalidRunId, "run_id",
@@ -143,7 +162,14 @@ std::optional<collision_lab::Rejected> checkInput(const collision_lab::InitialCo
                          "mode " + std::to_string(input.mode) + " is not one of MODE_FULL (0), "
                          "MODE_PREDICT_ONLY (1), MODE_SUMMARY_ONLY (2)");
   }
-  if (const auto error = collision_lab::core::validate(toScene(input))) return toRejectedMsg(*error);
+  const std::size_t n = std::max({input.masses.size(), input.positions.size(), input.velocities.size()});
+  if (n > max_bodies) {
+    return toRejectedMsg(NodeReason::kTooManyBodies, "masses",
+                         std::to_string(n) + " bodies are more than this node's ~max_bodies = " +
+                             std::to_string(max_bodies) + "; send a smaller scene, or start the node with a "
+                             "larger ~max_bodies");
+  }
+  if (const auto error = collision_lab::core::validateForRun(toScene(input))) return toRejectedMsg(*error);
   return std::nullopt;
 }
 
@@ -229,6 +255,7 @@ LabNodeParams LabNodeParams::load(const ros::NodeHandle& private_nh) {
   params.max_published_events =
       getUint64(private_nh, "max_published_events", kDefaultMaxPublishedEvents);
   private_nh.param("publish_markers", params.publish_markers, true);
+  params.max_bodies = getUint64(private_nh, "max_bodies", kDefaultMaxBodies);
   private_nh.param("min_free_space_mb", params.min_free_space_mb, kDefaultMinFreeSpaceMb);
   private_nh.param("scenario_file", params.scenario_file,
                    ros::package::getPath("collision_lab") + "/" + kDefaultScenarioFile);
@@ -250,7 +277,8 @@ std::string runIdProblem(const std::string& run_id) {
 LabNode::LabNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
     : nh_(nh),
       params_(LabNodeParams::load(private_nh)),
-      service_spinner_(kServiceThreads, &service_queue_) {
+      service_spinner_(kServiceThreads, &service_queue_),
+      cancel_spinner_(1, &cancel_queue_) {
   topics_.predictions = nh_.advertise<collision_lab::Prediction>(
       kPredictionsTopic, kOutputQueueSize, kLatchPredictions);
   topics_.events =
@@ -282,10 +310,17 @@ LabNode::LabNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   run_scene_srv_ = service_nh.advertiseService(kRunSceneService, &LabNode::onRunScene, this);
   run_preset_srv_ = service_nh.advertiseService(kRunPresetService, &LabNode::onRunPreset, this);
   service_spinner_.start();
+  // ~cancel has a queue and thread of its own: it is answered even while every service
+  // thread waits for a run.
+  ros::NodeHandle cancel_nh(private_nh);
+  cancel_nh.setCallbackQueue(&cancel_queue_);
+  cancel_srv_ = cancel_nh.advertiseService(kCancelService, &LabNode::onCancel, this);
+  cancel_spinner_.start();
   ROS_INFO_STREAM("collision_lab_node: recording " << (params_.record ? "on" : "off")
                   << ", bags in " << params_.bag_directory << ", max_collisions "
                   << params_.max_collisions << ", max_published_events "
-                  << params_.max_published_events << ", presets from " << params_.scenario_file);
+                  << params_.max_published_events << ", max_bodies " << params_.max_bodies
+                  << ", presets from " << params_.scenario_file);
 }
 
 LabNode::~LabNode() {
@@ -297,8 +332,15 @@ LabNode::~LabNode() {
     stopping_ = true;
     inputs_.clear();  // breaks the promises of waiting calls
   }
+  {
+    std::lock_guard<std::mutex> lock(running_mutex_);
+    stopping_run_ = true;
+    cancel_ = true;  // the run in progress stops within 1024 impacts, its bag closed
+  }
   wake_.notify_one();
   worker_.join();
+  cancel_srv_.shutdown();
+  cancel_spinner_.stop();
   service_spinner_.stop();
 }
 
@@ -334,6 +376,7 @@ bool LabNode::onRunScene(collision_lab::RunScene::Request& request,
   input.masses = request.masses;
   input.positions = request.positions;
   input.velocities = request.velocities;
+  input.restitution = request.restitution;
   input.max_collisions = request.max_collisions;
   fillResponse(serveAndWait(input), response);
   return true;
@@ -341,19 +384,10 @@ bool LabNode::onRunScene(collision_lab::RunScene::Request& request,
 
 bool LabNode::onRunPreset(collision_lab::RunPreset::Request& request,
                           collision_lab::RunPreset::Response& response) {
-  collision_lab::io::NamedScene preset;
+  collision_lab::io::SceneEntry preset;
   try {
     // Read on every call, so that an edited file counts at once.
-    std::vector<std::string> skipped;
-    const auto presets = collision_lab::io::loadScenarioFile(params_.scenario_file, &skipped);
-    if (std::find(skipped.begin(), skipped.end(), request.name) != skipped.end()) {
-      response.ok = false;
-      response.message = "preset '" + request.name + "' is not a three-body elastic scene; the node runs three "
-                         "bodies only until the N-body node (issue 12); collision_lab_cli runs it";
-      ROS_INFO_STREAM(response.message);
-      return true;
-    }
-    preset = collision_lab::io::findScenario(presets, request.name);
+    preset = collision_lab::io::findScene(collision_lab::io::loadScenes(params_.scenario_file), request.name);
   } catch (const collision_lab::io::ScenarioFileError& e) {
     response.ok = false;
     response.message = e.what();
@@ -419,7 +453,7 @@ ServeOutcome LabNode::reject(collision_lab::Rejected msg, const std::string& run
 
 ServeOutcome LabNode::serve(collision_lab::InitialConditions input) {
   const std::string requested = input.run_id;
-  if (auto rejection = checkInput(input)) return reject(std::move(*rejection), requested);
+  if (auto rejection = checkInput(input, params_.max_bodies)) return reject(std::move(*rejection), requested);
   input.run_id = requested.empty() ? newRunId() : claimRunId(requested);
   if (!requested.empty() && input.run_id != requested) {
     ROS_WARN_STREAM("run_id '" << requested << "' is taken (its bag exists, or this node served "
@@ -433,29 +467,40 @@ ServeOutcome LabNode::serve(collision_lab::InitialConditions input) {
 
 collision_lab::RunSummary LabNode::run(collision_lab::InitialConditions& input,
                                        const std::string& requested_run_id) {
+  namespace core = collision_lab::core;
   const ros::Time start = stampNow();
-  const collision_lab::core::ThreeBodyScene scene = toScene(input);
-  const collision_lab::core::RunMode mode = *toRunMode(input.mode);
-  // The prediction goes out before the simulation starts; it also fixes the timeline.
-  const collision_lab::core::AnalyticPrediction prediction = collision_lab::core::predict(scene);
+  const core::Scene scene = toScene(input);
+  const core::RunMode mode = *toRunMode(input.mode);
+  // The prediction goes out before the simulation starts.
+  const ScenePrediction prediction = predictScene(scene);
   std::optional<RunRecorder> recorder;
   if (params_.record) recorder.emplace(params_.bag_directory, input.run_id);
-  RunWriter out(input.run_id,
-                RunTimeline(start, chooseTimelineScale(firstContactTime(scene, prediction.first_pair))),
+  RunWriter out(input.run_id, RunTimeline(start, chooseTimelineScale(firstContactTime(scene))),
                 recorder ? &*recorder : nullptr);
   input.header.stamp = start;
   publishStart(out, input, prediction);
 
-  collision_lab::core::RunOptions options;
-  options.max_collisions = input.max_collisions ? input.max_collisions : params_.max_collisions;
-  options.events = collision_lab::core::EventPolicy::none();
-  options.mode = mode;
-  options.skip_simulation_over_cap = true;
-  EventStream events(topics_, out, marker_view_.get(), params_.max_published_events);
-  const collision_lab::core::RunResult result = collision_lab::core::runLab(
-      scene, options, prediction, [&events](const collision_lab::core::LabEvent& e) { events(e); });
+  core::SceneRunOptions options;
+  options.lab.max_collisions = input.max_collisions ? input.max_collisions : params_.max_collisions;
+  // Events are streamed to the visitors, never kept; asking for them makes a closed-form
+  // scene simulated too (its events are published), as the CLI does when it shows events.
+  options.lab.events = mode == core::RunMode::kFull ? core::EventPolicy::all() : core::EventPolicy::none();
+  options.lab.mode = mode;
+  options.lab.skip_simulation_over_cap = true;
+  options.keep_events = false;
+  options.cancel = &cancel_;
+  EventStream events(topics_, out, marker_view_.get(), params_.max_published_events, scene);
+  core::SceneVisitors visitors;
+  visitors.three_body_event = [&events](const core::LabEvent& e) { events(e); };
+  visitors.impact = [&events](const core::ImpactRecord& r) { events(r); };
+  const core::SceneRunResult result = runCancellable(input.run_id, scene, options, visitors);
+  // The engine reports collapses with its result; each follows the impact before it (for
+  // the scenes it resolves, the last of the run's impacts of those bodies).
+  if (mode == core::RunMode::kFull) {
+    for (const core::Collapse& collapse : result.simulation.collapses) events(collapse);
+  }
 
-  collision_lab::RunSummary summary = toRunSummaryMsg(result.summary, result.prediction, mode);
+  collision_lab::RunSummary summary = toRunSummaryMsg(result, scene.size(), mode);
   summary.published_events = events.published();
   summary.events_not_published = events.cut();
   summary.requested_run_id = requested_run_id;
@@ -463,8 +508,40 @@ collision_lab::RunSummary LabNode::run(collision_lab::InitialConditions& input,
   return summary;
 }
 
+collision_lab::core::SceneRunResult LabNode::runCancellable(const std::string& run_id,
+                                                            const collision_lab::core::Scene& scene,
+                                                            const collision_lab::core::SceneRunOptions& options,
+                                                            const collision_lab::core::SceneVisitors& visitors) {
+  {
+    std::lock_guard<std::mutex> lock(running_mutex_);
+    running_run_id_ = run_id;
+    cancel_ = stopping_run_.load();  // the node's shutdown cancels every run
+  }
+  collision_lab::core::SceneRunResult result = collision_lab::core::runScene(scene, options, visitors);
+  std::lock_guard<std::mutex> lock(running_mutex_);
+  running_run_id_.clear();
+  return result;
+}
+
+bool LabNode::onCancel(collision_lab::Cancel::Request& request, collision_lab::Cancel::Response& response) {
+  std::lock_guard<std::mutex> lock(running_mutex_);
+  if (running_run_id_.empty()) {
+    response.ok = false;
+    response.message = "no run in progress";
+  } else if (!request.run_id.empty() && request.run_id != running_run_id_) {
+    response.ok = false;
+    response.message = "run '" + running_run_id_ + "' is in progress, not '" + request.run_id + "'; nothing stopped";
+  } else {
+    cancel_ = true;
+    response.ok = true;
+    response.message = "run '" + running_run_id_ + "' asked to stop";
+  }
+  ROS_INFO_STREAM("~cancel: " << response.message);
+  return true;
+}
+
 void LabNode::publishStart(RunWriter& out, const collision_lab::InitialConditions& input,
-                           const collision_lab::core::AnalyticPrediction& core_prediction) {
+                           const ScenePrediction& core_prediction) {
   out.record(nh_.resolveName(kInitialConditionsTopic), input);
   if (marker_view_) marker_view_->onInitialConditions(input);
   collision_lab::Prediction prediction = toPredictionMsg(core_prediction);

@@ -1,19 +1,21 @@
 #include "collision_lab/ros/msg_conversion.h"
 
+#include <cmath>
 #include <limits>
 
-#include "collision_lab/core/nbody/models.h"
 #include "collision_lab/core/wedge.h"
 
 namespace collision_lab_ros {
 
 using collision_lab::Rejected;
+namespace core = collision_lab::core;
 
 namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-// The interim node serves three elastic bodies only (issue 12 serves any scene).
 constexpr char kThreeBodyRotationReason[] =
     "three elastic bodies: the paper's rotation by 2 alpha per AB+BC cycle, corrected";
+
+double valueOr(const std::optional<double>& value) { return value.value_or(kNaN); }
 }  // namespace
 
 static_assert(collision_lab::InitialConditions::MODE_FULL ==
@@ -40,14 +42,32 @@ static_assert(Rejected::NON_FINITE_VALUE == static_cast<std::uint8_t>(collision_
               Rejected::POSITIONS_COINCIDENT ==
                   static_cast<std::uint8_t>(collision_lab::core::Reason::kPositionsCoincident) &&
               Rejected::TRIPLE_COLLISION == static_cast<std::uint8_t>(collision_lab::core::Reason::kTripleCollision) &&
-              Rejected::OVERFLOW == static_cast<std::uint8_t>(collision_lab::core::Reason::kOverflow),
+              Rejected::OVERFLOW == static_cast<std::uint8_t>(collision_lab::core::Reason::kOverflow) &&
+              Rejected::UNEQUAL_LENGTHS == static_cast<std::uint8_t>(core::Reason::kUnequalLengths) &&
+              Rejected::EMPTY_SCENE == static_cast<std::uint8_t>(core::Reason::kEmptyScene) &&
+              Rejected::RESTITUTION_OUT_OF_RANGE ==
+                  static_cast<std::uint8_t>(core::Reason::kRestitutionOutOfRange) &&
+              Rejected::RESTITUTION_COUNT == static_cast<std::uint8_t>(core::Reason::kRestitutionCount) &&
+              Rejected::WALL_NOT_AT_END == static_cast<std::uint8_t>(core::Reason::kWallNotAtEnd),
               "Rejected reason codes must match collision_lab::core::Reason");
+static_assert(collision_lab::Prediction::MODEL_NO_COLLISIONS == static_cast<std::uint8_t>(core::ModelKind::kNoCollisions) &&
+              collision_lab::Prediction::MODEL_TWO_WALLS_INFINITE ==
+                  static_cast<std::uint8_t>(core::ModelKind::kTwoWallsInfinite) &&
+              collision_lab::Prediction::MODEL_TWO_BODY == static_cast<std::uint8_t>(core::ModelKind::kTwoBody) &&
+              collision_lab::Prediction::MODEL_THREE_BODY_ROTATION ==
+                  static_cast<std::uint8_t>(core::ModelKind::kThreeBodyRotation) &&
+              collision_lab::Prediction::MODEL_GHOSTS == static_cast<std::uint8_t>(core::ModelKind::kGhosts) &&
+              collision_lab::Prediction::MODEL_EVENT_ENGINE == static_cast<std::uint8_t>(core::ModelKind::kEventEngine) &&
+              collision_lab::Prediction::MODEL_THREE_BODY_SPIRAL ==
+                  static_cast<std::uint8_t>(core::ModelKind::kThreeBodySpiral),
+              "Prediction::MODEL_* must match collision_lab::core::ModelKind");
 
 const char* nodeReasonName(NodeReason reason) {
   switch (reason) {
     case NodeReason::kDuplicateRunId: return "DUPLICATE_RUN_ID";
     case NodeReason::kInvalidRunId: return "INVALID_RUN_ID";
     case NodeReason::kInvalidMode: return "INVALID_MODE";
+    case NodeReason::kTooManyBodies: return "TOO_MANY_BODIES";
   }
   return "UNKNOWN";
 }
@@ -62,12 +82,20 @@ std::vector<double> toVector(const std::array<double, 3>& values) {
   return {values.begin(), values.end()};
 }
 
-collision_lab::core::ThreeBodyScene toScene(const collision_lab::InitialConditions& msg) {
-  collision_lab::core::ThreeBodyScene scene;
-  scene.masses = toArray(msg.masses);
-  scene.positions = toArray(msg.positions);
-  scene.velocities = toArray(msg.velocities);
-  return scene;
+core::Scene toScene(const collision_lab::InitialConditions& msg) {
+  return core::Scene{msg.masses, msg.positions, msg.velocities, msg.restitution};
+}
+
+collision_lab::InitialConditions toInitialConditions(const core::Scene& scene, core::RunMode mode,
+                                                     std::uint64_t max_collisions) {
+  collision_lab::InitialConditions msg;
+  msg.mode = static_cast<std::uint8_t>(mode);
+  msg.masses = scene.masses;
+  msg.positions = scene.positions;
+  msg.velocities = scene.velocities;
+  msg.restitution = scene.restitution;
+  msg.max_collisions = max_collisions;
+  return msg;
 }
 
 collision_lab::InitialConditions toInitialConditions(const collision_lab::core::ThreeBodyScene& scene,
@@ -103,12 +131,67 @@ std::optional<collision_lab::core::Pair> toPair(std::uint32_t code) {
   }
 }
 
-collision_lab::Prediction toPredictionMsg(const collision_lab::core::AnalyticPrediction& prediction) {
+core::ModelChoice threeBodyRotationModel() {
+  return {core::ModelKind::kThreeBodyRotation, kThreeBodyRotationReason};
+}
+
+ScenePrediction predictScene(const core::Scene& scene) {
+  ScenePrediction prediction;
+  prediction.model = core::chooseModel(scene);
+  prediction.body_count = scene.size();
+  if (core::usesThreeBodyPath(scene)) {
+    prediction.three_body = core::predict(core::toThreeBodyScene(scene));
+  } else {
+    prediction.nbody = core::predict(scene);
+    if (prediction.model.kind == core::ModelKind::kThreeBodySpiral) {
+      prediction.spiral_alpha = core::alphaOf<double>({scene.masses[0], scene.masses[1], scene.masses[2]});
+    }
+  }
+  return prediction;
+}
+
+namespace {
+
+/// The fields every model fills the same way; the rest say "not given".
+collision_lab::Prediction modelPrediction(const core::ModelChoice& model, std::size_t body_count) {
   collision_lab::Prediction msg;
-  msg.model = collision_lab::Prediction::MODEL_THREE_BODY_ROTATION;
-  msg.model_name = collision_lab::core::modelKindName(collision_lab::core::ModelKind::kThreeBodyRotation);
-  msg.model_reason = kThreeBodyRotationReason;
-  msg.body_count = 3;
+  msg.model = static_cast<std::uint8_t>(model.kind);
+  msg.model_name = core::modelKindName(model.kind);
+  msg.model_reason = model.reason;
+  msg.body_count = static_cast<std::uint32_t>(body_count);
+  msg.alpha = msg.theta = msg.omega = msg.phi_bc = msg.psi = kNaN;
+  msg.first_pair_index = collision_lab::Prediction::PAIR_NONE;
+  msg.energy_lost = msg.collapse_time = msg.collapse_position = kNaN;
+  msg.critical_restitution = msg.spiral_angle = kNaN;
+  return msg;
+}
+
+}  // namespace
+
+collision_lab::Prediction toPredictionMsg(const ScenePrediction& prediction) {
+  if (prediction.three_body) return toPredictionMsg(*prediction.three_body, prediction.model);
+  collision_lab::Prediction msg = modelPrediction(prediction.model, prediction.body_count);
+  if (!prediction.nbody) return msg;  // event_engine: no closed form
+  const core::Prediction& p = *prediction.nbody;
+  msg.collision_count = p.impact_count.value_or(0);
+  msg.collision_count_defined = p.impact_count.has_value();
+  msg.infinite_collisions = p.infinite;
+  if (p.kind == core::ModelKind::kTwoBody && p.impact_count == std::uint64_t{1}) {
+    msg.first_pair_index = collision_lab::Prediction::PAIR_AB;
+  }
+  msg.final_velocities = p.final_velocities;
+  if (!p.final_velocities.empty()) msg.energy_lost = p.energy_lost;
+  msg.collapsed = p.collapsed;
+  msg.collapse_time = valueOr(p.collapse_time);
+  msg.collapse_position = valueOr(p.collapse_position);
+  msg.critical_restitution = valueOr(p.critical_restitution);
+  msg.spiral_angle = valueOr(p.spiral_angle);
+  msg.alpha = prediction.spiral_alpha;
+  return msg;
+}
+
+collision_lab::Prediction toPredictionMsg(const core::AnalyticPrediction& prediction, const core::ModelChoice& model) {
+  collision_lab::Prediction msg = modelPrediction(model, 3);
   msg.collision_count = prediction.collision_count;
   msg.collision_count_defined = true;
   msg.infinite_collisions = false;
@@ -124,9 +207,7 @@ collision_lab::Prediction toPredictionMsg(const collision_lab::core::AnalyticPre
   msg.final_velocities = toVector(prediction.final_velocities);
   msg.energy_lost = 0.0;
   msg.collapsed = false;
-  msg.collapse_time = kNaN;
-  msg.collapse_position = kNaN;
-  msg.critical_restitution = collision_lab::core::criticalRestitution(prediction.angles.alpha);
+  msg.critical_restitution = core::criticalRestitution(prediction.angles.alpha);
   msg.spiral_angle = prediction.angles.theta;
   return msg;
 }
@@ -215,9 +296,9 @@ PlotMessage plotMessageOf(const collision_lab::CollisionEvent& event) {
 
 }  // namespace
 
-collision_lab::Velocities toVelocitiesMsg(const collision_lab::CollisionEvent& event) {
+collision_lab::Velocities toVelocitiesMsg(const collision_lab::CollisionEvent& event, std::vector<double> v) {
   auto msg = plotMessageOf<collision_lab::Velocities>(event);
-  msg.v = event.velocities_after;
+  msg.v = std::move(v);
   const std::array<double, 3> first_three = toArray(msg.v);
   msg.v_a = first_three[0];
   msg.v_b = first_three[1];
@@ -226,31 +307,225 @@ collision_lab::Velocities toVelocitiesMsg(const collision_lab::CollisionEvent& e
 }
 
 collision_lab::EnergyTransfer toEnergyTransferMsg(const collision_lab::CollisionEvent& event,
+                                                  std::vector<double> delta, std::vector<double> kinetic,
                                                   double cumulative_energy_lost) {
   auto msg = plotMessageOf<collision_lab::EnergyTransfer>(event);
-  msg.delta = event.energy_transfer;
-  msg.kinetic = event.kinetic_energy_after;
+  msg.delta = std::move(delta);
+  msg.kinetic = std::move(kinetic);
   msg.energy_lost = event.energy_lost;
   msg.cumulative_energy_lost = cumulative_energy_lost;
-  const std::array<double, 3> delta = toArray(msg.delta), kinetic = toArray(msg.kinetic);
-  msg.delta_a = delta[0];
-  msg.delta_b = delta[1];
-  msg.delta_c = delta[2];
-  msg.kinetic_a = kinetic[0];
-  msg.kinetic_b = kinetic[1];
-  msg.kinetic_c = kinetic[2];
+  const std::array<double, 3> d = toArray(msg.delta), k = toArray(msg.kinetic);
+  msg.delta_a = d[0];
+  msg.delta_b = d[1];
+  msg.delta_c = d[2];
+  msg.kinetic_a = k[0];
+  msg.kinetic_b = k[1];
+  msg.kinetic_c = k[2];
   return msg;
 }
 
-collision_lab::RunSummary toRunSummaryMsg(const collision_lab::core::LabRunSummary& summary,
-                                          const collision_lab::core::AnalyticPrediction& prediction,
-                                          collision_lab::core::RunMode mode) {
+collision_lab::Velocities toVelocitiesMsg(const collision_lab::CollisionEvent& event) {
+  return toVelocitiesMsg(event, event.velocities_after);
+}
+
+collision_lab::EnergyTransfer toEnergyTransferMsg(const collision_lab::CollisionEvent& event,
+                                                  double cumulative_energy_lost) {
+  return toEnergyTransferMsg(event, event.energy_transfer, event.kinetic_energy_after, cumulative_energy_lost);
+}
+
+// ---- SceneEventConverter ----
+
+SceneEventConverter::SceneEventConverter(const core::Scene& scene)
+    : scene_(scene),
+      full_state_(scene.size() <= collision_lab::CollisionEvent::FULL_STATE_MAX_BODIES),
+      v_(scene.velocities),
+      stuck_(scene.pairCount(), false) {
+  if (full_state_) x_ = scene.positions;
+}
+
+void SceneEventConverter::advance(double t) {
+  if (full_state_) {
+    for (std::size_t i = 0; i < x_.size(); ++i) x_[i] += v_[i] * (t - t_);
+  }
+  t_ = t;
+}
+
+double SceneEventConverter::kinetic(std::size_t body) const {
+  return scene_.isWall(body) ? 0.0 : 0.5 * scene_.masses[body] * v_[body] * v_[body];
+}
+
+void SceneEventConverter::move(std::size_t first, std::size_t last, double v, double x) {
+  for (std::size_t i = first; i <= last; ++i) {
+    const double before = kinetic(i);
+    v_[i] = v;
+    if (full_state_) x_[i] = x;
+    moved_gain_.push_back(kinetic(i) - before);
+  }
+}
+
+std::size_t SceneEventConverter::clusterEnd(std::size_t body, int direction) const {
+  if (direction < 0) {
+    while (body > 0 && stuck_[body - 1]) --body;
+  } else {
+    while (body + 1 < scene_.size() && stuck_[body]) ++body;
+  }
+  return body;
+}
+
+void SceneEventConverter::fillBodies(collision_lab::CollisionEvent& msg,
+                                     const std::vector<double>& velocities_before) const {
+  if (!full_state_) {
+    msg.total_energy = msg.total_momentum = kNaN;
+    return;
+  }
+  const std::size_t n = scene_.size();
+  msg.positions = x_;
+  msg.velocities_before = velocities_before;
+  msg.velocities_after = v_;
+  msg.energy_transfer.assign(n, 0.0);
+  for (std::size_t k = 0; k < moved_gain_.size(); ++k) msg.energy_transfer[moved_first_ + k] = moved_gain_[k];
+  msg.kinetic_energy_after.resize(n);
+  msg.total_energy = msg.total_momentum = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    msg.kinetic_energy_after[i] = kinetic(i);
+    msg.total_energy += msg.kinetic_energy_after[i];
+    if (!scene_.isWall(i)) msg.total_momentum += scene_.masses[i] * v_[i];
+  }
+}
+
+collision_lab::CollisionEvent SceneEventConverter::impact(const core::ImpactRecord& record) {
+  const std::size_t p = record.pair_index;
+  advance(record.time);
+  const std::vector<double> before = full_state_ ? v_ : std::vector<double>{};
+  collision_lab::CollisionEvent msg;
+  msg.kind = collision_lab::CollisionEvent::KIND_IMPACT;
+  msg.index = record.index;
+  msg.pair_index = static_cast<std::uint32_t>(p);
+  msg.time = record.time;
+  msg.position = record.position;
+  msg.restitution = scene_.restitutionOf(p);
+  msg.first_moved = static_cast<std::uint32_t>(clusterEnd(p, -1));
+  msg.last_moved = static_cast<std::uint32_t>(clusterEnd(p + 1, +1));
+  msg.cluster_impact = msg.first_moved != p || msg.last_moved != p + 1;
+  for (std::size_t side = 0; side < 2; ++side) {
+    msg.pair_velocities_before[side] = record.velocities_before[side];
+    msg.pair_velocities_after[side] = record.velocities_after[side];
+    msg.pair_energy_transfer[side] = scene_.isWall(p + side) ? 0.0 : record.energy_gained[side];
+  }
+  msg.energy_lost = record.energy_lost;
+  moved_first_ = msg.first_moved;
+  moved_gain_.clear();
+  move(msg.first_moved, p, record.velocities_after[0], record.position);
+  move(p + 1, msg.last_moved, record.velocities_after[1], record.position);
+  if (msg.restitution == 0.0) stuck_[p] = true;  // e = 0: the pair moves on as one (engine.h)
+  cumulative_lost_ += record.energy_lost;
+  fillBodies(msg, before);
+  return msg;
+}
+
+collision_lab::CollisionEvent SceneEventConverter::collapse(const core::Collapse& collapse) {
+  const std::size_t first = collapse.first_body, last = collapse.last_body;
+  advance(collapse.time);
+  const std::vector<double> before = full_state_ ? v_ : std::vector<double>{};
+  // The cluster's velocity: its wall's, or the centre of mass's.
+  double momentum = 0.0, mass = 0.0, heat = 0.0;
+  std::optional<double> wall;
+  for (std::size_t i = first; i <= last; ++i) {
+    if (scene_.isWall(i)) wall = v_[i];
+    if (!scene_.isWall(i)) momentum += scene_.masses[i] * v_[i], mass += scene_.masses[i];
+    heat += kinetic(i);
+  }
+  const double velocity = wall.value_or(momentum / mass);
+  collision_lab::CollisionEvent msg;
+  msg.kind = collision_lab::CollisionEvent::KIND_COLLAPSE;
+  msg.index = collapse.impacts_before;
+  msg.pair_index = static_cast<std::uint32_t>(first);
+  msg.time = collapse.time;
+  msg.position = collapse.position;
+  msg.restitution = scene_.restitutionOf(first);
+  msg.first_moved = static_cast<std::uint32_t>(first);
+  msg.last_moved = static_cast<std::uint32_t>(last);
+  msg.cluster_impact = false;
+  moved_first_ = first;
+  moved_gain_.clear();
+  for (std::size_t side = 0; side < 2; ++side) msg.pair_velocities_before[side] = v_[first + side];
+  move(first, last, velocity, collapse.position);
+  for (std::size_t side = 0; side < 2; ++side) {
+    msg.pair_velocities_after[side] = velocity;
+    msg.pair_energy_transfer[side] = moved_gain_[side];
+  }
+  for (std::size_t i = first; i <= last; ++i) heat -= kinetic(i);
+  for (std::size_t i = first; i < last; ++i) stuck_[i] = true;
+  msg.energy_lost = heat;
+  cumulative_lost_ += heat;
+  fillBodies(msg, before);
+  return msg;
+}
+
+collision_lab::Velocities SceneEventConverter::velocitiesMsg(const collision_lab::CollisionEvent& event) const {
+  return toVelocitiesMsg(event, v_);
+}
+
+collision_lab::EnergyTransfer SceneEventConverter::energyTransferMsg(const collision_lab::CollisionEvent& event) const {
+  std::vector<double> delta(scene_.size(), 0.0), kinetic_after(scene_.size());
+  for (std::size_t k = 0; k < moved_gain_.size(); ++k) delta[moved_first_ + k] = moved_gain_[k];
+  for (std::size_t i = 0; i < kinetic_after.size(); ++i) kinetic_after[i] = kinetic(i);
+  return toEnergyTransferMsg(event, std::move(delta), std::move(kinetic_after), cumulative_lost_);
+}
+
+namespace {
+
+/// The summary's model fields and the "not given" values of the rest.
+collision_lab::RunSummary modelSummary(const core::ModelChoice& model, std::size_t body_count, core::RunMode mode) {
   collision_lab::RunSummary msg;
   msg.mode = static_cast<std::uint8_t>(mode);
-  msg.model = collision_lab::Prediction::MODEL_THREE_BODY_ROTATION;
-  msg.model_name = collision_lab::core::modelKindName(collision_lab::core::ModelKind::kThreeBodyRotation);
-  msg.model_reason = kThreeBodyRotationReason;
-  msg.body_count = 3;
+  msg.model = static_cast<std::uint8_t>(model.kind);
+  msg.model_name = core::modelKindName(model.kind);
+  msg.model_reason = model.reason;
+  msg.body_count = static_cast<std::uint32_t>(body_count);
+  msg.energy_lost = msg.collapse_time = msg.collapse_position = kNaN;
+  msg.critical_restitution = msg.spiral_angle = kNaN;
+  return msg;
+}
+
+}  // namespace
+
+collision_lab::RunSummary toRunSummaryMsg(const core::SceneRunResult& result, std::size_t body_count,
+                                          core::RunMode mode) {
+  if (result.three_body) {
+    return toRunSummaryMsg(result.three_body->summary, result.three_body->prediction, mode, result.model);
+  }
+  const core::SceneSimulation& s = result.simulation;
+  collision_lab::RunSummary msg = modelSummary(result.model, body_count, mode);
+  msg.collision_count = s.simulated ? s.impact_count : 0;
+  msg.truncated = s.truncated;
+  msg.truncation_reason = s.truncated ? s.stop_message : std::string();
+  msg.cancelled = s.simulated && s.stop == core::StopReason::kCancelled;
+  msg.stop_reason = s.simulated ? core::stopReasonName(s.stop) : "NOT_SIMULATED";
+  msg.simulated = s.simulated;
+  if (const auto& p = result.prediction) {
+    msg.predicted_collision_count = p->impact_count.value_or(0);
+    msg.predicted_collision_count_defined = p->impact_count.has_value();
+    msg.critical_restitution = valueOr(p->critical_restitution);
+    msg.spiral_angle = valueOr(p->spiral_angle);
+  }
+  msg.final_velocities = s.final_velocities;
+  msg.energy_lost = s.energy_lost;
+  msg.collapsed = s.collapsed;
+  msg.collapse_time = valueOr(s.collapse_time);
+  msg.collapse_position = valueOr(s.collapse_position);
+  msg.collapse_count = static_cast<std::uint32_t>(s.collapses.size());
+  msg.cluster_impacts = s.cluster_impacts;
+  msg.max_prediction_error = s.max_prediction_error;
+  msg.energy_relative_drift = s.energy_relative_drift;
+  msg.momentum_relative_drift = s.momentum_relative_drift;
+  msg.compute_time = result.compute_time_s;
+  return msg;
+}
+
+collision_lab::RunSummary toRunSummaryMsg(const core::LabRunSummary& summary, const core::AnalyticPrediction& prediction,
+                                          core::RunMode mode, const core::ModelChoice& model) {
+  collision_lab::RunSummary msg = modelSummary(model, 3, mode);
   msg.collision_count = summary.collision_count;
   msg.truncated = summary.truncated;
   msg.truncation_reason = summary.truncation_reason;
@@ -267,11 +542,9 @@ collision_lab::RunSummary toRunSummaryMsg(const collision_lab::core::LabRunSumma
   msg.final_velocities = toVector(summary.final_velocities);
   msg.energy_lost = 0.0;
   msg.collapsed = false;
-  msg.collapse_time = kNaN;
-  msg.collapse_position = kNaN;
   msg.collapse_count = 0;
   msg.cluster_impacts = 0;
-  msg.critical_restitution = collision_lab::core::criticalRestitution(prediction.angles.alpha);
+  msg.critical_restitution = core::criticalRestitution(prediction.angles.alpha);
   msg.spiral_angle = prediction.angles.theta;
   msg.max_prediction_error = summary.max_prediction_error;
   msg.energy_relative_drift = summary.energy_relative_drift;

@@ -14,13 +14,15 @@ constexpr int kMaxExponent = 300;      ///< 10^+-300 are normal doubles
 constexpr std::uint64_t kNsPerS = 1'000'000'000;
 }  // namespace
 
-std::optional<double> firstContactTime(const collision_lab::core::ThreeBodyScene& scene,
-                                       const std::optional<collision_lab::core::Pair>& first_pair) {
-  if (!first_pair) return std::nullopt;
-  const int right = *first_pair == collision_lab::core::Pair::AB ? 0 : 1;  // the pair (right, right + 1)
-  const double gap = scene.positions[right] - scene.positions[right + 1];
-  const double closing = scene.velocities[right + 1] - scene.velocities[right];
-  return gap / closing;
+std::optional<double> firstContactTime(const collision_lab::core::Scene& scene) {
+  std::optional<double> first;
+  for (std::size_t p = 0; p < scene.pairCount(); ++p) {
+    const double closing = scene.velocities[p + 1] - scene.velocities[p];
+    if (!(closing > 0)) continue;
+    const double t = (scene.positions[p] - scene.positions[p + 1]) / closing;
+    if (!first || t < *first) first = t;
+  }
+  return first;
 }
 
 double chooseTimelineScale(const std::optional<double>& first_contact) {

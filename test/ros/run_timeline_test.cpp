@@ -2,6 +2,7 @@
 // saturation. Expected values are written out by hand from the rule.
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -15,18 +16,16 @@ using collision_lab_ros::RunTimeline;
 namespace core = collision_lab::core;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-collision_lab::core::ThreeBodyScene scene(std::array<double, 3> x, std::array<double, 3> v) {
-  collision_lab::core::ThreeBodyScene s;
-  s.masses = {1, 1, 1};
-  s.positions = x;
-  s.velocities = v;
-  return s;
+collision_lab::core::Scene scene(std::vector<double> x, std::vector<double> v) {
+  return {std::vector<double>(x.size(), 1.0), x, v, {}};
 }
 
 TEST(FirstContactTime, GapOverClosingSpeedOfTheFirstPair) {
-  EXPECT_EQ(firstContactTime(scene({2, 0, -2}, {-1, 0.5, 1}), collision_lab::core::Pair::AB), 2.0 / 1.5);
-  EXPECT_EQ(firstContactTime(scene({3, 1, 0}, {-0.5, 0, 2}), collision_lab::core::Pair::BC), 0.5);
-  EXPECT_FALSE(firstContactTime(scene({2, 1, 0}, {1, 0, -1}), std::nullopt));
+  EXPECT_EQ(firstContactTime(scene({2, 0, -2}, {-1, 0.5, 1})), 2.0 / 1.5);  // AB: 2 m at 1.5 m/s; BC never
+  EXPECT_EQ(firstContactTime(scene({3, 1, 0}, {-0.5, 0, 2})), 0.5);         // BC: 1 m at 2 m/s; AB after 4 s
+  EXPECT_FALSE(firstContactTime(scene({2, 1, 0}, {1, 0, -1})));
+  EXPECT_EQ(firstContactTime(scene({9, 5, 4, 0}, {0, 0, -1, 1})), 2.0);  // the last pair: 4 m at 2 m/s
+  EXPECT_FALSE(firstContactTime(scene({0}, {1})));
 }
 
 TEST(TimelineScale, OneForOrdinaryScenesAPowerOfTenOtherwise) {

@@ -1,7 +1,8 @@
-// collision_lab_node: serves InitialConditions with the core's runLab, publishes every
-// output, records one bag per run and feeds the marker view. Inputs come from the topic
-// `initial_conditions` and from the services ~run_scene and ~run_preset; all three take
-// the same path (served, published, recorded, drawn).
+// collision_lab_node: serves InitialConditions of any size with the core's runScene (the
+// CLI's entry point, so both give the same answers), publishes every output, records one
+// bag per run and feeds the marker view. Inputs come from the topic `initial_conditions`
+// and from the services ~run_scene and ~run_preset; all three take the same path (served,
+// published, recorded, drawn). ~cancel stops the run in progress.
 //
 // Threading contract:
 // - One worker thread serves every input, from the topic and the services alike, in
@@ -14,11 +15,15 @@
 //   service thread until the worker hands back the outcome (a promise): the worker, topic
 //   inputs, diagnostics and the marker animation (global queue) go on meanwhile. Further
 //   concurrent calls wait in roscpp for a free service thread.
+// - ~cancel runs on a callback queue and thread of its own, so it is answered while every
+//   service thread waits for a run. It sets cancel_, which the run in progress polls
+//   (SceneRunOptions::cancel); running_mutex_ guards which run that is.
 // - The diagnostics timer (global queue) reads the worker's counters through atomics and
 //   recording_mutex_.
 // - Destruction: the subscription and the services stop, queued inputs are dropped (a
-//   call waiting for one answers ok = false), the run in progress finishes and closes its
-//   bag, then the worker and the service threads are joined.
+//   call waiting for one answers ok = false), the run in progress is cancelled and closes
+//   its bag (its summary says cancelled), then the worker and the service threads are
+//   joined.
 #pragma once
 
 #include <atomic>
@@ -37,14 +42,15 @@
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
 
+#include "collision_lab/Cancel.h"
 #include "collision_lab/InitialConditions.h"
 #include "collision_lab/Rejected.h"
 #include "collision_lab/RunPreset.h"
 #include "collision_lab/RunScene.h"
 #include "collision_lab/RunSummary.h"
-#include "collision_lab/core/lab_run.h"
-#include "collision_lab/core/scene.h"
+#include "collision_lab/core/scene_run.h"
 #include "collision_lab/ros/marker_view.h"
+#include "collision_lab/ros/msg_conversion.h"
 
 namespace collision_lab_ros {
 
@@ -54,11 +60,12 @@ struct LabNodeParams {
   std::uint64_t max_collisions = 0;
   std::uint64_t max_published_events = 0;
   bool publish_markers = true;
+  std::uint64_t max_bodies = 0;    ///< larger scenes are rejected (TOO_MANY_BODIES)
   double min_free_space_mb = 0.0;  ///< [MB] diagnostics warn below it
   std::string scenario_file;       ///< the presets of ~run_preset
 
   /// Reads ~record, ~bag_directory, ~max_collisions, ~max_published_events,
-  /// ~publish_markers, ~min_free_space_mb and ~scenario_file (default: the package's
+  /// ~publish_markers, ~max_bodies, ~min_free_space_mb and ~scenario_file (default: the package's
   /// config/scenarios.yaml), with the defaults of node_constants.h.
   static LabNodeParams load(const ros::NodeHandle& private_nh);
 };
@@ -97,6 +104,7 @@ class LabNode {
                   collision_lab::RunScene::Response& response);
   bool onRunPreset(collision_lab::RunPreset::Request& request,
                    collision_lab::RunPreset::Response& response);
+  bool onCancel(collision_lab::Cancel::Request& request, collision_lab::Cancel::Response& response);
   /// Queues input for the worker and waits for its outcome; empty when the node stops
   /// before serving it.
   std::optional<ServeOutcome> serveAndWait(const collision_lab::InitialConditions& input);
@@ -110,9 +118,14 @@ class LabNode {
   /// summary. requested_run_id: RunSummary.requested_run_id.
   collision_lab::RunSummary run(collision_lab::InitialConditions& input,
                                 const std::string& requested_run_id);
+  /// runScene, as the run that ~cancel stops.
+  collision_lab::core::SceneRunResult runCancellable(const std::string& run_id,
+                                                     const collision_lab::core::Scene& scene,
+                                                     const collision_lab::core::SceneRunOptions& options,
+                                                     const collision_lab::core::SceneVisitors& visitors);
   /// Records the input (stamped at the run's start) and publishes the prediction.
   void publishStart(RunWriter& out, const collision_lab::InitialConditions& input,
-                    const collision_lab::core::AnalyticPrediction& prediction);
+                    const ScenePrediction& prediction);
   /// Stamps, records and publishes the summary last, closes the bag, counts the run.
   void publishEnd(RunWriter& out, collision_lab::RunSummary& summary, double last_event_time);
   ServeOutcome reject(collision_lab::Rejected msg, const std::string& run_id);
@@ -154,9 +167,17 @@ class LabNode {
   bool stopping_ = false;
   std::thread worker_;
 
+  std::mutex running_mutex_;
+  std::string running_run_id_;  ///< empty when no run is in progress
+  std::atomic<bool> cancel_{false};
+  std::atomic<bool> stopping_run_{false};  ///< set by the destructor: cancel every run
+
   ros::CallbackQueue service_queue_;
   ros::AsyncSpinner service_spinner_;
   ros::ServiceServer run_scene_srv_, run_preset_srv_;
+  ros::CallbackQueue cancel_queue_;
+  ros::AsyncSpinner cancel_spinner_;
+  ros::ServiceServer cancel_srv_;
 };
 
 }  // namespace collision_lab_ros

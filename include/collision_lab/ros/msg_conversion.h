@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 
@@ -20,7 +21,11 @@
 #include "collision_lab/RunSummary.h"
 #include "collision_lab/Velocities.h"
 #include "collision_lab/core/lab_run.h"
+#include "collision_lab/core/nbody/engine.h"
+#include "collision_lab/core/nbody/models.h"
+#include "collision_lab/core/nbody/scene.h"
 #include "collision_lab/core/scene.h"
+#include "collision_lab/core/scene_run.h"
 
 namespace collision_lab_ros {
 
@@ -29,6 +34,7 @@ enum class NodeReason : std::uint8_t {
   kDuplicateRunId = collision_lab::Rejected::DUPLICATE_RUN_ID,
   kInvalidRunId = collision_lab::Rejected::INVALID_RUN_ID,
   kInvalidMode = collision_lab::Rejected::INVALID_MODE,
+  kTooManyBodies = collision_lab::Rejected::TOO_MANY_BODIES,
 };
 
 const char* nodeReasonName(NodeReason reason);
@@ -37,8 +43,13 @@ const char* nodeReasonName(NodeReason reason);
 std::array<double, 3> toArray(const std::vector<double>& values);
 std::vector<double> toVector(const std::array<double, 3>& values);
 
-collision_lab::core::ThreeBodyScene toScene(const collision_lab::InitialConditions& msg);
+/// Any N, the lists (restitution included) exactly as given: core::validateForRun judges them.
+collision_lab::core::Scene toScene(const collision_lab::InitialConditions& msg);
 /// mode and max_collisions as given; header and run_id left for the caller.
+collision_lab::InitialConditions toInitialConditions(const collision_lab::core::Scene& scene,
+                                                     collision_lab::core::RunMode mode,
+                                                     std::uint64_t max_collisions);
+/// The same for three elastic bodies (restitution empty).
 collision_lab::InitialConditions toInitialConditions(const collision_lab::core::ThreeBodyScene& scene,
                                                      collision_lab::core::RunMode mode,
                                                      std::uint64_t max_collisions);
@@ -50,26 +61,95 @@ std::optional<collision_lab::core::RunMode> toRunMode(std::uint8_t mode);
 std::uint32_t toPairCode(const std::optional<collision_lab::core::Pair>& pair);
 std::optional<collision_lab::core::Pair> toPair(std::uint32_t code);
 
-collision_lab::Prediction toPredictionMsg(const collision_lab::core::AnalyticPrediction& prediction);
+/// The model of three elastic bodies with a generic reason, for callers without the scene
+/// (the node passes chooseModel's, as the CLI prints it).
+collision_lab::core::ModelChoice threeBodyRotationModel();
+
+/// What is known of a scene before its run: the model and the closed form of its path.
+struct ScenePrediction {
+  collision_lab::core::ModelChoice model;
+  std::size_t body_count = 0;
+  std::optional<collision_lab::core::AnalyticPrediction> three_body;  ///< the three-body path
+  std::optional<collision_lab::core::Prediction> nbody;               ///< the N-body models' closed form
+  /// three_body_spiral: the opening angle of the three masses [rad]; NaN otherwise.
+  double spiral_alpha = std::numeric_limits<double>::quiet_NaN();
+};
+/// The predictions runScene makes for a scene. Precondition: validateForRun(scene) passed.
+ScenePrediction predictScene(const collision_lab::core::Scene& scene);
+
+collision_lab::Prediction toPredictionMsg(const ScenePrediction& prediction);
+/// Three elastic bodies (the three-body path).
+collision_lab::Prediction toPredictionMsg(const collision_lab::core::AnalyticPrediction& prediction,
+                                          const collision_lab::core::ModelChoice& model = threeBodyRotationModel());
 collision_lab::core::AnalyticPrediction toPrediction(const collision_lab::Prediction& msg);
 
+/// An event of the three-body path (N = 3, elastic: every array filled).
 collision_lab::CollisionEvent toCollisionEventMsg(const collision_lab::core::LabEvent& event);
 /// Inverse of toCollisionEventMsg: the message carries every field of a LabEvent.
 collision_lab::core::LabEvent toLabEvent(const collision_lab::CollisionEvent& msg);
 
-/// The plot topics' projections of a CollisionEvent (header and run_id included): each
-/// field copies one element of the event's arrays (docs/messages.md).
+/// The plot topics' projections of a CollisionEvent (header and run_id included), with the
+/// velocities v [m/s] of every body after it; delta and kinetic [J] likewise, and
+/// cumulative_energy_lost the run's heat up to and including this event [J]
+/// (docs/messages.md). The scalar fields copy bodies 0, 1, 2 (NaN beyond N).
+collision_lab::Velocities toVelocitiesMsg(const collision_lab::CollisionEvent& event, std::vector<double> v);
+collision_lab::EnergyTransfer toEnergyTransferMsg(const collision_lab::CollisionEvent& event,
+                                                  std::vector<double> delta, std::vector<double> kinetic,
+                                                  double cumulative_energy_lost);
+/// The same from the event's own arrays (three-body events, or N <= FULL_STATE_MAX_BODIES).
 collision_lab::Velocities toVelocitiesMsg(const collision_lab::CollisionEvent& event);
-/// cumulative_energy_lost: the run's heat up to and including this event [J].
 collision_lab::EnergyTransfer toEnergyTransferMsg(const collision_lab::CollisionEvent& event,
                                                   double cumulative_energy_lost);
+
+/// The run's bodies, followed through the engine's notifications, and the CollisionEvent
+/// of each. Velocities are kept for every body; positions (and the per-body arrays of the
+/// messages) only for N <= FULL_STATE_MAX_BODIES: a body moves to x + v (t - t_last)
+/// between notifications, and the bodies an impact or a collapse moved sit at its point.
+/// Header and run_id are the caller's to fill.
+class SceneEventConverter {
+ public:
+  explicit SceneEventConverter(const collision_lab::core::Scene& scene);
+
+  /// One impact of the event engine (KIND_IMPACT).
+  collision_lab::CollisionEvent impact(const collision_lab::core::ImpactRecord& record);
+  /// One resolved inelastic collapse (KIND_COLLAPSE): its bodies move on as one cluster.
+  collision_lab::CollisionEvent collapse(const collision_lab::core::Collapse& collapse);
+
+  /// The plot messages of the last event converted (O(N) each).
+  collision_lab::Velocities velocitiesMsg(const collision_lab::CollisionEvent& event) const;
+  collision_lab::EnergyTransfer energyTransferMsg(const collision_lab::CollisionEvent& event) const;
+
+ private:
+  /// Moves every tracked position to time t [s].
+  void advance(double t);
+  /// Sets bodies [first, last] to velocity v and position x, recording each one's energy gain.
+  void move(std::size_t first, std::size_t last, double v, double x);
+  /// Fills the per-body arrays and totals of msg (or empties them, NaN totals, for large N).
+  void fillBodies(collision_lab::CollisionEvent& msg, const std::vector<double>& velocities_before) const;
+  double kinetic(std::size_t body) const;
+  /// Extends body's cluster (bodies stuck by e = 0 or a collapse) to the right (-1) or left (+1).
+  std::size_t clusterEnd(std::size_t body, int direction) const;
+
+  collision_lab::core::Scene scene_;
+  bool full_state_;
+  std::vector<double> x_, v_;
+  std::vector<bool> stuck_;  ///< stuck_[i]: bodies i and i + 1 move as one
+  double t_ = 0.0;
+  double cumulative_lost_ = 0.0;
+  std::size_t moved_first_ = 0;
+  std::vector<double> moved_gain_;  ///< energy gained by bodies moved_first_, ... in the last event [J]
+};
 
 /// The physics fields of a summary; published_events, events_not_published, bag_path,
 /// recording_ok, recording_error, timeline_scale, timeline_saturated and
 /// requested_run_id are the node's to fill.
+collision_lab::RunSummary toRunSummaryMsg(const collision_lab::core::SceneRunResult& result,
+                                          std::size_t body_count, collision_lab::core::RunMode mode);
+/// Three elastic bodies (the three-body path).
 collision_lab::RunSummary toRunSummaryMsg(const collision_lab::core::LabRunSummary& summary,
                                           const collision_lab::core::AnalyticPrediction& prediction,
-                                          collision_lab::core::RunMode mode);
+                                          collision_lab::core::RunMode mode,
+                                          const collision_lab::core::ModelChoice& model = threeBodyRotationModel());
 
 collision_lab::Rejected toRejectedMsg(const collision_lab::core::ValidationError& error);
 collision_lab::Rejected toRejectedMsg(NodeReason reason, const std::string& field,

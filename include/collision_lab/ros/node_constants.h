@@ -34,6 +34,8 @@ constexpr bool kLatchRejected = true;
 /// Private services of collision_lab_node (srv/RunScene.srv, srv/RunPreset.srv).
 constexpr char kRunSceneService[] = "run_scene";
 constexpr char kRunPresetService[] = "run_preset";
+/// Stops the run in progress (srv/Cancel.srv); served by a thread of its own.
+constexpr char kCancelService[] = "cancel";
 /// Service calls served at once; each blocks its thread until its run is over (the runs
 /// themselves are served one at a time by the worker). Further calls wait in roscpp.
 constexpr std::uint32_t kServiceThreads = 4;
@@ -45,8 +47,9 @@ constexpr double kDiagnosticsPeriod = 1.0;  ///< [s]
 /// Below this much free space in bag_directory the diagnostics warn.
 constexpr double kDefaultMinFreeSpaceMb = 500.0;  ///< [MB]
 
-/// Inputs arrive in bursts from scripts; the subscriber callback only queues them, so
-/// this covers bursts of up to 10,000 inputs between two spins.
+/// Inputs arrive in bursts from scripts; the subscriber callback only queues them (the
+/// worker's queue is unbounded), so this covers bursts of up to 10,000 inputs between two
+/// spins.
 constexpr std::uint32_t kInputQueueSize = 10000;
 /// Per-run topics: a burst of runs may queue many messages per subscriber link before a
 /// slow subscriber reads them. roscpp drops the oldest beyond this, so it is sized for
@@ -56,6 +59,9 @@ constexpr std::uint32_t kOutputQueueSize = 100000;
 constexpr std::uint32_t kMarkerQueueSize = 10;
 
 constexpr std::uint64_t kDefaultMaxCollisions = 10'000'000;
+/// ~max_bodies: a larger scene is rejected (TOO_MANY_BODIES), so that a typo in a script
+/// cannot flood a lab machine; a 10,000-body gas still runs.
+constexpr std::uint64_t kDefaultMaxBodies = 10'000;
 /// Per run; beyond it, events go to the bag only. Keeps a 2-million-collision run from
 /// putting 6 million messages on the network.
 constexpr std::uint64_t kDefaultMaxPublishedEvents = 10'000;

@@ -11,15 +11,14 @@
 
 #include <ros/time.h>
 
-#include "collision_lab/core/lab_run.h"
-#include "collision_lab/core/scene.h"
+#include "collision_lab/core/nbody/scene.h"
 
 namespace collision_lab_ros {
 
-/// Time of the scene's first contact [s]: gap / closing speed of first_pair (inf when the
-/// quotient overflows); empty when nothing collides (first_pair empty).
-std::optional<double> firstContactTime(const collision_lab::core::ThreeBodyScene& scene,
-                                       const std::optional<collision_lab::core::Pair>& first_pair);
+/// Time of the scene's first contact [s]: the least gap / closing speed over the pairs that
+/// approach (inf when the quotient overflows); empty when none approaches.
+/// Precondition: validateForRun(scene) passed.
+std::optional<double> firstContactTime(const collision_lab::core::Scene& scene);
 
 /// [bag s per simulated s]: 1 when first_contact is empty or within [1e-3, 1e3] s,
 /// otherwise 10^(-floor(log10 first_contact)) (exponent clamped to +-300).
