@@ -1,6 +1,7 @@
 // Message <-> core conversions (no master).
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -20,10 +21,143 @@ TEST(MsgConversion, SceneRoundTripKeepsWallsAndValues) {
   const auto msg = toInitialConditions(scene, collision_lab::core::RunMode::kSummaryOnly, 77);
   EXPECT_EQ(msg.mode, collision_lab::InitialConditions::MODE_SUMMARY_ONLY);
   EXPECT_EQ(msg.max_collisions, 77u);
-  const collision_lab::core::ThreeBodyScene back = toScene(msg);
+  const collision_lab::core::Scene back = toScene(msg);
+  EXPECT_EQ(back.masses, std::vector<double>(scene.masses.begin(), scene.masses.end()));
+  EXPECT_EQ(back.positions, std::vector<double>(scene.positions.begin(), scene.positions.end()));
+  EXPECT_EQ(back.velocities, std::vector<double>(scene.velocities.begin(), scene.velocities.end()));
+  EXPECT_TRUE(back.restitution.empty());
+}
+
+TEST(MsgConversion, AnySceneRoundTripKeepsItsListsAsGiven) {
+  // Invalid on purpose (unequal lengths): the conversion copies, validation judges.
+  const collision_lab::core::Scene scene{{1, 2, kInf, 4}, {5, 4, 3}, {-1, 0}, {0.5, 0.25, 1, 7}};
+  const auto msg = toInitialConditions(scene, collision_lab::core::RunMode::kFull, 0);
+  const collision_lab::core::Scene back = toScene(msg);
   EXPECT_EQ(back.masses, scene.masses);
   EXPECT_EQ(back.positions, scene.positions);
   EXPECT_EQ(back.velocities, scene.velocities);
+  EXPECT_EQ(back.restitution, scene.restitution);
+}
+
+collision_lab::core::ImpactRecord record(std::uint64_t index, std::size_t pair, double t, double x,
+                                         std::array<double, 2> before, std::array<double, 2> after,
+                                         std::array<double, 2> gained, double lost) {
+  collision_lab::core::ImpactRecord r;
+  r.index = index, r.pair_index = pair, r.time = t, r.position = x;
+  r.velocities_before = before, r.velocities_after = after, r.energy_gained = gained, r.energy_lost = lost;
+  return r;
+}
+
+// Masses 1, 1, 2 at x = 2, 1, 0, v = -1, 0, 0; AB sticks (e = 0), BC is elastic. By hand:
+// AB meet at t = 1 s, x = 1 m and both move at -1/2 m/s (0.25 J of heat); the 2 kg cluster
+// AB reaches C at t = 3 s, x = 0 m, and (equal masses, e = 1) stops while C takes -1/2 m/s.
+TEST(SceneEventConverter, RebuildsEveryBodyThroughAStickingImpactAndAClusterImpact) {
+  SceneEventConverter converter({{1, 1, 2}, {2, 1, 0}, {-1, 0, 0}, {0, 1}});
+  const auto first = converter.impact(record(1, 0, 1.0, 1.0, {-1, 0}, {-0.5, -0.5}, {-0.375, 0.125}, 0.25));
+  EXPECT_EQ(first.kind, collision_lab::CollisionEvent::KIND_IMPACT);
+  EXPECT_EQ(first.restitution, 0.0);
+  EXPECT_EQ(first.first_moved, 0u);
+  EXPECT_EQ(first.last_moved, 1u);
+  EXPECT_FALSE(first.cluster_impact);
+  EXPECT_EQ(first.positions, (std::vector<double>{1, 1, 0}));
+  EXPECT_EQ(first.velocities_before, (std::vector<double>{-1, 0, 0}));
+  EXPECT_EQ(first.velocities_after, (std::vector<double>{-0.5, -0.5, 0}));
+  EXPECT_EQ(first.energy_transfer, (std::vector<double>{-0.375, 0.125, 0}));
+  EXPECT_EQ(first.kinetic_energy_after, (std::vector<double>{0.125, 0.125, 0}));
+  EXPECT_EQ(first.total_energy, 0.25);
+  EXPECT_EQ(first.total_momentum, -1.0);
+  EXPECT_EQ(converter.energyTransferMsg(first).cumulative_energy_lost, 0.25);
+
+  const auto second = converter.impact(record(2, 1, 3.0, 0.0, {-0.5, 0}, {0, -0.5}, {-0.25, 0.25}, 0));
+  EXPECT_EQ(second.first_moved, 0u);  // the cluster AB moved as one
+  EXPECT_EQ(second.last_moved, 2u);
+  EXPECT_TRUE(second.cluster_impact);
+  EXPECT_EQ(second.positions, (std::vector<double>{0, 0, 0}));
+  EXPECT_EQ(second.velocities_after, (std::vector<double>{0, 0, -0.5}));
+  EXPECT_EQ(second.energy_transfer, (std::vector<double>{-0.125, -0.125, 0.25}));
+  EXPECT_EQ(second.total_energy, 0.25);
+  EXPECT_EQ(second.total_momentum, -1.0);
+  const auto v = converter.velocitiesMsg(second);
+  EXPECT_EQ(v.v, (std::vector<double>{0, 0, -0.5}));
+  EXPECT_EQ(v.v_c, -0.5);
+  const auto t = converter.energyTransferMsg(second);
+  EXPECT_EQ(t.delta, (std::vector<double>{-0.125, -0.125, 0.25}));
+  EXPECT_EQ(t.kinetic, (std::vector<double>{0, 0, 0.25}));
+  EXPECT_EQ(t.energy_lost, 0.0);
+  EXPECT_EQ(t.cumulative_energy_lost, 0.25);
+}
+
+// Three equal masses that collapse: afterwards all move at the centre-of-mass velocity.
+TEST(SceneEventConverter, ACollapseMovesItsBodiesOnAsOneAtTheirCentreOfMass) {
+  SceneEventConverter converter({{1, 1, 1}, {2, 1, 0}, {-1, 0, 0}, {0.05}});
+  collision_lab::core::Collapse collapse;
+  collapse.first_body = 0, collapse.last_body = 2, collapse.time = 2.5, collapse.position = -0.5;
+  collapse.impacts_before = 40;
+  const auto msg = converter.collapse(collapse);
+  EXPECT_EQ(msg.kind, collision_lab::CollisionEvent::KIND_COLLAPSE);
+  EXPECT_EQ(msg.index, 40u);
+  EXPECT_EQ(msg.first_moved, 0u);
+  EXPECT_EQ(msg.last_moved, 2u);
+  for (double v : msg.velocities_after) EXPECT_DOUBLE_EQ(v, -1.0 / 3);
+  EXPECT_EQ(msg.positions, (std::vector<double>{-0.5, -0.5, -0.5}));
+  EXPECT_DOUBLE_EQ(msg.energy_lost, 0.5 - 1.0 / 6);  // 1/2 J before, 3 (1/2)(1/9) J after
+  EXPECT_DOUBLE_EQ(converter.energyTransferMsg(msg).cumulative_energy_lost, 1.0 / 3);
+}
+
+TEST(SceneEventConverter, AboveTheFullStateLimitOnlyThePairFieldsAndThePlotsCarryTheBodies) {
+  const std::size_t n = collision_lab::CollisionEvent::FULL_STATE_MAX_BODIES + 1;
+  collision_lab::core::Scene scene{std::vector<double>(n, 1.0), {}, std::vector<double>(n, 0.0), {}};
+  for (std::size_t i = 0; i < n; ++i) scene.positions.push_back(static_cast<double>(n - i));
+  scene.velocities[10] = -1;
+  SceneEventConverter converter(scene);
+  const auto msg = converter.impact(record(1, 10, 1.0, static_cast<double>(n - 11), {-1, 0}, {0, -1}, {-0.5, 0.5}, 0));
+  EXPECT_TRUE(msg.positions.empty());
+  EXPECT_TRUE(msg.velocities_after.empty());
+  EXPECT_TRUE(std::isnan(msg.total_energy));
+  EXPECT_TRUE(std::isnan(msg.total_momentum));
+  EXPECT_EQ(msg.pair_velocities_after[1], -1.0);
+  const auto v = converter.velocitiesMsg(msg);
+  ASSERT_EQ(v.v.size(), n);
+  EXPECT_EQ(v.v[10], 0.0);
+  EXPECT_EQ(v.v[11], -1.0);
+  const auto t = converter.energyTransferMsg(msg);
+  ASSERT_EQ(t.delta.size(), n);
+  EXPECT_EQ(t.delta[10], -0.5);
+  EXPECT_EQ(t.delta[11], 0.5);
+  EXPECT_EQ(t.kinetic[11], 0.5);
+}
+
+TEST(MsgConversion, AScenePredictedByNoFormulaFlagsEveryFieldAsNotGiven) {
+  ScenePrediction p;
+  p.model = {collision_lab::core::ModelKind::kEventEngine, "no formula"};
+  p.body_count = 7;
+  const auto msg = toPredictionMsg(p);
+  EXPECT_EQ(msg.model, collision_lab::Prediction::MODEL_EVENT_ENGINE);
+  EXPECT_EQ(msg.model_name, "event_engine");
+  EXPECT_EQ(msg.model_reason, "no formula");
+  EXPECT_EQ(msg.body_count, 7u);
+  EXPECT_FALSE(msg.collision_count_defined);
+  EXPECT_EQ(msg.first_pair_index, collision_lab::Prediction::PAIR_NONE);
+  EXPECT_TRUE(msg.final_velocities.empty());
+  for (double x : {msg.alpha, msg.theta, msg.energy_lost, msg.collapse_time, msg.collapse_position,
+                   msg.critical_restitution, msg.spiral_angle}) {
+    EXPECT_TRUE(std::isnan(x));
+  }
+}
+
+TEST(MsgConversion, ANotSimulatedSceneSaysSoAndLeavesNoZeros) {
+  collision_lab::core::SceneRunResult result;
+  result.model = {collision_lab::core::ModelKind::kEventEngine, "no formula"};
+  result.simulation.energy_lost = std::nan("");
+  result.simulation.energy_relative_drift = result.simulation.momentum_relative_drift = std::nan("");
+  const auto msg = toRunSummaryMsg(result, 5, collision_lab::core::RunMode::kPredictOnly);
+  EXPECT_EQ(msg.stop_reason, "NOT_SIMULATED");
+  EXPECT_FALSE(msg.simulated);
+  EXPECT_EQ(msg.body_count, 5u);
+  EXPECT_FALSE(msg.predicted_collision_count_defined);
+  EXPECT_TRUE(std::isnan(msg.energy_lost));
+  EXPECT_TRUE(std::isnan(msg.collapse_time));
+  EXPECT_TRUE(std::isnan(msg.critical_restitution));
 }
 
 TEST(MsgConversion, RunModes) {
