@@ -19,12 +19,15 @@ if(TARGET ros_tools_unit_test)
 endif()
 
 find_package(rostest REQUIRED)
-foreach(name node_test burst_test demo_test crash_test markers_test markers_clock_test)
+foreach(name node_test nbody_node_test burst_test demo_test crash_test markers_test markers_clock_test)
   add_rostest_gtest(${name} test/ros/${name}.test test/ros/${name}.cpp)
   target_link_libraries(${name} collision_lab_ros ${catkin_LIBRARIES})
   # The rostests start these nodes.
   add_dependencies(${name} collision_lab_node collision_lab_markers scenario_publisher)
 endforeach()
+# nbody_node_test checks the node against the exact rational reference of the core's tests.
+target_sources(nbody_node_test PRIVATE test/core/nbody/reference.cpp)
+target_include_directories(nbody_node_test PRIVATE test/core/nbody)
 # node_test reads the bad-input catalogue, docs/bad_inputs.md; demo_test runs scripts/play_run.
 target_compile_definitions(node_test PRIVATE COLLISION_LAB_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
 target_compile_definitions(demo_test PRIVATE COLLISION_LAB_SOURCE_DIR="${PROJECT_SOURCE_DIR}")

@@ -1,7 +1,11 @@
-// A burst of 1,000 inputs, valid and bad mixed, published as fast as possible
-// (burst_test.test): exactly one run_summaries or rejected per input, matched by run_id,
-// every announced per-collision message, and one readable bag per valid run.
+// Bursts published as fast as possible (burst_test.test): 1,000 three-body inputs, valid
+// and bad mixed, with one readable bag per valid run; and 10,000 mixed scenes of 1 to 50
+// bodies, with and without restitution, in every mode, some invalid with a known reason.
+// Each gets exactly one run_summaries or rejected, matched by run_id, and every announced
+// per-collision message.
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <cstdio>
 #include <filesystem>
 #include <random>
@@ -84,6 +88,104 @@ TEST(Burst, OneAnswerPerInputAndOneBagPerValidRun) {
   }
   EXPECT_EQ(bags, static_cast<std::size_t>(valid_runs));
   RecordProperty("valid_runs", valid_runs);
+}
+
+/// One scene of the mixed burst and the reason code it must be rejected with (0: valid).
+struct MixedInput {
+  collision_lab::InitialConditions input;
+  std::uint8_t reason = 0;
+};
+
+/// n bodies with gaps in [0.5, 2] m, masses in [0.5, 5] kg (1 in 8 with a wall at rest at
+/// one end, 1 in 24 with walls at both ends),
+/// velocities in [-1, 1] m/s, restitution none, one or per pair in [0.8, 1]; 1 in 10 is
+/// spoilt in one field, whose reason the test knows.
+MixedInput mixedInput(std::mt19937& rng, int i) {
+  using collision_lab::Rejected;
+  std::uniform_real_distribution<double> mass(0.5, 5.0), gap(0.5, 2.0), speed(-1.0, 1.0), e(0.8, 1.0);
+  MixedInput mixed;
+  auto& in = mixed.input;
+  char run_id[32];
+  std::snprintf(run_id, sizeof run_id, "mixed_%05d", i);
+  in.run_id = run_id;
+  const std::size_t n = 1 + rng() % 50;
+  in.positions.assign(n, 0.0);
+  for (std::size_t k = n - 1; k-- > 0;) in.positions[k] = in.positions[k + 1] + gap(rng);
+  for (std::size_t k = 0; k < n; ++k) in.masses.push_back(mass(rng)), in.velocities.push_back(speed(rng));
+  const unsigned walls = rng() % 8;
+  const unsigned how = rng() % 3;
+  if (walls == 0 && n >= 2) in.masses[0] = std::numeric_limits<double>::infinity(), in.velocities[0] = 0;
+  // Two walls are elastic only: inelastic bodies between walls can near an inelastic
+  // collapse, where the engine's exact tiers take minutes for the 2,000 impacts of a cap.
+  if (walls == 1 && n >= 3 && how == 0) {
+    in.masses.front() = in.masses.back() = std::numeric_limits<double>::infinity();
+    in.velocities.front() = in.velocities.back() = 0;
+  }
+  if (how == 1) in.restitution = {e(rng)};
+  if (how == 2) {
+    for (std::size_t p = 0; p + 1 < n; ++p) in.restitution.push_back(e(rng));
+  }
+  in.mode = rng() % 5 == 0 ? collision_lab::InitialConditions::MODE_SUMMARY_ONLY
+                           : collision_lab::InitialConditions::MODE_FULL;
+  in.max_collisions = 2000;
+  switch (rng() % 20) {
+    case 0: in.velocities[n / 2] = std::nan(""), mixed.reason = Rejected::NON_FINITE_VALUE; break;
+    case 1: in.masses[n / 2] = -1.0, mixed.reason = Rejected::NON_POSITIVE_MASS; break;
+    case 2: in.velocities.push_back(0.0), mixed.reason = Rejected::UNEQUAL_LENGTHS; break;
+    case 3:
+      if (n >= 2) in.restitution.assign(n - 1, 0.9), in.restitution.back() = 1.5, mixed.reason = Rejected::RESTITUTION_OUT_OF_RANGE;
+      break;
+    case 4:
+      if (n >= 3) in.restitution.assign(n, 0.9), mixed.reason = Rejected::RESTITUTION_COUNT;
+      break;
+    default: break;
+  }
+  return mixed;
+}
+
+TEST(Burst, TenThousandMixedScenesOfUpTo50BodiesAreAnsweredOneForOne) {
+  constexpr int kMixed = 10000;
+  std::mt19937 rng(20261212);
+  std::vector<MixedInput> inputs;
+  for (int i = 0; i < kMixed; ++i) inputs.push_back(mixedInput(rng, i));
+
+  RunCollector node("collision_lab_mixed");
+  node.waitForConnection();
+  const ros::WallTime start = ros::WallTime::now();
+  for (const auto& mixed : inputs) node.publish(mixed.input);
+
+  int valid_runs = 0, restitution_runs = 0, nbody_runs = 0;
+  for (const auto& [input, reason] : inputs) {
+    SCOPED_TRACE(input.run_id);
+    const auto& out = node.waitFor(input.run_id);
+    ASSERT_EQ(out.summaries.size() + out.rejections.size(), 1u);
+    if (reason != 0) {
+      ASSERT_EQ(out.rejections.size(), 1u);
+      EXPECT_EQ(out.rejections.front().reason, reason) << out.rejections.front().message;
+      EXPECT_TRUE(out.predictions.empty());
+      continue;
+    }
+    ASSERT_EQ(out.summaries.size(), 1u) << out.rejections.front().message;
+    ++valid_runs;
+    restitution_runs += !input.restitution.empty();
+    nbody_runs += input.masses.size() != 3;
+    const auto& s = out.summaries.front();
+    EXPECT_EQ(out.predictions.size(), 1u);
+    EXPECT_EQ(s.body_count, input.masses.size());
+    EXPECT_LE(s.collision_count, 2000u);
+    EXPECT_EQ(out.events.size(), s.published_events);
+    EXPECT_EQ(out.velocities.size(), s.published_events);
+    EXPECT_EQ(out.energies.size(), s.published_events);
+    for (const auto& v : out.velocities) EXPECT_EQ(v.v.size(), input.masses.size());
+    if (input.mode == collision_lab::InitialConditions::MODE_SUMMARY_ONLY) EXPECT_TRUE(out.events.empty());
+  }
+  const double seconds = (ros::WallTime::now() - start).toSec();
+  EXPECT_EQ(node.runs().size(), static_cast<std::size_t>(kMixed));
+  EXPECT_GT(restitution_runs, kMixed / 2);  // the mix covers what it claims
+  EXPECT_GT(nbody_runs, kMixed / 2);
+  RecordProperty("mixed_valid_runs", valid_runs);
+  RecordProperty("mixed_burst_seconds", std::to_string(seconds));
+  std::printf("mixed burst: %d inputs (%d valid) answered in %.1f s\n", kMixed, valid_runs, seconds);
 }
 
 }  // namespace
