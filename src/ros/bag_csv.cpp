@@ -1,5 +1,6 @@
 #include "collision_lab/ros/bag_csv.h"
 
+#include <algorithm>
 #include <cinttypes>
 #include <cmath>
 #include <cstdio>
@@ -8,7 +9,10 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <ostream>
+#include <set>
+#include <utility>
 
 #include <boost/array.hpp>
 #include <rosbag/bag.h>
@@ -21,12 +25,14 @@
 #include "collision_lab/Rejected.h"
 #include "collision_lab/RunSummary.h"
 #include "collision_lab/Velocities.h"
+#include "collision_lab/core/nbody/scene.h"
 
 namespace collision_lab_ros {
 
 namespace {
 
 namespace fs = std::filesystem;
+namespace core = collision_lab::core;
 
 // ---- Cell formats ----
 
@@ -58,15 +64,24 @@ void writeStamp(std::ostream& out, const ros::Time& stamp) {
   out << buffer;
 }
 void writeBool(std::ostream& out, std::uint8_t value) { out << (value ? "true" : "false"); }
-void writePair(std::ostream& out, std::uint32_t pair) {
-  static_assert(collision_lab::CollisionEvent::PAIR_AB == collision_lab::Prediction::PAIR_AB &&
-                    collision_lab::CollisionEvent::PAIR_BC == collision_lab::Prediction::PAIR_BC,
-                "one pair code for every message");
-  switch (pair) {
-    case collision_lab::Prediction::PAIR_AB: out << "AB"; return;
-    case collision_lab::Prediction::PAIR_BC: out << "BC"; return;
-    case collision_lab::Prediction::PAIR_NONE: out << "none"; return;
-    default: out << pair;
+static_assert(std::uint32_t{collision_lab::CollisionEvent::PAIR_AB} == collision_lab::Prediction::PAIR_AB &&
+                  std::uint32_t{collision_lab::CollisionEvent::PAIR_BC} == collision_lab::Prediction::PAIR_BC,
+              "one pair code for every message");
+void writePairIndex(std::ostream& out, std::uint32_t pair) {
+  if (pair == collision_lab::Prediction::PAIR_NONE) {
+    out << "none";
+  } else {
+    out << pair;
+  }
+}
+void writePairName(std::ostream& out, std::uint32_t pair) {
+  out << (pair == collision_lab::Prediction::PAIR_NONE ? std::string("none") : core::pairName(pair));
+}
+void writeKind(std::ostream& out, std::uint8_t kind) {
+  switch (kind) {
+    case collision_lab::CollisionEvent::KIND_IMPACT: out << "impact"; return;
+    case collision_lab::CollisionEvent::KIND_COLLAPSE: out << "collapse"; return;
+    default: out << static_cast<int>(kind);
   }
 }
 void writeMode(std::ostream& out, std::uint8_t mode) {
@@ -86,84 +101,105 @@ struct Column {
   std::function<void(std::ostream&, const M&)> write;
 };
 
+/// The columns of one topic's CSV: the scalar fields of M.
 template <class M>
 class Table {
  public:
   Table() {
-    add({"stamp_s", "header"}, [](std::ostream& o, const M& m) { writeStamp(o, m.header.stamp); });
-    add({"run_id", "run_id"}, [](std::ostream& o, const M& m) { writeCell(o, m.run_id); });
+    add("stamp_s", "header", [](std::ostream& o, const M& m) { writeStamp(o, m.header.stamp); });
+    add("run_id", "run_id", [](std::ostream& o, const M& m) { writeCell(o, m.run_id); });
   }
   /// A number or string field, written as it is; its column is the field's name and unit
   /// (e.g. "_s"; empty for [1] and strings).
   template <class T>
   Table& field(const std::string& field, T M::*member, const std::string& unit = "") {
-    return add({field + unit, field}, [member](std::ostream& o, const M& m) {
+    return add(field + unit, field, [member](std::ostream& o, const M& m) {
       if constexpr (std::is_same_v<T, std::uint8_t>) {
         o << static_cast<int>(m.*member);
+      } else if constexpr (std::is_integral_v<T> && std::is_unsigned_v<T>) {
+        writeCell(o, static_cast<std::uint64_t>(m.*member));
+      } else if constexpr (std::is_integral_v<T>) {
+        writeCell(o, static_cast<std::int64_t>(m.*member));
       } else {
         writeCell(o, m.*member);
       }
     });
   }
   Table& flag(const std::string& field, std::uint8_t M::*member) {
-    return add({field, field}, [member](std::ostream& o, const M& m) { writeBool(o, m.*member); });
+    return add(field, field, [member](std::ostream& o, const M& m) { writeBool(o, m.*member); });
   }
-  Table& pair(const std::string& field, std::uint32_t M::*member) {
-    return add({field, field}, [member](std::ostream& o, const M& m) { writePair(o, m.*member); });
+  /// Two columns: the pair's number (pair_index; "none" for PAIR_NONE) and its name
+  /// (name_column: "AB", "BC", ..., core::pairName).
+  Table& pair(const std::string& field, const std::string& name_column, std::uint32_t M::*member) {
+    add(field, field, [member](std::ostream& o, const M& m) { writePairIndex(o, m.*member); });
+    return add(name_column, field, [member](std::ostream& o, const M& m) { writePairName(o, m.*member); });
   }
-  Table& mode(std::uint8_t M::*member) {
-    return add({"mode", "mode"}, [member](std::ostream& o, const M& m) { writeMode(o, m.*member); });
+  /// A uint8 enum field written by its name (write: e.g. writeMode).
+  Table& named(const std::string& field, std::uint8_t M::*member, void (*write)(std::ostream&, std::uint8_t)) {
+    return add(field, field, [member, write](std::ostream& o, const M& m) { write(o, m.*member); });
   }
-  /// Three columns for A, B, C (bodies 0, 1, 2): pattern with "{}" replaced by a, b, c;
-  /// an empty cell for a body the array does not have.
-  Table& triple(const std::string& pattern, const std::string& field,
-                std::vector<double> M::*member) {
-    for (std::size_t i = 0; i < 3; ++i) {
-      add({abc(pattern, i), field}, [member, i](std::ostream& o, const M& m) {
-        if (i < (m.*member).size()) writeCell(o, (m.*member)[i]);
-      });
+  /// A fixed pair array [2] as columns <prefix>_0<unit> and <prefix>_1<unit>: bodies
+  /// pair_index and pair_index + 1.
+  Table& pairArray(const std::string& prefix, const std::string& field, const std::string& unit,
+                   boost::array<double, 2> M::*member) {
+    for (std::size_t i = 0; i < 2; ++i) {
+      add(prefix + "_" + std::to_string(i) + unit, field,
+          [member, i](std::ostream& o, const M& m) { writeCell(o, (m.*member)[i]); });
     }
     return *this;
   }
-  /// Three scalar fields for A, B, C named pattern with "{}" replaced by a, b, c; the
-  /// column adds unit.
-  Table& scalars(const std::string& pattern, const std::string& unit,
-                 const std::array<double M::*, 3>& members) {
-    for (int i = 0; i < 3; ++i) {
-      const std::string name = abc(pattern, i);
-      field(name, members[i], unit);
-    }
+  /// A list in one cell, values separated by ';' (empty cell: an empty list).
+  Table& list(const std::string& field, const std::string& unit, std::vector<double> M::*member) {
+    return add(field + unit, field, [member](std::ostream& o, const M& m) {
+      const char* separator = "";
+      for (double value : m.*member) {
+        o << separator;
+        writeCell(o, value);
+        separator = ";";
+      }
+    });
+  }
+  /// A field that is exported to a tidy table (file), not to this topic's CSV: listed by
+  /// columns() so that every field has a column.
+  Table& elsewhere(const std::string& file, const std::vector<std::pair<std::string, std::string>>& columns) {
+    for (const auto& [name, field] : columns) elsewhere_.push_back({name, field, file});
     return *this;
   }
   const std::vector<Column<M>>& columns() const { return columns_; }
+  const std::vector<CsvColumn>& elsewhereColumns() const { return elsewhere_; }
 
  private:
-  static std::string abc(const std::string& pattern, int i) {
-    const auto at = pattern.find("{}");
-    return pattern.substr(0, at) + static_cast<char>('a' + i) + pattern.substr(at + 2);
-  }
-  Table& add(CsvColumn name, std::function<void(std::ostream&, const M&)> write) {
-    columns_.push_back({std::move(name), std::move(write)});
+  Table& add(std::string name, std::string field, std::function<void(std::ostream&, const M&)> write) {
+    columns_.push_back({CsvColumn{std::move(name), std::move(field), ""}, std::move(write)});
     return *this;
   }
   std::vector<Column<M>> columns_;
+  std::vector<CsvColumn> elsewhere_;
 };
+
+constexpr const char* kBodiesFile = "bodies.csv";
+constexpr const char* kFinalVelocitiesFile = "final_velocities.csv";
 
 Table<collision_lab::InitialConditions> initialConditionsTable() {
   using M = collision_lab::InitialConditions;
   Table<M> t;
-  t.mode(&M::mode)
-      .triple("m_{}_kg", "masses", &M::masses)
-      .triple("x_{}_m", "positions", &M::positions)
-      .triple("v_{}_m_s", "velocities", &M::velocities)
-      .field("max_collisions", &M::max_collisions);
+  t.named("mode", &M::mode, writeMode)
+      .list("restitution", "", &M::restitution)
+      .field("max_collisions", &M::max_collisions)
+      .elsewhere(kBodiesFile, {{"mass_kg", "masses"}, {"x_m", "positions"}, {"v_m_s", "velocities"}});
   return t;
 }
 
 Table<collision_lab::Prediction> predictionTable() {
   using M = collision_lab::Prediction;
   Table<M> t;
-  t.field("collision_count", &M::collision_count)
+  t.field("model", &M::model)
+      .field("model_name", &M::model_name)
+      .field("model_reason", &M::model_reason)
+      .field("body_count", &M::body_count)
+      .field("collision_count", &M::collision_count)
+      .flag("collision_count_defined", &M::collision_count_defined)
+      .flag("infinite_collisions", &M::infinite_collisions)
       .field("paper_collision_count", &M::paper_collision_count)
       .flag("paper_collision_count_defined", &M::paper_collision_count_defined)
       .field("max_possible_collision_count", &M::max_possible_collision_count)
@@ -172,31 +208,45 @@ Table<collision_lab::Prediction> predictionTable() {
       .field("omega", &M::omega, "_rad")
       .field("phi_bc", &M::phi_bc, "_rad")
       .field("psi", &M::psi, "_rad")
-      .pair("first_pair_index", &M::first_pair_index)
-      .triple("v_{}_final_m_s", "final_velocities", &M::final_velocities)
-      .field("timeline_scale", &M::timeline_scale, "_bag_s_per_s");
+      .pair("first_pair_index", "first_pair", &M::first_pair_index)
+      .field("energy_lost", &M::energy_lost, "_J")
+      .flag("collapsed", &M::collapsed)
+      .field("collapse_time", &M::collapse_time, "_s")
+      .field("collapse_position", &M::collapse_position, "_m")
+      .field("critical_restitution", &M::critical_restitution)
+      .field("spiral_angle", &M::spiral_angle, "_rad")
+      .field("timeline_scale", &M::timeline_scale, "_bag_s_per_s")
+      .elsewhere(kFinalVelocitiesFile, {{"v_m_s", "final_velocities"}});
   return t;
 }
 
 Table<collision_lab::CollisionEvent> collisionEventTable() {
   using M = collision_lab::CollisionEvent;
   Table<M> t;
-  t.field("index", &M::index)
-      .pair("pair_index", &M::pair_index)
+  t.named("kind", &M::kind, writeKind)
+      .field("index", &M::index)
+      .pair("pair_index", "pair", &M::pair_index)
       .field("time", &M::time, "_s")
       .field("position", &M::position, "_m")
-      .triple("x_{}_m", "positions", &M::positions)
-      .triple("v_{}_before_m_s", "velocities_before", &M::velocities_before)
-      .triple("v_{}_after_m_s", "velocities_after", &M::velocities_after)
-      .triple("predicted_v_{}_after_m_s", "predicted_velocities_after", &M::predicted_velocities_after)
-      .triple("paper_v_{}_after_m_s", "paper_velocities_after", &M::paper_velocities_after)
-      .triple("energy_transfer_{}_J", "energy_transfer", &M::energy_transfer)
-      .triple("predicted_energy_transfer_{}_J", "predicted_energy_transfer",
-              &M::predicted_energy_transfer)
-      .triple("paper_energy_transfer_{}_J", "paper_energy_transfer", &M::paper_energy_transfer)
-      .triple("kinetic_energy_{}_after_J", "kinetic_energy_after", &M::kinetic_energy_after)
+      .field("restitution", &M::restitution)
+      .field("first_moved", &M::first_moved)
+      .field("last_moved", &M::last_moved)
+      .flag("cluster_impact", &M::cluster_impact)
+      .pairArray("pair_v_before", "pair_velocities_before", "_m_s", &M::pair_velocities_before)
+      .pairArray("pair_v_after", "pair_velocities_after", "_m_s", &M::pair_velocities_after)
+      .pairArray("pair_energy_transfer", "pair_energy_transfer", "_J", &M::pair_energy_transfer)
+      .field("energy_lost", &M::energy_lost, "_J")
       .field("total_energy", &M::total_energy, "_J")
-      .field("total_momentum", &M::total_momentum, "_kg_m_s");
+      .field("total_momentum", &M::total_momentum, "_kg_m_s")
+      .elsewhere(kBodiesFile, {{"x_m", "positions"},
+                               {"v_before_m_s", "velocities_before"},
+                               {"v_m_s", "velocities_after"},
+                               {"energy_transfer_J", "energy_transfer"},
+                               {"kinetic_J", "kinetic_energy_after"},
+                               {"predicted_v_m_s", "predicted_velocities_after"},
+                               {"paper_v_m_s", "paper_velocities_after"},
+                               {"predicted_energy_transfer_J", "predicted_energy_transfer"},
+                               {"paper_energy_transfer_J", "paper_energy_transfer"}});
   return t;
 }
 
@@ -205,7 +255,10 @@ Table<collision_lab::Velocities> velocitiesTable() {
   Table<M> t;
   t.field("index", &M::index)
       .field("time", &M::time, "_s")
-      .scalars("v_{}", "_m_s", {&M::v_a, &M::v_b, &M::v_c});
+      .list("v", "_m_s", &M::v)
+      .field("v_a", &M::v_a, "_m_s")
+      .field("v_b", &M::v_b, "_m_s")
+      .field("v_c", &M::v_c, "_m_s");
   return t;
 }
 
@@ -214,23 +267,45 @@ Table<collision_lab::EnergyTransfer> energyTransferTable() {
   Table<M> t;
   t.field("index", &M::index)
       .field("time", &M::time, "_s")
-      .scalars("delta_{}", "_J", {&M::delta_a, &M::delta_b, &M::delta_c})
-      .scalars("kinetic_{}", "_J", {&M::kinetic_a, &M::kinetic_b, &M::kinetic_c});
+      .list("delta", "_J", &M::delta)
+      .list("kinetic", "_J", &M::kinetic)
+      .field("energy_lost", &M::energy_lost, "_J")
+      .field("cumulative_energy_lost", &M::cumulative_energy_lost, "_J");
+  t.field("delta_a", &M::delta_a, "_J")
+      .field("delta_b", &M::delta_b, "_J")
+      .field("delta_c", &M::delta_c, "_J")
+      .field("kinetic_a", &M::kinetic_a, "_J")
+      .field("kinetic_b", &M::kinetic_b, "_J")
+      .field("kinetic_c", &M::kinetic_c, "_J");
   return t;
 }
 
 Table<collision_lab::RunSummary> runSummaryTable() {
   using M = collision_lab::RunSummary;
   Table<M> t;
-  t.mode(&M::mode)
+  t.named("mode", &M::mode, writeMode)
+      .field("model", &M::model)
+      .field("model_name", &M::model_name)
+      .field("model_reason", &M::model_reason)
+      .field("body_count", &M::body_count)
       .field("collision_count", &M::collision_count)
       .flag("truncated", &M::truncated)
       .field("truncation_reason", &M::truncation_reason)
+      .flag("cancelled", &M::cancelled)
+      .field("stop_reason", &M::stop_reason)
       .flag("simulated", &M::simulated)
       .field("predicted_collision_count", &M::predicted_collision_count)
+      .flag("predicted_collision_count_defined", &M::predicted_collision_count_defined)
       .field("paper_predicted_collision_count", &M::paper_predicted_collision_count)
       .flag("paper_predicted_collision_count_defined", &M::paper_predicted_collision_count_defined)
-      .triple("v_{}_final_m_s", "final_velocities", &M::final_velocities)
+      .field("energy_lost", &M::energy_lost, "_J")
+      .flag("collapsed", &M::collapsed)
+      .field("collapse_time", &M::collapse_time, "_s")
+      .field("collapse_position", &M::collapse_position, "_m")
+      .field("collapse_count", &M::collapse_count)
+      .field("cluster_impacts", &M::cluster_impacts)
+      .field("critical_restitution", &M::critical_restitution)
+      .field("spiral_angle", &M::spiral_angle, "_rad")
       .field("max_prediction_error", &M::max_prediction_error)
       .field("energy_relative_drift", &M::energy_relative_drift)
       .field("momentum_relative_drift", &M::momentum_relative_drift)
@@ -242,7 +317,8 @@ Table<collision_lab::RunSummary> runSummaryTable() {
       .field("recording_error", &M::recording_error)
       .field("timeline_scale", &M::timeline_scale, "_bag_s_per_s")
       .flag("timeline_saturated", &M::timeline_saturated)
-      .field("requested_run_id", &M::requested_run_id);
+      .field("requested_run_id", &M::requested_run_id)
+      .elsewhere(kFinalVelocitiesFile, {{"v_m_s", "final_velocities"}});
   return t;
 }
 
@@ -256,6 +332,196 @@ Table<collision_lab::Rejected> rejectedTable() {
   return t;
 }
 
+// ---- Tidy tables: one row per body ----
+
+void writeCell(std::ostream& out, const std::optional<double>& value) {
+  if (value) writeCell(out, *value);  // empty cell: not given
+}
+void writeHeader(std::ostream& out, const std::vector<std::string>& names) {
+  const char* separator = "";
+  for (const auto& name : names) out << std::exchange(separator, ",") << name;
+  out << '\n';
+}
+/// Kinetic energy m v^2 / 2 [J]; 0 for a wall (as the messages' kinetic_energy_after).
+double kinetic(double mass, double velocity) {
+  return std::isinf(mass) ? 0.0 : 0.5 * mass * velocity * velocity;
+}
+template <class T>
+std::optional<T> at(const std::vector<T>& values, std::size_t i) {
+  return i < values.size() ? std::optional<T>(values[i]) : std::nullopt;
+}
+
+/// A tidy CSV file, opened by the first row.
+class TidyFile {
+ public:
+  TidyFile(std::string path, std::vector<std::string> header) : path_(std::move(path)), header_(std::move(header)) {}
+  /// The stream of a new row; throws BagCsvError when the file cannot be written.
+  std::ostream& row() {
+    if (!out_.is_open()) {
+      out_.open(path_);
+      if (!out_) throw BagCsvError("cannot write " + path_);
+      writeHeader(out_, header_);
+    }
+    ++rows_;
+    return out_;
+  }
+  /// The file written, or nothing when it has no rows.
+  std::optional<CsvFile> close(const std::string& topics) {
+    if (!out_.is_open()) return std::nullopt;
+    out_.close();
+    if (!out_) throw BagCsvError("writing " + path_ + " failed");
+    return CsvFile{topics, path_, rows_};
+  }
+
+ private:
+  std::string path_;
+  std::vector<std::string> header_;
+  std::ofstream out_;
+  std::size_t rows_ = 0;
+};
+
+/// bodies.csv (bag_csv.h): the start and the bodies after each event, per run_id.
+class BodiesCsv {
+ public:
+  explicit BodiesCsv(const std::string& out_dir)
+      : file_((fs::path(out_dir) / kBodiesFile).string(),
+              {"run_id", "index", "time_s", "body", "body_name", "moved", "mass_kg", "x_m", "v_before_m_s", "v_m_s",
+               "energy_transfer_J", "kinetic_J", "predicted_v_m_s", "paper_v_m_s", "predicted_energy_transfer_J",
+               "paper_energy_transfer_J"}) {}
+
+  void add(const collision_lab::InitialConditions& m) {
+    const std::size_t n = std::min({m.masses.size(), m.positions.size(), m.velocities.size()});
+    runs_[m.run_id] = Run{m.masses, m.velocities};
+    for (std::size_t i = 0; i < n; ++i) {
+      BodyRow r(0, 0.0, i, false);
+      r.mass = m.masses[i], r.x = m.positions[i], r.v = m.velocities[i];
+      r.kinetic = kinetic(m.masses[i], m.velocities[i]);
+      write(m.run_id, r);
+    }
+  }
+
+  void add(const collision_lab::CollisionEvent& m) {
+    const auto run = runs_.find(m.run_id);
+    Run* state = run == runs_.end() ? nullptr : &run->second;
+    if (!m.velocities_after.empty()) {
+      addFullState(m, state);
+    } else if (state) {
+      addMoved(m, *state);
+    } else if (unknown_runs_.insert(m.run_id).second) {
+      warnings.push_back("bodies.csv: run '" + m.run_id + "' has events without per-body arrays (more than " +
+                         std::to_string(collision_lab::CollisionEvent::FULL_STATE_MAX_BODIES) +
+                         " bodies) and no InitialConditions in the bag to rebuild them from: no body rows");
+    }
+  }
+
+  std::optional<CsvFile> close(const std::string& topics) { return file_.close(topics); }
+  std::vector<std::string> warnings;
+
+ private:
+  struct Run {
+    std::vector<double> masses;      ///< [kg]
+    std::vector<double> velocities;  ///< [m/s], after the last event read
+  };
+  struct BodyRow {
+    BodyRow(std::uint64_t index, double time, std::size_t body, bool moved)
+        : index(index), time(time), body(body), moved(moved) {}
+    std::uint64_t index;
+    double time;
+    std::size_t body;
+    bool moved;
+    std::optional<double> mass, x, v_before, v, energy_transfer, kinetic, predicted_v, paper_v, predicted_energy,
+        paper_energy;
+  };
+
+  /// An event that carries every body: the arrays as they are.
+  void addFullState(const collision_lab::CollisionEvent& m, Run* state) {
+    const std::size_t n = m.velocities_after.size();
+    const bool known = state && state->velocities.size() == n && state->masses.size() == n;
+    for (std::size_t i = 0; i < n; ++i) {
+      BodyRow r(m.index, m.time, i, m.first_moved <= i && i <= m.last_moved);
+      if (known) r.mass = state->masses[i];
+      r.x = at(m.positions, i), r.v_before = at(m.velocities_before, i), r.v = m.velocities_after[i];
+      r.energy_transfer = at(m.energy_transfer, i), r.kinetic = at(m.kinetic_energy_after, i);
+      r.predicted_v = at(m.predicted_velocities_after, i), r.paper_v = at(m.paper_velocities_after, i);
+      r.predicted_energy = at(m.predicted_energy_transfer, i), r.paper_energy = at(m.paper_energy_transfer, i);
+      write(m.run_id, r);
+    }
+    if (known) state->velocities = m.velocities_after;
+  }
+
+  /// An event with the pair fields only: the bodies it moved, rebuilt from the run's state
+  /// (bag_csv.h says how).
+  void addMoved(const collision_lab::CollisionEvent& m, Run& state) {
+    const std::size_t n = std::min(state.masses.size(), state.velocities.size());
+    for (std::size_t i = m.first_moved; i <= m.last_moved && i < n; ++i) {
+      const bool right_side = m.kind == collision_lab::CollisionEvent::KIND_COLLAPSE || i <= m.pair_index;
+      const double mass = state.masses[i], before = state.velocities[i];
+      const double after = m.pair_velocities_after[right_side ? 0 : 1];
+      BodyRow r(m.index, m.time, i, true);
+      r.mass = mass, r.x = m.position, r.v_before = before, r.v = after;
+      r.kinetic = kinetic(mass, after);
+      r.energy_transfer = *r.kinetic - kinetic(mass, before);
+      write(m.run_id, r);
+      state.velocities[i] = after;
+    }
+  }
+
+  void write(const std::string& run_id, const BodyRow& r) {
+    std::ostream& o = file_.row();
+    writeCell(o, run_id);
+    o << ',' << r.index << ',';
+    writeCell(o, r.time);
+    o << ',' << r.body << ',' << core::bodyName(r.body) << ',';
+    writeBool(o, r.moved);
+    for (const auto* value : {&r.mass, &r.x, &r.v_before, &r.v, &r.energy_transfer, &r.kinetic, &r.predicted_v,
+                              &r.paper_v, &r.predicted_energy, &r.paper_energy}) {
+      o << ',';
+      writeCell(o, *value);
+    }
+    o << '\n';
+  }
+
+  TidyFile file_;
+  std::map<std::string, Run> runs_;
+  std::set<std::string> unknown_runs_;
+};
+
+/// final_velocities.csv: the final velocities of Prediction (source "prediction", the
+/// closed form) and RunSummary (source "summary"), one row per body.
+class FinalVelocitiesCsv {
+ public:
+  explicit FinalVelocitiesCsv(const std::string& out_dir)
+      : file_((fs::path(out_dir) / kFinalVelocitiesFile).string(), {"run_id", "source", "body", "body_name", "v_m_s"}) {}
+  void add(const collision_lab::Prediction& m) { write(m.run_id, "prediction", m.final_velocities); }
+  void add(const collision_lab::RunSummary& m) { write(m.run_id, "summary", m.final_velocities); }
+  std::optional<CsvFile> close(const std::string& topics) { return file_.close(topics); }
+
+ private:
+  void write(const std::string& run_id, const char* source, const std::vector<double>& v) {
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      std::ostream& o = file_.row();
+      writeCell(o, run_id);
+      o << ',' << source << ',' << i << ',' << core::bodyName(i) << ',';
+      writeCell(o, v[i]);
+      o << '\n';
+    }
+  }
+  TidyFile file_;
+};
+
+/// Both tidy tables; add() takes every exported message and keeps what they need.
+struct TidyTables {
+  explicit TidyTables(const std::string& out_dir) : bodies(out_dir), final_velocities(out_dir) {}
+  void add(const collision_lab::InitialConditions& m) { bodies.add(m); }
+  void add(const collision_lab::CollisionEvent& m) { bodies.add(m); }
+  void add(const collision_lab::Prediction& m) { final_velocities.add(m); }
+  void add(const collision_lab::RunSummary& m) { final_velocities.add(m); }
+  template <class M>
+  void add(const M&) {}
+  BodiesCsv bodies;
+  FinalVelocitiesCsv final_velocities;
+};
+
 // ---- Export ----
 
 class Exporter {
@@ -263,8 +529,9 @@ class Exporter {
   virtual ~Exporter() = default;
   virtual std::string md5sum() const = 0;
   virtual std::vector<CsvColumn> columns() const = 0;
-  /// False when the message cannot be read as this type.
-  virtual bool writeRow(const rosbag::MessageInstance& m, std::ostream& out) const = 0;
+  /// Writes the message's row to out and its per-body rows to tidy; false when the
+  /// message cannot be read as this type.
+  virtual bool writeRow(const rosbag::MessageInstance& m, std::ostream& out, TidyTables& tidy) const = 0;
 };
 
 template <class M>
@@ -275,11 +542,13 @@ class TableExporter : public Exporter {
   std::vector<CsvColumn> columns() const override {
     std::vector<CsvColumn> names;
     for (const auto& c : table_.columns()) names.push_back(c.name);
+    names.insert(names.end(), table_.elsewhereColumns().begin(), table_.elsewhereColumns().end());
     return names;
   }
-  bool writeRow(const rosbag::MessageInstance& m, std::ostream& out) const override {
+  bool writeRow(const rosbag::MessageInstance& m, std::ostream& out, TidyTables& tidy) const override {
     const auto msg = m.instantiate<M>();
     if (!msg) return false;
+    tidy.add(*msg);
     const char* separator = "";
     for (const auto& c : table_.columns()) {
       out << separator;
@@ -340,8 +609,67 @@ std::map<std::string, std::string> fileNames(const std::vector<std::string>& top
 
 struct OpenFile {
   CsvFile info;
+  const Exporter* exporter = nullptr;
   std::ofstream out;
 };
+
+struct ExportedTopic {
+  std::string name;
+  std::string datatype;
+};
+
+/// The bag's topics that hold a collision_lab type of this version, in the order of first
+/// appearance; every other topic goes to skipped as "topic (type...)".
+std::vector<ExportedTopic> exportedTopics(rosbag::View& view, std::vector<std::string>& skipped) {
+  std::vector<ExportedTopic> topics;
+  std::set<std::string> seen;
+  for (const rosbag::ConnectionInfo* c : view.getConnections()) {
+    if (!seen.insert(c->topic).second) continue;
+    const Exporter* exporter = exporterFor(c->datatype);
+    if (!exporter) {
+      skipped.push_back(c->topic + " (" + c->datatype + ")");
+    } else if (exporter->md5sum() != c->md5sum) {
+      skipped.push_back(c->topic + " (" + c->datatype + " of another definition: recorded by another version)");
+    } else {
+      topics.push_back({c->topic, c->datatype});
+    }
+  }
+  return topics;
+}
+
+/// One CSV per topic, its header written; throws BagCsvError.
+std::map<std::string, OpenFile> openTopicFiles(const std::vector<ExportedTopic>& topics, const std::string& out_dir) {
+  std::vector<std::string> names;
+  for (const auto& topic : topics) names.push_back(topic.name);
+  const auto file_names = fileNames(names);
+  std::map<std::string, OpenFile> files;
+  for (const auto& topic : topics) {
+    OpenFile& file = files[topic.name];
+    file.info = CsvFile{topic.name, (fs::path(out_dir) / file_names.at(topic.name)).string(), 0};
+    file.exporter = exporterFor(topic.datatype);
+    file.out.open(file.info.path);
+    if (!file.out) throw BagCsvError("cannot write " + file.info.path);
+    std::vector<std::string> header;
+    for (const auto& c : file.exporter->columns()) {
+      if (c.file.empty()) header.push_back(c.name);
+    }
+    writeHeader(file.out, header);
+  }
+  return files;
+}
+
+/// The topics of types A and B, joined by " + " (a tidy table's sources).
+template <class A, class B>
+std::string topicsOf(const std::vector<ExportedTopic>& topics) {
+  std::string joined;
+  for (const auto& topic : topics) {
+    if (topic.datatype == ros::message_traits::DataType<A>::value() ||
+        topic.datatype == ros::message_traits::DataType<B>::value()) {
+      joined += (joined.empty() ? "" : " + ") + topic.name;
+    }
+  }
+  return joined;
+}
 
 }  // namespace
 
@@ -358,52 +686,31 @@ CsvExport bagToCsv(const std::string& bag_path, const std::string& out_dir) {
     throw BagCsvError("cannot read bag " + bag_path + ": " + e.what());
   }
   rosbag::View view(bag);
-
   CsvExport result;
-  std::vector<std::string> topics;  // exported, in the order of first appearance
-  std::map<std::string, std::string> datatypes;  // of every topic
-  for (const rosbag::ConnectionInfo* c : view.getConnections()) {
-    if (!datatypes.emplace(c->topic, c->datatype).second) continue;
-    const Exporter* exporter = exporterFor(c->datatype);
-    if (!exporter) {
-      result.skipped_topics.push_back(c->topic + " (" + c->datatype + ")");
-    } else if (exporter->md5sum() != c->md5sum) {
-      result.skipped_topics.push_back(c->topic + " (" + c->datatype +
-                                      " of another definition: recorded by another version)");
-    } else {
-      topics.push_back(c->topic);
-    }
-  }
+  const std::vector<ExportedTopic> topics = exportedTopics(view, result.skipped_topics);
 
   std::error_code ec;
   fs::create_directories(out_dir, ec);
   if (ec) throw BagCsvError("cannot create " + out_dir + ": " + ec.message());
-  const auto names = fileNames(topics);
-  std::map<std::string, OpenFile> files;
-  for (const auto& topic : topics) {
-    OpenFile& file = files[topic];
-    file.info = CsvFile{topic, (fs::path(out_dir) / names.at(topic)).string(), 0};
-    file.out.open(file.info.path);
-    if (!file.out) throw BagCsvError("cannot write " + file.info.path);
-    const char* separator = "";
-    for (const auto& c : exporterFor(datatypes.at(topic))->columns()) {
-      file.out << separator << c.name;
-      separator = ",";
-    }
-    file.out << '\n';
-  }
+  std::map<std::string, OpenFile> files = openTopicFiles(topics, out_dir);
+  TidyTables tidy(out_dir);
   for (const rosbag::MessageInstance& m : view) {
     const auto file = files.find(m.getTopic());
     if (file == files.end()) continue;
     OpenFile& f = file->second;
-    if (exporterFor(datatypes.at(m.getTopic()))->writeRow(m, f.out)) ++f.info.rows;
+    if (f.exporter->writeRow(m, f.out, tidy)) ++f.info.rows;
   }
   for (const auto& topic : topics) {
-    OpenFile& f = files.at(topic);
+    OpenFile& f = files.at(topic.name);
     f.out.close();
     if (!f.out) throw BagCsvError("writing " + f.info.path + " failed");
     result.files.push_back(f.info);
   }
+  using collision_lab::InitialConditions, collision_lab::CollisionEvent;
+  using collision_lab::Prediction, collision_lab::RunSummary;
+  if (auto f = tidy.bodies.close(topicsOf<InitialConditions, CollisionEvent>(topics))) result.files.push_back(*f);
+  if (auto f = tidy.final_velocities.close(topicsOf<Prediction, RunSummary>(topics))) result.files.push_back(*f);
+  result.warnings = tidy.bodies.warnings;
   return result;
 }
 

@@ -1,5 +1,6 @@
-// bag_to_csv RUN.bag [OUTDIR]: one CSV per topic of a collision_lab bag, with units in the
-// column names (see bag_csv.h). OUTDIR defaults to RUN_csv beside the bag.
+// bag_to_csv RUN.bag [OUTDIR]: one CSV per topic of a collision_lab bag plus the tidy
+// per-body tables bodies.csv and final_velocities.csv, with units in the column names (see
+// bag_csv.h). OUTDIR defaults to RUN_csv beside the bag.
 #include <iostream>
 #include <string>
 
@@ -10,8 +11,10 @@
 int main(int argc, char** argv) {
   if (argc < 2 || argc > 3 || std::string(argv[1]) == "-h" || std::string(argv[1]) == "--help") {
     std::cerr << "usage: bag_to_csv RUN.bag [OUTDIR]\n"
-                 "Writes one CSV per topic of RUN.bag (collision_events.csv, velocities.csv, ...)\n"
-                 "into OUTDIR (default: RUN_csv beside the bag), with units in the column names.\n";
+                 "Writes one CSV per topic of RUN.bag (collision_events.csv, run_summaries.csv, ...)\n"
+                 "and, one row per body, bodies.csv (the start and the bodies after each event)\n"
+                 "and final_velocities.csv into OUTDIR (default: RUN_csv beside the bag), with\n"
+                 "units in the column names.\n";
     return 2;
   }
   const std::string bag = argv[1];
@@ -27,6 +30,7 @@ int main(int argc, char** argv) {
       std::cout << file.path << ": " << file.rows << " rows from " << file.topic << "\n";
     }
     for (const auto& topic : result.skipped_topics) std::cerr << "skipped " << topic << "\n";
+    for (const auto& warning : result.warnings) std::cerr << "warning: " << warning << "\n";
     if (result.files.empty()) {
       std::cerr << "bag_to_csv: " << bag << " holds no collision_lab messages\n";
       return 1;

@@ -1,7 +1,8 @@
-// scenario_publisher: serves preset scenes one at a time through collision_lab_node's
-// ~run_scene service (so each is published, recorded and drawn like any input), prints a
-// table, and ends with one plain line: "demo finished: N runs, bags in DIR", or
-// "demo FAILED: ..." naming the failed runs.
+// scenario_publisher: serves preset scenes of any size (N bodies, restitution) one at a time
+// through collision_lab_node's ~run_scene service (so each is published, recorded and drawn
+// like any input), prints a table, and ends with one plain line: "demo finished: N runs,
+// bags in DIR", or "demo FAILED: ..." naming the failed runs. It reads the scenario files
+// the CLI reads (collision_lab/io/scenario_file.h).
 //
 // Private parameters:
 //   ~scenario_file (string, required)  YAML file of named scenes (config/scenarios.yaml)
@@ -31,9 +32,9 @@
 
 #include <ros/ros.h>
 
+#include "collision_lab/InitialConditions.h"
 #include "collision_lab/RunScene.h"
 #include "collision_lab/io/scenario_file.h"
-#include "collision_lab/ros/msg_conversion.h"
 
 namespace {
 
@@ -65,22 +66,25 @@ struct Row {
 };
 
 Row row(const std::string& scene, const collision_lab::RunScene::Response& response) {
-  char buffer[768];
+  char buffer[1024];
   if (!response.ok) {
-    std::snprintf(buffer, sizeof buffer, "%-22s FAILED: %s", scene.c_str(), response.message.c_str());
+    std::snprintf(buffer, sizeof buffer, "%-20s FAILED: %s", scene.c_str(), response.message.c_str());
     return {buffer, true};
   }
   const auto& s = response.summary;
-  const std::string collisions =
-      std::to_string(s.collision_count) + (s.truncated ? "*" : "") + (s.simulated ? "" : " (n/s)");
+  const std::string collisions = std::to_string(s.collision_count) + (s.collapsed ? "+c" : "") +
+                                 (s.cancelled ? " (cancelled)" : s.truncated ? "*" : "") +
+                                 (s.simulated ? "" : " (n/s)");
+  const std::string predicted =
+      s.predicted_collision_count_defined ? std::to_string(s.predicted_collision_count) : "-";
   const std::string paper =
-      s.paper_predicted_collision_count_defined ? std::to_string(s.paper_predicted_collision_count) : "undef.";
+      s.paper_predicted_collision_count_defined ? std::to_string(s.paper_predicted_collision_count) : "-";
   const std::string bag = s.bag_path.empty()     ? std::string("(not recorded)")
                           : s.recording_ok        ? s.bag_path
                                                   : "FAILED: " + s.recording_error;
-  std::snprintf(buffer, sizeof buffer, "%-22s %12s %12llu %12s %10.2e  %s", scene.c_str(),
-                collisions.c_str(), static_cast<unsigned long long>(s.predicted_collision_count),
-                paper.c_str(), s.max_prediction_error, bag.c_str());
+  std::snprintf(buffer, sizeof buffer, "%-20s %5u %-20s %14s %10s %8s %10.2e %10.3g  %s", scene.c_str(),
+                s.body_count, s.model_name.c_str(), collisions.c_str(), predicted.c_str(), paper.c_str(),
+                s.max_prediction_error, s.energy_lost, bag.c_str());
   return {buffer, !s.bag_path.empty() && !s.recording_ok};
 }
 
@@ -109,37 +113,32 @@ bool endLaunch() {
   return true;
 }
 
-std::vector<collision_lab::io::NamedScene> selectScenes(const std::string& file,
-                                                        const std::string& selection) {
-  std::vector<std::string> skipped;
-  const auto all = collision_lab::io::loadScenarioFile(file, &skipped);
-  for (const auto& name : skipped) {
-    ROS_INFO_STREAM("skipping preset '" << name << "': not a three-body elastic scene, and this node runs "
-                                           "three bodies only until the N-body node (issue 12)");
-  }
+std::vector<collision_lab::io::SceneEntry> selectScenes(const std::string& file, const std::string& selection) {
+  const auto all = collision_lab::io::loadScenes(file);
   const auto names = splitNames(selection);
   if (names.empty()) return all;
-  std::vector<collision_lab::io::NamedScene> scenes;
-  for (const auto& name : names) scenes.push_back(collision_lab::io::findScenario(all, name));
+  std::vector<collision_lab::io::SceneEntry> scenes;
+  for (const auto& name : names) scenes.push_back(collision_lab::io::findScene(all, name));
   return scenes;
 }
 
 void printTable(const std::vector<Row>& rows) {
   std::ostringstream table;
   char header[256];
-  std::snprintf(header, sizeof header, "%-22s %12s %12s %12s %10s  %s", "scene", "collisions",
-                "predicted", "paper (3.22)", "error", "bag");
-  table << "\n" << header << "\n" << std::string(110, '-') << "\n";
+  std::snprintf(header, sizeof header, "%-20s %5s %-20s %14s %10s %8s %10s %10s  %s", "scene", "N", "model",
+                "collisions", "predicted", "paper", "error", "heat [J]", "bag");
+  table << "\n" << header << "\n" << std::string(130, '-') << "\n";
   for (const auto& r : rows) table << r.text << "\n";
-  table << "(* truncated at the collision cap; n/s: not simulated; error: max |S (v_sim - v_pred)| / "
-           "|S v_0|, S = diag(sqrt m))\n";
+  table << "(* truncated at the collision cap; +c: then an inelastic collapse; n/s: not simulated; -: no "
+           "formula;\n paper: eq. (3.22); error: the simulation against the closed form (RunSummary."
+           "max_prediction_error; nan: no closed form); heat: kinetic energy lost)\n";
   std::cout << table.str() << std::flush;
 }
 
 /// The publisher's private parameters (see the top of this file).
 struct Options {
   std::string scenario_file, selection, suffix, service;
-  collision_lab::core::RunMode mode = collision_lab::core::RunMode::kFull;
+  std::uint8_t mode = collision_lab::InitialConditions::MODE_FULL;
   double wait_timeout = 60.0;  ///< [s]
   double dwell = 0.0;          ///< [s]
   bool exit_when_done = true, end_launch_when_done = false;
@@ -160,12 +159,12 @@ struct Options {
     private_nh.param("dwell", o.dwell, 0.0);
     private_nh.param("exit_when_done", o.exit_when_done, true);
     private_nh.param("end_launch_when_done", o.end_launch_when_done, false);
-    const auto run_mode = collision_lab_ros::toRunMode(static_cast<std::uint8_t>(mode));
-    if (mode < 0 || mode > 255 || !run_mode) {
-      ROS_FATAL_STREAM("~mode = " << mode << " is not one of InitialConditions.MODE_*");
+    if (mode < collision_lab::InitialConditions::MODE_FULL ||
+        mode > collision_lab::InitialConditions::MODE_SUMMARY_ONLY) {
+      ROS_FATAL_STREAM("~mode = " << mode << " is not one of InitialConditions.MODE_* (0, 1, 2)");
       return std::nullopt;
     }
-    o.mode = *run_mode;
+    o.mode = static_cast<std::uint8_t>(mode);
     return o;
   }
 };
@@ -174,7 +173,7 @@ struct Options {
 /// a time, and keeps the table of their outcomes.
 class RunSceneClient {
  public:
-  RunSceneClient(std::string service, collision_lab::core::RunMode mode, std::string suffix)
+  RunSceneClient(std::string service, std::uint8_t mode, std::string suffix)
       : service_(std::move(service)), mode_(mode), suffix_(std::move(suffix)) {}
 
   /// Waits up to timeout [s] for the service; false (with a ROS_FATAL) when it is not there.
@@ -189,17 +188,17 @@ class RunSceneClient {
   }
 
   /// Serves scene as run <name>_<suffix> and adds its row to the table.
-  void send(const collision_lab::io::NamedScene& scene) {
+  void send(const collision_lab::io::SceneEntry& scene) {
     collision_lab::RunScene call;
     call.request.run_id = scene.name + "_" + suffix_;
-    const auto input = collision_lab_ros::toInitialConditions(scene.scene, mode_, scene.max_collisions);
-    call.request.mode = input.mode;
-    call.request.masses = input.masses;
-    call.request.positions = input.positions;
-    call.request.velocities = input.velocities;
-    call.request.max_collisions = input.max_collisions;
-    ROS_INFO_STREAM("running " << scene.name << " (" << scene.description << ") as run "
-                    << call.request.run_id);
+    call.request.mode = mode_;
+    call.request.masses = scene.scene.masses;
+    call.request.positions = scene.scene.positions;
+    call.request.velocities = scene.scene.velocities;
+    call.request.restitution = scene.scene.restitution;
+    call.request.max_collisions = scene.max_collisions;
+    ROS_INFO_STREAM("running " << scene.name << " (" << scene.scene.size() << " bodies: " << scene.description
+                    << ") as run " << call.request.run_id);
     if (!ros::service::call(service_, call)) {
       call.response.ok = false;
       call.response.message = "the call to " + service_ + " failed (did collision_lab_node die?)";
@@ -230,7 +229,7 @@ class RunSceneClient {
 
  private:
   std::string service_;
-  collision_lab::core::RunMode mode_;
+  std::uint8_t mode_;
   std::string suffix_;
   std::vector<Row> rows_;
   std::size_t failed_ = 0;
@@ -244,7 +243,7 @@ int main(int argc, char** argv) {
   ros::NodeHandle nh, private_nh("~");
   const std::optional<Options> options = Options::load(private_nh);
   if (!options) return 1;
-  std::vector<collision_lab::io::NamedScene> scenes;
+  std::vector<collision_lab::io::SceneEntry> scenes;
   try {
     scenes = selectScenes(options->scenario_file, options->selection);
   } catch (const collision_lab::io::ScenarioFileError& e) {

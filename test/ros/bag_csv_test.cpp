@@ -66,11 +66,17 @@ Table readCsv(const std::string& path) {
   return table;
 }
 
-std::vector<std::string> split(const std::string& header) {
-  std::vector<std::string> names;
-  std::istringstream in(header);
-  for (std::string name; std::getline(in, name, ',');) names.push_back(name);
-  return names;
+/// The cells of one unquoted CSV line (a trailing ',' ends with an empty cell).
+std::vector<std::string> split(const std::string& line) {
+  std::vector<std::string> cells(1);
+  for (char c : line) {
+    if (c == ',') {
+      cells.emplace_back();
+    } else {
+      cells.back() += c;
+    }
+  }
+  return cells;
 }
 
 /// The cell of `column` in data row `row` (1-based: row 0 is the header).
@@ -134,6 +140,8 @@ class BagCsvTest : public testing::Test {
       event.index = k;
       event.pair_index = k == 1 ? collision_lab::CollisionEvent::PAIR_AB : collision_lab::CollisionEvent::PAIR_BC;
       event.time = 0.25 * k;
+      event.first_moved = event.pair_index;
+      event.last_moved = event.pair_index + 1;
       event.velocities_after = {{-0.1 * k, 2.0 / 3.0, 0}};
       event.kinetic_energy_after = {{0.005 * k, 2.0 / 9.0, 0}};
       event.total_momentum = -10000;
@@ -182,19 +190,22 @@ class BagCsvTest : public testing::Test {
 TEST_F(BagCsvTest, OneCsvPerTopicWithUnitsAndExactNumbers) {
   writeBag();
   const auto result = bagToCsv(bag_path_, dir_ + "/csv");
-  ASSERT_EQ(result.files.size(), 7u);
+  ASSERT_EQ(result.files.size(), 9u);
   std::set<std::string> names;
   for (const auto& file : result.files) names.insert(fs::path(file.path).filename().string());
   EXPECT_EQ(names, (std::set<std::string>{"initial_conditions.csv", "predictions.csv",
                                            "collision_events.csv", "velocities.csv",
                                            "energy_transfers.csv", "run_summaries.csv",
-                                           "rejected.csv"}));
+                                           "rejected.csv", "bodies.csv", "final_velocities.csv"}));
   ASSERT_EQ(result.skipped_topics.size(), 1u);
   EXPECT_EQ(result.skipped_topics.front(), "/note (std_msgs/String)");
+  EXPECT_TRUE(result.warnings.empty());
+  EXPECT_EQ(result.files.at(7).topic, "/collision_lab/initial_conditions + /collision_lab/collision_events");
+  EXPECT_EQ(result.files.at(7).rows, 3u + 2 * 3u);  // the start and two events, three bodies each
 
   const Table velocities = readCsv(dir_ + "/csv/velocities.csv");
   ASSERT_EQ(velocities.size(), 3u);
-  EXPECT_EQ(velocities[0], split("stamp_s,run_id,index,time_s,v_a_m_s,v_b_m_s,v_c_m_s"));
+  EXPECT_EQ(velocities[0], split("stamp_s,run_id,index,time_s,v_m_s,v_a_m_s,v_b_m_s,v_c_m_s"));
   EXPECT_EQ(cell(velocities, 1, "stamp_s"), "1700000000.250000005");
   EXPECT_EQ(cell(velocities, 2, "stamp_s"), "1700000000.500000005");
   EXPECT_EQ(number(velocities, 2, "time_s"), 0.5);
@@ -202,26 +213,44 @@ TEST_F(BagCsvTest, OneCsvPerTopicWithUnitsAndExactNumbers) {
 
   const Table input = readCsv(dir_ + "/csv/initial_conditions.csv");
   ASSERT_EQ(input.size(), 2u);
-  EXPECT_EQ(input[0], split("stamp_s,run_id,mode,m_a_kg,m_b_kg,m_c_kg,x_a_m,x_b_m,x_c_m,"
-                            "v_a_m_s,v_b_m_s,v_c_m_s,max_collisions"));
-  EXPECT_EQ(input[1], split("1700000000.000000005,csv_run,full,10000,1,inf,2,1,0,-1,0,0,0"));
+  EXPECT_EQ(input[0], split("stamp_s,run_id,mode,restitution,max_collisions"));
+  EXPECT_EQ(input[1], (std::vector<std::string>{"1700000000.000000005", "csv_run", "full", "", "0"}));
+
+  // The masses, positions and velocities of the input are the start's rows (index 0).
+  const Table bodies = readCsv(dir_ + "/csv/bodies.csv");
+  ASSERT_EQ(bodies.size(), 10u);
+  EXPECT_EQ(bodies[0], split("run_id,index,time_s,body,body_name,moved,mass_kg,x_m,v_before_m_s,v_m_s,"
+                             "energy_transfer_J,kinetic_J,predicted_v_m_s,paper_v_m_s,"
+                             "predicted_energy_transfer_J,paper_energy_transfer_J"));
+  EXPECT_EQ(bodies[1], split("csv_run,0,0,0,A,false,10000,2,,-1,,5000,,,,"));
+  EXPECT_EQ(bodies[3], split("csv_run,0,0,2,C,false,inf,0,,0,,0,,,,"));  // -0.0 as 0; a wall has no kinetic energy
 
   const Table prediction = readCsv(dir_ + "/csv/predictions.csv");
   EXPECT_EQ(number(prediction, 1, "alpha_rad"), 1.0 / 3.0);
   EXPECT_EQ(cell(prediction, 1, "phi_bc_rad"), "nan");
-  EXPECT_EQ(cell(prediction, 1, "first_pair_index"), "AB");
-  EXPECT_EQ(cell(prediction, 1, "v_b_final_m_s"), "-inf");
-  EXPECT_EQ(number(prediction, 1, "v_c_final_m_s"), 1e-300);
+  EXPECT_EQ(cell(prediction, 1, "first_pair_index"), "0");
+  EXPECT_EQ(cell(prediction, 1, "first_pair"), "AB");
   EXPECT_EQ(number(prediction, 1, "timeline_scale_bag_s_per_s"), 1e9);
   EXPECT_EQ(cell(prediction, 1, "paper_collision_count_defined"), "false");
+  const Table finals = readCsv(dir_ + "/csv/final_velocities.csv");
+  ASSERT_EQ(finals.size(), 4u);  // the prediction's three; the summary has none
+  EXPECT_EQ(finals[0], split("run_id,source,body,body_name,v_m_s"));
+  EXPECT_EQ(finals[2], split("csv_run,prediction,1,B,-inf"));
+  EXPECT_EQ(number(finals, 3, "v_m_s"), 1e-300);
 
   const Table events = readCsv(dir_ + "/csv/collision_events.csv");
   ASSERT_EQ(events.size(), 3u);
-  EXPECT_EQ(cell(events, 2, "pair_index"), "BC");
-  EXPECT_EQ(number(events, 2, "kinetic_energy_a_after_J"), 0.005 * 2);
-  EXPECT_EQ(number(events, 1, "kinetic_energy_b_after_J"), 2.0 / 9.0);
-  EXPECT_EQ(number(events, 2, "v_a_after_m_s"), -0.1 * 2);
+  EXPECT_EQ(cell(events, 2, "pair"), "BC");
+  EXPECT_EQ(cell(events, 2, "pair_index"), "1");
+  EXPECT_EQ(cell(events, 2, "kind"), "impact");
   EXPECT_EQ(number(events, 1, "total_momentum_kg_m_s"), -10000);
+  // Event k's bodies: rows 1 + 3k .. 3 + 3k.
+  EXPECT_EQ(number(bodies, 7, "kinetic_J"), 0.005 * 2);
+  EXPECT_EQ(number(bodies, 5, "kinetic_J"), 2.0 / 9.0);
+  EXPECT_EQ(number(bodies, 7, "v_m_s"), -0.1 * 2);
+  EXPECT_EQ(cell(bodies, 7, "moved"), "false");  // event 2 is pair BC: bodies 1 and 2
+  EXPECT_EQ(cell(bodies, 8, "moved"), "true");
+  EXPECT_EQ(cell(bodies, 7, "x_m"), "");  // not in the event
   const Table energy = readCsv(dir_ + "/csv/energy_transfers.csv");
   EXPECT_EQ(number(energy, 1, "delta_c_J"), -1.5e-15);
 
@@ -233,6 +262,181 @@ TEST_F(BagCsvTest, OneCsvPerTopicWithUnitsAndExactNumbers) {
   const Table rejected = readCsv(dir_ + "/csv/rejected.csv");
   EXPECT_EQ(cell(rejected, 1, "message"), "positions (0, 1, 2) m must be strictly decreasing");
   EXPECT_EQ(cell(rejected, 1, "reason"), "5");
+}
+
+/// An impact of a CollisionEvent of run run_id, pair fields only.
+collision_lab::CollisionEvent impact(const std::string& run_id, std::uint64_t index, std::uint32_t pair,
+                                     double time, double position, double restitution) {
+  collision_lab::CollisionEvent event;
+  event.header.stamp = ros::Time(1'700'000'000) + ros::Duration(time);
+  event.run_id = run_id;
+  event.index = index;
+  event.pair_index = pair;
+  event.time = time;
+  event.position = position;
+  event.restitution = restitution;
+  event.first_moved = pair;
+  event.last_moved = pair + 1;
+  event.total_energy = event.total_momentum = std::nan("");
+  return event;
+}
+
+collision_lab::InitialConditions scene(const std::string& run_id, std::vector<double> masses,
+                                       std::vector<double> positions, std::vector<double> velocities,
+                                       std::vector<double> restitution) {
+  collision_lab::InitialConditions input;
+  input.header.stamp = ros::Time(1'700'000'000);
+  input.run_id = run_id;
+  input.masses = std::move(masses);
+  input.positions = std::move(positions);
+  input.velocities = std::move(velocities);
+  input.restitution = std::move(restitution);
+  return input;
+}
+
+// Newton's cradle with gaps and e = 0.5: five 1 kg bodies at 4, 3, 2, 1, 0 m, body 0 at
+// -1 m/s. By hand (v' = V -+ e (v_i - v_j) / 2 for equal masses):
+//  impact 1, pair 0 at t = 1 s, x = 3 m: V = -0.5, (-1, 0) -> (-0.25, -0.75); heat
+//    (1 - e^2) mu v_rel^2 / 2 = 0.75 * 0.5 * 1 / 2 = 0.1875 J.
+//  impact 2, pair 1 at t = 1 + 1/0.75 = 7/3 s, x = 2 m: V = -0.375, (-0.75, 0) ->
+//    (-0.1875, -0.5625); heat 0.75 * 0.5 * 0.5625 / 2 = 0.10546875 J. Body 0 is then at
+//    3 - 0.25 * 4/3 = 8/3 m.
+TEST_F(BagCsvTest, FiveBodiesWithRestitutionEveryBodyAfterEveryImpact) {
+  {
+    rosbag::Bag bag(bag_path_, rosbag::bagmode::Write);
+    const auto input = scene("cradle", {1, 1, 1, 1, 1}, {4, 3, 2, 1, 0}, {-1, 0, 0, 0, 0}, {0.5});
+    bag.write("/collision_lab/initial_conditions", input.header.stamp, input);
+    auto first = impact("cradle", 1, 0, 1.0, 3.0, 0.5);
+    first.pair_velocities_before = {{-1, 0}};
+    first.pair_velocities_after = {{-0.25, -0.75}};
+    first.energy_lost = 0.1875;
+    first.positions = {3, 3, 2, 1, 0};
+    first.velocities_before = {-1, 0, 0, 0, 0};
+    first.velocities_after = {-0.25, -0.75, 0, 0, 0};
+    first.energy_transfer = {0.03125 - 0.5, 0.28125, 0, 0, 0};
+    first.kinetic_energy_after = {0.03125, 0.28125, 0, 0, 0};
+    bag.write("/collision_lab/collision_events", first.header.stamp, first);
+    auto second = impact("cradle", 2, 1, 7.0 / 3.0, 2.0, 0.5);
+    second.pair_velocities_before = {{-0.75, 0}};
+    second.pair_velocities_after = {{-0.1875, -0.5625}};
+    second.energy_lost = 0.10546875;
+    second.positions = {8.0 / 3.0, 2, 2, 1, 0};
+    second.velocities_before = first.velocities_after;
+    second.velocities_after = {-0.25, -0.1875, -0.5625, 0, 0};
+    second.energy_transfer = {0, 0.017578125 - 0.28125, 0.158203125, 0, 0};
+    second.kinetic_energy_after = {0.03125, 0.017578125, 0.158203125, 0, 0};
+    bag.write("/collision_lab/collision_events", second.header.stamp, second);
+  }
+  bagToCsv(bag_path_, dir_ + "/csv");
+  const Table input = readCsv(dir_ + "/csv/initial_conditions.csv");
+  EXPECT_EQ(cell(input, 1, "restitution"), "0.5");
+  const Table events = readCsv(dir_ + "/csv/collision_events.csv");
+  EXPECT_EQ(number(events, 2, "restitution"), 0.5);
+  EXPECT_EQ(number(events, 2, "pair_v_before_0_m_s"), -0.75);
+  EXPECT_EQ(number(events, 2, "pair_v_after_1_m_s"), -0.5625);
+  EXPECT_EQ(number(events, 1, "energy_lost_J"), 0.1875);
+  EXPECT_EQ(cell(events, 1, "total_energy_J"), "nan");
+  EXPECT_EQ(cell(events, 2, "first_moved") + cell(events, 2, "last_moved"), "12");
+
+  const Table bodies = readCsv(dir_ + "/csv/bodies.csv");
+  ASSERT_EQ(bodies.size(), 1u + 3 * 5);
+  // Impact 2: rows 11..15 (bodies 0..4).
+  EXPECT_EQ(bodies[11], split("cradle,2,2.3333333333333335,0,A,false,1,2.6666666666666665,-0.25,-0.25,0,0.03125,,,,"));
+  EXPECT_EQ(bodies[13], split("cradle,2,2.3333333333333335,2,C,true,1,2,0,-0.5625,0.158203125,0.158203125,,,,"));
+  EXPECT_EQ(cell(bodies, 15, "body_name"), "E");
+  // Each impact's heat is what the bodies lost together.
+  for (std::size_t event = 1; event <= 2; ++event) {
+    double gained = 0.0;
+    for (std::size_t row = 1 + 5 * event; row <= 5 + 5 * event; ++row) gained += number(bodies, row, "energy_transfer_J");
+    EXPECT_EQ(-gained, number(events, event, "energy_lost_J")) << event;
+  }
+}
+
+// 70 bodies (over FULL_STATE_MAX_BODIES): the events carry the pair fields only, and
+// bodies.csv rebuilds the bodies each one moved. 1 kg each, 1 m apart (body i at 69 - i m),
+// e = 0 everywhere, body 0 at -1 m/s. By hand:
+//  impact 1, pair 0 at t = 1 s, x = 68 m: 0 and 1 stick at -0.5 m/s (heat 0.25 J).
+//  impact 2, pair 1 at t = 1 + 1/0.5 = 3 s, x = 67 m: the cluster {0, 1} (2 kg) hits body
+//    2: all three at -1/3 m/s (heat 1/12 J); a cluster impact, bodies 0 .. 2 moved.
+// A second run, "collapse" (65 bodies), stands for a run whose engine resolved a collapse
+// right after its first impact: three 1 kg bodies at 2, 1, 0 m (body 0 at -1 m/s, e = 0.05),
+// the rest at rest far left. Impact 1, pair 0 at t = 1 s, x = 1 m: (-1, 0) -> (-0.475,
+// -0.525); then the collapse of bodies 0 .. 2 moves all three at -1/3 m/s.
+TEST_F(BagCsvTest, OverSixtyFourBodiesTheMovedBodiesAreRebuiltFromThePairFields) {
+  {
+    rosbag::Bag bag(bag_path_, rosbag::bagmode::Write);
+    std::vector<double> ones(70, 1.0), positions(70), velocities(70, 0.0);
+    for (std::size_t i = 0; i < 70; ++i) positions[i] = 69.0 - static_cast<double>(i);
+    velocities[0] = -1;
+    const auto gas = scene("big", ones, positions, velocities, {0});
+    bag.write("/collision_lab/initial_conditions", gas.header.stamp, gas);
+    auto first = impact("big", 1, 0, 1.0, 68.0, 0.0);
+    first.pair_velocities_before = {{-1, 0}};
+    first.pair_velocities_after = {{-0.5, -0.5}};
+    bag.write("/collision_lab/collision_events", first.header.stamp, first);
+    auto second = impact("big", 2, 1, 3.0, 67.0, 0.0);
+    second.first_moved = 0;
+    second.cluster_impact = true;
+    second.pair_velocities_before = {{-0.5, 0}};
+    second.pair_velocities_after = {{-1.0 / 3.0, -1.0 / 3.0}};
+    bag.write("/collision_lab/collision_events", second.header.stamp, second);
+
+    std::vector<double> far(65, 1.0), far_x(65), far_v(65, 0.0);
+    for (std::size_t i = 0; i < 65; ++i) far_x[i] = i < 3 ? 2.0 - static_cast<double>(i) : -10.0 - static_cast<double>(i);
+    far_v[0] = -1;
+    const ros::Duration later(100.0);  // after the run "big" in the bag
+    const auto three = scene("collapse", far, far_x, far_v, {0.05});
+    bag.write("/collision_lab/initial_conditions", three.header.stamp + later, three);
+    auto hit = impact("collapse", 1, 0, 1.0, 1.0, 0.05);
+    hit.pair_velocities_after = {{-0.475, -0.525}};
+    bag.write("/collision_lab/collision_events", hit.header.stamp + later, hit);
+    auto collapse = impact("collapse", 1, 1, 1.5, 0.25, 0.05);
+    collapse.kind = collision_lab::CollisionEvent::KIND_COLLAPSE;
+    collapse.first_moved = 0;
+    collapse.last_moved = 2;
+    collapse.pair_velocities_after = {{-1.0 / 3.0, -1.0 / 3.0}};
+    bag.write("/collision_lab/collision_events", collapse.header.stamp + later, collapse);
+  }
+  const auto result = bagToCsv(bag_path_, dir_ + "/csv");
+  EXPECT_TRUE(result.warnings.empty());
+  const Table bodies = readCsv(dir_ + "/csv/bodies.csv");
+  // The starts (70 and 65 rows) and the moved bodies: 2 + 3, then 2 + 3.
+  ASSERT_EQ(bodies.size(), 1u + 70 + 5 + 65 + 5);
+  const std::size_t big = 1 + 70;  // impact 1 of "big"
+  EXPECT_EQ(bodies[big], split("big,1,1,0,A,true,1,68,-1,-0.5,-0.375,0.125,,,,"));
+  EXPECT_EQ(bodies[big + 1], split("big,1,1,1,B,true,1,68,0,-0.5,0.125,0.125,,,,"));
+  const double third = 1.0 / 3.0, kinetic = 0.5 * third * third;
+  for (std::size_t body = 0; body < 3; ++body) {
+    const std::size_t row = big + 2 + body;
+    EXPECT_EQ(cell(bodies, row, "index") + cell(bodies, row, "body"), "2" + std::to_string(body));
+    EXPECT_EQ(number(bodies, row, "x_m"), 67.0);
+    EXPECT_EQ(number(bodies, row, "v_before_m_s"), body < 2 ? -0.5 : 0.0);
+    EXPECT_EQ(number(bodies, row, "v_m_s"), -third);
+    EXPECT_EQ(number(bodies, row, "kinetic_J"), kinetic);
+    EXPECT_EQ(number(bodies, row, "energy_transfer_J"), kinetic - (body < 2 ? 0.125 : 0.0));
+  }
+  const std::size_t collapse = big + 5 + 65 + 2;  // the collapse's rows, after impact 1 of "collapse"
+  EXPECT_EQ(number(bodies, collapse - 1, "v_m_s"), -0.525);  // impact 1's body B
+  EXPECT_EQ(number(bodies, collapse - 1, "energy_transfer_J"), 0.5 * 0.525 * 0.525);
+  for (std::size_t body = 0; body < 3; ++body) {
+    EXPECT_EQ(cell(bodies, collapse + body, "body"), std::to_string(body));
+    EXPECT_EQ(number(bodies, collapse + body, "x_m"), 0.25);
+    EXPECT_EQ(number(bodies, collapse + body, "v_before_m_s"), std::vector<double>({-0.475, -0.525, 0.0})[body]);
+    EXPECT_EQ(number(bodies, collapse + body, "v_m_s"), -third);
+  }
+}
+
+TEST_F(BagCsvTest, EventsWithoutArraysAndWithoutTheirInputHaveNoBodyRowsAndAWarning) {
+  {
+    rosbag::Bag bag(bag_path_, rosbag::bagmode::Write);
+    auto first = impact("lost_input", 1, 0, 1.0, 68.0, 1.0);
+    bag.write("/collision_lab/collision_events", first.header.stamp, first);
+  }
+  const auto result = bagToCsv(bag_path_, dir_ + "/csv");
+  ASSERT_EQ(result.files.size(), 1u);  // no bodies.csv
+  ASSERT_EQ(result.warnings.size(), 1u);
+  EXPECT_NE(result.warnings.front().find("run 'lost_input'"), std::string::npos) << result.warnings.front();
+  EXPECT_FALSE(fs::exists(dir_ + "/csv/bodies.csv"));
 }
 
 /// The top-level field names of a message definition (constants and nested types left out).
@@ -254,7 +458,11 @@ template <class M>
 void expectEveryFieldExported() {
   const std::string datatype = ros::message_traits::DataType<M>::value();
   std::set<std::string> exported;
-  for (const auto& column : csvColumns(datatype)) exported.insert(column.field);
+  for (const auto& column : csvColumns(datatype)) {
+    exported.insert(column.field);
+    EXPECT_TRUE(column.file.empty() || column.file == "bodies.csv" || column.file == "final_velocities.csv")
+        << column.file;
+  }
   EXPECT_EQ(exported, fieldsOf(ros::message_traits::Definition<M>::value())) << datatype;
 }
 

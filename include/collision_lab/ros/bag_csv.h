@@ -1,7 +1,21 @@
-// From a bag to CSV files, one per topic, for spreadsheets and Python
-// (`bag_to_csv RUN.bag [OUTDIR]`). Every collision_lab message type has its own table of
-// columns; each header names the column and its unit, e.g. `time_s`, `v_a_m_s`,
-// `delta_a_J`, `alpha_rad`. Arrays of A, B, C become three columns (_a, _b, _c).
+// From a bag to CSV files, for spreadsheets and Python (`bag_to_csv RUN.bag [OUTDIR]`), for
+// scenes of any size N. Each header names the column and its unit (`time_s`, `x_m`,
+// `v_m_s`, `energy_lost_J`, `alpha_rad`); docs/ros.md lists the files.
+//  - <topic>.csv, one row per message of a collision_lab topic: the scalar fields (a
+//    fixed pair array [2] as two columns _0 and _1). Per-body arrays are not columns here:
+//  - bodies.csv, tidy, one row per body and event: the start (index 0, from
+//    InitialConditions) and the bodies after each CollisionEvent. Up to
+//    CollisionEvent::FULL_STATE_MAX_BODIES bodies the event carries every body and every
+//    body has a row (column moved: whether the event moved it); above, the event carries
+//    the pair fields only, and the rows are those of the bodies it moved (first_moved ..
+//    last_moved), rebuilt: velocities copied from pair_velocities_after, position = the
+//    contact point, velocity before from the run's state so far, kinetic energy and its
+//    change from the masses. A 1,000-body gas has 245,308 impacts: every body after every
+//    impact would be 245 million rows.
+//  - final_velocities.csv, tidy: Prediction's and RunSummary's final velocities, one row
+//    per body.
+//  - A list that no table holds by body (InitialConditions.restitution, the plot topics'
+//    v, delta, kinetic) is one cell, values separated by ';' (empty: an empty list).
 // Numbers round-trip: doubles are written with 17 significant digits ("inf", "-inf",
 // "nan" as Python's float() reads them), header.stamp as exact seconds with 9 decimals.
 #pragma once
@@ -19,28 +33,34 @@ struct BagCsvError : std::runtime_error {
 };
 
 struct CsvFile {
-  std::string topic;
+  std::string topic;  ///< the topic; for bodies.csv and final_velocities.csv, their topics joined by " + "
   std::string path;
   std::size_t rows = 0;
 };
 
 struct CsvExport {
-  std::vector<CsvFile> files;               ///< in the order topics first appear
+  std::vector<CsvFile> files;               ///< topics in the order they first appear, then the tidy tables
   std::vector<std::string> skipped_topics;  ///< "topic (type)": not a collision_lab message
+  /// Events above FULL_STATE_MAX_BODIES whose run has no InitialConditions in the bag: no
+  /// body rows (nothing to rebuild from); one line per run.
+  std::vector<std::string> warnings;
 };
 
 /// Writes <out_dir>/<last part of topic>.csv for every topic of the bag that holds a
 /// collision_lab message type, rows in bag order (the full topic, with '/' as '_', when
-/// two topics share a last part). Creates out_dir. Throws BagCsvError.
+/// two topics share a last part), and the tidy tables bodies.csv and final_velocities.csv
+/// when the bag has their topics. Creates out_dir. Throws BagCsvError.
 CsvExport bagToCsv(const std::string& bag_path, const std::string& out_dir);
 
-/// The CSV columns of a collision_lab message type and, for each, the message field it
-/// comes from ("header" for stamp_s); for tests that check every field is exported.
+/// The CSV columns of a collision_lab message type, each with the message field it comes
+/// from ("header" for stamp_s) and its file ("" for the topic's own, else "bodies.csv" or
+/// "final_velocities.csv"); for tests that check every field is exported.
 struct CsvColumn {
   std::string name;
   std::string field;
+  std::string file;
 };
-/// Empty for a type that is not exported, e.g. "collision_lab/CollisionEvent".
+/// Empty for a type that is not exported, e.g. "std_msgs/String".
 std::vector<CsvColumn> csvColumns(const std::string& datatype);
 
 }  // namespace collision_lab_ros
