@@ -20,6 +20,7 @@ add_library(collision_lab_ros
   src/ros/markers/steps.cpp
   src/ros/markers/worldlines.cpp
   src/ros/markers/energy_bars.cpp
+  src/ros/markers/velocities.cpp
   src/ros/markers/overlays.cpp
   src/ros/markers/rviz_limits.cpp)
 target_include_directories(collision_lab_ros PUBLIC include)

@@ -149,49 +149,95 @@ std::vector<Envelope::Vertex> Envelope::polyline() const {
 
 // ---- RunRecord ----
 
-using markers::isWall;
-using markers::toArray3;
+namespace {
 
-double kineticEnergy(const collision_lab::InitialConditions& input, const std::array<double, 3>& v) {
+/// n evenly spaced indices of 0 .. count - 1, the first and the last included (all when
+/// count <= n).
+std::vector<std::size_t> evenlySpaced(std::size_t count, std::size_t n) {
+  std::vector<std::size_t> out;
+  if (count <= n) {
+    for (std::size_t i = 0; i < count; ++i) out.push_back(i);
+    return out;
+  }
+  for (std::size_t j = 0; j < n; ++j) out.push_back(j * (count - 1) / (n - 1));
+  return out;
+}
+
+std::vector<int> slotsOf(const std::vector<std::size_t>& bodies, std::size_t count) {
+  std::vector<int> slot(count, -1);
+  for (std::size_t k = 0; k < bodies.size(); ++k) slot[bodies[k]] = static_cast<int>(k);
+  return slot;
+}
+
+bool isWallMass(double m) { return std::isinf(m); }
+
+}  // namespace
+
+double kineticEnergy(const collision_lab::InitialConditions& input, const std::vector<double>& v) {
   double energy = 0.0;
-  for (int i = 0; i < 3; ++i) {
-    if (!isWall(input, i)) energy += 0.5 * input.masses[i] * v[i] * v[i];
+  for (std::size_t i = 0; i < v.size() && i < input.masses.size(); ++i) {
+    if (!isWallMass(input.masses[i])) energy += 0.5 * input.masses[i] * v[i] * v[i];
   }
   return energy;
 }
 
-double momentum(const collision_lab::InitialConditions& input, const std::array<double, 3>& v) {
+double momentum(const collision_lab::InitialConditions& input, const std::vector<double>& v) {
   double p = 0.0;
-  for (int i = 0; i < 3; ++i) {
-    if (!isWall(input, i)) p += input.masses[i] * v[i];
+  for (std::size_t i = 0; i < v.size() && i < input.masses.size(); ++i) {
+    if (!isWallMass(input.masses[i])) p += input.masses[i] * v[i];
   }
   return p;
 }
 
 RunRecord::RunRecord(const collision_lab::InitialConditions& input, const RecordLimits& limits)
-    : input_(input), limits_(limits) {
+    : input_(input), limits_(limits), first_collapse_time_(std::nan("")) {
+  // An input of unequal lengths (the node rejects those) is cut to its shortest list.
+  const std::size_t n = std::min({input_.masses.size(), input_.positions.size(), input_.velocities.size()});
+  input_.masses.resize(n), input_.positions.resize(n), input_.velocities.resize(n);
   limits_.keyframes = std::max<std::size_t>(limits_.keyframes, 8);
+  tracked_ = evenlySpaced(n, kMaxTrackedBodies);
+  if (n <= kMaxPlottedBodies) plotted_ = evenlySpaced(n, n);
+  track_slot_ = slotsOf(tracked_, n);
+  plot_slot_ = slotsOf(plotted_, n);
   const Envelope empty(limits_.envelope_vertices);
-  velocity_.fill(empty);
-  paper_velocity_.fill(empty);
-  worldline_.fill(empty);
-  energy_ = momentum_ = empty;
-  const auto v0 = toArray3(input.velocities);
-  for (int i = 0; i < 3; ++i) {
-    velocity_[i].add(0.0, v0[i]);
-    worldline_[i].add(0.0, input.positions[i]);
+  velocity_.assign(plotted_.size(), empty);
+  paper_velocity_.assign(plotted_.size(), empty);
+  body_energy_.assign(plotted_.size(), empty);
+  worldline_.assign(tracked_.size(), empty);
+  energy_ = momentum_ = energy_lost_ = none_ = empty;
+  for (std::size_t i = 0; i < n; ++i) flights_.push_back({0.0, input_.positions[i], input_.velocities[i]});
+  for (std::size_t k = 0; k < plotted_.size(); ++k) {
+    const std::size_t i = plotted_[k];
+    velocity_[k].add(0.0, input_.velocities[i]);
+    body_energy_[k].add(0.0, isWall(i) ? 0.0 : 0.5 * input_.masses[i] * input_.velocities[i] * input_.velocities[i]);
   }
-  energy_.add(0.0, kineticEnergy(input, v0));
-  momentum_.add(0.0, collision_lab_ros::momentum(input, v0));
+  for (std::size_t k = 0; k < tracked_.size(); ++k) worldline_[k].add(0.0, input_.positions[tracked_[k]]);
+  kinetic_ = kineticEnergy(input_, input_.velocities);
+  momentum_sum_ = collision_lab_ros::momentum(input_, input_.velocities);
+  energy_.add(0.0, kinetic_);
+  momentum_.add(0.0, momentum_sum_);
+  energy_lost_.add(0.0, 0.0);
+}
+
+bool RunRecord::isWall(std::size_t i) const { return i < bodies() && isWallMass(input_.masses[i]); }
+
+const Envelope& RunRecord::seriesOf(const std::vector<Envelope>& series, const std::vector<int>& slot,
+                                    std::size_t i) const {
+  return i < slot.size() && slot[i] >= 0 ? series[static_cast<std::size_t>(slot[i])] : none_;
+}
+
+std::size_t RunRecord::keyframeLimit() const {
+  const std::size_t by_values = limits_.keyframe_values / std::max<std::size_t>(bodies(), 1);
+  return std::max<std::size_t>(8, std::min(limits_.keyframes, by_values));
 }
 
 bool RunRecord::keeps(const Keyframe& frame) const {
-  if (frame.index == keyframes_.front().index || frame.index % stride_ == 0) return true;
+  if (keyframes_.empty() || frame.index == keyframes_.front().index || frame.index % stride_ == 0) return true;
   return bucket_ > 0 && std::floor(frame.time / bucket_) > std::floor(frame.previous_time / bucket_);
 }
 
 void RunRecord::prune() {
-  while (keyframes_.size() > limits_.keyframes) {
+  while (keyframes_.size() > keyframeLimit()) {
     std::size_t by_index = 0, by_time = 0;
     for (std::size_t k = 1; k + 1 < keyframes_.size(); ++k) {
       const Keyframe& f = keyframes_[k];
@@ -212,38 +258,119 @@ void RunRecord::prune() {
   }
 }
 
-void RunRecord::add(const collision_lab::CollisionEvent& event) {
-  const std::uint64_t expected = collisions() + 1;
-  if (event.index < expected) return;
-  missed_ += event.index - expected;
-  Keyframe frame;
-  frame.index = event.index;
-  frame.time = event.time;
-  frame.valid_until = kInf;
-  frame.positions = toArray3(event.positions);
-  frame.velocities = toArray3(event.velocities_after);
-  frame.predicted = toArray3(event.predicted_velocities_after);
-  if (!keyframes_.empty()) {
-    Keyframe& newest = keyframes_.back();
-    frame.previous_time = newest.time;
-    newest.valid_until = event.index == expected ? event.time : newest.time;
-    if (keyframes_.size() > 1 && !keeps(newest)) keyframes_.pop_back();
+bool RunRecord::wellFormed(const collision_lab::CollisionEvent& event) const {
+  const std::size_t n = bodies();
+  if (event.kind == collision_lab::CollisionEvent::KIND_COLLAPSE) {
+    return event.first_moved < event.last_moved && event.last_moved < n;
   }
-  if (bucket_ == 0 && event.time > 0) {
-    bucket_ = powerOfTwoAtMost(event.time / static_cast<double>(limits_.keyframes));
-  }
-  keyframes_.push_back(frame);
-  if (keyframes_.size() > limits_.keyframes) prune();
+  return std::size_t{event.pair_index} + 1 < n && event.first_moved <= event.pair_index &&
+         event.last_moved > event.pair_index && event.last_moved < n;
+}
 
-  const double k = static_cast<double>(event.index);
-  for (int i = 0; i < 3; ++i) {
-    velocity_[i].step(k, frame.velocities[i]);
-    worldline_[i].add(event.time, frame.positions[i]);
-    const double paper = event.paper_velocities_after[i];
-    if (std::isfinite(paper)) paper_velocity_[i].step(k, paper, std::abs(paper - frame.velocities[i]));
+void RunRecord::move(std::size_t body, double time, double position, double velocity) {
+  Flight& f = flights_[body];
+  if (!isWall(body)) {
+    const double m = input_.masses[body];
+    kinetic_ += 0.5 * m * (velocity * velocity - f.velocity * f.velocity);
+    momentum_sum_ += m * (velocity - f.velocity);
   }
-  energy_.step(k, event.total_energy);
-  momentum_.step(k, event.total_momentum);
+  f = Flight{time, position, velocity};
+  const double k = static_cast<double>(newest_index_);
+  if (track_slot_[body] >= 0) worldline_[static_cast<std::size_t>(track_slot_[body])].add(time, position);
+  if (plot_slot_[body] >= 0) {
+    const auto slot = static_cast<std::size_t>(plot_slot_[body]);
+    velocity_[slot].step(k, velocity);
+    body_energy_[slot].step(k, isWall(body) ? 0.0 : 0.5 * input_.masses[body] * velocity * velocity);
+  }
+}
+
+void RunRecord::apply(const collision_lab::CollisionEvent& event) {
+  const std::size_t n = bodies();
+  const double t = event.time;
+  if (event.positions.size() == n && event.velocities_after.size() == n) {
+    for (std::size_t i = 0; i < n; ++i) move(i, t, event.positions[i], event.velocities_after[i]);
+  } else if (event.kind == collision_lab::CollisionEvent::KIND_COLLAPSE) {
+    for (std::size_t i = event.first_moved; i <= event.last_moved; ++i) move(i, t, event.position, event.pair_velocities_after[0]);
+  } else {
+    // A cluster's bodies sit at the contact point, all at their side's velocity.
+    for (std::size_t i = event.first_moved; i <= event.last_moved; ++i) {
+      move(i, t, event.position, event.pair_velocities_after[i <= event.pair_index ? 0 : 1]);
+    }
+  }
+  const double k = static_cast<double>(newest_index_);
+  if (event.paper_velocities_after.size() == n) {
+    for (std::size_t slot = 0; slot < plotted_.size(); ++slot) {
+      const double paper = event.paper_velocities_after[plotted_[slot]];
+      const double simulated = flights_[plotted_[slot]].velocity;
+      if (std::isfinite(paper)) paper_velocity_[slot].step(k, paper, std::abs(paper - simulated));
+    }
+  }
+  lost_ += std::isfinite(event.energy_lost) ? event.energy_lost : 0.0;
+  // The message's totals when it has them (no rounding builds up), else the running sums.
+  energy_.step(k, std::isfinite(event.total_energy) ? event.total_energy : kinetic_);
+  momentum_.step(k, std::isfinite(event.total_momentum) ? event.total_momentum : momentum_sum_);
+  energy_lost_.step(k, lost_);
+}
+
+Keyframe RunRecord::snapshot(double time) const {
+  Keyframe frame;
+  frame.index = newest_index_;
+  frame.time = time;
+  frame.valid_until = kInf;
+  frame.previous_time = previous_time_;
+  frame.predicted = newest_predicted_;
+  for (const Flight& f : flights_) {
+    frame.positions.push_back(f.position + f.velocity * (time - f.since));
+    frame.velocities.push_back(f.velocity);
+  }
+  return frame;
+}
+
+void RunRecord::add(const collision_lab::CollisionEvent& event) {
+  if (!wellFormed(event)) {
+    ++malformed_;
+    return;
+  }
+  const bool collapse = event.kind == collision_lab::CollisionEvent::KIND_COLLAPSE;
+  // A collapse counts no impact: its index is the count before it.
+  const std::uint64_t expected = collapse ? newest_index_ : newest_index_ + 1;
+  if (event.index < expected || (collapse && event.index == newest_index_ && newest_is_collapse_ && has_newest_)) return;
+  missed_ += event.index - expected;
+  if (provisional_) keyframes_.pop_back(), provisional_ = false;
+  // The newest kept state is exact up to this event, unless events are missing or the
+  // infinitely many impacts of a collapse lie between.
+  if (newest_kept_) {
+    Keyframe& before = keyframes_.back();
+    before.valid_until = event.index == expected && !collapse ? event.time : before.time;
+  }
+  previous_time_ = has_newest_ ? newest_time_ : 0.0;
+  newest_index_ = event.index;
+  newest_time_ = event.time;
+  newest_is_collapse_ = collapse;
+  has_newest_ = true;
+  newest_predicted_ = event.predicted_velocities_after;
+  if (collapse && collapses_++ == 0) first_collapse_time_ = event.time;
+  apply(event);
+  if (bucket_ == 0 && event.time > 0) {
+    bucket_ = powerOfTwoAtMost(event.time / static_cast<double>(keyframeLimit()));
+  }
+  Keyframe meta;
+  meta.index = event.index;
+  meta.time = event.time;
+  meta.previous_time = previous_time_;
+  newest_kept_ = keeps(meta);
+  if (newest_kept_) {
+    keyframes_.push_back(snapshot(event.time));
+    if (keyframes_.size() > keyframeLimit()) prune();
+  }
+}
+
+const std::vector<Keyframe>& RunRecord::keyframes() const {
+  if (has_newest_ && !newest_kept_ && !provisional_) {
+    keyframes_.push_back(snapshot(newest_time_));
+    provisional_ = true;
+  }
+  return keyframes_;
 }
 
 bool RunRecord::finished() const {
@@ -251,14 +378,15 @@ bool RunRecord::finished() const {
     return summary->simulated && !summary->truncated && summary->collision_count == collisions();
   }
   return prediction && input_.mode == collision_lab::InitialConditions::MODE_FULL &&
+         prediction->collision_count_defined && !prediction->infinite_collisions &&
          prediction->collision_count == collisions();
 }
 
 // ---- the trajectory shown ----
 
-double freeFlightHorizon(const std::array<double, 3>& x, const std::array<double, 3>& v) {
+double freeFlightHorizon(const std::vector<double>& x, const std::vector<double>& v) {
   double horizon = kInf;
-  for (int left = 0; left < 2; ++left) {
+  for (std::size_t left = 0; left + 1 < x.size() && left + 1 < v.size(); ++left) {
     // Pair (left, left + 1) closes in when the right-hand body (left) is slower.
     const double closing = v[left + 1] - v[left];
     if (closing > 0) horizon = std::min(horizon, std::max(x[left] - x[left + 1], 0.0) / closing);
@@ -270,8 +398,8 @@ namespace {
 
 SceneState initialState(const RunRecord& run) {
   SceneState s;
-  s.positions = toArray3(run.input().positions);
-  s.velocities = toArray3(run.input().velocities);
+  s.positions = run.input().positions;
+  s.velocities = run.input().velocities;
   return s;
 }
 
@@ -286,7 +414,7 @@ SceneState stateOf(const Keyframe& frame) {
 
 /// Free flight from `from` to time t (exact while no pair meets).
 SceneState flown(SceneState from, double t) {
-  for (int i = 0; i < 3; ++i) from.positions[i] += from.velocities[i] * (t - from.time);
+  for (std::size_t i = 0; i < from.positions.size(); ++i) from.positions[i] += from.velocities[i] * (t - from.time);
   from.time = t;
   return from;
 }
@@ -300,7 +428,7 @@ double openEnd(const RunRecord& run, const SceneState& newest) {
 /// How long bodies that never meet again are shown flying apart [s].
 double flyApartTime(const collision_lab::InitialConditions& input) {
   double gap = 0.0, speed = 0.0;
-  for (int i = 0; i < 2; ++i) gap = std::max(gap, input.positions[i] - input.positions[i + 1]);
+  for (std::size_t i = 0; i + 1 < input.positions.size(); ++i) gap = std::max(gap, input.positions[i] - input.positions[i + 1]);
   for (double v : input.velocities) speed = std::max(speed, std::abs(v));
   return speed > 0 && gap > 0 ? gap / speed : 1.0;
 }
@@ -391,6 +519,7 @@ visualization_msgs::MarkerArray buildStaticMarkers(const RunRecord& run, const s
   markers::drawTitle(canvas);
   markers::drawSceneAxis(canvas);
   markers::drawWedge(canvas);
+  markers::drawSideViewAxes(canvas);
   markers::drawVelocitySteps(canvas);
   markers::drawConservedSteps(canvas);
   markers::drawWorldlines(canvas);
@@ -407,6 +536,7 @@ visualization_msgs::MarkerArray buildAnimatedMarkers(const RunRecord& run, const
   markers::drawMagnifier(canvas, state);
   markers::drawStatus(canvas, state, clock);
   markers::drawWedgeCursor(canvas, state);
+  markers::drawSideViewNow(canvas, state);
   markers::drawStepsCursor(canvas, state);
   markers::drawWorldlinesCursor(canvas, state);
   markers::drawEnergyBars(canvas, state);

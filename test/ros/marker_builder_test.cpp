@@ -13,6 +13,7 @@
 #include "collision_lab/ros/marker_builder.h"
 #include "collision_lab/ros/markers/ids.h"
 #include "collision_lab/ros/msg_conversion.h"
+#include "marker_test_checks.h"
 
 namespace {
 
@@ -288,47 +289,9 @@ TEST(MarkerBuilder, WarpPlaysDenseBurstsInSlowMotion) {
 
 // ---- markers ----
 
-bool isLine(const Marker& m) { return m.type == Marker::LINE_STRIP || m.type == Marker::LINE_LIST; }
-
-/// What rviz 1.14 accepts and survives (see kRvizMaxLinePoints and rviz's marker_utils.cpp).
-void expectFitForRviz(const MarkerArray& array) {
-  std::set<std::pair<std::string, int>> ids;
-  for (const auto& m : array.markers) {
-    if (m.action != Marker::ADD) continue;
-    EXPECT_TRUE(ids.insert({m.ns, m.id}).second) << "duplicate " << m.ns << "/" << m.id;
-    EXPECT_TRUE(std::isfinite(m.pose.position.x) && std::isfinite(m.pose.position.y)) << m.ns;
-    for (const auto& p : m.points) {
-      ASSERT_TRUE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) << m.ns << "/" << m.id;
-    }
-    if (isLine(m)) {
-      EXPECT_GE(m.points.size(), 2u) << m.ns << "/" << m.id;
-      EXPECT_LE(m.points.size(), 16384u) << m.ns << "/" << m.id;  // BillboardLine MAX_ELEMENTS
-      EXPECT_GT(m.scale.x, 0) << m.ns;
-    }
-    if (m.type == Marker::LINE_LIST) {
-      EXPECT_EQ(m.points.size() % 2, 0u) << m.ns << "/" << m.id;
-    }
-    if (m.type == Marker::TRIANGLE_LIST) {
-      EXPECT_EQ(m.points.size() % 3, 0u) << m.ns;
-    }
-    if (m.type == Marker::SPHERE_LIST) {
-      EXPECT_FALSE(m.points.empty()) << m.ns << "/" << m.id;
-    }
-    if (m.type == Marker::TEXT_VIEW_FACING) {
-      EXPECT_NE(m.text.find_first_not_of(" \n"), std::string::npos) << m.ns << "/" << m.id;
-      EXPECT_GT(m.scale.z, 0);
-    }
-  }
-  MarkerArray copy = array;
-  EXPECT_EQ(enforceRvizLimits(copy), 0u);
-}
-
-/// rviz keeps one marker per namespace and id: a second one in the same array would
-/// replace the first, and a view would lose a part without a word.
-void expectOneMarkerPerId(const MarkerArray& array) {
-  std::set<std::pair<std::string, int>> seen;
-  for (const auto& m : array.markers) EXPECT_TRUE(seen.insert({m.ns, m.id}).second) << m.ns << "/" << m.id;
-}
+using marker_checks::expectFitForRviz;
+using marker_checks::expectOneMarkerPerId;
+using marker_checks::find;
 
 TEST(MarkerBuilder, EveryViewFitsRvizForEveryCount) {
   const std::vector<Fed> runs = {
@@ -386,13 +349,6 @@ TEST(MarkerBuilder, RvizGuardThinsLongLinesAndDropsWhatRvizRejects) {
   ASSERT_EQ(array.markers.size(), 1u);
   EXPECT_LE(array.markers[0].points.size(), kRvizMaxLinePoints);
   EXPECT_GE(array.markers[0].points.size(), kRvizMaxLinePoints / 2);
-}
-
-const Marker* find(const MarkerArray& array, const std::string& ns, int id) {
-  for (const auto& m : array.markers) {
-    if (m.ns == ns && m.id == id) return &m;
-  }
-  return nullptr;
 }
 
 TEST(MarkerBuilder, VelocitiesArePlottedAsSteps) {

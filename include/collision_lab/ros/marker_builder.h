@@ -1,15 +1,22 @@
-// rviz markers for one run, built from the run's messages alone (so a live node and a
-// bag replay draw the same picture). The views:
-//   - the scene: bodies sized by mass, walls as walls, animated along the exact trajectory
-//     (never extrapolated), with the time, the collision counter and the velocities;
-//   - the wedge in velocity space s-perp (the paper's Figure 1): lines L_AB and L_BC, the
-//     escape cone, u_perp after the collisions (simulated and by the closed form);
-//   - v_A, v_B, v_C against collision index as steps (constant between impacts), with the
+// rviz markers for one run of N bodies, built from the run's messages alone (so a live
+// node and a bag replay draw the same picture). The views (docs/rviz.md):
+//   - the scene: bodies sized by mass (log scale), walls as walls, animated along the exact
+//     trajectory (never extrapolated), with the time and the collision counter; labelled
+//     with their velocities up to kMaxPlottedBodies, coloured by velocity beyond;
+//   - three bodies (at most one wall): the wedge in velocity space s-perp (the paper's
+//     Figure 1): lines L_AB and L_BC, the escape cone, u_perp after the collisions
+//     (simulated and by the closed form); with e < 1 the spiral, and for a collapse the
+//     orbit's directions converging to the eigen-directions of the cycle, r_c in the legend;
+//     other scenes in its place: the velocities now body by body (small N) or their
+//     histogram against the Maxwell-like Gaussian (large N);
+//   - velocities against collision index as steps (constant between impacts), with the
 //     paper's printed eqs. (2.15)/(2.16) as a third series where they differ, and B on its
-//     own scale when it dwarfs A and C;
-//   - the x-t diagram (worldlines);
-//   - total energy and momentum of the finite masses against collision index;
-//   - kinetic energy per body as bars.
+//     own scale when it dwarfs A and C (three bodies);
+//   - the x-t diagram (worldlines; a sample for large N), with the ghosts' straight
+//     worldlines for equal elastic masses;
+//   - kinetic energy per body, the total and the heat so far against collision index;
+//     momentum of the finite masses;
+//   - kinetic energy per body now as bars (small N), or the totals now (large N).
 // Each view is drawn by its own functions in src/ros/markers/<view>.cpp; their marker
 // namespaces and ids are in markers/ids.h, their layout in markers/layout.h.
 //
@@ -86,90 +93,146 @@ class Envelope {
   double min_y_, max_y_;
 };
 
-/// The exact state just after one collision.
+/// The exact state of every body just after one collision (or a collapse).
 struct Keyframe {
-  std::uint64_t index = 0;  ///< collision number [1]
+  std::uint64_t index = 0;  ///< collisions so far [1] (a collapse keeps its impacts' count)
   double time = 0.0;        ///< [s]
   /// Up to this time [s] the free flight from this state is exact: the next collision's
   /// time once it is known, +inf while this is the newest collision.
   double valid_until = 0.0;
-  double previous_time = 0.0;  ///< the previous collision's time [s] (0 for the first)
-  std::array<double, 3> positions{};   ///< [m]
-  std::array<double, 3> velocities{};  ///< after the collision [m/s]
-  std::array<double, 3> predicted{};   ///< closed form after the collision [m/s]
+  double previous_time = 0.0;      ///< the previous collision's time [s] (0 for the first)
+  std::vector<double> positions;   ///< body i at index i [m]
+  std::vector<double> velocities;  ///< after the collision [m/s]
+  std::vector<double> predicted;   ///< closed form after the collision [m/s]; empty when none
 };
 
-/// Bounds of a RunRecord's memory, whatever the count.
+/// Bounds of a RunRecord's memory, whatever the count and N.
 struct RecordLimits {
   std::size_t keyframes = kMarkerKeyframes;
   std::size_t envelope_vertices = kMarkerEnvelopeVertices;
+  /// Keyframes hold N values each: at most this many values in all, so a 1,000-body gas
+  /// keeps about a thousand states [1].
+  std::size_t keyframe_values = std::size_t{1} << 21;
 };
 
-/// What the marker view keeps of one run. Collisions are added in index order; the record
-/// keeps the first and the newest collision, every collision whose index is a multiple of
-/// a power-of-two stride, and the first collision in every time bucket (a power of two
-/// wide), doubling stride or bucket as needed to stay within limits.keyframes. So both
-/// the sparse phases (uniform in time) and the dense bursts (uniform in index) keep exact
-/// states close together.
+/// Bodies whose worldlines the x-t diagram draws (all of them up to this N; beyond, this
+/// many evenly spaced ones, the outermost two included), and bodies with their own
+/// velocity and energy steps (all up to kMaxPlottedBodies; beyond, none: the plots show sums).
+constexpr std::size_t kMaxTrackedBodies = 24;
+constexpr std::size_t kMaxPlottedBodies = 10;
+
+/// What the marker view keeps of one run of N bodies. Collisions are added in index order;
+/// the record keeps the first and the newest collision, every collision whose index is a
+/// multiple of a power-of-two stride, and the first collision in every time bucket (a
+/// power of two wide), doubling stride or bucket as needed to stay within the limits. So
+/// both the sparse phases (uniform in time) and the dense bursts (uniform in index) keep
+/// exact states close together.
+/// The state of every body is rebuilt from the InitialConditions and each event's pair
+/// fields (the per-body arrays when the event carries them): O(1) per impact (O(size) for
+/// a cluster), so a 1,000-body gas with 245,000 impacts costs 245,000 small updates; a
+/// keyframe (O(N)) is copied only when it is kept.
+/// Not thread-safe, not even for const calls (keyframes() materialises the newest state).
 class RunRecord {
  public:
   explicit RunRecord(const collision_lab::InitialConditions& input, const RecordLimits& limits = {});
 
   /// Collisions must come in index order; an index already added is ignored, and a
-  /// skipped index is counted in missedCollisions().
+  /// skipped index is counted in missedCollisions(). A KIND_COLLAPSE record (its index is
+  /// the count of the impacts before it) is applied once. An event naming bodies the scene
+  /// does not have is counted in malformedEvents() and ignored.
   void add(const collision_lab::CollisionEvent& event);
 
   const collision_lab::InitialConditions& input() const { return input_; }
   std::optional<collision_lab::Prediction> prediction;
   std::optional<collision_lab::RunSummary> summary;
 
+  /// Number of bodies N (walls included) [1].
+  std::size_t bodies() const { return input_.masses.size(); }
+  bool isWall(std::size_t i) const;
   /// Index of the newest collision added [1].
-  std::uint64_t collisions() const { return keyframes_.empty() ? 0 : keyframes_.back().index; }
+  std::uint64_t collisions() const { return newest_index_; }
   std::uint64_t missedCollisions() const { return missed_; }
-  const std::vector<Keyframe>& keyframes() const { return keyframes_; }
+  std::uint64_t malformedEvents() const { return malformed_; }
+  /// Collapses applied [1] and the first one's time [s] (NaN when none).
+  std::uint32_t collapses() const { return collapses_; }
+  double firstCollapseTime() const { return first_collapse_time_; }
+  /// The kept states, the newest last (materialised on demand).
+  const std::vector<Keyframe>& keyframes() const;
   /// True when every collision of the run is here: the summary (or, before it, the exact
   /// predicted count) says the simulated run ended with the newest collision.
   bool finished() const;
 
-  /// Steps against collision index: velocities [m/s] (simulated, and the paper's with
-  /// mark |paper - simulated|), total energy [J] and momentum [kg m/s] of the finite
-  /// masses. Worldlines: positions [m] against time [s].
-  const Envelope& velocity(int i) const { return velocity_[i]; }
-  const Envelope& paperVelocity(int i) const { return paper_velocity_[i]; }
+  /// Bodies with a worldline (kMaxTrackedBodies) and with velocity and energy steps
+  /// (kMaxPlottedBodies), in increasing order.
+  const std::vector<std::size_t>& trackedBodies() const { return tracked_; }
+  const std::vector<std::size_t>& plottedBodies() const { return plotted_; }
+
+  /// Steps against collision index, per plotted body i: velocity [m/s] (simulated, and
+  /// the paper's with mark |paper - simulated|) and kinetic energy [J]; total kinetic
+  /// energy [J] and momentum [kg m/s] of the finite masses, and the energy turned into heat
+  /// so far [J]. Worldlines, per tracked body i: position [m] against time [s].
+  /// Precondition: i is plotted (tracked for worldline); otherwise an empty envelope.
+  const Envelope& velocity(std::size_t i) const { return seriesOf(velocity_, plot_slot_, i); }
+  const Envelope& paperVelocity(std::size_t i) const { return seriesOf(paper_velocity_, plot_slot_, i); }
+  const Envelope& bodyEnergy(std::size_t i) const { return seriesOf(body_energy_, plot_slot_, i); }
+  const Envelope& worldline(std::size_t i) const { return seriesOf(worldline_, track_slot_, i); }
   const Envelope& energy() const { return energy_; }
   const Envelope& momentum() const { return momentum_; }
-  const Envelope& worldline(int i) const { return worldline_[i]; }
+  const Envelope& energyLost() const { return energy_lost_; }
 
  private:
+  /// Each body's free flight: x(t) = position + velocity (t - since).
+  struct Flight {
+    double since = 0.0, position = 0.0, velocity = 0.0;
+  };
+  const Envelope& seriesOf(const std::vector<Envelope>& series, const std::vector<int>& slot, std::size_t i) const;
+  bool wellFormed(const collision_lab::CollisionEvent& event) const;
+  /// Applies the event to flights_, the sums and the per-body series.
+  void apply(const collision_lab::CollisionEvent& event);
+  void move(std::size_t body, double time, double position, double velocity);
+  Keyframe snapshot(double time) const;
   bool keeps(const Keyframe& frame) const;
   void prune();
+  std::size_t keyframeLimit() const;
 
   collision_lab::InitialConditions input_;
   RecordLimits limits_;
-  std::vector<Keyframe> keyframes_;
+  std::vector<Flight> flights_;
+  mutable std::vector<Keyframe> keyframes_;
+  /// keyframes_.back() is the newest state materialised for keyframes(), not a kept one.
+  mutable bool provisional_ = false;
+  std::uint64_t newest_index_ = 0;
+  double newest_time_ = 0.0, previous_time_ = 0.0;
+  bool has_newest_ = false, newest_kept_ = false, newest_is_collapse_ = false;
+  std::vector<double> newest_predicted_;
   std::uint64_t stride_ = 1;   ///< keeps indices that are multiples of it
   double bucket_ = 0.0;        ///< [s]; 0 until the first collision at t > 0
-  std::uint64_t missed_ = 0;
-  std::array<Envelope, 3> velocity_, paper_velocity_, worldline_;
-  Envelope energy_, momentum_;
+  std::uint64_t missed_ = 0, malformed_ = 0;
+  std::uint32_t collapses_ = 0;
+  double first_collapse_time_;
+  std::vector<std::size_t> tracked_, plotted_;
+  std::vector<int> track_slot_, plot_slot_;  ///< body -> its series, -1 for none
+  std::vector<Envelope> velocity_, paper_velocity_, body_energy_, worldline_;
+  Envelope energy_, momentum_, energy_lost_, none_;
+  double kinetic_ = 0.0, momentum_sum_ = 0.0, lost_ = 0.0;
 };
 
 /// Kinetic energy [J] and momentum [kg m/s] of the finite masses (walls excluded).
-double kineticEnergy(const collision_lab::InitialConditions& input, const std::array<double, 3>& v);
-double momentum(const collision_lab::InitialConditions& input, const std::array<double, 3>& v);
+double kineticEnergy(const collision_lab::InitialConditions& input, const std::vector<double>& v);
+double momentum(const collision_lab::InitialConditions& input, const std::vector<double>& v);
 
 /// How long bodies at positions x [m] with velocities v [m/s] fly freely before two
 /// touch [s]: +inf when no pair approaches. Bounds the animation of an unfinished run.
-double freeFlightHorizon(const std::array<double, 3>& x, const std::array<double, 3>& v);
+double freeFlightHorizon(const std::vector<double>& x, const std::vector<double>& v);
 
 /// What the scene shows at simulated time t [s].
 struct SceneState {
   /// The simulated time shown [s]: t itself when its exact state is known, otherwise the
   /// nearest instant whose exact state is known (never an extrapolation).
   double time = 0.0;
-  std::array<double, 3> positions{};   ///< [m]
-  std::array<double, 3> velocities{};  ///< [m/s]
-  std::uint64_t collisions = 0;        ///< collisions before `time` [1]
+  std::vector<double> positions;   ///< body i at index i [m]
+  std::vector<double> velocities;  ///< [m/s]
+  std::uint64_t collisions = 0;    ///< collisions before `time` [1]
 };
 SceneState stateAt(const RunRecord& run, double t);
 

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "collision_lab/core/nbody/scene.h"
+
 namespace collision_lab_ros::markers {
 
 using namespace layout;
@@ -15,10 +17,19 @@ std_msgs::ColorRGBA color(const Rgba& c) {
   return out;
 }
 
-std_msgs::ColorRGBA particleColor(int i, double lighten) {
-  const Rgba& c = kParticleRgb[i];
+std_msgs::ColorRGBA particleColor(std::size_t i, double lighten) {
+  const Rgba& c = kParticleRgb[i % kPaletteSize];
   return color({c.r + (1 - c.r) * lighten, c.g + (1 - c.g) * lighten, c.b + (1 - c.b) * lighten});
 }
+
+std_msgs::ColorRGBA velocityColor(double v, double v_max) {
+  const double f = std::isfinite(v) && v_max > 0 ? std::clamp(v / v_max, -1.0, 1.0) : 0.0;
+  const Rgba& end = f < 0 ? kSlowBlue : kFastRed;
+  const double a = std::abs(f);
+  return color({1 + (end.r - 1) * a, 1 + (end.g - 1) * a, 1 + (end.b - 1) * a});
+}
+
+std::string bodyName(std::size_t i) { return collision_lab::core::bodyName(i); }
 
 geometry_msgs::Point point(double x, double y, double z) {
   geometry_msgs::Point p;
@@ -47,7 +58,26 @@ std::array<double, 3> toArray3(const std::vector<double>& a) {
   return result;
 }
 
-bool isWall(const collision_lab::InitialConditions& input, int i) { return std::isinf(input.masses[i]); }
+bool isWall(const collision_lab::InitialConditions& input, std::size_t i) {
+  return i < input.masses.size() && std::isinf(input.masses[i]);
+}
+
+double velocityScale(const RunRecord& run) {
+  double v_max = 0.0;
+  for (std::size_t i = 0; i < run.bodies(); ++i) {
+    if (!run.isWall(i)) v_max = std::max(v_max, std::abs(run.input().velocities[i]));
+  }
+  return v_max > 0 && std::isfinite(v_max) ? v_max : 1.0;
+}
+
+bool largeScene(const RunRecord& run) { return run.bodies() > kMaxPlottedBodies; }
+
+SideView sideView(const RunRecord& run) {
+  std::size_t walls = 0;
+  for (std::size_t i = 0; i < run.bodies(); ++i) walls += run.isWall(i) ? 1 : 0;
+  if (run.bodies() == 3 && walls <= 1) return SideView::kWedge;
+  return largeScene(run) ? SideView::kHistogram : SideView::kVelocityProfile;
+}
 
 namespace {
 

@@ -1,5 +1,5 @@
 // The kinetic energy per body as bars: the axis with the bodies' names (static) and the
-// bars with their values now (animated).
+// bars with their values now (animated); for a large scene, the totals now.
 #include <algorithm>
 
 #include "collision_lab/ros/markers/draw.h"
@@ -10,8 +10,8 @@ using namespace layout;
 
 namespace {
 
-constexpr double kPitch = (kBarsBox.right - kBarsBox.left) / 3;  ///< per body
-double barX(int i) { return kBarsBox.left + (i + 0.5) * kPitch; }
+double pitch(std::size_t n) { return (kBarsBox.right - kBarsBox.left) / static_cast<double>(std::max<std::size_t>(n, 1)); }
+double barX(std::size_t i, std::size_t n) { return kBarsBox.left + (static_cast<double>(i) + 0.5) * pitch(n); }
 
 }  // namespace
 
@@ -19,31 +19,43 @@ void drawEnergyBarsAxis(const Canvas& c) {
   Marker axis = c.lines(ns::kEnergy, kEnergyAxis, Marker::LINE_LIST, kAxisWidth, color(kGrey));
   axis.points = {point(kBarsBox.left, kBarsBox.bottom), point(kBarsBox.right, kBarsBox.bottom)};
   c.add(axis);
-  for (int i = 0; i < 3; ++i) {
-    c.add(c.text(ns::kEnergy, kEnergyBodyNames + i, barX(i), kBarsBox.bottom + kBarNameDy,
-                 isWall(c.run.input(), i) ? std::string(kNames[i]) + " (wall)" : kNames[i], kSmallTextSize,
-                 particleColor(i)));
+  const std::size_t n = c.run.bodies();
+  if (!largeScene(c.run)) {
+    for (std::size_t i = 0; i < n; ++i) {
+      const bool wall = isWall(c.run.input(), i);
+      c.add(c.text(ns::kEnergy, kEnergyBodyNames + static_cast<int>(i), barX(i, n), kBarsBox.bottom + kBarNameDy,
+                   wall && n <= 3 ? bodyName(i) + " (wall)" : bodyName(i), kSmallTextSize, particleColor(i)));
+    }
   }
-  c.add(c.text(ns::kEnergy, kEnergyTitle, kBarsBox.midX(), kBarsBox.top + kBarsTitleDy, "kinetic energy now [J]",
-               kTextSize));
+  c.add(c.text(ns::kEnergy, kEnergyTitle, kBarsBox.midX(), kBarsBox.top + kBarsTitleDy,
+               largeScene(c.run) ? "kinetic energy now [J]" : "kinetic energy now, per body [J]", kTextSize));
 }
 
 void drawEnergyBars(const Canvas& c, const SceneState& state) {
-  std::array<double, 3> kinetic{};
-  for (int i = 0; i < 3; ++i) {
+  const std::size_t n = c.run.bodies();
+  std::vector<double> kinetic(n, 0.0);
+  double total = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
     if (!isWall(c.run.input(), i)) kinetic[i] = 0.5 * c.run.input().masses[i] * state.velocities[i] * state.velocities[i];
+    total += kinetic[i];
   }
-  const double total = kinetic[0] + kinetic[1] + kinetic[2];
+  if (largeScene(c.run)) {
+    c.add(c.text(ns::kEnergyBars, kEnergyTotals, kBarsBox.midX(), kBarsBox.midY(),
+                 format("all %.0f bodies: ", static_cast<double>(n)) + format("%.5g J", total) +
+                     format("\nat the start: %.5g J", kineticEnergy(c.run.input(), c.run.input().velocities)),
+                 kTextSize));
+    return;
+  }
   const double height = kBarsBox.top - kBarsBox.bottom;
-  for (int i = 0; i < 3; ++i) {
+  for (std::size_t i = 0; i < n; ++i) {
     const double h = std::max(total > 0 ? height * kinetic[i] / total : 0.0, kBarMinHeight);
-    Marker bar = c.base(ns::kEnergyBars, kEnergyBar + i, Marker::CUBE);
-    bar.pose.position = point(barX(i), kBarsBox.bottom + h / 2);
-    bar.scale.x = kBarWidth * kPitch, bar.scale.y = h, bar.scale.z = kBarDepth;
+    Marker bar = c.base(ns::kEnergyBars, kEnergyBar + static_cast<int>(i), Marker::CUBE);
+    bar.pose.position = point(barX(i, n), kBarsBox.bottom + h / 2);
+    bar.scale.x = kBarWidth * pitch(n), bar.scale.y = h, bar.scale.z = kBarDepth;
     bar.color = particleColor(i);
     c.add(bar);
-    c.add(c.text(ns::kEnergyBars, kEnergyBarValue + i, barX(i), kBarsBox.bottom + h + kBarValueDy,
-                 format("%.3g", kinetic[i]), kSmallTextSize));
+    c.add(c.text(ns::kEnergyBars, kEnergyBarValue + static_cast<int>(i), barX(i, n),
+                 kBarsBox.bottom + h + kBarValueDy, format("%.3g", kinetic[i]), kSmallTextSize));
   }
 }
 

@@ -16,7 +16,7 @@ bool simulatedStepByStep(const RunRecord& run) {
 
 std::uint64_t expectedCollisions(const RunRecord& run) {
   if (run.summary && run.summary->simulated && !run.summary->truncated) return run.summary->collision_count;
-  if (run.prediction) return std::max<std::uint64_t>(run.prediction->collision_count, run.collisions());
+  if (run.prediction && run.prediction->collision_count_defined) return std::max<std::uint64_t>(run.prediction->collision_count, run.collisions());
   return run.collisions();
 }
 
@@ -25,29 +25,41 @@ double indexAxisEnd(const RunRecord& run) {
   return static_cast<double>(n) + 1.0;
 }
 
-std::optional<std::pair<std::uint64_t, Vec3>> finalVelocitiesNotDrawn(const RunRecord& run) {
+std::optional<std::pair<std::uint64_t, std::vector<double>>> finalVelocitiesNotDrawn(const RunRecord& run) {
   if (simulatedStepByStep(run) && !(run.summary && run.summary->truncated)) return std::nullopt;
   if (run.summary && run.summary->simulated && !run.summary->truncated) {
-    return std::make_pair(run.summary->collision_count, toArray3(run.summary->final_velocities));
+    return std::make_pair(run.summary->collision_count, run.summary->final_velocities);
   }
-  if (run.prediction && run.prediction->collision_count > run.collisions()) {
-    return std::make_pair(run.prediction->collision_count, toArray3(run.prediction->final_velocities));
+  if (run.prediction && run.prediction->collision_count_defined && run.prediction->collision_count > run.collisions()) {
+    return std::make_pair(run.prediction->collision_count, run.prediction->final_velocities);
   }
   return std::nullopt;
 }
 
 std::string runTitle(const RunRecord& run) {
   std::string title = "run " + run.input().run_id;
+  if (run.bodies() != 3) title += ",  " + withSeparators(run.bodies()) + " bodies";
   if (run.prediction) {
-    title += ":  predicted " + withSeparators(run.prediction->collision_count) + " collisions";
-    title += run.prediction->paper_collision_count_defined
-                 ? "  (paper's eq. 3.22: " + std::to_string(run.prediction->paper_collision_count) + ")"
-                 : "  (paper's eq. 3.22: undefined)";
+    const auto& p = *run.prediction;
+    if (p.model != collision_lab::Prediction::MODEL_THREE_BODY_ROTATION) title += " (" + p.model_name + ")";
+    if (p.collapsed) {
+      title += ":  predicted collapse at t = " + format("%.6g s", p.collapse_time);
+    } else if (p.infinite_collisions) {
+      title += ":  predicted: infinitely many collisions";
+    } else if (p.collision_count_defined) {
+      title += ":  predicted " + withSeparators(p.collision_count) + " collisions";
+    }
+    if (p.model == collision_lab::Prediction::MODEL_THREE_BODY_ROTATION) {
+      title += p.paper_collision_count_defined
+                   ? "  (paper's eq. 3.22: " + std::to_string(p.paper_collision_count) + ")"
+                   : "  (paper's eq. 3.22: undefined)";
+    }
   }
   if (run.summary) {
     title += run.summary->simulated ? ",  simulated " + withSeparators(run.summary->collision_count)
                                     : ",  not simulated";
     if (run.summary->truncated) title += " (truncated)";
+    if (run.summary->collapse_count > 0) title += " + " + withSeparators(run.summary->collapse_count) + " collapse(s)";
   }
   return title;
 }

@@ -14,29 +14,109 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-double bodyDiameter(const collision_lab::InitialConditions& input, int i) {
+/// The finite masses' range [kg], for sizes on a log scale.
+std::pair<double, double> massRange(const collision_lab::InitialConditions& input) {
   double lo = kInf, hi = 0.0;
-  for (int j = 0; j < 3; ++j) {
+  for (std::size_t j = 0; j < input.masses.size(); ++j) {
     if (!isWall(input, j)) lo = std::min(lo, input.masses[j]), hi = std::max(hi, input.masses[j]);
   }
-  const double decades = std::max(std::log10(hi / lo), 1.0);
-  return kSmallestBody + kBodyGrowth * std::log10(input.masses[i] / lo) / decades;
+  return {lo, hi};
 }
 
-/// A wall as a slab on its outer side of x, a body as a sphere sized by its mass.
-Marker bodyMarker(const Canvas& c, int i, double x) {
-  if (isWall(c.run.input(), i)) {
-    Marker m = c.base(ns::kBodies, kBody + i, Marker::CUBE);
-    m.pose.position = point(x + (i == 0 ? kWallWidth / 2 : -kWallWidth / 2), kSceneY);
-    m.scale.x = kWallWidth, m.scale.y = kWallHeight, m.scale.z = kWallDepth;
-    m.color = color(kGrey);
-    return m;
-  }
-  Marker m = c.base(ns::kBodies, kBody + i, Marker::SPHERE);
+/// Where mass m sits between the lightest (0) and the heaviest (1) on a log scale, over
+/// at least one decade.
+double massShare(double m, const std::pair<double, double>& range) {
+  const double decades = std::max(std::log10(range.second / range.first), 1.0);
+  return std::clamp(std::log10(m / range.first) / decades, 0.0, 1.0);
+}
+
+/// A wall as a slab on its outer side of x (body 0 on the right).
+Marker wallMarker(const Canvas& c, int id, bool right, double x) {
+  Marker m = c.base(ns::kBodies, id, Marker::CUBE);
+  m.pose.position = point(x + (right ? kWallWidth / 2 : -kWallWidth / 2), kSceneY);
+  m.scale.x = kWallWidth, m.scale.y = kWallHeight, m.scale.z = kWallDepth;
+  m.color = color(kGrey);
+  return m;
+}
+
+/// A body as a sphere sized by its mass.
+Marker bodyMarker(const Canvas& c, std::size_t i, double x, const std::pair<double, double>& range) {
+  if (isWall(c.run.input(), i)) return wallMarker(c, kBody + static_cast<int>(i), i == 0, x);
+  Marker m = c.base(ns::kBodies, kBody + static_cast<int>(i), Marker::SPHERE);
   m.pose.position = point(x, kSceneY);
-  m.scale.x = m.scale.y = m.scale.z = bodyDiameter(c.run.input(), i);
+  m.scale.x = m.scale.y = m.scale.z = kSmallestBody + kBodyGrowth * massShare(c.run.input().masses[i], range);
   m.color = particleColor(i);
   return m;
+}
+
+/// Few bodies: each with its tag beside it and its velocity in a row above.
+void drawLabelledBodies(const Canvas& c, const SceneState& state, const SceneAxis& axis) {
+  const std::size_t n = c.run.bodies();
+  const auto range = massRange(c.run.input());
+  // Three bodies keep their wide row; more share the scene's width.
+  const double pitch = n <= 3 ? kVelocityRowPitch : (kSceneRight - kSceneLeft) / static_cast<double>(n);
+  const char* fmt = n <= 3 ? " = %.6g m/s" : " = %.3g m/s";
+  for (std::size_t i = 0; i < n; ++i) {
+    const bool wall = isWall(c.run.input(), i);
+    const double x = axis.toX(state.positions[i]);
+    c.add(bodyMarker(c, i, x, range));
+    // A short tag beside the body (walls: on their outer side), the value in a fixed row.
+    const double tag_x = wall ? x + (i == 0 ? kWallTagDx : -kWallTagDx) : x;
+    const double tag_y = wall ? kSceneY + kTagDy : kSceneY + (i % 2 == 1 ? -kTagDy : kTagDy);
+    c.add(c.text(ns::kLabels, kBodyTag + static_cast<int>(i), tag_x, tag_y,
+                 wall ? bodyName(i) + " (wall)" : bodyName(i), kTextSize, particleColor(i, kTagLighten)));
+    const double row_x = kCentreX + pitch * (static_cast<double>(i) - (static_cast<double>(n) - 1) / 2);
+    c.add(c.text(ns::kLabels, kVelocityRow + static_cast<int>(i), row_x, kVelocityRowY,
+                 "v_" + bodyName(i) + format(fmt, state.velocities[i]), n <= 3 ? kTextSize : kSmallTextSize,
+                 particleColor(i, kTagLighten)));
+  }
+}
+
+/// Many bodies: one list per mass class, each body coloured by its velocity; walls as walls.
+void drawManyBodies(const Canvas& c, const SceneState& state, const SceneAxis& axis) {
+  const auto range = massRange(c.run.input());
+  const double v_max = velocityScale(c.run);
+  std::vector<Marker> classes;
+  for (int k = 0; k < kMassClasses; ++k) {
+    Marker m = c.dots(ns::kBodies, kBodyClass + k, kManyBodySize + kManyBodyGrowth * k, color(kWhite));
+    classes.push_back(m);
+  }
+  const std::size_t n = c.run.bodies();
+  for (std::size_t i = 0; i < n; ++i) {
+    const double x = axis.toX(state.positions[i]);
+    if (isWall(c.run.input(), i)) {
+      c.add(wallMarker(c, kBodyWall + (i == 0 ? 0 : 1), i == 0, x));
+      continue;
+    }
+    const int k = std::min(kMassClasses - 1, static_cast<int>(massShare(c.run.input().masses[i], range) * kMassClasses));
+    classes[static_cast<std::size_t>(k)].points.push_back(point(x, kSceneY));
+    classes[static_cast<std::size_t>(k)].colors.push_back(velocityColor(state.velocities[i], v_max));
+  }
+  for (Marker& m : classes) {
+    if (m.points.empty()) c.add(deleteMarker(ns::kBodies, m.id, c.frame_id));
+    else c.add(std::move(m));
+  }
+}
+
+/// The legend of the colour by velocity: a bar from -v_max to +v_max.
+void drawColourLegend(const Canvas& c) {
+  const double v_max = velocityScale(c.run);
+  const Box& b = kColourBarBox;
+  Marker bar = c.base(ns::kScene, kColourBar, Marker::CUBE_LIST);
+  const double step = (b.right - b.left) / kColourBarSteps;
+  bar.scale.x = step, bar.scale.y = b.top - b.bottom, bar.scale.z = kBarDepth;
+  for (int k = 0; k < kColourBarSteps; ++k) {
+    bar.points.push_back(point(b.left + (k + 0.5) * step, b.midY()));
+    bar.colors.push_back(velocityColor(-v_max + (k + 0.5) * 2 * v_max / kColourBarSteps, v_max));
+  }
+  c.add(bar);
+  c.add(c.text(ns::kScene, kColourMin, b.left - kColourLabelDx, b.midY(), format("%.3g m/s", -v_max), kSmallTextSize,
+               color(kLabelGrey)));
+  c.add(c.text(ns::kScene, kColourMax, b.right + kColourLabelDx, b.midY(), format("+%.3g m/s", v_max), kSmallTextSize,
+               color(kLabelGrey)));
+  c.add(c.text(ns::kScene, kColourCaption, b.midX(), b.top + kFrameLabelDy,
+               "colour: velocity v [m/s] (clipped at the start's largest |v|); size: mass (log)", kSmallTextSize,
+               color(kLabelGrey)));
 }
 
 }  // namespace
@@ -46,8 +126,9 @@ double SceneAxis::toX(double position) const {
 }
 
 SceneAxis sceneAxis(const RunRecord& run) {
+  // The outermost bodies bound the others (they never pass each other); both are tracked.
   double lo = kInf, hi = -kInf;
-  for (int i = 0; i < 3; ++i) {
+  for (std::size_t i : run.trackedBodies()) {
     lo = std::min(lo, run.worldline(i).minY());
     hi = std::max(hi, run.worldline(i).maxY());
   }
@@ -73,22 +154,15 @@ void drawSceneAxis(const Canvas& c) {
                format("x = %.4g m", scene.max), kSmallTextSize, color(kLabelGrey)));
   const std::string note = runNote(c.run);
   if (!note.empty()) c.add(c.text(ns::kScene, kSceneNote, kCentreX, kNoteY, note, kTextSize, color(kAmber)));
+  if (largeScene(c.run)) drawColourLegend(c);
 }
 
 void drawBodies(const Canvas& c, const SceneState& state) {
   const SceneAxis axis = sceneAxis(c.run);
-  for (int i = 0; i < 3; ++i) {
-    const bool wall = isWall(c.run.input(), i);
-    const double x = axis.toX(state.positions[i]);
-    c.add(bodyMarker(c, i, x));
-    // A short tag beside the body (walls: on their outer side), the value in a fixed row.
-    const double tag_x = wall ? x + (i == 0 ? kWallTagDx : -kWallTagDx) : x;
-    const double tag_y = wall ? kSceneY + kTagDy : kSceneY + (i == 1 ? -kTagDy : kTagDy);
-    c.add(c.text(ns::kLabels, kBodyTag + i, tag_x, tag_y, wall ? std::string(kNames[i]) + " (wall)" : kNames[i],
-                 kTextSize, particleColor(i, kTagLighten)));
-    c.add(c.text(ns::kLabels, kVelocityRow + i, kCentreX + kVelocityRowPitch * (i - 1), kVelocityRowY,
-                 std::string("v_") + kNames[i] + format(" = %.6g m/s", state.velocities[i]), kTextSize,
-                 particleColor(i, kTagLighten)));
+  if (largeScene(c.run)) {
+    drawManyBodies(c, state, axis);
+  } else {
+    drawLabelledBodies(c, state, axis);
   }
 }
 

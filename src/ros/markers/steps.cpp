@@ -18,17 +18,17 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 
 struct VelocityPanel {
   Axes axes;
-  std::vector<int> bodies;
+  std::vector<std::size_t> bodies;
 };
 
 double largestSpeed(const Envelope& e) { return std::max(std::abs(e.minY()), std::abs(e.maxY())); }
 
 /// The scale of a panel of these bodies: their steps and final velocities, and the
 /// paper's values unless they would squash the simulated ones.
-std::pair<double, double> velocityRange(const RunRecord& run, const std::vector<int>& bodies) {
+std::pair<double, double> velocityRange(const RunRecord& run, const std::vector<std::size_t>& bodies) {
   const auto final_v = finalVelocitiesNotDrawn(run);
   double lo = kInf, hi = -kInf;
-  for (int i : bodies) {
+  for (std::size_t i : bodies) {
     lo = std::min(lo, run.velocity(i).minY());
     hi = std::max(hi, run.velocity(i).maxY());
     if (final_v && std::isfinite(final_v->second[i])) {
@@ -36,7 +36,7 @@ std::pair<double, double> velocityRange(const RunRecord& run, const std::vector<
     }
   }
   double paper_lo = lo, paper_hi = hi;
-  for (int i : bodies) {
+  for (std::size_t i : bodies) {
     paper_lo = std::min(paper_lo, run.paperVelocity(i).minY());
     paper_hi = std::max(paper_hi, run.paperVelocity(i).maxY());
   }
@@ -44,13 +44,15 @@ std::pair<double, double> velocityRange(const RunRecord& run, const std::vector<
   return paddedRange(lo, hi);
 }
 
-/// One panel for all three, or B on its own (top) when it dwarfs A and C.
+/// One panel for all plotted bodies, or (three bodies) B on its own (top) when it dwarfs
+/// A and C.
 std::vector<VelocityPanel> velocityPanels(const RunRecord& run) {
   const double x1 = indexAxisEnd(run);
-  const auto panel = [&](const Box& box, const std::vector<int>& bodies) {
+  const auto panel = [&](const Box& box, const std::vector<std::size_t>& bodies) {
     const auto [y0, y1] = velocityRange(run, bodies);
     return VelocityPanel{Axes{box, 0.0, x1, y0, y1}, bodies};
   };
+  if (run.bodies() != 3) return {panel(kVelocityBox, run.plottedBodies())};
   const double others = std::max(largestSpeed(run.velocity(0)), largestSpeed(run.velocity(2)));
   if (largestSpeed(run.velocity(1)) > kOwnScaleFactor * others) {
     const double middle = kVelocityBox.midY();
@@ -62,7 +64,7 @@ std::vector<VelocityPanel> velocityPanels(const RunRecord& run) {
 
 /// The paper's series of body i where it differs from the simulated one; true when some
 /// of it lies off the panel's scale.
-bool addPaperSeries(const Canvas& c, const Axes& axes, int i, int id) {
+bool addPaperSeries(const Canvas& c, const Axes& axes, std::size_t i, int id) {
   const Envelope& paper = c.run.paperVelocity(i);
   if (paper.empty()) return false;
   const double tolerance = kPaperTolerance * (axes.y1 - axes.y0);
@@ -73,13 +75,13 @@ bool addPaperSeries(const Canvas& c, const Axes& axes, int i, int id) {
 
 /// The closed form's velocities of body i after each kept collision (and the final ones
 /// when the steps do not get there), as dots on the steps.
-void addPredictedDots(const Canvas& c, const Axes& axes, int i, int id) {
+void addPredictedDots(const Canvas& c, const Axes& axes, std::size_t i, int id) {
   const auto final_v = finalVelocitiesNotDrawn(c.run);
   Marker predicted = c.dots(ns::kPlot, id, kPredictedDotSize, particleColor(i, kDotLighten));
   for (const Keyframe* f : thinned(c.run.keyframes(), kMaxPredictedDots)) {
-    predicted.points.push_back(point(axes.toX(f->index + 0.5), axes.toY(f->predicted[i]), kDotZ));
+    if (i < f->predicted.size()) predicted.points.push_back(point(axes.toX(f->index + 0.5), axes.toY(f->predicted[i]), kDotZ));
   }
-  if (final_v) predicted.points.push_back(point(axes.toX(final_v->first + 0.5), axes.toY(final_v->second[i]), kDotZ));
+  if (final_v && i < final_v->second.size() && std::isfinite(final_v->second[i])) predicted.points.push_back(point(axes.toX(final_v->first + 0.5), axes.toY(final_v->second[i]), kDotZ));
   if (!predicted.points.empty()) c.add(predicted);
 }
 
@@ -92,11 +94,12 @@ void addVelocityPanel(const Canvas& c, const VelocityPanel& panel, int p, std::s
   const std::string label = panels == 1 ? "v [m/s]" : p == 0 ? "v_B [m/s]" : "v_A, v_C [m/s]";
   addFrame(c, ns::kPlot, base + kPlotFrame, panel.axes, label);
   const double tail = static_cast<double>(c.run.collisions()) + 1;
-  for (int i : panel.bodies) {
-    addSeries(c, ns::kPlot, base + kPlotSeries + i, withTail(c.run.velocity(i), tail), panel.axes, particleColor(i));
-    addPredictedDots(c, panel.axes, i, base + kPlotPredicted + i);
+  for (std::size_t i : panel.bodies) {
+    const int b = static_cast<int>(i);
+    addSeries(c, ns::kPlot, base + kPlotSeries + b, withTail(c.run.velocity(i), tail), panel.axes, particleColor(i));
+    addPredictedDots(c, panel.axes, i, base + kPlotPredicted + b);
     paper.any = paper.any || !c.run.paperVelocity(i).empty();
-    paper.off_scale = addPaperSeries(c, panel.axes, i, base + kPlotPaper + i) || paper.off_scale;
+    paper.off_scale = addPaperSeries(c, panel.axes, i, base + kPlotPaper + b) || paper.off_scale;
   }
 }
 
@@ -108,13 +111,19 @@ void addVelocityLegend(const Canvas& c, bool own_scale, const PaperShown& paper)
   std::string legend = "steps: simulated   dots: closed form";
   if (paper.any) legend += "   pink: paper's eqs. (2.15)/(2.16) where they differ";
   if (paper.off_scale) legend += " (clipped)";
-  if (!paper.any && (isWall(c.run.input(), 0) || isWall(c.run.input(), 2))) {
+  const bool rotation = c.run.prediction && c.run.prediction->model == collision_lab::Prediction::MODEL_THREE_BODY_ROTATION;
+  if (!paper.any && rotation && (isWall(c.run.input(), 0) || isWall(c.run.input(), 2))) {
     legend += "   paper's (2.15)/(2.16): undefined with a wall";
   }
+  if (largeScene(c.run)) {
+    legend = withSeparators(c.run.bodies()) + " bodies: no velocity per body here; see the histogram (left)";
+  }
   c.add(c.text(ns::kPlot, kPlotLegend, kVelocityBox.midX(), kLegendY, legend, kSmallTextSize, color(kLabelGrey)));
-  for (int i = 0; i < 3; ++i) {
-    c.add(c.text(ns::kPlot, kPlotSeriesNames + i, kVelocityBox.right + kSeriesNameDx,
-                 kVelocityBox.top - kSeriesNamePitch * i, std::string("v_") + kNames[i], kTextSize, particleColor(i)));
+  const auto& plotted = c.run.plottedBodies();
+  for (std::size_t k = 0; k < plotted.size(); ++k) {
+    c.add(c.text(ns::kPlot, kPlotSeriesNames + static_cast<int>(plotted[k]), kVelocityBox.right + kSeriesNameDx,
+                 kVelocityBox.top - kSeriesNamePitch * static_cast<double>(k), "v_" + bodyName(plotted[k]),
+                 plotted.size() <= 3 ? kTextSize : kSmallTextSize, particleColor(plotted[k])));
   }
 }
 
@@ -125,6 +134,30 @@ void addConservedPlot(const Canvas& c, const Envelope& series, const Box& box, i
   addSeries(c, ns::kConserved, base + kConservedSeries, withTail(series, static_cast<double>(c.run.collisions()) + 1),
             axes, color(kWhite), kConservedWidth);
   addIndexAxisLabels(c, ns::kConserved, base + kConservedIndexLabels, axes);
+}
+
+/// Kinetic energy against collision index, stepped: the total of the finite masses
+/// (white), the heat so far (amber, when any), and each plotted body's (its colour).
+void addEnergyPlot(const Canvas& c, const std::string& label) {
+  const RunRecord& run = c.run;
+  double lo = std::min(run.energy().minY(), run.energyLost().minY());
+  double hi = std::max(run.energy().maxY(), run.energyLost().maxY());
+  for (std::size_t i : run.plottedBodies()) lo = std::min(lo, run.bodyEnergy(i).minY()), hi = std::max(hi, run.bodyEnergy(i).maxY());
+  const auto [y0, y1] = paddedRange(lo, hi);
+  const Axes axes{kEnergyBox, 0.0, indexAxisEnd(run), y0, y1};
+  const double tail = static_cast<double>(run.collisions()) + 1;
+  addFrame(c, ns::kConserved, kConservedEnergy, axes, label);
+  for (std::size_t i : run.plottedBodies()) {
+    addSeries(c, ns::kConserved, kConservedEnergy + kConservedBodies + static_cast<int>(i),
+              withTail(run.bodyEnergy(i), tail), axes, particleColor(i), kCursorWidth);
+  }
+  addSeries(c, ns::kConserved, kConservedEnergy + kConservedSeries, withTail(run.energy(), tail), axes, color(kWhite),
+            kConservedWidth);
+  if (run.energyLost().maxY() > 0) {
+    addSeries(c, ns::kConserved, kConservedEnergy + kConservedLost, withTail(run.energyLost(), tail), axes, color(kAmber),
+              kConservedWidth);
+  }
+  addIndexAxisLabels(c, ns::kConserved, kConservedEnergy + kConservedIndexLabels, axes);
 }
 
 }  // namespace
@@ -138,14 +171,16 @@ void drawVelocitySteps(const Canvas& c) {
 }
 
 void drawConservedSteps(const Canvas& c) {
-  std::string energy = "E [J] of the finite masses vs collision index";
+  std::string energy = "E [J] vs collision index: white total";
+  if (c.run.energyLost().maxY() > 0) energy += ", amber heat so far";
+  if (!c.run.plottedBodies().empty()) energy += ", colours per body";
   std::string p = "p [kg m/s] of the finite masses vs collision index";
   if (c.run.summary && c.run.summary->simulated) {
     energy += format(";  drift %.2g", c.run.summary->energy_relative_drift);
     const double drift = c.run.summary->momentum_relative_drift;
     p += std::isnan(drift) ? "; a wall takes some" : format(";  drift %.2g", drift);
   }
-  addConservedPlot(c, c.run.energy(), kEnergyBox, kConservedEnergy, energy);
+  addEnergyPlot(c, energy);
   addConservedPlot(c, c.run.momentum(), kMomentumBox, kConservedMomentum, p);
 }
 

@@ -1,7 +1,10 @@
-// The wedge in velocity space s-perp (the paper's Figure 1): lines L_AB and L_BC, the
-// escape cone, u_perp after the collisions (simulated and by the closed form), and the
-// cursor at u_perp now.
+// The wedge in velocity space s-perp (the paper's Figure 1), for three bodies with at most
+// one wall: lines L_AB and L_BC, the escape cone, u_perp after the collisions (simulated
+// and by the closed form), and the cursor at u_perp now. With e < 1 the path spirals in;
+// the directions of u_perp are shown on the circle too, and when the cycle's map has real
+// eigenvalues (e <= r_c, a collapse) its eigen-directions, which those directions approach.
 #include <cmath>
+#include <optional>
 
 #include <Eigen/Core>
 
@@ -43,6 +46,9 @@ class WedgeFrame {
 
   /// Angle of r_AB from r_BC: the cone's opening, alpha [rad].
   double abAngle() const { return wedge_.alpha; }
+  /// The unit normals n_AB and n_BC in the plane's coordinates.
+  std::array<double, 2> normalAB() const { return wedge_.coordinates(wedge_.n_ab); }
+  std::array<double, 2> normalBC() const { return wedge_.coordinates(wedge_.n_bc); }
 
  private:
   const collision_lab::InitialConditions& input_;
@@ -90,9 +96,97 @@ void addWedgeGeometry(const Canvas& c, double a) {
   c.add(circle);
 }
 
+/// Restitution of pair p [1] (InitialConditions: none, one for all, or one per pair).
+double restitutionOf(const collision_lab::InitialConditions& input, std::size_t p) {
+  const auto& e = input.restitution;
+  return e.empty() ? 1.0 : e.size() == 1 ? e[0] : p < e.size() ? e[p] : 1.0;
+}
+
+using Matrix2 = std::array<std::array<double, 2>, 2>;
+
+/// The impact of a pair on u_perp: u' = u - (1 + e)(n.u) n.
+Matrix2 impactMap(const std::array<double, 2>& n, double e) {
+  Matrix2 m;
+  for (int r = 0; r < 2; ++r) {
+    for (int k = 0; k < 2; ++k) m[r][k] = (r == k ? 1.0 : 0.0) - (1 + e) * n[r] * n[k];
+  }
+  return m;
+}
+
+Matrix2 product(const Matrix2& a, const Matrix2& b) {
+  Matrix2 m{};
+  for (int r = 0; r < 2; ++r) {
+    for (int k = 0; k < 2; ++k) m[r][k] = a[r][0] * b[0][k] + a[r][1] * b[1][k];
+  }
+  return m;
+}
+
+/// The eigenvector of the larger eigenvalue of m, when both are real (empty otherwise).
+std::optional<std::array<double, 2>> dominantDirection(const Matrix2& m) {
+  const double trace = m[0][0] + m[1][1];
+  const double det = m[0][0] * m[1][1] - m[0][1] * m[1][0];
+  const double discriminant = trace * trace - 4 * det;
+  if (discriminant < 0) return std::nullopt;
+  const double lambda = (trace + std::sqrt(discriminant)) / 2;
+  // (m - lambda I) v = 0: v is orthogonal to the larger row of m - lambda I.
+  const std::array<double, 2> r0{m[0][0] - lambda, m[0][1]}, r1{m[1][0], m[1][1] - lambda};
+  const auto& row = std::hypot(r0[0], r0[1]) >= std::hypot(r1[0], r1[1]) ? r0 : r1;
+  const double norm = std::hypot(row[0], row[1]);
+  if (!(norm > 0)) return std::nullopt;
+  return std::array<double, 2>{-row[1] / norm, row[0] / norm};
+}
+
+/// Where u_perp goes after each cycle, for a collapse: the eigen-directions of the cycle
+/// map after a BC impact (AB then BC) and after an AB impact (BC then AB), as lines
+/// through the centre.
+void addEigenDirections(const Canvas& c, const WedgeFrame& wedge) {
+  const Matrix2 ab = impactMap(wedge.normalAB(), restitutionOf(c.run.input(), 0));
+  const Matrix2 bc = impactMap(wedge.normalBC(), restitutionOf(c.run.input(), 1));
+  Marker lines = c.lines(ns::kWedge, kWedgeEigen, Marker::LINE_LIST, kWedgeLineWidth, color(kPredicted));
+  for (const Matrix2& cycle : {product(bc, ab), product(ab, bc)}) {
+    const auto d = dominantDirection(cycle);
+    if (!d) continue;
+    lines.points.push_back(point(kWedgeX - kWedgeRadius * (*d)[0], kWedgeY - kWedgeRadius * (*d)[1], kDotZ));
+    lines.points.push_back(point(kWedgeX + kWedgeRadius * (*d)[0], kWedgeY + kWedgeRadius * (*d)[1], kDotZ));
+  }
+  c.addLines(lines);
+}
+
+/// The directions of u_perp after the shown collisions, on the circle. Near a collapse
+/// u_perp shrinks geometrically; below kDirectionFloor of its start its direction is
+/// rounding noise of the double velocities, and is not drawn.
+void addDirections(const Canvas& c, const WedgeFrame& wedge, const std::vector<const Keyframe*>& shown) {
+  constexpr double kDirectionFloor = 1e-9;
+  const auto u0 = wedge.project(toArray3(c.run.input().velocities));
+  const double floor = kDirectionFloor * std::hypot(u0[0], u0[1]);
+  Marker dirs = c.dots(ns::kWedge, kWedgeDirections, kPredictedWedgeDotSize, color(kConeYellow));
+  for (const Keyframe* f : shown) {
+    const auto u = wedge.project(toArray3(f->velocities));
+    const double r = std::hypot(u[0], u[1]);
+    if (r > floor && std::isfinite(r)) dirs.points.push_back(onCircle(kPathRadius, std::atan2(u[1], u[0]), kDotZ));
+  }
+  if (!dirs.points.empty()) c.add(dirs);
+}
+
+bool inelastic(const collision_lab::InitialConditions& input) {
+  return restitutionOf(input, 0) < 1 || restitutionOf(input, 1) < 1;
+}
+
+/// The legend's line on e: the spiral, or the collapse with r_c.
+std::string restitutionLegend(const RunRecord& run) {
+  const double e0 = restitutionOf(run.input(), 0), e1 = restitutionOf(run.input(), 1);
+  std::string s = e0 == e1 ? format("e = %.4g", e0) : format("e_AB = %.4g", e0) + format(", e_BC = %.4g", e1);
+  const double r_c = run.prediction ? run.prediction->critical_restitution : std::nan("");
+  if (std::isfinite(r_c)) s += format(", r_c = %.4g", r_c);
+  const bool collapsed = (run.prediction && run.prediction->collapsed) || run.collapses() > 0;
+  s += collapsed ? ": collapse; violet: eigen-directions" : ": a spiral (shrinks each cycle)";
+  return s;
+}
+
 }  // namespace
 
 void drawWedge(const Canvas& c) {
+  if (sideView(c.run) != SideView::kWedge) return;
   const RunRecord& run = c.run;
   const WedgeFrame wedge(run.input());
   const double scale = wedgeScale(wedge, run);
@@ -107,13 +201,18 @@ void drawWedge(const Canvas& c) {
   path.points.push_back(start);
   sim.points.push_back(start);
   if (every_collision) {
-    for (const Keyframe& f : frames) path.points.push_back(wedgePoint(wedge.project(f.velocities), scale));
+    for (const Keyframe& f : frames) path.points.push_back(wedgePoint(wedge.project(toArray3(f.velocities)), scale));
   }
   // Spheres are costly in rviz: at most kMaxWedgeDots of them per series.
   const auto shown = thinned(frames, kMaxWedgeDots);
   for (const Keyframe* f : shown) {
-    sim.points.push_back(wedgePoint(wedge.project(f->velocities), scale));
-    pred.points.push_back(wedgePoint(wedge.project(f->predicted), scale, kDotZ));
+    sim.points.push_back(wedgePoint(wedge.project(toArray3(f->velocities)), scale));
+    if (f->predicted.size() == 3) pred.points.push_back(wedgePoint(wedge.project(toArray3(f->predicted)), scale, kDotZ));
+  }
+  const bool lossy = inelastic(run.input());
+  if (lossy) {
+    addDirections(c, wedge, shown);
+    if ((run.prediction && run.prediction->collapsed) || run.collapses() > 0) addEigenDirections(c, wedge);
   }
   c.addLines(path);
   c.add(sim);
@@ -126,14 +225,16 @@ void drawWedge(const Canvas& c) {
   const std::string which = shown.size() == run.collisions()
                                 ? "each collision"
                                 : withSeparators(shown.size()) + " of " + withSeparators(run.collisions()) + " collisions";
-  c.add(c.text(ns::kWedge, kWedgeLegend, kWedgeX, kWedgeBox.bottom + kWedgeLegendDy,
-               "orange: u_perp after " + which + "\nviolet: closed form", kSmallTextSize));
+  const std::string text = lossy ? "orange: u_perp after " + which + ", yellow: its direction\n" + restitutionLegend(run)
+                                 : "orange: u_perp after " + which + "\nviolet: closed form";
+  c.add(c.text(ns::kWedge, kWedgeLegend, kWedgeX, kWedgeBox.bottom + kWedgeLegendDy, text, kSmallTextSize));
 }
 
 void drawWedgeCursor(const Canvas& c, const SceneState& state) {
+  if (sideView(c.run) != SideView::kWedge) return;
   const WedgeFrame wedge(c.run.input());
   Marker now = c.base(ns::kWedgeNow, kCursor, Marker::SPHERE);
-  now.pose.position = wedgePoint(wedge.project(state.velocities), wedgeScale(wedge, c.run), kCursorZ);
+  now.pose.position = wedgePoint(wedge.project(toArray3(state.velocities)), wedgeScale(wedge, c.run), kCursorZ);
   now.scale.x = now.scale.y = now.scale.z = kCursorSize;
   c.add(now);
 }

@@ -1,5 +1,6 @@
-// The x-t diagram: the worldlines (time up, position across on the scene's axis) and the
-// line of now with the bodies on it.
+// The x-t diagram: the worldlines (time up, position across on the scene's axis; a sample
+// of kMaxTrackedBodies for large N), the ghosts' straight worldlines for equal elastic
+// masses, and the line of now with the bodies on it.
 #include <algorithm>
 
 #include "collision_lab/ros/markers/draw.h"
@@ -36,6 +37,27 @@ void addWorldLabels(const Canvas& c, const WorldAxes& axes) {
   label(kWorldPositionUnit, b.midX(), b.bottom + kWorldPositionDy, "x [m]");
 }
 
+/// Equal elastic masses move as ghosts that pass through each other: the straight lines
+/// x_i + v_i t of the tracked bodies' initial states, cut to the box.
+void addGhosts(const Canvas& c, const WorldAxes& axes) {
+  Marker ghosts = c.lines(ns::kWorldlines, kWorldGhosts, Marker::LINE_LIST, kGhostWidth, color(kGhostGrey));
+  for (std::size_t i : c.run.trackedBodies()) {
+    const double x = c.run.input().positions[i], v = c.run.input().velocities[i];
+    // Inside the box while scene.min <= x + v t <= scene.max.
+    double t_end = axes.end;
+    if (v > 0) t_end = std::min(t_end, (axes.scene.max - x) / v);
+    if (v < 0) t_end = std::min(t_end, (axes.scene.min - x) / v);
+    if (!(t_end > 0)) continue;
+    ghosts.points.push_back(point(axes.toX(x), axes.toY(0.0)));
+    ghosts.points.push_back(point(axes.toX(x + v * t_end), axes.toY(t_end)));
+  }
+  c.addLines(ghosts);
+}
+
+bool ghostScene(const RunRecord& run) {
+  return run.prediction && run.prediction->model == collision_lab::Prediction::MODEL_GHOSTS;
+}
+
 }  // namespace
 
 void drawWorldlines(const Canvas& c) {
@@ -45,20 +67,33 @@ void drawWorldlines(const Canvas& c) {
   Marker frame = c.lines(ns::kWorldlines, kWorldFrame, Marker::LINE_LIST, kFrameWidth, color(kGrey));
   frame.points = {point(b.left, b.bottom), point(b.right, b.bottom), point(b.left, b.bottom), point(b.left, b.top)};
   c.add(frame);
-  for (int i = 0; i < 3; ++i) {
+  const auto& tracked = c.run.trackedBodies();
+  const double v_max = velocityScale(c.run);
+  for (std::size_t k = 0; k < tracked.size(); ++k) {
+    const std::size_t i = tracked[k];
     Polyline poly = c.run.worldline(i).polyline();
     poly.push_back({last.time, last.positions[i], 0.0});
     const bool wall = isWall(c.run.input(), i);
-    Marker line = c.lines(ns::kWorldlines, kWorldLines + i, Marker::LINE_STRIP, wall ? kWallLineWidth : kBodyLineWidth,
-                          wall ? color(kGrey) : particleColor(i));
+    const auto colour = wall ? color(kGrey)
+                             : largeScene(c.run) ? velocityColor(c.run.input().velocities[i], v_max) : particleColor(i);
+    Marker line = c.lines(ns::kWorldlines, kWorldLines + static_cast<int>(k), Marker::LINE_STRIP,
+                          wall ? kWallLineWidth : kBodyLineWidth, colour);
     for (const auto& v : poly) line.points.push_back(point(axes.toX(v.y), axes.toY(v.x)));
     c.addLines(line);
   }
+  const bool ghosts = ghostScene(c.run);
+  if (ghosts) addGhosts(c, axes);
   addWorldLabels(c, axes);
   c.add(c.text(ns::kWorldlines, kWorldTitle, b.midX(), kPanelTitleY, "x-t diagram (worldlines)", kTextSize));
-  c.add(c.text(ns::kWorldlines, kWorldLegend, b.midX(), kLegendY,
-               c.run.worldline(1).exact() ? "exact" : "min/max of x per time column", kSmallTextSize,
-               color(kLabelGrey)));
+  bool exact = true;
+  for (std::size_t i : tracked) exact = exact && c.run.worldline(i).exact();
+  std::string legend = exact ? "exact" : "min/max of x per time column";
+  if (tracked.size() < c.run.bodies()) {
+    legend += ";  " + withSeparators(tracked.size()) + " of " + withSeparators(c.run.bodies()) +
+              " bodies, coloured by v at the start";
+  }
+  if (ghosts) legend += "\ngrey: the ghosts x_i + v_i t (equal masses pass through each other)";
+  c.add(c.text(ns::kWorldlines, kWorldLegend, b.midX(), kLegendY, legend, kSmallTextSize, color(kLabelGrey)));
 }
 
 void drawWorldlinesCursor(const Canvas& c, const SceneState& state) {
@@ -67,7 +102,9 @@ void drawWorldlinesCursor(const Canvas& c, const SceneState& state) {
   now.points = {point(kWorldBox.left, world.toY(state.time)), point(kWorldBox.right, world.toY(state.time))};
   c.add(now);
   Marker bodies = c.dots(ns::kWorldlinesNow, kWorldNowBodies, kWorldNowDotSize, color(kWhite));
-  for (double x : state.positions) bodies.points.push_back(point(world.toX(x), world.toY(state.time), kDotZ));
+  for (std::size_t i : c.run.trackedBodies()) {
+    bodies.points.push_back(point(world.toX(state.positions[i]), world.toY(state.time), kDotZ));
+  }
   c.add(bodies);
 }
 

@@ -24,19 +24,32 @@ using visualization_msgs::Marker;
 using Vec3 = std::array<double, 3>;
 using Polyline = std::vector<Envelope::Vertex>;
 
-constexpr const char* kNames[3] = {"A", "B", "C"};
 
 // ---- primitives ----
 std_msgs::ColorRGBA color(const Rgba& c);
-/// Body i's colour, lightened towards white by `lighten` (0..1).
-std_msgs::ColorRGBA particleColor(int i, double lighten = 0.0);
+/// Body i's colour (a palette of layout::kPaletteSize), lightened towards white by
+/// `lighten` (0..1).
+std_msgs::ColorRGBA particleColor(std::size_t i, double lighten = 0.0);
+/// Velocity v [m/s] on a diverging map: blue at -v_max, white at 0, red at +v_max
+/// (clipped beyond).
+std_msgs::ColorRGBA velocityColor(double v, double v_max);
+/// "A", "B", ... (core::bodyName).
+std::string bodyName(std::size_t i);
 geometry_msgs::Point point(double x, double y, double z = 0.0);
 std::string format(const char* fmt, double value);
 /// 31415 -> "31,415".
 std::string withSeparators(std::uint64_t n);
 /// Bodies A, B, C (0, 1, 2) of a per-body array; NaN for a body it does not have.
 std::array<double, 3> toArray3(const std::vector<double>& a);
-bool isWall(const collision_lab::InitialConditions& input, int i);
+bool isWall(const collision_lab::InitialConditions& input, std::size_t i);
+/// Largest |v| [m/s] of the finite bodies at the start (1 when all are at rest): the
+/// scale of the colour by velocity.
+double velocityScale(const RunRecord& run);
+/// Which view takes the wedge's place (markers/ids.h: ns kWedge or kVelocities).
+enum class SideView { kWedge, kVelocityProfile, kHistogram };
+SideView sideView(const RunRecord& run);
+/// More bodies than each can be labelled: colour by velocity, sums in the plots.
+bool largeScene(const RunRecord& run);
 
 /// Where a view draws: the run, the frame of its markers, and the array it appends to.
 struct Canvas {
@@ -96,7 +109,7 @@ std::uint64_t expectedCollisions(const RunRecord& run);
 double indexAxisEnd(const RunRecord& run);
 /// Velocities after all the collisions when the steps do not get there: the summary's
 /// (simulated or, when not simulated, predicted) or the prediction's, at index n.
-std::optional<std::pair<std::uint64_t, Vec3>> finalVelocitiesNotDrawn(const RunRecord& run);
+std::optional<std::pair<std::uint64_t, std::vector<double>>> finalVelocitiesNotDrawn(const RunRecord& run);
 std::string runTitle(const RunRecord& run);
 /// What the picture does not show, in one line (empty when it shows the whole run).
 std::string runNote(const RunRecord& run);
@@ -119,6 +132,7 @@ void drawVelocitySteps(const Canvas& c);
 void drawConservedSteps(const Canvas& c);
 void drawWorldlines(const Canvas& c);
 void drawEnergyBarsAxis(const Canvas& c);
+void drawSideViewAxes(const Canvas& c);  ///< the velocity profile or the histogram, when not the wedge
 
 void drawBodies(const Canvas& c, const SceneState& state);
 void drawMagnifier(const Canvas& c, const SceneState& state);
@@ -127,5 +141,6 @@ void drawWedgeCursor(const Canvas& c, const SceneState& state);
 void drawStepsCursor(const Canvas& c, const SceneState& state);
 void drawWorldlinesCursor(const Canvas& c, const SceneState& state);
 void drawEnergyBars(const Canvas& c, const SceneState& state);
+void drawSideViewNow(const Canvas& c, const SceneState& state);
 
 }  // namespace collision_lab_ros::markers

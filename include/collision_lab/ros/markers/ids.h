@@ -16,6 +16,7 @@ constexpr const char* kPlot = "plot";            // velocity steps and the paper
 constexpr const char* kConserved = "conserved";  // energy and momentum steps
 constexpr const char* kWorldlines = "worldlines";
 constexpr const char* kEnergy = "energy";        // the kinetic energy bars' axis
+constexpr const char* kVelocities = "velocities";  // in the wedge's place: profile or histogram
 // animated: every frame (topic `markers_animated`)
 constexpr const char* kBodies = "bodies";
 constexpr const char* kLabels = "labels";
@@ -24,6 +25,7 @@ constexpr const char* kWedgeNow = "wedge_now";
 constexpr const char* kPlotCursor = "plot_cursor";
 constexpr const char* kWorldlinesNow = "worldlines_now";
 constexpr const char* kEnergyBars = "energy_bars";
+constexpr const char* kVelocitiesNow = "velocities_now";
 // overlays, also on `markers_animated`
 constexpr const char* kRejected = "rejected";
 constexpr const char* kHint = "hint";
@@ -38,6 +40,10 @@ enum MarkerId : int {
   kSceneMinLabel = 1,
   kSceneMaxLabel = 2,
   kSceneNote = 4,  ///< what the picture does not show
+  kColourBar = 5,  ///< large scenes: the colour by velocity's legend
+  kColourMin = 6,
+  kColourMax = 7,
+  kColourCaption = 8,
 
   // a plot frame (addFrame): base + these
   kFrameLines = 0,
@@ -61,6 +67,8 @@ enum MarkerId : int {
   kWedgeStartLabel = 9,
   kWedgeTitle = 10,
   kWedgeLegend = 11,
+  kWedgeDirections = 12,  ///< e < 1: the directions of u_perp, on the circle
+  kWedgeEigen = 13,       ///< collapse: the cycle's eigen-directions
 
   // ns "plot": panel p (0, or 1 for A and C when B has its own) at p * kPlotPanelStride
   kPlotPanelStride = 100,
@@ -78,6 +86,8 @@ enum MarkerId : int {
   kConservedMomentum = 100, ///< base of the momentum plot
   kConservedSeries = 10,    ///< base + this
   kConservedIndexLabels = 20,  ///< base + this + label number
+  kConservedLost = 50,         ///< energy plot: the heat so far
+  kConservedBodies = 60,       ///< energy plot: + plotted body index
 
   // ns "worldlines"
   kWorldFrame = 0,
@@ -89,20 +99,31 @@ enum MarkerId : int {
   kWorldPositionUnit = 6,
   kWorldTitle = 7,
   kWorldLegend = 8,
-  kWorldLines = 10,  ///< + body index
+  kWorldLines = 10,  ///< + tracked body's slot (RunRecord::trackedBodies)
+  kWorldGhosts = 50, ///< equal elastic masses: the ghosts' straight worldlines
 
   // ns "energy"
   kEnergyAxis = 0,
-  kEnergyBodyNames = 1,  ///< + body index
   kEnergyTitle = 4,
+  kEnergyBodyNames = 10,  ///< + body index
+
+  // ns "velocities" (in the wedge's place)
+  kSideFrame = 0,  ///< + kFrame*
+  kSideTitle = 10,
+  kSideLegend = 11,
+  kSideAxisLabel = 12,
+  kSideAxisMin = 13,
+  kSideAxisMax = 14,
 
   // ns "bodies"
-  kBody = 0,  ///< + body index
+  kBody = 0,         ///< + body index (small scenes)
+  kBodyClass = 10,   ///< large scenes: + mass class (a SPHERE_LIST each)
+  kBodyWall = 20,    ///< large scenes: + 0 (body 0) or 1 (body N-1)
 
   // ns "labels"
-  kBodyTag = 0,  ///< + body index
   kStatus = 3,
-  kVelocityRow = 10,  ///< + body index
+  kBodyTag = 100,      ///< + body index
+  kVelocityRow = 200,  ///< + body index
 
   // ns "zoom"
   kZoomLine = 0,
@@ -121,6 +142,12 @@ enum MarkerId : int {
   // ns "energy_bars"
   kEnergyBar = 0,       ///< + body index
   kEnergyBarValue = 10, ///< + body index
+  kEnergyTotals = 100,  ///< large scenes: the totals now
+
+  // ns "velocities_now"
+  kSideBars = 0,      ///< the histogram's bars or the profile's dots
+  kSideGaussian = 1,  ///< the Maxwell-like Gaussian
+  kSideNowText = 2,   ///< its mean and spread
 
   // ns "rejected" and "hint": a framed text
   kFramedText = 0,

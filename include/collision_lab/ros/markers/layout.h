@@ -6,6 +6,7 @@
 
 #include <cstddef>
 
+
 namespace collision_lab_ros::markers {
 
 /// A rectangle in the marker frame [rviz units].
@@ -43,7 +44,14 @@ constexpr double kTextZ = 0.2;  ///< texts over everything
 constexpr double kDotZ = 0.05;  ///< dots over lines
 
 // ---- colours ----
-constexpr Rgba kParticleRgb[3] = {{0.95, 0.25, 0.25}, {0.25, 0.8, 0.3}, {0.3, 0.55, 1.0}};
+/// Bodies' colours: A, B, C as always, then more for up to kMaxPlottedBodies bodies.
+constexpr std::size_t kPaletteSize = 10;
+constexpr Rgba kParticleRgb[kPaletteSize] = {
+    {0.95, 0.25, 0.25}, {0.25, 0.8, 0.3}, {0.3, 0.55, 1.0}, {1.0, 0.75, 0.2}, {0.75, 0.45, 1.0},
+    {0.2, 0.85, 0.85},  {1.0, 0.5, 0.75}, {0.65, 0.8, 0.25}, {1.0, 0.55, 0.3}, {0.6, 0.6, 0.95}};
+/// The ends of the diverging colour map of velocity (white at 0).
+constexpr Rgba kSlowBlue{0.2, 0.4, 1.0};
+constexpr Rgba kFastRed{1.0, 0.2, 0.15};
 constexpr Rgba kWhite{0.95, 0.95, 0.95};
 constexpr Rgba kGrey{0.6, 0.6, 0.6};
 /// Small grey text lighter than lines: rviz draws a minus sign one pixel thin.
@@ -119,11 +127,28 @@ constexpr double kStartLabelDy = -0.3, kCaptionDy = -0.1, kWedgeLegendDy = -0.65
 /// At most this many states per series in the wedge when not every collision is kept.
 constexpr std::size_t kMaxWedgeDots = 600;
 
+// ---- many bodies: mass classes, the colour legend ----
+/// Bodies of a large scene are drawn in this many mass classes (log scale), one list each.
+constexpr int kMassClasses = 4;
+constexpr double kManyBodySize = 0.18;     ///< the lightest class's diameter
+constexpr double kManyBodyGrowth = 0.12;   ///< added per class
+constexpr Box kColourBarBox{-3.0, 3.0, 5.0, 5.2};
+constexpr int kColourBarSteps = 24;
+constexpr double kColourLabelDx = 1.1;
+
+// ---- in the wedge's place: velocities now (profile or histogram) ----
+constexpr Box kSideBox{-10.0, -4.6, -0.3, 3.45};
+constexpr int kHistogramBins = 24;
+constexpr int kGaussianSegments = 64;
+constexpr double kProfileDotSize = 0.16;
+
 // ---- the x-t diagram ----
 constexpr double kWallLineWidth = 0.08, kBodyLineWidth = 0.03;
 constexpr double kWorldZeroDx = -0.3, kWorldEndDx = -0.55, kWorldUnitDx = -0.45, kWorldUnitDy = 0.3;
 constexpr double kWorldPositionDy = -0.3;
 constexpr double kWorldNowDotSize = 0.16;
+constexpr double kGhostWidth = 0.015;
+constexpr Rgba kGhostGrey{0.75, 0.75, 0.75, 0.6};
 
 // ---- the kinetic energy bars ----
 constexpr double kBarNameDy = -0.3, kBarsTitleDy = 0.75;

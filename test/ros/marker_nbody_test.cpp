@@ -1,0 +1,331 @@
+// rviz markers of N-body runs (no master). The runs come from the core's exact event
+// engine; the CollisionEvent messages are built here from its ImpactRecords (pair fields
+// only, as the node sends for N > FULL_STATE_MAX_BODIES, or with the per-body arrays),
+// independently of the node's conversion. References: hand-derived numbers, the engine's
+// final state, and conservation laws.
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <random>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "collision_lab/core/nbody/engine.h"
+#include "collision_lab/ros/marker_builder.h"
+#include "collision_lab/ros/markers/ids.h"
+#include "marker_test_checks.h"
+
+namespace {
+
+using namespace collision_lab_ros;
+using collision_lab::CollisionEvent;
+using collision_lab::core::Scene;
+using marker_checks::expectFitForRviz;
+using marker_checks::expectOneMarkerPerId;
+using marker_checks::find;
+
+const double kInf = std::numeric_limits<double>::infinity();
+
+/// The message of one impact. full_state: the per-body arrays too (from `state`, the
+/// velocities after every impact so far, kept by the caller).
+CollisionEvent impactMessage(const collision_lab::core::ImpactRecord& r, const Scene& scene, bool full_state,
+                             std::vector<double>& x, std::vector<double>& since, std::vector<double>& v) {
+  CollisionEvent msg;
+  msg.run_id = "nbody";
+  msg.kind = CollisionEvent::KIND_IMPACT;
+  msg.index = r.index;
+  msg.pair_index = static_cast<std::uint32_t>(r.pair_index);
+  msg.time = r.time;
+  msg.position = r.position;
+  msg.restitution = scene.restitutionOf(r.pair_index);
+  msg.first_moved = msg.pair_index;
+  msg.last_moved = msg.pair_index + 1;
+  msg.pair_velocities_before = {r.velocities_before[0], r.velocities_before[1]};
+  msg.pair_velocities_after = {r.velocities_after[0], r.velocities_after[1]};
+  msg.pair_energy_transfer = {r.energy_gained[0], r.energy_gained[1]};
+  msg.energy_lost = r.energy_lost;
+  msg.total_energy = msg.total_momentum = std::nan("");
+  for (std::size_t j : {r.pair_index, r.pair_index + 1}) {
+    x[j] = r.position, since[j] = r.time;
+    v[j] = r.velocities_after[j - r.pair_index];
+  }
+  if (full_state) {
+    for (std::size_t i = 0; i < v.size(); ++i) msg.positions.push_back(x[i] + v[i] * (r.time - since[i]));
+    msg.velocities_after = v;
+  }
+  return msg;
+}
+
+struct NBodyRun {
+  Scene scene;
+  collision_lab::core::EngineResult result;
+  std::vector<CollisionEvent> events;  ///< impacts and collapses, in order
+  RunRecord run;
+};
+
+collision_lab::InitialConditions inputOf(const Scene& scene, std::uint64_t cap) {
+  collision_lab::InitialConditions input;
+  input.run_id = "nbody";
+  input.masses = scene.masses;
+  input.positions = scene.positions;
+  input.velocities = scene.velocities;
+  input.restitution = scene.restitution;
+  input.max_collisions = cap;
+  return input;
+}
+
+/// Runs the scene in the engine and feeds the record as the node would.
+NBodyRun runScene(const Scene& scene, bool full_state, std::uint64_t cap = 10'000'000, bool keep = true) {
+  EXPECT_FALSE(collision_lab::core::validate(scene).has_value());
+  NBodyRun out{scene, {}, {}, RunRecord(inputOf(scene, cap))};
+  std::vector<double> x = scene.positions, since(scene.size(), 0.0), v = scene.velocities;
+  collision_lab::core::EngineOptions options;
+  options.max_impacts = cap;
+  std::vector<CollisionEvent> impacts;
+  out.result = collision_lab::core::runEngine(scene, options, [&](const collision_lab::core::ImpactRecord& r) {
+    impacts.push_back(impactMessage(r, scene, full_state, x, since, v));
+  });
+  // These scenes have no cluster impacts, so every impact moves exactly its pair.
+  EXPECT_EQ(out.result.cluster_impacts, 0u);
+  std::size_t next_collapse = 0;
+  for (const CollisionEvent& e : impacts) {
+    out.run.add(e);
+    if (keep) out.events.push_back(e);
+    while (next_collapse < out.result.collapses.size() && out.result.collapses[next_collapse].impacts_before == e.index) {
+      const auto& c = out.result.collapses[next_collapse++];
+      CollisionEvent msg;
+      msg.kind = CollisionEvent::KIND_COLLAPSE;
+      msg.index = c.impacts_before;
+      msg.time = c.time;
+      msg.position = c.position;
+      msg.first_moved = static_cast<std::uint32_t>(c.first_body);
+      msg.last_moved = static_cast<std::uint32_t>(c.last_body);
+      msg.pair_index = msg.first_moved;
+      // The cluster moves at its centre-of-mass velocity: momentum of its bodies / mass.
+      double p = 0.0, m = 0.0;
+      for (std::size_t i = c.first_body; i <= c.last_body; ++i) p += scene.masses[i] * v[i], m += scene.masses[i];
+      msg.pair_velocities_after = {p / m, p / m};
+      msg.total_energy = msg.total_momentum = std::nan("");
+      out.run.add(msg);
+      out.events.push_back(msg);
+    }
+  }
+  collision_lab::RunSummary summary;
+  summary.simulated = true;
+  summary.truncated = out.result.truncated;
+  summary.collision_count = out.result.impact_count;
+  out.run.summary = summary;
+  return out;
+}
+
+Scene scene(std::vector<double> m, std::vector<double> x, std::vector<double> v, std::vector<double> e = {}) {
+  Scene s;
+  s.masses = std::move(m), s.positions = std::move(x), s.velocities = std::move(v), s.restitution = std::move(e);
+  return s;
+}
+
+/// Long after the last impact: the state the run ends in.
+SceneState lastState(const RunRecord& run) { return stateAt(run, 1e30); }
+
+void expectViewsFit(const RunRecord& run) {
+  const auto fixed = buildStaticMarkers(run, "f");
+  expectFitForRviz(fixed);
+  expectOneMarkerPerId(fixed);
+  const double end = endTime(run);
+  for (double t : {0.0, 0.3 * end, end}) {
+    const auto animated = buildAnimatedMarkers(run, FrameClock{t, "test"}, "f");
+    expectFitForRviz(animated);
+    expectOneMarkerPerId(animated);
+  }
+}
+
+std::set<std::string> namespacesOf(const visualization_msgs::MarkerArray& array) {
+  std::set<std::string> out;
+  for (const auto& m : array.markers) out.insert(m.ns);
+  return out;
+}
+
+TEST(MarkerNBody, TwoCartsWithRestitutionPartAtEightTenths) {
+  // 1 kg carts at +-1 m/s, e = 0.8: they part at -+0.8 m/s; heat (1 - 0.64) * 1 J = 0.36 J.
+  for (bool full : {true, false}) {
+    SCOPED_TRACE(full);
+    const NBodyRun r = runScene(scene({1, 1}, {1, 0}, {-1, 1}, {0.8}), full);
+    ASSERT_EQ(r.run.collisions(), 1u);
+    const SceneState end = lastState(r.run);
+    EXPECT_NEAR(end.velocities[0], 0.8, 1e-15);
+    EXPECT_NEAR(end.velocities[1], -0.8, 1e-15);
+    // They meet at x = 0.5 at t = 0.5 s, then part: at t = 1.5 s they are 0.8 m either side.
+    const SceneState later = stateAt(r.run, 1.5);
+    EXPECT_NEAR(later.positions[0], 1.3, 1e-12);
+    EXPECT_NEAR(later.positions[1], -0.3, 1e-12);
+    EXPECT_NEAR(r.run.energyLost().last().y, 0.36, 1e-12);
+    EXPECT_NEAR(r.run.energy().last().y, 0.64, 1e-12);
+    expectViewsFit(r.run);
+  }
+}
+
+TEST(MarkerNBody, CradleOfFiveHandsTheVelocityOn) {
+  // Five equal masses 1 m apart, the right one at -1 m/s: 4 impacts, the left one leaves.
+  for (bool full : {true, false}) {
+    SCOPED_TRACE(full);
+    NBodyRun r = runScene(scene({1, 1, 1, 1, 1}, {4, 3, 2, 1, 0}, {-1, 0, 0, 0, 0}), full);
+    ASSERT_EQ(r.run.collisions(), 4u);
+    const SceneState end = lastState(r.run);
+    for (std::size_t i = 0; i < 4; ++i) EXPECT_EQ(end.velocities[i], 0.0) << i;
+    EXPECT_EQ(end.velocities[4], -1.0);
+    // Impact k comes at t = k s at x = 4 - k: bodies 0..k-1 rest where they were hit.
+    const SceneState mid = stateAt(r.run, 2.5);
+    EXPECT_EQ(mid.collisions, 2u);
+    EXPECT_NEAR(mid.positions[0], 3.0, 1e-12);
+    EXPECT_NEAR(mid.positions[1], 2.0, 1e-12);
+    EXPECT_NEAR(mid.positions[2], 1.5, 1e-12);
+    for (std::size_t i = 0; i < 5; ++i) EXPECT_EQ(end.velocities[i], r.result.final_velocities[i]);
+    // Equal elastic masses: the ghosts are drawn over the x-t diagram, the wedge is not.
+    collision_lab::Prediction ghosts;
+    ghosts.model = collision_lab::Prediction::MODEL_GHOSTS;
+    r.run.prediction = ghosts;
+    const auto fixed = buildStaticMarkers(r.run, "f");
+    EXPECT_TRUE(find(fixed, markers::ns::kWorldlines, markers::kWorldGhosts));
+    EXPECT_FALSE(namespacesOf(fixed).count(markers::ns::kWedge));
+    EXPECT_TRUE(namespacesOf(fixed).count(markers::ns::kVelocities));
+    // Five labelled bodies with their velocities.
+    const auto animated = buildAnimatedMarkers(r.run, FrameClock{0.0, "test"}, "f");
+    for (int i = 0; i < 5; ++i) EXPECT_TRUE(find(animated, markers::ns::kLabels, markers::kVelocityRow + i)) << i;
+    expectViewsFit(r.run);
+  }
+}
+
+TEST(MarkerNBody, BallBetweenTwoWallsBouncesAtEverySecond) {
+  // Walls at 1 m and 0, the ball at 0.5 m with +1 m/s: bounce k at t = k - 0.5 s, v = (-1)^k.
+  const NBodyRun r = runScene(scene({kInf, 1, kInf}, {1, 0.5, 0}, {0, 1, 0}), false, 1000);
+  ASSERT_EQ(r.run.collisions(), 1000u);
+  const SceneState at = stateAt(r.run, 999.5);
+  EXPECT_EQ(at.velocities[1], 1.0);
+  EXPECT_NEAR(at.positions[1], 0.0, 1e-9);
+  const SceneState between = stateAt(r.run, 500.75);  // after bounce 501 at the right wall
+  EXPECT_EQ(between.velocities[1], -1.0);
+  EXPECT_NEAR(between.positions[1], 0.75, 1e-9);
+  EXPECT_EQ(at.positions[0], 1.0);
+  EXPECT_EQ(at.positions[2], 0.0);
+  // The walls are walls (cubes), not spheres.
+  const auto animated = buildAnimatedMarkers(r.run, FrameClock{10.0, "test"}, "f");
+  for (int i : {0, 2}) {
+    const auto* wall = find(animated, markers::ns::kBodies, markers::kBody + i);
+    ASSERT_TRUE(wall);
+    EXPECT_EQ(wall->type, visualization_msgs::Marker::CUBE);
+  }
+  expectViewsFit(r.run);
+}
+
+TEST(MarkerNBody, CollapseOfThreeEqualMassesEndsAtTheCentreOfMass) {
+  // Three equal masses, e = 0.05 < r_c: infinitely many impacts before t_c, then the three
+  // move as one at the centre-of-mass velocity -1/3 m/s, along x_cm(t) = 1 - t/3 m.
+  NBodyRun r = runScene(scene({1, 1, 1}, {2, 1, 0}, {-1, 0, 0}, {0.05}), true);
+  ASSERT_EQ(r.result.collapses.size(), 1u);
+  EXPECT_EQ(r.run.collapses(), 1u);
+  const double t_c = r.result.collapses[0].time;
+  const SceneState after = stateAt(r.run, t_c + 1.0);
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_NEAR(after.velocities[i], -1.0 / 3, 1e-12) << i;
+    EXPECT_NEAR(after.velocities[i], r.result.final_velocities[i], 1e-12) << i;
+    EXPECT_NEAR(after.positions[i], 1 - (t_c + 1.0) / 3, 1e-9) << i;
+  }
+  // Before the collapse nothing is invented: every shown state keeps the order.
+  for (int k = 0; k <= 200; ++k) {
+    const SceneState s = stateAt(r.run, t_c * k / 200);
+    EXPECT_GE(s.positions[0] + 1e-12, s.positions[1]);
+    EXPECT_GE(s.positions[1] + 1e-12, s.positions[2]);
+  }
+  // The wedge shows the orbit's directions and the cycle's eigen-directions, r_c in the legend.
+  collision_lab::Prediction p;
+  p.model = collision_lab::Prediction::MODEL_THREE_BODY_SPIRAL;
+  p.collapsed = true;
+  p.critical_restitution = 7 - 4 * std::sqrt(3.0);
+  r.run.prediction = p;
+  const auto fixed = buildStaticMarkers(r.run, "f");
+  const auto* eigen = find(fixed, markers::ns::kWedge, markers::kWedgeEigen);
+  ASSERT_TRUE(eigen);
+  const auto* legend = find(fixed, markers::ns::kWedge, markers::kWedgeLegend);
+  ASSERT_TRUE(legend);
+  EXPECT_NE(legend->text.find("r_c = 0.0718"), std::string::npos) << legend->text;
+  // The last directions before the collapse lie on an eigen-direction (within 2 degrees).
+  const auto* dirs = find(fixed, markers::ns::kWedge, markers::kWedgeDirections);
+  ASSERT_TRUE(dirs);
+  const auto& centre_a = eigen->points[0];
+  const auto& centre_b = eigen->points[1];
+  const double cx = (centre_a.x + centre_b.x) / 2, cy = (centre_a.y + centre_b.y) / 2;
+  const auto& d = dirs->points.back();
+  double best = M_PI;
+  for (std::size_t k = 0; k + 1 < eigen->points.size(); k += 2) {
+    const double line = std::atan2(eigen->points[k + 1].y - cy, eigen->points[k + 1].x - cx);
+    const double angle = std::remainder(std::atan2(d.y - cy, d.x - cx) - line, M_PI);
+    best = std::min(best, std::abs(angle));
+  }
+  EXPECT_LT(best, 2 * M_PI / 180);
+  expectViewsFit(r.run);
+}
+
+TEST(MarkerNBody, ThousandBodyGasRebuiltFromPairFieldsAlone) {
+  // A seeded gas like config/gas_1000.csv: masses in [1, 2] kg, v in [-1, 1] m/s, 1 m apart.
+  std::mt19937_64 rng(1000);
+  std::uniform_real_distribution<double> mass(1.0, 2.0), speed(-1.0, 1.0);
+  Scene gas;
+  for (int i = 0; i < 1000; ++i) {
+    gas.masses.push_back(mass(rng));
+    gas.positions.push_back(999.0 - i);
+    gas.velocities.push_back(speed(rng));
+  }
+  const NBodyRun r = runScene(gas, false, 10'000'000, false);
+  ASSERT_FALSE(r.result.truncated);
+  EXPECT_GT(r.run.collisions(), 100'000u);
+  const SceneState end = lastState(r.run);
+  ASSERT_EQ(end.velocities.size(), 1000u);
+  for (std::size_t i = 0; i < 1000; ++i) EXPECT_EQ(end.velocities[i], r.result.final_velocities[i]) << i;
+  // Momentum and energy are conserved by the rebuilt state (elastic, no walls).
+  double p0 = 0, p1 = 0, e0 = 0, e1 = 0, scale = 0;
+  for (std::size_t i = 0; i < 1000; ++i) {
+    p0 += gas.masses[i] * gas.velocities[i], p1 += gas.masses[i] * end.velocities[i];
+    e0 += 0.5 * gas.masses[i] * gas.velocities[i] * gas.velocities[i];
+    e1 += 0.5 * gas.masses[i] * end.velocities[i] * end.velocities[i];
+    scale += gas.masses[i] * std::abs(gas.velocities[i]);
+  }
+  EXPECT_NEAR(p1, p0, 1e-12 * scale);
+  EXPECT_NEAR(e1, e0, 1e-12 * e0);
+  EXPECT_NEAR(r.run.energy().last().y, e0, 1e-9 * e0);  // the running sum
+  // Bounded memory: the keyframes hold at most RecordLimits::keyframe_values numbers.
+  EXPECT_LE(r.run.keyframes().size() * 1000, RecordLimits{}.keyframe_values + 1000);
+  EXPECT_EQ(r.run.trackedBodies().size(), kMaxTrackedBodies);
+  EXPECT_TRUE(r.run.plottedBodies().empty());
+  // Every shown state is ordered (bodies never pass each other) and keeps momentum.
+  const double t_end = endTime(r.run);
+  for (int k = 0; k <= 60; ++k) {
+    const SceneState s = stateAt(r.run, t_end * k / 60);
+    double p = 0;
+    for (std::size_t i = 0; i < 1000; ++i) {
+      p += gas.masses[i] * s.velocities[i];
+      if (i > 0) {
+        ASSERT_GE(s.positions[i - 1] + 1e-9, s.positions[i]) << "t = " << s.time << ", body " << i;
+      }
+    }
+    EXPECT_NEAR(p, p0, 1e-12 * scale) << s.time;
+  }
+  // The gas is coloured by velocity with a legend, and the histogram takes the wedge's place.
+  const auto fixed = buildStaticMarkers(r.run, "f");
+  EXPECT_TRUE(find(fixed, markers::ns::kScene, markers::kColourBar));
+  EXPECT_FALSE(namespacesOf(fixed).count(markers::ns::kWedge));
+  const auto animated = buildAnimatedMarkers(r.run, FrameClock{t_end / 2, "test"}, "f");
+  const auto* bars = find(animated, markers::ns::kVelocitiesNow, markers::kSideBars);
+  ASSERT_TRUE(bars);
+  EXPECT_EQ(bars->type, visualization_msgs::Marker::TRIANGLE_LIST);
+  std::size_t drawn = 0;
+  for (int k = 0; k < 10; ++k) {
+    if (const auto* m = find(animated, markers::ns::kBodies, markers::kBodyClass + k)) drawn += m->points.size();
+  }
+  EXPECT_EQ(drawn, 1000u);
+  expectViewsFit(r.run);
+}
+
+}  // namespace

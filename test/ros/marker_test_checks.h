@@ -1,0 +1,72 @@
+// Checks shared by the marker unit tests: what rviz 1.14 accepts and survives, and one
+// marker per namespace and id.
+#pragma once
+
+#include <cmath>
+#include <set>
+#include <string>
+#include <utility>
+
+#include <gtest/gtest.h>
+#include <visualization_msgs/MarkerArray.h>
+
+#include "collision_lab/ros/marker_builder.h"
+
+namespace marker_checks {
+
+using visualization_msgs::Marker;
+using visualization_msgs::MarkerArray;
+
+inline bool isLine(const Marker& m) { return m.type == Marker::LINE_STRIP || m.type == Marker::LINE_LIST; }
+
+/// What rviz 1.14 accepts and survives (see kRvizMaxLinePoints and rviz's marker_utils.cpp).
+inline void expectFitForRviz(const MarkerArray& array) {
+  std::set<std::pair<std::string, int>> ids;
+  for (const auto& m : array.markers) {
+    if (m.action != Marker::ADD) continue;
+    EXPECT_TRUE(ids.insert({m.ns, m.id}).second) << "duplicate " << m.ns << "/" << m.id;
+    EXPECT_TRUE(std::isfinite(m.pose.position.x) && std::isfinite(m.pose.position.y)) << m.ns;
+    for (const auto& p : m.points) {
+      ASSERT_TRUE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) << m.ns << "/" << m.id;
+    }
+    if (!m.colors.empty()) {
+      EXPECT_EQ(m.colors.size(), m.points.size()) << m.ns << "/" << m.id;
+    }
+    if (isLine(m)) {
+      EXPECT_GE(m.points.size(), 2u) << m.ns << "/" << m.id;
+      EXPECT_LE(m.points.size(), 16384u) << m.ns << "/" << m.id;  // BillboardLine MAX_ELEMENTS
+      EXPECT_GT(m.scale.x, 0) << m.ns;
+    }
+    if (m.type == Marker::LINE_LIST) {
+      EXPECT_EQ(m.points.size() % 2, 0u) << m.ns << "/" << m.id;
+    }
+    if (m.type == Marker::TRIANGLE_LIST) {
+      EXPECT_EQ(m.points.size() % 3, 0u) << m.ns;
+    }
+    if (m.type == Marker::SPHERE_LIST || m.type == Marker::CUBE_LIST) {
+      EXPECT_FALSE(m.points.empty()) << m.ns << "/" << m.id;
+    }
+    if (m.type == Marker::TEXT_VIEW_FACING) {
+      EXPECT_NE(m.text.find_first_not_of(" \n"), std::string::npos) << m.ns << "/" << m.id;
+      EXPECT_GT(m.scale.z, 0);
+    }
+  }
+  MarkerArray copy = array;
+  EXPECT_EQ(collision_lab_ros::enforceRvizLimits(copy), 0u);
+}
+
+/// rviz keeps one marker per namespace and id: a second one in the same array would
+/// replace the first, and a view would lose a part without a word.
+inline void expectOneMarkerPerId(const MarkerArray& array) {
+  std::set<std::pair<std::string, int>> seen;
+  for (const auto& m : array.markers) EXPECT_TRUE(seen.insert({m.ns, m.id}).second) << m.ns << "/" << m.id;
+}
+
+inline const Marker* find(const MarkerArray& array, const std::string& ns, int id) {
+  for (const auto& m : array.markers) {
+    if (m.ns == ns && m.id == id) return &m;
+  }
+  return nullptr;
+}
+
+}  // namespace marker_checks
