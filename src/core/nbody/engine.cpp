@@ -48,7 +48,12 @@ class Driver {
   explicit Driver(const Scene& scene) : tables_(scene) {}
 
   StepResult start() { return startOrEscalate<DD>(); }
-  StepResult step(ImpactRecord* record) { return stepOrEscalate<DD>(record); }
+  StepResult step(ImpactRecord* record) {
+    const std::uint64_t exact = escalations_.exact_rational;
+    const StepResult r = stepOrEscalate<DD>(record);
+    exact_streak_ = escalations_.exact_rational > exact ? exact_streak_ + 1 : 0;
+    return r;
+  }
 
   const Tier<DD>& fast() const { return *fast_; }
 
@@ -67,7 +72,9 @@ class Driver {
     result.collapses.push_back({found->first, found->last, found->time, found->position, fast_->count()});
     alternating_ = 0;
     last_ = before_last_ = kNone;
-    return catchUp<DD>();
+    const StepResult r = catchUp<DD>();
+    result.collapses.back().velocity = fast_->velocity(found->first);
+    return r;
   }
   Escalations escalations() const {
     Escalations e = escalations_;
@@ -103,6 +110,7 @@ class Driver {
   StepResult stepOrEscalate(ImpactRecord* record) {
     Tier<S>& t = *tier<S>();
     const std::uint64_t count = t.count();
+    if (exact_streak_ >= kExactStreak && t.oversized()) return {StepKind::kExhausted, 0, t.lastTime()};
     StepResult r = t.step(record);
     if constexpr (Arithmetic<S>::kExact) {
       if (r.kind == StepKind::kAmbiguous || r.kind == StepKind::kImprecise) r.kind = StepKind::kInconsistent;  // cannot happen
@@ -124,10 +132,14 @@ class Driver {
   StepResult escalate(const StepResult& r, std::uint64_t count, ImpactRecord* record) {
     ++(std::is_same_v<H, Float100> ? escalations_.high_precision : escalations_.exact_rational);
     const StepResult higher = advanceAndStep<H>(count, record);
+    if (higher.kind == StepKind::kExhausted) return higher;  // tier S keeps its state, at `count`
     Tier<S>& t = *tier<S>();
     const bool followed =
         r.kind == StepKind::kAmbiguous && higher.kind == StepKind::kImpact && t.follow(*tier<H>(), higher.pair);
     if (!followed) t.adopt(*tier<H>());
+    if (record && higher.kind == StepKind::kImpact) {  // publish what this tier now holds
+      record->velocities_after = {t.velocity(higher.pair), t.velocity(higher.pair + 1)};
+    }
     return higher;
   }
 
@@ -148,12 +160,16 @@ class Driver {
       if (r.kind != StepKind::kImpact) return {StepKind::kInconsistent, r.pair, r.time};
     }
     if (tier<S>()->count() > target) return {StepKind::kInconsistent, 0, 0.0};
+    // A replay must retrace the impacts already taken; only the exact tier's size cap may stop it.
+    const auto failed = [](const StepResult& r) {
+      return r.kind == StepKind::kExhausted ? r : StepResult{StepKind::kInconsistent, r.pair, r.time};
+    };
     for (;;) {
       const StepResult c = catchUp<S>();
-      if (c.kind != StepKind::kImpact) return {StepKind::kInconsistent, c.pair, c.time};
+      if (c.kind != StepKind::kImpact) return failed(c);
       if (tier<S>()->count() == target) return {};
       const StepResult r = stepOrEscalate<S>(nullptr);
-      if (r.kind != StepKind::kImpact) return {StepKind::kInconsistent, r.pair, r.time};
+      if (r.kind != StepKind::kImpact) return failed(r);
       ++escalations_.replayed_impacts;
     }
   }
@@ -188,6 +204,7 @@ class Driver {
   std::vector<CollapseEvent> collapses_;
   std::size_t last_ = kNone, before_last_ = kNone;  ///< pairs of the last two impacts
   std::uint64_t alternating_ = 0;                   ///< impacts alternating between them
+  std::uint64_t exact_streak_ = 0;                  ///< impacts in a row that needed the exact tier
   SceneTables tables_;
   std::unique_ptr<Tier<DD>> fast_;
   std::unique_ptr<Tier<Float100>> high_;
@@ -237,7 +254,7 @@ void fillDrift(const Scene& scene, EngineResult& result) {
       scene.wallCount() > 0 ? kNaN : static_cast<double>(magnitude > 0 ? std::fabs(p1 - p0) / magnitude : 0.0L);
 }
 
-std::string stopMessage(const Scene& scene, const EngineResult& result) {
+std::string stopMessage(const Scene& scene, const EngineResult& result, bool exhausted) {
   const std::string count = std::to_string(result.impact_count);
   switch (result.stop) {
     case StopReason::kFinished: {
@@ -253,6 +270,11 @@ std::string stopMessage(const Scene& scene, const EngineResult& result) {
       return text;
     }
     case StopReason::kCap:
+      if (exhausted) {
+        return "stopped after " + count + " impacts at the exactness cap (truncated): the impacts accumulate, each " +
+               "needing exact arithmetic of more than " + std::to_string(kExactBits) +
+               " bits; an inelastic collapse of a kind the engine does not resolve (engine.h, Collapse)";
+      }
       return "stopped at the cap of " + count + " impacts (truncated)" +
              (scene.wallCount() == 2 ? "; two walls keep the bodies between them colliding forever" : "");
     case StopReason::kCancelled: return "cancelled after " + count + " impacts (truncated)";
@@ -282,6 +304,7 @@ void finish(const StepResult& r, EngineResult& result) {
       result.multiple_collision = MultipleCollision{r.pair, r.time};
       break;
     case StepKind::kOutOfRange: result.stop = StopReason::kOutOfRange; break;
+    case StepKind::kExhausted: result.stop = StopReason::kCap; break;
     case StepKind::kAmbiguous:
     case StepKind::kImprecise:
     case StepKind::kInconsistent: result.stop = StopReason::kInternalError; break;
@@ -304,7 +327,7 @@ const char* stopReasonName(StopReason reason) {
 }
 
 EngineResult runEngine(const Scene& scene, const EngineOptions& options, const ImpactVisitor& visitor,
-                       const ProgressCallback& progress) {
+                       const ProgressCallback& progress, const CollapseVisitor& on_collapse) {
   using namespace nbody_detail;
   EngineResult result;
   Driver driver(scene);
@@ -330,11 +353,13 @@ EngineResult runEngine(const Scene& scene, const EngineOptions& options, const I
       if (visitor) visitor(record);
       if (count <= options.keep_events) result.events.push_back(record);
     }
+    const std::size_t collapses = result.collapses.size();
     const StepResult collapse = driver.afterImpact(r.pair, result);
     if (collapse.kind != StepKind::kImpact) {
       r = collapse;
       break;
     }
+    if (on_collapse && result.collapses.size() > collapses) on_collapse(result.collapses.back());
     if (progress && options.progress_interval > 0 && count % options.progress_interval == 0) {
       progress(EngineProgress{count, driver.fast().lastTime()});
     }
@@ -353,7 +378,7 @@ EngineResult runEngine(const Scene& scene, const EngineOptions& options, const I
   result.energy_lost = driver.fast().energyLost();
   result.escalations = driver.escalations();
   fillDrift(scene, result);
-  result.stop_message = stopMessage(scene, result);
+  result.stop_message = stopMessage(scene, result, r.kind == StepKind::kExhausted);
   return result;
 }
 

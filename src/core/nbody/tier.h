@@ -58,8 +58,19 @@ struct SceneTables {
 };
 
 /// kAmbiguous: a decision this tier cannot take; kImprecise: its state no longer pins down
-/// the time of the impact it was about to perform (the precision guard).
-enum class StepKind { kImpact, kFinished, kMultipleCollision, kAmbiguous, kImprecise, kOutOfRange, kInconsistent };
+/// the time of the impact it was about to perform (the precision guard); kExhausted: the
+/// exact tier's numbers outgrew kExactBits (an accumulation of impacts not resolved).
+enum class StepKind {
+  kImpact, kFinished, kMultipleCollision, kAmbiguous, kImprecise, kOutOfRange, kInconsistent, kExhausted
+};
+
+/// The exactness cap. Impacts that accumulate towards an unrecognised collapse need the
+/// exact tier for every step, with rationals that grow by some bits per impact, so each step
+/// costs more than the last. When kExactStreak impacts in a row needed the exact tier and
+/// its last one left a denominator above kExactBits, the run stops (truncated). Isolated
+/// exact steps of a long run (exact ties) and runs of small exact ties never meet both.
+constexpr unsigned kExactBits = 2048;
+constexpr std::uint64_t kExactStreak = 256;
 
 struct StepResult {
   StepKind kind = StepKind::kImpact;
@@ -250,6 +261,22 @@ class Tier {
     ++merged_;
     return {};
   }
+
+  /// The exact tier's last impact left a denominator above kExactBits (false in other tiers).
+  bool oversized() const {
+    if constexpr (std::is_same_v<S, Rational>) {
+      if (count_ == 0) return false;
+      for (std::size_t k : {now_.pair, now_.pair + 1}) {
+        for (const S* x : {&bodies_[k].b, &bodies_[k].v}) {
+          if (boost::multiprecision::msb(denominator(*x)) > kExactBits) return true;
+        }
+      }
+    }
+    return false;
+  }
+
+  /// Velocity of body k [m/s], rounded to double.
+  double velocity(std::size_t k) const { return Ar::toDouble(bodies_[k].v); }
 
   /// Positions [m] at time t [s] and velocities [m/s], rounded to double.
   void state(double t, std::vector<double>& positions, std::vector<double>& velocities) const {
@@ -571,6 +598,8 @@ class Tier {
     const BodyState& slow = std::fabs(Ar::toDouble(i.v)) <= std::fabs(Ar::toDouble(j.v)) ? i : j;
     const S time = (i.b - j.b) / (j.v - i.v);
     record.pair_index = m;
+    record.first_moved = m;
+    record.last_moved = m + 1;
     record.time = Ar::toDouble(time);
     record.position = Ar::toDouble(S(slow.b + S(slow.v * time)));
     record.velocities_before = {Ar::toDouble(i.v), Ar::toDouble(j.v)};
@@ -676,7 +705,7 @@ class Tier {
     now_.pair = m;
     now_.upper = pairs_[m].upper;
     const S before_i = i.v, before_j = j.v;
-    if (record) recordBefore(m, *record);
+    if (record) recordBefore(m, *record), record->first_moved = lo, record->last_moved = hi;
     now_.eu = eu_, now_.eb = eb_, now_.extra = 0.0;
     const ImpactChange<S> dv = applyImpactMap(map, i.v, j.v);
     const ImpactChange<S> db = applyImpactMap(map, i.b, j.b);

@@ -47,7 +47,10 @@
 namespace collision_lab {
 namespace core {
 
-/// One impact of pair p (bodies p and p+1).
+/// One impact of pair p (bodies p and p+1). Replaying the records (and the collapse notices,
+/// CollapseVisitor) in order from the initial velocities rebuilds the velocity of every body:
+/// an impact sets bodies first_moved..pair_index to velocities_after[0] and
+/// pair_index+1..last_moved to velocities_after[1].
 struct ImpactRecord {
   std::uint64_t index = 0;                    ///< 1-based impact number
   std::size_t pair_index = 0;                 ///< p; its name is pairName(p)
@@ -59,12 +62,16 @@ struct ImpactRecord {
   /// body gained and the heat, so the two entries and energy_lost sum to zero.
   std::array<double, 2> energy_gained{};
   double energy_lost = 0.0;  ///< kinetic energy turned into heat, (1 - e^2) mu A^2 / 2 [J]
+  /// The bodies the impact moved: p and p+1 for two single bodies; for a cluster impact
+  /// (the cluster rule) the whole clusters on both sides, each moving as one.
+  std::size_t first_moved = 0;
+  std::size_t last_moved = 0;
 };
 
 /// Why a run ended. Values are stable: append only.
 enum class StopReason : std::uint8_t {
   kFinished = 0,           ///< no pair approaches any more
-  kCap = 1,                ///< max_impacts reached (truncated)
+  kCap = 1,                ///< max_impacts reached, or the exactness cap of an unresolved accumulation (truncated)
   kCancelled = 2,          ///< the cancel flag was set (truncated)
   kMultipleCollision = 3,  ///< two impacts sharing a body at the same instant
   kOutOfRange = 4,         ///< a time, position or velocity left the safe range of a double
@@ -107,13 +114,17 @@ struct MultipleCollision {
 /// first_body..last_body before `time`, after which they move as one cluster at their
 /// centre-of-mass velocity. Recognised for three bodies or clusters whose two pairs
 /// alternate (the three-body closed form, src/core/nbody/spiral.h, decides that the impacts
-/// never stop and gives the limit time); larger groups are not recognised (the cap ends them).
+/// never stop and gives the limit time). Not recognised: larger groups whose impacts follow
+/// another pattern, and any group with a wall (a body squeezed against it). Their impacts
+/// soon need the exact tier at every step; the exactness cap (tier.h, kExactBits) then ends
+/// the run as kCap, truncated, with a message saying so.
 struct Collapse {
   std::size_t first_body = 0;
   std::size_t last_body = 0;
   double time = 0.0;                 ///< [s], the limit of the impact times
   double position = 0.0;             ///< where the bodies meet [m]
   std::uint64_t impacts_before = 0;  ///< impacts performed (and counted) before it was resolved
+  double velocity = 0.0;             ///< the cluster's velocity after it [m/s]
 };
 
 struct EngineResult {
@@ -145,14 +156,22 @@ struct EngineResult {
 
 /// Called for every impact, in order. May be empty.
 using ImpactVisitor = std::function<void(const ImpactRecord&)>;
+/// Called for every resolved collapse, in order with the impacts: right after the record of
+/// impact number collapse.impacts_before, before the next impact. It sets bodies
+/// first_body..last_body to collapse.velocity. May be empty.
+using CollapseVisitor = std::function<void(const Collapse&)>;
 /// Called every options.progress_interval impacts. May be empty.
 using ProgressCallback = std::function<void(const EngineProgress&)>;
 
 /// Runs the scene to its end, the cap, cancellation or a multiple collision.
 /// Precondition: validate(scene) passed. Never throws for a valid scene (short of running
-/// out of memory); the visitor and the progress callback may throw, which ends the run.
+/// out of memory); the visitors and the progress callback may throw, which ends the run.
+/// The records and notices carry the working tier's values rounded to double, as do
+/// final_velocities, so their replay gives final_velocities exactly; the one exception is a
+/// value within about 2^-100 (relative) of a rounding boundary of doubles when a more precise
+/// tier's state is adopted, which can move its rounding by one unit in the last place.
 EngineResult runEngine(const Scene& scene, const EngineOptions& options = {}, const ImpactVisitor& visitor = {},
-                       const ProgressCallback& progress = {});
+                       const ProgressCallback& progress = {}, const CollapseVisitor& on_collapse = {});
 
 }  // namespace core
 }  // namespace collision_lab
