@@ -148,6 +148,49 @@ std::set<std::string> namespacesOf(const visualization_msgs::MarkerArray& array)
   return out;
 }
 
+using TextId = std::pair<std::string, int>;
+
+/// The left column's legends and notes stay on screen (its left edge is at x = -10.7 in
+/// rviz/collision_lab.rviz), left of the middle column's value labels (from x = -3.4), and
+/// clear of every other text, at the start, midway and at the end.
+void expectLeftColumnClear(const RunRecord& run, const std::vector<TextId>& texts) {
+  const auto fixed = buildStaticMarkers(run, "f");
+  for (double t : {0.0, 0.5 * endTime(run), endTime(run)}) {
+    const auto animated = buildAnimatedMarkers(run, FrameClock{t, "test"}, "f");
+    for (const auto& [ns, id] : texts) {
+      const auto* m = find(fixed, ns, id);
+      if (!m) m = find(animated, ns, id);
+      ASSERT_TRUE(m) << ns << "/" << id;
+      marker_checks::expectTextClear(*m, -10.7, -3.4, {&fixed, &animated});
+    }
+  }
+}
+
+TEST(MarkerNBody, LeftColumnTextsStayOnScreenAndClearOfOtherTexts) {
+  // The wedge's legends for a collapse (e = 0.05) and a spiral just above r_c (e = 0.072).
+  for (double e : {0.05, 0.072}) {
+    SCOPED_TRACE(e);
+    NBodyRun r = runScene(scene({1, 1, 1}, {2, 1, 0}, {-1, 0, 0}, {e}), true);
+    collision_lab::Prediction p;
+    p.model = collision_lab::Prediction::MODEL_THREE_BODY_SPIRAL;
+    p.collapsed = !r.result.collapses.empty();
+    p.critical_restitution = 7 - 4 * std::sqrt(3.0);
+    r.run.prediction = p;
+    expectLeftColumnClear(r.run, {{markers::ns::kWedge, markers::kWedgeKey}, {markers::ns::kWedge, markers::kWedgeLegend}});
+  }
+  // A gas of 100 bodies: the histogram's key, the note on its Gaussian, and V and sigma now.
+  std::mt19937_64 rng(100);
+  std::uniform_real_distribution<double> mass(1.0, 2.0), speed(-1.0, 1.0);
+  Scene gas;
+  for (int i = 0; i < 100; ++i) {
+    gas.masses.push_back(mass(rng)), gas.positions.push_back(99.0 - i), gas.velocities.push_back(speed(rng));
+  }
+  const NBodyRun r = runScene(gas, false);
+  expectLeftColumnClear(r.run, {{markers::ns::kVelocities, markers::kSideLegend},
+                                {markers::ns::kVelocities, markers::kSideNote},
+                                {markers::ns::kVelocitiesNow, markers::kSideNowText}});
+}
+
 TEST(MarkerNBody, TwoCartsWithRestitutionPartAtEightTenths) {
   // 1 kg carts at +-1 m/s, e = 0.8: they part at -+0.8 m/s; heat (1 - 0.64) * 1 J = 0.36 J.
   for (bool full : {true, false}) {

@@ -183,6 +183,20 @@ std::string restitutionLegend(const RunRecord& run) {
   return s;
 }
 
+/// The orange key in the legend row; under the caption (at most two lines, within the
+/// column) what the yellow and violet marks are and, for e < 1, the restitution.
+void addWedgeLegend(const Canvas& c, const std::vector<const Keyframe*>& shown, bool lossy) {
+  const RunRecord& run = c.run;
+  const std::string which = shown.size() == run.collisions()
+                                ? "each collision"
+                                : withSeparators(shown.size()) + " of " + withSeparators(run.collisions()) + " collisions";
+  c.add(c.text(ns::kWedge, kWedgeKey, kWedgeX, kLegendY, wrapped("orange: u_perp after " + which, kSmallTextSize, kLeftTextWidth),
+               kSmallTextSize, color(kLabelGrey)));
+  const std::string rest = lossy ? "yellow: its direction; " + restitutionLegend(run) : "violet: closed form";
+  c.add(c.text(ns::kWedge, kWedgeLegend, kWedgeX, kWedgeBox.bottom + kWedgeLegendDy,
+               wrapped(rest, kSmallTextSize, kLeftTextWidth), kSmallTextSize));
+}
+
 }  // namespace
 
 void drawWedge(const Canvas& c) {
@@ -222,12 +236,7 @@ void drawWedge(const Canvas& c) {
   c.add(c.text(ns::kWedge, kWedgeCaption, kWedgeX, kWedgeBox.bottom + kCaptionDy,
                "yellow: escape cone, alpha = " + format("%.4g rad", wedge.abAngle()), kSmallTextSize,
                color(kConeYellow)));
-  const std::string which = shown.size() == run.collisions()
-                                ? "each collision"
-                                : withSeparators(shown.size()) + " of " + withSeparators(run.collisions()) + " collisions";
-  const std::string text = lossy ? "orange: u_perp after " + which + ", yellow: its direction\n" + restitutionLegend(run)
-                                 : "orange: u_perp after " + which + "\nviolet: closed form";
-  c.add(c.text(ns::kWedge, kWedgeLegend, kWedgeX, kWedgeBox.bottom + kWedgeLegendDy, text, kSmallTextSize));
+  addWedgeLegend(c, shown, lossy);
 }
 
 void drawWedgeCursor(const Canvas& c, const SceneState& state) {

@@ -69,6 +69,7 @@ enum MarkerId : int {
   kWedgeLegend = 11,
   kWedgeDirections = 12,  ///< e < 1: the directions of u_perp, on the circle
   kWedgeEigen = 13,       ///< collapse: the cycle's eigen-directions
+  kWedgeKey = 14,         ///< the orange key, in the legend row
 
   // ns "plot": panel p (0, or 1 for A and C when B has its own) at p * kPlotPanelStride
   kPlotPanelStride = 100,
@@ -114,6 +115,7 @@ enum MarkerId : int {
   kSideAxisLabel = 12,
   kSideAxisMin = 13,
   kSideAxisMax = 14,
+  kSideNote = 15,  ///< under the axis labels (the histogram's Gaussian)
 
   // ns "bodies"
   kBody = 0,         ///< + body index (small scenes)
