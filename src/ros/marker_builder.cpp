@@ -319,6 +319,7 @@ Keyframe RunRecord::snapshot(double time) const {
   frame.valid_until = kInf;
   frame.previous_time = previous_time_;
   frame.predicted = newest_predicted_;
+  frame.collapse = newest_is_collapse_;
   for (const Flight& f : flights_) {
     frame.positions.push_back(f.position + f.velocity * (time - f.since));
     frame.velocities.push_back(f.velocity);

@@ -294,6 +294,11 @@ TEST(MarkerNBody, CollapseOfThreeEqualMassesEndsAtTheCentreOfMass) {
   const auto* legend = find(fixed, markers::ns::kWedge, markers::kWedgeLegend);
   ASSERT_TRUE(legend);
   EXPECT_NE(legend->text.find("r_c = 0.0718"), std::string::npos) << legend->text;
+  // The collapse record is no collision: u_perp after 8 collisions and a collapse, not "9 of 8".
+  ASSERT_EQ(r.result.impact_count, 8u);
+  const auto* key = find(fixed, markers::ns::kWedge, markers::kWedgeKey);
+  ASSERT_TRUE(key);
+  EXPECT_EQ(key->text, "orange: u_perp after 8 collisions and a collapse");
   // The last directions before the collapse lie on an eigen-direction (within 2 degrees).
   const auto* dirs = find(fixed, markers::ns::kWedge, markers::kWedgeDirections);
   ASSERT_TRUE(dirs);

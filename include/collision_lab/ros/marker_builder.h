@@ -104,6 +104,7 @@ struct Keyframe {
   std::vector<double> positions;   ///< body i at index i [m]
   std::vector<double> velocities;  ///< after the collision [m/s]
   std::vector<double> predicted;   ///< closed form after the collision [m/s]; empty when none
+  bool collapse = false;           ///< the state after a collapse (KIND_COLLAPSE), not an impact
 };
 
 /// Bounds of a RunRecord's memory, whatever the count and N.
