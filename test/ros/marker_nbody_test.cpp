@@ -243,7 +243,7 @@ TEST(MarkerNBody, CradleOfFiveHandsTheVelocityOn) {
 
 TEST(MarkerNBody, BallBetweenTwoWallsBouncesAtEverySecond) {
   // Walls at 1 m and 0, the ball at 0.5 m with +1 m/s: bounce k at t = k - 0.5 s, v = (-1)^k.
-  const NBodyRun r = runScene(scene({kInf, 1, kInf}, {1, 0.5, 0}, {0, 1, 0}), false, 1000);
+  NBodyRun r = runScene(scene({kInf, 1, kInf}, {1, 0.5, 0}, {0, 1, 0}), false, 1000);
   ASSERT_EQ(r.run.collisions(), 1000u);
   const SceneState at = stateAt(r.run, 999.5);
   EXPECT_EQ(at.velocities[1], 1.0);
@@ -253,6 +253,24 @@ TEST(MarkerNBody, BallBetweenTwoWallsBouncesAtEverySecond) {
   EXPECT_NEAR(between.positions[1], 0.75, 1e-9);
   EXPECT_EQ(at.positions[0], 1.0);
   EXPECT_EQ(at.positions[2], 0.0);
+  // Infinitely many predicted, 1,000 simulated (the cap): at t = 15.9 s 16 bounces are
+  // behind, "of 1,000 simulated"; never a finite count "predicted".
+  collision_lab::Prediction infinite;
+  infinite.model = collision_lab::Prediction::MODEL_TWO_WALLS_INFINITE;
+  infinite.infinite_collisions = true;
+  r.run.prediction = infinite;
+  const auto status = [&r] {
+    const auto animated = buildAnimatedMarkers(r.run, FrameClock{15.9, ""}, "f");
+    const auto* m = find(animated, markers::ns::kLabels, markers::kStatus);
+    return m ? m->text : std::string("(none)");
+  };
+  ASSERT_TRUE(r.run.summary && r.run.summary->truncated);
+  EXPECT_NE(status().find("collisions 16 of 1,000 simulated"), std::string::npos) << status();
+  EXPECT_EQ(status().find("predicted"), std::string::npos) << status();
+  const auto summary = r.run.summary;
+  r.run.summary.reset();  // still running: the prediction is infinitely many
+  EXPECT_NE(status().find("collisions 16 (infinitely many predicted)"), std::string::npos) << status();
+  r.run.summary = summary;
   // The walls are walls (cubes), not spheres.
   const auto animated = buildAnimatedMarkers(r.run, FrameClock{10.0, "test"}, "f");
   for (int i : {0, 2}) {
