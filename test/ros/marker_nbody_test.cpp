@@ -3,6 +3,7 @@
 // only, as the node sends for N > FULL_STATE_MAX_BODIES, or with the per-body arrays),
 // independently of the node's conversion. References: hand-derived numbers, the engine's
 // final state, and conservation laws.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -16,6 +17,7 @@
 #include "collision_lab/core/nbody/engine.h"
 #include "collision_lab/ros/marker_builder.h"
 #include "collision_lab/ros/markers/ids.h"
+#include "collision_lab/ros/markers/layout.h"
 #include "marker_test_checks.h"
 
 namespace {
@@ -391,6 +393,42 @@ TEST(MarkerNBody, ThousandBodyGasRebuiltFromPairFieldsAlone) {
     if (const auto* m = find(animated, markers::ns::kBodies, markers::kBodyClass + k)) drawn += m->points.size();
   }
   EXPECT_EQ(drawn, 1000u);
+  // After a minute the gas is about 1 km wide, at the end about 1e8 m: the scene's axis
+  // follows the bodies now, so at either time they spread over most of it (26 units).
+  for (double t : {60.0, t_end}) {
+    SCOPED_TRACE(t);
+    const auto frame = buildAnimatedMarkers(r.run, FrameClock{t, "test"}, "f");
+    double lo = kInf, hi = -kInf;
+    for (int k = 0; k < 10; ++k) {
+      if (const auto* m = find(frame, markers::ns::kBodies, markers::kBodyClass + k)) {
+        for (const auto& p : m->points) lo = std::min(lo, p.x), hi = std::max(hi, p.x);
+      }
+    }
+    EXPECT_GT(hi - lo, 0.8 * (markers::layout::kSceneRight - markers::layout::kSceneLeft));
+    ASSERT_TRUE(find(frame, markers::ns::kLabels, markers::kSceneRangeNote));
+    // The x-t diagram runs up to now: no worldline goes above the line of now, and the
+    // tracked bodies (the outermost two among them) span most of its width.
+    const auto* now = find(frame, markers::ns::kWorldlinesNow, markers::kWorldNowLine);
+    ASSERT_TRUE(now);
+    const auto& box = markers::layout::kWorldBox;
+    EXPECT_NEAR(now->points[0].y, box.top, 1e-9);
+    double left = kInf, right = -kInf;
+    for (std::size_t k = 0; k < kMaxTrackedBodies; ++k) {
+      const auto* line = find(frame, markers::ns::kWorldlinesNow, markers::kWorldNowLines + static_cast<int>(k));
+      ASSERT_TRUE(line) << k;
+      for (const auto& p : line->points) {
+        EXPECT_LE(p.y, box.top + 1e-9);
+        left = std::min(left, p.x), right = std::max(right, p.x);
+      }
+    }
+    EXPECT_GT(right - left, 0.8 * (box.right - box.left));
+  }
+  // The velocity plot shows the tracked bodies' steps, each ending at the engine's final velocity.
+  for (std::size_t k = 0; k < kMaxTrackedBodies; ++k) {
+    EXPECT_TRUE(find(fixed, markers::ns::kPlot, markers::kPlotTracked + static_cast<int>(k))) << k;
+    const std::size_t i = r.run.trackedBodies()[k];
+    EXPECT_EQ(r.run.trackedVelocity(i).last().y, r.result.final_velocities[i]) << i;
+  }
   expectViewsFit(r.run);
 }
 

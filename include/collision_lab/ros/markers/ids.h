@@ -81,6 +81,7 @@ enum MarkerId : int {
   kPlotLegend = 311,
   kPlotSeriesNames = 320,  ///< + body index
   kPlotIndexLabels = 400,  ///< + label number
+  kPlotTracked = 500,      ///< large scenes: + tracked body's slot (RunRecord::trackedBodies)
 
   // ns "conserved"
   kConservedEnergy = 0,     ///< base of the energy plot
@@ -124,6 +125,9 @@ enum MarkerId : int {
 
   // ns "labels"
   kStatus = 3,
+  kSceneNowMin = 4,    ///< large scenes: the scene's ends, the bodies' spread now
+  kSceneNowMax = 5,
+  kSceneRangeNote = 6,
   kBodyTag = 100,      ///< + body index
   kVelocityRow = 200,  ///< + body index
 
@@ -140,6 +144,11 @@ enum MarkerId : int {
   // ns "worldlines_now"
   kWorldNowLine = 0,
   kWorldNowBodies = 1,
+  kWorldNowTimeEnd = 2,   ///< large scenes: the axes' ends, up to now
+  kWorldNowPositionMin = 4,
+  kWorldNowPositionMax = 5,
+  kWorldNowLines = 10,    ///< large scenes: + tracked body's slot
+  kWorldNowGhosts = 50,
 
   // ns "energy_bars"
   kEnergyBar = 0,       ///< + body index
