@@ -234,6 +234,11 @@ TEST(MarkerNBody, CradleOfFiveHandsTheVelocityOn) {
     r.run.prediction = ghosts;
     const auto fixed = buildStaticMarkers(r.run, "f");
     EXPECT_TRUE(find(fixed, markers::ns::kWorldlines, markers::kWorldGhosts));
+    // The x-t legend names the ghosts, on screen (right edge x = 16.3) and clear of "t [s]".
+    const auto* legend = find(fixed, markers::ns::kWorldlines, markers::kWorldLegend);
+    ASSERT_TRUE(legend);
+    EXPECT_NE(legend->text.find("ghosts"), std::string::npos) << legend->text;
+    marker_checks::expectTextClear(*legend, markers::layout::kWorldBox.left, 16.3, {&fixed});
     EXPECT_FALSE(namespacesOf(fixed).count(markers::ns::kWedge));
     EXPECT_TRUE(namespacesOf(fixed).count(markers::ns::kVelocities));
     // Five labelled bodies with their velocities.

@@ -150,7 +150,8 @@ void drawWorldlines(const Canvas& c) {
     legend += ";  " + withSeparators(tracked.size()) + " of " + withSeparators(c.run.bodies()) +
               " bodies, coloured by v at the start";
   }
-  if (ghostScene(c.run)) legend += "\ngrey: the ghosts x_i + v_i t (equal masses pass through each other)";
+  // One line: a second would run into the "t [s]" label over the box.
+  if (ghostScene(c.run)) legend += ";  grey: ghosts x_i + v_i t, passing through each other";
   c.add(c.text(ns::kWorldlines, kWorldLegend, b.midX(), kLegendY, legend, kSmallTextSize, color(kLabelGrey)));
 }
 
