@@ -212,6 +212,10 @@ RunRecord::RunRecord(const collision_lab::InitialConditions& input, const Record
     body_energy_[k].add(0.0, isWall(i) ? 0.0 : 0.5 * input_.masses[i] * input_.velocities[i] * input_.velocities[i]);
   }
   for (std::size_t k = 0; k < tracked_.size(); ++k) worldline_[k].add(0.0, input_.positions[tracked_[k]]);
+  if (plotted_.empty()) {
+    tracked_velocity_.assign(tracked_.size(), empty);
+    for (std::size_t k = 0; k < tracked_.size(); ++k) tracked_velocity_[k].add(0.0, input_.velocities[tracked_[k]]);
+  }
   kinetic_ = kineticEnergy(input_, input_.velocities);
   momentum_sum_ = collision_lab_ros::momentum(input_, input_.velocities);
   energy_.add(0.0, kinetic_);
@@ -223,7 +227,8 @@ bool RunRecord::isWall(std::size_t i) const { return i < bodies() && isWallMass(
 
 const Envelope& RunRecord::seriesOf(const std::vector<Envelope>& series, const std::vector<int>& slot,
                                     std::size_t i) const {
-  return i < slot.size() && slot[i] >= 0 ? series[static_cast<std::size_t>(slot[i])] : none_;
+  const bool kept = i < slot.size() && slot[i] >= 0 && static_cast<std::size_t>(slot[i]) < series.size();
+  return kept ? series[static_cast<std::size_t>(slot[i])] : none_;
 }
 
 std::size_t RunRecord::keyframeLimit() const {
@@ -276,7 +281,11 @@ void RunRecord::move(std::size_t body, double time, double position, double velo
   }
   f = Flight{time, position, velocity};
   const double k = static_cast<double>(newest_index_);
-  if (track_slot_[body] >= 0) worldline_[static_cast<std::size_t>(track_slot_[body])].add(time, position);
+  if (track_slot_[body] >= 0) {
+    const auto slot = static_cast<std::size_t>(track_slot_[body]);
+    worldline_[slot].add(time, position);
+    if (!tracked_velocity_.empty()) tracked_velocity_[slot].step(k, velocity);
+  }
   if (plot_slot_[body] >= 0) {
     const auto slot = static_cast<std::size_t>(plot_slot_[body]);
     velocity_[slot].step(k, velocity);
@@ -319,6 +328,7 @@ Keyframe RunRecord::snapshot(double time) const {
   frame.valid_until = kInf;
   frame.previous_time = previous_time_;
   frame.predicted = newest_predicted_;
+  frame.collapse = newest_is_collapse_;
   for (const Flight& f : flights_) {
     frame.positions.push_back(f.position + f.velocity * (time - f.since));
     frame.velocities.push_back(f.velocity);

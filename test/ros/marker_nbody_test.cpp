@@ -3,6 +3,7 @@
 // only, as the node sends for N > FULL_STATE_MAX_BODIES, or with the per-body arrays),
 // independently of the node's conversion. References: hand-derived numbers, the engine's
 // final state, and conservation laws.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -16,6 +17,7 @@
 #include "collision_lab/core/nbody/engine.h"
 #include "collision_lab/ros/marker_builder.h"
 #include "collision_lab/ros/markers/ids.h"
+#include "collision_lab/ros/markers/layout.h"
 #include "marker_test_checks.h"
 
 namespace {
@@ -148,6 +150,49 @@ std::set<std::string> namespacesOf(const visualization_msgs::MarkerArray& array)
   return out;
 }
 
+using TextId = std::pair<std::string, int>;
+
+/// The left column's legends and notes stay on screen (its left edge is at x = -10.7 in
+/// rviz/collision_lab.rviz), left of the middle column's value labels (from x = -3.4), and
+/// clear of every other text, at the start, midway and at the end.
+void expectLeftColumnClear(const RunRecord& run, const std::vector<TextId>& texts) {
+  const auto fixed = buildStaticMarkers(run, "f");
+  for (double t : {0.0, 0.5 * endTime(run), endTime(run)}) {
+    const auto animated = buildAnimatedMarkers(run, FrameClock{t, "test"}, "f");
+    for (const auto& [ns, id] : texts) {
+      const auto* m = find(fixed, ns, id);
+      if (!m) m = find(animated, ns, id);
+      ASSERT_TRUE(m) << ns << "/" << id;
+      marker_checks::expectTextClear(*m, -10.7, -3.4, {&fixed, &animated});
+    }
+  }
+}
+
+TEST(MarkerNBody, LeftColumnTextsStayOnScreenAndClearOfOtherTexts) {
+  // The wedge's legends for a collapse (e = 0.05) and a spiral just above r_c (e = 0.072).
+  for (double e : {0.05, 0.072}) {
+    SCOPED_TRACE(e);
+    NBodyRun r = runScene(scene({1, 1, 1}, {2, 1, 0}, {-1, 0, 0}, {e}), true);
+    collision_lab::Prediction p;
+    p.model = collision_lab::Prediction::MODEL_THREE_BODY_SPIRAL;
+    p.collapsed = !r.result.collapses.empty();
+    p.critical_restitution = 7 - 4 * std::sqrt(3.0);
+    r.run.prediction = p;
+    expectLeftColumnClear(r.run, {{markers::ns::kWedge, markers::kWedgeKey}, {markers::ns::kWedge, markers::kWedgeLegend}});
+  }
+  // A gas of 100 bodies: the histogram's key, the note on its Gaussian, and V and sigma now.
+  std::mt19937_64 rng(100);
+  std::uniform_real_distribution<double> mass(1.0, 2.0), speed(-1.0, 1.0);
+  Scene gas;
+  for (int i = 0; i < 100; ++i) {
+    gas.masses.push_back(mass(rng)), gas.positions.push_back(99.0 - i), gas.velocities.push_back(speed(rng));
+  }
+  const NBodyRun r = runScene(gas, false);
+  expectLeftColumnClear(r.run, {{markers::ns::kVelocities, markers::kSideLegend},
+                                {markers::ns::kVelocities, markers::kSideNote},
+                                {markers::ns::kVelocitiesNow, markers::kSideNowText}});
+}
+
 TEST(MarkerNBody, TwoCartsWithRestitutionPartAtEightTenths) {
   // 1 kg carts at +-1 m/s, e = 0.8: they part at -+0.8 m/s; heat (1 - 0.64) * 1 J = 0.36 J.
   for (bool full : {true, false}) {
@@ -189,6 +234,11 @@ TEST(MarkerNBody, CradleOfFiveHandsTheVelocityOn) {
     r.run.prediction = ghosts;
     const auto fixed = buildStaticMarkers(r.run, "f");
     EXPECT_TRUE(find(fixed, markers::ns::kWorldlines, markers::kWorldGhosts));
+    // The x-t legend names the ghosts, on screen (right edge x = 16.3) and clear of "t [s]".
+    const auto* legend = find(fixed, markers::ns::kWorldlines, markers::kWorldLegend);
+    ASSERT_TRUE(legend);
+    EXPECT_NE(legend->text.find("ghosts"), std::string::npos) << legend->text;
+    marker_checks::expectTextClear(*legend, markers::layout::kWorldBox.left, 16.3, {&fixed});
     EXPECT_FALSE(namespacesOf(fixed).count(markers::ns::kWedge));
     EXPECT_TRUE(namespacesOf(fixed).count(markers::ns::kVelocities));
     // Five labelled bodies with their velocities.
@@ -200,7 +250,7 @@ TEST(MarkerNBody, CradleOfFiveHandsTheVelocityOn) {
 
 TEST(MarkerNBody, BallBetweenTwoWallsBouncesAtEverySecond) {
   // Walls at 1 m and 0, the ball at 0.5 m with +1 m/s: bounce k at t = k - 0.5 s, v = (-1)^k.
-  const NBodyRun r = runScene(scene({kInf, 1, kInf}, {1, 0.5, 0}, {0, 1, 0}), false, 1000);
+  NBodyRun r = runScene(scene({kInf, 1, kInf}, {1, 0.5, 0}, {0, 1, 0}), false, 1000);
   ASSERT_EQ(r.run.collisions(), 1000u);
   const SceneState at = stateAt(r.run, 999.5);
   EXPECT_EQ(at.velocities[1], 1.0);
@@ -210,6 +260,24 @@ TEST(MarkerNBody, BallBetweenTwoWallsBouncesAtEverySecond) {
   EXPECT_NEAR(between.positions[1], 0.75, 1e-9);
   EXPECT_EQ(at.positions[0], 1.0);
   EXPECT_EQ(at.positions[2], 0.0);
+  // Infinitely many predicted, 1,000 simulated (the cap): at t = 15.9 s 16 bounces are
+  // behind, "of 1,000 simulated"; never a finite count "predicted".
+  collision_lab::Prediction infinite;
+  infinite.model = collision_lab::Prediction::MODEL_TWO_WALLS_INFINITE;
+  infinite.infinite_collisions = true;
+  r.run.prediction = infinite;
+  const auto status = [&r] {
+    const auto animated = buildAnimatedMarkers(r.run, FrameClock{15.9, ""}, "f");
+    const auto* m = find(animated, markers::ns::kLabels, markers::kStatus);
+    return m ? m->text : std::string("(none)");
+  };
+  ASSERT_TRUE(r.run.summary && r.run.summary->truncated);
+  EXPECT_NE(status().find("collisions 16 of 1,000 simulated"), std::string::npos) << status();
+  EXPECT_EQ(status().find("predicted"), std::string::npos) << status();
+  const auto summary = r.run.summary;
+  r.run.summary.reset();  // still running: the prediction is infinitely many
+  EXPECT_NE(status().find("collisions 16 (infinitely many predicted)"), std::string::npos) << status();
+  r.run.summary = summary;
   // The walls are walls (cubes), not spheres.
   const auto animated = buildAnimatedMarkers(r.run, FrameClock{10.0, "test"}, "f");
   for (int i : {0, 2}) {
@@ -251,6 +319,11 @@ TEST(MarkerNBody, CollapseOfThreeEqualMassesEndsAtTheCentreOfMass) {
   const auto* legend = find(fixed, markers::ns::kWedge, markers::kWedgeLegend);
   ASSERT_TRUE(legend);
   EXPECT_NE(legend->text.find("r_c = 0.0718"), std::string::npos) << legend->text;
+  // The collapse record is no collision: u_perp after 8 collisions and a collapse, not "9 of 8".
+  ASSERT_EQ(r.result.impact_count, 8u);
+  const auto* key = find(fixed, markers::ns::kWedge, markers::kWedgeKey);
+  ASSERT_TRUE(key);
+  EXPECT_EQ(key->text, "orange: u_perp after 8 collisions and a collapse");
   // The last directions before the collapse lie on an eigen-direction (within 2 degrees).
   const auto* dirs = find(fixed, markers::ns::kWedge, markers::kWedgeDirections);
   ASSERT_TRUE(dirs);
@@ -325,6 +398,42 @@ TEST(MarkerNBody, ThousandBodyGasRebuiltFromPairFieldsAlone) {
     if (const auto* m = find(animated, markers::ns::kBodies, markers::kBodyClass + k)) drawn += m->points.size();
   }
   EXPECT_EQ(drawn, 1000u);
+  // After a minute the gas is about 1 km wide, at the end about 1e8 m: the scene's axis
+  // follows the bodies now, so at either time they spread over most of it (26 units).
+  for (double t : {60.0, t_end}) {
+    SCOPED_TRACE(t);
+    const auto frame = buildAnimatedMarkers(r.run, FrameClock{t, "test"}, "f");
+    double lo = kInf, hi = -kInf;
+    for (int k = 0; k < 10; ++k) {
+      if (const auto* m = find(frame, markers::ns::kBodies, markers::kBodyClass + k)) {
+        for (const auto& p : m->points) lo = std::min(lo, p.x), hi = std::max(hi, p.x);
+      }
+    }
+    EXPECT_GT(hi - lo, 0.8 * (markers::layout::kSceneRight - markers::layout::kSceneLeft));
+    ASSERT_TRUE(find(frame, markers::ns::kLabels, markers::kSceneRangeNote));
+    // The x-t diagram runs up to now: no worldline goes above the line of now, and the
+    // tracked bodies (the outermost two among them) span most of its width.
+    const auto* now = find(frame, markers::ns::kWorldlinesNow, markers::kWorldNowLine);
+    ASSERT_TRUE(now);
+    const auto& box = markers::layout::kWorldBox;
+    EXPECT_NEAR(now->points[0].y, box.top, 1e-9);
+    double left = kInf, right = -kInf;
+    for (std::size_t k = 0; k < kMaxTrackedBodies; ++k) {
+      const auto* line = find(frame, markers::ns::kWorldlinesNow, markers::kWorldNowLines + static_cast<int>(k));
+      ASSERT_TRUE(line) << k;
+      for (const auto& p : line->points) {
+        EXPECT_LE(p.y, box.top + 1e-9);
+        left = std::min(left, p.x), right = std::max(right, p.x);
+      }
+    }
+    EXPECT_GT(right - left, 0.8 * (box.right - box.left));
+  }
+  // The velocity plot shows the tracked bodies' steps, each ending at the engine's final velocity.
+  for (std::size_t k = 0; k < kMaxTrackedBodies; ++k) {
+    EXPECT_TRUE(find(fixed, markers::ns::kPlot, markers::kPlotTracked + static_cast<int>(k))) << k;
+    const std::size_t i = r.run.trackedBodies()[k];
+    EXPECT_EQ(r.run.trackedVelocity(i).last().y, r.result.final_velocities[i]) << i;
+  }
   expectViewsFit(r.run);
 }
 

@@ -6,6 +6,8 @@
 #include <set>
 #include <string>
 #include <utility>
+#include <vector>
+#include <algorithm>
 
 #include <gtest/gtest.h>
 #include <visualization_msgs/MarkerArray.h>
@@ -60,6 +62,40 @@ inline void expectFitForRviz(const MarkerArray& array) {
 inline void expectOneMarkerPerId(const MarkerArray& array) {
   std::set<std::pair<std::string, int>> seen;
   for (const auto& m : array.markers) EXPECT_TRUE(seen.insert({m.ns, m.id}).second) << m.ns << "/" << m.id;
+}
+
+/// Where a TEXT_VIEW_FACING marker's glyphs lie [rviz units], centred on its position:
+/// rviz's font is about 0.42 text heights wide per character, its lines 1.25 heights apart,
+/// each glyph about one height tall (measured on the headless screenshots: 60 characters
+/// at height 0.29 spanned 7.1 units).
+struct TextBox {
+  double left, right, bottom, top;
+};
+inline TextBox textBox(const Marker& m) {
+  std::size_t longest = 0, lines = 1, start = 0;
+  for (std::size_t end = m.text.find('\n');; end = m.text.find('\n', start)) {
+    longest = std::max(longest, (end == std::string::npos ? m.text.size() : end) - start);
+    if (end == std::string::npos) break;
+    start = end + 1, ++lines;
+  }
+  const double h = m.scale.z, half_w = 0.21 * h * static_cast<double>(longest);
+  const double half_h = (1.25 * h * static_cast<double>(lines - 1) + h) / 2;
+  return {m.pose.position.x - half_w, m.pose.position.x + half_w, m.pose.position.y - half_h, m.pose.position.y + half_h};
+}
+
+/// `text` lies within [left, right] and overlaps no other text of the arrays.
+inline void expectTextClear(const Marker& text, double left, double right, const std::vector<const MarkerArray*>& arrays) {
+  const TextBox a = textBox(text);
+  EXPECT_GE(a.left, left) << text.ns << "/" << text.id << " '" << text.text << "'";
+  EXPECT_LE(a.right, right) << text.ns << "/" << text.id << " '" << text.text << "'";
+  for (const MarkerArray* array : arrays) {
+    for (const Marker& m : array->markers) {
+      if (m.type != Marker::TEXT_VIEW_FACING || m.action != Marker::ADD || (m.ns == text.ns && m.id == text.id)) continue;
+      const TextBox b = textBox(m);
+      const bool apart = a.right <= b.left || b.right <= a.left || a.top <= b.bottom || b.top <= a.bottom;
+      EXPECT_TRUE(apart) << "'" << text.text << "' overlaps " << m.ns << "/" << m.id << " '" << m.text << "'";
+    }
+  }
 }
 
 inline const Marker* find(const MarkerArray& array, const std::string& ns, int id) {

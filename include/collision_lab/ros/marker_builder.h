@@ -104,6 +104,7 @@ struct Keyframe {
   std::vector<double> positions;   ///< body i at index i [m]
   std::vector<double> velocities;  ///< after the collision [m/s]
   std::vector<double> predicted;   ///< closed form after the collision [m/s]; empty when none
+  bool collapse = false;           ///< the state after a collapse (KIND_COLLAPSE), not an impact
 };
 
 /// Bounds of a RunRecord's memory, whatever the count and N.
@@ -176,6 +177,8 @@ class RunRecord {
   const Envelope& paperVelocity(std::size_t i) const { return seriesOf(paper_velocity_, plot_slot_, i); }
   const Envelope& bodyEnergy(std::size_t i) const { return seriesOf(body_energy_, plot_slot_, i); }
   const Envelope& worldline(std::size_t i) const { return seriesOf(worldline_, track_slot_, i); }
+  /// Large scenes (no plotted bodies): velocity steps [m/s] of each tracked body i.
+  const Envelope& trackedVelocity(std::size_t i) const { return seriesOf(tracked_velocity_, track_slot_, i); }
   const Envelope& energy() const { return energy_; }
   const Envelope& momentum() const { return momentum_; }
   const Envelope& energyLost() const { return energy_lost_; }
@@ -185,6 +188,7 @@ class RunRecord {
   struct Flight {
     double since = 0.0, position = 0.0, velocity = 0.0;
   };
+  /// Empty when i has no slot or `series` is not kept.
   const Envelope& seriesOf(const std::vector<Envelope>& series, const std::vector<int>& slot, std::size_t i) const;
   bool wellFormed(const collision_lab::CollisionEvent& event) const;
   /// Applies the event to flights_, the sums and the per-body series.
@@ -213,6 +217,7 @@ class RunRecord {
   std::vector<std::size_t> tracked_, plotted_;
   std::vector<int> track_slot_, plot_slot_;  ///< body -> its series, -1 for none
   std::vector<Envelope> velocity_, paper_velocity_, body_energy_, worldline_;
+  std::vector<Envelope> tracked_velocity_;  ///< empty unless no body is plotted
   Envelope energy_, momentum_, energy_lost_, none_;
   double kinetic_ = 0.0, momentum_sum_ = 0.0, lost_ = 0.0;
 };

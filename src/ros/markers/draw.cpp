@@ -52,6 +52,43 @@ std::string withSeparators(std::uint64_t n) {
   return out;
 }
 
+std::pair<std::size_t, std::size_t> textExtent(const std::string& s) {
+  std::size_t longest = 0, lines_count = 1, start = 0;
+  for (std::size_t end = s.find('\n'); ; end = s.find('\n', start)) {
+    longest = std::max(longest, (end == std::string::npos ? s.size() : end) - start);
+    if (end == std::string::npos) break;
+    start = end + 1;
+    ++lines_count;
+  }
+  return {longest, lines_count};
+}
+
+double textWidth(const std::string& s, double size) {
+  return 2 * kHalfCharWidth * size * static_cast<double>(textExtent(s).first);
+}
+
+double textHeight(const std::string& s, double size) {
+  return 2 * kHalfLineHeight * size * static_cast<double>(textExtent(s).second);
+}
+
+std::string wrapped(const std::string& s, double size, double width) {
+  const auto fits = static_cast<std::size_t>(std::max(width / (2 * kHalfCharWidth * size), 1.0));
+  std::string out, line, word;
+  const auto flushWord = [&] {
+    if (word.empty()) return;
+    if (!line.empty() && line.size() + 1 + word.size() > fits) out += line + '\n', line.clear();
+    line += (line.empty() ? "" : " ") + word;
+    word.clear();
+  };
+  for (char ch : s + '\n') {
+    if (ch == ' ' || ch == '\n') flushWord();
+    else word += ch;
+    if (ch == '\n') out += line + '\n', line.clear();
+  }
+  out.pop_back();  // the '\n' added after the last line
+  return out;
+}
+
 std::array<double, 3> toArray3(const std::vector<double>& a) {
   std::array<double, 3> result;
   for (std::size_t i = 0; i < result.size(); ++i) result[i] = i < a.size() ? a[i] : std::nan("");

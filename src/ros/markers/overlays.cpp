@@ -12,18 +12,6 @@ namespace {
 using namespace markers;
 using namespace markers::layout;
 
-/// The longest line of s and the number of its lines [characters, lines].
-std::pair<std::size_t, std::size_t> textExtent(const std::string& s) {
-  std::size_t longest = 0, lines_count = 1, start = 0;
-  for (std::size_t end = s.find('\n'); ; end = s.find('\n', start)) {
-    longest = std::max(longest, (end == std::string::npos ? s.size() : end) - start);
-    if (end == std::string::npos) break;
-    start = end + 1;
-    ++lines_count;
-  }
-  return {longest, lines_count};
-}
-
 /// A text with a frame around it. The frame also makes rviz 1.14 draw a text that comes
 /// alone: an array of only TEXT_VIEW_FACING markers is received but not drawn.
 std::vector<Marker> framedText(const std::string& frame_id, const std::string& ns, double y, const std::string& s,

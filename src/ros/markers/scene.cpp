@@ -119,6 +119,25 @@ void drawColourLegend(const Canvas& c) {
                color(kLabelGrey)));
 }
 
+/// Large scenes: the bodies' spread now, so a gas that ends 1e8 m wide still shows its first
+/// minutes, when it is a kilometre wide and nearly every collision happens.
+SceneAxis bodiesNow(const SceneState& state) {
+  double lo = kInf, hi = -kInf;
+  for (double x : state.positions) {
+    if (std::isfinite(x)) lo = std::min(lo, x), hi = std::max(hi, x);
+  }
+  const auto [min, max] = paddedRange(lo, hi, lo);
+  return {min, max};
+}
+
+/// The ends of the scene's axis [m], and (large scenes) that they follow the bodies.
+void addRangeLabels(const Canvas& c, const std::string& ns, int min_id, int max_id, const SceneAxis& axis) {
+  c.add(c.text(ns, min_id, kSceneLeft + kSceneLabelDx, kSceneY + kSceneLabelDy, format("x = %.4g m", axis.min),
+               kSmallTextSize, color(kLabelGrey)));
+  c.add(c.text(ns, max_id, kSceneRight - kSceneLabelDx, kSceneY + kSceneLabelDy, format("x = %.4g m", axis.max),
+               kSmallTextSize, color(kLabelGrey)));
+}
+
 }  // namespace
 
 double SceneAxis::toX(double position) const {
@@ -147,22 +166,21 @@ void drawSceneAxis(const Canvas& c) {
   Marker axis = c.lines(ns::kScene, kSceneAxis, Marker::LINE_LIST, kAxisWidth, color(kGrey));
   axis.points = {point(kSceneLeft, kSceneY), point(kSceneRight, kSceneY)};
   c.add(axis);
-  const SceneAxis scene = sceneAxis(c.run);
-  c.add(c.text(ns::kScene, kSceneMinLabel, kSceneLeft + kSceneLabelDx, kSceneY + kSceneLabelDy,
-               format("x = %.4g m", scene.min), kSmallTextSize, color(kLabelGrey)));
-  c.add(c.text(ns::kScene, kSceneMaxLabel, kSceneRight - kSceneLabelDx, kSceneY + kSceneLabelDy,
-               format("x = %.4g m", scene.max), kSmallTextSize, color(kLabelGrey)));
+  if (!largeScene(c.run)) addRangeLabels(c, ns::kScene, kSceneMinLabel, kSceneMaxLabel, sceneAxis(c.run));
   const std::string note = runNote(c.run);
   if (!note.empty()) c.add(c.text(ns::kScene, kSceneNote, kCentreX, kNoteY, note, kTextSize, color(kAmber)));
   if (largeScene(c.run)) drawColourLegend(c);
 }
 
 void drawBodies(const Canvas& c, const SceneState& state) {
-  const SceneAxis axis = sceneAxis(c.run);
   if (largeScene(c.run)) {
+    const SceneAxis axis = bodiesNow(state);
     drawManyBodies(c, state, axis);
+    addRangeLabels(c, ns::kLabels, kSceneNowMin, kSceneNowMax, axis);
+    c.add(c.text(ns::kLabels, kSceneRangeNote, kSceneRight + kSceneRangeNoteDx, kSceneY + kSceneRangeNoteDy,
+                 "x range: the bodies now", kSmallTextSize, color(kLabelGrey)));
   } else {
-    drawLabelledBodies(c, state, axis);
+    drawLabelledBodies(c, state, sceneAxis(c.run));
   }
 }
 

@@ -21,6 +21,11 @@ struct VelocityPanel {
   std::vector<std::size_t> bodies;
 };
 
+/// Body i's velocity steps: the plotted bodies', or (large scenes) the tracked bodies'.
+const Envelope& stepsOf(const RunRecord& run, std::size_t i) {
+  return largeScene(run) ? run.trackedVelocity(i) : run.velocity(i);
+}
+
 double largestSpeed(const Envelope& e) { return std::max(std::abs(e.minY()), std::abs(e.maxY())); }
 
 /// The scale of a panel of these bodies: their steps and final velocities, and the
@@ -29,8 +34,8 @@ std::pair<double, double> velocityRange(const RunRecord& run, const std::vector<
   const auto final_v = finalVelocitiesNotDrawn(run);
   double lo = kInf, hi = -kInf;
   for (std::size_t i : bodies) {
-    lo = std::min(lo, run.velocity(i).minY());
-    hi = std::max(hi, run.velocity(i).maxY());
+    lo = std::min(lo, stepsOf(run, i).minY());
+    hi = std::max(hi, stepsOf(run, i).maxY());
     if (final_v && std::isfinite(final_v->second[i])) {
       lo = std::min(lo, final_v->second[i]), hi = std::max(hi, final_v->second[i]);
     }
@@ -52,6 +57,7 @@ std::vector<VelocityPanel> velocityPanels(const RunRecord& run) {
     const auto [y0, y1] = velocityRange(run, bodies);
     return VelocityPanel{Axes{box, 0.0, x1, y0, y1}, bodies};
   };
+  if (largeScene(run)) return {panel(kVelocityBox, run.trackedBodies())};
   if (run.bodies() != 3) return {panel(kVelocityBox, run.plottedBodies())};
   const double others = std::max(largestSpeed(run.velocity(0)), largestSpeed(run.velocity(2)));
   if (largestSpeed(run.velocity(1)) > kOwnScaleFactor * others) {
@@ -94,6 +100,16 @@ void addVelocityPanel(const Canvas& c, const VelocityPanel& panel, int p, std::s
   const std::string label = panels == 1 ? "v [m/s]" : p == 0 ? "v_B [m/s]" : "v_A, v_C [m/s]";
   addFrame(c, ns::kPlot, base + kPlotFrame, panel.axes, label);
   const double tail = static_cast<double>(c.run.collisions()) + 1;
+  if (largeScene(c.run)) {
+    // The tracked bodies' steps, coloured by their start velocity as in the x-t diagram; no
+    // closed form or paper's series for many bodies.
+    for (std::size_t k = 0; k < panel.bodies.size(); ++k) {
+      const std::size_t i = panel.bodies[k];
+      addSeries(c, ns::kPlot, kPlotTracked + static_cast<int>(k), withTail(stepsOf(c.run, i), tail), panel.axes,
+                velocityColor(c.run.input().velocities[i], velocityScale(c.run)), kCursorWidth);
+    }
+    return;
+  }
   for (std::size_t i : panel.bodies) {
     const int b = static_cast<int>(i);
     addSeries(c, ns::kPlot, base + kPlotSeries + b, withTail(c.run.velocity(i), tail), panel.axes, particleColor(i));
@@ -116,7 +132,8 @@ void addVelocityLegend(const Canvas& c, bool own_scale, const PaperShown& paper)
     legend += "   paper's (2.15)/(2.16): undefined with a wall";
   }
   if (largeScene(c.run)) {
-    legend = withSeparators(c.run.bodies()) + " bodies: no velocity per body here; see the histogram (left)";
+    legend = withSeparators(c.run.trackedBodies().size()) + " of " + withSeparators(c.run.bodies()) +
+             " bodies (those of the x-t diagram), coloured by v at the start";
   }
   c.add(c.text(ns::kPlot, kPlotLegend, kVelocityBox.midX(), kLegendY, legend, kSmallTextSize, color(kLabelGrey)));
   const auto& plotted = c.run.plottedBodies();

@@ -50,7 +50,7 @@ void drawHistogramNow(const Canvas& c, const SceneState& state) {
   const double peak = sigma > 0 ? width / (sigma * std::sqrt(2 * M_PI)) : 1.0;
   double top = peak;
   for (double& s : share) s = mass > 0 ? s / mass : 0.0, top = std::max(top, s);
-  const Axes axes{kSideBox, v0, v1, 0.0, top * (1 + kRangePadding)};
+  const Axes axes{kHistogramBox, v0, v1, 0.0, top * (1 + kRangePadding)};
   Marker bars = c.base(ns::kVelocitiesNow, kSideBars, Marker::TRIANGLE_LIST);
   bars.color = color(kSimulatedOrange);
   for (int k = 0; k < kHistogramBins; ++k) {
@@ -67,8 +67,8 @@ void drawHistogramNow(const Canvas& c, const SceneState& state) {
     gauss.points.push_back(point(axes.toX(v), axes.toY(peak * std::exp(-0.5 * std::pow((v - mean) / sigma, 2))), kDotZ));
   }
   c.addLines(gauss);
-  c.add(c.text(ns::kVelocitiesNow, kSideNowText, kSideBox.midX(), kSideBox.top - kSeriesNamePitch,
-               format("V = %.3g m/s", mean) + format(", sigma = %.3g m/s", sigma), kSmallTextSize, color(kLabelGrey)));
+  c.add(c.text(ns::kVelocitiesNow, kSideNowText, kHistogramBox.midX(), kHistogramTextY,
+               format("now: V = %.3g m/s", mean) + format(", sigma = %.3g m/s", sigma), kSmallTextSize, color(kLabelGrey)));
 }
 
 void drawProfileNow(const Canvas& c, const SceneState& state) {
@@ -90,8 +90,8 @@ void drawSideViewAxes(const Canvas& c) {
   const SideView view = sideView(c.run);
   if (view == SideView::kWedge) return;
   const auto [v0, v1] = velocityAxis(c.run);
-  const Box& b = kSideBox;
   const bool histogram = view == SideView::kHistogram;
+  const Box& b = histogram ? kHistogramBox : kSideBox;
   if (histogram) {
     Marker frame = c.lines(ns::kVelocities, kSideFrame, Marker::LINE_LIST, kFrameWidth, color(kGrey));
     frame.points = {point(b.left, b.bottom), point(b.right, b.bottom), point(b.left, b.bottom), point(b.left, b.top)};
@@ -106,10 +106,17 @@ void drawSideViewAxes(const Canvas& c) {
   }
   c.add(c.text(ns::kVelocities, kSideTitle, b.midX(), kPanelTitleY,
                histogram ? "velocities now: histogram" : "velocities now, body by body", kTextSize));
+  const double width = b.right - b.left;
   c.add(c.text(ns::kVelocities, kSideLegend, b.midX(), kLegendY,
-               histogram ? "orange: mass share per bin;  white: Gaussian, same mean and\nmass-weighted kinetic-energy spread (Maxwell-like)"
-                         : "dots: v of each body now (walls grey)",
+               wrapped(histogram ? "orange: mass share per bin" : "dots: v of each body now (walls grey)",
+                       kSmallTextSize, width),
                kSmallTextSize, color(kLabelGrey)));
+  if (histogram) {
+    c.add(c.text(ns::kVelocities, kSideNote, b.midX(), b.bottom + kSideNoteDy,
+                 wrapped("white: Gaussian of the same mean V and mass-weighted spread sigma (Maxwell-like)",
+                         kSmallTextSize, width),
+                 kSmallTextSize, color(kLabelGrey)));
+  }
 }
 
 void drawSideViewNow(const Canvas& c, const SceneState& state) {

@@ -3,6 +3,7 @@
 // and by the closed form), and the cursor at u_perp now. With e < 1 the path spirals in;
 // the directions of u_perp are shown on the circle too, and when the cycle's map has real
 // eigenvalues (e <= r_c, a collapse) its eigen-directions, which those directions approach.
+#include <algorithm>
 #include <cmath>
 #include <optional>
 
@@ -183,6 +184,24 @@ std::string restitutionLegend(const RunRecord& run) {
   return s;
 }
 
+/// The orange key in the legend row; under the caption (at most two lines, within the
+/// column) what the yellow and violet marks are and, for e < 1, the restitution.
+void addWedgeLegend(const Canvas& c, const std::vector<const Keyframe*>& shown, bool lossy) {
+  const RunRecord& run = c.run;
+  // A collapse record is no collision: it is counted on its own.
+  const auto collapses = static_cast<std::uint64_t>(
+      std::count_if(shown.begin(), shown.end(), [](const Keyframe* f) { return f->collapse; }));
+  const std::uint64_t impacts = shown.size() - collapses;
+  std::string which = impacts == run.collisions() ? (collapses > 0 ? withSeparators(impacts) + " collisions" : "each collision")
+                                                  : withSeparators(impacts) + " of " + withSeparators(run.collisions()) + " collisions";
+  if (collapses > 0) which += collapses == 1 ? " and a collapse" : " and " + withSeparators(collapses) + " collapses";
+  c.add(c.text(ns::kWedge, kWedgeKey, kWedgeX, kLegendY, wrapped("orange: u_perp after " + which, kSmallTextSize, kLeftTextWidth),
+               kSmallTextSize, color(kLabelGrey)));
+  const std::string rest = lossy ? "yellow: its direction; " + restitutionLegend(run) : "violet: closed form";
+  c.add(c.text(ns::kWedge, kWedgeLegend, kWedgeX, kWedgeBox.bottom + kWedgeLegendDy,
+               wrapped(rest, kSmallTextSize, kLeftTextWidth), kSmallTextSize));
+}
+
 }  // namespace
 
 void drawWedge(const Canvas& c) {
@@ -222,12 +241,7 @@ void drawWedge(const Canvas& c) {
   c.add(c.text(ns::kWedge, kWedgeCaption, kWedgeX, kWedgeBox.bottom + kCaptionDy,
                "yellow: escape cone, alpha = " + format("%.4g rad", wedge.abAngle()), kSmallTextSize,
                color(kConeYellow)));
-  const std::string which = shown.size() == run.collisions()
-                                ? "each collision"
-                                : withSeparators(shown.size()) + " of " + withSeparators(run.collisions()) + " collisions";
-  const std::string text = lossy ? "orange: u_perp after " + which + ", yellow: its direction\n" + restitutionLegend(run)
-                                 : "orange: u_perp after " + which + "\nviolet: closed form";
-  c.add(c.text(ns::kWedge, kWedgeLegend, kWedgeX, kWedgeBox.bottom + kWedgeLegendDy, text, kSmallTextSize));
+  addWedgeLegend(c, shown, lossy);
 }
 
 void drawWedgeCursor(const Canvas& c, const SceneState& state) {

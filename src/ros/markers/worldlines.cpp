@@ -2,6 +2,8 @@
 // of kMaxTrackedBodies for large N), the ghosts' straight worldlines for equal elastic
 // masses, and the line of now with the bodies on it.
 #include <algorithm>
+#include <cmath>
+#include <limits>
 
 #include "collision_lab/ros/markers/draw.h"
 
@@ -24,23 +26,68 @@ struct WorldAxes {
   }
 };
 
-void addWorldLabels(const Canvas& c, const WorldAxes& axes) {
-  const auto label = [&](int id, double x, double y, const std::string& s) {
-    c.add(c.text(ns::kWorldlines, id, x, y, s, kSmallTextSize));
-  };
+/// The axes' fixed labels: "0", "t [s]" and "x [m]".
+void addWorldUnits(const Canvas& c) {
   const Box& b = kWorldBox;
-  label(kWorldTimeZero, b.left + kWorldZeroDx, b.bottom, "0");
-  label(kWorldTimeEnd, b.left + kWorldEndDx, b.top, format("%.3g", axes.end));
-  label(kWorldTimeUnit, b.left + kWorldUnitDx, b.top + kWorldUnitDy, "t [s]");
-  label(kWorldPositionMin, b.left, b.bottom + kWorldPositionDy, format("%.3g", axes.scene.min));
-  label(kWorldPositionMax, b.right, b.bottom + kWorldPositionDy, format("%.3g", axes.scene.max));
-  label(kWorldPositionUnit, b.midX(), b.bottom + kWorldPositionDy, "x [m]");
+  c.add(c.text(ns::kWorldlines, kWorldTimeZero, b.left + kWorldZeroDx, b.bottom, "0", kSmallTextSize));
+  c.add(c.text(ns::kWorldlines, kWorldTimeUnit, b.left + kWorldUnitDx, b.top + kWorldUnitDy, "t [s]", kSmallTextSize));
+  c.add(c.text(ns::kWorldlines, kWorldPositionUnit, b.midX(), b.bottom + kWorldPositionDy, "x [m]", kSmallTextSize));
+}
+
+/// The axes' ends: the time at the top [s], the positions at the bottom [m] (ids in `ns`).
+void addWorldRange(const Canvas& c, const std::string& ns, int end_id, int min_id, int max_id, const WorldAxes& axes) {
+  const Box& b = kWorldBox;
+  c.add(c.text(ns, end_id, b.left + kWorldEndDx, b.top, format("%.3g", axes.end), kSmallTextSize));
+  c.add(c.text(ns, min_id, b.left, b.bottom + kWorldPositionDy, format("%.3g", axes.scene.min), kSmallTextSize));
+  c.add(c.text(ns, max_id, b.right, b.bottom + kWorldPositionDy, format("%.3g", axes.scene.max), kSmallTextSize));
+}
+
+/// Large scenes: the tracked worldlines from 0 to now, and the axes that hold them (time up
+/// to now; positions over the worldlines so far and the bodies now).
+WorldAxes axesUpToNow(const RunRecord& run, const SceneState& state, std::vector<Polyline>& lines) {
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (std::size_t i : run.trackedBodies()) {
+    Polyline poly;
+    for (const auto& v : run.worldline(i).polyline()) {
+      if (v.x >= state.time) break;
+      poly.push_back(v);
+    }
+    poly.push_back({state.time, state.positions[i], 0.0});
+    for (const auto& v : poly) lo = std::min(lo, v.y), hi = std::max(hi, v.y);
+    lines.push_back(std::move(poly));
+  }
+  for (double x : state.positions) {
+    if (std::isfinite(x)) lo = std::min(lo, x), hi = std::max(hi, x);
+  }
+  const auto [min, max] = paddedRange(lo, hi, lo);
+  return WorldAxes{SceneAxis{min, max}, state.time > 0 ? state.time : 1.0};
+}
+
+/// At most the first, lowest, highest and last vertex of each of `rows` equal rows of time
+/// up to `end`, in time order: all that the rows of pixels can show.
+Polyline perRow(const Polyline& poly, double end, int rows) {
+  Polyline out;
+  std::size_t first = 0;
+  while (first < poly.size()) {
+    const auto row = [&](const Envelope::Vertex& v) { return std::min(static_cast<int>(v.x / end * rows), rows - 1); };
+    std::size_t last = first, lowest = first, highest = first;
+    while (last + 1 < poly.size() && row(poly[last + 1]) == row(poly[first])) {
+      ++last;
+      if (poly[last].y < poly[lowest].y) lowest = last;
+      if (poly[last].y > poly[highest].y) highest = last;
+    }
+    std::vector<std::size_t> kept{first, std::min(lowest, highest), std::max(lowest, highest), last};
+    kept.erase(std::unique(kept.begin(), kept.end()), kept.end());
+    for (std::size_t k : kept) out.push_back(poly[k]);
+    first = last + 1;
+  }
+  return out;
 }
 
 /// Equal elastic masses move as ghosts that pass through each other: the straight lines
 /// x_i + v_i t of the tracked bodies' initial states, cut to the box.
-void addGhosts(const Canvas& c, const WorldAxes& axes) {
-  Marker ghosts = c.lines(ns::kWorldlines, kWorldGhosts, Marker::LINE_LIST, kGhostWidth, color(kGhostGrey));
+void addGhosts(const Canvas& c, const std::string& ns, int id, const WorldAxes& axes) {
+  Marker ghosts = c.lines(ns, id, Marker::LINE_LIST, kGhostWidth, color(kGhostGrey));
   for (std::size_t i : c.run.trackedBodies()) {
     const double x = c.run.input().positions[i], v = c.run.input().velocities[i];
     // Inside the box while scene.min <= x + v t <= scene.max.
@@ -54,6 +101,19 @@ void addGhosts(const Canvas& c, const WorldAxes& axes) {
   c.addLines(ghosts);
 }
 
+/// Body i's worldline (time up, position across): grey and thick for a wall, else its colour
+/// (large scenes: its start velocity's).
+void addWorldline(const Canvas& c, const std::string& ns, int id, std::size_t i, const Polyline& poly,
+                  const WorldAxes& axes) {
+  const bool wall = isWall(c.run.input(), i);
+  const auto colour = wall ? color(kGrey)
+                           : largeScene(c.run) ? velocityColor(c.run.input().velocities[i], velocityScale(c.run))
+                                               : particleColor(i);
+  Marker line = c.lines(ns, id, Marker::LINE_STRIP, wall ? kWallLineWidth : kBodyLineWidth, colour);
+  for (const auto& v : poly) line.points.push_back(point(axes.toX(v.y), axes.toY(v.x)));
+  c.addLines(line);
+}
+
 bool ghostScene(const RunRecord& run) {
   return run.prediction && run.prediction->model == collision_lab::Prediction::MODEL_GHOSTS;
 }
@@ -61,30 +121,28 @@ bool ghostScene(const RunRecord& run) {
 }  // namespace
 
 void drawWorldlines(const Canvas& c) {
-  const WorldAxes axes{sceneAxis(c.run), endTime(c.run)};
-  const SceneState last = stateAt(c.run, axes.end);
   const Box& b = kWorldBox;
   Marker frame = c.lines(ns::kWorldlines, kWorldFrame, Marker::LINE_LIST, kFrameWidth, color(kGrey));
   frame.points = {point(b.left, b.bottom), point(b.right, b.bottom), point(b.left, b.bottom), point(b.left, b.top)};
   c.add(frame);
+  addWorldUnits(c);
   const auto& tracked = c.run.trackedBodies();
-  const double v_max = velocityScale(c.run);
-  for (std::size_t k = 0; k < tracked.size(); ++k) {
-    const std::size_t i = tracked[k];
-    Polyline poly = c.run.worldline(i).polyline();
-    poly.push_back({last.time, last.positions[i], 0.0});
-    const bool wall = isWall(c.run.input(), i);
-    const auto colour = wall ? color(kGrey)
-                             : largeScene(c.run) ? velocityColor(c.run.input().velocities[i], v_max) : particleColor(i);
-    Marker line = c.lines(ns::kWorldlines, kWorldLines + static_cast<int>(k), Marker::LINE_STRIP,
-                          wall ? kWallLineWidth : kBodyLineWidth, colour);
-    for (const auto& v : poly) line.points.push_back(point(axes.toX(v.y), axes.toY(v.x)));
-    c.addLines(line);
+  const bool large = largeScene(c.run);
+  // Large scenes draw the worldlines up to now, every frame (drawWorldlinesCursor).
+  if (!large) {
+    const WorldAxes axes{sceneAxis(c.run), endTime(c.run)};
+    const SceneState last = stateAt(c.run, axes.end);
+    for (std::size_t k = 0; k < tracked.size(); ++k) {
+      const std::size_t i = tracked[k];
+      Polyline poly = c.run.worldline(i).polyline();
+      poly.push_back({last.time, last.positions[i], 0.0});
+      addWorldline(c, ns::kWorldlines, kWorldLines + static_cast<int>(k), i, poly, axes);
+    }
+    if (ghostScene(c.run)) addGhosts(c, ns::kWorldlines, kWorldGhosts, axes);
+    addWorldRange(c, ns::kWorldlines, kWorldTimeEnd, kWorldPositionMin, kWorldPositionMax, axes);
   }
-  const bool ghosts = ghostScene(c.run);
-  if (ghosts) addGhosts(c, axes);
-  addWorldLabels(c, axes);
-  c.add(c.text(ns::kWorldlines, kWorldTitle, b.midX(), kPanelTitleY, "x-t diagram (worldlines)", kTextSize));
+  c.add(c.text(ns::kWorldlines, kWorldTitle, b.midX(), kPanelTitleY,
+               large ? "x-t diagram (worldlines), up to now" : "x-t diagram (worldlines)", kTextSize));
   bool exact = true;
   for (std::size_t i : tracked) exact = exact && c.run.worldline(i).exact();
   std::string legend = exact ? "exact" : "min/max of x per time column";
@@ -92,12 +150,23 @@ void drawWorldlines(const Canvas& c) {
     legend += ";  " + withSeparators(tracked.size()) + " of " + withSeparators(c.run.bodies()) +
               " bodies, coloured by v at the start";
   }
-  if (ghosts) legend += "\ngrey: the ghosts x_i + v_i t (equal masses pass through each other)";
+  // One line: a second would run into the "t [s]" label over the box.
+  if (ghostScene(c.run)) legend += ";  grey: ghosts x_i + v_i t, passing through each other";
   c.add(c.text(ns::kWorldlines, kWorldLegend, b.midX(), kLegendY, legend, kSmallTextSize, color(kLabelGrey)));
 }
 
 void drawWorldlinesCursor(const Canvas& c, const SceneState& state) {
-  const WorldAxes world{sceneAxis(c.run), endTime(c.run)};
+  const bool large = largeScene(c.run);
+  std::vector<Polyline> lines;
+  const WorldAxes world = large ? axesUpToNow(c.run, state, lines) : WorldAxes{sceneAxis(c.run), endTime(c.run)};
+  if (large) {
+    for (std::size_t k = 0; k < lines.size(); ++k) {
+      addWorldline(c, ns::kWorldlinesNow, kWorldNowLines + static_cast<int>(k), c.run.trackedBodies()[k],
+                   perRow(lines[k], world.end, kWorldRows), world);
+    }
+    if (ghostScene(c.run)) addGhosts(c, ns::kWorldlinesNow, kWorldNowGhosts, world);
+    addWorldRange(c, ns::kWorldlinesNow, kWorldNowTimeEnd, kWorldNowPositionMin, kWorldNowPositionMax, world);
+  }
   Marker now = c.lines(ns::kWorldlinesNow, kWorldNowLine, Marker::LINE_LIST, kCursorWidth, color(kCursorWhite));
   now.points = {point(kWorldBox.left, world.toY(state.time)), point(kWorldBox.right, world.toY(state.time))};
   c.add(now);

@@ -39,6 +39,15 @@ geometry_msgs::Point point(double x, double y, double z = 0.0);
 std::string format(const char* fmt, double value);
 /// 31415 -> "31,415".
 std::string withSeparators(std::uint64_t n);
+/// The longest line of s and the number of its lines [characters, lines].
+std::pair<std::size_t, std::size_t> textExtent(const std::string& s);
+/// Estimated size of s on screen at text height `size` [rviz units] (rviz's font, see
+/// layout::kHalfCharWidth and kHalfLineHeight): the longest line's width, all lines' height.
+double textWidth(const std::string& s, double size);
+double textHeight(const std::string& s, double size);
+/// s with each line broken at spaces so that it fits `width` [rviz units] at `size` (a
+/// word wider than that stays whole).
+std::string wrapped(const std::string& s, double size, double width);
 /// Bodies A, B, C (0, 1, 2) of a per-body array; NaN for a body it does not have.
 std::array<double, 3> toArray3(const std::vector<double>& a);
 bool isWall(const collision_lab::InitialConditions& input, std::size_t i);

@@ -69,6 +69,7 @@ enum MarkerId : int {
   kWedgeLegend = 11,
   kWedgeDirections = 12,  ///< e < 1: the directions of u_perp, on the circle
   kWedgeEigen = 13,       ///< collapse: the cycle's eigen-directions
+  kWedgeKey = 14,         ///< the orange key, in the legend row
 
   // ns "plot": panel p (0, or 1 for A and C when B has its own) at p * kPlotPanelStride
   kPlotPanelStride = 100,
@@ -80,6 +81,7 @@ enum MarkerId : int {
   kPlotLegend = 311,
   kPlotSeriesNames = 320,  ///< + body index
   kPlotIndexLabels = 400,  ///< + label number
+  kPlotTracked = 500,      ///< large scenes: + tracked body's slot (RunRecord::trackedBodies)
 
   // ns "conserved"
   kConservedEnergy = 0,     ///< base of the energy plot
@@ -114,6 +116,7 @@ enum MarkerId : int {
   kSideAxisLabel = 12,
   kSideAxisMin = 13,
   kSideAxisMax = 14,
+  kSideNote = 15,  ///< under the axis labels (the histogram's Gaussian)
 
   // ns "bodies"
   kBody = 0,         ///< + body index (small scenes)
@@ -122,6 +125,9 @@ enum MarkerId : int {
 
   // ns "labels"
   kStatus = 3,
+  kSceneNowMin = 4,    ///< large scenes: the scene's ends, the bodies' spread now
+  kSceneNowMax = 5,
+  kSceneRangeNote = 6,
   kBodyTag = 100,      ///< + body index
   kVelocityRow = 200,  ///< + body index
 
@@ -138,6 +144,11 @@ enum MarkerId : int {
   // ns "worldlines_now"
   kWorldNowLine = 0,
   kWorldNowBodies = 1,
+  kWorldNowTimeEnd = 2,   ///< large scenes: the axes' ends, up to now
+  kWorldNowPositionMin = 4,
+  kWorldNowPositionMax = 5,
+  kWorldNowLines = 10,    ///< large scenes: + tracked body's slot
+  kWorldNowGhosts = 50,
 
   // ns "energy_bars"
   kEnergyBar = 0,       ///< + body index

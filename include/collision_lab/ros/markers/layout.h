@@ -123,7 +123,10 @@ constexpr double kNarrowCone = 0.3, kNarrowConeDy = 0.35;
 /// The path's circle: |u_perp| at this share of the wedge's radius.
 constexpr double kPathRadius = 0.8 * kWedgeRadius;
 constexpr double kSimulatedDotSize = 0.16, kPredictedWedgeDotSize = 0.08, kCursorSize = 0.3, kCursorZ = 0.1;
+/// The legend: the orange key in the legend row, the rest (at most two lines) under the caption.
 constexpr double kStartLabelDy = -0.3, kCaptionDy = -0.1, kWedgeLegendDy = -0.65;
+/// Texts of the left column fit this width, so they stay on screen and clear of the middle.
+constexpr double kLeftTextWidth = kWedgeBox.right - kWedgeBox.left;
 /// At most this many states per series in the wedge when not every collision is kept.
 constexpr std::size_t kMaxWedgeDots = 600;
 
@@ -138,6 +141,11 @@ constexpr double kColourLabelDx = 1.1;
 
 // ---- in the wedge's place: velocities now (profile or histogram) ----
 constexpr Box kSideBox{-10.0, -4.6, -0.3, 3.45};
+/// The histogram leaves room over it for the mean and spread now (kHistogramTextY).
+constexpr Box kHistogramBox{kSideBox.left, kSideBox.right, kSideBox.bottom, 2.95};
+constexpr double kHistogramTextY = 3.3;
+/// The note under the side view's axis labels (at most two lines), from its box's bottom.
+constexpr double kSideNoteDy = -0.9;
 constexpr int kHistogramBins = 24;
 constexpr int kGaussianSegments = 64;
 constexpr double kProfileDotSize = 0.16;
@@ -146,6 +154,10 @@ constexpr double kProfileDotSize = 0.16;
 constexpr double kWallLineWidth = 0.08, kBodyLineWidth = 0.03;
 constexpr double kWorldZeroDx = -0.3, kWorldEndDx = -0.55, kWorldUnitDx = -0.45, kWorldUnitDy = 0.3;
 constexpr double kWorldPositionDy = -0.3;
+/// Large scenes: "x range: the bodies now" under the scene's right end label.
+constexpr double kSceneRangeNoteDx = -2.0, kSceneRangeNoteDy = -0.85;
+/// Large scenes: a worldline drawn up to now keeps first, lowest, highest, last x per row.
+constexpr int kWorldRows = 240;
 constexpr double kWorldNowDotSize = 0.16;
 constexpr double kGhostWidth = 0.015;
 constexpr Rgba kGhostGrey{0.75, 0.75, 0.75, 0.6};
