@@ -95,8 +95,10 @@ SceneSimulation simulateScene(const Scene& scene, const SceneRunOptions& options
   engine_options.max_impacts = lab.max_collisions;
   engine_options.progress_interval = options.progress_interval;
   engine_options.cancel = options.cancel;
-  const ImpactVisitor visitor = lab.mode == RunMode::kFull ? visitors.impact : ImpactVisitor{};
-  SceneSimulation simulation = fromEngine(runEngine(scene, engine_options, visitor, visitors.progress));
+  const bool full = lab.mode == RunMode::kFull;
+  SceneSimulation simulation =
+      fromEngine(runEngine(scene, engine_options, full ? visitors.impact : ImpactVisitor{}, visitors.progress,
+                           full ? visitors.collapse : CollapseVisitor{}));
   if (prediction && prediction->impact_count && simulation.stop == StopReason::kFinished) {
     simulation.max_prediction_error =
         relativeVelocityError(simulation.final_velocities, prediction->final_velocities, scene.velocities);

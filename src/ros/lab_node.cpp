@@ -493,12 +493,8 @@ collision_lab::RunSummary LabNode::run(collision_lab::InitialConditions& input,
   core::SceneVisitors visitors;
   visitors.three_body_event = [&events](const core::LabEvent& e) { events(e); };
   visitors.impact = [&events](const core::ImpactRecord& r) { events(r); };
+  visitors.collapse = [&events](const core::Collapse& c) { events(c); };  // in order, between the impacts
   const core::SceneRunResult result = runCancellable(input.run_id, scene, options, visitors);
-  // The engine reports collapses with its result; each follows the impact before it (for
-  // the scenes it resolves, the last of the run's impacts of those bodies).
-  if (mode == core::RunMode::kFull) {
-    for (const core::Collapse& collapse : result.simulation.collapses) events(collapse);
-  }
 
   collision_lab::RunSummary summary = toRunSummaryMsg(result, scene.size(), mode);
   summary.published_events = events.published();

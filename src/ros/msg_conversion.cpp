@@ -338,8 +338,7 @@ collision_lab::EnergyTransfer toEnergyTransferMsg(const collision_lab::Collision
 SceneEventConverter::SceneEventConverter(const core::Scene& scene)
     : scene_(scene),
       full_state_(scene.size() <= collision_lab::CollisionEvent::FULL_STATE_MAX_BODIES),
-      v_(scene.velocities),
-      stuck_(scene.pairCount(), false) {
+      v_(scene.velocities) {
   if (full_state_) x_ = scene.positions;
 }
 
@@ -361,15 +360,6 @@ void SceneEventConverter::move(std::size_t first, std::size_t last, double v, do
     if (full_state_) x_[i] = x;
     moved_gain_.push_back(kinetic(i) - before);
   }
-}
-
-std::size_t SceneEventConverter::clusterEnd(std::size_t body, int direction) const {
-  if (direction < 0) {
-    while (body > 0 && stuck_[body - 1]) --body;
-  } else {
-    while (body + 1 < scene_.size() && stuck_[body]) ++body;
-  }
-  return body;
 }
 
 void SceneEventConverter::fillBodies(collision_lab::CollisionEvent& msg,
@@ -404,9 +394,9 @@ collision_lab::CollisionEvent SceneEventConverter::impact(const core::ImpactReco
   msg.time = record.time;
   msg.position = record.position;
   msg.restitution = scene_.restitutionOf(p);
-  msg.first_moved = static_cast<std::uint32_t>(clusterEnd(p, -1));
-  msg.last_moved = static_cast<std::uint32_t>(clusterEnd(p + 1, +1));
-  msg.cluster_impact = msg.first_moved != p || msg.last_moved != p + 1;
+  msg.first_moved = static_cast<std::uint32_t>(record.first_moved);
+  msg.last_moved = static_cast<std::uint32_t>(record.last_moved);
+  msg.cluster_impact = record.first_moved != p || record.last_moved != p + 1;
   for (std::size_t side = 0; side < 2; ++side) {
     msg.pair_velocities_before[side] = record.velocities_before[side];
     msg.pair_velocities_after[side] = record.velocities_after[side];
@@ -415,9 +405,8 @@ collision_lab::CollisionEvent SceneEventConverter::impact(const core::ImpactReco
   msg.energy_lost = record.energy_lost;
   moved_first_ = msg.first_moved;
   moved_gain_.clear();
-  move(msg.first_moved, p, record.velocities_after[0], record.position);
-  move(p + 1, msg.last_moved, record.velocities_after[1], record.position);
-  if (msg.restitution == 0.0) stuck_[p] = true;  // e = 0: the pair moves on as one (engine.h)
+  move(record.first_moved, p, record.velocities_after[0], record.position);
+  move(p + 1, record.last_moved, record.velocities_after[1], record.position);
   cumulative_lost_ += record.energy_lost;
   fillBodies(msg, before);
   return msg;
@@ -427,15 +416,8 @@ collision_lab::CollisionEvent SceneEventConverter::collapse(const core::Collapse
   const std::size_t first = collapse.first_body, last = collapse.last_body;
   advance(collapse.time);
   const std::vector<double> before = full_state_ ? v_ : std::vector<double>{};
-  // The cluster's velocity: its wall's, or the centre of mass's.
-  double momentum = 0.0, mass = 0.0, heat = 0.0;
-  std::optional<double> wall;
-  for (std::size_t i = first; i <= last; ++i) {
-    if (scene_.isWall(i)) wall = v_[i];
-    if (!scene_.isWall(i)) momentum += scene_.masses[i] * v_[i], mass += scene_.masses[i];
-    heat += kinetic(i);
-  }
-  const double velocity = wall.value_or(momentum / mass);
+  double heat = 0.0;  // the bodies' kinetic energy before, less after
+  for (std::size_t i = first; i <= last; ++i) heat += kinetic(i);
   collision_lab::CollisionEvent msg;
   msg.kind = collision_lab::CollisionEvent::KIND_COLLAPSE;
   msg.index = collapse.impacts_before;
@@ -449,13 +431,12 @@ collision_lab::CollisionEvent SceneEventConverter::collapse(const core::Collapse
   moved_first_ = first;
   moved_gain_.clear();
   for (std::size_t side = 0; side < 2; ++side) msg.pair_velocities_before[side] = v_[first + side];
-  move(first, last, velocity, collapse.position);
+  move(first, last, collapse.velocity, collapse.position);
   for (std::size_t side = 0; side < 2; ++side) {
-    msg.pair_velocities_after[side] = velocity;
+    msg.pair_velocities_after[side] = collapse.velocity;
     msg.pair_energy_transfer[side] = moved_gain_[side];
   }
   for (std::size_t i = first; i <= last; ++i) heat -= kinetic(i);
-  for (std::size_t i = first; i < last; ++i) stuck_[i] = true;
   msg.energy_lost = heat;
   cumulative_lost_ += heat;
   fillBodies(msg, before);

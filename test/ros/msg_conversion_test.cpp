@@ -1,6 +1,7 @@
 // Message <-> core conversions (no master).
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -39,12 +40,16 @@ TEST(MsgConversion, AnySceneRoundTripKeepsItsListsAsGiven) {
   EXPECT_EQ(back.restitution, scene.restitution);
 }
 
+/// The engine's record of an impact of pair `pair` that moved bodies first..last (the
+/// pair alone unless given).
 collision_lab::core::ImpactRecord record(std::uint64_t index, std::size_t pair, double t, double x,
                                          std::array<double, 2> before, std::array<double, 2> after,
-                                         std::array<double, 2> gained, double lost) {
+                                         std::array<double, 2> gained, double lost,
+                                         std::optional<std::size_t> first = {}, std::optional<std::size_t> last = {}) {
   collision_lab::core::ImpactRecord r;
   r.index = index, r.pair_index = pair, r.time = t, r.position = x;
   r.velocities_before = before, r.velocities_after = after, r.energy_gained = gained, r.energy_lost = lost;
+  r.first_moved = first.value_or(pair), r.last_moved = last.value_or(pair + 1);
   return r;
 }
 
@@ -68,7 +73,8 @@ TEST(SceneEventConverter, RebuildsEveryBodyThroughAStickingImpactAndAClusterImpa
   EXPECT_EQ(first.total_momentum, -1.0);
   EXPECT_EQ(converter.energyTransferMsg(first).cumulative_energy_lost, 0.25);
 
-  const auto second = converter.impact(record(2, 1, 3.0, 0.0, {-0.5, 0}, {0, -0.5}, {-0.25, 0.25}, 0));
+  // The engine's record says the cluster AB moved (bodies 0..2).
+  const auto second = converter.impact(record(2, 1, 3.0, 0.0, {-0.5, 0}, {0, -0.5}, {-0.25, 0.25}, 0, 0, 2));
   EXPECT_EQ(second.first_moved, 0u);  // the cluster AB moved as one
   EXPECT_EQ(second.last_moved, 2u);
   EXPECT_TRUE(second.cluster_impact);
@@ -93,6 +99,7 @@ TEST(SceneEventConverter, ACollapseMovesItsBodiesOnAsOneAtTheirCentreOfMass) {
   collision_lab::core::Collapse collapse;
   collapse.first_body = 0, collapse.last_body = 2, collapse.time = 2.5, collapse.position = -0.5;
   collapse.impacts_before = 40;
+  collapse.velocity = -1.0 / 3;  // the centre of mass: momentum -1 kg m/s, 3 kg
   const auto msg = converter.collapse(collapse);
   EXPECT_EQ(msg.kind, collision_lab::CollisionEvent::KIND_COLLAPSE);
   EXPECT_EQ(msg.index, 40u);
@@ -102,6 +109,33 @@ TEST(SceneEventConverter, ACollapseMovesItsBodiesOnAsOneAtTheirCentreOfMass) {
   EXPECT_EQ(msg.positions, (std::vector<double>{-0.5, -0.5, -0.5}));
   EXPECT_DOUBLE_EQ(msg.energy_lost, 0.5 - 1.0 / 6);  // 1/2 J before, 3 (1/2)(1/9) J after
   EXPECT_DOUBLE_EQ(converter.energyTransferMsg(msg).cumulative_energy_lost, 1.0 / 3);
+}
+
+// The collapse above with a fourth body D (1 kg at x = -10 m, 0.5 m/s, e = 0.5 with C) that
+// meets the cluster afterwards. By hand: the cluster's centre of mass is at 2 - t/3 m, so D
+// meets it at t = 14.4 s, x = -2.8 m; one body of 3 kg at -1/3 m/s against 1 kg at 1/2 m/s
+// (momentum -1/2, approach 5/6 m/s) leaves the cluster at -1/48 m/s and D at -7/16 m/s, and
+// turns (1 - e^2) mu A^2 / 2 = (3/4)(3/4)(25/36)/2 = 25/128 J into heat.
+TEST(SceneEventConverter, AnImpactAfterACollapseMovesTheWholeClusterAsItsRecordSays) {
+  SceneEventConverter converter({{1, 1, 1, 1}, {3, 2, 1, -10}, {-1, 0, 0, 0.5}, {0.05, 0.05, 0.5}});
+  collision_lab::core::Collapse collapse;
+  collapse.first_body = 0, collapse.last_body = 2, collapse.time = 3.5, collapse.position = 2 - 3.5 / 3;
+  collapse.velocity = -1.0 / 3;
+  converter.collapse(collapse);
+  const auto msg = converter.impact(
+      record(41, 2, 14.4, -2.8, {-1.0 / 3, 0.5}, {-1.0 / 48, -7.0 / 16}, {0, 0}, 25.0 / 128, 0, 3));
+  EXPECT_TRUE(msg.cluster_impact);
+  EXPECT_EQ(msg.first_moved, 0u);
+  EXPECT_EQ(msg.last_moved, 3u);
+  ASSERT_EQ(msg.velocities_before.size(), 4u);
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_DOUBLE_EQ(msg.velocities_before[i], -1.0 / 3);
+  EXPECT_EQ(msg.velocities_before[3], 0.5);
+  EXPECT_EQ(msg.velocities_after, (std::vector<double>{-1.0 / 48, -1.0 / 48, -1.0 / 48, -7.0 / 16}));
+  EXPECT_EQ(msg.positions, (std::vector<double>{-2.8, -2.8, -2.8, -2.8}));
+  EXPECT_DOUBLE_EQ(msg.total_momentum, -0.5);
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_DOUBLE_EQ(msg.energy_transfer[i], 0.5 / 2304 - 1.0 / 18);
+  EXPECT_DOUBLE_EQ(msg.energy_transfer[3], 49.0 / 512 - 0.125);
+  EXPECT_DOUBLE_EQ(converter.energyTransferMsg(msg).cumulative_energy_lost, 1.0 / 3 + 25.0 / 128);
 }
 
 TEST(SceneEventConverter, AboveTheFullStateLimitOnlyThePairFieldsAndThePlotsCarryTheBodies) {

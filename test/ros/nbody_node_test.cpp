@@ -245,6 +245,86 @@ TEST(NBodyNode, ThreeEqualMassesCollapseAtE005) {
   EXPECT_NEAR(out.energies.back().cumulative_energy_lost, 1.0 / 3, 1e-12);
 }
 
+// A, B, C (1 kg each at x = 3, 2, 1 m, v = -1, 0, 0 m/s, e = 0.05) collapse; then D (1 kg
+// at -10 m, 0.5 m/s, e = 0.5 with C) hits the cluster. By hand: the cluster's centre of mass
+// is at 2 - t/3 m throughout, so the collapse is at x = 2 - t_c/3 and D meets the cluster
+// at t = 14.4 s, x = -2.8 m. (Impacts of equal masses keep every velocity of A, B, C within
+// [-1, 0] m/s, so C stays right of 1 - t m and D, at -10 + t/2 m, could not reach it before
+// t = 22/3 s: after the collapse, about 3.5 s.) The cluster is one body of 3 kg at -1/3 m/s against
+// 1 kg at 1/2 m/s: momentum -1/2 kg m/s, approach 5/6 m/s, so it leaves at
+// (-1/2 + (1/2)(5/6))/4 = -1/48 m/s and D at (-1/2 - 3 (1/2)(5/6))/4 = -7/16 m/s, with
+// (1 - e^2) mu A^2 / 2 = (3/4)(3/4)(25/36)/2 = 25/128 J of heat; the collapse turned 1/3 J.
+TEST(NBodyNode, AnImpactAfterACollapseIsPublishedAfterTheCollapseAndMovesTheWholeCluster) {
+  const auto input = scene("impact_after_collapse", {1, 1, 1, 1}, {3, 2, 1, -10}, {-1, 0, 0, 0.5}, {0.05, 0.05, 0.5});
+  const auto& out = run(g_node, input);
+  ASSERT_EQ(out.summaries.size(), 1u) << (out.rejections.empty() ? "" : out.rejections.front().message);
+  const auto& s = out.summaries.front();
+  EXPECT_TRUE(s.collapsed);
+  EXPECT_EQ(s.collapse_count, 1u);
+  EXPECT_EQ(s.cluster_impacts, 1u);
+  const std::size_t k = s.collision_count;  // impacts 1..k-1 of A, B, C, the collapse, impact k
+  ASSERT_GE(k, 2u);
+  ASSERT_EQ(out.events.size(), k + 1);
+  ASSERT_EQ(out.velocities.size(), k + 1);
+  // The collapse record comes in its place: after the last impact of A, B, C, before D's.
+  const auto& collapse = out.events[k - 1];
+  ASSERT_EQ(collapse.kind, collision_lab::CollisionEvent::KIND_COLLAPSE);
+  for (std::size_t j = 0; j < out.events.size(); ++j) {
+    if (j != k - 1) {
+      EXPECT_EQ(out.events[j].kind, collision_lab::CollisionEvent::KIND_IMPACT) << "record " << j;
+    }
+  }
+  EXPECT_EQ(collapse.index, k - 1);
+  EXPECT_EQ(collapse.first_moved, 0u);
+  EXPECT_EQ(collapse.last_moved, 2u);
+  EXPECT_EQ(collapse.time, s.collapse_time);
+  // The limit of the exact impact times of A, B, C alone (their intervals shrink by about
+  // 0.16 per pair of impacts, so 60 impacts pin it far below 1e-12 s).
+  const reference::Run abc = reference::simulate({{1, 1, 1}, {3, 2, 1}, {-1, 0, 0}, {0.05, 0.05}}, 60);
+  EXPECT_TRUE(abc.truncated);  // still colliding: a collapse
+  EXPECT_NEAR(collapse.time, toDouble(abc.last_time), 1e-12);
+  EXPECT_NEAR(collapse.position, 2 - collapse.time / 3, 1e-12);
+  EXPECT_LE(out.events[k - 2].time, collapse.time);
+  EXPECT_LE(out.events[k - 2].header.stamp, collapse.header.stamp);
+  EXPECT_LE(collapse.header.stamp, out.events[k].header.stamp);
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_NEAR(out.velocities[k - 1].v[i], -1.0 / 3, 1e-15);
+  EXPECT_EQ(out.velocities[k - 1].v[3], 0.5);  // D untouched so far
+
+  const auto& impact = out.events[k];
+  EXPECT_EQ(impact.index, k);
+  EXPECT_EQ(impact.pair_index, 2u);
+  EXPECT_TRUE(impact.cluster_impact);
+  EXPECT_EQ(impact.first_moved, 0u);
+  EXPECT_EQ(impact.last_moved, 3u);
+  EXPECT_EQ(impact.restitution, 0.5);
+  EXPECT_NEAR(impact.time, 14.4, 1e-12);
+  EXPECT_NEAR(impact.position, -2.8, 1e-12);
+  EXPECT_NEAR(impact.pair_velocities_before[0], -1.0 / 3, 1e-15);
+  EXPECT_NEAR(impact.pair_velocities_after[0], -1.0 / 48, 1e-15);
+  EXPECT_NEAR(impact.pair_velocities_after[1], -7.0 / 16, 1e-15);
+  EXPECT_NEAR(impact.energy_lost, 25.0 / 128, 1e-15);
+  const std::vector<double> by_hand{-1.0 / 48, -1.0 / 48, -1.0 / 48, -7.0 / 16};
+  ASSERT_EQ(s.final_velocities.size(), 4u);
+  for (std::size_t i = 0; i < 4; ++i) {
+    EXPECT_NEAR(s.final_velocities[i], by_hand[i], 1e-15) << "body " << i;
+    EXPECT_NEAR(impact.velocities_after[i], by_hand[i], 1e-15) << "body " << i;
+    EXPECT_NEAR(out.velocities.back().v[i], by_hand[i], 1e-15) << "body " << i;
+  }
+  EXPECT_NEAR(s.energy_lost, 1.0 / 3 + 25.0 / 128, 1e-12);
+  EXPECT_NEAR(out.energies.back().cumulative_energy_lost, 1.0 / 3 + 25.0 / 128, 1e-12);
+
+  // The bag keeps the same order.
+  ASSERT_TRUE(s.recording_ok) << s.recording_error;
+  rosbag::Bag bag(s.bag_path, rosbag::bagmode::Read);
+  std::vector<std::uint8_t> kinds;
+  for (const auto& m : rosbag::View(bag, rosbag::TopicQuery("/collision_lab/collision_events"))) {
+    kinds.push_back(m.instantiate<collision_lab::CollisionEvent>()->kind);
+  }
+  ASSERT_EQ(kinds.size(), k + 1);
+  EXPECT_EQ(kinds[k - 1], collision_lab::CollisionEvent::KIND_COLLAPSE);
+  EXPECT_EQ(kinds[k], collision_lab::CollisionEvent::KIND_IMPACT);
+}
+
 TEST(NBodyNode, CollapseTimeAtE006IsPhysicsMdsValue) {
   const auto& out = run(g_node, scene("collapse_e006", {1, 1, 1}, {2, 1, 0}, {-1, 0, 0}, {0.06}));
   ASSERT_EQ(out.summaries.size(), 1u);

@@ -88,6 +88,9 @@ ThreeBodyScene toThreeBodyScene(const Scene& scene);
 struct SceneVisitors {
   LabEventVisitor three_body_event;  ///< every event of the three-body path (full mode)
   ImpactVisitor impact;              ///< every impact of the event engine (full mode)
+  /// Every collapse the event engine resolves (full mode), in order with the impacts
+  /// (CollapseVisitor: right after the record of impact impacts_before).
+  CollapseVisitor collapse;
   ProgressCallback progress;         ///< the event engine's progress
 };
 

@@ -101,11 +101,13 @@ collision_lab::Velocities toVelocitiesMsg(const collision_lab::CollisionEvent& e
 collision_lab::EnergyTransfer toEnergyTransferMsg(const collision_lab::CollisionEvent& event,
                                                   double cumulative_energy_lost);
 
-/// The run's bodies, followed through the engine's notifications, and the CollisionEvent
-/// of each. Velocities are kept for every body; positions (and the per-body arrays of the
-/// messages) only for N <= FULL_STATE_MAX_BODIES: a body moves to x + v (t - t_last)
-/// between notifications, and the bodies an impact or a collapse moved sit at its point.
-/// Header and run_id are the caller's to fill.
+/// The run's bodies, followed through the engine's notifications in the order the engine
+/// gives them (impacts and collapses interleaved, engine.h), and the CollisionEvent of each.
+/// Velocities are kept for every body, set from the notifications alone: an impact sets
+/// its record's first_moved..last_moved, a collapse its bodies to Collapse::velocity.
+/// Positions (and the per-body arrays of the messages) only for N <= FULL_STATE_MAX_BODIES:
+/// a body moves to x + v (t - t_last) between notifications, and the bodies an impact or a
+/// collapse moved sit at its point. Header and run_id are the caller's to fill.
 class SceneEventConverter {
  public:
   explicit SceneEventConverter(const collision_lab::core::Scene& scene);
@@ -127,13 +129,10 @@ class SceneEventConverter {
   /// Fills the per-body arrays and totals of msg (or empties them, NaN totals, for large N).
   void fillBodies(collision_lab::CollisionEvent& msg, const std::vector<double>& velocities_before) const;
   double kinetic(std::size_t body) const;
-  /// Extends body's cluster (bodies stuck by e = 0 or a collapse) to the right (-1) or left (+1).
-  std::size_t clusterEnd(std::size_t body, int direction) const;
 
   collision_lab::core::Scene scene_;
   bool full_state_;
   std::vector<double> x_, v_;
-  std::vector<bool> stuck_;  ///< stuck_[i]: bodies i and i + 1 move as one
   double t_ = 0.0;
   double cumulative_lost_ = 0.0;
   std::size_t moved_first_ = 0;
