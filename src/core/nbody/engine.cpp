@@ -159,6 +159,7 @@ class Driver {
       const StepResult r = startOrEscalate<S>();
       if (r.kind != StepKind::kImpact) return {StepKind::kInconsistent, r.pair, r.time};
     }
+    skipAhead<S>(target);
     if (tier<S>()->count() > target) return {StepKind::kInconsistent, 0, 0.0};
     // A replay must retrace the impacts already taken; only the exact tier's size cap may stop it.
     const auto failed = [](const StepResult& r) {
@@ -171,6 +172,19 @@ class Driver {
       const StepResult r = stepOrEscalate<S>(nullptr);
       if (r.kind != StepKind::kImpact) return failed(r);
       ++escalations_.replayed_impacts;
+    }
+  }
+
+  /// The next tier may be ahead of tier S, at most at `target`: an exact tie goes from
+  /// double-double straight to the rationals, past the 100-digit tier. Tier S then starts
+  /// from that state, so its replay never asks the next tier to decide at a count it has
+  /// already passed (it cannot go back: that was the tiers' disagreement).
+  template <class S>
+  void skipAhead(std::uint64_t target) {
+    if constexpr (!Arithmetic<S>::kExact) {
+      const auto& higher = tier<typename NextTier<S>::type>();
+      Tier<S>& t = *tier<S>();
+      if (higher && higher->count() > t.count() && higher->count() <= target) t.adopt(*higher);
     }
   }
 

@@ -248,9 +248,11 @@ class Tier {
       bodies_[k] = {b, v};
     }
     addLoss(heat);
-    const double ops = 4.0 * static_cast<double>(hi - lo + 3) * Ar::kOpError * sqrt_mass;
-    eu_ += ops * std::fabs(Ar::toDouble(v)) + kTiny;
-    eb_ += ops * std::fabs(Ar::toDouble(b)) + kTiny;
+    if constexpr (!Ar::kExact) {  // the exact tier's bounds stay 0: it must decide every tie
+      const double ops = 4.0 * static_cast<double>(hi - lo + 3) * Ar::kOpError * sqrt_mass;
+      eu_ += ops * std::fabs(Ar::toDouble(v)) + kTiny;
+      eb_ += ops * std::fabs(Ar::toDouble(b)) + kTiny;
+    }
     for (std::size_t k = lo; k < hi; ++k) bonded_[k] = 1, setSchedule(k, kInf, kInf);
     for (std::size_t r : {lo, hi + 1}) {
       if (r == 0 || r > pairs_.size()) continue;
