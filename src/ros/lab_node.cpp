@@ -181,10 +181,23 @@ void addValue(diagnostic_msgs::DiagnosticStatus& status, const std::string& key,
   status.values.push_back(pair);
 }
 
+/// "predicted 31", or why there is no count ("no count predicted by event_engine"), and the
+/// collapse when there is one.
+std::string predictedText(const collision_lab::RunSummary& summary) {
+  std::ostringstream text;
+  if (summary.predicted_collision_count_defined) {
+    text << "predicted " << summary.predicted_collision_count;
+  } else {
+    text << "no count predicted by " << summary.model_name;
+  }
+  if (summary.collapsed) text << ", collapsed at t = " << summary.collapse_time << " s";
+  return text.str();
+}
+
 void logRun(const collision_lab::RunSummary& summary) {
   ROS_INFO_STREAM("run " << summary.run_id << ": " << summary.collision_count << " collisions"
-                  << (summary.truncated ? " (truncated)" : "") << ", predicted "
-                  << summary.predicted_collision_count << ", " << summary.compute_time << " s"
+                  << (summary.truncated ? " (truncated)" : "") << ", " << predictedText(summary)
+                  << ", " << summary.compute_time << " s"
                   << (summary.bag_path.empty() ? std::string() : ", bag " + summary.bag_path));
 }
 
@@ -207,8 +220,7 @@ void fillResponse(const std::optional<ServeOutcome>& outcome, Response& response
   const collision_lab::RunSummary& s = *outcome->summary;
   response.summary = s;
   std::ostringstream line;
-  line << "run " << s.run_id << ": " << s.collision_count << " collisions, predicted "
-       << s.predicted_collision_count;
+  line << "run " << s.run_id << ": " << s.collision_count << " collisions, " << predictedText(s);
   if (s.truncated) line << " (truncated: " << s.truncation_reason << ")";
   if (!s.requested_run_id.empty()) line << "; run_id '" << s.requested_run_id << "' was taken";
   if (s.bag_path.empty()) {

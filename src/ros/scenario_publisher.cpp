@@ -33,6 +33,7 @@
 #include <ros/ros.h>
 
 #include "collision_lab/InitialConditions.h"
+#include "collision_lab/Prediction.h"
 #include "collision_lab/RunScene.h"
 #include "collision_lab/io/scenario_file.h"
 
@@ -75,8 +76,12 @@ Row row(const std::string& scene, const collision_lab::RunScene::Response& respo
   const std::string collisions = std::to_string(s.collision_count) + (s.collapsed ? "+c" : "") +
                                  (s.cancelled ? " (cancelled)" : s.truncated ? "*" : "") +
                                  (s.simulated ? "" : " (n/s)");
-  const std::string predicted =
-      s.predicted_collision_count_defined ? std::to_string(s.predicted_collision_count) : "-";
+  // Infinitely many: a body between two walls, or the spiral's predicted collapse.
+  const bool infinite = s.model == collision_lab::Prediction::MODEL_TWO_WALLS_INFINITE ||
+                        (s.model == collision_lab::Prediction::MODEL_THREE_BODY_SPIRAL && s.collapsed);
+  const std::string predicted = s.predicted_collision_count_defined ? std::to_string(s.predicted_collision_count)
+                                : infinite                           ? "inf"
+                                                                     : "-";
   const std::string paper =
       s.paper_predicted_collision_count_defined ? std::to_string(s.paper_predicted_collision_count) : "-";
   const std::string bag = s.bag_path.empty()     ? std::string("(not recorded)")
@@ -129,8 +134,8 @@ void printTable(const std::vector<Row>& rows) {
                 "collisions", "predicted", "paper", "error", "heat [J]", "bag");
   table << "\n" << header << "\n" << std::string(130, '-') << "\n";
   for (const auto& r : rows) table << r.text << "\n";
-  table << "(* truncated at the collision cap; +c: then an inelastic collapse; n/s: not simulated; -: no "
-           "formula;\n paper: eq. (3.22); error: the simulation against the closed form (RunSummary."
+  table << "(* truncated at the collision cap; +c: then an inelastic collapse; n/s: not simulated; inf: infinitely "
+           "many; -: no formula;\n paper: eq. (3.22); error: the simulation against the closed form (RunSummary."
            "max_prediction_error; nan: no closed form); heat: kinetic energy lost)\n";
   std::cout << table.str() << std::flush;
 }
