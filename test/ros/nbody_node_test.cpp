@@ -26,6 +26,7 @@
 
 namespace {
 
+using collision_lab_test::callService;
 using collision_lab_test::RunCollector;
 using collision_lab_test::RunOutputs;
 using collision_lab_test::waitUntil;
@@ -53,25 +54,6 @@ collision_lab::InitialConditions scene(const std::string& run_id, std::vector<do
 const RunOutputs& run(RunCollector* node, const collision_lab::InitialConditions& input) {
   node->publish(input);
   return node->waitFor(input.run_id);
-}
-
-/// Calls service in a thread of its own while the main thread spins the collector.
-template <class Service>
-bool callService(const std::string& service, Service& call) {
-  struct Shared {
-    Service call;
-    std::atomic<bool> done{false};
-    bool ok = false;
-  };
-  auto shared = std::make_shared<Shared>();
-  shared->call = call;
-  std::thread([shared, service] {
-    shared->ok = ros::service::call(service, shared->call);
-    shared->done = true;
-  }).detach();
-  if (!waitUntil([&] { return shared->done.load(); }, "an answer from " + service)) return false;
-  call = shared->call;
-  return shared->ok;
 }
 
 double toDouble(const reference::Rational& r) { return static_cast<double>(r); }

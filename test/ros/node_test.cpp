@@ -30,6 +30,7 @@
 
 namespace {
 
+using collision_lab_test::callService;
 using collision_lab_test::makeInput;
 using collision_lab_test::RunCollector;
 using collision_lab_test::RunOutputs;
@@ -46,26 +47,6 @@ RunCollector* g_node = nullptr;      // namespace collision_lab
 RunCollector* g_faulty = nullptr;    // namespace collision_lab_faulty
 constexpr char kRunScene[] = "/collision_lab/collision_lab_node/run_scene";
 constexpr char kRunPreset[] = "/collision_lab/collision_lab_node/run_preset";
-
-/// Calls service like ros::service::call, but gives up after kWaitTimeout with a failure
-/// naming the service (the call then finishes, unseen, in its own thread).
-template <class Service>
-bool callService(const std::string& service, Service& call) {
-  struct Shared {
-    Service call;
-    std::atomic<bool> done{false};
-    bool ok = false;
-  };
-  auto shared = std::make_shared<Shared>();
-  shared->call = call;
-  std::thread([shared, service] {
-    shared->ok = ros::service::call(service, shared->call);
-    shared->done = true;
-  }).detach();
-  if (!waitUntil([&] { return shared->done.load(); }, "an answer from " + service)) return false;
-  call = shared->call;
-  return shared->ok;
-}
 
 /// Publishes input to node unless this run_id was sent before, and waits for the run.
 const RunOutputs& runOnce(RunCollector* node, const collision_lab::InitialConditions& input) {

@@ -4,11 +4,14 @@
 // what it waited for, so a regression fails instead of hanging until rostest's limit.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -129,6 +132,26 @@ inline collision_lab::InitialConditions makeInput(const std::string& run_id,
   input.positions.assign(positions.begin(), positions.end());
   input.velocities.assign(velocities.begin(), velocities.end());
   return input;
+}
+
+/// Calls service like ros::service::call, but gives up after kWaitTimeout with a failure
+/// naming the service (the call then finishes, unseen, in its own thread).
+template <class Service>
+bool callService(const std::string& service, Service& call) {
+  struct Shared {
+    Service call;
+    std::atomic<bool> done{false};
+    bool ok = false;
+  };
+  auto shared = std::make_shared<Shared>();
+  shared->call = call;
+  std::thread([shared, service] {
+    shared->ok = ros::service::call(service, shared->call);
+    shared->done = true;
+  }).detach();
+  if (!waitUntil([&] { return shared->done.load(); }, "an answer from " + service)) return false;
+  call = shared->call;
+  return shared->ok;
 }
 
 }  // namespace collision_lab_test
