@@ -84,6 +84,13 @@ core::SceneRunResult runWithProgress(const core::Scene& scene, const core::RunOp
   return core::runScene(scene, options, visitors);
 }
 
+/// The policy counts impacts. Under first:N a collapse is shown when it comes before impact
+/// N + 1 (so right after impact N at the latest), as the impacts around it would be.
+bool showsCollapse(const core::EventPolicy& policy, const core::Collapse& collapse) {
+  return policy.kind == core::EventPolicy::Kind::kAll ||
+         (policy.kind == core::EventPolicy::Kind::kFirstN && collapse.impacts_before <= policy.first_n);
+}
+
 /// The visitors that hand the shown events to the writer of their path.
 core::SceneVisitors showEvents(const core::RunOptions& shown, io::RunReportWriter& three_body,
                                io::SceneReportWriter& nbody) {
@@ -95,6 +102,9 @@ core::SceneVisitors showEvents(const core::RunOptions& shown, io::RunReportWrite
   };
   visitors.impact = [&nbody, policy](const core::ImpactRecord& impact) {
     if (policy.keeps(impact.index)) nbody.impact(impact);
+  };
+  visitors.collapse = [&nbody, policy](const core::Collapse& collapse) {
+    if (showsCollapse(policy, collapse)) nbody.collapse(collapse);
   };
   // The event engine runs to the end even when only the first N impacts are shown.
   return visitors;

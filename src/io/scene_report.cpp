@@ -69,6 +69,11 @@ std::string restitutionText(const core::Scene& scene) {
 const char* const kNoCountFormula =
     "none: no closed form gives the number of impacts of this scene; the count is the exact event engine's";
 
+/// "A..C": the bodies of a collapse.
+std::string collapseBodies(const core::Collapse& c) {
+  return core::bodyName(c.first_body) + ".." + core::bodyName(c.last_body);
+}
+
 std::string stopReasonText(const core::SceneSimulation& s) {
   return s.simulated ? core::stopReasonName(s.stop) : "NOT_SIMULATED";
 }
@@ -138,6 +143,14 @@ class SceneTableWriter : public SceneReportWriter {
       out_ << padLeft(humanText(value, kEventDigits), 15);
     }
     out_ << "\n";
+  }
+
+  void collapse(const core::Collapse& c) override {
+    if (!header_written_) writeImpactHeader();
+    out_ << padLeft("-", 9) << padLeft("-", 8) << "  collapse of bodies " << collapseBodies(c)
+         << " at t = " << humanText(c.time, kDigits) << " s, x = " << humanText(c.position, kDigits)
+         << " m (the limit of infinitely many impacts, not counted), then all at " << humanText(c.velocity, kDigits)
+         << " m/s\n";
   }
 
   void end(const core::SceneRunResult& result) override {
@@ -210,7 +223,8 @@ class SceneTableWriter : public SceneReportWriter {
 
   void writeImpactHeader() {
     header_written_ = true;
-    out_ << "\nImpacts (velocities of the pair's two bodies after it, right body first; energy turned into heat)\n"
+    out_ << "\nImpacts (velocities of the pair's two bodies after it, right body first; energy turned into heat;"
+            " a collapse on a line of its own)\n"
          << padLeft("#", 9) << padLeft("pair", 8);
     for (const char* label : {"t [s]", "x [m]", "v_right [m/s]", "v_left [m/s]", "lost [J]"}) {
       out_ << padLeft(label, 15);
@@ -307,10 +321,8 @@ class SceneJsonWriter : public SceneReportWriter {
          << ",\n\"events\": [";
   }
 
-  void impact(const core::ImpactRecord& impact) override {
-    out_ << (any_event_ ? ",\n" : "\n") << jsonText(impactJson(impact));
-    any_event_ = true;
-  }
+  void impact(const core::ImpactRecord& impact) override { writeEvent(impactJson(impact)); }
+  void collapse(const core::Collapse& collapse) override { writeEvent(collapseJson(collapse)); }
 
   void end(const core::SceneRunResult& result) override {
     out_ << (any_event_ ? "\n]" : "]") << ",\n\"summary\": ";
@@ -319,13 +331,20 @@ class SceneJsonWriter : public SceneReportWriter {
   }
 
  private:
+  void writeEvent(const Json& event) {
+    out_ << (any_event_ ? ",\n" : "\n") << jsonText(event);
+    any_event_ = true;
+  }
+
   std::ostream& out_;
   bool any_event_ = false;
 };
 
 // ---------------------------------------------------------------------------------------
 // CSV: "# key,value..." comment lines for the scene, options and model, a header line, one
-// row per impact, then "# summary.key,value..." lines (the JSON summary's keys).
+// row per event (kind impact or collapse), then "# summary.key,value..." lines (the JSON
+// summary's keys). A collapse row leaves the pair, the velocities before and the energies
+// empty; its index is the number of impacts before it.
 
 void writeCsvComment(std::ostream& out, const std::string& key, const Json& value) {
   if (value.is_object()) {
@@ -373,7 +392,7 @@ class SceneCsvWriter : public SceneReportWriter {
     writeCsvComment(out_, "model", core::modelKindName(model.kind));
     writeCsvComment(out_, "model_reason", model.reason);
     out_ << "index,pair,pair_index,time_s,position_m,v_right_before_m_s,v_left_before_m_s,v_right_after_m_s,"
-            "v_left_after_m_s,energy_gained_right_J,energy_gained_left_J,energy_lost_J\n";
+            "v_left_after_m_s,energy_gained_right_J,energy_gained_left_J,energy_lost_J,kind,first_moved,last_moved\n";
   }
 
   void impact(const core::ImpactRecord& r) override {
@@ -382,7 +401,13 @@ class SceneCsvWriter : public SceneReportWriter {
                      r.velocities_after[1], r.energy_gained[0], r.energy_gained[1], r.energy_lost}) {
       out_ << "," << csvNumber(v);
     }
-    out_ << "\n";
+    out_ << ",impact," << r.first_moved << "," << r.last_moved << "\n";
+  }
+
+  void collapse(const core::Collapse& c) override {
+    out_ << c.impacts_before << ",,," << csvNumber(c.time) << "," << csvNumber(c.position) << ",,,"
+         << csvNumber(c.velocity) << "," << csvNumber(c.velocity) << ",,,,collapse," << c.first_body << ","
+         << c.last_body << "\n";
   }
 
   void end(const core::SceneRunResult& result) override {
@@ -532,7 +557,8 @@ Json sceneEntryJson(const SceneEntry& entry) {
 }
 
 Json impactJson(const core::ImpactRecord& r) {
-  return Json{{"index", r.index},
+  return Json{{"kind", "impact"},
+              {"index", r.index},
               {"pair", core::pairName(r.pair_index)},
               {"pair_index", r.pair_index},
               {"bodies", Json::array({core::bodyName(r.pair_index), core::bodyName(r.pair_index + 1)})},
@@ -542,6 +568,18 @@ Json impactJson(const core::ImpactRecord& r) {
               {"velocities_after", Json::array({number(r.velocities_after[0]), number(r.velocities_after[1])})},
               {"energy_gained", Json::array({number(r.energy_gained[0]), number(r.energy_gained[1])})},
               {"energy_lost", number(r.energy_lost)}};
+}
+
+Json collapseJson(const core::Collapse& c) {
+  return Json{{"kind", "collapse"},
+              {"impacts_before", c.impacts_before},
+              {"first_body", core::bodyName(c.first_body)},
+              {"last_body", core::bodyName(c.last_body)},
+              {"first_body_index", c.first_body},
+              {"last_body_index", c.last_body},
+              {"time", number(c.time)},
+              {"position", number(c.position)},
+              {"velocity", number(c.velocity)}};
 }
 
 Json sceneSummaryJson(const core::SceneRunResult& result) {

@@ -23,13 +23,15 @@ namespace io {
 /// Bodies shown at each end of the table's body lists.
 constexpr std::size_t kTableBodies = 5;
 
-/// Writes the report of one N-body run while it runs: begin(), impact() for each impact to
-/// show, then end(). Nothing is kept per impact.
+/// Writes the report of one N-body run while it runs: begin(), then impact() and collapse()
+/// for each event to show, in the order they happen, then end(). Nothing is kept per event.
 class SceneReportWriter {
  public:
   virtual ~SceneReportWriter() = default;
   virtual void begin(const SceneEntry& entry, const core::RunOptions& options, const core::ModelChoice& model) = 0;
   virtual void impact(const core::ImpactRecord& impact) = 0;
+  /// An inelastic collapse: an event of its own, not counted as a collision.
+  virtual void collapse(const core::Collapse& collapse) = 0;
   virtual void end(const core::SceneRunResult& result) = 0;
 };
 
@@ -42,8 +44,12 @@ std::unique_ptr<RunReportWriter> makeThreeBodyReportWriter(ReportFormat format, 
 
 /// name, description, bodies (N), masses, positions, velocities, restitution, walls (names).
 Json sceneEntryJson(const SceneEntry& entry);
-/// One impact: pair (name) and pair_index, bodies, time, position, velocities, energies.
+/// One impact: kind "impact", index, pair (name) and pair_index, bodies, time, position,
+/// velocities, energies.
 Json impactJson(const core::ImpactRecord& impact);
+/// One collapse: kind "collapse", impacts_before, first_body and last_body (names and
+/// indices), time [s], position [m], velocity (the cluster's, after it) [m/s].
+Json collapseJson(const core::Collapse& collapse);
 /// The summary of an N-body run (see docs/cli.md for the keys).
 Json sceneSummaryJson(const core::SceneRunResult& result);
 
