@@ -2,11 +2,14 @@
 # Regenerates every benchmark output in docs/ with one command:
 #   docs/speed_vs_error.csv, docs/speed_vs_error.md, docs/speed_vs_error.png  (collision_lab_speed_vs_error)
 #   docs/hard_cases.md                                                        (collision_lab_hard_cases)
+#   docs/restitution_count.csv, docs/restitution_count.png                   (collision_lab_bench_restitution,
+#                                                                              bench/plot_restitution_count.py)
 # and prints the core speed benchmark (collision_lab_bench_core).
 #
 # Usage: bash bench/run_benchmarks.sh [--quick]
-#   --quick: fewer scenes, dt values and repeats (each program under a minute); outputs go
-#            to $BUILD_DIR/bench_quick/ instead of docs/.
+#   --quick: fewer scenes, dt values and repeats (each program under a minute, except the
+#            restitution sweep: one repeat, but its exact run at e = r_c + 1e-6 alone takes
+#            about 2 minutes); outputs go to $BUILD_DIR/bench_quick/ instead of docs/.
 # Environment: BUILD_DIR (default: build_bench next to this repository's sources).
 # Needs: libgmp-dev; optional engines libbullet-dev, libode-dev, libbox2d-dev; python3-matplotlib.
 set -euo pipefail
@@ -24,7 +27,8 @@ fi
 export COLLISION_LAB_BENCH_SOURCE
 
 cmake -S "$repo" -B "$build" -DCMAKE_BUILD_TYPE=Release >/dev/null
-cmake --build "$build" -j2 --target collision_lab_bench_core collision_lab_speed_vs_error collision_lab_hard_cases
+cmake --build "$build" -j2 --target collision_lab_bench_core collision_lab_speed_vs_error collision_lab_hard_cases \
+  collision_lab_bench_restitution
 bin="$build/devel/lib/collision_lab"
 
 if [[ "${1:-}" == "--quick" ]]; then
@@ -33,11 +37,17 @@ if [[ "${1:-}" == "--quick" ]]; then
   "$bin/collision_lab_speed_vs_error" --quick --csv "$out/speed_vs_error.csv" --md "$out/speed_vs_error.md" \
     --plot "$out/speed_vs_error.png" >/dev/null
   "$bin/collision_lab_hard_cases" --quick --md "$out/hard_cases.md" >/dev/null
+  "$bin/collision_lab_bench_restitution" --repeats 1 --csv "$out/restitution_count.csv" >/dev/null
+  python3 "$repo/bench/plot_restitution_count.py" --csv "$out/restitution_count.csv" --out "$out/restitution_count.png"
   "$bin/collision_lab_bench_core" --quick
   echo "quick outputs in $out" >&2
 else
   "$bin/collision_lab_speed_vs_error" >/dev/null
   "$bin/collision_lab_hard_cases" >/dev/null
+  "$bin/collision_lab_bench_restitution" >/dev/null
+  python3 "$repo/bench/plot_restitution_count.py" --csv "$repo/docs/restitution_count.csv" \
+    --out "$repo/docs/restitution_count.png"
   "$bin/collision_lab_bench_core"
-  echo "regenerated $repo/docs/speed_vs_error.{csv,md,png} and $repo/docs/hard_cases.md" >&2
+  echo "regenerated $repo/docs/speed_vs_error.{csv,md,png}, $repo/docs/hard_cases.md and" \
+    "$repo/docs/restitution_count.{csv,png}" >&2
 fi
