@@ -86,7 +86,6 @@ TEST(ImpactStream, ReplayOfRecordsAndNoticesGivesTheFinalVelocitiesExactly) {
   std::uint64_t collapses = 0, cluster_impacts = 0, runs = 0;
   for (int scene_index = 0; scene_index < 300; ++scene_index) {
     testing_support::SceneMix mix;
-    mix.walls = false;  // a body squeezed against a wall is not resolved yet
     mix.mass_decades = scene_index % 2 == 0 ? 0.0 : 0.5;  // half equal masses: collapses are frequent
     Scene scene = testing_support::randomScene(rng, size(rng), mix);
     scene.restitution.clear();
