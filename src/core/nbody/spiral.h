@@ -20,6 +20,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <optional>
 
 #include <boost/multiprecision/cpp_bin_float.hpp>
@@ -38,31 +39,50 @@ using Rational = boost::multiprecision::cpp_rational;
 constexpr std::uint64_t kWalkLimit = std::uint64_t{1} << 26;  ///< impacts; beyond: undecided
 constexpr std::uint64_t kRationalLimit = 3000;              ///< impacts walked in rationals
 
-/// Masses [kg] (finite) and restitution [1] of three bodies (or clusters); the cycle's
-/// invariants. e_bc < 0 means e_bc = e (the model's case: one e for both pairs).
+/// Masses [kg] and restitution [1] of three bodies (or clusters); the cycle's invariants.
+/// e_bc < 0 means e_bc = e (the model's case: one e for both pairs). wall_a (wall_c): A (C)
+/// is a wall, an infinite mass, and m[0] (m[2]) is unused; then m_A/(m_A+m_B) = 1, so
+/// k_A = 1+e and cos^2(alpha) = m_C/(m_B+m_C). Not both: then T^2 - 4 e^2 has the dominant
+/// eigenvalue 1 (no collapse) and collapseTime() would divide by a wall's relative speed.
 struct Cycle {
   double m[3];
   double e;
   double e_bc = -1.0;
+  bool wall_a = false, wall_c = false;
   double eBC() const { return e_bc < 0 ? e : e_bc; }
-  double cos2_alpha() const { return m[0] * m[2] / ((m[0] + m[1]) * (m[1] + m[2])); }
+  /// m_A/(m_A+m_B) and m_C/(m_B+m_C) in arithmetic T (1 for a wall); cos^2(alpha) is their product.
+  template <class T>
+  T ratioA() const { return wall_a ? T(1) : T(m[0]) / (T(m[0]) + T(m[1])); }
+  template <class T>
+  T ratioC() const { return wall_c ? T(1) : T(m[2]) / (T(m[1]) + T(m[2])); }
+  double cos2_alpha() const {
+    if (wall_a || wall_c) return ratioA<double>() * ratioC<double>();
+    return m[0] * m[2] / ((m[0] + m[1]) * (m[1] + m[2]));
+  }
   /// T^2 - 4 e^2 > 0 exactly (real, distinct eigenvalues), decided in rationals.
   bool realEigenvalues() const {
-    const Rational c2 = Rational(m[0]) * m[2] / ((Rational(m[0]) + m[1]) * (Rational(m[1]) + m[2]));
-    const Rational t = (1 + Rational(e)) * (1 + Rational(e)) * c2 - 2 * Rational(e);
+    const Rational t = exactTrace();
     return t * t > 4 * Rational(e) * Rational(e) && t > 0;
   }
   /// T^2 < 4 e^2 exactly: complex eigenvalues, the spiral (e > r_c).
   bool complexEigenvalues() const {
-    const Rational c2 = Rational(m[0]) * m[2] / ((Rational(m[0]) + m[1]) * (Rational(m[1]) + m[2]));
-    const Rational t = (1 + Rational(e)) * (1 + Rational(e)) * c2 - 2 * Rational(e);
+    const Rational t = exactTrace();
     return t * t < 4 * Rational(e) * Rational(e);
   }
   double trace() const { return (1 + e) * (1 + e) * cos2_alpha() - 2 * e; }
   double kappa() const {
     const double t = trace(), gap = std::sqrt(std::fabs(t * t - 4 * e * e));
-    const double spread = std::sqrt(std::max(m[0], std::max(m[1], m[2])) / std::min(m[0], std::min(m[1], m[2])));
-    return (1 + 2 * std::max(e, eBC()) / std::max(gap, 1e-300)) * spread;
+    double heaviest = 0.0, lightest = std::numeric_limits<double>::infinity();  // of the finite masses
+    for (int k = 0; k < 3; ++k) {
+      if ((k == 0 && wall_a) || (k == 2 && wall_c)) continue;
+      heaviest = std::max(heaviest, m[k]), lightest = std::min(lightest, m[k]);
+    }
+    return (1 + 2 * std::max(e, eBC()) / std::max(gap, 1e-300)) * std::sqrt(heaviest / lightest);
+  }
+
+ private:
+  Rational exactTrace() const {
+    return (1 + Rational(e)) * (1 + Rational(e)) * ratioA<Rational>() * ratioC<Rational>() - 2 * Rational(e);
   }
 };
 
@@ -71,8 +91,9 @@ template <class T>
 struct Maps {
   T e_ab, e_bc, k_a, k_c;
   explicit Maps(const Cycle& c)
-      : e_ab(T(c.e)), e_bc(T(c.eBC())), k_a((1 + T(c.e)) * T(c.m[0]) / (T(c.m[0]) + T(c.m[1]))),
-        k_c((1 + T(c.eBC())) * T(c.m[2]) / (T(c.m[1]) + T(c.m[2]))) {}
+      : e_ab(T(c.e)), e_bc(T(c.eBC())),
+        k_a(c.wall_a ? 1 + T(c.e) : (1 + T(c.e)) * T(c.m[0]) / (T(c.m[0]) + T(c.m[1]))),
+        k_c(c.wall_c ? 1 + T(c.eBC()) : (1 + T(c.eBC())) * T(c.m[2]) / (T(c.m[1]) + T(c.m[2]))) {}
   void apply(int pair, T& a, T& c) const {
     if (pair == 0) {
       c = c + k_a * a;

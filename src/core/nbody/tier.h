@@ -191,17 +191,25 @@ class Tier {
 
   /// Pairs p < q alternate with a cluster between them: do the three clusters collapse
   /// (spiral.h, dominates(): every later check provably stays positive), and does nothing
-  /// outside reach them before the collapse time? `q_next`: q hits next (else p). Only
-  /// finite masses and e < 1 on both pairs; conservative: "no" just lets the run go on.
+  /// outside reach them before the collapse time? `q_next`: q hits next (else p). e < 1 on
+  /// both pairs; an outer cluster may hold a wall (a body squeezed against it), not both
+  /// and not the middle one. Conservative: "no" just lets the run go on.
   std::optional<CollapseFound> collapseCandidate(std::size_t p, std::size_t q, bool q_next) const {
     const Scene& scene = tables_.scene;
     const std::size_t lo = clusterLow(p), hi = clusterHigh(q + 1);
     if (clusterHigh(p + 1) != q || scene.restitutionOf(p) == 1.0 || scene.restitutionOf(q) == 1.0) return {};
     spiral_detail::Cycle cycle{{0.0, 0.0, 0.0}, scene.restitutionOf(p), scene.restitutionOf(q)};
     for (std::size_t k = lo; k <= hi; ++k) {
-      if (scene.isWall(k)) return {};
-      cycle.m[k <= p ? 0 : (k <= q ? 1 : 2)] += scene.masses[k];
+      const int part = k <= p ? 0 : (k <= q ? 1 : 2);
+      if (!scene.isWall(k)) {
+        cycle.m[part] += scene.masses[k];
+      } else if (part == 1) {
+        return {};
+      } else {
+        (part == 0 ? cycle.wall_a : cycle.wall_c) = true;
+      }
     }
+    if (cycle.wall_a && cycle.wall_c) return {};
     const Approx a = approach(p), c = approach(q);
     const double size = std::fabs(a.value) + std::fabs(c.value);
     if (!(a.error + c.error <= 0x1p-30 * size)) return {};
@@ -217,41 +225,45 @@ class Tier {
     CollapseFound found{lo, hi, spiral_detail::collapseTime(cycle, q_next ? 1 : 0, dv, db), 0.0};
     const double now = lastTime();
     if (!(found.time >= now) || !clearOfNeighbours(lo, hi, now, found.time)) return {};
-    double mass = 0.0, momentum = 0.0, intercept = 0.0;
-    for (std::size_t k = lo; k <= hi; ++k) {
-      mass += scene.masses[k];
-      momentum += scene.masses[k] * Ar::toDouble(bodies_[k].v);
-      intercept += scene.masses[k] * Ar::toDouble(bodies_[k].b);
-    }
-    found.position = (intercept + momentum * found.time) / mass;
+    const Line line = limitLine(lo, hi);
+    found.position = (line.intercept + line.velocity * found.time) / line.mass;
     return found;
   }
 
-  /// Bodies lo..hi become one cluster at their centre of mass: b and v projected onto the
-  /// mass-weighted mean (the limit of the collapse; an orthogonal projection in mass-weighted
-  /// coordinates, so the error bounds only gain the rounding). The heat of the remaining
-  /// impacts, the group's kinetic energy about its centre, is added to the loss.
+  /// Bodies lo..hi become one cluster on their limit line (limitLine()): the centre of mass,
+  /// b and v projected onto the mass-weighted mean (an orthogonal projection in mass-weighted
+  /// coordinates, so the error bounds only gain the rounding); or, with a wall in the group,
+  /// the wall's line (exact: the bounds stay). The heat of the remaining impacts, the group's
+  /// kinetic energy about that line, is added to the loss.
   StepResult merge(std::size_t lo, std::size_t hi) {
     const Scene& scene = tables_.scene;
-    S mass = S(0), momentum = S(0), intercept = S(0);
-    for (std::size_t k = lo; k <= hi; ++k) {
-      mass = mass + S(scene.masses[k]);
-      momentum = momentum + S(scene.masses[k]) * bodies_[k].v;
-      intercept = intercept + S(scene.masses[k]) * bodies_[k].b;
+    const std::optional<std::size_t> wall = wallIn(lo, hi);
+    S v = bodies_[wall.value_or(lo)].v, b = bodies_[wall.value_or(lo)].b;
+    if (!wall) {
+      S mass = S(0), momentum = S(0), intercept = S(0);
+      for (std::size_t k = lo; k <= hi; ++k) {
+        mass = mass + S(scene.masses[k]);
+        momentum = momentum + S(scene.masses[k]) * bodies_[k].v;
+        intercept = intercept + S(scene.masses[k]) * bodies_[k].b;
+      }
+      v = momentum / mass, b = intercept / mass;
     }
-    const S v = momentum / mass, b = intercept / mass;
     double heat = 0.0, sqrt_mass = 0.0;
     for (std::size_t k = lo; k <= hi; ++k) {
-      const double dv = Ar::toDouble(S(bodies_[k].v - v));
-      heat += 0.5 * scene.masses[k] * dv * dv;
+      if (!scene.isWall(k)) {
+        const double dv = Ar::toDouble(S(bodies_[k].v - v));
+        heat += 0.5 * scene.masses[k] * dv * dv;
+      }
       sqrt_mass += tables_.sqrt_mass[k];
       bodies_[k] = {b, v};
     }
     addLoss(heat);
     if constexpr (!Ar::kExact) {  // the exact tier's bounds stay 0: it must decide every tie
-      const double ops = 4.0 * static_cast<double>(hi - lo + 3) * Ar::kOpError * sqrt_mass;
-      eu_ += ops * std::fabs(Ar::toDouble(v)) + kTiny;
-      eb_ += ops * std::fabs(Ar::toDouble(b)) + kTiny;
+      if (!wall) {
+        const double ops = 4.0 * static_cast<double>(hi - lo + 3) * Ar::kOpError * sqrt_mass;
+        eu_ += ops * std::fabs(Ar::toDouble(v)) + kTiny;
+        eb_ += ops * std::fabs(Ar::toDouble(b)) + kTiny;
+      }
     }
     for (std::size_t k = lo; k < hi; ++k) bonded_[k] = 1, setSchedule(k, kInf, kInf);
     for (std::size_t r : {lo, hi + 1}) {
@@ -347,21 +359,45 @@ class Tier {
 
   double pairScale(std::size_t p) const { return pairs_[p].scale; }
 
+  /// The line bodies lo..hi end on after their collapse, in double: the centre of mass
+  /// (intercept / mass [m], velocity / mass [m/s] with mass [kg] the group's), or with a
+  /// wall among them the wall's line (mass 1). The energy about it never grows: impacts
+  /// inside the group lose energy in every frame, and against the wall in the wall's frame.
+  struct Line {
+    double mass = 0.0, intercept = 0.0, velocity = 0.0;
+  };
+  Line limitLine(std::size_t lo, std::size_t hi) const {
+    if (const std::optional<std::size_t> wall = wallIn(lo, hi)) {
+      return {1.0, Ar::toDouble(bodies_[*wall].b), Ar::toDouble(bodies_[*wall].v)};
+    }
+    Line line;
+    for (std::size_t k = lo; k <= hi; ++k) {
+      const double m = tables_.scene.masses[k];
+      line.mass += m, line.intercept += m * Ar::toDouble(bodies_[k].b), line.velocity += m * Ar::toDouble(bodies_[k].v);
+    }
+    return line;
+  }
+  /// A wall among bodies lo..hi, if any.
+  std::optional<std::size_t> wallIn(std::size_t lo, std::size_t hi) const {
+    for (std::size_t k = lo; k <= hi; ++k) {
+      if (tables_.scene.isWall(k)) return k;
+    }
+    return std::nullopt;
+  }
+
   /// Nothing outside bodies lo..hi can reach them in [now, until]: the group stays within
-  /// its extent at `now` widened by the fastest speed its energy about its centre allows,
+  /// its extent at `now` widened by the fastest speed its energy about its limit line allows,
   /// the outer neighbours move freely (their other pairs have no impact before `until`).
   bool clearOfNeighbours(std::size_t lo, std::size_t hi, double now, double until) const {
     const Scene& scene = tables_.scene;
-    double mass = 0.0, momentum = 0.0, lightest = kInf;
+    const Line line = limitLine(lo, hi);
+    const double centre = line.velocity / line.mass;
+    double heat = 0.0, lightest = kInf;
     for (std::size_t k = lo; k <= hi; ++k) {
-      mass += scene.masses[k], momentum += scene.masses[k] * Ar::toDouble(bodies_[k].v);
-      lightest = std::min(lightest, scene.masses[k]);
-    }
-    const double centre = momentum / mass;
-    double heat = 0.0;
-    for (std::size_t k = lo; k <= hi; ++k) {
+      if (scene.isWall(k)) continue;
       const double dv = Ar::toDouble(bodies_[k].v) - centre;
       heat += 0.5 * scene.masses[k] * dv * dv;
+      lightest = std::min(lightest, scene.masses[k]);
     }
     const double spread = std::sqrt(2 * heat / lightest) * (1 + 0x1p-20), span = until - now;
     const auto at = [&](std::size_t k) { return Ar::toDouble(S(bodies_[k].b + S(bodies_[k].v * S(now)))); };

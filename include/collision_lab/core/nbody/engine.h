@@ -114,8 +114,16 @@ struct MultipleCollision {
 /// first_body..last_body before `time`, after which they move as one cluster at their
 /// centre-of-mass velocity. Recognised for three bodies or clusters whose two pairs
 /// alternate (the three-body closed form, src/core/nbody/spiral.h, decides that the impacts
-/// never stop and gives the limit time). Not recognised: larger groups whose impacts follow
-/// another pattern, and any group with a wall (a body squeezed against it). Their impacts
+/// never stop and gives the limit time), including a body (or cluster) squeezed between a
+/// wall and another: there the wall is the outer cluster of infinite mass (k = 1 + e,
+/// cos^2(alpha) = m_C/(m_B+m_C) with B the squeezed body and C the other; a collapse when
+/// e is below tan^2(pi/4 - alpha/2) and the start lies in the approaching cone); all of
+/// them end on the wall's line: they meet at the wall and move on with it; the energy
+/// about it is lost (the wall absorbs the momentum). Not recognised: larger groups whose
+/// impacts follow another pattern, a wall in the middle of the three, a body between two
+/// walls (walls at one velocity: no collapse, the bounces slow down without end; walls
+/// closing in: they meet, where nothing is defined), and a group that a body outside could
+/// reach before the collapse time (conservative, even beyond a wall). Their impacts
 /// soon need the exact tier at every step; the exactness cap (tier.h, kExactBits) then ends
 /// the run as kCap, truncated, with a message saying so.
 struct Collapse {
