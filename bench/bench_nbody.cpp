@@ -3,11 +3,14 @@
 // [1, 2] kg, velocities in [-1, 1] m/s and spacing 1 m. Prints ns per impact of both,
 // medians of several repeats run round-robin in one process, their ratio (the issue's goal:
 // at most 1.5x, and beat it if we can), the same lean loop on the engine's queue (which
-// isolates the queue choice), and the peak memory of a run on 10^5 bodies.
+// isolates the queue choice), the peak memory of runs on 10^4 and 10^5 bodies (the goal:
+// O(N), flat in the number of impacts), and the 1,000-body gas preset (config/gas_1000.csv)
+// run to its end. Each issue-13 goal is one line starting with "goal:".
 //
-//   collision_lab_bench_nbody [--quick] [--repeats R] [--long]
+//   collision_lab_bench_nbody [--quick] [--repeats R] [--long] [--gas FILE]
 //     --quick   first 2e6 impacts instead of 2e7 for N = 10^4 and 10^5; 3 repeats
-//     --long    also a 10^8-impact run on 10^5 bodies (engine only), for the memory figure
+//     --long    the memory runs make 10^8 impacts instead of 2e7 (2e6 with --quick)
+//     --gas     the gas preset's bodies CSV (default: this source tree's config/gas_1000.csv)
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -18,6 +21,7 @@
 #include <cstdio>
 #include <cstring>
 #include <ctime>
+#include <fstream>
 #include <limits>
 #include <random>
 #include <string>
@@ -39,6 +43,22 @@ Scene gasScene(std::size_t n, std::uint64_t seed) {
     scene.masses.push_back(mass(rng));
     scene.positions.push_back(static_cast<double>(n - 1 - k));  // right to left, 1 m apart
     scene.velocities.push_back(velocity(rng));
+  }
+  return scene;
+}
+
+/// The bodies of a preset's CSV (header mass,position,velocity; one body per line, right to left).
+Scene csvScene(const std::string& path) {
+  std::ifstream in(path);
+  std::string line;
+  Scene scene;
+  if (!std::getline(in, line)) return scene;
+  double mass = 0, position = 0, velocity = 0;
+  char comma = 0;
+  while (in >> mass >> comma >> position >> comma >> velocity) {
+    scene.masses.push_back(mass);
+    scene.positions.push_back(position);
+    scene.velocities.push_back(velocity);
   }
   return scene;
 }
@@ -225,22 +245,30 @@ double engineMaxRssMb(const Scene& scene, std::uint64_t max_impacts) {
 int main(int argc, char** argv) {
   bool quick = false, long_run = false;
   int repeats = 5;
+  std::string gas_path = COLLISION_LAB_CONFIG_DIR "/gas_1000.csv";
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--quick")) {
       quick = true;
       repeats = 3;
     } else if (!std::strcmp(argv[i], "--long")) {
       long_run = true;
+    } else if (!std::strcmp(argv[i], "--gas") && i + 1 < argc) {
+      gas_path = argv[++i];
     } else if (!std::strcmp(argv[i], "--repeats") && i + 1 < argc) {
       repeats = std::max(1, std::atoi(argv[++i]));
     } else {
-      std::fprintf(stderr, "usage: %s [--quick] [--repeats R] [--long]\n", argv[0]);
+      std::fprintf(stderr, "usage: %s [--quick] [--repeats R] [--long] [--gas FILE]\n", argv[0]);
       return 2;
     }
   }
   const std::uint64_t budget = quick ? 2'000'000 : 20'000'000;
   std::vector<Case> cases;
-  cases.push_back({1'000, std::numeric_limits<std::uint64_t>::max(), gasScene(1'000, 1), {}, {}, {}});
+  const Scene gas = csvScene(gas_path);
+  if (gas.size() < 2) {
+    std::fprintf(stderr, "collision_lab_bench_nbody: cannot read the gas preset's bodies from %s\n", gas_path.c_str());
+    return 2;
+  }
+  cases.push_back({gas.size(), std::numeric_limits<std::uint64_t>::max(), gas, {}, {}, {}});
   cases.push_back({10'000, budget, gasScene(10'000, 2), {}, {}, {}});
   cases.push_back({100'000, budget, gasScene(100'000, 3), {}, {}, {}});
 
@@ -284,8 +312,38 @@ int main(int argc, char** argv) {
               "blocked tournament tree (what the queue choice is worth); engine: the exact engine.\n"
               "'same': both lean loops made as many impacts (they are not exact, but agree on these scenes).\n");
   const std::uint64_t memory_impacts = long_run ? 100'000'000 : budget;
-  const double rss = engineMaxRssMb(cases.back().scene, memory_impacts);
-  std::printf("peak memory (max RSS) of one engine run on 10^5 bodies, %llu impacts, no events kept: %.1f MB\n",
-              static_cast<unsigned long long>(memory_impacts), rss);
+  const double rss_small = engineMaxRssMb(cases[1].scene, memory_impacts);
+  const double rss_large = engineMaxRssMb(cases[2].scene, memory_impacts);
+  const double rss_short = engineMaxRssMb(cases[2].scene, memory_impacts / 10);
+  std::printf("peak memory (max RSS) of one engine run, no events kept: %.1f MB on 10^4 bodies and %.1f MB on 10^5 "
+              "(%llu impacts); %.1f MB on 10^5 with a tenth of the impacts\n",
+              rss_small, rss_large, static_cast<unsigned long long>(memory_impacts), rss_short);
+
+  double worst = 0.0;
+  std::size_t worst_n = 0;
+  for (const Case& c : cases) {
+    const double ratio = median(c.engine_ns) / median(c.anchor_ns);
+    if (ratio > worst) worst = ratio, worst_n = c.n;
+  }
+  const Case& worst_case = *std::find_if(cases.begin(), cases.end(), [&](const Case& c) { return c.n == worst_n; });
+  std::printf("\ngoal: N-body engine, ns per impact (worst of the %zu sizes: N = %zu) = %.1f against lean heap loop = "
+              "%.1f (%.2fx; goal <= 1.5x): %s\n",
+              cases.size(), worst_n, median(worst_case.engine_ns), median(worst_case.anchor_ns), worst,
+              worst <= 1.5 ? "met" : "missed");
+  // O(N): the memory added by 9 x 10^4 more bodies, per body, against the state a body needs at least
+  // (mass, position, velocity, time: 32 B).
+  const double bytes_per_body = (rss_large - rss_small) * 1024 * 1024 / 90'000.0;
+  const bool flat = rss_large <= 1.1 * rss_short;
+  std::printf("goal: N-body engine memory, bytes per added body (10^4 -> 10^5 bodies, %llu impacts each) = %.0f "
+              "against the 4 doubles of a body's state = 32 (%.1fx; %.1f MB at a tenth of the impacts; goal O(N), "
+              "flat in impacts): %s\n",
+              static_cast<unsigned long long>(memory_impacts), bytes_per_body, bytes_per_body / 32.0, rss_short,
+              bytes_per_body < 1024 && flat ? "met" : "missed");
+  const double gas_seconds = 1e-9 * median(cases[0].engine_ns) * static_cast<double>(cases[0].engine_impacts);
+  std::printf("goal: the 1,000-body gas preset run to its end (%llu impacts), s = %.3f against lean heap loop = %.3f "
+              "(%.2fx; goal well under 1 s): %s\n",
+              static_cast<unsigned long long>(cases[0].engine_impacts), gas_seconds,
+              1e-9 * median(cases[0].anchor_ns) * static_cast<double>(cases[0].anchor_impacts),
+              median(cases[0].engine_ns) / median(cases[0].anchor_ns), gas_seconds < 0.25 ? "met" : "missed");
   return 0;
 }

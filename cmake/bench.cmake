@@ -26,6 +26,7 @@ target_link_libraries(collision_lab_bench_core PRIVATE collision_lab_core)
 add_executable(collision_lab_bench_nbody bench/bench_nbody.cpp)
 target_include_directories(collision_lab_bench_nbody PRIVATE src/core/nbody)  # the engine's queue, compared
 target_link_libraries(collision_lab_bench_nbody PRIVATE collision_lab_core)
+target_compile_definitions(collision_lab_bench_nbody PRIVATE COLLISION_LAB_CONFIG_DIR="${PROJECT_SOURCE_DIR}/config")
 
 add_executable(collision_lab_bench_restitution bench/bench_restitution.cpp)
 target_link_libraries(collision_lab_bench_restitution PRIVATE collision_lab_core)
