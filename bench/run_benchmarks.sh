@@ -1,15 +1,15 @@
 #!/usr/bin/env bash
-# Regenerates every benchmark output in docs/ with one command:
-#   docs/speed_vs_error.csv, docs/speed_vs_error.md, docs/speed_vs_error.png  (collision_lab_speed_vs_error)
-#   docs/hard_cases.md                                                        (collision_lab_hard_cases)
-#   docs/restitution_count.csv, docs/restitution_count.png                   (collision_lab_bench_restitution,
-#                                                                              bench/plot_restitution_count.py)
-# and prints the core speed benchmark (collision_lab_bench_core).
+# Runs every benchmark and prints each speed goal (issue 13) with its figure and the anchor
+# measured beside it in the same run. Regenerates the benchmark outputs in docs/:
+#   docs/speed_vs_error.{csv,md,png}      collision_lab_speed_vs_error
+#   docs/hard_cases.md                    collision_lab_hard_cases
+#   docs/restitution_count.{csv,png}      collision_lab_bench_restitution, bench/plot_restitution_count.py
+#   docs/benchmark_goals.md               every "goal:" line of this run, as a table
+# and prints the core and N-body speed tables (collision_lab_bench_core, collision_lab_bench_nbody).
 #
 # Usage: bash bench/run_benchmarks.sh [--quick]
-#   --quick: fewer scenes, dt values and repeats (each program under a minute, except the
-#            restitution sweep: one repeat, but its exact run at e = r_c + 1e-6 alone takes
-#            about 2 minutes); outputs go to $BUILD_DIR/bench_quick/ instead of docs/.
+#   --quick: fewer scenes, dt values, impacts and repeats (a few minutes); every output goes
+#            to $BUILD_DIR/bench_quick/ instead of docs/.
 # Environment: BUILD_DIR (default: build_bench next to this repository's sources).
 # Needs: libgmp-dev; optional engines libbullet-dev, libode-dev, libbox2d-dev; python3-matplotlib.
 set -euo pipefail
@@ -18,36 +18,46 @@ repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${BUILD_DIR:-$repo/build_bench}"
 # catkin's CMake needs Debian's python3 (with catkin_pkg), not a pyenv one earlier on PATH.
 export PATH="/usr/bin:$PATH"
+quick=""
+[[ "${1:-}" == "--quick" ]] && quick="--quick"
 
 # Every output names the source it measured: the commit, marked when the core has local changes.
 COLLISION_LAB_BENCH_SOURCE="$(git -C "$repo" rev-parse --short HEAD 2>/dev/null || echo unknown)"
-if ! git -C "$repo" diff --quiet HEAD -- src/core include/collision_lab/core 2>/dev/null; then
-  COLLISION_LAB_BENCH_SOURCE+=" with local changes in the core"
+if ! git -C "$repo" diff --quiet HEAD -- src include 2>/dev/null; then
+  COLLISION_LAB_BENCH_SOURCE+=" with local changes"
 fi
 export COLLISION_LAB_BENCH_SOURCE
 
 cmake -S "$repo" -B "$build" -DCMAKE_BUILD_TYPE=Release >/dev/null
-cmake --build "$build" -j2 --target collision_lab_bench_core collision_lab_speed_vs_error collision_lab_hard_cases \
-  collision_lab_bench_restitution
+cmake --build "$build" -j2 --target collision_lab_bench_core collision_lab_bench_nbody collision_lab_speed_vs_error \
+  collision_lab_hard_cases collision_lab_bench_restitution
 bin="$build/devel/lib/collision_lab"
 
-if [[ "${1:-}" == "--quick" ]]; then
-  out="$build/bench_quick"
-  mkdir -p "$out"
-  "$bin/collision_lab_speed_vs_error" --quick --csv "$out/speed_vs_error.csv" --md "$out/speed_vs_error.md" \
-    --plot "$out/speed_vs_error.png" >/dev/null
-  "$bin/collision_lab_hard_cases" --quick --md "$out/hard_cases.md" >/dev/null
-  "$bin/collision_lab_bench_restitution" --repeats 1 --csv "$out/restitution_count.csv" >/dev/null
-  python3 "$repo/bench/plot_restitution_count.py" --csv "$out/restitution_count.csv" --out "$out/restitution_count.png"
-  "$bin/collision_lab_bench_core" --quick
-  echo "quick outputs in $out" >&2
-else
-  "$bin/collision_lab_speed_vs_error" >/dev/null
-  "$bin/collision_lab_hard_cases" >/dev/null
-  "$bin/collision_lab_bench_restitution" >/dev/null
-  python3 "$repo/bench/plot_restitution_count.py" --csv "$repo/docs/restitution_count.csv" \
-    --out "$repo/docs/restitution_count.png"
-  "$bin/collision_lab_bench_core"
-  echo "regenerated $repo/docs/speed_vs_error.{csv,md,png}, $repo/docs/hard_cases.md and" \
-    "$repo/docs/restitution_count.{csv,png}" >&2
-fi
+if [[ -n "$quick" ]]; then out="$build/bench_quick"; else out="$repo/docs"; fi
+mkdir -p "$out"
+log="$build/benchmarks.log"
+: > "$log"
+
+# step TITLE COMMAND...: runs one benchmark; its output goes to the terminal and to the log.
+step() {
+  local title="$1"
+  shift
+  printf '\n=== %s (%s)\n' "$title" "$(date +%H:%M:%S)" | tee -a "$log"
+  "$@" 2>&1 | tee -a "$log"
+}
+
+restitution_repeats=()
+[[ -n "$quick" ]] && restitution_repeats=(--repeats 1)
+step "speed against error" "$bin/collision_lab_speed_vs_error" $quick --csv "$out/speed_vs_error.csv" \
+  --md "$out/speed_vs_error.md" --plot "$out/speed_vs_error.png"
+step "hard cases" "$bin/collision_lab_hard_cases" $quick --md "$out/hard_cases.md"
+step "restitution: impacts against e" "$bin/collision_lab_bench_restitution" "${restitution_repeats[@]}" \
+  --csv "$out/restitution_count.csv"
+python3 "$repo/bench/plot_restitution_count.py" --csv "$out/restitution_count.csv" --out "$out/restitution_count.png"
+step "core speed" "$bin/collision_lab_bench_core" $quick
+step "N-body engine speed and memory" "$bin/collision_lab_bench_nbody" $quick
+
+python3 "$repo/bench/goals_table.py" --log "$log" --source "$COLLISION_LAB_BENCH_SOURCE" --out "$out/benchmark_goals.md"
+printf '\n=== Goals (issue 13), each with its anchor from this run\n'
+grep '^goal:' "$log" | sed 's/^goal: /  /'
+echo "outputs in $out; the whole log in $log" >&2
