@@ -16,14 +16,10 @@ namespace {
 
 const char* const kParticleNames[3] = {"A", "B", "C"};
 
-/// Shortest text that reads back to the same double; "inf", "-inf", "nan" for any NaN,
-/// and "0" for either zero.
+/// writeCsvNumber's text: shortest round trip, 0 for either zero, nan, inf, -inf.
 std::string roundTripText(double value) {
-  if (std::isnan(value)) return "nan";
-  if (value == 0) return "0";
-  char buffer[64];
-  const auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
-  return std::string(buffer, result.ptr);
+  char buffer[kNumberTextMax];
+  return std::string(buffer, writeCsvNumber(buffer, value));
 }
 
 using report_text::humanText;
@@ -163,7 +159,7 @@ class TableWriter : public RunReportWriter {
 
 class JsonWriter : public RunReportWriter {
  public:
-  explicit JsonWriter(std::ostream& out) : out_(out) {}
+  explicit JsonWriter(std::ostream& out) : out_(out), sink_(out) {}
 
   void begin(const NamedScene& named, const core::RunOptions& options) override {
     out_ << "{\"scene\": " << jsonText(sceneJson(named)) << ",\n\"options\": " << jsonText(optionsJson(options))
@@ -171,16 +167,20 @@ class JsonWriter : public RunReportWriter {
   }
 
   void event(const core::LabEvent& lab) override {
-    out_ << (any_event_ ? ",\n" : "\n") << jsonText(eventJson(lab));
+    sink_.put(any_event_ ? ",\n" : "\n");
+    report_text::writeEventJson(sink_, lab);
+    sink_.flushIfFull();
     any_event_ = true;
   }
 
   void end(const core::RunResult& result) override {
+    sink_.flush();
     out_ << (any_event_ ? "\n]" : "]") << ",\n\"summary\": " << jsonText(summaryJson(result)) << "}\n";
   }
 
  private:
   std::ostream& out_;
+  TextSink sink_;
   bool any_event_ = false;
 };
 
@@ -219,7 +219,7 @@ void writeCsvComments(std::ostream& out, const std::string& prefix, const Json& 
 
 class CsvWriter : public RunReportWriter {
  public:
-  explicit CsvWriter(std::ostream& out) : out_(out) {}
+  explicit CsvWriter(std::ostream& out) : out_(out), sink_(out) {}
 
   void begin(const NamedScene& named, const core::RunOptions& options) override {
     out_ << "# scene," << named.name << "\n";
@@ -248,19 +248,33 @@ class CsvWriter : public RunReportWriter {
 
   void event(const core::LabEvent& lab) override {
     const core::ImpactEvent& e = lab.event;
-    out_ << e.index << "," << core::pairName(e.pair) << "," << roundTripText(e.time) << "," << roundTripText(e.position);
+    sink_.count(e.index);
+    sink_.put(',');
+    sink_.put(core::pairName(e.pair));
+    for (double v : {e.time, e.position}) writeCell(v);
     for (const auto* values : {&e.positions, &e.velocities_before, &e.velocities_after, &e.energy_transfer,
                                &lab.predicted_velocities_after, &lab.paper_velocities_after,
                                &lab.predicted_energy_transfer, &lab.paper_energy_transfer}) {
-      for (double v : *values) out_ << "," << roundTripText(v);
+      for (double v : *values) writeCell(v);
     }
-    out_ << "," << roundTripText(e.total_energy) << "," << roundTripText(e.total_momentum) << "\n";
+    for (double v : {e.total_energy, e.total_momentum}) writeCell(v);
+    sink_.put('\n');
+    sink_.flushIfFull();
   }
 
-  void end(const core::RunResult& result) override { writeCsvComments(out_, "summary.", summaryJson(result)); }
+  void end(const core::RunResult& result) override {
+    sink_.flush();
+    writeCsvComments(out_, "summary.", summaryJson(result));
+  }
 
  private:
+  void writeCell(double value) {
+    sink_.put(',');
+    sink_.csvNumber(value);
+  }
+
   std::ostream& out_;
+  TextSink sink_;
 };
 
 // ---------------------------------------------------------------------------------------
@@ -417,6 +431,46 @@ Json eventJson(const core::LabEvent& lab) {
               {"total_energy", number(e.total_energy)},
               {"total_momentum", number(e.total_momentum)}};
 }
+
+namespace report_text {
+
+void writeEventJson(TextSink& sink, const core::LabEvent& lab) {
+  const core::ImpactEvent& e = lab.event;
+  const auto write_number = [&sink](const char* key, double value) {
+    sink.put(key);
+    sink.jsonNumber(value);
+  };
+  const auto write_array3 = [&sink](const char* key, const std::array<double, 3>& values) {
+    sink.put(key);
+    for (int i = 0; i < 3; ++i) {
+      sink.put(i == 0 ? '[' : ',');
+      sink.jsonNumber(values[i]);
+    }
+    sink.put(']');
+  };
+  // The keys and order of eventJson.
+  sink.put("{\"index\":");
+  sink.count(e.index);
+  sink.put(",\"pair\":\"");
+  sink.put(core::pairName(e.pair));
+  sink.put('"');
+  write_number(",\"time\":", e.time);
+  write_number(",\"position\":", e.position);
+  write_array3(",\"positions\":", e.positions);
+  write_array3(",\"velocities_before\":", e.velocities_before);
+  write_array3(",\"velocities_after\":", e.velocities_after);
+  write_array3(",\"energy_transfer\":", e.energy_transfer);
+  write_array3(",\"predicted_velocities_after\":", lab.predicted_velocities_after);
+  write_array3(",\"predicted_energy_transfer\":", lab.predicted_energy_transfer);
+  write_array3(",\"paper_velocities_after\":", lab.paper_velocities_after);
+  write_array3(",\"paper_energy_transfer\":", lab.paper_energy_transfer);
+  write_array3(",\"kinetic_energy_after\":", lab.kinetic_energy_after);
+  write_number(",\"total_energy\":", e.total_energy);
+  write_number(",\"total_momentum\":", e.total_momentum);
+  sink.put('}');
+}
+
+}  // namespace report_text
 
 Json summaryJson(const core::RunResult& result) {
   const core::AnalyticPrediction& p = result.prediction;

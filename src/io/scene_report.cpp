@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <optional>
 
 #include "report_text.h"
 
@@ -429,7 +430,13 @@ class SceneCsvWriter : public SceneReportWriter {
 class ThreeBodyModelWriter : public RunReportWriter {
  public:
   ThreeBodyModelWriter(ReportFormat format, std::ostream& out, const core::ModelChoice& model)
-      : format_(format), out_(out), model_(model), inner_(makeRunReportWriter(format, out)) {}
+      : format_(format), out_(out), model_(model) {
+    if (format == ReportFormat::kJson) {
+      sink_.emplace(out);
+    } else {
+      inner_ = makeRunReportWriter(format, out);
+    }
+  }
 
   void begin(const NamedScene& scene, const core::RunOptions& options) override {
     if (format_ != ReportFormat::kJson) return inner_->begin(scene, options);
@@ -439,12 +446,15 @@ class ThreeBodyModelWriter : public RunReportWriter {
 
   void event(const core::LabEvent& event) override {
     if (format_ != ReportFormat::kJson) return inner_->event(event);
-    out_ << (any_event_ ? ",\n" : "\n") << jsonText(eventJson(event));
+    sink_->put(any_event_ ? ",\n" : "\n");
+    report_text::writeEventJson(*sink_, event);
+    sink_->flushIfFull();
     any_event_ = true;
   }
 
   void end(const core::RunResult& result) override {
     if (format_ == ReportFormat::kJson) {
+      sink_->flush();
       Json summary = summaryJson(result);
       summary["model"] = core::modelKindName(model_.kind);
       summary["model_reason"] = model_.reason;
@@ -464,7 +474,8 @@ class ThreeBodyModelWriter : public RunReportWriter {
   ReportFormat format_;
   std::ostream& out_;
   core::ModelChoice model_;
-  std::unique_ptr<RunReportWriter> inner_;
+  std::unique_ptr<RunReportWriter> inner_;  ///< table and CSV
+  std::optional<TextSink> sink_;            ///< JSON events
   bool any_event_ = false;
 };
 
