@@ -7,6 +7,7 @@
 
 #include "collision_lab/io/number_text.h"
 
+#include "event_pipeline.h"
 #include "report_text.h"
 
 namespace collision_lab {
@@ -159,7 +160,7 @@ class TableWriter : public RunReportWriter {
 
 class JsonWriter : public RunReportWriter {
  public:
-  explicit JsonWriter(std::ostream& out) : out_(out), sink_(out) {}
+  explicit JsonWriter(std::ostream& out) : out_(out), events_(out, report_text::writeEventJsonLine) {}
 
   void begin(const NamedScene& named, const core::RunOptions& options) override {
     out_ << "{\"scene\": " << jsonText(sceneJson(named)) << ",\n\"options\": " << jsonText(optionsJson(options))
@@ -167,20 +168,18 @@ class JsonWriter : public RunReportWriter {
   }
 
   void event(const core::LabEvent& lab) override {
-    sink_.put(any_event_ ? ",\n" : "\n");
-    report_text::writeEventJson(sink_, lab);
-    sink_.flushIfFull();
+    events_.push(lab);
     any_event_ = true;
   }
 
   void end(const core::RunResult& result) override {
-    sink_.flush();
+    events_.finish();
     out_ << (any_event_ ? "\n]" : "]") << ",\n\"summary\": " << jsonText(summaryJson(result)) << "}\n";
   }
 
  private:
   std::ostream& out_;
-  TextSink sink_;
+  EventPipeline events_;
   bool any_event_ = false;
 };
 
@@ -217,9 +216,31 @@ void writeCsvComments(std::ostream& out, const std::string& prefix, const Json& 
   }
 }
 
+/// One event row, in the columns of CsvWriter's header.
+void writeEventCsv(TextSink& sink, const core::LabEvent& lab, bool /*first*/) {
+  const core::ImpactEvent& e = lab.event;
+  const auto cell = [&sink](double value) {
+    sink.put(',');
+    sink.csvNumber(value);
+  };
+  sink.count(e.index);
+  sink.put(',');
+  sink.put(core::pairName(e.pair));
+  cell(e.time);
+  cell(e.position);
+  for (const auto* values : {&e.positions, &e.velocities_before, &e.velocities_after, &e.energy_transfer,
+                             &lab.predicted_velocities_after, &lab.paper_velocities_after,
+                             &lab.predicted_energy_transfer, &lab.paper_energy_transfer}) {
+    for (double v : *values) cell(v);
+  }
+  cell(e.total_energy);
+  cell(e.total_momentum);
+  sink.put('\n');
+}
+
 class CsvWriter : public RunReportWriter {
  public:
-  explicit CsvWriter(std::ostream& out) : out_(out), sink_(out) {}
+  explicit CsvWriter(std::ostream& out) : out_(out), events_(out, writeEventCsv) {}
 
   void begin(const NamedScene& named, const core::RunOptions& options) override {
     out_ << "# scene," << named.name << "\n";
@@ -246,35 +267,16 @@ class CsvWriter : public RunReportWriter {
     out_ << ",total_energy_J,total_momentum_kg_m_s\n";
   }
 
-  void event(const core::LabEvent& lab) override {
-    const core::ImpactEvent& e = lab.event;
-    sink_.count(e.index);
-    sink_.put(',');
-    sink_.put(core::pairName(e.pair));
-    for (double v : {e.time, e.position}) writeCell(v);
-    for (const auto* values : {&e.positions, &e.velocities_before, &e.velocities_after, &e.energy_transfer,
-                               &lab.predicted_velocities_after, &lab.paper_velocities_after,
-                               &lab.predicted_energy_transfer, &lab.paper_energy_transfer}) {
-      for (double v : *values) writeCell(v);
-    }
-    for (double v : {e.total_energy, e.total_momentum}) writeCell(v);
-    sink_.put('\n');
-    sink_.flushIfFull();
-  }
+  void event(const core::LabEvent& lab) override { events_.push(lab); }
 
   void end(const core::RunResult& result) override {
-    sink_.flush();
+    events_.finish();
     writeCsvComments(out_, "summary.", summaryJson(result));
   }
 
  private:
-  void writeCell(double value) {
-    sink_.put(',');
-    sink_.csvNumber(value);
-  }
-
   std::ostream& out_;
-  TextSink sink_;
+  EventPipeline events_;
 };
 
 // ---------------------------------------------------------------------------------------
@@ -468,6 +470,11 @@ void writeEventJson(TextSink& sink, const core::LabEvent& lab) {
   write_number(",\"total_energy\":", e.total_energy);
   write_number(",\"total_momentum\":", e.total_momentum);
   sink.put('}');
+}
+
+void writeEventJsonLine(TextSink& sink, const core::LabEvent& lab, bool first) {
+  sink.put(first ? "\n" : ",\n");
+  writeEventJson(sink, lab);
 }
 
 }  // namespace report_text

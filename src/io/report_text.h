@@ -36,6 +36,8 @@ inline Json number(double value) { return Json(value == 0 ? 0.0 : value); }
 /// eventJson(lab) as compact JSON text (its keys in its order, numbers as writeJsonNumber),
 /// written without building a document.
 void writeEventJson(TextSink& sink, const core::LabEvent& lab);
+/// The same as a line of the "events" array: "\n" before the first event, ",\n" before others.
+void writeEventJsonLine(TextSink& sink, const core::LabEvent& lab, bool first);
 
 }  // namespace report_text
 }  // namespace io

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <optional>
 
+#include "event_pipeline.h"
 #include "report_text.h"
 
 namespace collision_lab {
@@ -432,7 +433,7 @@ class ThreeBodyModelWriter : public RunReportWriter {
   ThreeBodyModelWriter(ReportFormat format, std::ostream& out, const core::ModelChoice& model)
       : format_(format), out_(out), model_(model) {
     if (format == ReportFormat::kJson) {
-      sink_.emplace(out);
+      events_.emplace(out, report_text::writeEventJsonLine);
     } else {
       inner_ = makeRunReportWriter(format, out);
     }
@@ -446,15 +447,13 @@ class ThreeBodyModelWriter : public RunReportWriter {
 
   void event(const core::LabEvent& event) override {
     if (format_ != ReportFormat::kJson) return inner_->event(event);
-    sink_->put(any_event_ ? ",\n" : "\n");
-    report_text::writeEventJson(*sink_, event);
-    sink_->flushIfFull();
+    events_->push(event);
     any_event_ = true;
   }
 
   void end(const core::RunResult& result) override {
     if (format_ == ReportFormat::kJson) {
-      sink_->flush();
+      events_->finish();
       Json summary = summaryJson(result);
       summary["model"] = core::modelKindName(model_.kind);
       summary["model_reason"] = model_.reason;
@@ -475,7 +474,7 @@ class ThreeBodyModelWriter : public RunReportWriter {
   std::ostream& out_;
   core::ModelChoice model_;
   std::unique_ptr<RunReportWriter> inner_;  ///< table and CSV
-  std::optional<TextSink> sink_;            ///< JSON events
+  std::optional<EventPipeline> events_;     ///< JSON events
   bool any_event_ = false;
 };
 

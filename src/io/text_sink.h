@@ -3,14 +3,15 @@
 // no stream call per field. Internal to collision_lab_io.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <memory>
 #include <ostream>
 #include <string_view>
+#include <vector>
 
 #include "collision_lab/io/number_text.h"
 
@@ -62,12 +63,14 @@ class NumberTextCache {
 
 /// Text gathered in a buffer and written to `out` in chunks of about kChunk bytes.
 /// Call flushIfFull() after each event and flush() before writing to `out` directly.
+/// With auto_flush false the buffer grows instead and only flush() writes (a block of
+/// events formatted ahead of its turn); it keeps its size, so it allocates only at first.
 class TextSink {
  public:
   static constexpr std::size_t kChunk = std::size_t{1} << 18;
 
-  explicit TextSink(std::ostream& out)
-      : out_(out), buffer_(new char[kCapacity]), csv_(writeCsvNumber), json_(writeJsonNumber) {}
+  explicit TextSink(std::ostream& out, bool auto_flush = true)
+      : out_(out), auto_flush_(auto_flush), buffer_(kChunk + kSlack), csv_(writeCsvNumber), json_(writeJsonNumber) {}
   ~TextSink() { flush(); }
   TextSink(const TextSink&) = delete;
   TextSink& operator=(const TextSink&) = delete;
@@ -77,48 +80,46 @@ class TextSink {
     buffer_[size_++] = c;
   }
   void put(std::string_view text) {
-    if (text.size() > kCapacity - kChunk) {
-      flush();
-      out_.write(text.data(), static_cast<std::streamsize>(text.size()));
-      return;
-    }
     room(text.size());
-    std::memcpy(buffer_.get() + size_, text.data(), text.size());
+    std::memcpy(at(), text.data(), text.size());
     size_ += text.size();
   }
   void count(std::uint64_t value) {
     room(24);
-    size_ = static_cast<std::size_t>(std::to_chars(at(), at() + 24, value).ptr - buffer_.get());
+    size_ = static_cast<std::size_t>(std::to_chars(at(), at() + 24, value).ptr - buffer_.data());
   }
   /// writeCsvNumber's text.
   void csvNumber(double value) {
     room(kNumberTextMax + 1);
-    size_ = static_cast<std::size_t>(csv_.write(at(), value) - buffer_.get());
+    size_ = static_cast<std::size_t>(csv_.write(at(), value) - buffer_.data());
   }
   /// writeJsonNumber's text.
   void jsonNumber(double value) {
     room(kNumberTextMax + 1);
-    size_ = static_cast<std::size_t>(json_.write(at(), value) - buffer_.get());
+    size_ = static_cast<std::size_t>(json_.write(at(), value) - buffer_.data());
   }
 
   void flushIfFull() {
     if (size_ >= kChunk) flush();
   }
   void flush() {
-    if (size_ > 0) out_.write(buffer_.get(), static_cast<std::streamsize>(size_));
+    if (size_ > 0) out_.write(buffer_.data(), static_cast<std::streamsize>(size_));
     size_ = 0;
   }
 
  private:
-  static constexpr std::size_t kCapacity = kChunk + (std::size_t{1} << 16);
+  static constexpr std::size_t kSlack = std::size_t{1} << 16;
 
-  char* at() { return buffer_.get() + size_; }
+  char* at() { return buffer_.data() + size_; }
   void room(std::size_t bytes) {
-    if (size_ + bytes > kCapacity) flush();
+    if (size_ + bytes <= buffer_.size()) return;
+    if (auto_flush_) flush();
+    if (size_ + bytes > buffer_.size()) buffer_.resize(std::max(2 * buffer_.size(), size_ + bytes));
   }
 
   std::ostream& out_;
-  std::unique_ptr<char[]> buffer_;
+  bool auto_flush_;
+  std::vector<char> buffer_;
   std::size_t size_ = 0;
   NumberTextCache csv_;
   NumberTextCache json_;
