@@ -314,7 +314,7 @@ void writeSummaryJson(std::ostream& out, const core::SceneRunResult& result) {
 
 class SceneJsonWriter : public SceneReportWriter {
  public:
-  explicit SceneJsonWriter(std::ostream& out) : out_(out) {}
+  explicit SceneJsonWriter(std::ostream& out) : out_(out), sink_(out) {}
 
   void begin(const SceneEntry& entry, const core::RunOptions& options, const core::ModelChoice&) override {
     out_ << "{\"scene\": ";
@@ -323,22 +323,80 @@ class SceneJsonWriter : public SceneReportWriter {
          << ",\n\"events\": [";
   }
 
-  void impact(const core::ImpactRecord& impact) override { writeEvent(impactJson(impact)); }
-  void collapse(const core::Collapse& collapse) override { writeEvent(collapseJson(collapse)); }
+  void impact(const core::ImpactRecord& r) override {
+    startEvent();
+    // The keys and order of impactJson; names are letters, digits, '#' and '-': no escapes.
+    sink_.put("{\"kind\":\"impact\",\"index\":");
+    sink_.count(r.index);
+    sink_.put(",\"pair\":\"");
+    sink_.put(core::pairName(r.pair_index));
+    sink_.put("\",\"pair_index\":");
+    sink_.count(r.pair_index);
+    sink_.put(",\"bodies\":[\"");
+    sink_.put(core::bodyName(r.pair_index));
+    sink_.put("\",\"");
+    sink_.put(core::bodyName(r.pair_index + 1));
+    sink_.put("\"]");
+    writeNumber(",\"time\":", r.time);
+    writeNumber(",\"position\":", r.position);
+    writePair(",\"velocities_before\":", r.velocities_before);
+    writePair(",\"velocities_after\":", r.velocities_after);
+    writePair(",\"energy_gained\":", r.energy_gained);
+    writeNumber(",\"energy_lost\":", r.energy_lost);
+    endEvent();
+  }
+
+  void collapse(const core::Collapse& c) override {
+    startEvent();
+    // The keys and order of collapseJson.
+    sink_.put("{\"kind\":\"collapse\",\"impacts_before\":");
+    sink_.count(c.impacts_before);
+    sink_.put(",\"first_body\":\"");
+    sink_.put(core::bodyName(c.first_body));
+    sink_.put("\",\"last_body\":\"");
+    sink_.put(core::bodyName(c.last_body));
+    sink_.put("\",\"first_body_index\":");
+    sink_.count(c.first_body);
+    sink_.put(",\"last_body_index\":");
+    sink_.count(c.last_body);
+    writeNumber(",\"time\":", c.time);
+    writeNumber(",\"position\":", c.position);
+    writeNumber(",\"velocity\":", c.velocity);
+    endEvent();
+  }
 
   void end(const core::SceneRunResult& result) override {
+    sink_.flush();
     out_ << (any_event_ ? "\n]" : "]") << ",\n\"summary\": ";
     writeSummaryJson(out_, result);
     out_ << "}\n";
   }
 
  private:
-  void writeEvent(const Json& event) {
-    out_ << (any_event_ ? ",\n" : "\n") << jsonText(event);
+  void startEvent() {
+    sink_.put(any_event_ ? ",\n" : "\n");
     any_event_ = true;
+  }
+  void endEvent() {
+    sink_.put('}');
+    sink_.flushIfFull();
+  }
+  void writeNumber(const char* key, double value) {
+    sink_.put(key);
+    sink_.jsonNumber(value);
+  }
+  template <class Pair>
+  void writePair(const char* key, const Pair& values) {
+    sink_.put(key);
+    sink_.put('[');
+    sink_.jsonNumber(values[0]);
+    sink_.put(',');
+    sink_.jsonNumber(values[1]);
+    sink_.put(']');
   }
 
   std::ostream& out_;
+  TextSink sink_;
   bool any_event_ = false;
 };
 
@@ -380,7 +438,7 @@ void writeCsvNumbers(std::ostream& out, const char* key, const std::vector<doubl
 
 class SceneCsvWriter : public SceneReportWriter {
  public:
-  explicit SceneCsvWriter(std::ostream& out) : out_(out) {}
+  explicit SceneCsvWriter(std::ostream& out) : out_(out), sink_(out) {}
 
   void begin(const SceneEntry& entry, const core::RunOptions& options, const core::ModelChoice& model) override {
     const core::Scene& s = entry.scene;
@@ -398,21 +456,39 @@ class SceneCsvWriter : public SceneReportWriter {
   }
 
   void impact(const core::ImpactRecord& r) override {
-    out_ << r.index << "," << core::pairName(r.pair_index) << "," << r.pair_index;
+    sink_.count(r.index);
+    sink_.put(',');
+    sink_.put(core::pairName(r.pair_index));
+    sink_.put(',');
+    sink_.count(r.pair_index);
     for (double v : {r.time, r.position, r.velocities_before[0], r.velocities_before[1], r.velocities_after[0],
                      r.velocities_after[1], r.energy_gained[0], r.energy_gained[1], r.energy_lost}) {
-      out_ << "," << csvNumber(v);
+      cell(v);
     }
-    out_ << ",impact," << r.first_moved << "," << r.last_moved << "\n";
+    sink_.put(",impact,");
+    sink_.count(r.first_moved);
+    sink_.put(',');
+    sink_.count(r.last_moved);
+    sink_.put('\n');
+    sink_.flushIfFull();
   }
 
   void collapse(const core::Collapse& c) override {
-    out_ << c.impacts_before << ",,," << csvNumber(c.time) << "," << csvNumber(c.position) << ",,,"
-         << csvNumber(c.velocity) << "," << csvNumber(c.velocity) << ",,,,collapse," << c.first_body << ","
-         << c.last_body << "\n";
+    sink_.count(c.impacts_before);
+    sink_.put(",,");
+    for (double v : {c.time, c.position}) cell(v);
+    sink_.put(",,");
+    for (double v : {c.velocity, c.velocity}) cell(v);
+    sink_.put(",,,,collapse,");
+    sink_.count(c.first_body);
+    sink_.put(',');
+    sink_.count(c.last_body);
+    sink_.put('\n');
+    sink_.flushIfFull();
   }
 
   void end(const core::SceneRunResult& result) override {
+    sink_.flush();
     const Json summary = summaryScalars(result);
     for (const auto& item : summary.items()) {
       writeCsvComment(out_, "summary." + item.key(), item.value());
@@ -422,7 +498,13 @@ class SceneCsvWriter : public SceneReportWriter {
   }
 
  private:
+  void cell(double value) {
+    sink_.put(',');
+    sink_.csvNumber(value);
+  }
+
   std::ostream& out_;
+  TextSink sink_;
 };
 
 // ---------------------------------------------------------------------------------------

@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <limits>
+#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -17,6 +18,7 @@
 
 #include "collision_lab/core/lab_run.h"
 #include "collision_lab/core/nbody/models.h"
+#include "collision_lab/core/scene_run.h"
 #include "collision_lab/io/report.h"
 #include "collision_lab/io/scene_report.h"
 
@@ -162,18 +164,21 @@ double jsonDouble(const io::Json& value) {
   return value.is_null() ? std::numeric_limits<double>::quiet_NaN() : value.get<double>();
 }
 
-void expectJsonCarriesEvents(const std::string& text, const std::vector<core::LabEvent>& events) {
+/// The "events" of a JSON report against the document API's objects (eventJson,
+/// impactJson, collapseJson): the same keys in the same order, the same strings and
+/// counts, every double bit for bit (null for NaN and infinities).
+void expectJsonEvents(const std::string& text, const std::vector<io::Json>& expected_events) {
   const io::Json doc = io::Json::parse(text);  // throws on invalid JSON
   const io::Json& printed = doc.at("events");
-  ASSERT_EQ(printed.size(), events.size());
-  for (std::size_t k = 0; k < events.size(); ++k) {
-    const io::Json expected = io::eventJson(events[k]);  // keys, order and types of the document API
+  ASSERT_EQ(printed.size(), expected_events.size());
+  for (std::size_t k = 0; k < expected_events.size(); ++k) {
+    const io::Json& expected = expected_events[k];
     const io::Json& event = printed[k];
     ASSERT_EQ(event.size(), expected.size());
     auto e = expected.begin();
     for (auto p = event.begin(); p != event.end(); ++p, ++e) {
       ASSERT_EQ(p.key(), e.key());
-      if (e->is_array()) {
+      if (e->is_array() && !e->empty() && !(*e)[0].is_string()) {
         ASSERT_EQ(p->size(), e->size()) << p.key();
         for (std::size_t i = 0; i < e->size(); ++i) {
           ASSERT_EQ((*p)[i].is_number_float(), std::isfinite(jsonDouble((*e)[i]))) << p.key();  // else null
@@ -186,6 +191,12 @@ void expectJsonCarriesEvents(const std::string& text, const std::vector<core::La
       }
     }
   }
+}
+
+void expectJsonCarriesEvents(const std::string& text, const std::vector<core::LabEvent>& events) {
+  std::vector<io::Json> expected;
+  for (const core::LabEvent& event : events) expected.push_back(io::eventJson(event));
+  expectJsonEvents(text, expected);
 }
 
 TEST(ReportStream, CsvAndJsonCarryEveryEventValueBitForBit) {
@@ -213,6 +224,89 @@ TEST(ReportStream, WallsZerosAndUndefinedPaperValues) {
   for (bool with_model : {false, true}) {
     expectCsvCarriesEvents(report(run, io::ReportFormat::kCsv, with_model), run.result.events);
     expectJsonCarriesEvents(report(run, io::ReportFormat::kJson, with_model), run.result.events);
+  }
+}
+
+}  // namespace
+
+namespace {
+
+/// An N-body run's shown events, as the document API prints them, and its CSV and JSON.
+struct SceneReports {
+  std::vector<io::Json> events;
+  std::vector<std::vector<double>> csv_values;  ///< the numeric cells of each row, in order
+  std::string csv, json;
+};
+
+SceneReports sceneReports(const core::Scene& scene) {
+  SceneReports reports;
+  core::SceneRunOptions options;
+  options.lab.events = core::EventPolicy::all();
+  options.keep_events = false;
+  std::ostringstream csv, json;
+  const io::SceneEntry entry{"stream", "", scene, 0};
+  const core::ModelChoice model = core::chooseModel(scene);
+  const auto csv_writer = io::makeSceneReportWriter(io::ReportFormat::kCsv, csv);
+  const auto json_writer = io::makeSceneReportWriter(io::ReportFormat::kJson, json);
+  csv_writer->begin(entry, options.lab, model);
+  json_writer->begin(entry, options.lab, model);
+  core::SceneVisitors visitors;
+  visitors.impact = [&](const core::ImpactRecord& r) {
+    reports.events.push_back(io::impactJson(r));
+    reports.csv_values.push_back({r.time, r.position, r.velocities_before[0], r.velocities_before[1],
+                                  r.velocities_after[0], r.velocities_after[1], r.energy_gained[0],
+                                  r.energy_gained[1], r.energy_lost});
+    csv_writer->impact(r);
+    json_writer->impact(r);
+  };
+  visitors.collapse = [&](const core::Collapse& c) {
+    reports.events.push_back(io::collapseJson(c));
+    reports.csv_values.push_back({c.time, c.position, c.velocity, c.velocity});
+    csv_writer->collapse(c);
+    json_writer->collapse(c);
+  };
+  const core::SceneRunResult result = core::runScene(scene, options, visitors);
+  csv_writer->end(result);
+  json_writer->end(result);
+  reports.csv = csv.str();
+  reports.json = json.str();
+  return reports;
+}
+
+TEST(ReportStream, NBodyImpactsAndCollapsesCarryTheEngineValues) {
+  // 100 bodies (a seeded gas like the gas_1000 preset) and the collapse of three
+  // equal masses at e = 0.05 < r_c (a collapse event among the impacts).
+  std::mt19937_64 random(13);
+  std::uniform_real_distribution<double> speed(-1, 1), mass(0.5, 2);
+  core::Scene gas;
+  for (int i = 99; i >= 0; --i) {
+    gas.masses.push_back(mass(random));
+    gas.positions.push_back(i * 0.1);
+    gas.velocities.push_back(speed(random));
+  }
+  const core::Scene collapse{{1, 1, 1}, {2, 1, 0}, {-1, 0, 0}, {0.05}};
+  for (const core::Scene& scene : {gas, collapse}) {
+    ASSERT_FALSE(core::validateForRun(scene));
+    const SceneReports reports = sceneReports(scene);
+    ASSERT_GT(reports.events.size(), 2u);
+    expectJsonEvents(reports.json, reports.events);
+    std::istringstream in(reports.csv);
+    std::string line;
+    std::size_t row = 0;
+    while (std::getline(in, line)) {
+      if (line.empty() || line[0] == '#' || line.rfind("index,", 0) == 0) continue;
+      ASSERT_LT(row, reports.csv_values.size());
+      const std::vector<double>& expected = reports.csv_values[row++];
+      std::vector<double> printed;
+      const std::vector<std::string> fields = split(line);
+      ASSERT_EQ(fields.size(), 15u) << line;
+      for (std::size_t i = 3; i < 12; ++i) {
+        if (!fields[i].empty()) printed.push_back(std::strtod(fields[i].c_str(), nullptr));
+      }
+      ASSERT_EQ(printed.size(), expected.size()) << line;
+      for (std::size_t i = 0; i < expected.size(); ++i) ASSERT_TRUE(samePrinted(printed[i], expected[i])) << line;
+    }
+    EXPECT_EQ(row, reports.csv_values.size());
   }
 }
 
