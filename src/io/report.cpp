@@ -438,37 +438,25 @@ namespace report_text {
 
 void writeEventJson(TextSink& sink, const core::LabEvent& lab) {
   const core::ImpactEvent& e = lab.event;
-  const auto write_number = [&sink](const char* key, double value) {
-    sink.put(key);
-    sink.jsonNumber(value);
-  };
-  const auto write_array3 = [&sink](const char* key, const std::array<double, 3>& values) {
-    sink.put(key);
-    for (int i = 0; i < 3; ++i) {
-      sink.put(i == 0 ? '[' : ',');
-      sink.jsonNumber(values[i]);
-    }
-    sink.put(']');
-  };
   // The keys and order of eventJson.
   sink.put("{\"index\":");
   sink.count(e.index);
   sink.put(",\"pair\":\"");
   sink.put(core::pairName(e.pair));
   sink.put('"');
-  write_number(",\"time\":", e.time);
-  write_number(",\"position\":", e.position);
-  write_array3(",\"positions\":", e.positions);
-  write_array3(",\"velocities_before\":", e.velocities_before);
-  write_array3(",\"velocities_after\":", e.velocities_after);
-  write_array3(",\"energy_transfer\":", e.energy_transfer);
-  write_array3(",\"predicted_velocities_after\":", lab.predicted_velocities_after);
-  write_array3(",\"predicted_energy_transfer\":", lab.predicted_energy_transfer);
-  write_array3(",\"paper_velocities_after\":", lab.paper_velocities_after);
-  write_array3(",\"paper_energy_transfer\":", lab.paper_energy_transfer);
-  write_array3(",\"kinetic_energy_after\":", lab.kinetic_energy_after);
-  write_number(",\"total_energy\":", e.total_energy);
-  write_number(",\"total_momentum\":", e.total_momentum);
+  sink.jsonField(",\"time\":", e.time);
+  sink.jsonField(",\"position\":", e.position);
+  sink.jsonArray(",\"positions\":", e.positions);
+  sink.jsonArray(",\"velocities_before\":", e.velocities_before);
+  sink.jsonArray(",\"velocities_after\":", e.velocities_after);
+  sink.jsonArray(",\"energy_transfer\":", e.energy_transfer);
+  sink.jsonArray(",\"predicted_velocities_after\":", lab.predicted_velocities_after);
+  sink.jsonArray(",\"predicted_energy_transfer\":", lab.predicted_energy_transfer);
+  sink.jsonArray(",\"paper_velocities_after\":", lab.paper_velocities_after);
+  sink.jsonArray(",\"paper_energy_transfer\":", lab.paper_energy_transfer);
+  sink.jsonArray(",\"kinetic_energy_after\":", lab.kinetic_energy_after);
+  sink.jsonField(",\"total_energy\":", e.total_energy);
+  sink.jsonField(",\"total_momentum\":", e.total_momentum);
   sink.put('}');
 }
 

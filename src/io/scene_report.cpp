@@ -337,12 +337,12 @@ class SceneJsonWriter : public SceneReportWriter {
     sink_.put("\",\"");
     sink_.put(core::bodyName(r.pair_index + 1));
     sink_.put("\"]");
-    writeNumber(",\"time\":", r.time);
-    writeNumber(",\"position\":", r.position);
-    writePair(",\"velocities_before\":", r.velocities_before);
-    writePair(",\"velocities_after\":", r.velocities_after);
-    writePair(",\"energy_gained\":", r.energy_gained);
-    writeNumber(",\"energy_lost\":", r.energy_lost);
+    sink_.jsonField(",\"time\":", r.time);
+    sink_.jsonField(",\"position\":", r.position);
+    sink_.jsonArray(",\"velocities_before\":", r.velocities_before);
+    sink_.jsonArray(",\"velocities_after\":", r.velocities_after);
+    sink_.jsonArray(",\"energy_gained\":", r.energy_gained);
+    sink_.jsonField(",\"energy_lost\":", r.energy_lost);
     endEvent();
   }
 
@@ -359,9 +359,9 @@ class SceneJsonWriter : public SceneReportWriter {
     sink_.count(c.first_body);
     sink_.put(",\"last_body_index\":");
     sink_.count(c.last_body);
-    writeNumber(",\"time\":", c.time);
-    writeNumber(",\"position\":", c.position);
-    writeNumber(",\"velocity\":", c.velocity);
+    sink_.jsonField(",\"time\":", c.time);
+    sink_.jsonField(",\"position\":", c.position);
+    sink_.jsonField(",\"velocity\":", c.velocity);
     endEvent();
   }
 
@@ -381,20 +381,6 @@ class SceneJsonWriter : public SceneReportWriter {
     sink_.put('}');
     sink_.flushIfFull();
   }
-  void writeNumber(const char* key, double value) {
-    sink_.put(key);
-    sink_.jsonNumber(value);
-  }
-  template <class Pair>
-  void writePair(const char* key, const Pair& values) {
-    sink_.put(key);
-    sink_.put('[');
-    sink_.jsonNumber(values[0]);
-    sink_.put(',');
-    sink_.jsonNumber(values[1]);
-    sink_.put(']');
-  }
-
   std::ostream& out_;
   TextSink sink_;
   bool any_event_ = false;

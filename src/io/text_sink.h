@@ -99,6 +99,23 @@ class TextSink {
     size_ = static_cast<std::size_t>(json_.write(at(), value) - buffer_.data());
   }
 
+  /// `key` (e.g. ",\"time\":") and the value as jsonNumber.
+  void jsonField(std::string_view key, double value) {
+    put(key);
+    jsonNumber(value);
+  }
+  /// `key` and the values (an indexable of size() doubles) as a JSON array.
+  template <class Values>
+  void jsonArray(std::string_view key, const Values& values) {
+    put(key);
+    put('[');
+    for (std::size_t i = 0; i < values.size(); ++i) {
+      if (i > 0) put(',');
+      jsonNumber(values[i]);
+    }
+    put(']');
+  }
+
   void flushIfFull() {
     if (size_ >= kChunk) flush();
   }
