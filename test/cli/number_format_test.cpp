@@ -137,7 +137,9 @@ TEST(NumberFormat, EveryDoubleReadsBackExactlyFromTheShortestText) {
     const std::string csv = csvText(value);
     expectReadsBack(csv, value);
     ASSERT_EQ(csv.size(), shortest.characters) << csv;
-    if (!isPlainInteger(csv)) ASSERT_EQ(significantDigits(csv), shortest.digits) << csv;
+    if (!isPlainInteger(csv)) {
+      ASSERT_EQ(significantDigits(csv), shortest.digits) << csv;
+    }
     // JSON, nlohmann's layout: always the fewest significant digits.
     const std::string json = jsonText(value);
     expectReadsBack(json, value);
