@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cctype>
+#include <charconv>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <limits>
 
 namespace collision_lab {
@@ -29,7 +31,74 @@ std::optional<double> yamlSpecialValue(const std::string& lower) {
   return std::nullopt;
 }
 
+/// nlohmann::json's layout (dtoa_impl::format_buffer with min_exp -4, max_exp 15) of
+/// digits[0..k) * 10^(n - k), written at `out`, where `out` already holds the k digits.
+char* jsonLayout(char* out, int k, int n) {
+  constexpr int kMinExp = -4;
+  constexpr int kMaxExp = 15;
+  if (k <= n && n <= kMaxExp) {  // digits[000].0
+    std::memset(out + k, '0', static_cast<std::size_t>(n - k));
+    out[n] = '.';
+    out[n + 1] = '0';
+    return out + n + 2;
+  }
+  if (0 < n && n <= kMaxExp) {  // dig.its
+    std::memmove(out + n + 1, out + n, static_cast<std::size_t>(k - n));
+    out[n] = '.';
+    return out + k + 1;
+  }
+  if (kMinExp < n && n <= 0) {  // 0.[000]digits
+    std::memmove(out + 2 - n, out, static_cast<std::size_t>(k));
+    out[0] = '0';
+    out[1] = '.';
+    std::memset(out + 2, '0', static_cast<std::size_t>(-n));
+    return out + 2 - n + k;
+  }
+  if (k > 1) {  // d.igits
+    std::memmove(out + 2, out + 1, static_cast<std::size_t>(k - 1));
+    out[1] = '.';
+  }
+  out += k == 1 ? 1 : k + 1;
+  *out++ = 'e';
+  int e = n - 1;
+  *out++ = e < 0 ? '-' : '+';
+  e = e < 0 ? -e : e;
+  if (e >= 100) *out++ = static_cast<char>('0' + e / 100);
+  *out++ = static_cast<char>('0' + e / 10 % 10);
+  *out++ = static_cast<char>('0' + e % 10);
+  return out;
+}
+
 }  // namespace
+
+char* writeCsvNumber(char* out, double value) {
+  if (std::isnan(value)) return std::copy_n("nan", 3, out);
+  if (value == 0) {
+    *out = '0';
+    return out + 1;
+  }
+  return std::to_chars(out, out + kNumberTextMax, value).ptr;  // inf and -inf as such
+}
+
+char* writeJsonNumber(char* out, double value) {
+  if (!std::isfinite(value)) return std::copy_n("null", 4, out);
+  if (value == 0) return std::copy_n("0.0", 3, out);
+  if (value < 0) {
+    *out++ = '-';
+    value = -value;
+  }
+  // Shortest round-trip digits in exponent form, "d.ddde+XX" or "de-XX", then laid out.
+  char scientific[kNumberTextMax];
+  char* const end = std::to_chars(scientific, scientific + sizeof scientific, value, std::chars_format::scientific).ptr;
+  char* const e = std::find(scientific, end, 'e');
+  int k = 0;
+  for (const char* c = scientific; c != e; ++c) {
+    if (*c != '.') out[k++] = *c;
+  }
+  int exponent = 0;
+  std::from_chars(e + (e[1] == '+' ? 2 : 1), end, exponent);
+  return jsonLayout(out, k, exponent + 1);
+}
 
 ParsedNumber parseNumber(std::string_view text) {
   if (text.empty()) return {0.0, "is empty"};

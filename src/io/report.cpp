@@ -7,6 +7,7 @@
 
 #include "collision_lab/io/number_text.h"
 
+#include "event_pipeline.h"
 #include "report_text.h"
 
 namespace collision_lab {
@@ -16,14 +17,10 @@ namespace {
 
 const char* const kParticleNames[3] = {"A", "B", "C"};
 
-/// Shortest text that reads back to the same double; "inf", "-inf", "nan" for any NaN,
-/// and "0" for either zero.
+/// writeCsvNumber's text: shortest round trip, 0 for either zero, nan, inf, -inf.
 std::string roundTripText(double value) {
-  if (std::isnan(value)) return "nan";
-  if (value == 0) return "0";
-  char buffer[64];
-  const auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
-  return std::string(buffer, result.ptr);
+  char buffer[kNumberTextMax];
+  return std::string(buffer, writeCsvNumber(buffer, value));
 }
 
 using report_text::humanText;
@@ -163,7 +160,7 @@ class TableWriter : public RunReportWriter {
 
 class JsonWriter : public RunReportWriter {
  public:
-  explicit JsonWriter(std::ostream& out) : out_(out) {}
+  explicit JsonWriter(std::ostream& out) : out_(out), events_(out, report_text::writeEventJsonLine) {}
 
   void begin(const NamedScene& named, const core::RunOptions& options) override {
     out_ << "{\"scene\": " << jsonText(sceneJson(named)) << ",\n\"options\": " << jsonText(optionsJson(options))
@@ -171,16 +168,18 @@ class JsonWriter : public RunReportWriter {
   }
 
   void event(const core::LabEvent& lab) override {
-    out_ << (any_event_ ? ",\n" : "\n") << jsonText(eventJson(lab));
+    events_.push(lab);
     any_event_ = true;
   }
 
   void end(const core::RunResult& result) override {
+    events_.finish();
     out_ << (any_event_ ? "\n]" : "]") << ",\n\"summary\": " << jsonText(summaryJson(result)) << "}\n";
   }
 
  private:
   std::ostream& out_;
+  EventPipeline events_;
   bool any_event_ = false;
 };
 
@@ -217,9 +216,31 @@ void writeCsvComments(std::ostream& out, const std::string& prefix, const Json& 
   }
 }
 
+/// One event row, in the columns of CsvWriter's header.
+void writeEventCsv(TextSink& sink, const core::LabEvent& lab, bool /*first*/) {
+  const core::ImpactEvent& e = lab.event;
+  const auto cell = [&sink](double value) {
+    sink.put(',');
+    sink.csvNumber(value);
+  };
+  sink.count(e.index);
+  sink.put(',');
+  sink.put(core::pairName(e.pair));
+  cell(e.time);
+  cell(e.position);
+  for (const auto* values : {&e.positions, &e.velocities_before, &e.velocities_after, &e.energy_transfer,
+                             &lab.predicted_velocities_after, &lab.paper_velocities_after,
+                             &lab.predicted_energy_transfer, &lab.paper_energy_transfer}) {
+    for (double v : *values) cell(v);
+  }
+  cell(e.total_energy);
+  cell(e.total_momentum);
+  sink.put('\n');
+}
+
 class CsvWriter : public RunReportWriter {
  public:
-  explicit CsvWriter(std::ostream& out) : out_(out) {}
+  explicit CsvWriter(std::ostream& out) : out_(out), events_(out, writeEventCsv) {}
 
   void begin(const NamedScene& named, const core::RunOptions& options) override {
     out_ << "# scene," << named.name << "\n";
@@ -246,21 +267,16 @@ class CsvWriter : public RunReportWriter {
     out_ << ",total_energy_J,total_momentum_kg_m_s\n";
   }
 
-  void event(const core::LabEvent& lab) override {
-    const core::ImpactEvent& e = lab.event;
-    out_ << e.index << "," << core::pairName(e.pair) << "," << roundTripText(e.time) << "," << roundTripText(e.position);
-    for (const auto* values : {&e.positions, &e.velocities_before, &e.velocities_after, &e.energy_transfer,
-                               &lab.predicted_velocities_after, &lab.paper_velocities_after,
-                               &lab.predicted_energy_transfer, &lab.paper_energy_transfer}) {
-      for (double v : *values) out_ << "," << roundTripText(v);
-    }
-    out_ << "," << roundTripText(e.total_energy) << "," << roundTripText(e.total_momentum) << "\n";
-  }
+  void event(const core::LabEvent& lab) override { events_.push(lab); }
 
-  void end(const core::RunResult& result) override { writeCsvComments(out_, "summary.", summaryJson(result)); }
+  void end(const core::RunResult& result) override {
+    events_.finish();
+    writeCsvComments(out_, "summary.", summaryJson(result));
+  }
 
  private:
   std::ostream& out_;
+  EventPipeline events_;
 };
 
 // ---------------------------------------------------------------------------------------
@@ -417,6 +433,39 @@ Json eventJson(const core::LabEvent& lab) {
               {"total_energy", number(e.total_energy)},
               {"total_momentum", number(e.total_momentum)}};
 }
+
+namespace report_text {
+
+void writeEventJson(TextSink& sink, const core::LabEvent& lab) {
+  const core::ImpactEvent& e = lab.event;
+  // The keys and order of eventJson.
+  sink.put("{\"index\":");
+  sink.count(e.index);
+  sink.put(",\"pair\":\"");
+  sink.put(core::pairName(e.pair));
+  sink.put('"');
+  sink.jsonField(",\"time\":", e.time);
+  sink.jsonField(",\"position\":", e.position);
+  sink.jsonArray(",\"positions\":", e.positions);
+  sink.jsonArray(",\"velocities_before\":", e.velocities_before);
+  sink.jsonArray(",\"velocities_after\":", e.velocities_after);
+  sink.jsonArray(",\"energy_transfer\":", e.energy_transfer);
+  sink.jsonArray(",\"predicted_velocities_after\":", lab.predicted_velocities_after);
+  sink.jsonArray(",\"predicted_energy_transfer\":", lab.predicted_energy_transfer);
+  sink.jsonArray(",\"paper_velocities_after\":", lab.paper_velocities_after);
+  sink.jsonArray(",\"paper_energy_transfer\":", lab.paper_energy_transfer);
+  sink.jsonArray(",\"kinetic_energy_after\":", lab.kinetic_energy_after);
+  sink.jsonField(",\"total_energy\":", e.total_energy);
+  sink.jsonField(",\"total_momentum\":", e.total_momentum);
+  sink.put('}');
+}
+
+void writeEventJsonLine(TextSink& sink, const core::LabEvent& lab, bool first) {
+  sink.put(first ? "\n" : ",\n");
+  writeEventJson(sink, lab);
+}
+
+}  // namespace report_text
 
 Json summaryJson(const core::RunResult& result) {
   const core::AnalyticPrediction& p = result.prediction;

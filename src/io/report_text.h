@@ -7,6 +7,7 @@
 #include <string>
 
 #include "collision_lab/io/report.h"  // Json
+#include "text_sink.h"
 
 namespace collision_lab {
 namespace io {
@@ -31,6 +32,12 @@ inline std::string padRight(const std::string& text, std::size_t width) {
 
 /// A double for JSON: never a negative zero (NaN and infinities become null when dumped).
 inline Json number(double value) { return Json(value == 0 ? 0.0 : value); }
+
+/// eventJson(lab) as compact JSON text (its keys in its order, numbers as writeJsonNumber),
+/// written without building a document.
+void writeEventJson(TextSink& sink, const core::LabEvent& lab);
+/// The same as a line of the "events" array: "\n" before the first event, ",\n" before others.
+void writeEventJsonLine(TextSink& sink, const core::LabEvent& lab, bool first);
 
 }  // namespace report_text
 }  // namespace io

@@ -5,7 +5,9 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <optional>
 
+#include "event_pipeline.h"
 #include "report_text.h"
 
 namespace collision_lab {
@@ -312,7 +314,7 @@ void writeSummaryJson(std::ostream& out, const core::SceneRunResult& result) {
 
 class SceneJsonWriter : public SceneReportWriter {
  public:
-  explicit SceneJsonWriter(std::ostream& out) : out_(out) {}
+  explicit SceneJsonWriter(std::ostream& out) : out_(out), sink_(out) {}
 
   void begin(const SceneEntry& entry, const core::RunOptions& options, const core::ModelChoice&) override {
     out_ << "{\"scene\": ";
@@ -321,22 +323,66 @@ class SceneJsonWriter : public SceneReportWriter {
          << ",\n\"events\": [";
   }
 
-  void impact(const core::ImpactRecord& impact) override { writeEvent(impactJson(impact)); }
-  void collapse(const core::Collapse& collapse) override { writeEvent(collapseJson(collapse)); }
+  void impact(const core::ImpactRecord& r) override {
+    startEvent();
+    // The keys and order of impactJson; names are letters, digits, '#' and '-': no escapes.
+    sink_.put("{\"kind\":\"impact\",\"index\":");
+    sink_.count(r.index);
+    sink_.put(",\"pair\":\"");
+    sink_.put(core::pairName(r.pair_index));
+    sink_.put("\",\"pair_index\":");
+    sink_.count(r.pair_index);
+    sink_.put(",\"bodies\":[\"");
+    sink_.put(core::bodyName(r.pair_index));
+    sink_.put("\",\"");
+    sink_.put(core::bodyName(r.pair_index + 1));
+    sink_.put("\"]");
+    sink_.jsonField(",\"time\":", r.time);
+    sink_.jsonField(",\"position\":", r.position);
+    sink_.jsonArray(",\"velocities_before\":", r.velocities_before);
+    sink_.jsonArray(",\"velocities_after\":", r.velocities_after);
+    sink_.jsonArray(",\"energy_gained\":", r.energy_gained);
+    sink_.jsonField(",\"energy_lost\":", r.energy_lost);
+    endEvent();
+  }
+
+  void collapse(const core::Collapse& c) override {
+    startEvent();
+    // The keys and order of collapseJson.
+    sink_.put("{\"kind\":\"collapse\",\"impacts_before\":");
+    sink_.count(c.impacts_before);
+    sink_.put(",\"first_body\":\"");
+    sink_.put(core::bodyName(c.first_body));
+    sink_.put("\",\"last_body\":\"");
+    sink_.put(core::bodyName(c.last_body));
+    sink_.put("\",\"first_body_index\":");
+    sink_.count(c.first_body);
+    sink_.put(",\"last_body_index\":");
+    sink_.count(c.last_body);
+    sink_.jsonField(",\"time\":", c.time);
+    sink_.jsonField(",\"position\":", c.position);
+    sink_.jsonField(",\"velocity\":", c.velocity);
+    endEvent();
+  }
 
   void end(const core::SceneRunResult& result) override {
+    sink_.flush();
     out_ << (any_event_ ? "\n]" : "]") << ",\n\"summary\": ";
     writeSummaryJson(out_, result);
     out_ << "}\n";
   }
 
  private:
-  void writeEvent(const Json& event) {
-    out_ << (any_event_ ? ",\n" : "\n") << jsonText(event);
+  void startEvent() {
+    sink_.put(any_event_ ? ",\n" : "\n");
     any_event_ = true;
   }
-
+  void endEvent() {
+    sink_.put('}');
+    sink_.flushIfFull();
+  }
   std::ostream& out_;
+  TextSink sink_;
   bool any_event_ = false;
 };
 
@@ -378,7 +424,7 @@ void writeCsvNumbers(std::ostream& out, const char* key, const std::vector<doubl
 
 class SceneCsvWriter : public SceneReportWriter {
  public:
-  explicit SceneCsvWriter(std::ostream& out) : out_(out) {}
+  explicit SceneCsvWriter(std::ostream& out) : out_(out), sink_(out) {}
 
   void begin(const SceneEntry& entry, const core::RunOptions& options, const core::ModelChoice& model) override {
     const core::Scene& s = entry.scene;
@@ -396,21 +442,39 @@ class SceneCsvWriter : public SceneReportWriter {
   }
 
   void impact(const core::ImpactRecord& r) override {
-    out_ << r.index << "," << core::pairName(r.pair_index) << "," << r.pair_index;
+    sink_.count(r.index);
+    sink_.put(',');
+    sink_.put(core::pairName(r.pair_index));
+    sink_.put(',');
+    sink_.count(r.pair_index);
     for (double v : {r.time, r.position, r.velocities_before[0], r.velocities_before[1], r.velocities_after[0],
                      r.velocities_after[1], r.energy_gained[0], r.energy_gained[1], r.energy_lost}) {
-      out_ << "," << csvNumber(v);
+      cell(v);
     }
-    out_ << ",impact," << r.first_moved << "," << r.last_moved << "\n";
+    sink_.put(",impact,");
+    sink_.count(r.first_moved);
+    sink_.put(',');
+    sink_.count(r.last_moved);
+    sink_.put('\n');
+    sink_.flushIfFull();
   }
 
   void collapse(const core::Collapse& c) override {
-    out_ << c.impacts_before << ",,," << csvNumber(c.time) << "," << csvNumber(c.position) << ",,,"
-         << csvNumber(c.velocity) << "," << csvNumber(c.velocity) << ",,,,collapse," << c.first_body << ","
-         << c.last_body << "\n";
+    sink_.count(c.impacts_before);
+    sink_.put(",,");
+    for (double v : {c.time, c.position}) cell(v);
+    sink_.put(",,");
+    for (double v : {c.velocity, c.velocity}) cell(v);
+    sink_.put(",,,,collapse,");
+    sink_.count(c.first_body);
+    sink_.put(',');
+    sink_.count(c.last_body);
+    sink_.put('\n');
+    sink_.flushIfFull();
   }
 
   void end(const core::SceneRunResult& result) override {
+    sink_.flush();
     const Json summary = summaryScalars(result);
     for (const auto& item : summary.items()) {
       writeCsvComment(out_, "summary." + item.key(), item.value());
@@ -420,7 +484,13 @@ class SceneCsvWriter : public SceneReportWriter {
   }
 
  private:
+  void cell(double value) {
+    sink_.put(',');
+    sink_.csvNumber(value);
+  }
+
   std::ostream& out_;
+  TextSink sink_;
 };
 
 // ---------------------------------------------------------------------------------------
@@ -429,7 +499,13 @@ class SceneCsvWriter : public SceneReportWriter {
 class ThreeBodyModelWriter : public RunReportWriter {
  public:
   ThreeBodyModelWriter(ReportFormat format, std::ostream& out, const core::ModelChoice& model)
-      : format_(format), out_(out), model_(model), inner_(makeRunReportWriter(format, out)) {}
+      : format_(format), out_(out), model_(model) {
+    if (format == ReportFormat::kJson) {
+      events_.emplace(out, report_text::writeEventJsonLine);
+    } else {
+      inner_ = makeRunReportWriter(format, out);
+    }
+  }
 
   void begin(const NamedScene& scene, const core::RunOptions& options) override {
     if (format_ != ReportFormat::kJson) return inner_->begin(scene, options);
@@ -439,12 +515,13 @@ class ThreeBodyModelWriter : public RunReportWriter {
 
   void event(const core::LabEvent& event) override {
     if (format_ != ReportFormat::kJson) return inner_->event(event);
-    out_ << (any_event_ ? ",\n" : "\n") << jsonText(eventJson(event));
+    events_->push(event);
     any_event_ = true;
   }
 
   void end(const core::RunResult& result) override {
     if (format_ == ReportFormat::kJson) {
+      events_->finish();
       Json summary = summaryJson(result);
       summary["model"] = core::modelKindName(model_.kind);
       summary["model_reason"] = model_.reason;
@@ -464,7 +541,8 @@ class ThreeBodyModelWriter : public RunReportWriter {
   ReportFormat format_;
   std::ostream& out_;
   core::ModelChoice model_;
-  std::unique_ptr<RunReportWriter> inner_;
+  std::unique_ptr<RunReportWriter> inner_;  ///< table and CSV
+  std::optional<EventPipeline> events_;     ///< JSON events
   bool any_event_ = false;
 };
 

@@ -1,6 +1,8 @@
-// Numbers typed by people: command-line lists and scenario-file scalars. ROS-free.
+// Numbers typed by people (command-line lists, scenario-file scalars) and numbers printed
+// for programs (CSV and JSON reports). ROS-free.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -34,6 +36,21 @@ struct ParsedCount {
 /// Reads a non-negative decimal integer ("10000000"); signs, fractions, exponents and
 /// blanks are not integers, and more than 2^64 - 1 is too large (and says so).
 ParsedCount parseCount(std::string_view text);
+
+/// Room that writeCsvNumber and writeJsonNumber need at `out` (the longest text is 24
+/// characters, e.g. -2.2250738585072014e-308 or -0.00012345678901234567).
+constexpr std::size_t kNumberTextMax = 32;
+
+/// A double for a CSV cell: the shortest decimal text that reads back (strtod) to the same
+/// double, laid out as std::to_chars does (fixed or exponent form, whichever is shorter:
+/// 0.5, 1e+12); 0 for either zero; nan for any NaN; inf and -inf. Returns the end.
+char* writeCsvNumber(char* out, double value);
+
+/// A double for JSON, laid out as nlohmann::json dumps doubles (fixed form from 1e-4 up to
+/// 1e15 with a fraction always shown, as in 2.0 or 1000000000000.0; else 1.5e-05, 1e+15)
+/// but with the shortest digits that read back to the same double; 0.0 for either zero;
+/// null for NaN and infinities. Returns the end.
+char* writeJsonNumber(char* out, double value);
 
 /// Splits "a,b,c" at commas. Items are not trimmed; "1,,2" gives an empty middle item.
 std::vector<std::string> splitCommaList(std::string_view text);

@@ -1,0 +1,313 @@
+// The streamed three-body reports (io/report.h, io/scene_report.h) carry the core's event
+// values bit for bit: whole CSV and JSON runs of thousands of impacts (several buffer
+// chunks) are parsed back, by strtod and by nlohmann::json, and compared with the events
+// that the core keeps in its RunResult.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <limits>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "collision_lab/core/lab_run.h"
+#include "collision_lab/core/nbody/models.h"
+#include "collision_lab/core/scene_run.h"
+#include "collision_lab/io/report.h"
+#include "collision_lab/io/scene_report.h"
+
+namespace {
+
+namespace core = collision_lab::core;
+namespace io = collision_lab::io;
+
+std::uint64_t bitsOf(double value) {
+  std::uint64_t bits;
+  std::memcpy(&bits, &value, sizeof bits);
+  return bits;
+}
+
+/// A printed value against the core's: the same bits, except that -0 is printed as 0 and
+/// (JSON) NaN and infinities as null, read here as NaN.
+bool samePrinted(double printed, double core_value) {
+  if (core_value == 0) return bitsOf(printed) == bitsOf(0.0);
+  if (std::isnan(core_value)) return std::isnan(printed);
+  return bitsOf(printed) == bitsOf(core_value);
+}
+
+/// The values of one event in the CSV column order after index and pair.
+std::vector<double> csvRowValues(const core::LabEvent& lab) {
+  const core::ImpactEvent& e = lab.event;
+  std::vector<double> values = {e.time, e.position};
+  for (const auto* group : {&e.positions, &e.velocities_before, &e.velocities_after, &e.energy_transfer,
+                            &lab.predicted_velocities_after, &lab.paper_velocities_after,
+                            &lab.predicted_energy_transfer, &lab.paper_energy_transfer}) {
+    values.insert(values.end(), group->begin(), group->end());
+  }
+  values.push_back(e.total_energy);
+  values.push_back(e.total_momentum);
+  return values;
+}
+
+struct LabRun {
+  io::NamedScene named;
+  core::RunOptions options;
+  core::RunResult result;
+};
+
+LabRun runScene(const core::ThreeBodyScene& scene) {
+  LabRun run{{"stream", "", scene}, {}, {}};
+  run.options.events = core::EventPolicy::all();
+  run.result = core::runLab(scene, run.options);
+  return run;
+}
+
+/// The report as the CLI writes it (with the model) or as report.h's plain writer does.
+std::string report(const LabRun& run, io::ReportFormat format, bool with_model) {
+  std::ostringstream out;
+  const core::Scene scene{{run.named.scene.masses.begin(), run.named.scene.masses.end()},
+                          {run.named.scene.positions.begin(), run.named.scene.positions.end()},
+                          {run.named.scene.velocities.begin(), run.named.scene.velocities.end()},
+                          {}};
+  const auto writer = with_model ? io::makeThreeBodyReportWriter(format, out, core::chooseModel(scene))
+                                 : io::makeRunReportWriter(format, out);
+  writer->begin(run.named, run.options);
+  for (const core::LabEvent& event : run.result.events) writer->event(event);
+  writer->end(run.result);
+  return out.str();
+}
+
+std::vector<std::string> split(const std::string& line) {
+  std::vector<std::string> fields;
+  std::size_t start = 0;
+  for (std::size_t comma; (comma = line.find(',', start)) != std::string::npos; start = comma + 1) {
+    fields.push_back(line.substr(start, comma - start));
+  }
+  fields.push_back(line.substr(start));
+  return fields;
+}
+
+void expectCsvCarriesEvents(const std::string& text, const std::vector<core::LabEvent>& events) {
+  std::istringstream in(text);
+  std::string line;
+  std::size_t row = 0;
+  bool header_seen = false;
+  while (std::getline(in, line)) {
+    if (line.rfind("#", 0) == 0) continue;
+    if (!header_seen) {
+      header_seen = true;
+      ASSERT_EQ(line.rfind("index,pair,time_s,position_m,x_A_m", 0), 0u) << line;
+      continue;
+    }
+    ASSERT_LT(row, events.size());
+    const core::LabEvent& lab = events[row++];
+    const std::vector<std::string> fields = split(line);
+    const std::vector<double> expected = csvRowValues(lab);
+    ASSERT_EQ(fields.size(), 2 + expected.size()) << line;
+    ASSERT_EQ(fields[0], std::to_string(lab.event.index));
+    ASSERT_EQ(fields[1], core::pairName(lab.event.pair));
+    for (std::size_t i = 0; i < expected.size(); ++i) {
+      char* end = nullptr;
+      const double value = std::strtod(fields[2 + i].c_str(), &end);
+      ASSERT_EQ(*end, '\0') << fields[2 + i];
+      ASSERT_TRUE(samePrinted(value, expected[i])) << "row " << row << " column " << 2 + i << ": " << fields[2 + i];
+    }
+  }
+  EXPECT_EQ(row, events.size());
+}
+
+/// Every number token of the first `lines` event lines of a JSON report has the fewest
+/// significant digits that read back (brute force over printf's %.{p}g); nlohmann's own
+/// Grisu2 dump, which the JSON used before, gives 17 where 16 do in a few of them.
+void expectShortestJsonNumbers(const std::string& text, std::size_t lines) {
+  std::istringstream in(text);
+  std::string line;
+  std::size_t checked = 0;
+  while (std::getline(in, line) && checked < lines) {
+    if (line.rfind("{\"index\":", 0) != 0) continue;
+    ++checked;
+    for (std::size_t i = line.find(':'); i < line.size(); ++i) {
+      if (line[i] != ':' && line[i] != '[' && line[i] != ',') continue;
+      const std::size_t end = line.find_first_not_of("-+.0123456789e", i + 1);
+      const std::string token = line.substr(i + 1, end - i - 1);
+      if (token.find_first_of(".e") == std::string::npos) continue;  // counts, strings, null
+      const double value = std::strtod(token.c_str(), nullptr);
+      if (value == 0) continue;
+      int fewest = 17;
+      for (int p = 1; p < 17; ++p) {
+        char shorter[40];
+        std::snprintf(shorter, sizeof shorter, "%.*g", p, value);
+        if (std::strtod(shorter, nullptr) == value) {
+          fewest = p;
+          break;
+        }
+      }
+      std::string digits;
+      for (char c : token.substr(0, token.find('e'))) {
+        if (c >= '0' && c <= '9') digits += c;
+      }
+      digits.erase(0, digits.find_first_not_of('0'));
+      digits.erase(digits.find_last_not_of('0') + 1);
+      ASSERT_EQ(static_cast<int>(digits.size()), fewest) << token << " in " << line.substr(0, 40);
+    }
+  }
+  EXPECT_EQ(checked, lines);
+}
+
+double jsonDouble(const io::Json& value) {
+  return value.is_null() ? std::numeric_limits<double>::quiet_NaN() : value.get<double>();
+}
+
+/// The "events" of a JSON report against the document API's objects (eventJson,
+/// impactJson, collapseJson): the same keys in the same order, the same strings and
+/// counts, every double bit for bit (null for NaN and infinities).
+void expectJsonEvents(const std::string& text, const std::vector<io::Json>& expected_events) {
+  const io::Json doc = io::Json::parse(text);  // throws on invalid JSON
+  const io::Json& printed = doc.at("events");
+  ASSERT_EQ(printed.size(), expected_events.size());
+  for (std::size_t k = 0; k < expected_events.size(); ++k) {
+    const io::Json& expected = expected_events[k];
+    const io::Json& event = printed[k];
+    ASSERT_EQ(event.size(), expected.size());
+    auto e = expected.begin();
+    for (auto p = event.begin(); p != event.end(); ++p, ++e) {
+      ASSERT_EQ(p.key(), e.key());
+      if (e->is_array() && !e->empty() && !(*e)[0].is_string()) {
+        ASSERT_EQ(p->size(), e->size()) << p.key();
+        for (std::size_t i = 0; i < e->size(); ++i) {
+          ASSERT_EQ((*p)[i].is_number_float(), std::isfinite(jsonDouble((*e)[i]))) << p.key();  // else null
+          ASSERT_TRUE(samePrinted(jsonDouble((*p)[i]), jsonDouble((*e)[i]))) << "event " << k + 1 << " " << p.key();
+        }
+      } else if (e->is_number_float() || e->is_null()) {
+        ASSERT_TRUE(samePrinted(jsonDouble(*p), jsonDouble(*e))) << "event " << k + 1 << " " << p.key();
+      } else {
+        ASSERT_EQ(*p, *e) << p.key();
+      }
+    }
+  }
+}
+
+void expectJsonCarriesEvents(const std::string& text, const std::vector<core::LabEvent>& events) {
+  std::vector<io::Json> expected;
+  for (const core::LabEvent& event : events) expected.push_back(io::eventJson(event));
+  expectJsonEvents(text, expected);
+}
+
+TEST(ReportStream, CsvAndJsonCarryEveryEventValueBitForBit) {
+  // Masses (1e8, 1, 1e8): 22214 impacts (ceil(pi / alpha) - 1 with alpha = atan(sqrt(m_B
+  // (m_A + m_B + m_C) / (m_A m_C))) = atan(sqrt(2.00000001e-8)), pi / alpha = 22214.4), about
+  // 11 MB of CSV: many blocks of the pipeline, formatted by its workers, written in order.
+  const LabRun run = runScene({{1e8, 1, 1e8}, {2, 1, 0}, {-1, 0, 0}});
+  ASSERT_EQ(run.result.events.size(), 22214u);
+  for (bool with_model : {false, true}) {
+    SCOPED_TRACE(with_model ? "with the model" : "report.h writer");
+    const std::string csv = report(run, io::ReportFormat::kCsv, with_model);
+    EXPECT_GT(csv.size(), std::size_t{10} << 20);
+    expectCsvCarriesEvents(csv, run.result.events);
+    const std::string json = report(run, io::ReportFormat::kJson, with_model);
+    expectJsonCarriesEvents(json, run.result.events);
+    expectShortestJsonNumbers(json, 400);
+  }
+}
+
+TEST(ReportStream, WallsZerosAndUndefinedPaperValues) {
+  // A wall at C: the wall's values, exact zeros and the paper's undefined expressions (NaN,
+  // infinities) print as the conventions say and read back.
+  const LabRun run = runScene({{100, 1, std::numeric_limits<double>::infinity()}, {2, 1, 0}, {-1, -0.0, 0}});
+  ASSERT_EQ(run.result.events.size(), 31u);  // m_A / m_B = 100: 31 collisions (shared/physics.md)
+  for (bool with_model : {false, true}) {
+    expectCsvCarriesEvents(report(run, io::ReportFormat::kCsv, with_model), run.result.events);
+    expectJsonCarriesEvents(report(run, io::ReportFormat::kJson, with_model), run.result.events);
+  }
+}
+
+}  // namespace
+
+namespace {
+
+/// An N-body run's shown events, as the document API prints them, and its CSV and JSON.
+struct SceneReports {
+  std::vector<io::Json> events;
+  std::vector<std::vector<double>> csv_values;  ///< the numeric cells of each row, in order
+  std::string csv, json;
+};
+
+SceneReports sceneReports(const core::Scene& scene) {
+  SceneReports reports;
+  core::SceneRunOptions options;
+  options.lab.events = core::EventPolicy::all();
+  options.keep_events = false;
+  std::ostringstream csv, json;
+  const io::SceneEntry entry{"stream", "", scene, 0};
+  const core::ModelChoice model = core::chooseModel(scene);
+  const auto csv_writer = io::makeSceneReportWriter(io::ReportFormat::kCsv, csv);
+  const auto json_writer = io::makeSceneReportWriter(io::ReportFormat::kJson, json);
+  csv_writer->begin(entry, options.lab, model);
+  json_writer->begin(entry, options.lab, model);
+  core::SceneVisitors visitors;
+  visitors.impact = [&](const core::ImpactRecord& r) {
+    reports.events.push_back(io::impactJson(r));
+    reports.csv_values.push_back({r.time, r.position, r.velocities_before[0], r.velocities_before[1],
+                                  r.velocities_after[0], r.velocities_after[1], r.energy_gained[0],
+                                  r.energy_gained[1], r.energy_lost});
+    csv_writer->impact(r);
+    json_writer->impact(r);
+  };
+  visitors.collapse = [&](const core::Collapse& c) {
+    reports.events.push_back(io::collapseJson(c));
+    reports.csv_values.push_back({c.time, c.position, c.velocity, c.velocity});
+    csv_writer->collapse(c);
+    json_writer->collapse(c);
+  };
+  const core::SceneRunResult result = core::runScene(scene, options, visitors);
+  csv_writer->end(result);
+  json_writer->end(result);
+  reports.csv = csv.str();
+  reports.json = json.str();
+  return reports;
+}
+
+TEST(ReportStream, NBodyImpactsAndCollapsesCarryTheEngineValues) {
+  // 100 bodies (a seeded gas like the gas_1000 preset) and the collapse of three
+  // equal masses at e = 0.05 < r_c (a collapse event among the impacts).
+  std::mt19937_64 random(13);
+  std::uniform_real_distribution<double> speed(-1, 1), mass(0.5, 2);
+  core::Scene gas;
+  for (int i = 99; i >= 0; --i) {
+    gas.masses.push_back(mass(random));
+    gas.positions.push_back(i * 0.1);
+    gas.velocities.push_back(speed(random));
+  }
+  const core::Scene collapse{{1, 1, 1}, {2, 1, 0}, {-1, 0, 0}, {0.05}};
+  for (const core::Scene& scene : {gas, collapse}) {
+    ASSERT_FALSE(core::validateForRun(scene));
+    const SceneReports reports = sceneReports(scene);
+    ASSERT_GT(reports.events.size(), 2u);
+    expectJsonEvents(reports.json, reports.events);
+    std::istringstream in(reports.csv);
+    std::string line;
+    std::size_t row = 0;
+    while (std::getline(in, line)) {
+      if (line.empty() || line[0] == '#' || line.rfind("index,", 0) == 0) continue;
+      ASSERT_LT(row, reports.csv_values.size());
+      const std::vector<double>& expected = reports.csv_values[row++];
+      std::vector<double> printed;
+      const std::vector<std::string> fields = split(line);
+      ASSERT_EQ(fields.size(), 15u) << line;
+      for (std::size_t i = 3; i < 12; ++i) {
+        if (!fields[i].empty()) printed.push_back(std::strtod(fields[i].c_str(), nullptr));
+      }
+      ASSERT_EQ(printed.size(), expected.size()) << line;
+      for (std::size_t i = 0; i < expected.size(); ++i) ASSERT_TRUE(samePrinted(printed[i], expected[i])) << line;
+    }
+    EXPECT_EQ(row, reports.csv_values.size());
+  }
+}
+
+}  // namespace
