@@ -5,7 +5,8 @@
 #   docs/hard_cases.md                    collision_lab_hard_cases
 #   docs/restitution_count.{csv,png}      collision_lab_bench_restitution, bench/plot_restitution_count.py
 #   docs/benchmark_goals.md               every "goal:" line of this run, as a table
-# and prints the core and N-body speed tables (collision_lab_bench_core, collision_lab_bench_nbody).
+# and prints the core and N-body speed tables (collision_lab_bench_core, collision_lab_bench_nbody)
+# and the CLI's output speed against dd (bench/bench_output.sh).
 #
 # Usage: bash bench/run_benchmarks.sh [--quick]
 #   --quick: fewer scenes, dt values, impacts and repeats (a few minutes); every output goes
@@ -30,7 +31,7 @@ export COLLISION_LAB_BENCH_SOURCE
 
 cmake -S "$repo" -B "$build" -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build "$build" -j2 --target collision_lab_bench_core collision_lab_bench_nbody collision_lab_speed_vs_error \
-  collision_lab_hard_cases collision_lab_bench_restitution
+  collision_lab_hard_cases collision_lab_bench_restitution collision_lab_cli
 bin="$build/devel/lib/collision_lab"
 
 if [[ -n "$quick" ]]; then out="$build/bench_quick"; else out="$repo/docs"; fi
@@ -56,6 +57,7 @@ step "restitution: impacts against e" "$bin/collision_lab_bench_restitution" "${
 python3 "$repo/bench/plot_restitution_count.py" --csv "$out/restitution_count.csv" --out "$out/restitution_count.png"
 step "core speed" "$bin/collision_lab_bench_core" $quick
 step "N-body engine speed and memory" "$bin/collision_lab_bench_nbody" $quick
+step "CSV and JSON output against dd" env BUILD_DIR="$build" bash "$repo/bench/bench_output.sh" $quick
 
 python3 "$repo/bench/goals_table.py" --log "$log" --source "$COLLISION_LAB_BENCH_SOURCE" --out "$out/benchmark_goals.md"
 printf '\n=== Goals (issue 13), each with its anchor from this run\n'
