@@ -239,7 +239,7 @@ void printRecordingGoal(ros::NodeHandle& nh, const std::string& target, const st
     return;
   }
   std::printf("goal: recording, node-thread hand-over per run (median; p99 %.1f us) = %.1f us against "
-              "a whole recorded run end to end = %.1f us (%.2fx; goal <= 100 us): %s\n",
+              "a whole recorded run end to end = %.1f us (%.3fx; goal <= 100 us): %s\n",
               p99, median, per_run_us, median / per_run_us, median <= 100.0 ? "met" : "missed");
 }
 
