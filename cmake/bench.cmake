@@ -6,6 +6,8 @@
 #   collision_lab_hard_cases      adaptive precision on the hard cases of physics.md (issue 4)
 #   collision_lab_node_throughput, collision_lab_relay_node   the whole node over loopback
 #                                 (issue 4; built with the ROS layer; bench/node/node_throughput.launch)
+#   collision_lab_recording_bench the node's recording against rosbag record (issue 13;
+#                                 bench/node/recording_vs_rosbag.launch)
 # Real engines are optional: each is compiled in only when found. GMP (exact reference
 # trajectories) is required by the last two; without it they are skipped with a message.
 
@@ -40,9 +42,11 @@ if(TARGET collision_lab_ros)
   target_link_libraries(collision_lab_relay_node PRIVATE collision_lab_ros)
   add_executable(collision_lab_node_throughput bench/node/node_throughput.cpp)
   target_link_libraries(collision_lab_node_throughput PRIVATE collision_lab_ros)
-  set_target_properties(collision_lab_relay_node collision_lab_node_throughput PROPERTIES
+  add_executable(collision_lab_recording_bench bench/node/recording_vs_rosbag.cpp)
+  target_link_libraries(collision_lab_recording_bench PRIVATE collision_lab_ros)
+  set_target_properties(collision_lab_relay_node collision_lab_node_throughput collision_lab_recording_bench PROPERTIES
     RUNTIME_OUTPUT_DIRECTORY ${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_BIN_DESTINATION})
-  install(TARGETS collision_lab_relay_node collision_lab_node_throughput
+  install(TARGETS collision_lab_relay_node collision_lab_node_throughput collision_lab_recording_bench
     RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 endif()
 

@@ -3,8 +3,10 @@
 #include <sys/statvfs.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdlib>
 #include <ctime>
+#include <functional>
 #include <optional>
 #include <sstream>
 #include <utility>
@@ -20,15 +22,21 @@
 
 namespace collision_lab_ros {
 
-/// Stamps the messages of one run on its timeline, publishes them and records them.
+/// Stamps the messages of one run on its timeline, publishes them and hands what is
+/// recorded over to the bag writer, in batches of at most kRecordBatchEvents events.
 class RunWriter {
  public:
-  /// recorder may be null (not recording).
-  RunWriter(std::string run_id, RunTimeline timeline, RunRecorder* recorder)
-      : run_id_(std::move(run_id)), timeline_(timeline), recorder_(recorder) {}
+  /// bags may be null (not recording).
+  RunWriter(std::string run_id, RunTimeline timeline, RunBagWriter* bags)
+      : run_id_(std::move(run_id)), timeline_(timeline), bags_(bags) {
+    batch_.run_id = run_id_;
+    batch_.opens = true;
+  }
 
   const RunTimeline& timeline() const { return timeline_; }
-  RunRecorder* recorder() const { return recorder_; }
+  bool recording() const { return bags_ != nullptr; }
+  /// [s] of this (the node's) thread spent handing messages over to the bag writer.
+  double recordingSeconds() const { return recording_time_.count(); }
 
   /// Sets run_id and header.stamp: the timeline's stamp of simulated time t [s].
   template <class Message>
@@ -36,23 +44,56 @@ class RunWriter {
     msg.run_id = run_id_;
     msg.header.stamp = timeline_.stamp(t);
   }
-  /// Records msg at its header.stamp.
-  template <class Message>
-  void record(const std::string& topic, const Message& msg) {
-    if (recorder_) recorder_->write(topic, msg.header.stamp, msg);
-  }
-  /// Stamps at t, publishes and records.
+  /// Stamps at t and publishes.
   template <class Message>
   void publish(const ros::Publisher& pub, Message& msg, double t) {
     stamp(msg, t);
     pub.publish(msg);
-    record(pub.getTopic(), msg);
+  }
+
+  /// Record (at their header.stamp): the input, the prediction, each event.
+  void record(const collision_lab::InitialConditions& input) {
+    if (bags_) timed([&] { batch_.input = input; });
+  }
+  void record(const collision_lab::Prediction& prediction) {
+    if (bags_) timed([&] { batch_.prediction = prediction; });
+  }
+  void record(collision_lab::CollisionEvent&& event) {
+    if (!bags_) return;
+    timed([&] {
+      batch_.events.push_back(std::move(event));
+      if (batch_.events.size() >= kRecordBatchEvents) handOver();
+    });
+  }
+  /// Records the summary last and closes the bag on the writer's thread, which then
+  /// calls on_closed with the summary's final recording fields.
+  void finish(const collision_lab::RunSummary& summary,
+              std::function<void(collision_lab::RunSummary&)> on_closed) {
+    timed([&] {
+      batch_.summary = summary;
+      batch_.on_closed = std::move(on_closed);
+      handOver();
+    });
   }
 
  private:
+  template <class F>
+  void timed(F&& f) {
+    const auto start = std::chrono::steady_clock::now();
+    f();
+    recording_time_ += std::chrono::steady_clock::now() - start;
+  }
+  void handOver() {
+    bags_->push(std::move(batch_));
+    batch_ = RunBagBatch();
+    batch_.run_id = run_id_;
+  }
+
   std::string run_id_;
   RunTimeline timeline_;
-  RunRecorder* recorder_;
+  RunBagWriter* bags_;
+  RunBagBatch batch_;
+  std::chrono::duration<double> recording_time_{0.0};
 };
 
 namespace {
@@ -90,6 +131,7 @@ class EventStream {
       topics_.velocities.publish(toVelocitiesMsg(msg));
       topics_.energies.publish(toEnergyTransferMsg(msg, 0.0));  // elastic: no heat
     }
+    out_.record(std::move(msg));
   }
   /// An impact of the event engine.
   void operator()(const collision_lab::core::ImpactRecord& impact) { sendWithPlots(converter_.impact(impact)); }
@@ -104,21 +146,23 @@ class EventStream {
 
  private:
   void sendWithPlots(collision_lab::CollisionEvent msg) {
-    if (!send(msg)) return;
-    topics_.velocities.publish(converter_.velocitiesMsg(msg));
-    topics_.energies.publish(converter_.energyTransferMsg(msg));
+    if (send(msg)) {
+      topics_.velocities.publish(converter_.velocitiesMsg(msg));
+      topics_.energies.publish(converter_.energyTransferMsg(msg));
+    }
+    out_.record(std::move(msg));
   }
-  /// Stamps, draws and records msg, and publishes it unless the cap is reached; true when published.
+  /// Stamps and draws msg, and publishes it unless the cap is reached; true when
+  /// published. The caller records it.
   bool send(collision_lab::CollisionEvent& msg) {
     last_time_ = msg.time;
     out_.stamp(msg, last_time_);
     if (markers_) markers_->onCollisionEvent(msg);
     if (published_ == max_published_) {
       cut_ = true;
-      out_.record(topics_.events.getTopic(), msg);
       return false;
     }
-    out_.publish(topics_.events, msg, last_time_);
+    topics_.events.publish(msg);
     ++published_;
     return true;
   }
@@ -132,21 +176,6 @@ class EventStream {
   bool cut_ = false;
   double last_time_ = 0.0;
 };
-
-/// Fills summary's recording fields from recorder and closes the bag: the recorded
-/// summary tells the state before closing, the returned one (published) after it.
-void closeRecording(RunWriter& out, const std::string& topic, collision_lab::RunSummary& summary) {
-  RunRecorder* recorder = out.recorder();
-  summary.bag_path = recorder->path();
-  summary.recording_ok = recorder->ok();
-  summary.recording_error = recorder->error();
-  out.record(topic, summary);
-  if (!recorder->close()) {
-    ROS_ERROR_STREAM("run " << summary.run_id << ": recording failed: " << recorder->error());
-  }
-  summary.recording_ok = recorder->ok();
-  summary.recording_error = recorder->error();
-}
 
 /// The reason to refuse input before simulating it (run_id, mode, size, then the scene), if any.
 std::optional<collision_lab::Rejected> checkInput(const collision_lab::InitialConditions& input,
@@ -194,8 +223,11 @@ std::string predictedText(const collision_lab::RunSummary& summary) {
   return text.str();
 }
 
+/// At DEBUG level: at thousands of runs per second, an INFO line per run (console, log
+/// file and /rosout, another process) costs more than the run itself; every result is on
+/// run_summaries, and failures and warnings are still logged as such.
 void logRun(const collision_lab::RunSummary& summary) {
-  ROS_INFO_STREAM("run " << summary.run_id << ": " << summary.collision_count << " collisions"
+  ROS_DEBUG_STREAM("run " << summary.run_id << ": " << summary.collision_count << " collisions"
                   << (summary.truncated ? " (truncated)" : "") << ", " << predictedText(summary)
                   << ", " << summary.compute_time << " s"
                   << (summary.bag_path.empty() ? std::string() : ", bag " + summary.bag_path));
@@ -275,6 +307,33 @@ LabNodeParams LabNodeParams::load(const ros::NodeHandle& private_nh) {
   return params;
 }
 
+void RecentDurations::add(double seconds) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (samples_.size() < kRecordingTimeWindow) {
+    samples_.push_back(seconds);
+  } else {
+    samples_[next_] = seconds;
+    next_ = (next_ + 1) % kRecordingTimeWindow;
+  }
+}
+
+double RecentDurations::quantile(double q) const {
+  std::vector<double> sorted;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    sorted = samples_;
+  }
+  if (sorted.empty()) return 0.0;
+  const auto k = static_cast<std::size_t>(q * static_cast<double>(sorted.size() - 1) + 0.5);
+  std::nth_element(sorted.begin(), sorted.begin() + k, sorted.end());
+  return sorted[k];
+}
+
+std::size_t RecentDurations::size() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return samples_.size();
+}
+
 std::string runIdProblem(const std::string& run_id) {
   if (run_id.size() > 200) return "is longer than 200 characters";
   if (run_id.empty() || run_id[0] == '.') return "must not be empty or start with '.'";
@@ -308,6 +367,13 @@ LabNode::LabNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   }
 
   run_id_prefix_ = std::string("run_") + utcStamp("%Y%m%d_%H%M%S") + "_";
+  if (params_.record) {
+    bags_ = std::make_unique<RunBagWriter>(
+        params_.bag_directory,
+        RunBagWriter::Topics{nh_.resolveName(kInitialConditionsTopic), topics_.predictions.getTopic(),
+                             topics_.events.getTopic(), topics_.summaries.getTopic()},
+        kRecordQueueMessages);
+  }
 
   diagnostics_pub_ = nh_.advertise<diagnostic_msgs::DiagnosticArray>(kDiagnosticsTopic, 10);
   diagnostics_timer_ = nh_.createWallTimer(ros::WallDuration(kDiagnosticsPeriod),
@@ -351,6 +417,7 @@ LabNode::~LabNode() {
   }
   wake_.notify_one();
   worker_.join();
+  bags_.reset();  // writes and closes every bag handed over, then publishes its summary
   cancel_srv_.shutdown();
   cancel_spinner_.stop();
   service_spinner_.stop();
@@ -424,8 +491,7 @@ void LabNode::workerLoop() {
       job = std::move(inputs_.front());
       inputs_.pop_front();
     }
-    ServeOutcome outcome = serve(*job.input);
-    if (job.reply) job.reply->set_value(std::move(outcome));
+    serve(*job.input, std::move(job.reply));
   }
 }
 
@@ -463,32 +529,29 @@ ServeOutcome LabNode::reject(collision_lab::Rejected msg, const std::string& run
   return ServeOutcome{std::nullopt, msg};
 }
 
-ServeOutcome LabNode::serve(collision_lab::InitialConditions input) {
+void LabNode::serve(collision_lab::InitialConditions input, Reply reply) {
   const std::string requested = input.run_id;
-  if (auto rejection = checkInput(input, params_.max_bodies)) return reject(std::move(*rejection), requested);
+  if (auto rejection = checkInput(input, params_.max_bodies)) {
+    ServeOutcome outcome = reject(std::move(*rejection), requested);
+    if (reply) reply->set_value(std::move(outcome));
+    return;
+  }
   input.run_id = requested.empty() ? newRunId() : claimRunId(requested);
   if (!requested.empty() && input.run_id != requested) {
     ROS_WARN_STREAM("run_id '" << requested << "' is taken (its bag exists, or this node served "
                     "it before); serving the run as '" << input.run_id << "'");
   }
-  const collision_lab::RunSummary summary =
-      run(input, input.run_id != requested ? requested : std::string());
-  logRun(summary);
-  return ServeOutcome{summary, {}};
+  run(input, input.run_id != requested ? requested : std::string(), std::move(reply));
 }
 
-collision_lab::RunSummary LabNode::run(collision_lab::InitialConditions& input,
-                                       const std::string& requested_run_id) {
+void LabNode::run(collision_lab::InitialConditions& input, const std::string& requested_run_id, Reply reply) {
   namespace core = collision_lab::core;
   const ros::Time start = stampNow();
   const core::Scene scene = toScene(input);
   const core::RunMode mode = *toRunMode(input.mode);
   // The prediction goes out before the simulation starts.
   const ScenePrediction prediction = predictScene(scene);
-  std::optional<RunRecorder> recorder;
-  if (params_.record) recorder.emplace(params_.bag_directory, input.run_id);
-  RunWriter out(input.run_id, RunTimeline(start, chooseTimelineScale(firstContactTime(scene))),
-                recorder ? &*recorder : nullptr);
+  RunWriter out(input.run_id, RunTimeline(start, chooseTimelineScale(firstContactTime(scene))), bags_.get());
   input.header.stamp = start;
   publishStart(out, input, prediction);
 
@@ -512,8 +575,7 @@ collision_lab::RunSummary LabNode::run(collision_lab::InitialConditions& input,
   summary.published_events = events.published();
   summary.events_not_published = events.cut();
   summary.requested_run_id = requested_run_id;
-  publishEnd(out, summary, events.lastTime());
-  return summary;
+  publishEnd(out, summary, events.lastTime(), std::move(reply));
 }
 
 collision_lab::core::SceneRunResult LabNode::runCancellable(const std::string& run_id,
@@ -550,15 +612,16 @@ bool LabNode::onCancel(collision_lab::Cancel::Request& request, collision_lab::C
 
 void LabNode::publishStart(RunWriter& out, const collision_lab::InitialConditions& input,
                            const ScenePrediction& core_prediction) {
-  out.record(nh_.resolveName(kInitialConditionsTopic), input);
+  out.record(input);
   if (marker_view_) marker_view_->onInitialConditions(input);
   collision_lab::Prediction prediction = toPredictionMsg(core_prediction);
   prediction.timeline_scale = out.timeline().scale();
   out.publish(topics_.predictions, prediction, 0.0);
+  out.record(prediction);
   if (marker_view_) marker_view_->onPrediction(prediction);
 }
 
-void LabNode::publishEnd(RunWriter& out, collision_lab::RunSummary& summary, double last_event_time) {
+void LabNode::publishEnd(RunWriter& out, collision_lab::RunSummary& summary, double last_event_time, Reply reply) {
   summary.timeline_scale = out.timeline().scale();
   out.stamp(summary, last_event_time);
   summary.timeline_saturated = out.timeline().saturated();
@@ -567,16 +630,27 @@ void LabNode::publishEnd(RunWriter& out, collision_lab::RunSummary& summary, dou
                     << " bag s are stamped at that limit (timeline_scale "
                     << summary.timeline_scale << ")");
   }
-  if (out.recorder()) {
-    closeRecording(out, topics_.summaries.getTopic(), summary);
+  if (!out.recording()) {
+    finishRun(summary, reply);
+    return;
+  }
+  out.finish(summary, [this, reply](collision_lab::RunSummary& closed) { finishRun(closed, reply); });
+  recording_times_.add(out.recordingSeconds());
+}
+
+void LabNode::finishRun(const collision_lab::RunSummary& summary, const Reply& reply) {
+  if (params_.record) {
     std::lock_guard<std::mutex> lock(recording_mutex_);
     last_recording_error_ = summary.recording_error;
+    if (!summary.recording_ok) ROS_ERROR_STREAM("run " << summary.run_id << ": recording failed: " << summary.recording_error);
   }
-  // The summary goes out last, after everything it counts.
+  // The summary goes out last, after everything it counts (and its bag is closed).
   topics_.summaries.publish(summary);
   ++runs_accepted_;
   last_compute_time_ = summary.compute_time;
   if (marker_view_) marker_view_->onRunSummary(summary);
+  logRun(summary);
+  if (reply) reply->set_value(ServeOutcome{summary, {}});
 }
 
 void LabNode::publishDiagnostics() {
@@ -604,6 +678,9 @@ void LabNode::addRecordingStatus(diagnostic_msgs::DiagnosticStatus& status) {
     recording_error = last_recording_error_;
   }
   addValue(status, "last recording error", recording_error);
+  addValue(status, "recording hand-over per run, runs sampled", std::to_string(recording_times_.size()));
+  addValue(status, "recording hand-over per run, median [us]", std::to_string(1e6 * recording_times_.quantile(0.5)));
+  addValue(status, "recording hand-over per run, p99 [us]", std::to_string(1e6 * recording_times_.quantile(0.99)));
   if (!recording_error.empty()) {
     status.level = diagnostic_msgs::DiagnosticStatus::ERROR;
     status.message = "recording failed: " + recording_error;

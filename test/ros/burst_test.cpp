@@ -79,6 +79,18 @@ TEST(Burst, OneAnswerPerInputAndOneBagPerValidRun) {
     rosbag::View summaries(bag, rosbag::TopicQuery("/collision_lab/run_summaries"));
     EXPECT_EQ(summaries.size(), 1u);
     EXPECT_EQ(rosbag::View(bag).size(), 3 + summary.collision_count);  // one event per collision
+    // The bag, written behind the run by the writer thread, holds the events published live.
+    rosbag::View events(bag, rosbag::TopicQuery("/collision_lab/collision_events"));
+    ASSERT_EQ(events.size(), out.events.size());
+    std::size_t k = 0;
+    for (const auto& m : events) {
+      const auto event = m.instantiate<collision_lab::CollisionEvent>();
+      ASSERT_NE(event, nullptr);
+      EXPECT_EQ(event->index, out.events[k].index);
+      EXPECT_EQ(event->time, out.events[k].time);
+      EXPECT_EQ(event->velocities_after, out.events[k].velocities_after);
+      ++k;
+    }
   }
   EXPECT_EQ(node.runs().size(), static_cast<std::size_t>(kInputs));
 

@@ -1,11 +1,16 @@
-// Per-run bags without a master: final name only when closed, failures reported.
+// Per-run bags without a master: final name only when closed, failures reported; the
+// writer thread (RunBagWriter) writes every message handed over, under backpressure, and
+// closes every bag before it is destroyed.
 #include <filesystem>
 #include <fstream>
+#include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <ros/time.h>
 #include <rosbag/view.h>
 
+#include "collision_lab/CollisionEvent.h"
 #include "collision_lab/RunSummary.h"
 #include "collision_lab/ros/run_recorder.h"
 
@@ -73,6 +78,92 @@ TEST_F(RunRecorderTest, WriteAtTimeZeroFailsCleanly) {
   EXPECT_FALSE(recorder.ok());
   EXPECT_FALSE(recorder.close());
   EXPECT_FALSE(fs::exists(dir_ + "/r0.bag"));
+}
+
+/// One run for RunBagWriter: its input, prediction and events (index k at 1 + k s), in
+/// batches of at most batch_events, the summary last.
+std::vector<collision_lab_ros::RunBagBatch> runBatches(const std::string& run_id, std::size_t events,
+                                                       std::size_t batch_events) {
+  const ros::Time start(1.5e9);
+  std::vector<collision_lab_ros::RunBagBatch> batches(1);
+  batches[0].run_id = run_id;
+  batches[0].opens = true;
+  batches[0].input.emplace();
+  batches[0].input->header.stamp = start;
+  batches[0].prediction.emplace();
+  batches[0].prediction->header.stamp = start;
+  for (std::size_t k = 0; k < events; ++k) {
+    if (batches.back().events.size() == batch_events) {
+      batches.emplace_back();
+      batches.back().run_id = run_id;
+    }
+    collision_lab::CollisionEvent event;
+    event.index = k;
+    event.header.stamp = start + ros::Duration(1.0 + static_cast<double>(k));
+    batches.back().events.push_back(event);
+  }
+  auto& last = batches.back();
+  last.summary.emplace();
+  last.summary->run_id = run_id;
+  last.summary->collision_count = events;
+  last.summary->header.stamp = start + ros::Duration(1.0 + static_cast<double>(events));
+  return batches;
+}
+
+TEST_F(RunRecorderTest, BagWriterClosesEveryBagHandedOverWithEveryMessage) {
+  constexpr int kRuns = 40;
+  std::vector<collision_lab::RunSummary> closed;  // on_closed runs on the writer's thread, in order
+  {
+    // A bound of 100 queued messages: the runs below (up to 1,000 events) push against it.
+    collision_lab_ros::RunBagWriter writer(dir_, {"/in", "/pred", "/events", "/sum"}, 100);
+    for (int r = 0; r < kRuns; ++r) {
+      for (auto& batch : runBatches("run" + std::to_string(r), 25 * static_cast<std::size_t>(r), 64)) {
+        if (batch.summary) batch.on_closed = [&closed](collision_lab::RunSummary& s) { closed.push_back(s); };
+        writer.push(std::move(batch));
+      }
+    }
+  }  // the destructor drains the queue
+  ASSERT_EQ(closed.size(), static_cast<std::size_t>(kRuns));
+  for (int r = 0; r < kRuns; ++r) {
+    SCOPED_TRACE(r);
+    const std::string run_id = "run" + std::to_string(r);
+    const auto events = 25u * static_cast<unsigned>(r);
+    EXPECT_EQ(closed[r].run_id, run_id);
+    EXPECT_TRUE(closed[r].recording_ok) << closed[r].recording_error;
+    EXPECT_EQ(closed[r].bag_path, dir_ + "/" + run_id + ".bag");
+    EXPECT_FALSE(fs::exists(dir_ + "/" + run_id + ".bag.active"));
+    rosbag::Bag bag(closed[r].bag_path, rosbag::bagmode::Read);
+    EXPECT_EQ(rosbag::View(bag).size(), 3 + events);
+    EXPECT_EQ(rosbag::View(bag, rosbag::TopicQuery("/in")).size(), 1u);
+    EXPECT_EQ(rosbag::View(bag, rosbag::TopicQuery("/pred")).size(), 1u);
+    std::uint64_t index = 0;
+    for (const auto& m : rosbag::View(bag, rosbag::TopicQuery("/events"))) {
+      EXPECT_EQ(m.instantiate<collision_lab::CollisionEvent>()->index, index++);
+    }
+    EXPECT_EQ(index, events);
+    rosbag::View summaries(bag, rosbag::TopicQuery("/sum"));
+    ASSERT_EQ(summaries.size(), 1u);
+    EXPECT_EQ(summaries.begin()->instantiate<collision_lab::RunSummary>()->collision_count, events);
+  }
+}
+
+TEST_F(RunRecorderTest, BagWriterReportsAFailedBagAndGoesOn) {
+  std::ofstream(dir_ + "/file") << "x";
+  std::vector<collision_lab::RunSummary> closed;
+  {
+    collision_lab_ros::RunBagWriter writer(dir_ + "/file/bags", {"/in", "/pred", "/events", "/sum"}, 10);
+    for (const char* run_id : {"a", "b"}) {
+      for (auto& batch : runBatches(run_id, 30, 8)) {
+        if (batch.summary) batch.on_closed = [&closed](collision_lab::RunSummary& s) { closed.push_back(s); };
+        writer.push(std::move(batch));
+      }
+    }
+  }
+  ASSERT_EQ(closed.size(), 2u);
+  for (const auto& summary : closed) {
+    EXPECT_FALSE(summary.recording_ok);
+    EXPECT_NE(summary.recording_error.find(dir_ + "/file/bags"), std::string::npos) << summary.recording_error;
+  }
 }
 
 TEST(ExpandUser, ExpandsLeadingTildeOnly) {

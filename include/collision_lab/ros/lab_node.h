@@ -18,12 +18,18 @@
 // - ~cancel runs on a callback queue and thread of its own, so it is answered while every
 //   service thread waits for a run. It sets cancel_, which the run in progress polls
 //   (SceneRunOptions::cancel); running_mutex_ guards which run that is.
+// - With recording on, the worker hands each run's recorded messages over to a bag writer
+//   thread (RunBagWriter; it blocks only while kRecordQueueMessages messages wait). The
+//   writer closes the run's bag, then publishes its summary and answers its service call
+//   (finishRun), so a run's summary may follow the next run's first messages; every
+//   summary still follows its own run's messages and its bag is closed when it goes out.
 // - The diagnostics timer (global queue) reads the worker's counters through atomics and
 //   recording_mutex_.
 // - Destruction: the subscription and the services stop, queued inputs are dropped (a
 //   call waiting for one answers ok = false), the run in progress is cancelled and closes
-//   its bag (its summary says cancelled), then the worker and the service threads are
-//   joined.
+//   its bag (its summary says cancelled), the worker is joined, the bag writer writes and
+//   closes every bag handed over (publishing their summaries), then the service threads
+//   are stopped.
 #pragma once
 
 #include <atomic>
@@ -37,6 +43,7 @@
 #include <string>
 #include <thread>
 #include <unordered_set>
+#include <vector>
 
 #include <diagnostic_msgs/DiagnosticStatus.h>
 #include <ros/callback_queue.h>
@@ -80,6 +87,21 @@ struct RunTopics {
 
 /// Stamps, publishes and records the messages of one run (lab_node.cpp).
 class RunWriter;
+class RunBagWriter;
+
+/// The newest kRecordingTimeWindow samples of a duration [s], thread-safe.
+class RecentDurations {
+ public:
+  void add(double seconds);
+  /// The q-quantile (q in [0, 1]) of the kept samples [s]; 0 when there are none.
+  double quantile(double q) const;
+  std::size_t size() const;
+
+ private:
+  mutable std::mutex mutex_;
+  std::vector<double> samples_;
+  std::size_t next_ = 0;
+};
 
 /// The answer to one input: its summary when served, else its rejection.
 struct ServeOutcome {
@@ -94,9 +116,11 @@ class LabNode {
   ~LabNode();
 
  private:
+  /// Where a service call waits for its outcome; null for topic inputs.
+  using Reply = std::shared_ptr<std::promise<ServeOutcome>>;
   struct Job {
     collision_lab::InitialConditions::ConstPtr input;
-    std::shared_ptr<std::promise<ServeOutcome>> reply;  ///< null for topic inputs
+    Reply reply;
   };
 
   void onInitialConditions(const collision_lab::InitialConditions::ConstPtr& msg);
@@ -112,12 +136,12 @@ class LabNode {
   void workerLoop();
 
   // ---- The worker's (not thread-safe) ----
-  /// Validates input, assigns its run_id, then runs it or rejects it.
-  ServeOutcome serve(collision_lab::InitialConditions input);
-  /// Publishes, records and draws one validated run (its run_id assigned); returns its
-  /// summary. requested_run_id: RunSummary.requested_run_id.
-  collision_lab::RunSummary run(collision_lab::InitialConditions& input,
-                                const std::string& requested_run_id);
+  /// Validates input, assigns its run_id, then runs it or rejects it; reply gets the
+  /// outcome once the run is finished (its bag closed).
+  void serve(collision_lab::InitialConditions input, Reply reply);
+  /// Publishes, records and draws one validated run (its run_id assigned).
+  /// requested_run_id: RunSummary.requested_run_id.
+  void run(collision_lab::InitialConditions& input, const std::string& requested_run_id, Reply reply);
   /// runScene, as the run that ~cancel stops.
   collision_lab::core::SceneRunResult runCancellable(const std::string& run_id,
                                                      const collision_lab::core::Scene& scene,
@@ -126,8 +150,12 @@ class LabNode {
   /// Records the input (stamped at the run's start) and publishes the prediction.
   void publishStart(RunWriter& out, const collision_lab::InitialConditions& input,
                     const ScenePrediction& prediction);
-  /// Stamps, records and publishes the summary last, closes the bag, counts the run.
-  void publishEnd(RunWriter& out, collision_lab::RunSummary& summary, double last_event_time);
+  /// Stamps the summary and finishes the run: at once when not recording, else on the
+  /// bag writer's thread once the bag is closed.
+  void publishEnd(RunWriter& out, collision_lab::RunSummary& summary, double last_event_time, Reply reply);
+  /// Publishes the summary last, counts, draws and logs the run, answers reply. Runs on
+  /// the worker (not recording) or on the bag writer's thread.
+  void finishRun(const collision_lab::RunSummary& summary, const Reply& reply);
   ServeOutcome reject(collision_lab::Rejected msg, const std::string& run_id);
   std::string newRunId();
   /// requested, or the first free requested.N (N = 2, 3, ...) when it is taken; marks the
@@ -160,6 +188,9 @@ class LabNode {
   std::atomic<double> last_compute_time_{0.0};
   std::mutex recording_mutex_;
   std::string last_recording_error_;  ///< empty while recording works
+  RecentDurations recording_times_;   ///< the worker's hand-over time per run [s]
+  /// Writes the bags (null when not recording); on_closed publishes each run's summary.
+  std::unique_ptr<RunBagWriter> bags_;
 
   std::mutex mutex_;
   std::condition_variable wake_;

@@ -65,6 +65,14 @@ constexpr std::uint64_t kDefaultMaxBodies = 10'000;
 /// Per run; beyond it, events go to the bag only. Keeps a 2-million-collision run from
 /// putting 6 million messages on the network.
 constexpr std::uint64_t kDefaultMaxPublishedEvents = 10'000;
+/// Recording: a run's events go to the bag writer thread in batches of this many (a
+/// long run never sits whole in memory), and the worker blocks while this many recorded
+/// messages wait to be written (about 40 MB for three bodies): backpressure, never loss.
+constexpr std::size_t kRecordBatchEvents = 1024;
+constexpr std::size_t kRecordQueueMessages = 100'000;
+/// /diagnostics reports the median and p99 of the worker's recording hand-over time
+/// over this many newest runs.
+constexpr std::size_t kRecordingTimeWindow = 10'000;
 /// Relative to $ROS_HOME (default ~/.ros).
 constexpr char kDefaultBagSubdirectory[] = "collision_lab/runs";
 

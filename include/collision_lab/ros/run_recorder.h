@@ -4,13 +4,29 @@
 // it is closed, so a finished run's bag is always complete, and the bag of a run cut
 // short by a crash is left as .bag.active (recoverable with `rosbag reindex`).
 // Recording never throws: a failure is kept in error() and later writes are skipped.
+//
+// RunBagWriter writes those bags on a thread of its own, so that a run's publisher only
+// hands its messages over (see its contract below).
 #pragma once
 
+#include <condition_variable>
+#include <cstddef>
+#include <deque>
+#include <functional>
 #include <memory>
+#include <mutex>
+#include <optional>
 #include <string>
+#include <thread>
+#include <vector>
 
 #include <ros/time.h>
 #include <rosbag/bag.h>
+
+#include "collision_lab/CollisionEvent.h"
+#include "collision_lab/InitialConditions.h"
+#include "collision_lab/Prediction.h"
+#include "collision_lab/RunSummary.h"
 
 namespace collision_lab_ros {
 
@@ -27,6 +43,9 @@ class RunRecorder {
  public:
   /// Creates directory if needed and opens the run's bag (LZ4-compressed).
   RunRecorder(const std::string& directory, const std::string& run_id);
+  /// The same in reused, a closed Bag that outlives this recorder: constructing a
+  /// rosbag::Bag loads its encryption plugin (milliseconds), reopening one does not.
+  RunRecorder(const std::string& directory, const std::string& run_id, rosbag::Bag& reused);
   ~RunRecorder();
   RunRecorder(const RunRecorder&) = delete;
   RunRecorder& operator=(const RunRecorder&) = delete;
@@ -51,12 +70,67 @@ class RunRecorder {
   const std::string& path() const { return path_; }
 
  private:
+  void open(const std::string& directory);
   void fail(const std::string& what);
 
   std::string path_;
   std::string active_path_;
   std::string error_;
-  std::unique_ptr<rosbag::Bag> bag_;
+  std::unique_ptr<rosbag::Bag> owned_;  ///< null when the bag is reused
+  rosbag::Bag* bag_ = nullptr;          ///< the open bag; null once closed or failed
+};
+
+/// A part of one run's bag, in recording order: the input, the prediction, the events,
+/// then the summary. Each message is written at its header.stamp.
+struct RunBagBatch {
+  std::string run_id;
+  bool opens = false;  ///< the run's first batch: its bag is opened first
+  std::optional<collision_lab::InitialConditions> input;
+  std::optional<collision_lab::Prediction> prediction;
+  std::vector<collision_lab::CollisionEvent> events;
+  /// The run's last batch: its summary is written with bag_path, recording_ok and
+  /// recording_error as they stand before closing, then the bag is closed, and on_closed
+  /// gets the summary with the recording fields as they stand after closing.
+  std::optional<collision_lab::RunSummary> summary;
+  std::function<void(collision_lab::RunSummary&)> on_closed;
+
+  std::size_t messages() const { return input.has_value() + prediction.has_value() + events.size() + summary.has_value(); }
+};
+
+/// Writes per-run bags (RunRecorder) on its own thread.
+/// Contract: batches are written in the order handed over, one run at a time (a run's
+/// batches are contiguous). push() blocks while more than max_queued_messages messages
+/// wait (backpressure: nothing is ever dropped). The destructor writes everything handed
+/// over and closes every bag, calling each on_closed, before it returns. on_closed runs
+/// on the writer's thread.
+class RunBagWriter {
+ public:
+  struct Topics {
+    std::string inputs, predictions, events, summaries;
+  };
+  RunBagWriter(std::string directory, Topics topics, std::size_t max_queued_messages);
+  ~RunBagWriter();
+  RunBagWriter(const RunBagWriter&) = delete;
+  RunBagWriter& operator=(const RunBagWriter&) = delete;
+
+  void push(RunBagBatch batch);
+
+ private:
+  void loop();
+  void write(RunBagBatch& batch);
+
+  const std::string directory_;
+  const Topics topics_;
+  const std::size_t max_queued_;
+  rosbag::Bag bag_;                       ///< the writer thread's, reopened for every run
+  std::optional<RunRecorder> recorder_;  ///< the writer thread's: the run being written
+
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  std::deque<RunBagBatch> queue_;
+  std::size_t queued_messages_ = 0;
+  bool stopping_ = false;
+  std::thread thread_;
 };
 
 }  // namespace collision_lab_ros
