@@ -223,14 +223,17 @@ std::string predictedText(const collision_lab::RunSummary& summary) {
   return text.str();
 }
 
-/// At DEBUG level: at thousands of runs per second, an INFO line per run (console, log
-/// file and /rosout, another process) costs more than the run itself; every result is on
-/// run_summaries, and failures and warnings are still logged as such.
-void logRun(const collision_lab::RunSummary& summary) {
-  ROS_DEBUG_STREAM("run " << summary.run_id << ": " << summary.collision_count << " collisions"
-                  << (summary.truncated ? " (truncated)" : "") << ", " << predictedText(summary)
-                  << ", " << summary.compute_time << " s"
-                  << (summary.bag_path.empty() ? std::string() : ", bag " + summary.bag_path));
+/// At INFO for a lab, at DEBUG with ~log_runs false: at thousands of runs per second an
+/// INFO line per run (console, log file and /rosout, another process) costs more than the
+/// run itself. Every result is on run_summaries either way, and failures and warnings are
+/// still logged as such.
+void logRun(const collision_lab::RunSummary& summary, bool at_info) {
+  const auto level = at_info ? ::ros::console::levels::Info : ::ros::console::levels::Debug;
+  ROS_LOG_STREAM(level, ROSCONSOLE_DEFAULT_NAME,
+                 "run " << summary.run_id << ": " << summary.collision_count << " collisions"
+                        << (summary.truncated ? " (truncated)" : "") << ", " << predictedText(summary) << ", "
+                        << summary.compute_time << " s"
+                        << (summary.bag_path.empty() ? std::string() : ", bag " + summary.bag_path));
 }
 
 /// Fills a RunScene or RunPreset response (their fields are the same).
@@ -299,6 +302,7 @@ LabNodeParams LabNodeParams::load(const ros::NodeHandle& private_nh) {
   params.max_published_events =
       getUint64(private_nh, "max_published_events", kDefaultMaxPublishedEvents);
   private_nh.param("publish_markers", params.publish_markers, true);
+  private_nh.param("log_runs", params.log_runs, true);
   params.max_bodies = getUint64(private_nh, "max_bodies", kDefaultMaxBodies);
   private_nh.param("min_free_space_mb", params.min_free_space_mb, kDefaultMinFreeSpaceMb);
   private_nh.param("scenario_file", params.scenario_file,
@@ -649,7 +653,7 @@ void LabNode::finishRun(const collision_lab::RunSummary& summary, const Reply& r
   ++runs_accepted_;
   last_compute_time_ = summary.compute_time;
   if (marker_view_) marker_view_->onRunSummary(summary);
-  logRun(summary);
+  logRun(summary, params_.log_runs);
   if (reply) reply->set_value(ServeOutcome{summary, {}});
 }
 

@@ -72,18 +72,22 @@ TEST(Crash, KillNineKeepsFinishedBagsAndNeverOverwrites) {
     client.publish(finished);
     ASSERT_EQ(client.waitFor("finished").summaries.size(), 1u);
     client.publish(long_run);
-    // In progress: 10,000 collisions published (the default ~max_published_events), so the
-    // bag has flushed its first chunks (768 kB each); the rest of the run goes on.
-    const auto inProgress = [&client] {
+    // In progress: 10,000 collisions published (the default ~max_published_events), and the
+    // bag (written behind the run, on the writer thread) has flushed its first chunks (768 kB
+    // each); the rest of the run goes on.
+    const std::string active = dir + "/long_run.bag.active";
+    const auto inProgress = [&client, &active] {
       const auto run = client.runs().find("long_run");
-      return run != client.runs().end() && run->second.events.size() >= 10000;
+      std::error_code no_file;
+      return run != client.runs().end() && run->second.events.size() >= 10000 &&
+             fs::file_size(active, no_file) > 3 * 768 * 1024 && !no_file;
     };
     const auto over = [&client] {
       const auto run = client.runs().find("long_run");
       return run != client.runs().end() && !run->second.summaries.empty();
     };
-    waitUntil([&] { return inProgress() || over(); }, "10,000 collisions of long_run");
-    const bool killed_mid_run = fs::exists(dir + "/long_run.bag.active") && !over();
+    waitUntil([&] { return inProgress() || over(); }, "10,000 collisions of long_run, and 3 chunks of its bag");
+    const bool killed_mid_run = fs::exists(active) && !over();
     stop(node, SIGKILL);
     ASSERT_TRUE(killed_mid_run);
   }

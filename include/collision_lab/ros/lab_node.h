@@ -67,12 +67,13 @@ struct LabNodeParams {
   std::uint64_t max_collisions = 0;
   std::uint64_t max_published_events = 0;
   bool publish_markers = true;
+  bool log_runs = true;            ///< one INFO line per served run (else DEBUG)
   std::uint64_t max_bodies = 0;    ///< larger scenes are rejected (TOO_MANY_BODIES)
   double min_free_space_mb = 0.0;  ///< [MB] diagnostics warn below it
   std::string scenario_file;       ///< the presets of ~run_preset
 
   /// Reads ~record, ~bag_directory, ~max_collisions, ~max_published_events,
-  /// ~publish_markers, ~max_bodies, ~min_free_space_mb and ~scenario_file (default: the package's
+  /// ~publish_markers, ~log_runs, ~max_bodies, ~min_free_space_mb and ~scenario_file (default: the package's
   /// config/scenarios.yaml), with the defaults of node_constants.h.
   static LabNodeParams load(const ros::NodeHandle& private_nh);
 };
