@@ -6,7 +6,8 @@
 #   docs/restitution_count.{csv,png}      collision_lab_bench_restitution, bench/plot_restitution_count.py
 #   docs/benchmark_goals.md               every "goal:" line of this run, as a table
 # and prints the core and N-body speed tables (collision_lab_bench_core, collision_lab_bench_nbody)
-# and the CLI's output speed against dd (bench/bench_output.sh).
+# the CLI's output speed against dd (bench/bench_output.sh), and the node against a relay that
+# publishes the same messages and against rosbag record (bench/node/*.launch).
 #
 # Usage: bash bench/run_benchmarks.sh [--quick]
 #   --quick: fewer scenes, dt values, impacts and repeats (a few minutes); every output goes
@@ -31,7 +32,8 @@ export COLLISION_LAB_BENCH_SOURCE
 
 cmake -S "$repo" -B "$build" -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build "$build" -j2 --target collision_lab_bench_core collision_lab_bench_nbody collision_lab_speed_vs_error \
-  collision_lab_hard_cases collision_lab_bench_restitution collision_lab_cli
+  collision_lab_hard_cases collision_lab_bench_restitution collision_lab_cli collision_lab_node collision_lab_relay_node \
+  collision_lab_node_throughput collision_lab_recording_bench
 bin="$build/devel/lib/collision_lab"
 
 if [[ -n "$quick" ]]; then out="$build/bench_quick"; else out="$repo/docs"; fi
@@ -58,6 +60,21 @@ python3 "$repo/bench/plot_restitution_count.py" --csv "$out/restitution_count.cs
 step "core speed" "$bin/collision_lab_bench_core" $quick
 step "N-body engine speed and memory" "$bin/collision_lab_bench_nbody" $quick
 step "CSV and JSON output against dd" env BUILD_DIR="$build" bash "$repo/bench/bench_output.sh" $quick
+
+# The node against its anchors: a master of its own on a free port, bags in a temporary
+# directory that is removed afterwards.
+set +u
+source "$build/devel/setup.bash"
+set -u
+bags="$(mktemp -d)"
+trap 'rm -rf "$bags"' EXIT
+port=$((11700 + RANDOM % 200))
+node_runs=(runs:=3000 rounds:=7)
+[[ -n "$quick" ]] && node_runs=(runs:=1000 rounds:=3)
+step "node throughput against a relay publishing the same messages" \
+  roslaunch -p "$port" "$repo/bench/node/node_throughput.launch" "${node_runs[@]}" bag_directory:="$bags/throughput"
+step "recording a long run against rosbag record" \
+  roslaunch -p "$port" "$repo/bench/node/recording_vs_rosbag.launch" bag_directory:="$bags/recording"
 
 python3 "$repo/bench/goals_table.py" --log "$log" --source "$COLLISION_LAB_BENCH_SOURCE" --out "$out/benchmark_goals.md"
 printf '\n=== Goals (issue 13), each with its anchor from this run\n'
