@@ -195,7 +195,6 @@ class LabEvents {
   /// The next event; `event` is collision previous + 1. The paper's BC energy formulas
   /// refer to the velocities before the collision before it, which this keeps.
   void describe(const ImpactEvent& event, LabEvent& lab) {
-    lab.event = event;
     closed_form_.describe(event.index, lab);
     lab.paper_velocities_after = paper_.velocitiesAfter(event.index);
     lab.paper_energy_transfer =
@@ -205,6 +204,7 @@ class LabEvents {
       lab.kinetic_energy_after[i] = i == wall_ ? 0.0 : scene_.masses[i] * v * v / 2;
     }
     previous_before_ = event.velocities_before;
+    lab.event = event;  // last: the engine has only just written it (store forwarding)
   }
 
  private:
