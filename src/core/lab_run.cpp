@@ -72,7 +72,10 @@ class ClosedForm {
 class ClosedFormInTurn {
  public:
   explicit ClosedFormInTurn(const ClosedForm& model) : model_(model) {
-    if (model.fast_) sequence_.emplace(*model.fast_);
+    if (model.fast_) {
+      sequence_.emplace(*model.fast_);
+      previous_ = sequence_->velocitiesAfter(0);
+    }
   }
 
   void describe(std::uint64_t n, LabEvent& lab) {
@@ -109,7 +112,7 @@ class ClosedFormInTurn {
   const ClosedForm& model_;
   detail::ImpactEnergy<double> energy_{model_.masses()};
   std::optional<ClosedFormSequence> sequence_;
-  Eigen::Vector3d previous_ = Eigen::Vector3d::Zero();  // after collision last_
+  Eigen::Vector3d previous_;  // after collision last_
   std::uint64_t last_ = 0;
 };
 
