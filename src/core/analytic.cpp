@@ -189,10 +189,15 @@ typename AnalyticModel<Scalar>::Vec3 AnalyticModel<Scalar>::initialVelocitiesFro
 
 template <class Scalar>
 std::array<Scalar, 3> AnalyticModel<Scalar>::energyTransfer(std::uint64_t n) const {
+  if (!first_pair_ || n == 0) return {Scalar(0), Scalar(0), Scalar(0)};
+  return energyTransfer(n, velocitiesAfter(n - 1));
+}
+
+template <class Scalar>
+std::array<Scalar, 3> AnalyticModel<Scalar>::energyTransfer(std::uint64_t n, const Vec3& before) const {
   std::array<Scalar, 3> gained{Scalar(0), Scalar(0), Scalar(0)};
   if (!first_pair_ || n == 0) return gained;
   const Pair pair = n % 2 == 1 ? *first_pair_ : otherPair(*first_pair_);
-  const Vec3 before = velocitiesAfter(n - 1);
   const std::array<Scalar, 3> v{before(0), before(1), before(2)};
   const int i = pairIndex(pair);
   const int j = i + 1;
@@ -209,6 +214,26 @@ std::array<Scalar, 3> AnalyticModel<Scalar>::energyTransfer(std::uint64_t n) con
     if (gained[body] == 0) gained[body] = Scalar(0);  // an underflow keeps no sign
   }
   return gained;
+}
+
+ClosedFormSequence::ClosedFormSequence(const AnalyticModel<double>& model)
+    : rotation_(model.firstPair() ? (*model.firstPair() == Pair::AB ? -1.0 : 1.0) * model.theta() : 0.0),
+      centre_(Eigen::Vector3d::Constant(model.centreVelocity())) {
+  // velocitiesAfter: V 1 + S^-1 (cos w + sin (s_hat x w)), turned by -theta per cycle for
+  // AB first, +theta for BC first; an odd n adds the first pair's map, which is linear
+  // and keeps V 1.
+  const Eigen::Vector3d& w = model.uPerp();
+  const Eigen::Vector3d x = cross<double>(model.sHat(), w);
+  for (int i = 0; i < 3; ++i) {
+    const double s = model.sqrtMassScaled()(i);
+    cos_part_[0](i) = s > 0 ? w(i) / s : 0.0;  // a wall (s = 0) only has V
+    sin_part_[0](i) = s > 0 ? x(i) / s : 0.0;
+  }
+  const Eigen::Matrix3d map = !model.firstPair()                  ? Eigen::Matrix3d::Identity()
+                              : *model.firstPair() == Pair::AB ? model.dAB()
+                                                                : model.dBC();
+  cos_part_[1] = map * cos_part_[0];
+  sin_part_[1] = map * sin_part_[0];
 }
 
 // The scalars analytic.h promises.

@@ -10,6 +10,7 @@
 #include "collision_lab/core/paper.h"
 #include "collision_lab/core/precision.h"
 #include "float_ops.h"
+#include "impact_energy.h"
 
 namespace collision_lab {
 namespace core {
@@ -35,7 +36,7 @@ std::array<double, 3> toArray(const std::array<T, 3>& v) {
 /// mass-weighted velocities (S = diag(sqrt(m / m_max))) in double.
 class ClosedForm {
  public:
-  explicit ClosedForm(const ThreeBodyScene& scene) {
+  explicit ClosedForm(const ThreeBodyScene& scene) : masses_(scene.masses) {
     int smallest = std::numeric_limits<int>::max(), largest = std::numeric_limits<int>::min();
     for (int i = 0; i < 3; ++i) {
       if (scene.isWall(i)) continue;
@@ -56,10 +57,79 @@ class ClosedForm {
     return fast_ ? toArray(fast_->energyTransfer(n)) : toArray(wide_->energyTransfer(n));
   }
   double psi() const { return fast_ ? fast_->psi() : static_cast<double>(wide_->psi()); }
+  const std::array<double, 3>& masses() const { return masses_; }
 
  private:
+  friend class ClosedFormInTurn;
+  std::array<double, 3> masses_;
   std::optional<AnalyticModel<double>> fast_;
   std::optional<AnalyticModel<HighPrecision>> wide_;
+};
+
+/// A ClosedForm's velocities after collision n and the energies gained in it, for n = 1,
+/// 2, 3, ... in turn: in double by the ClosedFormSequence recurrence (a few ns each), at
+/// 50 digits directly.
+class ClosedFormInTurn {
+ public:
+  explicit ClosedFormInTurn(const ClosedForm& model) : model_(model) {
+    if (model.fast_) {
+      sequence_.emplace(*model.fast_);
+      previous_ = sequence_->velocitiesAfter(0);
+    }
+  }
+
+  void describe(std::uint64_t n, LabEvent& lab) {
+    if (!sequence_) {
+      lab.predicted_velocities_after = model_.velocitiesAfter(n);
+      lab.predicted_energy_transfer = model_.energyTransfer(n);
+      return;
+    }
+    if (n == 0 || n - 1 != last_) previous_ = sequence_->velocitiesAfter(n - 1);
+    const Eigen::Vector3d after = sequence_->velocitiesAfter(n);
+    lab.predicted_velocities_after = toArray(after);
+    lab.predicted_energy_transfer = energyTransfer(n);
+    previous_ = after;
+    last_ = n;
+  }
+
+ private:
+  /// The closed form's energy gains in collision n from the state before it, previous_:
+  /// in double where the gain is safely inside its range, else in the model's wider type.
+  std::array<double, 3> energyTransfer(std::uint64_t n) const {
+    const AnalyticModel<double>& model = *model_.fast_;
+    const std::optional<Pair> first = model.firstPair();
+    if (!first || n == 0) return {0.0, 0.0, 0.0};
+    const Pair pair = n % 2 == 1 ? *first : otherPair(*first);
+    const int i = pairIndex(pair);
+    const std::array<double, 3> before{previous_(0), previous_(1), previous_(2)};
+    const std::array<double, 3> gained = energy_.gained(pair, before, before[i + 1] - before[i]);
+    const double size = std::fabs(gained[i]);
+    constexpr double kSafe = 0x1p-900;  // no underflow or overflow on the way
+    if (size > kSafe && size < 1 / kSafe) return gained;
+    return toArray(model.energyTransfer(n, previous_));
+  }
+
+  const ClosedForm& model_;
+  detail::ImpactEnergy<double> energy_{model_.masses()};
+  std::optional<ClosedFormSequence> sequence_;
+  Eigen::Vector3d previous_;  // after collision last_
+  std::uint64_t last_ = 0;
+};
+
+/// The paper's printed closed form at collisions n = 1, 2, 3, ... in turn, its angle
+/// advanced by a RotationRecurrence.
+class PaperInTurn {
+ public:
+  explicit PaperInTurn(const ThreeBodyScene& scene) : printed_(scene), rotation_(printed_.theta()) {}
+
+  std::array<double, 3> velocitiesAfter(std::uint64_t n) {
+    rotation_.moveTo(n / 2);
+    return printed_.velocitiesAfter(n, rotation_.cos(), rotation_.sin());
+  }
+
+ private:
+  paper::PrintedClosedForm printed_;
+  RotationRecurrence rotation_;
 };
 
 /// Relative error in the energy norm: |S (a - b)| / |S v_0| with S = diag(sqrt(m)), in
@@ -67,8 +137,9 @@ class ClosedForm {
 /// light body's rounding is weighed by the energy it carries.
 class EnergyNormError {
  public:
-  explicit EnergyNormError(const ThreeBodyScene& scene) : scene_(scene), mass_max_(largestFiniteMass(scene.masses)) {
+  explicit EnergyNormError(const ThreeBodyScene& scene) : mass_max_(largestFiniteMass(scene.masses)) {
     const int wall = scene.wallIndex();
+    for (int i = 0; i < 3; ++i) weight_[i] = i == wall ? 0.0 : scene.masses[i] / mass_max_;
     const double frame = wall >= 0 ? scene.velocities[wall] : 0.0;
     double norm_sq = 0.0;
     for (int i = 0; i < 3; ++i) {
@@ -80,18 +151,24 @@ class EnergyNormError {
   }
 
   double operator()(const std::array<double, 3>& a, const std::array<double, 3>& b) const {
-    double norm_sq = 0.0;
-    for (int i = 0; i < 3; ++i) {
-      if (scene_.isWall(i)) continue;
-      const double d = a[i] - b[i];
-      norm_sq += scene_.masses[i] / mass_max_ * d * d;
-    }
-    return std::sqrt(norm_sq) / initial_norm_;
+    return fromSquared(squared(a, b));
   }
 
+  /// |S (a - b)|^2 with S scaled by 1/sqrt(m_max): the largest of many errors is
+  /// fromSquared of the largest squared one (sqrt and division are monotone).
+  double squared(const std::array<double, 3>& a, const std::array<double, 3>& b) const {
+    double norm_sq = 0.0;
+    for (int i = 0; i < 3; ++i) {
+      const double d = a[i] - b[i];
+      norm_sq += weight_[i] * d * d;
+    }
+    return norm_sq;
+  }
+  double fromSquared(double norm_sq) const { return std::sqrt(norm_sq) / initial_norm_; }
+
  private:
-  const ThreeBodyScene& scene_;
   double mass_max_;
+  std::array<double, 3> weight_{};  // m_i / m_max; 0 for a wall
   double initial_norm_ = 1.0;
 };
 
@@ -112,24 +189,34 @@ void describeNotSimulated(const RunOptions& options, bool skipped, RunResult& re
   }
 }
 
-/// One simulated collision beside the closed form and the paper's printed formulas.
-/// `previous_before`: the velocities before the collision before it (the paper's BC
-/// energy formulas refer to them).
-LabEvent labEvent(const ThreeBodyScene& scene, const ClosedForm& model, const ImpactEvent& event,
-                  const std::array<double, 3>& previous_before) {
-  LabEvent lab;
-  lab.event = event;
-  lab.predicted_velocities_after = model.velocitiesAfter(event.index);
-  lab.paper_velocities_after = paper::velocitiesAfter(scene, event.index);
-  lab.predicted_energy_transfer = model.energyTransfer(event.index);
-  lab.paper_energy_transfer =
-      paper::energyTransfer(scene, event.index, event.pair, event.velocities_before, previous_before);
-  for (int i = 0; i < 3; ++i) {
-    const double v = event.velocities_after[i];
-    lab.kinetic_energy_after[i] = scene.isWall(i) ? 0.0 : scene.masses[i] * v * v / 2;
+/// Simulated collisions beside the closed form and the paper's printed formulas, in turn.
+class LabEvents {
+ public:
+  explicit LabEvents(const ThreeBodyScene& scene, const ClosedForm& model)
+      : scene_(scene), wall_(scene.wallIndex()), closed_form_(model), paper_(scene), previous_before_(scene.velocities) {}
+
+  /// The next event; `event` is collision previous + 1. The paper's BC energy formulas
+  /// refer to the velocities before the collision before it, which this keeps.
+  void describe(const ImpactEvent& event, LabEvent& lab) {
+    closed_form_.describe(event.index, lab);
+    lab.paper_velocities_after = paper_.velocitiesAfter(event.index);
+    lab.paper_energy_transfer =
+        paper::energyTransfer(scene_, event.index, event.pair, event.velocities_before, previous_before_);
+    for (int i = 0; i < 3; ++i) {
+      const double v = event.velocities_after[i];
+      lab.kinetic_energy_after[i] = i == wall_ ? 0.0 : scene_.masses[i] * v * v / 2;
+    }
+    previous_before_ = event.velocities_before;
+    lab.event = event;  // last: the engine has only just written it (store forwarding)
   }
-  return lab;
-}
+
+ private:
+  const ThreeBodyScene& scene_;
+  int wall_;
+  ClosedFormInTurn closed_form_;
+  PaperInTurn paper_;
+  std::array<double, 3> previous_before_;
+};
 
 /// Simulates, in full mode with every event put beside the prediction, and measures how
 /// far the simulation is from the closed form.
@@ -142,18 +229,19 @@ void simulateBesidePrediction(const ThreeBodyScene& scene, const RunOptions& opt
   simulation_options.max_collisions = options.max_collisions;
   simulation_options.cancel = options.cancel;
   EventVisitor enrich;
-  std::array<double, 3> previous_before = scene.velocities;
+  LabEvents lab_events(scene, model);
+  LabEvent lab;
+  double max_error_sq = 0.0;
   if (options.mode == RunMode::kFull) {
     enrich = [&](const ImpactEvent& event) {
-      LabEvent lab = labEvent(scene, model, event, previous_before);
-      previous_before = event.velocities_before;
-      summary.max_prediction_error = std::max(summary.max_prediction_error,
-                                              relative_error(event.velocities_after, lab.predicted_velocities_after));
+      lab_events.describe(event, lab);
+      max_error_sq = std::max(max_error_sq, relative_error.squared(event.velocities_after, lab.predicted_velocities_after));
       if (visitor) visitor(lab);
-      if (options.events.keeps(event.index)) result.events.push_back(std::move(lab));
+      if (options.events.keeps(event.index)) result.events.push_back(lab);
     };
   }
   const SimulationResult simulation = simulate(scene, simulation_options, options.precision, enrich);
+  summary.max_prediction_error = relative_error.fromSquared(max_error_sq);
   summary.simulated = true;
   summary.collision_count = simulation.collision_count;
   summary.truncated = simulation.truncated;

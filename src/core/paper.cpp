@@ -45,21 +45,35 @@ Constants constantsOf(const std::array<double, 3>& masses) {
 }  // namespace
 
 std::array<double, 3> velocitiesAfter(const ThreeBodyScene& scene, std::uint64_t n) {
+  const PrintedClosedForm printed(scene);
+  const double kth = static_cast<double>(n / 2) * printed.theta();
+  return printed.velocitiesAfter(n, std::cos(kth), std::sin(kth));
+}
+
+PrintedClosedForm::PrintedClosedForm(const ThreeBodyScene& scene) {
   const auto& m = scene.masses;
   const auto& v0 = scene.velocities;
   const Constants k = constantsOf(m);
-  const double vbar = (v0[kA] + v0[kB]) / 2;  // the *initial* average (eq. 2.14)
-  const double half_ba = (v0[kB] - v0[kA]) / 2;
-  const double kth = static_cast<double>(n / 2) * k.theta;
-  const double s = std::sin(kth), co = std::cos(kth);
+  c_ = k.c;
+  d_ = k.d;
+  nu_sq_ = k.nu_sq;
+  theta_ = k.theta;
+  vbar_ = (v0[kA] + v0[kB]) / 2;  // the *initial* average (eq. 2.14)
+  half_ba_ = (v0[kB] - v0[kA]) / 2;
+  v_c_ = v0[kC];
+  m_ab_ = m[kA] + m[kB];
+  odd_a_ = m[kA] - 3 * m[kB];
+  odd_b_ = m[kB] - 3 * m[kA];
+}
+
+std::array<double, 3> PrintedClosedForm::velocitiesAfter(std::uint64_t n, double co, double s) const {
   // The two brackets of eq. (2.15).
-  const double x = ((vbar - v0[kC]) * k.nu_sq + k.c * half_ba) * s - k.d * half_ba * co;
-  const double y = (-half_ba - k.c * (vbar - v0[kC])) * s - k.d * (vbar - v0[kC]) * co;
-  if (n % 2 == 0) return plusZeros({x / k.d + vbar, -x / k.d + vbar, y / k.d + vbar});
-  const double m_ab = m[kA] + m[kB];
+  const double x = ((vbar_ - v_c_) * nu_sq_ + c_ * half_ba_) * s - d_ * half_ba_ * co;
+  const double y = (-half_ba_ - c_ * (vbar_ - v_c_)) * s - d_ * (vbar_ - v_c_) * co;
+  if (n % 2 == 0) return plusZeros({x / d_ + vbar_, -x / d_ + vbar_, y / d_ + vbar_});
   // Eq. (2.16).
-  return plusZeros({(m[kA] - 3 * m[kB]) * x / (k.d * m_ab) + vbar, (m[kB] - 3 * m[kA]) * x / (k.d * m_ab) + vbar,
-                    m_ab * y / (k.d * m_ab) + vbar});
+  return plusZeros({odd_a_ * x / (d_ * m_ab_) + vbar_, odd_b_ * x / (d_ * m_ab_) + vbar_,
+                    m_ab_ * y / (d_ * m_ab_) + vbar_});
 }
 
 double phiBC(const ThreeBodyScene& scene) {

@@ -479,11 +479,11 @@ class Trajectory {
   }
 
   /// Commits `impact` of `pair` (velocities `before` -> `after`, approach speed
-  /// `approach`, all in working units) and describes it in SI units.
-  ImpactEvent commit(std::uint64_t index, Pair pair, const Impact& impact, const std::array<T, 3>& before,
-                     const std::array<T, 3>& after, const T& approach, const WorkingUnits& units) {
+  /// `approach`, all in working units) and describes it in SI units in `event` (written in
+  /// place: a returned copy of the freshly written event stalls on store forwarding).
+  void commit(std::uint64_t index, Pair pair, const Impact& impact, const std::array<T, 3>& before,
+              const std::array<T, 3>& after, const T& approach, const WorkingUnits& units, ImpactEvent& event) {
     now_ = impact.time;
-    ImpactEvent event;
     event.index = index;
     event.pair = pair;
     event.time = units.time_si(now_.value());
@@ -499,7 +499,6 @@ class Trajectory {
       reference_position_[i] = impact.positions[pair_index];
       reference_time_[i] = now_;
     }
-    return event;
   }
 
   /// Time [working units] of the last impact (0 before any).
@@ -724,7 +723,7 @@ class EngineRun {
     if (!(impact.in_range && held) && !std::is_same_v<T, Wide>) return false;
     v_.impact(coefficients_.of(pair), i);
     ++k_;
-    event = path.commit(k_, pair, impact, before, v_.template valuesAs<T>(), approach, units_);
+    path.commit(k_, pair, impact, before, v_.template valuesAs<T>(), approach, units_, event);
     return true;
   }
 

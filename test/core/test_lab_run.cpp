@@ -151,6 +151,7 @@ TEST(EnergyTransferPerImpact, ThePairsEntriesAreExactOppositesAndExact) {
       EXPECT_EQ(lab.predicted_energy_transfer[left], -lab.predicted_energy_transfer[left + 1]) << k;
       for (int i : {left, left + 1}) {
         EXPECT_NEAR(lab.event.energy_transfer[i], exactGain(scene, truth, k, i), 1e-12 * energy) << k;
+        EXPECT_NEAR(lab.predicted_energy_transfer[i], exactGain(scene, truth, k, i), 1e-12 * energy) << k;
       }
     }
   }

@@ -18,6 +18,24 @@ namespace paper {
 /// paper's c, d, nu^2 and the *initial* average vbar_AB. Written for AB first.
 std::array<double, 3> velocitiesAfter(const ThreeBodyScene& scene, std::uint64_t n);
 
+/// Eqs. (2.15)/(2.16) of one scene with the paper's constants computed once, for runs that
+/// evaluate them at every collision.
+class PrintedClosedForm {
+ public:
+  explicit PrintedClosedForm(const ThreeBodyScene& scene);
+
+  /// The paper's theta = arg(lambda_+), eq. (2.2), as its formulas use it [rad].
+  double theta() const { return theta_; }
+
+  /// velocitiesAfter(scene, n) [m/s], given cos and sin of (n / 2) theta().
+  std::array<double, 3> velocitiesAfter(std::uint64_t n, double cos_k_theta, double sin_k_theta) const;
+
+ private:
+  double c_, d_, nu_sq_, theta_;
+  double vbar_, half_ba_, v_c_;  // the initial averages and velocities the formulas use [m/s]
+  double m_ab_, odd_a_, odd_b_;  // M_AB, m_A - 3 m_B, m_B - 3 m_A [kg]
+};
+
 /// phi_BC of eq. (3.21): atan2(u1.n_BC, u1.l_BC) with u1 = u after the first AB impact [rad].
 double phiBC(const ThreeBodyScene& scene);
 
