@@ -226,6 +226,12 @@ Prediction predictThreeBodySpiral(const Scene& scene) {
     prediction.reason += "; undecided: the walk needs more impacts than it may take exactly (run the engine)";
     return prediction;
   }
+  if (walked.end == WalkEnd::kEndless) {
+    prediction.infinite = true;
+    prediction.reason += "; the approach speeds start on the cycle's slower eigenvector, which stays in the cone: "
+                         "infinitely many impacts in an infinite time, no collapse (spiral.h, slowEigenvector)";
+    return prediction;
+  }
   if (walked.end == WalkEnd::kCollapse) {
     prediction.collapsed = true;
     prediction.final_velocities.assign(3, centre);
