@@ -8,8 +8,10 @@
 // and on the first pair. The same maps act on the differences of the intercepts
 // b = x - v t, which gives the collapse time in closed form (collapseTime()).
 //
-// Decisions. The walk runs in double, then double-double, then 100-digit floats, then in
-// exact rationals.
+// Decisions. Whether the impacts go on for ever is decided exactly (ConeTest); the count
+// comes from the checks' closed forms (closedFormWalk(), doubleEigenvalueWalk()). Where
+// those leave it open (a value next to an integer), the walk runs in double, then
+// double-double, then 100-digit floats, then in exact rationals.
 // A sign is taken when it exceeds a forward error estimate, 64 (k+1) u kappa^2 |d|_1 after
 // k impacts, with u the unit roundoff and kappa the conditioning of the cycle's eigenbasis
 // (about 2e / sqrt|T^2 - 4e^2| times the mass spread, which grows near r_c): an error made
@@ -59,11 +61,6 @@ struct Cycle {
   double cos2_alpha() const {
     if (wall_a || wall_c) return ratioA<double>() * ratioC<double>();
     return m[0] * m[2] / ((m[0] + m[1]) * (m[1] + m[2]));
-  }
-  /// T^2 - 4 e^2 > 0 exactly (real, distinct eigenvalues), decided in rationals.
-  bool realEigenvalues() const {
-    const Rational t = exactTrace();
-    return t * t > 4 * Rational(e) * Rational(e) && t > 0;
   }
   /// T^2 < 4 e^2 exactly: complex eigenvalues, the spiral (e > r_c).
   bool complexEigenvalues() const {
