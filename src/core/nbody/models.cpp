@@ -51,11 +51,14 @@ std::string modelReason(ModelKind kind, const Scene& scene) {
       return "equal masses exchange velocities, so the bodies move like ghosts passing through each other: "
              "the count is the number of inversions and the final velocities are the initial ones sorted";
     case ModelKind::kThreeBodySpiral:
-      return "three bodies with one e < 1: the AB/BC cycle is a spiral (e > r_c) or may collapse (e <= r_c); "
-             "count, state and collapse from the 2x2 cycle map";
+      return std::string("three bodies with one e < 1: the AB/BC cycle is a spiral (e > r_c) or may collapse (e <= r_c); "
+                         "count, state and collapse from the 2x2 cycle map") +
+             (scene.wallCount() == 1 ? "; the wall is the outer body of infinite mass (k = 1 + e at the wall, "
+                                       "cos^2 alpha = m/(m_B + m) of the two bodies), and a collapse ends on the wall"
+                                     : "");
     case ModelKind::kEventEngine: break;
   }
-  if (scene.size() == 3 && scene.wallCount() == 0 && scene.restitutionOf(0) != scene.restitutionOf(1)) {
+  if (scene.size() == 3 && scene.wallCount() < 2 && scene.restitutionOf(0) != scene.restitutionOf(1)) {
     return "three bodies with two different e: the spiral model (r_c, phi) is defined for one e, so the exact "
            "event engine simulates every impact";
   }
@@ -69,7 +72,7 @@ ModelKind chooseKind(const Scene& scene) {
   if (confinedForever(scene)) return ModelKind::kTwoWallsInfinite;
   if (n == 2) return ModelKind::kTwoBody;
   if (n == 3 && scene.isElastic() && scene.wallCount() < 2) return ModelKind::kThreeBodyRotation;
-  if (n == 3 && scene.wallCount() == 0 && scene.restitutionOf(0) == scene.restitutionOf(1)) {
+  if (n == 3 && scene.wallCount() < 2 && !scene.isWall(1) && scene.restitutionOf(0) == scene.restitutionOf(1)) {
     return ModelKind::kThreeBodySpiral;
   }
   if (equalFiniteMasses(scene) && scene.isElastic()) return ModelKind::kGhosts;
@@ -112,17 +115,25 @@ int firstPair(const Scene& scene, const Rational& a, const Rational& c) {
   return a > 0 ? 0 : (c > 0 ? 1 : -1);
 }
 
-/// Velocities [m/s] relative to the centre of mass from approach speeds (a, c) * 2^exponent.
-std::vector<double> relativeVelocities(const double m[3], double a, double c, long exponent) {
-  const double total = m[0] + m[1] + m[2];
-  const double w_a = -(m[1] * a + m[2] * (a + c)) / total;
+/// Velocities [m/s] relative to the frame (the centre of mass, or the wall) from approach
+/// speeds (a, c) * 2^exponent.
+std::vector<double> relativeVelocities(const spiral_detail::Cycle& cy, double a, double c, long exponent) {
+  const double* m = cy.m;
+  double w_a = -(m[1] * a + m[2] * (a + c)) / (m[0] + m[1] + m[2]);
+  if (cy.wall_a) w_a = 0.0;
+  if (cy.wall_c) w_a = -(a + c);
   std::vector<double> w{w_a, w_a + a, w_a + a + c};
   for (double& x : w) x = std::ldexp(x, static_cast<int>(std::max(-2000L, std::min(2000L, exponent))));
   return w;
 }
 
-double kineticEnergy(const double m[3], const std::vector<double>& v) {
-  return 0.5 * (m[0] * v[0] * v[0] + m[1] * v[1] * v[1] + m[2] * v[2] * v[2]);
+/// Kinetic energy [J] of the finite bodies.
+double kineticEnergy(const spiral_detail::Cycle& cy, const std::vector<double>& v) {
+  double sum = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    if (!(k == 0 && cy.wall_a) && !(k == 2 && cy.wall_c)) sum += 0.5 * cy.m[k] * v[k] * v[k];
+  }
+  return sum;
 }
 
 Rational weightedMean(const double m[3], const std::vector<double>& q) {
@@ -195,16 +206,24 @@ Prediction predictGhosts(const Scene& scene) {
 Prediction predictThreeBodySpiral(const Scene& scene) {
   using namespace spiral_detail;
   Prediction prediction = base(ModelKind::kThreeBodySpiral, scene);
-  const Cycle cycle{{scene.masses[0], scene.masses[1], scene.masses[2]}, scene.restitutionOf(0)};
+  Cycle cycle{{scene.masses[0], scene.masses[1], scene.masses[2]}, scene.restitutionOf(0)};
+  cycle.wall_a = scene.isWall(0), cycle.wall_c = scene.isWall(2);
+  const std::optional<int> wall = cycle.wall_a ? std::optional<int>(0) : (cycle.wall_c ? std::optional<int>(2) : std::nullopt);
   const double* m = cycle.m;
-  const double alpha = std::atan(std::sqrt(m[1] * (m[0] + m[1] + m[2]) / (m[0] * m[2])));
-  const double root = std::tan(M_PI / 4 - alpha / 2);
-  prediction.critical_restitution = root * root;
+  if (wall) {  // r_c = tan^2(pi/4 - alpha/2) = (1 - sin alpha) / (1 + sin alpha)
+    const double sine = std::sqrt(1 - cycle.cos2_alpha());
+    prediction.critical_restitution = (1 - sine) / (1 + sine);
+  } else {
+    const double alpha = std::atan(std::sqrt(m[1] * (m[0] + m[1] + m[2]) / (m[0] * m[2])));
+    const double root = std::tan(M_PI / 4 - alpha / 2);
+    prediction.critical_restitution = root * root;
+  }
   if (cycle.complexEigenvalues()) prediction.spiral_angle = std::acos(cycle.trace() / (2 * cycle.e));
   const auto& v = scene.velocities;
   const Rational a0 = Rational(v[1]) - v[0], c0 = Rational(v[2]) - v[1];
-  const double centre = static_cast<double>(weightedMean(m, v));
-  const double heat0 = kineticEnergy(m, relativeVelocities(m, static_cast<double>(a0), static_cast<double>(c0), 0));
+  // The frame: the centre of mass, or the wall (which the bodies follow after a collapse).
+  const double centre = wall ? v[*wall] : static_cast<double>(weightedMean(m, v));
+  const double heat0 = kineticEnergy(cycle, relativeVelocities(cycle, static_cast<double>(a0), static_cast<double>(c0), 0));
   const int first = firstPair(scene, a0, c0);
   Walk walked;
   if (first < 0) {
@@ -226,6 +245,12 @@ Prediction predictThreeBodySpiral(const Scene& scene) {
     prediction.reason += "; undecided: the walk needs more impacts than it may take exactly (run the engine)";
     return prediction;
   }
+  if (walked.end == WalkEnd::kEndless) {
+    prediction.infinite = true;
+    prediction.reason += "; the approach speeds start on the cycle's slower eigenvector, which stays in the cone: "
+                         "infinitely many impacts in an infinite time, no collapse (spiral.h, slowEigenvector)";
+    return prediction;
+  }
   if (walked.end == WalkEnd::kCollapse) {
     prediction.collapsed = true;
     prediction.final_velocities.assign(3, centre);
@@ -236,13 +261,14 @@ Prediction predictThreeBodySpiral(const Scene& scene) {
                             Rational(scene.positions[2]) - scene.positions[1]};
     const double t = collapseTime(cycle, first, dv, db);
     prediction.collapse_time = t;
-    prediction.collapse_position = static_cast<double>(weightedMean(m, scene.positions) + Rational(centre) * t);
+    const Rational start = wall ? Rational(scene.positions[*wall]) : weightedMean(m, scene.positions);
+    prediction.collapse_position = static_cast<double>(start + Rational(centre) * t);
     return prediction;
   }
   prediction.impact_count = walked.count;
-  const std::vector<double> w = relativeVelocities(m, walked.a, walked.c, walked.exponent);
+  const std::vector<double> w = relativeVelocities(cycle, walked.a, walked.c, walked.exponent);
   for (double x : w) prediction.final_velocities.push_back(centre + x);
-  prediction.energy_lost = heat0 - kineticEnergy(m, w);
+  prediction.energy_lost = heat0 - kineticEnergy(cycle, w);
   return prediction;
 }
 

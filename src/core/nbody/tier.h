@@ -190,8 +190,8 @@ class Tier {
   };
 
   /// Pairs p < q alternate with a cluster between them: do the three clusters collapse
-  /// (spiral.h, dominates(): every later check provably stays positive), and does nothing
-  /// outside reach them before the collapse time? `q_next`: q hits next (else p). e < 1 on
+  /// (spiral.h, dominates() or, next to r_c, ConeTest: every later check provably stays
+  /// positive), and does nothing outside reach them before the collapse time? `q_next`: q hits next (else p). e < 1 on
   /// both pairs; an outer cluster may hold a wall (a body squeezed against it), not both
   /// and not the middle one. Conservative: "no" just lets the run go on.
   std::optional<CollapseFound> collapseCandidate(std::size_t p, std::size_t q, bool q_next) const {
@@ -213,7 +213,12 @@ class Tier {
     const Approx a = approach(p), c = approach(q);
     const double size = std::fabs(a.value) + std::fabs(c.value);
     if (!(a.error + c.error <= 0x1p-30 * size)) return {};
-    if (!spiral_detail::dominates(cycle, q_next ? 1 : 0, a.value, c.value)) return {};
+    const int pair = q_next ? 1 : 0;  // next to r_c, dominance may take ever more cycles: the exact test
+    if (!spiral_detail::dominates(cycle, pair, a.value, c.value) &&
+        !(spiral_detail::nearDoubleEigenvalue(cycle) &&
+          spiral_detail::ConeTest(cycle).boxStaysInCone(pair, a.value, a.error, c.value, c.error))) {
+      return {};
+    }
     using spiral_detail::Rational;
     const auto exact = [](const S& x) {  // the tier's value as a rational (to within its bound)
       if constexpr (std::is_same_v<S, DD>) return Rational(x.hi) + Rational(x.lo);

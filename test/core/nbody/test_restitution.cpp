@@ -97,6 +97,74 @@ TEST(Restitution, CollapseTimesAreTheLimitOfTheExactImpactTimes) {
   }
 }
 
+// Masses (4, 1, 4): cos^2(alpha) = m_A m_C / ((m_A + m_B)(m_B + m_C)) = 16/25, sin(alpha) = 3/5 and
+// r_c = tan^2(pi/4 - alpha/2) = (1 - sin alpha) / (1 + sin alpha) = 1/4, a double: at e = 1/4 the
+// cycle has the double eigenvalue e (a Jordan block), and the doubles next to it lie on both
+// sides. Every count and state against the exact rational reference.
+TEST(Restitution, AtRcExactlyTheDoubleEigenvalueAndTheDoublesNextToIt) {
+  const double below = std::nextafter(0.25, 0.0), above = std::nextafter(0.25, 1.0);
+  const auto scene = [](double v_c, double e) { return Scene{{4, 1, 4}, {2, 1, 0}, {-1, 1, v_c}, {e}}; };
+  EXPECT_NEAR(*predict(scene(0, 0.25))->critical_restitution, 0.25, 1e-16);
+  // Starts that leave the cone after a few impacts; at e = r_c two of them graze (A and B
+  // end at the same velocity, exactly), so the counts differ by one across r_c.
+  for (double v_c : {-0.25, -0.5, -0.75}) {
+    for (double e : {below, 0.25, above}) {
+      const Scene s = scene(v_c, e);
+      const std::string label = "v_C = " + std::to_string(v_c) + ", e = 1/4 " + (e < 0.25 ? "- ulp" : e > 0.25 ? "+ ulp" : "");
+      const reference::Run exact = reference::simulate(s, 100);
+      ASSERT_FALSE(exact.truncated) << label;
+      const Prediction p = *predict(s);
+      const EngineResult run = runEngine(s);
+      ASSERT_TRUE(p.impact_count) << label << ": " << p.reason;
+      EXPECT_EQ(*p.impact_count, exact.events.size()) << label;
+      EXPECT_EQ(run.impact_count, exact.events.size()) << label;
+      for (std::size_t k = 0; k < 3; ++k) {
+        EXPECT_NEAR(p.final_velocities[k], static_cast<double>(exact.velocities[k]), 4e-16) << label;
+        EXPECT_NEAR(run.final_velocities[k], static_cast<double>(exact.velocities[k]), 4e-16) << label;
+      }
+      EXPECT_NEAR(p.energy_lost, static_cast<double>(exact.energy_lost), 1e-15) << label;
+    }
+  }
+  // v = (-1, 0, 0): a collapse at r_c and below it (the exact impact times converge to the
+  // predicted time), a spiral of 2.7e8 impacts one double above, predicted in O(1).
+  for (double e : {below, 0.25}) {
+    const Scene s{{4, 1, 4}, {2, 1, 0}, {-1, 0, 0}, {e}};
+    const Prediction p = *predict(s);
+    ASSERT_TRUE(p.collapsed) << "e = " << e << ": " << p.reason;
+    const EngineResult run = runEngine(s);
+    ASSERT_TRUE(run.collapsed) << run.stop_message;
+    EXPECT_NEAR(*run.collapse_time, *p.collapse_time, 1e-13 * *p.collapse_time);
+    // At the double eigenvalue the orbit is d0 + n N d0 times e^n, so one pair's impact times
+    // are a Moebius function of the cycle n, t = L + K / (n + c): three of them give L exactly.
+    const reference::Run exact = reference::simulate(s, 200);
+    ASSERT_TRUE(exact.truncated);
+    const auto& ev = exact.events;
+    const reference::Rational u0 = ev[195].time, u1 = ev[197].time, u2 = ev[199].time, d1 = u0 - u1, d2 = u1 - u2;
+    const double limit = static_cast<double>(reference::Rational(((2 * u2 - u1) * d1 - u1 * d2) / (d1 - d2)));
+    EXPECT_LT(static_cast<double>(u2), *p.collapse_time);
+    // Exact at e = r_c; one double below, the eigenvalues differ by 2e-8 relative and the
+    // Moebius form holds to about that over 100 cycles.
+    EXPECT_NEAR(limit, *p.collapse_time, (e == 0.25 ? 1e-15 : 1e-6) * *p.collapse_time) << "e = " << e;
+  }
+  const Prediction spiral = *predict(Scene{{4, 1, 4}, {2, 1, 0}, {-1, 0, 0}, {above}});
+  EXPECT_FALSE(spiral.collapsed);
+  ASSERT_TRUE(spiral.impact_count) << spiral.reason;
+  EXPECT_GT(*spiral.impact_count, 100'000'000u);
+  // v = (-1, 1, 0): the approach speeds (2, -1) are the eigenvector itself. The orbit stays
+  // in the cone, but without a dominant part the impact times grow linearly: infinitely many
+  // impacts in an infinite time, not a collapse (the exact times: constant steps per cycle).
+  const Prediction endless = *predict(scene(0, 0.25));
+  EXPECT_TRUE(endless.infinite) << endless.reason;
+  EXPECT_FALSE(endless.collapsed);
+  EXPECT_FALSE(endless.impact_count);
+  const reference::Run exact = reference::simulate(scene(0, 0.25), 200);
+  ASSERT_TRUE(exact.truncated);
+  const auto& ev = exact.events;
+  const reference::Rational step = ev[199].time - ev[197].time;
+  EXPECT_EQ(step, ev[99].time - ev[97].time);
+  EXPECT_GT(step, 0);
+}
+
 TEST(Restitution, ZeroRestitutionSticksAndTheClusterIsHitAsOneBody) {
   // A sticks to B at 1 s, the pair (2 kg, -0.5 m/s) sticks to C at 3 s: two impacts, all
   // three at -1/3 m/s, by the model and by the engine.

@@ -64,9 +64,11 @@ Walked<Real> walk(const Scene& s, std::uint64_t cap) {
       w[0] = w[1] = w[2] = 0;
     } else {
       const int i = pair, j = pair + 1;
+      // Every product in Real: e * m_j in double would round the map's coefficient, and next
+      // to r_c the spiral angle is so sensitive to it that the count moved by one (scene 709).
       const Real mass = Real(m[i]) + m[j], pair_centre = (m[i] * w[i] + m[j] * w[j]) / mass, rel = w[i] - w[j];
-      w[i] = pair_centre - e * m[j] * rel / mass;
-      w[j] = pair_centre + e * m[i] * rel / mass;
+      w[i] = pair_centre - Real(e) * m[j] * rel / mass;
+      w[j] = pair_centre + Real(e) * m[i] * rel / mass;
     }
     // Rounding leaves a small total momentum, which the impacts keep while the velocities
     // shrink by e per cycle: remove it, or it swamps them after a few hundred impacts.
@@ -117,7 +119,7 @@ Scene randomThreeBodies(std::mt19937_64& rng, int trial) {
 TEST(SpiralModelRandom, EqualsTheSimulationOnAThousandScenes) {
   std::mt19937_64 rng(1111);
   constexpr std::uint64_t kCap = 1000000;
-  int off_by_one = 0, redone = 0, near = 0, long_spirals = 0, collapses = 0, engine_checked = 0, engine_collapses = 0, sticking = 0;
+  int redone = 0, near = 0, long_spirals = 0, collapses = 0, engine_checked = 0, engine_collapses = 0, sticking = 0;
   for (int trial = 0; trial < 1000; ++trial) {
     const Scene s = randomThreeBodies(rng, trial);
     const std::string label = "scene " + std::to_string(trial) + ", e = " + std::to_string(s.restitution[0]);
@@ -147,15 +149,7 @@ TEST(SpiralModelRandom, EqualsTheSimulationOnAThousandScenes) {
     } else {
       ASSERT_TRUE(p.impact_count) << label << ": " << p.reason;
       EXPECT_TRUE(w.stopped) << label;
-      if (*p.impact_count <= 100000) {
-        EXPECT_EQ(*p.impact_count, w.count) << label;
-      } else {
-        // OPEN (issue 11 report): one scene of this seed, 560000 impacts at e = r_c + 1e-9,
-        // differs by one impact between the model (double-double and 100-digit walks agree)
-        // and this walk (quadruple and 100 digits agree). Unresolved; bounded here.
-        EXPECT_LE(std::max(*p.impact_count, w.count) - std::min(*p.impact_count, w.count), 1u) << label;
-        off_by_one += *p.impact_count != w.count;
-      }
+      EXPECT_EQ(*p.impact_count, w.count) << label;
       long_spirals += *p.impact_count > 1000;
       const Quad centre = (Quad(s.masses[0]) * s.velocities[0] + Quad(s.masses[1]) * s.velocities[1] +
                            Quad(s.masses[2]) * s.velocities[2]) / (Quad(s.masses[0]) + s.masses[1] + s.masses[2]);
@@ -191,7 +185,6 @@ TEST(SpiralModelRandom, EqualsTheSimulationOnAThousandScenes) {
   EXPECT_GT(engine_collapses, 0);
   EXPECT_GT(sticking, 40);
   EXPECT_LT(redone, 50);
-  EXPECT_LE(off_by_one, 1);
 }
 
 }  // namespace

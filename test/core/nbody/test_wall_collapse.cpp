@@ -20,6 +20,7 @@
 #include <random>
 
 #include "collision_lab/core/nbody/engine.h"
+#include "collision_lab/core/nbody/models.h"
 #include "reference.h"
 
 namespace collision_lab {
@@ -159,6 +160,88 @@ TEST(WallCollapse, SeededScenesWithOneWallAgreeWithTheExactReference) {
   }
   EXPECT_GT(collapses, 10);
   EXPECT_GT(finished, 100);
+}
+
+// The spiral model with the wall as its outer body, in O(1): the squeeze scenes above by hand,
+// the counts above r_c against the exact reference.
+TEST(WallCollapse, TheSpiralModelTakesTheWallAsAnInfiniteMass) {
+  const Scene squeeze{{kWall, 1, 10}, {2, 1, 0}, {0, 0, 1}, {0.5}};
+  ASSERT_EQ(chooseModel(squeeze).kind, ModelKind::kThreeBodySpiral);
+  const Prediction p = *predict(squeeze);
+  EXPECT_NE(p.reason.find("wall"), std::string::npos);
+  EXPECT_NEAR(*p.critical_restitution, (6 - std::sqrt(11.0)) / 5, 1e-15);
+  ASSERT_TRUE(p.collapsed) << p.reason;
+  const EngineResult run = runEngine(squeeze);
+  ASSERT_TRUE(run.collapsed) << run.stop_message;
+  EXPECT_NEAR(*p.collapse_time, *run.collapse_time, 1e-13 * *run.collapse_time);
+  EXPECT_NEAR(*p.collapse_time, 2.276, 5e-4);  // physics.md
+  EXPECT_NEAR(*p.collapse_position, 2.0, 1e-15);
+  EXPECT_NEAR(p.energy_lost, 5.0, 1e-15);
+  for (double v : p.final_velocities) EXPECT_EQ(v, 0.0);
+  const Prediction mirror = *predict(Scene{{10, 1, kWall}, {2, 1, 0}, {-1, 0, 0}, {0.5}});
+  ASSERT_TRUE(mirror.collapsed);
+  EXPECT_NEAR(*mirror.collapse_time, *p.collapse_time, 1e-15 * *p.collapse_time);
+  EXPECT_NEAR(*mirror.collapse_position, 0.0, 1e-15);
+  const Prediction moving = *predict(Scene{{kWall, 1, 10}, {2, 1, 0}, {0.25, 0.25, 1.25}, {0.5}});
+  ASSERT_TRUE(moving.collapsed);
+  EXPECT_NEAR(*moving.collapse_position, 2.0 + 0.25 * *moving.collapse_time, 1e-15);
+  for (double v : moving.final_velocities) EXPECT_EQ(v, 0.25);
+  EXPECT_NEAR(moving.energy_lost, 5.0, 1e-14);
+  for (double e : {0.54, 0.6, 0.8}) {  // above r_c = 0.5367
+    const Scene s{{kWall, 1, 10}, {2, 1, 0}, {0, 0, 1}, {e}};
+    const Prediction q = *predict(s);
+    const reference::Run exact = reference::simulate(s, 100000);
+    ASSERT_FALSE(exact.truncated);
+    ASSERT_TRUE(q.impact_count) << q.reason;
+    EXPECT_EQ(*q.impact_count, exact.events.size()) << "e = " << e;
+    EXPECT_LT(reference::energyNormError(s, q.final_velocities, exact.velocities), 1e-13) << "e = " << e;
+    EXPECT_NEAR(q.energy_lost, static_cast<double>(exact.energy_lost), 1e-13 * 5) << "e = " << e;
+  }
+}
+
+// Seeded scenes with one wall, e from a set and 1 % either side of the wall's r_c: the
+// model against the engine (which the test above checks against the exact reference).
+TEST(WallCollapse, SpiralModelWithAWallEqualsTheEngineOnSeededScenes) {
+  std::mt19937_64 rng(4242);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0), gap(0.2, 2.0), decades(-1.0, 1.0);
+  const double set[] = {0.0, 0.3, 0.5, 0.8, 0.95};
+  int collapses = 0, finished = 0, near = 0;
+  for (int trial = 0; trial < 150; ++trial) {
+    Scene s;
+    const bool wall_right = trial % 2 == 0;
+    for (int k = 0; k < 3; ++k) s.masses.push_back(std::pow(10.0, decades(rng)));
+    s.masses[wall_right ? 0 : 2] = kWall;
+    const double x2 = unit(rng), x1 = x2 + gap(rng), x0 = x1 + gap(rng);
+    s.positions = {x0, x1, x2};
+    for (int k = 0; k < 3; ++k) s.velocities.push_back(unit(rng));
+    const double m_c = s.masses[wall_right ? 2 : 0], sine = std::sqrt(1 - m_c / (s.masses[1] + m_c));
+    const double rc = (1 - sine) / (1 + sine);  // cos^2(alpha) = m/(m_B + m) by hand
+    const int kind = trial / 2 % 3;
+    s.restitution = {kind == 0 ? set[trial / 6 % 5] : rc * (kind == 1 ? 1.01 : 0.99)};
+    if (validate(s) || chooseModel(s).kind != ModelKind::kThreeBodySpiral) continue;  // e.g. nothing approaches
+    const std::string label = "scene " + std::to_string(trial) + ", e = " + std::to_string(s.restitution[0]);
+    near += kind != 0;
+    const Prediction p = *predict(s);
+    EXPECT_NEAR(*p.critical_restitution, rc, 1e-14) << label;
+    const EngineResult run = runEngine(s);
+    ASSERT_EQ(run.stop, StopReason::kFinished) << label << ": " << run.stop_message;
+    EXPECT_EQ(p.collapsed, run.collapsed) << label;
+    if (run.collapsed && p.collapsed) {
+      ++collapses;
+      EXPECT_NEAR(*p.collapse_time, *run.collapse_time, 1e-12 * *run.collapse_time) << label;
+      EXPECT_NEAR(*p.collapse_position, *run.collapse_position, 1e-12 * (1 + std::fabs(*run.collapse_position))) << label;
+    } else if (!run.collapsed) {
+      ++finished;
+      ASSERT_TRUE(p.impact_count) << label << ": " << p.reason;
+      EXPECT_EQ(*p.impact_count, run.impact_count) << label;
+    }
+    const double scale = std::fabs(s.velocities[0]) + std::fabs(s.velocities[1]) + std::fabs(s.velocities[2]);
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(p.final_velocities[k], run.final_velocities[k], 1e-12 * scale) << label;
+    EXPECT_NEAR(p.energy_lost, run.energy_lost, 1e-12 * (1 + run.energy_lost)) << label;
+  }
+  EXPECT_GT(collapses, 8);
+  EXPECT_GT(finished, 80);
+  EXPECT_GT(near, 60);
 }
 
 }  // namespace

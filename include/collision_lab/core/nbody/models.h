@@ -9,11 +9,14 @@
 //                        they move like ghosts passing through each other; the count is the
 //                        number of inversions, O(N log N), and the final velocities are the
 //                        initial ones sorted
-//   three_body_spiral    N = 3 finite masses, one e < 1 for both pairs: the AB/BC cycle is a
-//                        2x2 map of trace T = (1+e)^2 cos^2(alpha) - 2e and determinant e^2;
-//                        a spiral for e > r_c = tan^2(pi/4 - alpha/2), possibly an inelastic
-//                        collapse for e <= r_c. The count is walked in O(count) with exact
-//                        decisions (src/core/nbody/spiral.h), the collapse time is closed form.
+//   three_body_spiral    N = 3, at most one wall (at an end), one e < 1 for both pairs: the
+//                        AB/BC cycle is a 2x2 map of trace T = (1+e)^2 cos^2(alpha) - 2e and
+//                        determinant e^2; a spiral for e > r_c = tan^2(pi/4 - alpha/2),
+//                        possibly an inelastic collapse for e <= r_c. A wall is the outer body
+//                        of infinite mass (k = 1+e, cos^2 alpha = m/(m_B + m)); a collapse then
+//                        ends on the wall's line. Collapse decided exactly, count and state in
+//                        O(1) from closed forms (src/core/nbody/spiral.h), the walk only where
+//                        those are too close to call; the collapse time is closed form.
 //                        e = 0: the first pair sticks, and the third body hits that cluster as
 //                        one body (engine.h, the cluster rule). Two different e: event_engine.
 //   event_engine         anything else: no count formula exists; the exact event engine
