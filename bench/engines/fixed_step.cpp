@@ -1,6 +1,7 @@
 // The hand-written time-stepping script a student would write: move every body by v dt,
-// then give each overlapping, approaching pair an elastic impulse (AB first, then BC).
-// No position correction, no sub-stepping, no collision-time search.
+// then give each overlapping, approaching pair the two-body impulse with its restitution
+// (pairs in list order, right to left). No position correction, no sub-stepping, no
+// collision-time search.
 #include <cmath>
 
 #include "engines.h"
@@ -18,10 +19,16 @@ double fraction(double m_i, double m_j) {
   return m_i / (m_i + m_j);
 }
 
-SteppedRun runFixedStep(const core::ThreeBodyScene& scene, const StepConfig& config) {
+SteppedRun runFixedStep(const core::Scene& scene, const StepConfig& config) {
   const auto& m = scene.masses;
-  const double f_left[2] = {fraction(m[core::kA], m[core::kB]), fraction(m[core::kB], m[core::kC])};
-  const double f_right[2] = {fraction(m[core::kB], m[core::kA]), fraction(m[core::kC], m[core::kB])};
+  const std::size_t pairs = scene.pairCount();
+  // Pair p's impulse: v_p += k_right (v_{p+1} - v_p), v_{p+1} -= k_left (v_{p+1} - v_p).
+  std::vector<double> k_left(pairs), k_right(pairs);
+  for (std::size_t p = 0; p < pairs; ++p) {
+    const double one_plus_e = 1.0 + scene.restitutionOf(p);
+    k_left[p] = one_plus_e * fraction(m[p], m[p + 1]);
+    k_right[p] = one_plus_e * fraction(m[p + 1], m[p]);
+  }
   SteppedRun run;
   auto& x = run.positions;
   auto& v = run.velocities;
@@ -31,14 +38,12 @@ SteppedRun runFixedStep(const core::ThreeBodyScene& scene, const StepConfig& con
   const double dt = config.dt;
   run.steps = stepCount(config);
   for (std::uint64_t step = 0; step < run.steps; ++step) {
-    for (int i = 0; i < 3; ++i) x[i] += v[i] * dt;
-    for (int pair = 0; pair < 2; ++pair) {
-      const int left = pair;  // A of AB, B of BC: the body on the right of the pair
-      const int right = pair + 1;
-      const double approach = v[right] - v[left];
-      if (x[left] <= x[right] && approach > 0) {
-        v[left] += 2 * f_right[pair] * approach;
-        v[right] -= 2 * f_left[pair] * approach;
+    for (std::size_t i = 0; i < x.size(); ++i) x[i] += v[i] * dt;
+    for (std::size_t p = 0; p < pairs; ++p) {
+      const double approach = v[p + 1] - v[p];
+      if (x[p] <= x[p + 1] && approach > 0) {
+        v[p] += k_right[p] * approach;
+        v[p + 1] -= k_left[p] * approach;
       }
     }
     counter.update(v);
@@ -51,9 +56,10 @@ SteppedRun runFixedStep(const core::ThreeBodyScene& scene, const StepConfig& con
 
 SteppedMethod fixedStepMethod() {
   return {"fixed_step",
-          "Hand-written loop in double: x += v dt for all bodies, then for AB and then BC, "
-          "if the pair overlaps (x_left <= x_right) and approaches, the exact elastic "
-          "two-body impulse. Point masses, no position correction, no collision-time search.",
+          "Hand-written loop in double: x += v dt for all bodies, then for each pair in "
+          "list order (AB, BC, ...), if it overlaps (x_right <= x_left) and approaches, the "
+          "exact two-body impulse with the pair's e (factor 1 + e). Point masses, no position "
+          "correction, no collision-time search.",
           runFixedStep};
 }
 
