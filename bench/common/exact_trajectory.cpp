@@ -80,12 +80,15 @@ void ExactTrajectory::run(std::uint64_t max_collisions, double until) {
       return;
     }
     if (!first_pair_) first_pair_ = next.front();
-    if (bounded && s.t + dt_min > end) return;
     if (collision_count_ + next.size() > max_collisions) {
       truncated_ = true;
       return;
     }
-    s.t += dt_min;
+    s.t += dt_min;  // then compared: t's denominator grows fast, so no extra sum per impact
+    if (bounded && s.t > end) {
+      s.t -= dt_min;
+      return;
+    }
     for (std::size_t i = 0; i < s.x.size(); ++i) s.x[i] += s.v[i] * dt_min;
     for (std::size_t p : next) {
       approach = s.v[p + 1] - s.v[p];
