@@ -87,7 +87,8 @@ BenchScene nBody(std::string name, std::string description, Scene scene, double 
 /// Positions are generic decimals, off every dt grid: with round numbers the collisions
 /// of a simple scene can fall exactly on step boundaries and a stepper looks exact by luck.
 /// The N-body and restitution scenes keep their preset's masses, velocities and e, with
-/// the positions moved off the grid the same way.
+/// the positions moved off the grid down to 1e-7 s (7 decimals: with v = -1 m/s a 4-decimal
+/// gap puts the first impact on the 1e-4 s grid).
 std::vector<BenchScene> benchScenes() {
   std::vector<BenchScene> scenes = {
       threeBody("equal", "equal masses, 3 collisions", {{1, 1, 1}, {1.0371, 0, -1.5193}, {-1, 0, 1}}, true),
@@ -102,15 +103,15 @@ std::vector<BenchScene> benchScenes() {
       threeBody("near_triple", "near-triple (1, 3, 1): BC first by ulps",
                 {{1, 3, 1}, {0.9371, 0, -0.23427499999999998}, {-0.7, 0.1, 0.3}}, true),
       nBody("two_carts_e08", "two equal carts head on, e = 0.8: 1 impact, they part at 0.8 m/s each",
-            {{1, 1}, {1.0371, 0}, {-1, 1}, {0.8}}, 3.0, "two_carts_inelastic", 1),
-      // Bounces at t_1 = 0.4629 s and t_k = t_1 + sum_{j=1}^{k-1} 0.9^-j s: 4 before 5 s.
+            {{1, 1}, {1.0371371, 0}, {-1, 1}, {0.8}}, 3.0, "two_carts_inelastic", 1),
+      // Bounces at t_1 = 0.4628629 s and t_k = t_1 + sum_{j=1}^{k-1} 0.9^-j s: 4 before 5 s.
       nBody("ball_walls_e09", "a ball between two walls 1 m apart, e = 0.9: bounces forever; 4 before 5 s",
-            {{kInf, 1, kInf}, {1, 0.5371, 0}, {0, 1, 0}, {0.9}}, 5.0, "bouncing_ball_wall", 4,
+            {{kInf, 1, kInf}, {1, 0.5371371, 0}, {0, 1, 0}, {0.9}}, 5.0, "bouncing_ball_wall", 4,
             50),  // the preset's max_collisions
       nBody("cradle_5", "Newton's cradle with gaps, 5 equal masses: 4 impacts, the left one leaves at -1 m/s",
-            {{1, 1, 1, 1, 1}, {3.9613, 2.9371, 1.9193, 0.9627, 0}, {-1, 0, 0, 0, 0}, {}}, 5.0, "cradle_5", 4),
+            {{1, 1, 1, 1, 1}, {3.9613371, 2.9371, 1.9193, 0.9627, 0}, {-1, 0, 0, 0, 0}, {}}, 5.0, "cradle_5", 4),
       nBody("near_collapse", "three equal masses, e = 0.072, just above r_c = 0.0718: 63 impacts",
-            {{1, 1, 1}, {2.0371, 1, 0}, {-1, 0, 0}, {0.072}}, 13.0, "near_collapse", 63),
+            {{1, 1, 1}, {2.0371371, 1, 0}, {-1, 0, 0}, {0.072}}, 13.0, "near_collapse", 63),
       // From Python's random.Random(32): masses 0.5 + 1.5 u, velocities 2u - 1, gaps
       // 0.1 + 0.3 u, e 0.6 + 0.4 u (u uniform in [0, 1)), rounded to 3-4 decimals.
       nBody("random_10",
