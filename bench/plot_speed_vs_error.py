@@ -1,10 +1,11 @@
 #!/usr/bin/env python3
 """Plot docs/speed_vs_error.csv: wall time against error, log-log.
 
-One row of panels per scene: final-velocity relative error on the left, trajectory error
-(max |x - x_exact| at the common end time) on the right. One series per method; stepped
-methods are swept over dt (smaller dt = further right). Exact zeros sit on a floor line;
-runs that got the collision count wrong are crossed out.
+Two panels per scene, two scenes per row: final-velocity relative error, then trajectory
+error (max |x - x_exact| at the scene's end time). One series per method; stepped methods
+are swept over dt (smaller dt = further right). Exact zeros sit on a floor line; runs that
+got the collision count wrong are crossed out. Rows with a note (the method cannot answer
+the scene) have no numbers and are left out.
 
 Usage: plot_speed_vs_error.py --csv FILE --out FILE.png [--title-suffix TEXT]
 Needs matplotlib (Debian: python3-matplotlib).
@@ -26,6 +27,8 @@ STYLE = OrderedDict([
     ("event_long_double", dict(color="#5aae61", marker="s", label="event_long_double (ours)")),
     ("event_high", dict(color="#00441b", marker="D", label="event_high, 50 digits (ours)")),
     ("closed_form", dict(color="#2166ac", marker="*", label="closed_form (ours, no positions)")),
+    ("nbody_engine", dict(color="#35978f", marker="P", label="nbody_engine, exact N-body engine (ours)")),
+    ("model", dict(color="#4393c3", marker="X", label="model, closed form of the scene (ours, no positions)")),
     ("fixed_step", dict(color="#636363", marker="v", label="fixed_step (hand-written), dt sweep")),
     ("bullet", dict(color="#e66101", marker="^", label="Bullet, dt sweep")),
     ("ode", dict(color="#b2182b", marker="<", label="ODE, dt sweep")),
@@ -52,17 +55,19 @@ def main():
     args = parser.parse_args()
 
     with open(args.csv, newline="") as f:
-        rows = list(csv.DictReader(f))
+        rows = [r for r in csv.DictReader(f) if not r.get("note")]
     scenes = list(OrderedDict.fromkeys(r["scene"] for r in rows))
     methods = [m for m in STYLE if any(r["method"] == m for r in rows)]
     methods += sorted({r["method"] for r in rows} - set(methods))
 
-    header = 1.7  # inches above the panels for the title and the legend
-    height = 3.1 * len(scenes) + header
-    fig, axes = plt.subplots(len(scenes), 2, figsize=(13, height), squeeze=False)
+    per_row = 2  # scenes side by side
+    nrows = (len(scenes) + per_row - 1) // per_row
+    header = 1.9  # inches above the panels for the title and the legend
+    height = 2.9 * nrows + header
+    fig, axes = plt.subplots(nrows, 2 * per_row, figsize=(22, height), squeeze=False)
     for i, scene in enumerate(scenes):
         for j, (metric, ylabel, goal) in enumerate(METRICS):
-            ax = axes[i][j]
+            ax = axes[i // per_row][2 * (i % per_row) + j]
             for method in methods:
                 pts = [r for r in rows if r["scene"] == scene and r["method"] == method]
                 pts = [r for r in pts if not math.isnan(number(r[metric]))]
@@ -94,10 +99,13 @@ def main():
             ax.text(0.0, goal, f" goal {goal:g}", transform=ax.get_yaxis_transform(), fontsize=7,
                     va="bottom", ha="left", color="#2166ac")
             ax.grid(True, which="major", linewidth=0.3)
-            ax.set_title(f"{scene}: {ylabel}", fontsize=10)
-            ax.set_ylabel(ylabel, fontsize=8)
-            if i == len(scenes) - 1:
-                ax.set_xlabel("wall time per run [s] (median)")
+            ax.set_title(f"{scene}: {ylabel}", fontsize=9)
+            ax.tick_params(labelsize=7)
+            if i >= len(scenes) - per_row:
+                ax.set_xlabel("wall time per run [s] (median)", fontsize=8)
+    for k in range(len(scenes), nrows * per_row):  # an odd scene count leaves two panels empty
+        for j in range(2):
+            axes[k // per_row][2 * (k % per_row) + j].axis("off")
 
     handles = [Line2D([], [], color=STYLE[m].get("color"), marker=STYLE[m]["marker"], label=STYLE[m]["label"])
                for m in methods if m in STYLE]
@@ -107,8 +115,8 @@ def main():
     fig.subplots_adjust(top=1.0 - header / height)
     fig.suptitle("Speed against error: exact event-driven simulation vs time stepping"
                  + args.title_suffix + "\nlower left is better; each stepped series goes right as dt shrinks "
-                 "(1e-2 ... 1e-6 s)", fontsize=12, y=1.0 - 0.05 / height, va="top")
-    fig.legend(handles=handles, loc="upper center", ncol=4, fontsize=9, frameon=False,
+                 "(1e-2 ... 1e-6 s; real engines to 1e-5 s on the N-body and restitution scenes)", fontsize=12, y=1.0 - 0.05 / height, va="top")
+    fig.legend(handles=handles, loc="upper center", ncol=5, fontsize=9, frameon=False,
                bbox_to_anchor=(0.5, 1.0 - 0.5 / height))
     fig.savefig(args.out, dpi=110)
 

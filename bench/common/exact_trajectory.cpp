@@ -9,9 +9,11 @@ namespace collision_lab {
 namespace bench {
 
 struct ExactTrajectory::State {
-  std::array<mpq_class, 3> x;  // positions at time t [m]
-  std::array<mpq_class, 3> v;  // velocities [m/s]
-  mpq_class t;                 // time of the last collision [s]
+  std::vector<mpq_class> x;  // positions at time t [m]
+  std::vector<mpq_class> v;  // velocities [m/s]
+  mpq_class t;               // time of the last impact [s]
+  // Pair p's impulse: v_p += k_right[p] (v_{p+1} - v_p), v_{p+1} -= k_left[p] (v_{p+1} - v_p).
+  std::vector<mpq_class> k_left, k_right;
 };
 
 namespace {
@@ -24,55 +26,76 @@ mpq_class massFraction(double m_i, double m_j) {
   return mpq_class(mi / (mi + mpq_class(m_j)));
 }
 
+core::Scene toScene(const core::ThreeBodyScene& three) {
+  core::Scene scene;
+  scene.masses.assign(three.masses.begin(), three.masses.end());
+  scene.positions.assign(three.positions.begin(), three.positions.end());
+  scene.velocities.assign(three.velocities.begin(), three.velocities.end());
+  return scene;
+}
+
 }  // namespace
 
-ExactTrajectory::ExactTrajectory(const core::ThreeBodyScene& scene, std::uint64_t max_collisions)
+ExactTrajectory::ExactTrajectory(const core::Scene& scene, std::uint64_t max_collisions, double until)
     : state_(std::make_unique<State>()) {
-  auto& x = state_->x;
-  auto& v = state_->v;
-  auto& t = state_->t;
-  for (int i = 0; i < 3; ++i) {
-    x[i] = scene.positions[i];
-    v[i] = scene.velocities[i];
+  const std::size_t n = scene.size();
+  auto& s = *state_;
+  s.x.assign(scene.positions.begin(), scene.positions.end());
+  s.v.assign(scene.velocities.begin(), scene.velocities.end());
+  s.t = 0;
+  for (std::size_t p = 0; p + 1 < n; ++p) {
+    const mpq_class one_plus_e = 1 + mpq_class(scene.restitutionOf(p));
+    s.k_left.push_back(one_plus_e * massFraction(scene.masses[p], scene.masses[p + 1]));
+    s.k_right.push_back(one_plus_e * massFraction(scene.masses[p + 1], scene.masses[p]));
   }
-  t = 0;
-  const auto& m = scene.masses;
-  const std::array<mpq_class, 2> f_left = {massFraction(m[core::kA], m[core::kB]), massFraction(m[core::kB], m[core::kC])};
-  const std::array<mpq_class, 2> f_right = {massFraction(m[core::kB], m[core::kA]), massFraction(m[core::kC], m[core::kB])};
+  run(max_collisions, until);
+}
 
-  const bool ab = v[core::kB] > v[core::kA];
-  const bool bc = v[core::kC] > v[core::kB];
-  if (ab && bc) {
-    // t_AB < t_BC  <=>  (x_A - x_B)(v_C - v_B) < (x_B - x_C)(v_B - v_A); triple excluded.
-    const mpq_class lhs = (x[core::kA] - x[core::kB]) * (v[core::kC] - v[core::kB]);
-    const mpq_class rhs = (x[core::kB] - x[core::kC]) * (v[core::kB] - v[core::kA]);
-    if (lhs == rhs) throw std::invalid_argument("exact reference: triple collision");
-    first_pair_ = lhs < rhs ? core::Pair::AB : core::Pair::BC;
-  } else if (ab) {
-    first_pair_ = core::Pair::AB;
-  } else if (bc) {
-    first_pair_ = core::Pair::BC;
-  }
-  if (!first_pair_) return;
+ExactTrajectory::ExactTrajectory(const core::ThreeBodyScene& scene, std::uint64_t max_collisions)
+    : ExactTrajectory(toScene(scene), max_collisions, HUGE_VAL) {}
 
-  int pair = *first_pair_ == core::Pair::AB ? 0 : 1;
-  mpq_class approach, dt;
+void ExactTrajectory::run(std::uint64_t max_collisions, double until) {
+  auto& s = *state_;
+  const std::size_t pairs = s.k_left.size();
+  const bool bounded = std::isfinite(until);
+  const mpq_class end = bounded ? mpq_class(until) : mpq_class(0);
+  std::vector<std::size_t> next;  // the pairs that meet first, in pair order
+  mpq_class dt_min, dt, approach;
   for (;;) {
-    const int left = pair;  // AB: A=0, B=1; BC: B=1, C=2
-    const int right = left + 1;
-    approach = v[right] - v[left];
-    if (sgn(approach) <= 0) break;
-    if (collision_count_ == max_collisions) {
-      truncated_ = true;
-      break;
+    next.clear();
+    for (std::size_t p = 0; p < pairs; ++p) {
+      approach = s.v[p + 1] - s.v[p];
+      if (sgn(approach) <= 0) continue;
+      dt = (s.x[p] - s.x[p + 1]) / approach;
+      if (next.empty() || dt < dt_min) {
+        next.assign(1, p);
+        dt_min = dt;
+      } else if (dt == dt_min) {
+        if (next.back() + 1 == p) throw std::invalid_argument("exact reference: multiple collision");
+        next.push_back(p);
+      }
     }
-    dt = (x[left] - x[right]) / approach;
-    t += dt;
-    for (int i = 0; i < 3; ++i) x[i] += v[i] * dt;
-    v[left] += 2 * f_right[pair] * approach;
-    v[right] -= 2 * f_left[pair] * approach;
-    ++collision_count_;
-    pair = 1 - pair;
+    if (next.empty()) {
+      finished_ = true;
+      return;
+    }
+    if (!first_pair_) first_pair_ = next.front();
+    if (collision_count_ + next.size() > max_collisions) {
+      truncated_ = true;
+      return;
+    }
+    s.t += dt_min;  // then compared: t's denominator grows fast, so no extra sum per impact
+    if (bounded && s.t > end) {
+      s.t -= dt_min;
+      return;
+    }
+    for (std::size_t i = 0; i < s.x.size(); ++i) s.x[i] += s.v[i] * dt_min;
+    for (std::size_t p : next) {
+      approach = s.v[p + 1] - s.v[p];
+      s.v[p] += s.k_right[p] * approach;
+      s.v[p + 1] -= s.k_left[p] * approach;
+    }
+    collision_count_ += next.size();
   }
 }
 
@@ -80,19 +103,26 @@ ExactTrajectory::~ExactTrajectory() = default;
 ExactTrajectory::ExactTrajectory(ExactTrajectory&&) noexcept = default;
 ExactTrajectory& ExactTrajectory::operator=(ExactTrajectory&&) noexcept = default;
 
-std::array<double, 3> ExactTrajectory::finalVelocities() const {
-  return {state_->v[0].get_d(), state_->v[1].get_d(), state_->v[2].get_d()};
+std::optional<core::Pair> ExactTrajectory::firstPair() const {
+  if (!first_pair_) return std::nullopt;
+  return *first_pair_ == 0 ? core::Pair::AB : core::Pair::BC;
+}
+
+std::vector<double> ExactTrajectory::finalVelocities() const {
+  std::vector<double> out;
+  for (const auto& v : state_->v) out.push_back(v.get_d());
+  return out;
 }
 
 double ExactTrajectory::lastCollisionTime() const { return state_->t.get_d(); }
 
-std::array<double, 3> ExactTrajectory::positionsAt(double t) const {
+std::vector<double> ExactTrajectory::positionsAt(double t) const {
   const mpq_class elapsed = mpq_class(t) - state_->t;
   if (sgn(elapsed) < 0) throw std::invalid_argument("exact reference: time before the last collision");
-  std::array<double, 3> out{};
-  for (int i = 0; i < 3; ++i) {
+  std::vector<double> out;
+  for (std::size_t i = 0; i < state_->x.size(); ++i) {
     const mpq_class xi = state_->x[i] + state_->v[i] * elapsed;
-    out[i] = xi.get_d();
+    out.push_back(xi.get_d());
   }
   return out;
 }

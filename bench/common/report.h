@@ -3,6 +3,7 @@
 
 #include <array>
 #include <string>
+#include <vector>
 
 #include "collision_lab/core/scene.h"
 
@@ -23,9 +24,12 @@ std::string triple(const std::array<double, 3>& values);
 double relativeVelocityError(const core::ThreeBodyScene& scene, const std::array<double, 3>& a,
                              const std::array<double, 3>& b);
 
-/// |E - E_0| / E_0 with E the kinetic energy of the finite masses (walls are at rest in
-/// every benchmark scene). Computed in long double.
-double energyRelativeDrift(const core::ThreeBodyScene& scene, const std::array<double, 3>& v);
+/// The same for N bodies: masses[i] = +inf marks a wall, which is skipped.
+double relativeVelocityError(const std::vector<double>& masses, const std::vector<double>& a,
+                             const std::vector<double>& b);
+
+/// Kinetic energy of the finite masses [J], in long double.
+long double kineticEnergy(const std::vector<double>& masses, const std::vector<double>& v);
 
 /// The source version the results belong to, from $COLLISION_LAB_BENCH_SOURCE (set by
 /// bench/run_benchmarks.sh to the commit, marked when src/ or include/ have local changes).

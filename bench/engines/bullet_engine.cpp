@@ -1,7 +1,8 @@
 // Bullet (the double-precision build when CMake found bullet-float64), configured as
-// elastically as it allows (shared/physics.md, last section).
+// elastically as it allows (shared/physics.md, last section), with per-pair restitution.
 #include <cmath>
 #include <memory>
+#include <optional>
 
 #include <btBulletDynamicsCommon.h>
 
@@ -12,7 +13,37 @@ namespace bench {
 
 namespace {
 
-SteppedRun runBullet(const core::ThreeBodyScene& scene, const StepConfig& config) {
+/// Per-body restitutions r whose products r_p r_{p+1} are the pairs' e (Bullet combines a
+/// contact's restitution as the product of its two bodies'). On a line only neighbours
+/// touch, so a chain solve gives every pair its own e: r_0 = sqrt(e_0), r_{p+1} = e_p / r_p
+/// (each product is e_p to within one rounding); after a zero r the next r is free and the
+/// chain restarts. Empty when no such r exists (a pair with e = 0 between two with e > 0).
+std::optional<std::vector<double>> bodyRestitutions(const core::Scene& scene) {
+  const std::size_t pairs = scene.pairCount();
+  auto fresh = [&](std::size_t pair) { return pair < pairs ? std::sqrt(scene.restitutionOf(pair)) : 1.0; };
+  std::vector<double> r(scene.size(), 1.0);
+  if (pairs == 0) return r;
+  r[0] = fresh(0);
+  for (std::size_t p = 0; p < pairs; ++p) {
+    const double e = scene.restitutionOf(p);
+    if (r[p] != 0.0) {
+      r[p + 1] = e / r[p];
+    } else if (e == 0.0) {
+      r[p + 1] = fresh(p + 1);
+    } else {
+      return std::nullopt;
+    }
+  }
+  return r;
+}
+
+SteppedRun runBullet(const core::Scene& scene, const StepConfig& config) {
+  SteppedRun run;
+  const auto restitution = bodyRestitutions(scene);
+  if (!restitution) {
+    run.unsupported = "Bullet multiplies the bodies' restitutions: a pair with e = 0 between two with e > 0 cannot be set";
+    return run;
+  }
   btDefaultCollisionConfiguration collision_config;
   btCollisionDispatcher dispatcher(&collision_config);
   btDbvtBroadphase broadphase;
@@ -29,18 +60,18 @@ SteppedRun runBullet(const core::ThreeBodyScene& scene, const StepConfig& config
   // scenes with thousands of fast collisions.
   info.m_erp2 = 0;
 
+  const std::size_t n = scene.size();
   btSphereShape sphere(kEngineRadius);
-  const double offset[3] = {2 * kEngineRadius, 0.0, -2 * kEngineRadius};
-  std::array<std::unique_ptr<btRigidBody>, 3> bodies;
-  for (int i = 0; i < 3; ++i) {
-    const bool wall = std::isinf(scene.masses[i]);
+  std::vector<std::unique_ptr<btRigidBody>> bodies(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const bool wall = scene.isWall(i);
     const btScalar mass = wall ? 0 : scene.masses[i];  // mass 0 = static: a wall is a static sphere
     btVector3 inertia(0, 0, 0);
     if (!wall) sphere.calculateLocalInertia(mass, inertia);
     btRigidBody::btRigidBodyConstructionInfo body_info(mass, nullptr, &sphere, inertia);
     body_info.m_startWorldTransform.setIdentity();
-    body_info.m_startWorldTransform.setOrigin(btVector3(scene.positions[i] + offset[i], 0, 0));
-    body_info.m_restitution = 1;  // combined as the product over the pair: 1 * 1
+    body_info.m_startWorldTransform.setOrigin(btVector3(scene.positions[i] + engineOffset(i, n), 0, 0));
+    body_info.m_restitution = (*restitution)[i];
     body_info.m_friction = 0;
     body_info.m_rollingFriction = 0;
     body_info.m_linearDamping = 0;
@@ -54,10 +85,11 @@ SteppedRun runBullet(const core::ThreeBodyScene& scene, const StepConfig& config
     world.addRigidBody(&body);
   }
 
-  SteppedRun run;
+  run.positions.resize(n);
+  run.velocities.resize(n);
   auto read = [&] {
-    for (int i = 0; i < 3; ++i) {
-      run.positions[i] = bodies[i]->getWorldTransform().getOrigin().x() - offset[i];
+    for (std::size_t i = 0; i < n; ++i) {
+      run.positions[i] = bodies[i]->getWorldTransform().getOrigin().x() - engineOffset(i, n);
       run.velocities[i] = bodies[i]->getLinearVelocity().x();
     }
   };
@@ -86,8 +118,11 @@ SteppedMethod bulletMethod() {
           std::string("Bullet 3.24, ") + precision +
               ", btDiscreteDynamicsWorld with btSequentialImpulseConstraintSolver and "
               "btDbvtBroadphase, gravity 0, stepSimulation(dt, 0) (one step of dt). Spheres "
-              "of radius 0.01 m; a wall is a static sphere (mass 0). Every body: restitution "
-              "1 (Bullet multiplies the pair's restitutions), friction 0, rolling friction 0, "
+              "of radius 0.01 m; a wall is a static sphere (mass 0). Restitution: Bullet "
+              "uses the product of the two bodies' m_restitution, so body i gets r_i with "
+              "r_0 = sqrt(e_0), r_{p+1} = e_p / r_p: every neighbouring pair's product is its "
+              "e to within one rounding (elastic scenes: r = 1 everywhere; on a line only "
+              "neighbours touch). Every body: friction 0, rolling friction 0, "
               "damping 0, setLinearFactor(1,0,0), setAngularFactor(0), DISABLE_DEACTIVATION. "
               "Solver: m_restitutionVelocityThreshold = 0 (default 0.2 m/s), warm starting "
               "off, m_splitImpulse = 1, m_splitImpulsePenetrationThreshold = 1e30, m_erp2 = 0 "

@@ -1,25 +1,27 @@
 // Time-stepping methods compared against the exact event simulation: a hand-written
-// fixed-step loop and real physics engines. Each runs a scene from t = 0 to end_time in
-// steps of dt and reports the state at end_time, so trajectories can be compared with
-// the exact one at the same instant.
+// fixed-step loop and real physics engines. Each runs an N-body scene (walls, per-pair
+// restitution) from t = 0 to end_time in steps of dt and reports the state at end_time, so
+// trajectories can be compared with the exact one at the same instant.
 #pragma once
 
-#include <array>
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
 
-#include "collision_lab/core/scene.h"
+#include "collision_lab/core/nbody/scene.h"
 
 namespace collision_lab {
 namespace bench {
 
 struct SteppedRun {
-  std::array<double, 3> positions{};   ///< point-mass positions at end_time [m]
-  std::array<double, 3> velocities{};  ///< at end_time [m/s]
-  std::uint64_t collisions = 0;        ///< counted as by CollisionCounter
+  std::vector<double> positions;   ///< point-mass positions at end_time [m]
+  std::vector<double> velocities;  ///< at end_time [m/s]
+  std::uint64_t collisions = 0;    ///< counted as by CollisionCounter
   std::uint64_t steps = 0;
+  /// Non-empty when the method cannot represent the scene: why (then nothing was run).
+  std::string unsupported;
 };
 
 struct StepConfig {
@@ -27,25 +29,26 @@ struct StepConfig {
   double end_time = 1.0;   ///< [s]; the run takes round(end_time / dt) steps
 };
 
-/// Counts collisions of any stepping method the same way: a pair's collision is counted
-/// when, from one step to the next, it goes from approaching (v_right > v_left, e.g.
-/// v_B > v_A for AB) to not approaching. Free flight never changes that state, so each
-/// count is one impact (or one engine-side resolution of several impacts in one step).
+/// Counts collisions of any stepping method the same way: pair p's collision is counted
+/// when, from one step to the next, it goes from approaching (v_{p+1} > v_p) to not
+/// approaching. Free flight never changes that state, so each count is one impact (or one
+/// engine-side resolution of several impacts in one step).
 class CollisionCounter {
  public:
-  explicit CollisionCounter(const std::array<double, 3>& v) { update(v); }
-  void update(const std::array<double, 3>& v) {
-    const bool ab = v[core::kB] > v[core::kA];
-    const bool bc = v[core::kC] > v[core::kB];
-    count_ += (approach_ab_ && !ab) + (approach_bc_ && !bc);
-    approach_ab_ = ab;
-    approach_bc_ = bc;
+  explicit CollisionCounter(const std::vector<double>& v) : approaching_(v.size() > 0 ? v.size() - 1 : 0) {
+    update(v);  // sets the flags; nothing was approaching before, so nothing is counted
+  }
+  void update(const std::vector<double>& v) {
+    for (std::size_t p = 0; p < approaching_.size(); ++p) {
+      const bool now = v[p + 1] > v[p];
+      count_ += approaching_[p] && !now;
+      approaching_[p] = now;
+    }
   }
   std::uint64_t count() const { return count_; }
 
  private:
-  bool approach_ab_ = false;
-  bool approach_bc_ = false;
+  std::vector<char> approaching_;
   std::uint64_t count_ = 0;
 };
 
@@ -54,12 +57,18 @@ class CollisionCounter {
 struct SteppedMethod {
   std::string name;
   std::string settings;  ///< every setting, as prose for docs/speed_vs_error.md
-  std::function<SteppedRun(const core::ThreeBodyScene&, const StepConfig&)> run;
+  /// Precondition: validate(scene) passed and every wall is at rest.
+  std::function<SteppedRun(const core::Scene&, const StepConfig&)> run;
 };
 
-/// Radius of the spheres/circles the engines use [m]. Centres are shifted by the radii
-/// (A by +2r, C by -2r) so spheres touch exactly when the point masses would.
+/// Radius of the spheres/circles the engines use [m].
 constexpr double kEngineRadius = 0.01;
+
+/// Shift of body i's centre in an engine scene of n bodies [m]: neighbours differ by 2r, so
+/// spheres touch exactly when the point masses would (A +2r, B 0, C -2r for three bodies).
+inline double engineOffset(std::size_t body, std::size_t n) {
+  return kEngineRadius * (static_cast<double>(n) - 1.0 - 2.0 * static_cast<double>(body));
+}
 
 /// Number of steps for a config (round(end_time / dt)).
 std::uint64_t stepCount(const StepConfig& config);
