@@ -27,7 +27,9 @@ def main():
     rows = list(csv.DictReader(open(args.csv)))
     finite = [r for r in rows if r["collapsed"] == "0"]
     collapsed = [r for r in rows if r["collapsed"] == "1"]
-    engine = [r for r in rows if r["engine_count"] not in ("", None) and r["engine_collapsed"] == "0"]
+    # Runs stopped at the engine's exactness cap (truncated) are not counts: left out.
+    engine = [r for r in rows if r["engine_count"] not in ("", None) and r["engine_collapsed"] == "0"
+              and r.get("engine_truncated") != "1"]
     rc = float(rows[0]["e"]) - float(rows[0]["e_minus_rc"])
     top = max(int(r["model_count"]) for r in finite) * 3
 

@@ -287,7 +287,9 @@ std::string stopMessage(const Scene& scene, const EngineResult& result, bool exh
       if (exhausted) {
         return "stopped after " + count + " impacts at the exactness cap (truncated): the impacts accumulate, each " +
                "needing exact arithmetic of more than " + std::to_string(kExactBits) +
-               " bits; an inelastic collapse of a kind the engine does not resolve (engine.h, Collapse)";
+               " bits: a collapse of a kind the engine does not resolve (engine.h, Collapse), or a spiral just above "
+               "its critical restitution, whose approach speeds shrink by ever more bits (the three_body_spiral "
+               "model counts it)";
       }
       return "stopped at the cap of " + count + " impacts (truncated)" +
              (scene.wallCount() == 2 ? "; two walls keep the bodies between them colliding forever" : "");
