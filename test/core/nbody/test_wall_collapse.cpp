@@ -29,6 +29,19 @@ namespace {
 
 constexpr double kWall = std::numeric_limits<double>::infinity();
 
+/// Two bodies and a wall at the right (body 0) or left end (body 2): masses 10^[-1, 1] kg,
+/// gaps 0.2-2 m, velocities in [-1, 1] m/s; no restitution set.
+Scene seededOneWallScene(std::mt19937_64& rng, bool wall_right) {
+  std::uniform_real_distribution<double> unit(-1.0, 1.0), gap(0.2, 2.0), decades(-1.0, 1.0);
+  Scene s;
+  for (int k = 0; k < 3; ++k) s.masses.push_back(std::pow(10.0, decades(rng)));
+  s.masses[wall_right ? 0 : 2] = kWall;
+  const double x2 = unit(rng), x1 = x2 + gap(rng), x0 = x1 + gap(rng);
+  s.positions = {x0, x1, x2};
+  for (int k = 0; k < 3; ++k) s.velocities.push_back(unit(rng));
+  return s;
+}
+
 /// Aitken's limit, in rationals, of every second exact impact time (one pair's impacts).
 double limitOfImpactTimes(const reference::Run& exact) {
   const auto& ev = exact.events;
@@ -119,18 +132,12 @@ TEST(WallCollapse, AboveTheWallsCriticalRestitutionTheImpactsStop) {
 
 TEST(WallCollapse, SeededScenesWithOneWallAgreeWithTheExactReference) {
   std::mt19937_64 rng(2024);
-  std::uniform_real_distribution<double> unit(-1.0, 1.0), gap(0.2, 2.0), decades(-1.0, 1.0);
   const double set[] = {0.0, 0.05, 0.3, 0.5, 0.8, 0.95, 1.0};
   constexpr std::uint64_t kCap = 400;
   int collapses = 0, finished = 0;
   for (int trial = 0; trial < 300; ++trial) {
-    Scene s;
     const bool wall_right = trial % 2 == 0;
-    for (int k = 0; k < 3; ++k) s.masses.push_back(std::pow(10.0, decades(rng)));
-    s.masses[wall_right ? 0 : 2] = kWall;
-    const double x2 = unit(rng), x1 = x2 + gap(rng), x0 = x1 + gap(rng);
-    s.positions = {x0, x1, x2};
-    for (int k = 0; k < 3; ++k) s.velocities.push_back(unit(rng));
+    Scene s = seededOneWallScene(rng, wall_right);
     s.restitution = {set[trial / 2 % 7]};
     if (validate(s)) continue;
     const std::string label = "scene " + std::to_string(trial) + ", e = " + std::to_string(s.restitution[0]);
@@ -203,17 +210,11 @@ TEST(WallCollapse, TheSpiralModelTakesTheWallAsAnInfiniteMass) {
 // model against the engine (which the test above checks against the exact reference).
 TEST(WallCollapse, SpiralModelWithAWallEqualsTheEngineOnSeededScenes) {
   std::mt19937_64 rng(4242);
-  std::uniform_real_distribution<double> unit(-1.0, 1.0), gap(0.2, 2.0), decades(-1.0, 1.0);
   const double set[] = {0.0, 0.3, 0.5, 0.8, 0.95};
   int collapses = 0, finished = 0, near = 0;
   for (int trial = 0; trial < 150; ++trial) {
-    Scene s;
     const bool wall_right = trial % 2 == 0;
-    for (int k = 0; k < 3; ++k) s.masses.push_back(std::pow(10.0, decades(rng)));
-    s.masses[wall_right ? 0 : 2] = kWall;
-    const double x2 = unit(rng), x1 = x2 + gap(rng), x0 = x1 + gap(rng);
-    s.positions = {x0, x1, x2};
-    for (int k = 0; k < 3; ++k) s.velocities.push_back(unit(rng));
+    Scene s = seededOneWallScene(rng, wall_right);
     const double m_c = s.masses[wall_right ? 2 : 0], sine = std::sqrt(1 - m_c / (s.masses[1] + m_c));
     const double rc = (1 - sine) / (1 + sine);  // cos^2(alpha) = m/(m_B + m) by hand
     const int kind = trial / 2 % 3;
