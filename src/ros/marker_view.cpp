@@ -61,6 +61,7 @@ void MarkerView::subscribe() {
 
 void MarkerView::select(const std::string& run_id) {
   if (has_run_id_ && run_id == run_id_) return;
+  if (has_run_id_) left_run_id_ = run_id_;
   run_id_ = run_id;
   has_run_id_ = true;
   run_.reset();
@@ -84,6 +85,7 @@ void MarkerView::onInitialConditions(const collision_lab::InitialConditions& msg
 template <typename Msg>
 void MarkerView::keep(const Msg& msg, std::optional<Msg> RunRecord::*in_run, std::optional<Msg> Pending::*pending) {
   std::lock_guard<std::mutex> lock(mutex_);
+  if (stale(msg.run_id)) return;
   select(msg.run_id);
   (run_ ? (*run_).*in_run : pending_.*pending) = msg;
   static_dirty_ = true;
@@ -95,6 +97,7 @@ void MarkerView::onPrediction(const collision_lab::Prediction& msg) {
 
 void MarkerView::onCollisionEvent(const collision_lab::CollisionEvent& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
+  if (stale(msg.run_id)) return;
   select(msg.run_id);
   if (run_) {
     run_->add(msg);

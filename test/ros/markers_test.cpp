@@ -5,12 +5,14 @@
 // are latched, so an rviz opened late gets the last run's picture at once.
 #include <cstdint>
 #include <limits>
+#include <set>
 #include <string>
 
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 
 #include "collision_lab/InitialConditions.h"
+#include "collision_lab/RunSummary.h"
 #include "collision_lab/ros/markers/ids.h"
 #include "marker_test_client.h"
 
@@ -81,6 +83,41 @@ TEST(Markers, HintRejectionAndTheTrueCountOnALongRun) {
   EXPECT_TRUE(late_latched);
   EXPECT_NE(late_title.find("pi_digits_5_markers"), std::string::npos) << late_title;
   EXPECT_NE(late_title.find("simulated 31,415"), std::string::npos) << late_title;
+}
+
+// With recording on, a run's summary goes out only once its bag is closed (bags are written
+// behind the run), so a long run's summary can come after the next run has started. The
+// view must stay on the newest run.
+TEST(Markers, ALateSummaryOfTheRunBeforeDoesNotTakeTheViewBack) {
+  ros::NodeHandle nh("collision_lab_recording");
+  AnimationWatcher watcher(nh);
+  std::string title;
+  ros::Subscriber picture = nh.subscribe<visualization_msgs::MarkerArray>(
+      collision_lab_ros::kMarkersTopic, 100, [&](const visualization_msgs::MarkerArray::ConstPtr& a) {
+        for (const auto& m : a->markers) {
+          if (m.ns == collision_lab_ros::markers::ns::kTitle) title = m.text;
+        }
+      });
+  std::set<std::string> summaries;
+  ros::Subscriber summary_sub = nh.subscribe<collision_lab::RunSummary>(
+      collision_lab_ros::kRunSummariesTopic, 10,
+      [&](const collision_lab::RunSummary::ConstPtr& s) { summaries.insert(s->run_id); });
+  ros::Publisher inputs = nh.advertise<collision_lab::InitialConditions>(collision_lab_ros::kInitialConditionsTopic, 10);
+  ASSERT_TRUE(spinUntil([&] { return inputs.getNumSubscribers() > 0 && summary_sub.getNumPublishers() > 0; }, kTimeout))
+      << "the recording node never connected";
+
+  // 31,415 collisions to write into its bag, then at once a run of 31 (m_A/m_B = 100).
+  inputs.publish(input("long_before", 1.0e8, {2.0, 1.0, 0.0}));
+  inputs.publish(input("right_after", 100.0, {2.0, 1.0, 0.0}));
+  ASSERT_TRUE(spinUntil([&] { return summaries.count("long_before") && summaries.count("right_after"); }, kTimeout))
+      << "both runs' summaries never came";
+  const std::string done = "collisions 31 of 31";
+  ASSERT_TRUE(spinUntil([&] { return watcher.status.find(done) != std::string::npos; }, kTimeout))
+      << "the view left the newest run; last shown: " << watcher.status << " / " << title;
+  ASSERT_TRUE(spinUntil([&] { return title.find("simulated 31,") == std::string::npos &&
+                                     title.find("simulated 31") != std::string::npos; }, kTimeout))
+      << title;
+  EXPECT_NE(title.find("right_after"), std::string::npos) << title;
 }
 
 }  // namespace

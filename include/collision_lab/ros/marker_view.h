@@ -70,6 +70,10 @@ class MarkerView {
   void onTimer(const ros::WallTimerEvent& event);
   /// Switches to run_id when it is not the current run. Call with mutex_ held.
   void select(const std::string& run_id);
+  /// A message of the run shown before the current one: with recording on, a run's summary
+  /// goes out only once its bag is closed, which can be after the next run has started.
+  /// Such a message must not switch the view back. Call with mutex_ held.
+  bool stale(const std::string& run_id) const { return has_run_id_ && run_id != run_id_ && run_id == left_run_id_; }
   FrameClock frameClock(const RunRecord& run, const ros::WallTime& now) const;
   std::string hintText() const;
   /// The banner and hint markers of this frame (adds, or deletes of ones shown before).
@@ -84,6 +88,7 @@ class MarkerView {
 
   std::mutex mutex_;
   std::string run_id_;
+  std::string left_run_id_;  ///< the run shown before run_id_
   bool has_run_id_ = false;
   std::optional<RunRecord> run_;
   Pending pending_;
