@@ -186,6 +186,7 @@ Table<collision_lab::InitialConditions> initialConditionsTable() {
   t.named("mode", &M::mode, writeMode)
       .list("restitution", "", &M::restitution)
       .field("max_collisions", &M::max_collisions)
+      .field("student", &M::student)
       .elsewhere(kBodiesFile, {{"mass_kg", "masses"}, {"x_m", "positions"}, {"v_m_s", "velocities"}});
   return t;
 }
@@ -318,6 +319,7 @@ Table<collision_lab::RunSummary> runSummaryTable() {
       .field("timeline_scale", &M::timeline_scale, "_bag_s_per_s")
       .flag("timeline_saturated", &M::timeline_saturated)
       .field("requested_run_id", &M::requested_run_id)
+      .field("student", &M::student)
       .elsewhere(kFinalVelocitiesFile, {{"v_m_s", "final_velocities"}});
   return t;
 }
@@ -328,7 +330,8 @@ Table<collision_lab::Rejected> rejectedTable() {
   t.field("reason", &M::reason)
       .field("reason_name", &M::reason_name)
       .field("field", &M::field)
-      .field("message", &M::message);
+      .field("message", &M::message)
+      .field("student", &M::student);
   return t;
 }
 

@@ -177,13 +177,22 @@ class EventStream {
   double last_time_ = 0.0;
 };
 
-/// The reason to refuse input before simulating it (run_id, mode, size, then the scene), if any.
+/// The reason to refuse input before simulating it (student, run_id, mode, size, then the scene), if any.
 std::optional<collision_lab::Rejected> checkInput(const collision_lab::InitialConditions& input,
                                                   std::size_t max_bodies) {
+  if (const std::string problem = studentProblem(input.student); !problem.empty()) {
+    return toRejectedMsg(NodeReason::kInvalidStudent, "student", "student '" + input.student + "' " + problem);
+  }
   if (!input.run_id.empty()) {
     if (const std::string problem = runIdProblem(input.run_id); !problem.empty()) {
       return toRejectedMsg(NodeReason::kInvalidRunId, "run_id",
                            "run_id '" + input.run_id + "' " + problem);
+    }
+  }
+  if (const std::string served = requestedRunId(input); !input.student.empty() && !served.empty()) {
+    if (const std::string problem = runIdProblem(served); !problem.empty()) {
+      return toRejectedMsg(NodeReason::kInvalidRunId, "run_id",
+                           "run_id '" + served + "' (<student>.<run_id>) " + problem);
     }
   }
   if (!toRunMode(input.mode)) {
@@ -349,6 +358,54 @@ std::string runIdProblem(const std::string& run_id) {
   return {};
 }
 
+std::string studentProblem(const std::string& student) {
+  if (student.size() > kMaxStudentLength) {
+    return "is longer than " + std::to_string(kMaxStudentLength) + " characters";
+  }
+  for (char c : student) {
+    const bool safe = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
+    if (!safe) return "may contain only letters, digits, '_' and '-' ('.' separates it from the run_id)";
+  }
+  return {};
+}
+
+std::string requestedRunId(const collision_lab::InitialConditions& input) {
+  if (input.student.empty()) return input.run_id;
+  return input.run_id.empty() ? input.student : input.student + "." + input.run_id;
+}
+
+void ServedRuns::accepted(const collision_lab::AcceptedRun& run) {
+  collision_lab::ServedRun served;
+  served.accepted = run;
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (runs_.size() == kServedRunsKept) runs_.pop_front();
+  runs_.push_back(std::move(served));
+}
+
+void ServedRuns::finished(const collision_lab::RunSummary& summary) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  // Summaries come in the order of the runs, so the run is one of the newest.
+  const auto it = std::find_if(runs_.rbegin(), runs_.rend(), [&](const collision_lab::ServedRun& run) {
+    return run.accepted.run_id == summary.run_id;
+  });
+  if (it == runs_.rend()) return;  // no longer kept
+  it->finished = true;
+  it->collision_count = summary.collision_count;
+  it->truncated = summary.truncated;
+  it->stop_reason = summary.stop_reason;
+  it->bag_path = summary.bag_path;
+  it->recording_ok = summary.recording_ok;
+}
+
+std::vector<collision_lab::ServedRun> ServedRuns::list(const std::string& student) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<collision_lab::ServedRun> listed;
+  for (const auto& run : runs_) {
+    if (student.empty() || run.accepted.student == student) listed.push_back(run);
+  }
+  return listed;
+}
+
 LabNode::LabNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
     : nh_(nh),
       params_(LabNodeParams::load(private_nh)),
@@ -366,6 +423,8 @@ LabNode::LabNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
       kRunSummariesTopic, kOutputQueueSize, kLatchRunSummaries);
   rejected_pub_ =
       nh_.advertise<collision_lab::Rejected>(kRejectedTopic, kOutputQueueSize, kLatchRejected);
+  accepted_pub_ = nh_.advertise<collision_lab::AcceptedRun>(kAcceptedRunsTopic, kOutputQueueSize, kLatchAcceptedRuns);
+  served_inputs_pub_ = nh_.advertise<collision_lab::InitialConditions>(kServedInputsTopic, kOutputQueueSize);
   if (params_.publish_markers) {
     marker_view_ = std::make_unique<MarkerView>(nh_, MarkerViewParams::load(private_nh));
   }
@@ -397,6 +456,7 @@ LabNode::LabNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   ros::NodeHandle cancel_nh(private_nh);
   cancel_nh.setCallbackQueue(&cancel_queue_);
   cancel_srv_ = cancel_nh.advertiseService(kCancelService, &LabNode::onCancel, this);
+  list_runs_srv_ = cancel_nh.advertiseService(kListRunsService, &LabNode::onListRuns, this);
   cancel_spinner_.start();
   ROS_INFO_STREAM("collision_lab_node: recording " << (params_.record ? "on" : "off")
                   << ", bags in " << params_.bag_directory << ", max_collisions "
@@ -423,6 +483,7 @@ LabNode::~LabNode() {
   worker_.join();
   bags_.reset();  // writes and closes every bag handed over, then publishes its summary
   cancel_srv_.shutdown();
+  list_runs_srv_.shutdown();
   cancel_spinner_.stop();
   service_spinner_.stop();
 }
@@ -455,6 +516,7 @@ bool LabNode::onRunScene(collision_lab::RunScene::Request& request,
                          collision_lab::RunScene::Response& response) {
   collision_lab::InitialConditions input;
   input.run_id = request.run_id;
+  input.student = request.student;
   input.mode = request.mode;
   input.masses = request.masses;
   input.positions = request.positions;
@@ -479,6 +541,7 @@ bool LabNode::onRunPreset(collision_lab::RunPreset::Request& request,
   collision_lab::InitialConditions input =
       toInitialConditions(preset.scene, collision_lab::core::RunMode::kFull, preset.max_collisions);
   input.mode = request.mode;
+  input.student = request.student;
   input.run_id =
       request.run_id.empty() ? preset.name + "_" + utcStamp("%Y%m%dT%H%M%SZ") : request.run_id;
   fillResponse(serveAndWait(input), response);
@@ -522,12 +585,34 @@ std::string LabNode::claimRunId(const std::string& requested) {
   return run_id;
 }
 
+void LabNode::announce(const collision_lab::InitialConditions& input, const std::string& requested) {
+  collision_lab::AcceptedRun accepted;
+  accepted.header.stamp = stampNow();
+  accepted.run_id = input.run_id;
+  accepted.requested_run_id = requested;
+  accepted.student = input.student;
+  accepted_pub_.publish(accepted);
+  served_runs_.accepted(accepted);
+  // As logRun: at INFO for a lab, at DEBUG with ~log_runs false.
+  const auto level = params_.log_runs ? ::ros::console::levels::Info : ::ros::console::levels::Debug;
+  ROS_LOG_STREAM(level, ROSCONSOLE_DEFAULT_NAME,
+                 "accepted run " << input.run_id
+                                 << (input.student.empty() ? std::string() : " of student '" + input.student + "'")
+                                 << (requested.empty() || requested == input.run_id ? std::string() : " (asked for '" + requested + "')"));
+}
+
+bool LabNode::onListRuns(collision_lab::ListRuns::Request& request, collision_lab::ListRuns::Response& response) {
+  response.runs = served_runs_.list(request.student);
+  return true;
+}
+
 ServeOutcome LabNode::reject(collision_lab::Rejected msg, const std::string& run_id) {
   msg.header.stamp = stampNow();
   msg.run_id = run_id;
   ++runs_rejected_;
-  ROS_WARN_STREAM("rejected run '" << run_id << "': " << msg.reason_name << " in field "
-                  << msg.field << ": " << msg.message);
+  ROS_WARN_STREAM("rejected run '" << run_id << "'"
+                  << (msg.student.empty() ? std::string() : " of student '" + msg.student + "'") << ": "
+                  << msg.reason_name << " in field " << msg.field << ": " << msg.message);
   rejected_pub_.publish(msg);
   if (marker_view_) marker_view_->onRejected(msg);
   return ServeOutcome{std::nullopt, msg};
@@ -536,15 +621,18 @@ ServeOutcome LabNode::reject(collision_lab::Rejected msg, const std::string& run
 void LabNode::serve(collision_lab::InitialConditions input, Reply reply) {
   const std::string requested = input.run_id;
   if (auto rejection = checkInput(input, params_.max_bodies)) {
+    rejection->student = input.student;
     ServeOutcome outcome = reject(std::move(*rejection), requested);
     if (reply) reply->set_value(std::move(outcome));
     return;
   }
-  input.run_id = requested.empty() ? newRunId() : claimRunId(requested);
-  if (!requested.empty() && input.run_id != requested) {
-    ROS_WARN_STREAM("run_id '" << requested << "' is taken (its bag exists, or this node served "
+  const std::string base = requestedRunId(input);
+  input.run_id = base.empty() ? newRunId() : claimRunId(base);
+  if (!base.empty() && input.run_id != base) {
+    ROS_WARN_STREAM("run_id '" << base << "' is taken (its bag exists, or this node served "
                     "it before); serving the run as '" << input.run_id << "'");
   }
+  announce(input, requested);
   run(input, input.run_id != requested ? requested : std::string(), std::move(reply));
 }
 
@@ -579,6 +667,7 @@ void LabNode::run(collision_lab::InitialConditions& input, const std::string& re
   summary.published_events = events.published();
   summary.events_not_published = events.cut();
   summary.requested_run_id = requested_run_id;
+  summary.student = input.student;
   publishEnd(out, summary, events.lastTime(), std::move(reply));
 }
 
@@ -617,6 +706,7 @@ bool LabNode::onCancel(collision_lab::Cancel::Request& request, collision_lab::C
 void LabNode::publishStart(RunWriter& out, const collision_lab::InitialConditions& input,
                            const ScenePrediction& core_prediction) {
   out.record(input);
+  served_inputs_pub_.publish(input);
   if (marker_view_) marker_view_->onInitialConditions(input);
   collision_lab::Prediction prediction = toPredictionMsg(core_prediction);
   prediction.timeline_scale = out.timeline().scale();
@@ -649,6 +739,7 @@ void LabNode::finishRun(const collision_lab::RunSummary& summary, const Reply& r
     if (!summary.recording_ok) ROS_ERROR_STREAM("run " << summary.run_id << ": recording failed: " << summary.recording_error);
   }
   // The summary goes out last, after everything it counts (and its bag is closed).
+  served_runs_.finished(summary);  // before the summary: whoever saw it finds the run finished
   topics_.summaries.publish(summary);
   ++runs_accepted_;
   last_compute_time_ = summary.compute_time;

@@ -15,8 +15,28 @@ namespace {
 constexpr std::size_t kMaxPendingEvents = 100000;
 }  // namespace
 
+bool MarkerViewParams::follows(const std::string& run_id) const {
+  // prefix, or prefix followed by '.' and what follows (any text, or digits only)
+  const auto named = [&](const std::string& prefix, bool digits_only) {
+    if (run_id.compare(0, prefix.size(), prefix) != 0) return false;
+    if (run_id.size() == prefix.size()) return true;
+    if (run_id[prefix.size()] != '.' || run_id.size() == prefix.size() + 1) return false;
+    return !digits_only || std::all_of(run_id.begin() + prefix.size() + 1, run_id.end(),
+                                       [](char c) { return c >= '0' && c <= '9'; });
+  };
+  return (follow_run_id.empty() || named(follow_run_id, true)) &&
+         (follow_student.empty() || named(follow_student, false));
+}
+
+bool MarkerViewParams::follows(const collision_lab::Rejected& rejected) const {
+  return (follow_run_id.empty() || rejected.run_id == follow_run_id) &&
+         (follow_student.empty() || rejected.student == follow_student);
+}
+
 MarkerViewParams MarkerViewParams::load(const ros::NodeHandle& private_nh) {
   MarkerViewParams params;
+  private_nh.param("follow_run_id", params.follow_run_id, std::string());
+  private_nh.param("follow_student", params.follow_student, std::string());
   private_nh.param("time_scale", params.time_scale, kDefaultTimeScale);
   private_nh.param("marker_rate", params.marker_rate, kDefaultMarkerRate);
   private_nh.param("frame_id", params.frame_id, std::string(kMarkerFrame));
@@ -42,11 +62,11 @@ MarkerView::MarkerView(ros::NodeHandle nh, const MarkerViewParams& params) : nh_
   timer_ = nh_.createWallTimer(ros::WallDuration(1.0 / params_.marker_rate), &MarkerView::onTimer, this);
 }
 
-void MarkerView::subscribe() {
-  replay_ = true;
+void MarkerView::subscribe(const std::string& inputs_topic) {
+  replay_ = inputs_topic == kInitialConditionsTopic;
   // Queues as deep as the node's, so a replayed burst is not thinned out.
   subscribers_.push_back(nh_.subscribe<collision_lab::InitialConditions>(
-      kInitialConditionsTopic, kOutputQueueSize,
+      inputs_topic, kOutputQueueSize,
       [this](const collision_lab::InitialConditions::ConstPtr& m) { onInitialConditions(*m); }));
   subscribers_.push_back(nh_.subscribe<collision_lab::Prediction>(
       kPredictionsTopic, kOutputQueueSize, [this](const collision_lab::Prediction::ConstPtr& m) { onPrediction(*m); }));
@@ -70,9 +90,11 @@ void MarkerView::select(const std::string& run_id) {
 }
 
 void MarkerView::onInitialConditions(const collision_lab::InitialConditions& msg) {
+  if (!params_.follows(msg.run_id)) return;
   std::lock_guard<std::mutex> lock(mutex_);
   if (run_ && msg.run_id == run_id_) has_run_id_ = false;  // the same run again: start afresh
   select(msg.run_id);
+  rejected_.reset();  // a rejection stays on screen until the next run
   run_.emplace(msg);
   run_->prediction = pending_.prediction;
   run_->summary = pending_.summary;
@@ -84,6 +106,7 @@ void MarkerView::onInitialConditions(const collision_lab::InitialConditions& msg
 
 template <typename Msg>
 void MarkerView::keep(const Msg& msg, std::optional<Msg> RunRecord::*in_run, std::optional<Msg> Pending::*pending) {
+  if (!params_.follows(msg.run_id)) return;
   std::lock_guard<std::mutex> lock(mutex_);
   if (stale(msg.run_id)) return;
   select(msg.run_id);
@@ -96,6 +119,7 @@ void MarkerView::onPrediction(const collision_lab::Prediction& msg) {
 }
 
 void MarkerView::onCollisionEvent(const collision_lab::CollisionEvent& msg) {
+  if (!params_.follows(msg.run_id)) return;
   std::lock_guard<std::mutex> lock(mutex_);
   if (stale(msg.run_id)) return;
   select(msg.run_id);
@@ -112,9 +136,9 @@ void MarkerView::onRunSummary(const collision_lab::RunSummary& msg) {
 }
 
 void MarkerView::onRejected(const collision_lab::Rejected& msg) {
+  if (!params_.follows(msg)) return;
   std::lock_guard<std::mutex> lock(mutex_);
   rejected_ = msg;
-  rejected_at_ = ros::WallTime::now();
 }
 
 FrameClock MarkerView::frameClock(const RunRecord& run, const ros::WallTime& now) const {
@@ -144,15 +168,21 @@ FrameClock MarkerView::frameClock(const RunRecord& run, const ros::WallTime& now
 }
 
 std::string MarkerView::hintText() const {
+  std::string following;
+  if (!params_.follow_student.empty()) following += " student '" + params_.follow_student + "'";
+  if (!params_.follow_run_id.empty()) following += " run '" + params_.follow_run_id + "'";
+  if (!following.empty()) following = "Following" + following + ". ";
   if (replay_) {
-    return "Waiting for a run. Replay one:\nroslaunch collision_lab replay.launch bag:=<run>.bag";
+    return following + "Waiting for a run. Replay one:\nroslaunch collision_lab replay.launch bag:=<run>.bag";
   }
-  return "No run yet. Send one, e.g.:\nrostopic pub -1 " + nh_.resolveName(kInitialConditionsTopic) +
-         " collision_lab/InitialConditions\n'{masses: [100.0, 1.0, .inf], positions: [2.0, 1.0, 0.0], "
+  const std::string student = params_.follow_student.empty() ? "" : "student: " + params_.follow_student + ", ";
+  return following + "No run yet. Send one, e.g.:\nrostopic pub -1 " + nh_.resolveName(kInitialConditionsTopic) +
+         " collision_lab/InitialConditions\n'{" + student +
+         "masses: [100.0, 1.0, .inf], positions: [2.0, 1.0, 0.0], "
          "velocities: [-1.0, 0.0, 0.0]}'\n(numbers as 1.0e+8, not 1e8; .inf is a wall)";
 }
 
-void MarkerView::addOverlays(visualization_msgs::MarkerArray& animated, const ros::WallTime& now) {
+void MarkerView::addOverlays(visualization_msgs::MarkerArray& animated) {
   auto& out = animated.markers;
   const auto show = [&](bool shown, bool& was_shown, const std::string& ns,
                         const std::vector<visualization_msgs::Marker>& markers) {
@@ -162,7 +192,7 @@ void MarkerView::addOverlays(visualization_msgs::MarkerArray& animated, const ro
     }
     was_shown = shown;
   };
-  const bool banner = rejected_ && (now - rejected_at_).toSec() < kRejectedShowTime;
+  const bool banner = rejected_.has_value();
   show(banner, banner_shown_, markers::ns::kRejected,
        banner ? rejectedBanner(*rejected_, params_.frame_id) : std::vector<visualization_msgs::Marker>{});
   const bool hint = !has_run_id_;
@@ -193,7 +223,7 @@ void MarkerView::onTimer(const ros::WallTimerEvent&) {
       const auto built = buildAnimatedMarkers(*run_, frameClock(*run_, now), params_.frame_id);
       animated.markers.insert(animated.markers.end(), built.markers.begin(), built.markers.end());
     }
-    addOverlays(animated, now);
+    addOverlays(animated);
   }
   for (auto* array : {&static_markers, &animated}) {
     if (const std::size_t changed = enforceRvizLimits(*array)) {

@@ -68,6 +68,7 @@ const char* nodeReasonName(NodeReason reason) {
     case NodeReason::kInvalidRunId: return "INVALID_RUN_ID";
     case NodeReason::kInvalidMode: return "INVALID_MODE";
     case NodeReason::kTooManyBodies: return "TOO_MANY_BODIES";
+    case NodeReason::kInvalidStudent: return "INVALID_STUDENT";
   }
   return "UNKNOWN";
 }

@@ -116,6 +116,7 @@ class BagCsvTest : public testing::Test {
     collision_lab::InitialConditions input;
     input.header.stamp = start;
     input.run_id = "csv_run";
+    input.student = "ana";
     input.mode = collision_lab::InitialConditions::MODE_FULL;
     input.masses = {{1e4, 1, kInf}};
     input.positions = {{2, 1, 0}};
@@ -169,11 +170,13 @@ class BagCsvTest : public testing::Test {
     summary.truncation_reason = "stopped at 2, the \"cap\", by request";
     summary.recording_ok = true;
     summary.requested_run_id = "csv";
+    summary.student = "ana";
     bag.write("/collision_lab/run_summaries", summary.header.stamp, summary);
 
     collision_lab::Rejected rejected;
     rejected.header.stamp = summary.header.stamp;
     rejected.run_id = "bad";
+    rejected.student = "ben";
     rejected.reason = collision_lab::Rejected::POSITIONS_NOT_ORDERED;
     rejected.message = "positions (0, 1, 2) m must be strictly decreasing";
     bag.write("/other_ns/rejected", rejected.header.stamp, rejected);
@@ -213,8 +216,8 @@ TEST_F(BagCsvTest, OneCsvPerTopicWithUnitsAndExactNumbers) {
 
   const Table input = readCsv(dir_ + "/csv/initial_conditions.csv");
   ASSERT_EQ(input.size(), 2u);
-  EXPECT_EQ(input[0], split("stamp_s,run_id,mode,restitution,max_collisions"));
-  EXPECT_EQ(input[1], (std::vector<std::string>{"1700000000.000000005", "csv_run", "full", "", "0"}));
+  EXPECT_EQ(input[0], split("stamp_s,run_id,mode,restitution,max_collisions,student"));
+  EXPECT_EQ(input[1], (std::vector<std::string>{"1700000000.000000005", "csv_run", "full", "", "0", "ana"}));
 
   // The masses, positions and velocities of the input are the start's rows (index 0).
   const Table bodies = readCsv(dir_ + "/csv/bodies.csv");
@@ -259,9 +262,11 @@ TEST_F(BagCsvTest, OneCsvPerTopicWithUnitsAndExactNumbers) {
   EXPECT_EQ(cell(summary, 1, "truncation_reason"), "stopped at 2, the \"cap\", by request");
   EXPECT_EQ(cell(summary, 1, "truncated"), "true");
   EXPECT_EQ(cell(summary, 1, "requested_run_id"), "csv");
+  EXPECT_EQ(cell(summary, 1, "student"), "ana");
   const Table rejected = readCsv(dir_ + "/csv/rejected.csv");
   EXPECT_EQ(cell(rejected, 1, "message"), "positions (0, 1, 2) m must be strictly decreasing");
   EXPECT_EQ(cell(rejected, 1, "reason"), "5");
+  EXPECT_EQ(cell(rejected, 1, "student"), "ben");
 }
 
 /// An impact of a CollisionEvent of run run_id, pair fields only.

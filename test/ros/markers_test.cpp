@@ -12,6 +12,7 @@
 #include <ros/ros.h>
 
 #include "collision_lab/InitialConditions.h"
+#include "collision_lab/Rejected.h"
 #include "collision_lab/RunSummary.h"
 #include "collision_lab/ros/markers/ids.h"
 #include "marker_test_client.h"
@@ -118,6 +119,80 @@ TEST(Markers, ALateSummaryOfTheRunBeforeDoesNotTakeTheViewBack) {
                                      title.find("simulated 31") != std::string::npos; }, kTimeout))
       << title;
   EXPECT_NE(title.find("right_after"), std::string::npos) << title;
+}
+
+// A student's own view in a class (~follow_student ana): another student's runs and
+// rejections never show, and ana's rejection stays on screen until ana's next run (it used
+// to vanish after 6 s, before a student had read it).
+TEST(Markers, AViewThatFollowsAStudentShowsTheirRunsAndKeepsTheirRejection) {
+  ros::NodeHandle nh("collision_lab_follow");
+  AnimationWatcher watcher(nh);
+  bool banner_visible = false;
+  std::set<std::string> banners, titles;
+  ros::Subscriber animated = nh.subscribe<visualization_msgs::MarkerArray>(
+      collision_lab_ros::kAnimatedMarkersTopic, 100, [&](const visualization_msgs::MarkerArray::ConstPtr& a) {
+        for (const auto& m : a->markers) {
+          if (m.action == visualization_msgs::Marker::DELETEALL) banner_visible = false;
+          if (m.ns != collision_lab_ros::markers::ns::kRejected) continue;
+          banner_visible = m.action == visualization_msgs::Marker::ADD;
+          if (banner_visible && !m.text.empty()) banners.insert(m.text);
+        }
+      });
+  ros::Subscriber picture = nh.subscribe<visualization_msgs::MarkerArray>(
+      collision_lab_ros::kMarkersTopic, 100, [&](const visualization_msgs::MarkerArray::ConstPtr& a) {
+        for (const auto& m : a->markers) {
+          if (m.ns == collision_lab_ros::markers::ns::kTitle) titles.insert(m.text);
+        }
+      });
+  std::set<std::string> summaries, rejections;
+  ros::Subscriber summary_sub = nh.subscribe<collision_lab::RunSummary>(
+      collision_lab_ros::kRunSummariesTopic, 10,
+      [&](const collision_lab::RunSummary::ConstPtr& s) { summaries.insert(s->run_id); });
+  ros::Subscriber rejected_sub = nh.subscribe<collision_lab::Rejected>(
+      collision_lab_ros::kRejectedTopic, 10,
+      [&](const collision_lab::Rejected::ConstPtr& r) { rejections.insert(r->student); });
+  ros::Publisher inputs = nh.advertise<collision_lab::InitialConditions>(collision_lab_ros::kInitialConditionsTopic, 10);
+  ASSERT_TRUE(spinUntil([&] { return inputs.getNumSubscribers() > 0 && summary_sub.getNumPublishers() > 0 &&
+                                     rejected_sub.getNumPublishers() > 0; }, kTimeout))
+      << "the following node never connected";
+  ASSERT_TRUE(spinUntil([&] { return !watcher.hint.empty(); }, kTimeout)) << "no hint before the first run";
+  EXPECT_NE(watcher.hint.find("Following student 'ana'"), std::string::npos) << watcher.hint;
+
+  // Ben's run and Ben's rejection: not ana's, never drawn.
+  auto bens_run = input("bens_run", 100.0, {2.0, 1.0, 0.0});
+  bens_run.student = "ben";
+  auto bens_mistake = input("bens_mistake", 100.0, {0.0, 1.0, 2.0});
+  bens_mistake.student = "ben";
+  inputs.publish(bens_run);
+  inputs.publish(bens_mistake);
+  ASSERT_TRUE(spinUntil([&] { return summaries.count("ben.bens_run") && rejections.count("ben"); }, kTimeout))
+      << "ben's run or rejection never came";
+
+  auto anas_mistake = input("anas_mistake", 100.0, {0.0, 1.0, 2.0});
+  anas_mistake.student = "ana";
+  inputs.publish(anas_mistake);
+  ASSERT_TRUE(spinUntil([&] { return banner_visible; }, kTimeout)) << "no banner for ana's rejected input";
+  // Frames go out in order: ben's run or banner would have come before ana's banner.
+  EXPECT_EQ(banners.size(), 1u);
+  for (const auto& text : banners) EXPECT_NE(text.find("anas_mistake"), std::string::npos) << text;
+  for (const auto& text : titles) EXPECT_EQ(text.find("ben"), std::string::npos) << text;
+  EXPECT_NE(watcher.hint.find("Following student 'ana'"), std::string::npos) << "the view left its hint";
+
+  // Longer than the 6 s the banner used to stay: still there.
+  const ros::WallTime shown = ros::WallTime::now();
+  ASSERT_TRUE(spinUntil([&] { return !banner_visible || ros::WallTime::now() - shown > ros::WallDuration(8.0); }, kTimeout));
+  EXPECT_TRUE(banner_visible) << "ana's rejection left the screen before her next run";
+
+  // Ana's next run takes its place.
+  auto anas_run = input("anas_run", 100.0, {2.0, 1.0, 0.0});
+  anas_run.student = "ana";
+  inputs.publish(anas_run);
+  ASSERT_TRUE(spinUntil([&] { return watcher.status.find("collisions 31 of 31") != std::string::npos; }, kTimeout))
+      << "ana's run never drawn; last shown: " << watcher.status;
+  EXPECT_FALSE(banner_visible) << "the rejection stayed over ana's next run";
+  bool titled = false;
+  for (const auto& text : titles) titled = titled || text.find("ana.anas_run") != std::string::npos;
+  EXPECT_TRUE(titled);
 }
 
 }  // namespace

@@ -7,7 +7,9 @@
 #include <gtest/gtest.h>
 
 #include "collision_lab/ros/lab_node.h"
+#include "collision_lab/ros/marker_view.h"
 #include "collision_lab/ros/msg_conversion.h"
+#include "collision_lab/ros/node_constants.h"
 
 namespace {
 
@@ -353,6 +355,114 @@ TEST(RunId, OnlySafeFileNames) {
   EXPECT_NE(runIdProblem("a/b"), "");
   EXPECT_NE(runIdProblem("a b"), "");
   EXPECT_NE(runIdProblem(std::string(201, 'a')), "");
+}
+
+TEST(MsgConversion, InvalidStudentHasItsOwnCode) {
+  const auto msg = toRejectedMsg(NodeReason::kInvalidStudent, "student", "bad");
+  EXPECT_EQ(msg.reason, 204);
+  EXPECT_EQ(msg.reason_name, "INVALID_STUDENT");
+}
+
+TEST(Student, NamesAreLettersDigitsUnderscoreAndDash) {
+  EXPECT_EQ(studentProblem(""), "");  // anonymous
+  EXPECT_EQ(studentProblem("ana"), "");
+  EXPECT_EQ(studentProblem("Ana_Lima-2"), "");
+  EXPECT_EQ(studentProblem(std::string(64, 'x')), "");
+  EXPECT_NE(studentProblem(std::string(65, 'x')), "");
+  EXPECT_NE(studentProblem("ana.b"), "");  // '.' separates the student in a run_id
+  EXPECT_NE(studentProblem("a/b"), "");
+  EXPECT_NE(studentProblem("a b"), "");
+  EXPECT_NE(studentProblem("\xc3\xa9"), "");  // UTF-8 e-acute
+}
+
+TEST(Student, TheRunIdAnInputAsksFor) {
+  collision_lab::InitialConditions input;
+  EXPECT_EQ(requestedRunId(input), "");
+  input.run_id = "pi_by_hand";
+  EXPECT_EQ(requestedRunId(input), "pi_by_hand");
+  input.student = "ana";
+  EXPECT_EQ(requestedRunId(input), "ana.pi_by_hand");
+  input.run_id.clear();
+  EXPECT_EQ(requestedRunId(input), "ana");
+}
+
+collision_lab::AcceptedRun accepted(const std::string& run_id, const std::string& student) {
+  collision_lab::AcceptedRun run;
+  run.run_id = run_id;
+  run.student = student;
+  return run;
+}
+
+TEST(ServedRuns, ListsOneStudentsRunsOldestFirstAndCompletesThemWithTheirSummary) {
+  ServedRuns runs;
+  runs.accepted(accepted("ana", "ana"));
+  runs.accepted(accepted("ben.x", "ben"));
+  runs.accepted(accepted("ana.2", "ana"));
+  runs.accepted(accepted("run_1", ""));
+  collision_lab::RunSummary summary;
+  summary.run_id = "ana";
+  summary.collision_count = 31;
+  summary.bag_path = "/bags/ana.bag";
+  summary.recording_ok = true;
+  summary.stop_reason = "FINISHED";
+  runs.finished(summary);
+
+  const auto ana = runs.list("ana");
+  ASSERT_EQ(ana.size(), 2u);
+  EXPECT_EQ(ana[0].accepted.run_id, "ana");
+  EXPECT_TRUE(ana[0].finished);
+  EXPECT_EQ(ana[0].collision_count, 31u);
+  EXPECT_EQ(ana[0].bag_path, "/bags/ana.bag");
+  EXPECT_TRUE(ana[0].recording_ok);
+  EXPECT_EQ(ana[0].stop_reason, "FINISHED");
+  EXPECT_EQ(ana[1].accepted.run_id, "ana.2");
+  EXPECT_FALSE(ana[1].finished);
+  EXPECT_EQ(runs.list("").size(), 4u);  // everyone, anonymous runs included
+  EXPECT_TRUE(runs.list("cy").empty());
+}
+
+TEST(ServedRuns, KeepsTheNewestRunsOnly) {
+  ServedRuns runs;
+  for (std::size_t k = 0; k <= collision_lab_ros::kServedRunsKept; ++k) runs.accepted(accepted("r" + std::to_string(k), ""));
+  const auto all = runs.list("");
+  ASSERT_EQ(all.size(), collision_lab_ros::kServedRunsKept);
+  EXPECT_EQ(all.front().accepted.run_id, "r1");
+  EXPECT_EQ(all.back().accepted.run_id, "r" + std::to_string(collision_lab_ros::kServedRunsKept));
+}
+
+TEST(MarkerFollow, AViewFollowsOneRunIdOrOneStudent) {
+  MarkerViewParams everyone;
+  EXPECT_TRUE(everyone.follows("anything"));
+
+  MarkerViewParams run;
+  run.follow_run_id = "pi";
+  EXPECT_TRUE(run.follows("pi"));
+  EXPECT_TRUE(run.follows("pi.2"));  // served as pi.2 when pi was taken
+  EXPECT_TRUE(run.follows("pi.17"));
+  EXPECT_FALSE(run.follows("pi."));
+  EXPECT_FALSE(run.follows("pi.x"));
+  EXPECT_FALSE(run.follows("pie"));
+  EXPECT_FALSE(run.follows("p"));
+
+  MarkerViewParams student;
+  student.follow_student = "ana";
+  EXPECT_TRUE(student.follows("ana"));
+  EXPECT_TRUE(student.follows("ana.2"));
+  EXPECT_TRUE(student.follows("ana.pi_by_hand"));
+  EXPECT_TRUE(student.follows("ana.pi_by_hand.3"));
+  EXPECT_FALSE(student.follows("anabel"));
+  EXPECT_FALSE(student.follows("ben.ana"));
+  EXPECT_FALSE(student.follows("run_20261126_011500_1"));
+
+  collision_lab::Rejected rejected;
+  rejected.student = "ana";
+  rejected.run_id = "pi";
+  EXPECT_TRUE(student.follows(rejected));
+  EXPECT_TRUE(run.follows(rejected));
+  rejected.student = "ben";
+  EXPECT_FALSE(student.follows(rejected));
+  rejected.run_id = "other";
+  EXPECT_FALSE(run.follows(rejected));
 }
 
 }  // namespace

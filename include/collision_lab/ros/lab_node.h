@@ -2,7 +2,8 @@
 // CLI's entry point, so both give the same answers), publishes every output, records one
 // bag per run and feeds the marker view. Inputs come from the topic `initial_conditions`
 // and from the services ~run_scene and ~run_preset; all three take the same path (served,
-// published, recorded, drawn). ~cancel stops the run in progress.
+// published, recorded, drawn). ~cancel stops the run in progress. Each accepted input is
+// announced on `accepted_runs` with the run_id it got; ~list_runs lists the runs served.
 //
 // Threading contract:
 // - One worker thread serves every input, from the topic and the services alike, in
@@ -15,8 +16,8 @@
 //   service thread until the worker hands back the outcome (a promise): the worker, topic
 //   inputs, diagnostics and the marker animation (global queue) go on meanwhile. Further
 //   concurrent calls wait in roscpp for a free service thread.
-// - ~cancel runs on a callback queue and thread of its own, so it is answered while every
-//   service thread waits for a run. It sets cancel_, which the run in progress polls
+// - ~cancel and ~list_runs run on a callback queue and thread of their own, so they are
+//   answered while every service thread waits for a run. It sets cancel_, which the run in progress polls
 //   (SceneRunOptions::cancel); running_mutex_ guards which run that is.
 // - With recording on, the worker hands each run's recorded messages over to a bag writer
 //   thread (RunBagWriter; it blocks only while kRecordQueueMessages messages wait). The
@@ -49,8 +50,10 @@
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
 
+#include "collision_lab/AcceptedRun.h"
 #include "collision_lab/Cancel.h"
 #include "collision_lab/InitialConditions.h"
+#include "collision_lab/ListRuns.h"
 #include "collision_lab/Rejected.h"
 #include "collision_lab/RunPreset.h"
 #include "collision_lab/RunScene.h"
@@ -80,6 +83,28 @@ struct LabNodeParams {
 
 /// Empty when run_id is safe as a bag file name; otherwise why not.
 std::string runIdProblem(const std::string& run_id);
+/// Empty when student is a valid InitialConditions.student (empty is: anonymous);
+/// otherwise why not.
+std::string studentProblem(const std::string& student);
+/// The run_id an input asks for: <student>.<run_id>, <student> when it names no run_id,
+/// or run_id when it names no student (empty: the node assigns one). A taken one is then
+/// served as <that>.N.
+std::string requestedRunId(const collision_lab::InitialConditions& input);
+
+/// The runs a node accepted, the newest kServedRunsKept of them, for ~list_runs.
+/// Thread-safe: the worker adds each run as it accepts it, and whichever thread publishes
+/// a run's summary completes it.
+class ServedRuns {
+ public:
+  void accepted(const collision_lab::AcceptedRun& run);
+  void finished(const collision_lab::RunSummary& summary);
+  /// Oldest first; those of student, or every run when student is empty.
+  std::vector<collision_lab::ServedRun> list(const std::string& student) const;
+
+ private:
+  mutable std::mutex mutex_;
+  std::deque<collision_lab::ServedRun> runs_;
+};
 
 /// The publishers of a run's outputs, in the order a run uses them.
 struct RunTopics {
@@ -130,6 +155,7 @@ class LabNode {
   bool onRunPreset(collision_lab::RunPreset::Request& request,
                    collision_lab::RunPreset::Response& response);
   bool onCancel(collision_lab::Cancel::Request& request, collision_lab::Cancel::Response& response);
+  bool onListRuns(collision_lab::ListRuns::Request& request, collision_lab::ListRuns::Response& response);
   /// Queues input for the worker and waits for its outcome; empty when the node stops
   /// before serving it.
   std::optional<ServeOutcome> serveAndWait(const collision_lab::InitialConditions& input);
@@ -158,6 +184,9 @@ class LabNode {
   /// the worker (not recording) or on the bag writer's thread.
   void finishRun(const collision_lab::RunSummary& summary, const Reply& reply);
   ServeOutcome reject(collision_lab::Rejected msg, const std::string& run_id);
+  /// Tells the sender which run_id input got (`accepted_runs`, the log) and records the
+  /// run for ~list_runs. requested: the input's run_id as sent.
+  void announce(const collision_lab::InitialConditions& input, const std::string& requested);
   std::string newRunId();
   /// requested, or the first free requested.N (N = 2, 3, ...) when it is taken; marks the
   /// result as taken.
@@ -176,6 +205,8 @@ class LabNode {
   ros::Subscriber input_sub_;
   RunTopics topics_;
   ros::Publisher rejected_pub_;
+  ros::Publisher accepted_pub_, served_inputs_pub_;
+  ServedRuns served_runs_;
   ros::Publisher diagnostics_pub_;
   ros::WallTimer diagnostics_timer_;
   std::unique_ptr<MarkerView> marker_view_;
@@ -209,7 +240,7 @@ class LabNode {
   ros::ServiceServer run_scene_srv_, run_preset_srv_;
   ros::CallbackQueue cancel_queue_;
   ros::AsyncSpinner cancel_spinner_;
-  ros::ServiceServer cancel_srv_;
+  ros::ServiceServer cancel_srv_, list_runs_srv_;
 };
 
 }  // namespace collision_lab_ros

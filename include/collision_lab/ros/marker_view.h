@@ -11,6 +11,11 @@
 //           (ros::Time::now() - InitialConditions stamp) / Prediction.timeline_scale, so
 //           that rosbag play --clock drives it: rate (-r), pause (space) and step (s).
 // The default is "ros" under use_sim_time, "wall" otherwise.
+//
+// Which runs it shows (~follow_run_id, ~follow_student): by default whichever run is
+// newest; a view that follows shows only the runs, and rejections, of one run_id or one
+// student (MarkerViewParams::follows), so that a student's rviz keeps their own run while
+// the class sends theirs.
 #pragma once
 
 #include <cstddef>
@@ -32,9 +37,21 @@ struct MarkerViewParams {
   double marker_rate = 0.0;  ///< [Hz]
   std::string frame_id;
   Clock clock = Clock::kWall;
+  /// Empty: every run. Otherwise the run_id to show, also as served when taken
+  /// (<follow_run_id>.N).
+  std::string follow_run_id;
+  /// Empty: every run. Otherwise the student whose runs to show: the run_ids <student>
+  /// and <student>.*, which the node gives every input that names that student
+  /// (InitialConditions.run_id), and the rejections that name them.
+  std::string follow_student;
 
-  /// Reads ~time_scale, ~marker_rate, ~frame_id and ~clock ("wall" or "ros"), with the
-  /// defaults of node_constants.h.
+  /// True when a message of run_id is to be shown.
+  bool follows(const std::string& run_id) const;
+  /// True when a rejection is to be shown.
+  bool follows(const collision_lab::Rejected& rejected) const;
+
+  /// Reads ~time_scale, ~marker_rate, ~frame_id, ~clock ("wall" or "ros"),
+  /// ~follow_run_id and ~follow_student, with the defaults of node_constants.h.
   static MarkerViewParams load(const ros::NodeHandle& private_nh);
 };
 
@@ -42,8 +59,9 @@ class MarkerView {
  public:
   MarkerView(ros::NodeHandle nh, const MarkerViewParams& params);
 
-  /// Subscribes to the run topics and `rejected` in nh's namespace (for replay).
-  void subscribe();
+  /// Subscribes to the run topics and `rejected` in nh's namespace: the inputs from
+  /// inputs_topic (kInitialConditionsTopic on replay, kServedInputsTopic beside a live node).
+  void subscribe(const std::string& inputs_topic);
 
   /// A message of a new run_id starts a new picture; so does a second InitialConditions
   /// of the current run (a bag played again). A run's other messages may arrive before
@@ -52,7 +70,8 @@ class MarkerView {
   void onPrediction(const collision_lab::Prediction& msg);
   void onCollisionEvent(const collision_lab::CollisionEvent& msg);
   void onRunSummary(const collision_lab::RunSummary& msg);
-  /// Shown for kRejectedShowTime (wall time) over whatever run is on screen.
+  /// Shown over whatever run is on screen until the next run starts. Messages of runs
+  /// (and rejections) the params do not follow are ignored.
   void onRejected(const collision_lab::Rejected& msg);
 
  private:
@@ -77,7 +96,7 @@ class MarkerView {
   FrameClock frameClock(const RunRecord& run, const ros::WallTime& now) const;
   std::string hintText() const;
   /// The banner and hint markers of this frame (adds, or deletes of ones shown before).
-  void addOverlays(visualization_msgs::MarkerArray& animated, const ros::WallTime& now);
+  void addOverlays(visualization_msgs::MarkerArray& animated);
 
   ros::NodeHandle nh_;
   MarkerViewParams params_;
@@ -95,8 +114,7 @@ class MarkerView {
   bool run_changed_ = false;   // the previous run's markers must be deleted
   bool static_dirty_ = false;  // the static markers must be rebuilt
   ros::WallTime run_start_;
-  std::optional<collision_lab::Rejected> rejected_;
-  ros::WallTime rejected_at_;
+  std::optional<collision_lab::Rejected> rejected_;  ///< since the current run started
   bool banner_shown_ = false, hint_shown_ = false;
 };
 

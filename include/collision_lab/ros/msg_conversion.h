@@ -2,7 +2,7 @@
 // functions (like cartographer_ros/msg_conversion.h). Conversions copy values only; the
 // caller fills header and run_id, the run's timeline (timeline_scale of Prediction and
 // RunSummary), and the node-only fields of RunSummary (bag and publishing state,
-// timeline_saturated, requested_run_id).
+// timeline_saturated, requested_run_id, student).
 #pragma once
 
 #include <array>
@@ -35,6 +35,7 @@ enum class NodeReason : std::uint8_t {
   kInvalidRunId = collision_lab::Rejected::INVALID_RUN_ID,
   kInvalidMode = collision_lab::Rejected::INVALID_MODE,
   kTooManyBodies = collision_lab::Rejected::TOO_MANY_BODIES,
+  kInvalidStudent = collision_lab::Rejected::INVALID_STUDENT,
 };
 
 const char* nodeReasonName(NodeReason reason);
@@ -140,8 +141,8 @@ class SceneEventConverter {
 };
 
 /// The physics fields of a summary; published_events, events_not_published, bag_path,
-/// recording_ok, recording_error, timeline_scale, timeline_saturated and
-/// requested_run_id are the node's to fill.
+/// recording_ok, recording_error, timeline_scale, timeline_saturated,
+/// requested_run_id and student are the node's to fill.
 collision_lab::RunSummary toRunSummaryMsg(const collision_lab::core::SceneRunResult& result,
                                           std::size_t body_count, collision_lab::core::RunMode mode);
 /// Three elastic bodies (the three-body path).

@@ -14,6 +14,12 @@ constexpr char kVelocitiesTopic[] = "velocities";
 constexpr char kEnergyTransfersTopic[] = "energy_transfers";
 constexpr char kRunSummariesTopic[] = "run_summaries";
 constexpr char kRejectedTopic[] = "rejected";
+/// One AcceptedRun per accepted input: the run_id it got.
+constexpr char kAcceptedRunsTopic[] = "accepted_runs";
+/// Each run's InitialConditions as served (its run_id filled in, stamped at the run's
+/// start), first of the run's messages: what a live collision_lab_markers (~live) draws
+/// from; initial_conditions carries the inputs as sent.
+constexpr char kServedInputsTopic[] = "served_inputs";
 /// The run's picture that changes only when a message arrives (axes, plots, titles), and
 /// the animation's frames (bodies, counter, cursors, banners). Both are latched, so an
 /// rviz opened late shows the last run and its last frame at once.
@@ -30,12 +36,22 @@ constexpr char kAnimatedMarkersTopic[] = "markers_animated";
 constexpr bool kLatchPredictions = true;
 constexpr bool kLatchRunSummaries = true;
 constexpr bool kLatchRejected = true;
+/// accepted_runs: the newest accepted input's run_id, for a `rostopic echo -n1` just after
+/// a `rostopic pub` (in a busy class, ~list_runs has every run).
+constexpr bool kLatchAcceptedRuns = true;
 
 /// Private services of collision_lab_node (srv/RunScene.srv, srv/RunPreset.srv).
 constexpr char kRunSceneService[] = "run_scene";
 constexpr char kRunPresetService[] = "run_preset";
 /// Stops the run in progress (srv/Cancel.srv); served by a thread of its own.
 constexpr char kCancelService[] = "cancel";
+/// Lists the runs served (srv/ListRuns.srv); served by ~cancel's thread (quick answers).
+constexpr char kListRunsService[] = "list_runs";
+/// ~list_runs keeps the newest this many runs (a few hundred bytes each): a term of a
+/// class, and bounded memory under the benchmarks' millions of runs.
+constexpr std::size_t kServedRunsKept = 100'000;
+/// InitialConditions.student: at most this many characters.
+constexpr std::size_t kMaxStudentLength = 64;
 /// Service calls served at once; each blocks its thread until its run is over (the runs
 /// themselves are served one at a time by the worker). Further calls wait in roscpp.
 constexpr std::uint32_t kServiceThreads = 4;
@@ -84,8 +100,6 @@ constexpr double kDefaultTimeScale = 0.0;
 constexpr double kAutoLoopDuration = 8.0;  ///< [s] wall time
 /// Each loop ends by holding its last frame (the final count) this long [s] wall time.
 constexpr double kMarkerEndHold = 2.5;
-/// A rejected input stays on screen this long [s] wall time.
-constexpr double kRejectedShowTime = 6.0;
 /// What the marker view keeps of one run, whatever its count (RunRecord): exact states
 /// after this many selected collisions, and plotted series of at most this many vertices
 /// each (beyond it, min/max per column: 256 to 512 columns, about a plot's pixels).
