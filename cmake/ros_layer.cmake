@@ -50,3 +50,5 @@ install(TARGETS ${collision_lab_ROS_EXECUTABLES}
 # replay.launch's bag resolver (bag:=latest, a run_id or a path), found in the source
 # folder by rosrun and roslaunch, installed beside the executables.
 install(PROGRAMS scripts/play_run DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
+# The teacher's list of runs from the bags (docs/ros.md), installed the same way.
+install(PROGRAMS scripts/list_runs DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})

@@ -32,5 +32,7 @@ target_include_directories(nbody_node_test PRIVATE test/core/nbody)
 # node_test reads the bad-input catalogue, docs/bad_inputs.md; demo_test runs scripts/play_run.
 target_compile_definitions(node_test PRIVATE COLLISION_LAB_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
 target_compile_definitions(demo_test PRIVATE COLLISION_LAB_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+# class_test runs scripts/list_runs.
+target_compile_definitions(class_test PRIVATE COLLISION_LAB_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
 # crash_test starts and kills the node itself.
 target_compile_definitions(crash_test PRIVATE COLLISION_LAB_NODE_PATH="$<TARGET_FILE:collision_lab_node>")

@@ -5,7 +5,9 @@
 // (<student>.<run_id>, <student> without a run_id, then .2 when taken), and ~list_runs
 // lists each student's runs by name, finished, with the count of the paper's example
 // (m_A/m_B = 100 against a wall: 31 collisions, the first two digits of pi) and a bag. A
-// student with a bad name, and one with a bad scene, find their rejection by name.
+// student with a bad name, and one with a bad scene, find their rejection by name. The
+// teacher's scripts/list_runs, which reads the bags, lists the same runs.
+#include <cstdio>
 #include <filesystem>
 #include <limits>
 #include <map>
@@ -37,6 +39,17 @@ std::string student(int k) { return "s" + std::to_string(100 + k); }
 std::string requested(int k) {
   if (k < 10) return "pi_by_hand";
   return k < 15 ? "" : "mine";
+}
+
+/// stdout of command.
+std::string output(const std::string& command) {
+  std::string text;
+  FILE* pipe = popen(command.c_str(), "r");
+  if (!pipe) return text;
+  char buffer[4096];
+  while (std::fgets(buffer, sizeof buffer, pipe)) text += buffer;
+  pclose(pipe);
+  return text;
 }
 
 /// The documented rule: <student>.<run_id> (or <student>), then .2 for the second.
@@ -125,6 +138,15 @@ TEST(Class, TwentyStudentsAtOnceEachFindTheirOwnRunsByName) {
       EXPECT_TRUE(listed.recording_ok);
       EXPECT_TRUE(std::filesystem::is_regular_file(listed.bag_path)) << listed.bag_path;
     }
+  }
+  // After a restart the node's record is gone; scripts/list_runs reads the bags.
+  for (int k : {0, 12, 19}) {
+    std::string expected = "run_id\tstudent\tcollisions\tstop_reason\tbag\n";
+    for (int run = 0; run < kRunsEach; ++run) {
+      expected += expectedRunId(k, run) + "\t" + student(k) + "\t31\tFINISHED\t" + bag_directory + "/" +
+                  expectedRunId(k, run) + ".bag\n";
+    }
+    EXPECT_EQ(output(COLLISION_LAB_SOURCE_DIR "/scripts/list_runs --student " + student(k) + " " + bag_directory), expected);
   }
   collision_lab::ListRuns everyone;
   ASSERT_TRUE(callService(kListRuns, everyone));
