@@ -29,10 +29,10 @@ constexpr char kAnimatedMarkersTopic[] = "markers_animated";
 /// Latched: a late joiner (rviz or `rostopic echo` started after a run, a second client)
 /// gets the newest of these at once. predictions and run_summaries: the newest run's
 /// prediction and result, what a late window needs to show it. rejected: the answer to
-/// "why did nothing happen?" for whoever looks after the fact; its stamp and run_id say
-/// whose it was. Not latched: the per-collision topics (their last message alone is a
-/// fragment of a run), initial_conditions (a late-joining node would serve a stale scene
-/// again) and /diagnostics (periodic).
+/// "why did nothing happen?" for whoever looks after the fact; its stamp, run_id and
+/// student say whose it was. Not latched: the per-collision topics (their last message
+/// alone is a fragment of a run), initial_conditions and served_inputs (a late-joining
+/// node or view would serve or draw a stale scene again) and /diagnostics (periodic).
 constexpr bool kLatchPredictions = true;
 constexpr bool kLatchRunSummaries = true;
 constexpr bool kLatchRejected = true;
