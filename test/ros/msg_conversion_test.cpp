@@ -138,24 +138,51 @@ TEST(SceneEventConverter, AnImpactAfterACollapseMovesTheWholeClusterAsItsRecordS
   EXPECT_DOUBLE_EQ(converter.energyTransferMsg(msg).cumulative_energy_lost, 1.0 / 3 + 25.0 / 128);
 }
 
-TEST(SceneEventConverter, AboveTheFullStateLimitOnlyThePairFieldsAndThePlotsCarryTheBodies) {
+TEST(SceneEventConverter, AboveTheFullStateLimitOnlyThePairFieldsAndThePlotScalarsCarryTheBodies) {
   const std::size_t n = collision_lab::CollisionEvent::FULL_STATE_MAX_BODIES + 1;
   collision_lab::core::Scene scene{std::vector<double>(n, 1.0), {}, std::vector<double>(n, 0.0), {}};
   for (std::size_t i = 0; i < n; ++i) scene.positions.push_back(static_cast<double>(n - i));
-  scene.velocities[10] = -1;
+  scene.velocities[1] = -1;
   SceneEventConverter converter(scene);
-  const auto msg = converter.impact(record(1, 10, 1.0, static_cast<double>(n - 11), {-1, 0}, {0, -1}, {-0.5, 0.5}, 0));
+  // Equal masses: bodies 1 and 2 swap velocities, body 1 gives its 0.5 J to body 2.
+  const auto msg = converter.impact(record(1, 1, 1.0, static_cast<double>(n - 2), {-1, 0}, {0, -1}, {-0.5, 0.5}, 0));
   EXPECT_TRUE(msg.positions.empty());
   EXPECT_TRUE(msg.velocities_after.empty());
   EXPECT_TRUE(std::isnan(msg.total_energy));
   EXPECT_TRUE(std::isnan(msg.total_momentum));
   EXPECT_EQ(msg.pair_velocities_after[1], -1.0);
+  // The plot topics follow the same rule: no length-N arrays (240 KB an impact at
+  // N = 10,000), the scalar fields of bodies 0, 1, 2 still there.
+  const auto v = converter.velocitiesMsg(msg);
+  EXPECT_TRUE(v.v.empty());
+  EXPECT_EQ(v.v_a, 0.0);
+  EXPECT_EQ(v.v_b, 0.0);
+  EXPECT_EQ(v.v_c, -1.0);
+  const auto t = converter.energyTransferMsg(msg);
+  EXPECT_TRUE(t.delta.empty());
+  EXPECT_TRUE(t.kinetic.empty());
+  EXPECT_EQ(t.delta_a, 0.0);
+  EXPECT_EQ(t.delta_b, -0.5);
+  EXPECT_EQ(t.delta_c, 0.5);
+  EXPECT_EQ(t.kinetic_b, 0.0);
+  EXPECT_EQ(t.kinetic_c, 0.5);
+  EXPECT_EQ(t.cumulative_energy_lost, 0.0);
+}
+
+TEST(SceneEventConverter, AtTheFullStateLimitThePlotsCarryEveryBody) {
+  const std::size_t n = collision_lab::CollisionEvent::FULL_STATE_MAX_BODIES;
+  collision_lab::core::Scene scene{std::vector<double>(n, 1.0), {}, std::vector<double>(n, 0.0), {}};
+  for (std::size_t i = 0; i < n; ++i) scene.positions.push_back(static_cast<double>(n - i));
+  scene.velocities[10] = -1;
+  SceneEventConverter converter(scene);
+  const auto msg = converter.impact(record(1, 10, 1.0, static_cast<double>(n - 11), {-1, 0}, {0, -1}, {-0.5, 0.5}, 0));
   const auto v = converter.velocitiesMsg(msg);
   ASSERT_EQ(v.v.size(), n);
   EXPECT_EQ(v.v[10], 0.0);
   EXPECT_EQ(v.v[11], -1.0);
   const auto t = converter.energyTransferMsg(msg);
   ASSERT_EQ(t.delta.size(), n);
+  ASSERT_EQ(t.kinetic.size(), n);
   EXPECT_EQ(t.delta[10], -0.5);
   EXPECT_EQ(t.delta[11], 0.5);
   EXPECT_EQ(t.kinetic[11], 0.5);
