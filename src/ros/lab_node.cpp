@@ -107,10 +107,14 @@ ros::Time stampNow() {
   return ros::Time(wall.sec, wall.nsec);
 }
 
+/// Now, in UTC, as format. Thread-safe (the service threads call it concurrently):
+/// gmtime_r, not std::gmtime's shared buffer.
 std::string utcStamp(const char* format) {
   char buffer[32];
   const std::time_t now = std::time(nullptr);
-  std::strftime(buffer, sizeof buffer, format, std::gmtime(&now));
+  std::tm utc{};
+  gmtime_r(&now, &utc);
+  std::strftime(buffer, sizeof buffer, format, &utc);
   return buffer;
 }
 
