@@ -382,4 +382,28 @@ TEST(RunId, OnlySafeFileNames) {
   EXPECT_NE(runIdProblem(std::string(201, 'a')), "");
 }
 
+TEST(CountParameter, WholeNumbersUpTo2To64Minus1AreTheirValue) {
+  EXPECT_EQ(countParameter("max_bodies", 0.0).value, 0u);
+  EXPECT_EQ(countParameter("max_bodies", 10000.0).value, 10000u);
+  // 2^53 + 2 and the largest double below 2^64, 2^64 - 2^11: exact in a double.
+  EXPECT_EQ(countParameter("max_collisions", 9007199254740994.0).value, 9007199254740994u);
+  const CountParameter largest = countParameter("max_collisions", 18446744073709549568.0);
+  EXPECT_EQ(largest.error, "");
+  EXPECT_EQ(largest.value, 18446744073709549568u);
+}
+
+TEST(CountParameter, AnythingElseIsAnErrorNamingTheParameterTheValueAndTheRange) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (const double value : {kInf, -kInf, nan, -1.0, -0.5, 2.5, 1e-300, 1.0e+30, 18446744073709551616.0}) {
+    SCOPED_TRACE(value);
+    const CountParameter count = countParameter("max_collisions", value);
+    EXPECT_NE(count.error.find("~max_collisions = "), std::string::npos) << count.error;
+    EXPECT_NE(count.error.find("from 0 to 18446744073709551615"), std::string::npos) << count.error;
+  }
+  EXPECT_EQ(countParameter("max_bodies", 1.0e+30).error,
+            std::string("~max_bodies = 1e+30 is out of range; ") + kCountParameterRange);
+  EXPECT_EQ(countParameter("max_bodies", kInf).error,
+            std::string("~max_bodies = inf is out of range; ") + kCountParameterRange);
+}
+
 }  // namespace
