@@ -1,7 +1,7 @@
 // collision_lab_cli: runs scenes from the command line or a scenario file and prints a
 // table, JSON or CSV report. Exit codes: 0 done (a truncated run included), 2 bad input
 // (one line on stderr; with --format json also an {"error": ...} document on stdout),
-// 1 internal error.
+// 1 internal error, 3 the output could not be written (one line on stderr).
 #include <algorithm>
 #include <cstdio>
 #include <fstream>
@@ -19,6 +19,7 @@ namespace {
 
 constexpr int kExitBadInput = 2;
 constexpr int kExitInternalError = 1;
+constexpr int kExitOutputFailed = 3;
 
 /// The package's presets: the source tree's (devel space) or the installed copy.
 std::string defaultScenarioPath() {
@@ -104,6 +105,16 @@ void reportBadInput(const CliError& error, io::ReportFormat format) {
   }
 }
 
+/// code, or kExitOutputFailed (and one line on stderr) when standard output lost any of
+/// what was written to it: a full disk must not pass for a finished report.
+int checkedOutput(int code) {
+  std::cout.flush();
+  if (std::cout) return code;
+  // No errno: the failed write may have been a report thread's (errno is per thread).
+  std::cerr << "collision_lab_cli: cannot write to standard output; the output is incomplete" << std::endl;
+  return kExitOutputFailed;
+}
+
 }  // namespace
 }  // namespace cli
 }  // namespace collision_lab
@@ -113,7 +124,7 @@ int main(int argc, char** argv) {
   std::ios::sync_with_stdio(false);
   const std::vector<std::string> args(argv + 1, argv + argc);
   try {
-    return cli::run(args);
+    return cli::checkedOutput(cli::run(args));
   } catch (const cli::CliError& error) {
     cli::reportBadInput(error, cli::requestedFormat(args));
     return cli::kExitBadInput;

@@ -8,6 +8,8 @@
 #include <cstdint>
 #include <mutex>
 #include <ostream>
+#include <stdexcept>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -22,7 +24,9 @@ namespace io {
 /// run's thread only copies, so formatting costs the run little when a core is free.
 /// Memory is fixed: kBlocks blocks and one buffer per worker, reused; nothing per event.
 /// finish() (or the destructor) writes every event before it returns; only then may the
-/// owner write to `out` again.
+/// owner write to `out` again. An exception on a worker (from `format` or the stream) stops
+/// the writing there: later blocks are dropped, the run goes on, and finish() throws
+/// std::runtime_error saying what failed.
 class EventPipeline {
  public:
   /// Appends one event's text; `first` is true for the run's first event only.
@@ -35,7 +39,7 @@ class EventPipeline {
     }
     current_ = takeFree();
   }
-  ~EventPipeline() { finish(); }
+  ~EventPipeline() { stop(); }
   EventPipeline(const EventPipeline&) = delete;
   EventPipeline& operator=(const EventPipeline&) = delete;
 
@@ -47,8 +51,23 @@ class EventPipeline {
     }
   }
 
-  /// Formats and writes the events pushed so far; the workers end.
+  /// Formats and writes the events pushed so far; the workers end. Throws
+  /// std::runtime_error when a worker failed.
   void finish() {
+    stop();
+    if (!error_.empty()) throw std::runtime_error("writing the events failed: " + error_);
+  }
+
+ private:
+  static constexpr std::size_t kBlockEvents = 1024;
+  static constexpr std::size_t kBlocks = 4;
+  struct Block {
+    std::vector<core::LabEvent> events;
+    std::uint64_t sequence = 0;
+  };
+
+  /// finish() without the throw (the destructor's).
+  void stop() {
     if (current_ && !current_->events.empty()) submit(current_);
     current_ = nullptr;
     {
@@ -59,14 +78,6 @@ class EventPipeline {
     for (std::thread& worker : workers_) worker.join();
     workers_.clear();
   }
-
- private:
-  static constexpr std::size_t kBlockEvents = 1024;
-  static constexpr std::size_t kBlocks = 4;
-  struct Block {
-    std::vector<core::LabEvent> events;
-    std::uint64_t sequence = 0;
-  };
 
   Block* takeFree() {
     std::unique_lock<std::mutex> lock(mutex_);
@@ -90,14 +101,20 @@ class EventPipeline {
   void work() {
     TextSink sink(out_, /*auto_flush=*/false);
     while (Block* block = nextReady()) {
-      for (std::size_t i = 0; i < block->events.size(); ++i) {
-        format_(sink, block->events[i], block->sequence == 0 && i == 0);
-      }
+      // Every block still takes its turn and goes back to free_, so that nothing waits for
+      // ever after a failure.
+      const bool format = !failed();
+      if (format) guarded(sink, [&] {
+        for (std::size_t i = 0; i < block->events.size(); ++i) {
+          format_(sink, block->events[i], block->sequence == 0 && i == 0);
+        }
+      });
       {
         std::unique_lock<std::mutex> lock(mutex_);
         changed_.wait(lock, [&] { return written_ == block->sequence; });
       }
-      sink.flush();  // the only writer now: earlier blocks are out, later ones wait
+      // The only writer now: earlier blocks are out, later ones wait.
+      if (format && !failed()) guarded(sink, [&] { sink.flush(); });
       {
         std::lock_guard<std::mutex> lock(mutex_);
         ++written_;
@@ -106,6 +123,28 @@ class EventPipeline {
       }
       changed_.notify_all();
     }
+  }
+
+  bool failed() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return !error_.empty();
+  }
+
+  /// Runs f; an exception becomes error_ (the first one is kept) and sink is emptied.
+  template <class F>
+  void guarded(TextSink& sink, F&& f) {
+    std::string what;
+    try {
+      f();
+      return;
+    } catch (const std::exception& e) {
+      what = e.what();
+    } catch (...) {
+      what = "an exception of unknown type";
+    }
+    sink.discard();
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (error_.empty()) error_ = what.empty() ? "an exception without a message" : what;
   }
 
   /// The oldest submitted block, or nullptr when finish() was called and none is left.
@@ -129,6 +168,7 @@ class EventPipeline {
   std::uint64_t submitted_ = 0;
   std::uint64_t written_ = 0;
   bool done_ = false;
+  std::string error_;  ///< the first worker failure; empty while none
   std::vector<std::thread> workers_;
 
   static std::vector<Block*> reservedList() {

@@ -123,6 +123,8 @@ class TextSink {
     if (size_ > 0) out_.write(buffer_.data(), static_cast<std::streamsize>(size_));
     size_ = 0;
   }
+  /// Drops the text not yet written (after a failure, so that it is never written late).
+  void discard() { size_ = 0; }
 
  private:
   static constexpr std::size_t kSlack = std::size_t{1} << 16;

@@ -4,11 +4,13 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <ctime>
 #include <functional>
 #include <optional>
 #include <sstream>
+#include <stdexcept>
 #include <utility>
 
 #include <diagnostic_msgs/DiagnosticArray.h>
@@ -107,10 +109,14 @@ ros::Time stampNow() {
   return ros::Time(wall.sec, wall.nsec);
 }
 
+/// Now, in UTC, as format. Thread-safe (the service threads call it concurrently):
+/// gmtime_r, not std::gmtime's shared buffer.
 std::string utcStamp(const char* format) {
   char buffer[32];
   const std::time_t now = std::time(nullptr);
-  std::strftime(buffer, sizeof buffer, format, std::gmtime(&now));
+  std::tm utc{};
+  gmtime_r(&now, &utc);
+  std::strftime(buffer, sizeof buffer, format, &utc);
   return buffer;
 }
 
@@ -283,24 +289,37 @@ std::string defaultBagDirectory() {
   return base + "/" + kDefaultBagSubdirectory;
 }
 
+/// The count parameter `name`, or fallback when it is not set. Throws std::invalid_argument
+/// when it is set to anything but a whole number in countParameter's range.
 std::uint64_t getUint64(const ros::NodeHandle& nh, const std::string& name,
                         std::uint64_t fallback) {
-  // XmlRpc integers are 32-bit; large values may come as doubles.
-  double value = static_cast<double>(fallback);
-  int as_int = 0;
-  if (nh.getParam(name, as_int)) {
-    value = as_int;
+  // XmlRpc integers are 32-bit; large values come as doubles. Read as they are: the typed
+  // getParam rounds a double to int (2.5 -> 3, 1e30 -> undefined).
+  XmlRpc::XmlRpcValue param;
+  if (!nh.getParam(name, param)) return fallback;
+  double value = 0.0;
+  if (param.getType() == XmlRpc::XmlRpcValue::TypeInt) {
+    value = static_cast<int>(param);
+  } else if (param.getType() == XmlRpc::XmlRpcValue::TypeDouble) {
+    value = static_cast<double>(param);
   } else {
-    nh.getParam(name, value);
+    throw std::invalid_argument("~" + name + " is not a number; " + kCountParameterRange);
   }
-  if (!(value >= 0)) {
-    ROS_WARN_STREAM("~" << name << " = " << value << " is negative; using " << fallback);
-    return fallback;
-  }
-  return static_cast<std::uint64_t>(value);
+  const CountParameter count = countParameter(name, value);
+  if (!count.error.empty()) throw std::invalid_argument(count.error);
+  return count.value;
 }
 
 }  // namespace
+
+CountParameter countParameter(const std::string& name, double value) {
+  // 2^64, exactly: every double below it converts to std::uint64_t without overflow.
+  constexpr double kTwoTo64 = 18446744073709551616.0;
+  if (value >= 0 && value < kTwoTo64 && value == std::floor(value)) return {static_cast<std::uint64_t>(value), {}};
+  std::ostringstream error;
+  error << "~" << name << " = " << value << " is out of range; " << kCountParameterRange;
+  return {0, error.str()};
+}
 
 LabNodeParams LabNodeParams::load(const ros::NodeHandle& private_nh) {
   LabNodeParams params;
@@ -466,9 +485,8 @@ LabNode::LabNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
 }
 
 LabNode::~LabNode() {
-  input_sub_.shutdown();
-  run_scene_srv_.shutdown();
-  run_preset_srv_.shutdown();
+  // Cancel first: shutting a service down waits for its calls in progress, and a call
+  // waits for its run (and for every input queued before it).
   {
     std::lock_guard<std::mutex> lock(mutex_);
     stopping_ = true;
@@ -481,6 +499,10 @@ LabNode::~LabNode() {
   }
   wake_.notify_one();
   worker_.join();
+  // Calls still in progress end once their run's bag is closed (the writer runs on).
+  input_sub_.shutdown();
+  run_scene_srv_.shutdown();
+  run_preset_srv_.shutdown();
   bags_.reset();  // writes and closes every bag handed over, then publishes its summary
   cancel_srv_.shutdown();
   list_runs_srv_.shutdown();

@@ -141,7 +141,7 @@ void MarkerView::onRejected(const collision_lab::Rejected& msg) {
   rejected_ = msg;
 }
 
-FrameClock MarkerView::frameClock(const RunRecord& run, const ros::WallTime& now) const {
+FrameClock MarkerView::frameClock(const RunRecord& run, const ros::WallTime& run_start, const ros::WallTime& now) const {
   FrameClock clock;
   if (params_.clock == MarkerViewParams::Clock::kRos) {
     const double scale = run.prediction ? run.prediction->timeline_scale : 0.0;
@@ -149,7 +149,7 @@ FrameClock MarkerView::frameClock(const RunRecord& run, const ros::WallTime& now
     clock.description = "ROS clock" + std::string(ros::Time::isSimTime() ? " (bag)" : "");
     return clock;
   }
-  const double elapsed = (now - run_start_).toSec();
+  const double elapsed = (now - run_start).toSec();
   if (params_.time_scale > 0) {
     const double end = endTime(run);
     const double into = std::fmod(elapsed, end / params_.time_scale + kMarkerEndHold);
@@ -200,31 +200,39 @@ void MarkerView::addOverlays(visualization_msgs::MarkerArray& animated) {
 }
 
 void MarkerView::onTimer(const ros::WallTimerEvent&) {
-  visualization_msgs::MarkerArray static_markers, animated;
+  // The node's worker takes mutex_ on every collision: hold it only to copy the run when
+  // it changed (a RunRecord is bounded by its RecordLimits), and build the markers without it.
+  visualization_msgs::MarkerArray static_markers, animated, overlays;
+  bool rebuild_static = false;
+  ros::WallTime run_start;
+  const ros::WallTime now = ros::WallTime::now();
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    const ros::WallTime now = ros::WallTime::now();
     // A deletion goes in the same message as the new picture, so rviz never shows the
     // two together, and every static message (the latched one too) is a whole picture.
     if (run_changed_) {
       animated = deleteAllMarkers(params_.frame_id);
       banner_shown_ = hint_shown_ = false;
     }
-    if (run_changed_ || (run_ && static_dirty_)) {
-      static_markers = deleteAllMarkers(params_.frame_id);
-      if (run_) {
-        const auto built = buildStaticMarkers(*run_, params_.frame_id);
-        static_markers.markers.insert(static_markers.markers.end(), built.markers.begin(), built.markers.end());
-        static_dirty_ = false;
-      }
-    }
+    rebuild_static = run_changed_ || (run_ && static_dirty_);
+    if (rebuild_static && run_) static_dirty_ = false;
     run_changed_ = false;
-    if (run_) {
-      const auto built = buildAnimatedMarkers(*run_, frameClock(*run_, now), params_.frame_id);
-      animated.markers.insert(animated.markers.end(), built.markers.begin(), built.markers.end());
-    }
-    addOverlays(animated);
+    if (rebuild_static) drawn_run_ = run_;  // every change of run_ sets run_changed_ or static_dirty_
+    run_start = run_start_;
+    addOverlays(overlays);
   }
+  if (rebuild_static) {
+    static_markers = deleteAllMarkers(params_.frame_id);
+    if (drawn_run_) {
+      const auto built = buildStaticMarkers(*drawn_run_, params_.frame_id);
+      static_markers.markers.insert(static_markers.markers.end(), built.markers.begin(), built.markers.end());
+    }
+  }
+  if (drawn_run_) {
+    const auto built = buildAnimatedMarkers(*drawn_run_, frameClock(*drawn_run_, run_start, now), params_.frame_id);
+    animated.markers.insert(animated.markers.end(), built.markers.begin(), built.markers.end());
+  }
+  animated.markers.insert(animated.markers.end(), overlays.markers.begin(), overlays.markers.end());
   for (auto* array : {&static_markers, &animated}) {
     if (const std::size_t changed = enforceRvizLimits(*array)) {
       ROS_WARN_STREAM_THROTTLE(10, changed << " markers did not fit rviz's limits and were thinned or dropped");

@@ -1,5 +1,6 @@
 #include "collision_lab/ros/msg_conversion.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -444,15 +445,30 @@ collision_lab::CollisionEvent SceneEventConverter::collapse(const core::Collapse
   return msg;
 }
 
+std::size_t SceneEventConverter::plottedBodies() const {
+  // Above the limit the arrays are empty, as CollisionEvent's are, and only bodies 0, 1, 2
+  // are worked out, for the scalar fields.
+  return full_state_ ? scene_.size() : std::min<std::size_t>(scene_.size(), 3);
+}
+
 collision_lab::Velocities SceneEventConverter::velocitiesMsg(const collision_lab::CollisionEvent& event) const {
-  return toVelocitiesMsg(event, v_);
+  collision_lab::Velocities msg = toVelocitiesMsg(event, {v_.begin(), v_.begin() + plottedBodies()});
+  if (!full_state_) msg.v.clear();
+  return msg;
 }
 
 collision_lab::EnergyTransfer SceneEventConverter::energyTransferMsg(const collision_lab::CollisionEvent& event) const {
-  std::vector<double> delta(scene_.size(), 0.0), kinetic_after(scene_.size());
-  for (std::size_t k = 0; k < moved_gain_.size(); ++k) delta[moved_first_ + k] = moved_gain_[k];
-  for (std::size_t i = 0; i < kinetic_after.size(); ++i) kinetic_after[i] = kinetic(i);
-  return toEnergyTransferMsg(event, std::move(delta), std::move(kinetic_after), cumulative_lost_);
+  const std::size_t n = plottedBodies();
+  std::vector<double> delta(n, 0.0), kinetic_after(n);
+  for (std::size_t k = 0; k < moved_gain_.size() && moved_first_ + k < n; ++k) delta[moved_first_ + k] = moved_gain_[k];
+  for (std::size_t i = 0; i < n; ++i) kinetic_after[i] = kinetic(i);
+  collision_lab::EnergyTransfer msg =
+      toEnergyTransferMsg(event, std::move(delta), std::move(kinetic_after), cumulative_lost_);
+  if (!full_state_) {
+    msg.delta.clear();
+    msg.kinetic.clear();
+  }
+  return msg;
 }
 
 namespace {

@@ -3,8 +3,11 @@
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>
+#include <stdexcept>
 #include <system_error>
 #include <utility>
+
+#include <ros/console.h>
 
 namespace collision_lab_ros {
 
@@ -119,7 +122,13 @@ void RunBagWriter::loop() {
       batch = std::move(queue_.front());
       queue_.pop_front();
     }
-    write(batch);
+    try {
+      write(batch);
+    } catch (const std::exception& e) {
+      recover(batch, e.what());
+    } catch (...) {
+      recover(batch, "an exception of unknown type");
+    }
     {
       std::lock_guard<std::mutex> lock(mutex_);
       queued_messages_ -= batch.messages();
@@ -129,7 +138,9 @@ void RunBagWriter::loop() {
 }
 
 void RunBagWriter::write(RunBagBatch& batch) {
-  if (batch.opens || !recorder_) recorder_.emplace(directory_, batch.run_id, bag_);
+  if (batch.opens) recorder_.emplace(directory_, batch.run_id, bag_);
+  // Only after a failure that lost the run's recorder (recover()).
+  if (!recorder_) throw std::runtime_error("no bag is open for this batch");
   if (batch.input) recorder_->write(topics_.inputs, batch.input->header.stamp, *batch.input);
   if (batch.prediction) recorder_->write(topics_.predictions, batch.prediction->header.stamp, *batch.prediction);
   for (const auto& event : batch.events) recorder_->write(topics_.events, event.header.stamp, event);
@@ -143,7 +154,30 @@ void RunBagWriter::write(RunBagBatch& batch) {
   summary.recording_ok = recorder_->ok();
   summary.recording_error = recorder_->error();
   recorder_.reset();
-  if (batch.on_closed) batch.on_closed(summary);
+  // Taken out first: when it throws, recover() must not call it again.
+  const auto on_closed = std::exchange(batch.on_closed, nullptr);
+  if (on_closed) on_closed(summary);
+}
+
+void RunBagWriter::recover(RunBagBatch& batch, const std::string& what) {
+  const std::string error = "the bag writer failed: " + what;
+  ROS_ERROR_STREAM("run " << batch.run_id << ": " << error);
+  // The rest of the run is not written, and its bag keeps the .active name.
+  if (recorder_) recorder_->fail(error);
+  if (!batch.summary || !batch.on_closed) return;
+  collision_lab::RunSummary& summary = *batch.summary;
+  summary.bag_path = bagPath(directory_, batch.run_id);
+  recorder_.reset();
+  summary.recording_ok = false;
+  summary.recording_error = error;
+  const auto on_closed = std::exchange(batch.on_closed, nullptr);
+  try {
+    on_closed(summary);
+  } catch (const std::exception& e) {
+    ROS_ERROR_STREAM("run " << batch.run_id << ": the bag writer failed again, reporting it: " << e.what());
+  } catch (...) {
+    ROS_ERROR_STREAM("run " << batch.run_id << ": the bag writer failed again, reporting it");
+  }
 }
 
 void RunRecorder::fail(const std::string& what) {

@@ -56,7 +56,9 @@ std::vector<std::string> splitNames(const std::string& text) {
 std::string utcStamp() {
   char buffer[32];
   const std::time_t now = std::time(nullptr);
-  std::strftime(buffer, sizeof buffer, "%Y%m%dT%H%M%SZ", std::gmtime(&now));
+  std::tm utc{};
+  gmtime_r(&now, &utc);  // not std::gmtime's shared buffer
+  std::strftime(buffer, sizeof buffer, "%Y%m%dT%H%M%SZ", &utc);
   return buffer;
 }
 

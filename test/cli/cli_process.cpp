@@ -22,7 +22,8 @@ std::string readWhole(const std::string& path) {
 
 }  // namespace
 
-CliOutput runCli(const std::vector<std::string>& args, const std::string& cwd, const std::string& stdin_path) {
+CliOutput runCli(const std::vector<std::string>& args, const std::string& cwd, const std::string& stdin_path,
+                 const std::string& stdout_path) {
   char dir_template[] = "/tmp/collision_lab_cli_test_XXXXXX";
   const char* dir = mkdtemp(dir_template);
   if (dir == nullptr) throw std::runtime_error("mkdtemp failed");
@@ -40,7 +41,8 @@ CliOutput runCli(const std::vector<std::string>& args, const std::string& cwd, c
   if (pid < 0) throw std::runtime_error("fork failed");
   if (pid == 0) {
     const int in_fd = open(stdin_path.c_str(), O_RDONLY);
-    const int out_fd = open(out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
+    const int out_fd = stdout_path.empty() ? open(out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600)
+                                           : open(stdout_path.c_str(), O_WRONLY);
     const int err_fd = open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
     if (in_fd < 0 || out_fd < 0 || err_fd < 0 || dup2(in_fd, 0) < 0 || dup2(out_fd, 1) < 0 ||
         dup2(err_fd, 2) < 0 || chdir(cwd.c_str()) != 0) {
@@ -55,7 +57,7 @@ CliOutput runCli(const std::vector<std::string>& args, const std::string& cwd, c
   }
   CliOutput result;
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  result.out = readWhole(out_path);
+  if (stdout_path.empty()) result.out = readWhole(out_path);
   result.err = readWhole(err_path);
   unlink(out_path.c_str());
   unlink(err_path.c_str());

@@ -13,9 +13,10 @@ struct CliOutput {
 };
 
 /// Runs COLLISION_LAB_CLI_PATH with `args` in the working directory `cwd`, stdin from
-/// `stdin_path` (default /dev/null), stdout and stderr into unique temporary files.
+/// `stdin_path` (default /dev/null), stdout and stderr into unique temporary files, or
+/// stdout into `stdout_path` when given (then `out` stays empty).
 CliOutput runCli(const std::vector<std::string>& args, const std::string& cwd,
-                 const std::string& stdin_path = "/dev/null");
+                 const std::string& stdin_path = "/dev/null", const std::string& stdout_path = "");
 
 /// The lines of `text` (a final newline does not start another line).
 std::vector<std::string> linesOf(const std::string& text);

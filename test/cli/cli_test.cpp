@@ -309,6 +309,22 @@ TEST(CliHelp, HelpGoesToStdoutAndExitsZero) {
   EXPECT_NE(result.out.find("--velocities"), std::string::npos);
 }
 
+TEST(CliOutputs, AnOutputThatCannotBeWrittenExitsNonZeroWithOneLine) {
+  // /dev/full fails every write with ENOSPC: a table, a streamed JSON report of 31 events,
+  // a batch, the list of presets and the help.
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{"--masses", "1,2,3", "--positions", "2,0,-2", "--velocities", "-1,0.5,1"},
+        {"--name", "pi_digits_2", "--format", "json", "--events", "all"},
+        {"--scenario", "config/scenarios.yaml", "--format", "csv"},
+        {"--list"},
+        {"--help"}}) {
+    SCOPED_TRACE(args.front());
+    const CliOutput result = runCli(args, COLLISION_LAB_SOURCE_DIR, "/dev/null", "/dev/full");
+    EXPECT_EQ(result.exit_code, 3);
+    EXPECT_EQ(result.err, "collision_lab_cli: cannot write to standard output; the output is incomplete\n");
+  }
+}
+
 // ---------------------------------------------------------------------------------------
 // Issue 14 as a user meets it: the issue's own commands and exact figures.
 

@@ -11,6 +11,7 @@
 #include <limits>
 #include <random>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,7 @@
 #include "collision_lab/core/scene_run.h"
 #include "collision_lab/io/report.h"
 #include "collision_lab/io/scene_report.h"
+#include "event_pipeline.h"
 
 namespace {
 
@@ -308,6 +310,38 @@ TEST(ReportStream, NBodyImpactsAndCollapsesCarryTheEngineValues) {
     }
     EXPECT_EQ(row, reports.csv_values.size());
   }
+}
+
+// ---- A failure on a report thread (src/io/event_pipeline.h) ----
+
+/// Writes each event's time as a line, and throws at time 2500.
+void formatOrThrow(io::TextSink& sink, const core::LabEvent& lab, bool) {
+  if (lab.event.time == 2500) throw std::runtime_error("injected failure at t = 2500");
+  sink.count(static_cast<std::uint64_t>(lab.event.time));
+  sink.put('\n');
+}
+
+TEST(EventPipeline, AWorkerFailureIsReportedByFinishAndTheRunGoesOn) {
+  std::ostringstream out;
+  io::EventPipeline pipeline(out, formatOrThrow);
+  core::LabEvent lab;
+  // 10 blocks of 1024 events: the run's pushes must not wait for ever behind the failed one.
+  for (int i = 0; i < 10240; ++i) {
+    lab.event.time = i;
+    pipeline.push(lab);
+  }
+  try {
+    pipeline.finish();
+    ADD_FAILURE() << "finish() did not report the failure";
+  } catch (const std::runtime_error& e) {
+    EXPECT_STREQ(e.what(), "writing the events failed: injected failure at t = 2500");
+  }
+  // What was written is whole blocks before the failed one (events 2048..3071), in order.
+  std::istringstream lines(out.str());
+  std::uint64_t expected = 0;
+  for (std::uint64_t value = 0; lines >> value; ++expected) EXPECT_EQ(value, expected);
+  EXPECT_EQ(expected % 1024, 0u);
+  EXPECT_LE(expected, 2048u);
 }
 
 }  // namespace

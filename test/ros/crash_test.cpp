@@ -2,7 +2,8 @@
 // intact, the run in progress is left as <run_id>.bag.active and `rosbag reindex`
 // recovers it, and a restarted node never overwrites an existing bag: it serves a taken
 // run_id as <run_id>.2. SIGINT during a burst: every bag handed to the writer is closed
-// and complete.
+// and complete. SIGINT during a run_scene call cancels the run first. A count parameter
+// out of range stops the node at start-up, saying which.
 #include <signal.h>
 #include <stdlib.h>
 #include <sys/wait.h>
@@ -11,8 +12,12 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <limits>
 #include <string>
+#include <thread>
+#include <tuple>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -20,6 +25,7 @@
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 
+#include "collision_lab/RunScene.h"
 #include "run_collector.h"
 
 namespace {
@@ -31,23 +37,30 @@ using collision_lab_test::waitUntil;
 
 constexpr char kNamespace[] = "crash";
 
-/// Starts collision_lab_node in namespace `crash` with its bags in directory.
-pid_t startNode(const std::string& directory) {
+/// Starts collision_lab_node in namespace `crash` with its bags in directory, and
+/// parameter, if any, a further `_name:=value`; its stderr goes to stderr_path, if given.
+pid_t startNode(const std::string& directory, const std::string& parameter = "",
+                const std::string& stderr_path = "") {
   const pid_t pid = fork();
   if (pid == 0) {
+    if (!stderr_path.empty() && !std::freopen(stderr_path.c_str(), "w", stderr)) _exit(126);
     // The binary itself (rosrun may find several in a source tree with many builds).
-    execl(COLLISION_LAB_NODE_PATH, COLLISION_LAB_NODE_PATH, "__ns:=crash",
-           ("_bag_directory:=" + directory).c_str(), "_publish_markers:=false",
-           static_cast<char*>(nullptr));
+    const std::string bags = "_bag_directory:=" + directory;
+    std::vector<const char*> args{COLLISION_LAB_NODE_PATH, "__ns:=crash", bags.c_str(), "_publish_markers:=false"};
+    if (!parameter.empty()) args.push_back(parameter.c_str());
+    args.push_back(nullptr);
+    execv(COLLISION_LAB_NODE_PATH, const_cast<char* const*>(args.data()));
     _exit(127);
   }
   return pid;
 }
 
-void stop(pid_t pid, int signal) {
+/// Sends signal and returns the exit status (waitpid's).
+int stop(pid_t pid, int signal) {
   kill(pid, signal);
   int status = 0;
   waitpid(pid, &status, 0);
+  return status;
 }
 
 std::size_t messageCount(const std::string& path) {
@@ -133,6 +146,90 @@ TEST(Crash, KillNineKeepsFinishedBagsAndNeverOverwrites) {
   EXPECT_EQ(messageCount(dir + "/finished.bag"), finished_messages);
   EXPECT_EQ(fs::file_size(dir + "/long_run.bag.active"), active_size);
   EXPECT_FALSE(fs::exists(dir + "/long_run.bag"));
+  fs::remove_all(dir);
+}
+
+TEST(Crash, SigintDuringAServiceCallCancelsTheRunFirst) {
+  char pattern[] = "/tmp/collision_lab_sigint_call_XXXXXX";
+  ASSERT_NE(mkdtemp(pattern), nullptr);
+  const std::string dir = pattern;
+  constexpr std::uint64_t kPredicted = 2221441;  // masses 1e12, 1, 1e12 (docs/physics.md)
+  const pid_t node = startNode(dir);
+  ASSERT_GT(node, 0);
+  RunCollector client(kNamespace);
+  client.waitForConnection();
+  const std::string service = std::string("/") + kNamespace + "/collision_lab_node/run_scene";
+  ASSERT_TRUE(ros::service::waitForService(service, ros::Duration(collision_lab_test::kWaitTimeout)));
+  // A service call waits for its run: the node must cancel the run before it shuts its
+  // services down (and before ros::shutdown, which waits for the calls in progress).
+  collision_lab::RunScene call;
+  const auto input = makeInput("long_call", {1e12, 1, 1e12}, {2, 1, 0}, {-1, 0, 0});
+  call.request.run_id = input.run_id;
+  call.request.masses = input.masses;
+  call.request.positions = input.positions;
+  call.request.velocities = input.velocities;
+  std::thread caller([service, call]() mutable { ros::service::call(service, call); });
+  const auto over = [&client] {
+    const auto run = client.runs().find("long_call");
+    return run != client.runs().end() && !run->second.summaries.empty();
+  };
+  waitUntil([&] {
+    const auto run = client.runs().find("long_call");
+    return over() || (run != client.runs().end() && run->second.events.size() >= 1000);
+  }, "1,000 collisions of long_call");
+  const bool signalled_mid_run = !over();
+  const int status = stop(node, SIGINT);
+  caller.join();
+  ASSERT_TRUE(signalled_mid_run);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "wait status " << status;
+
+  // The bag is closed, and its summary (written last) says the run was cancelled.
+  ASSERT_TRUE(fs::exists(dir + "/long_call.bag"));
+  EXPECT_FALSE(fs::exists(dir + "/long_call.bag.active"));
+  rosbag::Bag bag(dir + "/long_call.bag", rosbag::bagmode::Read);
+  rosbag::View summaries(bag, rosbag::TopicQuery("/crash/run_summaries"));
+  ASSERT_EQ(summaries.size(), 1u);
+  const auto summary = summaries.begin()->instantiate<collision_lab::RunSummary>();
+  ASSERT_NE(summary, nullptr);
+  EXPECT_TRUE(summary->cancelled);
+  EXPECT_EQ(summary->predicted_collision_count, kPredicted);
+  EXPECT_LT(summary->collision_count, kPredicted);
+  EXPECT_TRUE(summary->recording_ok) << summary->recording_error;
+  EXPECT_EQ(rosbag::View(bag, rosbag::TopicQuery("/crash/collision_events")).size(), summary->collision_count);
+  std::printf("SIGINT during a run_scene call: cancelled after %llu of %llu collisions\n",
+              static_cast<unsigned long long>(summary->collision_count), static_cast<unsigned long long>(kPredicted));
+  bag.close();
+  fs::remove_all(dir);
+}
+
+TEST(Crash, ACountParameterOutOfRangeStopsTheNodeAtStartUp) {
+  char pattern[] = "/tmp/collision_lab_params_XXXXXX";
+  ASSERT_NE(mkdtemp(pattern), nullptr);
+  const std::string dir = pattern;
+  const std::string log = dir + "/stderr.txt";
+  // roscpp reads `_name:=value` as an int, else a double (boost::lexical_cast), else a string.
+  for (const auto& [name, value, message] :
+       {std::tuple<std::string, std::string, std::string>{"max_bodies", "1.0e+30", "~max_bodies = 1e+30 is out of range"},
+        {"max_collisions", "inf", "~max_collisions = inf is out of range"},
+        {"max_collisions", "nan", "~max_collisions = nan is out of range"},
+        {"max_published_events", "-1", "~max_published_events = -1 is out of range"},
+        {"max_published_events", "2.5", "~max_published_events = 2.5 is out of range"},
+        {"max_bodies", "many", "~max_bodies is not a number"}}) {
+    const std::string parameter = "_" + name + ":=" + value;
+    SCOPED_TRACE(parameter);
+    const pid_t node = startNode(dir, parameter, log);
+    ASSERT_GT(node, 0);
+    int status = 0;
+    // A node that starts anyway serves until killed: stop it after the wait gives up.
+    const bool exited = waitUntil([&] { return waitpid(node, &status, WNOHANG) == node; }, "the node to exit");
+    if (!exited) status = stop(node, SIGKILL);
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 1) << "wait status " << status;
+    std::ifstream text(log);
+    const std::string printed((std::istreambuf_iterator<char>(text)), std::istreambuf_iterator<char>());
+    EXPECT_NE(printed.find(message), std::string::npos) << printed;
+    EXPECT_NE(printed.find("from 0 to 18446744073709551615"), std::string::npos) << printed;
+    ros::param::del(std::string("/") + kNamespace + "/collision_lab_node/" + name);  // the next node's default
+  }
   fs::remove_all(dir);
 }
 

@@ -140,24 +140,51 @@ TEST(SceneEventConverter, AnImpactAfterACollapseMovesTheWholeClusterAsItsRecordS
   EXPECT_DOUBLE_EQ(converter.energyTransferMsg(msg).cumulative_energy_lost, 1.0 / 3 + 25.0 / 128);
 }
 
-TEST(SceneEventConverter, AboveTheFullStateLimitOnlyThePairFieldsAndThePlotsCarryTheBodies) {
+TEST(SceneEventConverter, AboveTheFullStateLimitOnlyThePairFieldsAndThePlotScalarsCarryTheBodies) {
   const std::size_t n = collision_lab::CollisionEvent::FULL_STATE_MAX_BODIES + 1;
   collision_lab::core::Scene scene{std::vector<double>(n, 1.0), {}, std::vector<double>(n, 0.0), {}};
   for (std::size_t i = 0; i < n; ++i) scene.positions.push_back(static_cast<double>(n - i));
-  scene.velocities[10] = -1;
+  scene.velocities[1] = -1;
   SceneEventConverter converter(scene);
-  const auto msg = converter.impact(record(1, 10, 1.0, static_cast<double>(n - 11), {-1, 0}, {0, -1}, {-0.5, 0.5}, 0));
+  // Equal masses: bodies 1 and 2 swap velocities, body 1 gives its 0.5 J to body 2.
+  const auto msg = converter.impact(record(1, 1, 1.0, static_cast<double>(n - 2), {-1, 0}, {0, -1}, {-0.5, 0.5}, 0));
   EXPECT_TRUE(msg.positions.empty());
   EXPECT_TRUE(msg.velocities_after.empty());
   EXPECT_TRUE(std::isnan(msg.total_energy));
   EXPECT_TRUE(std::isnan(msg.total_momentum));
   EXPECT_EQ(msg.pair_velocities_after[1], -1.0);
+  // The plot topics follow the same rule: no length-N arrays (240 KB an impact at
+  // N = 10,000), the scalar fields of bodies 0, 1, 2 still there.
+  const auto v = converter.velocitiesMsg(msg);
+  EXPECT_TRUE(v.v.empty());
+  EXPECT_EQ(v.v_a, 0.0);
+  EXPECT_EQ(v.v_b, 0.0);
+  EXPECT_EQ(v.v_c, -1.0);
+  const auto t = converter.energyTransferMsg(msg);
+  EXPECT_TRUE(t.delta.empty());
+  EXPECT_TRUE(t.kinetic.empty());
+  EXPECT_EQ(t.delta_a, 0.0);
+  EXPECT_EQ(t.delta_b, -0.5);
+  EXPECT_EQ(t.delta_c, 0.5);
+  EXPECT_EQ(t.kinetic_b, 0.0);
+  EXPECT_EQ(t.kinetic_c, 0.5);
+  EXPECT_EQ(t.cumulative_energy_lost, 0.0);
+}
+
+TEST(SceneEventConverter, AtTheFullStateLimitThePlotsCarryEveryBody) {
+  const std::size_t n = collision_lab::CollisionEvent::FULL_STATE_MAX_BODIES;
+  collision_lab::core::Scene scene{std::vector<double>(n, 1.0), {}, std::vector<double>(n, 0.0), {}};
+  for (std::size_t i = 0; i < n; ++i) scene.positions.push_back(static_cast<double>(n - i));
+  scene.velocities[10] = -1;
+  SceneEventConverter converter(scene);
+  const auto msg = converter.impact(record(1, 10, 1.0, static_cast<double>(n - 11), {-1, 0}, {0, -1}, {-0.5, 0.5}, 0));
   const auto v = converter.velocitiesMsg(msg);
   ASSERT_EQ(v.v.size(), n);
   EXPECT_EQ(v.v[10], 0.0);
   EXPECT_EQ(v.v[11], -1.0);
   const auto t = converter.energyTransferMsg(msg);
   ASSERT_EQ(t.delta.size(), n);
+  ASSERT_EQ(t.kinetic.size(), n);
   EXPECT_EQ(t.delta[10], -0.5);
   EXPECT_EQ(t.delta[11], 0.5);
   EXPECT_EQ(t.kinetic[11], 0.5);
@@ -463,6 +490,30 @@ TEST(MarkerFollow, AViewFollowsOneRunIdOrOneStudent) {
   EXPECT_FALSE(student.follows(rejected));
   rejected.run_id = "other";
   EXPECT_FALSE(run.follows(rejected));
+}
+
+TEST(CountParameter, WholeNumbersUpTo2To64Minus1AreTheirValue) {
+  EXPECT_EQ(countParameter("max_bodies", 0.0).value, 0u);
+  EXPECT_EQ(countParameter("max_bodies", 10000.0).value, 10000u);
+  // 2^53 + 2 and the largest double below 2^64, 2^64 - 2^11: exact in a double.
+  EXPECT_EQ(countParameter("max_collisions", 9007199254740994.0).value, 9007199254740994u);
+  const CountParameter largest = countParameter("max_collisions", 18446744073709549568.0);
+  EXPECT_EQ(largest.error, "");
+  EXPECT_EQ(largest.value, 18446744073709549568u);
+}
+
+TEST(CountParameter, AnythingElseIsAnErrorNamingTheParameterTheValueAndTheRange) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (const double value : {kInf, -kInf, nan, -1.0, -0.5, 2.5, 1e-300, 1.0e+30, 18446744073709551616.0}) {
+    SCOPED_TRACE(value);
+    const CountParameter count = countParameter("max_collisions", value);
+    EXPECT_NE(count.error.find("~max_collisions = "), std::string::npos) << count.error;
+    EXPECT_NE(count.error.find("from 0 to 18446744073709551615"), std::string::npos) << count.error;
+  }
+  EXPECT_EQ(countParameter("max_bodies", 1.0e+30).error,
+            std::string("~max_bodies = 1e+30 is out of range; ") + kCountParameterRange);
+  EXPECT_EQ(countParameter("max_bodies", kInf).error,
+            std::string("~max_bodies = inf is out of range; ") + kCountParameterRange);
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 // closes every bag before it is destroyed.
 #include <filesystem>
 #include <fstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -164,6 +165,43 @@ TEST_F(RunRecorderTest, BagWriterReportsAFailedBagAndGoesOn) {
     EXPECT_FALSE(summary.recording_ok);
     EXPECT_NE(summary.recording_error.find(dir_ + "/file/bags"), std::string::npos) << summary.recording_error;
   }
+}
+
+TEST_F(RunRecorderTest, BagWriterSurvivesAnExceptionAndReportsTheRunItCost) {
+  std::vector<collision_lab::RunSummary> closed;
+  {
+    collision_lab_ros::RunBagWriter writer(dir_, {"/in", "/pred", "/events", "/sum"}, 10);
+    // Run a's on_closed throws (in the node: publishing its summary): before, the writer
+    // thread ended the process.
+    for (auto& batch : runBatches("a", 30, 8)) {
+      if (batch.summary) batch.on_closed = [](collision_lab::RunSummary&) { throw std::runtime_error("injected"); };
+      writer.push(std::move(batch));
+    }
+    // Run x's batches come without the one that opens its bag: they cannot be written,
+    // and its summary says so.
+    auto lost = runBatches("x", 30, 8);
+    lost.erase(lost.begin());
+    for (auto& batch : lost) {
+      if (batch.summary) batch.on_closed = [&closed](collision_lab::RunSummary& s) { closed.push_back(s); };
+      writer.push(std::move(batch));
+    }
+    for (auto& batch : runBatches("b", 30, 8)) {
+      if (batch.summary) batch.on_closed = [&closed](collision_lab::RunSummary& s) { closed.push_back(s); };
+      writer.push(std::move(batch));
+    }
+  }
+  // a: written and closed before its on_closed threw.
+  EXPECT_EQ(rosbag::View(rosbag::Bag(dir_ + "/a.bag", rosbag::bagmode::Read)).size(), 3 + 30u);
+  ASSERT_EQ(closed.size(), 2u);
+  EXPECT_EQ(closed[0].run_id, "x");
+  EXPECT_FALSE(closed[0].recording_ok);
+  EXPECT_EQ(closed[0].recording_error, "the bag writer failed: no bag is open for this batch");
+  EXPECT_FALSE(fs::exists(dir_ + "/x.bag"));
+  // b: served as if nothing had happened.
+  EXPECT_EQ(closed[1].run_id, "b");
+  EXPECT_TRUE(closed[1].recording_ok) << closed[1].recording_error;
+  rosbag::Bag bag(dir_ + "/b.bag", rosbag::bagmode::Read);
+  EXPECT_EQ(rosbag::View(bag).size(), 3 + 30u);
 }
 
 TEST(ExpandUser, ExpandsLeadingTildeOnly) {

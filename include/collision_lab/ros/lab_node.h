@@ -26,11 +26,13 @@
 //   summary still follows its own run's messages and its bag is closed when it goes out.
 // - The diagnostics timer (global queue) reads the worker's counters through atomics and
 //   recording_mutex_.
-// - Destruction: the subscription and the services stop, queued inputs are dropped (a
-//   call waiting for one answers ok = false), the run in progress is cancelled and closes
-//   its bag (its summary says cancelled), the worker is joined, the bag writer writes and
-//   closes every bag handed over (publishing their summaries), then the service threads
-//   are stopped.
+// - Destruction: queued inputs are dropped (a call waiting for one answers ok = false) and
+//   the run in progress is cancelled first, then the worker is joined (the cancelled run
+//   closes its bag, its summary says cancelled), then the subscription and the services
+//   stop (waiting only for calls whose run is over), the bag writer writes and closes
+//   every bag handed over (publishing their summaries), and the service threads are
+//   stopped. main destroys the node on SIGINT before ros::shutdown(), which would
+//   otherwise first wait for every service call in progress, and so for its whole run.
 #pragma once
 
 #include <atomic>
@@ -77,9 +79,25 @@ struct LabNodeParams {
 
   /// Reads ~record, ~bag_directory, ~max_collisions, ~max_published_events,
   /// ~publish_markers, ~log_runs, ~max_bodies, ~min_free_space_mb and ~scenario_file (default: the package's
-  /// config/scenarios.yaml), with the defaults of node_constants.h.
+  /// config/scenarios.yaml), with the defaults of node_constants.h. Throws
+  /// std::invalid_argument, naming the parameter, its value and the accepted range, when a
+  /// count (~max_collisions, ~max_published_events, ~max_bodies) is not a whole number in
+  /// [0, 2^64 - 1].
   static LabNodeParams load(const ros::NodeHandle& private_nh);
 };
+
+/// The accepted range of a count parameter, as the errors state it.
+constexpr char kCountParameterRange[] = "expected a whole number from 0 to 18446744073709551615 (2^64 - 1)";
+
+/// A count parameter's value read as a double (the parameter server gives large integers
+/// as doubles): value when it is a whole number in [0, 2^64 - 1]; otherwise error says so,
+/// naming ~name, the value and the range (NaN, infinities, negative, fractional and too
+/// large values, whose conversion to std::uint64_t would be undefined behaviour).
+struct CountParameter {
+  std::uint64_t value = 0;
+  std::string error;  ///< empty when value holds
+};
+CountParameter countParameter(const std::string& name, double value);
 
 /// Empty when run_id is safe as a bag file name; otherwise why not.
 std::string runIdProblem(const std::string& run_id);

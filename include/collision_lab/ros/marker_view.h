@@ -93,7 +93,8 @@ class MarkerView {
   /// goes out only once its bag is closed, which can be after the next run has started.
   /// Such a message must not switch the view back. Call with mutex_ held.
   bool stale(const std::string& run_id) const { return has_run_id_ && run_id != run_id_ && run_id == left_run_id_; }
-  FrameClock frameClock(const RunRecord& run, const ros::WallTime& now) const;
+  /// The animation's clock for run, started (wall clock) at run_start. Needs no lock.
+  FrameClock frameClock(const RunRecord& run, const ros::WallTime& run_start, const ros::WallTime& now) const;
   std::string hintText() const;
   /// The banner and hint markers of this frame (adds, or deletes of ones shown before).
   void addOverlays(visualization_msgs::MarkerArray& animated);
@@ -116,6 +117,9 @@ class MarkerView {
   ros::WallTime run_start_;
   std::optional<collision_lab::Rejected> rejected_;  ///< since the current run started
   bool banner_shown_ = false, hint_shown_ = false;
+
+  /// The timer's copy of run_, taken under mutex_ when run_ changed and drawn without it.
+  std::optional<RunRecord> drawn_run_;
 };
 
 }  // namespace collision_lab_ros

@@ -118,11 +118,15 @@ class SceneEventConverter {
   /// One resolved inelastic collapse (KIND_COLLAPSE): its bodies move on as one cluster.
   collision_lab::CollisionEvent collapse(const collision_lab::core::Collapse& collapse);
 
-  /// The plot messages of the last event converted (O(N) each).
+  /// The plot messages of the last event converted: their arrays have length N for
+  /// N <= FULL_STATE_MAX_BODIES (O(N) each) and are empty above it, like the event's own;
+  /// the scalar fields (bodies 0, 1, 2) are always filled.
   collision_lab::Velocities velocitiesMsg(const collision_lab::CollisionEvent& event) const;
   collision_lab::EnergyTransfer energyTransferMsg(const collision_lab::CollisionEvent& event) const;
 
  private:
+  /// The bodies 0 .. plottedBodies() - 1 whose values the plot messages are built from.
+  std::size_t plottedBodies() const;
   /// Moves every tracked position to time t [s].
   void advance(double t);
   /// Sets bodies [first, last] to velocity v and position x, recording each one's energy gain.

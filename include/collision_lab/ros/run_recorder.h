@@ -66,12 +66,14 @@ class RunRecorder {
 
   bool ok() const { return error_.empty(); }
   const std::string& error() const { return error_; }
+  /// Marks the recording failed, keeping the first error: later writes are skipped and
+  /// close() keeps the .active name.
+  void fail(const std::string& what);
   /// The final path <directory>/<run_id>.bag.
   const std::string& path() const { return path_; }
 
  private:
   void open(const std::string& directory);
-  void fail(const std::string& what);
 
   std::string path_;
   std::string active_path_;
@@ -102,7 +104,10 @@ struct RunBagBatch {
 /// batches are contiguous). push() blocks while more than max_queued_messages messages
 /// wait (backpressure: nothing is ever dropped). The destructor writes everything handed
 /// over and closes every bag, calling each on_closed, before it returns. on_closed runs
-/// on the writer's thread.
+/// on the writer's thread. An exception while writing a batch (on_closed's included) is
+/// logged (ROS_ERROR) and ends only that run's recording: its bag stays .bag.active, its
+/// on_closed, if not yet called, gets recording_ok false and recording_error saying so,
+/// and the writer serves the next runs.
 class RunBagWriter {
  public:
   struct Topics {
@@ -118,6 +123,8 @@ class RunBagWriter {
  private:
   void loop();
   void write(RunBagBatch& batch);
+  /// After write(batch) threw `what`: see the contract above.
+  void recover(RunBagBatch& batch, const std::string& what);
 
   const std::string directory_;
   const Topics topics_;
