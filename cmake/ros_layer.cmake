@@ -50,3 +50,5 @@ install(TARGETS ${collision_lab_ROS_EXECUTABLES}
 # replay.launch's bag resolver (bag:=latest, a run_id or a path), found in the source
 # folder by rosrun and roslaunch, installed beside the executables.
 install(PROGRAMS scripts/play_run DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
+# replay.launch's guard that removes /use_sim_time when the replay ends.
+catkin_install_python(PROGRAMS scripts/sim_time_guard DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})

@@ -83,6 +83,12 @@ int waitExit(pid_t pid, const std::string& what) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
+/// Whether a node of that name is registered with the master.
+bool nodeIsUp(const std::string& name) {
+  std::vector<std::string> nodes;
+  return ros::master::getNodes(nodes) && std::find(nodes.begin(), nodes.end(), name) != nodes.end();
+}
+
 std::string readFile(const std::string& path) {
   std::ifstream in(path);
   return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -164,11 +170,16 @@ TEST(Demo, HeadlessDemoEndsCleanlyAndReplayOfTheLatestBagDrawsMarkers) {
                              replay_log);
   ASSERT_GT(replay, 0);
   const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(kTimeout);
-  while (ros::ok() && !(title_seen && full_plot_seen) && ros::WallTime::now() < end) {
+  while (ros::ok() && !(title_seen && full_plot_seen && nodeIsUp("/sim_time_guard")) &&
+         ros::WallTime::now() < end) {
     ros::getGlobalCallbackQueue()->callAvailable(ros::WallDuration(0.1));
   }
+  bool sim_time = false;
+  EXPECT_TRUE(ros::param::get("/use_sim_time", sim_time) && sim_time);
   kill(replay, SIGINT);
   waitExit(replay, "the replay");
+  // The replay leaves the master as it found it: without simulated time.
+  EXPECT_FALSE(ros::param::has("/use_sim_time"));
   const std::string replay_output = readFile(replay_log);
   fs::remove(replay_log);
   EXPECT_TRUE(title_seen) << replay_output;
