@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -329,6 +330,35 @@ TEST(Demo, ReplayOfAMissingBagSaysWhy) {
                               empty.path + " > " + log + " 2>&1";
   EXPECT_NE(std::system(command.c_str()), 0);
   EXPECT_NE(readFile(log).find("found no finished bag (*.bag) in " + empty.path), std::string::npos)
+      << readFile(log);
+}
+
+// docs/ros.md's `scripts/play_run seven`: no folder given, the run id is looked up below the
+// node's runs folder ($ROS_HOME/collision_lab/runs, one folder per lab namespace); of two
+// labs' bags of that name the newest plays, and play_run names both. rosbag play's --help
+// ends the player before it opens the (empty) bag.
+TEST(Demo, PlayRunFindsARunIdBelowTheRunsFolder) {
+  TempDir home;
+  ASSERT_FALSE(home.path.empty());
+  const std::string runs = home.path + "/collision_lab/runs";
+  fs::create_directories(runs + "/lab2");
+  fs::create_directories(runs + "/lab3");
+  std::ofstream(runs + "/lab2/seven.bag");
+  std::ofstream(runs + "/lab3/seven.bag");
+  fs::last_write_time(runs + "/lab2/seven.bag", fs::last_write_time(runs + "/lab3/seven.bag") - std::chrono::hours(1));
+  const std::string log = home.path + "/play_run.log";
+  const std::string play_run = "ROS_HOME=" + home.path + " " COLLISION_LAB_SOURCE_DIR "/scripts/play_run ";
+  EXPECT_EQ(std::system((play_run + "seven --help > " + log + " 2>&1").c_str()), 0) << readFile(log);
+  const std::string output = readFile(log);
+  EXPECT_NE(output.find("replaying " + runs + "/lab3/seven.bag\n"), std::string::npos) << output;
+  EXPECT_NE(output.find("2 bags named seven.bag under " + runs), std::string::npos) << output;
+  EXPECT_NE(output.find("  " + runs + "/lab2/seven.bag\n"), std::string::npos) << output;
+
+  fs::remove(runs + "/lab3/seven.bag");
+  EXPECT_EQ(std::system((play_run + "seven --help > " + log + " 2>&1").c_str()), 0) << readFile(log);
+  EXPECT_NE(readFile(log).find("replaying " + runs + "/lab2/seven.bag\n"), std::string::npos) << readFile(log);
+  EXPECT_NE(std::system((play_run + "nine > " + log + " 2>&1").c_str()), 0);
+  EXPECT_NE(readFile(log).find("no bag 'nine' (nor nine.bag under " + runs + ")"), std::string::npos)
       << readFile(log);
 }
 
