@@ -6,11 +6,13 @@ add_executable(collision_lab_cli
   src/cli/progress.cpp
   src/cli/scene_runner.cpp)
 target_link_libraries(collision_lab_cli PRIVATE collision_lab_io CLI11::CLI11)
-# --name and --list without --scenario read the presets: the source tree's in the devel
-# space, the installed copy otherwise.
+# --name and --list without --scenario read the presets: an installed CLI its install's
+# copy (the share folder, relative to the executable), the devel space's the source tree's.
+file(RELATIVE_PATH collision_lab_BIN_TO_SHARE
+  "/prefix/${CATKIN_PACKAGE_BIN_DESTINATION}" "/prefix/${CATKIN_PACKAGE_SHARE_DESTINATION}")
 target_compile_definitions(collision_lab_cli PRIVATE
   COLLISION_LAB_SOURCE_SCENARIOS="${PROJECT_SOURCE_DIR}/config/scenarios.yaml"
-  COLLISION_LAB_INSTALLED_SCENARIOS="${CMAKE_INSTALL_PREFIX}/${CATKIN_PACKAGE_SHARE_DESTINATION}/config/scenarios.yaml")
+  COLLISION_LAB_BIN_TO_SHARE="${collision_lab_BIN_TO_SHARE}")
 set_target_properties(collision_lab_cli PROPERTIES
   RUNTIME_OUTPUT_DIRECTORY ${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_BIN_DESTINATION})
 

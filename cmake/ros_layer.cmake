@@ -52,3 +52,5 @@ install(TARGETS ${collision_lab_ROS_EXECUTABLES}
 install(PROGRAMS scripts/play_run DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 # The teacher's list of runs from the bags (docs/ros.md), installed the same way.
 install(PROGRAMS scripts/list_runs DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
+# replay.launch's guard that removes /use_sim_time when the replay ends.
+catkin_install_python(PROGRAMS scripts/sim_time_guard DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})

@@ -36,3 +36,12 @@ target_compile_definitions(demo_test PRIVATE COLLISION_LAB_SOURCE_DIR="${PROJECT
 target_compile_definitions(class_test PRIVATE COLLISION_LAB_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
 # crash_test starts and kills the node itself.
 target_compile_definitions(crash_test PRIVATE COLLISION_LAB_NODE_PATH="$<TARGET_FILE:collision_lab_node>")
+
+# Every launch file parses, and the packages and node executables it names exist
+# (roslaunch-check): a broken launch file fails the tests.
+find_package(roslaunch REQUIRED)
+file(GLOB collision_lab_LAUNCH_FILES RELATIVE ${PROJECT_SOURCE_DIR} ${PROJECT_SOURCE_DIR}/launch/*.launch)
+foreach(launch_file ${collision_lab_LAUNCH_FILES})
+  roslaunch_add_file_check(${launch_file}
+    DEPENDENCIES collision_lab_node collision_lab_markers scenario_publisher)
+endforeach()

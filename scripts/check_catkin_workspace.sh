@@ -37,4 +37,28 @@ out=$(rosrun collision_lab collision_lab_cli --masses 100,1,inf --positions 2,1,
   --mode predict --format json)
 echo "$out" | grep -Eq '"collision_count": ?31[,}]' || { echo "rosrun collision_lab_cli gave: $out" >&2; exit 1; }
 roslaunch --files collision_lab demo.launch > /dev/null
-echo "check_catkin_workspace.sh: $tool workspace OK (rospack, rosrun collision_lab_cli: 31 collisions, roslaunch finds demo.launch)"
+
+# The install space: every program, and an installed CLI that reads the installed presets
+# (a preset added to the installed copy only), not the source tree's.
+echo "== $tool install into $ws/install"
+(
+  cd "$ws"
+  if [ "$tool" = catkin_make ]; then
+    catkin_make install -DCMAKE_BUILD_TYPE=Release -DPYTHON_EXECUTABLE=/usr/bin/python3 -j"$(nproc)"
+  else
+    catkin config --install && catkin build --no-status -j"$(nproc)"
+  fi
+) >> "$ws/build.log" 2>&1 || { tail -n 60 "$ws/build.log"; echo "check_catkin_workspace.sh: $tool install failed" >&2; exit 1; }
+installed=$ws/install
+for program in collision_lab_cli collision_lab_node collision_lab_markers scenario_publisher bag_to_csv \
+               play_run sim_time_guard; do
+  [ -x "$installed/lib/collision_lab/$program" ] || { echo "not installed: lib/collision_lab/$program" >&2; exit 1; }
+done
+for file in config/scenarios.yaml launch/replay.launch rviz/collision_lab.rviz LICENSE package.xml; do
+  [ -f "$installed/share/collision_lab/$file" ] || { echo "not installed: share/collision_lab/$file" >&2; exit 1; }
+done
+printf 'installed_only:\n  description: "only in the install"\n  masses: [1, 1, 1]\n  positions: [2, 1, -1]\n  velocities: [-1, 0, 1]\n' \
+  >> "$installed/share/collision_lab/config/scenarios.yaml"
+listed=$("$installed/lib/collision_lab/collision_lab_cli" --list --format csv)
+echo "$listed" | grep -q '^installed_only,' || { echo "the installed CLI did not read the installed presets: $listed" >&2; exit 1; }
+echo "check_catkin_workspace.sh: $tool workspace OK (rospack, rosrun collision_lab_cli: 31 collisions, roslaunch finds demo.launch; install space complete, its CLI reads its presets)"

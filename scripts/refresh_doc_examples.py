@@ -10,8 +10,9 @@ An example is a marker line followed by a fenced code block:
 
 The command runs from the repository root through bash, with the built executables
 (build_ros/devel/lib/collision_lab) first on PATH and the devel space sourced, so roslaunch
-and rosrun work too. A command that fails leaves its block unchanged and makes the script
-exit 1. Usage: scripts/refresh_doc_examples.py [FILE ...]  (default: README.md docs/*.md)
+and rosrun work too, and with pipefail, so that a failing command inside a pipe fails the
+example. A command that fails, or prints nothing, leaves its block unchanged and makes the
+script exit 1. Usage: scripts/refresh_doc_examples.py [FILE ...]  (default: README.md docs/*.md)
 """
 import glob
 import os
@@ -27,12 +28,15 @@ TIMEOUT_S = 300
 def run(command):
     devel = os.path.join(REPO, "build_ros", "devel")
     script = (f"export PATH={devel}/lib/collision_lab:/usr/bin:/bin:$PATH; "
-              f"source {devel}/setup.bash; {command}")
+              f"source {devel}/setup.bash; set -o pipefail; {command}")
     result = subprocess.run(["bash", "-c", script], cwd=REPO, capture_output=True, text=True,
                             timeout=TIMEOUT_S)
     if result.returncode not in (0, 2):  # 2: a bad-input example shows its error on purpose
         raise RuntimeError(f"exit {result.returncode}: {result.stderr.strip()[-400:]}")
-    return (result.stdout + result.stderr).rstrip("\n")
+    output = (result.stdout + result.stderr).rstrip("\n")
+    if not output.strip():
+        raise RuntimeError("printed nothing (an example must show output)")
+    return output
 
 
 def refresh(path):

@@ -14,13 +14,15 @@ export PATH=/usr/bin:/bin:/usr/sbin:/sbin:$PATH
 
 # Every command that the README, the launch files and the tests use, on a bare machine:
 # rostest (python3-rostest) and rosrun (rosbash) are not part of ros-core-dev; rostopic
-# needs the Python messages of other packages to echo /diagnostics and the markers; rviz
-# is opened by the launch files whenever a display is set.
+# needs the Python messages of other packages to echo /diagnostics and the markers, and
+# rosservice those of std_srvs to pause a replay (/rosbag_play/pause_playback); rviz is
+# opened by the launch files whenever a display is set.
 packages=(
   build-essential cmake libgtest-dev
   ros-core-dev rosout rosbash python3-rostest
   python3-rostopic python3-roslaunch python3-rosbag python3-rosmaster python3-rosmsg
   python3-rosnode python3-rosservice python3-rosparam
+  python3-std-srvs
   libeigen3-dev libboost-dev libgmp-dev libvisualization-msgs-dev libdiagnostic-msgs-dev
   python3-visualization-msgs python3-diagnostic-msgs
   libyaml-cpp-dev nlohmann-json3-dev libcli11-dev

@@ -4,6 +4,7 @@
 // 1 internal error, 3 the output could not be written (one line on stderr).
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <optional>
@@ -21,10 +22,17 @@ constexpr int kExitBadInput = 2;
 constexpr int kExitInternalError = 1;
 constexpr int kExitOutputFailed = 3;
 
-/// The package's presets: the source tree's (devel space) or the installed copy.
+/// The package's presets. An installed CLI (<prefix>/lib/collision_lab/) reads its own
+/// install's copy (<prefix>/share/collision_lab/config/), found from where the executable
+/// is, so that a moved install works too; a CLI of the devel space has none there and reads
+/// the source tree's.
 std::string defaultScenarioPath() {
-  for (const char* candidate : {COLLISION_LAB_SOURCE_SCENARIOS, COLLISION_LAB_INSTALLED_SCENARIOS}) {
-    if (std::ifstream(candidate).good()) return candidate;
+  std::error_code ec;
+  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    const std::filesystem::path installed =
+        (exe.parent_path() / COLLISION_LAB_BIN_TO_SHARE / "config" / "scenarios.yaml").lexically_normal();
+    if (std::ifstream(installed).good()) return installed.string();
   }
   return COLLISION_LAB_SOURCE_SCENARIOS;
 }

@@ -26,6 +26,7 @@
 #include "collision_lab/RunSummary.h"
 #include "collision_lab/Velocities.h"
 #include "collision_lab/core/nbody/scene.h"
+#include "collision_lab/io/number_text.h"
 
 namespace collision_lab_ros {
 
@@ -36,16 +37,10 @@ namespace core = collision_lab::core;
 
 // ---- Cell formats ----
 
+/// The shortest text that reads back to the same double; "0" for either zero, "nan", "inf".
 void writeCell(std::ostream& out, double value) {
-  if (std::isnan(value)) {
-    out << "nan";
-  } else if (value == 0.0) {
-    out << "0";  // no "-0"
-  } else {
-    char buffer[32];
-    std::snprintf(buffer, sizeof buffer, "%.17g", value);
-    out << buffer;
-  }
+  char buffer[collision_lab::io::kNumberTextMax];
+  out.write(buffer, collision_lab::io::writeCsvNumber(buffer, value) - buffer);
 }
 void writeCell(std::ostream& out, std::uint64_t value) { out << value; }
 void writeCell(std::ostream& out, std::int64_t value) { out << value; }
@@ -125,6 +120,11 @@ class Table {
       }
     });
   }
+  /// The column time_s of a message that the node stamps at the run's start: simulated
+  /// time 0 [s] (run_timeline.h: stamp = start + scale * t).
+  Table& atRunStart() {
+    return add("time_s", "header", [](std::ostream& o, const M&) { o << '0'; });
+  }
   Table& flag(const std::string& field, std::uint8_t M::*member) {
     return add(field, field, [member](std::ostream& o, const M& m) { writeBool(o, m.*member); });
   }
@@ -183,7 +183,11 @@ constexpr const char* kFinalVelocitiesFile = "final_velocities.csv";
 Table<collision_lab::InitialConditions> initialConditionsTable() {
   using M = collision_lab::InitialConditions;
   Table<M> t;
-  t.named("mode", &M::mode, writeMode)
+  t.atRunStart()
+      .named("mode", &M::mode, writeMode)
+      .list("masses", "_kg", &M::masses)
+      .list("positions", "_m", &M::positions)
+      .list("velocities", "_m_s", &M::velocities)
       .list("restitution", "", &M::restitution)
       .field("max_collisions", &M::max_collisions)
       .field("student", &M::student)
@@ -194,7 +198,8 @@ Table<collision_lab::InitialConditions> initialConditionsTable() {
 Table<collision_lab::Prediction> predictionTable() {
   using M = collision_lab::Prediction;
   Table<M> t;
-  t.field("model", &M::model)
+  t.atRunStart()
+      .field("model", &M::model)
       .field("model_name", &M::model_name)
       .field("model_reason", &M::model_reason)
       .field("body_count", &M::body_count)

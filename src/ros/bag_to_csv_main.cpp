@@ -1,6 +1,8 @@
 // bag_to_csv RUN.bag [OUTDIR]: one CSV per topic of a collision_lab bag plus the tidy
 // per-body tables bodies.csv and final_velocities.csv, with units in the column names (see
-// bag_csv.h). OUTDIR defaults to RUN_csv beside the bag.
+// bag_csv.h). OUTDIR defaults to RUN_csv in the current folder, so that the node's runs
+// folder keeps its bags only.
+#include <filesystem>
 #include <iostream>
 #include <string>
 
@@ -13,16 +15,12 @@ int main(int argc, char** argv) {
     std::cerr << "usage: bag_to_csv RUN.bag [OUTDIR]\n"
                  "Writes one CSV per topic of RUN.bag (collision_events.csv, run_summaries.csv, ...)\n"
                  "and, one row per body, bodies.csv (the start and the bodies after each event)\n"
-                 "and final_velocities.csv into OUTDIR (default: RUN_csv beside the bag), with\n"
-                 "units in the column names.\n";
+                 "and final_velocities.csv into OUTDIR (default: RUN_csv in the current folder),\n"
+                 "with units in the column names.\n";
     return 2;
   }
   const std::string bag = argv[1];
-  std::string out_dir = argc == 3 ? argv[2] : bag;
-  if (argc == 2) {
-    if (out_dir.size() > 4 && out_dir.compare(out_dir.size() - 4, 4, ".bag") == 0) out_dir.resize(out_dir.size() - 4);
-    out_dir += "_csv";
-  }
+  const std::string out_dir = argc == 3 ? argv[2] : std::filesystem::path(bag).stem().string() + "_csv";
   ros::Time::init();
   try {
     const auto result = collision_lab_ros::bagToCsv(bag, out_dir);

@@ -24,6 +24,11 @@ std::string readWhole(const std::string& path) {
 
 CliOutput runCli(const std::vector<std::string>& args, const std::string& cwd, const std::string& stdin_path,
                  const std::string& stdout_path) {
+  return runProgram(COLLISION_LAB_CLI_PATH, args, cwd, stdin_path, stdout_path);
+}
+
+CliOutput runProgram(const std::string& program_path, const std::vector<std::string>& args, const std::string& cwd,
+                     const std::string& stdin_path, const std::string& stdout_path) {
   char dir_template[] = "/tmp/collision_lab_cli_test_XXXXXX";
   const char* dir = mkdtemp(dir_template);
   if (dir == nullptr) throw std::runtime_error("mkdtemp failed");
@@ -31,7 +36,7 @@ CliOutput runCli(const std::vector<std::string>& args, const std::string& cwd, c
   const std::string err_path = std::string(dir) + "/stderr";
 
   std::vector<char*> argv;
-  std::string program = COLLISION_LAB_CLI_PATH;
+  std::string program = program_path;
   argv.push_back(program.data());
   std::vector<std::string> owned(args);
   for (std::string& arg : owned) argv.push_back(arg.data());

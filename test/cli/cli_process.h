@@ -18,6 +18,10 @@ struct CliOutput {
 CliOutput runCli(const std::vector<std::string>& args, const std::string& cwd,
                  const std::string& stdin_path = "/dev/null", const std::string& stdout_path = "");
 
+/// As runCli, but runs the executable `program` (e.g. a copy of the CLI elsewhere).
+CliOutput runProgram(const std::string& program, const std::vector<std::string>& args, const std::string& cwd,
+                     const std::string& stdin_path = "/dev/null", const std::string& stdout_path = "");
+
 /// The lines of `text` (a final newline does not start another line).
 std::vector<std::string> linesOf(const std::string& text);
 

@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <limits>
 #include <regex>
 #include <sstream>
@@ -300,6 +302,31 @@ TEST(CliScenarioFile, WithoutANameRunsEveryScene) {
 
 TEST(CliScenarioFile, NameAloneUsesThePackagePresets) {
   EXPECT_EQ(runJson({"--name", "pi_digits_2"}).at("summary").at("collision_count"), 31);
+}
+
+// The catkin install layout: <prefix>/lib/collision_lab/collision_lab_cli and
+// <prefix>/share/collision_lab/config/scenarios.yaml. The install's own presets (here one
+// that the source tree does not have) win over the source tree's, wherever the prefix is.
+TEST(CliScenarioFile, AnInstalledCliReadsItsInstalledPresets) {
+  namespace fs = std::filesystem;
+  char pattern[] = "/tmp/collision_lab_install_XXXXXX";
+  ASSERT_NE(mkdtemp(pattern), nullptr);
+  const fs::path prefix = pattern;
+  fs::create_directories(prefix / "lib/collision_lab");
+  fs::create_directories(prefix / "share/collision_lab/config");
+  const fs::path cli = prefix / "lib/collision_lab/collision_lab_cli";
+  fs::copy_file(COLLISION_LAB_CLI_PATH, cli);
+  fs::permissions(cli, fs::perms::owner_all);
+  std::ofstream(prefix / "share/collision_lab/config/scenarios.yaml")
+      << "installed_only:\n  description: \"only in the install\"\n"
+         "  masses: [1, 1, 1]\n  positions: [2, 1, -1]\n  velocities: [-1, 0, 1]\n";
+  const CliOutput listed = runProgram(cli.string(), {"--list", "--format", "csv"}, prefix.string());
+  const CliOutput ran = runProgram(cli.string(), {"--name", "installed_only", "--format", "json"}, prefix.string());
+  fs::remove_all(prefix);
+  ASSERT_EQ(listed.exit_code, 0) << listed.err;
+  EXPECT_EQ(listed.out, "name,description\ninstalled_only,only in the install\n");
+  ASSERT_EQ(ran.exit_code, 0) << ran.err;
+  EXPECT_EQ(Json::parse(ran.out).at("summary").at("collision_count"), 3);  // equal masses: 3 impacts
 }
 
 TEST(CliHelp, HelpGoesToStdoutAndExitsZero) {

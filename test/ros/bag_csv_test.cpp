@@ -3,6 +3,8 @@
 #include <stdlib.h>
 
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -216,8 +218,10 @@ TEST_F(BagCsvTest, OneCsvPerTopicWithUnitsAndExactNumbers) {
 
   const Table input = readCsv(dir_ + "/csv/initial_conditions.csv");
   ASSERT_EQ(input.size(), 2u);
-  EXPECT_EQ(input[0], split("stamp_s,run_id,mode,restitution,max_collisions,student"));
-  EXPECT_EQ(input[1], (std::vector<std::string>{"1700000000.000000005", "csv_run", "full", "", "0", "ana"}));
+  EXPECT_EQ(input[0], split("stamp_s,run_id,time_s,mode,masses_kg,positions_m,velocities_m_s,restitution,"
+                            "max_collisions,student"));
+  EXPECT_EQ(input[1], (std::vector<std::string>{"1700000000.000000005", "csv_run", "0", "full", "10000;1;inf",
+                                                 "2;1;0", "-1;0;0", "", "0", "ana"}));
 
   // The masses, positions and velocities of the input are the start's rows (index 0).
   const Table bodies = readCsv(dir_ + "/csv/bodies.csv");
@@ -444,6 +448,85 @@ TEST_F(BagCsvTest, EventsWithoutArraysAndWithoutTheirInputHaveNoBodyRowsAndAWarn
   EXPECT_FALSE(fs::exists(dir_ + "/csv/bodies.csv"));
 }
 
+/// Whether `text` has more significant digits than the shortest decimal that reads back to
+/// `value`: some rounding of `value` to fewer digits reads back to it too.
+bool longerThanNeeded(const std::string& text, double value) {
+  std::string significant;
+  for (char c : text.substr(0, text.find_first_of("eE"))) {
+    if (c >= '0' && c <= '9') significant += c;
+  }
+  significant.erase(0, significant.find_first_not_of('0'));
+  significant.erase(significant.find_last_not_of('0') + 1);
+  const std::size_t digits = significant.size();
+  for (int fewer = 1; fewer < static_cast<int>(digits); ++fewer) {
+    char buffer[64];
+    std::snprintf(buffer, sizeof buffer, "%.*e", fewer - 1, value);
+    if (std::strtod(buffer, nullptr) == value) return true;
+  }
+  return false;
+}
+
+// Numbers as people and Python write them: the shortest digits that read back to the same
+// double (Python's repr gives 0.9, 0.1, 0.6666666666666666, 1e-300), never 17 digits
+// (0.90000000000000002); the simulated time beside the epoch stamp in every topic's file
+// that has a time; the start's masses, positions and velocities in initial_conditions.csv.
+TEST_F(BagCsvTest, ShortestDigitsSimulatedTimeAndTheStartInInitialConditions) {
+  rosbag::Bag bag(bag_path_, rosbag::bagmode::Write);
+  const ros::Time start(1'700'000'000);
+  collision_lab::InitialConditions input = scene("digits", {0.9, 0.1, 3}, {2.5, 0.3, -7}, {-0.9, 0.1, 0}, {});
+  input.header.stamp = start;
+  bag.write("/collision_lab/initial_conditions", start, input);
+  collision_lab::Prediction prediction;
+  prediction.header.stamp = start;
+  prediction.run_id = "digits";
+  prediction.alpha = 2.0 / 3.0;
+  prediction.final_velocities = {{0.9, 1e-300}};
+  bag.write("/collision_lab/predictions", start, prediction);
+  collision_lab::CollisionEvent event = impact("digits", 1, 0, 0.3, 0.1, 1);
+  event.header.stamp = start + ros::Duration(0, 300'000'000);
+  event.energy_lost = 0.9;
+  bag.write("/collision_lab/collision_events", event.header.stamp, event);
+  bag.close();
+  bagToCsv(bag_path_, dir_ + "/csv");
+
+  const Table input_csv = readCsv(dir_ + "/csv/initial_conditions.csv");
+  ASSERT_EQ(input_csv.size(), 2u);
+  EXPECT_EQ(cell(input_csv, 1, "time_s"), "0");
+  EXPECT_EQ(cell(input_csv, 1, "masses_kg"), "0.9;0.1;3");
+  EXPECT_EQ(cell(input_csv, 1, "positions_m"), "2.5;0.3;-7");
+  EXPECT_EQ(cell(input_csv, 1, "velocities_m_s"), "-0.9;0.1;0");
+  const Table prediction_csv = readCsv(dir_ + "/csv/predictions.csv");
+  EXPECT_EQ(cell(prediction_csv, 1, "time_s"), "0");
+  EXPECT_EQ(cell(prediction_csv, 1, "alpha_rad"), "0.6666666666666666");
+  const Table events = readCsv(dir_ + "/csv/collision_events.csv");
+  EXPECT_EQ(cell(events, 1, "stamp_s"), "1700000000.300000000");
+  EXPECT_EQ(cell(events, 1, "time_s"), "0.3");
+  EXPECT_EQ(cell(events, 1, "energy_lost_J"), "0.9");
+  const Table finals = readCsv(dir_ + "/csv/final_velocities.csv");
+  EXPECT_EQ(cell(finals, 1, "v_m_s"), "0.9");
+  EXPECT_EQ(cell(finals, 2, "v_m_s"), "1e-300");
+
+  // Every number cell of every file reads back exactly and is no longer than needed.
+  std::size_t numbers = 0;
+  for (const auto& entry : fs::directory_iterator(dir_ + "/csv")) {
+    const Table table = readCsv(entry.path().string());
+    for (std::size_t row = 1; row < table.size(); ++row) {
+      for (std::size_t col = 0; col < table[row].size(); ++col) {
+        if (table[0][col] == "stamp_s") continue;  // exact nanoseconds, not a double
+        std::istringstream items(table[row][col]);
+        for (std::string item; std::getline(items, item, ';');) {
+          char* end = nullptr;
+          const double value = std::strtod(item.c_str(), &end);
+          if (item.empty() || *end != '\0' || !std::isfinite(value)) continue;
+          ++numbers;
+          EXPECT_FALSE(longerThanNeeded(item, value)) << entry.path() << " " << table[0][col] << " = " << item;
+        }
+      }
+    }
+  }
+  EXPECT_GT(numbers, 30u);
+}
+
 /// The top-level field names of a message definition (constants and nested types left out).
 std::set<std::string> fieldsOf(const std::string& definition) {
   std::set<std::string> fields;
@@ -481,10 +564,15 @@ TEST(BagCsvColumns, EveryFieldOfEveryMessageHasAColumn) {
   expectEveryFieldExported<collision_lab::Rejected>();
 }
 
-TEST_F(BagCsvTest, CommandLineWritesBesideTheBagAndFailsClearly) {
+// Without OUTDIR the CSVs go to RUN_csv in the current folder, not into the bag's folder
+// (the node's runs folder holds bags only).
+TEST_F(BagCsvTest, CommandLineWritesIntoTheCurrentFolderAndFailsClearly) {
   writeBag();
-  EXPECT_EQ(std::system((std::string(COLLISION_LAB_BAG_TO_CSV) + " " + bag_path_ + " > /dev/null 2>&1").c_str()), 0);
-  EXPECT_EQ(readCsv(dir_ + "/run_csv/collision_events.csv").size(), 3u);
+  fs::create_directory(dir_ + "/work");
+  EXPECT_EQ(std::system(("cd " + dir_ + "/work && " + COLLISION_LAB_BAG_TO_CSV + " ../run.bag > /dev/null 2>&1").c_str()),
+            0);
+  EXPECT_EQ(readCsv(dir_ + "/work/run_csv/collision_events.csv").size(), 3u);
+  EXPECT_FALSE(fs::exists(dir_ + "/run_csv"));
   const std::string missing = dir_ + "/missing.bag";
   const std::string log = dir_ + "/stderr.txt";
   const int status = std::system(

@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -81,6 +82,12 @@ int waitExit(pid_t pid, const std::string& what) {
     ros::WallDuration(0.1).sleep();
   }
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+/// Whether a node of that name is registered with the master.
+bool nodeIsUp(const std::string& name) {
+  std::vector<std::string> nodes;
+  return ros::master::getNodes(nodes) && std::find(nodes.begin(), nodes.end(), name) != nodes.end();
 }
 
 std::string readFile(const std::string& path) {
@@ -164,11 +171,16 @@ TEST(Demo, HeadlessDemoEndsCleanlyAndReplayOfTheLatestBagDrawsMarkers) {
                              replay_log);
   ASSERT_GT(replay, 0);
   const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(kTimeout);
-  while (ros::ok() && !(title_seen && full_plot_seen) && ros::WallTime::now() < end) {
+  while (ros::ok() && !(title_seen && full_plot_seen && nodeIsUp("/sim_time_guard")) &&
+         ros::WallTime::now() < end) {
     ros::getGlobalCallbackQueue()->callAvailable(ros::WallDuration(0.1));
   }
+  bool sim_time = false;
+  EXPECT_TRUE(ros::param::get("/use_sim_time", sim_time) && sim_time);
   kill(replay, SIGINT);
   waitExit(replay, "the replay");
+  // The replay leaves the master as it found it: without simulated time.
+  EXPECT_FALSE(ros::param::has("/use_sim_time"));
   const std::string replay_output = readFile(replay_log);
   fs::remove(replay_log);
   EXPECT_TRUE(title_seen) << replay_output;
@@ -318,6 +330,35 @@ TEST(Demo, ReplayOfAMissingBagSaysWhy) {
                               empty.path + " > " + log + " 2>&1";
   EXPECT_NE(std::system(command.c_str()), 0);
   EXPECT_NE(readFile(log).find("found no finished bag (*.bag) in " + empty.path), std::string::npos)
+      << readFile(log);
+}
+
+// docs/ros.md's `scripts/play_run seven`: no folder given, the run id is looked up below the
+// node's runs folder ($ROS_HOME/collision_lab/runs, one folder per lab namespace); of two
+// labs' bags of that name the newest plays, and play_run names both. rosbag play's --help
+// ends the player before it opens the (empty) bag.
+TEST(Demo, PlayRunFindsARunIdBelowTheRunsFolder) {
+  TempDir home;
+  ASSERT_FALSE(home.path.empty());
+  const std::string runs = home.path + "/collision_lab/runs";
+  fs::create_directories(runs + "/lab2");
+  fs::create_directories(runs + "/lab3");
+  std::ofstream(runs + "/lab2/seven.bag");
+  std::ofstream(runs + "/lab3/seven.bag");
+  fs::last_write_time(runs + "/lab2/seven.bag", fs::last_write_time(runs + "/lab3/seven.bag") - std::chrono::hours(1));
+  const std::string log = home.path + "/play_run.log";
+  const std::string play_run = "ROS_HOME=" + home.path + " " COLLISION_LAB_SOURCE_DIR "/scripts/play_run ";
+  EXPECT_EQ(std::system((play_run + "seven --help > " + log + " 2>&1").c_str()), 0) << readFile(log);
+  const std::string output = readFile(log);
+  EXPECT_NE(output.find("replaying " + runs + "/lab3/seven.bag\n"), std::string::npos) << output;
+  EXPECT_NE(output.find("2 bags named seven.bag under " + runs), std::string::npos) << output;
+  EXPECT_NE(output.find("  " + runs + "/lab2/seven.bag\n"), std::string::npos) << output;
+
+  fs::remove(runs + "/lab3/seven.bag");
+  EXPECT_EQ(std::system((play_run + "seven --help > " + log + " 2>&1").c_str()), 0) << readFile(log);
+  EXPECT_NE(readFile(log).find("replaying " + runs + "/lab2/seven.bag\n"), std::string::npos) << readFile(log);
+  EXPECT_NE(std::system((play_run + "nine > " + log + " 2>&1").c_str()), 0);
+  EXPECT_NE(readFile(log).find("no bag 'nine' (nor nine.bag under " + runs + ")"), std::string::npos)
       << readFile(log);
 }
 

@@ -1,8 +1,11 @@
 // From a bag to CSV files, for spreadsheets and Python (`bag_to_csv RUN.bag [OUTDIR]`), for
 // scenes of any size N. Each header names the column and its unit (`time_s`, `x_m`,
 // `v_m_s`, `energy_lost_J`, `alpha_rad`); docs/ros.md lists the files.
-//  - <topic>.csv, one row per message of a collision_lab topic: the scalar fields (a
-//    fixed pair array [2] as two columns _0 and _1). Per-body arrays are not columns here:
+//  - <topic>.csv, one row per message of a collision_lab topic: stamp_s (the bag's ROS
+//    time, seconds since the epoch), the simulated time time_s (the message's `time`; 0 for
+//    InitialConditions and Prediction, stamped at the run's start) and the scalar fields (a
+//    fixed pair array [2] as two columns _0 and _1). initial_conditions.csv also has the
+//    masses, positions and velocities as lists. Other per-body arrays are not columns here:
 //  - bodies.csv, tidy, one row per body and event: the start (index 0, from
 //    InitialConditions) and the bodies after each CollisionEvent. Up to
 //    CollisionEvent::FULL_STATE_MAX_BODIES bodies the event carries every body and every
@@ -14,10 +17,11 @@
 //    impact would be 245 million rows.
 //  - final_velocities.csv, tidy: Prediction's and RunSummary's final velocities, one row
 //    per body.
-//  - A list that no table holds by body (InitialConditions.restitution, the plot topics'
-//    v, delta, kinetic) is one cell, values separated by ';' (empty: an empty list).
-// Numbers round-trip: doubles are written with 17 significant digits ("inf", "-inf",
-// "nan" as Python's float() reads them), header.stamp as exact seconds with 9 decimals.
+//  - A list in a topic's CSV (InitialConditions' arrays, the plot topics' v, delta,
+//    kinetic) is one cell, values separated by ';' (empty: an empty list).
+// Numbers round-trip: doubles are written with the shortest digits that read back to the
+// same double (io::writeCsvNumber: 0.9, not 0.90000000000000002; "inf", "-inf", "nan" as
+// Python's float() reads them), header.stamp as exact seconds with 9 decimals.
 #pragma once
 
 #include <cstddef>
