@@ -38,8 +38,9 @@ void addWorldUnits(const Canvas& c) {
 void addWorldRange(const Canvas& c, const std::string& ns, int end_id, int min_id, int max_id, const WorldAxes& axes) {
   const Box& b = kWorldBox;
   c.add(c.text(ns, end_id, b.left + kWorldEndDx, b.top, format("%.3g", axes.end), kSmallTextSize));
-  c.add(c.text(ns, min_id, b.left, b.bottom + kWorldPositionDy, format("%.3g", axes.scene.min), kSmallTextSize));
-  c.add(c.text(ns, max_id, b.right, b.bottom + kWorldPositionDy, format("%.3g", axes.scene.max), kSmallTextSize));
+  const auto value = [&axes](double x) { return axes.scene.min < 0 ? withSign("%.3g", x) : format("%.3g", x); };
+  c.add(c.text(ns, min_id, b.left, b.bottom + kWorldPositionDy, value(axes.scene.min), kSmallTextSize));
+  c.add(c.text(ns, max_id, b.right, b.bottom + kWorldPositionDy, value(axes.scene.max), kSmallTextSize));
 }
 
 /// Large scenes: the tracked worldlines from 0 to now, and the axes that hold them (time up
@@ -85,7 +86,9 @@ Polyline perRow(const Polyline& poly, double end, int rows) {
 }
 
 /// Equal elastic masses move as ghosts that pass through each other: the straight lines
-/// x_i + v_i t of the tracked bodies' initial states, cut to the box.
+/// x_i + v_i t of the tracked bodies' initial states, cut to the box. Each piece of a
+/// worldline lies on a ghost's line, so the ghosts are dashed and drawn over the
+/// worldlines: the worldline's colour shows between the dashes.
 void addGhosts(const Canvas& c, const std::string& ns, int id, const WorldAxes& axes) {
   Marker ghosts = c.lines(ns, id, Marker::LINE_LIST, kGhostWidth, color(kGhostGrey));
   for (std::size_t i : c.run.trackedBodies()) {
@@ -95,8 +98,15 @@ void addGhosts(const Canvas& c, const std::string& ns, int id, const WorldAxes& 
     if (v > 0) t_end = std::min(t_end, (axes.scene.max - x) / v);
     if (v < 0) t_end = std::min(t_end, (axes.scene.min - x) / v);
     if (!(t_end > 0)) continue;
-    ghosts.points.push_back(point(axes.toX(x), axes.toY(0.0)));
-    ghosts.points.push_back(point(axes.toX(x + v * t_end), axes.toY(t_end)));
+    const geometry_msgs::Point from = point(axes.toX(x), axes.toY(0.0), kGhostZ);
+    const geometry_msgs::Point to = point(axes.toX(x + v * t_end), axes.toY(t_end), kGhostZ);
+    const double length = std::hypot(to.x - from.x, to.y - from.y);
+    const int dashes = std::max(1, static_cast<int>(length / kGhostDashPeriod));
+    for (int k = 0; k < dashes; ++k) {
+      const double f0 = static_cast<double>(k) / dashes, f1 = (k + kGhostDashShare) / dashes;
+      ghosts.points.push_back(point(from.x + f0 * (to.x - from.x), from.y + f0 * (to.y - from.y), kGhostZ));
+      ghosts.points.push_back(point(from.x + f1 * (to.x - from.x), from.y + f1 * (to.y - from.y), kGhostZ));
+    }
   }
   c.addLines(ghosts);
 }
@@ -151,7 +161,7 @@ void drawWorldlines(const Canvas& c) {
               " bodies, coloured by v at the start";
   }
   // One line: a second would run into the "t [s]" label over the box.
-  if (ghostScene(c.run)) legend += ";  grey: ghosts x_i + v_i t, passing through each other";
+  if (ghostScene(c.run)) legend += ";  grey dashes: ghosts x_i + v_i t, passing through";
   c.add(c.text(ns::kWorldlines, kWorldLegend, b.midX(), kLegendY, legend, kSmallTextSize, color(kLabelGrey)));
 }
 
