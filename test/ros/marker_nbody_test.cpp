@@ -432,6 +432,24 @@ TEST(MarkerNBody, TagsOfBodiesCloseTogetherStayApart) {
   }
 }
 
+TEST(MarkerNBody, EnergyBarValuesStayApart) {
+  // Seven bars 0.66 units apart, values such as "0.00524" wider than that: neighbours never
+  // overlap. (Failed before: "0.001150.00524".)
+  const NBodyRun r = sevenBodies();
+  const double end = endTime(r.run);
+  for (int k = 0; k <= 100; ++k) {
+    const double t = end * k / 100;
+    const auto animated = buildAnimatedMarkers(r.run, FrameClock{t, "test"}, "f");
+    for (int i = 0; i + 1 < 7; ++i) {
+      const auto* a = find(animated, markers::ns::kEnergyBars, markers::kEnergyBarValue + i);
+      const auto* b = find(animated, markers::ns::kEnergyBars, markers::kEnergyBarValue + i + 1);
+      ASSERT_TRUE(a && b) << i;
+      EXPECT_TRUE(marker_checks::apart(marker_checks::textBox(*a), marker_checks::textBox(*b)))
+          << "t = " << t << ": '" << a->text << "' and '" << b->text << "'";
+    }
+  }
+}
+
 TEST(MarkerNBody, EndLabelsOfTheAxisStayOffTheWalls) {
   // The ball between walls at 0 and 1 m: the walls stand at the axis' ends, and its end
   // labels ("x = -0.06 m") once lay on them. (Failed before.)

@@ -174,7 +174,7 @@ constexpr Rgba kGhostGrey{0.8, 0.8, 0.8};
 // ---- the kinetic energy bars ----
 constexpr double kBarNameDy = -0.3, kBarsTitleDy = 0.75;
 constexpr double kBarWidth = 0.6;  ///< share of the pitch
-constexpr double kBarMinHeight = 0.01, kBarDepth = 0.1, kBarValueDy = 0.25;
+constexpr double kBarMinHeight = 0.01, kBarDepth = 0.1, kBarValueDy = 0.25, kBarValueStagger = 0.32;
 
 // ---- framed texts (banner, hint) ----
 /// rviz's font is about 0.42 text heights wide per character, 1.25 high per line.
