@@ -469,6 +469,46 @@ TEST(MarkerNBody, EndLabelsOfTheAxisStayOffTheWalls) {
   }
 }
 
+TEST(MarkerNBody, BallBetweenTwoWallsDrawsOnePeriodAndCountsThem) {
+  // Walls at 1 m and 0, the ball at 0.5 m with +1 m/s: periodic, T = 2 (1 - 0) / 1 = 2 s.
+  // 1,000 bounces once filled the x-t diagram with 1,000 lines thinner than a pixel; now
+  // one period is drawn, the line of now runs at t mod T, and the periods so far are
+  // counted. (Failed before.)
+  NBodyRun r = runScene(scene({kInf, 1, kInf}, {1, 0.5, 0}, {0, 1, 0}), false, 1000);
+  const auto fixed = buildStaticMarkers(r.run, "f");
+  const auto* ball = find(fixed, markers::ns::kWorldlines, markers::kWorldLines + 1);
+  ASSERT_TRUE(ball);
+  // One period: from 0.5 m to the wall at 1 m (t = 0.5 s), to 0 (1.5 s), back to 0.5 m (2 s).
+  ASSERT_EQ(ball->points.size(), 4u);
+  const auto* end_label = find(fixed, markers::ns::kWorldlines, markers::kWorldTimeEnd);
+  ASSERT_TRUE(end_label);
+  EXPECT_EQ(end_label->text, "2");
+  const auto* legend = find(fixed, markers::ns::kWorldlines, markers::kWorldLegend);
+  ASSERT_TRUE(legend);
+  EXPECT_NE(legend->text.find("one period drawn, T = 2 s"), std::string::npos) << legend->text;
+  // At t = 15.9 s: 7 periods behind, now at 1.9 s of the period (95 % up the box).
+  const auto animated = buildAnimatedMarkers(r.run, FrameClock{15.9, "test"}, "f");
+  const auto* periods = find(animated, markers::ns::kWorldlinesNow, markers::kWorldNowPeriods);
+  ASSERT_TRUE(periods);
+  EXPECT_EQ(periods->text, "periods so far: 7");
+  const auto* now = find(animated, markers::ns::kWorldlinesNow, markers::kWorldNowLine);
+  ASSERT_TRUE(now);
+  const auto& box = markers::layout::kWorldBox;
+  EXPECT_NEAR(now->points[0].y, box.bottom + 0.95 * (box.top - box.bottom), 1e-9);
+  // The ball's dot on the line of now: at 15.9 s it is at 0.9 m, going left.
+  const auto* dots = find(animated, markers::ns::kWorldlinesNow, markers::kWorldNowBodies);
+  ASSERT_TRUE(dots);
+  EXPECT_NEAR(dots->points[1].y, now->points[0].y, 1e-9);
+  // The note says "stopped" once (the engine's reason begins with it).
+  r.run.summary->truncation_reason = "stopped at the cap of 1000 impacts (truncated)";
+  const auto noted = buildStaticMarkers(r.run, "f");
+  const auto* note = find(noted, markers::ns::kScene, markers::kSceneNote);
+  ASSERT_TRUE(note);
+  EXPECT_EQ(note->text.find("stopped: stopped"), std::string::npos) << note->text;
+  EXPECT_NE(note->text.find("stopped at the cap"), std::string::npos) << note->text;
+  expectViewsFit(r.run);
+}
+
 TEST(MarkerNBody, CollapseOfThreeEqualMassesEndsAtTheCentreOfMass) {
   // Three equal masses, e = 0.05 < r_c: infinitely many impacts before t_c, then the three
   // move as one at the centre-of-mass velocity -1/3 m/s, along x_cm(t) = 1 - t/3 m.

@@ -70,7 +70,8 @@ std::string runNote(const RunRecord& run) {
     note += withSeparators(run.missedCollisions()) + " collision messages missing; ";
   }
   if (run.summary && run.summary->truncated) {
-    note += "stopped: " + run.summary->truncation_reason + ". Shown up to the last known state.";
+    const std::string& reason = run.summary->truncation_reason;
+    note += (reason.rfind("stopped", 0) == 0 ? "" : "stopped: ") + reason + ". Shown up to the last known state.";
   } else if (run.input().mode == collision_lab::InitialConditions::MODE_PREDICT_ONLY) {
     note += "predict-only run: shown up to the first contact; the plots show the closed form's final velocities.";
   } else if (run.input().mode == collision_lab::InitialConditions::MODE_SUMMARY_ONLY) {

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "collision_lab/ros/markers/draw.h"
 
@@ -128,6 +129,24 @@ bool ghostScene(const RunRecord& run) {
   return run.prediction && run.prediction->model == collision_lab::Prediction::MODEL_GHOSTS;
 }
 
+/// The period [s] of a ball between two walls at rest, all impacts elastic: there and back,
+/// T = 2 (x_A - x_C) / |v_B|. Empty for any other scene, and for a run shorter than
+/// kPeriodsToFold periods (drawn as it is).
+std::optional<double> periodOf(const RunRecord& run) {
+  const auto& in = run.input();
+  const bool elastic = std::all_of(in.restitution.begin(), in.restitution.end(), [](double e) { return e == 1.0; });
+  if (run.bodies() != 3 || !run.isWall(0) || !run.isWall(2) || run.isWall(1) || !elastic) return std::nullopt;
+  if (in.velocities[0] != 0 || in.velocities[2] != 0 || in.velocities[1] == 0) return std::nullopt;
+  const double period = 2 * (in.positions[0] - in.positions[2]) / std::abs(in.velocities[1]);
+  if (!(period > 0) || !(endTime(run) > kPeriodsToFold * period)) return std::nullopt;
+  return period;
+}
+
+/// The x-t diagram's axes of a small scene: its whole time, or one period of a periodic motion.
+WorldAxes wholeRunAxes(const RunRecord& run) {
+  return WorldAxes{sceneAxis(run), periodOf(run).value_or(endTime(run))};
+}
+
 }  // namespace
 
 void drawWorldlines(const Canvas& c) {
@@ -139,12 +158,18 @@ void drawWorldlines(const Canvas& c) {
   const auto& tracked = c.run.trackedBodies();
   const bool large = largeScene(c.run);
   // Large scenes draw the worldlines up to now, every frame (drawWorldlinesCursor).
+  // A periodic motion: its first period, the rest repeats it (a thousand periods would
+  // fill the box with lines thinner than a pixel).
+  const std::optional<double> period = large ? std::nullopt : periodOf(c.run);
   if (!large) {
-    const WorldAxes axes{sceneAxis(c.run), endTime(c.run)};
+    const WorldAxes axes = wholeRunAxes(c.run);
     const SceneState last = stateAt(c.run, axes.end);
     for (std::size_t k = 0; k < tracked.size(); ++k) {
       const std::size_t i = tracked[k];
-      Polyline poly = c.run.worldline(i).polyline();
+      Polyline poly;
+      for (const auto& v : c.run.worldline(i).polyline()) {
+        if (v.x < axes.end) poly.push_back(v);
+      }
       poly.push_back({last.time, last.positions[i], 0.0});
       addWorldline(c, ns::kWorldlines, kWorldLines + static_cast<int>(k), i, poly, axes);
     }
@@ -162,13 +187,24 @@ void drawWorldlines(const Canvas& c) {
   }
   // One line: a second would run into the "t [s]" label over the box.
   if (ghostScene(c.run)) legend += ";  grey dashes: ghosts x_i + v_i t, passing through";
+  if (period) legend = format("periodic: one period drawn, T = %.4g s; now at t mod T", *period);
   c.add(c.text(ns::kWorldlines, kWorldLegend, b.midX(), kLegendY, legend, kSmallTextSize, color(kLabelGrey)));
 }
 
 void drawWorldlinesCursor(const Canvas& c, const SceneState& state) {
   const bool large = largeScene(c.run);
   std::vector<Polyline> lines;
-  const WorldAxes world = large ? axesUpToNow(c.run, state, lines) : WorldAxes{sceneAxis(c.run), endTime(c.run)};
+  const WorldAxes world = large ? axesUpToNow(c.run, state, lines) : wholeRunAxes(c.run);
+  const std::optional<double> period = large ? std::nullopt : periodOf(c.run);
+  // A periodic motion: now within its period, and how many periods are behind.
+  const double t_now = period ? std::fmod(state.time, *period) : state.time;
+  if (period) {
+    c.add(c.text(ns::kWorldlinesNow, kWorldNowPeriods, kWorldBox.midX(), kLegendY + kWorldPeriodsDy,
+                 "periods so far: " + withSeparators(static_cast<std::uint64_t>(state.time / *period)), kSmallTextSize,
+                 color(kLabelGrey)));
+  } else {
+    c.add(deleteMarker(ns::kWorldlinesNow, kWorldNowPeriods, c.frame_id));
+  }
   if (large) {
     for (std::size_t k = 0; k < lines.size(); ++k) {
       addWorldline(c, ns::kWorldlinesNow, kWorldNowLines + static_cast<int>(k), c.run.trackedBodies()[k],
@@ -178,11 +214,11 @@ void drawWorldlinesCursor(const Canvas& c, const SceneState& state) {
     addWorldRange(c, ns::kWorldlinesNow, kWorldNowTimeEnd, kWorldNowPositionMin, kWorldNowPositionMax, world);
   }
   Marker now = c.lines(ns::kWorldlinesNow, kWorldNowLine, Marker::LINE_LIST, kCursorWidth, color(kCursorWhite));
-  now.points = {point(kWorldBox.left, world.toY(state.time)), point(kWorldBox.right, world.toY(state.time))};
+  now.points = {point(kWorldBox.left, world.toY(t_now)), point(kWorldBox.right, world.toY(t_now))};
   c.add(now);
   Marker bodies = c.dots(ns::kWorldlinesNow, kWorldNowBodies, kWorldNowDotSize, color(kWhite));
   for (std::size_t i : c.run.trackedBodies()) {
-    bodies.points.push_back(point(world.toX(state.positions[i]), world.toY(state.time), kDotZ));
+    bodies.points.push_back(point(world.toX(state.positions[i]), world.toY(t_now), kDotZ));
   }
   c.add(bodies);
 }

@@ -161,6 +161,9 @@ constexpr double kProfileDotSize = 0.16;
 constexpr double kWallLineWidth = 0.08, kBodyLineWidth = 0.03;
 constexpr double kWorldZeroDx = -0.3, kWorldEndDx = -0.55, kWorldUnitDx = -0.45, kWorldUnitDy = 0.3;
 constexpr double kWorldPositionDy = -0.3;
+constexpr double kWorldPeriodsDy = -0.35;  ///< the periods so far, under the legend
+/// A periodic motion is drawn over one period once the run lasts this many periods.
+constexpr double kPeriodsToFold = 2.0;
 /// Large scenes: "x range: the bodies now" under the scene's right end label.
 constexpr double kSceneRangeNoteDx = -2.0, kSceneRangeNoteDy = -0.85;
 /// Large scenes: a worldline drawn up to now keeps first, lowest, highest, last x per row.
