@@ -62,7 +62,9 @@ std::array<PlacedText, 2> endLabels(const RunRecord& run, const SceneAxis& axis)
   const auto y = [](bool wall) {
     return wall ? kSceneY - kWallHeight / 2 - kWallLabelDy : kSceneY + kSceneLabelDy;
   };
-  const auto value = [&axis](double x) { return "x = " + (axis.min < 0 ? withSign("%.4g", x) : format("%.4g", x)) + " m"; };
+  const auto value = [&axis](double x) {
+    return "x = " + (axis.min < 0 ? withSign("%.4g", x) : format("%.4g", x)) + " m";
+  };
   return {PlacedText{value(axis.min), kSceneLeft + kSceneLabelDx, y(run.isWall(run.bodies() - 1))},
           PlacedText{value(axis.max), kSceneRight - kSceneLabelDx, y(run.isWall(0))}};
 }
@@ -136,7 +138,8 @@ void drawLabelledBodies(const Canvas& c, const SceneState& state, const SceneAxi
                  kTextSize, particleColor(i, kTagLighten)));
     const double row_x = kCentreX + pitch * (static_cast<double>(i) - (static_cast<double>(n) - 1) / 2);
     c.add(c.text(ns::kLabels, kVelocityRow + static_cast<int>(i), row_x, kVelocityRowY,
-                 "v_" + bodyName(i) + " = " + withSign(fmt, state.velocities[i]) + " m/s", n <= 3 ? kTextSize : kSmallTextSize,
+                 "v_" + bodyName(i) + " = " + withSign(fmt, state.velocities[i]) + " m/s",
+                 n <= 3 ? kTextSize : kSmallTextSize,
                  particleColor(i, kTagLighten)));
   }
 }

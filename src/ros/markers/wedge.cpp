@@ -198,7 +198,9 @@ void addWedgeLegend(const Canvas& c, const std::vector<const Keyframe*>& shown, 
   if (collapses > 0) which += collapses == 1 ? " and a collapse" : " and " + withSeparators(collapses) + " collapses";
   c.add(c.text(ns::kWedge, kWedgeKey, kWedgeX, kLegendY, wrapped("orange: u_perp after " + which, kSmallTextSize, kLeftTextWidth),
                kSmallTextSize, color(kLabelGrey)));
-  const std::string rest = lossy ? "yellow: its direction; " + restitutionLegend(run) : predicted ? "violet: closed form" : "";
+  const std::string rest = lossy       ? "yellow: its direction; " + restitutionLegend(run)
+                           : predicted ? "violet: closed form"
+                                       : "";
   if (rest.empty()) return;
   c.add(c.text(ns::kWedge, kWedgeLegend, kWedgeX, kWedgeBox.bottom + kWedgeLegendDy,
                wrapped(rest, kSmallTextSize, kLeftTextWidth), kSmallTextSize));
