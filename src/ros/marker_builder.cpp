@@ -190,7 +190,7 @@ double momentum(const collision_lab::InitialConditions& input, const std::vector
 }
 
 RunRecord::RunRecord(const collision_lab::InitialConditions& input, const RecordLimits& limits)
-    : input_(input), limits_(limits), first_collapse_time_(std::nan("")) {
+    : input_(input), limits_(limits), first_collapse_time_(std::nan("")), min_velocity_(kInf), max_velocity_(-kInf) {
   // An input of unequal lengths (the node rejects those) is cut to its shortest list.
   const std::size_t n = std::min({input_.masses.size(), input_.positions.size(), input_.velocities.size()});
   input_.masses.resize(n), input_.positions.resize(n), input_.velocities.resize(n);
@@ -205,7 +205,10 @@ RunRecord::RunRecord(const collision_lab::InitialConditions& input, const Record
   body_energy_.assign(plotted_.size(), empty);
   worldline_.assign(tracked_.size(), empty);
   energy_ = momentum_ = energy_lost_ = none_ = empty;
-  for (std::size_t i = 0; i < n; ++i) flights_.push_back({0.0, input_.positions[i], input_.velocities[i]});
+  for (std::size_t i = 0; i < n; ++i) {
+    flights_.push_back({0.0, input_.positions[i], input_.velocities[i]});
+    widenVelocityRange(input_.velocities[i]);
+  }
   for (std::size_t k = 0; k < plotted_.size(); ++k) {
     const std::size_t i = plotted_[k];
     velocity_[k].add(0.0, input_.velocities[i]);
@@ -280,6 +283,7 @@ void RunRecord::move(std::size_t body, double time, double position, double velo
     momentum_sum_ += m * (velocity - f.velocity);
   }
   f = Flight{time, position, velocity};
+  widenVelocityRange(velocity);
   const double k = static_cast<double>(newest_index_);
   if (track_slot_[body] >= 0) {
     const auto slot = static_cast<std::size_t>(track_slot_[body]);
@@ -291,6 +295,12 @@ void RunRecord::move(std::size_t body, double time, double position, double velo
     velocity_[slot].step(k, velocity);
     body_energy_[slot].step(k, isWall(body) ? 0.0 : 0.5 * input_.masses[body] * velocity * velocity);
   }
+}
+
+void RunRecord::widenVelocityRange(double v) {
+  if (!std::isfinite(v)) return;
+  min_velocity_ = std::min(min_velocity_, v);
+  max_velocity_ = std::max(max_velocity_, v);
 }
 
 void RunRecord::apply(const collision_lab::CollisionEvent& event) {
@@ -519,6 +529,11 @@ double autoLoopDuration(std::uint64_t collisions) {
 double simulatedTimeOnTimeline(const ros::Time& now, const ros::Time& start, double timeline_scale) {
   const double scale = std::isfinite(timeline_scale) && timeline_scale > 0 ? timeline_scale : 1.0;
   return std::max((now - start).toSec() / scale, 0.0);
+}
+
+double replayedTime(const RunRecord& run, const ros::Time& now) {
+  const double scale = run.prediction ? run.prediction->timeline_scale : 0.0;
+  return std::max(simulatedTimeOnTimeline(now, run.input().header.stamp, scale), run.newestTime());
 }
 
 // ---- the pictures: one function per view (src/ros/markers/) ----

@@ -145,7 +145,10 @@ FrameClock MarkerView::frameClock(const RunRecord& run, const ros::WallTime& run
   FrameClock clock;
   if (params_.clock == MarkerViewParams::Clock::kRos) {
     const double scale = run.prediction ? run.prediction->timeline_scale : 0.0;
-    clock.t = std::min(simulatedTimeOnTimeline(ros::Time::now(), run.input().header.stamp, scale), endTime(run));
+    const double t = replay_ && ros::Time::isSimTime()
+                         ? replayedTime(run, ros::Time::now())
+                         : simulatedTimeOnTimeline(ros::Time::now(), run.input().header.stamp, scale);
+    clock.t = std::min(t, endTime(run));
     clock.description = "ROS clock" + std::string(ros::Time::isSimTime() ? " (bag)" : "");
     return clock;
   }

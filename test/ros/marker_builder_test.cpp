@@ -12,6 +12,7 @@
 
 #include "collision_lab/ros/marker_builder.h"
 #include "collision_lab/ros/markers/ids.h"
+#include "collision_lab/ros/markers/layout.h"
 #include "collision_lab/ros/msg_conversion.h"
 #include "marker_test_checks.h"
 
@@ -275,6 +276,27 @@ TEST(MarkerBuilder, TimelineClockFollowsRosTime) {
   EXPECT_DOUBLE_EQ(simulatedTimeOnTimeline(ros::Time(999, 0), start, 1.0), 0.0);
 }
 
+TEST(MarkerBuilder, ReplayNeverShowsATimeBeforeTheNewestCollisionReceived) {
+  // Equal masses at (2, 1, -1) m, v = (-1, 0, 1) m/s: collisions at t = 1, 1.5 and 2 s (by
+  // hand: equal masses swap velocities). Replayed at 2 bag s per simulated s from 1000 s.
+  const Fed fed = feed({1, 1, 1}, {2, 1, -1}, {-1, 0, 1});
+  ASSERT_EQ(fed.events.size(), 3u);
+  collision_lab::InitialConditions input = fed.run.input();
+  input.header.stamp = ros::Time(1000, 0);
+  RunRecord replay(input);
+  replay.prediction = fed.run.prediction;
+  replay.prediction->timeline_scale = 2.0;
+  replay.add(fed.events[0]);
+  replay.add(fed.events[1]);
+  // The clock ahead of the newest collision received: the timeline's time.
+  EXPECT_DOUBLE_EQ(replayedTime(replay, ros::Time(1003, 500'000'000)), 1.75);
+  // rosbag play's clock 5 ms short of the last collision's stamp (1004 s): its time.
+  replay.add(fed.events[2]);
+  EXPECT_NEAR(fed.events[2].time, 2.0, 1e-15);
+  EXPECT_EQ(replayedTime(replay, ros::Time(1003, 995'000'000)), fed.events[2].time);
+  EXPECT_EQ(stateAt(replay, replayedTime(replay, ros::Time(1003, 995'000'000))).collisions, 3u);
+}
+
 TEST(MarkerBuilder, WarpPlaysDenseBurstsInSlowMotion) {
   const Fed fed = feed({1e8, 1, kInf}, {2, 1, 0}, {-1, 0, 0});
   const TimeWarp warp(fed.run);
@@ -321,6 +343,7 @@ TEST(MarkerBuilder, EveryViewFitsRvizForEveryCount) {
       EXPECT_TRUE(namespaces.count(ns)) << ns;
     }
     expectOneMarkerPerId(fixed);
+    marker_checks::expectLegendMatchesDots(fixed);
     const double end = endTime(run);
     for (double t : {0.0, 0.3 * end, end, 2 * end}) {
       const auto animated = buildAnimatedMarkers(run, FrameClock{t, "test"}, "f");
@@ -328,6 +351,50 @@ TEST(MarkerBuilder, EveryViewFitsRvizForEveryCount) {
       expectOneMarkerPerId(animated);
     }
   }
+}
+
+TEST(MarkerBuilder, RejectionBannerHoldsItsWholeTextOnAnOpaquePanelOverThePanelTitles) {
+  // A message wider than the screen. (Failed before: the text ran out of its frame, the
+  // frame had no background, and it lay on the panels' titles.)
+  collision_lab::Rejected rejected;
+  rejected.run_id = "student 7";
+  rejected.reason_name = "POSITIONS_NOT_ORDERED";
+  rejected.field = "positions";
+  rejected.message = "positions (0, 1, 2, 3, 4, 5, 6) m must be strictly decreasing, x_A > x_B > x_C > x_D > x_E > "
+                     "x_F > x_G: body A at 0 m is left of body B at 1 m, and so on for every pair";
+  const auto banner = rejectedBanner(rejected, "f");
+  MarkerArray array;
+  array.markers = banner;
+  expectFitForRviz(array);
+  marker_checks::expectTextsOnScreen(array);
+  const Marker* text = find(array, markers::ns::kRejected, markers::kFramedText);
+  const Marker* panel = find(array, markers::ns::kRejected, markers::kFramedBox);
+  ASSERT_TRUE(text && panel);
+  // Every word is there, in order (wrapped, never cut).
+  std::string words = text->text;
+  std::replace(words.begin(), words.end(), '\n', ' ');
+  EXPECT_NE(words.find(rejected.message), std::string::npos) << text->text;
+  // An opaque panel, filled in rviz's background colour, over every view (bodies reach
+  // z = 0.45) and under its text.
+  ASSERT_EQ(panel->type, Marker::TRIANGLE_LIST);
+  ASSERT_EQ(panel->colors.size(), panel->points.size());
+  EXPECT_EQ(panel->colors.front().a, 1.0f);
+  EXPECT_LT(panel->colors.front().r + panel->colors.front().g + panel->colors.front().b, 0.5f);
+  EXPECT_GT(panel->pose.position.z, 0.45);
+  EXPECT_GT(text->pose.position.z, panel->pose.position.z);
+  double left = kInf, right = -kInf, bottom = kInf, top = -kInf;
+  for (const auto& p : panel->points) {
+    left = std::min(left, p.x), right = std::max(right, p.x), bottom = std::min(bottom, p.y), top = std::max(top, p.y);
+  }
+  const auto box = marker_checks::textBox(*text);
+  EXPECT_GE(box.left, left);
+  EXPECT_LE(box.right, right);
+  EXPECT_GE(box.bottom, bottom);
+  EXPECT_LE(box.top, top);
+  EXPECT_GE(left, -10.7);
+  EXPECT_LE(right, 16.3);
+  // Clear of the panels' titles (at y = 4.55, 0.32 high).
+  EXPECT_GT(bottom, markers::layout::kPanelTitleY + markers::layout::kTextSize / 2);
 }
 
 TEST(MarkerBuilder, RvizGuardThinsLongLinesAndDropsWhatRvizRejects) {

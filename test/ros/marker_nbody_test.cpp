@@ -136,11 +136,13 @@ void expectViewsFit(const RunRecord& run) {
   const auto fixed = buildStaticMarkers(run, "f");
   expectFitForRviz(fixed);
   expectOneMarkerPerId(fixed);
+  marker_checks::expectTextsOnScreen(fixed);
   const double end = endTime(run);
   for (double t : {0.0, 0.3 * end, end}) {
     const auto animated = buildAnimatedMarkers(run, FrameClock{t, "test"}, "f");
     expectFitForRviz(animated);
     expectOneMarkerPerId(animated);
+    marker_checks::expectTextsOnScreen(animated);
   }
 }
 
@@ -233,11 +235,22 @@ TEST(MarkerNBody, CradleOfFiveHandsTheVelocityOn) {
     ghosts.model = collision_lab::Prediction::MODEL_GHOSTS;
     r.run.prediction = ghosts;
     const auto fixed = buildStaticMarkers(r.run, "f");
-    EXPECT_TRUE(find(fixed, markers::ns::kWorldlines, markers::kWorldGhosts));
-    // The x-t legend names the ghosts, on screen (right edge x = 16.3) and clear of "t [s]".
+    const auto* ghost_lines = find(fixed, markers::ns::kWorldlines, markers::kWorldGhosts);
+    ASSERT_TRUE(ghost_lines);
+    // Each piece of a worldline lies on a ghost's line: the ghosts are dashes drawn over the
+    // worldlines, so both show. (Failed before: one solid line per ghost, under them.)
+    double highest_worldline = -kInf;
+    for (int k = 0; k < 5; ++k) {
+      const auto* line = find(fixed, markers::ns::kWorldlines, markers::kWorldLines + k);
+      ASSERT_TRUE(line) << k;
+      for (const auto& p : line->points) highest_worldline = std::max(highest_worldline, p.z);
+    }
+    for (const auto& p : ghost_lines->points) EXPECT_GT(p.z, highest_worldline);
+    EXPECT_GT(ghost_lines->points.size(), 2u * 5 * 4);
+    // The x-t legend names the ghosts as drawn, on screen (right edge x = 16.3) and clear of "t [s]".
     const auto* legend = find(fixed, markers::ns::kWorldlines, markers::kWorldLegend);
     ASSERT_TRUE(legend);
-    EXPECT_NE(legend->text.find("ghosts"), std::string::npos) << legend->text;
+    EXPECT_NE(legend->text.find("grey dashes: ghosts"), std::string::npos) << legend->text;
     marker_checks::expectTextClear(*legend, markers::layout::kWorldBox.left, 16.3, {&fixed});
     EXPECT_FALSE(namespacesOf(fixed).count(markers::ns::kWedge));
     EXPECT_TRUE(namespacesOf(fixed).count(markers::ns::kVelocities));
@@ -285,6 +298,214 @@ TEST(MarkerNBody, BallBetweenTwoWallsBouncesAtEverySecond) {
     ASSERT_TRUE(wall);
     EXPECT_EQ(wall->type, visualization_msgs::Marker::CUBE);
   }
+  expectViewsFit(r.run);
+}
+
+/// Seven bodies, 1 m apart: 4 kg at 6, 4, 2 and 0 m, 1 kg between them; the outer heavy
+/// ones close in at 1 m/s. A 4 kg body at 1 m/s sends a 1 kg one at rest off at
+/// 2 * 4 / 5 = 1.6 m/s (by hand, momentum and energy): faster than any body at the start.
+NBodyRun sevenBodies() {
+  return runScene(scene({4, 1, 4, 1, 4, 1, 4}, {6, 5, 4, 3, 2, 1, 0}, {-1, 0, 0, 0, 0, 0, 1}), true);
+}
+
+TEST(MarkerNBody, VelocitiesNowPanelHoldsEveryVelocityOfTheRun) {
+  // The panel once scaled to 1.12 x the start's largest speed: 1.6 m/s was drawn on the
+  // 1.12 line. (Failed before: dots at the panel's edge.)
+  const NBodyRun r = sevenBodies();
+  ASSERT_GT(r.run.maxVelocity(), 1.59);
+  const auto& box = markers::layout::kSideBox;
+  const double end = endTime(r.run);
+  double fastest = 0.0;
+  for (int k = 0; k <= 200; ++k) {
+    const SceneState state = stateAt(r.run, end * k / 200);
+    SCOPED_TRACE(state.time);
+    const auto animated = buildAnimatedMarkers(r.run, FrameClock{state.time, "test"}, "f");
+    const auto* dots = find(animated, markers::ns::kVelocitiesNow, markers::kSideBars);
+    ASSERT_TRUE(dots);
+    ASSERT_EQ(dots->points.size(), 7u);
+    // Body i's dot (the i-th point, in column 6 - i) lies inside the frame, never on its
+    // edge (where a clamped value would sit), and on one straight line y = a + b v through
+    // every body's v: no value was clamped.
+    std::size_t lo = 0, hi = 0;
+    for (std::size_t i = 0; i < 7; ++i) {
+      const double v = state.velocities[i];
+      fastest = std::max(fastest, std::abs(v));
+      if (v < state.velocities[lo]) lo = i;
+      if (v > state.velocities[hi]) hi = i;
+      const double y = dots->points[i].y;
+      EXPECT_GT(y, box.bottom) << i;
+      EXPECT_LT(y, box.top) << i;
+    }
+    if (state.velocities[hi] == state.velocities[lo]) continue;
+    const double b = (dots->points[hi].y - dots->points[lo].y) / (state.velocities[hi] - state.velocities[lo]);
+    EXPECT_GT(b, 0);
+    for (std::size_t i = 0; i < 7; ++i) {
+      EXPECT_NEAR(dots->points[i].y, dots->points[lo].y + b * (state.velocities[i] - state.velocities[lo]), 1e-9) << i;
+    }
+  }
+  EXPECT_GT(fastest, 1.59);  // the fast ones were among the frames checked
+  // The axis' end values hold the run's range, each with its sign written (rviz's minus is
+  // a few pixels wide: "-1.12" read as "1.12", like the other end).
+  const auto fixed = buildStaticMarkers(r.run, "f");
+  const auto* top = find(fixed, markers::ns::kVelocities, markers::kSideFrame + markers::kFrameTopValue);
+  const auto* bottom = find(fixed, markers::ns::kVelocities, markers::kSideFrame + markers::kFrameBottomValue);
+  ASSERT_TRUE(top && bottom);
+  EXPECT_EQ(top->text.front(), '+') << top->text;
+  EXPECT_EQ(bottom->text.front(), '-') << bottom->text;
+  EXPECT_GE(std::stod(top->text), 1.6);
+  EXPECT_LE(std::stod(bottom->text), -1.6);
+}
+
+std::string statusAt(const RunRecord& run, double t) {
+  const auto animated = buildAnimatedMarkers(run, FrameClock{t, ""}, "f");
+  const auto* m = find(animated, markers::ns::kLabels, markers::kStatus);
+  return m ? m->text : std::string("(none)");
+}
+
+TEST(MarkerNBody, StatusClaimsOnlyACountTheModelPredicted) {
+  // The event engine predicts no count: while the run is coming in, the status says how
+  // many collisions were received, never "predicted". (Failed before: "(N predicted)", N
+  // being the count received so far.)
+  NBodyRun r = sevenBodies();
+  const std::uint64_t n = r.run.collisions();
+  ASSERT_GT(n, 2u);
+  r.run.summary.reset();  // still running
+  collision_lab::Prediction engine;
+  engine.model = collision_lab::Prediction::MODEL_EVENT_ENGINE;
+  engine.collision_count_defined = false;
+  r.run.prediction = engine;
+  // Just after the first impacts (at t = 1 s, one at each end).
+  const double first = r.events.front().time;
+  const std::string shown = "collisions " + std::to_string(stateAt(r.run, first).collisions);
+  ASSERT_LT(stateAt(r.run, first).collisions, n);
+  EXPECT_NE(statusAt(r.run, first).find(shown + " (" + std::to_string(n) + " received so far)"), std::string::npos)
+      << statusAt(r.run, first);
+  EXPECT_EQ(statusAt(r.run, first).find("predicted"), std::string::npos) << statusAt(r.run, first);
+  // A model that predicts the count: "(n predicted)".
+  collision_lab::Prediction ghosts;
+  ghosts.model = collision_lab::Prediction::MODEL_GHOSTS;
+  ghosts.collision_count_defined = true;
+  ghosts.collision_count = n + 1;
+  r.run.prediction = ghosts;
+  EXPECT_NE(statusAt(r.run, first).find(shown + " (" + std::to_string(n + 1) + " predicted)"), std::string::npos)
+      << statusAt(r.run, first);
+}
+
+TEST(MarkerNBody, LegendNamesTheClosedFormOnlyWhereItsDotsAreDrawn) {
+  // The event engine's messages carry no closed-form velocities: no dots, and the legend
+  // says none. (Failed before: "dots: closed form" for two carts and seven bodies.)
+  for (const NBodyRun& r : {runScene(scene({1, 1}, {1, 0}, {-1, 1}, {0.8}), true), sevenBodies()}) {
+    SCOPED_TRACE(r.run.bodies());
+    const auto fixed = buildStaticMarkers(r.run, "f");
+    marker_checks::expectLegendMatchesDots(fixed);
+    const auto* legend = find(fixed, markers::ns::kPlot, markers::kPlotLegend);
+    ASSERT_TRUE(legend);
+    EXPECT_EQ(legend->text.find("dots"), std::string::npos) << legend->text;
+  }
+}
+
+TEST(MarkerNBody, TagsOfBodiesCloseTogetherStayApart) {
+  // Seven bodies meet in clusters: every frame, no two tags overlap, and none lies on an
+  // end label of the axis. (Failed before: "DB" and "GE", a tag on top of another.)
+  const NBodyRun r = sevenBodies();
+  const auto fixed = buildStaticMarkers(r.run, "f");
+  const double end = endTime(r.run);
+  for (int k = 0; k <= 400; ++k) {
+    const double t = end * k / 400;
+    const auto animated = buildAnimatedMarkers(r.run, FrameClock{t, "test"}, "f");
+    std::vector<marker_checks::TextBox> boxes;
+    for (int i = 0; i < 7; ++i) {
+      const auto* tag = find(animated, markers::ns::kLabels, markers::kBodyTag + i);
+      ASSERT_TRUE(tag) << i;
+      boxes.push_back(marker_checks::textBox(*tag));
+    }
+    for (int id : {markers::kSceneMinLabel, markers::kSceneMaxLabel}) {
+      const auto* label = find(fixed, markers::ns::kScene, id);
+      ASSERT_TRUE(label) << id;
+      boxes.push_back(marker_checks::textBox(*label));
+    }
+    for (std::size_t a = 0; a < 7; ++a) {
+      for (std::size_t b = a + 1; b < boxes.size(); ++b) {
+        EXPECT_TRUE(marker_checks::apart(boxes[a], boxes[b])) << "t = " << t << ": tag " << a << " and text " << b;
+      }
+    }
+  }
+}
+
+TEST(MarkerNBody, EnergyBarValuesStayApart) {
+  // Seven bars 0.66 units apart, values such as "0.00524" wider than that: neighbours never
+  // overlap. (Failed before: "0.001150.00524".)
+  const NBodyRun r = sevenBodies();
+  const double end = endTime(r.run);
+  for (int k = 0; k <= 100; ++k) {
+    const double t = end * k / 100;
+    const auto animated = buildAnimatedMarkers(r.run, FrameClock{t, "test"}, "f");
+    for (int i = 0; i + 1 < 7; ++i) {
+      const auto* a = find(animated, markers::ns::kEnergyBars, markers::kEnergyBarValue + i);
+      const auto* b = find(animated, markers::ns::kEnergyBars, markers::kEnergyBarValue + i + 1);
+      ASSERT_TRUE(a && b) << i;
+      EXPECT_TRUE(marker_checks::apart(marker_checks::textBox(*a), marker_checks::textBox(*b)))
+          << "t = " << t << ": '" << a->text << "' and '" << b->text << "'";
+    }
+  }
+}
+
+TEST(MarkerNBody, EndLabelsOfTheAxisStayOffTheWalls) {
+  // The ball between walls at 0 and 1 m: the walls stand at the axis' ends, and its end
+  // labels ("x = -0.06 m") once lay on them. (Failed before.)
+  const NBodyRun r = runScene(scene({kInf, 1, kInf}, {1, 0.5, 0}, {0, 1, 0}), false, 20);
+  const auto fixed = buildStaticMarkers(r.run, "f");
+  const auto animated = buildAnimatedMarkers(r.run, FrameClock{3.0, "test"}, "f");
+  for (int wall : {0, 2}) {
+    const auto* cube = find(animated, markers::ns::kBodies, markers::kBody + wall);
+    ASSERT_TRUE(cube);
+    const marker_checks::TextBox box{cube->pose.position.x - cube->scale.x / 2, cube->pose.position.x + cube->scale.x / 2,
+                                     cube->pose.position.y - cube->scale.y / 2, cube->pose.position.y + cube->scale.y / 2};
+    for (int id : {markers::kSceneMinLabel, markers::kSceneMaxLabel}) {
+      const auto* label = find(fixed, markers::ns::kScene, id);
+      ASSERT_TRUE(label) << id;
+      EXPECT_TRUE(marker_checks::apart(marker_checks::textBox(*label), box)) << label->text << " on wall " << wall;
+    }
+  }
+}
+
+TEST(MarkerNBody, BallBetweenTwoWallsDrawsOnePeriodAndCountsThem) {
+  // Walls at 1 m and 0, the ball at 0.5 m with +1 m/s: periodic, T = 2 (1 - 0) / 1 = 2 s.
+  // 1,000 bounces once filled the x-t diagram with 1,000 lines thinner than a pixel; now
+  // one period is drawn, the line of now runs at t mod T, and the periods so far are
+  // counted. (Failed before.)
+  NBodyRun r = runScene(scene({kInf, 1, kInf}, {1, 0.5, 0}, {0, 1, 0}), false, 1000);
+  const auto fixed = buildStaticMarkers(r.run, "f");
+  const auto* ball = find(fixed, markers::ns::kWorldlines, markers::kWorldLines + 1);
+  ASSERT_TRUE(ball);
+  // One period: from 0.5 m to the wall at 1 m (t = 0.5 s), to 0 (1.5 s), back to 0.5 m (2 s).
+  ASSERT_EQ(ball->points.size(), 4u);
+  const auto* end_label = find(fixed, markers::ns::kWorldlines, markers::kWorldTimeEnd);
+  ASSERT_TRUE(end_label);
+  EXPECT_EQ(end_label->text, "2");
+  const auto* legend = find(fixed, markers::ns::kWorldlines, markers::kWorldLegend);
+  ASSERT_TRUE(legend);
+  EXPECT_NE(legend->text.find("one period drawn, T = 2 s"), std::string::npos) << legend->text;
+  // At t = 15.9 s: 7 periods behind, now at 1.9 s of the period (95 % up the box).
+  const auto animated = buildAnimatedMarkers(r.run, FrameClock{15.9, "test"}, "f");
+  const auto* periods = find(animated, markers::ns::kWorldlinesNow, markers::kWorldNowPeriods);
+  ASSERT_TRUE(periods);
+  EXPECT_EQ(periods->text, "periods so far: 7");
+  const auto* now = find(animated, markers::ns::kWorldlinesNow, markers::kWorldNowLine);
+  ASSERT_TRUE(now);
+  const auto& box = markers::layout::kWorldBox;
+  EXPECT_NEAR(now->points[0].y, box.bottom + 0.95 * (box.top - box.bottom), 1e-9);
+  // The ball's dot on the line of now: at 15.9 s it is at 0.9 m, going left.
+  const auto* dots = find(animated, markers::ns::kWorldlinesNow, markers::kWorldNowBodies);
+  ASSERT_TRUE(dots);
+  EXPECT_NEAR(dots->points[1].y, now->points[0].y, 1e-9);
+  // The note says "stopped" once (the engine's reason begins with it).
+  r.run.summary->truncation_reason = "stopped at the cap of 1000 impacts (truncated)";
+  const auto noted = buildStaticMarkers(r.run, "f");
+  const auto* note = find(noted, markers::ns::kScene, markers::kSceneNote);
+  ASSERT_TRUE(note);
+  EXPECT_EQ(note->text.find("stopped: stopped"), std::string::npos) << note->text;
+  EXPECT_NE(note->text.find("stopped at the cap"), std::string::npos) << note->text;
   expectViewsFit(r.run);
 }
 

@@ -13,6 +13,7 @@
 #include <visualization_msgs/MarkerArray.h>
 
 #include "collision_lab/ros/marker_builder.h"
+#include "collision_lab/ros/markers/ids.h"
 
 namespace marker_checks {
 
@@ -83,6 +84,21 @@ inline TextBox textBox(const Marker& m) {
   return {m.pose.position.x - half_w, m.pose.position.x + half_w, m.pose.position.y - half_h, m.pose.position.y + half_h};
 }
 
+/// Every text lies across the screen of rviz/collision_lab.rviz (x in [-10.7, 16.3]):
+/// rviz cuts a text at the edge ("1.96e+03" lost its last digits).
+inline void expectTextsOnScreen(const MarkerArray& array) {
+  for (const Marker& m : array.markers) {
+    if (m.type != Marker::TEXT_VIEW_FACING || m.action != Marker::ADD) continue;
+    const TextBox box = textBox(m);
+    EXPECT_GE(box.left, -10.7 - 1e-9) << m.ns << "/" << m.id << " '" << m.text << "'";
+    EXPECT_LE(box.right, 16.3 + 1e-9) << m.ns << "/" << m.id << " '" << m.text << "'";
+  }
+}
+
+inline bool apart(const TextBox& a, const TextBox& b) {
+  return a.right <= b.left || b.right <= a.left || a.top <= b.bottom || b.top <= a.bottom;
+}
+
 /// `text` lies within [left, right] and overlaps no other text of the arrays.
 inline void expectTextClear(const Marker& text, double left, double right, const std::vector<const MarkerArray*>& arrays) {
   const TextBox a = textBox(text);
@@ -103,6 +119,21 @@ inline const Marker* find(const MarkerArray& array, const std::string& ns, int i
     if (m.ns == ns && m.id == id) return &m;
   }
   return nullptr;
+}
+
+/// The velocity plot's legend promises closed-form dots exactly when some are drawn (ns
+/// "plot", ids kPlotPredicted + body in each panel).
+inline void expectLegendMatchesDots(const MarkerArray& fixed) {
+  using namespace collision_lab_ros::markers;
+  bool dots = false;
+  for (const auto& m : fixed.markers) {
+    const int in_panel = m.id % kPlotPanelStride;
+    dots = dots || (m.ns == ns::kPlot && m.type == Marker::SPHERE_LIST && in_panel >= kPlotPredicted &&
+                    in_panel < kPlotPaper && !m.points.empty());
+  }
+  const Marker* legend = find(fixed, ns::kPlot, kPlotLegend);
+  ASSERT_TRUE(legend);
+  EXPECT_EQ(legend->text.find("dots: closed form") != std::string::npos, dots) << legend->text;
 }
 
 }  // namespace marker_checks

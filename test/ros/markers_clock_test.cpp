@@ -6,7 +6,11 @@
 // velocities, so by hand: AB meet at t = 1 s; then B (-1 m/s from 1 m) and C (+1 m/s from
 // 0 m) meet at t = 1.5 s; then B (+1 m/s from 0.5 m) reaches A (at rest at 1 m) at t = 2 s.
 // Three collisions; the view runs 25 % past the last one, to t = 2.5 s.
+#include <deque>
+#include <functional>
+#include <optional>
 #include <string>
+#include <utility>
 
 #include <gtest/gtest.h>
 #include <ros/ros.h>
@@ -24,6 +28,8 @@ constexpr double kTimeout = 60.0;  ///< [s] wall time for any one expected frame
 constexpr double kScale = 2.0;     ///< bag s per simulated s
 const ros::Time kStart(1000, 0);   ///< the run's InitialConditions stamp
 
+/// Plays a run as rosbag play does: a message goes out once the clock has (nearly) reached
+/// its stamp, never ahead of it.
 class Player {
  public:
   explicit Player(ros::NodeHandle nh)
@@ -46,38 +52,57 @@ class Player {
     clock_.publish(msg);
   }
 
-  /// The whole run, each message stamped on the timeline.
-  void publishRun() {
+  /// Queues the whole run, each message stamped on the timeline from `start`.
+  void load(const std::string& run_id, const ros::Time& start) {
     collision_lab::core::ThreeBodyScene scene;
     scene.masses = {1, 1, 1};
     scene.positions = {2, 1, -1};
     scene.velocities = {-1, 0, 1};
     auto input = toInitialConditions(scene, collision_lab::core::RunMode::kFull, 0);
-    input.run_id = "clock_run";
-    input.header.stamp = kStart;
-    input_.publish(input);
+    input.run_id = run_id;
+    input.header.stamp = start;
+    queue(input_, input);
     collision_lab::core::RunOptions options;
     options.events = collision_lab::core::EventPolicy::all();
     const collision_lab::core::RunResult result = collision_lab::core::runLab(scene, options);
     auto prediction = toPredictionMsg(result.prediction);
-    prediction.run_id = input.run_id;
-    prediction.header.stamp = kStart;
+    prediction.run_id = run_id;
+    prediction.header.stamp = start;
     prediction.timeline_scale = kScale;
-    prediction_.publish(prediction);
+    queue(prediction_, prediction);
     for (const auto& e : result.events) {
       auto msg = toCollisionEventMsg(e);
-      msg.run_id = input.run_id;
-      msg.header.stamp = kStart + ros::Duration(kScale * e.event.time);
-      events_.publish(msg);
+      msg.run_id = run_id;
+      msg.header.stamp = start + ros::Duration(kScale * e.event.time);
+      queue(events_, msg);
     }
     auto summary = toRunSummaryMsg(result.summary, result.prediction, collision_lab::core::RunMode::kFull);
-    summary.run_id = input.run_id;
-    summary.header.stamp = kStart + ros::Duration(kScale * result.events.back().event.time);
-    summary_.publish(summary);
+    summary.run_id = run_id;
+    summary.header.stamp = start + ros::Duration(kScale * result.events.back().event.time);
+    queue(summary_, summary);
+  }
+
+  /// Sends every queued message stamped up to `until`, each with the clock `lag` short of
+  /// its stamp (rosbag play's /clock goes out at most every 10 ms of wall time: at rate 0.5
+  /// up to 5 ms of bag time short), then sets the clock to `until`; with no `until`, sends
+  /// them all and the clock stops with the last one, as when rosbag play says "Done.".
+  void play(const std::optional<ros::Time>& until, const ros::Duration& lag = ros::Duration(0)) {
+    while (!queue_.empty() && (!until || queue_.front().first <= *until)) {
+      setClock(queue_.front().first - lag);
+      queue_.front().second();
+      queue_.pop_front();
+    }
+    if (until) setClock(*until);
   }
 
  private:
+  template <typename Msg>
+  void queue(const ros::Publisher& pub, const Msg& msg) {
+    queue_.emplace_back(msg.header.stamp, [pub, msg] { pub.publish(msg); });
+  }
+
   ros::Publisher clock_, input_, prediction_, events_, summary_;
+  std::deque<std::pair<ros::Time, std::function<void()>>> queue_;
 };
 
 std::string timeShown(const std::string& status) { return status.substr(0, status.find(" s ")); }
@@ -87,11 +112,10 @@ TEST(MarkersClock, AnimationFollowsTheBagClock) {
   AnimationWatcher watcher(nh);
   Player player(nh);
   ASSERT_TRUE(spinUntil([&] { return player.connected(); }, kTimeout)) << "collision_lab_markers never subscribed";
-  player.setClock(kStart);
-  player.publishRun();
+  player.load("clock_run", kStart);
 
   // Simulated t = 1.25 s: after the first collision, before the second.
-  player.setClock(kStart + ros::Duration(kScale * 1.25));
+  player.play(kStart + ros::Duration(kScale * 1.25));
   ASSERT_TRUE(spinUntil([&] { return timeShown(watcher.status) == "t = 1.25"; }, kTimeout))
       << "last shown: " << watcher.status;
   EXPECT_EQ(numberAfter(watcher.status, "collisions "), 1);
@@ -102,14 +126,30 @@ TEST(MarkersClock, AnimationFollowsTheBagClock) {
   EXPECT_EQ(timeShown(watcher.status), "t = 1.25");
 
   // A step forward to t = 1.75 s: two collisions done.
-  player.setClock(kStart + ros::Duration(kScale * 1.75));
+  player.play(kStart + ros::Duration(kScale * 1.75));
   ASSERT_TRUE(spinUntil([&] { return timeShown(watcher.status) == "t = 1.75"; }, kTimeout))
       << "last shown: " << watcher.status;
   EXPECT_EQ(numberAfter(watcher.status, "collisions "), 2);
 
   // Long after the end: all three, held at the end of the run's picture (2.5 s).
-  player.setClock(kStart + ros::Duration(kScale * 100.0));
+  player.play(kStart + ros::Duration(kScale * 100.0));
   ASSERT_TRUE(spinUntil([&] { return timeShown(watcher.status) == "t = 2.5"; }, kTimeout))
+      << "last shown: " << watcher.status;
+  EXPECT_NE(watcher.status.find("collisions 3 of 3"), std::string::npos) << watcher.status;
+}
+
+TEST(MarkersClock, ReplayEndsOnTheLastCollisionThoughTheClockLagsIt) {
+  // The clock stops 5 ms of bag time (2.5 ms simulated) short of the last collision's stamp
+  // (t = 2 s): the replay still ends showing all three collisions, from t = 2 s. (Failed
+  // before: "t = 1.9975 s  collisions 2 of 3" for ever.)
+  ros::NodeHandle nh("collision_lab");
+  AnimationWatcher watcher(nh);
+  Player player(nh);
+  ASSERT_TRUE(spinUntil([&] { return player.connected(); }, kTimeout)) << "collision_lab_markers never subscribed";
+  player.load("lagging_clock_run", kStart + ros::Duration(1000.0));  // after the other test's clock
+  player.play(std::nullopt, ros::Duration(0.005));
+  // (The latched frame of the run before shows t = 2.5 s.)
+  ASSERT_TRUE(spinUntil([&] { return timeShown(watcher.status) == "t = 2"; }, kTimeout))
       << "last shown: " << watcher.status;
   EXPECT_NE(watcher.status.find("collisions 3 of 3"), std::string::npos) << watcher.status;
 }

@@ -157,6 +157,12 @@ class RunRecord {
   /// Collapses applied [1] and the first one's time [s] (NaN when none).
   std::uint32_t collapses() const { return collapses_; }
   double firstCollapseTime() const { return first_collapse_time_; }
+  /// Time of the newest collision added [s] (0 before the first).
+  double newestTime() const { return newest_time_; }
+  /// Bounds of every finite velocity any body has had so far, the start's included [m/s]:
+  /// every state the record can show lies within them.
+  double minVelocity() const { return min_velocity_; }
+  double maxVelocity() const { return max_velocity_; }
   /// The kept states, the newest last (materialised on demand).
   const std::vector<Keyframe>& keyframes() const;
   /// True when every collision of the run is here: the summary (or, before it, the exact
@@ -194,6 +200,7 @@ class RunRecord {
   /// Applies the event to flights_, the sums and the per-body series.
   void apply(const collision_lab::CollisionEvent& event);
   void move(std::size_t body, double time, double position, double velocity);
+  void widenVelocityRange(double v);
   Keyframe snapshot(double time) const;
   bool keeps(const Keyframe& frame) const;
   void prune();
@@ -220,6 +227,7 @@ class RunRecord {
   std::vector<Envelope> tracked_velocity_;  ///< empty unless no body is plotted
   Envelope energy_, momentum_, energy_lost_, none_;
   double kinetic_ = 0.0, momentum_sum_ = 0.0, lost_ = 0.0;
+  double min_velocity_, max_velocity_;
 };
 
 /// Kinetic energy [J] and momentum [kg m/s] of the finite masses (walls excluded).
@@ -267,6 +275,14 @@ double autoLoopDuration(std::uint64_t collisions);
 /// from `start` (its InitialConditions) at timeline_scale bag s per simulated s; a scale
 /// <= 0 or not finite counts as 1. Never negative.
 double simulatedTimeOnTimeline(const ros::Time& now, const ros::Time& start, double timeline_scale);
+
+/// Simulated time [s] of a run replayed by `rosbag play --clock` at ROS time `now`: on the
+/// run's timeline (its InitialConditions stamp, Prediction.timeline_scale), but never before
+/// the newest collision received. rosbag play sends a message once its clock has reached
+/// the message's stamp, yet the /clock it publishes (at most every 10 ms of wall time) lags
+/// that stamp and stops with the last message, and a stamp rounded to the nanosecond can
+/// fall just before its collision's time: the received collision has happened.
+double replayedTime(const RunRecord& run, const ros::Time& now);
 
 /// One frame's time line for the status text.
 struct FrameClock {

@@ -9,7 +9,8 @@
 //           (time_scale <= 0) auto-timed with dense bursts in slow motion (TimeWarp);
 //   "ros":  follows ROS time on the run's timeline, simulated t =
 //           (ros::Time::now() - InitialConditions stamp) / Prediction.timeline_scale, so
-//           that rosbag play --clock drives it: rate (-r), pause (space) and step (s).
+//           that rosbag play --clock drives it: rate (-r), pause (space) and step (s);
+//           a replay never shows a time before the newest collision received (replayedTime).
 // The default is "ros" under use_sim_time, "wall" otherwise.
 //
 // Which runs it shows (~follow_run_id, ~follow_student): by default whichever run is

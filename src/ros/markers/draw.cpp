@@ -43,6 +43,11 @@ std::string format(const char* fmt, double value) {
   return buffer;
 }
 
+std::string withSign(const char* fmt, double value) {
+  if (value == 0 || std::isnan(value)) return format(fmt, value);
+  return (value > 0 ? "+" : "-") + format(fmt, std::abs(value));
+}
+
 std::string withSeparators(std::uint64_t n) {
   std::string digits = std::to_string(n), out;
   for (std::size_t k = 0; k < digits.size(); ++k) {
@@ -136,6 +141,9 @@ Marker baseMarker(const std::string& frame_id, const std::string& ns, int id, in
 Marker textMarker(const std::string& frame_id, const std::string& ns, int id, double x, double y,
                   const std::string& s, double size, const std_msgs::ColorRGBA& c) {
   Marker m = baseMarker(frame_id, ns, id, Marker::TEXT_VIEW_FACING);
+  // Moved sideways into the screen when it would run off an edge (rviz cuts it there).
+  const double half = textWidth(s, size) / 2;
+  if (2 * half < kScreen.right - kScreen.left) x = std::clamp(x, kScreen.left + half, kScreen.right - half);
   m.pose.position = point(x, y, kTextZ);
   m.scale.z = size;
   m.color = c;
@@ -205,13 +213,14 @@ void addFrame(const Canvas& c, const std::string& ns, int base, const Axes& axes
     frame.points.push_back(point(b.right, zero));
   }
   c.add(frame);
-  // Zero is labelled whenever it is inside; an end label too close to it gives way.
-  if (!zero_inside || b.top - zero > kLabelClearance) {
-    c.add(c.text(ns, base + kFrameTopValue, b.left + kValueLabelDx, b.top, format("%.3g", axes.y1), kSmallTextSize));
-  }
-  if (!zero_inside || zero - b.bottom > kLabelClearance) {
-    c.add(c.text(ns, base + kFrameBottomValue, b.left + kValueLabelDx, b.bottom, format("%.3g", axes.y0),
-                 kSmallTextSize));
+  // Zero is labelled whenever it is inside; an end label too close to it gives way. When a
+  // negative end value is shown, every sign is written.
+  const bool top_shown = !zero_inside || b.top - zero > kLabelClearance;
+  const bool bottom_shown = !zero_inside || zero - b.bottom > kLabelClearance;
+  const auto value = [&](double y) { return bottom_shown && axes.y0 < 0 ? withSign("%.3g", y) : format("%.3g", y); };
+  if (top_shown) c.add(c.text(ns, base + kFrameTopValue, b.left + kValueLabelDx, b.top, value(axes.y1), kSmallTextSize));
+  if (bottom_shown) {
+    c.add(c.text(ns, base + kFrameBottomValue, b.left + kValueLabelDx, b.bottom, value(axes.y0), kSmallTextSize));
   }
   if (zero_inside) c.add(c.text(ns, base + kFrameZeroLabel, b.left + kZeroLabelDx, zero, "0", kSmallTextSize));
   c.add(c.text(ns, base + kFrameLabel, b.midX(), b.top + kFrameLabelDy, label, kSmallTextSize));

@@ -54,8 +54,11 @@ void drawEnergyBars(const Canvas& c, const SceneState& state) {
     bar.scale.x = kBarWidth * pitch(n), bar.scale.y = h, bar.scale.z = kBarDepth;
     bar.color = particleColor(i);
     c.add(bar);
+    // Values wider than the pitch alternate between two heights, so neighbours stay apart.
+    const std::string value = format("%.3g", kinetic[i]);
+    const double dy = textWidth(value, kSmallTextSize) > pitch(n) && i % 2 == 1 ? kBarValueStagger : 0.0;
     c.add(c.text(ns::kEnergyBars, kEnergyBarValue + static_cast<int>(i), barX(i, n),
-                 kBarsBox.bottom + h + kBarValueDy, format("%.3g", kinetic[i]), kSmallTextSize));
+                 kBarsBox.bottom + h + kBarValueDy + dy, value, kSmallTextSize));
   }
 }
 

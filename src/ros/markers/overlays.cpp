@@ -12,29 +12,43 @@ namespace {
 using namespace markers;
 using namespace markers::layout;
 
-/// A text with a frame around it. The frame also makes rviz 1.14 draw a text that comes
-/// alone: an array of only TEXT_VIEW_FACING markers is received but not drawn.
-std::vector<Marker> framedText(const std::string& frame_id, const std::string& ns, double y, const std::string& s,
-                               const std_msgs::ColorRGBA& c, double size) {
-  const auto [longest, lines_count] = textExtent(s);
-  const double half_width = std::min(kHalfCharWidth * size * static_cast<double>(longest) + kFrameMarginX,
-                                     kMaxHalfFrameWidth);
-  const double half_height = kHalfLineHeight * size * static_cast<double>(lines_count) + kFrameMarginY;
-  Marker box = lineMarker(frame_id, ns, kFramedBox, Marker::LINE_LIST, kFramedBoxWidth, c);
+/// A text on an opaque panel with a coloured border (one TRIANGLE_LIST, coloured per
+/// vertex), over every view: the text is wrapped to fit the screen, and the panel fits the
+/// text. The panel also makes rviz 1.14 draw a text that comes alone: an array of only
+/// TEXT_VIEW_FACING markers is received but not drawn. `y` is the panel's centre, or with
+/// `grow_up` its bottom edge.
+std::vector<Marker> framedText(const std::string& frame_id, const std::string& ns, double y, const std::string& text,
+                               const std_msgs::ColorRGBA& c, double size, bool grow_up = false) {
+  const std::string s = wrapped(text, size, 2 * (kMaxHalfFrameWidth - kFrameMarginX) / kFramedWidthFactor);
+  const double half_width = kFramedWidthFactor * textWidth(s, size) / 2 + kFrameMarginX;
+  const double half_height = textHeight(s, size) / 2 + kFrameMarginY;
+  if (grow_up) y += half_height;
   const double l = kCentreX - half_width, r = kCentreX + half_width;
-  const double b = y - half_height, t = y + half_height;
-  box.points = {point(l, b), point(r, b), point(r, b), point(r, t), point(r, t), point(l, t), point(l, t), point(l, b)};
-  return {textMarker(frame_id, ns, kFramedText, kCentreX, y, s, size, c), box};
+  const double b = y - half_height, t = y + half_height, w = kFramedBoxWidth;
+  Marker panel = lineMarker(frame_id, ns, kFramedBox, Marker::TRIANGLE_LIST, 1.0, c);
+  panel.pose.position.z = kOverlayZ;
+  const auto rectangle = [&panel](double x0, double y0, double x1, double y1, const std_msgs::ColorRGBA& colour) {
+    for (const auto& p : {point(x0, y0), point(x1, y0), point(x1, y1), point(x0, y0), point(x1, y1), point(x0, y1)}) {
+      panel.points.push_back(p);
+      panel.colors.push_back(colour);
+    }
+  };
+  rectangle(l, b, r, t, color(kOverlayBackground));
+  rectangle(l, b, r, b + w, c), rectangle(l, t - w, r, t, c);  // the border, over the panel's edges
+  rectangle(l, b, l + w, t, c), rectangle(r - w, b, r, t, c);
+  Marker label = textMarker(frame_id, ns, kFramedText, kCentreX, y, s, size, c);
+  label.pose.position.z = kOverlayZ + kOverlayTextDz;
+  return {label, panel};
 }
 
 }  // namespace
 
 std::vector<Marker> rejectedBanner(const collision_lab::Rejected& rejected, const std::string& frame_id) {
   const std::string run = rejected.run_id.empty() ? "an input" : "run '" + rejected.run_id + "'";
-  return framedText(frame_id, ns::kRejected, kZoomY,
+  return framedText(frame_id, ns::kRejected, kBannerBottomY,
                     "REJECTED " + run + ": " + rejected.reason_name + " in " + rejected.field + "\n" +
                         rejected.message,
-                    color(kBannerRed), kTextSize);
+                    color(kBannerRed), kTextSize, true);
 }
 
 std::vector<Marker> hintMarkers(const std::string& command, const std::string& frame_id) {

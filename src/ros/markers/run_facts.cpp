@@ -70,7 +70,8 @@ std::string runNote(const RunRecord& run) {
     note += withSeparators(run.missedCollisions()) + " collision messages missing; ";
   }
   if (run.summary && run.summary->truncated) {
-    note += "stopped: " + run.summary->truncation_reason + ". Shown up to the last known state.";
+    const std::string& reason = run.summary->truncation_reason;
+    note += (reason.rfind("stopped", 0) == 0 ? "" : "stopped: ") + reason + ". Shown up to the last known state.";
   } else if (run.input().mode == collision_lab::InitialConditions::MODE_PREDICT_ONLY) {
     note += "predict-only run: shown up to the first contact; the plots show the closed form's final velocities.";
   } else if (run.input().mode == collision_lab::InitialConditions::MODE_SUMMARY_ONLY) {
@@ -83,16 +84,20 @@ std::string runNote(const RunRecord& run) {
 
 std::string statusLine(const RunRecord& run, const SceneState& state, const FrameClock& clock) {
   std::string s = format("t = %.6g s", state.time) + "     collisions " + withSeparators(state.collisions);
-  const std::uint64_t expected = expectedCollisions(run);
-  // "of N" only for what is known: the whole run, or what a cut-short run simulated.
+  // "of N" only for what is known: the whole run, or what a cut-short run simulated;
+  // "predicted" only for a count the model predicted.
+  const bool count_predicted = run.prediction && run.prediction->collision_count_defined &&
+                               !run.prediction->infinite_collisions;
   if (run.finished()) {
     s += " of " + withSeparators(run.collisions());
   } else if (run.summary && run.summary->simulated) {
     s += " of " + withSeparators(run.summary->collision_count) + " simulated";
   } else if (run.prediction && run.prediction->infinite_collisions) {
     s += " (infinitely many predicted)";
-  } else if (expected > state.collisions) {
-    s += " (" + withSeparators(expected) + " predicted)";
+  } else if (count_predicted && expectedCollisions(run) > state.collisions) {
+    s += " (" + withSeparators(expectedCollisions(run)) + " predicted)";
+  } else if (run.collisions() > state.collisions) {
+    s += " (" + withSeparators(run.collisions()) + " received so far)";
   }
   if (!clock.description.empty()) s += "     " + clock.description;
   return s;

@@ -1,6 +1,7 @@
 // The scene: the title, the position axis with its range and note, the bodies (sized by
 // mass, walls as walls) with their tags and velocities, and the status line.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -49,25 +50,96 @@ Marker bodyMarker(const Canvas& c, std::size_t i, double x, const std::pair<doub
   return m;
 }
 
+/// A text of the scene row and its centre [rviz units].
+struct PlacedText {
+  std::string text;
+  double x, y;
+};
+
+/// The labels of the axis' ends (min, max): under the axis, or under the wall at an end
+/// where a wall stands (a wall is taller than a body).
+std::array<PlacedText, 2> endLabels(const RunRecord& run, const SceneAxis& axis) {
+  const auto y = [](bool wall) {
+    return wall ? kSceneY - kWallHeight / 2 - kWallLabelDy : kSceneY + kSceneLabelDy;
+  };
+  const auto value = [&axis](double x) {
+    return "x = " + (axis.min < 0 ? withSign("%.4g", x) : format("%.4g", x)) + " m";
+  };
+  return {PlacedText{value(axis.min), kSceneLeft + kSceneLabelDx, y(run.isWall(run.bodies() - 1))},
+          PlacedText{value(axis.max), kSceneRight - kSceneLabelDx, y(run.isWall(0))}};
+}
+
+std::string tagOf(const RunRecord& run, std::size_t i) {
+  return isWall(run.input(), i) ? bodyName(i) + " (wall)" : bodyName(i);
+}
+
+/// Where each body's tag goes: a wall's on its outer side, over the axis; a body's over or
+/// under it (alternately), else in the other row, else moved sideways, so that bodies
+/// close together keep tags apart.
+std::vector<std::pair<double, double>> tagPlaces(const RunRecord& run, const std::vector<double>& x,
+                                                 const SceneAxis& axis) {
+  const std::size_t n = x.size();
+  std::vector<std::pair<double, double>> place(n);
+  std::vector<Box> taken;
+  const auto boxAt = [](double cx, double cy, double width, double size = kTextSize) {
+    return Box{cx - width / 2 - kTagGap, cx + width / 2 + kTagGap, cy - size / 2, cy + size / 2};
+  };
+  for (const PlacedText& end : endLabels(run, axis)) {
+    taken.push_back(boxAt(end.x, end.y, textWidth(end.text, kSmallTextSize), kSmallTextSize));
+  }
+  const auto free = [&taken](const Box& b) {
+    return std::none_of(taken.begin(), taken.end(), [&b](const Box& t) {
+      return b.left < t.right && t.left < b.right && b.bottom < t.top && t.bottom < b.top;
+    });
+  };
+  std::vector<std::size_t> order;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (isWall(run.input(), i)) {
+      place[i] = {x[i] + (i == 0 ? kWallTagDx : -kWallTagDx), kSceneY + kTagDy};
+      taken.push_back(boxAt(place[i].first, place[i].second, textWidth(tagOf(run, i), kTextSize)));
+    } else {
+      order.push_back(i);
+    }
+  }
+  // Left to right (the last body is the leftmost).
+  std::reverse(order.begin(), order.end());
+  for (std::size_t i : order) {
+    const double width = textWidth(tagOf(run, i), kTextSize);
+    const double first_row = kSceneY + (i % 2 == 1 ? -kTagDy : kTagDy), other_row = 2 * kSceneY - first_row;
+    place[i] = {x[i], first_row};
+    bool placed = false;
+    for (int step = 0; step <= kTagMaxSteps && !placed; ++step) {
+      for (double dx : {step * width, -step * width}) {
+        for (double row : {first_row, other_row}) {
+          if (!placed && free(boxAt(x[i] + dx, row, width))) place[i] = {x[i] + dx, row}, placed = true;
+        }
+        if (step == 0) break;
+      }
+    }
+    taken.push_back(boxAt(place[i].first, place[i].second, width));
+  }
+  return place;
+}
+
 /// Few bodies: each with its tag beside it and its velocity in a row above.
 void drawLabelledBodies(const Canvas& c, const SceneState& state, const SceneAxis& axis) {
   const std::size_t n = c.run.bodies();
   const auto range = massRange(c.run.input());
   // Three bodies keep their wide row; more share the scene's width.
   const double pitch = n <= 3 ? kVelocityRowPitch : (kSceneRight - kSceneLeft) / static_cast<double>(n);
-  const char* fmt = n <= 3 ? " = %.6g m/s" : " = %.3g m/s";
+  const char* fmt = n <= 3 ? "%.6g" : "%.3g";
+  std::vector<double> x(n);
+  for (std::size_t i = 0; i < n; ++i) x[i] = axis.toX(state.positions[i]);
+  const auto tags = tagPlaces(c.run, x, axis);
   for (std::size_t i = 0; i < n; ++i) {
-    const bool wall = isWall(c.run.input(), i);
-    const double x = axis.toX(state.positions[i]);
-    c.add(bodyMarker(c, i, x, range));
-    // A short tag beside the body (walls: on their outer side), the value in a fixed row.
-    const double tag_x = wall ? x + (i == 0 ? kWallTagDx : -kWallTagDx) : x;
-    const double tag_y = wall ? kSceneY + kTagDy : kSceneY + (i % 2 == 1 ? -kTagDy : kTagDy);
-    c.add(c.text(ns::kLabels, kBodyTag + static_cast<int>(i), tag_x, tag_y,
-                 wall ? bodyName(i) + " (wall)" : bodyName(i), kTextSize, particleColor(i, kTagLighten)));
+    c.add(bodyMarker(c, i, x[i], range));
+    // A short tag beside the body, the value in a fixed row.
+    c.add(c.text(ns::kLabels, kBodyTag + static_cast<int>(i), tags[i].first, tags[i].second, tagOf(c.run, i),
+                 kTextSize, particleColor(i, kTagLighten)));
     const double row_x = kCentreX + pitch * (static_cast<double>(i) - (static_cast<double>(n) - 1) / 2);
     c.add(c.text(ns::kLabels, kVelocityRow + static_cast<int>(i), row_x, kVelocityRowY,
-                 "v_" + bodyName(i) + format(fmt, state.velocities[i]), n <= 3 ? kTextSize : kSmallTextSize,
+                 "v_" + bodyName(i) + " = " + withSign(fmt, state.velocities[i]) + " m/s",
+                 n <= 3 ? kTextSize : kSmallTextSize,
                  particleColor(i, kTagLighten)));
   }
 }
@@ -132,10 +204,9 @@ SceneAxis bodiesNow(const SceneState& state) {
 
 /// The ends of the scene's axis [m], and (large scenes) that they follow the bodies.
 void addRangeLabels(const Canvas& c, const std::string& ns, int min_id, int max_id, const SceneAxis& axis) {
-  c.add(c.text(ns, min_id, kSceneLeft + kSceneLabelDx, kSceneY + kSceneLabelDy, format("x = %.4g m", axis.min),
-               kSmallTextSize, color(kLabelGrey)));
-  c.add(c.text(ns, max_id, kSceneRight - kSceneLabelDx, kSceneY + kSceneLabelDy, format("x = %.4g m", axis.max),
-               kSmallTextSize, color(kLabelGrey)));
+  const auto labels = endLabels(c.run, axis);
+  c.add(c.text(ns, min_id, labels[0].x, labels[0].y, labels[0].text, kSmallTextSize, color(kLabelGrey)));
+  c.add(c.text(ns, max_id, labels[1].x, labels[1].y, labels[1].text, kSmallTextSize, color(kLabelGrey)));
 }
 
 }  // namespace

@@ -80,19 +80,23 @@ bool addPaperSeries(const Canvas& c, const Axes& axes, std::size_t i, int id) {
 }
 
 /// The closed form's velocities of body i after each kept collision (and the final ones
-/// when the steps do not get there), as dots on the steps.
-void addPredictedDots(const Canvas& c, const Axes& axes, std::size_t i, int id) {
+/// when the steps do not get there), as dots on the steps; true when there are any.
+bool addPredictedDots(const Canvas& c, const Axes& axes, std::size_t i, int id) {
   const auto final_v = finalVelocitiesNotDrawn(c.run);
   Marker predicted = c.dots(ns::kPlot, id, kPredictedDotSize, particleColor(i, kDotLighten));
   for (const Keyframe* f : thinned(c.run.keyframes(), kMaxPredictedDots)) {
     if (i < f->predicted.size()) predicted.points.push_back(point(axes.toX(f->index + 0.5), axes.toY(f->predicted[i]), kDotZ));
   }
   if (final_v && i < final_v->second.size() && std::isfinite(final_v->second[i])) predicted.points.push_back(point(axes.toX(final_v->first + 0.5), axes.toY(final_v->second[i]), kDotZ));
-  if (!predicted.points.empty()) c.add(predicted);
+  if (predicted.points.empty()) return false;
+  c.add(predicted);
+  return true;
 }
 
+/// What the velocity panels drew besides the simulated steps, for the legend.
 struct PaperShown {
   bool any = false, off_scale = false;
+  bool dots = false;  ///< some closed-form dots
 };
 
 void addVelocityPanel(const Canvas& c, const VelocityPanel& panel, int p, std::size_t panels, PaperShown& paper) {
@@ -113,7 +117,7 @@ void addVelocityPanel(const Canvas& c, const VelocityPanel& panel, int p, std::s
   for (std::size_t i : panel.bodies) {
     const int b = static_cast<int>(i);
     addSeries(c, ns::kPlot, base + kPlotSeries + b, withTail(c.run.velocity(i), tail), panel.axes, particleColor(i));
-    addPredictedDots(c, panel.axes, i, base + kPlotPredicted + b);
+    paper.dots = addPredictedDots(c, panel.axes, i, base + kPlotPredicted + b) || paper.dots;
     paper.any = paper.any || !c.run.paperVelocity(i).empty();
     paper.off_scale = addPaperSeries(c, panel.axes, i, base + kPlotPaper + b) || paper.off_scale;
   }
@@ -124,7 +128,7 @@ void addVelocityLegend(const Canvas& c, bool own_scale, const PaperShown& paper)
   c.add(c.text(ns::kPlot, kPlotTitle, kVelocityBox.midX(), kPanelTitleY,
                own_scale ? "velocity vs collision index (B on its own scale)" : "velocity vs collision index",
                kTextSize));
-  std::string legend = "steps: simulated   dots: closed form";
+  std::string legend = paper.dots ? "steps: simulated   dots: closed form" : "steps: simulated";
   if (paper.any) legend += "   pink: paper's eqs. (2.15)/(2.16) where they differ";
   if (paper.off_scale) legend += " (clipped)";
   const bool rotation = c.run.prediction && c.run.prediction->model == collision_lab::Prediction::MODEL_THREE_BODY_ROTATION;

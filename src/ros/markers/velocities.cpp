@@ -13,10 +13,11 @@ using namespace layout;
 
 namespace {
 
-/// The velocity axis [m/s]: symmetric, the start's largest |v| padded (clipped beyond).
+/// The velocity axis [m/s]: symmetric, the largest |v| of the run so far padded, so that
+/// every state shown lies inside it (a live run's axis grows as its collisions come).
 std::pair<double, double> velocityAxis(const RunRecord& run) {
-  const double v_max = velocityScale(run);
-  return paddedRange(-v_max, v_max);
+  const double v_max = std::max(std::abs(run.minVelocity()), std::abs(run.maxVelocity()));
+  return v_max > 0 && std::isfinite(v_max) ? paddedRange(-v_max, v_max) : paddedRange(-1.0, 1.0);
 }
 
 /// Mass-weighted mean V [m/s] and spread sigma [m/s] of the finite bodies' velocities.
@@ -96,8 +97,8 @@ void drawSideViewAxes(const Canvas& c) {
     Marker frame = c.lines(ns::kVelocities, kSideFrame, Marker::LINE_LIST, kFrameWidth, color(kGrey));
     frame.points = {point(b.left, b.bottom), point(b.right, b.bottom), point(b.left, b.bottom), point(b.left, b.top)};
     c.add(frame);
-    c.add(c.text(ns::kVelocities, kSideAxisMin, b.left, b.bottom + kIndexLabelDy, format("%.3g", v0), kSmallTextSize));
-    c.add(c.text(ns::kVelocities, kSideAxisMax, b.right, b.bottom + kIndexLabelDy, format("%.3g", v1), kSmallTextSize));
+    c.add(c.text(ns::kVelocities, kSideAxisMin, b.left, b.bottom + kIndexLabelDy, withSign("%.3g", v0), kSmallTextSize));
+    c.add(c.text(ns::kVelocities, kSideAxisMax, b.right, b.bottom + kIndexLabelDy, withSign("%.3g", v1), kSmallTextSize));
     c.add(c.text(ns::kVelocities, kSideAxisLabel, b.midX(), b.bottom + kIndexLabelDy, "v [m/s]", kSmallTextSize));
   } else {
     addFrame(c, ns::kVelocities, kSideFrame, Axes{b, 0.0, 1.0, v0, v1}, "v [m/s]");

@@ -185,8 +185,9 @@ std::string restitutionLegend(const RunRecord& run) {
 }
 
 /// The orange key in the legend row; under the caption (at most two lines, within the
-/// column) what the yellow and violet marks are and, for e < 1, the restitution.
-void addWedgeLegend(const Canvas& c, const std::vector<const Keyframe*>& shown, bool lossy) {
+/// column) what the yellow and violet marks are (violet only when `predicted` dots are
+/// drawn) and, for e < 1, the restitution.
+void addWedgeLegend(const Canvas& c, const std::vector<const Keyframe*>& shown, bool lossy, bool predicted) {
   const RunRecord& run = c.run;
   // A collapse record is no collision: it is counted on its own.
   const auto collapses = static_cast<std::uint64_t>(
@@ -197,7 +198,10 @@ void addWedgeLegend(const Canvas& c, const std::vector<const Keyframe*>& shown, 
   if (collapses > 0) which += collapses == 1 ? " and a collapse" : " and " + withSeparators(collapses) + " collapses";
   c.add(c.text(ns::kWedge, kWedgeKey, kWedgeX, kLegendY, wrapped("orange: u_perp after " + which, kSmallTextSize, kLeftTextWidth),
                kSmallTextSize, color(kLabelGrey)));
-  const std::string rest = lossy ? "yellow: its direction; " + restitutionLegend(run) : "violet: closed form";
+  const std::string rest = lossy       ? "yellow: its direction; " + restitutionLegend(run)
+                           : predicted ? "violet: closed form"
+                                       : "";
+  if (rest.empty()) return;
   c.add(c.text(ns::kWedge, kWedgeLegend, kWedgeX, kWedgeBox.bottom + kWedgeLegendDy,
                wrapped(rest, kSmallTextSize, kLeftTextWidth), kSmallTextSize));
 }
@@ -241,7 +245,7 @@ void drawWedge(const Canvas& c) {
   c.add(c.text(ns::kWedge, kWedgeCaption, kWedgeX, kWedgeBox.bottom + kCaptionDy,
                "yellow: escape cone, alpha = " + format("%.4g rad", wedge.abAngle()), kSmallTextSize,
                color(kConeYellow)));
-  addWedgeLegend(c, shown, lossy);
+  addWedgeLegend(c, shown, lossy, !pred.points.empty());
 }
 
 void drawWedgeCursor(const Canvas& c, const SceneState& state) {

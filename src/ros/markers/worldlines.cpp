@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "collision_lab/ros/markers/draw.h"
 
@@ -38,8 +39,9 @@ void addWorldUnits(const Canvas& c) {
 void addWorldRange(const Canvas& c, const std::string& ns, int end_id, int min_id, int max_id, const WorldAxes& axes) {
   const Box& b = kWorldBox;
   c.add(c.text(ns, end_id, b.left + kWorldEndDx, b.top, format("%.3g", axes.end), kSmallTextSize));
-  c.add(c.text(ns, min_id, b.left, b.bottom + kWorldPositionDy, format("%.3g", axes.scene.min), kSmallTextSize));
-  c.add(c.text(ns, max_id, b.right, b.bottom + kWorldPositionDy, format("%.3g", axes.scene.max), kSmallTextSize));
+  const auto value = [&axes](double x) { return axes.scene.min < 0 ? withSign("%.3g", x) : format("%.3g", x); };
+  c.add(c.text(ns, min_id, b.left, b.bottom + kWorldPositionDy, value(axes.scene.min), kSmallTextSize));
+  c.add(c.text(ns, max_id, b.right, b.bottom + kWorldPositionDy, value(axes.scene.max), kSmallTextSize));
 }
 
 /// Large scenes: the tracked worldlines from 0 to now, and the axes that hold them (time up
@@ -85,7 +87,9 @@ Polyline perRow(const Polyline& poly, double end, int rows) {
 }
 
 /// Equal elastic masses move as ghosts that pass through each other: the straight lines
-/// x_i + v_i t of the tracked bodies' initial states, cut to the box.
+/// x_i + v_i t of the tracked bodies' initial states, cut to the box. Each piece of a
+/// worldline lies on a ghost's line, so the ghosts are dashed and drawn over the
+/// worldlines: the worldline's colour shows between the dashes.
 void addGhosts(const Canvas& c, const std::string& ns, int id, const WorldAxes& axes) {
   Marker ghosts = c.lines(ns, id, Marker::LINE_LIST, kGhostWidth, color(kGhostGrey));
   for (std::size_t i : c.run.trackedBodies()) {
@@ -95,8 +99,15 @@ void addGhosts(const Canvas& c, const std::string& ns, int id, const WorldAxes& 
     if (v > 0) t_end = std::min(t_end, (axes.scene.max - x) / v);
     if (v < 0) t_end = std::min(t_end, (axes.scene.min - x) / v);
     if (!(t_end > 0)) continue;
-    ghosts.points.push_back(point(axes.toX(x), axes.toY(0.0)));
-    ghosts.points.push_back(point(axes.toX(x + v * t_end), axes.toY(t_end)));
+    const geometry_msgs::Point from = point(axes.toX(x), axes.toY(0.0), kGhostZ);
+    const geometry_msgs::Point to = point(axes.toX(x + v * t_end), axes.toY(t_end), kGhostZ);
+    const double length = std::hypot(to.x - from.x, to.y - from.y);
+    const int dashes = std::max(1, static_cast<int>(length / kGhostDashPeriod));
+    for (int k = 0; k < dashes; ++k) {
+      const double f0 = static_cast<double>(k) / dashes, f1 = (k + kGhostDashShare) / dashes;
+      ghosts.points.push_back(point(from.x + f0 * (to.x - from.x), from.y + f0 * (to.y - from.y), kGhostZ));
+      ghosts.points.push_back(point(from.x + f1 * (to.x - from.x), from.y + f1 * (to.y - from.y), kGhostZ));
+    }
   }
   c.addLines(ghosts);
 }
@@ -118,6 +129,24 @@ bool ghostScene(const RunRecord& run) {
   return run.prediction && run.prediction->model == collision_lab::Prediction::MODEL_GHOSTS;
 }
 
+/// The period [s] of a ball between two walls at rest, all impacts elastic: there and back,
+/// T = 2 (x_A - x_C) / |v_B|. Empty for any other scene, and for a run shorter than
+/// kPeriodsToFold periods (drawn as it is).
+std::optional<double> periodOf(const RunRecord& run) {
+  const auto& in = run.input();
+  const bool elastic = std::all_of(in.restitution.begin(), in.restitution.end(), [](double e) { return e == 1.0; });
+  if (run.bodies() != 3 || !run.isWall(0) || !run.isWall(2) || run.isWall(1) || !elastic) return std::nullopt;
+  if (in.velocities[0] != 0 || in.velocities[2] != 0 || in.velocities[1] == 0) return std::nullopt;
+  const double period = 2 * (in.positions[0] - in.positions[2]) / std::abs(in.velocities[1]);
+  if (!(period > 0) || !(endTime(run) > kPeriodsToFold * period)) return std::nullopt;
+  return period;
+}
+
+/// The x-t diagram's axes of a small scene: its whole time, or one period of a periodic motion.
+WorldAxes wholeRunAxes(const RunRecord& run) {
+  return WorldAxes{sceneAxis(run), periodOf(run).value_or(endTime(run))};
+}
+
 }  // namespace
 
 void drawWorldlines(const Canvas& c) {
@@ -129,12 +158,18 @@ void drawWorldlines(const Canvas& c) {
   const auto& tracked = c.run.trackedBodies();
   const bool large = largeScene(c.run);
   // Large scenes draw the worldlines up to now, every frame (drawWorldlinesCursor).
+  // A periodic motion: its first period, the rest repeats it (a thousand periods would
+  // fill the box with lines thinner than a pixel).
+  const std::optional<double> period = large ? std::nullopt : periodOf(c.run);
   if (!large) {
-    const WorldAxes axes{sceneAxis(c.run), endTime(c.run)};
+    const WorldAxes axes = wholeRunAxes(c.run);
     const SceneState last = stateAt(c.run, axes.end);
     for (std::size_t k = 0; k < tracked.size(); ++k) {
       const std::size_t i = tracked[k];
-      Polyline poly = c.run.worldline(i).polyline();
+      Polyline poly;
+      for (const auto& v : c.run.worldline(i).polyline()) {
+        if (v.x < axes.end) poly.push_back(v);
+      }
       poly.push_back({last.time, last.positions[i], 0.0});
       addWorldline(c, ns::kWorldlines, kWorldLines + static_cast<int>(k), i, poly, axes);
     }
@@ -151,14 +186,25 @@ void drawWorldlines(const Canvas& c) {
               " bodies, coloured by v at the start";
   }
   // One line: a second would run into the "t [s]" label over the box.
-  if (ghostScene(c.run)) legend += ";  grey: ghosts x_i + v_i t, passing through each other";
+  if (ghostScene(c.run)) legend += ";  grey dashes: ghosts x_i + v_i t, passing through";
+  if (period) legend = format("periodic: one period drawn, T = %.4g s; now at t mod T", *period);
   c.add(c.text(ns::kWorldlines, kWorldLegend, b.midX(), kLegendY, legend, kSmallTextSize, color(kLabelGrey)));
 }
 
 void drawWorldlinesCursor(const Canvas& c, const SceneState& state) {
   const bool large = largeScene(c.run);
   std::vector<Polyline> lines;
-  const WorldAxes world = large ? axesUpToNow(c.run, state, lines) : WorldAxes{sceneAxis(c.run), endTime(c.run)};
+  const WorldAxes world = large ? axesUpToNow(c.run, state, lines) : wholeRunAxes(c.run);
+  const std::optional<double> period = large ? std::nullopt : periodOf(c.run);
+  // A periodic motion: now within its period, and how many periods are behind.
+  const double t_now = period ? std::fmod(state.time, *period) : state.time;
+  if (period) {
+    c.add(c.text(ns::kWorldlinesNow, kWorldNowPeriods, kWorldBox.midX(), kLegendY + kWorldPeriodsDy,
+                 "periods so far: " + withSeparators(static_cast<std::uint64_t>(state.time / *period)), kSmallTextSize,
+                 color(kLabelGrey)));
+  } else {
+    c.add(deleteMarker(ns::kWorldlinesNow, kWorldNowPeriods, c.frame_id));
+  }
   if (large) {
     for (std::size_t k = 0; k < lines.size(); ++k) {
       addWorldline(c, ns::kWorldlinesNow, kWorldNowLines + static_cast<int>(k), c.run.trackedBodies()[k],
@@ -168,11 +214,11 @@ void drawWorldlinesCursor(const Canvas& c, const SceneState& state) {
     addWorldRange(c, ns::kWorldlinesNow, kWorldNowTimeEnd, kWorldNowPositionMin, kWorldNowPositionMax, world);
   }
   Marker now = c.lines(ns::kWorldlinesNow, kWorldNowLine, Marker::LINE_LIST, kCursorWidth, color(kCursorWhite));
-  now.points = {point(kWorldBox.left, world.toY(state.time)), point(kWorldBox.right, world.toY(state.time))};
+  now.points = {point(kWorldBox.left, world.toY(t_now)), point(kWorldBox.right, world.toY(t_now))};
   c.add(now);
   Marker bodies = c.dots(ns::kWorldlinesNow, kWorldNowBodies, kWorldNowDotSize, color(kWhite));
   for (std::size_t i : c.run.trackedBodies()) {
-    bodies.points.push_back(point(world.toX(state.positions[i]), world.toY(state.time), kDotZ));
+    bodies.points.push_back(point(world.toX(state.positions[i]), world.toY(t_now), kDotZ));
   }
   c.add(bodies);
 }

@@ -37,6 +37,10 @@ std_msgs::ColorRGBA velocityColor(double v, double v_max);
 std::string bodyName(std::size_t i);
 geometry_msgs::Point point(double x, double y, double z = 0.0);
 std::string format(const char* fmt, double value);
+/// value with its sign always written: "+1.12", "-1.12", "0". rviz's font has no proper
+/// minus (U+2212 and the dashes are not drawn) and draws '-' a few pixels wide; beside the
+/// '+' of the positive values it still reads as a sign.
+std::string withSign(const char* fmt, double value);
 /// 31415 -> "31,415".
 std::string withSeparators(std::uint64_t n);
 /// The longest line of s and the number of its lines [characters, lines].

@@ -145,6 +145,7 @@ enum MarkerId : int {
   kWorldNowLine = 0,
   kWorldNowBodies = 1,
   kWorldNowTimeEnd = 2,   ///< large scenes: the axes' ends, up to now
+  kWorldNowPeriods = 3,   ///< a periodic motion: the periods so far
   kWorldNowPositionMin = 4,
   kWorldNowPositionMax = 5,
   kWorldNowLines = 10,    ///< large scenes: + tracked body's slot

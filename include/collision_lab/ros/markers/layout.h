@@ -24,6 +24,8 @@ struct Rgba {
 namespace layout {
 
 // ---- rows and panels ----
+/// What rviz/collision_lab.rviz shows: texts are kept inside it.
+constexpr Box kScreen{-10.7, 16.3, -6.8, 8.5};
 constexpr double kCentreX = 2.8;
 constexpr double kTitleY = 8.25, kNoteY = 7.8, kStatusY = 7.35, kVelocityRowY = 6.9;
 constexpr double kSceneY = 6.05, kSceneLeft = -10.2, kSceneRight = 15.8, kZoomY = 5.05;
@@ -99,9 +101,14 @@ constexpr std::size_t kMaxPredictedDots = 200;
 
 // ---- the scene and its magnifier ----
 constexpr double kSceneLabelDx = 0.9, kSceneLabelDy = -0.5;
+constexpr double kWallLabelDy = 0.25;  ///< an end label under a wall, from the wall's foot
 constexpr double kSmallestBody = 0.35, kBodyGrowth = 0.55;  ///< diameter over the mass decades
 constexpr double kWallWidth = 0.2, kWallHeight = 1.8, kWallDepth = 0.3;
 constexpr double kWallTagDx = 0.8, kTagDy = 0.5;
+/// Tags of bodies close together: at least this far apart, moved sideways by at most this
+/// many tag widths.
+constexpr double kTagGap = 0.08;
+constexpr int kTagMaxSteps = 4;
 constexpr double kVelocityRowPitch = 6.8;
 /// The magnifier shows while the bodies are closer than this share of the scene's axis.
 constexpr double kCrowded = 0.05;
@@ -154,24 +161,37 @@ constexpr double kProfileDotSize = 0.16;
 constexpr double kWallLineWidth = 0.08, kBodyLineWidth = 0.03;
 constexpr double kWorldZeroDx = -0.3, kWorldEndDx = -0.55, kWorldUnitDx = -0.45, kWorldUnitDy = 0.3;
 constexpr double kWorldPositionDy = -0.3;
+constexpr double kWorldPeriodsDy = -0.35;  ///< the periods so far, under the legend
+/// A periodic motion is drawn over one period once the run lasts this many periods.
+constexpr double kPeriodsToFold = 2.0;
 /// Large scenes: "x range: the bodies now" under the scene's right end label.
 constexpr double kSceneRangeNoteDx = -2.0, kSceneRangeNoteDy = -0.85;
 /// Large scenes: a worldline drawn up to now keeps first, lowest, highest, last x per row.
 constexpr int kWorldRows = 240;
 constexpr double kWorldNowDotSize = 0.16;
-constexpr double kGhostWidth = 0.015;
-constexpr Rgba kGhostGrey{0.75, 0.75, 0.75, 0.6};
+/// The ghosts' dashes lie over the worldlines: a dash and a gap every kGhostDashPeriod,
+/// the dash taking kGhostDashShare of it.
+constexpr double kGhostWidth = 0.03, kGhostZ = 0.03, kGhostDashPeriod = 0.3, kGhostDashShare = 0.5;
+constexpr Rgba kGhostGrey{0.8, 0.8, 0.8};
 
 // ---- the kinetic energy bars ----
 constexpr double kBarNameDy = -0.3, kBarsTitleDy = 0.75;
 constexpr double kBarWidth = 0.6;  ///< share of the pitch
-constexpr double kBarMinHeight = 0.01, kBarDepth = 0.1, kBarValueDy = 0.25;
+constexpr double kBarMinHeight = 0.01, kBarDepth = 0.1, kBarValueDy = 0.25, kBarValueStagger = 0.32;
 
 // ---- framed texts (banner, hint) ----
 /// rviz's font is about 0.42 text heights wide per character, 1.25 high per line.
 constexpr double kHalfCharWidth = 0.21, kHalfLineHeight = 0.62;
 constexpr double kFrameMarginX = 0.4, kFrameMarginY = 0.2, kMaxHalfFrameWidth = 13.0;
 constexpr double kFramedBoxWidth = 0.03;
+/// A framed text's panel is this much wider than the usual estimate of its text: capitals
+/// (REJECTED, reason names) are wider than the average character.
+constexpr double kFramedWidthFactor = 1.2;
+/// The panels lie over every view (bodies reach z = 0.45), their texts over the panels.
+constexpr double kOverlayZ = 1.0, kOverlayTextDz = 0.1;
+constexpr Rgba kOverlayBackground{0.12, 0.125, 0.157};  ///< rviz's background (30, 32, 40)
+/// The rejection banner's bottom edge: over the panels' titles, growing up over the scene.
+constexpr double kBannerBottomY = kPanelTitleY + 0.3;
 
 }  // namespace layout
 }  // namespace collision_lab_ros::markers
