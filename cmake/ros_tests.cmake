@@ -42,6 +42,7 @@ target_compile_definitions(crash_test PRIVATE COLLISION_LAB_NODE_PATH="$<TARGET_
 find_package(roslaunch REQUIRED)
 file(GLOB collision_lab_LAUNCH_FILES RELATIVE ${PROJECT_SOURCE_DIR} ${PROJECT_SOURCE_DIR}/launch/*.launch)
 foreach(launch_file ${collision_lab_LAUNCH_FILES})
-  roslaunch_add_file_check(${launch_file}
+  # student.launch needs a student: its default is $(env COLLISION_LAB_STUDENT).
+  roslaunch_add_file_check(${launch_file} COLLISION_LAB_STUDENT=ana
     DEPENDENCIES collision_lab_node collision_lab_markers scenario_publisher)
 endforeach()
