@@ -96,6 +96,7 @@ struct RawOptions {
   std::string max_collisions, events, format = "table", precision = "double", mode = "full";
   std::string scenario, name;
   bool list = false;
+  bool simulate_to_cap = false;
   bool masses_given = false, positions_given = false, velocities_given = false, bodies_given = false;
   bool restitution_given = false;
   bool max_collisions_given = false, events_given = false, scenario_given = false, name_given = false;
@@ -119,6 +120,7 @@ void readRunOptions(const RawOptions& raw, CliRequest& request) {
     throw makeCliError(CliReason::kInvalidOption, "mode", "'" + raw.mode + "' is not full, predict or summary");
   }
   request.options.mode = *mode;
+  request.simulate_to_cap = raw.simulate_to_cap;
   if (raw.max_collisions_given) {
     const io::ParsedCount cap = io::parseCount(raw.max_collisions);
     if (!cap.problem.empty()) {
@@ -231,6 +233,9 @@ void declareOptions(CLI::App& app, RawOptions& raw) {
       "--restitution", raw.restitution, "e in [0,1] for every pair, or e_AB,e_BC,... one per pair (default 1: elastic)");
   app.add_option(
       "--max-collisions", raw.max_collisions, "stop after N collisions and mark the run truncated (default 10000000)");
+  app.add_flag("--simulate-to-cap", raw.simulate_to_cap,
+               "simulate up to --max-collisions even when the model predicts more (default: the model answers at "
+               "once; two walls: 1000 impacts shown)");
   app.add_option(
       "--events", raw.events, "events to print: all|none|first:N (default all; none when running every scenario)");
   app.add_option("--format", raw.format, "table|json|csv (default table)");

@@ -43,6 +43,9 @@ struct CliRequest {
   io::ReportFormat format = io::ReportFormat::kTable;
   core::RunOptions options;
   bool max_collisions_given = false;  ///< else a scenario's own cap applies, if it has one
+  /// --simulate-to-cap: simulate up to the cap even when the model predicts more impacts
+  /// (core::SceneRunOptions::simulate_to_cap).
+  bool simulate_to_cap = false;
   std::string scenario_path;          ///< for kList, kRunAll, and kRunOne from a file
   std::string scenario_name;          ///< kRunOne from a file
   std::optional<core::Scene> scene;   ///< kRunOne from --masses/--positions/--velocities or --bodies

@@ -61,10 +61,11 @@ core::RunOptions optionsFor(const CliRequest& request, const io::SceneEntry& ent
 
 /// Runs a validated scene with a progress line on a terminal and Ctrl-C for the engine.
 /// `visitors` see the shown events; the run itself keeps none.
-core::SceneRunResult runWithProgress(const core::Scene& scene, const core::RunOptions& shown,
+core::SceneRunResult runWithProgress(const core::Scene& scene, const core::RunOptions& shown, bool simulate_to_cap,
                                      core::SceneVisitors visitors) {
   core::SceneRunOptions options;
   options.lab = shown;
+  options.simulate_to_cap = simulate_to_cap;
   options.keep_events = false;  // streamed to the report, not kept
   options.cancel = &g_cancel;
   std::optional<ProgressLine> progress;
@@ -84,13 +85,6 @@ core::SceneRunResult runWithProgress(const core::Scene& scene, const core::RunOp
   return core::runScene(scene, options, visitors);
 }
 
-/// The policy counts impacts. Under first:N a collapse is shown when it comes before impact
-/// N + 1 (so right after impact N at the latest), as the impacts around it would be.
-bool showsCollapse(const core::EventPolicy& policy, const core::Collapse& collapse) {
-  return policy.kind == core::EventPolicy::Kind::kAll ||
-         (policy.kind == core::EventPolicy::Kind::kFirstN && collapse.impacts_before <= policy.first_n);
-}
-
 /// The visitors that hand the shown events to the writer of their path.
 core::SceneVisitors showEvents(const core::RunOptions& shown, io::RunReportWriter& three_body,
                                io::SceneReportWriter& nbody) {
@@ -104,7 +98,7 @@ core::SceneVisitors showEvents(const core::RunOptions& shown, io::RunReportWrite
     if (policy.keeps(impact.index)) nbody.impact(impact);
   };
   visitors.collapse = [&nbody, policy](const core::Collapse& collapse) {
-    if (showsCollapse(policy, collapse)) nbody.collapse(collapse);
+    if (policy.keepsAfter(collapse.impacts_before)) nbody.collapse(collapse);
   };
   // The event engine runs to the end even when only the first N impacts are shown.
   return visitors;
@@ -126,7 +120,8 @@ void runEntry(const CliRequest& request, const io::SceneEntry& given) {
   } else {
     nbody->begin(entry, shown, model);
   }
-  const core::SceneRunResult result = runWithProgress(entry.scene, shown, showEvents(shown, *three_body, *nbody));
+  const core::SceneRunResult result =
+      runWithProgress(entry.scene, shown, request.simulate_to_cap, showEvents(shown, *three_body, *nbody));
   if (is_three_body) {
     three_body->end(*result.three_body);
   } else {
@@ -143,7 +138,8 @@ void runEntries(const CliRequest& request, const std::vector<io::SceneEntry>& gi
   for (const io::SceneEntry& entry : entries) {
     const core::RunOptions options = optionsFor(request, entry);
     core::SceneRunOptions run_options;
-    run_options.lab = options;  // the three-body path keeps the events that the options ask for
+    run_options.lab = options;  // the run keeps the events that the options ask for
+    run_options.simulate_to_cap = request.simulate_to_cap;
     run_options.cancel = &g_cancel;
     outcomes.push_back({entry, options, core::runScene(entry.scene, run_options)});
   }

@@ -172,21 +172,15 @@ class EnergyNormError {
   double initial_norm_ = 1.0;
 };
 
-/// The summary of a run that was not simulated: the closed form answers, and nothing was
-/// measured. `skipped`: over the cap, rather than predict-only.
-void describeNotSimulated(const RunOptions& options, bool skipped, RunResult& result) {
+/// The summary of a run that was not simulated (predict-only, or over the cap): the closed
+/// form answers with its count and final state, complete, and nothing was measured.
+void describeNotSimulated(RunResult& result) {
   LabRunSummary& summary = result.summary;
-  summary.collision_count = skipped ? 0 : result.prediction.collision_count;
+  summary.collision_count = result.prediction.collision_count;
   summary.final_velocities = result.prediction.final_velocities;
   summary.max_prediction_error = kNotMeasured;
   summary.energy_relative_drift = kNotMeasured;
   summary.momentum_relative_drift = kNotMeasured;
-  if (skipped) {
-    summary.truncated = true;
-    summary.truncation_reason = "predicted " + std::to_string(result.prediction.collision_count) +
-                                " collisions exceed max_collisions = " + std::to_string(options.max_collisions) +
-                                "; not simulated";
-  }
 }
 
 /// Simulated collisions beside the closed form and the paper's printed formulas, in turn.
@@ -293,7 +287,7 @@ RunResult runLab(const ThreeBodyScene& scene, const RunOptions& options, const A
   const bool over_cap = result.prediction.collision_count > options.max_collisions;
   const bool skipped = options.mode != RunMode::kPredictOnly && over_cap && options.skip_simulation_over_cap;
   if (options.mode == RunMode::kPredictOnly || skipped) {
-    describeNotSimulated(options, skipped, result);
+    describeNotSimulated(result);
   } else {
     simulateBesidePrediction(scene, options, visitor, result);
   }

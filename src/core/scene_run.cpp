@@ -19,7 +19,8 @@ bool isElasticTriple(const Scene& scene) {
          scene.restitution.size() <= 2 && allOnes(scene.restitution);
 }
 
-/// What the closed form alone says, for a finite prediction that no event needs checking.
+/// What the closed form alone says, for a finite prediction that no event needs checking
+/// (or that is over the cap).
 SceneSimulation fromPrediction(const Prediction& prediction) {
   SceneSimulation simulation;
   simulation.impact_count = prediction.impact_count.value_or(0);
@@ -79,26 +80,52 @@ SceneSimulation fromEngine(EngineResult&& engine) {
   return simulation;
 }
 
+/// The over-cap rule: the model's count exceeds the cap, so the model answers alone.
+SceneSimulation overCap(const Prediction& prediction, std::uint64_t cap) {
+  SceneSimulation simulation = fromPrediction(prediction);
+  simulation.stop_message = std::string("answered by the closed form of ") + modelKindName(prediction.kind) + ": " +
+                            std::to_string(*prediction.impact_count) + " impacts predicted, more than the cap of " +
+                            std::to_string(cap) + "; nothing simulated (simulating up to the cap must be asked for)";
+  return simulation;
+}
+
 /// The engine's run of an N-body scene, compared with a finite prediction when it finished.
+/// With options.keep_events, the shown impacts are kept in simulation.impacts.
 SceneSimulation simulateScene(const Scene& scene, const SceneRunOptions& options,
                               const std::optional<Prediction>& prediction, const SceneVisitors& visitors) {
   const RunOptions& lab = options.lab;
   if (lab.mode == RunMode::kPredictOnly) {
     return prediction && !prediction->infinite ? fromPrediction(*prediction) : notSimulated(prediction);
   }
+  const bool over_cap = prediction && prediction->impact_count && *prediction->impact_count > lab.max_collisions;
+  if (over_cap && !options.simulate_to_cap) return overCap(*prediction, lab.max_collisions);
   const bool wants_events = lab.mode == RunMode::kFull && lab.events.kind != EventPolicy::Kind::kNone;
   // Nothing approaching: there is nothing to simulate, events or not.
   const bool nothing_happens = prediction && prediction->kind == ModelKind::kNoCollisions;
-  if (prediction && !prediction->infinite && (!wants_events || nothing_happens)) return fromPrediction(*prediction);
+  if (prediction && !prediction->infinite && !over_cap && (!wants_events || nothing_happens)) {
+    return fromPrediction(*prediction);
+  }
 
   EngineOptions engine_options;
   engine_options.max_impacts = lab.max_collisions;
+  // Impacts that never end are shown, not counted: a display's worth unless asked for more.
+  if (prediction && prediction->kind == ModelKind::kTwoWallsInfinite && !options.simulate_to_cap) {
+    engine_options.max_impacts = std::min(lab.max_collisions, kInfiniteRunDisplayCap);
+  }
   engine_options.progress_interval = options.progress_interval;
   engine_options.cancel = options.cancel;
   const bool full = lab.mode == RunMode::kFull;
-  SceneSimulation simulation =
-      fromEngine(runEngine(scene, engine_options, full ? visitors.impact : ImpactVisitor{}, visitors.progress,
-                           full ? visitors.collapse : CollapseVisitor{}));
+  std::vector<ImpactRecord> kept;
+  ImpactVisitor on_impact = full ? visitors.impact : ImpactVisitor{};
+  if (full && options.keep_events && lab.events.kind != EventPolicy::Kind::kNone) {
+    on_impact = [&kept, &visitors, &lab](const ImpactRecord& impact) {
+      if (visitors.impact) visitors.impact(impact);
+      if (lab.events.keeps(impact.index)) kept.push_back(impact);
+    };
+  }
+  SceneSimulation simulation = fromEngine(
+      runEngine(scene, engine_options, on_impact, visitors.progress, full ? visitors.collapse : CollapseVisitor{}));
+  simulation.impacts = std::move(kept);
   if (prediction && prediction->impact_count && simulation.stop == StopReason::kFinished) {
     simulation.max_prediction_error =
         relativeVelocityError(simulation.final_velocities, prediction->final_velocities, scene.velocities);
@@ -119,15 +146,7 @@ ThreeBodyScene toThreeBodyScene(const Scene& scene) {
   return triple;
 }
 
-std::optional<ValidationError> validateForRun(const Scene& scene) {
-  if (isElasticTriple(scene)) {
-    auto error = validate(toThreeBodyScene(scene));
-    if (!error) return error;  // the three-body path takes it, whatever N-body limits say
-    // Walls at both ends around a body are an N-body scene now (two_walls_infinite).
-    if (error->reason != Reason::kTwoWalls) return error;
-  }
-  return validate(scene);
-}
+std::optional<ValidationError> validateForRun(const Scene& scene) { return validate(scene); }
 
 bool usesThreeBodyPath(const Scene& scene) {
   return isElasticTriple(scene) && !validate(toThreeBodyScene(scene));
@@ -140,6 +159,7 @@ SceneRunResult runScene(const Scene& scene, const SceneRunOptions& options, cons
   if (usesThreeBodyPath(scene)) {
     RunOptions lab = options.lab;
     if (!options.keep_events) lab.events = EventPolicy::none();
+    lab.skip_simulation_over_cap = !options.simulate_to_cap;
     lab.cancel = options.cancel;
     result.three_body = runLab(toThreeBodyScene(scene), lab, visitors.three_body_event);
   } else {

@@ -114,6 +114,10 @@ class TableWriter : public RunReportWriter {
                                                      : humanText(s.momentum_relative_drift, 3))
            << "\n";
     }
+    if (!s.simulated) {
+      out_ << "not simulated: the closed form answers (predict-only, or more collisions predicted than the cap; "
+              "--simulate-to-cap simulates up to it)\n";
+    }
     out_ << "truncated: " << (s.truncated ? "yes, " + s.truncation_reason : std::string("no")) << "\n";
     out_ << "precision: " << s.escalation.decisions << " decisions, " << s.escalation.high_precision
          << " taken at 100 digits or more, " << s.escalation.exact_rational << " by exact rationals; compute time "
@@ -419,6 +423,7 @@ Json eventJson(const core::LabEvent& lab) {
   const core::ImpactEvent& e = lab.event;
   return Json{{"index", e.index},
               {"pair", core::pairName(e.pair)},
+              {"pair_index", core::pairIndex(e.pair)},
               {"time", number(e.time)},
               {"position", number(e.position)},
               {"positions", array3(e.positions)},
@@ -443,7 +448,8 @@ void writeEventJson(TextSink& sink, const core::LabEvent& lab) {
   sink.count(e.index);
   sink.put(",\"pair\":\"");
   sink.put(core::pairName(e.pair));
-  sink.put('"');
+  sink.put("\",\"pair_index\":");
+  sink.count(static_cast<std::uint64_t>(core::pairIndex(e.pair)));
   sink.jsonField(",\"time\":", e.time);
   sink.jsonField(",\"position\":", e.position);
   sink.jsonArray(",\"positions\":", e.positions);

@@ -262,7 +262,7 @@ Json summaryScalars(const core::SceneRunResult& result) {
   const bool has_formula = p && (p->impact_count || p->infinite);
   Json json{{"model", core::modelKindName(result.model.kind)},
             {"model_reason", result.model.reason},
-            {"collision_count", s.simulated ? Json(s.impact_count) : Json(nullptr)},
+            {"collision_count", s.simulated || (p && p->impact_count) ? Json(s.impact_count) : Json(nullptr)},
             {"simulated", s.simulated},
             {"truncated", s.truncated},
             {"stop_reason", stopReasonText(s)},
@@ -562,13 +562,13 @@ BatchRow batchRow(const SceneBatchOutcome& outcome) {
   BatchRow row{outcome.entry.name, core::modelKindName(r.model.kind), outcome.entry.scene.size(), "-", "-", false, 0.0};
   if (r.three_body) {
     const core::LabRunSummary& s = r.three_body->summary;
-    if (s.simulated) row.simulated = std::to_string(s.collision_count);
+    row.simulated = std::to_string(s.collision_count);
     row.predicted = std::to_string(r.three_body->prediction.collision_count);
     row.truncated = s.truncated;
     return row;
   }
   const core::SceneSimulation& s = r.simulation;
-  if (s.simulated) row.simulated = std::to_string(s.impact_count);
+  if (s.simulated || (r.prediction && r.prediction->impact_count)) row.simulated = std::to_string(s.impact_count);
   if (r.prediction && r.prediction->infinite) row.predicted = "inf";
   if (r.prediction && r.prediction->impact_count) row.predicted = std::to_string(*r.prediction->impact_count);
   row.truncated = s.truncated;
@@ -587,7 +587,8 @@ void writeSceneBatchTable(const std::vector<SceneBatchOutcome>& outcomes, std::o
         << padLeft(row.simulated, 12) << padLeft(row.predicted, 12) << padLeft(humanText(row.energy_lost, 6), 17)
         << "  " << (row.truncated ? "yes" : "no") << "\n";
   }
-  out << "\ncollisions: simulated (- when a closed form answered alone); predicted: the model's closed form "
+  out << "\ncollisions: the run's answer, simulated or from the model (- when neither gives one); predicted: the "
+         "model's closed form "
          "(- when none exists, inf for infinitely many)\n";
 }
 
@@ -616,6 +617,21 @@ void writeSceneBatchJson(const std::vector<SceneBatchOutcome>& outcomes, std::os
       entry["summary"]["model"] = core::modelKindName(r.model.kind);
       entry["summary"]["model_reason"] = r.model.reason;
     } else {
+      // The kept impacts, each collapse after the impact it follows (as the stream shows them).
+      std::size_t next_collapse = 0;
+      const auto collapsesUpTo = [&](std::uint64_t impacts) {
+        for (; next_collapse < r.simulation.collapses.size() &&
+               r.simulation.collapses[next_collapse].impacts_before <= impacts;
+             ++next_collapse) {
+          const core::Collapse& c = r.simulation.collapses[next_collapse];
+          if (outcome.options.events.keepsAfter(c.impacts_before)) entry["events"].push_back(collapseJson(c));
+        }
+      };
+      for (const core::ImpactRecord& impact : r.simulation.impacts) {
+        collapsesUpTo(impact.index - 1);
+        entry["events"].push_back(impactJson(impact));
+      }
+      collapsesUpTo(r.simulation.impact_count);
       entry["summary"] = sceneSummaryJson(r);
     }
     out << (first ? "\n" : ",\n") << jsonText(entry);
@@ -684,6 +700,7 @@ std::unique_ptr<RunReportWriter> makeThreeBodyReportWriter(ReportFormat format, 
 }
 
 void writeSceneBatchReport(ReportFormat format, const std::vector<SceneBatchOutcome>& outcomes, std::ostream& out) {
+  if (format == ReportFormat::kCsv) return writeSceneBatchCsv(outcomes, out);  // one header, whatever the scenes
   const bool all_three_body = std::all_of(outcomes.begin(), outcomes.end(),
                                           [](const SceneBatchOutcome& o) { return o.result.three_body.has_value(); });
   if (all_three_body) {

@@ -327,6 +327,7 @@ LabNodeParams LabNodeParams::load(const ros::NodeHandle& private_nh) {
   private_nh.param("bag_directory", params.bag_directory, defaultBagDirectory());
   params.bag_directory = expandUser(params.bag_directory);
   params.max_collisions = getUint64(private_nh, "max_collisions", kDefaultMaxCollisions);
+  private_nh.param("simulate_to_cap", params.simulate_to_cap, false);
   params.max_published_events =
       getUint64(private_nh, "max_published_events", kDefaultMaxPublishedEvents);
   private_nh.param("publish_markers", params.publish_markers, true);
@@ -675,7 +676,7 @@ void LabNode::run(collision_lab::InitialConditions& input, const std::string& re
   // scene simulated too (its events are published), as the CLI does when it shows events.
   options.lab.events = mode == core::RunMode::kFull ? core::EventPolicy::all() : core::EventPolicy::none();
   options.lab.mode = mode;
-  options.lab.skip_simulation_over_cap = true;
+  options.simulate_to_cap = params_.simulate_to_cap;  // else the model answers over the cap (runScene)
   options.keep_events = false;
   options.cancel = &cancel_;
   EventStream events(topics_, out, marker_view_.get(), params_.max_published_events, scene);

@@ -495,7 +495,7 @@ collision_lab::RunSummary toRunSummaryMsg(const core::SceneRunResult& result, st
   }
   const core::SceneSimulation& s = result.simulation;
   collision_lab::RunSummary msg = modelSummary(result.model, body_count, mode);
-  msg.collision_count = s.simulated ? s.impact_count : 0;
+  msg.collision_count = s.impact_count;  // the run's answer, simulated or from the model
   msg.truncated = s.truncated;
   msg.truncation_reason = s.truncated ? s.stop_message : std::string();
   msg.cancelled = s.simulated && s.stop == core::StopReason::kCancelled;

@@ -136,6 +136,7 @@ TEST(BadInputCatalogue, HasTwentyRowsAndEveryReasonCode) {
   // size, issue 10) ...
   namespace core = collision_lab::core;
   for (int code = 1; code <= static_cast<int>(core::Reason::kWallNotAtEnd); ++code) {
+    if (code == static_cast<int>(core::Reason::kInfiniteMiddleMass)) continue;  // no longer given (issue 20)
     const std::string name = core::reasonName(static_cast<core::Reason>(code));
     EXPECT_EQ(reasons.count(name), 1u) << "no catalogue row for " << name;
   }

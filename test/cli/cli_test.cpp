@@ -183,7 +183,7 @@ TEST(CliEvents, FirstNKeepsTheFirstN) {
 }
 
 TEST(CliEvents, CapTruncatesTheRunButNotThePrediction) {
-  const Json doc = runPreset("pi_digits_3", {"--max-collisions", "100", "--events", "none"});
+  const Json doc = runPreset("pi_digits_3", {"--max-collisions", "100", "--simulate-to-cap", "--events", "none"});
   const Json& summary = doc.at("summary");
   EXPECT_EQ(summary.at("collision_count"), 100);
   EXPECT_EQ(summary.at("truncated"), true);

@@ -15,6 +15,8 @@
 #include <string>
 #include <vector>
 
+#include <boost/math/constants/constants.hpp>
+#include <boost/multiprecision/cpp_bin_float.hpp>
 #include <nlohmann/json.hpp>
 
 #include "cli_json.h"
@@ -378,6 +380,186 @@ TEST(NBodyCli, NearCollapseAndCollapseOfThreeEqualMasses) {
   EXPECT_GT(t_c, collapse.at("events").at(7).at("time").get<double>());
   EXPECT_NEAR(summary.at("collapse_position").get<double>(), 1 - t_c / 3, 1e-12);
   EXPECT_TRUE(summary.at("spiral_angle").is_null());  // real eigenvalues: no spiral
+}
+
+// ---- One scene, one run (issue 20): one validation, one answer field, one over-cap rule ----
+
+/// The stderr line of a rejected scene.
+std::string rejection(const std::vector<std::string>& args) {
+  const CliOutput result = run(args);
+  EXPECT_EQ(result.exit_code, 2) << result.err;
+  EXPECT_EQ(result.out, "");
+  return result.err;
+}
+
+// A wall in the middle has one reason whatever e and N: was INFINITE_MIDDLE_MASS for three
+// elastic bodies and WALL_NOT_AT_END at e = 0.5 (failed before).
+TEST(OneValidation, AWallInTheMiddleHasOneReasonWhateverEAndN) {
+  const std::string expected =
+      "collision_lab_cli: invalid masses[1] (WALL_NOT_AT_END): the mass of B is inf, but a wall may only be the "
+      "first or the last body; give it a finite mass in kg\n";
+  const std::vector<std::string> three = {"--masses", "1,inf,1", "--positions", "2,1,0", "--velocities", "-1,0,0"};
+  EXPECT_EQ(rejection(three), expected);
+  std::vector<std::string> inelastic = three;
+  inelastic.insert(inelastic.end(), {"--restitution", "0.5"});
+  EXPECT_EQ(rejection(inelastic), expected);
+  EXPECT_EQ(rejection({"--masses", "1,inf,1,1", "--positions", "3,2,1,0", "--velocities", "-1,0,0,0"}), expected);
+}
+
+// Four equal masses whose first contact comes at t = 1 / 1e-310 s > 1.8e308 s: a clear
+// OVERFLOW as for three (failed before: "internal error: Divide by zero", exit 1).
+TEST(OneValidation, AFirstContactBeyondTheLargestDoubleIsOverflowForEveryN) {
+  const std::string expected =
+      "collision_lab_cli: invalid positions (OVERFLOW): the first contact, of A and B, would come at t = 1e+310 s, "
+      "beyond the largest double (1.8e+308); a longer unit of time brings it into range\n";
+  EXPECT_EQ(rejection({"--masses", "1,1,1", "--positions", "2,1,0", "--velocities", "-1e-310,0,0"}), expected);
+  EXPECT_EQ(rejection({"--masses", "1,1,1,1", "--positions", "3,2,1,0", "--velocities", "-1e-310,0,0,0"}), expected);
+}
+
+// A body moving away from a wall: nothing collides, and the answer is 0, not null
+// (failed before: collision_count null beside predicted_collision_count 0).
+TEST(OneAnswer, NothingCollidingCountsZero) {
+  const Json doc = runJson({"--masses", "inf,1", "--positions", "1,0", "--velocities", "0,-1"});
+  const Json& summary = doc.at("summary");
+  EXPECT_EQ(summary.at("model"), "no_collisions");
+  EXPECT_EQ(summary.at("simulated"), false);
+  EXPECT_EQ(summary.at("collision_count"), 0);
+  EXPECT_EQ(summary.at("predicted_collision_count"), 0);
+}
+
+// A file with a three-body scene and a cradle, every event asked for: each scene keeps its
+// events (failed before: the cradle's 3 were lost). Equal masses 1 m apart, the right one at
+// -1 m/s: the velocity passes on at t = 1, 2 (three bodies) and 1, 2, 3 s (four).
+TEST(OneRun, ABatchKeepsTheEventsOfEveryScene) {
+  const TempFile file(
+      "three:\n  masses: [1, 1, 1]\n  positions: [2, 1, 0]\n  velocities: [-1, 0, 0]\n"
+      "cradle:\n  masses: [1, 1, 1, 1]\n  positions: [3, 2, 1, 0]\n  velocities: [-1, 0, 0, 0]\n");
+  const Json doc = runJson({"--scenario", file.path(), "--events", "all"});
+  const Json& scenes = doc.at("scenarios");
+  ASSERT_EQ(scenes.size(), 2u);
+  for (std::size_t s = 0; s < 2; ++s) {
+    const Json& events = scenes[s].at("events");
+    ASSERT_EQ(events.size(), s + 2) << "scene " << s;
+    for (std::size_t k = 0; k < events.size(); ++k) {
+      EXPECT_EQ(events[k].at("time"), static_cast<double>(k + 1));
+      EXPECT_EQ(events[k].at("pair_index"), k);
+    }
+    EXPECT_EQ(scenes[s].at("summary").at("collision_count"), s + 2);
+  }
+}
+
+// 10,000 equal masses with seeded velocities: the ghosts model predicts the inversions,
+// more than the default cap of 10^7, so the model answers at once, events asked for or not
+// (the final velocities are the initial ones sorted, fastest on the right).
+TEST(OverCap, TenThousandEqualMassesAreAnsweredByTheModel) {
+  const Bodies bodies = seededBodies(10000, 20, [](std::mt19937_64&) { return 1.0; });
+  const std::uint64_t inversions = inversionsByLoop(bodies.velocities);
+  ASSERT_GT(inversions, 10000000u);
+  std::vector<double> sorted = bodies.velocities;
+  std::sort(sorted.begin(), sorted.end(), std::greater<double>());
+  const TempFile file(bodiesCsv(bodies));
+  const Json doc = runJson({"--bodies", file.path()});
+  const Json& summary = doc.at("summary");
+  EXPECT_EQ(summary.at("model"), "ghosts");
+  EXPECT_EQ(summary.at("simulated"), false);
+  EXPECT_EQ(summary.at("truncated"), false);
+  EXPECT_EQ(summary.at("stop_reason"), "NOT_SIMULATED");
+  EXPECT_EQ(summary.at("collision_count"), inversions);
+  EXPECT_EQ(summary.at("predicted_collision_count"), inversions);
+  EXPECT_EQ(doubles(summary.at("final_velocities")), sorted);
+  EXPECT_TRUE(doc.at("events").empty());
+}
+
+// Galperin's billiard against a wall, m_B = 1 kg at rest and m_A = the double nearest 1e36
+// kg at -1 m/s: N = floor(pi / alpha) collisions, alpha = atan(sqrt(m_B / m_A)) (the largest
+// N with N alpha < pi; pi / alpha is irrational), about 3.14e18, here in 50 digits. Over the
+// cap, the closed form answers at once (failed before: simulated up to the cap, 10^7 events).
+// The end state, by physics: m_A v_A^2 + m_B v_B^2 = m_A (the wall at rest), and A moves
+// away from B (v_A >= v_B).
+TEST(OverCap, AThreeBodyRunOf3e18CollisionsIsAnsweredByTheModel) {
+  using Float50 = boost::multiprecision::cpp_bin_float_50;
+  const double m_a = 1e36;
+  const Float50 alpha = atan(sqrt(Float50(1) / Float50(m_a)));
+  const auto galperin = static_cast<std::uint64_t>(floor(boost::math::constants::pi<Float50>() / alpha));
+  ASSERT_GT(galperin, 3000000000000000000u);
+  const Json doc = runJson({"--masses", "1e36,1,inf", "--positions", "2,1,0", "--velocities", "-1,0,0"});
+  const Json& summary = doc.at("summary");
+  EXPECT_EQ(summary.at("model"), "three_body_rotation");
+  EXPECT_EQ(summary.at("simulated"), false);
+  EXPECT_EQ(summary.at("truncated"), false);
+  EXPECT_EQ(summary.at("collision_count"), galperin);
+  EXPECT_EQ(summary.at("predicted_collision_count"), galperin);
+  EXPECT_TRUE(doc.at("events").empty());
+  const std::vector<double> v = doubles(summary.at("final_velocities"));
+  ASSERT_EQ(v.size(), 3u);
+  EXPECT_NEAR(v[0] * v[0] + v[1] * v[1] / m_a, 1.0, 1e-12);
+  EXPECT_GE(v[0], v[1]);
+}
+
+// --simulate-to-cap asks for the simulation: 100 equal masses with seeded velocities have
+// more inversions (the plain loop counts them) than a cap of 100; asked, the engine
+// simulates 100 of them and marks the run truncated.
+TEST(OverCap, SimulateToCapSimulatesUpToTheCap) {
+  const Bodies bodies = seededBodies(100, 21, [](std::mt19937_64&) { return 1.0; });
+  const std::uint64_t inversions = inversionsByLoop(bodies.velocities);
+  ASSERT_GT(inversions, 100u);
+  const TempFile file(bodiesCsv(bodies));
+  const std::vector<std::string> scene = {"--bodies", file.path(), "--max-collisions", "100", "--events", "none"};
+  const Json answered = runJson(scene).at("summary");
+  EXPECT_EQ(answered.at("simulated"), false);
+  EXPECT_EQ(answered.at("collision_count"), inversions);
+  std::vector<std::string> asked = scene;
+  asked.push_back("--simulate-to-cap");
+  const Json simulated = runJson(asked).at("summary");
+  EXPECT_EQ(simulated.at("simulated"), true);
+  EXPECT_EQ(simulated.at("collision_count"), 100);
+  EXPECT_EQ(simulated.at("truncated"), true);
+  EXPECT_EQ(simulated.at("predicted_collision_count"), inversions);
+}
+
+// Two walls: infinitely many impacts, said at once; 1,000 are simulated for display, not
+// the cap of 10^7 (B between walls 2 m apart at 1 m/s hits a wall every 2 s from t = 1 s).
+TEST(OverCap, TwoWallsAreSimulatedForDisplayOnly) {
+  const Json doc = runJson({"--masses", "inf,1,inf", "--positions", "2,1,0", "--velocities", "0,1,0", "--events",
+                            "none"});
+  const Json& summary = doc.at("summary");
+  EXPECT_EQ(summary.at("predicted_infinite"), true);
+  EXPECT_EQ(summary.at("truncated"), true);
+  EXPECT_EQ(summary.at("collision_count"), 1000);
+  EXPECT_EQ(summary.at("final_time"), 1999.0);
+}
+
+// One event schema: a three-body event has pair_index as a four-body event does (failed
+// before: "pair" only). (1, 1, 1) at (2, 1, 0) m, A at -1 m/s: AB at t = 1 s, BC at 2 s.
+TEST(OneSchema, EveryEventHasItsPairIndex) {
+  const Json three = runJson({"--masses", "1,1,1", "--positions", "2,1,0", "--velocities", "-1,0,0"});
+  const Json four = runJson({"--masses", "1,1,1,1", "--positions", "3,2,1,0", "--velocities", "-1,0,0,0"});
+  for (const Json* doc : {&three, &four}) {
+    const Json& events = doc->at("events");
+    ASSERT_GE(events.size(), 2u);
+    EXPECT_EQ(events[0].at("pair"), "AB");
+    EXPECT_EQ(events[0].at("pair_index"), 0);
+    EXPECT_EQ(events[1].at("pair"), "BC");
+    EXPECT_EQ(events[1].at("pair_index"), 1);
+  }
+}
+
+// One batch CSV header whatever scenes a file holds (failed before: 15 columns for a file
+// of three-body scenes, 7 otherwise).
+TEST(OneSchema, TheBatchCsvHeaderIsTheSameWhateverTheScenes) {
+  const std::string header = "scenario,bodies,model,collision_count,predicted_collision_count,truncated,energy_lost_J";
+  const TempFile three("three:\n  masses: [1, 1, 1]\n  positions: [2, 1, 0]\n  velocities: [-1, 0, 0]\n");
+  const TempFile mixed(
+      "three:\n  masses: [1, 1, 1]\n  positions: [2, 1, 0]\n  velocities: [-1, 0, 0]\n"
+      "cradle:\n  masses: [1, 1, 1, 1]\n  positions: [3, 2, 1, 0]\n  velocities: [-1, 0, 0, 0]\n");
+  for (const TempFile* file : {&three, &mixed}) {
+    const CliOutput result = run({"--scenario", file->path(), "--format", "csv"});
+    ASSERT_EQ(result.exit_code, 0) << result.err;
+    const std::vector<std::string> lines = linesOf(result.out);
+    ASSERT_GE(lines.size(), 2u);
+    EXPECT_EQ(lines[0], header);
+    EXPECT_EQ(lines[1], "three,3,three_body_rotation,2,2,false,0");
+  }
 }
 
 }  // namespace

@@ -3,9 +3,11 @@
 // scenarios.yaml) and the exact rational reference of the core's tests
 // (test/core/nbody/reference.h, which shares no code with the engine), ~max_bodies,
 // N-body presets, and ~cancel of a run that would never end.
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <random>
@@ -13,6 +15,8 @@
 #include <thread>
 #include <vector>
 
+#include <boost/math/constants/constants.hpp>
+#include <boost/multiprecision/cpp_bin_float.hpp>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <rosbag/bag.h>
@@ -35,11 +39,12 @@ namespace reference = collision_lab::core::reference;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr char kRunPreset[] = "/collision_lab/collision_lab_node/run_preset";
-constexpr char kCancel[] = "/collision_lab/collision_lab_node/cancel";
+constexpr char kCancel[] = "/collision_lab_to_cap/collision_lab_node/cancel";
 
 std::string g_bag_directory;
 RunCollector* g_node = nullptr;   // namespace collision_lab
 RunCollector* g_small = nullptr;  // namespace collision_lab_small: ~max_bodies 4
+RunCollector* g_to_cap = nullptr;  // namespace collision_lab_to_cap: ~simulate_to_cap true
 
 collision_lab::InitialConditions scene(const std::string& run_id, std::vector<double> m, std::vector<double> x,
                                        std::vector<double> v, std::vector<double> e = {}) {
@@ -344,6 +349,78 @@ TEST(NBodyNode, RandomMassesWithPerPairRestitutionMatchTheExactReference) {
   }
 }
 
+// ---- The over-cap rule (runScene), as the CLI applies it (test/cli/nbody_cli_test.cpp) ----
+
+// 10,000 equal masses 1 m apart with seeded velocities: the ghosts model predicts the
+// inversions (counted here by the plain O(N^2) loop), more than the default cap of 10^7, so
+// the model answers at once, though full mode asks for every event: the count, the
+// initial velocities sorted (fastest on the right) and no event (failed before: simulated
+// at ~130 impacts/s, days).
+TEST(NBodyNode, TenThousandEqualMassesAreAnsweredByTheModel) {
+  std::mt19937_64 rng(20);
+  std::vector<double> m(10000, 1.0), x, v;
+  for (int k = 0; k < 10000; ++k) {
+    x.push_back(9999.0 - k);
+    v.push_back(2.0 * static_cast<double>(rng() >> 11) * 0x1p-53 - 1.0);
+  }
+  std::uint64_t inversions = 0;
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    for (std::size_t j = i + 1; j < v.size(); ++j) inversions += v[i] < v[j];
+  }
+  ASSERT_GT(inversions, 10000000u);
+  std::vector<double> sorted = v;
+  std::sort(sorted.begin(), sorted.end(), std::greater<double>());
+  const auto& out = run(g_node, scene("ghosts_over_cap", m, x, v));
+  ASSERT_EQ(out.summaries.size(), 1u) << (out.rejections.empty() ? "" : out.rejections.front().message);
+  const auto& s = out.summaries.front();
+  EXPECT_EQ(s.model_name, "ghosts");
+  EXPECT_FALSE(s.simulated);
+  EXPECT_FALSE(s.truncated);
+  EXPECT_EQ(s.stop_reason, "NOT_SIMULATED");
+  EXPECT_EQ(s.collision_count, inversions);
+  EXPECT_EQ(s.predicted_collision_count, inversions);
+  EXPECT_EQ(s.final_velocities, sorted);
+  EXPECT_TRUE(out.events.empty());
+}
+
+// Galperin's billiard against a wall, m_B = 1 kg at rest and m_A = the double nearest 1e36
+// kg at -1 m/s: N = floor(pi / alpha) collisions, alpha = atan(sqrt(m_B / m_A)), about
+// 3.14e18, here in 50 digits; answered by the closed form at once, as by the CLI. The end
+// state, by physics: m_A v_A^2 + m_B v_B^2 = m_A (the wall at rest), A moving away from B.
+TEST(NBodyNode, AThreeBodyRunOf3e18CollisionsIsAnsweredByTheModel) {
+  using Float50 = boost::multiprecision::cpp_bin_float_50;
+  const double m_a = 1e36;
+  const Float50 alpha = atan(sqrt(Float50(1) / Float50(m_a)));
+  const auto galperin = static_cast<std::uint64_t>(floor(boost::math::constants::pi<Float50>() / alpha));
+  ASSERT_GT(galperin, 3000000000000000000u);
+  const auto& out = run(g_node, scene("galperin_1e36", {m_a, 1, kInf}, {2, 1, 0}, {-1, 0, 0}));
+  ASSERT_EQ(out.summaries.size(), 1u) << (out.rejections.empty() ? "" : out.rejections.front().message);
+  const auto& s = out.summaries.front();
+  EXPECT_EQ(s.model_name, "three_body_rotation");
+  EXPECT_FALSE(s.simulated);
+  EXPECT_FALSE(s.truncated);
+  EXPECT_EQ(s.stop_reason, "NOT_SIMULATED");
+  EXPECT_EQ(s.collision_count, galperin);
+  EXPECT_EQ(s.predicted_collision_count, galperin);
+  EXPECT_TRUE(out.events.empty());
+  ASSERT_EQ(s.final_velocities.size(), 3u);
+  const double v_a = s.final_velocities[0], v_b = s.final_velocities[1];
+  EXPECT_NEAR(v_a * v_a + v_b * v_b / m_a, 1.0, 1e-12);
+  EXPECT_GE(v_a, v_b);
+}
+
+// Two walls: infinitely many impacts, said at once; 1,000 simulated for display, not the
+// cap of 10^7 (B between walls 2 m apart at 1 m/s hits a wall every 2 s from t = 1 s).
+TEST(NBodyNode, TwoWallsAreSimulatedForDisplayOnly) {
+  const auto& out = run(g_node, scene("walls_display", {kInf, 1, kInf}, {2, 1, 0}, {0, 1, 0}));
+  ASSERT_EQ(out.summaries.size(), 1u) << (out.rejections.empty() ? "" : out.rejections.front().message);
+  EXPECT_TRUE(out.predictions.front().infinite_collisions);
+  const auto& s = out.summaries.front();
+  EXPECT_TRUE(s.simulated);
+  EXPECT_TRUE(s.truncated);
+  EXPECT_EQ(s.collision_count, 1000u);
+}
+
 // ---- Modes: predict-only answers from the closed form ----
 
 TEST(NBodyNode, PredictOnlyGhostsCountTheInversions) {
@@ -403,7 +480,7 @@ TEST(NBodyNode, RunPresetServesTheNBodyPresets) {
   EXPECT_NEAR(collapse.response.summary.energy_lost, 1.0 / 3, 1e-15);
 }
 
-// ---- ~cancel: a run that would never end ----
+// ---- ~cancel: a run that would never end (~simulate_to_cap: true, else 1,000 are shown) ----
 
 TEST(NBodyNode, CancelStopsARunThatWouldNeverEndAndItsBagIsComplete) {
   collision_lab::Cancel idle;
@@ -414,10 +491,10 @@ TEST(NBodyNode, CancelStopsARunThatWouldNeverEndAndItsBagIsComplete) {
   // A ball between two walls with an unreachable cap: only ~cancel ends it.
   auto endless = scene("endless", {kInf, 1, kInf}, {1, 0.5, 0}, {0, 1, 0});
   endless.max_collisions = std::uint64_t{1} << 62;
-  g_node->publish(endless);
+  g_to_cap->publish(endless);
   const auto queued = scene("after_endless", {1, 1}, {1, 0}, {-1, 1});
-  g_node->publish(queued);  // waits in the queue meanwhile
-  ASSERT_TRUE(waitUntil([] { return g_node->runs().count("endless") && g_node->runs().at("endless").events.size() >= 10; },
+  g_to_cap->publish(queued);  // waits in the queue meanwhile
+  ASSERT_TRUE(waitUntil([] { return g_to_cap->runs().count("endless") && g_to_cap->runs().at("endless").events.size() >= 10; },
                         "the endless run's first collisions"));
 
   collision_lab::Cancel other;
@@ -430,7 +507,7 @@ TEST(NBodyNode, CancelStopsARunThatWouldNeverEndAndItsBagIsComplete) {
   cancel.request.run_id = "endless";
   ASSERT_TRUE(callService(kCancel, cancel));
   EXPECT_TRUE(cancel.response.ok) << cancel.response.message;
-  const RunOutputs& out = g_node->waitFor("endless");
+  const RunOutputs& out = g_to_cap->waitFor("endless");
   ASSERT_EQ(out.summaries.size(), 1u);
   const auto& s = out.summaries.front();
   EXPECT_TRUE(s.cancelled);
@@ -441,17 +518,17 @@ TEST(NBodyNode, CancelStopsARunThatWouldNeverEndAndItsBagIsComplete) {
   {
     rosbag::Bag bag(s.bag_path, rosbag::bagmode::Read);
     std::uint64_t index = 0;
-    for (const auto& m : rosbag::View(bag, rosbag::TopicQuery("/collision_lab/collision_events"))) {
+    for (const auto& m : rosbag::View(bag, rosbag::TopicQuery("/collision_lab_to_cap/collision_events"))) {
       ASSERT_EQ(m.instantiate<collision_lab::CollisionEvent>()->index, ++index);
     }
     EXPECT_EQ(index, s.collision_count);
-    EXPECT_EQ(rosbag::View(bag, rosbag::TopicQuery("/collision_lab/run_summaries")).size(), 1u);
+    EXPECT_EQ(rosbag::View(bag, rosbag::TopicQuery("/collision_lab_to_cap/run_summaries")).size(), 1u);
   }
   std::error_code ec;
   fs::remove(s.bag_path, ec);  // it may be large
 
   // Nothing lost: the input sent during the run is served after it.
-  EXPECT_EQ(g_node->waitFor("after_endless").summaries.size(), 1u);
+  EXPECT_EQ(g_to_cap->waitFor("after_endless").summaries.size(), 1u);
 }
 
 }  // namespace
@@ -463,11 +540,13 @@ int main(int argc, char** argv) {
     ADD_FAILURE() << "~bag_directory must be set";
     return 1;
   }
-  RunCollector node("collision_lab"), small("collision_lab_small");
+  RunCollector node("collision_lab"), small("collision_lab_small"), to_cap("collision_lab_to_cap");
   g_node = &node;
   g_small = &small;
+  g_to_cap = &to_cap;
   node.waitForConnection();
   small.waitForConnection();
+  to_cap.waitForConnection();
   for (const char* service : {kRunPreset, kCancel}) {
     if (!ros::service::waitForService(service, ros::Duration(collision_lab_test::kWaitTimeout))) {
       ADD_FAILURE() << "no service " << service << " after " << collision_lab_test::kWaitTimeout << " s";

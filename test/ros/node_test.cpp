@@ -246,7 +246,7 @@ TEST(LabNode, BadInputIsRejectedAndTheNextRunServed) {
   std::vector<BadCase> cases = {
       {makeInput("bad_nan", {1, 1, 1}, {2, 1, 0}, {-1, kNaN, 0}), Rejected::NON_FINITE_VALUE, "velocities"},
       {makeInput("bad_mass", {1, -2, 1}, {2, 1, 0}, {-1, 0, 0}), Rejected::NON_POSITIVE_MASS, "masses"},
-      {makeInput("bad_middle", {1, kInf, 1}, {2, 1, 0}, {-1, 0, 0}), Rejected::INFINITE_MIDDLE_MASS, "masses"},
+      {makeInput("bad_middle", {1, kInf, 1}, {2, 1, 0}, {-1, 0, 0}), Rejected::WALL_NOT_AT_END, "masses"},
       {makeInput("bad_order", {1, 1, 1}, {0, 1, 2}, {-1, 0, 0}), Rejected::POSITIONS_NOT_ORDERED, "positions"},
       {makeInput("bad_triple", {1, 1, 1}, {1, 0, -1}, {-1, 0, 1}), Rejected::TRIPLE_COLLISION, ""},
       {makeInput("../escape", {1, 1, 1}, {2, 1, 0}, {-1, 0, 0}), Rejected::INVALID_RUN_ID, "run_id"},
@@ -359,8 +359,9 @@ TEST(LabNode, EveryBadSceneOfTheCatalogueIsRejectedAsTheCliSays) {
   ASSERT_GE(rows.size(), 22u) << "docs/bad_inputs.md lost its scene rows";
   std::set<int> codes;
   for (const auto& row : rows) codes.insert(row.code);
-  // Every core reason but EMPTY_SCENE, which the catalogue gives as a bodies file (below).
-  EXPECT_EQ(codes, (std::set<int>{1, 2, 3, 4, 5, 6, 7, 8, 9, 11, 12, 13}));
+  // Every core reason but EMPTY_SCENE, which the catalogue gives as a bodies file (below),
+  // and INFINITE_MIDDLE_MASS, no longer given (a wall inside is WALL_NOT_AT_END for every N).
+  EXPECT_EQ(codes, (std::set<int>{1, 2, 3, 5, 6, 7, 8, 9, 11, 12, 13}));
   for (const auto& row : rows) {
     SCOPED_TRACE("catalogue row " + row.number);
     g_node->publish(row.input);
@@ -393,7 +394,8 @@ TEST(LabNode, AnEmptySceneIsRejectedAsTheCatalogueSays) {
 
 // ---- The collision cap: answered at once, never simulated up to the cap ----
 
-TEST(LabNode, OverCapRunIsAnsweredWithPredictionAndTruncatedSummary) {
+// The over-cap rule (runScene): the model answers, complete, with its count as the run's.
+TEST(LabNode, OverCapRunIsAnsweredByTheModel) {
   auto input = makeInput("over_cap", {1e12, 1, 1e12}, {2, 1, 0}, {-1, 0, 0});
   input.max_collisions = 1000;
   g_node->publish(input);
@@ -402,9 +404,10 @@ TEST(LabNode, OverCapRunIsAnsweredWithPredictionAndTruncatedSummary) {
   ASSERT_EQ(out.predictions.size(), 1u);
   EXPECT_EQ(out.predictions.front().collision_count, 2221441u);
   const auto& summary = out.summaries.front();
-  EXPECT_TRUE(summary.truncated);
-  EXPECT_FALSE(summary.truncation_reason.empty());
+  EXPECT_FALSE(summary.truncated);
   EXPECT_FALSE(summary.simulated);
+  EXPECT_EQ(summary.stop_reason, "NOT_SIMULATED");
+  EXPECT_EQ(summary.collision_count, 2221441u);
   EXPECT_EQ(summary.predicted_collision_count, 2221441u);
   EXPECT_TRUE(out.events.empty());
 }

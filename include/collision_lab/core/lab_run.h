@@ -53,8 +53,8 @@ struct RunOptions {
   EventPolicy events = EventPolicy::all();  ///< which LabEvents RunResult keeps
   RunMode mode = RunMode::kFull;
   Precision precision = Precision::kDouble;
-  /// When the predicted count exceeds max_collisions, answer at once with the prediction
-  /// and a truncated summary instead of simulating up to the cap.
+  /// When the predicted count exceeds max_collisions, answer at once from the closed form
+  /// (simulated false, its count and final velocities) instead of simulating up to the cap.
   bool skip_simulation_over_cap = false;
   /// When set (by a signal handler or another thread), the simulation stops within 1024
   /// collisions, marked truncated and cancelled.
@@ -65,11 +65,11 @@ struct RunOptions {
 /// its max_prediction_error, energy_relative_drift and momentum_relative_drift are NaN,
 /// "not measured", and its final_velocities are the predicted ones.
 struct LabRunSummary {
-  std::uint64_t collision_count = 0;        ///< simulated; the predicted count in predict-only mode
+  std::uint64_t collision_count = 0;        ///< simulated; the predicted count when not simulated
   bool truncated = false;
   std::string truncation_reason;            ///< empty unless truncated
   bool cancelled = false;                   ///< truncated by RunOptions::cancel
-  bool simulated = false;                   ///< false for predict-only and skipped runs
+  bool simulated = false;                   ///< false for predict-only and over-cap runs
   std::array<double, 3> final_velocities{}; ///< simulated, else the closed form's after the predicted count [m/s]
   /// max over reported states of |S (v_sim - v_pred)| / |S v_0|, S = diag(sqrt(m)):
   /// relative error in the energy norm, in the wall's frame (dimensionless).

@@ -7,6 +7,12 @@
 // Every other scene is answered by its model (models.h): a closed form alone when no event
 // is asked for and the prediction is finite; otherwise the exact event engine, whose
 // summary is put beside the prediction.
+//
+// The over-cap rule, the same for every front end: when a model predicts more impacts than
+// the cap (max_collisions), the model answers at once (simulated false, its count and final
+// state) and nothing is simulated unless SceneRunOptions::simulate_to_cap asks for it. Two
+// walls, whose impacts never end, are simulated up to kInfiniteRunDisplayCap impacts (or
+// the cap, if lower) unless simulate_to_cap asks for the cap.
 #pragma once
 
 #include <atomic>
@@ -25,15 +31,23 @@
 namespace collision_lab {
 namespace core {
 
+/// Impacts simulated of a run that never ends (two walls) unless simulate_to_cap: enough to
+/// show its pattern, few enough to show at once.
+constexpr std::uint64_t kInfiniteRunDisplayCap = 1000;
+
 struct SceneRunOptions {
   /// Cap, event policy, mode and precision. The precision applies to the three-body path
   /// only (the event engine decides everything exactly); max_collisions caps the engine.
   /// When lab.events asks for any event (in full mode), a closed-form scene is simulated
   /// too, and the simulation is checked against the prediction.
   RunOptions lab;
-  /// False: the three-body path keeps no event in RunResult::events (the visitor still sees
-  /// them all), for front ends that stream. The event engine never keeps any.
+  /// Keep the events that lab.events selects (RunResult::events of the three-body path,
+  /// SceneSimulation::impacts and collapses of the engine). False, for front ends that
+  /// stream: the visitors still see them all.
   bool keep_events = true;
+  /// Simulate up to the cap even when the model predicts more impacts than it (or, for two
+  /// walls, infinitely many). False: the over-cap rule (above) answers from the model.
+  bool simulate_to_cap = false;
   /// When set (by a signal handler or another thread), the run stops within 1024 impacts,
   /// marked truncated (the event engine's stop reason CANCELLED, the three-body summary's
   /// cancelled flag).
@@ -44,7 +58,9 @@ struct SceneRunOptions {
 /// The simulation of an N-body scene (not filled for the three-body path).
 struct SceneSimulation {
   bool simulated = false;          ///< false: answered by the closed form alone (or predict-only)
-  std::uint64_t impact_count = 0;  ///< simulated; the predicted count when not simulated
+  /// The run's answer: simulated, or the model's count when not simulated (0 when the model
+  /// gives none: predict-only without a count formula).
+  std::uint64_t impact_count = 0;
   bool truncated = false;          ///< the cap or a cancellation stopped it: more impacts were due
   StopReason stop = StopReason::kFinished;
   std::string stop_message;  ///< one sentence: why the run ended
@@ -68,6 +84,9 @@ struct SceneSimulation {
   std::optional<bool> matches_prediction;
   double max_prediction_error = std::numeric_limits<double>::quiet_NaN();  ///< [1], NaN: not compared
   Escalations escalations;
+  /// The impacts that options.lab.events selects, in order, when options.keep_events (the
+  /// collapses between them are in `collapses`, each after impacts_before impacts).
+  std::vector<ImpactRecord> impacts;
 };
 
 struct SceneRunResult {
@@ -94,10 +113,9 @@ struct SceneVisitors {
   ProgressCallback progress;         ///< the event engine's progress
 };
 
-/// Checks a scene for runScene. Three elastic bodies get the three-body validation (its
-/// reasons and messages, as today), except that walls at both ends around a body are now
-/// valid; every other scene gets validate(scene). The message never repeats the field.
-/// Returns nothing when the scene is valid.
+/// Checks a scene for runScene: validate(scene), one validation with one set of reasons for
+/// every N and every restitution. The message never repeats the field. Returns nothing when
+/// the scene is valid.
 /// Never throws for any input (short of memory).
 std::optional<ValidationError> validateForRun(const Scene& scene);
 

@@ -59,6 +59,11 @@ struct EventPolicy {
     }
     return false;
   }
+  /// Is an event between impacts (a collapse after `impacts_before` impacts) kept? Under
+  /// firstN(N) it is when it comes before impact N + 1, as the impacts around it would be.
+  bool keepsAfter(std::uint64_t impacts_before) const {
+    return kind == Kind::kAll || (kind == Kind::kFirstN && impacts_before <= first_n);
+  }
 };
 
 struct SimulationOptions {

@@ -60,9 +60,10 @@ struct SceneBatchOutcome {
   core::SceneRunResult result;
 };
 
-/// Several scenes of any size. When every scene took the three-body path, this is
-/// writeBatchReport's output; otherwise table and CSV give one row per scene (bodies,
-/// model, collisions simulated and predicted, truncated, energy lost) and JSON gives
+/// Several scenes of any size. CSV gives one row per scene with one header whatever the
+/// scenes (scenario, bodies, model, collision count and predicted count, truncated, energy
+/// lost). When every scene took the three-body path, table and JSON are writeBatchReport's;
+/// otherwise the table gives the CSV's columns and JSON gives
 /// {"units", "scenarios": [{"scene", "options", "events", "summary"}, ...]}.
 void writeSceneBatchReport(ReportFormat format, const std::vector<SceneBatchOutcome>& outcomes, std::ostream& out);
 

@@ -70,6 +70,9 @@ struct LabNodeParams {
   bool record = true;
   std::string bag_directory;  ///< "~" expanded
   std::uint64_t max_collisions = 0;
+  /// Simulate up to the cap even when the model predicts more impacts (else the model
+  /// answers at once: core::SceneRunOptions::simulate_to_cap).
+  bool simulate_to_cap = false;
   std::uint64_t max_published_events = 0;
   bool publish_markers = true;
   bool log_runs = true;            ///< one INFO line per served run (else DEBUG)
@@ -77,7 +80,7 @@ struct LabNodeParams {
   double min_free_space_mb = 0.0;  ///< [MB] diagnostics warn below it
   std::string scenario_file;       ///< the presets of ~run_preset
 
-  /// Reads ~record, ~bag_directory, ~max_collisions, ~max_published_events,
+  /// Reads ~record, ~bag_directory, ~max_collisions, ~simulate_to_cap, ~max_published_events,
   /// ~publish_markers, ~log_runs, ~max_bodies, ~min_free_space_mb and ~scenario_file (default: the package's
   /// config/scenarios.yaml), with the defaults of node_constants.h. Throws
   /// std::invalid_argument, naming the parameter, its value and the accepted range, when a

@@ -1,11 +1,17 @@
 #include "collision_lab/core/nbody/scene.h"
 
 #include <algorithm>
+#include <array>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
+#include <boost/multiprecision/cpp_bin_float.hpp>
 #include <boost/multiprecision/cpp_int.hpp>
+
+#include "collision_lab/core/analytic.h"
+#include "collision_lab/core/precision.h"
 
 namespace collision_lab {
 namespace core {
@@ -15,12 +21,17 @@ namespace {
 using Rational = boost::multiprecision::cpp_rational;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-/// Beyond this finite-mass ratio the engine's 100-digit tier loses its margin; a body
-/// that much heavier is a wall to every digit that matters.
+/// Beyond this finite-mass ratio the engine's 100-digit tier loses its margin (its error
+/// bounds, spread over the light bodies, exceed what it must decide, and the runs stop out of
+/// range); a body that much heavier is a wall to every digit that matters. Three elastic
+/// bodies are answered by the rotation model, exact at any ratio, and have no such limit.
 constexpr double kMaxMassRatio = 1e100;
 
-/// Shortest text that reads back as the same double.
+/// Shortest text that reads back as the same double; any NaN is "NaN" and a zero is "0",
+/// never signed.
 std::string formatValue(double value) {
+  if (std::isnan(value)) return "NaN";
+  if (value == 0) return "0";
   char buffer[32];
   const auto end = std::to_chars(buffer, buffer + sizeof buffer, value).ptr;
   return std::string(buffer, end);
@@ -67,11 +78,11 @@ std::optional<ValidationError> checkMasses(const Scene& scene) {
     const double m = scene.masses[i];
     if (std::isnan(m)) {
       return makeError(Reason::kNonFiniteValue, indexedField("masses", i),
-                       "the mass of " + bodyName(i) + " is NaN; a mass must be a positive number in kg, or inf for a wall");
+                       "m_" + bodyName(i) + " is NaN; a mass must be a positive number in kg, or inf for a wall");
     }
     if (!(m > 0.0)) {
       return makeError(Reason::kNonPositiveMass, indexedField("masses", i),
-                       "the mass of " + bodyName(i) + " is " + formatValue(m) + " kg; a mass must be positive");
+                       "m_" + bodyName(i) + " is " + formatValue(m) + " kg; a mass must be positive");
     }
     if (std::isinf(m) && i != 0 && i + 1 != n) {
       return makeError(Reason::kWallNotAtEnd, indexedField("masses", i),
@@ -82,6 +93,7 @@ std::optional<ValidationError> checkMasses(const Scene& scene) {
   if (n == 2 && scene.isWall(0) && scene.isWall(1)) {
     return makeError(Reason::kTwoWalls, "masses", "both bodies are walls (inf) with no body between them; give one a finite mass");
   }
+  if (n == 3 && scene.isElastic()) return std::nullopt;  // the rotation model: any ratio
   double lightest = kInf, heaviest = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
     if (scene.isWall(i)) continue;
@@ -96,13 +108,12 @@ std::optional<ValidationError> checkMasses(const Scene& scene) {
   return std::nullopt;
 }
 
-std::optional<ValidationError> checkFinite(const std::vector<double>& values, const char* list, const char* what,
+std::optional<ValidationError> checkFinite(const std::vector<double>& values, const char* list, const char* symbol,
                                            const char* unit) {
   for (std::size_t i = 0; i < values.size(); ++i) {
     if (!std::isfinite(values[i])) {
       return makeError(Reason::kNonFiniteValue, indexedField(list, i),
-                       std::string("the ") + what + " of " + bodyName(i) + " is " + formatValue(values[i]) + "; a " +
-                           what + " must be a finite number in " + unit);
+                       symbol + bodyName(i) + " is " + formatValue(values[i]) + "; a " + unit);
     }
   }
   return std::nullopt;
@@ -111,15 +122,15 @@ std::optional<ValidationError> checkFinite(const std::vector<double>& values, co
 std::optional<ValidationError> checkOrder(const Scene& scene) {
   const auto& x = scene.positions;
   for (std::size_t i = 0; i + 1 < x.size(); ++i) {
+    const std::string a = bodyName(i), b = bodyName(i + 1);
     if (x[i] == x[i + 1]) {
       return makeError(Reason::kPositionsCoincident, "positions",
-                       "the positions of " + bodyName(i) + " and " + bodyName(i + 1) + " coincide at " + formatValue(x[i]) +
-                           " m; touching point masses are a multiple collision, so they must be distinct");
+                       "x_" + a + " = x_" + b + " = " + formatValue(x[i]) + " m; " + a + " and " + b + " must start apart");
     }
     if (!(x[i] > x[i + 1])) {
       return makeError(Reason::kPositionsNotOrdered, "positions",
-                       "x_" + bodyName(i) + " = " + formatValue(x[i]) + " m is not greater than x_" + bodyName(i + 1) +
-                           " = " + formatValue(x[i + 1]) + " m; list the bodies right to left (strictly decreasing positions)");
+                       "x_" + a + " = " + formatValue(x[i]) + " m is not greater than x_" + b + " = " +
+                           formatValue(x[i + 1]) + " m; list the bodies right to left (strictly decreasing positions)");
     }
   }
   return std::nullopt;
@@ -137,9 +148,11 @@ std::optional<ValidationError> checkRange(const Scene& scene) {
     energy += m[i] * v[i] * v[i];
     momentum += m[i] * std::fabs(v[i]);
     if (!std::isfinite(energy) || !std::isfinite(momentum) || !std::isfinite(8.0 * v[i])) {
+      const bool own = !std::isfinite(m[i] * v[i] * v[i]) || !std::isfinite(8.0 * v[i]);
       return makeError(Reason::kOverflow, indexedField("velocities", i),
-                       "the momentum or kinetic energy of " + bodyName(i) + " (m = " + formatValue(m[i]) + " kg, v = " +
-                           formatValue(v[i]) + " m/s), or the total, overflows a double; rescale the units");
+                       std::string(own ? "" : "the total of the ") + "momentum or kinetic energy of " +
+                           (own ? "" : "the bodies up to ") + bodyName(i) + " (m = " + formatValue(m[i]) +
+                           " kg, v = " + formatValue(v[i]) + " m/s) overflows a double; rescale the units");
     }
   }
   for (std::size_t i = 0; i + 1 < scene.size(); ++i) {
@@ -152,12 +165,44 @@ std::optional<ValidationError> checkRange(const Scene& scene) {
   return std::nullopt;
 }
 
+/// Three significant digits, for values that are approximate anyway.
+std::string formatShort(double value) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.3g", value);
+  return buffer;
+}
+
+/// Three significant digits of an exact value of any size (beyond the range of a double too).
+std::string formatShort(const Rational& q) {
+  return HighPrecision(HighPrecision(numerator(q)) / HighPrecision(denominator(q))).str(3);
+}
+
+/// The rotation model (three elastic bodies, the middle one finite, at most one wall)
+/// reports its counts as 64-bit integers, and no start of these masses can have more
+/// collisions than ceil(pi / alpha). Only a light B makes that many: the count grows like
+/// pi sqrt(m / m_B) with m the lighter of A and C.
+std::optional<ValidationError> checkCountFits(const Scene& scene) {
+  if (scene.size() != 3 || !scene.isElastic() || scene.wallCount() == 2) return std::nullopt;
+  const std::array<double, 3> masses{scene.masses[0], scene.masses[1], scene.masses[2]};
+  if (checkedMaxPossibleCollisionCount(masses)) return std::nullopt;
+  const double most = M_PI / anglesFor(masses).alpha;
+  return makeError(Reason::kOverflow, "masses",
+                   "these masses allow up to ceil(pi / alpha) = " +
+                       (std::isfinite(most) ? formatShort(most) : std::string("1.8e+308 or more")) +
+                       " collisions, more than 2^64 - 1 = 18446744073709551615, the largest count collision_lab "
+                       "reports; the count grows like pi sqrt(m / m_B) with m = " +
+                       formatValue(std::min(masses[0], masses[2])) +
+                       " kg the lighter of A and C: make B heavier or that body lighter");
+}
+
 Rational exactTime(const Scene& scene, std::size_t p) {
   const Rational gap = Rational(scene.positions[p]) - Rational(scene.positions[p + 1]);
   return gap / (Rational(scene.velocities[p + 1]) - Rational(scene.velocities[p]));
 }
 
-/// The first contact: representable, and not two contacts sharing a body at once.
+/// The first contact, which certainly happens: not two contacts sharing a body at once, and
+/// its time and every position then within the range of a double (later contacts beyond it
+/// are the run's to report). Decided exactly for the given doubles.
 std::optional<ValidationError> checkFirstContact(const Scene& scene) {
   const auto& x = scene.positions;
   const auto& v = scene.velocities;
@@ -171,31 +216,42 @@ std::optional<ValidationError> checkFirstContact(const Scene& scene) {
     first = std::min(first, time[p]);
   }
   if (!approaching) return std::nullopt;
-  // Each double time is within 3 ulps of the truth; exact rationals settle the near-ties.
+  // Each double time is within 3 ulps of the truth (or beyond the range of a double, inf);
+  // exact rationals settle the near-ties. Only approaching pairs have a time.
   const double window = first * (1.0 + 0x1p-48) + 4.0 * std::numeric_limits<double>::denorm_min();
   std::vector<std::size_t> candidates;
   for (std::size_t p = 0; p < time.size(); ++p) {
-    if (time[p] <= window) candidates.push_back(p);
+    if (v[p] < v[p + 1] && time[p] <= window) candidates.push_back(p);
   }
-  if (candidates.size() > 1) {
-    std::vector<Rational> exact;
-    for (std::size_t p : candidates) exact.push_back(exactTime(scene, p));
-    const Rational earliest = *std::min_element(exact.begin(), exact.end());
-    for (std::size_t k = 0; k + 1 < candidates.size(); ++k) {
-      const std::size_t p = candidates[k];
-      if (candidates[k + 1] == p + 1 && exact[k] == earliest && exact[k + 1] == earliest) {
-        return makeError(Reason::kTripleCollision, "positions",
-                         bodyName(p) + ", " + bodyName(p + 1) + " and " + bodyName(p + 2) + " would meet at the same instant (t = " +
-                             formatValue(time[p]) + " s), a multiple collision whose outcome point masses do not define; "
-                             "move one of them");
-      }
+  std::vector<Rational> exact;
+  for (std::size_t p : candidates) exact.push_back(exactTime(scene, p));
+  const std::size_t earliest_k = static_cast<std::size_t>(std::min_element(exact.begin(), exact.end()) - exact.begin());
+  const Rational& earliest = exact[earliest_k];
+  for (std::size_t k = 0; k + 1 < candidates.size(); ++k) {
+    const std::size_t p = candidates[k];
+    if (candidates[k + 1] == p + 1 && exact[k] == earliest && exact[k + 1] == earliest) {
+      return makeError(Reason::kTripleCollision, "positions",
+                       bodyName(p) + ", " + bodyName(p + 1) + " and " + bodyName(p + 2) +
+                           " would meet at the same instant (t = " + formatShort(earliest) +
+                           " s), a multiple collision whose outcome point masses do not define; move one of them");
     }
   }
+  const std::size_t pair = candidates[earliest_k];
+  const std::string contact = "the first contact, of " + bodyName(pair) + " and " + bodyName(pair + 1) + ", ";
+  const Rational largest(std::numeric_limits<double>::max());
+  if (earliest > largest) {
+    return makeError(Reason::kOverflow, "positions",
+                     contact + "would come at t = " + formatShort(earliest) +
+                         " s, beyond the largest double (1.8e+308); a longer unit of time brings it into range");
+  }
   for (std::size_t i = 0; i < scene.size(); ++i) {
-    if (!std::isfinite(first) || !std::isfinite(x[i] + v[i] * first)) {
+    if (std::fabs(x[i] + v[i] * first) <= 0x1p1020) continue;  // far inside the range: no exact check needed
+    const Rational position = Rational(x[i]) + Rational(v[i]) * earliest;
+    if (abs(position) > largest) {
       return makeError(Reason::kOverflow, "positions",
-                       "the first contact would come at t = " + formatValue(first) +
-                           " s or beyond the range of a double in position; rescale the units");
+                       contact + "at t = " + formatShort(earliest) + " s, would find " + bodyName(i) + " at " +
+                           formatShort(position) +
+                           " m, beyond the largest double (1.8e+308); a longer unit of length brings it into range");
     }
   }
   return std::nullopt;
@@ -253,10 +309,11 @@ const char* reasonName(Reason reason) {
 std::optional<ValidationError> validate(const Scene& scene) {
   if (auto error = checkShape(scene)) return error;
   if (auto error = checkMasses(scene)) return error;
-  if (auto error = checkFinite(scene.positions, "positions", "position", "m")) return error;
-  if (auto error = checkFinite(scene.velocities, "velocities", "velocity", "m/s")) return error;
+  if (auto error = checkFinite(scene.positions, "positions", "x_", "position must be a finite number in m")) return error;
+  if (auto error = checkFinite(scene.velocities, "velocities", "v_", "velocity must be a finite number in m/s")) return error;
   if (auto error = checkOrder(scene)) return error;
   if (auto error = checkRange(scene)) return error;
+  if (auto error = checkCountFits(scene)) return error;
   return checkFirstContact(scene);
 }
 

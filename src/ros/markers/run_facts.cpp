@@ -74,6 +74,10 @@ std::string runNote(const RunRecord& run) {
     note += (reason.rfind("stopped", 0) == 0 ? "" : "stopped: ") + reason + ". Shown up to the last known state.";
   } else if (run.input().mode == collision_lab::InitialConditions::MODE_PREDICT_ONLY) {
     note += "predict-only run: shown up to the first contact; the plots show the closed form's final velocities.";
+  } else if (run.summary && !run.summary->simulated &&
+             run.input().mode != collision_lab::InitialConditions::MODE_PREDICT_ONLY) {
+    note += "answered by the model (more collisions predicted than the cap): shown up to the first contact; the "
+            "plots show the closed form's final velocities.";
   } else if (run.input().mode == collision_lab::InitialConditions::MODE_SUMMARY_ONLY) {
     note += "summary-only run: shown up to the first contact; the plots show the final velocities.";
   } else if (!run.finished()) {

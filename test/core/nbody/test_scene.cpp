@@ -103,6 +103,8 @@ TEST(NBodyValidation, ValueReasons) {
   expectRejected(s, Reason::kOverflow, "masses");
   // A first contact beyond the range of a double in time.
   expectRejected(Scene{{1, 1}, {1e300, -1e300}, {-1e-300, 0}, {}}, Reason::kOverflow, "positions");
+  // Another pair neither approaching nor tied (failed before: boost's "Divide by zero").
+  expectRejected(Scene{{1, 1, 1, 1}, {3, 2, 1, 0}, {-1e-310, 0, 0, 0}, {}}, Reason::kOverflow, "positions");
 }
 
 TEST(NBodyValidation, FirstContactMultipleCollisionIsExact) {

@@ -43,11 +43,11 @@ enum class Reason : std::uint8_t {
   kNonFiniteValue = 1,       ///< NaN or inf in a position or velocity, or NaN in a mass
   kNonPositiveMass = 2,      ///< mass <= 0
   kTwoWalls = 3,             ///< two walls with no finite body between them (N = 2)
-  kInfiniteMiddleMass = 4,   ///< three-body name of kWallNotAtEnd; N-body validate() reports 13
+  kInfiniteMiddleMass = 4,   ///< validate(ThreeBodyScene) only; validate(Scene) reports 13 for every N
   kPositionsNotOrdered = 5,  ///< not x_0 > x_1 > ... > x_{N-1}
   kPositionsCoincident = 6,  ///< two neighbouring positions are equal
   kTripleCollision = 7,      ///< two first contacts that share a body come at exactly the same instant
-  kOverflow = 8,             ///< a momentum, energy, gap, time or mass ratio leaves the double range
+  kOverflow = 8,             ///< a value, or the first contact, leaves the double range; a count or mass ratio
   kUnequalLengths = 9,       ///< masses, positions and velocities differ in length
   kEmptyScene = 10,          ///< no bodies at all
   kRestitutionOutOfRange = 11,  ///< a restitution is NaN or outside [0, 1]
@@ -66,9 +66,13 @@ struct ValidationError {
   std::string message;
 };
 
-/// Checks a scene. Returns nothing when the scene is valid. Never throws for any input
-/// (short of running out of memory). The first-contact multiple-collision test is exact
-/// for the given doubles. Two walls with bodies between them are valid.
+/// Checks a scene: the one validation of every N and every restitution (the front ends call
+/// it through validateForRun). Returns nothing when the scene is valid. Never throws for any
+/// input (short of running out of memory). The first contact (its multiple-collision test,
+/// its time and the positions then, which must be doubles) is decided exactly for the given
+/// doubles. Two walls with bodies between them are valid. Three elastic bodies (the rotation
+/// model) must allow at most 2^64 - 1 collisions and have no mass-ratio limit; other scenes,
+/// which the event engine may simulate, a finite-mass ratio of at most 1e100.
 std::optional<ValidationError> validate(const Scene& scene);
 
 }  // namespace core
