@@ -20,7 +20,8 @@ if(TARGET ros_tools_unit_test)
 endif()
 
 find_package(rostest REQUIRED)
-foreach(name node_test nbody_node_test burst_test demo_test crash_test markers_test markers_clock_test)
+foreach(name node_test nbody_node_test burst_test demo_test crash_test markers_test markers_clock_test
+    shared_folder_test)
   add_rostest_gtest(${name} test/ros/${name}.test test/ros/${name}.cpp)
   target_link_libraries(${name} collision_lab_ros ${catkin_LIBRARIES})
   # The rostests start these nodes.
@@ -32,5 +33,7 @@ target_include_directories(nbody_node_test PRIVATE test/core/nbody)
 # node_test reads the bad-input catalogue, docs/bad_inputs.md; demo_test runs scripts/play_run.
 target_compile_definitions(node_test PRIVATE COLLISION_LAB_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
 target_compile_definitions(demo_test PRIVATE COLLISION_LAB_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+# demo_test's replay echoes run_parameters with rostopic, which needs the Python messages.
+add_dependencies(demo_test ${PROJECT_NAME}_generate_messages_py)
 # crash_test starts and kills the node itself.
 target_compile_definitions(crash_test PRIVATE COLLISION_LAB_NODE_PATH="$<TARGET_FILE:collision_lab_node>")
