@@ -27,6 +27,9 @@ target_include_directories(collision_lab_ros PUBLIC include)
 # collision_lab_io: the node reads the presets of ~run_preset.
 target_link_libraries(collision_lab_ros PUBLIC collision_lab_core collision_lab_io ${catkin_LIBRARIES})
 add_dependencies(collision_lab_ros ${PROJECT_NAME}_generate_messages_cpp ${catkin_EXPORTED_TARGETS})
+# The version recorded in every bag (RunParameters.package_version): package.xml's, as
+# catkin_package() read it.
+target_compile_definitions(collision_lab_ros PRIVATE COLLISION_LAB_VERSION="${collision_lab_VERSION}")
 
 # Executables go to the devel space's package folder, where rosrun and roslaunch look.
 set(collision_lab_ROS_EXECUTABLES

@@ -23,6 +23,7 @@
 #include "collision_lab/InitialConditions.h"
 #include "collision_lab/Prediction.h"
 #include "collision_lab/Rejected.h"
+#include "collision_lab/RunParameters.h"
 #include "collision_lab/RunSummary.h"
 #include "collision_lab/Velocities.h"
 #include "collision_lab/core/nbody/scene.h"
@@ -340,6 +341,17 @@ Table<collision_lab::Rejected> rejectedTable() {
   return t;
 }
 
+Table<collision_lab::RunParameters> runParametersTable() {
+  using M = collision_lab::RunParameters;
+  Table<M> t;
+  t.field("package_version", &M::package_version)
+      .field("node_name", &M::node_name)
+      .field("max_collisions", &M::max_collisions)
+      .field("max_published_events", &M::max_published_events)
+      .field("max_bodies", &M::max_bodies);
+  return t;
+}
+
 // ---- Tidy tables: one row per body ----
 
 void writeCell(std::ostream& out, const std::optional<double>& value) {
@@ -587,6 +599,7 @@ const std::map<std::string, std::unique_ptr<Exporter>>& exporters() {
     addExporter(e, energyTransferTable());
     addExporter(e, runSummaryTable());
     addExporter(e, rejectedTable());
+    addExporter(e, runParametersTable());
     return e;
   }();
   return all;

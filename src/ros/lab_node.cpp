@@ -28,11 +28,12 @@ namespace collision_lab_ros {
 /// recorded over to the bag writer, in batches of at most kRecordBatchEvents events.
 class RunWriter {
  public:
-  /// bags may be null (not recording).
-  RunWriter(std::string run_id, RunTimeline timeline, RunBagWriter* bags)
+  /// bags may be null (not recording). claim_error: RunBagBatch::claim_error.
+  RunWriter(std::string run_id, RunTimeline timeline, RunBagWriter* bags, std::string claim_error)
       : run_id_(std::move(run_id)), timeline_(timeline), bags_(bags) {
     batch_.run_id = run_id_;
     batch_.opens = true;
+    batch_.claim_error = std::move(claim_error);
   }
 
   const RunTimeline& timeline() const { return timeline_; }
@@ -53,6 +54,12 @@ class RunWriter {
     pub.publish(msg);
   }
 
+  /// Records the run's parameters, stamped at the run's start.
+  void record(collision_lab::RunParameters parameters) {
+    if (!bags_) return;
+    stamp(parameters, 0.0);
+    timed([&] { batch_.parameters = std::move(parameters); });
+  }
   /// Record (at their header.stamp): the input, the prediction, each event.
   void record(const collision_lab::InitialConditions& input) {
     if (bags_) timed([&] { batch_.input = input; });
@@ -283,10 +290,34 @@ void fillResponse(const std::optional<ServeOutcome>& outcome, Response& response
   response.message = line.str();
 }
 
+/// $ROS_HOME/collision_lab/runs followed by the node's namespace, so that labs in other
+/// namespaces never share a folder by default: /collision_lab -> .../runs/collision_lab,
+/// /lab2 -> .../runs/lab2, /a/b -> .../runs/a/b, / -> .../runs.
 std::string defaultBagDirectory() {
   const char* ros_home = std::getenv("ROS_HOME");
   const std::string base = ros_home && *ros_home ? ros_home : expandUser("~/.ros");
-  return base + "/" + kDefaultBagSubdirectory;
+  const std::string& ns = ros::this_node::getNamespace();
+  return base + "/" + kDefaultBagSubdirectory + (ns == "/" ? std::string() : ns);
+}
+
+/// The recorded topics the node latches (node_constants.h): written with latching=1.
+std::vector<std::string> latchedRecordedTopics(const RunTopics& topics, const std::string& parameters_topic) {
+  std::vector<std::string> latched;
+  if (kLatchPredictions) latched.push_back(topics.predictions.getTopic());
+  if (kLatchRunSummaries) latched.push_back(topics.summaries.getTopic());
+  if (kLatchRunParameters) latched.push_back(parameters_topic);
+  return latched;
+}
+
+/// The settings a run is served with (run_id and stamp are the RunWriter's).
+collision_lab::RunParameters runParameters(const LabNodeParams& params, std::uint64_t max_collisions) {
+  collision_lab::RunParameters msg;
+  msg.package_version = COLLISION_LAB_VERSION;
+  msg.node_name = ros::this_node::getName();
+  msg.max_collisions = max_collisions;
+  msg.max_published_events = params.max_published_events;
+  msg.max_bodies = params.max_bodies;
+  return msg;
 }
 
 /// The count parameter `name`, or fallback when it is not set. Throws std::invalid_argument
@@ -451,10 +482,12 @@ LabNode::LabNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
 
   run_id_prefix_ = std::string("run_") + utcStamp("%Y%m%d_%H%M%S") + "_";
   if (params_.record) {
+    const std::string parameters_topic = nh_.resolveName(kRunParametersTopic);
     bags_ = std::make_unique<RunBagWriter>(
         params_.bag_directory,
         RunBagWriter::Topics{nh_.resolveName(kInitialConditionsTopic), topics_.predictions.getTopic(),
-                             topics_.events.getTopic(), topics_.summaries.getTopic()},
+                             topics_.events.getTopic(), topics_.summaries.getTopic(), parameters_topic,
+                             ros::this_node::getName(), latchedRecordedTopics(topics_, parameters_topic)},
         kRecordQueueMessages);
   }
 
@@ -585,26 +618,26 @@ void LabNode::workerLoop() {
   }
 }
 
-std::string LabNode::newRunId() {
+std::string LabNode::newRunId(std::string& claim_error) {
   std::string run_id;
   do {
     run_id = run_id_prefix_ + std::to_string(++run_counter_);
-  } while (runIdTaken(run_id));
-  used_run_ids_.insert(run_id);
+  } while (!claim(run_id, claim_error));
   return run_id;
 }
 
-bool LabNode::runIdTaken(const std::string& run_id) const {
-  return used_run_ids_.count(run_id) > 0 ||
-         (params_.record && bagExists(params_.bag_directory, run_id));
+bool LabNode::claim(const std::string& run_id, std::string& claim_error) {
+  if (used_run_ids_.count(run_id) > 0) return false;
+  if (params_.record && claimBag(params_.bag_directory, run_id, claim_error) == BagClaim::kTaken) return false;
+  used_run_ids_.insert(run_id);
+  return true;
 }
 
-std::string LabNode::claimRunId(const std::string& requested) {
+std::string LabNode::claimRunId(const std::string& requested, std::string& claim_error) {
   std::string run_id = requested;
-  for (std::uint64_t n = 2; runIdTaken(run_id); ++n) {
+  for (std::uint64_t n = 2; !claim(run_id, claim_error); ++n) {
     run_id = requested + "." + std::to_string(n);
   }
-  used_run_ids_.insert(run_id);
   return run_id;
 }
 
@@ -649,29 +682,35 @@ void LabNode::serve(collision_lab::InitialConditions input, Reply reply) {
     if (reply) reply->set_value(std::move(outcome));
     return;
   }
+  // Claimed here, before the run_id goes out on any message: the run_id a run reports
+  // names a bag file this node created.
   const std::string base = requestedRunId(input);
-  input.run_id = base.empty() ? newRunId() : claimRunId(base);
+  std::string claim_error;
+  input.run_id = base.empty() ? newRunId(claim_error) : claimRunId(base, claim_error);
   if (!base.empty() && input.run_id != base) {
     ROS_WARN_STREAM("run_id '" << base << "' is taken (its bag exists, or this node served "
                     "it before); serving the run as '" << input.run_id << "'");
   }
   announce(input, requested);
-  run(input, input.run_id != requested ? requested : std::string(), std::move(reply));
+  run(input, input.run_id != requested ? requested : std::string(), claim_error, std::move(reply));
 }
 
-void LabNode::run(collision_lab::InitialConditions& input, const std::string& requested_run_id, Reply reply) {
+void LabNode::run(collision_lab::InitialConditions& input, const std::string& requested_run_id,
+                  const std::string& claim_error, Reply reply) {
   namespace core = collision_lab::core;
   const ros::Time start = stampNow();
   const core::Scene scene = toScene(input);
   const core::RunMode mode = *toRunMode(input.mode);
   // The prediction goes out before the simulation starts.
   const ScenePrediction prediction = predictScene(scene);
-  RunWriter out(input.run_id, RunTimeline(start, chooseTimelineScale(firstContactTime(scene))), bags_.get());
+  RunWriter out(input.run_id, RunTimeline(start, chooseTimelineScale(firstContactTime(scene))), bags_.get(),
+                claim_error);
   input.header.stamp = start;
   publishStart(out, input, prediction);
 
   core::SceneRunOptions options;
   options.lab.max_collisions = input.max_collisions ? input.max_collisions : params_.max_collisions;
+  out.record(runParameters(params_, options.lab.max_collisions));
   // Events are streamed to the visitors, never kept; asking for them makes a closed-form
   // scene simulated too (its events are published), as the CLI does when it shows events.
   options.lab.events = mode == core::RunMode::kFull ? core::EventPolicy::all() : core::EventPolicy::none();

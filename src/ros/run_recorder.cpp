@@ -1,7 +1,13 @@
 #include "collision_lab/ros/run_recorder.h"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
+#include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <stdexcept>
 #include <system_error>
@@ -15,16 +21,41 @@ namespace fs = std::filesystem;
 
 namespace {
 constexpr char kActiveSuffix[] = ".active";
+
+/// Renames from to to unless to exists (then fails with EEXIST). Returns 0 or an errno.
+int renameNoReplace(const std::string& from, const std::string& to) {
+  if (::renameat2(AT_FDCWD, from.c_str(), AT_FDCWD, to.c_str(), RENAME_NOREPLACE) == 0) return 0;
+  if (errno != EINVAL && errno != ENOSYS) return errno;
+  // A file system without RENAME_NOREPLACE: link() never replaces either.
+  if (::link(from.c_str(), to.c_str()) != 0) return errno;
+  return ::unlink(from.c_str()) == 0 ? 0 : errno;
 }
+}  // namespace
 
 std::string bagPath(const std::string& directory, const std::string& run_id) {
   return (fs::path(directory) / (run_id + ".bag")).string();
 }
 
-bool bagExists(const std::string& directory, const std::string& run_id) {
+BagClaim claimBag(const std::string& directory, const std::string& run_id, std::string& error) {
   std::error_code ec;
+  fs::create_directories(directory, ec);
+  if (ec) {
+    error = "cannot create bag directory " + directory + ": " + ec.message();
+    return BagClaim::kFailed;
+  }
   const std::string path = bagPath(directory, run_id);
-  return fs::exists(path, ec) || fs::exists(path + kActiveSuffix, ec);
+  const std::string active = path + kActiveSuffix;
+  const int fd = ::open(active.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+  if (fd < 0) {
+    if (errno == EEXIST) return BagClaim::kTaken;
+    error = "cannot create " + active + ": " + std::strerror(errno);
+    return BagClaim::kFailed;
+  }
+  ::close(fd);
+  if (fs::symlink_status(path, ec).type() == fs::file_type::not_found) return BagClaim::kClaimed;
+  // A finished bag of that name (or its status unknown): give the name up.
+  fs::remove(active, ec);
+  return BagClaim::kTaken;
 }
 
 std::string expandUser(const std::string& path) {
@@ -41,23 +72,34 @@ RunRecorder::RunRecorder(const std::string& directory, const std::string& run_id
     fail(std::string("cannot create a bag: ") + e.what());
     return;
   }
-  bag_ = owned_.get();
-  open(directory);
+  std::string error;
+  switch (claimBag(directory, run_id, error)) {
+    case BagClaim::kClaimed:
+      bag_ = owned_.get();
+      open();
+      return;
+    case BagClaim::kTaken:
+      fail("a bag of run_id '" + run_id + "' exists in " + directory + " (" + path_ + " or " + active_path_ +
+           "): not overwritten");
+      return;
+    case BagClaim::kFailed:
+      fail(error);
+      return;
+  }
 }
 
-RunRecorder::RunRecorder(const std::string& directory, const std::string& run_id, rosbag::Bag& reused)
-    : path_(bagPath(directory, run_id)), active_path_(path_ + kActiveSuffix), bag_(&reused) {
-  open(directory);
-}
-
-void RunRecorder::open(const std::string& directory) {
-  std::error_code ec;
-  fs::create_directories(directory, ec);
-  if (ec) {
-    bag_ = nullptr;
-    fail("cannot create bag directory " + directory + ": " + ec.message());
+RunRecorder::RunRecorder(const std::string& directory, const std::string& run_id, rosbag::Bag& reused,
+                         const std::string& claim_error)
+    : path_(bagPath(directory, run_id)), active_path_(path_ + kActiveSuffix) {
+  if (!claim_error.empty()) {
+    fail(claim_error);
     return;
   }
+  bag_ = &reused;
+  open();
+}
+
+void RunRecorder::open() {
   try {
     bag_->setCompression(rosbag::compression::LZ4);
     bag_->open(active_path_, rosbag::bagmode::Write);
@@ -78,9 +120,12 @@ bool RunRecorder::close() {
   }
   bag_ = nullptr;
   if (ok()) {
-    std::error_code ec;
-    fs::rename(active_path_, path_, ec);
-    if (ec) fail("cannot rename " + active_path_ + " to " + path_ + ": " + ec.message());
+    const int error = renameNoReplace(active_path_, path_);
+    if (error == EEXIST) {
+      fail(path_ + " exists, written by someone else: not overwritten; this run's bag stays " + active_path_);
+    } else if (error != 0) {
+      fail("cannot rename " + active_path_ + " to " + path_ + ": " + std::strerror(error));
+    }
   }
   return ok();
 }
@@ -89,6 +134,10 @@ RunBagWriter::RunBagWriter(std::string directory, Topics topics, std::size_t max
     : directory_(std::move(directory)),
       topics_(std::move(topics)),
       max_queued_(std::max<std::size_t>(max_queued_messages, 1)),
+      parameters_header_(headerFor<collision_lab::RunParameters>(topics_.parameters)),
+      input_header_(headerFor<collision_lab::InitialConditions>(topics_.inputs)),
+      prediction_header_(headerFor<collision_lab::Prediction>(topics_.predictions)),
+      summary_header_(headerFor<collision_lab::RunSummary>(topics_.summaries)),
       thread_(&RunBagWriter::loop, this) {}
 
 RunBagWriter::~RunBagWriter() {
@@ -137,19 +186,30 @@ void RunBagWriter::loop() {
   }
 }
 
+template <class Message>
+boost::shared_ptr<ros::M_string> RunBagWriter::headerFor(const std::string& topic) const {
+  if (std::find(topics_.latched.begin(), topics_.latched.end(), topic) == topics_.latched.end()) return {};
+  return connectionHeader<Message>(topic, topics_.callerid, true);
+}
+
 void RunBagWriter::write(RunBagBatch& batch) {
-  if (batch.opens) recorder_.emplace(directory_, batch.run_id, bag_);
+  if (batch.opens) recorder_.emplace(directory_, batch.run_id, bag_, batch.claim_error);
   // Only after a failure that lost the run's recorder (recover()).
   if (!recorder_) throw std::runtime_error("no bag is open for this batch");
-  if (batch.input) recorder_->write(topics_.inputs, batch.input->header.stamp, *batch.input);
-  if (batch.prediction) recorder_->write(topics_.predictions, batch.prediction->header.stamp, *batch.prediction);
+  if (batch.parameters && !topics_.parameters.empty()) {
+    recorder_->write(topics_.parameters, batch.parameters->header.stamp, *batch.parameters, parameters_header_);
+  }
+  if (batch.input) recorder_->write(topics_.inputs, batch.input->header.stamp, *batch.input, input_header_);
+  if (batch.prediction) {
+    recorder_->write(topics_.predictions, batch.prediction->header.stamp, *batch.prediction, prediction_header_);
+  }
   for (const auto& event : batch.events) recorder_->write(topics_.events, event.header.stamp, event);
   if (!batch.summary) return;
   collision_lab::RunSummary& summary = *batch.summary;
   summary.bag_path = recorder_->path();
   summary.recording_ok = recorder_->ok();
   summary.recording_error = recorder_->error();
-  recorder_->write(topics_.summaries, summary.header.stamp, summary);
+  recorder_->write(topics_.summaries, summary.header.stamp, summary, summary_header_);
   recorder_->close();
   summary.recording_ok = recorder_->ok();
   summary.recording_error = recorder_->error();

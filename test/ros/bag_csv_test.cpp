@@ -23,6 +23,7 @@
 #include "collision_lab/InitialConditions.h"
 #include "collision_lab/Prediction.h"
 #include "collision_lab/Rejected.h"
+#include "collision_lab/RunParameters.h"
 #include "collision_lab/RunSummary.h"
 #include "collision_lab/Velocities.h"
 #include "collision_lab/ros/bag_csv.h"
@@ -562,6 +563,7 @@ TEST(BagCsvColumns, EveryFieldOfEveryMessageHasAColumn) {
   expectEveryFieldExported<collision_lab::EnergyTransfer>();
   expectEveryFieldExported<collision_lab::RunSummary>();
   expectEveryFieldExported<collision_lab::Rejected>();
+  expectEveryFieldExported<collision_lab::RunParameters>();
 }
 
 // Without OUTDIR the CSVs go to RUN_csv in the current folder, not into the bag's folder

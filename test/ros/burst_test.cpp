@@ -78,7 +78,8 @@ TEST(Burst, OneAnswerPerInputAndOneBagPerValidRun) {
     rosbag::Bag bag(summary.bag_path, rosbag::bagmode::Read);
     rosbag::View summaries(bag, rosbag::TopicQuery("/collision_lab/run_summaries"));
     EXPECT_EQ(summaries.size(), 1u);
-    EXPECT_EQ(rosbag::View(bag).size(), 3 + summary.collision_count);  // one event per collision
+    // parameters, input, prediction, one event per collision, summary
+    EXPECT_EQ(rosbag::View(bag).size(), 4 + summary.collision_count);
     // The bag, written behind the run by the writer thread, holds the events published live.
     rosbag::View events(bag, rosbag::TopicQuery("/collision_lab/collision_events"));
     ASSERT_EQ(events.size(), out.events.size());

@@ -106,7 +106,7 @@ TEST(Crash, KillNineKeepsFinishedBagsAndNeverOverwrites) {
   }
 
   const std::size_t finished_messages = messageCount(dir + "/finished.bag");
-  EXPECT_EQ(finished_messages, 3 + 3u);  // input, prediction, one event per collision (3), summary
+  EXPECT_EQ(finished_messages, 4 + 3u);  // parameters, input, prediction, one event per collision (3), summary
   EXPECT_FALSE(fs::exists(dir + "/long_run.bag"));
   ASSERT_TRUE(fs::exists(dir + "/long_run.bag.active"));
 
@@ -288,7 +288,7 @@ TEST(Crash, SigintDuringABurstClosesEveryBagStarted) {
       EXPECT_EQ(summary->collision_count, 3u);
     }
     EXPECT_EQ(rosbag::View(bag, rosbag::TopicQuery("/crash/collision_events")).size(), summary->collision_count);
-    EXPECT_EQ(rosbag::View(bag).size(), 3 + summary->collision_count);
+    EXPECT_EQ(rosbag::View(bag).size(), 4 + summary->collision_count);  // with parameters, input, prediction, summary
   }
   std::printf("SIGINT during a burst of %d: %zu bags closed, %zu summaries seen before the signal\n", kRuns,
               bags.size(), summaries_seen);

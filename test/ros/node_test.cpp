@@ -230,7 +230,7 @@ TEST(LabNode, BagHoldsExactlyThePublishedMessagesAndOneMessagePerCollision) {
   EXPECT_TRUE(readTopic<collision_lab::EnergyTransfer>(bag, ns + "energy_transfers").empty());
   expectSameMessages(out.summaries, readTopic<collision_lab::RunSummary>(bag, ns + "run_summaries"),
                      "run_summaries");
-  EXPECT_EQ(rosbag::View(bag).size(), 3 + out.events.size());
+  EXPECT_EQ(rosbag::View(bag).size(), 4 + out.events.size());  // and run_parameters
 }
 
 // ---- Bad input: rejected with the right reason, then the next valid run is served ----
@@ -537,7 +537,7 @@ TEST(Timeline, CollisionsBeyondTheRangeSaturateAndTheSummarySaysSo) {
   EXPECT_EQ(summary.header.stamp, out.events[1].header.stamp);
   ASSERT_TRUE(summary.recording_ok) << summary.recording_error;
   rosbag::Bag bag(summary.bag_path, rosbag::bagmode::Read);
-  EXPECT_EQ(rosbag::View(bag).size(), 3 + 2u);  // input, prediction, 2 events, summary
+  EXPECT_EQ(rosbag::View(bag).size(), 4 + 2u);  // parameters, input, prediction, 2 events, summary
 }
 
 // ---- A taken run_id: served under the next free suffix, nothing overwritten ----

@@ -1,10 +1,17 @@
-// Per-run bags without a master: final name only when closed, failures reported; the
-// writer thread (RunBagWriter) writes every message handed over, under backpressure, and
-// closes every bag before it is destroyed.
+// Per-run bags without a master: final name only when closed, failures reported; a
+// run's file is claimed exclusively and never overwritten, also by writers racing for the
+// same run_ids; the writer thread (RunBagWriter) writes every message handed over, under
+// backpressure, closes every bag before it is destroyed, and writes the latched topics'
+// connection headers as `rosbag record` does.
+#include <atomic>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
+#include <iterator>
+#include <map>
+#include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -18,8 +25,14 @@
 namespace {
 
 namespace fs = std::filesystem;
-using collision_lab_ros::bagExists;
+using collision_lab_ros::BagClaim;
+using collision_lab_ros::claimBag;
 using collision_lab_ros::RunRecorder;
+
+std::string contents(const std::string& path) {
+  std::ifstream in(path);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
 
 /// A fresh directory per test, removed afterwards.
 class RunRecorderTest : public testing::Test {
@@ -46,13 +59,10 @@ TEST_F(RunRecorderTest, WritesUnderActiveNameAndRenamesOnClose) {
     recorder.write("/collision_lab/run_summaries", stamp, summary);
     EXPECT_TRUE(fs::exists(dir_ + "/nested/r1.bag.active"));
     EXPECT_FALSE(fs::exists(dir_ + "/nested/r1.bag"));
-    EXPECT_TRUE(bagExists(dir_ + "/nested", "r1"));
     EXPECT_TRUE(recorder.close());
   }
   EXPECT_FALSE(fs::exists(dir_ + "/nested/r1.bag.active"));
   ASSERT_TRUE(fs::exists(dir_ + "/nested/r1.bag"));
-  EXPECT_TRUE(bagExists(dir_ + "/nested", "r1"));
-  EXPECT_FALSE(bagExists(dir_ + "/nested", "r2"));
 
   rosbag::Bag bag(dir_ + "/nested/r1.bag", rosbag::bagmode::Read);
   rosbag::View view(bag);
@@ -81,14 +91,95 @@ TEST_F(RunRecorderTest, WriteAtTimeZeroFailsCleanly) {
   EXPECT_FALSE(fs::exists(dir_ + "/r0.bag"));
 }
 
-/// One run for RunBagWriter: its input, prediction and events (index k at 1 + k s), in
-/// batches of at most batch_events, the summary last.
-std::vector<collision_lab_ros::RunBagBatch> runBatches(const std::string& run_id, std::size_t events,
-                                                       std::size_t batch_events) {
+TEST_F(RunRecorderTest, AClaimIsExclusiveAndAFinishedBagKeepsItsName) {
+  std::string error;
+  EXPECT_EQ(claimBag(dir_ + "/new", "r1", error), BagClaim::kClaimed) << error;
+  EXPECT_TRUE(fs::is_regular_file(dir_ + "/new/r1.bag.active"));
+  EXPECT_EQ(claimBag(dir_ + "/new", "r1", error), BagClaim::kTaken);  // its .active exists
+  std::ofstream(dir_ + "/r2.bag") << "finished";
+  EXPECT_EQ(claimBag(dir_, "r2", error), BagClaim::kTaken);
+  EXPECT_FALSE(fs::exists(dir_ + "/r2.bag.active"));  // the name was given up again
+  EXPECT_EQ(contents(dir_ + "/r2.bag"), "finished");
+  std::ofstream(dir_ + "/file") << "x";
+  EXPECT_EQ(claimBag(dir_ + "/file/bags", "r3", error), BagClaim::kFailed);
+  EXPECT_NE(error.find(dir_ + "/file/bags"), std::string::npos) << error;
+}
+
+TEST_F(RunRecorderTest, ARecorderNeverWritesOverAnotherRunsBag) {
+  std::ofstream(dir_ + "/done.bag") << "another run";
+  std::ofstream(dir_ + "/busy.bag.active") << "another run in progress";
+  for (const char* run_id : {"done", "busy"}) {
+    RunRecorder recorder(dir_, run_id);
+    EXPECT_FALSE(recorder.ok()) << run_id;
+    EXPECT_NE(recorder.error().find("not overwritten"), std::string::npos) << recorder.error();
+    EXPECT_FALSE(recorder.close());
+  }
+  EXPECT_EQ(contents(dir_ + "/done.bag"), "another run");
+  EXPECT_EQ(contents(dir_ + "/busy.bag.active"), "another run in progress");
+  EXPECT_FALSE(fs::exists(dir_ + "/done.bag.active"));
+  EXPECT_FALSE(fs::exists(dir_ + "/busy.bag"));
+}
+
+TEST_F(RunRecorderTest, CloseFailsLoudlyRatherThanReplaceAFile) {
+  RunRecorder recorder(dir_, "r1");
+  ASSERT_TRUE(recorder.ok()) << recorder.error();
+  recorder.write("/t", ros::Time(1.5e9), collision_lab::RunSummary());
+  std::ofstream(dir_ + "/r1.bag") << "written by a writer that does not claim";
+  EXPECT_FALSE(recorder.close());
+  EXPECT_NE(recorder.error().find("not overwritten"), std::string::npos) << recorder.error();
+  EXPECT_EQ(contents(dir_ + "/r1.bag"), "written by a writer that does not claim");
+  // This run's bag is kept, complete, under its .active name.
+  rosbag::Bag bag(dir_ + "/r1.bag.active", rosbag::bagmode::Read);
+  EXPECT_EQ(rosbag::View(bag).size(), 1u);
+}
+
+TEST_F(RunRecorderTest, RacingClaimersGetEachRunIdOnce) {
+  // Eight writers claim the same 300 run_ids at once; an owner finishes its bag at once
+  // (renames it), so later claimers meet finished bags as well as .active files.
+  constexpr int kWriters = 8;
+  constexpr int kRunIds = 300;
+  std::vector<std::atomic<int>> owners(kRunIds);
+  std::atomic<int> failures{0};
+  std::vector<std::thread> writers;
+  for (int w = 0; w < kWriters; ++w) {
+    writers.emplace_back([&, w] {
+      for (int k = 0; k < kRunIds; ++k) {
+        const std::string run_id = "r" + std::to_string(k);
+        std::string error;
+        const BagClaim claim = claimBag(dir_, run_id, error);
+        if (claim == BagClaim::kFailed) ++failures;
+        if (claim != BagClaim::kClaimed) continue;
+        ++owners[k];
+        const std::string path = dir_ + "/" + run_id + ".bag";
+        std::ofstream(path + ".active") << w;
+        fs::rename(path + ".active", path);
+      }
+    });
+  }
+  for (auto& writer : writers) writer.join();
+  EXPECT_EQ(failures.load(), 0);
+  for (int k = 0; k < kRunIds; ++k) EXPECT_EQ(owners[k].load(), 1) << "r" << k;
+  std::size_t files = 0;
+  for (const auto& entry : fs::directory_iterator(dir_)) {
+    EXPECT_EQ(entry.path().extension(), ".bag") << entry.path();
+    ++files;
+  }
+  EXPECT_EQ(files, static_cast<std::size_t>(kRunIds));
+}
+
+/// One run for RunBagWriter, its bag claimed in dir: its parameters, input, prediction
+/// and events (index k at 1 + k s), in batches of at most batch_events, the summary last.
+std::vector<collision_lab_ros::RunBagBatch> runBatches(const std::string& dir, const std::string& run_id,
+                                                       std::size_t events, std::size_t batch_events) {
   const ros::Time start(1.5e9);
   std::vector<collision_lab_ros::RunBagBatch> batches(1);
   batches[0].run_id = run_id;
   batches[0].opens = true;
+  if (claimBag(dir, run_id, batches[0].claim_error) == BagClaim::kTaken) batches[0].claim_error = "taken";
+  batches[0].parameters.emplace();
+  batches[0].parameters->header.stamp = start;
+  batches[0].parameters->run_id = run_id;
+  batches[0].parameters->max_collisions = 1000 + events;
   batches[0].input.emplace();
   batches[0].input->header.stamp = start;
   batches[0].prediction.emplace();
@@ -116,9 +207,9 @@ TEST_F(RunRecorderTest, BagWriterClosesEveryBagHandedOverWithEveryMessage) {
   std::vector<collision_lab::RunSummary> closed;  // on_closed runs on the writer's thread, in order
   {
     // A bound of 100 queued messages: the runs below (up to 1,000 events) push against it.
-    collision_lab_ros::RunBagWriter writer(dir_, {"/in", "/pred", "/events", "/sum"}, 100);
+    collision_lab_ros::RunBagWriter writer(dir_, {"/in", "/pred", "/events", "/sum", "", "", {}}, 100);
     for (int r = 0; r < kRuns; ++r) {
-      for (auto& batch : runBatches("run" + std::to_string(r), 25 * static_cast<std::size_t>(r), 64)) {
+      for (auto& batch : runBatches(dir_, "run" + std::to_string(r), 25 * static_cast<std::size_t>(r), 64)) {
         if (batch.summary) batch.on_closed = [&closed](collision_lab::RunSummary& s) { closed.push_back(s); };
         writer.push(std::move(batch));
       }
@@ -134,7 +225,7 @@ TEST_F(RunRecorderTest, BagWriterClosesEveryBagHandedOverWithEveryMessage) {
     EXPECT_EQ(closed[r].bag_path, dir_ + "/" + run_id + ".bag");
     EXPECT_FALSE(fs::exists(dir_ + "/" + run_id + ".bag.active"));
     rosbag::Bag bag(closed[r].bag_path, rosbag::bagmode::Read);
-    EXPECT_EQ(rosbag::View(bag).size(), 3 + events);
+    EXPECT_EQ(rosbag::View(bag).size(), 3 + events);  // no parameters topic given: not written
     EXPECT_EQ(rosbag::View(bag, rosbag::TopicQuery("/in")).size(), 1u);
     EXPECT_EQ(rosbag::View(bag, rosbag::TopicQuery("/pred")).size(), 1u);
     std::uint64_t index = 0;
@@ -152,9 +243,9 @@ TEST_F(RunRecorderTest, BagWriterReportsAFailedBagAndGoesOn) {
   std::ofstream(dir_ + "/file") << "x";
   std::vector<collision_lab::RunSummary> closed;
   {
-    collision_lab_ros::RunBagWriter writer(dir_ + "/file/bags", {"/in", "/pred", "/events", "/sum"}, 10);
+    collision_lab_ros::RunBagWriter writer(dir_ + "/file/bags", {"/in", "/pred", "/events", "/sum", "", "", {}}, 10);
     for (const char* run_id : {"a", "b"}) {
-      for (auto& batch : runBatches(run_id, 30, 8)) {
+      for (auto& batch : runBatches(dir_ + "/file/bags", run_id, 30, 8)) {
         if (batch.summary) batch.on_closed = [&closed](collision_lab::RunSummary& s) { closed.push_back(s); };
         writer.push(std::move(batch));
       }
@@ -173,19 +264,19 @@ TEST_F(RunRecorderTest, BagWriterSurvivesAnExceptionAndReportsTheRunItCost) {
     collision_lab_ros::RunBagWriter writer(dir_, {"/in", "/pred", "/events", "/sum"}, 10);
     // Run a's on_closed throws (in the node: publishing its summary): before, the writer
     // thread ended the process.
-    for (auto& batch : runBatches("a", 30, 8)) {
+    for (auto& batch : runBatches(dir_, "a", 30, 8)) {
       if (batch.summary) batch.on_closed = [](collision_lab::RunSummary&) { throw std::runtime_error("injected"); };
       writer.push(std::move(batch));
     }
     // Run x's batches come without the one that opens its bag: they cannot be written,
     // and its summary says so.
-    auto lost = runBatches("x", 30, 8);
+    auto lost = runBatches(dir_, "x", 30, 8);
     lost.erase(lost.begin());
     for (auto& batch : lost) {
       if (batch.summary) batch.on_closed = [&closed](collision_lab::RunSummary& s) { closed.push_back(s); };
       writer.push(std::move(batch));
     }
-    for (auto& batch : runBatches("b", 30, 8)) {
+    for (auto& batch : runBatches(dir_, "b", 30, 8)) {
       if (batch.summary) batch.on_closed = [&closed](collision_lab::RunSummary& s) { closed.push_back(s); };
       writer.push(std::move(batch));
     }
@@ -202,6 +293,46 @@ TEST_F(RunRecorderTest, BagWriterSurvivesAnExceptionAndReportsTheRunItCost) {
   EXPECT_TRUE(closed[1].recording_ok) << closed[1].recording_error;
   rosbag::Bag bag(dir_ + "/b.bag", rosbag::bagmode::Read);
   EXPECT_EQ(rosbag::View(bag).size(), 3 + 30u);
+}
+
+TEST_F(RunRecorderTest, LatchedTopicsAreWrittenAsRosbagRecordWritesThem) {
+  const collision_lab_ros::RunBagWriter::Topics topics{
+      "/lab2/in", "/lab2/pred", "/lab2/events", "/lab2/sum", "/lab2/params", "/lab2/lab_node",
+      {"/lab2/pred", "/lab2/sum", "/lab2/params"}};
+  {
+    collision_lab_ros::RunBagWriter writer(dir_, topics, 100);
+    for (const char* run_id : {"a", "b"}) {  // the second reuses the writer's Bag
+      for (auto& batch : runBatches(dir_, run_id, 5, 2)) {
+        if (batch.parameters) batch.parameters->package_version = "9.8.7";
+        writer.push(std::move(batch));
+      }
+    }
+  }
+  for (const char* run_id : {"a", "b"}) {
+    SCOPED_TRACE(run_id);
+    rosbag::Bag bag(dir_ + "/" + run_id + ".bag", rosbag::bagmode::Read);
+    rosbag::View view(bag);
+    std::map<std::string, std::map<std::string, std::string>> headers;  // by topic
+    for (const rosbag::ConnectionInfo* c : view.getConnections()) headers[c->topic] = *c->header;
+    ASSERT_EQ(headers.size(), 5u);
+    for (const char* latched : {"/lab2/pred", "/lab2/sum", "/lab2/params"}) {
+      EXPECT_EQ(headers[latched]["latching"], "1") << latched;
+      EXPECT_EQ(headers[latched]["callerid"], "/lab2/lab_node") << latched;
+    }
+    EXPECT_EQ(headers["/lab2/pred"]["type"], "collision_lab/Prediction");
+    for (const char* live : {"/lab2/in", "/lab2/events"}) EXPECT_EQ(headers[live].count("latching"), 0u) << live;
+    // The messages read back.
+    rosbag::View parameters_view(bag, rosbag::TopicQuery("/lab2/params"));
+    ASSERT_EQ(parameters_view.size(), 1u);
+    const auto parameters = parameters_view.begin()->instantiate<collision_lab::RunParameters>();
+    ASSERT_TRUE(parameters);
+    EXPECT_EQ(parameters->run_id, run_id);
+    EXPECT_EQ(parameters->package_version, "9.8.7");
+    EXPECT_EQ(parameters->max_collisions, 1005u);
+    rosbag::View summaries(bag, rosbag::TopicQuery("/lab2/sum"));
+    ASSERT_EQ(summaries.size(), 1u);
+    EXPECT_EQ(summaries.begin()->instantiate<collision_lab::RunSummary>()->collision_count, 5u);
+  }
 }
 
 TEST(ExpandUser, ExpandsLeadingTildeOnly) {

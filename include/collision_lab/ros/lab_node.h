@@ -24,6 +24,9 @@
 //   writer closes the run's bag, then publishes its summary and answers its service call
 //   (finishRun), so a run's summary may follow the next run's first messages; every
 //   summary still follows its own run's messages and its bag is closed when it goes out.
+// - The worker claims each run's bag file (claimBag, exclusive among every process that
+//   shares bag_directory) when it assigns the run_id, before any message names it; the
+//   bag writer only opens, writes and renames files so claimed.
 // - The diagnostics timer (global queue) reads the worker's counters through atomics and
 //   recording_mutex_.
 // - Destruction: queued inputs are dropped (a call waiting for one answers ok = false) and
@@ -189,7 +192,9 @@ class LabNode {
   void serve(collision_lab::InitialConditions input, Reply reply);
   /// Publishes, records and draws one validated run (its run_id assigned).
   /// requested_run_id: RunSummary.requested_run_id.
-  void run(collision_lab::InitialConditions& input, const std::string& requested_run_id, Reply reply);
+  /// claim_error: RunBagBatch::claim_error.
+  void run(collision_lab::InitialConditions& input, const std::string& requested_run_id,
+           const std::string& claim_error, Reply reply);
   /// runScene, as the run that ~cancel stops.
   collision_lab::core::SceneRunResult runCancellable(const std::string& run_id,
                                                      const collision_lab::core::Scene& scene,
@@ -208,12 +213,16 @@ class LabNode {
   /// Tells the sender which run_id input got (`accepted_runs`, the log) and records the
   /// run for ~list_runs. requested: the input's run_id as sent.
   void announce(const collision_lab::InitialConditions& input, const std::string& requested);
-  std::string newRunId();
-  /// requested, or the first free requested.N (N = 2, 3, ...) when it is taken; marks the
-  /// result as taken.
-  std::string claimRunId(const std::string& requested);
-  /// A bag of that name exists, or this node served it.
-  bool runIdTaken(const std::string& run_id) const;
+  /// <prefix><counter>, the first one claim() takes.
+  std::string newRunId(std::string& claim_error);
+  /// requested, or the first requested.N (N = 2, 3, ...) that claim() takes.
+  std::string claimRunId(const std::string& requested, std::string& claim_error);
+  /// Takes run_id for this node's next run. False when this node served it before or,
+  /// recording, when claimBag finds its bag taken (by any process sharing bag_directory).
+  /// True when taken: recording, its .bag.active file is this node's (claimBag), or, when
+  /// claimBag failed for another reason, claim_error says why (the run is served
+  /// unrecorded, recording_ok false).
+  bool claim(const std::string& run_id, std::string& claim_error);
 
   /// Publishes one DiagnosticArray: runs accepted and rejected, the last run's compute
   /// time, the recording state and the free space in bag_directory.

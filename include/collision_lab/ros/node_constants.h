@@ -39,6 +39,10 @@ constexpr bool kLatchRejected = true;
 /// accepted_runs: the newest accepted input's run_id, for a `rostopic echo -n1` just after
 /// a `rostopic pub` (in a busy class, ~list_runs has every run).
 constexpr bool kLatchAcceptedRuns = true;
+/// Bag only (the node does not publish it): the settings of the run (RunParameters),
+/// written first in each bag, latched on replay like the run's other one-shot messages.
+constexpr char kRunParametersTopic[] = "run_parameters";
+constexpr bool kLatchRunParameters = true;
 
 /// Private services of collision_lab_node (srv/RunScene.srv, srv/RunPreset.srv).
 constexpr char kRunSceneService[] = "run_scene";
@@ -89,7 +93,8 @@ constexpr std::size_t kRecordQueueMessages = 100'000;
 /// /diagnostics reports the median and p99 of the worker's recording hand-over time
 /// over this many newest runs.
 constexpr std::size_t kRecordingTimeWindow = 10'000;
-/// Relative to $ROS_HOME (default ~/.ros).
+/// Relative to $ROS_HOME (default ~/.ros), followed by the node's namespace
+/// (/collision_lab: collision_lab/runs/collision_lab): one folder per lab by default.
 constexpr char kDefaultBagSubdirectory[] = "collision_lab/runs";
 
 constexpr double kDefaultMarkerRate = 20.0;  ///< [Hz]

@@ -5,6 +5,16 @@
 // short by a crash is left as .bag.active (recoverable with `rosbag reindex`).
 // Recording never throws: a failure is kept in error() and later writes are skipped.
 //
+// Several writers (nodes, processes) may share one directory. A run's file is claimed
+// before the run starts (claimBag): the .bag.active file is created with O_CREAT|O_EXCL,
+// so exactly one claimer gets it, and a name whose finished .bag exists is given up
+// again. The owner then opens that file with rosbag (Write truncates and writes the
+// existing, empty file) and renames it on close with a rename that never replaces a
+// file (RENAME_NOREPLACE, or link + unlink where the file system lacks it); if the final
+// name exists anyway (a writer that does not claim), the run fails loudly (ok() false)
+// and its bag stays .bag.active. So a writer only ever writes and renames a file it
+// created itself, and reports success only for that file.
+//
 // RunBagWriter writes those bags on a thread of its own, so that a run's publisher only
 // hands its messages over (see its contract below).
 #pragma once
@@ -20,12 +30,14 @@
 #include <thread>
 #include <vector>
 
+#include <boost/make_shared.hpp>
 #include <ros/time.h>
 #include <rosbag/bag.h>
 
 #include "collision_lab/CollisionEvent.h"
 #include "collision_lab/InitialConditions.h"
 #include "collision_lab/Prediction.h"
+#include "collision_lab/RunParameters.h"
 #include "collision_lab/RunSummary.h"
 
 namespace collision_lab_ros {
@@ -33,35 +45,70 @@ namespace collision_lab_ros {
 /// <directory>/<run_id>.bag
 std::string bagPath(const std::string& directory, const std::string& run_id);
 
-/// True when a bag (finished or in progress) for run_id exists in directory.
-bool bagExists(const std::string& directory, const std::string& run_id);
+enum class BagClaim {
+  kClaimed,  ///< the caller created <run_id>.bag.active and owns it
+  kTaken,    ///< <run_id>.bag or <run_id>.bag.active exists (whoever made it); nothing was created
+  kFailed,   ///< the directory or the file could not be created; error says why
+};
+
+/// Claims <directory>/<run_id>.bag for the caller, race-free against every process that
+/// claims in directory this way: creates directory if needed, creates <run_id>.bag.active
+/// with O_CREAT|O_EXCL (kTaken when it exists), then gives the name up again (removes
+/// the file it just created: kTaken) when a finished <run_id>.bag exists. A finished bag
+/// only appears by its owner's rename of the .active file, which the exclusive create
+/// excludes until then, so after kClaimed no other claimer can get this run_id.
+BagClaim claimBag(const std::string& directory, const std::string& run_id, std::string& error);
+
+/// The connection header a live subscription to topic gives `rosbag record`: topic, type,
+/// md5sum, message_definition, callerid (the publishing node) and latching ("1" or "0").
+/// `rosbag play` publishes each (callerid, topic) as its own publisher, latched when
+/// latching is "1".
+template <class Message>
+boost::shared_ptr<ros::M_string> connectionHeader(const std::string& topic, const std::string& callerid,
+                                                  bool latching) {
+  auto header = boost::make_shared<ros::M_string>();
+  (*header)["topic"] = topic;
+  (*header)["type"] = ros::message_traits::datatype<Message>();
+  (*header)["md5sum"] = ros::message_traits::md5sum<Message>();
+  (*header)["message_definition"] = ros::message_traits::definition<Message>();
+  (*header)["callerid"] = callerid;
+  (*header)["latching"] = latching ? "1" : "0";
+  return header;
+}
 
 /// Expands a leading "~" to $HOME.
 std::string expandUser(const std::string& path);
 
 class RunRecorder {
  public:
-  /// Creates directory if needed and opens the run's bag (LZ4-compressed).
+  /// Claims the run's bag (claimBag; a run_id that is taken fails, nothing is
+  /// overwritten) and opens it (LZ4-compressed).
   RunRecorder(const std::string& directory, const std::string& run_id);
-  /// The same in reused, a closed Bag that outlives this recorder: constructing a
-  /// rosbag::Bag loads its encryption plugin (milliseconds), reopening one does not.
-  RunRecorder(const std::string& directory, const std::string& run_id, rosbag::Bag& reused);
+  /// Opens the bag the caller claimed with claimBag (claim_error empty) in reused, a
+  /// closed Bag that outlives this recorder: constructing a rosbag::Bag loads its
+  /// encryption plugin (milliseconds), reopening one does not. A non-empty claim_error
+  /// is why the claim failed: the recorder fails with it and touches no file.
+  RunRecorder(const std::string& directory, const std::string& run_id, rosbag::Bag& reused,
+              const std::string& claim_error);
   ~RunRecorder();
   RunRecorder(const RunRecorder&) = delete;
   RunRecorder& operator=(const RunRecorder&) = delete;
 
-  /// Writes msg on topic at stamp (which must be >= ros::TIME_MIN).
+  /// Writes msg on topic at stamp (which must be >= ros::TIME_MIN); with a
+  /// connection_header (connectionHeader()) its connection gets that header, as `rosbag
+  /// record` writes a live connection's.
   template <class Message>
-  void write(const std::string& topic, const ros::Time& stamp, const Message& msg) {
+  void write(const std::string& topic, const ros::Time& stamp, const Message& msg,
+             const boost::shared_ptr<ros::M_string>& connection_header = {}) {
     if (!ok()) return;
     try {
-      bag_->write(topic, stamp, msg);
+      bag_->write(topic, stamp, msg, connection_header);
     } catch (const std::exception& e) {
       fail(std::string("writing ") + topic + " failed: " + e.what());
     }
   }
 
-  /// Closes the bag and gives it its final name. Returns ok().
+  /// Closes the bag and gives it its final name, never replacing a file. Returns ok().
   bool close();
 
   bool ok() const { return error_.empty(); }
@@ -73,7 +120,7 @@ class RunRecorder {
   const std::string& path() const { return path_; }
 
  private:
-  void open(const std::string& directory);
+  void open();
 
   std::string path_;
   std::string active_path_;
@@ -82,11 +129,15 @@ class RunRecorder {
   rosbag::Bag* bag_ = nullptr;          ///< the open bag; null once closed or failed
 };
 
-/// A part of one run's bag, in recording order: the input, the prediction, the events,
-/// then the summary. Each message is written at its header.stamp.
+/// A part of one run's bag, in recording order: the parameters, the input, the
+/// prediction, the events, then the summary. Each message is written at its header.stamp.
 struct RunBagBatch {
   std::string run_id;
-  bool opens = false;  ///< the run's first batch: its bag is opened first
+  bool opens = false;  ///< the run's first batch: its bag (claimed by the caller) is opened first
+  /// With opens: empty when the caller claimed the run's bag (claimBag), else why that
+  /// failed; the run is then not recorded (recording_ok false, recording_error this).
+  std::string claim_error;
+  std::optional<collision_lab::RunParameters> parameters;
   std::optional<collision_lab::InitialConditions> input;
   std::optional<collision_lab::Prediction> prediction;
   std::vector<collision_lab::CollisionEvent> events;
@@ -96,11 +147,12 @@ struct RunBagBatch {
   std::optional<collision_lab::RunSummary> summary;
   std::function<void(collision_lab::RunSummary&)> on_closed;
 
-  std::size_t messages() const { return input.has_value() + prediction.has_value() + events.size() + summary.has_value(); }
+  std::size_t messages() const { return parameters.has_value() + input.has_value() + prediction.has_value() + events.size() + summary.has_value(); }
 };
 
 /// Writes per-run bags (RunRecorder) on its own thread.
-/// Contract: batches are written in the order handed over, one run at a time (a run's
+/// Contract: the caller claims each run's bag (claimBag) before handing over its first
+/// batch, or says in claim_error why it could not. Batches are written in the order handed over, one run at a time (a run's
 /// batches are contiguous). push() blocks while more than max_queued_messages messages
 /// wait (backpressure: nothing is ever dropped). The destructor writes everything handed
 /// over and closes every bag, calling each on_closed, before it returns. on_closed runs
@@ -112,6 +164,12 @@ class RunBagWriter {
  public:
   struct Topics {
     std::string inputs, predictions, events, summaries;
+    std::string parameters;  ///< of RunBagBatch::parameters; empty: they are not written
+    /// The recording node's name, callerid of the latched topics' connections.
+    std::string callerid;
+    /// Of the topics above, those the node latches: their connection headers get callerid
+    /// and latching=1, as `rosbag record` writes them, so that `rosbag play` latches them.
+    std::vector<std::string> latched;
   };
   RunBagWriter(std::string directory, Topics topics, std::size_t max_queued_messages);
   ~RunBagWriter();
@@ -125,10 +183,15 @@ class RunBagWriter {
   void write(RunBagBatch& batch);
   /// After write(batch) threw `what`: see the contract above.
   void recover(RunBagBatch& batch, const std::string& what);
+  /// connectionHeader<Message>(topic) for a latched topic; null (rosbag's own) for the others.
+  template <class Message>
+  boost::shared_ptr<ros::M_string> headerFor(const std::string& topic) const;
 
   const std::string directory_;
   const Topics topics_;
   const std::size_t max_queued_;
+  /// The connection headers of the latched topics (null: not latched), built once.
+  const boost::shared_ptr<ros::M_string> parameters_header_, input_header_, prediction_header_, summary_header_;
   rosbag::Bag bag_;                       ///< the writer thread's, reopened for every run
   std::optional<RunRecorder> recorder_;  ///< the writer thread's: the run being written
 
