@@ -16,12 +16,13 @@ int main(int argc, char** argv) {
   // listener on that topic, which `rosbag play --wait-for-subscribers` waits for.
   ros::NodeHandle nh;
   const ros::Subscriber parameters = nh.subscribe<collision_lab::RunParameters>(
-      collision_lab_ros::kRunParametersTopic, 10, [](const collision_lab::RunParameters::ConstPtr& p) {
+      collision_lab_ros::kRunParametersTopic, 10,
+      boost::function<void(const collision_lab::RunParameters::ConstPtr&)>([](const collision_lab::RunParameters::ConstPtr& p) {
         ROS_INFO_STREAM("run " << p->run_id << " was served by " << p->node_name << " (collision_lab "
                         << p->package_version << "), max_collisions " << p->max_collisions
                         << ", max_published_events " << p->max_published_events << ", max_bodies "
                         << p->max_bodies);
-      });
+      }));
   ros::spin();
   return 0;
 }
