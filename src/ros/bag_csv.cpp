@@ -303,6 +303,7 @@ Table<collision_lab::RunSummary> runSummaryTable() {
       .flag("simulated", &M::simulated)
       .field("predicted_collision_count", &M::predicted_collision_count)
       .flag("predicted_collision_count_defined", &M::predicted_collision_count_defined)
+      .flag("infinite_collisions", &M::infinite_collisions)
       .field("paper_predicted_collision_count", &M::paper_predicted_collision_count)
       .flag("paper_predicted_collision_count_defined", &M::paper_predicted_collision_count_defined)
       .field("energy_lost", &M::energy_lost, "_J")

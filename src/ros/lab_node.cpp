@@ -238,6 +238,8 @@ std::string predictedText(const collision_lab::RunSummary& summary) {
   std::ostringstream text;
   if (summary.predicted_collision_count_defined) {
     text << "predicted " << summary.predicted_collision_count;
+  } else if (summary.infinite_collisions) {
+    text << "predicted: infinitely many collisions (" << summary.model_name << ")";
   } else {
     text << "no count predicted by " << summary.model_name;
   }

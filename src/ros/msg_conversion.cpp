@@ -504,6 +504,7 @@ collision_lab::RunSummary toRunSummaryMsg(const core::SceneRunResult& result, st
   if (const auto& p = result.prediction) {
     msg.predicted_collision_count = p->impact_count.value_or(0);
     msg.predicted_collision_count_defined = p->impact_count.has_value();
+    msg.infinite_collisions = p->infinite;
     msg.critical_restitution = valueOr(p->critical_restitution);
     msg.spiral_angle = valueOr(p->spiral_angle);
   }

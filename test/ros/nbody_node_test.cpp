@@ -416,6 +416,9 @@ TEST(NBodyNode, TwoWallsAreSimulatedForDisplayOnly) {
   ASSERT_EQ(out.summaries.size(), 1u) << (out.rejections.empty() ? "" : out.rejections.front().message);
   EXPECT_TRUE(out.predictions.front().infinite_collisions);
   const auto& s = out.summaries.front();
+  // The summary says it too (the node's log line and the service answer read it from here).
+  EXPECT_TRUE(s.infinite_collisions);
+  EXPECT_FALSE(s.predicted_collision_count_defined);
   EXPECT_TRUE(s.simulated);
   EXPECT_TRUE(s.truncated);
   EXPECT_EQ(s.collision_count, 1000u);
