@@ -509,6 +509,61 @@ TEST(MarkerNBody, BallBetweenTwoWallsDrawsOnePeriodAndCountsThem) {
   expectViewsFit(r.run);
 }
 
+/// The centres' smallest distance between neighbours of the bodies drawn in `ns` with ids
+/// first + i (i < n) [rviz units], and the largest body's diameter.
+std::pair<double, double> closestNeighbours(const visualization_msgs::MarkerArray& array, const std::string& ns,
+                                            int first, int n) {
+  std::vector<double> x;
+  double size = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const auto* body = find(array, ns, first + i);
+    if (!body || body->action != visualization_msgs::Marker::ADD) return {0.0, kInf};
+    x.push_back(body->pose.position.x);
+    size = std::max(size, body->scale.x);
+  }
+  std::sort(x.begin(), x.end());
+  double closest = kInf;
+  for (std::size_t i = 0; i + 1 < x.size(); ++i) closest = std::min(closest, x[i + 1] - x[i]);
+  return {closest, size};
+}
+
+TEST(MarkerNBody, SevenBodiesCrowdedIntoAFewMetresAreMagnified) {
+  // Seven bodies 2/3 m apart, 4 m in all; the outer heavy ones close in at 1 m/s, and the
+  // run's axis spans over 30 m (where the fastest end up). On the scene's axis the
+  // neighbours lie less than a heavy body's diameter apart; the magnifier draws all seven
+  // at least twice the largest of its dots apart, in order, at their true separations.
+  // (Failed before: the magnifier showed for three bodies only.)
+  const double d = 2.0 / 3.0;
+  const NBodyRun r = runScene(scene({4, 1, 4, 1, 4, 1, 4}, {6 * d, 5 * d, 4 * d, 3 * d, 2 * d, d, 0},
+                                    {-1, 0, 0, 0, 0, 0, 1}), true);
+  const auto fixed = buildStaticMarkers(r.run, "f");
+  const auto* low = find(fixed, markers::ns::kScene, markers::kSceneMinLabel);
+  const auto* high = find(fixed, markers::ns::kScene, markers::kSceneMaxLabel);
+  ASSERT_TRUE(low && high);
+  EXPECT_GT(std::stod(high->text.substr(4)) - std::stod(low->text.substr(4)), 30.0) << low->text << " " << high->text;
+  const auto animated = buildAnimatedMarkers(r.run, FrameClock{0.0, "test"}, "f");
+  const auto [scene_gap, scene_size] = closestNeighbours(animated, markers::ns::kBodies, markers::kBody, 7);
+  EXPECT_LT(scene_gap, scene_size);  // crowded at full scale
+  const auto [zoom_gap, zoom_size] = closestNeighbours(animated, markers::ns::kZoom, markers::kZoomBody, 7);
+  EXPECT_GE(zoom_gap, 2 * zoom_size);
+  // True separations: 2/3 m between each pair of neighbours, on the window's scale.
+  const auto* window = find(animated, markers::ns::kZoom, markers::kZoomWindow);
+  ASSERT_TRUE(window);
+  EXPECT_EQ(window->text.rfind("window 10 m", 0), 0u) << window->text;
+  const double per_metre = (markers::layout::kSceneRight - markers::layout::kSceneLeft - 2 * markers::layout::kZoomInset) / 10;
+  for (int i = 0; i + 1 < 7; ++i) {
+    const auto* a = find(animated, markers::ns::kZoom, markers::kZoomBody + i);
+    const auto* b = find(animated, markers::ns::kZoom, markers::kZoomBody + i + 1);
+    ASSERT_TRUE(a && b);
+    EXPECT_NEAR(a->pose.position.x - b->pose.position.x, d * per_metre, 1e-9) << i;
+  }
+  // Once they fly apart, no magnifier.
+  const auto apart_now = buildAnimatedMarkers(r.run, FrameClock{endTime(r.run), "test"}, "f");
+  const auto* gone = find(apart_now, markers::ns::kZoom, markers::kZoomBody);
+  EXPECT_TRUE(gone && gone->action == visualization_msgs::Marker::DELETE);
+  expectViewsFit(r.run);
+}
+
 TEST(MarkerNBody, CollapseOfThreeEqualMassesEndsAtTheCentreOfMass) {
   // Three equal masses, e = 0.05 < r_c: infinitely many impacts before t_c, then the three
   // move as one at the centre-of-mass velocity -1/3 m/s, along x_cm(t) = 1 - t/3 m.

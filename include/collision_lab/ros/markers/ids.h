@@ -133,10 +133,10 @@ enum MarkerId : int {
 
   // ns "zoom"
   kZoomLine = 0,
-  kZoomBody = 1,  ///< + body index
-  kZoomMagnification = 4,
-  kZoomWindow = 5,
-  kZoomCount = 6,  ///< ids 0 .. kZoomCount - 1
+  kZoomMagnification = 1,
+  kZoomWindow = 2,
+  kZoomBody = 3,     ///< + body index (up to kMaxPlottedBodies bodies)
+  kZoomCount = 13,  ///< ids 0 .. kZoomCount - 1
 
   // ns "wedge_now", "plot_cursor"
   kCursor = 0,
