@@ -509,6 +509,61 @@ TEST(MarkerNBody, BallBetweenTwoWallsDrawsOnePeriodAndCountsThem) {
   expectViewsFit(r.run);
 }
 
+TEST(MarkerNBody, BallBetweenTwoWallsStepsOnePeriodAndCountsThem) {
+  // The same ball: per period T = 2 s one impact on each wall, v = +1, -1, then +1 again
+  // (m = 1 kg, so p = v). 1,000 impacts once filled the velocity and momentum plots with
+  // steps thinner than a pixel, solid blocks; now steps 0, 1, 2 (one period and its return)
+  // are drawn, the cursor at the step within the period, and the periods so far are
+  // counted as in the x-t diagram. (Failed before.)
+  NBodyRun r = runScene(scene({kInf, 1, kInf}, {1, 0.5, 0}, {0, 1, 0}), false, 1000);
+  const auto fixed = buildStaticMarkers(r.run, "f");
+  const auto& box = markers::layout::kVelocityBox;
+  const auto stepsOk = [](const visualization_msgs::Marker* m, const markers::Box& b) {
+    ASSERT_TRUE(m);
+    // (index, p or v): (0, 1) (1, 1) (1, -1) (2, -1) (2, 1) (3, 1), index 3 at the right edge.
+    ASSERT_EQ(m->points.size(), 6u);
+    const double width = b.right - b.left;
+    const double xs[] = {0, 1, 1, 2, 2, 3};
+    for (std::size_t k = 0; k < 6; ++k) EXPECT_NEAR(m->points[k].x, b.left + xs[k] / 3 * width, 1e-9) << k;
+    EXPECT_NEAR(m->points[0].y, m->points[5].y, 1e-9);
+    EXPECT_NEAR(m->points[1].y, m->points[4].y, 1e-9);
+    EXPECT_NEAR(m->points[2].y, m->points[3].y, 1e-9);
+    EXPECT_GT(m->points[1].y, m->points[2].y);  // +1 over -1
+  };
+  stepsOk(find(fixed, markers::ns::kPlot, markers::kPlotSeries + 1), box);
+  stepsOk(find(fixed, markers::ns::kConserved, markers::kConservedMomentum + markers::kConservedSeries),
+          markers::layout::kMomentumBox);
+  const auto* legend = find(fixed, markers::ns::kPlot, markers::kPlotLegend);
+  ASSERT_TRUE(legend);
+  EXPECT_NE(legend->text.find("one period drawn (2 impacts)"), std::string::npos) << legend->text;
+  // The index labels: 0, 1, 2 and no more.
+  for (int k = 0; k < 3; ++k) {
+    const auto* label = find(fixed, markers::ns::kPlot, markers::kPlotIndexLabels + k);
+    ASSERT_TRUE(label) << k;
+    EXPECT_EQ(label->text, std::to_string(k));
+  }
+  EXPECT_FALSE(find(fixed, markers::ns::kPlot, markers::kPlotIndexLabels + 3));
+  // At t = 15.9 s: 16 impacts, 7 periods (14 impacts) behind: step 2, the return.
+  const auto animated = buildAnimatedMarkers(r.run, FrameClock{15.9, "test"}, "f");
+  const auto* periods = find(animated, markers::ns::kPlotCursor, markers::kStepsPeriods);
+  ASSERT_TRUE(periods);
+  EXPECT_EQ(periods->text, "periods so far: 7");
+  const auto* cursor = find(animated, markers::ns::kPlotCursor, markers::kCursor);
+  ASSERT_TRUE(cursor);
+  EXPECT_NEAR(cursor->points[0].x, box.left + 2.5 / 3 * (box.right - box.left), 1e-9);
+  // At t = 16.6 s: 17 impacts, 8 periods behind: step 1.
+  const auto later = buildAnimatedMarkers(r.run, FrameClock{16.6, "test"}, "f");
+  cursor = find(later, markers::ns::kPlotCursor, markers::kCursor);
+  ASSERT_TRUE(cursor);
+  EXPECT_NEAR(cursor->points[0].x, box.left + 1.5 / 3 * (box.right - box.left), 1e-9);
+  expectViewsFit(r.run);
+  // A short run (under two periods) is drawn as it is, with no count.
+  const NBodyRun short_run = runScene(scene({kInf, 1, kInf}, {1, 0.5, 0}, {0, 1, 0}), false, 1);
+  const auto once = buildAnimatedMarkers(short_run.run, FrameClock{0.7, "test"}, "f");
+  const auto* none = find(once, markers::ns::kPlotCursor, markers::kStepsPeriods);
+  EXPECT_TRUE(!none || none->action == visualization_msgs::Marker::DELETE);
+}
+
 /// The centres' smallest distance between neighbours of the bodies drawn in `ns` with ids
 /// first + i (i < n) [rviz units], and the largest body's diameter.
 std::pair<double, double> closestNeighbours(const visualization_msgs::MarkerArray& array, const std::string& ns,

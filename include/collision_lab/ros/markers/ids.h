@@ -140,6 +140,7 @@ enum MarkerId : int {
 
   // ns "wedge_now", "plot_cursor"
   kCursor = 0,
+  kStepsPeriods = 1,  ///< "plot_cursor": a periodic motion's periods so far
 
   // ns "worldlines_now"
   kWorldNowLine = 0,
