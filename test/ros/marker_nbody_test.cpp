@@ -548,6 +548,8 @@ TEST(MarkerNBody, BallBetweenTwoWallsStepsOnePeriodAndCountsThem) {
   const auto* periods = find(animated, markers::ns::kPlotCursor, markers::kStepsPeriods);
   ASSERT_TRUE(periods);
   EXPECT_EQ(periods->text, "periods so far: 7");
+  // Over the velocity plot, clear of its frames' labels (B has a panel of its own).
+  marker_checks::expectTextClear(*periods, box.left, box.right, {&fixed, &animated});
   const auto* cursor = find(animated, markers::ns::kPlotCursor, markers::kCursor);
   ASSERT_TRUE(cursor);
   EXPECT_NEAR(cursor->points[0].x, box.left + 2.5 / 3 * (box.right - box.left), 1e-9);

@@ -227,7 +227,7 @@ void drawStepsCursor(const Canvas& c, const SceneState& state) {
   const std::uint64_t step = period ? period->inPeriod(state.time, state.collisions) : state.collisions;
   const double cx = index.toX(static_cast<double>(step) + 0.5);
   if (period) {
-    c.add(c.text(ns::kPlotCursor, kStepsPeriods, kVelocityBox.midX(), kLegendY + kWorldPeriodsDy,
+    c.add(c.text(ns::kPlotCursor, kStepsPeriods, kVelocityBox.right + kStepsPeriodsDx, kLegendY + kWorldPeriodsDy,
                  periodsSoFar(*period, state.time), kSmallTextSize, color(kLabelGrey)));
   } else {
     c.add(deleteMarker(ns::kPlotCursor, kStepsPeriods, c.frame_id));

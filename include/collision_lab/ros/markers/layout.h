@@ -166,6 +166,8 @@ constexpr double kWallLineWidth = 0.08, kBodyLineWidth = 0.03;
 constexpr double kWorldZeroDx = -0.3, kWorldEndDx = -0.55, kWorldUnitDx = -0.45, kWorldUnitDy = 0.3;
 constexpr double kWorldPositionDy = -0.3;
 constexpr double kWorldPeriodsDy = -0.35;  ///< the periods so far, under the legend
+/// The index plots' periods so far: in the same row, right of the frame's label.
+constexpr double kStepsPeriodsDx = -1.2;  ///< from the velocity box's right edge
 /// A periodic motion is drawn over one period once the run lasts this many periods.
 constexpr double kPeriodsToFold = 2.0;
 /// Large scenes: "x range: the bodies now" under the scene's right end label.
