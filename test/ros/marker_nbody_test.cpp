@@ -509,6 +509,118 @@ TEST(MarkerNBody, BallBetweenTwoWallsDrawsOnePeriodAndCountsThem) {
   expectViewsFit(r.run);
 }
 
+TEST(MarkerNBody, BallBetweenTwoWallsStepsOnePeriodAndCountsThem) {
+  // The same ball: per period T = 2 s one impact on each wall, v = +1, -1, then +1 again
+  // (m = 1 kg, so p = v). 1,000 impacts once filled the velocity and momentum plots with
+  // steps thinner than a pixel, solid blocks; now steps 0, 1, 2 (one period and its return)
+  // are drawn, the cursor at the step within the period, and the periods so far are
+  // counted as in the x-t diagram. (Failed before.)
+  NBodyRun r = runScene(scene({kInf, 1, kInf}, {1, 0.5, 0}, {0, 1, 0}), false, 1000);
+  const auto fixed = buildStaticMarkers(r.run, "f");
+  const auto& box = markers::layout::kVelocityBox;
+  const auto stepsOk = [](const visualization_msgs::Marker* m, const markers::Box& b) {
+    ASSERT_TRUE(m);
+    // (index, p or v): (0, 1) (1, 1) (1, -1) (2, -1) (2, 1) (3, 1), index 3 at the right edge.
+    ASSERT_EQ(m->points.size(), 6u);
+    const double width = b.right - b.left;
+    const double xs[] = {0, 1, 1, 2, 2, 3};
+    for (std::size_t k = 0; k < 6; ++k) EXPECT_NEAR(m->points[k].x, b.left + xs[k] / 3 * width, 1e-9) << k;
+    EXPECT_NEAR(m->points[0].y, m->points[5].y, 1e-9);
+    EXPECT_NEAR(m->points[1].y, m->points[4].y, 1e-9);
+    EXPECT_NEAR(m->points[2].y, m->points[3].y, 1e-9);
+    EXPECT_GT(m->points[1].y, m->points[2].y);  // +1 over -1
+  };
+  stepsOk(find(fixed, markers::ns::kPlot, markers::kPlotSeries + 1), box);
+  stepsOk(find(fixed, markers::ns::kConserved, markers::kConservedMomentum + markers::kConservedSeries),
+          markers::layout::kMomentumBox);
+  const auto* legend = find(fixed, markers::ns::kPlot, markers::kPlotLegend);
+  ASSERT_TRUE(legend);
+  EXPECT_NE(legend->text.find("one period drawn (2 impacts)"), std::string::npos) << legend->text;
+  // The index labels: 0, 1, 2 and no more.
+  for (int k = 0; k < 3; ++k) {
+    const auto* label = find(fixed, markers::ns::kPlot, markers::kPlotIndexLabels + k);
+    ASSERT_TRUE(label) << k;
+    EXPECT_EQ(label->text, std::to_string(k));
+  }
+  EXPECT_FALSE(find(fixed, markers::ns::kPlot, markers::kPlotIndexLabels + 3));
+  // At t = 15.9 s: 16 impacts, 7 periods (14 impacts) behind: step 2, the return.
+  const auto animated = buildAnimatedMarkers(r.run, FrameClock{15.9, "test"}, "f");
+  const auto* periods = find(animated, markers::ns::kPlotCursor, markers::kStepsPeriods);
+  ASSERT_TRUE(periods);
+  EXPECT_EQ(periods->text, "periods so far: 7");
+  // Over the velocity plot, clear of its frames' labels (B has a panel of its own).
+  marker_checks::expectTextClear(*periods, box.left, box.right, {&fixed, &animated});
+  const auto* cursor = find(animated, markers::ns::kPlotCursor, markers::kCursor);
+  ASSERT_TRUE(cursor);
+  EXPECT_NEAR(cursor->points[0].x, box.left + 2.5 / 3 * (box.right - box.left), 1e-9);
+  // At t = 16.6 s: 17 impacts, 8 periods behind: step 1.
+  const auto later = buildAnimatedMarkers(r.run, FrameClock{16.6, "test"}, "f");
+  cursor = find(later, markers::ns::kPlotCursor, markers::kCursor);
+  ASSERT_TRUE(cursor);
+  EXPECT_NEAR(cursor->points[0].x, box.left + 1.5 / 3 * (box.right - box.left), 1e-9);
+  expectViewsFit(r.run);
+  // A short run (under two periods) is drawn as it is, with no count.
+  const NBodyRun short_run = runScene(scene({kInf, 1, kInf}, {1, 0.5, 0}, {0, 1, 0}), false, 1);
+  const auto once = buildAnimatedMarkers(short_run.run, FrameClock{0.7, "test"}, "f");
+  const auto* none = find(once, markers::ns::kPlotCursor, markers::kStepsPeriods);
+  EXPECT_TRUE(!none || none->action == visualization_msgs::Marker::DELETE);
+}
+
+/// The centres' smallest distance between neighbours of the bodies drawn in `ns` with ids
+/// first + i (i < n) [rviz units], and the largest body's diameter.
+std::pair<double, double> closestNeighbours(const visualization_msgs::MarkerArray& array, const std::string& ns,
+                                            int first, int n) {
+  std::vector<double> x;
+  double size = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const auto* body = find(array, ns, first + i);
+    if (!body || body->action != visualization_msgs::Marker::ADD) return {0.0, kInf};
+    x.push_back(body->pose.position.x);
+    size = std::max(size, body->scale.x);
+  }
+  std::sort(x.begin(), x.end());
+  double closest = kInf;
+  for (std::size_t i = 0; i + 1 < x.size(); ++i) closest = std::min(closest, x[i + 1] - x[i]);
+  return {closest, size};
+}
+
+TEST(MarkerNBody, SevenBodiesCrowdedIntoAFewMetresAreMagnified) {
+  // Seven bodies 2/3 m apart, 4 m in all; the outer heavy ones close in at 1 m/s, and the
+  // run's axis spans over 30 m (where the fastest end up). On the scene's axis the
+  // neighbours lie less than a heavy body's diameter apart; the magnifier draws all seven
+  // at least twice the largest of its dots apart, in order, at their true separations.
+  // (Failed before: the magnifier showed for three bodies only.)
+  const double d = 2.0 / 3.0;
+  const NBodyRun r = runScene(scene({4, 1, 4, 1, 4, 1, 4}, {6 * d, 5 * d, 4 * d, 3 * d, 2 * d, d, 0},
+                                    {-1, 0, 0, 0, 0, 0, 1}), true);
+  const auto fixed = buildStaticMarkers(r.run, "f");
+  const auto* low = find(fixed, markers::ns::kScene, markers::kSceneMinLabel);
+  const auto* high = find(fixed, markers::ns::kScene, markers::kSceneMaxLabel);
+  ASSERT_TRUE(low && high);
+  EXPECT_GT(std::stod(high->text.substr(4)) - std::stod(low->text.substr(4)), 30.0) << low->text << " " << high->text;
+  const auto animated = buildAnimatedMarkers(r.run, FrameClock{0.0, "test"}, "f");
+  const auto [scene_gap, scene_size] = closestNeighbours(animated, markers::ns::kBodies, markers::kBody, 7);
+  EXPECT_LT(scene_gap, scene_size);  // crowded at full scale
+  const auto [zoom_gap, zoom_size] = closestNeighbours(animated, markers::ns::kZoom, markers::kZoomBody, 7);
+  EXPECT_GE(zoom_gap, 2 * zoom_size);
+  // True separations: 2/3 m between each pair of neighbours, on the window's scale.
+  const auto* window = find(animated, markers::ns::kZoom, markers::kZoomWindow);
+  ASSERT_TRUE(window);
+  EXPECT_EQ(window->text.rfind("window 10 m", 0), 0u) << window->text;
+  const double per_metre = (markers::layout::kSceneRight - markers::layout::kSceneLeft - 2 * markers::layout::kZoomInset) / 10;
+  for (int i = 0; i + 1 < 7; ++i) {
+    const auto* a = find(animated, markers::ns::kZoom, markers::kZoomBody + i);
+    const auto* b = find(animated, markers::ns::kZoom, markers::kZoomBody + i + 1);
+    ASSERT_TRUE(a && b);
+    EXPECT_NEAR(a->pose.position.x - b->pose.position.x, d * per_metre, 1e-9) << i;
+  }
+  // Once they fly apart, no magnifier.
+  const auto apart_now = buildAnimatedMarkers(r.run, FrameClock{endTime(r.run), "test"}, "f");
+  const auto* gone = find(apart_now, markers::ns::kZoom, markers::kZoomBody);
+  EXPECT_TRUE(gone && gone->action == visualization_msgs::Marker::DELETE);
+  expectViewsFit(r.run);
+}
+
 TEST(MarkerNBody, CollapseOfThreeEqualMassesEndsAtTheCentreOfMass) {
   // Three equal masses, e = 0.05 < r_c: infinitely many impacts before t_c, then the three
   // move as one at the centre-of-mass velocity -1/3 m/s, along x_cm(t) = 1 - t/3 m.

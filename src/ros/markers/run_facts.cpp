@@ -1,5 +1,6 @@
 // What kind of run it is, and the texts that say so (title, note, status line).
 #include <algorithm>
+#include <cmath>
 
 #include "collision_lab/ros/markers/draw.h"
 
@@ -20,7 +21,27 @@ std::uint64_t expectedCollisions(const RunRecord& run) {
   return run.collisions();
 }
 
+std::uint64_t Period::inPeriod(double t, std::uint64_t collisions) const {
+  const std::uint64_t behind = before(t) * impacts;
+  return std::min(impacts, collisions > behind ? collisions - behind : 0);
+}
+
+std::optional<Period> periodOf(const RunRecord& run) {
+  const auto& in = run.input();
+  const bool elastic = std::all_of(in.restitution.begin(), in.restitution.end(), [](double e) { return e == 1.0; });
+  if (run.bodies() != 3 || !run.isWall(0) || !run.isWall(2) || run.isWall(1) || !elastic) return std::nullopt;
+  if (in.velocities[0] != 0 || in.velocities[2] != 0 || in.velocities[1] == 0) return std::nullopt;
+  const double period = 2 * (in.positions[0] - in.positions[2]) / std::abs(in.velocities[1]);
+  if (!(period > 0) || !(endTime(run) > layout::kPeriodsToFold * period)) return std::nullopt;
+  return Period{period, 2};
+}
+
+std::string periodsSoFar(const Period& period, double t) {
+  return "periods so far: " + withSeparators(period.before(t));
+}
+
 double indexAxisEnd(const RunRecord& run) {
+  if (const auto period = periodOf(run)) return static_cast<double>(period->impacts) + 1.0;
   const std::uint64_t n = simulatedStepByStep(run) ? run.collisions() : expectedCollisions(run);
   return static_cast<double>(n) + 1.0;
 }

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "collision_lab/ros/markers/draw.h"
 
@@ -24,6 +25,20 @@ struct VelocityPanel {
 /// Body i's velocity steps: the plotted bodies', or (large scenes) the tracked bodies'.
 const Envelope& stepsOf(const RunRecord& run, std::size_t i) {
   return largeScene(run) ? run.trackedVelocity(i) : run.velocity(i);
+}
+
+/// A series as drawn: held at its last value up to one past the last collision; a periodic
+/// motion's first period only (a thousand periods would fill the panel with steps thinner
+/// than a pixel).
+Polyline shownSteps(const RunRecord& run, const Envelope& e) {
+  if (!periodOf(run)) return withTail(e, static_cast<double>(run.collisions()) + 1);
+  const double end = indexAxisEnd(run);
+  Polyline poly;
+  for (const auto& v : e.polyline()) {
+    if (v.x < end) poly.push_back(v);
+  }
+  if (!poly.empty()) poly.push_back({end, poly.back().y, poly.back().mark});
+  return poly;
 }
 
 double largestSpeed(const Envelope& e) { return std::max(std::abs(e.minY()), std::abs(e.maxY())); }
@@ -74,8 +89,7 @@ bool addPaperSeries(const Canvas& c, const Axes& axes, std::size_t i, int id) {
   const Envelope& paper = c.run.paperVelocity(i);
   if (paper.empty()) return false;
   const double tolerance = kPaperTolerance * (axes.y1 - axes.y0);
-  c.addLines(markedSegments(c, ns::kPlot, id, withTail(paper, static_cast<double>(c.run.collisions()) + 1), axes,
-                            tolerance, color(kPaper)));
+  c.addLines(markedSegments(c, ns::kPlot, id, shownSteps(c.run, paper), axes, tolerance, color(kPaper)));
   return !(axes.contains(paper.minY()) && axes.contains(paper.maxY()));
 }
 
@@ -85,9 +99,9 @@ bool addPredictedDots(const Canvas& c, const Axes& axes, std::size_t i, int id) 
   const auto final_v = finalVelocitiesNotDrawn(c.run);
   Marker predicted = c.dots(ns::kPlot, id, kPredictedDotSize, particleColor(i, kDotLighten));
   for (const Keyframe* f : thinned(c.run.keyframes(), kMaxPredictedDots)) {
-    if (i < f->predicted.size()) predicted.points.push_back(point(axes.toX(f->index + 0.5), axes.toY(f->predicted[i]), kDotZ));
+    if (i < f->predicted.size() && f->index + 0.5 < axes.x1) predicted.points.push_back(point(axes.toX(f->index + 0.5), axes.toY(f->predicted[i]), kDotZ));
   }
-  if (final_v && i < final_v->second.size() && std::isfinite(final_v->second[i])) predicted.points.push_back(point(axes.toX(final_v->first + 0.5), axes.toY(final_v->second[i]), kDotZ));
+  if (final_v && i < final_v->second.size() && std::isfinite(final_v->second[i]) && final_v->first + 0.5 < axes.x1) predicted.points.push_back(point(axes.toX(final_v->first + 0.5), axes.toY(final_v->second[i]), kDotZ));
   if (predicted.points.empty()) return false;
   c.add(predicted);
   return true;
@@ -103,20 +117,19 @@ void addVelocityPanel(const Canvas& c, const VelocityPanel& panel, int p, std::s
   const int base = kPlotPanelStride * p;
   const std::string label = panels == 1 ? "v [m/s]" : p == 0 ? "v_B [m/s]" : "v_A, v_C [m/s]";
   addFrame(c, ns::kPlot, base + kPlotFrame, panel.axes, label);
-  const double tail = static_cast<double>(c.run.collisions()) + 1;
   if (largeScene(c.run)) {
     // The tracked bodies' steps, coloured by their start velocity as in the x-t diagram; no
     // closed form or paper's series for many bodies.
     for (std::size_t k = 0; k < panel.bodies.size(); ++k) {
       const std::size_t i = panel.bodies[k];
-      addSeries(c, ns::kPlot, kPlotTracked + static_cast<int>(k), withTail(stepsOf(c.run, i), tail), panel.axes,
+      addSeries(c, ns::kPlot, kPlotTracked + static_cast<int>(k), shownSteps(c.run, stepsOf(c.run, i)), panel.axes,
                 velocityColor(c.run.input().velocities[i], velocityScale(c.run)), kCursorWidth);
     }
     return;
   }
   for (std::size_t i : panel.bodies) {
     const int b = static_cast<int>(i);
-    addSeries(c, ns::kPlot, base + kPlotSeries + b, withTail(c.run.velocity(i), tail), panel.axes, particleColor(i));
+    addSeries(c, ns::kPlot, base + kPlotSeries + b, shownSteps(c.run, c.run.velocity(i)), panel.axes, particleColor(i));
     paper.dots = addPredictedDots(c, panel.axes, i, base + kPlotPredicted + b) || paper.dots;
     paper.any = paper.any || !c.run.paperVelocity(i).empty();
     paper.off_scale = addPaperSeries(c, panel.axes, i, base + kPlotPaper + b) || paper.off_scale;
@@ -135,6 +148,9 @@ void addVelocityLegend(const Canvas& c, bool own_scale, const PaperShown& paper)
   if (!paper.any && rotation && (isWall(c.run.input(), 0) || isWall(c.run.input(), 2))) {
     legend += "   paper's (2.15)/(2.16): undefined with a wall";
   }
+  if (const auto period = periodOf(c.run)) {
+    legend += "   periodic: one period drawn (" + withSeparators(period->impacts) + " impacts)";
+  }
   if (largeScene(c.run)) {
     legend = withSeparators(c.run.trackedBodies().size()) + " of " + withSeparators(c.run.bodies()) +
              " bodies (those of the x-t diagram), coloured by v at the start";
@@ -152,8 +168,7 @@ void addConservedPlot(const Canvas& c, const Envelope& series, const Box& box, i
   const auto [y0, y1] = paddedRange(series.minY(), series.maxY());
   const Axes axes{box, 0.0, indexAxisEnd(c.run), y0, y1};
   addFrame(c, ns::kConserved, base, axes, label);
-  addSeries(c, ns::kConserved, base + kConservedSeries, withTail(series, static_cast<double>(c.run.collisions()) + 1),
-            axes, color(kWhite), kConservedWidth);
+  addSeries(c, ns::kConserved, base + kConservedSeries, shownSteps(c.run, series), axes, color(kWhite), kConservedWidth);
   addIndexAxisLabels(c, ns::kConserved, base + kConservedIndexLabels, axes);
 }
 
@@ -166,16 +181,15 @@ void addEnergyPlot(const Canvas& c, const std::string& label) {
   for (std::size_t i : run.plottedBodies()) lo = std::min(lo, run.bodyEnergy(i).minY()), hi = std::max(hi, run.bodyEnergy(i).maxY());
   const auto [y0, y1] = paddedRange(lo, hi);
   const Axes axes{kEnergyBox, 0.0, indexAxisEnd(run), y0, y1};
-  const double tail = static_cast<double>(run.collisions()) + 1;
   addFrame(c, ns::kConserved, kConservedEnergy, axes, label);
   for (std::size_t i : run.plottedBodies()) {
     addSeries(c, ns::kConserved, kConservedEnergy + kConservedBodies + static_cast<int>(i),
-              withTail(run.bodyEnergy(i), tail), axes, particleColor(i), kCursorWidth);
+              shownSteps(run, run.bodyEnergy(i)), axes, particleColor(i), kCursorWidth);
   }
-  addSeries(c, ns::kConserved, kConservedEnergy + kConservedSeries, withTail(run.energy(), tail), axes, color(kWhite),
+  addSeries(c, ns::kConserved, kConservedEnergy + kConservedSeries, shownSteps(run, run.energy()), axes, color(kWhite),
             kConservedWidth);
   if (run.energyLost().maxY() > 0) {
-    addSeries(c, ns::kConserved, kConservedEnergy + kConservedLost, withTail(run.energyLost(), tail), axes, color(kAmber),
+    addSeries(c, ns::kConserved, kConservedEnergy + kConservedLost, shownSteps(run, run.energyLost()), axes, color(kAmber),
               kConservedWidth);
   }
   addIndexAxisLabels(c, ns::kConserved, kConservedEnergy + kConservedIndexLabels, axes);
@@ -206,9 +220,18 @@ void drawConservedSteps(const Canvas& c) {
 }
 
 void drawStepsCursor(const Canvas& c, const SceneState& state) {
-  // The current step [k, k+1] of the index plots, across the velocity, energy and momentum plots.
+  // The current step [k, k+1] of the index plots, across the velocity, energy and momentum
+  // plots; a periodic motion's step within its period, and the periods so far.
   const Axes index{kVelocityBox, 0.0, indexAxisEnd(c.run), 0.0, 1.0};
-  const double cx = index.toX(static_cast<double>(state.collisions) + 0.5);
+  const std::optional<Period> period = periodOf(c.run);
+  const std::uint64_t step = period ? period->inPeriod(state.time, state.collisions) : state.collisions;
+  const double cx = index.toX(static_cast<double>(step) + 0.5);
+  if (period) {
+    c.add(c.text(ns::kPlotCursor, kStepsPeriods, kVelocityBox.right + kStepsPeriodsDx, kLegendY + kWorldPeriodsDy,
+                 periodsSoFar(*period, state.time), kSmallTextSize, color(kLabelGrey)));
+  } else {
+    c.add(deleteMarker(ns::kPlotCursor, kStepsPeriods, c.frame_id));
+  }
   Marker cursor = c.lines(ns::kPlotCursor, kCursor, Marker::LINE_LIST, kCursorWidth, color(kCursorWhite));
   cursor.points = {point(cx, kVelocityBox.bottom), point(cx, kVelocityBox.top), point(cx, kMomentumBox.bottom),
                    point(cx, kEnergyBox.top)};

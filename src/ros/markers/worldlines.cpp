@@ -129,22 +129,10 @@ bool ghostScene(const RunRecord& run) {
   return run.prediction && run.prediction->model == collision_lab::Prediction::MODEL_GHOSTS;
 }
 
-/// The period [s] of a ball between two walls at rest, all impacts elastic: there and back,
-/// T = 2 (x_A - x_C) / |v_B|. Empty for any other scene, and for a run shorter than
-/// kPeriodsToFold periods (drawn as it is).
-std::optional<double> periodOf(const RunRecord& run) {
-  const auto& in = run.input();
-  const bool elastic = std::all_of(in.restitution.begin(), in.restitution.end(), [](double e) { return e == 1.0; });
-  if (run.bodies() != 3 || !run.isWall(0) || !run.isWall(2) || run.isWall(1) || !elastic) return std::nullopt;
-  if (in.velocities[0] != 0 || in.velocities[2] != 0 || in.velocities[1] == 0) return std::nullopt;
-  const double period = 2 * (in.positions[0] - in.positions[2]) / std::abs(in.velocities[1]);
-  if (!(period > 0) || !(endTime(run) > kPeriodsToFold * period)) return std::nullopt;
-  return period;
-}
-
 /// The x-t diagram's axes of a small scene: its whole time, or one period of a periodic motion.
 WorldAxes wholeRunAxes(const RunRecord& run) {
-  return WorldAxes{sceneAxis(run), periodOf(run).value_or(endTime(run))};
+  const std::optional<Period> period = periodOf(run);
+  return WorldAxes{sceneAxis(run), period ? period->time : endTime(run)};
 }
 
 }  // namespace
@@ -160,7 +148,7 @@ void drawWorldlines(const Canvas& c) {
   // Large scenes draw the worldlines up to now, every frame (drawWorldlinesCursor).
   // A periodic motion: its first period, the rest repeats it (a thousand periods would
   // fill the box with lines thinner than a pixel).
-  const std::optional<double> period = large ? std::nullopt : periodOf(c.run);
+  const std::optional<Period> period = large ? std::nullopt : periodOf(c.run);
   if (!large) {
     const WorldAxes axes = wholeRunAxes(c.run);
     const SceneState last = stateAt(c.run, axes.end);
@@ -187,7 +175,7 @@ void drawWorldlines(const Canvas& c) {
   }
   // One line: a second would run into the "t [s]" label over the box.
   if (ghostScene(c.run)) legend += ";  grey dashes: ghosts x_i + v_i t, passing through";
-  if (period) legend = format("periodic: one period drawn, T = %.4g s; now at t mod T", *period);
+  if (period) legend = format("periodic: one period drawn, T = %.4g s; now at t mod T", period->time);
   c.add(c.text(ns::kWorldlines, kWorldLegend, b.midX(), kLegendY, legend, kSmallTextSize, color(kLabelGrey)));
 }
 
@@ -195,13 +183,12 @@ void drawWorldlinesCursor(const Canvas& c, const SceneState& state) {
   const bool large = largeScene(c.run);
   std::vector<Polyline> lines;
   const WorldAxes world = large ? axesUpToNow(c.run, state, lines) : wholeRunAxes(c.run);
-  const std::optional<double> period = large ? std::nullopt : periodOf(c.run);
+  const std::optional<Period> period = large ? std::nullopt : periodOf(c.run);
   // A periodic motion: now within its period, and how many periods are behind.
-  const double t_now = period ? std::fmod(state.time, *period) : state.time;
+  const double t_now = period ? std::fmod(state.time, period->time) : state.time;
   if (period) {
     c.add(c.text(ns::kWorldlinesNow, kWorldNowPeriods, kWorldBox.midX(), kLegendY + kWorldPeriodsDy,
-                 "periods so far: " + withSeparators(static_cast<std::uint64_t>(state.time / *period)), kSmallTextSize,
-                 color(kLabelGrey)));
+                 periodsSoFar(*period, state.time), kSmallTextSize, color(kLabelGrey)));
   } else {
     c.add(deleteMarker(ns::kWorldlinesNow, kWorldNowPeriods, c.frame_id));
   }

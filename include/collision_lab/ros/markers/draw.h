@@ -117,8 +117,22 @@ void addIndexAxisLabels(const Canvas& c, const std::string& ns, int base, const 
 // ---- facts of the run ----
 /// Collisions the run is known to have, as far as the messages tell [1].
 std::uint64_t expectedCollisions(const RunRecord& run);
+/// A periodic motion, drawn over one period (x-t diagram and index plots): a ball between two
+/// walls at rest, all impacts elastic, once the run lasts layout::kPeriodsToFold periods.
+struct Period {
+  double time;            ///< T = 2 (x_A - x_C) / |v_B| [s]
+  std::uint64_t impacts;  ///< per period, one on each wall [1]
+  /// Whole periods before time t [s].
+  std::uint64_t before(double t) const { return static_cast<std::uint64_t>(t / time); }
+  /// Collisions since the current period began, given `collisions` so far [1].
+  std::uint64_t inPeriod(double t, std::uint64_t collisions) const;
+};
+std::optional<Period> periodOf(const RunRecord& run);
+/// "periods so far: N" at time t [s].
+std::string periodsSoFar(const Period& period, double t);
 /// The collision index axis runs to this [1]: one past the last drawn step, or past the
-/// predicted count when the collisions are not shown one by one.
+/// predicted count when the collisions are not shown one by one; one past a period's
+/// impacts for a periodic motion.
 double indexAxisEnd(const RunRecord& run);
 /// Velocities after all the collisions when the steps do not get there: the summary's
 /// (simulated or, when not simulated, predicted) or the prediction's, at index n.

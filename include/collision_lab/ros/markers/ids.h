@@ -133,13 +133,14 @@ enum MarkerId : int {
 
   // ns "zoom"
   kZoomLine = 0,
-  kZoomBody = 1,  ///< + body index
-  kZoomMagnification = 4,
-  kZoomWindow = 5,
-  kZoomCount = 6,  ///< ids 0 .. kZoomCount - 1
+  kZoomMagnification = 1,
+  kZoomWindow = 2,
+  kZoomBody = 3,     ///< + body index (up to kMaxPlottedBodies bodies)
+  kZoomCount = 13,  ///< ids 0 .. kZoomCount - 1
 
   // ns "wedge_now", "plot_cursor"
   kCursor = 0,
+  kStepsPeriods = 1,  ///< "plot_cursor": a periodic motion's periods so far
 
   // ns "worldlines_now"
   kWorldNowLine = 0,

@@ -110,9 +110,13 @@ constexpr double kWallTagDx = 0.8, kTagDy = 0.5;
 constexpr double kTagGap = 0.08;
 constexpr int kTagMaxSteps = 4;
 constexpr double kVelocityRowPitch = 6.8;
-/// The magnifier shows while the bodies are closer than this share of the scene's axis.
+/// The magnifier shows while three bodies are closer than this share of the scene's axis.
 constexpr double kCrowded = 0.05;
 constexpr double kZoomMargin = 1.6;   ///< the window is a power of ten >= this x their spread
+/// Four to kMaxPlottedBodies bodies: the magnifier shows while two neighbours lie closer
+/// than kZoomCrowdedGap on the scene's axis and it magnifies at least kZoomLeast times; its
+/// window is 1, 2 or 5 times a power of ten, >= kZoomMargin x their spread.
+constexpr double kZoomCrowdedGap = 1.0, kZoomLeast = 2.0;
 constexpr double kZoomInset = 5.0;    ///< from each end of the scene's axis
 constexpr double kZoomLightSize = 0.16, kZoomHeavySize = 0.26, kZoomWallWidth = 0.08, kZoomWallHeight = 0.6;
 constexpr double kZoomLightZ = 0.3;  ///< B, the light one, on top: at a collision it touches A or C
@@ -162,6 +166,8 @@ constexpr double kWallLineWidth = 0.08, kBodyLineWidth = 0.03;
 constexpr double kWorldZeroDx = -0.3, kWorldEndDx = -0.55, kWorldUnitDx = -0.45, kWorldUnitDy = 0.3;
 constexpr double kWorldPositionDy = -0.3;
 constexpr double kWorldPeriodsDy = -0.35;  ///< the periods so far, under the legend
+/// The index plots' periods so far: in the same row, right of the frame's label.
+constexpr double kStepsPeriodsDx = -1.2;  ///< from the velocity box's right edge
 /// A periodic motion is drawn over one period once the run lasts this many periods.
 constexpr double kPeriodsToFold = 2.0;
 /// Large scenes: "x range: the bodies now" under the scene's right end label.
