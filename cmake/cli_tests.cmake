@@ -14,14 +14,13 @@ catkin_add_gtest(collision_lab_cli_test
   test/cli/random_input_test.cpp
   test/cli/nbody_cli_test.cpp
   test/cli/collapse_cli_test.cpp
-  test/cli/cli_process.cpp
-  test/core/nbody/reference.cpp)
+  test/cli/cli_process.cpp)
 if(TARGET collision_lab_cli_test)
-  target_link_libraries(collision_lab_cli_test collision_lab_core nlohmann_json::nlohmann_json GTest::gtest_main)
+  # collapse_cli_test checks the CLI against the exact rational reference of the test support.
+  target_link_libraries(collision_lab_cli_test collision_lab_test_support nlohmann_json::nlohmann_json
+    GTest::gtest_main)
   target_compile_definitions(collision_lab_cli_test PRIVATE
     COLLISION_LAB_CLI_PATH="$<TARGET_FILE:collision_lab_cli>"
     COLLISION_LAB_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
-  # collapse_cli_test checks the CLI against the exact rational reference of the core's tests.
-  target_include_directories(collision_lab_cli_test PRIVATE test/core/nbody)
   add_dependencies(collision_lab_cli_test collision_lab_cli)
 endif()

@@ -1,3 +1,11 @@
+# Test support, built once: the exact rational references written for the tests (no
+# engine code: rational_reference.h for three bodies, nbody/reference.cpp for N) and the
+# seeded scene generators (scenes.h, nbody/random_scenes.h). Used by the core, CLI and
+# node tests.
+add_library(collision_lab_test_support STATIC EXCLUDE_FROM_ALL test/core/nbody/reference.cpp)
+target_include_directories(collision_lab_test_support PUBLIC test/core test/core/nbody)
+target_link_libraries(collision_lab_test_support PUBLIC collision_lab_core)
+
 # Pure core tests: gtest, no ROS master.
 catkin_add_gtest(collision_lab_core_tests
   test/core/test_validation.cpp
@@ -8,13 +16,12 @@ catkin_add_gtest(collision_lab_core_tests
   test/core/test_lab_run.cpp
   test/core/test_full_run_accuracy.cpp)
 if(TARGET collision_lab_core_tests)
-  target_link_libraries(collision_lab_core_tests collision_lab_core GTest::gtest_main)
+  target_link_libraries(collision_lab_core_tests collision_lab_test_support GTest::gtest_main)
 endif()
 
-# N-body core (issue 10): scene, models, exact event engine, against an exact rational
-# reference written in the test directory.
+# N-body core (issue 10): scene, models, exact event engine, against the exact rational
+# reference of the test support.
 catkin_add_gtest(collision_lab_nbody_tests
-  test/core/nbody/reference.cpp
   test/core/nbody/test_scene.cpp
   test/core/nbody/test_models.cpp
   test/core/nbody/test_engine_hard.cpp
@@ -25,5 +32,5 @@ catkin_add_gtest(collision_lab_nbody_tests
   test/core/nbody/test_simultaneous.cpp
   test/core/nbody/test_wall_collapse.cpp)
 if(TARGET collision_lab_nbody_tests)
-  target_link_libraries(collision_lab_nbody_tests collision_lab_core GTest::gtest_main)
+  target_link_libraries(collision_lab_nbody_tests collision_lab_test_support GTest::gtest_main)
 endif()

@@ -27,9 +27,8 @@ foreach(name node_test nbody_node_test burst_test demo_test crash_test markers_t
   # The rostests start these nodes.
   add_dependencies(${name} collision_lab_node collision_lab_markers scenario_publisher)
 endforeach()
-# nbody_node_test checks the node against the exact rational reference of the core's tests.
-target_sources(nbody_node_test PRIVATE test/core/nbody/reference.cpp)
-target_include_directories(nbody_node_test PRIVATE test/core/nbody)
+# nbody_node_test checks the node against the exact rational reference of the test support.
+target_link_libraries(nbody_node_test collision_lab_test_support)
 # node_test reads the bad-input catalogue, docs/bad_inputs.md; demo_test runs scripts/play_run.
 target_compile_definitions(node_test PRIVATE COLLISION_LAB_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
 target_compile_definitions(demo_test PRIVATE COLLISION_LAB_SOURCE_DIR="${PROJECT_SOURCE_DIR}")

@@ -45,6 +45,21 @@ inline Wide toWide(const Q& q) {
   return Wide(boost::multiprecision::numerator(q)) / Wide(boost::multiprecision::denominator(q));
 }
 
+/// The textbook impact rule for the pair of left body i and right body i + 1.
+inline void applyImpact(const ThreeBodyScene& scene, int i, std::array<Q, 3>& v) {
+  const double m_l = scene.masses[i], m_r = scene.masses[i + 1];
+  const Q v_l = v[i], v_r = v[i + 1];
+  if (std::isinf(m_l)) {
+    v[i + 1] = 2 * v_l - v_r;
+  } else if (std::isinf(m_r)) {
+    v[i] = 2 * v_r - v_l;
+  } else {
+    const Q ml(m_l), mr(m_r);
+    v[i] = ((ml - mr) * v_l + 2 * mr * v_r) / (ml + mr);
+    v[i + 1] = ((mr - ml) * v_r + 2 * ml * v_l) / (ml + mr);
+  }
+}
+
 /// The run of `scene`, at most `max_impacts` impacts. Throws on a triple collision.
 inline Run simulate(const ThreeBodyScene& scene, std::size_t max_impacts) {
   std::array<Q, 3> x, v;
@@ -70,18 +85,39 @@ inline Run simulate(const ThreeBodyScene& scene, std::size_t max_impacts) {
     const Q dt = *delay[i];
     for (int j = 0; j < 3; ++j) x[j] += v[j] * dt;
     now += dt;
-    const double m_l = scene.masses[i], m_r = scene.masses[i + 1];
-    const Q v_l = v[i], v_r = v[i + 1];
-    if (std::isinf(m_l)) {
-      v[i + 1] = 2 * v_l - v_r;
-    } else if (std::isinf(m_r)) {
-      v[i] = 2 * v_r - v_l;
-    } else {
-      const Q ml(m_l), mr(m_r);
-      v[i] = ((ml - mr) * v_l + 2 * mr * v_r) / (ml + mr);
-      v[i + 1] = ((mr - ml) * v_r + 2 * ml * v_l) / (ml + mr);
-    }
+    applyImpact(scene, i, v);
     run.impacts.push_back({i == 0 ? Pair::AB : Pair::BC, now, x[i], x, v});
+  }
+  run.final_velocities = v;
+  return run;
+}
+
+/// The same run without times and positions (each impact holds its pair and velocities
+/// only), for long runs whose exact positions grow too large. Positions decide the pair
+/// only when both pairs approach, which the exact positions of the start settle; after an
+/// impact its pair separates, so at most one pair approaches: checked at every step (throws
+/// otherwise), not assumed.
+inline Run simulateVelocities(const ThreeBodyScene& scene, std::size_t max_impacts) {
+  std::array<Q, 3> v;
+  for (int i = 0; i < 3; ++i) v[i] = Q(scene.velocities[i]);
+  Run run;
+  while (true) {
+    const bool approaching[2] = {v[1] > v[0], v[2] > v[1]};
+    if (!approaching[0] && !approaching[1]) break;
+    int i = approaching[0] ? 0 : 1;
+    if (approaching[0] && approaching[1]) {
+      if (!run.impacts.empty()) throw std::logic_error("both pairs approach after an impact");
+      i = simulate(scene, 1).impacts.front().pair == Pair::AB ? 0 : 1;
+    }
+    if (run.impacts.size() == max_impacts) {
+      run.truncated = true;
+      break;
+    }
+    applyImpact(scene, i, v);
+    Impact impact;
+    impact.pair = i == 0 ? Pair::AB : Pair::BC;
+    impact.velocities = v;
+    run.impacts.push_back(std::move(impact));
   }
   run.final_velocities = v;
   return run;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 namespace collision_lab {
 namespace core {
@@ -138,6 +139,20 @@ Run simulate(const Scene& scene, std::uint64_t max_impacts) {
   run.velocities = s.v;
   for (std::size_t k = 0; k < s.x.size(); ++k) run.positions.push_back(s.x[k] - s.v[k] * (s.now - run.last_time));
   return run;
+}
+
+double limitOfImpactTimes(const Run& run) {
+  const auto& ev = run.events;
+  const std::size_t n = ev.size();
+  if (n < 5) throw std::invalid_argument("limitOfImpactTimes: fewer than 5 impacts");
+  const Rational t1 = ev[n - 5].time, t2 = ev[n - 3].time, t3 = ev[n - 1].time;
+  return static_cast<double>(Rational(t3 - (t3 - t2) * (t3 - t2) / ((t3 - t2) - (t2 - t1))));
+}
+
+double collapseTime(const Scene& scene, std::uint64_t impacts) {
+  const Run run = simulate(scene, impacts);
+  if (!run.truncated) throw std::invalid_argument("collapseTime: the scene does not collapse");
+  return limitOfImpactTimes(run);
 }
 
 double energyNormError(const Scene& scene, const std::vector<double>& velocities,

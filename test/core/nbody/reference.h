@@ -45,6 +45,15 @@ struct Run {
 /// collision: the run ends before it. Precondition: validate(scene) passed.
 Run simulate(const Scene& scene, std::uint64_t max_impacts);
 
+/// The collapse time [s] of a run that its cap ended inside an inelastic collapse: Aitken's
+/// limit, in rationals, of every second exact impact time (one pair's impacts), which
+/// converge geometrically (docs/physics.md, "Where the test constants come from").
+double limitOfImpactTimes(const Run& run);
+
+/// The collapse time [s] of `scene`, which collapses: the limit of its first `impacts`
+/// exact impact times (80 settle the scenes of physics.md to 1e-13 s).
+double collapseTime(const Scene& scene, std::uint64_t impacts = 80);
+
 /// sqrt(sum m (v - reference)^2) / sqrt(sum m v0^2) over the finite bodies, in the frame of
 /// the walls (the lab frame without walls): the scale-free energy norm.
 double energyNormError(const Scene& scene, const std::vector<double>& velocities,

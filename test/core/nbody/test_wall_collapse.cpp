@@ -42,14 +42,6 @@ Scene seededOneWallScene(std::mt19937_64& rng, bool wall_right) {
   return s;
 }
 
-/// Aitken's limit, in rationals, of every second exact impact time (one pair's impacts).
-double limitOfImpactTimes(const reference::Run& exact) {
-  const auto& ev = exact.events;
-  const std::size_t n = ev.size();
-  const reference::Rational t1 = ev[n - 5].time, t2 = ev[n - 3].time, t3 = ev[n - 1].time;
-  return static_cast<double>(reference::Rational(t3 - (t3 - t2) * (t3 - t2) / ((t3 - t2) - (t2 - t1))));
-}
-
 /// The engine's first impacts follow the exact reference's pairs.
 void expectSamePairs(const EngineResult& run, const reference::Run& exact, std::size_t count, const std::string& label) {
   ASSERT_LE(count, run.events.size()) << label;
@@ -73,7 +65,7 @@ void expectSqueeze(const Scene& s, double position, double wall_v, double heat) 
   const reference::Run exact = reference::simulate(s, 120);
   ASSERT_TRUE(exact.truncated);  // the impacts do not stop
   expectSamePairs(run, exact, std::min<std::size_t>(run.impact_count, 120), "squeeze");
-  const double limit = limitOfImpactTimes(exact);
+  const double limit = reference::limitOfImpactTimes(exact);
   EXPECT_NEAR(*run.collapse_time, limit, 1e-12 * limit);
   EXPECT_LE(static_cast<double>(exact.events.back().time), *run.collapse_time);
   EXPECT_NEAR(*run.collapse_position, position, 1e-12);
@@ -154,7 +146,7 @@ TEST(WallCollapse, SeededScenesWithOneWallAgreeWithTheExactReference) {
       ASSERT_LE(run.impact_count, kCap) << label;
       expectSamePairs(run, exact, run.impact_count, label);
       EXPECT_LE(static_cast<double>(exact.events.back().time), *run.collapse_time * (1 + 1e-15)) << label;
-      const double limit = limitOfImpactTimes(exact);
+      const double limit = reference::limitOfImpactTimes(exact);
       EXPECT_NEAR(*run.collapse_time, limit, 1e-9 * std::fabs(limit)) << label;
       for (double v : run.final_velocities) EXPECT_EQ(v, s.velocities[wall_right ? 0 : 2]) << label;
     } else {
