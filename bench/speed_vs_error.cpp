@@ -29,6 +29,7 @@
 
 #include "collision_lab/core/analytic.h"
 #include "collision_lab/core/exact.h"
+#include "collision_lab/core/nbody/body_state_replay.h"
 #include "collision_lab/core/nbody/engine.h"
 #include "collision_lab/core/nbody/models.h"
 #include "collision_lab/core/simulation.h"
@@ -283,41 +284,23 @@ Row runClosedForm(const BenchScene& s, const Reference& ref, bool quick) {
   return makeRow("closed_form", s, "double", ref, time, runs, count, v, {});
 }
 
-/// The state at end_time, rebuilt from the engine's impact records (ImpactRecord's replay
-/// contract): each body's position and velocity since its last impact at or before end_time.
-struct StateAt {
-  std::vector<double> x, v, since;  ///< [m], [m/s], time of that impact [s]
-  std::uint64_t impacts = 0;
-  void apply(const ImpactRecord& r, double end_time) {
-    if (r.time > end_time) return;
-    ++impacts;
-    for (std::size_t b = r.first_moved; b <= r.last_moved; ++b) {
-      v[b] = r.velocities_after[b <= r.pair_index ? 0 : 1];
-      x[b] = r.position;  // point masses at the contact (a cluster's members all are)
-      since[b] = r.time;
-    }
-  }
-  std::vector<double> positionsAt(double t) const {
-    std::vector<double> out(x.size());
-    for (std::size_t i = 0; i < x.size(); ++i) out[i] = x[i] + v[i] * (t - since[i]);
-    return out;
-  }
-};
-
 Row runNbodyEngine(const BenchScene& s, const Reference& ref, bool quick) {
   EngineOptions options;
   options.max_impacts = s.engine_cap;
-  StateAt state;
+  // The state at end_time: the core's replay of the impacts up to it.
+  BodyStateReplay state(s.scene);
   EngineResult result;
   auto work = [&] {
-    state = {s.scene.positions, s.scene.velocities, std::vector<double>(s.scene.size(), 0.0), 0};
-    result = runEngine(s.scene, options, [&](const ImpactRecord& r) { state.apply(r, s.end_time); });
+    state = BodyStateReplay(s.scene);
+    result = runEngine(s.scene, options, [&](const ImpactRecord& r) {
+      if (r.time <= s.end_time) state.apply(r);
+    });
   };
   int runs = 0;
   const double time = medianTime(work, quick, &runs);
   if (!result.collapses.empty()) return noteRow("nbody_engine", s, "exact", "collapsed: state not rebuilt");
-  return makeRow("nbody_engine", s, "exact", ref, time, runs, state.impacts, state.v,
-                 state.positionsAt(s.end_time));
+  return makeRow("nbody_engine", s, "exact", ref, time, runs, state.impacts(), state.velocities(),
+                 state.positions(s.end_time));
 }
 
 /// The closed-form model of the scene (models.h), when it gives one: count and final

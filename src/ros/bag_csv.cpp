@@ -26,8 +26,10 @@
 #include "collision_lab/RunParameters.h"
 #include "collision_lab/RunSummary.h"
 #include "collision_lab/Velocities.h"
+#include "collision_lab/core/nbody/body_state_replay.h"
 #include "collision_lab/core/nbody/scene.h"
 #include "collision_lab/io/number_text.h"
+#include "collision_lab/ros/msg_conversion.h"
 
 namespace collision_lab_ros {
 
@@ -363,10 +365,6 @@ void writeHeader(std::ostream& out, const std::vector<std::string>& names) {
   for (const auto& name : names) out << std::exchange(separator, ",") << name;
   out << '\n';
 }
-/// Kinetic energy m v^2 / 2 [J]; 0 for a wall (as the messages' kinetic_energy_after).
-double kinetic(double mass, double velocity) {
-  return std::isinf(mass) ? 0.0 : 0.5 * mass * velocity * velocity;
-}
 template <class T>
 std::optional<T> at(const std::vector<T>& values, std::size_t i) {
   return i < values.size() ? std::optional<T>(values[i]) : std::nullopt;
@@ -412,18 +410,19 @@ class BodiesCsv {
 
   void add(const collision_lab::InitialConditions& m) {
     const std::size_t n = std::min({m.masses.size(), m.positions.size(), m.velocities.size()});
-    runs_[m.run_id] = Run{m.masses, m.velocities};
+    const core::BodyStateReplay& replay =
+        runs_.insert_or_assign(m.run_id, core::BodyStateReplay(m.masses, m.positions, m.velocities)).first->second;
     for (std::size_t i = 0; i < n; ++i) {
       BodyRow r(0, 0.0, i, false);
       r.mass = m.masses[i], r.x = m.positions[i], r.v = m.velocities[i];
-      r.kinetic = kinetic(m.masses[i], m.velocities[i]);
+      r.kinetic = replay.kinetic(i);
       write(m.run_id, r);
     }
   }
 
   void add(const collision_lab::CollisionEvent& m) {
     const auto run = runs_.find(m.run_id);
-    Run* state = run == runs_.end() ? nullptr : &run->second;
+    core::BodyStateReplay* state = run == runs_.end() ? nullptr : &run->second;
     if (!m.velocities_after.empty()) {
       addFullState(m, state);
     } else if (state) {
@@ -439,10 +438,6 @@ class BodiesCsv {
   std::vector<std::string> warnings;
 
  private:
-  struct Run {
-    std::vector<double> masses;      ///< [kg]
-    std::vector<double> velocities;  ///< [m/s], after the last event read
-  };
   struct BodyRow {
     BodyRow(std::uint64_t index, double time, std::size_t body, bool moved)
         : index(index), time(time), body(body), moved(moved) {}
@@ -455,35 +450,30 @@ class BodiesCsv {
   };
 
   /// An event that carries every body: the arrays as they are.
-  void addFullState(const collision_lab::CollisionEvent& m, Run* state) {
+  void addFullState(const collision_lab::CollisionEvent& m, core::BodyStateReplay* state) {
     const std::size_t n = m.velocities_after.size();
-    const bool known = state && state->velocities.size() == n && state->masses.size() == n;
+    const bool known = state && state->size() == n;
     for (std::size_t i = 0; i < n; ++i) {
       BodyRow r(m.index, m.time, i, m.first_moved <= i && i <= m.last_moved);
-      if (known) r.mass = state->masses[i];
+      if (known) r.mass = state->mass(i);
       r.x = at(m.positions, i), r.v_before = at(m.velocities_before, i), r.v = m.velocities_after[i];
       r.energy_transfer = at(m.energy_transfer, i), r.kinetic = at(m.kinetic_energy_after, i);
       r.predicted_v = at(m.predicted_velocities_after, i), r.paper_v = at(m.paper_velocities_after, i);
       r.predicted_energy = at(m.predicted_energy_transfer, i), r.paper_energy = at(m.paper_energy_transfer, i);
       write(m.run_id, r);
     }
-    if (known) state->velocities = m.velocities_after;
+    if (known) replayEvent(*state, m);
   }
 
-  /// An event with the pair fields only: the bodies it moved, rebuilt from the run's state
-  /// (bag_csv.h says how).
-  void addMoved(const collision_lab::CollisionEvent& m, Run& state) {
-    const std::size_t n = std::min(state.masses.size(), state.velocities.size());
-    for (std::size_t i = m.first_moved; i <= m.last_moved && i < n; ++i) {
-      const bool right_side = m.kind == collision_lab::CollisionEvent::KIND_COLLAPSE || i <= m.pair_index;
-      const double mass = state.masses[i], before = state.velocities[i];
-      const double after = m.pair_velocities_after[right_side ? 0 : 1];
+  /// An event with the pair fields only: the bodies it moved, from the core's replay of the
+  /// run (bag_csv.h says how). An event that does not fit the run's bodies has no rows.
+  void addMoved(const collision_lab::CollisionEvent& m, core::BodyStateReplay& state) {
+    if (!replayEvent(state, m)) return;
+    for (std::size_t i = state.firstMoved(); i < state.endMoved(); ++i) {
       BodyRow r(m.index, m.time, i, true);
-      r.mass = mass, r.x = m.position, r.v_before = before, r.v = after;
-      r.kinetic = kinetic(mass, after);
-      r.energy_transfer = *r.kinetic - kinetic(mass, before);
+      r.mass = state.mass(i), r.x = state.position(i, m.time), r.v_before = state.velocityBefore(i);
+      r.v = state.velocities()[i], r.kinetic = state.kinetic(i), r.energy_transfer = state.energyGained(i);
       write(m.run_id, r);
-      state.velocities[i] = after;
     }
   }
 
@@ -503,7 +493,7 @@ class BodiesCsv {
   }
 
   TidyFile file_;
-  std::map<std::string, Run> runs_;
+  std::map<std::string, core::BodyStateReplay> runs_;  ///< each run's bodies after the last event read
   std::set<std::string> unknown_runs_;
 };
 

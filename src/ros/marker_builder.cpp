@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "collision_lab/ros/markers/draw.h"
+#include "collision_lab/ros/msg_conversion.h"
 
 namespace collision_lab_ros {
 
@@ -169,28 +170,15 @@ std::vector<int> slotsOf(const std::vector<std::size_t>& bodies, std::size_t cou
   return slot;
 }
 
-bool isWallMass(double m) { return std::isinf(m); }
-
 }  // namespace
 
-double kineticEnergy(const collision_lab::InitialConditions& input, const std::vector<double>& v) {
-  double energy = 0.0;
-  for (std::size_t i = 0; i < v.size() && i < input.masses.size(); ++i) {
-    if (!isWallMass(input.masses[i])) energy += 0.5 * input.masses[i] * v[i] * v[i];
-  }
-  return energy;
-}
-
-double momentum(const collision_lab::InitialConditions& input, const std::vector<double>& v) {
-  double p = 0.0;
-  for (std::size_t i = 0; i < v.size() && i < input.masses.size(); ++i) {
-    if (!isWallMass(input.masses[i])) p += input.masses[i] * v[i];
-  }
-  return p;
-}
-
 RunRecord::RunRecord(const collision_lab::InitialConditions& input, const RecordLimits& limits)
-    : input_(input), limits_(limits), first_collapse_time_(std::nan("")), min_velocity_(kInf), max_velocity_(-kInf) {
+    : input_(input),
+      limits_(limits),
+      replay_(input.masses, input.positions, input.velocities),
+      first_collapse_time_(std::nan("")),
+      min_velocity_(kInf),
+      max_velocity_(-kInf) {
   // An input of unequal lengths (the node rejects those) is cut to its shortest list.
   const std::size_t n = std::min({input_.masses.size(), input_.positions.size(), input_.velocities.size()});
   input_.masses.resize(n), input_.positions.resize(n), input_.velocities.resize(n);
@@ -205,28 +193,24 @@ RunRecord::RunRecord(const collision_lab::InitialConditions& input, const Record
   body_energy_.assign(plotted_.size(), empty);
   worldline_.assign(tracked_.size(), empty);
   energy_ = momentum_ = energy_lost_ = none_ = empty;
-  for (std::size_t i = 0; i < n; ++i) {
-    flights_.push_back({0.0, input_.positions[i], input_.velocities[i]});
-    widenVelocityRange(input_.velocities[i]);
-  }
+  for (std::size_t i = 0; i < n; ++i) widenVelocityRange(input_.velocities[i]);
   for (std::size_t k = 0; k < plotted_.size(); ++k) {
     const std::size_t i = plotted_[k];
     velocity_[k].add(0.0, input_.velocities[i]);
-    body_energy_[k].add(0.0, isWall(i) ? 0.0 : 0.5 * input_.masses[i] * input_.velocities[i] * input_.velocities[i]);
+    body_energy_[k].add(0.0, replay_.kinetic(i));
   }
   for (std::size_t k = 0; k < tracked_.size(); ++k) worldline_[k].add(0.0, input_.positions[tracked_[k]]);
   if (plotted_.empty()) {
     tracked_velocity_.assign(tracked_.size(), empty);
     for (std::size_t k = 0; k < tracked_.size(); ++k) tracked_velocity_[k].add(0.0, input_.velocities[tracked_[k]]);
   }
-  kinetic_ = kineticEnergy(input_, input_.velocities);
-  momentum_sum_ = collision_lab_ros::momentum(input_, input_.velocities);
-  energy_.add(0.0, kinetic_);
-  momentum_.add(0.0, momentum_sum_);
+  start_energy_ = replay_.totalKineticEnergy();
+  energy_.add(0.0, start_energy_);
+  momentum_.add(0.0, replay_.momentum());
   energy_lost_.add(0.0, 0.0);
 }
 
-bool RunRecord::isWall(std::size_t i) const { return i < bodies() && isWallMass(input_.masses[i]); }
+bool RunRecord::isWall(std::size_t i) const { return i < bodies() && replay_.isWall(i); }
 
 const Envelope& RunRecord::seriesOf(const std::vector<Envelope>& series, const std::vector<int>& slot,
                                     std::size_t i) const {
@@ -275,25 +259,13 @@ bool RunRecord::wellFormed(const collision_lab::CollisionEvent& event) const {
          event.last_moved > event.pair_index && event.last_moved < n;
 }
 
-void RunRecord::move(std::size_t body, double time, double position, double velocity) {
-  Flight& f = flights_[body];
-  if (!isWall(body)) {
-    const double m = input_.masses[body];
-    kinetic_ += 0.5 * m * (velocity * velocity - f.velocity * f.velocity);
-    momentum_sum_ += m * (velocity - f.velocity);
-  }
-  f = Flight{time, position, velocity};
+void RunRecord::recordMove(std::size_t body, double time) {
+  const double velocity = replay_.velocities()[body];
   widenVelocityRange(velocity);
-  const double k = static_cast<double>(newest_index_);
   if (track_slot_[body] >= 0) {
     const auto slot = static_cast<std::size_t>(track_slot_[body]);
-    worldline_[slot].add(time, position);
-    if (!tracked_velocity_.empty()) tracked_velocity_[slot].step(k, velocity);
-  }
-  if (plot_slot_[body] >= 0) {
-    const auto slot = static_cast<std::size_t>(plot_slot_[body]);
-    velocity_[slot].step(k, velocity);
-    body_energy_[slot].step(k, isWall(body) ? 0.0 : 0.5 * input_.masses[body] * velocity * velocity);
+    worldline_[slot].add(time, replay_.position(body, time));
+    if (!tracked_velocity_.empty()) tracked_velocity_[slot].step(static_cast<double>(newest_index_), velocity);
   }
 }
 
@@ -305,30 +277,24 @@ void RunRecord::widenVelocityRange(double v) {
 
 void RunRecord::apply(const collision_lab::CollisionEvent& event) {
   const std::size_t n = bodies();
-  const double t = event.time;
-  if (event.positions.size() == n && event.velocities_after.size() == n) {
-    for (std::size_t i = 0; i < n; ++i) move(i, t, event.positions[i], event.velocities_after[i]);
-  } else if (event.kind == collision_lab::CollisionEvent::KIND_COLLAPSE) {
-    for (std::size_t i = event.first_moved; i <= event.last_moved; ++i) move(i, t, event.position, event.pair_velocities_after[0]);
-  } else {
-    // A cluster's bodies sit at the contact point, all at their side's velocity.
-    for (std::size_t i = event.first_moved; i <= event.last_moved; ++i) {
-      move(i, t, event.position, event.pair_velocities_after[i <= event.pair_index ? 0 : 1]);
-    }
-  }
+  replayEvent(replay_, event);  // it fits: wellFormed
+  for (std::size_t i = replay_.firstMoved(); i < replay_.endMoved(); ++i) recordMove(i, event.time);
   const double k = static_cast<double>(newest_index_);
+  // The plotted bodies (at most kMaxPlottedBodies) have a step at every event.
+  for (std::size_t slot = 0; slot < plotted_.size(); ++slot) {
+    velocity_[slot].step(k, replay_.velocities()[plotted_[slot]]);
+    body_energy_[slot].step(k, replay_.kinetic(plotted_[slot]));
+  }
   if (event.paper_velocities_after.size() == n) {
     for (std::size_t slot = 0; slot < plotted_.size(); ++slot) {
       const double paper = event.paper_velocities_after[plotted_[slot]];
-      const double simulated = flights_[plotted_[slot]].velocity;
+      const double simulated = replay_.velocities()[plotted_[slot]];
       if (std::isfinite(paper)) paper_velocity_[slot].step(k, paper, std::abs(paper - simulated));
     }
   }
-  lost_ += std::isfinite(event.energy_lost) ? event.energy_lost : 0.0;
-  // The message's totals when it has them (no rounding builds up), else the running sums.
-  energy_.step(k, std::isfinite(event.total_energy) ? event.total_energy : kinetic_);
-  momentum_.step(k, std::isfinite(event.total_momentum) ? event.total_momentum : momentum_sum_);
-  energy_lost_.step(k, lost_);
+  energy_.step(k, replay_.totalKineticEnergy());
+  momentum_.step(k, replay_.momentum());
+  energy_lost_.step(k, replay_.heat());
 }
 
 Keyframe RunRecord::snapshot(double time) const {
@@ -339,10 +305,8 @@ Keyframe RunRecord::snapshot(double time) const {
   frame.previous_time = previous_time_;
   frame.predicted = newest_predicted_;
   frame.collapse = newest_is_collapse_;
-  for (const Flight& f : flights_) {
-    frame.positions.push_back(f.position + f.velocity * (time - f.since));
-    frame.velocities.push_back(f.velocity);
-  }
+  frame.positions = replay_.positions(time);
+  frame.velocities = replay_.velocities();
   return frame;
 }
 

@@ -298,6 +298,33 @@ PlotMessage plotMessageOf(const collision_lab::CollisionEvent& event) {
 
 }  // namespace
 
+bool replayEvent(core::BodyStateReplay& replay, const collision_lab::CollisionEvent& msg) {
+  if (msg.kind == collision_lab::CollisionEvent::KIND_COLLAPSE) {
+    core::Collapse collapse;
+    collapse.first_body = msg.first_moved;
+    collapse.last_body = msg.last_moved;
+    collapse.time = msg.time;
+    collapse.position = msg.position;
+    collapse.impacts_before = msg.index;
+    collapse.velocity = msg.pair_velocities_after[0];
+    return replay.apply(collapse);
+  }
+  core::ImpactRecord record;
+  record.index = msg.index;
+  record.pair_index = msg.pair_index;
+  record.time = msg.time;
+  record.position = msg.position;
+  for (std::size_t side = 0; side < 2; ++side) {
+    record.velocities_before[side] = msg.pair_velocities_before[side];
+    record.velocities_after[side] = msg.pair_velocities_after[side];
+    record.energy_gained[side] = msg.pair_energy_transfer[side];
+  }
+  record.energy_lost = msg.energy_lost;
+  record.first_moved = msg.first_moved;
+  record.last_moved = msg.last_moved;
+  return replay.apply(record);
+}
+
 collision_lab::Velocities toVelocitiesMsg(const collision_lab::CollisionEvent& event, std::vector<double> v) {
   auto msg = plotMessageOf<collision_lab::Velocities>(event);
   msg.v = std::move(v);
@@ -340,55 +367,30 @@ collision_lab::EnergyTransfer toEnergyTransferMsg(const collision_lab::Collision
 SceneEventConverter::SceneEventConverter(const core::Scene& scene)
     : scene_(scene),
       full_state_(scene.size() <= collision_lab::CollisionEvent::FULL_STATE_MAX_BODIES),
-      v_(scene.velocities) {
-  if (full_state_) x_ = scene.positions;
-}
+      replay_(scene) {}
 
-void SceneEventConverter::advance(double t) {
-  if (full_state_) {
-    for (std::size_t i = 0; i < x_.size(); ++i) x_[i] += v_[i] * (t - t_);
-  }
-  t_ = t;
-}
-
-double SceneEventConverter::kinetic(std::size_t body) const {
-  return scene_.isWall(body) ? 0.0 : 0.5 * scene_.masses[body] * v_[body] * v_[body];
-}
-
-void SceneEventConverter::move(std::size_t first, std::size_t last, double v, double x) {
-  for (std::size_t i = first; i <= last; ++i) {
-    const double before = kinetic(i);
-    v_[i] = v;
-    if (full_state_) x_[i] = x;
-    moved_gain_.push_back(kinetic(i) - before);
-  }
-}
-
-void SceneEventConverter::fillBodies(collision_lab::CollisionEvent& msg,
-                                     const std::vector<double>& velocities_before) const {
+void SceneEventConverter::fillBodies(collision_lab::CollisionEvent& msg) const {
   if (!full_state_) {
     msg.total_energy = msg.total_momentum = kNaN;
     return;
   }
   const std::size_t n = scene_.size();
-  msg.positions = x_;
-  msg.velocities_before = velocities_before;
-  msg.velocities_after = v_;
-  msg.energy_transfer.assign(n, 0.0);
-  for (std::size_t k = 0; k < moved_gain_.size(); ++k) msg.energy_transfer[moved_first_ + k] = moved_gain_[k];
-  msg.kinetic_energy_after.resize(n);
-  msg.total_energy = msg.total_momentum = 0.0;
+  msg.positions = replay_.positions(replay_.time());
+  msg.velocities_before.resize(n);
+  msg.energy_transfer.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
-    msg.kinetic_energy_after[i] = kinetic(i);
-    msg.total_energy += msg.kinetic_energy_after[i];
-    if (!scene_.isWall(i)) msg.total_momentum += scene_.masses[i] * v_[i];
+    msg.velocities_before[i] = replay_.velocityBefore(i);
+    msg.energy_transfer[i] = replay_.energyGained(i);
   }
+  msg.velocities_after = replay_.velocities();
+  msg.kinetic_energy_after = replay_.kineticEnergies();
+  msg.total_energy = replay_.totalKineticEnergy();
+  msg.total_momentum = replay_.momentum();
 }
 
 collision_lab::CollisionEvent SceneEventConverter::impact(const core::ImpactRecord& record) {
   const std::size_t p = record.pair_index;
-  advance(record.time);
-  const std::vector<double> before = full_state_ ? v_ : std::vector<double>{};
+  replay_.apply(record);
   collision_lab::CollisionEvent msg;
   msg.kind = collision_lab::CollisionEvent::KIND_IMPACT;
   msg.index = record.index;
@@ -405,21 +407,13 @@ collision_lab::CollisionEvent SceneEventConverter::impact(const core::ImpactReco
     msg.pair_energy_transfer[side] = scene_.isWall(p + side) ? 0.0 : record.energy_gained[side];
   }
   msg.energy_lost = record.energy_lost;
-  moved_first_ = msg.first_moved;
-  moved_gain_.clear();
-  move(record.first_moved, p, record.velocities_after[0], record.position);
-  move(p + 1, record.last_moved, record.velocities_after[1], record.position);
-  cumulative_lost_ += record.energy_lost;
-  fillBodies(msg, before);
+  fillBodies(msg);
   return msg;
 }
 
 collision_lab::CollisionEvent SceneEventConverter::collapse(const core::Collapse& collapse) {
-  const std::size_t first = collapse.first_body, last = collapse.last_body;
-  advance(collapse.time);
-  const std::vector<double> before = full_state_ ? v_ : std::vector<double>{};
-  double heat = 0.0;  // the bodies' kinetic energy before, less after
-  for (std::size_t i = first; i <= last; ++i) heat += kinetic(i);
+  const std::size_t first = collapse.first_body;
+  replay_.apply(collapse);
   collision_lab::CollisionEvent msg;
   msg.kind = collision_lab::CollisionEvent::KIND_COLLAPSE;
   msg.index = collapse.impacts_before;
@@ -428,20 +422,15 @@ collision_lab::CollisionEvent SceneEventConverter::collapse(const core::Collapse
   msg.position = collapse.position;
   msg.restitution = scene_.restitutionOf(first);
   msg.first_moved = static_cast<std::uint32_t>(first);
-  msg.last_moved = static_cast<std::uint32_t>(last);
+  msg.last_moved = static_cast<std::uint32_t>(collapse.last_body);
   msg.cluster_impact = false;
-  moved_first_ = first;
-  moved_gain_.clear();
-  for (std::size_t side = 0; side < 2; ++side) msg.pair_velocities_before[side] = v_[first + side];
-  move(first, last, collapse.velocity, collapse.position);
   for (std::size_t side = 0; side < 2; ++side) {
+    msg.pair_velocities_before[side] = replay_.velocityBefore(first + side);
     msg.pair_velocities_after[side] = collapse.velocity;
-    msg.pair_energy_transfer[side] = moved_gain_[side];
+    msg.pair_energy_transfer[side] = replay_.energyGained(first + side);
   }
-  for (std::size_t i = first; i <= last; ++i) heat -= kinetic(i);
-  msg.energy_lost = heat;
-  cumulative_lost_ += heat;
-  fillBodies(msg, before);
+  msg.energy_lost = replay_.lastHeat();
+  fillBodies(msg);
   return msg;
 }
 
@@ -452,18 +441,20 @@ std::size_t SceneEventConverter::plottedBodies() const {
 }
 
 collision_lab::Velocities SceneEventConverter::velocitiesMsg(const collision_lab::CollisionEvent& event) const {
-  collision_lab::Velocities msg = toVelocitiesMsg(event, {v_.begin(), v_.begin() + plottedBodies()});
+  const std::vector<double>& v = replay_.velocities();
+  collision_lab::Velocities msg = toVelocitiesMsg(event, {v.begin(), v.begin() + plottedBodies()});
   if (!full_state_) msg.v.clear();
   return msg;
 }
 
 collision_lab::EnergyTransfer SceneEventConverter::energyTransferMsg(const collision_lab::CollisionEvent& event) const {
   const std::size_t n = plottedBodies();
-  std::vector<double> delta(n, 0.0), kinetic_after(n);
-  for (std::size_t k = 0; k < moved_gain_.size() && moved_first_ + k < n; ++k) delta[moved_first_ + k] = moved_gain_[k];
-  for (std::size_t i = 0; i < n; ++i) kinetic_after[i] = kinetic(i);
-  collision_lab::EnergyTransfer msg =
-      toEnergyTransferMsg(event, std::move(delta), std::move(kinetic_after), cumulative_lost_);
+  std::vector<double> delta(n), kinetic_after(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    delta[i] = replay_.energyGained(i);
+    kinetic_after[i] = replay_.kinetic(i);
+  }
+  collision_lab::EnergyTransfer msg = toEnergyTransferMsg(event, std::move(delta), std::move(kinetic_after), replay_.heat());
   if (!full_state_) {
     msg.delta.clear();
     msg.kinetic.clear();

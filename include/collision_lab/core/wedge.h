@@ -8,6 +8,7 @@
 
 #include <array>
 #include <cmath>
+#include <vector>
 
 #include <Eigen/Core>
 #include <boost/multiprecision/eigen.hpp>  // Eigen traits of the multiprecision scalars
@@ -98,6 +99,13 @@ Wedge<T> wedgeOf(const std::array<double, 3>& masses) {
   wedge.alpha = alphaOf<T>(masses);
   return wedge;
 }
+
+/// The directions that u_perp approaches in a collapse (e <= r_c): the eigenvectors of the
+/// larger eigenvalue of the AB+BC cycle's map u' = u - (1 + e)(n.u) n per impact, in the
+/// wedge's coordinates (r_bc, n_bc), unit length. The first for the states after a BC impact
+/// (the cycle AB then BC), the second after an AB impact (BC then AB); each only when that
+/// cycle's eigenvalues are real (none for the spiral, e > r_c). Restitution e_ab, e_bc [1].
+std::vector<std::array<double, 2>> cycleEigenDirections(const Wedge<double>& wedge, double e_ab, double e_bc);
 
 }  // namespace core
 }  // namespace collision_lab

@@ -11,9 +11,9 @@
 //    CollisionEvent::FULL_STATE_MAX_BODIES bodies the event carries every body and every
 //    body has a row (column moved: whether the event moved it); above, the event carries
 //    the pair fields only, and the rows are those of the bodies it moved (first_moved ..
-//    last_moved), rebuilt: velocities copied from pair_velocities_after, position = the
-//    contact point, velocity before from the run's state so far, kinetic energy and its
-//    change from the masses. A 1,000-body gas has 245,308 impacts: every body after every
+//    last_moved), rebuilt by the core's replay of the run (core::BodyStateReplay): velocity
+//    from pair_velocities_after, position = the contact point, velocity before, kinetic
+//    energy and its change from the run's state so far. A 1,000-body gas has 245,308 impacts: every body after every
 //    impact would be 245 million rows.
 //  - final_velocities.csv, tidy: Prediction's and RunSummary's final velocities, one row
 //    per body.

@@ -39,6 +39,7 @@
 #include "collision_lab/Prediction.h"
 #include "collision_lab/Rejected.h"
 #include "collision_lab/RunSummary.h"
+#include "collision_lab/core/nbody/body_state_replay.h"
 #include "collision_lab/ros/node_constants.h"
 
 namespace collision_lab_ros {
@@ -128,9 +129,8 @@ constexpr std::size_t kMaxPlottedBodies = 10;
 /// power of two wide), doubling stride or bucket as needed to stay within the limits. So
 /// both the sparse phases (uniform in time) and the dense bursts (uniform in index) keep
 /// exact states close together.
-/// The state of every body is rebuilt from the InitialConditions and each event's pair
-/// fields (the per-body arrays when the event carries them): O(1) per impact (O(size) for
-/// a cluster), so a 1,000-body gas with 245,000 impacts costs 245,000 small updates; a
+/// The state of every body is the core's replay (core::BodyStateReplay) of the
+/// InitialConditions and each event's pair fields: O(1) per impact (O(size) for a cluster), so a 1,000-body gas with 245,000 impacts costs 245,000 small updates; a
 /// keyframe (O(N)) is copied only when it is kept.
 /// Not thread-safe, not even for const calls (keyframes() materialises the newest state).
 class RunRecord {
@@ -188,18 +188,17 @@ class RunRecord {
   const Envelope& energy() const { return energy_; }
   const Envelope& momentum() const { return momentum_; }
   const Envelope& energyLost() const { return energy_lost_; }
+  /// Total kinetic energy of the finite masses at the start [J].
+  double startEnergy() const { return start_energy_; }
 
  private:
-  /// Each body's free flight: x(t) = position + velocity (t - since).
-  struct Flight {
-    double since = 0.0, position = 0.0, velocity = 0.0;
-  };
   /// Empty when i has no slot or `series` is not kept.
   const Envelope& seriesOf(const std::vector<Envelope>& series, const std::vector<int>& slot, std::size_t i) const;
   bool wellFormed(const collision_lab::CollisionEvent& event) const;
-  /// Applies the event to flights_, the sums and the per-body series.
+  /// Applies the event to the replay and the series.
   void apply(const collision_lab::CollisionEvent& event);
-  void move(std::size_t body, double time, double position, double velocity);
+  /// Adds the moved body's new state (from the replay) to its worldline and velocity range.
+  void recordMove(std::size_t body, double time);
   void widenVelocityRange(double v);
   Keyframe snapshot(double time) const;
   bool keeps(const Keyframe& frame) const;
@@ -208,7 +207,7 @@ class RunRecord {
 
   collision_lab::InitialConditions input_;
   RecordLimits limits_;
-  std::vector<Flight> flights_;
+  collision_lab::core::BodyStateReplay replay_;  ///< every body now, from the events' pair fields
   mutable std::vector<Keyframe> keyframes_;
   /// keyframes_.back() is the newest state materialised for keyframes(), not a kept one.
   mutable bool provisional_ = false;
@@ -226,13 +225,9 @@ class RunRecord {
   std::vector<Envelope> velocity_, paper_velocity_, body_energy_, worldline_;
   std::vector<Envelope> tracked_velocity_;  ///< empty unless no body is plotted
   Envelope energy_, momentum_, energy_lost_, none_;
-  double kinetic_ = 0.0, momentum_sum_ = 0.0, lost_ = 0.0;
+  double start_energy_ = 0.0;
   double min_velocity_, max_velocity_;
 };
-
-/// Kinetic energy [J] and momentum [kg m/s] of the finite masses (walls excluded).
-double kineticEnergy(const collision_lab::InitialConditions& input, const std::vector<double>& v);
-double momentum(const collision_lab::InitialConditions& input, const std::vector<double>& v);
 
 /// How long bodies at positions x [m] with velocities v [m/s] fly freely before two
 /// touch [s]: +inf when no pair approaches. Bounds the animation of an unfinished run.

@@ -21,6 +21,7 @@
 #include "collision_lab/RunSummary.h"
 #include "collision_lab/Velocities.h"
 #include "collision_lab/core/lab_run.h"
+#include "collision_lab/core/nbody/body_state_replay.h"
 #include "collision_lab/core/nbody/engine.h"
 #include "collision_lab/core/nbody/models.h"
 #include "collision_lab/core/nbody/scene.h"
@@ -89,6 +90,12 @@ collision_lab::CollisionEvent toCollisionEventMsg(const collision_lab::core::Lab
 /// Inverse of toCollisionEventMsg: the message carries every field of a LabEvent.
 collision_lab::core::LabEvent toLabEvent(const collision_lab::CollisionEvent& msg);
 
+/// The core notification a received or recorded CollisionEvent stands for, from its pair
+/// fields (present for every N): KIND_IMPACT an impact record, KIND_COLLAPSE a collapse
+/// notice (velocity: pair_velocities_after[0]). Applies it to replay; false, and the replay
+/// unchanged, when its bodies do not fit the replay's scene.
+bool replayEvent(collision_lab::core::BodyStateReplay& replay, const collision_lab::CollisionEvent& msg);
+
 /// The plot topics' projections of a CollisionEvent (header and run_id included), with the
 /// velocities v [m/s] of every body after it; delta and kinetic [J] likewise, and
 /// cumulative_energy_lost the run's heat up to and including this event [J]
@@ -102,13 +109,11 @@ collision_lab::Velocities toVelocitiesMsg(const collision_lab::CollisionEvent& e
 collision_lab::EnergyTransfer toEnergyTransferMsg(const collision_lab::CollisionEvent& event,
                                                   double cumulative_energy_lost);
 
-/// The run's bodies, followed through the engine's notifications in the order the engine
-/// gives them (impacts and collapses interleaved, engine.h), and the CollisionEvent of each.
-/// Velocities are kept for every body, set from the notifications alone: an impact sets
-/// its record's first_moved..last_moved, a collapse its bodies to Collapse::velocity.
-/// Positions (and the per-body arrays of the messages) only for N <= FULL_STATE_MAX_BODIES:
-/// a body moves to x + v (t - t_last) between notifications, and the bodies an impact or a
-/// collapse moved sit at its point. Header and run_id are the caller's to fill.
+/// The CollisionEvent of each of the engine's notifications, in the order the engine gives
+/// them (impacts and collapses interleaved, engine.h), with the body state of the core's
+/// replay (core::BodyStateReplay): the per-body arrays (positions at the event's time,
+/// velocities before and after, energy transfer, kinetic energy) and the totals only for
+/// N <= FULL_STATE_MAX_BODIES. Header and run_id are the caller's to fill.
 class SceneEventConverter {
  public:
   explicit SceneEventConverter(const collision_lab::core::Scene& scene);
@@ -127,21 +132,12 @@ class SceneEventConverter {
  private:
   /// The bodies 0 .. plottedBodies() - 1 whose values the plot messages are built from.
   std::size_t plottedBodies() const;
-  /// Moves every tracked position to time t [s].
-  void advance(double t);
-  /// Sets bodies [first, last] to velocity v and position x, recording each one's energy gain.
-  void move(std::size_t first, std::size_t last, double v, double x);
   /// Fills the per-body arrays and totals of msg (or empties them, NaN totals, for large N).
-  void fillBodies(collision_lab::CollisionEvent& msg, const std::vector<double>& velocities_before) const;
-  double kinetic(std::size_t body) const;
+  void fillBodies(collision_lab::CollisionEvent& msg) const;
 
   collision_lab::core::Scene scene_;
   bool full_state_;
-  std::vector<double> x_, v_;
-  double t_ = 0.0;
-  double cumulative_lost_ = 0.0;
-  std::size_t moved_first_ = 0;
-  std::vector<double> moved_gain_;  ///< energy gained by bodies moved_first_, ... in the last event [J]
+  collision_lab::core::BodyStateReplay replay_;
 };
 
 /// The physics fields of a summary; published_events, events_not_published, bag_path,

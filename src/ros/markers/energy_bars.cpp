@@ -36,13 +36,13 @@ void drawEnergyBars(const Canvas& c, const SceneState& state) {
   std::vector<double> kinetic(n, 0.0);
   double total = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
-    if (!isWall(c.run.input(), i)) kinetic[i] = 0.5 * c.run.input().masses[i] * state.velocities[i] * state.velocities[i];
+    kinetic[i] = collision_lab::core::kineticEnergy(c.run.input().masses[i], state.velocities[i]);
     total += kinetic[i];
   }
   if (largeScene(c.run)) {
     c.add(c.text(ns::kEnergyBars, kEnergyTotals, kBarsBox.midX(), kBarsBox.midY(),
                  format("all %.0f bodies: ", static_cast<double>(n)) + format("%.5g J", total) +
-                     format("\nat the start: %.5g J", kineticEnergy(c.run.input(), c.run.input().velocities)),
+                     format("\nat the start: %.5g J", c.run.startEnergy()),
                  kTextSize));
     return;
   }

@@ -5,7 +5,6 @@
 // eigenvalues (e <= r_c, a collapse) its eigen-directions, which those directions approach.
 #include <algorithm>
 #include <cmath>
-#include <optional>
 
 #include <Eigen/Core>
 
@@ -47,9 +46,10 @@ class WedgeFrame {
 
   /// Angle of r_AB from r_BC: the cone's opening, alpha [rad].
   double abAngle() const { return wedge_.alpha; }
-  /// The unit normals n_AB and n_BC in the plane's coordinates.
-  std::array<double, 2> normalAB() const { return wedge_.coordinates(wedge_.n_ab); }
-  std::array<double, 2> normalBC() const { return wedge_.coordinates(wedge_.n_bc); }
+  /// The core's eigen-directions of the AB+BC cycle (core::cycleEigenDirections).
+  std::vector<std::array<double, 2>> cycleEigenDirections(double e_ab, double e_bc) const {
+    return collision_lab::core::cycleEigenDirections(wedge_, e_ab, e_bc);
+  }
 
  private:
   const collision_lab::InitialConditions& input_;
@@ -103,52 +103,14 @@ double restitutionOf(const collision_lab::InitialConditions& input, std::size_t 
   return e.empty() ? 1.0 : e.size() == 1 ? e[0] : p < e.size() ? e[p] : 1.0;
 }
 
-using Matrix2 = std::array<std::array<double, 2>, 2>;
-
-/// The impact of a pair on u_perp: u' = u - (1 + e)(n.u) n.
-Matrix2 impactMap(const std::array<double, 2>& n, double e) {
-  Matrix2 m;
-  for (int r = 0; r < 2; ++r) {
-    for (int k = 0; k < 2; ++k) m[r][k] = (r == k ? 1.0 : 0.0) - (1 + e) * n[r] * n[k];
-  }
-  return m;
-}
-
-Matrix2 product(const Matrix2& a, const Matrix2& b) {
-  Matrix2 m{};
-  for (int r = 0; r < 2; ++r) {
-    for (int k = 0; k < 2; ++k) m[r][k] = a[r][0] * b[0][k] + a[r][1] * b[1][k];
-  }
-  return m;
-}
-
-/// The eigenvector of the larger eigenvalue of m, when both are real (empty otherwise).
-std::optional<std::array<double, 2>> dominantDirection(const Matrix2& m) {
-  const double trace = m[0][0] + m[1][1];
-  const double det = m[0][0] * m[1][1] - m[0][1] * m[1][0];
-  const double discriminant = trace * trace - 4 * det;
-  if (discriminant < 0) return std::nullopt;
-  const double lambda = (trace + std::sqrt(discriminant)) / 2;
-  // (m - lambda I) v = 0: v is orthogonal to the larger row of m - lambda I.
-  const std::array<double, 2> r0{m[0][0] - lambda, m[0][1]}, r1{m[1][0], m[1][1] - lambda};
-  const auto& row = std::hypot(r0[0], r0[1]) >= std::hypot(r1[0], r1[1]) ? r0 : r1;
-  const double norm = std::hypot(row[0], row[1]);
-  if (!(norm > 0)) return std::nullopt;
-  return std::array<double, 2>{-row[1] / norm, row[0] / norm};
-}
-
 /// Where u_perp goes after each cycle, for a collapse: the eigen-directions of the cycle
 /// map after a BC impact (AB then BC) and after an AB impact (BC then AB), as lines
 /// through the centre.
 void addEigenDirections(const Canvas& c, const WedgeFrame& wedge) {
-  const Matrix2 ab = impactMap(wedge.normalAB(), restitutionOf(c.run.input(), 0));
-  const Matrix2 bc = impactMap(wedge.normalBC(), restitutionOf(c.run.input(), 1));
   Marker lines = c.lines(ns::kWedge, kWedgeEigen, Marker::LINE_LIST, kWedgeLineWidth, color(kPredicted));
-  for (const Matrix2& cycle : {product(bc, ab), product(ab, bc)}) {
-    const auto d = dominantDirection(cycle);
-    if (!d) continue;
-    lines.points.push_back(point(kWedgeX - kWedgeRadius * (*d)[0], kWedgeY - kWedgeRadius * (*d)[1], kDotZ));
-    lines.points.push_back(point(kWedgeX + kWedgeRadius * (*d)[0], kWedgeY + kWedgeRadius * (*d)[1], kDotZ));
+  for (const auto& d : wedge.cycleEigenDirections(restitutionOf(c.run.input(), 0), restitutionOf(c.run.input(), 1))) {
+    lines.points.push_back(point(kWedgeX - kWedgeRadius * d[0], kWedgeY - kWedgeRadius * d[1], kDotZ));
+    lines.points.push_back(point(kWedgeX + kWedgeRadius * d[0], kWedgeY + kWedgeRadius * d[1], kDotZ));
   }
   c.addLines(lines);
 }
