@@ -1,5 +1,9 @@
-# Thin ROS layer: message <-> core conversion, the lab node, per-run bags, rviz markers,
-# and the scenario publisher. Links the core (and collision_lab_io for scenario files).
+# Thin ROS layer in three libraries, as grid_map does, over the ROS-free core:
+#   collision_lab_ros    the node: message <-> core conversion, the lab node, per-run bags
+#   collision_lab_views  the rviz markers (links the node library for the conversions and
+#                        RunObserver, the node's hook for an in-process view)
+#   collision_lab_tools  bag_to_csv and the scenario publisher
+# Each executable links the library it runs.
 # ROS headers for this layer and everything built after it (nodes, ROS tests, the node
 # benchmarks); the core, built before, never sees them.
 include_directories(SYSTEM ${catkin_INCLUDE_DIRS})
@@ -7,8 +11,16 @@ add_library(collision_lab_ros
   src/ros/msg_conversion.cpp
   src/ros/run_recorder.cpp
   src/ros/run_timeline.cpp
-  src/ros/bag_csv.cpp
-  src/ros/lab_node.cpp
+  src/ros/lab_node.cpp)
+target_include_directories(collision_lab_ros PUBLIC include)
+# collision_lab_io: the node reads the presets of ~run_preset.
+target_link_libraries(collision_lab_ros PUBLIC collision_lab_core collision_lab_io ${catkin_LIBRARIES})
+add_dependencies(collision_lab_ros ${PROJECT_NAME}_generate_messages_cpp ${catkin_EXPORTED_TARGETS})
+# The version recorded in every bag (RunParameters.package_version): package.xml's, as
+# catkin_package() read it.
+target_compile_definitions(collision_lab_ros PRIVATE COLLISION_LAB_VERSION="${collision_lab_VERSION}")
+
+add_library(collision_lab_views
   src/ros/marker_builder.cpp
   src/ros/marker_view.cpp
   # the rviz views, one file each, and what they share (include/.../ros/markers/)
@@ -23,29 +35,30 @@ add_library(collision_lab_ros
   src/ros/markers/velocities.cpp
   src/ros/markers/overlays.cpp
   src/ros/markers/rviz_limits.cpp)
-target_include_directories(collision_lab_ros PUBLIC include)
-# collision_lab_io: the node reads the presets of ~run_preset.
-target_link_libraries(collision_lab_ros PUBLIC collision_lab_core collision_lab_io ${catkin_LIBRARIES})
-add_dependencies(collision_lab_ros ${PROJECT_NAME}_generate_messages_cpp ${catkin_EXPORTED_TARGETS})
-# The version recorded in every bag (RunParameters.package_version): package.xml's, as
-# catkin_package() read it.
-target_compile_definitions(collision_lab_ros PRIVATE COLLISION_LAB_VERSION="${collision_lab_VERSION}")
+target_link_libraries(collision_lab_views PUBLIC collision_lab_ros)
+
+add_library(collision_lab_tools
+  src/ros/bag_csv.cpp
+  src/ros/scenario_publisher.cpp)
+# collision_lab_io: the scenario files the publisher reads.
+target_link_libraries(collision_lab_tools PUBLIC collision_lab_ros collision_lab_io)
 
 # Executables go to the devel space's package folder, where rosrun and roslaunch look.
 set(collision_lab_ROS_EXECUTABLES
   collision_lab_node collision_lab_markers scenario_publisher bag_to_csv)
+# The node feeds the marker view in-process (~publish_markers): it links the views too.
 add_executable(collision_lab_node src/ros/lab_node_main.cpp)
-target_link_libraries(collision_lab_node PRIVATE collision_lab_ros)
+target_link_libraries(collision_lab_node PRIVATE collision_lab_ros collision_lab_views)
 add_executable(collision_lab_markers src/ros/markers_main.cpp)
-target_link_libraries(collision_lab_markers PRIVATE collision_lab_ros)
-add_executable(scenario_publisher src/ros/scenario_publisher.cpp)
-target_link_libraries(scenario_publisher PRIVATE collision_lab_ros collision_lab_io)
+target_link_libraries(collision_lab_markers PRIVATE collision_lab_views)
+add_executable(scenario_publisher src/ros/scenario_publisher_main.cpp)
+target_link_libraries(scenario_publisher PRIVATE collision_lab_tools)
 add_executable(bag_to_csv src/ros/bag_to_csv_main.cpp)
-target_link_libraries(bag_to_csv PRIVATE collision_lab_ros)
+target_link_libraries(bag_to_csv PRIVATE collision_lab_tools)
 set_target_properties(${collision_lab_ROS_EXECUTABLES} PROPERTIES
   RUNTIME_OUTPUT_DIRECTORY ${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_BIN_DESTINATION})
 
-install(TARGETS collision_lab_ros
+install(TARGETS collision_lab_ros collision_lab_views collision_lab_tools
   ARCHIVE DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
   LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION})
 install(TARGETS ${collision_lab_ROS_EXECUTABLES}

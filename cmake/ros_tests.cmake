@@ -5,7 +5,7 @@ catkin_add_gtest(ros_layer_unit_test
   test/ros/marker_builder_test.cpp
   test/ros/marker_nbody_test.cpp)
 if(TARGET ros_layer_unit_test)
-  target_link_libraries(ros_layer_unit_test collision_lab_ros GTest::gtest_main)
+  target_link_libraries(ros_layer_unit_test collision_lab_views GTest::gtest_main)
 endif()
 
 # The run timeline and bag_to_csv (no master).
@@ -13,7 +13,7 @@ catkin_add_gtest(ros_tools_unit_test
   test/ros/run_timeline_test.cpp
   test/ros/bag_csv_test.cpp)
 if(TARGET ros_tools_unit_test)
-  target_link_libraries(ros_tools_unit_test collision_lab_ros GTest::gtest_main)
+  target_link_libraries(ros_tools_unit_test collision_lab_tools GTest::gtest_main)
   add_dependencies(ros_tools_unit_test bag_to_csv)
   target_compile_definitions(ros_tools_unit_test PRIVATE
     COLLISION_LAB_BAG_TO_CSV="$<TARGET_FILE:bag_to_csv>")
@@ -27,6 +27,8 @@ foreach(name node_test nbody_node_test burst_test demo_test crash_test markers_t
   # The rostests start these nodes.
   add_dependencies(${name} collision_lab_node collision_lab_markers scenario_publisher)
 endforeach()
+# demo_test converts the demo's bags with bag_csv.
+target_link_libraries(demo_test collision_lab_tools)
 # nbody_node_test checks the node against the exact rational reference of the test support.
 target_link_libraries(nbody_node_test collision_lab_test_support)
 # node_test reads the bad-input catalogue, docs/bad_inputs.md; demo_test runs scripts/play_run.

@@ -133,7 +133,7 @@ std::string utcStamp(const char* format) {
 /// energy_transfers.
 class EventStream {
  public:
-  EventStream(const RunTopics& topics, RunWriter& out, MarkerView* markers, std::uint64_t max_published,
+  EventStream(const RunTopics& topics, RunWriter& out, RunObserver* markers, std::uint64_t max_published,
               const collision_lab::core::Scene& scene)
       : topics_(topics), out_(out), markers_(markers), max_published_(max_published), converter_(scene) {}
 
@@ -182,7 +182,7 @@ class EventStream {
 
   const RunTopics& topics_;
   RunWriter& out_;
-  MarkerView* markers_;
+  RunObserver* markers_;
   std::uint64_t max_published_;
   SceneEventConverter converter_;
   std::uint64_t published_ = 0;
@@ -459,7 +459,7 @@ std::vector<collision_lab::ServedRun> ServedRuns::list(const std::string& studen
   return listed;
 }
 
-LabNode::LabNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
+LabNode::LabNode(ros::NodeHandle nh, ros::NodeHandle private_nh, const RunObserverFactory& make_observer)
     : nh_(nh),
       params_(LabNodeParams::load(private_nh)),
       service_spinner_(kServiceThreads, &service_queue_),
@@ -478,9 +478,7 @@ LabNode::LabNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
       nh_.advertise<collision_lab::Rejected>(kRejectedTopic, kOutputQueueSize, kLatchRejected);
   accepted_pub_ = nh_.advertise<collision_lab::AcceptedRun>(kAcceptedRunsTopic, kOutputQueueSize, kLatchAcceptedRuns);
   served_inputs_pub_ = nh_.advertise<collision_lab::InitialConditions>(kServedInputsTopic, kOutputQueueSize);
-  if (params_.publish_markers) {
-    marker_view_ = std::make_unique<MarkerView>(nh_, MarkerViewParams::load(private_nh));
-  }
+  if (params_.publish_markers && make_observer) marker_view_ = make_observer(nh_, private_nh);
 
   run_id_prefix_ = std::string("run_") + utcStamp("%Y%m%d_%H%M%S") + "_";
   if (params_.record) {

@@ -1,4 +1,5 @@
 #include <csignal>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 
@@ -6,6 +7,7 @@
 #include <ros/ros.h>
 
 #include "collision_lab/ros/lab_node.h"
+#include "collision_lab/ros/marker_view.h"
 
 namespace {
 volatile std::sig_atomic_t g_interrupted = 0;
@@ -22,7 +24,10 @@ int main(int argc, char** argv) {
   ros::NodeHandle nh, private_nh("~");
   std::optional<collision_lab_ros::LabNode> node;
   try {
-    node.emplace(nh, private_nh);
+    node.emplace(nh, private_nh, [](ros::NodeHandle node_nh, ros::NodeHandle node_private_nh) {
+      return std::make_unique<collision_lab_ros::MarkerView>(node_nh,
+                                                              collision_lab_ros::MarkerViewParams::load(node_private_nh));
+    });
   } catch (const std::invalid_argument& e) {
     ROS_FATAL_STREAM("collision_lab_node: " << e.what());
     return 1;

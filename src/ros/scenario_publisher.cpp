@@ -1,22 +1,5 @@
-// scenario_publisher: serves preset scenes of any size (N bodies, restitution) one at a time
-// through collision_lab_node's ~run_scene service (so each is published, recorded and drawn
-// like any input), prints a table, and ends with one plain line: "demo finished: N runs,
-// bags in DIR", or "demo FAILED: ..." naming the failed runs. It reads the scenario files
-// the CLI reads (collision_lab/io/scenario_file.h).
-//
-// Private parameters:
-//   ~scenario_file (string, required)  YAML file of named scenes (config/scenarios.yaml)
-//   ~scenarios (string, default "")    names to run, separated by spaces or commas; empty: all
-//   ~mode (int, default 0)             InitialConditions.MODE_* for every run
-//   ~run_id_suffix (string, default: UTC start time)  run_id = <scene name>_<suffix>
-//   ~service (string, default "collision_lab_node/run_scene")  the node's service
-//   ~wait_timeout (double, default 60) [s]  how long to wait for that service to appear
-//   ~dwell (double, default 0) [s]     wall time each run stays on screen before the next
-//   ~exit_when_done (bool, default true)  exit after the last run; false: stay until shut down
-//   ~end_launch_when_done (bool, default false)  after a demo without failures, shut down the
-//       roslaunch that started this node as Ctrl-C does (SIGINT), so that a headless demo
-//       ends cleanly; after a failure, exit 1 instead, which roslaunch reports in red for a
-//       required node.
+#include "collision_lab/ros/scenario_publisher.h"
+
 #include <signal.h>
 #include <unistd.h>
 
@@ -28,6 +11,7 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <ros/ros.h>
@@ -37,6 +21,7 @@
 #include "collision_lab/RunScene.h"
 #include "collision_lab/io/scenario_file.h"
 
+namespace collision_lab_ros {
 namespace {
 
 std::vector<std::string> splitNames(const std::string& text) {
@@ -62,11 +47,7 @@ std::string utcStamp() {
   return buffer;
 }
 
-/// A run's row in the table, and whether it failed.
-struct Row {
-  std::string text;
-  bool failed = false;
-};
+using Row = RunSceneClient::Row;
 
 Row row(const std::string& scene, const collision_lab::RunScene::Response& response) {
   char buffer[1024];
@@ -95,12 +76,6 @@ Row row(const std::string& scene, const collision_lab::RunScene::Response& respo
   return {buffer, !s.bag_path.empty() && !s.recording_ok};
 }
 
-/// Sleeps seconds of wall time, or less when ROS shuts down.
-void sleepFor(double seconds) {
-  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(seconds);
-  while (ros::ok() && ros::WallTime::now() < end) ros::WallDuration(0.05).sleep();
-}
-
 /// True when our parent process is roslaunch (its command line names it).
 bool startedByRoslaunch() {
   std::ifstream cmdline("/proc/" + std::to_string(getppid()) + "/cmdline");
@@ -108,8 +83,26 @@ bool startedByRoslaunch() {
   return text.find("roslaunch") != std::string::npos;
 }
 
-/// Asks the roslaunch that started us to shut down, as Ctrl-C does; roslaunch then stops
-/// every node (us too) and ends with plain lines. Returns false when not started by roslaunch.
+void printTable(const std::vector<Row>& rows) {
+  std::ostringstream table;
+  char header[256];
+  std::snprintf(header, sizeof header, "%-20s %5s %-20s %14s %10s %8s %10s %10s  %s", "scene", "N", "model",
+                "collisions", "predicted", "paper", "error", "heat [J]", "bag");
+  table << "\n" << header << "\n" << std::string(130, '-') << "\n";
+  for (const auto& r : rows) table << r.text << "\n";
+  table << "(* truncated at the collision cap; +c: then an inelastic collapse; n/s: not simulated; inf: infinitely "
+           "many; -: no formula;\n paper: eq. (3.22); error: the simulation against the closed form (RunSummary."
+           "max_prediction_error; nan: no closed form); heat: kinetic energy lost)\n";
+  std::cout << table.str() << std::flush;
+}
+
+}  // namespace
+
+void sleepFor(double seconds) {
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(seconds);
+  while (ros::ok() && ros::WallTime::now() < end) ros::WallDuration(0.05).sleep();
+}
+
 bool endLaunch() {
   if (!startedByRoslaunch()) {
     ROS_WARN("~end_launch_when_done: not started by roslaunch; just exiting");
@@ -129,145 +122,78 @@ std::vector<collision_lab::io::SceneEntry> selectScenes(const std::string& file,
   return scenes;
 }
 
-void printTable(const std::vector<Row>& rows) {
-  std::ostringstream table;
-  char header[256];
-  std::snprintf(header, sizeof header, "%-20s %5s %-20s %14s %10s %8s %10s %10s  %s", "scene", "N", "model",
-                "collisions", "predicted", "paper", "error", "heat [J]", "bag");
-  table << "\n" << header << "\n" << std::string(130, '-') << "\n";
-  for (const auto& r : rows) table << r.text << "\n";
-  table << "(* truncated at the collision cap; +c: then an inelastic collapse; n/s: not simulated; inf: infinitely "
-           "many; -: no formula;\n paper: eq. (3.22); error: the simulation against the closed form (RunSummary."
-           "max_prediction_error; nan: no closed form); heat: kinetic energy lost)\n";
-  std::cout << table.str() << std::flush;
+std::optional<ScenarioPublisherOptions> ScenarioPublisherOptions::load(const ros::NodeHandle& private_nh) {
+  ScenarioPublisherOptions o;
+  if (!private_nh.getParam("scenario_file", o.scenario_file)) {
+    ROS_FATAL("~scenario_file is not set");
+    return std::nullopt;
+  }
+  int mode = 0;
+  private_nh.param("scenarios", o.selection, std::string());
+  private_nh.param("mode", mode, 0);
+  private_nh.param("run_id_suffix", o.suffix, utcStamp());
+  private_nh.param("service", o.service, std::string("collision_lab_node/run_scene"));
+  private_nh.param("wait_timeout", o.wait_timeout, 60.0);
+  private_nh.param("dwell", o.dwell, 0.0);
+  private_nh.param("exit_when_done", o.exit_when_done, true);
+  private_nh.param("end_launch_when_done", o.end_launch_when_done, false);
+  if (mode < collision_lab::InitialConditions::MODE_FULL ||
+      mode > collision_lab::InitialConditions::MODE_SUMMARY_ONLY) {
+    ROS_FATAL_STREAM("~mode = " << mode << " is not one of InitialConditions.MODE_* (0, 1, 2)");
+    return std::nullopt;
+  }
+  o.mode = static_cast<std::uint8_t>(mode);
+  return o;
 }
 
-/// The publisher's private parameters (see the top of this file).
-struct Options {
-  std::string scenario_file, selection, suffix, service;
-  std::uint8_t mode = collision_lab::InitialConditions::MODE_FULL;
-  double wait_timeout = 60.0;  ///< [s]
-  double dwell = 0.0;          ///< [s]
-  bool exit_when_done = true, end_launch_when_done = false;
+RunSceneClient::RunSceneClient(std::string service, std::uint8_t mode, std::string suffix)
+    : service_(std::move(service)), mode_(mode), suffix_(std::move(suffix)) {}
 
-  /// Empty with a ROS_FATAL when ~scenario_file is missing or ~mode is not a MODE_*.
-  static std::optional<Options> load(const ros::NodeHandle& private_nh) {
-    Options o;
-    if (!private_nh.getParam("scenario_file", o.scenario_file)) {
-      ROS_FATAL("~scenario_file is not set");
-      return std::nullopt;
-    }
-    int mode = 0;
-    private_nh.param("scenarios", o.selection, std::string());
-    private_nh.param("mode", mode, 0);
-    private_nh.param("run_id_suffix", o.suffix, utcStamp());
-    private_nh.param("service", o.service, std::string("collision_lab_node/run_scene"));
-    private_nh.param("wait_timeout", o.wait_timeout, 60.0);
-    private_nh.param("dwell", o.dwell, 0.0);
-    private_nh.param("exit_when_done", o.exit_when_done, true);
-    private_nh.param("end_launch_when_done", o.end_launch_when_done, false);
-    if (mode < collision_lab::InitialConditions::MODE_FULL ||
-        mode > collision_lab::InitialConditions::MODE_SUMMARY_ONLY) {
-      ROS_FATAL_STREAM("~mode = " << mode << " is not one of InitialConditions.MODE_* (0, 1, 2)");
-      return std::nullopt;
-    }
-    o.mode = static_cast<std::uint8_t>(mode);
-    return o;
+bool RunSceneClient::connect(double timeout) const {
+  ROS_INFO_STREAM("waiting up to " << timeout << " s for " << service_);
+  if (ros::service::waitForService(service_, ros::Duration(timeout))) return true;
+  if (ros::ok()) {
+    ROS_FATAL_STREAM("no service " << service_ << " after " << timeout
+                     << " s: is collision_lab_node running (rosnode list, rosservice list)?");
   }
-};
+  return false;
+}
 
-/// A client of collision_lab_node's ~run_scene service: waits for it, sends scenes one at
-/// a time, and keeps the table of their outcomes.
-class RunSceneClient {
- public:
-  RunSceneClient(std::string service, std::uint8_t mode, std::string suffix)
-      : service_(std::move(service)), mode_(mode), suffix_(std::move(suffix)) {}
+void RunSceneClient::send(const collision_lab::io::SceneEntry& scene) {
+  collision_lab::RunScene call;
+  call.request.run_id = scene.name + "_" + suffix_;
+  call.request.mode = mode_;
+  call.request.masses = scene.scene.masses;
+  call.request.positions = scene.scene.positions;
+  call.request.velocities = scene.scene.velocities;
+  call.request.restitution = scene.scene.restitution;
+  call.request.max_collisions = scene.max_collisions;
+  ROS_INFO_STREAM("running " << scene.name << " (" << scene.scene.size() << " bodies: " << scene.description
+                  << ") as run " << call.request.run_id);
+  if (!ros::service::call(service_, call)) {
+    call.response.ok = false;
+    call.response.message = "the call to " + service_ + " failed (did collision_lab_node die?)";
+  }
+  rows_.push_back(row(scene.name, call.response));
+  failed_ += rows_.back().failed;
+  if (bag_directory_.empty() && !call.response.summary.bag_path.empty()) {
+    bag_directory_ = std::filesystem::path(call.response.summary.bag_path).parent_path().string();
+  }
+}
 
-  /// Waits up to timeout [s] for the service; false (with a ROS_FATAL) when it is not there.
-  bool connect(double timeout) const {
-    ROS_INFO_STREAM("waiting up to " << timeout << " s for " << service_);
-    if (ros::service::waitForService(service_, ros::Duration(timeout))) return true;
-    if (ros::ok()) {
-      ROS_FATAL_STREAM("no service " << service_ << " after " << timeout
-                       << " s: is collision_lab_node running (rosnode list, rosservice list)?");
-    }
+bool RunSceneClient::finish(std::size_t expected) const {
+  printTable(rows_);
+  const bool complete = rows_.size() == expected;
+  if (failed_ > 0 || !complete) {
+    std::cout << "demo FAILED: " << failed_ << " of " << rows_.size() << " runs failed"
+              << (complete ? "" : ", the demo was cut short") << " (see the table above)"
+              << std::endl;
     return false;
   }
-
-  /// Serves scene as run <name>_<suffix> and adds its row to the table.
-  void send(const collision_lab::io::SceneEntry& scene) {
-    collision_lab::RunScene call;
-    call.request.run_id = scene.name + "_" + suffix_;
-    call.request.mode = mode_;
-    call.request.masses = scene.scene.masses;
-    call.request.positions = scene.scene.positions;
-    call.request.velocities = scene.scene.velocities;
-    call.request.restitution = scene.scene.restitution;
-    call.request.max_collisions = scene.max_collisions;
-    ROS_INFO_STREAM("running " << scene.name << " (" << scene.scene.size() << " bodies: " << scene.description
-                    << ") as run " << call.request.run_id);
-    if (!ros::service::call(service_, call)) {
-      call.response.ok = false;
-      call.response.message = "the call to " + service_ + " failed (did collision_lab_node die?)";
-    }
-    rows_.push_back(row(scene.name, call.response));
-    failed_ += rows_.back().failed;
-    if (bag_directory_.empty() && !call.response.summary.bag_path.empty()) {
-      bag_directory_ = std::filesystem::path(call.response.summary.bag_path).parent_path().string();
-    }
-  }
-
-  /// Prints the table and the last line; true when all of expected runs were served
-  /// without failure.
-  bool finish(std::size_t expected) const {
-    printTable(rows_);
-    const bool complete = rows_.size() == expected;
-    if (failed_ > 0 || !complete) {
-      std::cout << "demo FAILED: " << failed_ << " of " << rows_.size() << " runs failed"
-                << (complete ? "" : ", the demo was cut short") << " (see the table above)"
-                << std::endl;
-      return false;
-    }
-    std::cout << "demo finished: " << rows_.size() << " runs, bags in "
-              << (bag_directory_.empty() ? std::string("(not recorded)") : bag_directory_)
-              << std::endl;
-    return true;
-  }
-
- private:
-  std::string service_;
-  std::uint8_t mode_;
-  std::string suffix_;
-  std::vector<Row> rows_;
-  std::size_t failed_ = 0;
-  std::string bag_directory_;
-};
-
-}  // namespace
-
-int main(int argc, char** argv) {
-  ros::init(argc, argv, "scenario_publisher");
-  ros::NodeHandle nh, private_nh("~");
-  const std::optional<Options> options = Options::load(private_nh);
-  if (!options) return 1;
-  std::vector<collision_lab::io::SceneEntry> scenes;
-  try {
-    scenes = selectScenes(options->scenario_file, options->selection);
-  } catch (const collision_lab::io::ScenarioFileError& e) {
-    ROS_FATAL_STREAM(e.what());
-    return 1;
-  }
-  RunSceneClient client(nh.resolveName(options->service), options->mode, options->suffix);
-  if (!client.connect(options->wait_timeout)) return 1;
-  for (std::size_t i = 0; i < scenes.size() && ros::ok(); ++i) {
-    client.send(scenes[i]);
-    if (options->dwell > 0 && i + 1 < scenes.size()) {
-      ROS_INFO_STREAM("showing " << scenes[i].name << " for " << options->dwell << " s");
-      sleepFor(options->dwell);
-    }
-  }
-  if (!client.finish(scenes.size())) return 1;
-  if (options->end_launch_when_done && endLaunch()) return 0;
-  if (!options->exit_when_done) ros::waitForShutdown();
-  return 0;
+  std::cout << "demo finished: " << rows_.size() << " runs, bags in "
+            << (bag_directory_.empty() ? std::string("(not recorded)") : bag_directory_)
+            << std::endl;
+  return true;
 }
+
+}  // namespace collision_lab_ros

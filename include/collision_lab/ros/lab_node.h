@@ -64,8 +64,8 @@
 #include "collision_lab/RunScene.h"
 #include "collision_lab/RunSummary.h"
 #include "collision_lab/core/scene_run.h"
-#include "collision_lab/ros/marker_view.h"
 #include "collision_lab/ros/msg_conversion.h"
+#include "collision_lab/ros/run_observer.h"
 
 namespace collision_lab_ros {
 
@@ -161,7 +161,9 @@ struct ServeOutcome {
 
 class LabNode {
  public:
-  LabNode(ros::NodeHandle nh, ros::NodeHandle private_nh);
+  /// make_observer (may be empty) makes the in-process viewer fed when ~publish_markers
+  /// is true: collision_lab_node passes the marker view's.
+  LabNode(ros::NodeHandle nh, ros::NodeHandle private_nh, const RunObserverFactory& make_observer = {});
   /// Finishes the run in progress (closing its bag), drops queued inputs.
   ~LabNode();
 
@@ -239,7 +241,7 @@ class LabNode {
   ServedRuns served_runs_;
   ros::Publisher diagnostics_pub_;
   ros::WallTimer diagnostics_timer_;
-  std::unique_ptr<MarkerView> marker_view_;
+  std::unique_ptr<RunObserver> marker_view_;
   std::string run_id_prefix_;
   std::uint64_t run_counter_ = 0;
   std::unordered_set<std::string> used_run_ids_;

@@ -28,6 +28,7 @@
 #include <ros/ros.h>
 
 #include "collision_lab/ros/marker_builder.h"
+#include "collision_lab/ros/run_observer.h"
 
 namespace collision_lab_ros {
 
@@ -56,7 +57,7 @@ struct MarkerViewParams {
   static MarkerViewParams load(const ros::NodeHandle& private_nh);
 };
 
-class MarkerView {
+class MarkerView : public RunObserver {
  public:
   MarkerView(ros::NodeHandle nh, const MarkerViewParams& params);
 
@@ -67,13 +68,13 @@ class MarkerView {
   /// A message of a new run_id starts a new picture; so does a second InitialConditions
   /// of the current run (a bag played again). A run's other messages may arrive before
   /// its InitialConditions: they wait for it. Thread-safe.
-  void onInitialConditions(const collision_lab::InitialConditions& msg);
-  void onPrediction(const collision_lab::Prediction& msg);
-  void onCollisionEvent(const collision_lab::CollisionEvent& msg);
-  void onRunSummary(const collision_lab::RunSummary& msg);
+  void onInitialConditions(const collision_lab::InitialConditions& msg) override;
+  void onPrediction(const collision_lab::Prediction& msg) override;
+  void onCollisionEvent(const collision_lab::CollisionEvent& msg) override;
+  void onRunSummary(const collision_lab::RunSummary& msg) override;
   /// Shown over whatever run is on screen until the next run starts. Messages of runs
   /// (and rejections) the params do not follow are ignored.
-  void onRejected(const collision_lab::Rejected& msg);
+  void onRejected(const collision_lab::Rejected& msg) override;
 
  private:
   /// Messages of the current run that came before its InitialConditions.
