@@ -62,6 +62,24 @@ void TemperatureSampler::send(std::uint64_t impacts, double time) {
 
 std::uint64_t temperatureStride(std::size_t bodies) { return std::max<std::uint64_t>(1, bodies / 8); }
 
+void LogTimeSamples::add(const TemperatureSample& sample) {
+  const double bin = sample.time > 0 ? std::floor(std::log10(sample.time) * kPerDecade)
+                                     : -std::numeric_limits<double>::infinity();
+  if (kept_.empty() || bin > last_bin_) {
+    kept_.push_back(sample);
+    last_bin_ = bin;
+    newest_.reset();
+  } else {
+    newest_ = sample;
+  }
+}
+
+std::vector<TemperatureSample> LogTimeSamples::samples() const {
+  std::vector<TemperatureSample> all = kept_;
+  if (newest_) all.push_back(*newest_);
+  return all;
+}
+
 namespace {
 
 /// The usable samples as (t, ln T).

@@ -121,6 +121,28 @@ TEST(HaffFit, SkipsUnusableSamplesAndSaysWhenItCannotFit) {
   EXPECT_NEAR(flat.t0, 2.0, 1e-15);
 }
 
+TEST(LogTimeSamples, KeepsTheStartOnePerBinAndTheNewest) {
+  LogTimeSamples thin;
+  thin.add({0, 0.0, 5.0});
+  // 1 s, then 1.01 s (same 1/50-decade bin as 1 s: log10(1.01) = 0.0043 < 0.02), 1.1 s (a new bin).
+  thin.add({1, 1.0, 4.0});
+  thin.add({2, 1.01, 3.9});
+  thin.add({3, 1.1, 3.5});
+  thin.add({4, 1.12, 3.4});  // log10(1.12) * 50 = 2.46: bin 2, as 1.1 s (2.07)
+  const auto kept = thin.samples();
+  ASSERT_EQ(kept.size(), 4u);
+  EXPECT_EQ(kept[0].impacts, 0u);
+  EXPECT_EQ(kept[1].impacts, 1u);
+  EXPECT_EQ(kept[2].impacts, 3u);
+  EXPECT_EQ(kept[3].impacts, 4u);  // the newest
+  // A million samples over six decades keep at most 50 per decade, plus the start and newest.
+  LogTimeSamples many;
+  many.add({0, 0.0, 1.0});
+  for (int k = 1; k <= 1000000; ++k) many.add({static_cast<std::uint64_t>(k), 1e-3 * k, 1.0});
+  EXPECT_LE(many.samples().size(), 6u * 50 + 2);
+  EXPECT_EQ(many.samples().back().impacts, 1000000u);
+}
+
 }  // namespace
 }  // namespace core
 }  // namespace collision_lab

@@ -14,6 +14,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -69,6 +70,23 @@ class TemperatureSampler {
 
 /// A stride that keeps sampling O(1) per impact on average: max(1, N / 8) for N bodies.
 std::uint64_t temperatureStride(std::size_t bodies);
+
+/// Samples thinned for a log-log plot and the Haff fit: the start (t = 0), the first sample
+/// of every 1/kPerDecade of a decade of time, and the newest. Memory is bounded by the
+/// decades the run spans, whatever its impacts.
+class LogTimeSamples {
+ public:
+  static constexpr int kPerDecade = 50;
+  /// Samples must come in time order.
+  void add(const TemperatureSample& sample);
+  /// The kept samples and the newest, in time order.
+  std::vector<TemperatureSample> samples() const;
+
+ private:
+  std::vector<TemperatureSample> kept_;
+  std::optional<TemperatureSample> newest_;  ///< the newest when it is not kept
+  double last_bin_ = -std::numeric_limits<double>::infinity();
+};
 
 /// Haff's law T(t) = t0 / (1 + t/tau)^2 fitted to samples.
 struct HaffFit {
