@@ -22,6 +22,8 @@ add_library(collision_lab_ros
   src/ros/markers/energy_bars.cpp
   src/ros/markers/velocities.cpp
   src/ros/markers/overlays.cpp
+  src/ros/markers/temperature.cpp
+  src/ros/markers/clusters.cpp
   src/ros/markers/rviz_limits.cpp)
 target_include_directories(collision_lab_ros PUBLIC include)
 # collision_lab_io: the node reads the presets of ~run_preset.
