@@ -4,7 +4,8 @@ add_executable(collision_lab_cli
   src/cli/main.cpp
   src/cli/command_line.cpp
   src/cli/progress.cpp
-  src/cli/scene_runner.cpp)
+  src/cli/scene_runner.cpp
+  src/cli/temperature_csv.cpp)
 target_link_libraries(collision_lab_cli PRIVATE collision_lab_io CLI11::CLI11)
 # --name and --list without --scenario read the presets: an installed CLI its install's
 # copy (the share folder, relative to the executable), the devel space's the source tree's.

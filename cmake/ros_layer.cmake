@@ -34,6 +34,8 @@ add_library(collision_lab_views
   src/ros/markers/energy_bars.cpp
   src/ros/markers/velocities.cpp
   src/ros/markers/overlays.cpp
+  src/ros/markers/temperature.cpp
+  src/ros/markers/clusters.cpp
   src/ros/markers/rviz_limits.cpp)
 target_link_libraries(collision_lab_views PUBLIC collision_lab_ros)
 

@@ -15,9 +15,10 @@ namespace {
 
 /// Options that take a value. A value may start with '-' (negative numbers, "-inf",
 /// "-.5"), which CLI11 would take for a flag; normalizeArguments() prevents that.
-const std::array<const char*, 12> kValueOptions = {
+const std::array<const char*, 13> kValueOptions = {
     "--masses", "--positions", "--velocities", "--bodies",   "--restitution", "--max-collisions",
-    "--events", "--format",    "--precision",  "--mode",     "--scenario",    "--name"};
+    "--events", "--format",    "--precision",  "--mode",     "--scenario",    "--name",
+    "--temperature-csv"};
 
 bool isValueOption(const std::string& arg) {
   return std::find(kValueOptions.begin(), kValueOptions.end(), arg) != kValueOptions.end();
@@ -94,12 +95,13 @@ core::Scene readBodies(const std::string& path) {
 struct RawOptions {
   std::string masses, positions, velocities, bodies, restitution;
   std::string max_collisions, events, format = "table", precision = "double", mode = "full";
-  std::string scenario, name;
+  std::string scenario, name, temperature_csv;
   bool list = false;
   bool simulate_to_cap = false;
   bool masses_given = false, positions_given = false, velocities_given = false, bodies_given = false;
   bool restitution_given = false;
   bool max_collisions_given = false, events_given = false, scenario_given = false, name_given = false;
+  bool temperature_csv_given = false;
 };
 
 /// Format, precision, mode and collision cap.
@@ -193,6 +195,20 @@ void readEventPolicy(const RawOptions& raw, CliRequest& request) {
   request.options.events = *events;
 }
 
+/// --temperature-csv FILE: T(t) of one simulated scene.
+void readTemperatureCsv(const RawOptions& raw, CliRequest& request) {
+  if (!raw.temperature_csv_given) return;
+  if (request.action != CliRequest::Action::kRunOne) {
+    throw makeCliError(CliReason::kUsage, "temperature-csv",
+                       "T(t) is written for one scene: give --name, --bodies or the three lists");
+  }
+  if (request.options.mode != core::RunMode::kFull) {
+    throw makeCliError(CliReason::kInvalidOption, "temperature-csv",
+                       "T(t) needs the simulation's impacts: --mode full (the default)");
+  }
+  request.temperature_csv = raw.temperature_csv;
+}
+
 }  // namespace
 
 const char* cliReasonName(CliReason reason) {
@@ -244,6 +260,8 @@ void declareOptions(CLI::App& app, RawOptions& raw) {
   app.add_option("--scenario", raw.scenario, "scenario file (YAML); without --name runs every scene in it");
   app.add_option("--name", raw.name, "scene of the scenario file (default file: the package's presets)");
   app.add_flag("--list", raw.list, "list the scenes of the scenario file");
+  app.add_option("--temperature-csv", raw.temperature_csv,
+                 "write the granular temperature T(t) [J] of the run to this CSV file, with the fit of Haff's law");
 }
 
 /// Which options the user gave (a default value is not a choice).
@@ -257,6 +275,7 @@ void markGiven(const CLI::App& app, RawOptions& raw) {
   raw.events_given = app.count("--events") > 0;
   raw.scenario_given = app.count("--scenario") > 0;
   raw.name_given = app.count("--name") > 0;
+  raw.temperature_csv_given = app.count("--temperature-csv") > 0;
 }
 
 CliRequest parseCommandLine(const std::vector<std::string>& args, const std::string& default_scenario_path) {
@@ -294,6 +313,7 @@ CliRequest parseCommandLine(const std::vector<std::string>& args, const std::str
   readSceneSource(raw, default_scenario_path, request);
   if (raw.restitution_given) request.restitution = parseList(raw.restitution, "restitution");
   readEventPolicy(raw, request);
+  readTemperatureCsv(raw, request);
   return request;
 }
 

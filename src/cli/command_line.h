@@ -51,6 +51,8 @@ struct CliRequest {
   std::optional<core::Scene> scene;   ///< kRunOne from --masses/--positions/--velocities or --bodies
   /// --restitution: replaces every scene's restitution (one value, or one per pair).
   std::optional<std::vector<double>> restitution;
+  /// --temperature-csv: the file to write T(t) to (kRunOne, full mode only).
+  std::optional<std::string> temperature_csv;
 };
 
 /// The format asked for on the command line, found before full parsing so that even a

@@ -1,7 +1,8 @@
 // collision_lab_cli: runs scenes from the command line or a scenario file and prints a
 // table, JSON or CSV report. Exit codes: 0 done (a truncated run included), 2 bad input
 // (one line on stderr; with --format json also an {"error": ...} document on stdout),
-// 1 internal error, 3 the output could not be written (one line on stderr).
+// 1 internal error, 3 the output (standard output or --temperature-csv's file) could not be
+// written (one line on stderr).
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -13,6 +14,7 @@
 #include "collision_lab/io/scenario_file.h"
 #include "command_line.h"
 #include "scene_runner.h"
+#include "temperature_csv.h"
 
 namespace collision_lab {
 namespace cli {
@@ -136,6 +138,9 @@ int main(int argc, char** argv) {
   } catch (const cli::CliError& error) {
     cli::reportBadInput(error, cli::requestedFormat(args));
     return cli::kExitBadInput;
+  } catch (const cli::OutputFailed& e) {
+    std::cerr << "collision_lab_cli: " << e.what() << std::endl;
+    return cli::kExitOutputFailed;
   } catch (const std::exception& e) {
     std::cerr << "collision_lab_cli: internal error: " << e.what() << std::endl;
     return cli::kExitInternalError;

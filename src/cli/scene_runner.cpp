@@ -11,6 +11,7 @@
 #include "collision_lab/core/scene_run.h"
 #include "collision_lab/io/scene_report.h"
 #include "progress.h"
+#include "temperature_csv.h"
 
 namespace collision_lab {
 namespace cli {
@@ -110,6 +111,8 @@ void runEntry(const CliRequest& request, const io::SceneEntry& given) {
   const InterruptGuard interrupt_guard;  // from the first byte out, so Ctrl-C never cuts a report
   const io::SceneEntry entry = withRequestRestitution(request, given);
   validateOrThrow(entry);
+  std::optional<TemperatureCsv> temperature;  // opened before any report: a bad path is bad input
+  if (request.temperature_csv) temperature.emplace(*request.temperature_csv, entry.scene);
   const core::RunOptions shown = optionsFor(request, entry);
   const core::ModelChoice model = core::chooseModel(entry.scene);
   const auto three_body = io::makeThreeBodyReportWriter(request.format, std::cout, model);
@@ -120,8 +123,16 @@ void runEntry(const CliRequest& request, const io::SceneEntry& given) {
   } else {
     nbody->begin(entry, shown, model);
   }
-  const core::SceneRunResult result =
-      runWithProgress(entry.scene, shown, request.simulate_to_cap, showEvents(shown, *three_body, *nbody));
+  core::SceneVisitors visitors = showEvents(shown, *three_body, *nbody);
+  core::RunOptions run = shown;
+  if (temperature) {
+    // T(t) needs every impact: the run is simulated even where the closed form alone would
+    // answer, and the visitors see every event (the report still shows those asked for).
+    visitors = temperature->feeding(std::move(visitors));
+    run.events = core::EventPolicy::all();
+  }
+  const core::SceneRunResult result = runWithProgress(entry.scene, run, request.simulate_to_cap, visitors);
+  if (temperature) temperature->finish();
   if (is_three_body) {
     three_body->end(*result.three_body);
   } else {

@@ -513,6 +513,7 @@ visualization_msgs::MarkerArray buildStaticMarkers(const RunRecord& run, const s
   markers::drawConservedSteps(canvas);
   markers::drawWorldlines(canvas);
   markers::drawEnergyBarsAxis(canvas);
+  markers::drawTemperature(canvas);
   return array;
 }
 
@@ -529,6 +530,8 @@ visualization_msgs::MarkerArray buildAnimatedMarkers(const RunRecord& run, const
   markers::drawStepsCursor(canvas, state);
   markers::drawWorldlinesCursor(canvas, state);
   markers::drawEnergyBars(canvas, state);
+  markers::drawTemperatureNow(canvas, state);
+  markers::drawClusters(canvas, state);
   return array;
 }
 

@@ -183,4 +183,32 @@ TEST(CollapseCli, FirstNShowsACollapseThatComesBeforeImpactNPlusOne) {
   EXPECT_TRUE(runJson(with(kFourBodies, {"--events", "first:0"})).at("events").empty());
 }
 
+// The preset cluster_collapse_5 (issue 21), by hand: A, B, C collapse as in collapse_equal,
+// 2 m to the right (t = 3.5 s, x = 3 - 3.5/3 = 11/6 m), then move on as one cluster of 3 kg at
+// -1/3 m/s, x = 11/6 - (t - 3.5)/3, and meet D (at rest at 1 m) at t = 6 s. From there the
+// cluster, D and E are the three-body scene masses (3, 1, 1), x = (2, 1, 0) m,
+// v = (-1/3, 0, 0) m/s shifted by 3 s, whose collapse time the exact reference gives. All five
+// end at the centre-of-mass velocity -1/5 m/s; heat 1/2 - 5 (1/5)^2 / 2 = 0.4 J.
+TEST(CollapseCli, ClusterCollapse5CollapsesTwiceIntoOneCluster) {
+  const Json doc = runPreset("cluster_collapse_5", {"--events", "all"});
+  std::vector<Json> collapses;
+  for (const Json& event : doc.at("events")) {
+    if (event.at("kind") == "collapse") collapses.push_back(event);
+  }
+  ASSERT_EQ(collapses.size(), 2u);
+  EXPECT_EQ(collapses[0].at("first_body"), "A");
+  EXPECT_EQ(collapses[0].at("last_body"), "C");
+  EXPECT_NEAR(collapses[0].at("time").get<double>(), 3.5, 1e-15);
+  EXPECT_NEAR(collapses[0].at("position").get<double>(), 11.0 / 6, 1e-15);
+  EXPECT_EQ(collapses[1].at("first_body"), "A");
+  EXPECT_EQ(collapses[1].at("last_body"), "E");
+  const double second = 3 + collision_lab::core::reference::collapseTime(
+                                collision_lab::core::Scene{{3, 1, 1}, {2, 1, 0}, {-1.0 / 3, 0, 0}, {0.05}});
+  EXPECT_NEAR(collapses[1].at("time").get<double>(), second, 1e-12);
+  const Json& summary = doc.at("summary");
+  EXPECT_EQ(summary.at("stop_reason"), "FINISHED");
+  for (double v : doubles(summary.at("final_velocities"))) EXPECT_NEAR(v, -0.2, 1e-15);
+  EXPECT_NEAR(summary.at("energy_lost").get<double>(), 0.4, 1e-15);
+}
+
 }  // namespace

@@ -1,5 +1,6 @@
 // The kinetic energy per body as bars: the axis with the bodies' names (static) and the
-// bars with their values now (animated); for a large scene, the totals now.
+// bars with their values now (animated); for a large scene, the totals now. A large
+// inelastic scene shows T(t) in their place instead (temperature.cpp).
 #include <algorithm>
 
 #include "collision_lab/ros/markers/draw.h"
@@ -16,6 +17,7 @@ double barX(std::size_t i, std::size_t n) { return kBarsBox.left + (static_cast<
 }  // namespace
 
 void drawEnergyBarsAxis(const Canvas& c) {
+  if (temperatureView(c.run)) return;
   Marker axis = c.lines(ns::kEnergy, kEnergyAxis, Marker::LINE_LIST, kAxisWidth, color(kGrey));
   axis.points = {point(kBarsBox.left, kBarsBox.bottom), point(kBarsBox.right, kBarsBox.bottom)};
   c.add(axis);
@@ -32,6 +34,7 @@ void drawEnergyBarsAxis(const Canvas& c) {
 }
 
 void drawEnergyBars(const Canvas& c, const SceneState& state) {
+  if (temperatureView(c.run)) return;
   const std::size_t n = c.run.bodies();
   std::vector<double> kinetic(n, 0.0);
   double total = 0.0;

@@ -229,6 +229,10 @@ SceneAxis sceneAxis(const RunRecord& run) {
   return {min, max};
 }
 
+SceneAxis bodiesAxis(const RunRecord& run, const SceneState& state) {
+  return largeScene(run) ? bodiesNow(state) : sceneAxis(run);
+}
+
 void drawTitle(const Canvas& c) {
   c.add(c.text(ns::kTitle, kTitleText, kCentreX, kTitleY, runTitle(c.run), kTitleSize));
 }

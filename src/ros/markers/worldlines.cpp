@@ -1,6 +1,7 @@
 // The x-t diagram: the worldlines (time up, position across on the scene's axis; a sample
 // of kMaxTrackedBodies for large N), the ghosts' straight worldlines for equal elastic
-// masses, and the line of now with the bodies on it.
+// masses, the clusters' joined worldlines up to now (thick amber, under the bodies'), and
+// the line of now with the bodies on it.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -125,6 +126,31 @@ void addWorldline(const Canvas& c, const std::string& ns, int id, std::size_t i,
   c.addLines(line);
 }
 
+/// The clusters' worldlines up to t_now (clustersOf): from each kept state, for as long as
+/// its free flight is exact, to the next kept state; at most kMaxClusterSegments segments.
+void addClusterWorldlines(const Canvas& c, const WorldAxes& axes, double t_now) {
+  Marker lines = c.lines(ns::kClusters, kClusterLines, Marker::LINE_LIST, kClusterLineWidth, color(kClusterAmber));
+  if (mayCluster(c.run)) {
+    const auto& frames = c.run.keyframes();
+    for (std::size_t k = 0; k < frames.size() && frames[k].time < t_now; ++k) {
+      const Keyframe& f = frames[k];
+      const double next = k + 1 < frames.size() ? frames[k + 1].time : t_now;
+      const double until = std::min({f.valid_until, next, t_now});
+      for (const auto& [first, last] : clustersOf(c.run, f.positions, f.velocities)) {
+        if (lines.points.size() >= 2 * kMaxClusterSegments) break;
+        const double x = f.positions[first], v = f.velocities[first];
+        lines.points.push_back(point(axes.toX(x), axes.toY(f.time), -kDotZ));
+        lines.points.push_back(point(axes.toX(x + v * (until - f.time)), axes.toY(until), -kDotZ));
+      }
+    }
+  }
+  if (lines.points.empty()) {
+    c.add(deleteMarker(ns::kClusters, kClusterLines, c.frame_id));
+  } else {
+    c.addLines(lines);
+  }
+}
+
 bool ghostScene(const RunRecord& run) {
   return run.prediction && run.prediction->model == collision_lab::Prediction::MODEL_GHOSTS;
 }
@@ -175,6 +201,7 @@ void drawWorldlines(const Canvas& c) {
   }
   // One line: a second would run into the "t [s]" label over the box.
   if (ghostScene(c.run)) legend += ";  grey dashes: ghosts x_i + v_i t, passing through";
+  if (mayCluster(c.run)) legend += ";  amber: clusters, moving as one";
   if (period) legend = format("periodic: one period drawn, T = %.4g s; now at t mod T", period->time);
   c.add(c.text(ns::kWorldlines, kWorldLegend, b.midX(), kLegendY, legend, kSmallTextSize, color(kLabelGrey)));
 }
@@ -200,6 +227,7 @@ void drawWorldlinesCursor(const Canvas& c, const SceneState& state) {
     if (ghostScene(c.run)) addGhosts(c, ns::kWorldlinesNow, kWorldNowGhosts, world);
     addWorldRange(c, ns::kWorldlinesNow, kWorldNowTimeEnd, kWorldNowPositionMin, kWorldNowPositionMax, world);
   }
+  addClusterWorldlines(c, world, period ? 0.0 : state.time);
   Marker now = c.lines(ns::kWorldlinesNow, kWorldNowLine, Marker::LINE_LIST, kCursorWidth, color(kCursorWhite));
   now.points = {point(kWorldBox.left, world.toY(t_now)), point(kWorldBox.right, world.toY(t_now))};
   c.add(now);

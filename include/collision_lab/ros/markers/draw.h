@@ -150,6 +150,21 @@ struct SceneAxis {
 };
 /// Every position the animation can show: the worldlines and the end state.
 SceneAxis sceneAxis(const RunRecord& run);
+/// Where the scene draws the bodies of `state`: sceneAxis, or for a large scene the bodies'
+/// spread now.
+SceneAxis bodiesAxis(const RunRecord& run, const SceneState& state);
+
+/// Clusters (markers/clusters.cpp): runs [first, last] (last > first) of neighbouring finite
+/// bodies at exactly one position with exactly one velocity, in body order. The messages
+/// put a cluster's bodies (stuck by e = 0, or one after a collapse) at one point with one
+/// velocity.
+std::vector<std::pair<std::size_t, std::size_t>> clustersOf(const RunRecord& run, const std::vector<double>& x,
+                                                            const std::vector<double>& v);
+/// False when the run cannot have a cluster (no collapse so far and no pair with e = 0).
+bool mayCluster(const RunRecord& run);
+/// A large scene with a restitution below 1 (a granular gas): T(t) takes the kinetic
+/// energy bars' place (markers/temperature.cpp).
+bool temperatureView(const RunRecord& run);
 
 // ---- the views (static: when a message arrives; animated: every frame) ----
 void drawTitle(const Canvas& c);
@@ -160,6 +175,7 @@ void drawConservedSteps(const Canvas& c);
 void drawWorldlines(const Canvas& c);
 void drawEnergyBarsAxis(const Canvas& c);
 void drawSideViewAxes(const Canvas& c);  ///< the velocity profile or the histogram, when not the wedge
+void drawTemperature(const Canvas& c);   ///< T(t) and Haff's law, when temperatureView
 
 void drawBodies(const Canvas& c, const SceneState& state);
 void drawMagnifier(const Canvas& c, const SceneState& state);
@@ -169,5 +185,7 @@ void drawStepsCursor(const Canvas& c, const SceneState& state);
 void drawWorldlinesCursor(const Canvas& c, const SceneState& state);
 void drawEnergyBars(const Canvas& c, const SceneState& state);
 void drawSideViewNow(const Canvas& c, const SceneState& state);
+void drawTemperatureNow(const Canvas& c, const SceneState& state);
+void drawClusters(const Canvas& c, const SceneState& state);  ///< rings and names in the scene
 
 }  // namespace collision_lab_ros::markers

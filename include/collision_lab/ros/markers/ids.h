@@ -17,6 +17,7 @@ constexpr const char* kConserved = "conserved";  // energy and momentum steps
 constexpr const char* kWorldlines = "worldlines";
 constexpr const char* kEnergy = "energy";        // the kinetic energy bars' axis
 constexpr const char* kVelocities = "velocities";  // in the wedge's place: profile or histogram
+constexpr const char* kTemperature = "temperature";  // large inelastic scenes: T(t), log-log, and Haff's law
 // animated: every frame (topic `markers_animated`)
 constexpr const char* kBodies = "bodies";
 constexpr const char* kLabels = "labels";
@@ -26,6 +27,8 @@ constexpr const char* kPlotCursor = "plot_cursor";
 constexpr const char* kWorldlinesNow = "worldlines_now";
 constexpr const char* kEnergyBars = "energy_bars";
 constexpr const char* kVelocitiesNow = "velocities_now";
+constexpr const char* kTemperatureNow = "temperature_now";
+constexpr const char* kClusters = "clusters";  // bodies moving together, in the scene and the x-t diagram
 // overlays, also on `markers_animated`
 constexpr const char* kRejected = "rejected";
 constexpr const char* kHint = "hint";
@@ -161,6 +164,28 @@ enum MarkerId : int {
   kSideBars = 0,      ///< the histogram's bars or the profile's dots
   kSideGaussian = 1,  ///< the Maxwell-like Gaussian
   kSideNowText = 2,   ///< its mean and spread
+
+  // ns "temperature"
+  kTemperatureFrame = 0,
+  kTemperatureTitle = 1,
+  kTemperatureLegend = 2,
+  kTemperatureTimeMin = 3,
+  kTemperatureTimeMax = 4,
+  kTemperatureMin = 5,
+  kTemperatureMax = 6,
+  kTemperatureTicks = 7,  ///< a tick at every decade of t and of T
+  kTemperatureSeries = 8,
+  kTemperatureHaff = 9,
+  kTemperatureUnits = 10,
+
+  // ns "temperature_now"
+  kTemperatureNowDot = 0,
+  kTemperatureNowText = 1,
+
+  // ns "clusters" (animated)
+  kClusterRings = 0,   ///< a ring around each cluster in the scene
+  kClusterLines = 1,   ///< the clusters' joined worldlines in the x-t diagram
+  kClusterLabel = 10,  ///< + the cluster's number (at most kMaxClusterLabels)
 
   // ns "rejected" and "hint": a framed text
   kFramedText = 0,

@@ -185,6 +185,23 @@ constexpr double kBarNameDy = -0.3, kBarsTitleDy = 0.75;
 constexpr double kBarWidth = 0.6;  ///< share of the pitch
 constexpr double kBarMinHeight = 0.01, kBarDepth = 0.1, kBarValueDy = 0.25, kBarValueStagger = 0.32;
 
+// ---- large inelastic scenes: T(t) on log-log axes, in the energy bars' place ----
+constexpr Box kTemperatureBox{-9.4, -5.4, -5.75, -3.15};
+constexpr double kTemperatureLegendY = -2.6;  ///< under the title (two lines)
+constexpr double kTemperatureNowY = -6.45;    ///< T and E now, under the time axis' labels
+constexpr double kTickLength = 0.1;
+constexpr int kHaffSegments = 64;
+constexpr Rgba kHaffCyan{0.3, 0.85, 1.0};
+
+// ---- clusters: bodies moving together ----
+constexpr Rgba kClusterAmber{1.0, 0.75, 0.2, 0.9};
+constexpr double kClusterRingWidth = 0.05, kClusterRingMargin = 0.12;  ///< beyond the largest body's radius
+constexpr int kClusterRingSegments = 24;
+constexpr double kClusterLabelDy = 0.75;
+constexpr std::size_t kMaxClusterLabels = 8;
+constexpr double kClusterLineWidth = 0.09;  ///< a cluster's worldline, under the bodies'
+constexpr std::size_t kMaxClusterSegments = 4000;
+
 // ---- framed texts (banner, hint) ----
 /// rviz's font is about 0.42 text heights wide per character, 1.25 high per line.
 constexpr double kHalfCharWidth = 0.21, kHalfLineHeight = 0.62;

@@ -1,0 +1,232 @@
+// rviz views of granular scenes (issue 21, no master): T(t) on log-log axes with Haff's law
+// for a large inelastic scene, and clusters drawn joined in the scene and the x-t diagram.
+// The runs come from the core's engine; the CollisionEvent messages (pair fields only, as
+// the node sends for large N) are built here from its records. References: the engine's
+// final state through this test's own sums, and hand-derived collapse times.
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "collision_lab/core/nbody/engine.h"
+#include "collision_lab/ros/marker_builder.h"
+#include "collision_lab/ros/markers/ids.h"
+#include "collision_lab/ros/markers/layout.h"
+#include "marker_test_checks.h"
+
+namespace {
+
+using namespace collision_lab_ros;
+using collision_lab::CollisionEvent;
+using collision_lab::core::Scene;
+using marker_checks::find;
+namespace ids = collision_lab_ros::markers;
+namespace layout = collision_lab_ros::markers::layout;
+
+const double kInf = std::numeric_limits<double>::infinity();
+
+struct GranularRun {
+  collision_lab::core::EngineResult result;
+  RunRecord record;
+};
+
+/// The engine's run fed to a RunRecord as the node sends it: every impact with the bodies
+/// it moved (a cluster moves as one), every collapse with the cluster's velocity.
+GranularRun runScene(const Scene& scene, std::uint64_t cap) {
+  collision_lab::InitialConditions input;
+  input.run_id = "granular";
+  input.masses = scene.masses, input.positions = scene.positions, input.velocities = scene.velocities;
+  input.restitution = scene.restitution;
+  input.max_collisions = cap;
+  GranularRun out{{}, RunRecord(input)};
+  collision_lab::core::EngineOptions options;
+  options.max_impacts = cap;
+  out.result = collision_lab::core::runEngine(
+      scene, options,
+      [&](const collision_lab::core::ImpactRecord& r) {
+        CollisionEvent msg;
+        msg.run_id = "granular";
+        msg.kind = CollisionEvent::KIND_IMPACT;
+        msg.index = r.index;
+        msg.pair_index = static_cast<std::uint32_t>(r.pair_index);
+        msg.time = r.time, msg.position = r.position;
+        msg.restitution = scene.restitutionOf(r.pair_index);
+        msg.first_moved = static_cast<std::uint32_t>(r.first_moved);
+        msg.last_moved = static_cast<std::uint32_t>(r.last_moved);
+        msg.pair_velocities_before = {r.velocities_before[0], r.velocities_before[1]};
+        msg.pair_velocities_after = {r.velocities_after[0], r.velocities_after[1]};
+        msg.pair_energy_transfer = {r.energy_gained[0], r.energy_gained[1]};
+        msg.energy_lost = r.energy_lost;
+        msg.total_energy = msg.total_momentum = std::nan("");
+        out.record.add(msg);
+      },
+      {},
+      [&](const collision_lab::core::Collapse& c) {
+        CollisionEvent msg;
+        msg.run_id = "granular";
+        msg.kind = CollisionEvent::KIND_COLLAPSE;
+        msg.index = c.impacts_before;
+        msg.time = c.time, msg.position = c.position;
+        msg.pair_index = msg.first_moved = static_cast<std::uint32_t>(c.first_body);
+        msg.last_moved = static_cast<std::uint32_t>(c.last_body);
+        msg.pair_velocities_after = {c.velocity, c.velocity};
+        msg.total_energy = msg.total_momentum = std::nan("");
+        out.record.add(msg);
+      });
+  collision_lab::RunSummary summary;
+  summary.simulated = true;
+  summary.truncated = out.result.truncated;
+  summary.collision_count = out.result.impact_count;
+  out.record.summary = summary;
+  return out;
+}
+
+/// T = (1/N) sum m (v - V)^2 over the finite masses, V their centre-of-mass velocity [J].
+double temperatureOf(const Scene& scene, const std::vector<double>& v) {
+  double mass = 0, p = 0, n = 0;
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    if (std::isfinite(scene.masses[i])) mass += scene.masses[i], p += scene.masses[i] * v[i], n += 1;
+  }
+  double sum = 0;
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    if (std::isfinite(scene.masses[i])) sum += scene.masses[i] * (v[i] - p / mass) * (v[i] - p / mass);
+  }
+  return sum / n;
+}
+
+/// "1e-2" -> -2.
+double exponentOf(const std::string& label) {
+  EXPECT_EQ(label.rfind("1e", 0), 0u) << label;
+  return std::stod(label.substr(2));
+}
+
+void expectFit(const RunRecord& run) {
+  const auto fixed = buildStaticMarkers(run, "f");
+  marker_checks::expectFitForRviz(fixed);
+  marker_checks::expectOneMarkerPerId(fixed);
+  marker_checks::expectTextsOnScreen(fixed);
+  for (double t : {0.0, 0.5 * endTime(run), endTime(run)}) {
+    const auto animated = buildAnimatedMarkers(run, FrameClock{t, "test"}, "f");
+    marker_checks::expectFitForRviz(animated);
+    marker_checks::expectOneMarkerPerId(animated);
+    marker_checks::expectTextsOnScreen(animated);
+  }
+}
+
+/// 40 bodies of 1 kg and 2 kg alternately, 1 m apart, between two walls at rest, with
+/// seeded velocities in [-1, 1] m/s, e = 0.9.
+Scene boxGas() {
+  Scene s;
+  s.masses.push_back(kInf), s.positions.push_back(41.0), s.velocities.push_back(0.0);
+  std::uint64_t seed = 21;
+  for (int i = 0; i < 40; ++i) {
+    seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+    s.masses.push_back(i % 2 ? 2.0 : 1.0);
+    s.positions.push_back(40.0 - i);
+    s.velocities.push_back(static_cast<double>(seed >> 11) / 9007199254740992.0 * 2 - 1);
+  }
+  s.masses.push_back(kInf), s.positions.push_back(-1.0), s.velocities.push_back(0.0);
+  s.restitution = {0.9};
+  return s;
+}
+
+TEST(MarkerGranular, GasShowsTOnLogLogAxesWithHaffsLaw) {
+  const Scene scene = boxGas();
+  const GranularRun r = runScene(scene, 20000);
+  ASSERT_EQ(r.result.impact_count, 20000u) << r.result.stop_message;
+  const auto fixed = buildStaticMarkers(r.record, "f");
+  // T(t) takes the kinetic energy bars' place.
+  EXPECT_FALSE(find(fixed, ids::ns::kEnergy, ids::kEnergyTitle));
+  const auto* title = find(fixed, ids::ns::kTemperature, ids::kTemperatureTitle);
+  ASSERT_TRUE(title);
+  EXPECT_NE(title->text.find("log-log"), std::string::npos);
+  const auto* series = find(fixed, ids::ns::kTemperature, ids::kTemperatureSeries);
+  ASSERT_TRUE(series);
+  ASSERT_GE(series->points.size(), 20u);
+  // The curve ends at T of the last state, which this test sums from the engine's final
+  // velocities: on the log axis whose decades the labels name.
+  const auto* low = find(fixed, ids::ns::kTemperature, ids::kTemperatureMin);
+  const auto* high = find(fixed, ids::ns::kTemperature, ids::kTemperatureMax);
+  ASSERT_TRUE(low && high);
+  const double low_decade = exponentOf(low->text), high_decade = exponentOf(high->text);
+  const double t_end = temperatureOf(scene, r.result.final_velocities);
+  const auto& box = layout::kTemperatureBox;
+  EXPECT_NEAR((series->points.back().y - box.bottom) / (box.top - box.bottom), (std::log10(t_end) - low_decade) / (high_decade - low_decade),
+              1e-9);
+  EXPECT_NEAR(series->points.back().x, box.right, 0.5 * (box.right - box.left));
+  // The gas cools: T at the end is below T at the start, and the curve falls overall.
+  EXPECT_LT(t_end, temperatureOf(scene, scene.velocities));
+  EXPECT_LT(series->points.back().y, series->points.front().y);
+  // Haff's law beside it, labelled with its tau.
+  const auto* haff = find(fixed, ids::ns::kTemperature, ids::kTemperatureHaff);
+  ASSERT_TRUE(haff);
+  EXPECT_GT(haff->points.size(), 10u);
+  const auto* legend = find(fixed, ids::ns::kTemperature, ids::kTemperatureLegend);
+  ASSERT_TRUE(legend);
+  EXPECT_NE(legend->text.find("tau = "), std::string::npos) << legend->text;
+  // T now, in the animated view, after the last impact.
+  const auto animated = buildAnimatedMarkers(r.record, FrameClock{1e30, "test"}, "f");
+  const auto* now = find(animated, ids::ns::kTemperatureNow, ids::kTemperatureNowText);
+  ASSERT_TRUE(now);
+  char expected[64];
+  std::snprintf(expected, sizeof expected, "now: T = %.3g J", t_end);
+  EXPECT_EQ(now->text.rfind(expected, 0), 0u) << now->text << " vs " << expected;
+  EXPECT_TRUE(find(animated, ids::ns::kTemperatureNow, ids::kTemperatureNowDot));
+  // The left column's texts stay on screen and clear of the middle column.
+  for (const visualization_msgs::Marker* text : {legend, title, now}) {
+    marker_checks::expectTextClear(*text, -10.7, -3.4, {&fixed, &animated});
+  }
+  expectFit(r.record);
+}
+
+TEST(MarkerGranular, AnElasticGasKeepsItsEnergyTotals) {
+  Scene scene = boxGas();
+  scene.restitution = {};
+  const GranularRun r = runScene(scene, 2000);
+  const auto fixed = buildStaticMarkers(r.record, "f");
+  EXPECT_TRUE(find(fixed, ids::ns::kEnergy, ids::kEnergyTitle));
+  EXPECT_FALSE(find(fixed, ids::ns::kTemperature, ids::kTemperatureTitle));
+}
+
+// cluster_collapse_5 (config/scenarios.yaml), by hand: A, B, C collapse at t = 3.5 s at
+// x = 3 - 3.5/3 = 11/6 m and move on as one at -1/3 m/s; at t = 6 s they meet D at 1 m, and
+// the cluster, D and E collapse later; all five end as one at -0.2 m/s.
+TEST(MarkerGranular, ClustersAreDrawnJoined) {
+  const Scene scene{{1, 1, 1, 1, 1}, {4, 3, 2, 1, 0}, {-1, 0, 0, 0, 0}, {0.05}};
+  const GranularRun r = runScene(scene, 1000);
+  ASSERT_EQ(r.result.collapses.size(), 2u) << r.result.stop_message;
+  const auto label = [&](double t) -> std::string {
+    const auto frame = buildAnimatedMarkers(r.record, FrameClock{t, "test"}, "f");
+    const auto* m = find(frame, ids::ns::kClusters, ids::kClusterLabel);
+    return m && m->action == visualization_msgs::Marker::ADD ? m->text : "";
+  };
+  const auto rings = [&](double t) {
+    const auto frame = buildAnimatedMarkers(r.record, FrameClock{t, "test"}, "f");
+    const auto* m = find(frame, ids::ns::kClusters, ids::kClusterRings);
+    return m && m->action == visualization_msgs::Marker::ADD ? m->points.size() : 0u;
+  };
+  EXPECT_EQ(label(2.0), "");
+  EXPECT_EQ(rings(2.0), 0u);
+  EXPECT_EQ(label(5.0), "A..C: 3 as one");
+  EXPECT_EQ(rings(5.0), 2u * layout::kClusterRingSegments);
+  const double end = endTime(r.record);
+  EXPECT_EQ(label(end), "A..E: 5 as one");
+  EXPECT_EQ(rings(end), 2u * layout::kClusterRingSegments);
+  // The x-t diagram: the cluster's worldline starts at the first collapse, t = 3.5 s (time up,
+  // from 0 at the box's bottom to the end time at its top).
+  const auto frame = buildAnimatedMarkers(r.record, FrameClock{end, "test"}, "f");
+  const auto* lines = find(frame, ids::ns::kClusters, ids::kClusterLines);
+  ASSERT_TRUE(lines);
+  ASSERT_GE(lines->points.size(), 2u);
+  const auto& box = layout::kWorldBox;
+  EXPECT_NEAR(lines->points[0].y, box.bottom + 3.5 / end * (box.top - box.bottom), 1e-9);
+  // Before any collapse the x-t diagram has no cluster line.
+  const auto early = buildAnimatedMarkers(r.record, FrameClock{2.0, "test"}, "f");
+  const auto* none = find(early, ids::ns::kClusters, ids::kClusterLines);
+  EXPECT_TRUE(!none || none->action == visualization_msgs::Marker::DELETE);
+  expectFit(r.record);
+}
+
+}  // namespace
