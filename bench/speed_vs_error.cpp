@@ -572,7 +572,8 @@ std::string toMarkdown(const std::vector<Row>& rows, const std::vector<BenchScen
          "`AnalyticModel<double>(scene).velocitiesAfter(count)`; the time includes both.\n"
       << "- **nbody_engine** (every scene): the exact N-body engine, `runEngine(scene, options, visitor)` "
          "(include/collision_lab/core/nbody/engine.h), max_impacts 10^7 (ball_walls_e09: 50, the preset's "
-         "cap); the visitor rebuilds the state at t_end from the impact records (each body's contact "
+         "cap); the visitor rebuilds the state at t_end from the impact records with the core's replay, "
+         "`core::BodyStateReplay` (each body's contact "
          "position, time and velocity after its last impact at or before t_end); the time includes it.\n"
       << "- **model** (N-body and restitution scenes): `predict(scene)` (models.h), the closed-form model "
          "chosen for the scene (parameter column): its count and final velocities, no positions.\n";

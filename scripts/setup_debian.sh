@@ -24,6 +24,7 @@ packages=(
   python3-rosnode python3-rosservice python3-rosparam
   python3-std-srvs
   libeigen3-dev libboost-dev libgmp-dev libvisualization-msgs-dev libdiagnostic-msgs-dev
+  libdiagnostic-updater-dev
   python3-visualization-msgs python3-diagnostic-msgs
   libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
   rviz

@@ -204,7 +204,7 @@ std::vector<T> param(const ros::NodeHandle& pnh, const std::string& name, std::v
 std::map<std::string, std::string> diagnosticsOf(ros::NodeHandle& nh, const std::string& target, double timeout) {
   std::mutex mutex;
   std::map<std::string, std::string> values;
-  const std::string name = "/" + target + "/lab: lab runs";
+  const std::string name = target + "/lab: lab runs";  // diagnostic_updater drops the leading /
   ros::Subscriber sub = nh.subscribe<diagnostic_msgs::DiagnosticArray>(
       collision_lab_ros::kDiagnosticsTopic, 10, [&](const diagnostic_msgs::DiagnosticArray::ConstPtr& msg) {
         for (const auto& status : msg->status) {

@@ -13,7 +13,6 @@
 #include <stdexcept>
 #include <utility>
 
-#include <diagnostic_msgs/DiagnosticArray.h>
 #include <ros/package.h>
 
 #include "collision_lab/io/scenario_file.h"
@@ -222,14 +221,6 @@ std::optional<collision_lab::Rejected> checkInput(const collision_lab::InitialCo
   }
   if (const auto error = collision_lab::core::validateForRun(toScene(input))) return toRejectedMsg(*error);
   return std::nullopt;
-}
-
-void addValue(diagnostic_msgs::DiagnosticStatus& status, const std::string& key,
-              const std::string& value) {
-  diagnostic_msgs::KeyValue pair;
-  pair.key = key;
-  pair.value = value;
-  status.values.push_back(pair);
 }
 
 /// "predicted 31", or why there is no count ("no count predicted by event_engine"), and the
@@ -462,6 +453,7 @@ std::vector<collision_lab::ServedRun> ServedRuns::list(const std::string& studen
 LabNode::LabNode(ros::NodeHandle nh, ros::NodeHandle private_nh, const RunObserverFactory& make_observer)
     : nh_(nh),
       params_(LabNodeParams::load(private_nh)),
+      diagnostics_(nh, private_nh),
       service_spinner_(kServiceThreads, &service_queue_),
       cancel_spinner_(1, &cancel_queue_) {
   topics_.predictions = nh_.advertise<collision_lab::Prediction>(
@@ -491,9 +483,10 @@ LabNode::LabNode(ros::NodeHandle nh, ros::NodeHandle private_nh, const RunObserv
         kRecordQueueMessages);
   }
 
-  diagnostics_pub_ = nh_.advertise<diagnostic_msgs::DiagnosticArray>(kDiagnosticsTopic, 10);
+  diagnostics_.setHardwareID("collision_lab");
+  diagnostics_.add("lab runs", this, &LabNode::diagnose);
   diagnostics_timer_ = nh_.createWallTimer(ros::WallDuration(kDiagnosticsPeriod),
-                                           [this](const ros::WallTimerEvent&) { publishDiagnostics(); });
+                                           [this](const ros::WallTimerEvent&) { diagnostics_.force_update(); });
 
   worker_ = std::thread(&LabNode::workerLoop, this);
   input_sub_ = nh_.subscribe(kInitialConditionsTopic, kInputQueueSize,
@@ -810,48 +803,38 @@ void LabNode::finishRun(const collision_lab::RunSummary& summary, const Reply& r
   if (reply) reply->set_value(ServeOutcome{summary, {}});
 }
 
-void LabNode::publishDiagnostics() {
-  diagnostic_msgs::DiagnosticStatus status;
-  status.name = ros::this_node::getName() + ": lab runs";
-  status.hardware_id = "collision_lab";
-  status.level = diagnostic_msgs::DiagnosticStatus::OK;
-  status.message = "serving";
-  addValue(status, "runs accepted", std::to_string(runs_accepted_.load()));
-  addValue(status, "runs rejected", std::to_string(runs_rejected_.load()));
-  addValue(status, "last run compute time [s]", std::to_string(last_compute_time_.load()));
-  addValue(status, "recording", params_.record ? "on" : "off");
-  addValue(status, "bag directory", params_.bag_directory);
+void LabNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  status.summary(diagnostic_msgs::DiagnosticStatus::OK, "serving");
+  status.add("runs accepted", std::to_string(runs_accepted_.load()));
+  status.add("runs rejected", std::to_string(runs_rejected_.load()));
+  status.add("last run compute time [s]", std::to_string(last_compute_time_.load()));
+  status.add("recording", params_.record ? "on" : "off");
+  status.add("bag directory", params_.bag_directory);
   if (params_.record) addRecordingStatus(status);
-  diagnostic_msgs::DiagnosticArray array;
-  array.header.stamp = stampNow();
-  array.status.push_back(status);
-  diagnostics_pub_.publish(array);
 }
 
-void LabNode::addRecordingStatus(diagnostic_msgs::DiagnosticStatus& status) {
+void LabNode::addRecordingStatus(diagnostic_updater::DiagnosticStatusWrapper& status) {
   std::string recording_error;
   {
     std::lock_guard<std::mutex> lock(recording_mutex_);
     recording_error = last_recording_error_;
   }
-  addValue(status, "last recording error", recording_error);
-  addValue(status, "recording hand-over per run, runs sampled", std::to_string(recording_times_.size()));
-  addValue(status, "recording hand-over per run, median [us]", std::to_string(1e6 * recording_times_.quantile(0.5)));
-  addValue(status, "recording hand-over per run, p99 [us]", std::to_string(1e6 * recording_times_.quantile(0.99)));
+  status.add("last recording error", recording_error);
+  status.add("recording hand-over per run, runs sampled", std::to_string(recording_times_.size()));
+  status.add("recording hand-over per run, median [us]", std::to_string(1e6 * recording_times_.quantile(0.5)));
+  status.add("recording hand-over per run, p99 [us]", std::to_string(1e6 * recording_times_.quantile(0.99)));
   if (!recording_error.empty()) {
-    status.level = diagnostic_msgs::DiagnosticStatus::ERROR;
-    status.message = "recording failed: " + recording_error;
+    status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "recording failed: " + recording_error);
   }
   struct statvfs space {};
   if (statvfs(params_.bag_directory.c_str(), &space) != 0) {
-    addValue(status, "free space in bag directory [MB]", "unknown (directory not readable)");
+    status.add("free space in bag directory [MB]", "unknown (directory not readable)");
     return;
   }
   const double free_mb = static_cast<double>(space.f_bavail) * space.f_frsize / 1e6;
-  addValue(status, "free space in bag directory [MB]", std::to_string(free_mb));
+  status.add("free space in bag directory [MB]", std::to_string(free_mb));
   if (free_mb < params_.min_free_space_mb && status.level == diagnostic_msgs::DiagnosticStatus::OK) {
-    status.level = diagnostic_msgs::DiagnosticStatus::WARN;
-    status.message = "low free space for bags: " + std::to_string(free_mb) + " MB";
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "low free space for bags: " + std::to_string(free_mb) + " MB");
   }
 }
 

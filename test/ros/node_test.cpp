@@ -726,8 +726,9 @@ TEST(LabNode, DiagnosticsReportRunsAndRecordingState) {
     }
     return std::string();
   };
-  const std::string healthy = "/collision_lab/collision_lab_node: lab runs";
-  const std::string faulty = "/collision_lab_faulty/collision_lab_node: lab runs";
+  // diagnostic_updater names a status by the node's name without its leading '/'.
+  const std::string healthy = "collision_lab/collision_lab_node: lab runs";
+  const std::string faulty = "collision_lab_faulty/collision_lab_node: lab runs";
   // Published once a second; wait for a report from each node after their runs.
   const auto reported = [&] {
     return latest.count(healthy) && latest.count(faulty) && value(latest[healthy], "runs accepted") != "0" &&

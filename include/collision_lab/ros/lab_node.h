@@ -51,7 +51,7 @@
 #include <unordered_set>
 #include <vector>
 
-#include <diagnostic_msgs/DiagnosticStatus.h>
+#include <diagnostic_updater/diagnostic_updater.h>
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
 
@@ -226,11 +226,11 @@ class LabNode {
   /// unrecorded, recording_ok false).
   bool claim(const std::string& run_id, std::string& claim_error);
 
-  /// Publishes one DiagnosticArray: runs accepted and rejected, the last run's compute
-  /// time, the recording state and the free space in bag_directory.
-  void publishDiagnostics();
+  /// The status "<node>: lab runs" of /diagnostics: runs accepted and rejected, the last
+  /// run's compute time, the recording state and the free space in bag_directory.
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
   /// Adds the last recording error and the free space in bag_directory to status.
-  void addRecordingStatus(diagnostic_msgs::DiagnosticStatus& status);
+  void addRecordingStatus(diagnostic_updater::DiagnosticStatusWrapper& status);
 
   ros::NodeHandle nh_;
   LabNodeParams params_;
@@ -239,7 +239,9 @@ class LabNode {
   ros::Publisher rejected_pub_;
   ros::Publisher accepted_pub_, served_inputs_pub_;
   ServedRuns served_runs_;
-  ros::Publisher diagnostics_pub_;
+  /// Publishes /diagnostics; the wall timer forces an update every kDiagnosticsPeriod (the
+  /// updater's own rate follows ROS time, which stands still on a replay before its clock).
+  diagnostic_updater::Updater diagnostics_;
   ros::WallTimer diagnostics_timer_;
   std::unique_ptr<RunObserver> marker_view_;
   std::string run_id_prefix_;

@@ -61,7 +61,8 @@ constexpr std::size_t kMaxStudentLength = 64;
 constexpr std::uint32_t kServiceThreads = 4;
 /// ~scenario_file default, relative to the package folder.
 constexpr char kDefaultScenarioFile[] = "config/scenarios.yaml";
-/// Absolute by the ROS convention: the diagnostic aggregator listens there.
+/// Where diagnostic_updater publishes (absolute by the ROS convention: the diagnostic
+/// aggregator listens there).
 constexpr char kDiagnosticsTopic[] = "/diagnostics";
 constexpr double kDiagnosticsPeriod = 1.0;  ///< [s]
 /// Below this much free space in bag_directory the diagnostics warn.
