@@ -3,7 +3,8 @@
 // single entry point (the CLI today; the ROS node with issue 12). ROS-free.
 //
 // Three elastic bodies that the three-body path accepts (validate(ThreeBodyScene)) are
-// handed to runLab unchanged, so their output stays that of the paper's rotation model.
+// handed to runLab, which simulates them with the same event engine and puts the paper's
+// rotation model beside every impact.
 // Every other scene is answered by its model (models.h): a closed form alone when no event
 // is asked for and the prediction is finite; otherwise the exact event engine, whose
 // summary is put beside the prediction.
@@ -36,8 +37,8 @@ namespace core {
 constexpr std::uint64_t kInfiniteRunDisplayCap = 1000;
 
 struct SceneRunOptions {
-  /// Cap, event policy, mode and precision. The precision applies to the three-body path
-  /// only (the event engine decides everything exactly); max_collisions caps the engine.
+  /// Cap, event policy, mode and precision. The precision applies to the three-body
+  /// simulator only (RunOptions::precision); max_collisions caps the engine.
   /// When lab.events asks for any event (in full mode), a closed-form scene is simulated
   /// too, and the simulation is checked against the prediction.
   RunOptions lab;
