@@ -73,7 +73,7 @@ TEST(ThreeBodyRounding, FinalAndEventVelocitiesAreTheCorrectlyRoundedExactOnesAn
     ASSERT_FALSE(truth.truncated) << describe(scene);
     SceneRunOptions options;
     options.lab.events = EventPolicy::all();
-    const SceneRunResult run = runScene(general(scene), options);
+    const SceneRunResult run = runScene(planScene(general(scene)), options);
     ASSERT_TRUE(run.three_body) << describe(scene);
     const RunResult& result = *run.three_body;
     ASSERT_EQ(result.summary.collision_count, truth.impacts.size()) << describe(scene);
