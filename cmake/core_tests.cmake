@@ -15,7 +15,8 @@ catkin_add_gtest(collision_lab_core_tests
   test/core/test_double_range.cpp
   test/core/test_lab_run.cpp
   test/core/test_full_run_accuracy.cpp
-  test/core/test_wedge_cycle.cpp)
+  test/core/test_wedge_cycle.cpp
+  test/core/test_three_body_rounding.cpp)
 if(TARGET collision_lab_core_tests)
   target_link_libraries(collision_lab_core_tests collision_lab_test_support GTest::gtest_main)
 endif()

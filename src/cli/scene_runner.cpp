@@ -45,12 +45,16 @@ io::SceneEntry withRequestRestitution(const CliRequest& request, io::SceneEntry 
   return entry;
 }
 
-void validateOrThrow(const io::SceneEntry& entry) {
-  if (const auto error = core::validateForRun(entry.scene)) {
+/// The entry's plan (core::planScene: validation, model, prediction, once); throws CliError
+/// when the scene is rejected.
+core::ScenePlan planOrThrow(const io::SceneEntry& entry) {
+  core::ScenePlan plan = core::planScene(entry.scene);
+  if (const auto& error = plan.error) {
     const std::string where = entry.name.empty() ? "" : "scenario '" + entry.name + "': ";
     throw CliError{core::reasonName(error->reason), static_cast<int>(error->reason), error->field,
                    where + error->message};
   }
+  return plan;
 }
 
 /// The request's options, with a scene's own collision cap unless --max-collisions was given.
@@ -62,7 +66,7 @@ core::RunOptions optionsFor(const CliRequest& request, const io::SceneEntry& ent
 
 /// Runs a validated scene with a progress line on a terminal and Ctrl-C for the engine.
 /// `visitors` see the shown events; the run itself keeps none.
-core::SceneRunResult runWithProgress(const core::Scene& scene, const core::RunOptions& shown, bool simulate_to_cap,
+core::SceneRunResult runWithProgress(const core::ScenePlan& plan, const core::RunOptions& shown, bool simulate_to_cap,
                                      core::SceneVisitors visitors) {
   core::SceneRunOptions options;
   options.lab = shown;
@@ -71,10 +75,7 @@ core::SceneRunResult runWithProgress(const core::Scene& scene, const core::RunOp
   options.cancel = &g_cancel;
   std::optional<ProgressLine> progress;
   if (shown.mode != core::RunMode::kPredictOnly && isatty(STDERR_FILENO)) {
-    const bool three_body = core::usesThreeBodyPath(scene);
-    progress.emplace(stderr, three_body ? std::min(core::predict(core::toThreeBodyScene(scene)).collision_count,
-                                                   shown.max_collisions)
-                                        : 0);
+    progress.emplace(stderr, plan.three_body ? std::min(plan.three_body->collision_count, shown.max_collisions) : 0);
     options.progress_interval = std::uint64_t{1} << 16;
     visitors.progress = [&](const core::EngineProgress& p) { progress->onEngineProgress(p.impacts, p.time); };
     const core::LabEventVisitor on_event = visitors.three_body_event;
@@ -83,7 +84,7 @@ core::SceneRunResult runWithProgress(const core::Scene& scene, const core::RunOp
       progress->onCollision(event.event.index);
     };
   }
-  return core::runScene(scene, options, visitors);
+  return core::runScene(plan, options, visitors);
 }
 
 /// The visitors that hand the shown events to the writer of their path.
@@ -110,18 +111,19 @@ core::SceneVisitors showEvents(const core::RunOptions& shown, io::RunReportWrite
 void runEntry(const CliRequest& request, const io::SceneEntry& given) {
   const InterruptGuard interrupt_guard;  // from the first byte out, so Ctrl-C never cuts a report
   const io::SceneEntry entry = withRequestRestitution(request, given);
-  validateOrThrow(entry);
+  const core::ScenePlan plan = planOrThrow(entry);
   std::optional<TemperatureCsv> temperature;  // opened before any report: a bad path is bad input
   if (request.temperature_csv) temperature.emplace(*request.temperature_csv, entry.scene);
   const core::RunOptions shown = optionsFor(request, entry);
-  const core::ModelChoice model = core::chooseModel(entry.scene);
-  const auto three_body = io::makeThreeBodyReportWriter(request.format, std::cout, model);
+  const auto three_body = io::makeThreeBodyReportWriter(request.format, std::cout, plan.model);
   const auto nbody = io::makeSceneReportWriter(request.format, std::cout);
-  const bool is_three_body = core::usesThreeBodyPath(entry.scene);
+  // The three-body model's extras (its prediction, the closed form at each impact) have
+  // their report; every other scene the scene report.
+  const bool is_three_body = plan.three_body.has_value();
   if (is_three_body) {
     three_body->begin(io::toNamedScene(entry), shown);
   } else {
-    nbody->begin(entry, shown, model);
+    nbody->begin(entry, shown, plan.model);
   }
   core::SceneVisitors visitors = showEvents(shown, *three_body, *nbody);
   core::RunOptions run = shown;
@@ -131,7 +133,7 @@ void runEntry(const CliRequest& request, const io::SceneEntry& given) {
     visitors = temperature->feeding(std::move(visitors));
     run.events = core::EventPolicy::all();
   }
-  const core::SceneRunResult result = runWithProgress(entry.scene, run, request.simulate_to_cap, visitors);
+  const core::SceneRunResult result = runWithProgress(plan, run, request.simulate_to_cap, visitors);
   if (temperature) temperature->finish();
   if (is_three_body) {
     three_body->end(*result.three_body);
@@ -144,15 +146,17 @@ void runEntries(const CliRequest& request, const std::vector<io::SceneEntry>& gi
   const InterruptGuard interrupt_guard;  // Ctrl-C cuts every remaining run short; the report is whole
   std::vector<io::SceneEntry> entries;
   for (const io::SceneEntry& entry : given) entries.push_back(withRequestRestitution(request, entry));
-  for (const io::SceneEntry& entry : entries) validateOrThrow(entry);
+  std::vector<core::ScenePlan> plans;
+  for (const io::SceneEntry& entry : entries) plans.push_back(planOrThrow(entry));
   std::vector<io::SceneBatchOutcome> outcomes;
-  for (const io::SceneEntry& entry : entries) {
+  for (std::size_t i = 0; i < entries.size(); ++i) {
+    const io::SceneEntry& entry = entries[i];
     const core::RunOptions options = optionsFor(request, entry);
     core::SceneRunOptions run_options;
     run_options.lab = options;  // the run keeps the events that the options ask for
     run_options.simulate_to_cap = request.simulate_to_cap;
     run_options.cancel = &g_cancel;
-    outcomes.push_back({entry, options, core::runScene(entry.scene, run_options)});
+    outcomes.push_back({entry, options, core::runScene(plans[i], run_options)});
   }
   io::writeSceneBatchReport(request.format, outcomes, std::cout);
 }

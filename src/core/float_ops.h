@@ -2,6 +2,9 @@
 // double, long double and the multiprecision types alike. Private to the core.
 #pragma once
 
+#include <array>
+#include <cmath>
+
 namespace collision_lab {
 namespace core {
 namespace detail {
@@ -31,6 +34,30 @@ template <class T>
 double toDouble(const T& value) {
   const double rounded = static_cast<double>(value);
   return rounded == 0 ? 0.0 : rounded;
+}
+
+/// Does every value survive scaling by 2^shift and back unchanged?
+inline bool scalesExactly(const std::array<double, 3>& values, int shift) {
+  for (double x : values) {
+    if (std::ldexp(std::ldexp(x, shift), -shift) != x) return false;
+  }
+  return true;
+}
+
+/// The shift that brings the largest finite |value| to [1/2, 1), or as close as it goes
+/// without rounding any value (scaling down can push low bits below the smallest
+/// subnormal). Infinities (walls) are left out; they stay infinite.
+inline int shiftTowardsOne(const std::array<double, 3>& values) {
+  double largest = 0.0;
+  for (double x : values) {
+    if (std::isfinite(x)) largest = std::fabs(x) > largest ? std::fabs(x) : largest;
+  }
+  if (largest == 0.0) return 0;
+  int exponent = 0;
+  std::frexp(largest, &exponent);  // largest = f 2^exponent, f in [1/2, 1)
+  int shift = -exponent;
+  while (shift < 0 && !scalesExactly(values, shift)) ++shift;
+  return shift;
 }
 
 }  // namespace detail

@@ -7,6 +7,7 @@
 #include <optional>
 #include <string>
 
+#include "collision_lab/core/nbody/engine.h"
 #include "collision_lab/core/paper.h"
 #include "collision_lab/core/precision.h"
 #include "float_ops.h"
@@ -212,6 +213,120 @@ class LabEvents {
   std::array<double, 3> previous_before_;
 };
 
+/// A double that is never -0 (outputs must not show "-0").
+double noNegativeZero(long double x) { return x == 0 ? 0.0 : static_cast<double>(x); }
+
+/// value times 2^shift, rounded once to double (never -0).
+double scaled(long double value, int shift) { return noNegativeZero(std::ldexp(value, shift)); }
+
+/// The three bodies' run by the exact event engine (nbody/engine.h), the one simulator of
+/// every scene: exact decisions and correctly rounded values, told as ImpactEvents. The
+/// engine runs in exact power-of-two units (masses, velocities and positions near 1, as the
+/// three-body simulator's working units), so that tiny or huge inputs keep their digits;
+/// values are scaled back with one rounding. An impact's pair comes from the engine's
+/// record; the third body's position at that time is computed here from its last impact
+/// (to rounding, in long double), and the totals after it from the velocities. Escalations:
+/// one decision per impact and the final one.
+/// Returns nothing when the engine stopped because a value would leave its safe range
+/// (2^900), which the three-body simulator's working units reach beyond: `told` impacts
+/// were then visited. A run the engine ended otherwise than finished, capped or cancelled
+/// is truncated, with the engine's sentence in `stopped_otherwise`.
+std::optional<SimulationResult> simulateByEngine(const ThreeBodyScene& scene, const SimulationOptions& options,
+                                                 const EventVisitor& visitor, std::uint64_t& told,
+                                                 std::string& stopped_otherwise) {
+  const int mass_shift = detail::shiftTowardsOne(scene.masses);
+  const int velocity_shift = detail::shiftTowardsOne(scene.velocities);
+  const int position_shift = detail::shiftTowardsOne(scene.positions);
+  const int time_shift = velocity_shift - position_shift;  // to SI
+  const int energy_shift = -(mass_shift + 2 * velocity_shift);
+  const int momentum_shift = -(mass_shift + velocity_shift);
+  Scene working{std::vector<double>(3), std::vector<double>(3), std::vector<double>(3), {}};
+  for (int k = 0; k < 3; ++k) {
+    working.masses[k] = std::ldexp(scene.masses[k], mass_shift);
+    working.positions[k] = std::ldexp(scene.positions[k], position_shift);
+    working.velocities[k] = std::ldexp(scene.velocities[k], velocity_shift);
+  }
+  EngineOptions engine_options;
+  engine_options.max_impacts = options.max_collisions;
+  engine_options.progress_interval = 0;
+  engine_options.cancel = options.cancel;
+  SimulationResult result;
+  // In working units: velocities, and where body k was (since_position) at since_time[k].
+  std::array<double, 3> velocities{}, since_position{}, since_time{};
+  for (int k = 0; k < 3; ++k) {
+    velocities[k] = working.velocities[k];
+    since_position[k] = working.positions[k];
+  }
+  const int wall = scene.wallIndex();
+  const auto velocitiesSi = [&velocities, velocity_shift] {
+    return std::array<double, 3>{scaled(velocities[0], -velocity_shift), scaled(velocities[1], -velocity_shift),
+                                 scaled(velocities[2], -velocity_shift)};
+  };
+  ImpactEvent event;
+  ImpactVisitor on_impact;
+  if (visitor) {
+    on_impact = [&](const ImpactRecord& record) {
+      const int i = static_cast<int>(record.pair_index);
+      event.index = record.index;
+      event.pair = i == 0 ? Pair::AB : Pair::BC;
+      event.time = scaled(record.time, time_shift);
+      event.position = scaled(record.position, -position_shift);
+      event.velocities_before = velocitiesSi();
+      for (int k = 0; k < 3; ++k) {
+        const long double elapsed = static_cast<long double>(record.time) - since_time[k];
+        const long double position =
+            velocities[k] == 0 ? since_position[k] : since_position[k] + velocities[k] * elapsed;
+        event.positions[k] = scaled(position, -position_shift);
+        event.energy_transfer[k] = 0.0;
+      }
+      for (int side = 0; side < 2; ++side) {
+        const int body = i + side;
+        velocities[body] = record.velocities_after[side];
+        event.positions[body] = event.position;
+        since_position[body] = record.position;
+        since_time[body] = record.time;
+      }
+      // Elastic: what one body gains the other loses, exactly (a wall's entry is minus the
+      // ball's): the finite body's entry, or the left one's, sets both.
+      const int side = scene.isWall(i) ? 1 : 0;
+      event.energy_transfer[i + side] = scaled(record.energy_gained[side], energy_shift);
+      event.energy_transfer[i + 1 - side] = scaled(-static_cast<long double>(record.energy_gained[side]), energy_shift);
+      event.velocities_after = velocitiesSi();
+      long double energy = 0, momentum = 0;
+      for (int k = 0; k < 3; ++k) {
+        if (k == wall) continue;
+        energy += static_cast<long double>(working.masses[k]) * velocities[k] * velocities[k] / 2;
+        momentum += static_cast<long double>(working.masses[k]) * velocities[k];
+      }
+      event.total_energy = scaled(energy, energy_shift);
+      event.total_momentum = scaled(momentum, momentum_shift);
+      visitor(event);
+    };
+  }
+  EngineResult engine = runEngine(working, engine_options, on_impact);
+  told = engine.impact_count;
+  if (engine.stop == StopReason::kOutOfRange) return std::nullopt;
+  result.collision_count = engine.impact_count;
+  result.truncated = engine.truncated || engine.stop != StopReason::kFinished;
+  result.cancelled = engine.stop == StopReason::kCancelled;
+  if (engine.stop != StopReason::kFinished && engine.stop != StopReason::kCap && !result.cancelled) {
+    stopped_otherwise = engine.stop_message;
+  }
+  result.first_pair = firstPair(scene);
+  for (int k = 0; k < 3; ++k) {
+    result.final_velocities[k] = scaled(engine.final_velocities[k], -velocity_shift);
+    result.final_positions[k] = scaled(engine.final_positions[k], -position_shift);
+  }
+  result.final_time = scaled(engine.final_time, time_shift);
+  result.energy_relative_drift = engine.energy_relative_drift;
+  result.momentum_relative_drift = engine.momentum_relative_drift;
+  result.escalation.decisions = engine.impact_count + 1;
+  // Taken at 100 digits or more (the exact ones among them, as EscalationStats counts).
+  result.escalation.high_precision = engine.escalations.high_precision + engine.escalations.exact_rational;
+  result.escalation.exact_rational = engine.escalations.exact_rational;
+  return result;
+}
+
 /// Simulates, in full mode with every event put beside the prediction, and measures how
 /// far the simulation is from the closed form.
 void simulateBesidePrediction(const ThreeBodyScene& scene, const RunOptions& options, const LabEventVisitor& visitor,
@@ -234,7 +349,22 @@ void simulateBesidePrediction(const ThreeBodyScene& scene, const RunOptions& opt
       if (options.events.keeps(event.index)) result.events.push_back(lab);
     };
   }
-  const SimulationResult simulation = simulate(scene, simulation_options, options.precision, enrich);
+  std::string stopped_otherwise;
+  std::uint64_t told = 0;
+  std::optional<SimulationResult> by_engine =
+      simulateByEngine(scene, simulation_options, enrich, told, stopped_otherwise);
+  if (!by_engine) {
+    // Beyond the engine's range: the three-body simulator (exact decisions, velocities to a
+    // few units in the last place) runs it, telling only the impacts after those told.
+    EventVisitor rest;
+    if (enrich) {
+      rest = [&enrich, told](const ImpactEvent& event) {
+        if (event.index > told) enrich(event);
+      };
+    }
+    by_engine = simulate(scene, simulation_options, options.precision, rest);
+  }
+  const SimulationResult& simulation = *by_engine;
   summary.max_prediction_error = relative_error.fromSquared(max_error_sq);
   summary.simulated = true;
   summary.collision_count = simulation.collision_count;
@@ -243,6 +373,8 @@ void simulateBesidePrediction(const ThreeBodyScene& scene, const RunOptions& opt
   if (simulation.cancelled) {
     summary.truncation_reason = "cancelled after " + std::to_string(simulation.collision_count) + " of " +
                                 std::to_string(result.prediction.collision_count) + " predicted";
+  } else if (!stopped_otherwise.empty()) {
+    summary.truncation_reason = stopped_otherwise;
   } else if (simulation.truncated) {
     summary.truncation_reason = "stopped at max_collisions = " + std::to_string(options.max_collisions) + " of " +
                                 std::to_string(result.prediction.collision_count) + " predicted";

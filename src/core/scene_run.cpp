@@ -134,8 +134,7 @@ SceneSimulation simulateScene(const Scene& scene, const SceneRunOptions& options
   return simulation;
 }
 
-}  // namespace
-
+/// The three-body scene of a three-body scene. Precondition: scene.size() == 3.
 ThreeBodyScene toThreeBodyScene(const Scene& scene) {
   ThreeBodyScene triple;
   for (int i = 0; i < 3; ++i) {
@@ -146,27 +145,84 @@ ThreeBodyScene toThreeBodyScene(const Scene& scene) {
   return triple;
 }
 
-std::optional<ValidationError> validateForRun(const Scene& scene) { return validate(scene); }
-
+/// True when the three-body model answers: three elastic bodies that
+/// validate(ThreeBodyScene) accepts. Precondition: validate(scene) passed.
 bool usesThreeBodyPath(const Scene& scene) {
   return isElasticTriple(scene) && !validate(toThreeBodyScene(scene));
 }
 
-SceneRunResult runScene(const Scene& scene, const SceneRunOptions& options, const SceneVisitors& visitors) {
+/// The three-body run's summary as every scene's: the engine simulated it (lab_run.h).
+SceneSimulation fromThreeBody(const RunResult& run, const Scene& scene, std::uint64_t cap) {
+  const LabRunSummary& summary = run.summary;
+  SceneSimulation simulation;
+  simulation.simulated = summary.simulated;
+  simulation.impact_count = summary.collision_count;
+  simulation.truncated = summary.truncated;
+  // Truncated short of the cap and not cancelled: the engine reported an internal error (a
+  // multiple collision cannot follow a valid start of three bodies).
+  simulation.stop = summary.cancelled                      ? StopReason::kCancelled
+                    : !summary.truncated                   ? StopReason::kFinished
+                    : summary.collision_count >= cap ? StopReason::kCap
+                                                           : StopReason::kInternalError;
+  if (!summary.simulated) {
+    simulation.stop_message = "answered by the closed form of three_body_rotation: nothing simulated";
+  } else if (summary.truncated) {
+    simulation.stop_message = summary.truncation_reason;
+  } else {
+    simulation.stop_message = "no pair approaches any more after " + std::to_string(summary.collision_count) +
+                              " impacts: the run is complete";
+  }
+  simulation.final_velocities.assign(summary.final_velocities.begin(), summary.final_velocities.end());
+  simulation.energy_lost = 0.0;  // elastic
+  simulation.energy_relative_drift = summary.energy_relative_drift;
+  simulation.momentum_relative_drift = summary.momentum_relative_drift;
+  if (summary.simulated && !summary.truncated) {
+    const std::array<double, 3>& predicted = run.prediction.final_velocities;
+    simulation.max_prediction_error = relativeVelocityError(
+        simulation.final_velocities, std::vector<double>(predicted.begin(), predicted.end()), scene.velocities);
+    simulation.matches_prediction = summary.collision_count == run.prediction.collision_count;
+  }
+  return simulation;
+}
+
+}  // namespace
+
+ScenePlan planScene(Scene scene) {
+  const auto start = std::chrono::steady_clock::now();
+  ScenePlan plan;
+  plan.error = validate(scene);
+  if (!plan.error) {
+    plan.model = chooseModel(scene);
+    if (usesThreeBodyPath(scene)) {
+      plan.three_body = predict(toThreeBodyScene(scene));
+    } else {
+      plan.prediction = predict(scene);
+    }
+  }
+  plan.scene = std::move(scene);
+  plan.plan_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return plan;
+}
+
+SceneRunResult runScene(const ScenePlan& plan, const SceneRunOptions& options, const SceneVisitors& visitors) {
   const auto start = std::chrono::steady_clock::now();
   SceneRunResult result;
-  result.model = chooseModel(scene);
-  if (usesThreeBodyPath(scene)) {
+  result.model = plan.model;
+  result.prediction = plan.prediction;
+  if (plan.three_body) {
     RunOptions lab = options.lab;
     if (!options.keep_events) lab.events = EventPolicy::none();
     lab.skip_simulation_over_cap = !options.simulate_to_cap;
     lab.cancel = options.cancel;
-    result.three_body = runLab(toThreeBodyScene(scene), lab, visitors.three_body_event);
+    result.three_body =
+        runLab(toThreeBodyScene(plan.scene), lab, *plan.three_body, visitors.three_body_event);
+    result.simulation = fromThreeBody(*result.three_body, plan.scene, lab.max_collisions);
   } else {
-    result.prediction = predict(scene);
-    result.simulation = simulateScene(scene, options, result.prediction, visitors);
+    result.simulation = simulateScene(plan.scene, options, result.prediction, visitors);
   }
-  result.compute_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.compute_time_s =
+      plan.plan_time_s + std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (result.three_body) result.three_body->summary.compute_time_s = result.compute_time_s;
   return result;
 }
 

@@ -373,29 +373,9 @@ struct WorkingUnits {
   ToSi velocity_si{0}, position_si{0}, time_si{0}, energy_si{0};
 };
 
-bool scalesExactly(const std::array<double, 3>& values, int shift) {
-  for (double x : values) {
-    if (std::ldexp(std::ldexp(x, shift), -shift) != x) return false;
-  }
-  return true;
-}
-
-/// The shift that brings the largest |value| to [1/2, 1), or as close as it goes without
-/// rounding any value (scaling down can push low bits below the smallest subnormal).
-int shiftTowardsOne(const std::array<double, 3>& values) {
-  double largest = 0.0;
-  for (double x : values) largest = std::max(largest, std::fabs(x));
-  if (largest == 0.0) return 0;
-  int exponent = 0;
-  std::frexp(largest, &exponent);  // largest = f 2^exponent, f in [1/2, 1)
-  int shift = -exponent;
-  while (shift < 0 && !scalesExactly(values, shift)) ++shift;
-  return shift;
-}
-
 ThreeBodyScene inWorkingUnits(const ThreeBodyScene& scene, WorkingUnits& units) {
-  units.velocity = shiftTowardsOne(scene.velocities);
-  units.position = shiftTowardsOne(scene.positions);
+  units.velocity = detail::shiftTowardsOne(scene.velocities);
+  units.position = detail::shiftTowardsOne(scene.positions);
   units.velocity_si = ToSi(units.velocity);
   units.position_si = ToSi(units.position);
   units.time_si = ToSi(units.position - units.velocity);

@@ -189,9 +189,12 @@ class EventStream {
   double last_time_ = 0.0;
 };
 
-/// The reason to refuse input before simulating it (student, run_id, mode, size, then the scene), if any.
+/// The reason to refuse input before simulating it (student, run_id, mode, size, then the
+/// scene), if any. The scene's plan (core::planScene: its one validation, model and
+/// prediction) goes to `plan` when the checks before it pass.
 std::optional<collision_lab::Rejected> checkInput(const collision_lab::InitialConditions& input,
-                                                  std::size_t max_bodies) {
+                                                  std::size_t max_bodies,
+                                                  std::optional<collision_lab::core::ScenePlan>& plan) {
   if (const std::string problem = studentProblem(input.student); !problem.empty()) {
     return toRejectedMsg(NodeReason::kInvalidStudent, "student", "student '" + input.student + "' " + problem);
   }
@@ -219,7 +222,8 @@ std::optional<collision_lab::Rejected> checkInput(const collision_lab::InitialCo
                              std::to_string(max_bodies) + "; send a smaller scene, or start the node with a "
                              "larger ~max_bodies");
   }
-  if (const auto error = collision_lab::core::validateForRun(toScene(input))) return toRejectedMsg(*error);
+  plan = collision_lab::core::planScene(toScene(input));
+  if (const auto& error = plan->error) return toRejectedMsg(*error);
   return std::nullopt;
 }
 
@@ -669,7 +673,8 @@ ServeOutcome LabNode::reject(collision_lab::Rejected msg, const std::string& run
 
 void LabNode::serve(collision_lab::InitialConditions input, Reply reply) {
   const std::string requested = input.run_id;
-  if (auto rejection = checkInput(input, params_.max_bodies)) {
+  std::optional<collision_lab::core::ScenePlan> plan;
+  if (auto rejection = checkInput(input, params_.max_bodies, plan)) {
     rejection->student = input.student;
     ServeOutcome outcome = reject(std::move(*rejection), requested);
     if (reply) reply->set_value(std::move(outcome));
@@ -685,21 +690,19 @@ void LabNode::serve(collision_lab::InitialConditions input, Reply reply) {
                     "it before); serving the run as '" << input.run_id << "'");
   }
   announce(input, requested);
-  run(input, input.run_id != requested ? requested : std::string(), claim_error, std::move(reply));
+  run(input, *plan, input.run_id != requested ? requested : std::string(), claim_error, std::move(reply));
 }
 
-void LabNode::run(collision_lab::InitialConditions& input, const std::string& requested_run_id,
-                  const std::string& claim_error, Reply reply) {
+void LabNode::run(collision_lab::InitialConditions& input, const collision_lab::core::ScenePlan& plan,
+                  const std::string& requested_run_id, const std::string& claim_error, Reply reply) {
   namespace core = collision_lab::core;
   const ros::Time start = stampNow();
-  const core::Scene scene = toScene(input);
+  const core::Scene& scene = plan.scene;
   const core::RunMode mode = *toRunMode(input.mode);
-  // The prediction goes out before the simulation starts.
-  const ScenePrediction prediction = predictScene(scene);
   RunWriter out(input.run_id, RunTimeline(start, chooseTimelineScale(firstContactTime(scene))), bags_.get(),
                 claim_error);
   input.header.stamp = start;
-  publishStart(out, input, prediction);
+  publishStart(out, input, plan);  // the prediction goes out before the simulation starts
 
   core::SceneRunOptions options;
   options.lab.max_collisions = input.max_collisions ? input.max_collisions : params_.max_collisions;
@@ -716,7 +719,7 @@ void LabNode::run(collision_lab::InitialConditions& input, const std::string& re
   visitors.three_body_event = [&events](const core::LabEvent& e) { events(e); };
   visitors.impact = [&events](const core::ImpactRecord& r) { events(r); };
   visitors.collapse = [&events](const core::Collapse& c) { events(c); };  // in order, between the impacts
-  const core::SceneRunResult result = runCancellable(input.run_id, scene, options, visitors);
+  const core::SceneRunResult result = runCancellable(input.run_id, plan, options, visitors);
 
   collision_lab::RunSummary summary = toRunSummaryMsg(result, scene.size(), mode);
   summary.published_events = events.published();
@@ -727,7 +730,7 @@ void LabNode::run(collision_lab::InitialConditions& input, const std::string& re
 }
 
 collision_lab::core::SceneRunResult LabNode::runCancellable(const std::string& run_id,
-                                                            const collision_lab::core::Scene& scene,
+                                                            const collision_lab::core::ScenePlan& plan,
                                                             const collision_lab::core::SceneRunOptions& options,
                                                             const collision_lab::core::SceneVisitors& visitors) {
   {
@@ -735,7 +738,7 @@ collision_lab::core::SceneRunResult LabNode::runCancellable(const std::string& r
     running_run_id_ = run_id;
     cancel_ = stopping_run_.load();  // the node's shutdown cancels every run
   }
-  collision_lab::core::SceneRunResult result = collision_lab::core::runScene(scene, options, visitors);
+  collision_lab::core::SceneRunResult result = collision_lab::core::runScene(plan, options, visitors);
   std::lock_guard<std::mutex> lock(running_mutex_);
   running_run_id_.clear();
   return result;
@@ -759,11 +762,11 @@ bool LabNode::onCancel(collision_lab::Cancel::Request& request, collision_lab::C
 }
 
 void LabNode::publishStart(RunWriter& out, const collision_lab::InitialConditions& input,
-                           const ScenePrediction& core_prediction) {
+                           const collision_lab::core::ScenePlan& plan) {
   out.record(input);
   served_inputs_pub_.publish(input);
   if (marker_view_) marker_view_->onInitialConditions(input);
-  collision_lab::Prediction prediction = toPredictionMsg(core_prediction);
+  collision_lab::Prediction prediction = toPredictionMsg(plan);
   prediction.timeline_scale = out.timeline().scale();
   out.publish(topics_.predictions, prediction, 0.0);
   out.record(prediction);

@@ -137,21 +137,6 @@ core::ModelChoice threeBodyRotationModel() {
   return {core::ModelKind::kThreeBodyRotation, kThreeBodyRotationReason};
 }
 
-ScenePrediction predictScene(const core::Scene& scene) {
-  ScenePrediction prediction;
-  prediction.model = core::chooseModel(scene);
-  prediction.body_count = scene.size();
-  if (core::usesThreeBodyPath(scene)) {
-    prediction.three_body = core::predict(core::toThreeBodyScene(scene));
-  } else {
-    prediction.nbody = core::predict(scene);
-    if (prediction.model.kind == core::ModelKind::kThreeBodySpiral) {
-      prediction.spiral_alpha = core::alphaOf<double>({scene.masses[0], scene.masses[1], scene.masses[2]});
-    }
-  }
-  return prediction;
-}
-
 namespace {
 
 /// The fields every model fills the same way; the rest say "not given".
@@ -170,11 +155,11 @@ collision_lab::Prediction modelPrediction(const core::ModelChoice& model, std::s
 
 }  // namespace
 
-collision_lab::Prediction toPredictionMsg(const ScenePrediction& prediction) {
-  if (prediction.three_body) return toPredictionMsg(*prediction.three_body, prediction.model);
-  collision_lab::Prediction msg = modelPrediction(prediction.model, prediction.body_count);
-  if (!prediction.nbody) return msg;  // event_engine: no closed form
-  const core::Prediction& p = *prediction.nbody;
+collision_lab::Prediction toPredictionMsg(const core::ScenePlan& plan) {
+  if (plan.three_body) return toPredictionMsg(*plan.three_body, plan.model);
+  collision_lab::Prediction msg = modelPrediction(plan.model, plan.scene.size());
+  if (!plan.prediction) return msg;  // event_engine: no closed form
+  const core::Prediction& p = *plan.prediction;
   msg.collision_count = p.impact_count.value_or(0);
   msg.collision_count_defined = p.impact_count.has_value();
   msg.infinite_collisions = p.infinite;
@@ -188,7 +173,10 @@ collision_lab::Prediction toPredictionMsg(const ScenePrediction& prediction) {
   msg.collapse_position = valueOr(p.collapse_position);
   msg.critical_restitution = valueOr(p.critical_restitution);
   msg.spiral_angle = valueOr(p.spiral_angle);
-  msg.alpha = prediction.spiral_alpha;
+  if (plan.model.kind == core::ModelKind::kThreeBodySpiral) {  // the opening angle of the three masses
+    const std::vector<double>& m = plan.scene.masses;
+    msg.alpha = core::alphaOf<double>({m[0], m[1], m[2]});
+  }
   return msg;
 }
 

@@ -267,7 +267,7 @@ SceneReports sceneReports(const core::Scene& scene) {
     csv_writer->collapse(c);
     json_writer->collapse(c);
   };
-  const core::SceneRunResult result = core::runScene(scene, options, visitors);
+  const core::SceneRunResult result = core::runScene(core::planScene(scene), options, visitors);
   csv_writer->end(result);
   json_writer->end(result);
   reports.csv = csv.str();
@@ -288,7 +288,7 @@ TEST(ReportStream, NBodyImpactsAndCollapsesCarryTheEngineValues) {
   }
   const core::Scene collapse{{1, 1, 1}, {2, 1, 0}, {-1, 0, 0}, {0.05}};
   for (const core::Scene& scene : {gas, collapse}) {
-    ASSERT_FALSE(core::validateForRun(scene));
+    ASSERT_FALSE(core::planScene(scene).error);
     const SceneReports reports = sceneReports(scene);
     ASSERT_GT(reports.events.size(), 2u);
     expectJsonEvents(reports.json, reports.events);

@@ -130,7 +130,7 @@ TEST(ScenarioFile, PresetsOfAnySizeLoadAndAreValid) {
   const std::vector<SceneEntry> scenes = loadScenes(COLLISION_LAB_SOURCE_DIR "/config/scenarios.yaml");
   ASSERT_EQ(scenes.size(), 23u);
   for (const SceneEntry& entry : scenes) {
-    EXPECT_FALSE(collision_lab::core::validateForRun(entry.scene).has_value()) << entry.name;
+    EXPECT_FALSE(collision_lab::core::planScene(entry.scene).error.has_value()) << entry.name;
     EXPECT_FALSE(entry.description.empty()) << entry.name;
   }
   const SceneEntry gas = findScene(scenes, "gas_1000");  // from config/gas_1000.csv
@@ -178,7 +178,7 @@ TEST(ScenarioFile, ErrorsNameTheFileTheEntryAndTheField) {
   // Lists of any length load; different lengths are the physics' to reject (UNEQUAL_LENGTHS).
   const std::vector<SceneEntry> two_masses = loadScenes(kData + "wrong_count.yaml");
   ASSERT_EQ(two_masses.size(), 1u);
-  EXPECT_EQ(collision_lab::core::validateForRun(two_masses[0].scene)->reason,
+  EXPECT_EQ(collision_lab::core::planScene(two_masses[0].scene).error->reason,
             collision_lab::core::Reason::kUnequalLengths);
   const TemporaryYaml empty_list("a:\n  masses: []\n  positions: []\n  velocities: []\n");
   EXPECT_EQ(loadError(empty_list.path()),

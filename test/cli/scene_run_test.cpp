@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <vector>
 
 #include "collision_lab/core/scene_run.h"
 
@@ -20,40 +21,107 @@ core::SceneRunOptions withEvents(core::EventPolicy events) {
 
 TEST(SceneRun, ThreeElasticBodiesTakeTheThreeBodyPath) {
   const core::Scene scene{{1, 1, 1}, {2, 1, -1}, {-1, 0, 1}, {}};
-  ASSERT_FALSE(core::validateForRun(scene));
-  const core::SceneRunResult result = core::runScene(scene, withEvents(core::EventPolicy::all()));
+  ASSERT_FALSE(core::planScene(scene).error);
+  const core::SceneRunResult result = core::runScene(core::planScene(scene), withEvents(core::EventPolicy::all()));
   ASSERT_TRUE(result.three_body.has_value());
   EXPECT_EQ(result.model.kind, core::ModelKind::kThreeBodyRotation);
   EXPECT_EQ(result.three_body->summary.collision_count, 3u);  // shared/physics.md
   EXPECT_EQ(result.three_body->events.size(), 3u);
 }
 
+// Plan once (issue 20): planScene validates, chooses the model and predicts; runScene takes
+// the plan and neither chooses nor predicts again: a model and a prediction changed in the
+// plan are the ones the run reports (predict-only: the prediction is the answer).
+TEST(SceneRun, TheRunTakesTheModelAndPredictionOfItsPlan) {
+  core::ScenePlan ghosts = core::planScene(cradle());
+  ASSERT_FALSE(ghosts.error);
+  ASSERT_EQ(ghosts.model.kind, core::ModelKind::kGhosts);
+  ASSERT_TRUE(ghosts.prediction && ghosts.prediction->impact_count);
+  EXPECT_EQ(*ghosts.prediction->impact_count, 4u);  // shared/physics.md
+  ghosts.model.reason = "the plan's reason";
+  ghosts.prediction->impact_count = 7;
+  core::SceneRunOptions predict_only = withEvents(core::EventPolicy::none());
+  predict_only.lab.mode = core::RunMode::kPredictOnly;
+  const core::SceneRunResult answered = core::runScene(ghosts, predict_only);
+  EXPECT_EQ(answered.model.reason, "the plan's reason");
+  EXPECT_EQ(answered.simulation.impact_count, 7u);
+
+  core::ScenePlan triple = core::planScene({{1, 1, 1}, {2, 1, -1}, {-1, 0, 1}, {}});
+  ASSERT_TRUE(triple.three_body);
+  EXPECT_FALSE(triple.prediction);
+  EXPECT_EQ(triple.three_body->collision_count, 3u);  // shared/physics.md
+  triple.three_body->collision_count = 5;
+  const core::SceneRunResult run = core::runScene(triple, predict_only);
+  ASSERT_TRUE(run.three_body);
+  EXPECT_EQ(run.three_body->summary.collision_count, 5u);
+
+  const core::ScenePlan rejected = core::planScene({{1, 1}, {0, 1}, {1, 0}, {}});
+  ASSERT_TRUE(rejected.error);
+  EXPECT_EQ(rejected.error->reason, core::Reason::kPositionsNotOrdered);
+  EXPECT_FALSE(rejected.three_body || rejected.prediction);
+}
+
+// One run result (issue 20): the simulation summary is filled for three bodies too, with
+// the engine's count and final state; the over-cap rule answers from the model there too.
+TEST(SceneRun, ThreeBodiesFillTheSimulationSummaryLikeEveryScene) {
+  // The node's round-trip scene; the summary is the engine's run of the same scene
+  // (bit-identical, test_three_body_rounding.cpp).
+  const core::Scene scene{{1, 2, 3}, {2, 0, -2}, {-1, 0.5, 1}, {}};
+  const core::ScenePlan plan = core::planScene(scene);
+  ASSERT_FALSE(plan.error);
+  const core::SceneRunResult result = core::runScene(plan, withEvents(core::EventPolicy::none()));
+  ASSERT_TRUE(result.three_body);
+  const core::EngineResult engine = core::runEngine(scene);
+  EXPECT_TRUE(result.simulation.simulated);
+  EXPECT_FALSE(result.simulation.truncated);
+  EXPECT_EQ(result.simulation.stop, core::StopReason::kFinished);
+  EXPECT_EQ(result.simulation.impact_count, engine.impact_count);
+  EXPECT_EQ(result.simulation.impact_count, result.three_body->prediction.collision_count);
+  EXPECT_EQ(result.simulation.final_velocities, engine.final_velocities);
+  ASSERT_TRUE(result.simulation.matches_prediction.has_value());
+  EXPECT_TRUE(*result.simulation.matches_prediction);
+  EXPECT_LE(result.simulation.max_prediction_error, 1e-15);
+  EXPECT_EQ(result.simulation.energy_lost, 0.0);
+
+  // (1e12, 1, 1e12): 2,221,441 impacts (physics.md), over a cap of 1000: not simulated.
+  core::SceneRunOptions capped = withEvents(core::EventPolicy::none());
+  capped.lab.max_collisions = 1000;
+  const core::SceneRunResult over =
+      core::runScene(core::planScene({{1e12, 1, 1e12}, {2, 1, 0}, {-1, 0, 0}, {}}), capped);
+  EXPECT_FALSE(over.simulation.simulated);
+  EXPECT_FALSE(over.simulation.truncated);
+  EXPECT_EQ(over.simulation.impact_count, 2221441u);
+  ASSERT_TRUE(over.three_body);
+  const auto& predicted = over.three_body->prediction.final_velocities;
+  EXPECT_EQ(over.simulation.final_velocities, std::vector<double>(predicted.begin(), predicted.end()));
+}
+
 // One validation for every N and e (issue 20): a wall in the middle was INFINITE_MIDDLE_MASS
 // for three elastic bodies and WALL_NOT_AT_END otherwise (failed before).
 TEST(SceneRun, OneValidationGivesOneReasonWhateverNAndE) {
   core::Scene middle_wall{{1, INFINITY, 1}, {2, 1, 0}, {-1, 0, 0}, {}};
-  EXPECT_EQ(core::validateForRun(middle_wall)->reason, core::Reason::kWallNotAtEnd);
-  const std::string message = core::validateForRun(middle_wall)->message;
+  EXPECT_EQ(core::planScene(middle_wall).error->reason, core::Reason::kWallNotAtEnd);
+  const std::string message = core::planScene(middle_wall).error->message;
   middle_wall.restitution = {0.5};
-  EXPECT_EQ(core::validateForRun(middle_wall)->reason, core::Reason::kWallNotAtEnd);
-  EXPECT_EQ(core::validateForRun(middle_wall)->message, message);
+  EXPECT_EQ(core::planScene(middle_wall).error->reason, core::Reason::kWallNotAtEnd);
+  EXPECT_EQ(core::planScene(middle_wall).error->message, message);
   const core::Scene five{{1, 1, INFINITY, 1, 1}, {4, 3, 2, 1, 0}, {-1, 0, 0, 0, 0}, {}};
-  EXPECT_EQ(core::validateForRun(five)->reason, core::Reason::kWallNotAtEnd);
+  EXPECT_EQ(core::planScene(five).error->reason, core::Reason::kWallNotAtEnd);
   const core::Scene two_walls{{INFINITY, 1, INFINITY}, {2, 1, 0}, {0, 1, 0}, {}};
-  EXPECT_FALSE(core::validateForRun(two_walls));
-  EXPECT_FALSE(core::usesThreeBodyPath(two_walls));
+  EXPECT_FALSE(core::planScene(two_walls).error);
+  EXPECT_FALSE(core::planScene(two_walls).three_body);
 }
 
 // The cradle: 4 impacts (shared/physics.md). Without events the closed form answers alone.
 TEST(SceneRun, GhostsRunTheEngineOnlyWhenEventsAreAsked) {
-  const core::SceneRunResult closed = core::runScene(cradle(), withEvents(core::EventPolicy::none()));
+  const core::SceneRunResult closed = core::runScene(core::planScene(cradle()), withEvents(core::EventPolicy::none()));
   EXPECT_FALSE(closed.simulation.simulated);
   EXPECT_EQ(closed.simulation.impact_count, 4u);
 
   std::size_t visited = 0;
   core::SceneVisitors visitors;
   visitors.impact = [&](const core::ImpactRecord&) { ++visited; };
-  const core::SceneRunResult simulated = core::runScene(cradle(), withEvents(core::EventPolicy::all()), visitors);
+  const core::SceneRunResult simulated = core::runScene(core::planScene(cradle()), withEvents(core::EventPolicy::all()), visitors);
   EXPECT_TRUE(simulated.simulation.simulated);
   EXPECT_EQ(simulated.simulation.impact_count, 4u);
   EXPECT_EQ(visited, 4u);
@@ -69,7 +137,7 @@ TEST(SceneRun, TheCancelFlagStopsTheEngineWithAPartialSummary) {
   std::atomic<bool> cancel{true};
   core::SceneRunOptions options = withEvents(core::EventPolicy::none());
   options.cancel = &cancel;
-  const core::SceneRunResult result = core::runScene(scene, options);
+  const core::SceneRunResult result = core::runScene(core::planScene(scene), options);
   EXPECT_TRUE(result.simulation.simulated);
   EXPECT_TRUE(result.simulation.truncated);
   EXPECT_EQ(result.simulation.stop, core::StopReason::kCancelled);
@@ -82,7 +150,7 @@ TEST(SceneRun, PredictOnlyWithoutAClosedFormSimulatesNothing) {
   const core::Scene scene{{1, 2, 3, 4}, {3, 2, 1, 0}, {-1, 0, 0, 1}, {}};
   core::SceneRunOptions options;
   options.lab.mode = core::RunMode::kPredictOnly;
-  const core::SceneRunResult result = core::runScene(scene, options);
+  const core::SceneRunResult result = core::runScene(core::planScene(scene), options);
   EXPECT_EQ(result.model.kind, core::ModelKind::kEventEngine);
   EXPECT_FALSE(result.prediction.has_value());
   EXPECT_FALSE(result.simulation.simulated);
@@ -98,7 +166,7 @@ TEST(SceneRun, OverTheCapTheModelAnswersUnlessAskedToSimulate) {
   std::size_t visited = 0;
   core::SceneVisitors visitors;
   visitors.impact = [&](const core::ImpactRecord&) { ++visited; };
-  const core::SceneRunResult answered = core::runScene(cradle(), options, visitors);
+  const core::SceneRunResult answered = core::runScene(core::planScene(cradle()), options, visitors);
   EXPECT_FALSE(answered.simulation.simulated);
   EXPECT_FALSE(answered.simulation.truncated);
   EXPECT_EQ(answered.simulation.impact_count, 4u);
@@ -106,7 +174,7 @@ TEST(SceneRun, OverTheCapTheModelAnswersUnlessAskedToSimulate) {
   EXPECT_EQ(visited, 0u);
 
   options.simulate_to_cap = true;
-  const core::SceneRunResult simulated = core::runScene(cradle(), options, visitors);
+  const core::SceneRunResult simulated = core::runScene(core::planScene(cradle()), options, visitors);
   EXPECT_TRUE(simulated.simulation.simulated);
   EXPECT_TRUE(simulated.simulation.truncated);
   EXPECT_EQ(simulated.simulation.impact_count, 3u);
@@ -119,7 +187,7 @@ TEST(SceneRun, OverTheCapTheThreeBodyModelAnswersWithItsCount) {
   const core::Scene scene{{1e4, 1, INFINITY}, {2, 1, 0}, {-1, 0, 0}, {}};
   core::SceneRunOptions options = withEvents(core::EventPolicy::all());
   options.lab.max_collisions = 100;
-  const core::SceneRunResult result = core::runScene(scene, options);
+  const core::SceneRunResult result = core::runScene(core::planScene(scene), options);
   ASSERT_TRUE(result.three_body.has_value());
   EXPECT_FALSE(result.three_body->summary.simulated);
   EXPECT_FALSE(result.three_body->summary.truncated);
@@ -132,24 +200,24 @@ TEST(SceneRun, OverTheCapTheThreeBodyModelAnswersWithItsCount) {
 TEST(SceneRun, TwoWallsAreSimulatedForDisplayOnly) {
   const core::Scene scene{{INFINITY, 1, INFINITY}, {1, 0.5, 0}, {0, 1, 0}, {}};
   core::SceneRunOptions options = withEvents(core::EventPolicy::none());
-  const core::SceneRunResult shown = core::runScene(scene, options);
+  const core::SceneRunResult shown = core::runScene(core::planScene(scene), options);
   EXPECT_TRUE(shown.simulation.truncated);
   EXPECT_EQ(shown.simulation.impact_count, core::kInfiniteRunDisplayCap);
   options.simulate_to_cap = true;
   options.lab.max_collisions = 5000;
-  EXPECT_EQ(core::runScene(scene, options).simulation.impact_count, 5000u);
+  EXPECT_EQ(core::runScene(core::planScene(scene), options).simulation.impact_count, 5000u);
 }
 
 // The engine's run keeps the events asked for, as the three-body path does (failed before:
 // none kept, so a batch lost them).
 TEST(SceneRun, TheEngineKeepsTheEventsAskedFor) {
   core::SceneRunOptions options = withEvents(core::EventPolicy::firstN(2));
-  const core::SceneRunResult result = core::runScene(cradle(), options);
+  const core::SceneRunResult result = core::runScene(core::planScene(cradle()), options);
   ASSERT_EQ(result.simulation.impacts.size(), 2u);
   EXPECT_EQ(result.simulation.impacts[1].pair_index, 1u);
   EXPECT_EQ(result.simulation.impacts[1].time, 2.0);
   options.keep_events = false;
-  EXPECT_TRUE(core::runScene(cradle(), options).simulation.impacts.empty());
+  EXPECT_TRUE(core::runScene(core::planScene(cradle()), options).simulation.impacts.empty());
 }
 
 }  // namespace

@@ -191,9 +191,9 @@ TEST(SceneEventConverter, AtTheFullStateLimitThePlotsCarryEveryBody) {
 }
 
 TEST(MsgConversion, AScenePredictedByNoFormulaFlagsEveryFieldAsNotGiven) {
-  ScenePrediction p;
+  collision_lab::core::ScenePlan p;
   p.model = {collision_lab::core::ModelKind::kEventEngine, "no formula"};
-  p.body_count = 7;
+  p.scene.masses.assign(7, 1.0);
   const auto msg = toPredictionMsg(p);
   EXPECT_EQ(msg.model, collision_lab::Prediction::MODEL_EVENT_ENGINE);
   EXPECT_EQ(msg.model_name, "event_engine");

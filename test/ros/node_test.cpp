@@ -147,7 +147,8 @@ TEST(LabNode, RoundTripMatchesCore) {
   options.events = collision_lab::core::EventPolicy::all();
   options.skip_simulation_over_cap = true;
   const core::Scene scene = collision_lab_ros::toScene(input);
-  const collision_lab::core::RunResult expected = collision_lab::core::runLab(core::toThreeBodyScene(scene), options);
+  const collision_lab::core::RunResult expected =
+      collision_lab::core::runLab(core::ThreeBodyScene{{1, 2, 3}, {2, 0, -2}, {-1, 0.5, 1}}, options);
   ASSERT_GT(expected.events.size(), 0u);
 
   ASSERT_EQ(out.predictions.size(), 1u);

@@ -1,5 +1,9 @@
 // One lab run: prediction first, then the simulation with every event put beside the
-// closed-form prediction and the paper's printed formulas. Shared by the CLI, the ROS
+// closed-form prediction and the paper's printed formulas. The simulation is the exact
+// event engine's (nbody/engine.h), as for every scene: exact decisions and correctly
+// rounded velocities. Only a run whose values leave the engine's safe range (2^900) is
+// finished by the three-body simulator (simulation.h; exact decisions, velocities within a
+// few units in the last place), which reaches to the largest double. Shared by the CLI, the ROS
 // node and the benchmarks, so all of them report the same numbers.
 #pragma once
 
@@ -52,6 +56,8 @@ struct RunOptions {
   std::uint64_t max_collisions = 10'000'000;
   EventPolicy events = EventPolicy::all();  ///< which LabEvents RunResult keeps
   RunMode mode = RunMode::kFull;
+  /// Working precision of the three-body simulator (simulation.h), which finishes a run
+  /// whose values leave the event engine's range; the engine simulates every run first.
   Precision precision = Precision::kDouble;
   /// When the predicted count exceeds max_collisions, answer at once from the closed form
   /// (simulated false, its count and final velocities) instead of simulating up to the cap.

@@ -1,9 +1,11 @@
-// One run of a scene of any size: the model that the scene needs (chooseModel), its
-// closed-form prediction where one exists, and the simulation summary. The front ends'
-// single entry point (the CLI today; the ROS node with issue 12). ROS-free.
+// One run of a scene of any size, in two steps that every front end (the CLI, the ROS
+// node) takes: planScene validates the scene, chooses its model (chooseModel) and computes
+// the model's prediction, once; runScene runs that plan and gives one result whose
+// simulation summary is filled for every scene. ROS-free.
 //
 // Three elastic bodies that the three-body path accepts (validate(ThreeBodyScene)) are
-// handed to runLab unchanged, so their output stays that of the paper's rotation model.
+// handed to runLab, which simulates them with the same event engine and puts the paper's
+// rotation model beside every impact.
 // Every other scene is answered by its model (models.h): a closed form alone when no event
 // is asked for and the prediction is finite; otherwise the exact event engine, whose
 // summary is put beside the prediction.
@@ -36,8 +38,8 @@ namespace core {
 constexpr std::uint64_t kInfiniteRunDisplayCap = 1000;
 
 struct SceneRunOptions {
-  /// Cap, event policy, mode and precision. The precision applies to the three-body path
-  /// only (the event engine decides everything exactly); max_collisions caps the engine.
+  /// Cap, event policy, mode and precision. The precision applies to the three-body
+  /// simulator only (RunOptions::precision); max_collisions caps the engine.
   /// When lab.events asks for any event (in full mode), a closed-form scene is simulated
   /// too, and the simulation is checked against the prediction.
   RunOptions lab;
@@ -55,7 +57,8 @@ struct SceneRunOptions {
   std::uint64_t progress_interval = std::uint64_t{1} << 20;  ///< impacts between progress calls
 };
 
-/// The simulation of an N-body scene (not filled for the three-body path).
+/// The simulation of a scene, for every scene (the three-body model's extras are in
+/// SceneRunResult::three_body).
 struct SceneSimulation {
   bool simulated = false;          ///< false: answered by the closed form alone (or predict-only)
   /// The run's answer: simulated, or the model's count when not simulated (0 when the model
@@ -90,18 +93,32 @@ struct SceneSimulation {
 };
 
 struct SceneRunResult {
-  ModelChoice model;                       ///< which model answered, and why (one line)
-  std::optional<Prediction> prediction;    ///< closed-form models (not three_body_rotation, event_engine)
-  std::optional<RunResult> three_body;     ///< set when the three-body path answered
-  SceneSimulation simulation;              ///< the N-body summary (unset for the three-body path)
-  double compute_time_s = 0.0;             ///< wall time of choice, prediction and simulation [s]
+  ModelChoice model;                       ///< which model answered, and why (one line): the plan's
+  std::optional<Prediction> prediction;    ///< the plan's closed form (not three_body_rotation, event_engine)
+  /// The three-body model's extras, when it answered (three elastic bodies): its prediction,
+  /// the closed form and the paper's values at every impact, its own summary.
+  std::optional<RunResult> three_body;
+  SceneSimulation simulation;              ///< the run's summary, for every scene
+  double compute_time_s = 0.0;             ///< wall time of planning and simulation [s]
 };
 
-/// True when runScene hands this scene to runLab: three elastic bodies that
-/// validate(ThreeBodyScene) accepts. Precondition: validate(scene) passed.
-bool usesThreeBodyPath(const Scene& scene);
-/// The three-body scene of a three-body scene. Precondition: scene.size() == 3.
-ThreeBodyScene toThreeBodyScene(const Scene& scene);
+/// A scene's plan, computed once by planScene: its one validation, the model that answers
+/// it and that model's prediction. runScene and everything after it (the CLI's report, the
+/// node's publication, record and markers) take the plan: nothing validates, chooses a
+/// model or predicts again.
+struct ScenePlan {
+  Scene scene;
+  /// Set when the scene is rejected (validate(Scene): one set of reasons for every N and
+  /// every restitution; the message never repeats the field). Nothing below is set then.
+  std::optional<ValidationError> error;
+  ModelChoice model;
+  /// The chosen model's closed form (models.h); empty for three_body_rotation and event_engine.
+  std::optional<Prediction> prediction;
+  /// three_body_rotation: the rotation model's prediction (lab_run.h), which the run puts
+  /// beside every impact. Empty for every other model.
+  std::optional<AnalyticPrediction> three_body;
+  double plan_time_s = 0.0;  ///< wall time of validation, choice and prediction [s]
+};
 
 /// What runScene calls back. Each may be empty.
 struct SceneVisitors {
@@ -113,15 +130,13 @@ struct SceneVisitors {
   ProgressCallback progress;         ///< the event engine's progress
 };
 
-/// Checks a scene for runScene: validate(scene), one validation with one set of reasons for
-/// every N and every restitution. The message never repeats the field. Returns nothing when
-/// the scene is valid.
-/// Never throws for any input (short of memory).
-std::optional<ValidationError> validateForRun(const Scene& scene);
+/// Validates the scene and, when it is valid, chooses its model and computes the model's
+/// prediction. Never throws for any input (short of memory).
+ScenePlan planScene(Scene scene);
 
-/// Runs a scene. Precondition: validateForRun(scene) returned nothing. Never throws (short
-/// of memory); the visitors may throw, which ends the run.
-SceneRunResult runScene(const Scene& scene, const SceneRunOptions& options, const SceneVisitors& visitors = {});
+/// Runs a planned scene. Precondition: !plan.error. Never throws (short of memory); the
+/// visitors may throw, which ends the run.
+SceneRunResult runScene(const ScenePlan& plan, const SceneRunOptions& options, const SceneVisitors& visitors = {});
 
 }  // namespace core
 }  // namespace collision_lab

@@ -40,7 +40,7 @@ struct ScenarioFileError : std::runtime_error {
 };
 
 /// Loads every scene of a scenario file, in file order. Throws ScenarioFileError.
-/// Does not validate the physics (call core::validateForRun() on each scene).
+/// Does not validate the physics (core::planScene validates each scene).
 std::vector<SceneEntry> loadScenes(const std::string& path);
 
 /// True for an entry that the three-body path takes: three bodies, elastic, not walls at

@@ -195,16 +195,17 @@ class LabNode {
   /// Publishes, records and draws one validated run (its run_id assigned).
   /// requested_run_id: RunSummary.requested_run_id.
   /// claim_error: RunBagBatch::claim_error.
-  void run(collision_lab::InitialConditions& input, const std::string& requested_run_id,
-           const std::string& claim_error, Reply reply);
+  /// Runs the input's plan (core::planScene, made once when the input was checked).
+  void run(collision_lab::InitialConditions& input, const collision_lab::core::ScenePlan& plan,
+           const std::string& requested_run_id, const std::string& claim_error, Reply reply);
   /// runScene, as the run that ~cancel stops.
   collision_lab::core::SceneRunResult runCancellable(const std::string& run_id,
-                                                     const collision_lab::core::Scene& scene,
+                                                     const collision_lab::core::ScenePlan& plan,
                                                      const collision_lab::core::SceneRunOptions& options,
                                                      const collision_lab::core::SceneVisitors& visitors);
   /// Records the input (stamped at the run's start) and publishes the prediction.
   void publishStart(RunWriter& out, const collision_lab::InitialConditions& input,
-                    const ScenePrediction& prediction);
+                    const collision_lab::core::ScenePlan& plan);
   /// Stamps the summary and finishes the run: at once when not recording, else on the
   /// bag writer's thread once the bag is closed.
   void publishEnd(RunWriter& out, collision_lab::RunSummary& summary, double last_event_time, Reply reply);

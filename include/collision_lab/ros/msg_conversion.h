@@ -45,7 +45,7 @@ const char* nodeReasonName(NodeReason reason);
 std::array<double, 3> toArray(const std::vector<double>& values);
 std::vector<double> toVector(const std::array<double, 3>& values);
 
-/// Any N, the lists (restitution included) exactly as given: core::validateForRun judges them.
+/// Any N, the lists (restitution included) exactly as given: core::planScene judges them.
 collision_lab::core::Scene toScene(const collision_lab::InitialConditions& msg);
 /// mode and max_collisions as given; header and run_id left for the caller.
 collision_lab::InitialConditions toInitialConditions(const collision_lab::core::Scene& scene,
@@ -67,19 +67,9 @@ std::optional<collision_lab::core::Pair> toPair(std::uint32_t code);
 /// (the node passes chooseModel's, as the CLI prints it).
 collision_lab::core::ModelChoice threeBodyRotationModel();
 
-/// What is known of a scene before its run: the model and the closed form of its path.
-struct ScenePrediction {
-  collision_lab::core::ModelChoice model;
-  std::size_t body_count = 0;
-  std::optional<collision_lab::core::AnalyticPrediction> three_body;  ///< the three-body path
-  std::optional<collision_lab::core::Prediction> nbody;               ///< the N-body models' closed form
-  /// three_body_spiral: the opening angle of the three masses [rad]; NaN otherwise.
-  double spiral_alpha = std::numeric_limits<double>::quiet_NaN();
-};
-/// The predictions runScene makes for a scene. Precondition: validateForRun(scene) passed.
-ScenePrediction predictScene(const collision_lab::core::Scene& scene);
-
-collision_lab::Prediction toPredictionMsg(const ScenePrediction& prediction);
+/// The plan's model and prediction (core::planScene), as published before the run.
+/// Precondition: !plan.error.
+collision_lab::Prediction toPredictionMsg(const collision_lab::core::ScenePlan& plan);
 /// Three elastic bodies (the three-body path).
 collision_lab::Prediction toPredictionMsg(const collision_lab::core::AnalyticPrediction& prediction,
                                           const collision_lab::core::ModelChoice& model = threeBodyRotationModel());

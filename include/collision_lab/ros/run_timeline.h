@@ -17,7 +17,7 @@ namespace collision_lab_ros {
 
 /// Time of the scene's first contact [s]: the least gap / closing speed over the pairs that
 /// approach (inf when the quotient overflows); empty when none approaches.
-/// Precondition: validateForRun(scene) passed.
+/// Precondition: the scene is valid (core::planScene gave no error).
 std::optional<double> firstContactTime(const collision_lab::core::Scene& scene);
 
 /// [bag s per simulated s]: 1 when first_contact is empty or within [1e-3, 1e3] s,

@@ -67,7 +67,7 @@ struct ValidationError {
 };
 
 /// Checks a scene: the one validation of every N and every restitution (the front ends call
-/// it through validateForRun). Returns nothing when the scene is valid. Never throws for any
+/// it through planScene, scene_run.h). Returns nothing when the scene is valid. Never throws for any
 /// input (short of running out of memory). The first contact (its multiple-collision test,
 /// its time and the positions then, which must be doubles) is decided exactly for the given
 /// doubles. Two walls with bodies between them are valid. Three elastic bodies (the rotation
