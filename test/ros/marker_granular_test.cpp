@@ -96,10 +96,11 @@ double temperatureOf(const Scene& scene, const std::vector<double>& v) {
   return sum / n;
 }
 
-/// "1e-2" -> -2.
+/// "0.01" -> -2: a decade's label.
 double exponentOf(const std::string& label) {
-  EXPECT_EQ(label.rfind("1e", 0), 0u) << label;
-  return std::stod(label.substr(2));
+  const double exponent = std::log10(std::stod(label));
+  EXPECT_NEAR(exponent, std::round(exponent), 1e-12) << label;
+  return exponent;
 }
 
 void expectFit(const RunRecord& run) {
@@ -209,10 +210,10 @@ TEST(MarkerGranular, ClustersAreDrawnJoined) {
   };
   EXPECT_EQ(label(2.0), "");
   EXPECT_EQ(rings(2.0), 0u);
-  EXPECT_EQ(label(5.0), "A..C: 3 as one");
+  EXPECT_EQ(label(5.0), "moving as one (amber rings): A..C (3)");
   EXPECT_EQ(rings(5.0), 2u * layout::kClusterRingSegments);
   const double end = endTime(r.record);
-  EXPECT_EQ(label(end), "A..E: 5 as one");
+  EXPECT_EQ(label(end), "moving as one (amber rings): A..E (5)");
   EXPECT_EQ(rings(end), 2u * layout::kClusterRingSegments);
   // The x-t diagram: the cluster's worldline starts at the first collapse, t = 3.5 s (time up,
   // from 0 at the box's bottom to the end time at its top).

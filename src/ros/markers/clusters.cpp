@@ -1,7 +1,7 @@
 // Clusters: neighbours moving together (stuck by e = 0, or one after an inelastic collapse;
 // the cluster rule, core/nbody/engine.h). The messages put a cluster's bodies at one point
 // with one velocity, so equal positions and velocities (exactly) are what joins them. Drawn
-// joined in the scene (a ring around the bodies with their names) and as one thick amber
+// joined in the scene (an amber ring around the bodies; their names in the note row) and as one thick amber
 // worldline in the x-t diagram (worldlines.cpp).
 #include <algorithm>
 #include <cmath>
@@ -41,30 +41,31 @@ void drawClusters(const Canvas& c, const SceneState& state) {
   const double radius = (largeScene(c.run) ? kManyBodySize + kManyBodyGrowth * (kMassClasses - 1)
                                            : kSmallestBody + kBodyGrowth) / 2 + kClusterRingMargin;
   Marker rings = c.lines(ns::kClusters, kClusterRings, Marker::LINE_LIST, kClusterRingWidth, color(kClusterAmber));
+  std::string names;
   for (std::size_t k = 0; k < clusters.size(); ++k) {
-    const double x = axis.toX(state.positions[clusters[k].first]);
+    const auto [first, last] = clusters[k];
+    const double x = axis.toX(state.positions[first]);
     for (int s = 0; s < kClusterRingSegments; ++s) {
       for (int end : {s, s + 1}) {
         const double angle = 2 * M_PI * end / kClusterRingSegments;
         rings.points.push_back(point(x + radius * std::cos(angle), kSceneY + radius * std::sin(angle), kDotZ));
       }
     }
-    if (k < kMaxClusterLabels) {
-      const auto [first, last] = clusters[k];
-      c.add(c.text(ns::kClusters, kClusterLabel + static_cast<int>(k), x, kSceneY + kClusterLabelDy,
-                   bodyName(first) + (last == first + 1 ? "+" : "..") + bodyName(last) +
-                       format(": %.0f as one", static_cast<double>(last - first + 1)),
-                   kSmallTextSize, color(kClusterAmber)));
+    if (k < kMaxClusterNames) {
+      names += (k ? ", " : "") + bodyName(first) + (last == first + 1 ? "+" : "..") + bodyName(last) +
+               format(" (%.0f)", static_cast<double>(last - first + 1));
     }
   }
+  if (clusters.size() > kMaxClusterNames) names += format(" and %.0f more", static_cast<double>(clusters.size() - kMaxClusterNames));
   if (clusters.empty()) {
     c.add(deleteMarker(ns::kClusters, kClusterRings, c.frame_id));
-  } else {
-    c.addLines(rings);
+    c.add(deleteMarker(ns::kClusters, kClusterLabel, c.frame_id));
+    return;
   }
-  for (std::size_t k = clusters.size(); k < kMaxClusterLabels; ++k) {
-    c.add(deleteMarker(ns::kClusters, kClusterLabel + static_cast<int>(k), c.frame_id));
-  }
+  c.addLines(rings);
+  // In the note row's right part: the bodies' own tags crowd around the ring.
+  c.add(c.text(ns::kClusters, kClusterLabel, kClusterNamesX, kNoteY, "moving as one (amber rings): " + names,
+               kSmallTextSize, color(kClusterAmber)));
 }
 
 }  // namespace collision_lab_ros::markers

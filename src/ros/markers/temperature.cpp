@@ -61,7 +61,8 @@ LogAxes logAxes(const std::vector<collision_lab::core::TemperatureSample>& sampl
   return out;
 }
 
-std::string decade(double exponent) { return format("1e%.0f", exponent); }
+/// 10^exponent as "0.01", "1", "1e+05".
+std::string decade(double exponent) { return format("%g", std::pow(10.0, exponent)); }
 
 }  // namespace
 
@@ -110,7 +111,7 @@ void drawTemperature(const Canvas& c) {
   c.addLines(series);
 
   const collision_lab::core::HaffFit fit = collision_lab::core::fitHaff(samples);
-  std::string legend = "white: T = sum m (v - V)^2 / N;  cyan: Haff's law\nT0/(1 + t/tau)^2 fitted: ";
+  std::string legend = "white: T = sum m (v - V)^2 / N\ncyan: Haff's law T0/(1 + t/tau)^2 fitted on ln T:\n";
   if (fit.ok && std::isfinite(fit.tau)) {
     Marker haff = c.lines(ns::kTemperature, kTemperatureHaff, Marker::LINE_STRIP, kSeriesWidth, color(kHaffCyan));
     for (int k = 0; k <= kHaffSegments; ++k) {
@@ -131,9 +132,9 @@ void drawTemperatureNow(const Canvas& c, const SceneState& state) {
   if (!temperatureView(c.run)) return;
   const std::vector<double> masses = massesOf(c.run);
   const double now = collision_lab::core::granularTemperature(masses, state.velocities);
-  c.add(c.text(ns::kTemperatureNow, kTemperatureNowText, kBarsBox.midX(), kTemperatureNowY,
-               format("now: T = %.3g J", now) + format(",  E = %.4g J", kineticEnergy(c.run.input(), state.velocities)) +
-                   format(" (start %.4g J)", kineticEnergy(c.run.input(), c.run.input().velocities)),
+  c.add(c.text(ns::kTemperatureNow, kTemperatureNowText, kTemperatureBox.midX(), kTemperatureNowY,
+               format("now: T = %.3g J,  E = ", now) + format("%.3g J", kineticEnergy(c.run.input(), state.velocities)) +
+                   format(" of %.3g J", kineticEnergy(c.run.input(), c.run.input().velocities)),
                kSmallTextSize));
   const LogAxes log = logAxes(temperatureSamples(c.run));
   if (!(log.ok && state.time > 0 && now > 0)) {

@@ -185,7 +185,7 @@ enum MarkerId : int {
   // ns "clusters" (animated)
   kClusterRings = 0,   ///< a ring around each cluster in the scene
   kClusterLines = 1,   ///< the clusters' joined worldlines in the x-t diagram
-  kClusterLabel = 10,  ///< + the cluster's number (at most kMaxClusterLabels)
+  kClusterLabel = 2,   ///< the clusters' names
 
   // ns "rejected" and "hint": a framed text
   kFramedText = 0,

@@ -186,8 +186,8 @@ constexpr double kBarWidth = 0.6;  ///< share of the pitch
 constexpr double kBarMinHeight = 0.01, kBarDepth = 0.1, kBarValueDy = 0.25, kBarValueStagger = 0.32;
 
 // ---- large inelastic scenes: T(t) on log-log axes, in the energy bars' place ----
-constexpr Box kTemperatureBox{-9.4, -5.4, -5.75, -3.15};
-constexpr double kTemperatureLegendY = -2.6;  ///< under the title (two lines)
+constexpr Box kTemperatureBox{-9.4, -5.4, -5.75, -3.45};
+constexpr double kTemperatureLegendY = -2.75;  ///< under the title (three lines)
 constexpr double kTemperatureNowY = -6.45;    ///< T and E now, under the time axis' labels
 constexpr double kTickLength = 0.1;
 constexpr int kHaffSegments = 64;
@@ -197,8 +197,8 @@ constexpr Rgba kHaffCyan{0.3, 0.85, 1.0};
 constexpr Rgba kClusterAmber{1.0, 0.75, 0.2, 0.9};
 constexpr double kClusterRingWidth = 0.05, kClusterRingMargin = 0.12;  ///< beyond the largest body's radius
 constexpr int kClusterRingSegments = 24;
-constexpr double kClusterLabelDy = 0.75;
-constexpr std::size_t kMaxClusterLabels = 8;
+constexpr double kClusterNamesX = 11.0;  ///< centre of the clusters' names, in the note row
+constexpr std::size_t kMaxClusterNames = 3;
 constexpr double kClusterLineWidth = 0.09;  ///< a cluster's worldline, under the bodies'
 constexpr std::size_t kMaxClusterSegments = 4000;
 
