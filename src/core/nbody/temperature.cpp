@@ -29,15 +29,12 @@ double granularTemperature(const std::vector<double>& masses, const std::vector<
 }
 
 TemperatureSampler::TemperatureSampler(const Scene& scene, std::uint64_t every, Sink sink)
-    : masses_(scene.masses), velocities_(scene.velocities), every_(std::max<std::uint64_t>(every, 1)),
-      sink_(std::move(sink)) {
+    : state_(scene), every_(std::max<std::uint64_t>(every, 1)), sink_(std::move(sink)) {
   send(0, 0.0);
 }
 
 void TemperatureSampler::onImpact(const ImpactRecord& impact) {
-  const std::size_t p = impact.pair_index;
-  for (std::size_t i = impact.first_moved; i <= p; ++i) velocities_[i] = impact.velocities_after[0];
-  for (std::size_t i = p + 1; i <= impact.last_moved; ++i) velocities_[i] = impact.velocities_after[1];
+  state_.apply(impact);
   impacts_ = impact.index;
   time_ = impact.time;
   newest_sent_ = false;
@@ -45,7 +42,7 @@ void TemperatureSampler::onImpact(const ImpactRecord& impact) {
 }
 
 void TemperatureSampler::onCollapse(const Collapse& collapse) {
-  for (std::size_t i = collapse.first_body; i <= collapse.last_body; ++i) velocities_[i] = collapse.velocity;
+  state_.apply(collapse);
   impacts_ = collapse.impacts_before;
   time_ = collapse.time;
   send(impacts_, time_);
@@ -57,7 +54,7 @@ void TemperatureSampler::finish() {
 
 void TemperatureSampler::send(std::uint64_t impacts, double time) {
   newest_sent_ = true;
-  if (sink_) sink_(TemperatureSample{impacts, time, granularTemperature(masses_, velocities_)});
+  if (sink_) sink_(TemperatureSample{impacts, time, granularTemperature(state_.masses(), state_.velocities())});
 }
 
 std::uint64_t temperatureStride(std::size_t bodies) { return std::max<std::uint64_t>(1, bodies / 8); }

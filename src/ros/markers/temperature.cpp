@@ -132,9 +132,13 @@ void drawTemperatureNow(const Canvas& c, const SceneState& state) {
   if (!temperatureView(c.run)) return;
   const std::vector<double> masses = massesOf(c.run);
   const double now = collision_lab::core::granularTemperature(masses, state.velocities);
+  double energy = 0.0;  // [J] of the finite masses shown
+  for (std::size_t i = 0; i < masses.size() && i < state.velocities.size(); ++i) {
+    energy += collision_lab::core::kineticEnergy(masses[i], state.velocities[i]);
+  }
   c.add(c.text(ns::kTemperatureNow, kTemperatureNowText, kTemperatureBox.midX(), kTemperatureNowY,
-               format("now: T = %.3g J,  E = ", now) + format("%.3g J", kineticEnergy(c.run.input(), state.velocities)) +
-                   format(" of %.3g J", kineticEnergy(c.run.input(), c.run.input().velocities)),
+               format("now: T = %.3g J,  E = ", now) + format("%.3g J", energy) +
+                   format(" of %.3g J", c.run.startEnergy()),
                kSmallTextSize));
   const LogAxes log = logAxes(temperatureSamples(c.run));
   if (!(log.ok && state.time > 0 && now > 0)) {

@@ -38,6 +38,7 @@ class BodyStateReplay {
 
   std::size_t size() const { return velocities_.size(); }
   double mass(std::size_t body) const { return masses_[body]; }
+  const std::vector<double>& masses() const { return masses_; }
   bool isWall(std::size_t body) const;
   const std::vector<double>& velocities() const { return velocities_; }
   /// Position of body at time t [s] (not before its last move) [m]: its last point plus

@@ -18,6 +18,7 @@
 #include <optional>
 #include <vector>
 
+#include "collision_lab/core/nbody/body_state_replay.h"
 #include "collision_lab/core/nbody/engine.h"
 #include "collision_lab/core/nbody/scene.h"
 
@@ -35,8 +36,8 @@ struct TemperatureSample {
   double temperature = 0.0;   ///< [J]
 };
 
-/// Samples T(t) of a run from the engine's ImpactRecords and collapse notices (their replay
-/// contract, engine.h, rebuilds every velocity from the scene's). Feed it every impact and
+/// Samples T(t) of a run from the engine's ImpactRecords and collapse notices (replayed by
+/// BodyStateReplay). Feed it every impact and
 /// every collapse in the engine's order. O(N) memory; each sample costs O(N), each impact
 /// O(the bodies it moved).
 class TemperatureSampler {
@@ -54,13 +55,12 @@ class TemperatureSampler {
   void finish();
 
   /// Every body's velocity after the impacts fed so far [m/s].
-  const std::vector<double>& velocities() const { return velocities_; }
+  const std::vector<double>& velocities() const { return state_.velocities(); }
 
  private:
   void send(std::uint64_t impacts, double time);
 
-  std::vector<double> masses_;
-  std::vector<double> velocities_;
+  BodyStateReplay state_;  ///< the one replay of the records (body_state_replay.h)
   std::uint64_t every_;
   Sink sink_;
   std::uint64_t impacts_ = 0;
