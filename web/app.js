@@ -121,7 +121,7 @@ async function startPage() {
     tr.appendChild(td);
     tbody.appendChild(tr);
   }
-  const pi = presets.find((p) => p.name === 'pi_digits_3');
+  const pi = presets.find((p) => p.name === 'pi_digits_2');  // 31 impacts: the first two digits of pi
   loadPreset(pi || presets[0]);
   document.body.dataset.ready = 'true';
 }

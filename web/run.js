@@ -73,8 +73,10 @@ function drawScene(scene) {
     if (n <= 10) {
       g.fillStyle = '#222';
       g.font = '11px sans-serif';
-      g.fillText((m === 'inf' ? 'wall' : fmt(m, 3) + ' kg') + ', ' + fmt(scene.velocities[i], 3) + ' m/s', cx - 30, y0 + 18);
-      g.fillText(fmt(x[i], 4) + ' m', cx - 15, y0 + 31);
+      const label = (m === 'inf' ? 'wall' : fmt(m, 3) + ' kg') + ', ' + fmt(scene.velocities[i], 3) + ' m/s';
+      const at = (text) => Math.max(2, Math.min(canvas.width - g.measureText(text).width - 2, cx - g.measureText(text).width / 2));
+      g.fillText(label, at(label), y0 + 18);
+      g.fillText(fmt(x[i], 4) + ' m', at(fmt(x[i], 4) + ' m'), y0 + 31);
     }
   }
 }
