@@ -1,5 +1,8 @@
 #include "collision_lab/web/web_server.h"
 
+#include <netinet/in.h>
+#include <sys/socket.h>
+
 #include <cmath>
 #include <fstream>
 #include <limits>
@@ -94,6 +97,24 @@ std::string contentType(const std::string& path) {
   return "text/html; charset=utf-8";
 }
 
+/// Debian's cpp-httplib 0.11 is built with a listen backlog of 5: thirty students
+/// connecting at once overflow it, and some connections are dropped or reset. listen()
+/// again on the bound socket (found by its port) sets a backlog of SOMAXCONN.
+void widenBacklog(int port) {
+  for (int fd = 0; fd < 1024; ++fd) {
+    sockaddr_storage address{};
+    socklen_t length = sizeof address;
+    int listening = 0;
+    socklen_t flag_length = sizeof listening;
+    if (getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length) != 0) continue;
+    if (getsockopt(fd, SOL_SOCKET, SO_ACCEPTCONN, &listening, &flag_length) != 0 || !listening) continue;
+    int bound = -1;
+    if (address.ss_family == AF_INET) bound = ntohs(reinterpret_cast<sockaddr_in*>(&address)->sin_port);
+    if (address.ss_family == AF_INET6) bound = ntohs(reinterpret_cast<sockaddr_in6*>(&address)->sin6_port);
+    if (bound == port) ::listen(fd, SOMAXCONN);
+  }
+}
+
 }  // namespace
 
 WebServer::WebServer(RunBook& book, WebConfig config, Publish publish)
@@ -117,6 +138,7 @@ void WebServer::start() {
   if (port_ <= 0 || (config_.port != 0 && !server_->bind_to_port(config_.bind, config_.port))) {
     throw std::runtime_error("cannot listen on " + config_.bind + ":" + std::to_string(config_.port));
   }
+  widenBacklog(port_);
   thread_ = std::thread([this] { server_->listen_after_bind(); });
 }
 
