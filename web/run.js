@@ -110,7 +110,8 @@ function summaryRows(run) {
   const count = s ? s.collision_count : run.collisions;
   rows.push(['collisions', count, p ? (p.infinite_collisions ? 'infinitely many' : p.collision_count) : null,
     p ? p.paper_collision_count : null]);
-  rows.push(['heat [J]', s ? s.energy_lost : null, p ? p.energy_lost : null, null]);
+  const heat = run.plots.heat;  // while running: the heat so far
+  rows.push(['heat [J]', s ? s.energy_lost : (heat.length ? heat[heat.length - 1][1] : null), p ? p.energy_lost : null, null]);
   const n = run.scene.masses.length;
   if (n <= 10) {
     const paperFinal = run.plots.paper_final_velocities || [];
