@@ -9,3 +9,6 @@ add_rostest_gtest(web_browser_test test/ros/web_browser_test.test test/ros/web_b
 target_link_libraries(web_browser_test collision_lab_web_lib ${catkin_LIBRARIES})
 add_dependencies(web_browser_test collision_lab_node collision_lab_web)
 target_compile_definitions(web_browser_test PRIVATE COLLISION_LAB_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+# RunBook with the lab's topics out of order (no master).
+catkin_add_gtest(run_book_test test/ros/run_book_test.cpp)
+target_link_libraries(run_book_test collision_lab_web_lib ${catkin_LIBRARIES} GTest::gtest_main)

@@ -247,6 +247,16 @@ void RunBook::maybeFinishLocked(WebRun& run) {
   const collision_lab::RunSummary& summary = *run.pending_summary;
   if (run.record && run.events_received < summary.published_events) return;  // still on their way
   const bool recorded = summary.recording_ok && !summary.bag_path.empty();
+  // No served input yet: the topics are separate connections, so the summary may come
+  // first. The bag has the whole run. Without a bag, wait for the served input of a run
+  // seen accepted (it was published before the summary); a run joined midway ends with
+  // its summary alone.
+  if (!run.record && recorded) {
+    run.rebuilding = true;
+    rebuilds_.emplace_back(&RunBook::rebuildFromBag, this, run.run_id, summary.bag_path);
+    return;
+  }
+  if (!run.record && run.accepted_stamp > 0.0) return;
   if (recorded && run.record && summary.events_not_published) {
     // The bag holds every event; the topics stopped at ~max_published_events.
     run.rebuilding = true;

@@ -95,13 +95,13 @@ TEST_F(WebTest, BrowserRunIsServedRecordedAndListed) {
   const std::string run_id = json::parse(res->body)["run_id"];
   EXPECT_EQ(run_id.rfind("ana.", 0), 0u) << "a student's run is served as <student>.<run_id>";
   const json run = finishedRun(run_id);
-  EXPECT_EQ(run["summary"]["collision_count"], 31);
-  EXPECT_EQ(run["prediction"]["collision_count"], 31);
-  EXPECT_EQ(run["student"], "ana");
-  ASSERT_EQ(run["plots"]["velocity"].size(), 3u);
+  EXPECT_EQ(run.at("summary").at("collision_count"), 31);
+  EXPECT_EQ(run.at("prediction").at("collision_count"), 31);
+  EXPECT_EQ(run.at("student"), "ana");
+  ASSERT_EQ(run.at("plots").at("velocity").size(), 3u);
   // The final velocity of the light ball (body 1) in the plot is the summary's.
-  EXPECT_NEAR(run["plots"]["velocity"][1]["points"].back()[1].get<double>(),
-              run["summary"]["final_velocities"][1].get<double>(), 1e-5);
+  EXPECT_NEAR(run.at("plots").at("velocity")[1].at("points").back()[1].get<double>(),
+              run.at("summary").at("final_velocities")[1].get<double>(), 1e-5);
 
   auto c = client();
   auto csv = c.Get(("/api/runs/" + run_id + "/events.csv").c_str());
@@ -118,7 +118,7 @@ TEST_F(WebTest, BrowserRunIsServedRecordedAndListed) {
   ASSERT_TRUE(list);
   const json runs = json::parse(list->body);
   ASSERT_EQ(runs.size(), 1u);
-  EXPECT_EQ(runs[0]["run_id"], run_id);
+  EXPECT_EQ(runs[0].at("run_id"), run_id);
 
   auto page = c.Get(("/runs/" + run_id).c_str());
   ASSERT_TRUE(page);
@@ -143,7 +143,7 @@ TEST_F(WebTest, LiveStreamEndsWithTheFinalRun) {
   ASSERT_NE(final_at, std::string::npos) << received.substr(0, 200);
   const auto data = received.substr(final_at + 19);
   const json run = json::parse(data.substr(0, data.find('\n')));
-  EXPECT_EQ(run["summary"]["collision_count"], 31);
+  EXPECT_EQ(run.at("summary").at("collision_count"), 31);
 }
 
 TEST_F(WebTest, RunBeyondThePublishedEventsIsRebuiltFromItsBag) {
@@ -151,11 +151,11 @@ TEST_F(WebTest, RunBeyondThePublishedEventsIsRebuiltFromItsBag) {
   ASSERT_TRUE(res);
   ASSERT_EQ(res->status, 201) << res->body;
   const json run = finishedRun(json::parse(res->body)["run_id"]);
-  EXPECT_EQ(run["summary"]["published_events"], 100) << "the lab node's max_published_events";
-  EXPECT_EQ(run["collisions"], 314) << "every impact, from the bag";
+  EXPECT_EQ(run.at("summary").at("published_events"), 100) << "the lab node's max_published_events";
+  EXPECT_EQ(run.at("collisions"), 314) << "every impact, from the bag";
   EXPECT_FALSE(run.contains("bag_error"));
   // Light: at most the envelope's points per series whatever the count.
-  for (const auto& series : run["plots"]["velocity"]) EXPECT_LE(series["points"].size(), 1024u);
+  for (const auto& series : run.at("plots").at("velocity")) EXPECT_LE(series.at("points").size(), 1024u);
 }
 
 TEST_F(WebTest, RejectionCarriesReasonAndField) {
@@ -165,8 +165,8 @@ TEST_F(WebTest, RejectionCarriesReasonAndField) {
   ASSERT_TRUE(res);
   EXPECT_EQ(res->status, 422);
   const json body = json::parse(res->body);
-  EXPECT_EQ(body["rejected"]["reason_name"], "POSITIONS_NOT_ORDERED");
-  EXPECT_EQ(body["rejected"]["field"].get<std::string>().rfind("positions", 0), 0u);
+  EXPECT_EQ(body.at("rejected").at("reason_name"), "POSITIONS_NOT_ORDERED");
+  EXPECT_EQ(body.at("rejected").at("field").get<std::string>().rfind("positions", 0), 0u);
 
   scene = piScene("dora");
   scene["velocities"] = {-1, "fast", 0};
@@ -217,8 +217,8 @@ TEST_F(WebTest, TooManyBodiesIs422) {
   ASSERT_TRUE(res);
   EXPECT_EQ(res->status, 422);
   const json body = json::parse(res->body);
-  EXPECT_EQ(body["rejected"]["reason_name"], "TOO_MANY_BODIES");
-  EXPECT_EQ(body["rejected"]["field"], "masses");
+  EXPECT_EQ(body.at("rejected").at("reason_name"), "TOO_MANY_BODIES");
+  EXPECT_EQ(body.at("rejected").at("field"), "masses");
 }
 
 TEST_F(WebTest, RunsPerStudentPerMinuteIs429ForThatStudentOnly) {
@@ -347,7 +347,7 @@ TEST_F(WebTest, RunSentOverRosIsShownToo) {
         return runs.size() == 1 && runs[0]["state"] == "finished";
       },
       "the ROS run to be listed"));
-  EXPECT_EQ(runs[0]["collisions"], 31);
+  EXPECT_EQ(runs[0].at("collisions"), 31);
 }
 
 }  // namespace
