@@ -5,7 +5,8 @@
 #   docs/hard_cases.md                    collision_lab_hard_cases
 #   docs/restitution_count.{csv,png}      collision_lab_bench_restitution, bench/plot_restitution_count.py
 #   docs/benchmark_goals.md               every "goal:" line of this run, as a table
-# and prints the core and N-body speed tables (collision_lab_bench_core, collision_lab_bench_nbody)
+# and prints the core and N-body speed tables (collision_lab_bench_core, collision_lab_bench_nbody),
+# the granular gases' worst case (collision_lab_bench_gas)
 # the CLI's output speed against dd (bench/bench_output.sh), and the node against a relay that
 # publishes the same messages and against rosbag record (bench/node/*.launch).
 #
@@ -32,7 +33,7 @@ export COLLISION_LAB_BENCH_SOURCE
 
 cmake -S "$repo" -B "$build" -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build "$build" -j2 --target collision_lab_bench_core collision_lab_bench_nbody collision_lab_speed_vs_error \
-  collision_lab_hard_cases collision_lab_bench_restitution collision_lab_cli collision_lab_node collision_lab_relay_node \
+  collision_lab_hard_cases collision_lab_bench_restitution collision_lab_bench_gas collision_lab_cli collision_lab_node collision_lab_relay_node \
   collision_lab_node_throughput collision_lab_recording_bench
 bin="$build/devel/lib/collision_lab"
 
@@ -59,6 +60,7 @@ step "restitution: impacts against e" "$bin/collision_lab_bench_restitution" "${
 python3 "$repo/bench/plot_restitution_count.py" --csv "$out/restitution_count.csv" --out "$out/restitution_count.png"
 step "core speed" "$bin/collision_lab_bench_core" $quick
 step "N-body engine speed and memory" "$bin/collision_lab_bench_nbody" $quick
+step "granular gases: worst case, impacts, time and stop reason" "$bin/collision_lab_bench_gas" $quick
 step "CSV and JSON output against dd" env BUILD_DIR="$build" bash "$repo/bench/bench_output.sh" $quick
 
 # The node against its anchors: a master of its own on a free port, bags in a temporary

@@ -2,6 +2,7 @@
 #   collision_lab_bench_core      ns per collision of the core vs a lean double loop (issue 2)
 #   collision_lab_bench_nbody     ns per impact of the N-body engine vs a lean heap loop, memory (issue 10)
 #   collision_lab_bench_restitution  count against e across r_c, three equal masses (issue 11)
+#   collision_lab_bench_gas       worst case of seeded granular gases, N = 10 to 1000, e = 0.1 to 0.99 (issue 21)
 #   collision_lab_speed_vs_error  speed against error vs fixed stepping and real engines (issue 4)
 #   collision_lab_hard_cases      adaptive precision on the hard cases of physics.md (issue 4)
 #   collision_lab_node_throughput, collision_lab_relay_node   the whole node over loopback
@@ -33,8 +34,11 @@ target_compile_definitions(collision_lab_bench_nbody PRIVATE COLLISION_LAB_CONFI
 add_executable(collision_lab_bench_restitution bench/bench_restitution.cpp)
 target_link_libraries(collision_lab_bench_restitution PRIVATE collision_lab_core)
 target_compile_definitions(collision_lab_bench_restitution PRIVATE COLLISION_LAB_DOCS_DIR="${PROJECT_SOURCE_DIR}/docs")
+add_executable(collision_lab_bench_gas bench/bench_gas.cpp)
+target_include_directories(collision_lab_bench_gas PRIVATE test/core/nbody)  # the tests' seeded gas, one home
+target_link_libraries(collision_lab_bench_gas PRIVATE collision_lab_core)
 # Installed too, so that an install space can be benchmarked with rosrun.
-install(TARGETS collision_lab_bench_core collision_lab_bench_nbody collision_lab_bench_restitution
+install(TARGETS collision_lab_bench_core collision_lab_bench_nbody collision_lab_bench_restitution collision_lab_bench_gas
   RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 
 if(TARGET collision_lab_ros)

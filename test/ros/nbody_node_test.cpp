@@ -25,6 +25,7 @@
 #include "collision_lab/Cancel.h"
 #include "collision_lab/RunPreset.h"
 #include "collision_lab/RunScene.h"
+#include "granular_gas.h"
 #include "reference.h"
 #include "run_collector.h"
 
@@ -535,6 +536,31 @@ TEST(NBodyNode, CancelStopsARunThatWouldNeverEndAndItsBagIsComplete) {
 
   // Nothing lost: the input sent during the run is served after it.
   EXPECT_EQ(g_to_cap->waitFor("after_endless").summaries.size(), 1u);
+}
+
+// ---- Issue 21: a gas whose impacts crowd ends, or is cancelled, and the queue goes on ----
+
+TEST(NBodyNode, ACrowdingGasEndsOrIsCancelledAndTheSceneQueuedAfterItIsAnswered) {
+  // The seeded 100-body gas at e = 0.5 needs exact decisions after about 4,000 impacts (it
+  // gave no answer before the exactness budget); a pi scene waits behind it.
+  const collision_lab::core::Scene gas = collision_lab::core::testing_support::granularGas(100, 0.5, 1);
+  g_node->publish(scene("gas_e05", gas.masses, gas.positions, gas.velocities, gas.restitution));
+  g_node->publish(scene("pi_after_gas", {1e4, 1, kInf}, {2, 1, 0}, {-1, 0, 0}));
+  ASSERT_TRUE(waitUntil([] { return g_node->runs().count("gas_e05") && !g_node->runs().at("gas_e05").events.empty(); },
+                        "the gas's first impacts"));
+  collision_lab::Cancel cancel;
+  cancel.request.run_id = "gas_e05";
+  ASSERT_TRUE(callService("/collision_lab/collision_lab_node/cancel", cancel));
+  const RunOutputs& out = g_node->waitFor("gas_e05");
+  ASSERT_EQ(out.summaries.size(), 1u);
+  const auto& s = out.summaries.front();
+  EXPECT_TRUE(s.truncated);
+  // The run either saw ~cancel or had already stopped at its exactness budget.
+  EXPECT_EQ(s.stop_reason, cancel.response.ok ? "CANCELLED" : "PRECISION_BUDGET") << cancel.response.message;
+  // m_A/m_B = 1e4 against a wall: floor(pi * 100) = 314 collisions (Galperin).
+  const RunOutputs& pi = g_node->waitFor("pi_after_gas");
+  ASSERT_EQ(pi.summaries.size(), 1u);
+  EXPECT_EQ(pi.summaries.front().collision_count, 314u);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 #include "collision_lab/core/nbody/engine.h"
 
 #include <algorithm>
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <limits>
@@ -40,20 +41,52 @@ struct NextTier<Float100> {
   using type = Rational;
 };
 
+/// Where the exact tier stands: its impacts and the bits of its last impact's numbers.
+struct ExactProgress {
+  std::uint64_t count = 0;
+  unsigned bits = 0;
+};
+
 /// Owns the tiers: the double-double one always, the others from their first use on. A
 /// higher tier keeps its state between escalations, so each replays every impact at most
 /// once over the whole run.
 class Driver {
  public:
-  explicit Driver(const Scene& scene) : tables_(scene) {}
+  /// `cancel` (may be null) is read before every step of the exact tier, whose replays can be long.
+  Driver(const Scene& scene, const std::atomic<bool>* cancel) : tables_(scene), cancel_(cancel) {}
 
   StepResult start() { return startOrEscalate<DD>(); }
   StepResult step(ImpactRecord* record) {
     const std::uint64_t exact = escalations_.exact_rational;
+    const std::uint64_t escalated = exact + escalations_.high_precision;
     const StepResult r = stepOrEscalate<DD>(record);
     exact_streak_ = escalations_.exact_rational > exact ? exact_streak_ + 1 : 0;
+    if (r.kind == StepKind::kImpact && escalations_.exact_rational + escalations_.high_precision > escalated) {
+      crowd_[crowd_next_++ % crowd_.size()] = r.pair;
+    }
     return r;
   }
+
+  /// The bodies of the last kCrowdWindow impacts that needed more than double-double, and of
+  /// the decision that could not be taken (after kOverBudget), ascending.
+  std::vector<std::size_t> crowdingBodies() const {
+    std::vector<std::size_t> bodies;
+    const std::size_t recorded = std::min<std::size_t>(crowd_next_, crowd_.size());
+    for (std::size_t k = 0; k <= recorded; ++k) {
+      const std::size_t pair = k < recorded ? crowd_[k] : undecided_pair_;
+      if (pair == kNone) continue;
+      bodies.push_back(pair);
+      bodies.push_back(pair + 1);
+    }
+    std::sort(bodies.begin(), bodies.end());
+    bodies.erase(std::unique(bodies.begin(), bodies.end()), bodies.end());
+    return bodies;
+  }
+  /// Where the exact tier stands (zeros when it never ran).
+  ExactProgress exactProgress() const {
+    return exact_ ? ExactProgress{exact_->count(), exact_->exactBits()} : ExactProgress{};
+  }
+  static constexpr std::size_t kCrowdWindow = 32;
 
   const Tier<DD>& fast() const { return *fast_; }
 
@@ -111,12 +144,16 @@ class Driver {
     Tier<S>& t = *tier<S>();
     const std::uint64_t count = t.count();
     if (exact_streak_ >= kExactStreak && t.oversized()) return {StepKind::kExhausted, 0, t.lastTime()};
+    if constexpr (Arithmetic<S>::kExact) {
+      if (cancel_ && cancel_->load(std::memory_order_relaxed)) return {StepKind::kCancelled, 0, t.lastTime()};
+    }
     StepResult r = t.step(record);
     if constexpr (Arithmetic<S>::kExact) {
       if (r.kind == StepKind::kAmbiguous || r.kind == StepKind::kImprecise) r.kind = StepKind::kInconsistent;  // cannot happen
       return r;
     } else {
       if (r.kind != StepKind::kAmbiguous && r.kind != StepKind::kImprecise) return r;
+      if constexpr (std::is_same_v<S, DD>) undecided_pair_ = r.pair;
       // A value exactly 0 in double-double is in practice an exact tie, which 100 digits
       // cannot settle either: go straight to the rationals.
       if constexpr (std::is_same_v<S, DD>) {
@@ -132,7 +169,7 @@ class Driver {
   StepResult escalate(const StepResult& r, std::uint64_t count, ImpactRecord* record) {
     ++(std::is_same_v<H, Float100> ? escalations_.high_precision : escalations_.exact_rational);
     const StepResult higher = advanceAndStep<H>(count, record);
-    if (higher.kind == StepKind::kExhausted) return higher;  // tier S keeps its state, at `count`
+    if (stopsRun(higher)) return higher;  // tier S keeps its state, at `count`
     Tier<S>& t = *tier<S>();
     const bool followed =
         r.kind == StepKind::kAmbiguous && higher.kind == StepKind::kImpact && t.follow(*tier<H>(), higher.pair);
@@ -161,14 +198,21 @@ class Driver {
     }
     skipAhead<S>(target);
     if (tier<S>()->count() > target) return {StepKind::kInconsistent, 0, 0.0};
-    // A replay must retrace the impacts already taken; only the exact tier's size cap may stop it.
+    // A replay must retrace the impacts already taken; only the exact tier's size cap and
+    // budget, or cancellation, may stop it.
     const auto failed = [](const StepResult& r) {
-      return r.kind == StepKind::kExhausted ? r : StepResult{StepKind::kInconsistent, r.pair, r.time};
+      return stopsRun(r) ? r : StepResult{StepKind::kInconsistent, r.pair, r.time};
     };
+    double cost = 0.0;  // of this replay in the exact tier [bit^2]
     for (;;) {
       const StepResult c = catchUp<S>();
       if (c.kind != StepKind::kImpact) return failed(c);
       if (tier<S>()->count() == target) return {};
+      if constexpr (Arithmetic<S>::kExact) {
+        const double bits = tier<S>()->exactBits();
+        cost += bits * bits;
+        if (cost > kExactReplayBudget) return {StepKind::kOverBudget, 0, tier<S>()->lastTime()};
+      }
       const StepResult r = stepOrEscalate<S>(nullptr);
       if (r.kind != StepKind::kImpact) return failed(r);
       ++escalations_.replayed_impacts;
@@ -208,6 +252,12 @@ class Driver {
     return {};
   }
 
+  /// The exact tier stopped (or was stopped) before deciding: the run ends at the working
+  /// tier's last certified impact.
+  static bool stopsRun(const StepResult& r) {
+    return r.kind == StepKind::kExhausted || r.kind == StepKind::kOverBudget || r.kind == StepKind::kCancelled;
+  }
+
   /// A collapse of bodies first..last, applied after `count` impacts.
   struct CollapseEvent {
     std::uint64_t count;
@@ -219,7 +269,11 @@ class Driver {
   std::size_t last_ = kNone, before_last_ = kNone;  ///< pairs of the last two impacts
   std::uint64_t alternating_ = 0;                   ///< impacts alternating between them
   std::uint64_t exact_streak_ = 0;                  ///< impacts in a row that needed the exact tier
+  std::array<std::size_t, kCrowdWindow> crowd_{};   ///< pairs of the last impacts that escalated (a ring)
+  std::size_t crowd_next_ = 0;                      ///< impacts that escalated so far
+  std::size_t undecided_pair_ = kNone;              ///< the pair of the last decision double-double could not take
   SceneTables tables_;
+  const std::atomic<bool>* cancel_;
   std::unique_ptr<Tier<DD>> fast_;
   std::unique_ptr<Tier<Float100>> high_;
   std::unique_ptr<Tier<Rational>> exact_;
@@ -268,7 +322,20 @@ void fillDrift(const Scene& scene, EngineResult& result) {
       scene.wallCount() > 0 ? kNaN : static_cast<double>(magnitude > 0 ? std::fabs(p1 - p0) / magnitude : 0.0L);
 }
 
-std::string stopMessage(const Scene& scene, const EngineResult& result, bool exhausted) {
+/// Ascending indices as ranges: "3-5, 9".
+std::string indexRanges(const std::vector<std::size_t>& indices) {
+  std::string text;
+  for (std::size_t k = 0; k < indices.size();) {
+    std::size_t end = k;
+    while (end + 1 < indices.size() && indices[end + 1] == indices[end] + 1) ++end;
+    text += (text.empty() ? "" : ", ") + std::to_string(indices[k]);
+    if (end > k) text += "-" + std::to_string(indices[end]);
+    k = end + 1;
+  }
+  return text;
+}
+
+std::string stopMessage(const Scene& scene, const EngineResult& result, bool exhausted, const ExactProgress& exact) {
   const std::string count = std::to_string(result.impact_count);
   switch (result.stop) {
     case StopReason::kFinished: {
@@ -306,6 +373,14 @@ std::string stopMessage(const Scene& scene, const EngineResult& result, bool exh
     case StopReason::kInternalError:
       return "the engine's precision tiers disagreed after " + count + " impacts (a bug, please report it); "
              "the run ends here";
+    case StopReason::kPrecisionBudget:
+      return "stopped after " + count + " certified impacts (truncated): the next decision needs exact arithmetic, "
+             "whose numbers grow with every impact of the run; its exact replay reached the work budget after " +
+             std::to_string(exact.count) + " impacts, with numbers of " + std::to_string(exact.bits) +
+             " bits, so the next impact cannot be decided; the impacts crowd among bodies " +
+             indexRanges(result.crowding_bodies) +
+             " (indices from 0), as on the way to an inelastic collapse that the engine does not resolve; "
+             "a model of the physics there goes on: --restitution-model tc or --restitution-model viscoelastic";
   }
   return "";
 }
@@ -321,6 +396,8 @@ void finish(const StepResult& r, EngineResult& result) {
       break;
     case StepKind::kOutOfRange: result.stop = StopReason::kOutOfRange; break;
     case StepKind::kExhausted: result.stop = StopReason::kCap; break;
+    case StepKind::kOverBudget: result.stop = StopReason::kPrecisionBudget; break;
+    case StepKind::kCancelled: result.stop = StopReason::kCancelled; break;
     case StepKind::kAmbiguous:
     case StepKind::kImprecise:
     case StepKind::kInconsistent: result.stop = StopReason::kInternalError; break;
@@ -338,6 +415,7 @@ const char* stopReasonName(StopReason reason) {
     case StopReason::kMultipleCollision: return "MULTIPLE_COLLISION";
     case StopReason::kOutOfRange: return "OUT_OF_RANGE";
     case StopReason::kInternalError: return "INTERNAL_ERROR";
+    case StopReason::kPrecisionBudget: return "PRECISION_BUDGET";
   }
   return "UNKNOWN";
 }
@@ -346,7 +424,7 @@ EngineResult runEngine(const Scene& scene, const EngineOptions& options, const I
                        const ProgressCallback& progress, const CollapseVisitor& on_collapse) {
   using namespace nbody_detail;
   EngineResult result;
-  Driver driver(scene);
+  Driver driver(scene, options.cancel);
   StepResult r = driver.start();
   const bool wants_records = static_cast<bool>(visitor) || options.keep_events > 0;
   ImpactRecord record;
@@ -381,7 +459,9 @@ EngineResult runEngine(const Scene& scene, const EngineOptions& options, const I
     }
   }
   if (result.stop == StopReason::kFinished) finish(r, result);
-  result.truncated = result.stop == StopReason::kCap || result.stop == StopReason::kCancelled;
+  result.truncated = result.stop == StopReason::kCap || result.stop == StopReason::kCancelled ||
+                     result.stop == StopReason::kPrecisionBudget;
+  if (result.stop == StopReason::kPrecisionBudget) result.crowding_bodies = driver.crowdingBodies();
   result.final_time = driver.fast().lastTime();
   result.collapsed = !result.collapses.empty();
   if (result.collapsed) {
@@ -394,7 +474,7 @@ EngineResult runEngine(const Scene& scene, const EngineOptions& options, const I
   result.energy_lost = driver.fast().energyLost();
   result.escalations = driver.escalations();
   fillDrift(scene, result);
-  result.stop_message = stopMessage(scene, result, r.kind == StepKind::kExhausted);
+  result.stop_message = stopMessage(scene, result, r.kind == StepKind::kExhausted, driver.exactProgress());
   return result;
 }
 

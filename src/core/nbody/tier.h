@@ -59,9 +59,12 @@ struct SceneTables {
 
 /// kAmbiguous: a decision this tier cannot take; kImprecise: its state no longer pins down
 /// the time of the impact it was about to perform (the precision guard); kExhausted: the
-/// exact tier's numbers outgrew kExactBits (an accumulation of impacts not resolved).
+/// exact tier's numbers outgrew kExactBits (an accumulation of impacts not resolved);
+/// kOverBudget: its replay outgrew kExactReplayBudget; kCancelled: the cancel flag was seen inside
+/// a higher tier's work. The last three leave the working tier at its last certified impact.
 enum class StepKind {
-  kImpact, kFinished, kMultipleCollision, kAmbiguous, kImprecise, kOutOfRange, kInconsistent, kExhausted
+  kImpact, kFinished, kMultipleCollision, kAmbiguous, kImprecise, kOutOfRange, kInconsistent, kExhausted,
+  kOverBudget, kCancelled
 };
 
 /// The exactness cap. Impacts that accumulate towards an unrecognised collapse need the
@@ -71,6 +74,17 @@ enum class StepKind {
 /// exact steps of a long run (exact ties) and runs of small exact ties never meet both.
 constexpr unsigned kExactBits = 2048;
 constexpr std::uint64_t kExactStreak = 256;
+
+/// The exactness budget: the bound on the work of one exact decision. A rational's size
+/// grows with the impacts in its causal past (each adds the bits of a mass sum), so the
+/// exact tier's replay up to a decision deep into a long run with double inputs (a crowding
+/// cluster in a gas) costs more with every impact, without bound. The cost of a replay is
+/// counted as the sum over its impacts of the squared bits of the largest denominator the
+/// impact leaves (the work of one rational operation grows about so); a decision whose replay
+/// would exceed kExactReplayBudget [bit^2] is not taken: the run stops at its last certified
+/// impact (StopReason::kPrecisionBudget). The exact tier's own runs of steps are bounded by
+/// the exactness cap above; together, each decision costs at most a constant.
+constexpr double kExactReplayBudget = 1e10;
 
 struct StepResult {
   StepKind kind = StepKind::kImpact;
@@ -292,6 +306,21 @@ class Tier {
       }
     }
     return false;
+  }
+
+  /// Bits of the largest denominator that the last impact left in this tier's state (its
+  /// two bodies; a cluster's members share their values): O(1). 0 in the inexact tiers.
+  unsigned exactBits() const {
+    unsigned bits = 0;
+    if constexpr (std::is_same_v<S, Rational>) {
+      if (count_ == 0) return 0;
+      for (std::size_t k : {now_.pair, now_.pair + 1}) {
+        for (const S* x : {&bodies_[k].b, &bodies_[k].v}) {
+          bits = std::max(bits, static_cast<unsigned>(boost::multiprecision::msb(denominator(*x))));
+        }
+      }
+    }
+    return bits;
   }
 
   /// Velocity of body k [m/s], rounded to double.

@@ -9,7 +9,9 @@
 //   1. what that cannot decide, a tier of 100-digit floats with its own bound decides: it
 //      replays the run from the start (or from where it last stopped) to that impact and
 //      takes the step; the working tier then follows that step in O(1);
-//   2. what 100 digits cannot decide, exact rationals decide the same way. A value exactly
+//   2. what 100 digits cannot decide, exact rationals decide the same way, within a work
+//      budget per decision (tier.h, kExactReplayBudget: a run beyond it stops at its last
+//      certified impact, kPrecisionBudget; the cancel flag is read at each exact step). A value exactly
 //      0 in double-double (in practice an exact tie: equal velocities or simultaneous
 //      impacts, from inputs such as small integers, where rationals stay small) goes
 //      straight to this tier.
@@ -76,6 +78,9 @@ enum class StopReason : std::uint8_t {
   kMultipleCollision = 3,  ///< two impacts sharing a body at the same instant
   kOutOfRange = 4,         ///< a time, position or velocity left the safe range of a double
   kInternalError = 5,      ///< the tiers disagreed (a bug; reported, never hidden)
+  /// A decision needed exact arithmetic beyond its budget (tier.h, kExactReplayBudget): the run
+  /// stops at its last certified impact, naming the crowding bodies (truncated).
+  kPrecisionBudget = 6,
 };
 
 /// Machine-readable name, e.g. "MULTIPLE_COLLISION".
@@ -92,7 +97,8 @@ struct EngineOptions {
   std::uint64_t keep_events = 0;           ///< keep the first this many records in the result
   std::uint64_t progress_interval = std::uint64_t{1} << 20;  ///< impacts between progress calls (0: never)
   /// When set (by another thread or a signal handler), the run stops within 1024 impacts,
-  /// marked truncated, with the summary of what was done.
+  /// or sooner inside a long exact-tier replay (read before each of its steps), marked
+  /// truncated, with the summary of what was done.
   const std::atomic<bool>* cancel = nullptr;
 };
 
@@ -159,6 +165,9 @@ struct EngineResult {
   /// Impacts in which a cluster (stuck by e = 0 or left by a collapse) met its neighbour as
   /// ONE body of its total mass, with the restitution of the pair that touches (the cluster rule).
   std::uint64_t cluster_impacts = 0;
+  /// kPrecisionBudget: the bodies (indices from 0, ascending) of the last impacts that needed
+  /// more than double-double precision and of the decision left open; empty otherwise.
+  std::vector<std::size_t> crowding_bodies;
   std::vector<ImpactRecord> events;  ///< the first options.keep_events impacts
 };
 
@@ -171,7 +180,8 @@ using CollapseVisitor = std::function<void(const Collapse&)>;
 /// Called every options.progress_interval impacts. May be empty.
 using ProgressCallback = std::function<void(const EngineProgress&)>;
 
-/// Runs the scene to its end, the cap, cancellation or a multiple collision.
+/// Runs the scene to its end, the cap, cancellation, a multiple collision or the exactness
+/// budget. Its time grows with its impacts: the budget bounds the cost of each exact step.
 /// Precondition: validate(scene) passed. Never throws for a valid scene (short of running
 /// out of memory); the visitors and the progress callback may throw, which ends the run.
 /// The records and notices carry the working tier's values rounded to double, as do

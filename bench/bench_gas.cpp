@@ -1,0 +1,54 @@
+// Benchmark (not a test): the worst case of the exact engine on seeded one-dimensional
+// granular gases (issue 21, "No run hangs"). For each N, e and seed, one run of
+// granularGas(N, e, seed) (test/core/nbody/granular_gas.h: masses in [1, 2] kg, 1 m apart,
+// velocities in [-1, 1] m/s) with the default options: its impacts, wall time, time per
+// impact, escalations and stop reason; the process's CPU time beside the wall time, since
+// the machines are shared. Inelastic gases crowd into clusters whose decisions
+// need the exact tier; the exactness budget (tier.h) bounds what each exact step costs, so
+// the time stays bounded by the impacts. Ends with the slowest run and the largest time per impact.
+//
+//   collision_lab_bench_gas [--quick]   (--quick: N <= 300, one seed)
+#include <chrono>
+#include <cstdio>
+#include <ctime>
+#include <cstring>
+#include <vector>
+
+#include "collision_lab/core/nbody/engine.h"
+#include "granular_gas.h"
+
+int main(int argc, char** argv) {
+  using namespace collision_lab::core;
+  const bool quick = argc > 1 && !std::strcmp(argv[1], "--quick");
+  const std::vector<std::size_t> sizes = quick ? std::vector<std::size_t>{10, 100, 300}
+                                               : std::vector<std::size_t>{10, 30, 100, 300, 1000};
+  const std::vector<double> restitutions{0.1, 0.3, 0.5, 0.7, 0.9, 0.99};
+  const unsigned seeds = quick ? 1 : 3;
+  std::printf("%6s %5s %4s %10s %9s %9s %12s %8s %8s  %s\n", "N", "e", "seed", "impacts", "time_s", "cpu_s",
+              "us_per_impact", "hp", "exact", "stop");
+  double worst_time = 0.0, worst_cpu = 0.0, worst_per_impact = 0.0;
+  for (const std::size_t n : sizes) {
+    for (const double e : restitutions) {
+      for (unsigned seed = 1; seed <= seeds; ++seed) {
+        const Scene scene = testing_support::granularGas(n, e, seed);
+        const auto start = std::chrono::steady_clock::now();
+        const std::clock_t cpu_start = std::clock();
+        const EngineResult run = runEngine(scene);
+        const double cpu = static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;
+        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        const double per_impact = run.impact_count ? 1e6 * seconds / static_cast<double>(run.impact_count) : 0.0;
+        worst_time = std::max(worst_time, seconds);
+        worst_cpu = std::max(worst_cpu, cpu);
+        worst_per_impact = std::max(worst_per_impact, per_impact);
+        std::printf("%6zu %5.2f %4u %10llu %9.3f %9.3f %12.1f %8llu %8llu  %s\n", n, e, seed,
+                    static_cast<unsigned long long>(run.impact_count), seconds, cpu, per_impact,
+                    static_cast<unsigned long long>(run.escalations.high_precision),
+                    static_cast<unsigned long long>(run.escalations.exact_rational), stopReasonName(run.stop));
+        std::fflush(stdout);
+      }
+    }
+  }
+  std::printf("worst run: %.3f s wall, %.3f s CPU; worst time per impact: %.1f us\n", worst_time, worst_cpu,
+              worst_per_impact);
+  return 0;
+}
