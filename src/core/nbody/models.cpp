@@ -227,7 +227,7 @@ Prediction predictThreeBodySpiral(const Scene& scene) {
     prediction.critical_restitution = root * root;
   }
   if (cycle.complexEigenvalues()) {
-    prediction.spiral_angle = std::acos(cycle.trace() / (2 * std::sqrt(cycle.e * cycle.eBC())));
+    prediction.spiral_angle = std::acos(cycle.trace() / (2 * (one_e ? cycle.e : std::sqrt(cycle.e * cycle.eBC()))));
   }
   const auto& v = scene.velocities;
   const Rational a0 = Rational(v[1]) - v[0], c0 = Rational(v[2]) - v[1];

@@ -67,8 +67,10 @@ struct Cycle {
     const Rational t = exactTrace();
     return t * t < 4 * Rational(e) * Rational(eBC());
   }
-  /// T = (1+e)(1+e_bc) cos^2(alpha) - e - e_bc.
-  double trace() const { return (1 + e) * (1 + eBC()) * cos2_alpha() - e - eBC(); }
+  /// T = (1+e)(1+e_bc) cos^2(alpha) - e - e_bc (for one e rounded as (1+e)^2 cos^2(alpha) - 2e).
+  double trace() const {
+    return eBC() == e ? (1 + e) * (1 + e) * cos2_alpha() - 2 * e : (1 + e) * (1 + eBC()) * cos2_alpha() - e - eBC();
+  }
   double kappa() const {
     const double t = trace(), gap = std::sqrt(std::fabs(t * t - 4 * e * eBC()));
     double heaviest = 0.0, lightest = std::numeric_limits<double>::infinity();  // of the finite masses

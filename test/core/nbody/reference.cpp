@@ -141,11 +141,11 @@ Run simulate(const Scene& scene, std::uint64_t max_impacts) {
   return run;
 }
 
-double limitOfImpactTimes(const Run& run) {
+double limitOfImpactTimes(const Run& run, std::size_t period) {
   const auto& ev = run.events;
   const std::size_t n = ev.size();
-  if (n < 5) throw std::invalid_argument("limitOfImpactTimes: fewer than 5 impacts");
-  const Rational t1 = ev[n - 5].time, t2 = ev[n - 3].time, t3 = ev[n - 1].time;
+  if (n < 2 * period + 1) throw std::invalid_argument("limitOfImpactTimes: fewer than 2 periods of impacts");
+  const Rational t1 = ev[n - 1 - 2 * period].time, t2 = ev[n - 1 - period].time, t3 = ev[n - 1].time;
   return static_cast<double>(Rational(t3 - (t3 - t2) * (t3 - t2) / ((t3 - t2) - (t2 - t1))));
 }
 

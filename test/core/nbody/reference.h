@@ -46,9 +46,10 @@ struct Run {
 Run simulate(const Scene& scene, std::uint64_t max_impacts);
 
 /// The collapse time [s] of a run that its cap ended inside an inelastic collapse: Aitken's
-/// limit, in rationals, of every second exact impact time (one pair's impacts), which
-/// converge geometrically (docs/physics.md, "Where the test constants come from").
-double limitOfImpactTimes(const Run& run);
+/// limit, in rationals, of every `period`-th exact impact time (the same step of a repeating
+/// pattern: every second for three bodies), which converge geometrically (docs/physics.md,
+/// "Where the test constants come from").
+double limitOfImpactTimes(const Run& run, std::size_t period = 2);
 
 /// The collapse time [s] of `scene`, which collapses: the limit of its first `impacts`
 /// exact impact times (80 settle the scenes of physics.md to 1e-13 s).
