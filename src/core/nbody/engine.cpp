@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <charconv>
+#include <deque>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -97,18 +98,49 @@ class Driver {
     alternating_ = pair != last_ && pair == before_last_ ? alternating_ + 1 : 2;
     before_last_ = last_;
     last_ = pair;
-    if (alternating_ < 8) return {};
+    history_.push_back(pair);
+    if (history_.size() > 3 * group_detail::kMaxPeriod) history_.pop_front();
+    if (alternating_ < 8) return groupCollapse(result);
     const std::size_t p = std::min(last_, before_last_), q = std::max(last_, before_last_);
     const auto found = fast_->collapseCandidate(p, q, last_ == p);
     if (!found) return {};
-    collapses_.push_back({fast_->count(), found->first, found->last});
-    result.collapses.push_back({found->first, found->last, found->time, found->position, fast_->count()});
+    return resolve(*found, result);
+  }
+
+ private:
+  /// When the exact tier has taken every one of the last kGroupStreak impacts (an
+  /// accumulation) and they repeat a pattern of period 3 or more, asks it whether the group
+  /// collapses (every 8th impact: each try costs a few exact matrix products).
+  StepResult groupCollapse(EngineResult& result) {
+    if (exact_streak_ < kGroupStreak || !exact_ || exact_->count() != fast_->count() || fast_->count() % 8 != 0) {
+      return {};
+    }
+    const std::size_t n = history_.size();
+    for (std::size_t period = 3; 3 * period <= n; ++period) {
+      bool repeats = true;
+      for (std::size_t k = n - 2 * period; k < n && repeats; ++k) repeats = history_[k] == history_[k - period];
+      if (!repeats) continue;
+      std::vector<std::size_t> pattern(history_.end() - period, history_.end());  // next: pattern[0]
+      const auto found = exact_->groupCollapseCandidate(pattern);
+      return found ? resolve(*found, result) : StepResult{};
+    }
+    return {};
+  }
+
+  /// Records a proved collapse and applies it in every tier (each when it reaches this count).
+  template <class Found>
+  StepResult resolve(const Found& found, EngineResult& result) {
+    collapses_.push_back({fast_->count(), found.first, found.last});
+    result.collapses.push_back({found.first, found.last, found.time, found.position, fast_->count()});
     alternating_ = 0;
     last_ = before_last_ = kNone;
+    history_.clear();
     const StepResult r = catchUp<DD>();
-    result.collapses.back().velocity = fast_->velocity(found->first);
+    result.collapses.back().velocity = fast_->velocity(found.first);
     return r;
   }
+
+ public:
   Escalations escalations() const {
     Escalations e = escalations_;
     e.refinements = fast_->refinements();
@@ -272,6 +304,8 @@ class Driver {
   std::array<std::size_t, kCrowdWindow> crowd_{};   ///< pairs of the last impacts that escalated (a ring)
   std::size_t crowd_next_ = 0;                      ///< impacts that escalated so far
   std::size_t undecided_pair_ = kNone;              ///< the pair of the last decision double-double could not take
+  std::deque<std::size_t> history_;                 ///< pairs of the last impacts (3 kMaxPeriod at most)
+  static constexpr std::uint64_t kGroupStreak = 16;
   SceneTables tables_;
   const std::atomic<bool>* cancel_;
   std::unique_ptr<Tier<DD>> fast_;

@@ -51,16 +51,20 @@ std::string modelReason(ModelKind kind, const Scene& scene) {
       return "equal masses exchange velocities, so the bodies move like ghosts passing through each other: "
              "the count is the number of inversions and the final velocities are the initial ones sorted";
     case ModelKind::kThreeBodySpiral:
-      return std::string("three bodies with one e < 1: the AB/BC cycle is a spiral (e > r_c) or may collapse (e <= r_c); "
-                         "count, state and collapse from the 2x2 cycle map") +
+      return (scene.restitutionOf(0) == scene.restitutionOf(1)
+                  ? std::string("three bodies with one e < 1: the AB/BC cycle is a spiral (e > r_c) or may collapse "
+                                "(e <= r_c); count, state and collapse from the 2x2 cycle map")
+                  : std::string("three bodies with two e > 0 (AB and BC): the AB/BC cycle map has determinant e_AB e_BC; "
+                                "a spiral or a collapse, decided by the same cone test; count, state and collapse from "
+                                "the 2x2 cycle map (r_c is defined for one e)")) +
              (scene.wallCount() == 1 ? "; the wall is the outer body of infinite mass (k = 1 + e at the wall, "
                                        "cos^2 alpha = m/(m_B + m) of the two bodies), and a collapse ends on the wall"
                                      : "");
     case ModelKind::kEventEngine: break;
   }
   if (scene.size() == 3 && scene.wallCount() < 2 && scene.restitutionOf(0) != scene.restitutionOf(1)) {
-    return "three bodies with two different e: the spiral model (r_c, phi) is defined for one e, so the exact "
-           "event engine simulates every impact";
+    return "three bodies with two different e, one of them 0 (a pair that sticks): the exact event engine simulates "
+           "every impact";
   }
   return "no count formula exists for " + std::to_string(scene.size()) +
          " bodies with these masses, walls and restitution: the exact event engine simulates every impact";
@@ -72,7 +76,9 @@ ModelKind chooseKind(const Scene& scene) {
   if (confinedForever(scene)) return ModelKind::kTwoWallsInfinite;
   if (n == 2) return ModelKind::kTwoBody;
   if (n == 3 && scene.isElastic() && scene.wallCount() < 2) return ModelKind::kThreeBodyRotation;
-  if (n == 3 && scene.wallCount() < 2 && !scene.isWall(1) && scene.restitutionOf(0) == scene.restitutionOf(1)) {
+  if (n == 3 && scene.wallCount() < 2 && !scene.isWall(1) &&
+      (scene.restitutionOf(0) == scene.restitutionOf(1) ||
+       (scene.restitutionOf(0) > 0.0 && scene.restitutionOf(1) > 0.0))) {
     return ModelKind::kThreeBodySpiral;
   }
   if (equalFiniteMasses(scene) && scene.isElastic()) return ModelKind::kGhosts;
@@ -206,11 +212,13 @@ Prediction predictGhosts(const Scene& scene) {
 Prediction predictThreeBodySpiral(const Scene& scene) {
   using namespace spiral_detail;
   Prediction prediction = base(ModelKind::kThreeBodySpiral, scene);
-  Cycle cycle{{scene.masses[0], scene.masses[1], scene.masses[2]}, scene.restitutionOf(0)};
+  Cycle cycle{{scene.masses[0], scene.masses[1], scene.masses[2]}, scene.restitutionOf(0), scene.restitutionOf(1)};
   cycle.wall_a = scene.isWall(0), cycle.wall_c = scene.isWall(2);
+  const bool one_e = cycle.e == cycle.eBC();
   const std::optional<int> wall = cycle.wall_a ? std::optional<int>(0) : (cycle.wall_c ? std::optional<int>(2) : std::nullopt);
   const double* m = cycle.m;
-  if (wall) {  // r_c = tan^2(pi/4 - alpha/2) = (1 - sin alpha) / (1 + sin alpha)
+  if (!one_e) {  // r_c is a value of the one e
+  } else if (wall) {  // r_c = tan^2(pi/4 - alpha/2) = (1 - sin alpha) / (1 + sin alpha)
     const double sine = std::sqrt(1 - cycle.cos2_alpha());
     prediction.critical_restitution = (1 - sine) / (1 + sine);
   } else {
@@ -218,7 +226,9 @@ Prediction predictThreeBodySpiral(const Scene& scene) {
     const double root = std::tan(M_PI / 4 - alpha / 2);
     prediction.critical_restitution = root * root;
   }
-  if (cycle.complexEigenvalues()) prediction.spiral_angle = std::acos(cycle.trace() / (2 * cycle.e));
+  if (cycle.complexEigenvalues()) {
+    prediction.spiral_angle = std::acos(cycle.trace() / (2 * (one_e ? cycle.e : std::sqrt(cycle.e * cycle.eBC()))));
+  }
   const auto& v = scene.velocities;
   const Rational a0 = Rational(v[1]) - v[0], c0 = Rational(v[2]) - v[1];
   // The frame: the centre of mass, or the wall (which the bodies follow after a collapse).

@@ -62,14 +62,17 @@ struct Cycle {
     if (wall_a || wall_c) return ratioA<double>() * ratioC<double>();
     return m[0] * m[2] / ((m[0] + m[1]) * (m[1] + m[2]));
   }
-  /// T^2 < 4 e^2 exactly: complex eigenvalues, the spiral (e > r_c).
+  /// T^2 < 4 det = 4 e e_bc exactly: complex eigenvalues, the spiral (e > r_c for one e).
   bool complexEigenvalues() const {
     const Rational t = exactTrace();
-    return t * t < 4 * Rational(e) * Rational(e);
+    return t * t < 4 * Rational(e) * Rational(eBC());
   }
-  double trace() const { return (1 + e) * (1 + e) * cos2_alpha() - 2 * e; }
+  /// T = (1+e)(1+e_bc) cos^2(alpha) - e - e_bc (for one e rounded as (1+e)^2 cos^2(alpha) - 2e).
+  double trace() const {
+    return eBC() == e ? (1 + e) * (1 + e) * cos2_alpha() - 2 * e : (1 + e) * (1 + eBC()) * cos2_alpha() - e - eBC();
+  }
   double kappa() const {
-    const double t = trace(), gap = std::sqrt(std::fabs(t * t - 4 * e * e));
+    const double t = trace(), gap = std::sqrt(std::fabs(t * t - 4 * e * eBC()));
     double heaviest = 0.0, lightest = std::numeric_limits<double>::infinity();  // of the finite masses
     for (int k = 0; k < 3; ++k) {
       if ((k == 0 && wall_a) || (k == 2 && wall_c)) continue;
@@ -80,7 +83,8 @@ struct Cycle {
 
  private:
   Rational exactTrace() const {
-    return (1 + Rational(e)) * (1 + Rational(e)) * ratioA<Rational>() * ratioC<Rational>() - 2 * Rational(e);
+    return (1 + Rational(e)) * (1 + Rational(eBC())) * ratioA<Rational>() * ratioC<Rational>() - Rational(e) -
+           Rational(eBC());
   }
 };
 

@@ -30,6 +30,7 @@
 #include <vector>
 
 #include "arithmetic.h"
+#include "group_collapse.h"
 #include "spiral.h"
 #include "collision_lab/core/nbody/engine.h"
 #include "collision_lab/core/nbody/impact_rule.h"
@@ -247,6 +248,57 @@ class Tier {
     const Line line = limitLine(lo, hi);
     found.position = (line.intercept + line.velocity * found.time) / line.mass;
     return found;
+  }
+
+  /// A group whose impacts repeat `pattern` (pair indices, the next impact's first) over
+  /// three or more units: does it collapse (group_collapse.h, proved in exact rationals),
+  /// and does nothing outside reach it before? The exact tier only (others: no).
+  std::optional<CollapseFound> groupCollapseCandidate(const std::vector<std::size_t>& pattern) const {
+    if constexpr (!Ar::kExact) {
+      return {};
+    } else {
+      const Scene& scene = tables_.scene;
+      const auto [low, high] = std::minmax_element(pattern.begin(), pattern.end());
+      const std::size_t lo = clusterLow(*low), hi = clusterHigh(*high + 1);
+      std::vector<std::size_t> pairs;  // the group's pairs between units (global)
+      for (std::size_t p = lo; p < hi; ++p) {
+        if (!bonded_[p]) pairs.push_back(p);
+      }
+      if (pairs.size() < 3 || (scene.isWall(lo) && scene.isWall(hi))) return {};
+      const auto unitMass = [&](std::size_t body, bool& wall) {
+        Rational m = 0;
+        wall = false;
+        for (std::size_t k = clusterLow(body); k <= clusterHigh(body); ++k) {
+          if (scene.isWall(k)) wall = true;
+          else m += Rational(scene.masses[k]);
+        }
+        return m;
+      };
+      group_detail::GroupMaps maps;
+      group_detail::Vec c, d;
+      for (std::size_t p : pairs) {
+        bool wall_l = false, wall_r = false;
+        const Rational ml = unitMass(p, wall_l), mr = unitMass(p + 1, wall_r);
+        const Rational e = Rational(scene.restitutionOf(p));
+        maps.e.push_back(e);
+        const Rational k = 1 + e;
+        maps.share_down.push_back(wall_l ? Rational(0) : (wall_r ? k : Rational(k * mr / (ml + mr))));
+        maps.share_up.push_back(wall_r ? Rational(0) : (wall_l ? k : Rational(k * ml / (ml + mr))));
+        c.push_back(bodies_[p + 1].b - bodies_[p].b);
+        d.push_back(bodies_[p + 1].v - bodies_[p].v);
+      }
+      std::vector<std::size_t> local;
+      for (std::size_t p : pattern) {
+        const auto it = std::find(pairs.begin(), pairs.end(), p);
+        if (it == pairs.end()) return {};
+        local.push_back(static_cast<std::size_t>(it - pairs.begin()));
+      }
+      const std::optional<double> time = group_detail::proveCollapse(maps, local, c, d);
+      const double now = lastTime();
+      if (!time || !(*time >= now) || !clearOfNeighbours(lo, hi, now, *time)) return {};
+      const Line line = limitLine(lo, hi);
+      return CollapseFound{lo, hi, *time, (line.intercept + line.velocity * *time) / line.mass};
+    }
   }
 
   /// Bodies lo..hi become one cluster on their limit line (limitLine()): the centre of mass,

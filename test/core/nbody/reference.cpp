@@ -141,11 +141,11 @@ Run simulate(const Scene& scene, std::uint64_t max_impacts) {
   return run;
 }
 
-double limitOfImpactTimes(const Run& run) {
+double limitOfImpactTimes(const Run& run, std::size_t period) {
   const auto& ev = run.events;
   const std::size_t n = ev.size();
-  if (n < 5) throw std::invalid_argument("limitOfImpactTimes: fewer than 5 impacts");
-  const Rational t1 = ev[n - 5].time, t2 = ev[n - 3].time, t3 = ev[n - 1].time;
+  if (n < 2 * period + 1) throw std::invalid_argument("limitOfImpactTimes: fewer than 2 periods of impacts");
+  const Rational t1 = ev[n - 1 - 2 * period].time, t2 = ev[n - 1 - period].time, t3 = ev[n - 1].time;
   return static_cast<double>(Rational(t3 - (t3 - t2) * (t3 - t2) / ((t3 - t2) - (t2 - t1))));
 }
 
@@ -153,6 +153,52 @@ double collapseTime(const Scene& scene, std::uint64_t impacts) {
   const Run run = simulate(scene, impacts);
   if (!run.truncated) throw std::invalid_argument("collapseTime: the scene does not collapse");
   return limitOfImpactTimes(run);
+}
+
+AlternationWalk alternationCount(const Scene& scene, std::uint64_t cap) {
+  using boost::multiprecision::cpp_int;
+  const State s = initial(scene);
+  // Impact of pair p scaled by L: the hit pair's speed times -e L, the other's times L plus
+  // k L times the hit pair's, with k = (1 + e) m_far / (m_far + m_near) (1 + e for a wall).
+  struct Step {
+    cpp_int self, other, transfer;
+  };
+  Step steps[2];
+  for (int p = 0; p < 2; ++p) {
+    const std::size_t far = p == 0 ? 0 : 2, near = 1;
+    const Rational share = s.wall[far] ? Rational(1) : s.mass[far] / (s.mass[far] + s.mass[near]);
+    const Rational e = s.e[p], k = (1 + e) * share;
+    const cpp_int l = denominator(e) * denominator(k);
+    steps[p] = {-numerator(e) * (l / denominator(e)), l, numerator(k) * (l / denominator(k))};
+  }
+  const Rational a0 = s.v[1] - s.v[0], c0 = s.v[2] - s.v[1];
+  // Scale the initial speeds to integers.
+  const cpp_int common = denominator(a0) * denominator(c0);
+  cpp_int d[2] = {numerator(a0) * (common / denominator(a0)), numerator(c0) * (common / denominator(c0))};
+  int pair = 0;
+  if (d[0] > 0 && d[1] > 0) {
+    pair = (s.x[0] - s.x[1]) / a0 < (s.x[1] - s.x[2]) / c0 ? 0 : 1;
+  } else if (d[1] > 0) {
+    pair = 1;
+  }
+  AlternationWalk walk;
+  while (d[pair] > 0) {
+    if (walk.count == cap) {
+      walk.capped = true;
+      break;
+    }
+    const Step& st = steps[pair];
+    d[1 - pair] = st.other * d[1 - pair] + st.transfer * d[pair];
+    d[pair] = st.self * d[pair];
+    ++walk.count;
+    pair = 1 - pair;
+    const unsigned zero = ~0u;
+    const unsigned shift = std::min(d[0] == 0 ? zero : lsb(abs(d[0])), d[1] == 0 ? zero : lsb(abs(d[1])));
+    if (shift != zero && shift > 0) {
+      for (cpp_int& x : d) x = x < 0 ? cpp_int(-(cpp_int(-x) >> shift)) : cpp_int(x >> shift);
+    }
+  }
+  return walk;
 }
 
 double energyNormError(const Scene& scene, const std::vector<double>& velocities,

@@ -46,13 +46,28 @@ struct Run {
 Run simulate(const Scene& scene, std::uint64_t max_impacts);
 
 /// The collapse time [s] of a run that its cap ended inside an inelastic collapse: Aitken's
-/// limit, in rationals, of every second exact impact time (one pair's impacts), which
-/// converge geometrically (docs/physics.md, "Where the test constants come from").
-double limitOfImpactTimes(const Run& run);
+/// limit, in rationals, of every `period`-th exact impact time (the same step of a repeating
+/// pattern: every second for three bodies), which converge geometrically (docs/physics.md,
+/// "Where the test constants come from").
+double limitOfImpactTimes(const Run& run, std::size_t period = 2);
 
 /// The collapse time [s] of `scene`, which collapses: the limit of its first `impacts`
 /// exact impact times (80 settle the scenes of physics.md to 1e-13 s).
 double collapseTime(const Scene& scene, std::uint64_t impacts = 80);
+
+/// The impact count of three bodies (an outer one may be a wall; every e > 0), walked in
+/// exact integers: after the first impact the two pairs alternate (physics.md), so the count
+/// is decided by the approach speeds a = v_B - v_A, c = v_C - v_B alone. Impact AB maps
+/// (a, c) to (-e_AB a, c + (1 + e_AB) m_A/(m_A + m_B) a) (the centre-of-mass rule of
+/// physics.md, with m_A/(m_A + m_B) = 1 for a wall), BC likewise. The state is scaled by the
+/// maps' common denominators at each impact (signs are all that matter) and by common powers
+/// of two removed, so nothing is ever divided or normalised: linear cost per impact, for walks
+/// far longer than simulate() can take (32,774 impacts of 1.8 million bits in seconds).
+struct AlternationWalk {
+  std::uint64_t count = 0;
+  bool capped = false;  ///< the cap came first: a pair still approached
+};
+AlternationWalk alternationCount(const Scene& scene, std::uint64_t cap);
 
 /// sqrt(sum m (v - reference)^2) / sqrt(sum m v0^2) over the finite bodies, in the frame of
 /// the walls (the lab frame without walls): the scale-free energy norm.

@@ -39,11 +39,14 @@ TEST(NBodyModels, ChoosesTheCheapestExactModel) {
   EXPECT_EQ(kind(scene({1, 1, 1}, {2, 1, 0}, {-1, 0, 0.5})), ModelKind::kThreeBodyRotation);  // N = 3 keeps its model
   EXPECT_EQ(kind(scene({100, 1, kInf}, {2, 1, 0}, {-1, 0, 0})), ModelKind::kThreeBodyRotation);
   EXPECT_EQ(kind(scene({1, 2, 3}, {2, 1, 0}, {-1, 0, 0.5}, {0.5})), ModelKind::kThreeBodySpiral);
-  EXPECT_EQ(kind(scene({1, 2, 3}, {2, 1, 0}, {-1, 0, 0.5}, {0.5, 0.4})), ModelKind::kEventEngine);  // two e
-  EXPECT_NE(chooseModel(scene({1, 2, 3}, {2, 1, 0}, {-1, 0, 0.5}, {0.5, 0.4})).reason.find("different e"),
+  EXPECT_EQ(kind(scene({1, 2, 3}, {2, 1, 0}, {-1, 0, 0.5}, {0.5, 0.4})), ModelKind::kThreeBodySpiral);  // two e
+  EXPECT_NE(chooseModel(scene({1, 2, 3}, {2, 1, 0}, {-1, 0, 0.5}, {0.5, 0.4})).reason.find("two e > 0"),
+            std::string::npos);
+  EXPECT_EQ(kind(scene({1, 2, 3}, {2, 1, 0}, {-1, 0, 0.5}, {0.5, 0})), ModelKind::kEventEngine);  // one sticks
+  EXPECT_NE(chooseModel(scene({1, 2, 3}, {2, 1, 0}, {-1, 0, 0.5}, {0.5, 0})).reason.find("different e"),
             std::string::npos);
   EXPECT_EQ(kind(scene({kInf, 1, 3}, {2, 1, 0}, {0, 0, 0.5}, {0.5})), ModelKind::kThreeBodySpiral);  // a wall
-  EXPECT_EQ(kind(scene({kInf, 1, 3}, {2, 1, 0}, {0, 0, 0.5}, {0.5, 0.4})), ModelKind::kEventEngine);  // two e
+  EXPECT_EQ(kind(scene({kInf, 1, 3}, {2, 1, 0}, {0, 0, 0.5}, {0.5, 0.4})), ModelKind::kThreeBodySpiral);  // two e
   EXPECT_EQ(kind(scene({kInf, 1, kInf}, {2, 1, 0}, {0, 1, 0})), ModelKind::kTwoWallsInfinite);
   EXPECT_EQ(kind(scene({kInf, 1, 1, kInf}, {3, 2, 1, 0}, {0, 1, 0, 0.5}, {0.9})), ModelKind::kTwoWallsInfinite);
   EXPECT_EQ(kind(scene({kInf, 1, kInf}, {2, 1, 0}, {1, 3, -1})), ModelKind::kEventEngine);  // walls move apart

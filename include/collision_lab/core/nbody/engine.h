@@ -125,8 +125,11 @@ struct MultipleCollision {
 /// cos^2(alpha) = m_C/(m_B+m_C) with B the squeezed body and C the other; a collapse when
 /// e is below tan^2(pi/4 - alpha/2) and the start lies in the approaching cone); all of
 /// them end on the wall's line: they meet at the wall and move on with it; the energy
-/// about it is lost (the wall absorbs the momentum). Not recognised: larger groups whose
-/// impacts follow another pattern, a wall in the middle of the three, a body between two
+/// about it is lost (the wall absorbs the momentum). Also recognised: a group of 4 to 8
+/// bodies or clusters whose impacts repeat a pattern of period 3 to 24, once the exact tier
+/// takes every impact, when an invariant cone proves in exact rationals that the pattern never
+/// breaks (src/core/nbody/group_collapse.h, docs/physics.md). Not recognised: larger groups
+/// whose pattern that proof does not reach, a wall in the middle of the three, a body between two
 /// walls (walls at one velocity: no collapse, the bounces slow down without end; walls
 /// closing in: they meet, where nothing is defined), and a group that a body outside could
 /// reach before the collapse time (conservative, even beyond a wall). Their impacts

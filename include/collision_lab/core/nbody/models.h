@@ -67,8 +67,8 @@ struct Prediction {
   std::optional<double> impact_position;      ///< two_body: contact point [m]
   double energy_lost = 0.0;                   ///< kinetic energy turned into heat [J]
   // three_body_spiral only:
-  std::optional<double> critical_restitution;  ///< r_c = tan^2(pi/4 - alpha/2) [1]
-  std::optional<double> spiral_angle;          ///< phi, cos(phi) = T / (2e), when e > r_c [rad]
+  std::optional<double> critical_restitution;  ///< r_c = tan^2(pi/4 - alpha/2) [1]; one e for both pairs only
+  std::optional<double> spiral_angle;          ///< phi, cos(phi) = T / (2 sqrt(e_AB e_BC)), complex eigenvalues [rad]
   bool collapsed = false;                      ///< inelastic collapse (then infinite is true)
   std::optional<double> collapse_time;         ///< [s] since the start
   std::optional<double> collapse_position;     ///< where the three meet [m]
