@@ -30,7 +30,8 @@ catkin_add_gtest(collision_lab_nbody_tests
   test/core/nbody/test_impact_stream.cpp
   test/core/nbody/test_spiral_random.cpp
   test/core/nbody/test_simultaneous.cpp
-  test/core/nbody/test_wall_collapse.cpp)
+  test/core/nbody/test_wall_collapse.cpp
+  test/core/nbody/test_granular_models.cpp)
 if(TARGET collision_lab_nbody_tests)
   target_link_libraries(collision_lab_nbody_tests collision_lab_test_support GTest::gtest_main)
 endif()
