@@ -51,6 +51,11 @@ struct CliRequest {
   std::optional<core::Scene> scene;   ///< kRunOne from --masses/--positions/--velocities or --bodies
   /// --restitution: replaces every scene's restitution (one value, or one per pair).
   std::optional<std::vector<double>> restitution;
+  /// --restitution-model with its parameter (--tc, --elastic-below, --viscoelastic-speed):
+  /// replaces every scene's model (core::RestitutionModel).
+  std::optional<core::RestitutionModel> restitution_model;
+  /// --ring L: every scene on a ring of circumference L [m] (core::Scene::ring).
+  std::optional<double> ring;
 };
 
 /// The format asked for on the command line, found before full parsing so that even a

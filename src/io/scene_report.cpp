@@ -205,6 +205,9 @@ class SceneTableWriter : public SceneReportWriter {
       out_ << "cluster rule: " << s.cluster_impacts
            << " impacts hit a cluster (stuck or collapsed) as one body of its total mass\n";
     }
+    if (s.rule_elastic_impacts > 0) {
+      out_ << "restitution model: " << s.rule_elastic_impacts << " impacts made elastic by the rule\n";
+    }
   }
 
   void writeChecks(const core::SceneSimulation& s) {
@@ -241,6 +244,23 @@ class SceneTableWriter : public SceneReportWriter {
 // ---------------------------------------------------------------------------------------
 // JSON: one document, one impact per line; the bodies' lists are streamed.
 
+/// The restitution model and the ring, only when the scene has them (older outputs unchanged).
+void writeSceneOptionsJson(std::ostream& out, const core::Scene& s) {
+  const core::RestitutionModel& model = s.restitution_model;
+  if (model.kind != core::RestitutionModelKind::kConstant) {
+    const double parameter = model.kind == core::RestitutionModelKind::kTc
+                                 ? model.tc
+                                 : (model.kind == core::RestitutionModelKind::kThreshold ? model.elastic_below
+                                                                                        : model.viscoelastic_speed);
+    const char* key = model.kind == core::RestitutionModelKind::kTc
+                          ? "tc"
+                          : (model.kind == core::RestitutionModelKind::kThreshold ? "elastic_below" : "viscoelastic_speed");
+    out << ",\"restitution_model\":\"" << core::restitutionModelName(model.kind) << "\",\"" << key
+        << "\":" << jsonText(number(parameter));
+  }
+  if (s.isRing()) out << ",\"ring\":" << jsonText(number(s.ring));
+}
+
 void writeSceneJson(std::ostream& out, const SceneEntry& entry) {
   const core::Scene& s = entry.scene;
   out << "{\"name\":" << jsonText(Json(entry.name)) << ",\"description\":" << jsonText(Json(entry.description))
@@ -252,6 +272,7 @@ void writeSceneJson(std::ostream& out, const SceneEntry& entry) {
   writeJsonNumbers(out, s.velocities);
   out << ",\"restitution\":";
   writeJsonNumbers(out, s.restitution);
+  writeSceneOptionsJson(out, s);
   out << "}";
 }
 
@@ -281,6 +302,7 @@ Json summaryScalars(const core::SceneRunResult& result) {
   json["collapse_time"] = s.collapse_time ? number(*s.collapse_time) : Json(nullptr);
   json["collapse_position"] = s.collapse_position ? number(*s.collapse_position) : Json(nullptr);
   json["cluster_impacts"] = s.cluster_impacts;
+  json["rule_elastic_impacts"] = s.rule_elastic_impacts;
   json["critical_restitution"] = p && p->critical_restitution ? number(*p->critical_restitution) : Json(nullptr);
   json["spiral_angle"] = p && p->spiral_angle ? number(*p->spiral_angle) : Json(nullptr);
   json["multiple_collision"] = nullptr;
