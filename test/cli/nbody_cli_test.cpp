@@ -157,6 +157,8 @@ TEST(NBodyCli, RingSeamImpact) {
   ASSERT_EQ(doc.at("events").size(), 1u);
   const Json& event = doc.at("events")[0];
   EXPECT_EQ(event.at("pair_index"), 1);
+  EXPECT_EQ(event.at("pair"), "BA");  // B right, A left across the seam
+  EXPECT_EQ(event.at("bodies"), (Json{"B", "A"}));
   EXPECT_EQ(event.at("time"), 1.0);
   EXPECT_EQ(event.at("position"), 0.0);
   EXPECT_EQ(doubles(event.at("velocities_after")), (std::vector<double>{0, -2}));
