@@ -413,6 +413,7 @@ class Tier {
     return {(m + n - 1) % n, m, (m + 1) % n};
   }
   void updateRing(std::size_t m) {
+    if (m > 0 && m + 1 < pairs_.size()) return tree_.update(m - 1, m + 1);  // no wrap: one climb, as on a line
     for (std::size_t q : ringNeighbours(m)) tree_.update(q, q);
   }
 
