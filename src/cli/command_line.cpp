@@ -15,8 +15,9 @@ namespace {
 
 /// Options that take a value. A value may start with '-' (negative numbers, "-inf",
 /// "-.5"), which CLI11 would take for a flag; normalizeArguments() prevents that.
-const std::array<const char*, 13> kValueOptions = {
+const std::array<const char*, 18> kValueOptions = {
     "--masses", "--positions", "--velocities", "--bodies",   "--restitution", "--max-collisions",
+    "--restitution-model", "--tc", "--elastic-below", "--viscoelastic-speed", "--ring",
     "--events", "--format",    "--precision",  "--mode",     "--scenario",    "--name",
     "--temperature-csv"};
 
@@ -94,6 +95,7 @@ core::Scene readBodies(const std::string& path) {
 /// The options as typed, before their values are checked.
 struct RawOptions {
   std::string masses, positions, velocities, bodies, restitution;
+  std::string restitution_model, tc, elastic_below, viscoelastic_speed, ring;
   std::string max_collisions, events, format = "table", precision = "double", mode = "full";
   std::string scenario, name, temperature_csv;
   bool list = false;
@@ -177,6 +179,56 @@ void readSceneSource(const RawOptions& raw, const std::string& default_scenario_
   request.scene = std::move(scene);
 }
 
+/// One number of an option, e.g. --tc 1e-3.
+double parseOne(const std::string& text, const std::string& field) {
+  const std::vector<double> values = parseList(text, field);
+  if (values.size() != 1) throw makeCliError(CliReason::kInvalidOption, field, "'" + text + "' is not one number");
+  return values[0];
+}
+
+/// --restitution-model and its parameter, and --ring. A parameter needs its model; the
+/// model's parameter is checked by the core's validation (RESTITUTION_MODEL).
+void readSceneOptions(const CLI::App& app, const RawOptions& raw, CliRequest& request) {
+  struct Parameter {
+    const char* option;
+    const std::string& text;
+    core::RestitutionModelKind kind;
+  };
+  const Parameter parameters[] = {{"--tc", raw.tc, core::RestitutionModelKind::kTc},
+                                  {"--elastic-below", raw.elastic_below, core::RestitutionModelKind::kThreshold},
+                                  {"--viscoelastic-speed", raw.viscoelastic_speed, core::RestitutionModelKind::kViscoelastic}};
+  if (app.count("--restitution-model") > 0) {
+    core::RestitutionModel model;
+    const std::string& name = raw.restitution_model;
+    bool known = false;
+    for (auto kind : {core::RestitutionModelKind::kConstant, core::RestitutionModelKind::kTc,
+                      core::RestitutionModelKind::kThreshold, core::RestitutionModelKind::kViscoelastic}) {
+      if (name == core::restitutionModelName(kind)) model.kind = kind, known = true;
+    }
+    if (!known) {
+      throw makeCliError(CliReason::kInvalidOption, "restitution-model",
+                         "'" + name + "' is not constant, tc, threshold or viscoelastic");
+    }
+    request.restitution_model = model;
+  }
+  for (const Parameter& parameter : parameters) {
+    if (app.count(parameter.option) == 0) continue;
+    const std::string field = std::string(parameter.option).substr(2);
+    if (!request.restitution_model || request.restitution_model->kind != parameter.kind) {
+      throw makeCliError(CliReason::kUsage, field,
+                         std::string(parameter.option) + " belongs to --restitution-model " +
+                             core::restitutionModelName(parameter.kind));
+    }
+    const double value = parseOne(parameter.text, field);
+    core::RestitutionModel& model = *request.restitution_model;
+    (parameter.kind == core::RestitutionModelKind::kTc
+         ? model.tc
+         : (parameter.kind == core::RestitutionModelKind::kThreshold ? model.elastic_below : model.viscoelastic_speed)) =
+        value;
+  }
+  if (app.count("--ring") > 0) request.ring = parseOne(raw.ring, "ring");
+}
+
 /// Which events to show. Every scene of a file at once: the summary rows are the point,
 /// so none unless asked for.
 void readEventPolicy(const RawOptions& raw, CliRequest& request) {
@@ -247,6 +299,14 @@ void declareOptions(CLI::App& app, RawOptions& raw) {
       "--bodies", raw.bodies, "CSV file with the header mass,position,velocity, one body per line, right to left; - reads stdin");
   app.add_option(
       "--restitution", raw.restitution, "e in [0,1] for every pair, or e_AB,e_BC,... one per pair (default 1: elastic)");
+  app.add_option("--restitution-model", raw.restitution_model,
+                 "constant|tc|threshold|viscoelastic: how each impact's e is chosen (default constant: the pair's e; "
+                 "docs/physics.md)");
+  app.add_option("--tc", raw.tc, "TC model: t_c [s]; an impact is elastic unless both bodies' last impacts are more than t_c ago");
+  app.add_option("--elastic-below", raw.elastic_below, "threshold law: v_0 [m/s]; e = 1 for approach speeds below it");
+  app.add_option("--viscoelastic-speed", raw.viscoelastic_speed,
+                 "viscoelastic law: v* [m/s] in e(v) = 1 - C1 (v/v*)^(1/5) + C2 (v/v*)^(2/5)");
+  app.add_option("--ring", raw.ring, "put the bodies on a ring of circumference L [m] (positions in [0, L), no walls)");
   app.add_option(
       "--max-collisions", raw.max_collisions, "stop after N collisions and mark the run truncated (default 10000000)");
   app.add_flag("--simulate-to-cap", raw.simulate_to_cap,
@@ -312,6 +372,7 @@ CliRequest parseCommandLine(const std::vector<std::string>& args, const std::str
   readRunOptions(raw, request);
   readSceneSource(raw, default_scenario_path, request);
   if (raw.restitution_given) request.restitution = parseList(raw.restitution, "restitution");
+  readSceneOptions(app, raw, request);
   readEventPolicy(raw, request);
   readTemperatureCsv(raw, request);
   return request;

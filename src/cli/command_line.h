@@ -53,6 +53,11 @@ struct CliRequest {
   std::optional<std::vector<double>> restitution;
   /// --temperature-csv: the file to write T(t) to (kRunOne, full mode only).
   std::optional<std::string> temperature_csv;
+  /// --restitution-model with its parameter (--tc, --elastic-below, --viscoelastic-speed):
+  /// replaces every scene's model (core::RestitutionModel).
+  std::optional<core::RestitutionModel> restitution_model;
+  /// --ring L: every scene on a ring of circumference L [m] (core::Scene::ring).
+  std::optional<double> ring;
 };
 
 /// The format asked for on the command line, found before full parsing so that even a

@@ -39,9 +39,11 @@ class InterruptGuard {
   void (*previous_)(int) = SIG_DFL;
 };
 
-/// The scene with --restitution applied.
+/// The scene with --restitution, --restitution-model and --ring applied.
 io::SceneEntry withRequestRestitution(const CliRequest& request, io::SceneEntry entry) {
   if (request.restitution) entry.scene.restitution = *request.restitution;
+  if (request.restitution_model) entry.scene.restitution_model = *request.restitution_model;
+  if (request.ring) entry.scene.ring = *request.ring;
   return entry;
 }
 

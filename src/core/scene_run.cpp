@@ -74,6 +74,7 @@ SceneSimulation fromEngine(EngineResult&& engine) {
   simulation.collapse_position = engine.collapse_position;
   simulation.collapses = std::move(engine.collapses);
   simulation.cluster_impacts = engine.cluster_impacts;
+  simulation.rule_elastic_impacts = engine.rule_elastic_impacts;
   simulation.energy_relative_drift = engine.energy_relative_drift;
   simulation.momentum_relative_drift = engine.momentum_relative_drift;
   simulation.escalations = engine.escalations;
@@ -109,7 +110,9 @@ SceneSimulation simulateScene(const Scene& scene, const SceneRunOptions& options
   EngineOptions engine_options;
   engine_options.max_impacts = lab.max_collisions;
   // Impacts that never end are shown, not counted: a display's worth unless asked for more.
-  if (prediction && prediction->kind == ModelKind::kTwoWallsInfinite && !options.simulate_to_cap) {
+  const bool endless = prediction && (prediction->kind == ModelKind::kTwoWallsInfinite ||
+                                      (prediction->kind == ModelKind::kGhosts && prediction->infinite));  // a ring
+  if (endless && !options.simulate_to_cap) {
     engine_options.max_impacts = std::min(lab.max_collisions, kInfiniteRunDisplayCap);
   }
   engine_options.progress_interval = options.progress_interval;
@@ -148,6 +151,8 @@ ThreeBodyScene toThreeBodyScene(const Scene& scene) {
 /// True when the three-body model answers: three elastic bodies that
 /// validate(ThreeBodyScene) accepts. Precondition: validate(scene) passed.
 bool usesThreeBodyPath(const Scene& scene) {
+  // Not on a ring, nor under e(v) (which acts on elastic scenes too).
+  if (scene.isRing() || scene.restitution_model.kind == RestitutionModelKind::kViscoelastic) return false;
   return isElasticTriple(scene) && !validate(toThreeBodyScene(scene));
 }
 

@@ -16,7 +16,8 @@ namespace {
 
 const char* const kVectorKeys[3] = {"masses", "positions", "velocities"};
 const std::set<std::string> kKnownKeys = {"description", "masses",      "positions",     "velocities",
-                                          "bodies",      "restitution", "max_collisions"};
+                                          "bodies",      "restitution", "max_collisions", "restitution_model",
+                                          "tc",          "elastic_below", "viscoelastic_speed", "ring"};
 
 double readNumber(const YAML::Node& node, const std::string& where, const std::string& field) {
   if (!node.IsScalar()) throw ScenarioFileError(where + ": " + field + " is not a number");
@@ -76,6 +77,39 @@ void readScene(const YAML::Node& entry, const std::string& where, const std::str
   if (const YAML::Node restitution = entry["restitution"]) scene.restitution = readRestitution(restitution, where);
 }
 
+/// `restitution_model: tc|threshold|viscoelastic|constant` with its parameter (`tc: t_c`
+/// [s], `elastic_below: v_0` [m/s], `viscoelastic_speed: v*` [m/s]), and `ring: L` [m].
+void readSceneOptions(const YAML::Node& entry, const std::string& where, core::Scene& scene) {
+  if (const YAML::Node model = entry["restitution_model"]) {
+    bool known = false;
+    for (auto kind : {core::RestitutionModelKind::kConstant, core::RestitutionModelKind::kTc,
+                      core::RestitutionModelKind::kThreshold, core::RestitutionModelKind::kViscoelastic}) {
+      if (model.IsScalar() && model.Scalar() == core::restitutionModelName(kind)) {
+        scene.restitution_model.kind = kind, known = true;
+      }
+    }
+    if (!known) throw ScenarioFileError(where + ": 'restitution_model' must be constant, tc, threshold or viscoelastic");
+  }
+  const std::pair<const char*, core::RestitutionModelKind> parameters[] = {
+      {"tc", core::RestitutionModelKind::kTc},
+      {"elastic_below", core::RestitutionModelKind::kThreshold},
+      {"viscoelastic_speed", core::RestitutionModelKind::kViscoelastic}};
+  for (const auto& [key, kind] : parameters) {
+    const YAML::Node node = entry[key];
+    if (!node) continue;
+    if (scene.restitution_model.kind != kind) {
+      throw ScenarioFileError(where + ": '" + key + "' belongs to restitution_model: " + core::restitutionModelName(kind));
+    }
+    const double value = readNumber(node, where, key);
+    core::RestitutionModel& model = scene.restitution_model;
+    (kind == core::RestitutionModelKind::kTc ? model.tc
+                                             : (kind == core::RestitutionModelKind::kThreshold ? model.elastic_below
+                                                                                               : model.viscoelastic_speed)) =
+        value;
+  }
+  if (const YAML::Node ring = entry["ring"]) scene.ring = readNumber(ring, where, "ring");
+}
+
 SceneEntry readEntry(const std::string& name, const YAML::Node& entry, const std::string& path) {
   const std::string where = path + ": entry '" + name + "'";
   if (!entry.IsMap()) {
@@ -86,7 +120,7 @@ SceneEntry readEntry(const std::string& name, const YAML::Node& entry, const std
     if (kKnownKeys.count(key) == 0) {
       throw ScenarioFileError(where + ": unknown key '" + key +
                               "' (known: description, masses, positions, velocities, bodies, restitution, "
-                              "max_collisions)");
+                              "max_collisions, restitution_model, tc, elastic_below, viscoelastic_speed, ring)");
     }
   }
   SceneEntry named;
@@ -96,6 +130,7 @@ SceneEntry readEntry(const std::string& name, const YAML::Node& entry, const std
     named.description = description.Scalar();
   }
   readScene(entry, where, path, named.scene);
+  readSceneOptions(entry, where, named.scene);
   if (const YAML::Node cap = entry["max_collisions"]) {
     const ParsedCount value = cap.IsScalar() ? parseCount(cap.Scalar()) : ParsedCount{0, "is not a number"};
     if (value.problem.rfind("is too large", 0) == 0) {

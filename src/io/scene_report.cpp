@@ -52,6 +52,17 @@ std::string csvField(const std::string& text) {
   return quoted + "\"";
 }
 
+/// The left body of an impact: pair_index + 1, or body 0 across a ring's seam (the only
+/// record whose last_moved is below its pair_index; a ring has no clusters).
+std::size_t leftBody(const core::ImpactRecord& r) { return r.last_moved < r.pair_index ? 0 : r.pair_index + 1; }
+
+/// pairName, or for a ring's seam the two bodies' names ("CA", "#30-A").
+std::string impactPairName(const core::ImpactRecord& r) {
+  const std::size_t left = leftBody(r);
+  if (left == r.pair_index + 1) return core::pairName(r.pair_index);
+  return core::bodyName(r.pair_index) + (r.pair_index < 26 ? "" : "-") + core::bodyName(left);
+}
+
 Json wallNames(const core::Scene& scene) {
   Json walls = Json::array();
   for (std::size_t i = 0; i < scene.size(); ++i) {
@@ -140,7 +151,7 @@ class SceneTableWriter : public SceneReportWriter {
 
   void impact(const core::ImpactRecord& r) override {
     if (!header_written_) writeImpactHeader();
-    out_ << padLeft(std::to_string(r.index), 9) << padLeft(core::pairName(r.pair_index), 8);
+    out_ << padLeft(std::to_string(r.index), 9) << padLeft(impactPairName(r), 8);
     for (double value : {r.time, r.position, r.velocities_after[0], r.velocities_after[1], r.energy_lost}) {
       out_ << padLeft(humanText(value, kEventDigits), 15);
     }
@@ -205,6 +216,9 @@ class SceneTableWriter : public SceneReportWriter {
       out_ << "cluster rule: " << s.cluster_impacts
            << " impacts hit a cluster (stuck or collapsed) as one body of its total mass\n";
     }
+    if (s.rule_elastic_impacts > 0) {
+      out_ << "restitution model: " << s.rule_elastic_impacts << " impacts made elastic by the rule\n";
+    }
   }
 
   void writeChecks(const core::SceneSimulation& s) {
@@ -241,6 +255,23 @@ class SceneTableWriter : public SceneReportWriter {
 // ---------------------------------------------------------------------------------------
 // JSON: one document, one impact per line; the bodies' lists are streamed.
 
+/// The restitution model and the ring, only when the scene has them (older outputs unchanged).
+void writeSceneOptionsJson(std::ostream& out, const core::Scene& s) {
+  const core::RestitutionModel& model = s.restitution_model;
+  if (model.kind != core::RestitutionModelKind::kConstant) {
+    const double parameter = model.kind == core::RestitutionModelKind::kTc
+                                 ? model.tc
+                                 : (model.kind == core::RestitutionModelKind::kThreshold ? model.elastic_below
+                                                                                        : model.viscoelastic_speed);
+    const char* key = model.kind == core::RestitutionModelKind::kTc
+                          ? "tc"
+                          : (model.kind == core::RestitutionModelKind::kThreshold ? "elastic_below" : "viscoelastic_speed");
+    out << ",\"restitution_model\":\"" << core::restitutionModelName(model.kind) << "\",\"" << key
+        << "\":" << jsonText(number(parameter));
+  }
+  if (s.isRing()) out << ",\"ring\":" << jsonText(number(s.ring));
+}
+
 void writeSceneJson(std::ostream& out, const SceneEntry& entry) {
   const core::Scene& s = entry.scene;
   out << "{\"name\":" << jsonText(Json(entry.name)) << ",\"description\":" << jsonText(Json(entry.description))
@@ -252,6 +283,7 @@ void writeSceneJson(std::ostream& out, const SceneEntry& entry) {
   writeJsonNumbers(out, s.velocities);
   out << ",\"restitution\":";
   writeJsonNumbers(out, s.restitution);
+  writeSceneOptionsJson(out, s);
   out << "}";
 }
 
@@ -281,6 +313,7 @@ Json summaryScalars(const core::SceneRunResult& result) {
   json["collapse_time"] = s.collapse_time ? number(*s.collapse_time) : Json(nullptr);
   json["collapse_position"] = s.collapse_position ? number(*s.collapse_position) : Json(nullptr);
   json["cluster_impacts"] = s.cluster_impacts;
+  json["rule_elastic_impacts"] = s.rule_elastic_impacts;
   json["critical_restitution"] = p && p->critical_restitution ? number(*p->critical_restitution) : Json(nullptr);
   json["spiral_angle"] = p && p->spiral_angle ? number(*p->spiral_angle) : Json(nullptr);
   json["multiple_collision"] = nullptr;
@@ -329,13 +362,13 @@ class SceneJsonWriter : public SceneReportWriter {
     sink_.put("{\"kind\":\"impact\",\"index\":");
     sink_.count(r.index);
     sink_.put(",\"pair\":\"");
-    sink_.put(core::pairName(r.pair_index));
+    sink_.put(impactPairName(r));
     sink_.put("\",\"pair_index\":");
     sink_.count(r.pair_index);
     sink_.put(",\"bodies\":[\"");
     sink_.put(core::bodyName(r.pair_index));
     sink_.put("\",\"");
-    sink_.put(core::bodyName(r.pair_index + 1));
+    sink_.put(core::bodyName(leftBody(r)));
     sink_.put("\"]");
     sink_.jsonField(",\"time\":", r.time);
     sink_.jsonField(",\"position\":", r.position);
@@ -444,7 +477,7 @@ class SceneCsvWriter : public SceneReportWriter {
   void impact(const core::ImpactRecord& r) override {
     sink_.count(r.index);
     sink_.put(',');
-    sink_.put(core::pairName(r.pair_index));
+    sink_.put(impactPairName(r));
     sink_.put(',');
     sink_.count(r.pair_index);
     for (double v : {r.time, r.position, r.velocities_before[0], r.velocities_before[1], r.velocities_after[0],
@@ -653,9 +686,9 @@ Json sceneEntryJson(const SceneEntry& entry) {
 Json impactJson(const core::ImpactRecord& r) {
   return Json{{"kind", "impact"},
               {"index", r.index},
-              {"pair", core::pairName(r.pair_index)},
+              {"pair", impactPairName(r)},
               {"pair_index", r.pair_index},
-              {"bodies", Json::array({core::bodyName(r.pair_index), core::bodyName(r.pair_index + 1)})},
+              {"bodies", Json::array({core::bodyName(r.pair_index), core::bodyName(leftBody(r))})},
               {"time", number(r.time)},
               {"position", number(r.position)},
               {"velocities_before", Json::array({number(r.velocities_before[0]), number(r.velocities_before[1])})},

@@ -192,6 +192,11 @@ Table<collision_lab::InitialConditions> initialConditionsTable() {
       .list("positions", "_m", &M::positions)
       .list("velocities", "_m_s", &M::velocities)
       .list("restitution", "", &M::restitution)
+      .field("restitution_model", &M::restitution_model)
+      .field("tc", &M::tc, "_s")
+      .field("elastic_below", &M::elastic_below, "_m_s")
+      .field("viscoelastic_speed", &M::viscoelastic_speed, "_m_s")
+      .field("ring", &M::ring, "_m")
       .field("max_collisions", &M::max_collisions)
       .field("student", &M::student)
       .elsewhere(kBodiesFile, {{"mass_kg", "masses"}, {"x_m", "positions"}, {"v_m_s", "velocities"}});
@@ -314,6 +319,7 @@ Table<collision_lab::RunSummary> runSummaryTable() {
       .field("collapse_position", &M::collapse_position, "_m")
       .field("collapse_count", &M::collapse_count)
       .field("cluster_impacts", &M::cluster_impacts)
+      .field("rule_elastic_impacts", &M::rule_elastic_impacts)
       .field("critical_restitution", &M::critical_restitution)
       .field("spiral_angle", &M::spiral_angle, "_rad")
       .field("max_prediction_error", &M::max_prediction_error)
@@ -411,7 +417,7 @@ class BodiesCsv {
   void add(const collision_lab::InitialConditions& m) {
     const std::size_t n = std::min({m.masses.size(), m.positions.size(), m.velocities.size()});
     const core::BodyStateReplay& replay =
-        runs_.insert_or_assign(m.run_id, core::BodyStateReplay(m.masses, m.positions, m.velocities)).first->second;
+        runs_.insert_or_assign(m.run_id, core::BodyStateReplay(m.masses, m.positions, m.velocities, m.ring)).first->second;
     for (std::size_t i = 0; i < n; ++i) {
       BodyRow r(0, 0.0, i, false);
       r.mass = m.masses[i], r.x = m.positions[i], r.v = m.velocities[i];
@@ -469,7 +475,8 @@ class BodiesCsv {
   /// run (bag_csv.h says how). An event that does not fit the run's bodies has no rows.
   void addMoved(const collision_lab::CollisionEvent& m, core::BodyStateReplay& state) {
     if (!replayEvent(state, m)) return;
-    for (std::size_t i = state.firstMoved(); i < state.endMoved(); ++i) {
+    for (std::size_t k = 0; k < state.movedCount(); ++k) {
+      const std::size_t i = (state.firstMoved() + k) % state.size();  // a ring's seam wraps
       BodyRow r(m.index, m.time, i, true);
       r.mass = state.mass(i), r.x = state.position(i, m.time), r.v_before = state.velocityBefore(i);
       r.v = state.velocities()[i], r.kinetic = state.kinetic(i), r.energy_transfer = state.energyGained(i);

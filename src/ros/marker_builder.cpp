@@ -175,7 +175,7 @@ std::vector<int> slotsOf(const std::vector<std::size_t>& bodies, std::size_t cou
 RunRecord::RunRecord(const collision_lab::InitialConditions& input, const RecordLimits& limits)
     : input_(input),
       limits_(limits),
-      replay_(input.masses, input.positions, input.velocities),
+      replay_(input.masses, input.positions, input.velocities, input.ring),
       first_collapse_time_(std::nan("")),
       min_velocity_(kInf),
       max_velocity_(-kInf) {
@@ -278,7 +278,7 @@ void RunRecord::widenVelocityRange(double v) {
 void RunRecord::apply(const collision_lab::CollisionEvent& event) {
   const std::size_t n = bodies();
   replayEvent(replay_, event);  // it fits: wellFormed
-  for (std::size_t i = replay_.firstMoved(); i < replay_.endMoved(); ++i) recordMove(i, event.time);
+  for (std::size_t k = 0; k < replay_.movedCount(); ++k) recordMove((replay_.firstMoved() + k) % replay_.size(), event.time);
   const double k = static_cast<double>(newest_index_);
   // The plotted bodies (at most kMaxPlottedBodies) have a step at every event.
   for (std::size_t slot = 0; slot < plotted_.size(); ++slot) {

@@ -49,7 +49,9 @@ static_assert(Rejected::NON_FINITE_VALUE == static_cast<std::uint8_t>(collision_
               Rejected::RESTITUTION_OUT_OF_RANGE ==
                   static_cast<std::uint8_t>(core::Reason::kRestitutionOutOfRange) &&
               Rejected::RESTITUTION_COUNT == static_cast<std::uint8_t>(core::Reason::kRestitutionCount) &&
-              Rejected::WALL_NOT_AT_END == static_cast<std::uint8_t>(core::Reason::kWallNotAtEnd),
+              Rejected::WALL_NOT_AT_END == static_cast<std::uint8_t>(core::Reason::kWallNotAtEnd) &&
+              Rejected::RESTITUTION_MODEL == static_cast<std::uint8_t>(core::Reason::kRestitutionModel) &&
+              Rejected::RING == static_cast<std::uint8_t>(core::Reason::kRing),
               "Rejected reason codes must match collision_lab::core::Reason");
 static_assert(collision_lab::Prediction::MODEL_NO_COLLISIONS == static_cast<std::uint8_t>(core::ModelKind::kNoCollisions) &&
               collision_lab::Prediction::MODEL_TWO_WALLS_INFINITE ==
@@ -84,8 +86,22 @@ std::vector<double> toVector(const std::array<double, 3>& values) {
   return {values.begin(), values.end()};
 }
 
+static_assert(collision_lab::InitialConditions::RESTITUTION_CONSTANT ==
+                      static_cast<std::uint8_t>(core::RestitutionModelKind::kConstant) &&
+                  collision_lab::InitialConditions::RESTITUTION_TC == static_cast<std::uint8_t>(core::RestitutionModelKind::kTc) &&
+                  collision_lab::InitialConditions::RESTITUTION_VISCOELASTIC ==
+                      static_cast<std::uint8_t>(core::RestitutionModelKind::kViscoelastic) &&
+                  collision_lab::InitialConditions::RESTITUTION_THRESHOLD ==
+                      static_cast<std::uint8_t>(core::RestitutionModelKind::kThreshold),
+              "InitialConditions restitution models must match collision_lab::core::RestitutionModelKind");
+
 core::Scene toScene(const collision_lab::InitialConditions& msg) {
-  return core::Scene{msg.masses, msg.positions, msg.velocities, msg.restitution};
+  core::Scene scene{msg.masses, msg.positions, msg.velocities, msg.restitution};
+  // An unknown model number stays unknown, for validate() to reject (RESTITUTION_MODEL).
+  scene.restitution_model = {static_cast<core::RestitutionModelKind>(msg.restitution_model), msg.tc,
+                             msg.viscoelastic_speed, msg.elastic_below};
+  scene.ring = msg.ring;
+  return scene;
 }
 
 collision_lab::InitialConditions toInitialConditions(const core::Scene& scene, core::RunMode mode,
@@ -96,6 +112,11 @@ collision_lab::InitialConditions toInitialConditions(const core::Scene& scene, c
   msg.positions = scene.positions;
   msg.velocities = scene.velocities;
   msg.restitution = scene.restitution;
+  msg.restitution_model = static_cast<std::uint8_t>(scene.restitution_model.kind);
+  msg.tc = scene.restitution_model.tc;
+  msg.elastic_below = scene.restitution_model.elastic_below;
+  msg.viscoelastic_speed = scene.restitution_model.viscoelastic_speed;
+  msg.ring = scene.ring;
   msg.max_collisions = max_collisions;
   return msg;
 }
@@ -377,7 +398,7 @@ void SceneEventConverter::fillBodies(collision_lab::CollisionEvent& msg) const {
 }
 
 collision_lab::CollisionEvent SceneEventConverter::impact(const core::ImpactRecord& record) {
-  const std::size_t p = record.pair_index;
+  const std::size_t p = record.pair_index, left = scene_.leftOf(p);  // left: body 0 across a ring's seam
   replay_.apply(record);
   collision_lab::CollisionEvent msg;
   msg.kind = collision_lab::CollisionEvent::KIND_IMPACT;
@@ -388,11 +409,11 @@ collision_lab::CollisionEvent SceneEventConverter::impact(const core::ImpactReco
   msg.restitution = scene_.restitutionOf(p);
   msg.first_moved = static_cast<std::uint32_t>(record.first_moved);
   msg.last_moved = static_cast<std::uint32_t>(record.last_moved);
-  msg.cluster_impact = record.first_moved != p || record.last_moved != p + 1;
+  msg.cluster_impact = record.first_moved != p || record.last_moved != left;
   for (std::size_t side = 0; side < 2; ++side) {
     msg.pair_velocities_before[side] = record.velocities_before[side];
     msg.pair_velocities_after[side] = record.velocities_after[side];
-    msg.pair_energy_transfer[side] = scene_.isWall(p + side) ? 0.0 : record.energy_gained[side];
+    msg.pair_energy_transfer[side] = scene_.isWall(side == 0 ? p : left) ? 0.0 : record.energy_gained[side];
   }
   msg.energy_lost = record.energy_lost;
   fillBodies(msg);
@@ -494,6 +515,7 @@ collision_lab::RunSummary toRunSummaryMsg(const core::SceneRunResult& result, st
   msg.collapse_position = valueOr(s.collapse_position);
   msg.collapse_count = static_cast<std::uint32_t>(s.collapses.size());
   msg.cluster_impacts = s.cluster_impacts;
+  msg.rule_elastic_impacts = s.rule_elastic_impacts;
   msg.max_prediction_error = s.max_prediction_error;
   msg.energy_relative_drift = s.energy_relative_drift;
   msg.momentum_relative_drift = s.momentum_relative_drift;
@@ -522,6 +544,7 @@ collision_lab::RunSummary toRunSummaryMsg(const core::LabRunSummary& summary, co
   msg.collapsed = false;
   msg.collapse_count = 0;
   msg.cluster_impacts = 0;
+  msg.rule_elastic_impacts = 0;
   msg.critical_restitution = core::criticalRestitution(prediction.angles.alpha);
   msg.spiral_angle = prediction.angles.theta;
   msg.max_prediction_error = summary.max_prediction_error;

@@ -129,6 +129,46 @@ TEST(NBodyCli, RestitutionScalesTheRelativeVelocityAndLosesEnergy) {
   EXPECT_NEAR(preset.at("summary").at("energy_lost").get<double>(), 0.36, 1e-15);
 }
 
+// Issue 21, by hand (test/core/nbody/test_granular_models.cpp has the derivation): A at 2 m
+// (-1 m/s) hits B (1 m) at t = 1; B then hits C (0 m) 4/3 s later, within t_c = 2 s, so that
+// impact is elastic; A reaches B again at t = 5, dissipating. Velocities -0.0625, -0.1875, -0.75.
+TEST(NBodyCli, TcModelMakesTheQuickReboundElastic) {
+  const Json doc = runJson({"--masses", "1,1,1", "--positions", "2,1,0", "--velocities", "-1,0,0", "--restitution",
+                            "0.5", "--restitution-model", "tc", "--tc", "2"});
+  const Json& summary = doc.at("summary");
+  EXPECT_EQ(summary.at("model"), "event_engine");
+  EXPECT_NE(summary.at("model_reason").get<std::string>().find("TC model"), std::string::npos);
+  EXPECT_EQ(summary.at("collision_count"), 3);
+  EXPECT_EQ(summary.at("rule_elastic_impacts"), 1);
+  EXPECT_EQ(doubles(summary.at("final_velocities")), (std::vector<double>{-0.0625, -0.1875, -0.75}));
+  EXPECT_EQ(doc.at("scene").at("restitution_model"), "tc");
+  EXPECT_EQ(doc.at("scene").at("tc"), 2.0);
+  // A parameter without its model is a usage error.
+  const CliOutput orphan = run({"--masses", "1,1", "--positions", "1,0", "--velocities", "-1,1", "--tc", "2"});
+  EXPECT_EQ(orphan.exit_code, 2);
+  EXPECT_NE(orphan.err.find("--tc belongs to --restitution-model tc"), std::string::npos) << orphan.err;
+}
+
+// The seam by hand: on a ring of 10 m, A (1 kg, 9 m, +1 m/s) meets B (3 kg, 1 m, -1 m/s)
+// across the seam at t = 1 s, x = 0: B stops, A leaves at -2 m/s.
+TEST(NBodyCli, RingSeamImpact) {
+  const Json doc = runJson({"--masses", "1,3", "--positions", "9,1", "--velocities", "1,-1", "--ring", "10",
+                            "--max-collisions", "1"});
+  ASSERT_EQ(doc.at("events").size(), 1u);
+  const Json& event = doc.at("events")[0];
+  EXPECT_EQ(event.at("pair_index"), 1);
+  EXPECT_EQ(event.at("pair"), "BA");  // B right, A left across the seam
+  EXPECT_EQ(event.at("bodies"), (Json{"B", "A"}));
+  EXPECT_EQ(event.at("time"), 1.0);
+  EXPECT_EQ(event.at("position"), 0.0);
+  EXPECT_EQ(doubles(event.at("velocities_after")), (std::vector<double>{0, -2}));
+  EXPECT_EQ(doubles(doc.at("summary").at("final_velocities")), (std::vector<double>{-2, 0}));
+  EXPECT_EQ(doc.at("scene").at("ring"), 10.0);
+  const CliOutput outside = run({"--masses", "1,3", "--positions", "11,1", "--velocities", "1,-1", "--ring", "10"});
+  EXPECT_EQ(outside.exit_code, 2);
+  EXPECT_NE(outside.err.find("(RING)"), std::string::npos) << outside.err;
+}
+
 // Newton's cradle with gaps (shared/physics.md): the pulse runs down the chain, one impact
 // per pair at t = 1, 2, 3, 4 s at x = 3, 2, 1, 0 m; the last ball leaves at -1 m/s.
 TEST(NBodyCli, CradleGivesFourImpactsAndTheLastBallLeaves) {

@@ -206,6 +206,36 @@ TEST(ScenarioFile, PhysicsIsLeftToValidate) {
   EXPECT_EQ(validate(scenes[1].scene)->reason, collision_lab::core::Reason::kPositionsNotOrdered);
 }
 
+// Issue 21: the restitution model with its parameter, and the ring (failed before: unknown keys).
+TEST(ScenarioFile, RestitutionModelAndRingKeys) {
+  using collision_lab::core::RestitutionModelKind;
+  const TemporaryYaml file(
+      "tc_gas: {masses: [1, 1, 1], positions: [2, 1, 0], velocities: [-1, 0, 0], restitution: 0.5,\n"
+      "         restitution_model: tc, tc: 1.0e-3}\n"
+      "slow_elastic: {masses: [1, 1], positions: [1, 0], velocities: [-1, 1], restitution: 0.5,\n"
+      "               restitution_model: threshold, elastic_below: 0.01}\n"
+      "soft: {masses: [1, 1], positions: [1, 0], velocities: [-1, 1], restitution_model: viscoelastic,\n"
+      "       viscoelastic_speed: 2}\n"
+      "ring: {masses: [1, 3], positions: [9, 1], velocities: [1, -1], ring: 10}\n");
+  const std::vector<SceneEntry> scenes = loadScenes(file.path());
+  ASSERT_EQ(scenes.size(), 4u);
+  const auto tc = findScene(scenes, "tc_gas").scene.restitution_model;
+  EXPECT_EQ(tc.kind, RestitutionModelKind::kTc);
+  EXPECT_EQ(tc.tc, 1.0e-3);
+  const auto threshold = findScene(scenes, "slow_elastic").scene.restitution_model;
+  EXPECT_EQ(threshold.kind, RestitutionModelKind::kThreshold);
+  EXPECT_EQ(threshold.elastic_below, 0.01);
+  const auto soft = findScene(scenes, "soft").scene.restitution_model;
+  EXPECT_EQ(soft.kind, RestitutionModelKind::kViscoelastic);
+  EXPECT_EQ(soft.viscoelastic_speed, 2.0);
+  EXPECT_EQ(findScene(scenes, "ring").scene.ring, 10.0);
+  for (const SceneEntry& entry : scenes) EXPECT_FALSE(collision_lab::core::validate(entry.scene).has_value()) << entry.name;
+  // A parameter without its model is an error that names it.
+  const TemporaryYaml orphan("x: {masses: [1, 1], positions: [1, 0], velocities: [-1, 1], tc: 1}\n");
+  EXPECT_NE(loadError(orphan.path()).find("'tc' belongs to restitution_model: tc"), std::string::npos)
+      << loadError(orphan.path());
+}
+
 TEST(ScenarioFile, UnknownNameListsTheKnownOnes) {
   const std::vector<NamedScene> scenes = loadScenarioFile(kData + "invalid_physics.yaml");
   try {

@@ -220,9 +220,10 @@ TEST_F(BagCsvTest, OneCsvPerTopicWithUnitsAndExactNumbers) {
   const Table input = readCsv(dir_ + "/csv/initial_conditions.csv");
   ASSERT_EQ(input.size(), 2u);
   EXPECT_EQ(input[0], split("stamp_s,run_id,time_s,mode,masses_kg,positions_m,velocities_m_s,restitution,"
+                            "restitution_model,tc_s,elastic_below_m_s,viscoelastic_speed_m_s,ring_m,"
                             "max_collisions,student"));
   EXPECT_EQ(input[1], (std::vector<std::string>{"1700000000.000000005", "csv_run", "0", "full", "10000;1;inf",
-                                                 "2;1;0", "-1;0;0", "", "0", "ana"}));
+                                                 "2;1;0", "-1;0;0", "", "0", "0", "0", "0", "0", "0", "ana"}));
 
   // The masses, positions and velocities of the input are the start's rows (index 0).
   const Table bodies = readCsv(dir_ + "/csv/bodies.csv");

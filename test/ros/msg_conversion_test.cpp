@@ -42,6 +42,32 @@ TEST(MsgConversion, AnySceneRoundTripKeepsItsListsAsGiven) {
   EXPECT_EQ(back.restitution, scene.restitution);
 }
 
+// Issue 21 (failed before: no such fields).
+TEST(MsgConversion, RestitutionModelAndRingRoundTrip) {
+  collision_lab::core::Scene scene{{1, 1}, {9, 1}, {1, -1}, {0.5}};
+  scene.restitution_model.kind = collision_lab::core::RestitutionModelKind::kTc;
+  scene.restitution_model.tc = 1e-3;
+  scene.ring = 10;
+  const auto msg = toInitialConditions(scene, collision_lab::core::RunMode::kFull, 0);
+  EXPECT_EQ(msg.restitution_model, collision_lab::InitialConditions::RESTITUTION_TC);
+  EXPECT_EQ(msg.tc, 1e-3);
+  EXPECT_EQ(msg.ring, 10.0);
+  const collision_lab::core::Scene back = toScene(msg);
+  EXPECT_EQ(back.restitution_model.kind, collision_lab::core::RestitutionModelKind::kTc);
+  EXPECT_EQ(back.restitution_model.tc, 1e-3);
+  EXPECT_EQ(back.ring, 10.0);
+  collision_lab::InitialConditions threshold;
+  threshold.restitution_model = collision_lab::InitialConditions::RESTITUTION_THRESHOLD;
+  threshold.elastic_below = 0.01;
+  EXPECT_EQ(toScene(threshold).restitution_model.elastic_below, 0.01);
+  collision_lab::InitialConditions soft;
+  soft.restitution_model = collision_lab::InitialConditions::RESTITUTION_VISCOELASTIC;
+  soft.viscoelastic_speed = 2;
+  EXPECT_EQ(toScene(soft).restitution_model.viscoelastic_speed, 2.0);
+  EXPECT_EQ(toScene(collision_lab::InitialConditions{}).restitution_model.kind,
+            collision_lab::core::RestitutionModelKind::kConstant);  // the default
+}
+
 /// The engine's record of an impact of pair `pair` that moved bodies first..last (the
 /// pair alone unless given).
 collision_lab::core::ImpactRecord record(std::uint64_t index, std::size_t pair, double t, double x,
@@ -93,6 +119,24 @@ TEST(SceneEventConverter, RebuildsEveryBodyThroughAStickingImpactAndAClusterImpa
   EXPECT_EQ(t.kinetic, (std::vector<double>{0, 0, 0.25}));
   EXPECT_EQ(t.energy_lost, 0.0);
   EXPECT_EQ(t.cumulative_energy_lost, 0.25);
+}
+
+// A ring's seam impact (issue 21; wrote past the bodies before): L = 10 m, A (1 kg, 9 m,
+// +1 m/s) meets B (3 kg, 1 m, -1 m/s) across the seam at t = 1 s, x = 0; by hand B stops and
+// A leaves at -2 m/s: B gains -1.5 J, A +1.5 J. The record is pair 1 (B right, A left).
+TEST(SceneEventConverter, ARingSeamImpactMovesBodyNMinus1AndBody0) {
+  collision_lab::core::Scene scene{{1, 3}, {9, 1}, {1, -1}, {}};
+  scene.ring = 10;
+  SceneEventConverter converter(scene);
+  const auto event = converter.impact(record(1, 1, 1.0, 0.0, {-1, 1}, {0, -2}, {-1.5, 1.5}, 0, 1, 0));
+  EXPECT_FALSE(event.cluster_impact);
+  EXPECT_EQ(event.first_moved, 1u);
+  EXPECT_EQ(event.last_moved, 0u);
+  EXPECT_EQ(event.velocities_after, (std::vector<double>{-2, 0}));
+  EXPECT_EQ(event.energy_transfer, (std::vector<double>{1.5, -1.5}));
+  EXPECT_EQ(event.pair_energy_transfer[0], -1.5);
+  EXPECT_EQ(event.pair_energy_transfer[1], 1.5);
+  EXPECT_EQ(converter.energyTransferMsg(event).delta, (std::vector<double>{1.5, -1.5}));
 }
 
 // Three equal masses that collapse: afterwards all move at the centre-of-mass velocity.

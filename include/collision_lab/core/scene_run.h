@@ -80,6 +80,8 @@ struct SceneSimulation {
   /// Impacts in which a cluster (stuck by e = 0 or left by a collapse) was hit as one body
   /// of its total mass (the cluster rule, nbody/engine.h).
   std::uint64_t cluster_impacts = 0;
+  /// Impacts the scene's restitution model made elastic (EngineResult::rule_elastic_impacts).
+  std::uint64_t rule_elastic_impacts = 0;
   double energy_relative_drift = 0.0;    ///< as EngineResult; NaN when not simulated
   double momentum_relative_drift = 0.0;  ///< as EngineResult; NaN when not simulated or with a wall
   /// Simulated and predicted with a finite count: the engine's count equals it and

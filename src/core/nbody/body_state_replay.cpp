@@ -18,8 +18,8 @@ void BodyStateReplay::Sum::add(double x) {
 }
 
 BodyStateReplay::BodyStateReplay(std::vector<double> masses, std::vector<double> positions,
-                                 std::vector<double> velocities)
-    : masses_(std::move(masses)), velocities_(std::move(velocities)), points_(std::move(positions)) {
+                                 std::vector<double> velocities, double ring)
+    : masses_(std::move(masses)), velocities_(std::move(velocities)), points_(std::move(positions)), ring_(ring) {
   const std::size_t n = std::min({masses_.size(), points_.size(), velocities_.size()});
   masses_.resize(n), velocities_.resize(n), points_.resize(n);
   since_.assign(n, 0.0);
@@ -32,12 +32,19 @@ BodyStateReplay::BodyStateReplay(std::vector<double> masses, std::vector<double>
 }
 
 BodyStateReplay::BodyStateReplay(const Scene& scene)
-    : BodyStateReplay(scene.masses, scene.positions, scene.velocities) {}
+    : BodyStateReplay(scene.masses, scene.positions, scene.velocities, scene.ring) {}
 
 bool BodyStateReplay::isWall(std::size_t body) const { return std::isinf(masses_[body]); }
 
 double BodyStateReplay::position(std::size_t body, double t) const {
-  return points_[body] + velocities_[body] * (t - since_[body]);
+  const double x = points_[body] + velocities_[body] * (t - since_[body]);
+  if (ring_ == 0.0) return x;
+  const double wrapped = std::fmod(x, ring_);
+  return wrapped < 0.0 ? wrapped + ring_ : wrapped;
+}
+
+std::size_t BodyStateReplay::offset(std::size_t body) const {
+  return (body + size() - first_moved_) % size();
 }
 
 std::vector<double> BodyStateReplay::positions(double t) const {
@@ -47,17 +54,18 @@ std::vector<double> BodyStateReplay::positions(double t) const {
 }
 
 double BodyStateReplay::velocityBefore(std::size_t body) const {
-  return body >= first_moved_ && body < endMoved() ? before_[body - first_moved_] : velocities_[body];
+  return offset(body) < before_.size() ? before_[offset(body)] : velocities_[body];
 }
 
 double BodyStateReplay::energyGained(std::size_t body) const {
-  return body >= first_moved_ && body < endMoved() ? gained_[body - first_moved_] : 0.0;
+  return offset(body) < gained_.size() ? gained_[offset(body)] : 0.0;
 }
 
-void BodyStateReplay::begin(std::size_t first, std::size_t last, double time) {
+void BodyStateReplay::begin(std::size_t first, std::size_t count, double time) {
   time_ = time;
   first_moved_ = first;
-  before_.assign(velocities_.begin() + first, velocities_.begin() + last + 1);
+  before_.clear();
+  for (std::size_t k = 0; k < count; ++k) before_.push_back(velocities_[(first + k) % size()]);
   gained_.clear();
 }
 
@@ -77,11 +85,16 @@ void BodyStateReplay::set(std::size_t body, double velocity, double position) {
 }
 
 bool BodyStateReplay::apply(const ImpactRecord& record) {
-  const std::size_t p = record.pair_index;
-  if (!(record.first_moved <= p && p < record.last_moved && record.last_moved < size())) return false;
-  begin(record.first_moved, record.last_moved, record.time);
-  for (std::size_t i = record.first_moved; i <= record.last_moved; ++i) {
-    set(i, record.velocities_after[i <= p ? 0 : 1], record.position);
+  const std::size_t p = record.pair_index, n = size();
+  const bool seam = ring_ != 0.0 && n >= 2 && p == n - 1;  // a ring's seam: body N-1 meets body 0
+  const bool fits = seam ? record.first_moved <= p && record.last_moved < record.first_moved
+                         : record.first_moved <= p && p < record.last_moved && record.last_moved < n;
+  if (!fits) return false;
+  const std::size_t right = p - record.first_moved + 1;  // bodies first_moved..p
+  const std::size_t count = right + (record.last_moved + n - (p + 1)) % n + 1;
+  begin(record.first_moved, count, record.time);
+  for (std::size_t k = 0; k < count; ++k) {
+    set((record.first_moved + k) % n, record.velocities_after[k < right ? 0 : 1], record.position);
   }
   ++impacts_;
   last_heat_ = record.energy_lost;
@@ -91,7 +104,7 @@ bool BodyStateReplay::apply(const ImpactRecord& record) {
 
 bool BodyStateReplay::apply(const Collapse& collapse) {
   if (!(collapse.first_body < collapse.last_body && collapse.last_body < size())) return false;
-  begin(collapse.first_body, collapse.last_body, collapse.time);
+  begin(collapse.first_body, collapse.last_body - collapse.first_body + 1, collapse.time);
   last_heat_ = 0.0;
   for (std::size_t i = collapse.first_body; i <= collapse.last_body; ++i) {
     set(i, collapse.velocity, collapse.position);

@@ -17,7 +17,7 @@ namespace core {
 
 namespace nbody_detail {
 
-SceneTables::SceneTables(const Scene& s) : scene(s), pairs(s.pairCount()) {
+SceneTables::SceneTables(const Scene& s) : scene(s), pairs(s.contactCount()), ring(s.ring) {
   for (std::size_t k = 0; k < s.size(); ++k) {
     const bool wall = s.isWall(k);
     sqrt_mass.push_back(wall ? 0.0 : std::sqrt(s.masses[k]));
@@ -25,7 +25,7 @@ SceneTables::SceneTables(const Scene& s) : scene(s), pairs(s.pairCount()) {
   }
   for (std::size_t p = 0; p < pairs; ++p) {
     // The loss at unit approach speed, (1 - e^2) mu / 2: one home for the formula.
-    loss_factor.push_back(impactEnergyLost(s.masses[p], s.masses[p + 1], 1.0, s.restitutionOf(p)));
+    loss_factor.push_back(impactEnergyLost(s.masses[p], s.masses[s.leftOf(p)], 1.0, s.restitutionOf(p)));
   }
 }
 
@@ -100,6 +100,8 @@ class Driver {
     last_ = pair;
     history_.push_back(pair);
     if (history_.size() > 3 * group_detail::kMaxPeriod) history_.pop_front();
+    // The collapse tests assume each pair's constant e and an open line.
+    if (tables_.ring != 0.0 || tables_.scene.restitution_model.kind != RestitutionModelKind::kConstant) return {};
     if (alternating_ < 8) return groupCollapse(result);
     const std::size_t p = std::min(last_, before_last_), q = std::max(last_, before_last_);
     const auto found = fast_->collapseCandidate(p, q, last_ == p);
@@ -382,6 +384,10 @@ std::string stopMessage(const Scene& scene, const EngineResult& result, bool exh
       if (result.cluster_impacts > 0) {
         text += "; " + std::to_string(result.cluster_impacts) + " impacts hit a cluster as one body of its total mass";
       }
+      if (result.rule_elastic_impacts > 0) {
+        text += "; " + std::to_string(result.rule_elastic_impacts) + " impacts made elastic by the " +
+                restitutionModelName(scene.restitution_model.kind) + " restitution model";
+      }
       return text;
     }
     case StopReason::kCap:
@@ -397,7 +403,8 @@ std::string stopMessage(const Scene& scene, const EngineResult& result, bool exh
     case StopReason::kCancelled: return "cancelled after " + count + " impacts (truncated)";
     case StopReason::kMultipleCollision: {
       const MultipleCollision& c = *result.multiple_collision;
-      return bodyName(c.first_body) + ", " + bodyName(c.first_body + 1) + " and " + bodyName(c.first_body + 2) +
+      return bodyName(c.first_body) + ", " + bodyName(scene.leftOf(c.first_body)) + " and " +
+             bodyName(scene.leftOf(scene.leftOf(c.first_body))) +
              " meet at the same instant t = " + formatValue(c.time) + " s after " + count +
              " impacts: a multiple collision, whose outcome point masses do not define, so the run ends here";
     }
@@ -504,6 +511,7 @@ EngineResult runEngine(const Scene& scene, const EngineOptions& options, const I
     result.final_time = std::max(result.final_time, result.collapses.back().time);
   }
   result.cluster_impacts = driver.fast().clusterImpacts();
+  result.rule_elastic_impacts = driver.fast().ruleElastic();
   driver.fast().state(result.final_time, result.final_positions, result.final_velocities);
   result.energy_lost = driver.fast().energyLost();
   result.escalations = driver.escalations();

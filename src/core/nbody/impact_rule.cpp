@@ -1,5 +1,8 @@
 #include "collision_lab/core/nbody/impact_rule.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include "double_double.h"
 
 namespace collision_lab {
@@ -10,6 +13,13 @@ double impactEnergyLost(double m_i, double m_j, double approach, double e) {
   // mu = m_i m_j / (m_i + m_j), without overflow or inf / inf; a wall leaves the other mass.
   const double mu = std::isinf(m_i) ? m_j : (std::isinf(m_j) ? m_i : m_i / (1.0 + m_i / m_j));
   return 0.5 * (1.0 - e) * (1.0 + e) * mu * approach * approach;
+}
+
+double viscoelasticRestitution(double speed, double v_star) {
+  constexpr double kC1 = 1.15344, kC2 = 0.79826;
+  const double s = std::pow(speed / v_star, 0.2);
+  const double e = 1.0 - kC1 * s + kC2 * s * s;
+  return std::min(1.0, std::max(0.0, e));
 }
 
 ImpactOutcome impact(double m_i, double m_j, double v_i, double v_j, double e) {

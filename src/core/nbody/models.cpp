@@ -14,10 +14,33 @@ namespace core {
 namespace {
 
 bool anyApproaching(const Scene& scene) {
-  for (std::size_t p = 0; p < scene.pairCount(); ++p) {
-    if (scene.velocities[p] < scene.velocities[p + 1]) return true;
+  for (std::size_t p = 0; p < scene.contactCount(); ++p) {
+    if (scene.velocities[p] < scene.velocities[scene.leftOf(p)]) return true;
   }
   return false;
+}
+
+/// A restitution model that can change some impact's e (TC and the threshold only make
+/// impacts elastic, so they change nothing in an elastic scene).
+bool restitutionModelActs(const Scene& scene) {
+  const RestitutionModelKind kind = scene.restitution_model.kind;
+  return kind == RestitutionModelKind::kViscoelastic || (kind != RestitutionModelKind::kConstant && !scene.isElastic());
+}
+
+std::string restitutionModelText(const Scene& scene) {
+  const RestitutionModel& model = scene.restitution_model;
+  switch (model.kind) {
+    case RestitutionModelKind::kTc:
+      return "the TC model (t_c = " + std::to_string(model.tc) + " s: an impact is elastic unless both bodies' last "
+             "impacts are more than t_c ago)";
+    case RestitutionModelKind::kThreshold:
+      return "the threshold law (e = 1 below an approach speed of " + std::to_string(model.elastic_below) + " m/s)";
+    case RestitutionModelKind::kViscoelastic:
+      return "the viscoelastic law e(v) = 1 - C1 (v/v*)^(1/5) + C2 (v/v*)^(2/5) (v* = " +
+             std::to_string(model.viscoelastic_speed) + " m/s)";
+    case RestitutionModelKind::kConstant: break;
+  }
+  return "a constant e per pair";
 }
 
 /// Walls at both ends that do not move apart, and no pair that can stick (e = 0).
@@ -48,6 +71,11 @@ std::string modelReason(ModelKind kind, const Scene& scene) {
     case ModelKind::kThreeBodyRotation:
       return "three elastic bodies: the paper's rotation model gives the exact count and state in O(1)";
     case ModelKind::kGhosts:
+      if (scene.isRing()) {
+        return "equal masses on a ring exchange velocities, so the bodies move like ghosts passing through each other "
+               "round the ring: the impacts by time t are the ghosts' crossings by t (ringCrossingsBy), and ghosts of "
+               "different velocities cross again every L / |u_i - u_j|: infinitely many impacts (a run stops at its cap)";
+      }
       return "equal masses exchange velocities, so the bodies move like ghosts passing through each other: "
              "the count is the number of inversions and the final velocities are the initial ones sorted";
     case ModelKind::kThreeBodySpiral:
@@ -62,6 +90,15 @@ std::string modelReason(ModelKind kind, const Scene& scene) {
                                      : "");
     case ModelKind::kEventEngine: break;
   }
+  if (restitutionModelActs(scene)) {
+    return "the restitution of each impact follows " + restitutionModelText(scene) +
+           ": no count formula exists, so the exact event engine simulates every impact";
+  }
+  if (scene.isRing()) {
+    return "no count formula exists for " + std::to_string(scene.size()) +
+           " bodies on a ring with these masses and restitution: the exact event engine simulates every impact "
+           "(body N-1 meets body 0 across the seam)";
+  }
   if (scene.size() == 3 && scene.wallCount() < 2 && scene.restitutionOf(0) != scene.restitutionOf(1)) {
     return "three bodies with two different e, one of them 0 (a pair that sticks): the exact event engine simulates "
            "every impact";
@@ -74,6 +111,8 @@ ModelKind chooseKind(const Scene& scene) {
   const std::size_t n = scene.size();
   if (n == 1 || !anyApproaching(scene)) return ModelKind::kNoCollisions;
   if (confinedForever(scene)) return ModelKind::kTwoWallsInfinite;
+  if (restitutionModelActs(scene)) return ModelKind::kEventEngine;
+  if (scene.isRing()) return equalFiniteMasses(scene) && scene.isElastic() ? ModelKind::kGhosts : ModelKind::kEventEngine;
   if (n == 2) return ModelKind::kTwoBody;
   if (n == 3 && scene.isElastic() && scene.wallCount() < 2) return ModelKind::kThreeBodyRotation;
   if (n == 3 && scene.wallCount() < 2 && !scene.isWall(1) &&
@@ -202,6 +241,10 @@ Prediction predictTwoBody(const Scene& scene) {
 
 Prediction predictGhosts(const Scene& scene) {
   Prediction prediction = base(ModelKind::kGhosts, scene);
+  if (scene.isRing()) {  // some pair approaches, so two ghosts differ in velocity: they meet forever
+    prediction.infinite = true;
+    return prediction;
+  }
   prediction.impact_count = countInversions(scene.velocities);
   prediction.final_velocities = scene.velocities;
   // The fastest rightward ends on the right, at index 0.
@@ -293,6 +336,23 @@ std::optional<Prediction> predict(const Scene& scene) {
     case ModelKind::kEventEngine: break;
   }
   return std::nullopt;
+}
+
+std::uint64_t ringCrossingsBy(const Scene& scene, double t) {
+  const double length = scene.ring;
+  std::uint64_t crossings = 0;
+  for (std::size_t i = 0; i < scene.size(); ++i) {
+    for (std::size_t j = i + 1; j < scene.size(); ++j) {
+      // Ghost i is ahead of ghost j by d in (0, L) (x_i > x_j); their gap changes at w.
+      const double d = scene.positions[i] - scene.positions[j], w = scene.velocities[i] - scene.velocities[j];
+      if (w < 0) {  // i is caught up at d + w t = 0, -L, -2L, ...
+        if (-w * t >= d) crossings += static_cast<std::uint64_t>(std::floor((-w * t - d) / length)) + 1;
+      } else if (w > 0) {  // i laps j from behind at d + w t = L, 2L, ...
+        crossings += static_cast<std::uint64_t>(std::floor((d + w * t) / length));
+      }
+    }
+  }
+  return crossings;
 }
 
 std::uint64_t countInversions(const std::vector<double>& velocities) {

@@ -55,12 +55,12 @@ std::optional<ValidationError> checkShape(const Scene& scene) {
   if (n == 0) {
     return makeError(Reason::kEmptyScene, "masses", "the scene has no bodies; give at least one mass, position and velocity");
   }
-  const std::size_t count = scene.restitution.size();
-  if (count != 0 && count != 1 && count != n - 1) {
+  const std::size_t count = scene.restitution.size(), pairs = scene.contactCount();
+  if (count != 0 && count != 1 && count != pairs) {
     return makeError(Reason::kRestitutionCount, "restitution",
-                     std::to_string(count) + " values for " + std::to_string(n - 1) +
-                         " pairs; give none (elastic), one for every pair, or one per pair (N-1 = " +
-                         std::to_string(n - 1) + ")");
+                     std::to_string(count) + " values for " + std::to_string(pairs) +
+                         " pairs; give none (elastic), one for every pair, or one per pair (" +
+                         (scene.isRing() ? "N on a ring = " : "N-1 = ") + std::to_string(pairs) + ")");
   }
   for (std::size_t i = 0; i < count; ++i) {
     const double e = scene.restitution[i];
@@ -93,7 +93,7 @@ std::optional<ValidationError> checkMasses(const Scene& scene) {
   if (n == 2 && scene.isWall(0) && scene.isWall(1)) {
     return makeError(Reason::kTwoWalls, "masses", "both bodies are walls (inf) with no body between them; give one a finite mass");
   }
-  if (n == 3 && scene.isElastic()) return std::nullopt;  // the rotation model: any ratio
+  if (n == 3 && scene.isElastic() && !scene.isRing()) return std::nullopt;  // the rotation model: any ratio
   double lightest = kInf, heaviest = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
     if (scene.isWall(i)) continue;
@@ -104,6 +104,64 @@ std::optional<ValidationError> checkMasses(const Scene& scene) {
     return makeError(Reason::kOverflow, "masses",
                      "the ratio of the largest to the smallest finite mass exceeds 1e100 (" + formatValue(heaviest) +
                          " / " + formatValue(lightest) + " kg); make the heavy body a wall (inf) instead");
+  }
+  return std::nullopt;
+}
+
+/// The restitution model's parameter, and viscoelastic only with an elastic restitution
+/// list (its e(v) replaces the pairs' e).
+std::optional<ValidationError> checkRestitutionModel(const Scene& scene) {
+  const RestitutionModel& model = scene.restitution_model;
+  const auto positive = [](double value) { return value > 0.0 && std::isfinite(value); };
+  switch (model.kind) {
+    case RestitutionModelKind::kConstant: return std::nullopt;
+    case RestitutionModelKind::kTc:
+      if (positive(model.tc)) return std::nullopt;
+      return makeError(Reason::kRestitutionModel, "tc",
+                       "t_c = " + formatValue(model.tc) + " s; the TC model needs a positive finite time in s");
+    case RestitutionModelKind::kThreshold:
+      if (positive(model.elastic_below)) return std::nullopt;
+      return makeError(Reason::kRestitutionModel, "elastic_below",
+                       "v_0 = " + formatValue(model.elastic_below) +
+                           " m/s; the threshold model needs a positive finite speed in m/s");
+    case RestitutionModelKind::kViscoelastic:
+      if (!positive(model.viscoelastic_speed)) {
+        return makeError(Reason::kRestitutionModel, "viscoelastic_speed",
+                         "v* = " + formatValue(model.viscoelastic_speed) +
+                             " m/s; the viscoelastic model needs a positive finite speed in m/s");
+      }
+      if (scene.isElastic()) return std::nullopt;
+      return makeError(Reason::kRestitutionModel, "restitution",
+                       "the viscoelastic model gives every impact its e(v); leave restitution empty (or 1)");
+  }
+  return makeError(Reason::kRestitutionModel, "restitution_model",
+                   std::to_string(static_cast<int>(model.kind)) + " is not a restitution model (0-3)");
+}
+
+/// A ring: a positive finite circumference, no wall, every position in [0, L).
+std::optional<ValidationError> checkRing(const Scene& scene) {
+  if (!scene.isRing()) return std::nullopt;
+  const double length = scene.ring;
+  if (!(length > 0.0 && std::isfinite(length))) {
+    return makeError(Reason::kRing, "ring", "L = " + formatValue(length) + " m; a ring needs a positive finite circumference in m");
+  }
+  for (std::size_t p = 0; p < scene.contactCount(); ++p) {
+    if (scene.restitutionOf(p) == 0.0) {
+      return makeError(Reason::kRing, "restitution",
+                       "e = 0 makes bodies stick into clusters, which a ring does not support; give every pair e > 0");
+    }
+  }
+  for (std::size_t i = 0; i < scene.size(); ++i) {
+    if (scene.isWall(i)) {
+      return makeError(Reason::kRing, indexedField("masses", i),
+                       "the mass of " + bodyName(i) + " is inf, but a ring has no walls; give it a finite mass in kg");
+    }
+    const double x = scene.positions[i];
+    if (std::isfinite(x) && !(x >= 0.0 && x < length)) {
+      return makeError(Reason::kRing, indexedField("positions", i),
+                       "x_" + bodyName(i) + " = " + formatValue(x) + " m lies outside the ring's [0, " +
+                           formatValue(length) + ") m");
+    }
   }
   return std::nullopt;
 }
@@ -155,10 +213,12 @@ std::optional<ValidationError> checkRange(const Scene& scene) {
                            " kg, v = " + formatValue(v[i]) + " m/s) overflows a double; rescale the units");
     }
   }
-  for (std::size_t i = 0; i + 1 < scene.size(); ++i) {
-    if (!std::isfinite(x[i] - x[i + 1]) || !std::isfinite(4.0 * (std::fabs(v[i]) + std::fabs(v[i + 1])))) {
+  for (std::size_t i = 0; i < scene.contactCount(); ++i) {
+    const std::size_t j = scene.leftOf(i);
+    if (!std::isfinite(x[i] - x[j] + (j == 0 ? scene.ring : 0.0)) ||
+        !std::isfinite(4.0 * (std::fabs(v[i]) + std::fabs(v[j])))) {
       return makeError(Reason::kOverflow, "positions",
-                       "the gap or relative velocity between " + bodyName(i) + " and " + bodyName(i + 1) +
+                       "the gap or relative velocity between " + bodyName(i) + " and " + bodyName(j) +
                            " overflows a double; rescale the units");
     }
   }
@@ -182,7 +242,7 @@ std::string formatShort(const Rational& q) {
 /// collisions than ceil(pi / alpha). Only a light B makes that many: the count grows like
 /// pi sqrt(m / m_B) with m the lighter of A and C.
 std::optional<ValidationError> checkCountFits(const Scene& scene) {
-  if (scene.size() != 3 || !scene.isElastic() || scene.wallCount() == 2) return std::nullopt;
+  if (scene.size() != 3 || !scene.isElastic() || scene.wallCount() == 2 || scene.isRing()) return std::nullopt;
   const std::array<double, 3> masses{scene.masses[0], scene.masses[1], scene.masses[2]};
   if (checkedMaxPossibleCollisionCount(masses)) return std::nullopt;
   const double most = M_PI / anglesFor(masses).alpha;
@@ -195,9 +255,12 @@ std::optional<ValidationError> checkCountFits(const Scene& scene) {
                        " kg the lighter of A and C: make B heavier or that body lighter");
 }
 
+/// Contact pair p's first meeting time (the seam pair's left body at x_0 - L).
 Rational exactTime(const Scene& scene, std::size_t p) {
-  const Rational gap = Rational(scene.positions[p]) - Rational(scene.positions[p + 1]);
-  return gap / (Rational(scene.velocities[p + 1]) - Rational(scene.velocities[p]));
+  const std::size_t j = scene.leftOf(p);
+  const Rational gap =
+      Rational(scene.positions[p]) - Rational(scene.positions[j]) + (j == 0 ? Rational(scene.ring) : Rational(0));
+  return gap / (Rational(scene.velocities[j]) - Rational(scene.velocities[p]));
 }
 
 /// The first contact, which certainly happens: not two contacts sharing a body at once, and
@@ -206,13 +269,14 @@ Rational exactTime(const Scene& scene, std::size_t p) {
 std::optional<ValidationError> checkFirstContact(const Scene& scene) {
   const auto& x = scene.positions;
   const auto& v = scene.velocities;
-  std::vector<double> time(scene.pairCount(), kInf);
+  std::vector<double> time(scene.contactCount(), kInf);
   double first = kInf;
   bool approaching = false;
   for (std::size_t p = 0; p < time.size(); ++p) {
-    if (!(v[p] < v[p + 1])) continue;
+    const std::size_t j = scene.leftOf(p);
+    if (!(v[p] < v[j])) continue;
     approaching = true;
-    time[p] = (x[p] - x[p + 1]) / (v[p + 1] - v[p]);
+    time[p] = (x[p] - x[j] + (j == 0 ? scene.ring : 0.0)) / (v[j] - v[p]);
     first = std::min(first, time[p]);
   }
   if (!approaching) return std::nullopt;
@@ -221,23 +285,28 @@ std::optional<ValidationError> checkFirstContact(const Scene& scene) {
   const double window = first * (1.0 + 0x1p-48) + 4.0 * std::numeric_limits<double>::denorm_min();
   std::vector<std::size_t> candidates;
   for (std::size_t p = 0; p < time.size(); ++p) {
-    if (v[p] < v[p + 1] && time[p] <= window) candidates.push_back(p);
+    if (v[p] < v[scene.leftOf(p)] && time[p] <= window) candidates.push_back(p);
   }
   std::vector<Rational> exact;
   for (std::size_t p : candidates) exact.push_back(exactTime(scene, p));
   const std::size_t earliest_k = static_cast<std::size_t>(std::min_element(exact.begin(), exact.end()) - exact.begin());
   const Rational& earliest = exact[earliest_k];
-  for (std::size_t k = 0; k + 1 < candidates.size(); ++k) {
-    const std::size_t p = candidates[k];
-    if (candidates[k + 1] == p + 1 && exact[k] == earliest && exact[k + 1] == earliest) {
+  // Two contacts sharing a body: consecutive pairs, or on a ring the seam pair and pair 0.
+  const std::size_t n = candidates.size();
+  for (std::size_t k = 0; k < n && n >= 2; ++k) {
+    const std::size_t p = candidates[k], next = (k + 1) % n;
+    const bool shared = candidates[next] == p + 1 || (next == 0 && k == n - 1 && scene.leftOf(p) == 0 &&
+                                                      candidates[0] == 0 && scene.size() > 2);
+    if (shared && exact[k] == earliest && exact[next] == earliest) {
       return makeError(Reason::kTripleCollision, "positions",
-                       bodyName(p) + ", " + bodyName(p + 1) + " and " + bodyName(p + 2) +
+                       bodyName(p) + ", " + bodyName(scene.leftOf(p)) + " and " +
+                           bodyName(scene.leftOf(scene.leftOf(p))) +
                            " would meet at the same instant (t = " + formatShort(earliest) +
                            " s), a multiple collision whose outcome point masses do not define; move one of them");
     }
   }
   const std::size_t pair = candidates[earliest_k];
-  const std::string contact = "the first contact, of " + bodyName(pair) + " and " + bodyName(pair + 1) + ", ";
+  const std::string contact = "the first contact, of " + bodyName(pair) + " and " + bodyName(scene.leftOf(pair)) + ", ";
   const Rational largest(std::numeric_limits<double>::max());
   if (earliest > largest) {
     return makeError(Reason::kOverflow, "positions",
@@ -276,6 +345,16 @@ bool Scene::isElastic() const {
   return std::all_of(restitution.begin(), restitution.end(), [](double e) { return e == 1.0; });
 }
 
+const char* restitutionModelName(RestitutionModelKind kind) {
+  switch (kind) {
+    case RestitutionModelKind::kConstant: return "constant";
+    case RestitutionModelKind::kTc: return "tc";
+    case RestitutionModelKind::kViscoelastic: return "viscoelastic";
+    case RestitutionModelKind::kThreshold: return "threshold";
+  }
+  return "unknown";
+}
+
 std::string bodyName(std::size_t body) {
   if (body < 26) return std::string(1, static_cast<char>('A' + body));
   return "#" + std::to_string(body);
@@ -302,6 +381,8 @@ const char* reasonName(Reason reason) {
     case Reason::kRestitutionOutOfRange: return "RESTITUTION_OUT_OF_RANGE";
     case Reason::kRestitutionCount: return "RESTITUTION_COUNT";
     case Reason::kWallNotAtEnd: return "WALL_NOT_AT_END";
+    case Reason::kRestitutionModel: return "RESTITUTION_MODEL";
+    case Reason::kRing: return "RING";
   }
   return "UNKNOWN";
 }
@@ -309,6 +390,8 @@ const char* reasonName(Reason reason) {
 std::optional<ValidationError> validate(const Scene& scene) {
   if (auto error = checkShape(scene)) return error;
   if (auto error = checkMasses(scene)) return error;
+  if (auto error = checkRestitutionModel(scene)) return error;
+  if (auto error = checkRing(scene)) return error;
   if (auto error = checkFinite(scene.positions, "positions", "x_", "position must be a finite number in m")) return error;
   if (auto error = checkFinite(scene.velocities, "velocities", "v_", "velocity must be a finite number in m/s")) return error;
   if (auto error = checkOrder(scene)) return error;

@@ -25,8 +25,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <array>
 #include <cstdint>
+#include <cstring>
 #include <limits>
+#include <optional>
 #include <vector>
 
 #include "arithmetic.h"
@@ -56,6 +59,9 @@ struct SceneTables {
   std::vector<double> sqrt_mass;      ///< sqrt(m) [kg^0.5]; 0 for a wall (it carries no error)
   std::vector<double> inv_sqrt_mass;  ///< 1 / sqrt(m) [kg^-0.5]; 0 for a wall
   std::vector<double> loss_factor;    ///< (1 - e^2) mu / 2 per pair [kg]
+  /// Circumference of a ring [m] (0: none). Pair p's left body is scene.leftOf(p); across
+  /// the seam (pair N-1) it is body 0 seen at x - L, so its gap gains L.
+  double ring = 0.0;
 };
 
 /// kAmbiguous: a decision this tier cannot take; kImprecise: its state no longer pins down
@@ -94,6 +100,11 @@ struct StepResult {
   bool at_zero = false;  ///< kAmbiguous on a value exactly 0 at this precision: likely an exact tie
 };
 
+/// TC: bounds [s] of the time of a body's last impact (-inf: none yet); shared by the tiers.
+struct Clock {
+  double lo = -kInf, hi = -kInf;
+};
+
 template <class S>
 class Tier {
  public:
@@ -104,15 +115,24 @@ class Tier {
     for (std::size_t k = 0; k < scene.size(); ++k) {
       bodies_.push_back({S(scene.positions[k]), S(scene.velocities[k])});
     }
+    const RestitutionModelKind model = scene.restitution_model.kind;
     for (std::size_t p = 0; p < tables.pairs; ++p) {
+      const std::size_t j = left(p);
       PairState pair;
-      pair.map = makeImpactMap<S>(scene.masses[p], scene.masses[p + 1], scene.restitutionOf(p));
-      pair.scale = tables.inv_sqrt_mass[p] + tables.inv_sqrt_mass[p + 1];
-      pair.sqrt_heavy = tables.sqrt_mass[pair.map.heavy_is_i ? p : p + 1];
-      pair.sqrt_light = tables.sqrt_mass[pair.map.heavy_is_i ? p + 1 : p];
+      pair.map = makeImpactMap<S>(scene.masses[p], scene.masses[j], scene.restitutionOf(p));
+      pair.scale = tables.inv_sqrt_mass[p] + tables.inv_sqrt_mass[j];
+      pair.sqrt_heavy = tables.sqrt_mass[pair.map.heavy_is_i ? p : j];
+      pair.sqrt_light = tables.sqrt_mass[pair.map.heavy_is_i ? j : p];
       pairs_.push_back(pair);
+      if (model == RestitutionModelKind::kTc || model == RestitutionModelKind::kThreshold) {
+        elastic_maps_.push_back(makeImpactMap<S>(scene.masses[p], scene.masses[j], 1.0));
+      }
     }
     bonded_.assign(tables.pairs, 0);
+    if (model == RestitutionModelKind::kTc) {
+      clocks_.assign(scene.size(), Clock{});
+      if constexpr (Ar::kExact) last_exact_.assign(scene.size(), S(0));
+    }
   }
 
   /// Schedules every pair from the initial state.
@@ -129,6 +149,7 @@ class Tier {
   std::uint64_t count() const { return count_; }
   std::uint64_t refinements() const { return refinements_; }
   std::uint64_t clusterImpacts() const { return cluster_impacts_; }
+  std::uint64_t ruleElastic() const { return rule_elastic_; }
   std::size_t merged() const { return merged_; }
   double energyLost() const { return lost_ + lost_compensation_; }
   /// Time of the last impact [s], or of the one in progress (0 before the first).
@@ -164,6 +185,8 @@ class Tier {
     count_ = from.count_;
     bonded_ = from.bonded_;
     cluster_impacts_ = from.cluster_impacts_;
+    rule_elastic_ = from.rule_elastic_;
+    clocks_ = from.clocks_;  // a less precise tier needs only their bounds
     merged_ = from.merged_;
     lost_ = from.lost_;
     lost_compensation_ = from.lost_compensation_;
@@ -189,6 +212,12 @@ class Tier {
     if (collide(m, nullptr).kind != StepKind::kImpact) {
       restore(m, undo);
       return false;
+    }
+    if (tables_.ring != 0.0) {  // no clusters on a ring (validate: every e > 0)
+      for (std::size_t q : ringNeighbours(m)) setSchedule(q, from.tree_.key(q), from.pairs_[q].upper);
+      updateRing(m);
+      ++count_;
+      return true;
     }
     const std::size_t lo = clusterLow(m), hi = clusterHigh(m + 1);
     const std::size_t first = lo > 0 ? lo - 1 : lo, last = std::min(hi, pairs_.size() - 1);
@@ -351,7 +380,7 @@ class Tier {
   bool oversized() const {
     if constexpr (std::is_same_v<S, Rational>) {
       if (count_ == 0) return false;
-      for (std::size_t k : {now_.pair, now_.pair + 1}) {
+      for (std::size_t k : {now_.pair, left(now_.pair)}) {
         for (const S* x : {&bodies_[k].b, &bodies_[k].v}) {
           if (boost::multiprecision::msb(denominator(*x)) > kExactBits) return true;
         }
@@ -383,7 +412,7 @@ class Tier {
     positions.resize(bodies_.size());
     velocities.resize(bodies_.size());
     for (std::size_t k = 0; k < bodies_.size(); ++k) {
-      positions[k] = Ar::toDouble(S(bodies_[k].b + S(bodies_[k].v * S(t))));
+      positions[k] = wrap(Ar::toDouble(S(bodies_[k].b + S(bodies_[k].v * S(t)))));
       velocities[k] = Ar::toDouble(bodies_[k].v);
     }
   }
@@ -439,11 +468,35 @@ class Tier {
     Now now;
     char bonded;
     std::uint64_t cluster_impacts;
+    std::uint64_t rule_elastic;
+    Clock clock_i, clock_j;  ///< TC only
+    S exact_i, exact_j;      ///< TC in the exact tier only
     std::size_t lo;
     std::vector<BodyState> cluster;  ///< bodies lo..hi, only when a cluster takes part
   };
 
   double pairScale(std::size_t p) const { return pairs_[p].scale; }
+
+  /// The left body of pair p: p + 1, or body 0 across a ring's seam.
+  std::size_t left(std::size_t p) const { return p + 1 == bodies_.size() ? 0 : p + 1; }
+  /// L [m] for the seam pair of a ring (its left body is seen at x - L), else 0.
+  double offset(std::size_t p) const { return p + 1 == bodies_.size() ? tables_.ring : 0.0; }
+  /// A position [m] on a ring brought into [0, L); unchanged without a ring.
+  double wrap(double x) const {
+    const double length = tables_.ring;
+    if (length == 0.0) return x;
+    const double y = x - length * std::floor(x / length);
+    return y >= length || y < 0.0 ? 0.0 : y;
+  }
+  /// Pairs whose schedule an impact of pair m changes on a ring: m - 1, m, m + 1 (cyclic).
+  std::array<std::size_t, 3> ringNeighbours(std::size_t m) const {
+    const std::size_t n = pairs_.size();
+    return {(m + n - 1) % n, m, (m + 1) % n};
+  }
+  void updateRing(std::size_t m) {
+    if (m > 0 && m + 1 < pairs_.size()) return tree_.update(m - 1, m + 1);  // no wrap: one climb, as on a line
+    for (std::size_t q : ringNeighbours(m)) tree_.update(q, q);
+  }
 
   /// The line bodies lo..hi end on after their collapse, in double: the centre of mass
   /// (intercept / mass [m], velocity / mass [m/s] with mass [kg] the group's), or with a
@@ -519,13 +572,17 @@ class Tier {
 
   /// Approach speed v_{p+1} - v_p [m/s] in double, its error bound including the state's.
   Approx approach(std::size_t p) const {
-    Approx a = approxDifference(bodies_[p + 1].v, bodies_[p].v);
+    Approx a = approxDifference(bodies_[left(p)].v, bodies_[p].v);
     a.error = (a.error + eu_ * pairScale(p)) * kSlack;
     return a;
   }
   /// Gap at t = 0 of the two lines, G = b_p - b_{p+1} [m], likewise.
   Approx gap(std::size_t p) const {
-    Approx g = approxDifference(bodies_[p].b, bodies_[p + 1].b);
+    Approx g = approxDifference(bodies_[p].b, bodies_[left(p)].b);
+    if (const double length = offset(p); length != 0.0) {  // the seam: G + L, rounded once more
+      g.value += length;
+      g.error += 2 * kUnit * std::fabs(g.value) + 2.02 * Ar::kOpError * (std::fabs(g.value) + length);
+    }
     g.error = (g.error + eb_ * pairScale(p)) * kSlack;
     return g;
   }
@@ -542,7 +599,7 @@ class Tier {
     if (a.value - a.error > 0) return Decision::kYes;
     if (a.value + a.error <= 0) return Decision::kNo;
     ++refinements_;
-    const S precise = bodies_[p + 1].v - bodies_[p].v;
+    const S precise = bodies_[left(p)].v - bodies_[p].v;
     const double error = (eu_ * pairScale(p) + 1.01 * Ar::kOpError * std::fabs(Ar::toDouble(precise))) * kSlack;
     return positive(precise, error);
   }
@@ -561,12 +618,19 @@ class Tier {
   /// Pair p's next impact time in S (p approaches).
   Precise preciseTime(std::size_t p) {
     ++refinements_;
-    const S G = bodies_[p].b - bodies_[p + 1].b;
-    const S A = bodies_[p + 1].v - bodies_[p].v;
+    const S G = gapOf(p);
+    const S A = bodies_[left(p)].v - bodies_[p].v;
     if constexpr (Ar::kExact) return {G / A, 0.0, true};
-    const double eG = (eb_ * pairScale(p) + 1.01 * Ar::kOpError * std::fabs(Ar::toDouble(G))) * kSlack;
+    const double eG =
+        (eb_ * pairScale(p) + 2.02 * Ar::kOpError * (std::fabs(Ar::toDouble(G)) + offset(p))) * kSlack;
     const double eA = (eu_ * pairScale(p) + 1.01 * Ar::kOpError * std::fabs(Ar::toDouble(A))) * kSlack;
     return preciseTime(G, eG, A, eA);
+  }
+
+  /// G = b_p - b_left (+ L across the seam) [m] in S.
+  S gapOf(std::size_t p) const {
+    const S g = bodies_[p].b - bodies_[left(p)].b;
+    return offset(p) == 0.0 ? g : S(g + S(offset(p)));
   }
 
   Precise preciseNow() const {
@@ -694,6 +758,11 @@ class Tier {
         return {StepKind::kMultipleCollision, tied[k], Ar::toDouble(times[best].value)};
       }
     }
+    // On a ring the seam pair N-1 and pair 0 share body 0 (for N > 2; N = 2 cannot tie).
+    if (tables_.ring != 0.0 && tied.size() > 1 && tied.front() == 0 && tied.back() + 1 == bodies_.size() &&
+        bodies_.size() > 2) {
+      return {StepKind::kMultipleCollision, tied.back(), Ar::toDouble(times[best].value)};
+    }
     return {StepKind::kImpact, tied.front(), 0.0};
   }
 
@@ -717,32 +786,34 @@ class Tier {
 
   void recordBefore(std::size_t m, ImpactRecord& record) const {
     const BodyState& i = bodies_[m];
-    const BodyState& j = bodies_[m + 1];
+    const BodyState& j = bodies_[left(m)];
     // The contact point is best extrapolated along the slower body's line.
-    const BodyState& slow = std::fabs(Ar::toDouble(i.v)) <= std::fabs(Ar::toDouble(j.v)) ? i : j;
-    const S time = (i.b - j.b) / (j.v - i.v);
+    const bool i_slow = std::fabs(Ar::toDouble(i.v)) <= std::fabs(Ar::toDouble(j.v));
+    const BodyState& slow = i_slow ? i : j;
+    const S time = gapOf(m) / (j.v - i.v);
     record.pair_index = m;
     record.first_moved = m;
-    record.last_moved = m + 1;
+    record.last_moved = left(m);
     record.time = Ar::toDouble(time);
-    record.position = Ar::toDouble(S(slow.b + S(slow.v * time)));
+    record.position = wrap(Ar::toDouble(S(slow.b + S(slow.v * time))) - (i_slow ? 0.0 : offset(m)));
     record.velocities_before = {Ar::toDouble(i.v), Ar::toDouble(j.v)};
   }
 
   void recordAfter(std::size_t m, const S& before_i, const S& before_j, double lost, ImpactRecord& record) const {
-    record.velocities_after = {Ar::toDouble(bodies_[m].v), Ar::toDouble(bodies_[m + 1].v)};
+    const std::size_t body[2] = {m, left(m)};
+    record.velocities_after = {Ar::toDouble(bodies_[body[0]].v), Ar::toDouble(bodies_[body[1]].v)};
     record.energy_lost = lost;
     const S* before[2] = {&before_i, &before_j};
     const Scene& scene = tables_.scene;
     for (int k = 0; k < 2; ++k) {
-      if (scene.isWall(m + k)) continue;
-      const double dv = Ar::toDouble(S(bodies_[m + k].v - *before[k]));
+      if (scene.isWall(body[k])) continue;
+      const double dv = Ar::toDouble(S(bodies_[body[k]].v - *before[k]));
       const double sum = record.velocities_after[k] + record.velocities_before[k];
-      record.energy_gained[k] = 0.5 * scene.masses[m + k] * dv * sum;
+      record.energy_gained[k] = 0.5 * scene.masses[body[k]] * dv * sum;
     }
     // A wall takes what the finite body gave up minus the heat.
     for (int k = 0; k < 2; ++k) {
-      if (scene.isWall(m + k)) record.energy_gained[k] = -record.energy_gained[1 - k] - lost;
+      if (scene.isWall(body[k])) record.energy_gained[k] = -record.energy_gained[1 - k] - lost;
     }
   }
 
@@ -773,19 +844,28 @@ class Tier {
   }
 
   Undo saveFor(std::size_t m) const {
-    Undo undo{bodies_[m], bodies_[m + 1], eu_, eb_, lost_, lost_compensation_, now_, bonded_[m], cluster_impacts_, m, {}};
+    const std::size_t j = left(m);
+    Undo undo{bodies_[m], bodies_[j], eu_, eb_, lost_, lost_compensation_, now_, bonded_[m], cluster_impacts_,
+              rule_elastic_, {}, {}, S(0), S(0), m, {}};
+    if (!clocks_.empty()) undo.clock_i = clocks_[m], undo.clock_j = clocks_[j];
+    if (!last_exact_.empty()) undo.exact_i = last_exact_[m], undo.exact_j = last_exact_[j];
+    if (tables_.ring != 0.0) return undo;  // no clusters on a ring
     const std::size_t lo = clusterLow(m), hi = clusterHigh(m + 1);
     if (lo != m || hi != m + 1) undo.cluster.assign(bodies_.begin() + lo, bodies_.begin() + hi + 1), undo.lo = lo;
     return undo;
   }
 
   void restore(std::size_t m, const Undo& undo) {
-    bodies_[m] = undo.i, bodies_[m + 1] = undo.j;
+    const std::size_t j = left(m);
+    bodies_[m] = undo.i, bodies_[j] = undo.j;
     std::copy(undo.cluster.begin(), undo.cluster.end(), bodies_.begin() + undo.lo);
     eu_ = undo.eu, eb_ = undo.eb, lost_ = undo.lost, lost_compensation_ = undo.lost_compensation;
     now_ = undo.now;
     bonded_[m] = undo.bonded;
     cluster_impacts_ = undo.cluster_impacts;
+    rule_elastic_ = undo.rule_elastic;
+    if (!clocks_.empty()) clocks_[m] = undo.clock_i, clocks_[j] = undo.clock_j;
+    if (!last_exact_.empty()) last_exact_[m] = undo.exact_i, last_exact_[j] = undo.exact_j;
   }
 
   /// The first and last body of the cluster holding `body` (bodies stuck together by e = 0
@@ -801,15 +881,143 @@ class Tier {
 
   /// The impact of pair m on its two bodies, with the error bounds, the heat and the record.
   StepResult collide(std::size_t m, ImpactRecord* record) {
-    const std::size_t lo = clusterLow(m), hi = clusterHigh(m + 1);
-    const StepResult r = lo == m && hi == m + 1 ? collideBodies(m, record) : collideClusters(m, lo, hi, record);
-    if (r.kind == StepKind::kImpact && pairs_[m].map.light_factor == 0.0) bonded_[m] = 1;  // e = 0: they stick
+    Rule rule;
+    if (tables_.scene.restitution_model.kind != RestitutionModelKind::kConstant) {
+      rule = ruleFor(m);
+      if (rule.kind != StepKind::kImpact) return {rule.kind, m, lastTime(), rule.at_zero};
+    } else {
+      rule.e = tables_.scene.restitutionOf(m);
+    }
+    const std::size_t lo = tables_.ring != 0.0 ? m : clusterLow(m), hi = tables_.ring != 0.0 ? m + 1 : clusterHigh(m + 1);
+    const StepResult r = lo == m && hi == m + 1 ? collideBodies(m, rule, record) : collideClusters(m, lo, hi, rule.e, record);
+    if (r.kind != StepKind::kImpact) return r;
+    if (rule.e == 0.0) bonded_[m] = 1;  // e = 0: they stick
+    if (rule.made_elastic) ++rule_elastic_;
+    if (!clocks_.empty()) startClocks(m);
     return r;
+  }
+
+  /// The restitution of the impact of pair m about to happen under the scene's model
+  /// (scene.h, RestitutionModel), whether the model made it elastic, or kAmbiguous when this
+  /// tier cannot decide it (at_zero: only the exact tier can).
+  struct Rule {
+    StepKind kind = StepKind::kImpact;
+    double e = 1.0;
+    bool made_elastic = false;
+    bool at_zero = false;
+  };
+  Rule ruleFor(std::size_t m) {
+    const Scene& scene = tables_.scene;
+    const RestitutionModel& model = scene.restitution_model;
+    const double base = scene.restitutionOf(m);
+    const auto decided = [&](Decision elastic) {
+      switch (elastic) {
+        case Decision::kYes: return Rule{StepKind::kImpact, 1.0, base != 1.0, false};
+        case Decision::kNo: return Rule{StepKind::kImpact, base, false, false};
+        case Decision::kUnknownAtZero: return Rule{StepKind::kAmbiguous, 0.0, false, true};
+        case Decision::kUnknown: break;
+      }
+      return Rule{StepKind::kAmbiguous, 0.0, false, false};
+    };
+    switch (model.kind) {
+      case RestitutionModelKind::kConstant: break;
+      case RestitutionModelKind::kTc: return decided(base == 1.0 ? Decision::kNo : tooSoon(m));
+      case RestitutionModelKind::kThreshold: return decided(base == 1.0 ? Decision::kNo : slowerThan(m, model.elastic_below));
+      case RestitutionModelKind::kViscoelastic: {
+        Rule rule;
+        const std::optional<double> speed = roundedApproach(m, rule.at_zero);
+        if (!speed) return {StepKind::kAmbiguous, 0.0, false, rule.at_zero};
+        rule.e = viscoelasticRestitution(*speed, model.viscoelastic_speed);
+        rule.made_elastic = rule.e == 1.0;
+        return rule;
+      }
+    }
+    return {StepKind::kImpact, base, false, false};
+  }
+
+  /// TC: is the impact of pair m elastic, i.e. was the last impact of one of its finite
+  /// bodies at most t_c before it? Decided on the double bounds of the two impact times
+  /// (tree key and PairState::upper, rigorous for every tier); what they cannot decide
+  /// (a difference within about 2^-50 of t_c), only the exact tier decides, with the
+  /// exact impact times.
+  Decision tooSoon(std::size_t m) const {
+    const double tc = tables_.scene.restitution_model.tc;
+    const double now_lo = tree_.key(m), now_hi = pairs_[m].upper;
+    bool unknown = false;
+    for (std::size_t k : {m, left(m)}) {
+      if (tables_.scene.isWall(k) || clocks_[k].hi == -kInf) continue;  // no clock, or waited forever
+      const double low = now_lo - clocks_[k].hi, high = now_hi - clocks_[k].lo;
+      if (high + std::fabs(high) * 0x1p-51 <= tc) return Decision::kYes;
+      if (low - std::fabs(low) * 0x1p-51 > tc) continue;
+      if constexpr (Ar::kExact) {
+        const S since = S(gapOf(m) / S(bodies_[left(m)].v - bodies_[m].v)) - last_exact_[k];
+        if (Ar::sign(S(since - S(tc))) <= 0) return Decision::kYes;
+      } else {
+        unknown = true;
+      }
+    }
+    return unknown ? Decision::kUnknownAtZero : Decision::kNo;
+  }
+
+  /// TC: bodies m and left(m) had their last impact now (the bounds of its time, and in the
+  /// exact tier the exact time). Called after the impact: gapOf and the velocities have
+  /// changed, so the exact time comes from now_ (G and A before it).
+  void startClocks(std::size_t m) {
+    const Clock now{tree_.key(m), pairs_[m].upper};
+    for (std::size_t k : {m, left(m)}) {
+      clocks_[k] = now;
+      if constexpr (Ar::kExact) last_exact_[k] = now_.G / now_.A;
+    }
+  }
+
+  /// Threshold law: is pair m's approach speed below v0 [m/s]?
+  Decision slowerThan(std::size_t m, double v0) {
+    const Approx a = approach(m);
+    if ((a.value + a.error) * (1 + 0x1p-50) < v0) return Decision::kYes;
+    if ((a.value - a.error) * (1 - 0x1p-50) >= v0) return Decision::kNo;
+    const S difference = S(v0) - S(bodies_[left(m)].v - bodies_[m].v);
+    const double error =
+        (eu_ * pairScale(m) + 2.02 * Ar::kOpError * (std::fabs(a.value) + v0 + std::fabs(Ar::toDouble(difference)))) *
+        kSlack;
+    if constexpr (Ar::kExact) return Ar::sign(difference) > 0 ? Decision::kYes : Decision::kNo;
+    return positive(difference, error);
+  }
+
+  /// Viscoelastic law: pair m's approach speed rounded to the nearest double (ties to even),
+  /// the same in every tier: an inexact tier answers only when its bound keeps the exact
+  /// speed strictly between the two rounding midpoints; at_zero: a speed at a midpoint (to
+  /// this tier's precision), for the exact tier.
+  std::optional<double> roundedApproach(std::size_t m, bool& at_zero) const {
+    const S speed = bodies_[left(m)].v - bodies_[m].v;
+    double d = Ar::toDouble(speed);
+    const auto midpoint = [](double x, double y) { return S(S(x) + S(y)) / S(2); };
+    if constexpr (Ar::kExact) {
+      for (int step = 0; step < 8; ++step) {  // the conversion is within a few ulps
+        if (speed > midpoint(d, std::nextafter(d, kInf))) d = std::nextafter(d, kInf);
+        else if (speed < midpoint(std::nextafter(d, -kInf), d)) d = std::nextafter(d, -kInf);
+        else break;
+      }
+      const double up = std::nextafter(d, kInf), down = std::nextafter(d, -kInf);
+      std::uint64_t bits = 0;
+      std::memcpy(&bits, &d, sizeof bits);
+      if (speed == midpoint(d, up) && (bits & 1)) d = up;
+      if (speed == midpoint(down, d) && (bits & 1)) d = down;
+      return d;
+    } else {
+      const double error = (eu_ * pairScale(m) + 2.02 * Ar::kOpError * std::fabs(d)) * kSlack + kTiny;
+      const S above = S(midpoint(d, std::nextafter(d, kInf)) - speed);
+      const S below = S(speed - midpoint(std::nextafter(d, -kInf), d));
+      const Decision a = positive(above, error + 2 * Ar::kOpError * std::fabs(d));
+      const Decision b = positive(below, error + 2 * Ar::kOpError * std::fabs(d));
+      if (a == Decision::kYes && b == Decision::kYes) return d;
+      at_zero = a == Decision::kUnknownAtZero || b == Decision::kUnknownAtZero;
+      return std::nullopt;
+    }
   }
 
   /// The cluster rule: clusters lo..m and m+1..hi meet as two bodies of their total masses,
   /// with pair m's restitution; every member takes its cluster's new line.
-  StepResult collideClusters(std::size_t m, std::size_t lo, std::size_t hi, ImpactRecord* record) {
+  StepResult collideClusters(std::size_t m, std::size_t lo, std::size_t hi, double e, ImpactRecord* record) {
     const Scene& scene = tables_.scene;
     S mass[2] = {S(0), S(0)};
     bool wall[2] = {false, false};
@@ -822,7 +1030,6 @@ class Tier {
     for (int side = 0; side < 2; ++side) {
       if (wall[side]) mass_d[side] = kInf;
     }
-    const double e = scene.restitutionOf(m);
     const ImpactMap<S> map = makeClusterImpactMap<S>(mass[0], wall[0], mass[1], wall[1], e, mass_d[0] >= mass_d[1]);
     BodyState& i = bodies_[m];
     BodyState& j = bodies_[m + 1];
@@ -865,28 +1072,46 @@ class Tier {
   }
 
   /// The impact of pair m on its two single bodies.
-  StepResult collideBodies(std::size_t m, ImpactRecord* record) {
+  StepResult collideBodies(std::size_t m, const Rule& rule, ImpactRecord* record) {
     PairState& pair = pairs_[m];
+    const std::size_t left_body = left(m);
     BodyState& i = bodies_[m];
-    BodyState& j = bodies_[m + 1];
+    BodyState& j = bodies_[left_body];
+    // The pair's own map; the model's e, when it differs: the elastic map, or e(v)'s.
+    const bool own = rule.e == tables_.scene.restitutionOf(m);
+    const Scene& scene = tables_.scene;
+    ImpactMap<S> computed;
+    const ImpactMap<S>* chosen = own ? &pair.map : (rule.e == 1.0 ? &elastic_maps_[m] : &computed);
+    if (chosen == &computed) computed = makeImpactMap<S>(scene.masses[m], scene.masses[left_body], rule.e);
+    const ImpactMap<S>& map = *chosen;
     now_.pair = m;
     now_.upper = pair.upper;
     const S before_i = i.v, before_j = j.v;
     if (record) recordBefore(m, *record);
+    const double length = offset(m);
+    if (length != 0.0) {  // across the seam the left body is met at b - L; its rounding counts
+      j.b = j.b - S(length);
+      eb_ += 1.01 * Ar::kOpError * tables_.sqrt_mass[left_body] * std::fabs(Ar::toDouble(j.b)) + kTiny;
+    }
     now_.eu = eu_;
     now_.eb = eb_;
     now_.extra = 0.0;
-    const ImpactChange<S> dv = applyImpactMap(pair.map, i.v, j.v);
-    const ImpactChange<S> db = applyImpactMap(pair.map, i.b, j.b);
-    eu_ += rho(m, dv, i.v, j.v);
-    eb_ += rho(m, db, i.b, j.b);
+    const ImpactChange<S> dv = applyImpactMap(map, i.v, j.v);
+    const ImpactChange<S> db = applyImpactMap(map, i.b, j.b);
+    eu_ += map.exchange ? 0.0 : rhoWith(map.heavy_is_i, pair.sqrt_heavy, pair.sqrt_light, dv, i.v, j.v);
+    eb_ += map.exchange ? 0.0 : rhoWith(map.heavy_is_i, pair.sqrt_heavy, pair.sqrt_light, db, i.b, j.b);
+    if (length != 0.0) {
+      j.b = j.b + S(length);
+      eb_ += 1.01 * Ar::kOpError * tables_.sqrt_mass[left_body] * std::fabs(Ar::toDouble(j.b)) + kTiny;
+    }
     now_.A = dv.difference;
     now_.G = -db.difference;
     if (!timeIsPrecise(pair.scale)) return {StepKind::kImprecise, m, 0.0};
     double lost = 0.0;
-    if (std::fabs(pair.map.light_factor) != 1.0) {  // e < 1
+    if (std::fabs(map.light_factor) != 1.0) {  // e < 1
       const double approach_speed = Ar::toDouble(now_.A);
-      lost = tables_.loss_factor[m] * approach_speed * approach_speed;
+      lost = own ? tables_.loss_factor[m] * approach_speed * approach_speed
+                 : impactEnergyLost(scene.masses[m], scene.masses[left_body], approach_speed, rule.e);
       addLoss(lost);
     }
     if (record) recordAfter(m, before_i, before_j, lost, *record);
@@ -900,6 +1125,16 @@ class Tier {
   /// new schedules.
   StepResult scheduleAfter(std::size_t m) {
     setSchedule(m, kInf, kInf);
+    if (tables_.ring != 0.0 && pairs_.size() > 1) {  // no clusters on a ring; the neighbours are cyclic
+      const std::array<std::size_t, 3> around = ringNeighbours(m);
+      for (std::size_t q : {around[0], around[2]}) {
+        const StepResult r = reschedule(q, m);
+        if (r.kind != StepKind::kImpact) return r;
+      }
+      updateRing(m);
+      ++count_;
+      return {StepKind::kImpact, m, 0.0};
+    }
     // The pairs at the outer ends of the two clusters (m - 1 and m + 1 for single bodies).
     const std::size_t lo = clusterLow(m), hi = clusterHigh(m + 1);
     if (lo > 0) {
@@ -921,6 +1156,10 @@ class Tier {
   TournamentTree tree_;  ///< per pair: lower bound of the next impact time [s]
   std::vector<char> bonded_;           ///< per pair: its two bodies move as one (a cluster)
   std::uint64_t cluster_impacts_ = 0;  ///< impacts in which a cluster met a body as one body
+  std::uint64_t rule_elastic_ = 0;     ///< impacts the restitution model made elastic
+  std::vector<ImpactMap<S>> elastic_maps_;  ///< per pair, e = 1 (TC and threshold only)
+  std::vector<Clock> clocks_;               ///< per body, TC only
+  std::vector<S> last_exact_;               ///< per body, TC in the exact tier only: last impact time [s]
   std::size_t merged_ = 0;             ///< collapses applied (the driver's list, in order)
   double eu_ = 0.0;            ///< bound on ||U_computed - U_exact|| [kg^0.5 m/s]
   double eb_ = 0.0;            ///< bound on ||B_computed - B_exact|| [kg^0.5 m]

@@ -39,7 +39,7 @@ TEST(BodyStateReplay, AppliesRecordsByTheirContractWithHandWorkedEnergies) {
   EXPECT_EQ(replay.velocities(), (std::vector<double>{0, 0, -1, 0}));
   EXPECT_EQ(replay.kineticEnergies(), (std::vector<double>{0, 0, 0.5, 0}));
   EXPECT_EQ(replay.firstMoved(), 1u);
-  EXPECT_EQ(replay.endMoved(), 3u);
+  EXPECT_EQ(replay.movedCount(), 2u);
   EXPECT_EQ(replay.velocityBefore(1), -1.0);
   EXPECT_EQ(replay.velocityBefore(2), 0.0);
   EXPECT_EQ(replay.velocityBefore(0), 0.0);  // not moved: its velocity now
@@ -58,6 +58,25 @@ TEST(BodyStateReplay, AppliesRecordsByTheirContractWithHandWorkedEnergies) {
   EXPECT_EQ(replay.lastHeat(), 0.375);
   EXPECT_EQ(replay.momentum(), 0.5);  // the wall took the momentum: it is not counted either
   EXPECT_EQ(replay.position(2, 4.0), 1.0);
+}
+
+// A ring of L = 10 m: body 2 (2 kg, x = 1 m, -1 m/s) meets body 0 (1 kg, x = 8 m, seen at
+// -2 m across the seam, +1 m/s) at t = 1.5 s, x = -0.5 = 9.5 m. Elastic, by hand: the centre
+// of mass moves at -1/3 m/s, so body 2 leaves at 1/3 m/s and body 0 at -5/3 m/s.
+TEST(BodyStateReplay, ASeamImpactOfARingMovesBodyNMinus1ThenBody0) {
+  Scene ring;
+  ring.masses = {1, 1, 2}, ring.positions = {8, 5, 1}, ring.velocities = {1, 0, -1}, ring.ring = 10;
+  BodyStateReplay replay(ring);
+  ASSERT_TRUE(replay.apply(impact(2, 2, 0, 1.5, 9.5, 1.0 / 3, -5.0 / 3, 0.0)));
+  EXPECT_EQ(replay.movedCount(), 2u);
+  EXPECT_EQ(replay.velocities(), (std::vector<double>{-5.0 / 3, 0, 1.0 / 3}));
+  EXPECT_EQ(replay.velocityBefore(0), 1.0);
+  EXPECT_EQ(replay.velocityBefore(2), -1.0);
+  EXPECT_NEAR(replay.totalKineticEnergy(), 1.5, 1e-15);
+  EXPECT_NEAR(replay.energyGained(0), 25.0 / 18 - 0.5, 1e-15);
+  EXPECT_NEAR(replay.position(0, 2.5), 9.5 - 5.0 / 3, 1e-14);
+  EXPECT_NEAR(replay.position(2, 3.5), 0.5 - 1.0 / 3 + 0.0, 1e-14);  // 9.5 + 2/3 wraps past 10
+  EXPECT_FALSE(replay.apply(impact(2, 2, 2, 2.0, 9.0, 0.0, 0.0, 0.0)));  // the seam moves two sides
 }
 
 TEST(BodyStateReplay, RejectsRecordsOutsideTheSceneAndLeavesTheStateAlone) {

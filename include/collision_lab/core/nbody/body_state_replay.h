@@ -23,13 +23,17 @@ class BodyStateReplay {
  public:
   /// The state at t = 0: masses [kg] (inf: a wall), positions [m], velocities [m/s]. Lists
   /// of unequal lengths are cut to the shortest.
-  BodyStateReplay(std::vector<double> masses, std::vector<double> positions, std::vector<double> velocities);
+  /// ring: the circumference of a ring [m] (Scene::ring), 0 for an open line.
+  BodyStateReplay(std::vector<double> masses, std::vector<double> positions, std::vector<double> velocities,
+                  double ring = 0.0);
   explicit BodyStateReplay(const Scene& scene);
 
   /// An impact: bodies first_moved..pair_index take velocities_after[0], pair_index + 1..
   /// last_moved velocities_after[1], all at the contact point at record.time; the heat grows
-  /// by record.energy_lost. False, and nothing changes, when the record's bodies do not fit
-  /// the scene (first_moved <= pair_index < last_moved < size()).
+  /// by record.energy_lost. On a ring (a Scene with ring > 0) the seam pair N-1 moves bodies
+  /// first_moved..N-1, then 0..last_moved. False, and nothing changes, when the record's
+  /// bodies do not fit the scene (first_moved <= pair_index < last_moved < size(), or the
+  /// seam's wrap).
   bool apply(const ImpactRecord& record);
   /// A resolved collapse: bodies first_body..last_body take collapse.velocity at its point
   /// and time; the heat grows by their kinetic energy before less after. False, and nothing
@@ -42,7 +46,7 @@ class BodyStateReplay {
   bool isWall(std::size_t body) const;
   const std::vector<double>& velocities() const { return velocities_; }
   /// Position of body at time t [s] (not before its last move) [m]: its last point plus
-  /// its velocity times the time since.
+  /// its velocity times the time since; on a ring, wrapped into [0, L).
   double position(std::size_t body, double t) const;
   std::vector<double> positions(double t) const;
   /// Kinetic energy of a body now [J] (0 for a wall).
@@ -59,8 +63,8 @@ class BodyStateReplay {
   std::uint64_t impacts() const { return impacts_; }  ///< impact records applied
   double time() const { return time_; }               ///< [s]
   std::size_t firstMoved() const { return first_moved_; }
-  /// One past the last body moved (firstMoved() when none).
-  std::size_t endMoved() const { return first_moved_ + before_.size(); }
+  /// How many bodies the last notification moved (from firstMoved(), wrapping on a ring).
+  std::size_t movedCount() const { return before_.size(); }
   /// Velocity of a body before the last notification [m/s] (its velocity now if it did not move).
   double velocityBefore(std::size_t body) const;
   /// Kinetic energy the body gained in the last notification [J] (0 if it did not move).
@@ -78,13 +82,16 @@ class BodyStateReplay {
    private:
     double sum_ = 0.0, compensation_ = 0.0;
   };
-  void begin(std::size_t first, std::size_t last, double time);
+  void begin(std::size_t first, std::size_t count, double time);
+  /// Place of body after firstMoved() in the last notification's range (mod size()).
+  std::size_t offset(std::size_t body) const;
   void set(std::size_t body, double velocity, double position);
 
   std::vector<double> masses_, velocities_, points_, since_, kinetic_;
   Sum energy_, momentum_, heat_;
   std::uint64_t impacts_ = 0;
   double time_ = 0.0, last_heat_ = 0.0;
+  double ring_ = 0.0;  ///< circumference of a ring [m]; 0: an open line
   std::size_t first_moved_ = 0;
   std::vector<double> before_, gained_;  ///< velocity before and energy gained of the bodies last moved
 };

@@ -29,6 +29,14 @@
 // internal impacts one after the other, is ill-defined for point masses: at zero separation
 // every internal impact is simultaneous with the next, so its result depends on an
 // arbitrary order (a multiple collision). The run counts these impacts (cluster_impacts).
+// Restitution models (scene.h, RestitutionModel) choose each impact's e in every tier alike:
+// TC compares the time since each body's last impact with t_c on the rigorous bounds of
+// the two impact times, and what those cannot decide the exact tier decides with the exact
+// times (equal counts as "not more than t_c": elastic); the threshold law decides
+// "approach speed < v_0" like any sign; the viscoelastic law evaluates e(v) in double at
+// the approach speed rounded to the nearest double, a rounding each tier certifies or
+// hands to the next. Collapses are not recognised under a model, nor on a ring.
+// A ring (scene.ring = L) adds pair N-1 across the seam; it has no walls and no clusters.
 // Impacts happen in the canonical order: exact time, then pair index. Impacts of disjoint
 // pairs at the same instant are all performed; two impacts sharing a body at the same
 // instant are a multiple collision, which ends the run (its outcome is undefined for
@@ -49,7 +57,8 @@
 namespace collision_lab {
 namespace core {
 
-/// One impact of pair p (bodies p and p+1). Replaying the records (and the collapse notices,
+/// One impact of pair p (bodies p and p+1; on a ring's seam pair N-1, bodies N-1 and 0,
+/// with first_moved = N-1 and last_moved = 0). Replaying the records (and the collapse notices,
 /// CollapseVisitor) in order from the initial velocities rebuilds the velocity of every body:
 /// an impact sets bodies first_moved..pair_index to velocities_after[0] and
 /// pair_index+1..last_moved to velocities_after[1].
@@ -171,6 +180,9 @@ struct EngineResult {
   /// kPrecisionBudget: the bodies (indices from 0, ascending) of the last impacts that needed
   /// more than double-double precision and of the decision left open; empty otherwise.
   std::vector<std::size_t> crowding_bodies;
+  /// Impacts whose pair has e < 1 (or, viscoelastic, whose e(v) is 1) that the scene's
+  /// restitution model made elastic (scene.h, RestitutionModel); 0 for the constant model.
+  std::uint64_t rule_elastic_impacts = 0;
   std::vector<ImpactRecord> events;  ///< the first options.keep_events impacts
 };
 

@@ -8,7 +8,8 @@
 //   ghosts               equal masses, elastic, no walls: the bodies exchange velocities, so
 //                        they move like ghosts passing through each other; the count is the
 //                        number of inversions, O(N log N), and the final velocities are the
-//                        initial ones sorted
+//                        initial ones sorted. On a ring the ghosts meet forever: infinitely
+//                        many impacts, the count by time t is the crossing count (ringCrossingsBy)
 //   three_body_spiral    N = 3, at most one wall (at an end), one e < 1 for both pairs: the
 //                        AB/BC cycle is a 2x2 map of trace T = (1+e)^2 cos^2(alpha) - 2e and
 //                        determinant e^2; a spiral for e > r_c = tan^2(pi/4 - alpha/2),
@@ -20,7 +21,9 @@
 //                        e = 0: the first pair sticks, and the third body hits that cluster as
 //                        one body (engine.h, the cluster rule). Two different e: event_engine.
 //   event_engine         anything else: no count formula exists; the exact event engine
-//                        simulates every impact
+//                        simulates every impact. So does every scene whose restitution model
+//                        (scene.h, RestitutionModel) can change an impact's e, and every ring
+//                        that is not ghosts.
 // ROS-free; every function here never throws for a validated scene (short of memory).
 #pragma once
 
@@ -86,6 +89,12 @@ Prediction predictThreeBodySpiral(const Scene& scene);
 /// The prediction of chooseModel(scene)'s model. Empty for three_body_rotation (the
 /// three-body analytic model answers) and for event_engine (no formula: run the engine).
 std::optional<Prediction> predict(const Scene& scene);
+
+/// Equal masses on a ring (elastic): the number of crossings of the ghosts (each moving at
+/// its initial velocity round the ring of circumference scene.ring) in (0, t] [s], i.e. the
+/// impacts by time t; a crossing exactly at t counts. In double (the crossing times are
+/// rounded), O(N^2). Precondition: scene.isRing(), validate() passed, t >= 0.
+std::uint64_t ringCrossingsBy(const Scene& scene, double t);
 
 /// Number of pairs i < j with v_i < v_j (equal values are not inversions), by merge sort:
 /// O(N log N) time, O(N) memory; exact in 64 bits for N up to 6e9.

@@ -11,6 +11,33 @@
 namespace collision_lab {
 namespace core {
 
+/// How the restitution of an impact is chosen (docs/physics.md, "Restitution models").
+/// Values are stable (published): append only.
+enum class RestitutionModelKind : std::uint8_t {
+  kConstant = 0,      ///< each pair's e, always (the default)
+  kTc = 1,            ///< TC model (Luding and McNamara 1998): elastic unless both bodies' last impacts are > t_c ago
+  kViscoelastic = 2,  ///< e(v) of viscoelastic spheres (Brilliantov, Spahn, Hertzsch and Poschel 1996)
+  kThreshold = 3,     ///< e = 1 below an approach speed v_0, the pair's e from v_0 on
+};
+
+/// Machine-readable name: "constant", "tc", "viscoelastic", "threshold".
+const char* restitutionModelName(RestitutionModelKind kind);
+
+/// The restitution model and its parameter (only the one its kind uses is read).
+struct RestitutionModel {
+  RestitutionModelKind kind = RestitutionModelKind::kConstant;
+  /// kTc: t_c [s], > 0 and finite. An impact dissipates (the pair's e) only when the time
+  /// since the last impact of each of its finite bodies is strictly greater than t_c; a
+  /// body that has had no impact counts as having waited forever, and a wall has no clock.
+  double tc = 0.0;
+  /// kViscoelastic: v* [m/s], > 0 and finite: e(v) = 1 - C1 s + C2 s^2 with s = (v / v*)^(1/5),
+  /// C1 = 1.15344, C2 = 0.79826, clamped to [0, 1]; v* = (A alpha^(2/5))^-5 of the paper's
+  /// material constants. The pair's e is not used (the scene's restitution must be elastic).
+  double viscoelastic_speed = 0.0;
+  /// kThreshold: v_0 [m/s], > 0 and finite: e = 1 when the approach speed is < v_0.
+  double elastic_below = 0.0;
+};
+
 /// Initial conditions in SI units. Bodies are listed right to left: x_0 > x_1 > ... >
 /// x_{N-1}. Pair p joins bodies p and p+1; it approaches iff v_p < v_{p+1}.
 struct Scene {
@@ -20,12 +47,24 @@ struct Scene {
   /// Coefficients of restitution e in [0, 1] [1]: empty = elastic (e = 1); one value = every
   /// pair; N-1 values = one per pair. Each is taken as the exact value of its double.
   std::vector<double> restitution;
+  RestitutionModel restitution_model;  ///< the default: each pair's constant e
+  /// Circumference L [m] of a ring (periodic boundary); 0 = no ring (an open line). On a
+  /// ring, positions lie in [0, L), still strictly decreasing, no body is a wall, no pair
+  /// has e = 0 (clusters are not supported there), and
+  /// body N-1 meets body 0 across the seam: contact pair N-1 joins body N-1 (right) and
+  /// body 0 at x_0 - L (left). restitution then has 0, 1 or N values (N >= 2).
+  double ring = 0.0;
 
   std::size_t size() const { return masses.size(); }
   std::size_t pairCount() const { return masses.empty() ? 0 : masses.size() - 1; }
+  bool isRing() const { return ring != 0.0; }
+  /// Pairs that can touch: pairCount(), plus the seam pair N-1 on a ring of N >= 2 bodies.
+  std::size_t contactCount() const { return isRing() && size() >= 2 ? size() : pairCount(); }
+  /// The left body of contact pair p: p + 1, or 0 for the seam pair of a ring.
+  std::size_t leftOf(std::size_t pair) const { return pair + 1 == size() ? 0 : pair + 1; }
   bool isWall(std::size_t body) const;
   std::size_t wallCount() const;
-  /// e of pair p [1]. Precondition: validate() passed and p < pairCount().
+  /// e of pair p [1]. Precondition: validate() passed and p < contactCount().
   double restitutionOf(std::size_t pair) const;
   /// True when every pair has e = 1 (including an empty restitution list).
   bool isElastic() const;
@@ -53,6 +92,8 @@ enum class Reason : std::uint8_t {
   kRestitutionOutOfRange = 11,  ///< a restitution is NaN or outside [0, 1]
   kRestitutionCount = 12,    ///< restitution has neither 0, 1 nor N-1 values
   kWallNotAtEnd = 13,        ///< an infinite mass strictly inside the list
+  kRestitutionModel = 14,    ///< the restitution model's parameter is not positive and finite, or conflicts with restitution
+  kRing = 15,                ///< a ring that is not a positive finite circumference, a position outside [0, L), a wall or e = 0 on it
 };
 
 /// Machine-readable name of a reason, e.g. "UNEQUAL_LENGTHS".
