@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <sstream>
 
 #include "collision_lab/io/number_text.h"
 
@@ -220,26 +221,9 @@ void writeCsvComments(std::ostream& out, const std::string& prefix, const Json& 
   }
 }
 
-/// One event row, in the columns of CsvWriter's header.
+/// One event row, in the columns of kEventCsvHeader.
 void writeEventCsv(TextSink& sink, const core::LabEvent& lab, bool /*first*/) {
-  const core::ImpactEvent& e = lab.event;
-  const auto cell = [&sink](double value) {
-    sink.put(',');
-    sink.csvNumber(value);
-  };
-  sink.count(e.index);
-  sink.put(',');
-  sink.put(core::pairName(e.pair));
-  cell(e.time);
-  cell(e.position);
-  for (const auto* values : {&e.positions, &e.velocities_before, &e.velocities_after, &e.energy_transfer,
-                             &lab.predicted_velocities_after, &lab.paper_velocities_after,
-                             &lab.predicted_energy_transfer, &lab.paper_energy_transfer}) {
-    for (double v : *values) cell(v);
-  }
-  cell(e.total_energy);
-  cell(e.total_momentum);
-  sink.put('\n');
+  report_text::writeEventRecordCsv(sink, report_text::eventRecord(lab));
 }
 
 class CsvWriter : public RunReportWriter {
@@ -258,17 +242,7 @@ class CsvWriter : public RunReportWriter {
       out_ << "\n";
     }
     writeCsvComments(out_, "", optionsJson(options));
-    out_ << "index,pair,time_s,position_m";
-    for (const char* group : {"x_%s_m", "v_%s_before_m_s", "v_%s_after_m_s", "energy_transfer_%s_J",
-                              "predicted_v_%s_after_m_s", "paper_v_%s_after_m_s", "predicted_energy_transfer_%s_J",
-                              "paper_energy_transfer_%s_J"}) {
-      for (const char* particle : kParticleNames) {
-        char column[64];
-        std::snprintf(column, sizeof column, group, particle);
-        out_ << "," << column;
-      }
-    }
-    out_ << ",total_energy_J,total_momentum_kg_m_s\n";
+    out_ << report_text::kEventCsvHeader << "\n";
   }
 
   void event(const core::LabEvent& lab) override { events_.push(lab); }
@@ -420,51 +394,197 @@ Json optionsJson(const core::RunOptions& options) {
 }
 
 Json eventJson(const core::LabEvent& lab) {
-  const core::ImpactEvent& e = lab.event;
-  return Json{{"index", e.index},
-              {"pair", core::pairName(e.pair)},
-              {"pair_index", core::pairIndex(e.pair)},
-              {"time", number(e.time)},
-              {"position", number(e.position)},
-              {"positions", array3(e.positions)},
-              {"velocities_before", array3(e.velocities_before)},
-              {"velocities_after", array3(e.velocities_after)},
-              {"energy_transfer", array3(e.energy_transfer)},
-              {"predicted_velocities_after", array3(lab.predicted_velocities_after)},
-              {"predicted_energy_transfer", array3(lab.predicted_energy_transfer)},
-              {"paper_velocities_after", array3(lab.paper_velocities_after)},
-              {"paper_energy_transfer", array3(lab.paper_energy_transfer)},
-              {"kinetic_energy_after", array3(lab.kinetic_energy_after)},
-              {"total_energy", number(e.total_energy)},
-              {"total_momentum", number(e.total_momentum)}};
+  std::ostringstream text;
+  {
+    TextSink sink(text);
+    report_text::writeEventJson(sink, lab);
+  }
+  return Json::parse(text.str());
 }
 
 namespace report_text {
 
-void writeEventJson(TextSink& sink, const core::LabEvent& lab) {
+EventRecord eventRecord(const core::LabEvent& lab) {
   const core::ImpactEvent& e = lab.event;
-  // The keys and order of eventJson.
-  sink.put("{\"index\":");
-  sink.count(e.index);
+  const std::size_t p = static_cast<std::size_t>(core::pairIndex(e.pair));
+  EventRecord r;
+  r.index = e.index;
+  r.pair_index = p;
+  r.time = e.time;
+  r.position = e.position;
+  r.restitution = 1.0;  // the three-body path answers elastic scenes only
+  r.first_moved = p;
+  r.last_moved = p + 1;
+  for (std::size_t side = 0; side < 2; ++side) {
+    r.pair_velocities_before[side] = e.velocities_before[p + side];
+    r.pair_velocities_after[side] = e.velocities_after[p + side];
+    r.pair_energy_transfer[side] = e.energy_transfer[p + side];
+  }
+  r.energy_lost = 0.0;
+  r.full_state = true;
+  r.bodies = 3;
+  r.positions = e.positions.data();
+  r.velocities_before = e.velocities_before.data();
+  r.velocities_after = e.velocities_after.data();
+  r.energy_transfer = e.energy_transfer.data();
+  r.kinetic_energy_after = lab.kinetic_energy_after.data();
+  r.total_energy = e.total_energy;
+  r.total_momentum = e.total_momentum;
+  r.predicted_velocities_after = &lab.predicted_velocities_after;
+  r.predicted_energy_transfer = &lab.predicted_energy_transfer;
+  r.paper_velocities_after = &lab.paper_velocities_after;
+  r.paper_energy_transfer = &lab.paper_energy_transfer;
+  return r;
+}
+
+namespace {
+
+void jsonValues(TextSink& sink, std::string_view key, const double* values, std::size_t n) {
+  sink.put(key);
+  if (!values) return sink.put("null");
+  sink.put('[');
+  for (std::size_t i = 0; i < n; ++i) {
+    if (i > 0) sink.put(',');
+    sink.jsonNumber(values[i]);
+  }
+  sink.put(']');
+}
+
+void jsonModel(TextSink& sink, std::string_view key, const std::array<double, 3>* values) {
+  jsonValues(sink, key, values ? values->data() : nullptr, 3);
+}
+
+/// One CSV cell of n values separated by ';' (empty for none).
+void csvValues(TextSink& sink, const double* values, std::size_t n) {
+  sink.put(',');
+  if (!values) return;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (i > 0) sink.put(';');
+    sink.csvNumber(values[i]);
+  }
+}
+
+/// The bodies a record names, in order: the pair's two for an impact (body 0 second across a
+/// ring's seam, the only impact whose last_moved is below its pair_index: a ring has no
+/// clusters), the cluster's for a collapse.
+std::vector<std::size_t> namedBodies(const EventRecord& r) {
+  if (!r.collapse) return {r.pair_index, r.last_moved < r.pair_index ? std::size_t{0} : r.pair_index + 1};
+  std::vector<std::size_t> bodies;
+  for (std::size_t i = r.first_moved; i <= r.last_moved; ++i) bodies.push_back(i);
+  return bodies;
+}
+
+/// pairName, or for a ring's seam the two bodies' names ("CA", "#30-A").
+std::string recordPairName(const EventRecord& r) {
+  const std::size_t left = namedBodies(r)[1];
+  if (r.collapse || left == r.pair_index + 1) return core::pairName(r.pair_index);
+  return core::bodyName(r.pair_index) + (r.pair_index < 26 ? "" : "-") + core::bodyName(left);
+}
+
+}  // namespace
+
+const char* const kEventCsvHeader =
+    "kind,index,pair,pair_index,bodies,time_s,position_m,restitution,first_moved,last_moved,cluster_impact,"
+    "pair_v_before_right_m_s,pair_v_before_left_m_s,pair_v_after_right_m_s,pair_v_after_left_m_s,"
+    "pair_energy_transfer_right_J,pair_energy_transfer_left_J,energy_lost_J,positions_m,velocities_before_m_s,"
+    "velocities_after_m_s,energy_transfer_J,kinetic_energy_after_J,total_energy_J,total_momentum_kg_m_s,"
+    "predicted_velocities_after_m_s,predicted_energy_transfer_J,paper_velocities_after_m_s,"
+    "paper_energy_transfer_J";
+
+void writeEventRecordJson(TextSink& sink, const EventRecord& r) {
+  // Names are letters, digits, '#' and '-': no escapes.
+  sink.put(r.collapse ? "{\"kind\":\"collapse\",\"index\":" : "{\"kind\":\"impact\",\"index\":");
+  sink.count(r.index);
   sink.put(",\"pair\":\"");
-  sink.put(core::pairName(e.pair));
+  sink.put(recordPairName(r));
   sink.put("\",\"pair_index\":");
-  sink.count(static_cast<std::uint64_t>(core::pairIndex(e.pair)));
-  sink.jsonField(",\"time\":", e.time);
-  sink.jsonField(",\"position\":", e.position);
-  sink.jsonArray(",\"positions\":", e.positions);
-  sink.jsonArray(",\"velocities_before\":", e.velocities_before);
-  sink.jsonArray(",\"velocities_after\":", e.velocities_after);
-  sink.jsonArray(",\"energy_transfer\":", e.energy_transfer);
-  sink.jsonArray(",\"predicted_velocities_after\":", lab.predicted_velocities_after);
-  sink.jsonArray(",\"predicted_energy_transfer\":", lab.predicted_energy_transfer);
-  sink.jsonArray(",\"paper_velocities_after\":", lab.paper_velocities_after);
-  sink.jsonArray(",\"paper_energy_transfer\":", lab.paper_energy_transfer);
-  sink.jsonArray(",\"kinetic_energy_after\":", lab.kinetic_energy_after);
-  sink.jsonField(",\"total_energy\":", e.total_energy);
-  sink.jsonField(",\"total_momentum\":", e.total_momentum);
+  sink.count(r.pair_index);
+  sink.put(",\"bodies\":[");
+  bool first = true;
+  for (std::size_t i : namedBodies(r)) {
+    sink.put(first ? "\"" : ",\"");
+    sink.put(core::bodyName(i));
+    sink.put('"');
+    first = false;
+  }
+  sink.put(']');
+  sink.jsonField(",\"time\":", r.time);
+  sink.jsonField(",\"position\":", r.position);
+  sink.jsonField(",\"restitution\":", r.restitution);
+  sink.put(",\"first_moved\":");
+  sink.count(r.first_moved);
+  sink.put(",\"last_moved\":");
+  sink.count(r.last_moved);
+  sink.put(r.cluster_impact ? ",\"cluster_impact\":true" : ",\"cluster_impact\":false");
+  sink.jsonArray(",\"pair_velocities_before\":", r.pair_velocities_before);
+  sink.jsonArray(",\"pair_velocities_after\":", r.pair_velocities_after);
+  sink.jsonArray(",\"pair_energy_transfer\":", r.pair_energy_transfer);
+  sink.jsonField(",\"energy_lost\":", r.energy_lost);
+  const std::size_t n = r.full_state ? r.bodies : 0;
+  jsonValues(sink, ",\"positions\":", r.full_state ? r.positions : nullptr, n);
+  jsonValues(sink, ",\"velocities_before\":", r.full_state ? r.velocities_before : nullptr, n);
+  jsonValues(sink, ",\"velocities_after\":", r.full_state ? r.velocities_after : nullptr, n);
+  jsonValues(sink, ",\"energy_transfer\":", r.full_state ? r.energy_transfer : nullptr, n);
+  jsonValues(sink, ",\"kinetic_energy_after\":", r.full_state ? r.kinetic_energy_after : nullptr, n);
+  sink.jsonField(",\"total_energy\":", r.full_state ? r.total_energy : std::nan(""));
+  sink.jsonField(",\"total_momentum\":", r.full_state ? r.total_momentum : std::nan(""));
+  jsonModel(sink, ",\"predicted_velocities_after\":", r.predicted_velocities_after);
+  jsonModel(sink, ",\"predicted_energy_transfer\":", r.predicted_energy_transfer);
+  jsonModel(sink, ",\"paper_velocities_after\":", r.paper_velocities_after);
+  jsonModel(sink, ",\"paper_energy_transfer\":", r.paper_energy_transfer);
   sink.put('}');
 }
+
+void writeEventRecordCsv(TextSink& sink, const EventRecord& r) {
+  const auto cell = [&sink](double value) {
+    sink.put(',');
+    sink.csvNumber(value);
+  };
+  const auto count = [&sink](std::uint64_t value) {
+    sink.put(',');
+    sink.count(value);
+  };
+  sink.put(r.collapse ? "collapse" : "impact");
+  count(r.index);
+  sink.put(',');
+  sink.put(recordPairName(r));
+  count(r.pair_index);
+  sink.put(',');
+  bool first = true;
+  for (std::size_t i : namedBodies(r)) {
+    if (!first) sink.put(';');
+    sink.put(core::bodyName(i));
+    first = false;
+  }
+  cell(r.time);
+  cell(r.position);
+  cell(r.restitution);
+  count(r.first_moved);
+  count(r.last_moved);
+  sink.put(r.cluster_impact ? ",true" : ",false");
+  for (const auto* pair : {&r.pair_velocities_before, &r.pair_velocities_after, &r.pair_energy_transfer}) {
+    for (double v : *pair) cell(v);
+  }
+  cell(r.energy_lost);
+  const std::size_t n = r.full_state ? r.bodies : 0;
+  for (const double* values :
+       {r.positions, r.velocities_before, r.velocities_after, r.energy_transfer, r.kinetic_energy_after}) {
+    csvValues(sink, r.full_state ? values : nullptr, n);
+  }
+  if (r.full_state) {
+    cell(r.total_energy);
+    cell(r.total_momentum);
+  } else {
+    sink.put(",,");
+  }
+  for (const auto* values : {r.predicted_velocities_after, r.predicted_energy_transfer, r.paper_velocities_after,
+                             r.paper_energy_transfer}) {
+    csvValues(sink, values ? values->data() : nullptr, 3);
+  }
+  sink.put('\n');
+}
+
+void writeEventJson(TextSink& sink, const core::LabEvent& lab) { writeEventRecordJson(sink, eventRecord(lab)); }
 
 void writeEventJsonLine(TextSink& sink, const core::LabEvent& lab, bool first) {
   sink.put(first ? "\n" : ",\n");

@@ -6,12 +6,90 @@
 #include <cstdint>
 #include <cstdio>
 #include <optional>
+#include <sstream>
 
 #include "event_pipeline.h"
 #include "report_text.h"
 
 namespace collision_lab {
 namespace io {
+
+namespace report_text {
+
+SceneEventState::SceneEventState(const core::Scene& scene)
+    : scene_(scene), full_state_(scene.size() <= kFullStateMaxBodies), replay_(scene) {}
+
+void SceneEventState::fill(EventRecord& r) {
+  r.full_state = full_state_;
+  if (!full_state_) return;
+  const std::size_t n = replay_.size();
+  r.bodies = n;
+  positions_ = replay_.positions(r.time);
+  before_.resize(n);
+  gain_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    before_[i] = replay_.velocityBefore(i);
+    gain_[i] = replay_.energyGained(i);
+  }
+  r.total_energy = replay_.totalKineticEnergy();
+  r.total_momentum = replay_.momentum();
+  r.positions = positions_.data();
+  r.velocities_before = before_.data();
+  r.velocities_after = replay_.velocities().data();
+  r.energy_transfer = gain_.data();
+  r.kinetic_energy_after = replay_.kineticEnergies().data();
+}
+
+EventRecord SceneEventState::impact(const core::ImpactRecord& impact) {
+  const std::size_t p = impact.pair_index, left = scene_.leftOf(p);  // left: body 0 across a ring's seam
+  EventRecord r;
+  r.index = impact.index;
+  r.pair_index = p;
+  r.time = impact.time;
+  r.position = impact.position;
+  r.restitution = scene_.restitutionOf(p);
+  r.first_moved = impact.first_moved;
+  r.last_moved = impact.last_moved;
+  r.cluster_impact = impact.first_moved != p || impact.last_moved != left;
+  for (std::size_t side = 0; side < 2; ++side) {
+    r.pair_velocities_before[side] = impact.velocities_before[side];
+    r.pair_velocities_after[side] = impact.velocities_after[side];
+    r.pair_energy_transfer[side] = scene_.isWall(side == 0 ? p : left) ? 0.0 : impact.energy_gained[side];
+  }
+  r.energy_lost = impact.energy_lost;
+  replay_.apply(impact);
+  fill(r);
+  if (full_state_ && !r.cluster_impact) {
+    // Two single bodies: their entries are the engine's gains, as the pair's fields.
+    gain_[p] = r.pair_energy_transfer[0];
+    gain_[left] = r.pair_energy_transfer[1];
+  }
+  return r;
+}
+
+EventRecord SceneEventState::collapse(const core::Collapse& collapse) {
+  const std::size_t first = collapse.first_body;
+  EventRecord r;
+  r.collapse = true;
+  r.index = collapse.impacts_before;
+  r.pair_index = first;
+  r.time = collapse.time;
+  r.position = collapse.position;
+  r.restitution = scene_.restitutionOf(first);
+  r.first_moved = first;
+  r.last_moved = collapse.last_body;
+  replay_.apply(collapse);
+  for (std::size_t side = 0; side < 2; ++side) {
+    r.pair_velocities_before[side] = replay_.velocityBefore(first + side);
+    r.pair_velocities_after[side] = collapse.velocity;
+    r.pair_energy_transfer[side] = replay_.energyGained(first + side);
+  }
+  r.energy_lost = replay_.lastHeat();
+  fill(r);
+  return r;
+}
+
+}  // namespace report_text
 
 namespace {
 
@@ -350,53 +428,15 @@ class SceneJsonWriter : public SceneReportWriter {
   explicit SceneJsonWriter(std::ostream& out) : out_(out), sink_(out) {}
 
   void begin(const SceneEntry& entry, const core::RunOptions& options, const core::ModelChoice&) override {
+    state_.emplace(entry.scene);
     out_ << "{\"scene\": ";
     writeSceneJson(out_, entry);
     out_ << ",\n\"options\": " << jsonText(optionsJson(options)) << ",\n\"units\": " << jsonText(unitsJson())
          << ",\n\"events\": [";
   }
 
-  void impact(const core::ImpactRecord& r) override {
-    startEvent();
-    // The keys and order of impactJson; names are letters, digits, '#' and '-': no escapes.
-    sink_.put("{\"kind\":\"impact\",\"index\":");
-    sink_.count(r.index);
-    sink_.put(",\"pair\":\"");
-    sink_.put(impactPairName(r));
-    sink_.put("\",\"pair_index\":");
-    sink_.count(r.pair_index);
-    sink_.put(",\"bodies\":[\"");
-    sink_.put(core::bodyName(r.pair_index));
-    sink_.put("\",\"");
-    sink_.put(core::bodyName(leftBody(r)));
-    sink_.put("\"]");
-    sink_.jsonField(",\"time\":", r.time);
-    sink_.jsonField(",\"position\":", r.position);
-    sink_.jsonArray(",\"velocities_before\":", r.velocities_before);
-    sink_.jsonArray(",\"velocities_after\":", r.velocities_after);
-    sink_.jsonArray(",\"energy_gained\":", r.energy_gained);
-    sink_.jsonField(",\"energy_lost\":", r.energy_lost);
-    endEvent();
-  }
-
-  void collapse(const core::Collapse& c) override {
-    startEvent();
-    // The keys and order of collapseJson.
-    sink_.put("{\"kind\":\"collapse\",\"impacts_before\":");
-    sink_.count(c.impacts_before);
-    sink_.put(",\"first_body\":\"");
-    sink_.put(core::bodyName(c.first_body));
-    sink_.put("\",\"last_body\":\"");
-    sink_.put(core::bodyName(c.last_body));
-    sink_.put("\",\"first_body_index\":");
-    sink_.count(c.first_body);
-    sink_.put(",\"last_body_index\":");
-    sink_.count(c.last_body);
-    sink_.jsonField(",\"time\":", c.time);
-    sink_.jsonField(",\"position\":", c.position);
-    sink_.jsonField(",\"velocity\":", c.velocity);
-    endEvent();
-  }
+  void impact(const core::ImpactRecord& r) override { write(state_->impact(r)); }
+  void collapse(const core::Collapse& c) override { write(state_->collapse(c)); }
 
   void end(const core::SceneRunResult& result) override {
     sink_.flush();
@@ -406,16 +446,15 @@ class SceneJsonWriter : public SceneReportWriter {
   }
 
  private:
-  void startEvent() {
+  void write(const report_text::EventRecord& record) {
     sink_.put(any_event_ ? ",\n" : "\n");
     any_event_ = true;
-  }
-  void endEvent() {
-    sink_.put('}');
+    report_text::writeEventRecordJson(sink_, record);
     sink_.flushIfFull();
   }
   std::ostream& out_;
   TextSink sink_;
+  std::optional<report_text::SceneEventState> state_;  ///< from begin()
   bool any_event_ = false;
 };
 
@@ -470,41 +509,12 @@ class SceneCsvWriter : public SceneReportWriter {
     for (const auto& item : options_json.items()) writeCsvComment(out_, item.key(), item.value());
     writeCsvComment(out_, "model", core::modelKindName(model.kind));
     writeCsvComment(out_, "model_reason", model.reason);
-    out_ << "index,pair,pair_index,time_s,position_m,v_right_before_m_s,v_left_before_m_s,v_right_after_m_s,"
-            "v_left_after_m_s,energy_gained_right_J,energy_gained_left_J,energy_lost_J,kind,first_moved,last_moved\n";
+    out_ << report_text::kEventCsvHeader << "\n";
+    state_.emplace(s);
   }
 
-  void impact(const core::ImpactRecord& r) override {
-    sink_.count(r.index);
-    sink_.put(',');
-    sink_.put(impactPairName(r));
-    sink_.put(',');
-    sink_.count(r.pair_index);
-    for (double v : {r.time, r.position, r.velocities_before[0], r.velocities_before[1], r.velocities_after[0],
-                     r.velocities_after[1], r.energy_gained[0], r.energy_gained[1], r.energy_lost}) {
-      cell(v);
-    }
-    sink_.put(",impact,");
-    sink_.count(r.first_moved);
-    sink_.put(',');
-    sink_.count(r.last_moved);
-    sink_.put('\n');
-    sink_.flushIfFull();
-  }
-
-  void collapse(const core::Collapse& c) override {
-    sink_.count(c.impacts_before);
-    sink_.put(",,");
-    for (double v : {c.time, c.position}) cell(v);
-    sink_.put(",,");
-    for (double v : {c.velocity, c.velocity}) cell(v);
-    sink_.put(",,,,collapse,");
-    sink_.count(c.first_body);
-    sink_.put(',');
-    sink_.count(c.last_body);
-    sink_.put('\n');
-    sink_.flushIfFull();
-  }
+  void impact(const core::ImpactRecord& r) override { write(state_->impact(r)); }
+  void collapse(const core::Collapse& c) override { write(state_->collapse(c)); }
 
   void end(const core::SceneRunResult& result) override {
     sink_.flush();
@@ -517,13 +527,14 @@ class SceneCsvWriter : public SceneReportWriter {
   }
 
  private:
-  void cell(double value) {
-    sink_.put(',');
-    sink_.csvNumber(value);
+  void write(const report_text::EventRecord& record) {
+    report_text::writeEventRecordCsv(sink_, record);
+    sink_.flushIfFull();
   }
 
   std::ostream& out_;
   TextSink sink_;
+  std::optional<report_text::SceneEventState> state_;  ///< from begin()
 };
 
 // ---------------------------------------------------------------------------------------
@@ -650,19 +661,22 @@ void writeSceneBatchJson(const std::vector<SceneBatchOutcome>& outcomes, std::os
       entry["summary"]["model"] = core::modelKindName(r.model.kind);
       entry["summary"]["model_reason"] = r.model.reason;
     } else {
-      // The kept impacts, each collapse after the impact it follows (as the stream shows them).
+      // The kept impacts, each collapse after the impact it follows (as the stream shows
+      // them); every collapse before the last kept impact updates the bodies' state.
+      SceneEventJson records(outcome.entry.scene);
       std::size_t next_collapse = 0;
       const auto collapsesUpTo = [&](std::uint64_t impacts) {
         for (; next_collapse < r.simulation.collapses.size() &&
                r.simulation.collapses[next_collapse].impacts_before <= impacts;
              ++next_collapse) {
           const core::Collapse& c = r.simulation.collapses[next_collapse];
-          if (outcome.options.events.keepsAfter(c.impacts_before)) entry["events"].push_back(collapseJson(c));
+          Json json = records.collapse(c);
+          if (outcome.options.events.keepsAfter(c.impacts_before)) entry["events"].push_back(std::move(json));
         }
       };
       for (const core::ImpactRecord& impact : r.simulation.impacts) {
         collapsesUpTo(impact.index - 1);
-        entry["events"].push_back(impactJson(impact));
+        entry["events"].push_back(records.impact(impact));
       }
       collapsesUpTo(r.simulation.impact_count);
       entry["summary"] = sceneSummaryJson(r);
@@ -683,31 +697,25 @@ Json sceneEntryJson(const SceneEntry& entry) {
               {"velocities", s.velocities},   {"restitution", s.restitution}};
 }
 
-Json impactJson(const core::ImpactRecord& r) {
-  return Json{{"kind", "impact"},
-              {"index", r.index},
-              {"pair", impactPairName(r)},
-              {"pair_index", r.pair_index},
-              {"bodies", Json::array({core::bodyName(r.pair_index), core::bodyName(leftBody(r))})},
-              {"time", number(r.time)},
-              {"position", number(r.position)},
-              {"velocities_before", Json::array({number(r.velocities_before[0]), number(r.velocities_before[1])})},
-              {"velocities_after", Json::array({number(r.velocities_after[0]), number(r.velocities_after[1])})},
-              {"energy_gained", Json::array({number(r.energy_gained[0]), number(r.energy_gained[1])})},
-              {"energy_lost", number(r.energy_lost)}};
+namespace {
+
+Json recordJson(const report_text::EventRecord& record) {
+  std::ostringstream text;
+  {
+    TextSink sink(text);
+    report_text::writeEventRecordJson(sink, record);
+  }
+  return Json::parse(text.str());
 }
 
-Json collapseJson(const core::Collapse& c) {
-  return Json{{"kind", "collapse"},
-              {"impacts_before", c.impacts_before},
-              {"first_body", core::bodyName(c.first_body)},
-              {"last_body", core::bodyName(c.last_body)},
-              {"first_body_index", c.first_body},
-              {"last_body_index", c.last_body},
-              {"time", number(c.time)},
-              {"position", number(c.position)},
-              {"velocity", number(c.velocity)}};
-}
+}  // namespace
+
+SceneEventJson::SceneEventJson(const core::Scene& scene)
+    : state_(std::make_unique<report_text::SceneEventState>(scene)) {}
+SceneEventJson::~SceneEventJson() = default;
+
+Json SceneEventJson::impact(const core::ImpactRecord& impact) { return recordJson(state_->impact(impact)); }
+Json SceneEventJson::collapse(const core::Collapse& collapse) { return recordJson(state_->collapse(collapse)); }
 
 Json sceneSummaryJson(const core::SceneRunResult& result) {
   Json json = summaryScalars(result);

@@ -247,9 +247,9 @@ TEST(CliCsv, HeaderOneRowPerEventAndSummaryComments) {
   std::vector<std::string> comments;
   for (const std::string& line : linesOf(result.out)) (line.rfind("# ", 0) == 0 ? comments : rows).push_back(line);
   ASSERT_EQ(rows.size(), 4u);
-  EXPECT_EQ(rows[0].rfind("index,pair,time_s,position_m,", 0), 0u);
-  EXPECT_EQ(rows[1].rfind("1,AB,1,1,", 0), 0u);
-  EXPECT_EQ(rows[3].rfind("3,AB,2,1,", 0), 0u);
+  EXPECT_EQ(rows[0].rfind("kind,index,pair,pair_index,bodies,time_s,position_m,", 0), 0u);
+  EXPECT_EQ(rows[1].rfind("impact,1,AB,0,A;B,1,1,", 0), 0u);
+  EXPECT_EQ(rows[3].rfind("impact,3,AB,0,A;B,2,1,", 0), 0u);
   const auto count_columns = [](const std::string& row) { return std::count(row.begin(), row.end(), ','); };
   for (const std::string& row : rows) EXPECT_EQ(count_columns(row), count_columns(rows[0]));
   EXPECT_NE(std::find(comments.begin(), comments.end(), "# summary.collision_count,3"), comments.end());

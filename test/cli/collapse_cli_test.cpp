@@ -81,15 +81,18 @@ TEST(CollapseCli, CollapseEqualListsEightImpactsThenTheCollapseAtTheLimit) {
   }
   const Json& collapse = events[8];
   EXPECT_EQ(collapse.at("kind"), "collapse");
-  EXPECT_EQ(collapse.at("impacts_before"), 8);
-  EXPECT_EQ(collapse.at("first_body"), "A");
-  EXPECT_EQ(collapse.at("last_body"), "C");
-  EXPECT_EQ(collapse.at("first_body_index"), 0);
-  EXPECT_EQ(collapse.at("last_body_index"), 2);
+  EXPECT_EQ(collapse.at("index"), 8);  // not a collision: the number of impacts before it
+  EXPECT_EQ(collapse.at("bodies"), (Json{"A", "B", "C"}));
+  EXPECT_EQ(collapse.at("first_moved"), 0);
+  EXPECT_EQ(collapse.at("last_moved"), 2);
   EXPECT_NEAR(collapse.at("time").get<double>(), limit, 4e-16 * limit);
   EXPECT_NEAR(collapse.at("position").get<double>(), -1.0 / 6, 1e-15);
-  EXPECT_NEAR(collapse.at("velocity").get<double>(), -1.0 / 3, 1e-15);
-  EXPECT_FALSE(collapse.contains("index"));  // not a collision: it has no collision number
+  for (const Json& v : collapse.at("pair_velocities_after")) EXPECT_NEAR(v.get<double>(), -1.0 / 3, 1e-15);
+  // The full state: all three at the centre of mass, moving at -1/3 m/s; 3 (1/2) (1/9) J left.
+  for (const Json& v : collapse.at("velocities_after")) EXPECT_NEAR(v.get<double>(), -1.0 / 3, 1e-15);
+  for (const Json& x : collapse.at("positions")) EXPECT_NEAR(x.get<double>(), -1.0 / 6, 1e-15);
+  EXPECT_NEAR(collapse.at("total_energy").get<double>(), 1.0 / 6, 1e-15);
+  EXPECT_TRUE(collapse.at("predicted_velocities_after").is_null());
   EXPECT_EQ(doc.at("summary").at("collision_count"), 8);
   EXPECT_EQ(doc.at("summary").at("collapse_time"), collapse.at("time"));
 }
@@ -113,20 +116,28 @@ TEST(CollapseCli, TableAndCsvShowTheCollapseAfterTheEighthImpact) {
   const auto rows = csvRows(csv.out);
   ASSERT_EQ(rows.size(), 10u);  // the header, 8 impacts, the collapse
   const std::vector<std::string>& header = rows[0];
-  ASSERT_EQ(header.size(), 15u);
-  EXPECT_EQ(header[0], "index");
-  EXPECT_EQ(header[11], "energy_lost_J");
-  EXPECT_EQ((std::vector<std::string>(header.begin() + 12, header.end())),
-            (std::vector<std::string>{"kind", "first_moved", "last_moved"}));
+  ASSERT_EQ(header.size(), 29u);
+  EXPECT_EQ(header[0], "kind");
+  EXPECT_EQ(header[17], "energy_lost_J");
   for (std::size_t k = 1; k <= 8; ++k) {
     ASSERT_EQ(rows[k].size(), header.size()) << k;
-    EXPECT_EQ(rows[k][0], std::to_string(k));
-    EXPECT_EQ(rows[k][12], "impact");
+    EXPECT_EQ(rows[k][0], "impact");
+    EXPECT_EQ(rows[k][1], std::to_string(k));
   }
-  const std::vector<std::string> expected = {"8",  "",  "",  "3.5", "-0.16666666666666666", "",         "",
-                                             "-0.3333333333333333", "-0.3333333333333333", "", "", "",
-                                             "collapse", "0", "2"};
-  EXPECT_EQ(rows[9], expected);
+  const std::vector<std::string>& collapse = rows[9];
+  ASSERT_EQ(collapse.size(), header.size());
+  EXPECT_EQ(collapse[0], "collapse");
+  EXPECT_EQ(collapse[1], "8");
+  EXPECT_EQ(collapse[4], "A;B;C");
+  EXPECT_EQ(collapse[5], "3.5");
+  EXPECT_EQ(collapse[6], "-0.16666666666666666");
+  EXPECT_EQ(collapse[8], "0");
+  EXPECT_EQ(collapse[9], "2");
+  EXPECT_EQ(collapse[13], "-0.3333333333333333");
+  EXPECT_EQ(collapse[14], "-0.3333333333333333");
+  EXPECT_EQ(header[20], "velocities_after_m_s");
+  EXPECT_EQ(collapse[20], "-0.3333333333333333;-0.3333333333333333;-0.3333333333333333");
+  for (std::size_t c = 25; c < 29; ++c) EXPECT_EQ(collapse[c], "") << header[c];  // no model values
 }
 
 // By hand: A, B, C collapse as in collapse_equal, 1 m to the right: at t = 3.5 s at x_cm =
@@ -141,9 +152,9 @@ TEST(CollapseCli, CollapseComesBeforeTheClusterImpact) {
   expectImpacts(events, 8);
   const Json& collapse = events[8];
   EXPECT_EQ(collapse.at("kind"), "collapse");
-  EXPECT_EQ(collapse.at("impacts_before"), 8);
-  EXPECT_EQ(collapse.at("first_body"), "A");
-  EXPECT_EQ(collapse.at("last_body"), "C");
+  EXPECT_EQ(collapse.at("index"), 8);
+  EXPECT_EQ(collapse.at("first_moved"), 0);
+  EXPECT_EQ(collapse.at("last_moved"), 2);
   EXPECT_NEAR(collapse.at("time").get<double>(), 3.5, 4e-16 * 3.5);
   EXPECT_NEAR(collapse.at("position").get<double>(), 5.0 / 6, 1e-15);
   const Json& cluster = events[9];
@@ -152,16 +163,23 @@ TEST(CollapseCli, CollapseComesBeforeTheClusterImpact) {
   EXPECT_EQ(cluster.at("pair"), "CD");
   EXPECT_NEAR(cluster.at("time").get<double>(), 14.4, 1e-14);
   EXPECT_NEAR(cluster.at("position").get<double>(), -2.8, 1e-14);
-  EXPECT_NEAR(cluster.at("velocities_after")[0].get<double>(), -1.0 / 48, 1e-15);
-  EXPECT_NEAR(cluster.at("velocities_after")[1].get<double>(), -7.0 / 16, 1e-15);
+  EXPECT_NEAR(cluster.at("pair_velocities_after")[0].get<double>(), -1.0 / 48, 1e-15);
+  EXPECT_NEAR(cluster.at("pair_velocities_after")[1].get<double>(), -7.0 / 16, 1e-15);
+  EXPECT_EQ(cluster.at("cluster_impact"), true);
+  // The full state: the cluster A..C moved as one, D on its own.
+  const std::vector<double> after = doubles(cluster.at("velocities_after"));
+  ASSERT_EQ(after.size(), 4u);
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_NEAR(after[i], -1.0 / 48, 1e-15) << i;
+  EXPECT_NEAR(after[3], -7.0 / 16, 1e-15);
   EXPECT_EQ(doc.at("summary").at("collision_count"), 9);
 
   const CliOutput csv = run(with(kFourBodies, {"--format", "csv"}));
   const auto rows = csvRows(csv.out);
   ASSERT_EQ(rows.size(), 11u);
-  EXPECT_EQ(rows[9][12], "collapse");
-  EXPECT_EQ((std::vector<std::string>(rows[10].begin() + 12, rows[10].end())),
-            (std::vector<std::string>{"impact", "0", "3"}));  // the cluster A..C and D moved
+  EXPECT_EQ(rows[9][0], "collapse");
+  EXPECT_EQ(rows[10][0], "impact");
+  EXPECT_EQ((std::vector<std::string>(rows[10].begin() + 8, rows[10].begin() + 11)),
+            (std::vector<std::string>{"0", "3", "true"}));  // the cluster A..C and D moved
 }
 
 // --events first:N counts impacts; a collapse is shown when it comes before impact N + 1.

@@ -12,6 +12,7 @@
 #include <fstream>
 #include <functional>
 #include <random>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -103,8 +104,8 @@ TEST(NBodyCli, TwoCartsMeetOnceAsComputedByHand) {
     EXPECT_EQ(event.at("pair_index"), 0);
     EXPECT_EQ(event.at("time"), 0.5);
     EXPECT_EQ(event.at("position"), 0.5);
-    EXPECT_EQ(doubles(event.at("velocities_after")), (std::vector<double>{0, -2}));
-    EXPECT_EQ(doubles(event.at("energy_gained")), (std::vector<double>{-1.5, 1.5}));
+    EXPECT_EQ(doubles(event.at("pair_velocities_after")), (std::vector<double>{0, -2}));
+    EXPECT_EQ(doubles(event.at("pair_energy_transfer")), (std::vector<double>{-1.5, 1.5}));
     EXPECT_EQ(event.at("energy_lost"), 0.0);
   }
 }
@@ -186,7 +187,7 @@ TEST(NBodyCli, CradleGivesFourImpactsAndTheLastBallLeaves) {
     EXPECT_EQ(event.at("pair_index"), k);
     EXPECT_EQ(event.at("time"), k + 1.0);
     EXPECT_EQ(event.at("position"), 3.0 - k);
-    EXPECT_EQ(doubles(event.at("velocities_after")), (std::vector<double>{0, -1}));
+    EXPECT_EQ(doubles(event.at("pair_velocities_after")), (std::vector<double>{0, -1}));
   }
 }
 
@@ -600,6 +601,105 @@ TEST(OneSchema, TheBatchCsvHeaderIsTheSameWhateverTheScenes) {
     EXPECT_EQ(lines[0], header);
     EXPECT_EQ(lines[1], "three,3,three_body_rotation,2,2,false,0");
   }
+}
+
+// One event schema (issue 20): a three-body scene (the rotation's path) and a four-body scene
+// (the event engine's) give events with the same keys in the same order, and one CSV header.
+// The full state is the bodies' state: the last event's velocities after are the summary's
+// final velocities, each event starts where the one before left off, the pair's fields are
+// the full state's entries pair_index and pair_index + 1, and the momentum of the full state
+// is the initial one (no wall): -1 kg m/s for both scenes. Failed before: the four-body
+// events had kind, bodies and energy_gained and the pair's velocities only, the three-body
+// events the model's values and no kind; the CSV headers differed.
+TEST(NBodyCli, EveryEventOfEverySceneHasTheOneSchemaAndTheFullState) {
+  const std::vector<std::vector<std::string>> scenes = {
+      {"--masses", "1,2,3", "--positions", "3,2,1", "--velocities", "-1,0,0", "--events", "all"},
+      {"--masses", "1,2,3,4", "--positions", "3,2,1,0", "--velocities", "-1,0,0,0", "--events", "all"}};
+  std::vector<std::vector<std::string>> keys;
+  std::vector<std::string> headers;
+  for (const auto& args : scenes) {
+    SCOPED_TRACE(args[1]);
+    const std::size_t n = args[1] == "1,2,3" ? 3 : 4;
+    const Json doc = runJson(args);
+    const Json& events = doc.at("events");
+    ASSERT_GE(events.size(), 2u);
+    std::vector<double> previous = doubles(doc.at("scene").at("velocities"));
+    for (const Json& event : events) {
+      std::vector<std::string> names;
+      for (const auto& item : event.items()) names.push_back(item.key());
+      if (keys.empty() || keys.back() != names) keys.push_back(names);
+      EXPECT_EQ(event.at("kind"), "impact");
+      const std::size_t p = event.at("pair_index").get<std::size_t>();
+      const std::vector<double> before = doubles(event.at("velocities_before"));
+      const std::vector<double> after = doubles(event.at("velocities_after"));
+      const std::vector<double> transfer = doubles(event.at("energy_transfer"));
+      ASSERT_EQ(after.size(), n);
+      EXPECT_EQ(before, previous);
+      previous = after;
+      EXPECT_EQ(doubles(event.at("pair_velocities_before")), (std::vector<double>{before[p], before[p + 1]}));
+      EXPECT_EQ(doubles(event.at("pair_velocities_after")), (std::vector<double>{after[p], after[p + 1]}));
+      EXPECT_EQ(doubles(event.at("pair_energy_transfer")), (std::vector<double>{transfer[p], transfer[p + 1]}));
+      EXPECT_NEAR(event.at("total_momentum").get<double>(), -1.0, 1e-14);
+      EXPECT_EQ(event.at("predicted_velocities_after").is_null(), n != 3);  // the rotation's block
+    }
+    EXPECT_EQ(previous, doubles(doc.at("summary").at("final_velocities")));
+
+    std::vector<std::string> csv_args = args;
+    csv_args.insert(csv_args.end(), {"--format", "csv"});
+    const CliOutput csv = run(csv_args);
+    ASSERT_EQ(csv.exit_code, 0) << csv.err;
+    std::istringstream lines(csv.out);
+    std::string line;
+    while (std::getline(lines, line) && line.rfind("#", 0) == 0) {
+    }
+    headers.push_back(line);
+  }
+  EXPECT_EQ(keys.size(), 1u) << "every event of both scenes has the same keys";
+  ASSERT_EQ(headers.size(), 2u);
+  EXPECT_EQ(headers[0], headers[1]);
+  EXPECT_EQ(headers[0].rfind("kind,index,pair,pair_index,bodies,", 0), 0u) << headers[0];
+}
+
+// Above CollisionEvent::FULL_STATE_MAX_BODIES (64) bodies the full state's keys are null
+// (JSON) and its cells empty (CSV); the pair's fields still carry the event. By hand: 70
+// equal masses 1 m apart, A (x = 69 m) at -1 m/s hits B at rest at t = 1 s, x = 68 m, and
+// they swap velocities.
+TEST(NBodyCli, AboveSixtyFourBodiesTheFullStateIsNullAndThePairCarriesTheEvent) {
+  std::string masses = "1", positions = "69", velocities = "-1";
+  for (int i = 68; i >= 0; --i) {
+    masses += ",1";
+    positions += "," + std::to_string(i);
+    velocities += ",0";
+  }
+  const std::vector<std::string> args = {"--masses", masses, "--positions", positions, "--velocities", velocities,
+                                         "--events", "first:1"};
+  const Json doc = runJson(args);
+  ASSERT_EQ(doc.at("events").size(), 1u);
+  const Json& event = doc.at("events")[0];
+  EXPECT_EQ(event.at("time"), 1.0);
+  EXPECT_EQ(event.at("position"), 68.0);
+  EXPECT_EQ(doubles(event.at("pair_velocities_after")), (std::vector<double>{0, -1}));
+  for (const char* key : {"positions", "velocities_before", "velocities_after", "energy_transfer",
+                          "kinetic_energy_after", "total_energy", "total_momentum"}) {
+    EXPECT_TRUE(event.at(key).is_null()) << key;
+  }
+  std::vector<std::string> csv_args = args;
+  csv_args.insert(csv_args.end(), {"--format", "csv"});
+  const CliOutput csv = run(csv_args);
+  ASSERT_EQ(csv.exit_code, 0) << csv.err;
+  std::istringstream lines(csv.out);
+  std::string line;
+  std::vector<std::string> rows;
+  while (std::getline(lines, line)) {
+    if (line.rfind("#", 0) != 0) rows.push_back(line);
+  }
+  ASSERT_EQ(rows.size(), 2u);
+  // The pair's velocities after, energies gained and the heat, then 11 empty cells: the full
+  // state (7) and the model's values (4).
+  const std::string tail = ",0,-1,-0.5,0.5,0,,,,,,,,,,,";
+  ASSERT_GE(rows[1].size(), tail.size());
+  EXPECT_EQ(rows[1].substr(rows[1].size() - tail.size()), tail) << rows[1];
+  EXPECT_EQ(std::count(rows[1].begin(), rows[1].end(), ','), std::count(rows[0].begin(), rows[0].end(), ','));
 }
 
 }  // namespace

@@ -43,17 +43,30 @@ bool samePrinted(double printed, double core_value) {
   return bitsOf(printed) == bitsOf(core_value);
 }
 
-/// The values of one event in the CSV column order after index and pair.
+/// The numeric cells of one event row (the columns of report_text::kEventCsvHeader without
+/// the counts, names and flags; a per-body cell holds its values separated by ';').
+const std::vector<std::size_t> kImpactNumberColumns = {5, 6, 7, 11, 12, 13, 14, 15, 16, 17, 18, 19,
+                                                       20, 21, 22, 23, 24, 25, 26, 27, 28};
+
 std::vector<double> csvRowValues(const core::LabEvent& lab) {
   const core::ImpactEvent& e = lab.event;
-  std::vector<double> values = {e.time, e.position};
+  const std::size_t p = core::pairIndex(e.pair);
+  std::vector<double> values = {e.time, e.position, 1.0};  // restitution: elastic
+  for (const auto* group : {&e.velocities_before, &e.velocities_after, &e.energy_transfer}) {
+    values.push_back((*group)[p]);
+    values.push_back((*group)[p + 1]);
+  }
+  values.push_back(0.0);  // energy lost
   for (const auto* group : {&e.positions, &e.velocities_before, &e.velocities_after, &e.energy_transfer,
-                            &lab.predicted_velocities_after, &lab.paper_velocities_after,
-                            &lab.predicted_energy_transfer, &lab.paper_energy_transfer}) {
+                            &lab.kinetic_energy_after}) {
     values.insert(values.end(), group->begin(), group->end());
   }
   values.push_back(e.total_energy);
   values.push_back(e.total_momentum);
+  for (const auto* group : {&lab.predicted_velocities_after, &lab.predicted_energy_transfer,
+                            &lab.paper_velocities_after, &lab.paper_energy_transfer}) {
+    values.insert(values.end(), group->begin(), group->end());
+  }
   return values;
 }
 
@@ -85,14 +98,28 @@ std::string report(const LabRun& run, io::ReportFormat format, bool with_model) 
   return out.str();
 }
 
-std::vector<std::string> split(const std::string& line) {
+std::vector<std::string> split(const std::string& line, char separator) {
   std::vector<std::string> fields;
   std::size_t start = 0;
-  for (std::size_t comma; (comma = line.find(',', start)) != std::string::npos; start = comma + 1) {
-    fields.push_back(line.substr(start, comma - start));
+  for (std::size_t at; (at = line.find(separator, start)) != std::string::npos; start = at + 1) {
+    fields.push_back(line.substr(start, at - start));
   }
   fields.push_back(line.substr(start));
   return fields;
+}
+
+/// The numbers of the given columns of a row, per-body cells split at ';', empty cells left out.
+std::vector<double> csvNumbers(const std::vector<std::string>& fields, const std::vector<std::size_t>& columns) {
+  std::vector<double> values;
+  for (std::size_t c : columns) {
+    if (fields.at(c).empty()) continue;
+    for (const std::string& cell : split(fields[c], ';')) {
+      char* end = nullptr;
+      values.push_back(std::strtod(cell.c_str(), &end));
+      EXPECT_EQ(*end, '\0') << cell;
+    }
+  }
+  return values;
 }
 
 void expectCsvCarriesEvents(const std::string& text, const std::vector<core::LabEvent>& events) {
@@ -104,21 +131,21 @@ void expectCsvCarriesEvents(const std::string& text, const std::vector<core::Lab
     if (line.rfind("#", 0) == 0) continue;
     if (!header_seen) {
       header_seen = true;
-      ASSERT_EQ(line.rfind("index,pair,time_s,position_m,x_A_m", 0), 0u) << line;
+      ASSERT_EQ(line.rfind("kind,index,pair,pair_index,bodies,time_s", 0), 0u) << line;
       continue;
     }
     ASSERT_LT(row, events.size());
     const core::LabEvent& lab = events[row++];
-    const std::vector<std::string> fields = split(line);
+    const std::vector<std::string> fields = split(line, ',');
+    ASSERT_EQ(fields.size(), 29u) << line;
+    ASSERT_EQ(fields[0], "impact");
+    ASSERT_EQ(fields[1], std::to_string(lab.event.index));
+    ASSERT_EQ(fields[2], core::pairName(lab.event.pair));
     const std::vector<double> expected = csvRowValues(lab);
-    ASSERT_EQ(fields.size(), 2 + expected.size()) << line;
-    ASSERT_EQ(fields[0], std::to_string(lab.event.index));
-    ASSERT_EQ(fields[1], core::pairName(lab.event.pair));
+    const std::vector<double> printed = csvNumbers(fields, kImpactNumberColumns);
+    ASSERT_EQ(printed.size(), expected.size()) << line;
     for (std::size_t i = 0; i < expected.size(); ++i) {
-      char* end = nullptr;
-      const double value = std::strtod(fields[2 + i].c_str(), &end);
-      ASSERT_EQ(*end, '\0') << fields[2 + i];
-      ASSERT_TRUE(samePrinted(value, expected[i])) << "row " << row << " column " << 2 + i << ": " << fields[2 + i];
+      ASSERT_TRUE(samePrinted(printed[i], expected[i])) << "row " << row << " value " << i << ": " << line;
     }
   }
   EXPECT_EQ(row, events.size());
@@ -132,7 +159,7 @@ void expectShortestJsonNumbers(const std::string& text, std::size_t lines) {
   std::string line;
   std::size_t checked = 0;
   while (std::getline(in, line) && checked < lines) {
-    if (line.rfind("{\"index\":", 0) != 0) continue;
+    if (line.rfind("{\"kind\":", 0) != 0) continue;
     ++checked;
     for (std::size_t i = line.find(':'); i < line.size(); ++i) {
       if (line[i] != ':' && line[i] != '[' && line[i] != ',') continue;
@@ -167,7 +194,7 @@ double jsonDouble(const io::Json& value) {
 }
 
 /// The "events" of a JSON report against the document API's objects (eventJson,
-/// impactJson, collapseJson): the same keys in the same order, the same strings and
+/// SceneEventJson): the same keys in the same order, the same strings and
 /// counts, every double bit for bit (null for NaN and infinities).
 void expectJsonEvents(const std::string& text, const std::vector<io::Json>& expected_events) {
   const io::Json doc = io::Json::parse(text);  // throws on invalid JSON
@@ -252,9 +279,10 @@ SceneReports sceneReports(const core::Scene& scene) {
   const auto json_writer = io::makeSceneReportWriter(io::ReportFormat::kJson, json);
   csv_writer->begin(entry, options.lab, model);
   json_writer->begin(entry, options.lab, model);
+  io::SceneEventJson records(scene);
   core::SceneVisitors visitors;
   visitors.impact = [&](const core::ImpactRecord& r) {
-    reports.events.push_back(io::impactJson(r));
+    reports.events.push_back(records.impact(r));
     reports.csv_values.push_back({r.time, r.position, r.velocities_before[0], r.velocities_before[1],
                                   r.velocities_after[0], r.velocities_after[1], r.energy_gained[0],
                                   r.energy_gained[1], r.energy_lost});
@@ -262,7 +290,7 @@ SceneReports sceneReports(const core::Scene& scene) {
     json_writer->impact(r);
   };
   visitors.collapse = [&](const core::Collapse& c) {
-    reports.events.push_back(io::collapseJson(c));
+    reports.events.push_back(records.collapse(c));
     reports.csv_values.push_back({c.time, c.position, c.velocity, c.velocity});
     csv_writer->collapse(c);
     json_writer->collapse(c);
@@ -296,15 +324,15 @@ TEST(ReportStream, NBodyImpactsAndCollapsesCarryTheEngineValues) {
     std::string line;
     std::size_t row = 0;
     while (std::getline(in, line)) {
-      if (line.empty() || line[0] == '#' || line.rfind("index,", 0) == 0) continue;
+      if (line.empty() || line[0] == '#' || line.rfind("kind,", 0) == 0) continue;
       ASSERT_LT(row, reports.csv_values.size());
       const std::vector<double>& expected = reports.csv_values[row++];
-      std::vector<double> printed;
-      const std::vector<std::string> fields = split(line);
-      ASSERT_EQ(fields.size(), 15u) << line;
-      for (std::size_t i = 3; i < 12; ++i) {
-        if (!fields[i].empty()) printed.push_back(std::strtod(fields[i].c_str(), nullptr));
-      }
+      const std::vector<std::string> fields = split(line, ',');
+      ASSERT_EQ(fields.size(), 29u) << line;
+      // time, position; the pair's velocities before (impacts), after, energies and heat (impacts).
+      const std::vector<double> printed =
+          csvNumbers(fields, fields[0] == "impact" ? std::vector<std::size_t>{5, 6, 11, 12, 13, 14, 15, 16, 17}
+                                                   : std::vector<std::size_t>{5, 6, 13, 14});
       ASSERT_EQ(printed.size(), expected.size()) << line;
       for (std::size_t i = 0; i < expected.size(); ++i) ASSERT_TRUE(samePrinted(printed[i], expected[i])) << line;
     }

@@ -43,7 +43,8 @@ Json unitsJson();
 /// name, description, masses, positions, velocities, walls (["A"], ["C"] or []).
 Json sceneJson(const NamedScene& scene);
 Json optionsJson(const core::RunOptions& options);
-/// One event: simulation, closed-form prediction and the paper's printed values.
+/// One event in the one event record of every scene (docs/cli.md "Events"): the
+/// simulation's full state, the closed-form prediction and the paper's printed values.
 Json eventJson(const core::LabEvent& event);
 /// The summary of a run next to its predictions (see docs/cli_section.md for the keys).
 Json summaryJson(const core::RunResult& result);

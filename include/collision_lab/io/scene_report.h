@@ -19,6 +19,9 @@
 
 namespace collision_lab {
 namespace io {
+namespace report_text {
+class SceneEventState;
+}  // namespace report_text
 
 /// Bodies shown at each end of the table's body lists.
 constexpr std::size_t kTableBodies = 5;
@@ -44,12 +47,20 @@ std::unique_ptr<RunReportWriter> makeThreeBodyReportWriter(ReportFormat format, 
 
 /// name, description, bodies (N), masses, positions, velocities, restitution, walls (names).
 Json sceneEntryJson(const SceneEntry& entry);
-/// One impact: kind "impact", index, pair (name) and pair_index, bodies, time, position,
-/// velocities, energies.
-Json impactJson(const core::ImpactRecord& impact);
-/// One collapse: kind "collapse", impacts_before, first_body and last_body (names and
-/// indices), time [s], position [m], velocity (the cluster's, after it) [m/s].
-Json collapseJson(const core::Collapse& collapse);
+/// The events of one N-body run as JSON objects, in the one event schema of every report
+/// (docs/cli.md "Events", the fields of msg/CollisionEvent.msg). Give it every impact and
+/// collapse of the run in order from the first: it tracks the bodies' state for the full-state
+/// arrays (scenes of at most 64 bodies; null above).
+class SceneEventJson {
+ public:
+  explicit SceneEventJson(const core::Scene& scene);
+  ~SceneEventJson();
+  Json impact(const core::ImpactRecord& impact);
+  Json collapse(const core::Collapse& collapse);
+
+ private:
+  std::unique_ptr<report_text::SceneEventState> state_;
+};
 /// The summary of an N-body run (see docs/cli.md for the keys).
 Json sceneSummaryJson(const core::SceneRunResult& result);
 
