@@ -460,7 +460,10 @@ class BodiesCsv {
     const std::size_t n = m.velocities_after.size();
     const bool known = state && state->size() == n;
     for (std::size_t i = 0; i < n; ++i) {
-      BodyRow r(m.index, m.time, i, m.first_moved <= i && i <= m.last_moved);
+      // A ring's seam event wraps: first_moved..N-1, then 0..last_moved.
+      const bool moved = m.first_moved <= m.last_moved ? m.first_moved <= i && i <= m.last_moved
+                                                       : i >= m.first_moved || i <= m.last_moved;
+      BodyRow r(m.index, m.time, i, moved);
       if (known) r.mass = state->mass(i);
       r.x = at(m.positions, i), r.v_before = at(m.velocities_before, i), r.v = m.velocities_after[i];
       r.energy_transfer = at(m.energy_transfer, i), r.kinetic = at(m.kinetic_energy_after, i);

@@ -255,6 +255,10 @@ bool RunRecord::wellFormed(const collision_lab::CollisionEvent& event) const {
   if (event.kind == collision_lab::CollisionEvent::KIND_COLLAPSE) {
     return event.first_moved < event.last_moved && event.last_moved < n;
   }
+  if (input().ring > 0 && n >= 2 && std::size_t{event.pair_index} + 1 == n) {
+    // A ring's seam: body N-1 meets body 0 (BodyStateReplay moves first_moved..N-1, then 0..last_moved).
+    return event.first_moved <= event.pair_index && event.last_moved < event.first_moved;
+  }
   return std::size_t{event.pair_index} + 1 < n && event.first_moved <= event.pair_index &&
          event.last_moved > event.pair_index && event.last_moved < n;
 }

@@ -260,17 +260,18 @@ TEST(CliScenarioFile, ListNamesEveryPreset) {
   const CliOutput result = run({"--scenario", kPresets, "--list"});
   ASSERT_EQ(result.exit_code, 0) << result.err;
   const std::vector<std::string> lines = linesOf(result.out);
-  ASSERT_EQ(lines.size(), 23u);
+  ASSERT_EQ(lines.size(), 24u);
   EXPECT_EQ(lines[0].rfind("equal_masses ", 0), 0u);
   EXPECT_EQ(lines[11].rfind("moving_wall ", 0), 0u);
   EXPECT_EQ(lines[20].rfind("gas_1000 ", 0), 0u);
-  EXPECT_EQ(lines[22].rfind("cluster_collapse_5 ", 0), 0u);
+  EXPECT_EQ(lines[22].rfind("granular_ring ", 0), 0u);
+  EXPECT_EQ(lines[23].rfind("cluster_collapse_5 ", 0), 0u);
 }
 
 TEST(CliScenarioFile, WithoutANameRunsEveryScene) {
   const Json doc = runJson({"--scenario", kPresets});
   const Json& scenarios = doc.at("scenarios");
-  ASSERT_EQ(scenarios.size(), 23u);
+  ASSERT_EQ(scenarios.size(), 24u);
   const std::vector<std::pair<std::string, int>> expected = {
       {"equal_masses", 3}, {"no_collision", 0}, {"pi_digits_2", 31},  {"pi_digits_3", 314},
       {"pi_digits_4", 3141}, {"pi_digits_5", 31415}, {"kaleidoscopic", 3}, {"grazing", 2}};

@@ -214,12 +214,14 @@ TEST(CollapseCli, ClusterCollapse5CollapsesTwiceIntoOneCluster) {
     if (event.at("kind") == "collapse") collapses.push_back(event);
   }
   ASSERT_EQ(collapses.size(), 2u);
-  EXPECT_EQ(collapses[0].at("first_body"), "A");
-  EXPECT_EQ(collapses[0].at("last_body"), "C");
+  EXPECT_EQ(collapses[0].at("first_moved"), 0);
+  EXPECT_EQ(collapses[0].at("last_moved"), 2);
+  EXPECT_EQ(collapses[0].at("bodies"), (Json{"A", "B", "C"}));
   EXPECT_NEAR(collapses[0].at("time").get<double>(), 3.5, 1e-15);
   EXPECT_NEAR(collapses[0].at("position").get<double>(), 11.0 / 6, 1e-15);
-  EXPECT_EQ(collapses[1].at("first_body"), "A");
-  EXPECT_EQ(collapses[1].at("last_body"), "E");
+  EXPECT_EQ(collapses[1].at("first_moved"), 0);
+  EXPECT_EQ(collapses[1].at("last_moved"), 4);
+  EXPECT_EQ(collapses[1].at("bodies"), (Json{"A", "B", "C", "D", "E"}));
   const double second = 3 + collision_lab::core::reference::collapseTime(
                                 collision_lab::core::Scene{{3, 1, 1}, {2, 1, 0}, {-1.0 / 3, 0, 0}, {0.05}});
   EXPECT_NEAR(collapses[1].at("time").get<double>(), second, 1e-12);

@@ -162,7 +162,8 @@ TEST(NBodyCli, RingSeamImpact) {
   EXPECT_EQ(event.at("bodies"), (Json{"B", "A"}));
   EXPECT_EQ(event.at("time"), 1.0);
   EXPECT_EQ(event.at("position"), 0.0);
-  EXPECT_EQ(doubles(event.at("velocities_after")), (std::vector<double>{0, -2}));
+  EXPECT_EQ(doubles(event.at("pair_velocities_after")), (std::vector<double>{0, -2}));  // B, A
+  EXPECT_EQ(doubles(event.at("velocities_after")), (std::vector<double>{-2, 0}));       // every body: A, B
   EXPECT_EQ(doubles(doc.at("summary").at("final_velocities")), (std::vector<double>{-2, 0}));
   EXPECT_EQ(doc.at("scene").at("ring"), 10.0);
   const CliOutput outside = run({"--masses", "1,3", "--positions", "11,1", "--velocities", "1,-1", "--ring", "10"});

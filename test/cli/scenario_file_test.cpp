@@ -128,7 +128,7 @@ TEST(ScenarioFile, PresetsLoadInFileOrderAndAreValid) {
 
 TEST(ScenarioFile, PresetsOfAnySizeLoadAndAreValid) {
   const std::vector<SceneEntry> scenes = loadScenes(COLLISION_LAB_SOURCE_DIR "/config/scenarios.yaml");
-  ASSERT_EQ(scenes.size(), 23u);
+  ASSERT_EQ(scenes.size(), 24u);
   for (const SceneEntry& entry : scenes) {
     EXPECT_FALSE(collision_lab::core::planScene(entry.scene).error.has_value()) << entry.name;
     EXPECT_FALSE(entry.description.empty()) << entry.name;
@@ -148,7 +148,7 @@ TEST(ScenarioFile, PresetsOfAnySizeLoadAndAreValid) {
   EXPECT_EQ(skipped, (std::vector<std::string>{"two_carts", "two_carts_inelastic", "cradle_5", "ball_between_walls",
                                                "bouncing_ball_wall", "collapse_equal", "near_collapse",
                                                "equal_masses_100", "gas_1000", "granular_box_1000",
-                                               "cluster_collapse_5"}));
+                                               "granular_ring", "cluster_collapse_5"}));
 }
 
 TEST(ScenarioFile, RestitutionAndBodiesKeys) {

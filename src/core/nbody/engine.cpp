@@ -396,7 +396,10 @@ std::string stopMessage(const Scene& scene, const EngineResult& result, bool exh
                "needing exact arithmetic of more than " + std::to_string(kExactBits) +
                " bits: a collapse of a kind the engine does not resolve (engine.h, Collapse), or a spiral just above "
                "its critical restitution, whose approach speeds shrink by ever more bits (the three_body_spiral "
-               "model counts it)";
+               "model counts it); the impacts crowd among bodies " +
+               indexRanges(result.crowding_bodies) +
+               " (indices from 0); a model of the physics there goes on: --restitution-model tc or "
+               "--restitution-model viscoelastic";
       }
       return "stopped at the cap of " + count + " impacts (truncated)" +
              (scene.wallCount() == 2 ? "; two walls keep the bodies between them colliding forever" : "");
@@ -502,7 +505,9 @@ EngineResult runEngine(const Scene& scene, const EngineOptions& options, const I
   if (result.stop == StopReason::kFinished) finish(r, result);
   result.truncated = result.stop == StopReason::kCap || result.stop == StopReason::kCancelled ||
                      result.stop == StopReason::kPrecisionBudget;
-  if (result.stop == StopReason::kPrecisionBudget) result.crowding_bodies = driver.crowdingBodies();
+  if (result.stop == StopReason::kPrecisionBudget || r.kind == StepKind::kExhausted) {
+    result.crowding_bodies = driver.crowdingBodies();
+  }
   result.final_time = driver.fast().lastTime();
   result.collapsed = !result.collapses.empty();
   if (result.collapsed) {

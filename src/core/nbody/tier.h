@@ -82,7 +82,8 @@ enum class StepKind {
 constexpr unsigned kExactBits = 2048;
 constexpr std::uint64_t kExactStreak = 256;
 
-/// The exactness budget: the bound on the work of one exact decision. A rational's size
+/// The exactness budget: the bound on the work of one exact decision (10^11 bit^2: the proof of a
+/// four-body group collapse needs more than 10^10). A rational's size
 /// grows with the impacts in its causal past (each adds the bits of a mass sum), so the
 /// exact tier's replay up to a decision deep into a long run with double inputs (a crowding
 /// cluster in a gas) costs more with every impact, without bound. The cost of a replay is
@@ -91,7 +92,7 @@ constexpr std::uint64_t kExactStreak = 256;
 /// would exceed kExactReplayBudget [bit^2] is not taken: the run stops at its last certified
 /// impact (StopReason::kPrecisionBudget). The exact tier's own runs of steps are bounded by
 /// the exactness cap above; together, each decision costs at most a constant.
-constexpr double kExactReplayBudget = 1e10;
+constexpr double kExactReplayBudget = 1e11;
 
 struct StepResult {
   StepKind kind = StepKind::kImpact;

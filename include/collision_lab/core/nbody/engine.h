@@ -177,7 +177,8 @@ struct EngineResult {
   /// Impacts in which a cluster (stuck by e = 0 or left by a collapse) met its neighbour as
   /// ONE body of its total mass, with the restitution of the pair that touches (the cluster rule).
   std::uint64_t cluster_impacts = 0;
-  /// kPrecisionBudget: the bodies (indices from 0, ascending) of the last impacts that needed
+  /// kPrecisionBudget or the exactness cap (kCap of an accumulation): the bodies (indices from
+  /// 0, ascending) of the last impacts that needed
   /// more than double-double precision and of the decision left open; empty otherwise.
   std::vector<std::size_t> crowding_bodies;
   /// Impacts whose pair has e < 1 (or, viscoelastic, whose e(v) is 1) that the scene's
