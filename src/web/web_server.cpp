@@ -366,11 +366,13 @@ void WebServer::routes() {
           }
           const auto since = std::chrono::steady_clock::now() - *last;
           if (!finished && since < kStreamInterval) std::this_thread::sleep_for(kStreamInterval - since);
+          // Whether the run is final is read before its JSON (and after the pause above): a run
+          // that finishes after this read has a newer version, which wakes the next call.
+          const bool done = book_.finished(run_id);
           const auto run = book_.json(run_id);
           if (!run) return false;
           *seen = run->second;
           *last = std::chrono::steady_clock::now();
-          const bool done = finished && book_.finished(run_id);
           const std::string event = std::string("event: ") + (done ? "final" : "run") + "\ndata: " + run->first + "\n\n";
           if (!sink.write(event.data(), event.size())) return false;
           if (done) sink.done();
