@@ -6,6 +6,7 @@
 # Idempotent: apt-get runs only when a package is missing; the build is incremental.
 # Usage: bash scripts/setup_debian.sh [--no-build] [--with-screenshots] [--with-bench]
 #   --no-build: install the packages only (for a catkin workspace of your own).
+#   --with-screenshots: xvfb, imagemagick and chromium (rviz screenshots, the browser tests).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -16,7 +17,9 @@ export PATH=/usr/bin:/bin:/usr/sbin:/sbin:$PATH
 # rostest (python3-rostest) and rosrun (rosbash) are not part of ros-core-dev; rostopic
 # needs the Python messages of other packages to echo /diagnostics and the markers, and
 # rosservice those of std_srvs to pause a replay (/rosbag_play/pause_playback); rviz is
-# opened by the launch files whenever a display is set.
+# opened by the launch files whenever a display is set. The class's web server
+# (docs/web.md) needs cpp-httplib and serves Debian's Chart.js; its browser tests and
+# screenshots need chromium (--with-screenshots, as CI).
 packages=(
   build-essential cmake libgtest-dev
   ros-core-dev rosout rosbash python3-rostest
@@ -28,12 +31,13 @@ packages=(
   python3-visualization-msgs python3-diagnostic-msgs
   libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
   rviz
+  libcpp-httplib-dev libjs-chart.js
 )
 build=true
 for arg in "$@"; do
   case "$arg" in
     --no-build) build=false ;;
-    --with-screenshots) packages+=(xvfb imagemagick) ;;
+    --with-screenshots) packages+=(xvfb imagemagick chromium) ;;
     --with-bench) packages+=(libbullet-dev libode-dev libbox2d-dev gnuplot python3-matplotlib) ;;
     *) echo "setup_debian.sh: unknown option $arg" >&2; exit 2 ;;
   esac

@@ -3,7 +3,8 @@
 # tests, rostests), then prints catkin's summary. Exits non-zero when any test fails.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/setup_debian.sh
+# Options go to setup_debian.sh (CI: --with-screenshots, for the browser tests).
+bash scripts/setup_debian.sh "$@"
 # The usual ROS way works too: a fresh catkin workspace, catkin_make, rosrun, roslaunch.
 bash scripts/check_catkin_workspace.sh
 export PATH=/usr/bin:/bin:$PATH

@@ -1,0 +1,20 @@
+# The class's web server (issue 23, docs/web.md): a node of its own beside the lab node,
+# on cpp-httplib (Debian's libcpp-httplib-dev) with pages under web/ and Chart.js from
+# Debian's libjs-chart.js (no CDN: a lab may have no internet).
+# (include, not find_package: bench.cmake finds PkgConfig too, and catkin_lint flags a second find_package.)
+include(FindPkgConfig)
+pkg_check_modules(CPP_HTTPLIB REQUIRED IMPORTED_TARGET cpp-httplib)
+add_library(collision_lab_web_lib
+  src/web/run_book.cpp
+  src/web/web_server.cpp)
+target_include_directories(collision_lab_web_lib PUBLIC include)
+target_link_libraries(collision_lab_web_lib PUBLIC collision_lab_ros collision_lab_views collision_lab_tools PkgConfig::CPP_HTTPLIB)
+add_executable(collision_lab_web src/web/web_node_main.cpp)
+target_link_libraries(collision_lab_web PRIVATE collision_lab_web_lib)
+set_target_properties(collision_lab_web PROPERTIES
+  RUNTIME_OUTPUT_DIRECTORY ${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_BIN_DESTINATION})
+
+install(TARGETS collision_lab_web_lib
+  ARCHIVE DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
+  LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION})
+install(TARGETS collision_lab_web RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})

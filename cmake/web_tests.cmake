@@ -1,0 +1,14 @@
+# The class's web server against a real lab node (rostest): the JSON API over a real HTTP
+# client and each safety limit; the pages in a real browser. Included after
+# ros_tests.cmake, which finds rostest.
+add_rostest_gtest(web_test test/ros/web_test.test test/ros/web_test.cpp)
+target_link_libraries(web_test collision_lab_web_lib ${catkin_LIBRARIES})
+add_dependencies(web_test collision_lab_node collision_lab_web)
+# The pages in headless chromium (skipped without it); reads test/ros/web_form_driver.html.
+add_rostest_gtest(web_browser_test test/ros/web_browser_test.test test/ros/web_browser_test.cpp)
+target_link_libraries(web_browser_test collision_lab_web_lib ${catkin_LIBRARIES})
+add_dependencies(web_browser_test collision_lab_node collision_lab_web)
+target_compile_definitions(web_browser_test PRIVATE COLLISION_LAB_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+# RunBook with the lab's topics out of order (no master).
+catkin_add_gtest(run_book_test test/ros/run_book_test.cpp)
+target_link_libraries(run_book_test collision_lab_web_lib ${catkin_LIBRARIES} GTest::gtest_main)

@@ -1,0 +1,114 @@
+// collision_lab_web: the class's web server beside collision_lab_node (docs/web.md).
+// Sends scenes as InitialConditions on the lab node's `initial_conditions` and follows its
+// topics, so a browser's run is recorded, published and drawn like any other.
+#include <arpa/inet.h>
+#include <ifaddrs.h>
+#include <netinet/in.h>
+
+#include <string>
+#include <vector>
+
+#include <ros/package.h>
+#include <ros/ros.h>
+
+#include "collision_lab/AcceptedRun.h"
+#include "collision_lab/CollisionEvent.h"
+#include "collision_lab/InitialConditions.h"
+#include "collision_lab/Prediction.h"
+#include "collision_lab/Rejected.h"
+#include "collision_lab/RunSummary.h"
+#include "collision_lab/ros/node_constants.h"
+#include "collision_lab/web/run_book.h"
+#include "collision_lab/web/web_server.h"
+
+namespace {
+
+using namespace collision_lab_ros;  // topic names and queue sizes
+using collision_lab_web::WebConfig;
+
+WebConfig loadConfig(const ros::NodeHandle& pnh) {
+  WebConfig c;
+  const std::string package = ros::package::getPath("collision_lab");
+  int port = c.port, max_body = static_cast<int>(c.max_body_bytes), max_bodies = static_cast<int>(c.max_bodies),
+      per_minute = static_cast<int>(c.runs_per_minute), streams = static_cast<int>(c.max_streams);
+  pnh.param("bind", c.bind, c.bind);
+  pnh.param("port", port, port);
+  pnh.param("code", c.code, c.code);
+  pnh.param("max_body_bytes", max_body, max_body);
+  pnh.param("max_bodies", max_bodies, max_bodies);
+  pnh.param("runs_per_minute", per_minute, per_minute);
+  pnh.param("max_streams", streams, streams);
+  pnh.param("answer_timeout", c.answer_timeout, c.answer_timeout);
+  pnh.param("web_root", c.web_root, package + "/web");
+  pnh.param("chartjs_path", c.chartjs_path, std::string("/usr/share/javascript/chart.js/chart.min.js"));
+  pnh.param("scenario_file", c.scenario_file, package + "/" + kDefaultScenarioFile);
+  c.port = port;
+  c.max_body_bytes = static_cast<std::size_t>(std::max(1, max_body));
+  c.max_bodies = static_cast<std::size_t>(std::max(1, max_bodies));
+  c.runs_per_minute = static_cast<std::size_t>(std::max(1, per_minute));
+  c.max_streams = static_cast<std::size_t>(std::max(1, streams));
+  return c;
+}
+
+/// The addresses to give the class: the bound one, or every IPv4 address of the machine
+/// when bound to all (0.0.0.0).
+std::vector<std::string> addresses(const std::string& bind) {
+  if (bind != "0.0.0.0") return {bind};
+  std::vector<std::string> out;
+  ifaddrs* list = nullptr;
+  if (getifaddrs(&list) != 0) return {bind};
+  for (ifaddrs* a = list; a; a = a->ifa_next) {
+    if (!a->ifa_addr || a->ifa_addr->sa_family != AF_INET) continue;
+    char text[INET_ADDRSTRLEN];
+    inet_ntop(AF_INET, &reinterpret_cast<sockaddr_in*>(a->ifa_addr)->sin_addr, text, sizeof text);
+    out.emplace_back(text);
+  }
+  freeifaddrs(list);
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  ros::init(argc, argv, "collision_lab_web");
+  ros::NodeHandle nh, pnh("~");
+  const WebConfig config = loadConfig(pnh);
+  collision_lab_web::RunBook book;
+  ros::Publisher inputs = nh.advertise<collision_lab::InitialConditions>(kInitialConditionsTopic, kInputQueueSize);
+  // Sized as the lab node's outputs (node_constants.h): a run's burst of events is never dropped.
+  std::vector<ros::Subscriber> subs = {
+      nh.subscribe(kAcceptedRunsTopic, kOutputQueueSize, &collision_lab_web::RunBook::onAccepted, &book),
+      nh.subscribe(kRejectedTopic, kOutputQueueSize, &collision_lab_web::RunBook::onRejected, &book),
+      nh.subscribe(kServedInputsTopic, kOutputQueueSize, &collision_lab_web::RunBook::onServedInput, &book),
+      nh.subscribe(kPredictionsTopic, kOutputQueueSize, &collision_lab_web::RunBook::onPrediction, &book),
+      nh.subscribe(kCollisionEventsTopic, kOutputQueueSize, &collision_lab_web::RunBook::onEvent, &book),
+      nh.subscribe(kRunSummariesTopic, kOutputQueueSize, &collision_lab_web::RunBook::onSummary, &book)};
+  auto publish = [&inputs](const collision_lab::InitialConditions& input) {
+    if (inputs.getNumSubscribers() == 0) return false;
+    collision_lab::InitialConditions stamped = input;
+    stamped.header.stamp = ros::Time::now();
+    inputs.publish(stamped);
+    return true;
+  };
+  try {
+    collision_lab_web::WebServer server(book, config, publish);
+    server.start();
+    std::string urls;
+    for (const auto& a : addresses(config.bind)) {
+      const std::string url = "http://" + a + ":" + std::to_string(server.port()) + "/";
+      urls += (urls.empty() ? "" : " ") + url;
+    }
+    pnh.setParam("url", "http://" + (config.bind == "0.0.0.0" ? std::string("127.0.0.1") : config.bind) + ":" +
+                            std::to_string(server.port()) + "/");
+    ROS_INFO_STREAM("Class page: " << urls << (config.bind == "127.0.0.1" ? " (this machine only; web_bind:=0.0.0.0 opens it to the lab's network)" : " (give this address to the class)")
+                                   << (config.code.empty() ? "" : "; sending a scene needs the class code"));
+    ros::AsyncSpinner spinner(1);
+    spinner.start();
+    ros::waitForShutdown();
+    server.stop();
+  } catch (const std::exception& e) {
+    ROS_FATAL_STREAM("collision_lab_web: " << e.what());
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,360 @@
+// The class's web server (issue 23) against a real collision_lab_node, through a real HTTP
+// client (web_test.test): the JSON API, the safety limits one by one, and a run sent over
+// ROS found beside the browser's. Counts are checked against pi's digits (m_A/m_B = 100
+// against a wall: 31 impacts; 1e4: 314), not against the code under test.
+#include <atomic>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <ros/ros.h>
+
+#include "collision_lab/AcceptedRun.h"
+#include "collision_lab/InitialConditions.h"
+#include "collision_lab/web/run_book.h"
+#include "run_collector.h"
+// Last: it includes <resolv.h>, whose macro _res breaks Eigen's headers included after it.
+#include <httplib.h>
+
+namespace {
+
+using collision_lab_test::waitUntil;
+using nlohmann::json;
+
+constexpr char kUrlParam[] = "/collision_lab/collision_lab_web/url";
+constexpr char kCode[] = "sesame";
+
+std::string g_host;
+int g_port = 0;
+
+httplib::Client client() {
+  httplib::Client c(g_host, g_port);
+  c.set_read_timeout(60, 0);
+  return c;
+}
+
+json piScene(const std::string& student) {
+  return {{"student", student},
+          {"code", kCode},
+          {"masses", {100, 1, "inf"}},
+          {"positions", {2, 1, 0}},
+          {"velocities", {-1, 0, 0}}};
+}
+
+httplib::Result post(const json& body, const httplib::Headers& headers = {}) {
+  auto c = client();
+  return c.Post("/api/runs", headers, body.dump(), "application/json");
+}
+
+/// The run once its state is finished (fails the test when it never is).
+json finishedRun(const std::string& run_id) {
+  json run;
+  waitUntil(
+      [&] {
+        auto c = client();
+        auto res = c.Get(("/api/runs/" + run_id).c_str());
+        if (!res || res->status != 200) return false;
+        run = json::parse(res->body);
+        return run["state"] == "finished";
+      },
+      "run " + run_id + " to finish");
+  return run;
+}
+
+std::size_t lines(const std::string& text) {
+  std::size_t n = 0;
+  for (char c : text) n += c == '\n';
+  return n;
+}
+
+class WebTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    std::string url;
+    waitUntil([&] { return ros::param::get(kUrlParam, url); }, "the web node to publish its address");
+    // url: http://HOST:PORT/
+    const auto colon = url.rfind(':');
+    g_host = url.substr(7, colon - 7);
+    g_port = std::stoi(url.substr(colon + 1));
+    // The lab node subscribes to the web node's input: a POST answered 201 says so.
+    waitUntil(
+        [] {
+          auto res = post(piScene("warmup"));
+          return res && res->status == 201;
+        },
+        "the web node to reach the lab node");
+  }
+};
+
+TEST_F(WebTest, BrowserRunIsServedRecordedAndListed) {
+  auto res = post(piScene("ana"));
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 201) << res->body;
+  const std::string run_id = json::parse(res->body)["run_id"];
+  EXPECT_EQ(run_id.rfind("ana.", 0), 0u) << "a student's run is served as <student>.<run_id>";
+  const json run = finishedRun(run_id);
+  EXPECT_EQ(run.at("summary").at("collision_count"), 31);
+  EXPECT_EQ(run.at("prediction").at("collision_count"), 31);
+  EXPECT_EQ(run.at("student"), "ana");
+  ASSERT_EQ(run.at("plots").at("velocity").size(), 3u);
+  // The final velocity of the light ball (body 1) in the plot is the summary's.
+  EXPECT_NEAR(run.at("plots").at("velocity")[1].at("points").back()[1].get<double>(),
+              run.at("summary").at("final_velocities")[1].get<double>(), 1e-5);
+
+  auto c = client();
+  auto csv = c.Get(("/api/runs/" + run_id + "/events.csv").c_str());
+  ASSERT_TRUE(csv);
+  EXPECT_EQ(csv->status, 200);
+  EXPECT_EQ(lines(csv->body), 1u + 31u) << "a header and one row per impact";
+
+  auto bag = c.Get(("/api/runs/" + run_id + "/bag").c_str());
+  ASSERT_TRUE(bag);
+  EXPECT_EQ(bag->status, 200);
+  EXPECT_EQ(bag->body.rfind("#ROSBAG V2.0", 0), 0u);
+
+  auto list = c.Get("/api/runs?student=ana");
+  ASSERT_TRUE(list);
+  const json runs = json::parse(list->body);
+  ASSERT_EQ(runs.size(), 1u);
+  EXPECT_EQ(runs[0].at("run_id"), run_id);
+
+  auto page = c.Get(("/runs/" + run_id).c_str());
+  ASSERT_TRUE(page);
+  EXPECT_EQ(page->status, 200);
+  EXPECT_NE(page->body.find("data-run-id=\"" + run_id + "\""), std::string::npos);
+}
+
+TEST_F(WebTest, LiveStreamEndsWithTheFinalRun) {
+  auto res = post(piScene("ben"));
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 201) << res->body;
+  const std::string run_id = json::parse(res->body)["run_id"];
+  std::string received;
+  auto c = client();
+  auto stream = c.Get(("/api/runs/" + run_id + "/stream").c_str(), [&](const char* data, std::size_t n) {
+    received.append(data, n);
+    return true;  // the server ends the stream after its `final` event
+  });
+  ASSERT_TRUE(stream);
+  EXPECT_EQ(stream->status, 200);
+  const auto final_at = received.find("event: final\ndata: ");
+  ASSERT_NE(final_at, std::string::npos) << received.substr(0, 200);
+  const auto data = received.substr(final_at + 19);
+  const json run = json::parse(data.substr(0, data.find('\n')));
+  EXPECT_EQ(run.at("summary").at("collision_count"), 31);
+}
+
+TEST_F(WebTest, RunBeyondThePublishedEventsIsRebuiltFromItsBag) {
+  auto res = post({{"student", "cleo"}, {"code", kCode}, {"preset", "pi_digits_3"}});
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 201) << res->body;
+  const json run = finishedRun(json::parse(res->body)["run_id"]);
+  EXPECT_EQ(run.at("summary").at("published_events"), 100) << "the lab node's max_published_events";
+  EXPECT_EQ(run.at("collisions"), 314) << "every impact, from the bag";
+  EXPECT_FALSE(run.contains("bag_error"));
+  // Light: at most the envelope's points per series whatever the count.
+  for (const auto& series : run.at("plots").at("velocity")) EXPECT_LE(series.at("points").size(), 1024u);
+}
+
+TEST_F(WebTest, RejectionCarriesReasonAndField) {
+  json scene = piScene("dora");
+  scene["positions"] = {0, 1, 2};  // not strictly decreasing
+  auto res = post(scene);
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 422);
+  const json body = json::parse(res->body);
+  EXPECT_EQ(body.at("rejected").at("reason_name"), "POSITIONS_NOT_ORDERED");
+  EXPECT_EQ(body.at("rejected").at("field").get<std::string>().rfind("positions", 0), 0u);
+
+  scene = piScene("dora");
+  scene["velocities"] = {-1, "fast", 0};
+  res = post(scene);
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 400);
+  EXPECT_EQ(json::parse(res->body)["field"], "velocities[1]");
+}
+
+TEST_F(WebTest, ClassCodeIsNeededToSend) {
+  json scene = piScene("eve");
+  scene.erase("code");
+  auto res = post(scene);
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 403);
+  scene["code"] = "guess";
+  res = post(scene);
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 403);
+  // In a header instead of the body.
+  scene.erase("code");
+  res = post(scene, {{"X-Class-Code", kCode}});
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 201) << res->body;
+  // Reading needs none.
+  auto c = client();
+  auto list = c.Get("/api/runs");
+  ASSERT_TRUE(list);
+  EXPECT_EQ(list->status, 200);
+}
+
+TEST_F(WebTest, LargeBodyIs413) {
+  json scene = piScene("fay");
+  scene["padding"] = std::string(10000, 'x');  // over max_body_bytes = 8192
+  auto res = post(scene);
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 413);
+}
+
+TEST_F(WebTest, TooManyBodiesIs422) {
+  json scene = {{"student", "gus"}, {"code", kCode}};
+  for (int i = 0; i < 21; ++i) {  // max_bodies = 20
+    scene["masses"].push_back(1);
+    scene["positions"].push_back(21 - i);
+    scene["velocities"].push_back(0);
+  }
+  auto res = post(scene);
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 422);
+  const json body = json::parse(res->body);
+  EXPECT_EQ(body.at("rejected").at("reason_name"), "TOO_MANY_BODIES");
+  EXPECT_EQ(body.at("rejected").at("field"), "masses");
+}
+
+TEST_F(WebTest, RunsPerStudentPerMinuteIs429ForThatStudentOnly) {
+  for (int i = 0; i < 3; ++i) {  // runs_per_minute = 3
+    auto res = post(piScene("hal"));
+    ASSERT_TRUE(res);
+    EXPECT_EQ(res->status, 201) << res->body;
+  }
+  auto res = post(piScene("hal"));
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 429);
+  EXPECT_FALSE(res->get_header_value("Retry-After").empty());
+  res = post(piScene("ivy"));
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 201) << "another student is not held back";
+}
+
+TEST_F(WebTest, ConcurrentStreamsAreLimited) {
+  // A run that never finishes: an AcceptedRun with no run behind it.
+  ros::NodeHandle nh;
+  ros::Publisher accepted = nh.advertise<collision_lab::AcceptedRun>("/collision_lab/accepted_runs", 10);
+  collision_lab::AcceptedRun phantom;
+  phantom.run_id = "phantom";
+  phantom.student = "nobody";
+  auto bump = [&] {
+    phantom.header.stamp = ros::Time::now();
+    accepted.publish(phantom);
+  };
+  ASSERT_TRUE(waitUntil(
+      [&] {
+        bump();
+        auto c = client();
+        auto res = c.Get("/api/runs/phantom");
+        return res && res->status == 200;
+      },
+      "the phantom run to be listed"));
+
+  std::atomic<bool> close_first{false}, close_all{false};
+  std::atomic<int> open{0}, ended{0};
+  std::vector<std::thread> streams;
+  for (int k = 0; k < 2; ++k) {  // max_streams = 2
+    streams.emplace_back([&, k] {
+      auto c = client();
+      bool counted = false;
+      c.Get("/api/runs/phantom/stream", [&](const char*, std::size_t) {
+        if (!counted) counted = true, ++open;
+        return !(close_all || (k == 0 && close_first));
+      });
+      ++ended;
+    });
+  }
+  ASSERT_TRUE(waitUntil(
+      [&] {
+        bump();  // each stream sends the changed run: its first bytes arrive
+        return open == 2;
+      },
+      "two streams to open"));
+  auto c = client();
+  auto third = c.Get("/api/runs/phantom/stream");
+  ASSERT_TRUE(third);
+  EXPECT_EQ(third->status, 503);
+
+  // The first stream closes; its slot is free once the server notices (at its next write).
+  close_first = true;
+  EXPECT_TRUE(waitUntil(
+      [&] {
+        bump();
+        bool got = false;
+        auto cc = client();
+        cc.Get("/api/runs/phantom/stream", [&](const char*, std::size_t) {
+          got = true;
+          return false;
+        });
+        return got;
+      },
+      "a stream slot to be free again"));
+  close_all = true;
+  waitUntil(
+      [&] {
+        bump();
+        return ended == 2;
+      },
+      "the streams to close");
+  for (auto& t : streams) t.join();
+}
+
+TEST_F(WebTest, NoPathLeavesTheServedFiles) {
+  auto c = client();
+  for (const char* path : {"/runs/../../etc/passwd", "/static/../../etc/passwd", "/api/runs/..%2F..%2Fetc%2Fpasswd/bag",
+                           "/api/runs/../../../etc/passwd/events.csv", "/static/..%2f..%2fetc%2fpasswd"}) {
+    auto res = c.Get(path);
+    ASSERT_TRUE(res) << path;
+    EXPECT_EQ(res->status, 404) << path;
+    EXPECT_EQ(res->body.find("root:"), std::string::npos) << path;
+  }
+}
+
+TEST_F(WebTest, NamesAreEscapedInPages) {
+  EXPECT_EQ(collision_lab_web::htmlEscape("<b onclick='x'>&\"</b>"),
+            "&lt;b onclick=&#39;x&#39;&gt;&amp;&quot;&lt;/b&gt;");
+  auto c = client();
+  auto res = c.Get("/runs/%3Cscript%3Ealert(1)%3C%2Fscript%3E");
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 404);
+  EXPECT_EQ(res->body.find("<script"), std::string::npos);
+}
+
+TEST_F(WebTest, RunSentOverRosIsShownToo) {
+  ros::NodeHandle nh;
+  ros::Publisher pub = nh.advertise<collision_lab::InitialConditions>("/collision_lab/initial_conditions", 10);
+  ASSERT_TRUE(waitUntil([&] { return pub.getNumSubscribers() > 0; }, "the lab node to subscribe"));
+  collision_lab::InitialConditions input;
+  input.student = "rosie";
+  input.masses = {100.0, 1.0, std::numeric_limits<double>::infinity()};
+  input.positions = {2.0, 1.0, 0.0};
+  input.velocities = {-1.0, 0.0, 0.0};
+  input.header.stamp = ros::Time::now();
+  pub.publish(input);
+  json runs;
+  ASSERT_TRUE(waitUntil(
+      [&] {
+        auto c = client();
+        auto res = c.Get("/api/runs?student=rosie");
+        if (!res || res->status != 200) return false;
+        runs = json::parse(res->body);
+        return runs.size() == 1 && runs[0]["state"] == "finished";
+      },
+      "the ROS run to be listed"));
+  EXPECT_EQ(runs[0].at("collisions"), 31);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "web_test");
+  ros::NodeHandle nh;
+  return RUN_ALL_TESTS();
+}

@@ -1,0 +1,168 @@
+// The start page (a scene form, the presets) and the teacher's page. Every text from the
+// server goes into the page with textContent, never as HTML.
+'use strict';
+
+function el(tag, text, attrs) {
+  const node = document.createElement(tag);
+  if (text !== undefined && text !== null) node.textContent = String(text);
+  for (const [k, v] of Object.entries(attrs || {})) node.setAttribute(k, v);
+  return node;
+}
+
+function bodyRow(mass, position, velocity) {
+  const rows = document.querySelector('#bodies tbody');
+  const tr = el('tr');
+  tr.appendChild(el('td', rows.children.length));
+  for (const [name, value] of [['mass', mass], ['position', position], ['velocity', velocity]]) {
+    const td = el('td');
+    td.appendChild(el('input', null, {type: 'text', name: name, value: value === undefined ? '' : String(value)}));
+    tr.appendChild(td);
+  }
+  const remove = el('button', 'remove', {type: 'button'});
+  remove.onclick = () => { tr.remove(); renumber(); };
+  const td = el('td');
+  td.appendChild(remove);
+  tr.appendChild(td);
+  rows.appendChild(tr);
+}
+
+function renumber() {
+  document.querySelectorAll('#bodies tbody tr').forEach((tr, i) => { tr.firstChild.textContent = i; });
+}
+
+let loadedPreset = null;  // a preset too large for the form is sent by name
+
+function loadPreset(p) {
+  document.querySelector('#bodies tbody').replaceChildren();
+  loadedPreset = null;
+  const note = document.getElementById('preset_note');
+  note.textContent = '';
+  if (!p.scene) {
+    loadedPreset = p.name;
+    note.textContent = 'Preset ' + p.name + ' (' + p.bodies + ' bodies) is sent as it is; edit a smaller one to change it.';
+  } else {
+    const s = p.scene;
+    s.masses.forEach((m, i) => bodyRow(m, s.positions[i], s.velocities[i]));
+    document.getElementById('restitution').value = (s.restitution || []).join(', ');
+    document.getElementById('max_collisions').value = s.max_collisions || '';
+  }
+}
+
+function numberOrText(text) {
+  const t = text.trim();
+  const x = Number(t);
+  return t !== '' && Number.isFinite(x) ? x : t;
+}
+
+function sceneFromForm() {
+  const scene = {masses: [], positions: [], velocities: []};
+  document.querySelectorAll('#bodies tbody tr').forEach((tr) => {
+    scene.masses.push(numberOrText(tr.querySelector('[name=mass]').value));
+    scene.positions.push(numberOrText(tr.querySelector('[name=position]').value));
+    scene.velocities.push(numberOrText(tr.querySelector('[name=velocity]').value));
+  });
+  const e = document.getElementById('restitution').value.trim();
+  if (e !== '') scene.restitution = e.split(/[ ,;]+/).filter((t) => t !== '').map(numberOrText);
+  const cap = document.getElementById('max_collisions').value.trim();
+  if (cap !== '') scene.max_collisions = Number(cap);
+  return scene;
+}
+
+async function sendScene() {
+  const result = document.getElementById('result');
+  const student = document.getElementById('student').value.trim();
+  const code = document.getElementById('code').value.trim();
+  localStorage.setItem('collision_lab_student', student);
+  const body = loadedPreset ? {preset: loadedPreset} : sceneFromForm();
+  body.student = student;
+  if (code) body.code = code;
+  result.className = '';
+  result.textContent = 'Sending...';
+  let answer;
+  let status;
+  try {
+    const res = await fetch('/api/runs', {method: 'POST', headers: {'Content-Type': 'application/json'}, body: JSON.stringify(body)});
+    status = res.status;
+    answer = await res.json();
+  } catch (err) {
+    result.className = 'error';
+    result.textContent = 'The lab did not answer: ' + err;
+    return;
+  }
+  if (status === 201) {
+    result.textContent = 'Accepted as run ' + answer.run_id + '.';
+    window.location.href = '/runs/' + encodeURIComponent(answer.run_id);
+    return;
+  }
+  result.className = 'error';
+  if (answer.rejected) {
+    const r = answer.rejected;
+    result.textContent = 'Rejected (' + r.reason_name + ', field ' + r.field + '): ' + r.message;
+  } else {
+    result.textContent = 'HTTP ' + status + ': ' + answer.error + (answer.field ? ' (field ' + answer.field + ')' : '');
+  }
+}
+
+async function startPage() {
+  document.getElementById('student').value = localStorage.getItem('collision_lab_student') || '';
+  document.getElementById('add').onclick = () => { loadedPreset = null; document.getElementById('preset_note').textContent = ''; bodyRow('1', '', '0'); };
+  document.getElementById('send').onclick = sendScene;
+  const presets = await (await fetch('/api/presets')).json();
+  const tbody = document.querySelector('#presets tbody');
+  for (const p of presets) {
+    const tr = el('tr');
+    tr.appendChild(el('td', p.name));
+    tr.appendChild(el('td', p.bodies));
+    tr.appendChild(el('td', p.description));
+    const td = el('td');
+    const load = el('button', 'Load', {type: 'button', 'data-preset': p.name});
+    load.onclick = () => loadPreset(p);
+    td.appendChild(load);
+    tr.appendChild(td);
+    tbody.appendChild(tr);
+  }
+  const pi = presets.find((p) => p.name === 'pi_digits_2');  // 31 impacts: the first two digits of pi
+  loadPreset(pi || presets[0]);
+  document.body.dataset.ready = 'true';
+}
+
+async function teacherPage() {
+  const box = document.getElementById('students');
+  async function refresh() {
+    const runs = await (await fetch('/api/runs')).json();
+    const byStudent = new Map();
+    for (const r of runs) {
+      const name = r.student || '(anonymous)';
+      if (!byStudent.has(name)) byStudent.set(name, []);
+      byStudent.get(name).push(r);
+    }
+    const parts = [];
+    for (const name of [...byStudent.keys()].sort()) {
+      const section = el('section');
+      section.appendChild(el('h2', name + ' (' + byStudent.get(name).length + ' runs)'));
+      const table = el('table');
+      const head = el('tr');
+      for (const h of ['run', 'state', 'bodies', 'collisions', 'model', 'accepted']) head.appendChild(el('th', h));
+      table.appendChild(head);
+      for (const r of byStudent.get(name)) {
+        const tr = el('tr');
+        const td = el('td');
+        td.appendChild(el('a', r.run_id, {href: '/runs/' + encodeURIComponent(r.run_id)}));
+        tr.appendChild(td);
+        tr.appendChild(el('td', r.state + (r.truncated ? ' (truncated)' : '')));
+        tr.appendChild(el('td', r.bodies === undefined ? '' : r.bodies));
+        tr.appendChild(el('td', r.collisions));
+        tr.appendChild(el('td', r.model || ''));
+        tr.appendChild(el('td', r.accepted_stamp ? new Date(r.accepted_stamp * 1000).toLocaleTimeString() : ''));
+        table.appendChild(tr);
+      }
+      section.appendChild(table);
+      parts.push(section);
+    }
+    if (parts.length === 0) parts.push(el('p', 'No runs yet.'));
+    box.replaceChildren(...parts);
+    document.body.dataset.runs = String(runs.length);
+  }
+  await refresh();
+  setInterval(refresh, 5000);
+}
