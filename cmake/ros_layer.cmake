@@ -9,6 +9,7 @@
 include_directories(SYSTEM ${catkin_INCLUDE_DIRS})
 add_library(collision_lab_ros
   src/ros/msg_conversion.cpp
+  src/ros/bag_reading.cpp
   src/ros/run_recorder.cpp
   src/ros/run_timeline.cpp
   src/ros/lab_node.cpp)

@@ -29,6 +29,7 @@
 #include "collision_lab/core/nbody/body_state_replay.h"
 #include "collision_lab/core/nbody/scene.h"
 #include "collision_lab/io/number_text.h"
+#include "collision_lab/ros/bag_reading.h"
 #include "collision_lab/ros/msg_conversion.h"
 
 namespace collision_lab_ros {
@@ -701,13 +702,13 @@ std::vector<CsvColumn> csvColumns(const std::string& datatype) {
 }
 
 CsvExport bagToCsv(const std::string& bag_path, const std::string& out_dir) {
-  rosbag::Bag bag;
+  ReadableBag bag;
   try {
-    bag.open(bag_path, rosbag::bagmode::Read);
+    bag = openBagForReading(bag_path);
   } catch (const std::exception& e) {
     throw BagCsvError("cannot read bag " + bag_path + ": " + e.what());
   }
-  rosbag::View view(bag);
+  rosbag::View view(*bag);
   CsvExport result;
   const std::vector<ExportedTopic> topics = exportedTopics(view, result.skipped_topics);
 

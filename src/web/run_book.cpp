@@ -14,6 +14,7 @@
 #include <rosbag/view.h>
 
 #include "collision_lab/ros/bag_csv.h"
+#include "collision_lab/ros/bag_reading.h"
 
 namespace collision_lab_web {
 
@@ -401,9 +402,8 @@ std::string RunBook::list(const std::optional<std::string>& student) const {
 
 BagRun readRunFromBag(const std::string& bag_path, std::size_t envelope_vertices) {
   BagRun run;
-  rosbag::Bag bag;
-  bag.open(bag_path, rosbag::bagmode::Read);  // throws rosbag::BagException (a std::runtime_error)
-  rosbag::View view(bag);
+  const collision_lab_ros::ReadableBag bag = collision_lab_ros::openBagForReading(bag_path);
+  rosbag::View view(*bag);
   std::optional<collision_lab::Prediction> prediction;
   RecordLimits limits;
   limits.envelope_vertices = envelope_vertices;

@@ -1,0 +1,29 @@
+#include "collision_lab/ros/bag_reading.h"
+
+#include <mutex>
+
+#include <rosbag/bag.h>
+
+namespace collision_lab_ros {
+namespace {
+
+std::mutex& pluginLoaderMutex() {
+  static std::mutex mutex;
+  return mutex;
+}
+
+}  // namespace
+
+void LockedBagDeleter::operator()(rosbag::Bag* bag) const {
+  std::lock_guard<std::mutex> lock(pluginLoaderMutex());
+  delete bag;
+}
+
+ReadableBag openBagForReading(const std::string& bag_path) {
+  std::lock_guard<std::mutex> lock(pluginLoaderMutex());
+  std::unique_ptr<rosbag::Bag> bag = std::make_unique<rosbag::Bag>();
+  bag->open(bag_path, rosbag::bagmode::Read);
+  return ReadableBag(bag.release());
+}
+
+}  // namespace collision_lab_ros
