@@ -174,12 +174,34 @@ collision_lab::Prediction modelPrediction(const core::ModelChoice& model, std::s
   return msg;
 }
 
+/// The rotation model's block of a three-body prediction: its closed form and the paper's
+/// printed count.
+void addRotationModel(collision_lab::Prediction& msg, const core::AnalyticPrediction& prediction) {
+  msg.collision_count = prediction.collision_count;
+  msg.collision_count_defined = true;
+  msg.infinite_collisions = false;
+  msg.paper_collision_count_defined = prediction.paper_collision_count.has_value();
+  msg.paper_collision_count = prediction.paper_collision_count.value_or(0);
+  msg.max_possible_collision_count = prediction.max_possible_collision_count;
+  msg.alpha = prediction.angles.alpha;
+  msg.theta = prediction.angles.theta;
+  msg.omega = prediction.angles.omega;
+  msg.phi_bc = prediction.phi_bc;
+  msg.psi = prediction.psi;
+  msg.first_pair_index = toPairCode(prediction.first_pair);
+  msg.final_velocities = toVector(prediction.final_velocities);
+  msg.energy_lost = 0.0;
+  msg.collapsed = false;
+  msg.critical_restitution = core::criticalRestitution(prediction.angles.alpha);
+  msg.spiral_angle = prediction.angles.theta;
+}
+
 }  // namespace
 
 collision_lab::Prediction toPredictionMsg(const core::ScenePlan& plan) {
-  if (plan.three_body) return toPredictionMsg(*plan.three_body, plan.model);
   collision_lab::Prediction msg = modelPrediction(plan.model, plan.scene.size());
-  if (!plan.prediction) return msg;  // event_engine: no closed form
+  if (plan.three_body) addRotationModel(msg, *plan.three_body);
+  if (!plan.prediction) return msg;  // three_body_rotation (above) or event_engine: no closed form of models.h
   const core::Prediction& p = *plan.prediction;
   msg.collision_count = p.impact_count.value_or(0);
   msg.collision_count_defined = p.impact_count.has_value();
@@ -203,23 +225,7 @@ collision_lab::Prediction toPredictionMsg(const core::ScenePlan& plan) {
 
 collision_lab::Prediction toPredictionMsg(const core::AnalyticPrediction& prediction, const core::ModelChoice& model) {
   collision_lab::Prediction msg = modelPrediction(model, 3);
-  msg.collision_count = prediction.collision_count;
-  msg.collision_count_defined = true;
-  msg.infinite_collisions = false;
-  msg.paper_collision_count_defined = prediction.paper_collision_count.has_value();
-  msg.paper_collision_count = prediction.paper_collision_count.value_or(0);
-  msg.max_possible_collision_count = prediction.max_possible_collision_count;
-  msg.alpha = prediction.angles.alpha;
-  msg.theta = prediction.angles.theta;
-  msg.omega = prediction.angles.omega;
-  msg.phi_bc = prediction.phi_bc;
-  msg.psi = prediction.psi;
-  msg.first_pair_index = toPairCode(prediction.first_pair);
-  msg.final_velocities = toVector(prediction.final_velocities);
-  msg.energy_lost = 0.0;
-  msg.collapsed = false;
-  msg.critical_restitution = core::criticalRestitution(prediction.angles.alpha);
-  msg.spiral_angle = prediction.angles.theta;
+  addRotationModel(msg, prediction);
   return msg;
 }
 
@@ -490,9 +496,6 @@ collision_lab::RunSummary modelSummary(const core::ModelChoice& model, std::size
 
 collision_lab::RunSummary toRunSummaryMsg(const core::SceneRunResult& result, std::size_t body_count,
                                           core::RunMode mode) {
-  if (result.three_body) {
-    return toRunSummaryMsg(result.three_body->summary, result.three_body->prediction, mode, result.model);
-  }
   const core::SceneSimulation& s = result.simulation;
   collision_lab::RunSummary msg = modelSummary(result.model, body_count, mode);
   msg.collision_count = s.impact_count;  // the run's answer, simulated or from the model
@@ -520,37 +523,17 @@ collision_lab::RunSummary toRunSummaryMsg(const core::SceneRunResult& result, st
   msg.energy_relative_drift = s.energy_relative_drift;
   msg.momentum_relative_drift = s.momentum_relative_drift;
   msg.compute_time = result.compute_time_s;
-  return msg;
-}
-
-collision_lab::RunSummary toRunSummaryMsg(const core::LabRunSummary& summary, const core::AnalyticPrediction& prediction,
-                                          core::RunMode mode, const core::ModelChoice& model) {
-  collision_lab::RunSummary msg = modelSummary(model, 3, mode);
-  msg.collision_count = summary.collision_count;
-  msg.truncated = summary.truncated;
-  msg.truncation_reason = summary.truncation_reason;
-  msg.cancelled = summary.cancelled;
-  msg.stop_reason = !summary.simulated ? "NOT_SIMULATED"
-                    : summary.cancelled ? "CANCELLED"
-                    : summary.truncated ? "CAP"
-                                        : "FINISHED";
-  msg.simulated = summary.simulated;
-  msg.predicted_collision_count = prediction.collision_count;
-  msg.predicted_collision_count_defined = true;
-  msg.paper_predicted_collision_count_defined = prediction.paper_collision_count.has_value();
-  msg.paper_predicted_collision_count = prediction.paper_collision_count.value_or(0);
-  msg.final_velocities = toVector(summary.final_velocities);
-  msg.energy_lost = 0.0;
-  msg.collapsed = false;
-  msg.collapse_count = 0;
-  msg.cluster_impacts = 0;
-  msg.rule_elastic_impacts = 0;
-  msg.critical_restitution = core::criticalRestitution(prediction.angles.alpha);
-  msg.spiral_angle = prediction.angles.theta;
-  msg.max_prediction_error = summary.max_prediction_error;
-  msg.energy_relative_drift = summary.energy_relative_drift;
-  msg.momentum_relative_drift = summary.momentum_relative_drift;
-  msg.compute_time = summary.compute_time_s;
+  if (const auto& rotation = result.three_body) {  // the rotation model's block
+    const core::AnalyticPrediction& p = rotation->prediction;
+    msg.predicted_collision_count = p.collision_count;
+    msg.predicted_collision_count_defined = true;
+    msg.paper_predicted_collision_count_defined = p.paper_collision_count.has_value();
+    msg.paper_predicted_collision_count = p.paper_collision_count.value_or(0);
+    msg.critical_restitution = core::criticalRestitution(p.angles.alpha);
+    msg.spiral_angle = p.angles.theta;
+    // The model is compared at every reported impact, not only at the end (lab_run.h).
+    msg.max_prediction_error = rotation->summary.max_prediction_error;
+  }
   return msg;
 }
 

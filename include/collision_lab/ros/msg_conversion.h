@@ -67,10 +67,11 @@ std::optional<collision_lab::core::Pair> toPair(std::uint32_t code);
 /// (the node passes chooseModel's, as the CLI prints it).
 collision_lab::core::ModelChoice threeBodyRotationModel();
 
-/// The plan's model and prediction (core::planScene), as published before the run.
-/// Precondition: !plan.error.
+/// The plan's model and prediction (core::planScene), as published before the run, for
+/// every scene: the model's fields, plus the closed form of models.h or, when the rotation
+/// model answers, its prediction and the paper's printed count. Precondition: !plan.error.
 collision_lab::Prediction toPredictionMsg(const collision_lab::core::ScenePlan& plan);
-/// Three elastic bodies (the three-body path).
+/// The rotation model's prediction alone (three elastic bodies), as toPredictionMsg(plan) gives it.
 collision_lab::Prediction toPredictionMsg(const collision_lab::core::AnalyticPrediction& prediction,
                                           const collision_lab::core::ModelChoice& model = threeBodyRotationModel());
 collision_lab::core::AnalyticPrediction toPrediction(const collision_lab::Prediction& msg);
@@ -130,16 +131,13 @@ class SceneEventConverter {
   collision_lab::core::BodyStateReplay replay_;
 };
 
-/// The physics fields of a summary; published_events, events_not_published, bag_path,
+/// The physics fields of a summary, from the run's one SceneSimulation for every scene,
+/// plus the rotation model's block when it answered (its predicted and paper's counts, and
+/// its prediction error at every impact); published_events, events_not_published, bag_path,
 /// recording_ok, recording_error, timeline_scale, timeline_saturated,
 /// requested_run_id and student are the node's to fill.
 collision_lab::RunSummary toRunSummaryMsg(const collision_lab::core::SceneRunResult& result,
                                           std::size_t body_count, collision_lab::core::RunMode mode);
-/// Three elastic bodies (the three-body path).
-collision_lab::RunSummary toRunSummaryMsg(const collision_lab::core::LabRunSummary& summary,
-                                          const collision_lab::core::AnalyticPrediction& prediction,
-                                          collision_lab::core::RunMode mode,
-                                          const collision_lab::core::ModelChoice& model = threeBodyRotationModel());
 
 collision_lab::Rejected toRejectedMsg(const collision_lab::core::ValidationError& error);
 collision_lab::Rejected toRejectedMsg(NodeReason reason, const std::string& field,
