@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "collision_lab/io/scene_report.h"
 #include "collision_lab/ros/lab_node.h"
 #include "collision_lab/ros/marker_view.h"
 #include "collision_lab/ros/msg_conversion.h"
@@ -119,6 +120,36 @@ TEST(SceneEventConverter, RebuildsEveryBodyThroughAStickingImpactAndAClusterImpa
   EXPECT_EQ(t.kinetic, (std::vector<double>{0, 0, 0.25}));
   EXPECT_EQ(t.energy_lost, 0.0);
   EXPECT_EQ(t.cumulative_energy_lost, 0.25);
+}
+
+// The node's events and the CLI's are one record (io::SceneEventState): every impact of an
+// inelastic run carries the same values in both. The energy a single body gains in an
+// impact is the engine's own (pair_energy_transfer), not a difference of the replay's
+// kinetic energies, which rounds otherwise (it did before: the node's differed).
+TEST(SceneEventConverter, EveryEventCarriesTheCliRecordsValues) {
+  const collision_lab::core::Scene scene{{1, 2.7, 0.3, 1.9, 5}, {4, 3.1, 2.2, 1.3, 0}, {-0.7, 0.1, 0.3, -0.2, 0.9},
+                                         {0.9, 0.7, 1, 0.55}};
+  SceneEventConverter converter(scene);
+  collision_lab::io::SceneEventJson cli(scene);
+  std::size_t single_pair_impacts = 0;
+  const auto result = collision_lab::core::runEngine(scene, {}, [&](const collision_lab::core::ImpactRecord& r) {
+    const auto msg = converter.impact(r);
+    const collision_lab::io::Json json = cli.impact(r);
+    ASSERT_EQ(msg.energy_transfer.size(), 5u);
+    for (std::size_t i = 0; i < 5; ++i) {
+      EXPECT_EQ(msg.energy_transfer[i], json.at("energy_transfer")[i].get<double>()) << "impact " << r.index;
+      EXPECT_EQ(msg.velocities_after[i], json.at("velocities_after")[i].get<double>());
+      EXPECT_EQ(msg.positions[i], json.at("positions")[i].get<double>());
+    }
+    EXPECT_EQ(msg.total_energy, json.at("total_energy").get<double>());
+    if (!msg.cluster_impact) {
+      ++single_pair_impacts;
+      EXPECT_EQ(msg.energy_transfer[msg.pair_index], msg.pair_energy_transfer[0]) << "impact " << r.index;
+      EXPECT_EQ(msg.energy_transfer[msg.pair_index + 1], msg.pair_energy_transfer[1]) << "impact " << r.index;
+    }
+  });
+  EXPECT_GT(result.impact_count, 3u);
+  EXPECT_GT(single_pair_impacts, 0u);
 }
 
 // A ring's seam impact (issue 21; wrote past the bodies before): L = 10 m, A (1 kg, 9 m,

@@ -27,6 +27,7 @@
 #include "collision_lab/core/nbody/scene.h"
 #include "collision_lab/core/scene.h"
 #include "collision_lab/core/scene_run.h"
+#include "collision_lab/io/event_record.h"
 
 namespace collision_lab_ros {
 
@@ -101,10 +102,11 @@ collision_lab::EnergyTransfer toEnergyTransferMsg(const collision_lab::Collision
                                                   double cumulative_energy_lost);
 
 /// The CollisionEvent of each of the engine's notifications, in the order the engine gives
-/// them (impacts and collapses interleaved, engine.h), with the body state of the core's
-/// replay (core::BodyStateReplay): the per-body arrays (positions at the event's time,
-/// velocities before and after, energy transfer, kinetic energy) and the totals only for
-/// N <= FULL_STATE_MAX_BODIES. Header and run_id are the caller's to fill.
+/// them (impacts and collapses interleaved, engine.h): a copy of the one event record that
+/// the CLI's reports write too (io::SceneEventState, event_record.h), so both carry the same
+/// values. The per-body arrays (positions at the event's time, velocities before and after,
+/// energy transfer, kinetic energy) and the totals only for N <= FULL_STATE_MAX_BODIES
+/// (NaN totals above). Header and run_id are the caller's to fill.
 class SceneEventConverter {
  public:
   explicit SceneEventConverter(const collision_lab::core::Scene& scene);
@@ -115,20 +117,17 @@ class SceneEventConverter {
   collision_lab::CollisionEvent collapse(const collision_lab::core::Collapse& collapse);
 
   /// The plot messages of the last event converted: their arrays have length N for
-  /// N <= FULL_STATE_MAX_BODIES (O(N) each) and are empty above it, like the event's own;
-  /// the scalar fields (bodies 0, 1, 2) are always filled.
+  /// N <= FULL_STATE_MAX_BODIES (O(N) each, the event's own) and are empty above it, like
+  /// the event's; the scalar fields (bodies 0, 1, 2) are always filled.
   collision_lab::Velocities velocitiesMsg(const collision_lab::CollisionEvent& event) const;
   collision_lab::EnergyTransfer energyTransferMsg(const collision_lab::CollisionEvent& event) const;
 
  private:
-  /// The bodies 0 .. plottedBodies() - 1 whose values the plot messages are built from.
-  std::size_t plottedBodies() const;
-  /// Fills the per-body arrays and totals of msg (or empties them, NaN totals, for large N).
-  void fillBodies(collision_lab::CollisionEvent& msg) const;
+  /// The message of one record of state_.
+  static collision_lab::CollisionEvent toMsg(const collision_lab::io::EventRecord& record);
 
-  collision_lab::core::Scene scene_;
+  collision_lab::io::SceneEventState state_;
   bool full_state_;
-  collision_lab::core::BodyStateReplay replay_;
 };
 
 /// The physics fields of a summary, from the run's one SceneSimulation for every scene,
