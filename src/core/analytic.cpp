@@ -302,14 +302,25 @@ std::uint64_t predictedCollisionCount(const ThreeBodyScene& scene) {
 std::optional<std::uint64_t> checkedMaxPossibleCollisionCount(const std::array<double, 3>& m) {
   // pi / alpha is an integer only for alpha = pi/3, pi/4, pi/6, where
   // cos^2 alpha = m_A m_C / ((m_A + m_B)(m_B + m_C)) is the rational 1/4, 1/2, 3/4.
-  using exact::Rational;
-  auto ratio = [](double mi, double mj) {
-    return std::isinf(mi) ? Rational(1) : Rational(mi) / (Rational(mi) + Rational(mj));
-  };
-  const Rational cos_sq = ratio(m[kA], m[kB]) * ratio(m[kC], m[kB]);
-  if (cos_sq == Rational(1, 4)) return 3;
-  if (cos_sq == Rational(1, 2)) return 4;
-  if (cos_sq == Rational(3, 4)) return 6;
+  // In double (no sum overflowing), cos^2 alpha in [0, 1] is within 1e-15 of the exact
+  // value; only a value near 1/4, 1/2 or 3/4 needs the exact rationals, which cost about
+  // as much as the rest of a short run.
+  auto near_ratio = [](double mi, double mj) { return std::isinf(mi) ? 1.0 : mi / (mi + mj); };
+  const double cos_sq_near = near_ratio(m[kA], m[kB]) * near_ratio(m[kC], m[kB]);
+  const auto summable = [](double mass) { return std::isinf(mass) || mass < 1e300; };
+  const bool may_be_kaleidoscopic = !(summable(m[kA]) && summable(m[kB]) && summable(m[kC])) ||
+                                    !(std::fabs(cos_sq_near - 0.25) > 1e-9 && std::fabs(cos_sq_near - 0.5) > 1e-9 &&
+                                      std::fabs(cos_sq_near - 0.75) > 1e-9);
+  if (may_be_kaleidoscopic) {
+    using exact::Rational;
+    auto ratio = [](double mi, double mj) {
+      return std::isinf(mi) ? Rational(1) : Rational(mi) / (Rational(mi) + Rational(mj));
+    };
+    const Rational cos_sq = ratio(m[kA], m[kB]) * ratio(m[kC], m[kB]);
+    if (cos_sq == Rational(1, 4)) return 3;
+    if (cos_sq == Rational(1, 2)) return 4;
+    if (cos_sq == Rational(3, 4)) return 6;
+  }
   // Otherwise pi / alpha is irrational. In double, far enough below 2^53 and from an
   // integer; else at 50 digits, or 500 when even 50 cannot tell the integer above it.
   const double quotient = pi<double>() / alphaOf<double>(m);

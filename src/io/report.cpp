@@ -481,6 +481,35 @@ std::string recordPairName(const EventRecord& r) {
   return core::bodyName(r.pair_index) + (r.pair_index < 26 ? "" : "-") + core::bodyName(left);
 }
 
+/// core::bodyName(body), written without building a string.
+void putBodyName(TextSink& sink, std::size_t body) {
+  if (body < 26) return sink.put(static_cast<char>('A' + body));
+  sink.put('#');
+  sink.count(body);
+}
+
+/// The CSV cells pair (recordPairName), pair_index and bodies (namedBodies, separated by
+/// ';') of a record, written without building strings.
+void putCsvPairAndBodies(TextSink& sink, const EventRecord& r) {
+  const std::size_t first = r.pair_index;
+  const std::size_t second = r.collapse || r.last_moved >= r.pair_index ? r.pair_index + 1 : 0;
+  putBodyName(sink, first);
+  if (second >= 26 || (second == 0 && first >= 26)) sink.put('-');  // as core::pairName
+  putBodyName(sink, second);
+  sink.put(',');
+  sink.count(r.pair_index);
+  sink.put(',');
+  if (!r.collapse) {
+    putBodyName(sink, first);
+    sink.put(';');
+    return putBodyName(sink, second);
+  }
+  for (std::size_t i = r.first_moved; i <= r.last_moved; ++i) {
+    if (i > r.first_moved) sink.put(';');
+    putBodyName(sink, i);
+  }
+}
+
 }  // namespace
 
 const char* const kEventCsvHeader =
@@ -547,15 +576,7 @@ void writeEventRecordCsv(TextSink& sink, const EventRecord& r) {
   sink.put(r.collapse ? "collapse" : "impact");
   count(r.index);
   sink.put(',');
-  sink.put(recordPairName(r));
-  count(r.pair_index);
-  sink.put(',');
-  bool first = true;
-  for (std::size_t i : namedBodies(r)) {
-    if (!first) sink.put(';');
-    sink.put(core::bodyName(i));
-    first = false;
-  }
+  putCsvPairAndBodies(sink, r);
   cell(r.time);
   cell(r.position);
   cell(r.restitution);

@@ -14,8 +14,6 @@
 namespace collision_lab {
 namespace io {
 
-namespace report_text {
-
 SceneEventState::SceneEventState(const core::Scene& scene)
     : scene_(scene), full_state_(scene.size() <= kFullStateMaxBodies), replay_(scene) {}
 
@@ -88,8 +86,6 @@ EventRecord SceneEventState::collapse(const core::Collapse& collapse) {
   fill(r);
   return r;
 }
-
-}  // namespace report_text
 
 namespace {
 
@@ -446,7 +442,7 @@ class SceneJsonWriter : public SceneReportWriter {
   }
 
  private:
-  void write(const report_text::EventRecord& record) {
+  void write(const EventRecord& record) {
     sink_.put(any_event_ ? ",\n" : "\n");
     any_event_ = true;
     report_text::writeEventRecordJson(sink_, record);
@@ -454,7 +450,7 @@ class SceneJsonWriter : public SceneReportWriter {
   }
   std::ostream& out_;
   TextSink sink_;
-  std::optional<report_text::SceneEventState> state_;  ///< from begin()
+  std::optional<SceneEventState> state_;  ///< from begin()
   bool any_event_ = false;
 };
 
@@ -527,14 +523,14 @@ class SceneCsvWriter : public SceneReportWriter {
   }
 
  private:
-  void write(const report_text::EventRecord& record) {
+  void write(const EventRecord& record) {
     report_text::writeEventRecordCsv(sink_, record);
     sink_.flushIfFull();
   }
 
   std::ostream& out_;
   TextSink sink_;
-  std::optional<report_text::SceneEventState> state_;  ///< from begin()
+  std::optional<SceneEventState> state_;  ///< from begin()
 };
 
 // ---------------------------------------------------------------------------------------
@@ -699,7 +695,7 @@ Json sceneEntryJson(const SceneEntry& entry) {
 
 namespace {
 
-Json recordJson(const report_text::EventRecord& record) {
+Json recordJson(const EventRecord& record) {
   std::ostringstream text;
   {
     TextSink sink(text);
@@ -711,7 +707,7 @@ Json recordJson(const report_text::EventRecord& record) {
 }  // namespace
 
 SceneEventJson::SceneEventJson(const core::Scene& scene)
-    : state_(std::make_unique<report_text::SceneEventState>(scene)) {}
+    : state_(std::make_unique<SceneEventState>(scene)) {}
 SceneEventJson::~SceneEventJson() = default;
 
 Json SceneEventJson::impact(const core::ImpactRecord& impact) { return recordJson(state_->impact(impact)); }

@@ -174,12 +174,34 @@ collision_lab::Prediction modelPrediction(const core::ModelChoice& model, std::s
   return msg;
 }
 
+/// The rotation model's block of a three-body prediction: its closed form and the paper's
+/// printed count.
+void addRotationModel(collision_lab::Prediction& msg, const core::AnalyticPrediction& prediction) {
+  msg.collision_count = prediction.collision_count;
+  msg.collision_count_defined = true;
+  msg.infinite_collisions = false;
+  msg.paper_collision_count_defined = prediction.paper_collision_count.has_value();
+  msg.paper_collision_count = prediction.paper_collision_count.value_or(0);
+  msg.max_possible_collision_count = prediction.max_possible_collision_count;
+  msg.alpha = prediction.angles.alpha;
+  msg.theta = prediction.angles.theta;
+  msg.omega = prediction.angles.omega;
+  msg.phi_bc = prediction.phi_bc;
+  msg.psi = prediction.psi;
+  msg.first_pair_index = toPairCode(prediction.first_pair);
+  msg.final_velocities = toVector(prediction.final_velocities);
+  msg.energy_lost = 0.0;
+  msg.collapsed = false;
+  msg.critical_restitution = core::criticalRestitution(prediction.angles.alpha);
+  msg.spiral_angle = prediction.angles.theta;
+}
+
 }  // namespace
 
 collision_lab::Prediction toPredictionMsg(const core::ScenePlan& plan) {
-  if (plan.three_body) return toPredictionMsg(*plan.three_body, plan.model);
   collision_lab::Prediction msg = modelPrediction(plan.model, plan.scene.size());
-  if (!plan.prediction) return msg;  // event_engine: no closed form
+  if (plan.three_body) addRotationModel(msg, *plan.three_body);
+  if (!plan.prediction) return msg;  // three_body_rotation (above) or event_engine: no closed form of models.h
   const core::Prediction& p = *plan.prediction;
   msg.collision_count = p.impact_count.value_or(0);
   msg.collision_count_defined = p.impact_count.has_value();
@@ -203,23 +225,7 @@ collision_lab::Prediction toPredictionMsg(const core::ScenePlan& plan) {
 
 collision_lab::Prediction toPredictionMsg(const core::AnalyticPrediction& prediction, const core::ModelChoice& model) {
   collision_lab::Prediction msg = modelPrediction(model, 3);
-  msg.collision_count = prediction.collision_count;
-  msg.collision_count_defined = true;
-  msg.infinite_collisions = false;
-  msg.paper_collision_count_defined = prediction.paper_collision_count.has_value();
-  msg.paper_collision_count = prediction.paper_collision_count.value_or(0);
-  msg.max_possible_collision_count = prediction.max_possible_collision_count;
-  msg.alpha = prediction.angles.alpha;
-  msg.theta = prediction.angles.theta;
-  msg.omega = prediction.angles.omega;
-  msg.phi_bc = prediction.phi_bc;
-  msg.psi = prediction.psi;
-  msg.first_pair_index = toPairCode(prediction.first_pair);
-  msg.final_velocities = toVector(prediction.final_velocities);
-  msg.energy_lost = 0.0;
-  msg.collapsed = false;
-  msg.critical_restitution = core::criticalRestitution(prediction.angles.alpha);
-  msg.spiral_angle = prediction.angles.theta;
+  addRotationModel(msg, prediction);
   return msg;
 }
 
@@ -373,101 +379,72 @@ collision_lab::EnergyTransfer toEnergyTransferMsg(const collision_lab::Collision
 
 // ---- SceneEventConverter ----
 
-SceneEventConverter::SceneEventConverter(const core::Scene& scene)
-    : scene_(scene),
-      full_state_(scene.size() <= collision_lab::CollisionEvent::FULL_STATE_MAX_BODIES),
-      replay_(scene) {}
+static_assert(collision_lab::io::kFullStateMaxBodies == collision_lab::CollisionEvent::FULL_STATE_MAX_BODIES,
+              "the event record's full-state limit must be CollisionEvent's");
 
-void SceneEventConverter::fillBodies(collision_lab::CollisionEvent& msg) const {
-  if (!full_state_) {
+SceneEventConverter::SceneEventConverter(const core::Scene& scene)
+    : state_(scene), full_state_(scene.size() <= collision_lab::CollisionEvent::FULL_STATE_MAX_BODIES) {}
+
+collision_lab::CollisionEvent SceneEventConverter::toMsg(const collision_lab::io::EventRecord& r) {
+  collision_lab::CollisionEvent msg;
+  msg.kind = r.collapse ? collision_lab::CollisionEvent::KIND_COLLAPSE : collision_lab::CollisionEvent::KIND_IMPACT;
+  msg.index = r.index;
+  msg.pair_index = static_cast<std::uint32_t>(r.pair_index);
+  msg.time = r.time;
+  msg.position = r.position;
+  msg.restitution = r.restitution;
+  msg.first_moved = static_cast<std::uint32_t>(r.first_moved);
+  msg.last_moved = static_cast<std::uint32_t>(r.last_moved);
+  msg.cluster_impact = r.cluster_impact;
+  for (std::size_t side = 0; side < 2; ++side) {
+    msg.pair_velocities_before[side] = r.pair_velocities_before[side];
+    msg.pair_velocities_after[side] = r.pair_velocities_after[side];
+    msg.pair_energy_transfer[side] = r.pair_energy_transfer[side];
+  }
+  msg.energy_lost = r.energy_lost;
+  if (!r.full_state) {
     msg.total_energy = msg.total_momentum = kNaN;
-    return;
+    return msg;
   }
-  const std::size_t n = scene_.size();
-  msg.positions = replay_.positions(replay_.time());
-  msg.velocities_before.resize(n);
-  msg.energy_transfer.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    msg.velocities_before[i] = replay_.velocityBefore(i);
-    msg.energy_transfer[i] = replay_.energyGained(i);
-  }
-  msg.velocities_after = replay_.velocities();
-  msg.kinetic_energy_after = replay_.kineticEnergies();
-  msg.total_energy = replay_.totalKineticEnergy();
-  msg.total_momentum = replay_.momentum();
+  const std::size_t n = r.bodies;
+  msg.positions.assign(r.positions, r.positions + n);
+  msg.velocities_before.assign(r.velocities_before, r.velocities_before + n);
+  msg.velocities_after.assign(r.velocities_after, r.velocities_after + n);
+  msg.energy_transfer.assign(r.energy_transfer, r.energy_transfer + n);
+  msg.kinetic_energy_after.assign(r.kinetic_energy_after, r.kinetic_energy_after + n);
+  msg.total_energy = r.total_energy;
+  msg.total_momentum = r.total_momentum;
+  return msg;
 }
 
 collision_lab::CollisionEvent SceneEventConverter::impact(const core::ImpactRecord& record) {
-  const std::size_t p = record.pair_index, left = scene_.leftOf(p);  // left: body 0 across a ring's seam
-  replay_.apply(record);
-  collision_lab::CollisionEvent msg;
-  msg.kind = collision_lab::CollisionEvent::KIND_IMPACT;
-  msg.index = record.index;
-  msg.pair_index = static_cast<std::uint32_t>(p);
-  msg.time = record.time;
-  msg.position = record.position;
-  msg.restitution = scene_.restitutionOf(p);
-  msg.first_moved = static_cast<std::uint32_t>(record.first_moved);
-  msg.last_moved = static_cast<std::uint32_t>(record.last_moved);
-  msg.cluster_impact = record.first_moved != p || record.last_moved != left;
-  for (std::size_t side = 0; side < 2; ++side) {
-    msg.pair_velocities_before[side] = record.velocities_before[side];
-    msg.pair_velocities_after[side] = record.velocities_after[side];
-    msg.pair_energy_transfer[side] = scene_.isWall(side == 0 ? p : left) ? 0.0 : record.energy_gained[side];
-  }
-  msg.energy_lost = record.energy_lost;
-  fillBodies(msg);
-  return msg;
+  return toMsg(state_.impact(record));
 }
 
 collision_lab::CollisionEvent SceneEventConverter::collapse(const core::Collapse& collapse) {
-  const std::size_t first = collapse.first_body;
-  replay_.apply(collapse);
-  collision_lab::CollisionEvent msg;
-  msg.kind = collision_lab::CollisionEvent::KIND_COLLAPSE;
-  msg.index = collapse.impacts_before;
-  msg.pair_index = static_cast<std::uint32_t>(first);
-  msg.time = collapse.time;
-  msg.position = collapse.position;
-  msg.restitution = scene_.restitutionOf(first);
-  msg.first_moved = static_cast<std::uint32_t>(first);
-  msg.last_moved = static_cast<std::uint32_t>(collapse.last_body);
-  msg.cluster_impact = false;
-  for (std::size_t side = 0; side < 2; ++side) {
-    msg.pair_velocities_before[side] = replay_.velocityBefore(first + side);
-    msg.pair_velocities_after[side] = collapse.velocity;
-    msg.pair_energy_transfer[side] = replay_.energyGained(first + side);
-  }
-  msg.energy_lost = replay_.lastHeat();
-  fillBodies(msg);
-  return msg;
-}
-
-std::size_t SceneEventConverter::plottedBodies() const {
-  // Above the limit the arrays are empty, as CollisionEvent's are, and only bodies 0, 1, 2
-  // are worked out, for the scalar fields.
-  return full_state_ ? scene_.size() : std::min<std::size_t>(scene_.size(), 3);
+  return toMsg(state_.collapse(collapse));
 }
 
 collision_lab::Velocities SceneEventConverter::velocitiesMsg(const collision_lab::CollisionEvent& event) const {
-  const std::vector<double>& v = replay_.velocities();
-  collision_lab::Velocities msg = toVelocitiesMsg(event, {v.begin(), v.begin() + plottedBodies()});
-  if (!full_state_) msg.v.clear();
+  if (full_state_) return toVelocitiesMsg(event);
+  // Above the limit the arrays stay empty, as the event's; bodies 0, 1, 2 give the scalars.
+  const std::vector<double>& v = state_.replay().velocities();
+  collision_lab::Velocities msg = toVelocitiesMsg(event, {v.begin(), v.begin() + 3});
+  msg.v.clear();
   return msg;
 }
 
 collision_lab::EnergyTransfer SceneEventConverter::energyTransferMsg(const collision_lab::CollisionEvent& event) const {
-  const std::size_t n = plottedBodies();
-  std::vector<double> delta(n), kinetic_after(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    delta[i] = replay_.energyGained(i);
-    kinetic_after[i] = replay_.kinetic(i);
+  const core::BodyStateReplay& replay = state_.replay();
+  if (full_state_) return toEnergyTransferMsg(event, replay.heat());
+  std::vector<double> delta(3), kinetic_after(3);
+  for (std::size_t i = 0; i < 3; ++i) {
+    delta[i] = replay.energyGained(i);
+    kinetic_after[i] = replay.kinetic(i);
   }
-  collision_lab::EnergyTransfer msg = toEnergyTransferMsg(event, std::move(delta), std::move(kinetic_after), replay_.heat());
-  if (!full_state_) {
-    msg.delta.clear();
-    msg.kinetic.clear();
-  }
+  collision_lab::EnergyTransfer msg = toEnergyTransferMsg(event, std::move(delta), std::move(kinetic_after), replay.heat());
+  msg.delta.clear();
+  msg.kinetic.clear();
   return msg;
 }
 
@@ -490,9 +467,6 @@ collision_lab::RunSummary modelSummary(const core::ModelChoice& model, std::size
 
 collision_lab::RunSummary toRunSummaryMsg(const core::SceneRunResult& result, std::size_t body_count,
                                           core::RunMode mode) {
-  if (result.three_body) {
-    return toRunSummaryMsg(result.three_body->summary, result.three_body->prediction, mode, result.model);
-  }
   const core::SceneSimulation& s = result.simulation;
   collision_lab::RunSummary msg = modelSummary(result.model, body_count, mode);
   msg.collision_count = s.impact_count;  // the run's answer, simulated or from the model
@@ -520,37 +494,17 @@ collision_lab::RunSummary toRunSummaryMsg(const core::SceneRunResult& result, st
   msg.energy_relative_drift = s.energy_relative_drift;
   msg.momentum_relative_drift = s.momentum_relative_drift;
   msg.compute_time = result.compute_time_s;
-  return msg;
-}
-
-collision_lab::RunSummary toRunSummaryMsg(const core::LabRunSummary& summary, const core::AnalyticPrediction& prediction,
-                                          core::RunMode mode, const core::ModelChoice& model) {
-  collision_lab::RunSummary msg = modelSummary(model, 3, mode);
-  msg.collision_count = summary.collision_count;
-  msg.truncated = summary.truncated;
-  msg.truncation_reason = summary.truncation_reason;
-  msg.cancelled = summary.cancelled;
-  msg.stop_reason = !summary.simulated ? "NOT_SIMULATED"
-                    : summary.cancelled ? "CANCELLED"
-                    : summary.truncated ? "CAP"
-                                        : "FINISHED";
-  msg.simulated = summary.simulated;
-  msg.predicted_collision_count = prediction.collision_count;
-  msg.predicted_collision_count_defined = true;
-  msg.paper_predicted_collision_count_defined = prediction.paper_collision_count.has_value();
-  msg.paper_predicted_collision_count = prediction.paper_collision_count.value_or(0);
-  msg.final_velocities = toVector(summary.final_velocities);
-  msg.energy_lost = 0.0;
-  msg.collapsed = false;
-  msg.collapse_count = 0;
-  msg.cluster_impacts = 0;
-  msg.rule_elastic_impacts = 0;
-  msg.critical_restitution = core::criticalRestitution(prediction.angles.alpha);
-  msg.spiral_angle = prediction.angles.theta;
-  msg.max_prediction_error = summary.max_prediction_error;
-  msg.energy_relative_drift = summary.energy_relative_drift;
-  msg.momentum_relative_drift = summary.momentum_relative_drift;
-  msg.compute_time = summary.compute_time_s;
+  if (const auto& rotation = result.three_body) {  // the rotation model's block
+    const core::AnalyticPrediction& p = rotation->prediction;
+    msg.predicted_collision_count = p.collision_count;
+    msg.predicted_collision_count_defined = true;
+    msg.paper_predicted_collision_count_defined = p.paper_collision_count.has_value();
+    msg.paper_predicted_collision_count = p.paper_collision_count.value_or(0);
+    msg.critical_restitution = core::criticalRestitution(p.angles.alpha);
+    msg.spiral_angle = p.angles.theta;
+    // The model is compared at every reported impact, not only at the end (lab_run.h).
+    msg.max_prediction_error = rotation->summary.max_prediction_error;
+  }
   return msg;
 }
 

@@ -171,6 +171,22 @@ TEST(NBodyCli, RingSeamImpact) {
   EXPECT_NE(outside.err.find("(RING)"), std::string::npos) << outside.err;
 }
 
+// Body names past Z in the CSV's pair and bodies cells: 30 equal carts 1 m apart on a ring
+// of 40 m, A (30 m) at +1 m/s and #29 (1 m) at -1 m/s, the rest at rest; by hand they meet
+// first across the seam (11 m apart) at t = 5.5 s, x = 35.5 m, and swap velocities.
+TEST(NBodyCli, CsvNamesTheSeamPairOfALargeRing) {
+  std::string masses, positions, velocities;
+  for (int i = 0; i < 30; ++i) {
+    masses += std::string(i ? "," : "") + "1";
+    positions += std::string(i ? "," : "") + std::to_string(30 - i);
+    velocities += std::string(i ? "," : "") + (i == 0 ? "1" : i == 29 ? "-1" : "0");
+  }
+  const CliOutput out = run({"--masses", masses, "--positions", positions, "--velocities", velocities, "--ring", "40",
+                             "--max-collisions", "1", "--format", "csv"});
+  ASSERT_EQ(out.exit_code, 0) << out.err;
+  EXPECT_NE(out.out.find("\nimpact,1,#29-A,29,#29;A,5.5,35.5,1,29,0,false,-1,1,1,-1,"), std::string::npos) << out.out;
+}
+
 // Newton's cradle with gaps (shared/physics.md): the pulse runs down the chain, one impact
 // per pair at t = 1, 2, 3, 4 s at x = 3, 2, 1, 0 m; the last ball leaves at -1 m/s.
 TEST(NBodyCli, CradleGivesFourImpactsAndTheLastBallLeaves) {

@@ -95,6 +95,11 @@ TEST(Count, PiBilliardByClosedForm) {
 
 TEST(Count, MaxPossibleIsExactForKaleidoscopicMasses) {
   EXPECT_EQ(maxPossibleCollisionCount({1, 1, 1}), 3u);
+  // One unit in the last place off (1, 1, 1): cos^2 alpha just above 1/4, alpha just below
+  // pi/3, so pi/alpha just above 3.
+  EXPECT_EQ(maxPossibleCollisionCount({1, 1, 1 + 0x1p-52}), 4u);
+  EXPECT_EQ(maxPossibleCollisionCount({kInf, 1, 1}), 4u);           // cos^2 = 1/2: pi/4
+  EXPECT_EQ(maxPossibleCollisionCount({5 * 0x1p1020, 0x1p1020, 9 * 0x1p1020}), 6u);  // (5, 1, 9) scaled: 3/4
   EXPECT_EQ(maxPossibleCollisionCount({2, 1, 3}), 4u);
   EXPECT_EQ(maxPossibleCollisionCount({5, 1, 9}), 6u);
   EXPECT_EQ(maxPossibleCollisionCount({1e12, 1, 1e12}), 2221442u);

@@ -54,19 +54,21 @@ Fed feed(const Array3& masses, const Array3& positions, const Array3& velocities
   collision_lab::InitialConditions input = toInitialConditions(scene, run_mode, o.max_collisions);
   input.run_id = "markers";
   Fed fed{RunRecord(input, o.limits), {}};
-  collision_lab::core::RunOptions options;
-  options.mode = run_mode;
-  options.max_collisions = o.max_collisions;
-  options.events = collision_lab::core::EventPolicy::none();
-  options.skip_simulation_over_cap = o.skip_simulation_over_cap;
-  const collision_lab::core::AnalyticPrediction prediction = collision_lab::core::predict(scene);
-  fed.run.prediction = toPredictionMsg(prediction);
-  const collision_lab::core::RunResult result = collision_lab::core::runLab(scene, options, prediction, [&](const collision_lab::core::LabEvent& e) {
+  // The node's one path: plan, publish the prediction, run, summarise.
+  const collision_lab::core::ScenePlan plan = collision_lab::core::planScene(toScene(input));
+  fed.run.prediction = toPredictionMsg(plan);
+  collision_lab::core::SceneRunOptions options;
+  options.lab.mode = run_mode;
+  options.lab.max_collisions = o.max_collisions;
+  options.lab.events = collision_lab::core::EventPolicy::none();
+  options.simulate_to_cap = !o.skip_simulation_over_cap;
+  collision_lab::core::SceneVisitors visitors;
+  visitors.three_body_event = [&](const collision_lab::core::LabEvent& e) {
     const auto msg = toCollisionEventMsg(e);
     fed.run.add(msg);
     if (o.keep_events) fed.events.push_back(msg);
-  });
-  fed.run.summary = toRunSummaryMsg(result.summary, result.prediction, run_mode);
+  };
+  fed.run.summary = toRunSummaryMsg(collision_lab::core::runScene(plan, options, visitors), 3, run_mode);
   return fed;
 }
 

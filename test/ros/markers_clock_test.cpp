@@ -62,10 +62,12 @@ class Player {
     input.run_id = run_id;
     input.header.stamp = start;
     queue(input_, input);
-    collision_lab::core::RunOptions options;
-    options.events = collision_lab::core::EventPolicy::all();
-    const collision_lab::core::RunResult result = collision_lab::core::runLab(scene, options);
-    auto prediction = toPredictionMsg(result.prediction);
+    const collision_lab::core::ScenePlan plan = collision_lab::core::planScene(toScene(input));
+    collision_lab::core::SceneRunOptions options;
+    options.lab.events = collision_lab::core::EventPolicy::all();
+    const collision_lab::core::SceneRunResult run = collision_lab::core::runScene(plan, options);
+    const collision_lab::core::RunResult& result = *run.three_body;
+    auto prediction = toPredictionMsg(plan);
     prediction.run_id = run_id;
     prediction.header.stamp = start;
     prediction.timeline_scale = kScale;
@@ -76,7 +78,7 @@ class Player {
       msg.header.stamp = start + ros::Duration(kScale * e.event.time);
       queue(events_, msg);
     }
-    auto summary = toRunSummaryMsg(result.summary, result.prediction, collision_lab::core::RunMode::kFull);
+    auto summary = toRunSummaryMsg(run, 3, collision_lab::core::RunMode::kFull);
     summary.run_id = run_id;
     summary.header.stamp = start + ros::Duration(kScale * result.events.back().event.time);
     queue(summary_, summary);

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "collision_lab/io/scene_report.h"
 #include "collision_lab/ros/lab_node.h"
 #include "collision_lab/ros/marker_view.h"
 #include "collision_lab/ros/msg_conversion.h"
@@ -119,6 +120,36 @@ TEST(SceneEventConverter, RebuildsEveryBodyThroughAStickingImpactAndAClusterImpa
   EXPECT_EQ(t.kinetic, (std::vector<double>{0, 0, 0.25}));
   EXPECT_EQ(t.energy_lost, 0.0);
   EXPECT_EQ(t.cumulative_energy_lost, 0.25);
+}
+
+// The node's events and the CLI's are one record (io::SceneEventState): every impact of an
+// inelastic run carries the same values in both. The energy a single body gains in an
+// impact is the engine's own (pair_energy_transfer), not a difference of the replay's
+// kinetic energies, which rounds otherwise (it did before: the node's differed).
+TEST(SceneEventConverter, EveryEventCarriesTheCliRecordsValues) {
+  const collision_lab::core::Scene scene{{1, 2.7, 0.3, 1.9, 5}, {4, 3.1, 2.2, 1.3, 0}, {-0.7, 0.1, 0.3, -0.2, 0.9},
+                                         {0.9, 0.7, 1, 0.55}};
+  SceneEventConverter converter(scene);
+  collision_lab::io::SceneEventJson cli(scene);
+  std::size_t single_pair_impacts = 0;
+  const auto result = collision_lab::core::runEngine(scene, {}, [&](const collision_lab::core::ImpactRecord& r) {
+    const auto msg = converter.impact(r);
+    const collision_lab::io::Json json = cli.impact(r);
+    ASSERT_EQ(msg.energy_transfer.size(), 5u);
+    for (std::size_t i = 0; i < 5; ++i) {
+      EXPECT_EQ(msg.energy_transfer[i], json.at("energy_transfer")[i].get<double>()) << "impact " << r.index;
+      EXPECT_EQ(msg.velocities_after[i], json.at("velocities_after")[i].get<double>());
+      EXPECT_EQ(msg.positions[i], json.at("positions")[i].get<double>());
+    }
+    EXPECT_EQ(msg.total_energy, json.at("total_energy").get<double>());
+    if (!msg.cluster_impact) {
+      ++single_pair_impacts;
+      EXPECT_EQ(msg.energy_transfer[msg.pair_index], msg.pair_energy_transfer[0]) << "impact " << r.index;
+      EXPECT_EQ(msg.energy_transfer[msg.pair_index + 1], msg.pair_energy_transfer[1]) << "impact " << r.index;
+    }
+  });
+  EXPECT_GT(result.impact_count, 3u);
+  EXPECT_GT(single_pair_impacts, 0u);
 }
 
 // A ring's seam impact (issue 21; wrote past the bodies before): L = 10 m, A (1 kg, 9 m,
@@ -382,28 +413,72 @@ TEST(MsgConversion, PlotTopicsAreTheEventsSimulatedValues) {
 }
 
 TEST(MsgConversion, RunSummaryPhysicsFields) {
-  collision_lab::core::LabRunSummary s;
-  s.collision_count = 10;
-  s.truncated = true;
-  s.truncation_reason = "cap";
+  // A three-body result: the summary comes from the one simulation, the rotation model's
+  // block (its counts, its error at every impact) from three_body.
+  collision_lab::core::SceneRunResult result;
+  result.model = collision_lab::core::ModelChoice{collision_lab::core::ModelKind::kThreeBodyRotation, "rotation"};
+  collision_lab::core::SceneSimulation& s = result.simulation;
   s.simulated = true;
+  s.impact_count = 10;
+  s.truncated = true;
+  s.stop = collision_lab::core::StopReason::kCap;
+  s.stop_message = "cap";
   s.final_velocities = {1, 2, 3};
-  s.max_prediction_error = 1e-15;
+  s.max_prediction_error = 0.25;  // the end's comparison, replaced by the model's
   s.energy_relative_drift = 2e-16;
   s.momentum_relative_drift = std::nan("");
-  s.compute_time_s = 0.5;
-  collision_lab::core::AnalyticPrediction p;
-  p.collision_count = 11;
-  const auto msg = toRunSummaryMsg(s, p, collision_lab::core::RunMode::kFull);
+  result.compute_time_s = 0.5;
+  collision_lab::core::RunResult rotation;
+  rotation.prediction.collision_count = 11;
+  rotation.prediction.angles = {M_PI / 3, 0.5, M_PI - M_PI / 3};
+  rotation.summary.max_prediction_error = 1e-15;
+  result.three_body = rotation;
+  const auto msg = toRunSummaryMsg(result, 3, collision_lab::core::RunMode::kFull);
   EXPECT_EQ(msg.collision_count, 10u);
   EXPECT_TRUE(msg.truncated);
   EXPECT_EQ(msg.truncation_reason, "cap");
+  EXPECT_EQ(msg.stop_reason, "CAP");
   EXPECT_EQ(msg.predicted_collision_count, 11u);
+  EXPECT_TRUE(msg.predicted_collision_count_defined);
   EXPECT_FALSE(msg.paper_predicted_collision_count_defined);
+  EXPECT_EQ(msg.spiral_angle, 0.5);
+  EXPECT_EQ(msg.max_prediction_error, 1e-15);
   EXPECT_EQ(msg.final_velocities[2], 3.0);
+  EXPECT_EQ(msg.energy_lost, 0.0);
   EXPECT_TRUE(std::isnan(msg.momentum_relative_drift));
   EXPECT_EQ(msg.compute_time, 0.5);
   EXPECT_EQ(msg.mode, collision_lab::InitialConditions::MODE_FULL);
+}
+
+TEST(MsgConversion, ThreeEqualMassesTakeTheOnePathToThreeImpacts) {
+  // Three equal masses, the outer ones approaching the middle one: 3 impacts (shared/physics.md),
+  // the outer velocities exchanged; the rotation model answers, and its block rides along.
+  const collision_lab::core::Scene scene{{1, 1, 1}, {2, 1, -1}, {-1, 0, 1}, {}};
+  const collision_lab::core::ScenePlan plan = collision_lab::core::planScene(scene);
+  ASSERT_FALSE(plan.error);
+  const auto prediction = toPredictionMsg(plan);
+  EXPECT_EQ(prediction.model_name, "three_body_rotation");
+  EXPECT_EQ(prediction.collision_count, 3u);
+  EXPECT_TRUE(prediction.collision_count_defined);
+  EXPECT_NEAR(prediction.alpha, M_PI / 3, 1e-15);  // equal masses: alpha = pi/3
+  for (const auto mode : {collision_lab::core::RunMode::kFull, collision_lab::core::RunMode::kPredictOnly}) {
+    collision_lab::core::SceneRunOptions options;
+    options.lab.mode = mode;
+    const auto msg = toRunSummaryMsg(collision_lab::core::runScene(plan, options), 3, mode);
+    const bool simulated = mode == collision_lab::core::RunMode::kFull;
+    EXPECT_EQ(msg.simulated, simulated);
+    EXPECT_EQ(msg.stop_reason, simulated ? "FINISHED" : "NOT_SIMULATED");
+    EXPECT_EQ(msg.collision_count, 3u);
+    EXPECT_EQ(msg.predicted_collision_count, 3u);
+    EXPECT_TRUE(msg.predicted_collision_count_defined);
+    EXPECT_FALSE(msg.truncated);
+    ASSERT_EQ(msg.final_velocities.size(), 3u);
+    EXPECT_NEAR(msg.final_velocities[0], 1.0, 1e-15);
+    EXPECT_NEAR(msg.final_velocities[1], 0.0, 1e-15);
+    EXPECT_NEAR(msg.final_velocities[2], -1.0, 1e-15);
+    EXPECT_EQ(msg.energy_lost, 0.0);
+    EXPECT_EQ(std::isnan(msg.max_prediction_error), !simulated);
+  }
 }
 
 TEST(MsgConversion, Rejections) {

@@ -19,9 +19,7 @@
 
 namespace collision_lab {
 namespace io {
-namespace report_text {
 class SceneEventState;
-}  // namespace report_text
 
 /// Bodies shown at each end of the table's body lists.
 constexpr std::size_t kTableBodies = 5;
@@ -59,7 +57,7 @@ class SceneEventJson {
   Json collapse(const core::Collapse& collapse);
 
  private:
-  std::unique_ptr<report_text::SceneEventState> state_;
+  std::unique_ptr<SceneEventState> state_;
 };
 /// The summary of an N-body run (see docs/cli.md for the keys).
 Json sceneSummaryJson(const core::SceneRunResult& result);

@@ -27,6 +27,7 @@
 #include "collision_lab/core/nbody/scene.h"
 #include "collision_lab/core/scene.h"
 #include "collision_lab/core/scene_run.h"
+#include "collision_lab/io/event_record.h"
 
 namespace collision_lab_ros {
 
@@ -67,10 +68,11 @@ std::optional<collision_lab::core::Pair> toPair(std::uint32_t code);
 /// (the node passes chooseModel's, as the CLI prints it).
 collision_lab::core::ModelChoice threeBodyRotationModel();
 
-/// The plan's model and prediction (core::planScene), as published before the run.
-/// Precondition: !plan.error.
+/// The plan's model and prediction (core::planScene), as published before the run, for
+/// every scene: the model's fields, plus the closed form of models.h or, when the rotation
+/// model answers, its prediction and the paper's printed count. Precondition: !plan.error.
 collision_lab::Prediction toPredictionMsg(const collision_lab::core::ScenePlan& plan);
-/// Three elastic bodies (the three-body path).
+/// The rotation model's prediction alone (three elastic bodies), as toPredictionMsg(plan) gives it.
 collision_lab::Prediction toPredictionMsg(const collision_lab::core::AnalyticPrediction& prediction,
                                           const collision_lab::core::ModelChoice& model = threeBodyRotationModel());
 collision_lab::core::AnalyticPrediction toPrediction(const collision_lab::Prediction& msg);
@@ -100,10 +102,11 @@ collision_lab::EnergyTransfer toEnergyTransferMsg(const collision_lab::Collision
                                                   double cumulative_energy_lost);
 
 /// The CollisionEvent of each of the engine's notifications, in the order the engine gives
-/// them (impacts and collapses interleaved, engine.h), with the body state of the core's
-/// replay (core::BodyStateReplay): the per-body arrays (positions at the event's time,
-/// velocities before and after, energy transfer, kinetic energy) and the totals only for
-/// N <= FULL_STATE_MAX_BODIES. Header and run_id are the caller's to fill.
+/// them (impacts and collapses interleaved, engine.h): a copy of the one event record that
+/// the CLI's reports write too (io::SceneEventState, event_record.h), so both carry the same
+/// values. The per-body arrays (positions at the event's time, velocities before and after,
+/// energy transfer, kinetic energy) and the totals only for N <= FULL_STATE_MAX_BODIES
+/// (NaN totals above). Header and run_id are the caller's to fill.
 class SceneEventConverter {
  public:
   explicit SceneEventConverter(const collision_lab::core::Scene& scene);
@@ -114,32 +117,26 @@ class SceneEventConverter {
   collision_lab::CollisionEvent collapse(const collision_lab::core::Collapse& collapse);
 
   /// The plot messages of the last event converted: their arrays have length N for
-  /// N <= FULL_STATE_MAX_BODIES (O(N) each) and are empty above it, like the event's own;
-  /// the scalar fields (bodies 0, 1, 2) are always filled.
+  /// N <= FULL_STATE_MAX_BODIES (O(N) each, the event's own) and are empty above it, like
+  /// the event's; the scalar fields (bodies 0, 1, 2) are always filled.
   collision_lab::Velocities velocitiesMsg(const collision_lab::CollisionEvent& event) const;
   collision_lab::EnergyTransfer energyTransferMsg(const collision_lab::CollisionEvent& event) const;
 
  private:
-  /// The bodies 0 .. plottedBodies() - 1 whose values the plot messages are built from.
-  std::size_t plottedBodies() const;
-  /// Fills the per-body arrays and totals of msg (or empties them, NaN totals, for large N).
-  void fillBodies(collision_lab::CollisionEvent& msg) const;
+  /// The message of one record of state_.
+  static collision_lab::CollisionEvent toMsg(const collision_lab::io::EventRecord& record);
 
-  collision_lab::core::Scene scene_;
+  collision_lab::io::SceneEventState state_;
   bool full_state_;
-  collision_lab::core::BodyStateReplay replay_;
 };
 
-/// The physics fields of a summary; published_events, events_not_published, bag_path,
+/// The physics fields of a summary, from the run's one SceneSimulation for every scene,
+/// plus the rotation model's block when it answered (its predicted and paper's counts, and
+/// its prediction error at every impact); published_events, events_not_published, bag_path,
 /// recording_ok, recording_error, timeline_scale, timeline_saturated,
 /// requested_run_id and student are the node's to fill.
 collision_lab::RunSummary toRunSummaryMsg(const collision_lab::core::SceneRunResult& result,
                                           std::size_t body_count, collision_lab::core::RunMode mode);
-/// Three elastic bodies (the three-body path).
-collision_lab::RunSummary toRunSummaryMsg(const collision_lab::core::LabRunSummary& summary,
-                                          const collision_lab::core::AnalyticPrediction& prediction,
-                                          collision_lab::core::RunMode mode,
-                                          const collision_lab::core::ModelChoice& model = threeBodyRotationModel());
 
 collision_lab::Rejected toRejectedMsg(const collision_lab::core::ValidationError& error);
 collision_lab::Rejected toRejectedMsg(NodeReason reason, const std::string& field,
