@@ -247,12 +247,13 @@ struct WorkingUnits {
 /// The run of three elastic bodies whose count the closed form gives (`count`), without the
 /// engine's queue or any decision (nbody/elastic_triple.h), for a run that publishes no
 /// event: its count, final velocities (correctly rounded, the engine's) and drifts, as
-/// simulateByEngine gives them; no final time or positions. After each impact n,
-/// visit(n, v) sees the velocities [m/s] that simulateByEngine's event would carry. Returns
-/// nothing when the run cannot be certified this way (then the engine runs it).
-template <class Visit>
+/// simulateByEngine gives them; no final time or positions. restart() is called before
+/// each pass over the impacts (at most two); after each impact n, visit(n, v) sees the
+/// velocities [m/s] that simulateByEngine's event would carry. Returns nothing when the run
+/// cannot be taken this way (then the engine runs it).
+template <class Restart, class Visit>
 std::optional<SimulationResult> simulateKnownCount(const ThreeBodyScene& scene, std::uint64_t count,
-                                                   const SimulationOptions& options, Visit&& visit) {
+                                                   const SimulationOptions& options, Restart&& restart, Visit&& visit) {
   if (scene.isWall(0) && scene.isWall(2)) return std::nullopt;
   const std::optional<Pair> first = firstPair(scene);
   if (count > 0 && !first) return std::nullopt;
@@ -269,7 +270,7 @@ std::optional<SimulationResult> simulateKnownCount(const ThreeBodyScene& scene, 
     return std::fabs(x) >= std::numeric_limits<double>::min() ? x : scaled(v, -shift);
   };
   const std::optional<nbody_detail::ElasticTripleRun> run = nbody_detail::runElasticTriple(
-      units.scene, count, first == Pair::BC ? 1 : 0, options.max_collisions, options.cancel,
+      units.scene, count, first == Pair::BC ? 1 : 0, options.max_collisions, options.cancel, restart,
       [&](std::uint64_t n, const std::array<double, 3>& v) { visit(n, std::array<double, 3>{si(v[0]), si(v[1]), si(v[2])}); });
   if (!run) return std::nullopt;
   SimulationResult result;
@@ -420,13 +421,18 @@ void simulateBesidePrediction(const ThreeBodyScene& scene, const RunOptions& opt
   const bool publishes = options.mode == RunMode::kFull && (visitor || options.events.kind != EventPolicy::Kind::kNone);
   if (!publishes) {
     if (options.mode == RunMode::kFull) {
-      ClosedFormInTurn predicted(model);
-      by_engine = simulateKnownCount(scene, result.prediction.collision_count, simulation_options,
-                                     [&](std::uint64_t n, const std::array<double, 3>& v) {
-                                       max_error_sq = std::max(max_error_sq, relative_error.squared(v, predicted.velocitiesAfter(n)));
-                                     });
+      std::optional<ClosedFormInTurn> predicted;
+      by_engine = simulateKnownCount(
+          scene, result.prediction.collision_count, simulation_options,
+          [&] {
+            predicted.emplace(model);
+            max_error_sq = 0.0;
+          },
+          [&](std::uint64_t n, const std::array<double, 3>& v) {
+            max_error_sq = std::max(max_error_sq, relative_error.squared(v, predicted->velocitiesAfter(n)));
+          });
     } else {
-      by_engine = simulateKnownCount(scene, result.prediction.collision_count, simulation_options,
+      by_engine = simulateKnownCount(scene, result.prediction.collision_count, simulation_options, [] {},
                                      [](std::uint64_t, const std::array<double, 3>&) {});
     }
     if (!by_engine) max_error_sq = 0.0;  // the engine measures it again

@@ -63,32 +63,32 @@ inline bool roundsTo(const DD& value, double error) {
   return value.lo + error < up * kMargin && value.lo - error > -down * kMargin;
 }
 
-/// Runs scene (three bodies, every e = 1, no ring; at most one wall), whose exact count is
-/// `count` with first pair `first_pair` (0: AB, 1: BC), up to `cap` impacts; the cancel flag
-/// (may be null) is read every 1024 impacts, as the engine does. After impact n,
-/// visit(n, v) sees the velocities rounded to double (the engine's record values while it
-/// keeps its working tier). Returns nothing when the engine must run it: the run may leave
-/// the engine's safe range, or the engine may have left its working tier (its precision
-/// guard, tier.h timeIsPrecise, replayed here with a margin of 2) and the final velocities
-/// cannot be certified.
-template <class Visit>
+/// The two passes of runElasticTriple: the engine's replica (its precision guard watched),
+/// and the certified one (componentwise bounds; the intercepts in double, for the range).
+enum class ElasticTriplePass { kReplica, kCertified };
+
+/// One pass; empty when it cannot answer (kReplica: the guard may fire; kCertified: not
+/// certified; either: out of range).
+template <ElasticTriplePass kPass, class Visit>
 #if defined(__GNUC__)
 __attribute__((flatten))  // the impact maps and the bounds inline into the loop
 #endif
-std::optional<ElasticTripleRun> runElasticTriple(const Scene& scene, std::uint64_t count, std::size_t first_pair,
-                                                 std::uint64_t cap, const std::atomic<bool>* cancel, Visit&& visit) {
+std::optional<ElasticTripleRun> runElasticTriplePass(const Scene& scene, std::uint64_t count, std::size_t first_pair,
+                                                     std::uint64_t cap, const std::atomic<bool>* cancel, Visit& visit) {
+  constexpr bool kReplica = kPass == ElasticTriplePass::kReplica;
   constexpr double kEta = kDoubleDoubleOpError;  // one double-double operation, relative
   constexpr double kSlack = 1.0 + 0x1p-40;       // the rounding of evaluating a bound in double
   constexpr double kTinyError = 0x1p-998;        // underflow in double-double, per bound (4 operations)
-  constexpr double kRange = 0x1p900;             // the engine's safe range (tier.h, kMaxMagnitude)
-  constexpr double kGuard = 0x1p-43;             // the engine's precision guard (2^-42), halved
-  std::array<double, 3> sqrt_mass{};             // 0 for a wall, as tier.h's tables
+  // The engine's safe range (tier.h, kMaxMagnitude); 2^10 below it for intercepts in double.
+  constexpr double kRange = kReplica ? 0x1p900 : 0x1p890;
+  constexpr double kGuard = 0x1p-43;  // the engine's precision guard (2^-42), halved
+  std::array<double, 3> sqrt_mass{};  // 0 for a wall, as tier.h's tables
   for (int k = 0; k < 3; ++k) sqrt_mass[k] = scene.isWall(k) ? 0.0 : std::sqrt(scene.masses[k]);
   struct PairTables {
     ImpactMap<DD> map;
-    double gain;       // |c_h|, 0 for a wall
-    double s_h, s_l;   // sqrt of the heavier and lighter mass, 0 for a wall
-    double scale;      // 1/sqrt(m_p) + 1/sqrt(m_p+1), a wall counting 0
+    double gain;      // |c_h|, 0 for a wall
+    double s_h, s_l;  // sqrt of the heavier and lighter mass, 0 for a wall
+    double scale;     // 1/sqrt(m_p) + 1/sqrt(m_p+1), a wall counting 0
   };
   std::array<PairTables, 2> pairs;
   for (int p = 0; p < 2; ++p) {
@@ -109,10 +109,10 @@ std::optional<ElasticTripleRun> runElasticTriple(const Scene& scene, std::uint64
            (pair.s_h + pair.s_l) * 0x1p-1000;
   };
   std::array<DD, 3> v = {DD(scene.velocities[0]), DD(scene.velocities[1]), DD(scene.velocities[2])};
-  std::array<DD, 3> b = {DD(scene.positions[0]), DD(scene.positions[1]), DD(scene.positions[2])};
-  std::array<double, 3> error{};  // E_k [m/s]; the inputs are exact
-  double eu = 0.0, eb = 0.0;      // the engine's mass-weighted bounds (tier.h)
-  bool working_tier = true;       // the engine would have kept its double-double state
+  std::array<DD, 3> b = {DD(scene.positions[0]), DD(scene.positions[1]), DD(scene.positions[2])};  // kReplica
+  std::array<double, 3> b_double = {scene.positions[0], scene.positions[1], scene.positions[2]};  // kCertified
+  std::array<double, 3> error{};  // E_k [m/s] (kCertified); the inputs are exact
+  double eu = 0.0, eb = 0.0;      // the engine's mass-weighted bounds (tier.h; kReplica)
   ElasticTripleRun run;
   const std::uint64_t target = count < cap ? count : cap;
   std::size_t p = first_pair;
@@ -126,43 +126,74 @@ std::optional<ElasticTripleRun> runElasticTriple(const Scene& scene, std::uint64
     const ImpactMap<DD>& map = pair.map;
     DD& vi = v[p];
     DD& vj = v[p + 1];
-    double& ei = error[p];
-    double& ej = error[p + 1];
-    const double eu_before = eu, eb_before = eb;
     const ImpactChange<DD> dv = applyImpactMap(map, vi, vj);
-    const ImpactChange<DD> db = applyImpactMap(map, b[p], b[p + 1]);
-    eu += rho(pair, dv, vi, vj);
-    eb += rho(pair, db, b[p], b[p + 1]);
-    working_tier = working_tier && eu_before * pair.scale <= kGuard * std::fabs(dv.difference.hi) &&
-                   eb_before * pair.scale <= kGuard * std::fabs(db.difference.hi);
-    const double magnitude = std::fabs(b[p].hi) + std::fabs(b[p + 1].hi) + std::fabs(vi.hi) + std::fabs(vj.hi);
-    if (!(magnitude < kRange)) return std::nullopt;
-    const double difference_error = (ei + ej + kEta * std::fabs(dv.difference.hi)) * kSlack + kTinyError;
-    if (map.exchange) {  // a swap rounds nothing
-      const double e = ei;
-      ei = ej;
-      ej = e;
-    } else {
-      double& eh = map.heavy_is_i ? ei : ej;
-      double& el = map.heavy_is_i ? ej : ei;
-      const DD& heavy = map.heavy_is_i ? vi : vj;
-      const DD& light = map.heavy_is_i ? vj : vi;
-      if (pair.s_h != 0.0) {  // not a wall: the increment g d rounds, and g itself (4 eta covers both)
-        const double increment_error =
-            (pair.gain * difference_error + 4 * kEta * std::fabs(dv.heavy_increment.hi)) * kSlack + kTinyError;
-        eh = (eh + increment_error + kEta * std::fabs(heavy.hi)) * kSlack + kTinyError;
+    if constexpr (kReplica) {
+      const double eu_before = eu, eb_before = eb;
+      const ImpactChange<DD> db = applyImpactMap(map, b[p], b[p + 1]);
+      eu += rho(pair, dv, vi, vj);
+      eb += rho(pair, db, b[p], b[p + 1]);
+      if (!(eu_before * pair.scale <= kGuard * std::fabs(dv.difference.hi) &&
+            eb_before * pair.scale <= kGuard * std::fabs(db.difference.hi))) {
+        return std::nullopt;  // the engine may adopt a 100-digit state here
       }
-      el = (eh + difference_error + kEta * std::fabs(light.hi)) * kSlack + kTinyError;
+      const double magnitude = std::fabs(b[p].hi) + std::fabs(b[p + 1].hi) + std::fabs(vi.hi) + std::fabs(vj.hi);
+      if (!(magnitude < kRange)) return std::nullopt;
+    } else {
+      double& ei = error[p];
+      double& ej = error[p + 1];
+      const double difference_error = (ei + ej + kEta * std::fabs(dv.difference.hi)) * kSlack + kTinyError;
+      if (map.exchange) {  // a swap rounds nothing
+        std::swap(ei, ej);
+        std::swap(b_double[p], b_double[p + 1]);
+      } else {
+        double& eh = map.heavy_is_i ? ei : ej;
+        double& el = map.heavy_is_i ? ej : ei;
+        const DD& heavy = map.heavy_is_i ? vi : vj;
+        const DD& light = map.heavy_is_i ? vj : vi;
+        if (pair.s_h != 0.0) {  // not a wall: the increment g d rounds, and g itself (4 eta covers both)
+          const double increment_error =
+              (pair.gain * difference_error + 4 * kEta * std::fabs(dv.heavy_increment.hi)) * kSlack + kTinyError;
+          eh = (eh + increment_error + kEta * std::fabs(heavy.hi)) * kSlack + kTinyError;
+        }
+        el = (eh + difference_error + kEta * std::fabs(light.hi)) * kSlack + kTinyError;
+        const double d = b_double[p + 1] - b_double[p];
+        double& bh = map.heavy_is_i ? b_double[p] : b_double[p + 1];
+        double& bl = map.heavy_is_i ? b_double[p + 1] : b_double[p];
+        bh += map.heavy_gain.hi * d;
+        bl = map.heavy_is_i ? bh - d : bh + d;
+      }
+      const double magnitude =
+          std::fabs(b_double[p]) + std::fabs(b_double[p + 1]) + std::fabs(vi.hi) + std::fabs(vj.hi);
+      if (!(magnitude < kRange)) return std::nullopt;
     }
     visit(n + 1, std::array<double, 3>{v[0].hi, v[1].hi, v[2].hi});
   }
   for (int k = 0; k < 3; ++k) {
-    if (!working_tier && !scene.isWall(k) && !roundsTo(v[k], error[k])) return std::nullopt;
+    if (!kReplica && !scene.isWall(k) && !roundsTo(v[k], error[k])) return std::nullopt;
     run.final_velocities[k] = v[k].hi;
   }
   run.impact_count = n;
   run.capped = !run.cancelled && count > cap;
   return run;
+}
+
+/// Runs scene (three bodies, every e = 1, no ring; at most one wall), whose exact count is
+/// `count` with first pair `first_pair` (0: AB, 1: BC), up to `cap` impacts; the cancel flag
+/// (may be null) is read every 1024 impacts, as the engine does. First as the engine's
+/// replica, which stops where the engine's precision guard may fire; then, if it stopped,
+/// certified. restart() is called before each pass; after impact n, visit(n, v) sees the
+/// velocities rounded to double (the engine's record values in the replica). Returns
+/// nothing when the engine must run it (then visit has seen an unfinished pass).
+template <class Restart, class Visit>
+std::optional<ElasticTripleRun> runElasticTriple(const Scene& scene, std::uint64_t count, std::size_t first_pair,
+                                                 std::uint64_t cap, const std::atomic<bool>* cancel, Restart&& restart,
+                                                 Visit&& visit) {
+  restart();
+  if (auto run = runElasticTriplePass<ElasticTriplePass::kReplica>(scene, count, first_pair, cap, cancel, visit)) {
+    return run;
+  }
+  restart();
+  return runElasticTriplePass<ElasticTriplePass::kCertified>(scene, count, first_pair, cap, cancel, visit);
 }
 
 }  // namespace nbody_detail
