@@ -112,7 +112,14 @@ std::optional<ElasticTripleRun> runElasticTriplePass(const Scene& scene, std::ui
   std::array<DD, 3> b = {DD(scene.positions[0]), DD(scene.positions[1]), DD(scene.positions[2])};  // kReplica
   std::array<double, 3> b_double = {scene.positions[0], scene.positions[1], scene.positions[2]};  // kCertified
   std::array<double, 3> error{};  // E_k [m/s] (kCertified); the inputs are exact
-  double eu = 0.0, eb = 0.0;      // the engine's mass-weighted bounds (tier.h; kReplica)
+  // The engine's mass-weighted bounds (tier.h; kReplica), from what its start adds when it
+  // adopts a more precise tier's state (tier.h, adopt(): 2^-100 per conversion), so that
+  // they bound the engine's either way.
+  double eu = 0.0, eb = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    eu += 2 * 0x1p-100 * sqrt_mass[k] * std::fabs(scene.velocities[k]);
+    eb += 2 * 0x1p-100 * sqrt_mass[k] * std::fabs(scene.positions[k]);
+  }
   ElasticTripleRun run;
   const std::uint64_t target = count < cap ? count : cap;
   std::size_t p = first_pair;
