@@ -246,8 +246,8 @@ struct WorkingUnits {
 
 /// The run of three elastic bodies whose count the closed form gives (`count`), without the
 /// engine's queue or any decision (nbody/elastic_triple.h), for a run that publishes no
-/// event: its count, final velocities (correctly rounded, the engine's) and drifts, as
-/// simulateByEngine gives them; no final time or positions. restart() is called before
+/// event: its count, final velocities (the engine's bit for bit, or certified correctly
+/// rounded) and drifts, as simulateByEngine gives them; no final time or positions. restart() is called before
 /// each pass over the impacts (at most two); after each impact n, visit(n, v) sees the
 /// velocities [m/s] that simulateByEngine's event would carry. Returns nothing when the run
 /// cannot be taken this way (then the engine runs it).
