@@ -12,6 +12,7 @@
 #include "collision_lab/core/precision.h"
 #include "float_ops.h"
 #include "impact_energy.h"
+#include "nbody/elastic_triple.h"
 
 namespace collision_lab {
 namespace core {
@@ -77,6 +78,12 @@ class ClosedFormInTurn {
       sequence_.emplace(*model.fast_);
       previous_ = sequence_->velocitiesAfter(0);
     }
+  }
+
+  /// The velocities after collision n alone, as describe() gives them [m/s]; n = 1, 2, 3,
+  /// ... in turn (not mixed with describe()).
+  std::array<double, 3> velocitiesAfter(std::uint64_t n) {
+    return sequence_ ? toArray(sequence_->velocitiesAfter(n)) : model_.velocitiesAfter(n);
   }
 
   void describe(std::uint64_t n, LabEvent& lab) {
@@ -219,6 +226,68 @@ double noNegativeZero(long double x) { return x == 0 ? 0.0 : static_cast<double>
 /// value times 2^shift, rounded once to double (never -0).
 double scaled(long double value, int shift) { return noNegativeZero(std::ldexp(value, shift)); }
 
+/// The engine's working units: masses, velocities and positions scaled by exact powers of
+/// two towards 1, so that tiny or huge inputs keep their digits.
+struct WorkingUnits {
+  explicit WorkingUnits(const ThreeBodyScene& si)
+      : mass_shift(detail::shiftTowardsOne(si.masses)),
+        velocity_shift(detail::shiftTowardsOne(si.velocities)),
+        position_shift(detail::shiftTowardsOne(si.positions)),
+        scene{std::vector<double>(3), std::vector<double>(3), std::vector<double>(3), {}} {
+    for (int k = 0; k < 3; ++k) {
+      scene.masses[k] = std::ldexp(si.masses[k], mass_shift);
+      scene.positions[k] = std::ldexp(si.positions[k], position_shift);
+      scene.velocities[k] = std::ldexp(si.velocities[k], velocity_shift);
+    }
+  }
+  int mass_shift, velocity_shift, position_shift;
+  Scene scene;
+};
+
+/// The run of three elastic bodies whose count the closed form gives (`count`), without the
+/// engine's queue or any decision (nbody/elastic_triple.h), for a run that publishes no
+/// event: its count, final velocities (the engine's bit for bit, or certified correctly
+/// rounded) and drifts, as simulateByEngine gives them; no final time or positions. restart() is called before
+/// each pass over the impacts (at most two); after each impact n, visit(n, v) sees the
+/// velocities [m/s] that simulateByEngine's event would carry. Returns nothing when the run
+/// cannot be taken this way (then the engine runs it).
+template <class Restart, class Visit>
+std::optional<SimulationResult> simulateKnownCount(const ThreeBodyScene& scene, std::uint64_t count,
+                                                   const SimulationOptions& options, Restart&& restart, Visit&& visit) {
+  if (scene.isWall(0) && scene.isWall(2)) return std::nullopt;
+  const std::optional<Pair> first = firstPair(scene);
+  if (count > 0 && !first) return std::nullopt;
+  const WorkingUnits units(scene);
+  for (int p = 0; p < 2; ++p) {  // a heavy body's coefficient must not underflow
+    const double light = std::min(units.scene.masses[p], units.scene.masses[p + 1]);
+    const double heavy = std::max(units.scene.masses[p], units.scene.masses[p + 1]);
+    if (!std::isinf(heavy) && !(light / heavy > 0x1p-900)) return std::nullopt;
+  }
+  const int shift = units.velocity_shift;
+  const double to_si = std::ldexp(1.0, -shift);
+  const auto si = [to_si, shift](double v) {  // scaled(v, -shift), without ldexp where exact
+    const double x = v * to_si;
+    return std::fabs(x) >= std::numeric_limits<double>::min() ? x : scaled(v, -shift);
+  };
+  const std::optional<nbody_detail::ElasticTripleRun> run = nbody_detail::runElasticTriple(
+      units.scene, count, first == Pair::BC ? 1 : 0, options.max_collisions, options.cancel, restart,
+      [&](std::uint64_t n, const std::array<double, 3>& v) { visit(n, std::array<double, 3>{si(v[0]), si(v[1]), si(v[2])}); });
+  if (!run) return std::nullopt;
+  SimulationResult result;
+  result.collision_count = run->impact_count;
+  result.truncated = run->capped || run->cancelled;
+  result.cancelled = run->cancelled;
+  result.first_pair = first;
+  EngineResult drift;
+  drift.final_velocities.assign(run->final_velocities.begin(), run->final_velocities.end());
+  nbody_detail::fillEngineDrift(units.scene, drift);
+  for (int k = 0; k < 3; ++k) result.final_velocities[k] = scaled(run->final_velocities[k], -shift);
+  result.energy_relative_drift = drift.energy_relative_drift;
+  result.momentum_relative_drift = drift.momentum_relative_drift;
+  result.escalation.decisions = run->impact_count + 1;
+  return result;
+}
+
 /// The three bodies' run by the exact event engine (nbody/engine.h), the one simulator of
 /// every scene: exact decisions and correctly rounded values, told as ImpactEvents. The
 /// engine runs in exact power-of-two units (masses, velocities and positions near 1, as the
@@ -234,18 +303,13 @@ double scaled(long double value, int shift) { return noNegativeZero(std::ldexp(v
 std::optional<SimulationResult> simulateByEngine(const ThreeBodyScene& scene, const SimulationOptions& options,
                                                  const EventVisitor& visitor, std::uint64_t& told,
                                                  std::string& stopped_otherwise) {
-  const int mass_shift = detail::shiftTowardsOne(scene.masses);
-  const int velocity_shift = detail::shiftTowardsOne(scene.velocities);
-  const int position_shift = detail::shiftTowardsOne(scene.positions);
+  const WorkingUnits units(scene);
+  const int mass_shift = units.mass_shift, velocity_shift = units.velocity_shift;
+  const int position_shift = units.position_shift;
   const int time_shift = velocity_shift - position_shift;  // to SI
   const int energy_shift = -(mass_shift + 2 * velocity_shift);
   const int momentum_shift = -(mass_shift + velocity_shift);
-  Scene working{std::vector<double>(3), std::vector<double>(3), std::vector<double>(3), {}};
-  for (int k = 0; k < 3; ++k) {
-    working.masses[k] = std::ldexp(scene.masses[k], mass_shift);
-    working.positions[k] = std::ldexp(scene.positions[k], position_shift);
-    working.velocities[k] = std::ldexp(scene.velocities[k], velocity_shift);
-  }
+  const Scene& working = units.scene;
   EngineOptions engine_options;
   engine_options.max_impacts = options.max_collisions;
   engine_options.progress_interval = 0;
@@ -351,8 +415,29 @@ void simulateBesidePrediction(const ThreeBodyScene& scene, const RunOptions& opt
   }
   std::string stopped_otherwise;
   std::uint64_t told = 0;
-  std::optional<SimulationResult> by_engine =
-      simulateByEngine(scene, simulation_options, enrich, told, stopped_otherwise);
+  std::optional<SimulationResult> by_engine;
+  // No event published: only the count, the final state, the drifts and (in full mode) the
+  // largest prediction error are needed, which the known count gives without the engine.
+  const bool publishes = options.mode == RunMode::kFull && (visitor || options.events.kind != EventPolicy::Kind::kNone);
+  if (!publishes) {
+    if (options.mode == RunMode::kFull) {
+      std::optional<ClosedFormInTurn> predicted;
+      by_engine = simulateKnownCount(
+          scene, result.prediction.collision_count, simulation_options,
+          [&] {
+            predicted.emplace(model);
+            max_error_sq = 0.0;
+          },
+          [&](std::uint64_t n, const std::array<double, 3>& v) {
+            max_error_sq = std::max(max_error_sq, relative_error.squared(v, predicted->velocitiesAfter(n)));
+          });
+    } else {
+      by_engine = simulateKnownCount(scene, result.prediction.collision_count, simulation_options, [] {},
+                                     [](std::uint64_t, const std::array<double, 3>&) {});
+    }
+    if (!by_engine) max_error_sq = 0.0;  // the engine measures it again
+  }
+  if (!by_engine) by_engine = simulateByEngine(scene, simulation_options, enrich, told, stopped_otherwise);
   if (!by_engine) {
     // Beyond the engine's range: the three-body simulator (exact decisions, velocities to a
     // few units in the last place) runs it, telling only the impacts after those told.

@@ -97,6 +97,60 @@ TEST(ThreeBodyRounding, FinalAndEventVelocitiesAreTheCorrectlyRoundedExactOnesAn
   EXPECT_EQ(scenes_checked, 69);
 }
 
+// Issue 24: a run that publishes no event (summary mode, or full mode with events none) is
+// taken from the closed form's exact count without the engine's queue or decisions
+// (nbody/elastic_triple.h). Its count, final velocities and largest prediction error are
+// those of the run that publishes every event (the engine's), its velocities the correctly
+// rounded exact ones, and, its count being known, it never escalates: at (1e37, 1, inf) the
+// engine took 28 of 101 decisions at 100 digits before.
+TEST(ThreeBodyRounding, RunsWithoutEventsAreTheEnginesAndNeverEscalateAtExtremeMassRatios) {
+  struct Case {
+    ThreeBodyScene scene;
+    std::uint64_t cap;
+  };
+  const std::vector<Case> cases = {
+      {{{1e37, 1, kInf}, {2, 1, 0}, {-1, 0, 0}}, 100},         // a wall, the issue's example
+      {{{kInf, 1, 1e37}, {2, 1, 0}, {0, 0, 1}}, 101},          // the wall on the other side
+      {{{1e30, 1, 1e30}, {1, 0, -1}, {-1, 0, 0}}, 100},
+      {{{1e14, 1, 1e14}, {1, 0, -1}, {-1, 0, 0}}, 150},
+      {{{1e18, 1e-18, 1}, {1, 0, -1}, {-1e-10, 3, 0.5}}, 100},
+      {{{2, 1, 3}, {1, 0, -1}, {-1, 0, 0}}, 100},              // kaleidoscopic: ends at zero approach speed
+      {{{3, 1, 0.5}, {1, 0, -1}, {-1, 0, 0}}, 100},            // grazing
+      {{{1e4, 1, kInf}, {2, 1, 0}, {-1, 0, 0}}, 400},          // pi billiard (314 impacts), run to its end
+  };
+  for (const Case& c : cases) {
+    const reference::Run truth = reference::simulateVelocities(c.scene, c.cap);
+    SceneRunOptions with_events;
+    with_events.lab.events = EventPolicy::all();
+    with_events.lab.max_collisions = c.cap;
+    with_events.simulate_to_cap = true;
+    const SceneRunResult published = runScene(planScene(general(c.scene)), with_events);
+    ASSERT_TRUE(published.three_body) << describe(c.scene);
+    for (const RunMode mode : {RunMode::kFull, RunMode::kSummaryOnly}) {
+      SceneRunOptions options = with_events;
+      options.lab.events = EventPolicy::none();
+      options.lab.mode = mode;
+      const SceneRunResult run = runScene(planScene(general(c.scene)), options);
+      ASSERT_TRUE(run.three_body) << describe(c.scene);
+      const LabRunSummary& summary = run.three_body->summary;
+      ASSERT_EQ(summary.collision_count, truth.impacts.size()) << describe(c.scene);
+      EXPECT_EQ(summary.truncated, truth.truncated) << describe(c.scene);
+      EXPECT_EQ(summary.escalation.high_precision, 0u) << describe(c.scene);
+      EXPECT_EQ(summary.escalation.decisions, summary.collision_count + 1) << describe(c.scene);
+      for (int i = 0; i < 3; ++i) {
+        EXPECT_TRUE(correctlyRounded(summary.final_velocities[i], truth.final_velocities[i]))
+            << describe(c.scene) << " body " << i << ": " << summary.final_velocities[i];
+        EXPECT_EQ(summary.final_velocities[i], published.three_body->summary.final_velocities[i]) << describe(c.scene);
+      }
+      EXPECT_EQ(summary.energy_relative_drift, published.three_body->summary.energy_relative_drift) << describe(c.scene);
+      if (mode == RunMode::kFull) {
+        EXPECT_EQ(summary.max_prediction_error, published.three_body->summary.max_prediction_error)
+            << describe(c.scene);
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace core
 }  // namespace collision_lab

@@ -10,6 +10,7 @@
 #include <optional>
 #include <string>
 
+#include "elastic_triple.h"
 #include "tier.h"
 
 namespace collision_lab {
@@ -449,6 +450,9 @@ void finish(const StepResult& r, EngineResult& result) {
 }
 
 }  // namespace
+
+void fillEngineDrift(const Scene& scene, EngineResult& result) { fillDrift(scene, result); }
+
 }  // namespace nbody_detail
 
 const char* stopReasonName(StopReason reason) {

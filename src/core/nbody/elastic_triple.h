@@ -1,0 +1,208 @@
+// Three elastic bodies whose impact count is known in advance (the three-body closed form,
+// predictedCollisionCount): the engine's working tier on velocities alone, with no
+// decision taken (internal; not installed).
+//
+// Why no decision is needed. With three bodies the pairs alternate: after an impact its
+// pair separates (e = 1), and only the other pair can meet next. The closed form gives the
+// exact count N and the first pair, so impacts 1..N are known to be those pairs in turn, and
+// nothing approaches after N. The queue, the impact times and their precision guard serve
+// only to order events and publish times; a run that publishes neither needs none of them.
+//
+// What it computes. The engine's working tier without its queue: the double-double
+// velocities and intercepts after every impact by the same impact map (applyImpactMap,
+// impact_rule.h), the same mass-weighted bounds (tier.h, rho) and the same range check. The
+// engine leaves that state only when its precision guard (tier.h, timeIsPrecise) hands an
+// impact to 100 digits and adopts that tier's state; every other escalation (which pair is
+// next, does a pair still approach) is followed in double-double, which keeps the state. So
+// where the guard, replayed here with a margin of 2, never fires, the velocities are the
+// engine's bit for bit. Where it may fire, the final velocities must be certified instead:
+// a componentwise bound E_k on |v_k(computed) - v_k(exact)|, summed from each operation's
+// rounding (double_double.h; the mass-weighted bound is loose for a light body next to a
+// heavy one, whose error is the heavy body's), must keep v_k +- E_k strictly inside the
+// rounding cell of its double, which is then the correctly rounded exact velocity. A run
+// it can neither replay nor certify, or that leaves the engine's safe range, it declines:
+// the engine runs it.
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+
+#include "collision_lab/core/nbody/engine.h"
+#include "collision_lab/core/nbody/impact_rule.h"
+#include "collision_lab/core/nbody/scene.h"
+#include "double_double.h"
+
+namespace collision_lab {
+namespace core {
+namespace nbody_detail {
+
+/// The engine's energy and momentum drifts of a run from its final_velocities (and
+/// energy_lost), as runEngine fills them (engine.cpp).
+void fillEngineDrift(const Scene& scene, EngineResult& result);
+
+/// How a run of runElasticTriple ended. Velocities in the scene's units [m/s].
+struct ElasticTripleRun {
+  std::uint64_t impact_count = 0;
+  bool capped = false;     ///< stopped at the cap, more impacts due (the engine's kCap)
+  bool cancelled = false;  ///< stopped by the cancel flag (the engine's kCancelled)
+  std::array<double, 3> final_velocities{};  ///< certified correctly rounded
+};
+
+/// Is `hi + lo` within `error` of x certainly rounded to hi (x strictly inside hi's rounding
+/// cell)? hi + lo is a normalized double-double.
+inline bool roundsTo(const DD& value, double error) {
+  if (error == 0.0) return true;  // exact: hi is nearest to hi + lo
+  if (value.hi == 0.0) return false;
+  constexpr double kMargin = 1.0 - 0x1p-20;  // covers the rounding of lo +- error
+  const double up = 0.5 * (std::nextafter(value.hi, HUGE_VAL) - value.hi);
+  const double down = 0.5 * (value.hi - std::nextafter(value.hi, -HUGE_VAL));
+  return value.lo + error < up * kMargin && value.lo - error > -down * kMargin;
+}
+
+/// The two passes of runElasticTriple: the engine's replica (its precision guard watched),
+/// and the certified one (componentwise bounds; the intercepts in double, for the range).
+enum class ElasticTriplePass { kReplica, kCertified };
+
+/// One pass; empty when it cannot answer (kReplica: the guard may fire; kCertified: not
+/// certified; either: out of range).
+template <ElasticTriplePass kPass, class Visit>
+#if defined(__GNUC__)
+__attribute__((flatten))  // the impact maps and the bounds inline into the loop
+#endif
+std::optional<ElasticTripleRun> runElasticTriplePass(const Scene& scene, std::uint64_t count, std::size_t first_pair,
+                                                     std::uint64_t cap, const std::atomic<bool>* cancel, Visit& visit) {
+  constexpr bool kReplica = kPass == ElasticTriplePass::kReplica;
+  constexpr double kEta = kDoubleDoubleOpError;  // one double-double operation, relative
+  constexpr double kSlack = 1.0 + 0x1p-40;       // the rounding of evaluating a bound in double
+  constexpr double kTinyError = 0x1p-998;        // underflow in double-double, per bound (4 operations)
+  // The engine's safe range (tier.h, kMaxMagnitude); 2^10 below it for intercepts in double.
+  constexpr double kRange = kReplica ? 0x1p900 : 0x1p890;
+  constexpr double kGuard = 0x1p-43;  // the engine's precision guard (2^-42), halved
+  std::array<double, 3> sqrt_mass{};  // 0 for a wall, as tier.h's tables
+  for (int k = 0; k < 3; ++k) sqrt_mass[k] = scene.isWall(k) ? 0.0 : std::sqrt(scene.masses[k]);
+  struct PairTables {
+    ImpactMap<DD> map;
+    double gain;      // |c_h|, 0 for a wall
+    double s_h, s_l;  // sqrt of the heavier and lighter mass, 0 for a wall
+    double scale;     // 1/sqrt(m_p) + 1/sqrt(m_p+1), a wall counting 0
+  };
+  std::array<PairTables, 2> pairs;
+  for (int p = 0; p < 2; ++p) {
+    PairTables& pair = pairs[p];
+    pair.map = makeImpactMap<DD>(scene.masses[p], scene.masses[p + 1], 1.0);
+    pair.gain = std::fabs(pair.map.heavy_gain.hi);
+    pair.s_h = sqrt_mass[pair.map.heavy_is_i ? p : p + 1];
+    pair.s_l = sqrt_mass[pair.map.heavy_is_i ? p + 1 : p];
+    pair.scale = (sqrt_mass[p] > 0 ? 1 / sqrt_mass[p] : 0.0) + (sqrt_mass[p + 1] > 0 ? 1 / sqrt_mass[p + 1] : 0.0);
+  }
+  // tier.h, rho(): the engine's bound on one impact's mass-weighted rounding.
+  const auto rho = [](const PairTables& pair, const ImpactChange<DD>& change, const DD& q_i, const DD& q_j) {
+    if (pair.map.exchange) return 0.0;
+    const double q_h = std::fabs((pair.map.heavy_is_i ? q_i : q_j).hi);
+    const double q_l = std::fabs((pair.map.heavy_is_i ? q_j : q_i).hi);
+    const double inc = std::fabs(change.heavy_increment.hi), d = std::fabs(change.difference.hi);
+    return 2 * kEta * (pair.s_h * (q_h + 8 * inc) + pair.s_l * (q_l + q_h + 8 * inc + 2 * d)) +
+           (pair.s_h + pair.s_l) * 0x1p-1000;
+  };
+  std::array<DD, 3> v = {DD(scene.velocities[0]), DD(scene.velocities[1]), DD(scene.velocities[2])};
+  std::array<DD, 3> b = {DD(scene.positions[0]), DD(scene.positions[1]), DD(scene.positions[2])};  // kReplica
+  std::array<double, 3> b_double = {scene.positions[0], scene.positions[1], scene.positions[2]};  // kCertified
+  std::array<double, 3> error{};  // E_k [m/s] (kCertified); the inputs are exact
+  // The engine's mass-weighted bounds (tier.h; kReplica), from what its start adds when it
+  // adopts a more precise tier's state (tier.h, adopt(): 2^-100 per conversion), so that
+  // they bound the engine's either way.
+  double eu = 0.0, eb = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    eu += 2 * 0x1p-100 * sqrt_mass[k] * std::fabs(scene.velocities[k]);
+    eb += 2 * 0x1p-100 * sqrt_mass[k] * std::fabs(scene.positions[k]);
+  }
+  ElasticTripleRun run;
+  const std::uint64_t target = count < cap ? count : cap;
+  std::size_t p = first_pair;
+  std::uint64_t n = 0;
+  for (; n < target; ++n, p ^= 1) {
+    if (cancel && n % 1024 == 0 && cancel->load(std::memory_order_relaxed)) {
+      run.cancelled = true;
+      break;
+    }
+    const PairTables& pair = pairs[p];
+    const ImpactMap<DD>& map = pair.map;
+    DD& vi = v[p];
+    DD& vj = v[p + 1];
+    const ImpactChange<DD> dv = applyImpactMap(map, vi, vj);
+    if constexpr (kReplica) {
+      const double eu_before = eu, eb_before = eb;
+      const ImpactChange<DD> db = applyImpactMap(map, b[p], b[p + 1]);
+      eu += rho(pair, dv, vi, vj);
+      eb += rho(pair, db, b[p], b[p + 1]);
+      if (!(eu_before * pair.scale <= kGuard * std::fabs(dv.difference.hi) &&
+            eb_before * pair.scale <= kGuard * std::fabs(db.difference.hi))) {
+        return std::nullopt;  // the engine may adopt a 100-digit state here
+      }
+      const double magnitude = std::fabs(b[p].hi) + std::fabs(b[p + 1].hi) + std::fabs(vi.hi) + std::fabs(vj.hi);
+      if (!(magnitude < kRange)) return std::nullopt;
+    } else {
+      double& ei = error[p];
+      double& ej = error[p + 1];
+      const double difference_error = (ei + ej + kEta * std::fabs(dv.difference.hi)) * kSlack + kTinyError;
+      if (map.exchange) {  // a swap rounds nothing
+        std::swap(ei, ej);
+        std::swap(b_double[p], b_double[p + 1]);
+      } else {
+        double& eh = map.heavy_is_i ? ei : ej;
+        double& el = map.heavy_is_i ? ej : ei;
+        const DD& heavy = map.heavy_is_i ? vi : vj;
+        const DD& light = map.heavy_is_i ? vj : vi;
+        if (pair.s_h != 0.0) {  // not a wall: the increment g d rounds, and g itself (4 eta covers both)
+          const double increment_error =
+              (pair.gain * difference_error + 4 * kEta * std::fabs(dv.heavy_increment.hi)) * kSlack + kTinyError;
+          eh = (eh + increment_error + kEta * std::fabs(heavy.hi)) * kSlack + kTinyError;
+        }
+        el = (eh + difference_error + kEta * std::fabs(light.hi)) * kSlack + kTinyError;
+        const double d = b_double[p + 1] - b_double[p];
+        double& bh = map.heavy_is_i ? b_double[p] : b_double[p + 1];
+        double& bl = map.heavy_is_i ? b_double[p + 1] : b_double[p];
+        bh += map.heavy_gain.hi * d;
+        bl = map.heavy_is_i ? bh - d : bh + d;
+      }
+      const double magnitude =
+          std::fabs(b_double[p]) + std::fabs(b_double[p + 1]) + std::fabs(vi.hi) + std::fabs(vj.hi);
+      if (!(magnitude < kRange)) return std::nullopt;
+    }
+    visit(n + 1, std::array<double, 3>{v[0].hi, v[1].hi, v[2].hi});
+  }
+  for (int k = 0; k < 3; ++k) {
+    if (!kReplica && !scene.isWall(k) && !roundsTo(v[k], error[k])) return std::nullopt;
+    run.final_velocities[k] = v[k].hi;
+  }
+  run.impact_count = n;
+  run.capped = !run.cancelled && count > cap;
+  return run;
+}
+
+/// Runs scene (three bodies, every e = 1, no ring; at most one wall), whose exact count is
+/// `count` with first pair `first_pair` (0: AB, 1: BC), up to `cap` impacts; the cancel flag
+/// (may be null) is read every 1024 impacts, as the engine does. First as the engine's
+/// replica, which stops where the engine's precision guard may fire; then, if it stopped,
+/// certified. restart() is called before each pass; after impact n, visit(n, v) sees the
+/// velocities rounded to double (the engine's record values in the replica). Returns
+/// nothing when the engine must run it (then visit has seen an unfinished pass).
+template <class Restart, class Visit>
+std::optional<ElasticTripleRun> runElasticTriple(const Scene& scene, std::uint64_t count, std::size_t first_pair,
+                                                 std::uint64_t cap, const std::atomic<bool>* cancel, Restart&& restart,
+                                                 Visit&& visit) {
+  restart();
+  if (auto run = runElasticTriplePass<ElasticTriplePass::kReplica>(scene, count, first_pair, cap, cancel, visit)) {
+    return run;
+  }
+  restart();
+  return runElasticTriplePass<ElasticTriplePass::kCertified>(scene, count, first_pair, cap, cancel, visit);
+}
+
+}  // namespace nbody_detail
+}  // namespace core
+}  // namespace collision_lab
