@@ -39,6 +39,7 @@ GranularRun runScene(const Scene& scene, std::uint64_t cap) {
   input.run_id = "granular";
   input.masses = scene.masses, input.positions = scene.positions, input.velocities = scene.velocities;
   input.restitution = scene.restitution;
+  input.ring = scene.ring;
   input.max_collisions = cap;
   GranularRun out{{}, RunRecord(input)};
   collision_lab::core::EngineOptions options;
@@ -189,6 +190,46 @@ TEST(MarkerGranular, AnElasticGasKeepsItsEnergyTotals) {
   const auto fixed = buildStaticMarkers(r.record, "f");
   EXPECT_TRUE(find(fixed, ids::ns::kEnergy, ids::kEnergyTitle));
   EXPECT_FALSE(find(fixed, ids::ns::kTemperature, ids::kTemperatureTitle));
+}
+
+// A ring of 8 m (masses 1, 2, 1, 2 kg at x = 7.5, 5, 3, 1 m, A at +1 m/s, e = 0.9): A crosses
+// the seam at t = 0.5 s (x = 8 m is x = 0 m) and hits D at x = 1 m at t = 1.5 s. Positions are
+// reported in [0, 8), so A's worldline is cut at the seam: no step of any worldline spans the
+// diagram (before, A's was drawn from x = 7.5 to 1 m straight across it), and A's reaches the
+// seam at t = 0.5 s at both ends of [0, 8).
+TEST(MarkerGranular, RingWorldlinesAreCutAtTheSeam) {
+  Scene scene;
+  scene.masses = {1, 2, 1, 2}, scene.positions = {7.5, 5, 3, 1}, scene.velocities = {1, 0, 0, 0};
+  scene.restitution = {0.9}, scene.ring = 8;
+  const GranularRun r = runScene(scene, 20);
+  ASSERT_GT(r.result.impact_count, 4u) << r.result.stop_message;
+  const auto fixed = buildStaticMarkers(r.record, "f");
+  const auto& box = layout::kWorldBox;
+  const double end = endTime(r.record), seam_y = box.bottom + 0.5 / end * (box.top - box.bottom);
+  // Half the ring [m] across the diagram, on the axis its end labels give.
+  const auto* min = find(fixed, ids::ns::kWorldlines, ids::kWorldPositionMin);
+  const auto* max = find(fixed, ids::ns::kWorldlines, ids::kWorldPositionMax);
+  ASSERT_TRUE(min && max);
+  const double half_ring = 4.0 / (std::stod(max->text) - std::stod(min->text)) * (box.right - box.left);
+  for (int k = 0; k < 4; ++k) {
+    const auto* line = find(fixed, ids::ns::kWorldlines, ids::kWorldLines + k);
+    ASSERT_TRUE(line) << k;
+    ASSERT_EQ(line->type, visualization_msgs::Marker::LINE_LIST) << k;
+    ASSERT_EQ(line->points.size() % 2, 0u);
+    std::vector<double> at_seam;
+    for (std::size_t p = 0; p < line->points.size(); p += 2) {
+      const auto &a = line->points[p], &b = line->points[p + 1];
+      EXPECT_LE(std::abs(b.x - a.x), half_ring * (1 + 1e-2)) << "body " << k << ", step " << p / 2;
+      for (const auto& q : {a, b}) {
+        if (std::abs(q.y - seam_y) < 1e-9) at_seam.push_back(q.x);
+      }
+    }
+    if (k == 0) {
+      ASSERT_EQ(at_seam.size(), 2u);
+      EXPECT_GT(std::abs(at_seam[1] - at_seam[0]), (box.right - box.left) * 0.9);  // the two ends of [0, 8)
+    }
+  }
+  expectFit(r.record);
 }
 
 // cluster_collapse_5 (config/scenarios.yaml), by hand: A, B, C collapse at t = 3.5 s at

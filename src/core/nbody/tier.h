@@ -398,7 +398,7 @@ class Tier {
     unsigned bits = 0;
     if constexpr (std::is_same_v<S, Rational>) {
       if (count_ == 0) return 0;
-      for (std::size_t k : {now_.pair, now_.pair + 1}) {
+      for (std::size_t k : {now_.pair, left(now_.pair)}) {  // across a ring's seam: body 0
         for (const S* x : {&bodies_[k].b, &bodies_[k].v}) {
           bits = std::max(bits, static_cast<unsigned>(boost::multiprecision::msb(denominator(*x))));
         }

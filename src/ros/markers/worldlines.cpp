@@ -114,15 +114,34 @@ void addGhosts(const Canvas& c, const std::string& ns, int id, const WorldAxes& 
 }
 
 /// Body i's worldline (time up, position across): grey and thick for a wall, else its colour
-/// (large scenes: its start velocity's).
+/// (large scenes: its start velocity's). On a ring the positions are wrapped into [0, L), so
+/// a step across the seam is cut there: drawn to one edge of [0, L) and on from the other,
+/// each step taken the shorter way round (a body moves less than L/2 between two vertices).
 void addWorldline(const Canvas& c, const std::string& ns, int id, std::size_t i, const Polyline& poly,
                   const WorldAxes& axes) {
   const bool wall = isWall(c.run.input(), i);
   const auto colour = wall ? color(kGrey)
                            : largeScene(c.run) ? velocityColor(c.run.input().velocities[i], velocityScale(c.run))
                                                : particleColor(i);
-  Marker line = c.lines(ns, id, Marker::LINE_STRIP, wall ? kWallLineWidth : kBodyLineWidth, colour);
-  for (const auto& v : poly) line.points.push_back(point(axes.toX(v.y), axes.toY(v.x)));
+  const double ring = c.run.input().ring;
+  Marker line =
+      c.lines(ns, id, ring > 0 ? Marker::LINE_LIST : Marker::LINE_STRIP, wall ? kWallLineWidth : kBodyLineWidth, colour);
+  const auto add = [&](double t, double x) { line.points.push_back(point(axes.toX(x), axes.toY(t))); };
+  if (!(ring > 0)) {
+    for (const auto& v : poly) add(v.x, v.y);
+  }
+  for (std::size_t k = 1; ring > 0 && k < poly.size(); ++k) {
+    const Envelope::Vertex &a = poly[k - 1], &b = poly[k];
+    const double step = b.y - a.y;
+    if (std::abs(step) <= ring / 2) {
+      add(a.x, a.y), add(b.x, b.y);
+      continue;
+    }
+    const double round = step > 0 ? step - ring : step + ring;  // across the seam
+    const double edge = round < 0 ? 0.0 : ring;                 // where it leaves [0, L)
+    const double seam = a.x + (edge - a.y) / round * (b.x - a.x);
+    add(a.x, a.y), add(seam, edge), add(seam, ring - edge), add(b.x, b.y);
+  }
   c.addLines(line);
 }
 

@@ -194,6 +194,30 @@ TEST(Ring, SeamImpactByHand) {
   for (double x : run.final_positions) EXPECT_TRUE(x >= 0.0 && x < 10.0) << x;
 }
 
+// An exact decision right after a seam impact: the exact tier's size check read body N
+// (one past the last) for the seam pair instead of body 0, out of bounds (a crash, also in
+// the CLI). A ring of 8 m, masses 1, 2, 1, 2 kg, A at +1 m/s crosses the seam and hits D:
+// the run now ends at its cap, conserving momentum, with the heat plus the final kinetic
+// energy equal to the start's (summed here).
+TEST(Ring, ExactDecisionAfterASeamImpact) {
+  Scene scene{{1, 2, 1, 2}, {7.5, 5, 3, 1}, {1, 0, 0, 0.1}, {0.5}};
+  scene.ring = 8.0;
+  ASSERT_FALSE(validate(scene));
+  EngineOptions options;
+  options.max_impacts = 20;
+  const EngineResult run = runEngine(scene, options);
+  EXPECT_TRUE(run.stop == StopReason::kCap || run.stop == StopReason::kFinished) << run.stop_message;
+  EXPECT_GT(run.escalations.exact_rational, 0u);
+  long double p0 = 0, p1 = 0, e0 = 0, e1 = 0;
+  for (std::size_t k = 0; k < scene.size(); ++k) {
+    const long double m = scene.masses[k], v0 = scene.velocities[k], v1 = run.final_velocities[k];
+    p0 += m * v0, p1 += m * v1, e0 += m * v0 * v0 / 2, e1 += m * v1 * v1 / 2;
+  }
+  EXPECT_NEAR(static_cast<double>(p1), static_cast<double>(p0), 1e-14);
+  EXPECT_NEAR(static_cast<double>(e1) + run.energy_lost, static_cast<double>(e0), 1e-14);
+  EXPECT_GT(run.energy_lost, 0.0);
+}
+
 Scene randomRing(std::uint64_t seed, std::size_t n, bool equal) {
   std::mt19937_64 random(seed);
   std::uniform_real_distribution<double> mass(1.0, 2.0), speed(-1.0, 1.0), gap(0.2, 1.0);
