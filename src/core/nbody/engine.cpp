@@ -92,12 +92,6 @@ class Driver {
 
   const Tier<DD>& fast() const { return *fast_; }
 
-  /// Makes the working tier's last impact time good to kTimePrecision, where it is
-  /// published (tier.h, timeIsPrecise()): a more precise tier replays up to it and the working
-  /// tier adopts its state. False when that replay stopped (budget, cap or cancel): the
-  /// time then stays to the working tier's bounds.
-  bool makeLastTimePrecise() { return lastTimePrecise<DD>().kind == StepKind::kImpact; }
-
   /// After the impact of `pair`: when two pairs have alternated for 8 impacts, asks the
   /// working tier whether their three clusters collapse, and resolves a collapse in every
   /// tier (each applies it when it reaches this impact count, replays included).
@@ -111,7 +105,6 @@ class Driver {
     if (tables_.ring != 0.0 || tables_.scene.restitution_model.kind != RestitutionModelKind::kConstant) return {};
     if (alternating_ < 8) return groupCollapse(result);
     const std::size_t p = std::min(last_, before_last_), q = std::max(last_, before_last_);
-    if (!makeLastTimePrecise()) return {};  // the test measures the collapse time from the last impact's
     const auto found = fast_->collapseCandidate(p, q, last_ == p);
     if (!found) return {};
     return resolve(*found, result);
@@ -163,22 +156,6 @@ class Driver {
     if constexpr (std::is_same_v<S, DD>) return fast_;
     if constexpr (std::is_same_v<S, Float100>) return high_;
     if constexpr (std::is_same_v<S, Rational>) return exact_;
-  }
-
-  template <class S>
-  StepResult lastTimePrecise() {
-    Tier<S>& t = *tier<S>();
-    if constexpr (!Arithmetic<S>::kExact) {
-      if (!t.lastTimeIsPrecise()) {
-        using H = typename NextTier<S>::type;
-        ++(std::is_same_v<H, Float100> ? escalations_.high_precision : escalations_.exact_rational);
-        StepResult r = advanceTo<H>(t.count());
-        if (r.kind == StepKind::kImpact) r = lastTimePrecise<H>();
-        if (r.kind != StepKind::kImpact) return r;
-        t.adopt(*tier<H>());
-      }
-    }
-    return {};
   }
 
   template <class S>
@@ -535,7 +512,6 @@ EngineResult runEngine(const Scene& scene, const EngineOptions& options, const I
   if (result.stop == StopReason::kPrecisionBudget || r.kind == StepKind::kExhausted) {
     result.crowding_bodies = driver.crowdingBodies();
   }
-  if (result.stop != StopReason::kCancelled) driver.makeLastTimePrecise();
   result.final_time = driver.fast().lastTime();
   result.collapsed = !result.collapses.empty();
   if (result.collapsed) {

@@ -153,8 +153,6 @@ class Tier {
   std::uint64_t ruleElastic() const { return rule_elastic_; }
   std::size_t merged() const { return merged_; }
   double energyLost() const { return lost_ + lost_compensation_; }
-  /// lastTime() is good to kTimePrecision (see timeIsPrecise()).
-  bool lastTimeIsPrecise() const { return count_ == 0 || timeIsPrecise(pairs_[now_.pair].scale); }
   /// Time of the last impact [s], or of the one in progress (0 before the first).
   double lastTime() const { return Ar::sign(now_.A) > 0 ? Ar::toDouble(S(now_.G / now_.A)) : 0.0; }
 
@@ -820,17 +818,13 @@ class Tier {
     }
   }
 
-  /// Precision guard: a published impact time t = G / A is good to about 1e-12. When this
+  /// Precision guard: an impact's time t = G / A is published to about 1e-12. When this
   /// tier's state pins G or A down less well than 2^-42 of their size (tiny approach speeds,
-  /// as on the way to an inelastic collapse), a more precise tier takes the step. Only
-  /// published times need it: an impact with a record (checked in collide), and the run's
-  /// last impact (lastTimeIsPrecise(), checked by the driver where it publishes it). The
-  /// decisions never do: they carry their own bounds. A summary run thus replays in a higher
-  /// tier only for a decision, not for every impact its growing bounds blur.
+  /// as on the way to an inelastic collapse), a more precise tier takes the step.
   bool timeIsPrecise(double scale) const {
     if constexpr (Ar::kExact) return true;
-    return now_.eb * scale + now_.extra <= kTimePrecision * std::fabs(Ar::toDouble(now_.G)) &&
-           now_.eu * scale + now_.extra <= kTimePrecision * std::fabs(Ar::toDouble(now_.A));
+    return now_.eb * scale <= kTimePrecision * std::fabs(Ar::toDouble(now_.G)) &&
+           now_.eu * scale <= kTimePrecision * std::fabs(Ar::toDouble(now_.A));
   }
 
   void addLoss(double loss) {
@@ -893,7 +887,7 @@ class Tier {
       rule = ruleFor(m);
       if (rule.kind != StepKind::kImpact) return {rule.kind, m, lastTime(), rule.at_zero};
     } else {
-      rule.e = std::fabs(pairs_[m].map.light_factor);  // the pair's own e, exactly (impact_rule.h)
+      rule.e = tables_.scene.restitutionOf(m);
     }
     const std::size_t lo = tables_.ring != 0.0 ? m : clusterLow(m), hi = tables_.ring != 0.0 ? m + 1 : clusterHigh(m + 1);
     const StepResult r = lo == m && hi == m + 1 ? collideBodies(m, rule, record) : collideClusters(m, lo, hi, rule.e, record);
@@ -1056,7 +1050,7 @@ class Tier {
     for (std::size_t k = lo; k <= hi; ++k) bodies_[k] = k <= m ? i : j;
     now_.A = dv.difference;
     now_.G = -db.difference;
-    if (record && !timeIsPrecise(pairs_[m].scale)) return {StepKind::kImprecise, m, 0.0};
+    if (!timeIsPrecise(pairs_[m].scale)) return {StepKind::kImprecise, m, 0.0};
     const double lost = impactEnergyLost(mass_d[0], mass_d[1], Ar::toDouble(now_.A), e);
     if (lost != 0.0) addLoss(lost);
     if (record) {
@@ -1085,7 +1079,7 @@ class Tier {
     BodyState& i = bodies_[m];
     BodyState& j = bodies_[left_body];
     // The pair's own map; the model's e, when it differs: the elastic map, or e(v)'s.
-    const bool own = rule.e == std::fabs(pair.map.light_factor);
+    const bool own = rule.e == tables_.scene.restitutionOf(m);
     const Scene& scene = tables_.scene;
     ImpactMap<S> computed;
     const ImpactMap<S>* chosen = own ? &pair.map : (rule.e == 1.0 ? &elastic_maps_[m] : &computed);
@@ -1113,7 +1107,7 @@ class Tier {
     }
     now_.A = dv.difference;
     now_.G = -db.difference;
-    if (record && !timeIsPrecise(pair.scale)) return {StepKind::kImprecise, m, 0.0};
+    if (!timeIsPrecise(pair.scale)) return {StepKind::kImprecise, m, 0.0};
     double lost = 0.0;
     if (std::fabs(map.light_factor) != 1.0) {  // e < 1
       const double approach_speed = Ar::toDouble(now_.A);

@@ -98,8 +98,7 @@ const char* stopReasonName(StopReason reason);
 /// Progress of a long run.
 struct EngineProgress {
   std::uint64_t impacts = 0;  ///< impacts so far
-  double time = 0.0;          ///< time of the last impact [s] (an indication: in a run without records, good
-                              ///< only to the working tier's bounds, not to the 1e-12 of published times)
+  double time = 0.0;          ///< time of the last impact [s]
 };
 
 struct EngineOptions {
