@@ -23,6 +23,12 @@ build="${BUILD_DIR:-$repo/build_bench}"
 export PATH="/usr/bin:$PATH"
 quick=""
 [[ "${1:-}" == "--quick" ]] && quick="--quick"
+# The plots need matplotlib: without it the first benchmark fails after minutes of work.
+if ! python3 -c 'import matplotlib' 2>/dev/null; then
+  echo "run_benchmarks.sh: python3-matplotlib is missing; install the benchmark packages with" >&2
+  echo "  bash scripts/setup_debian.sh --with-bench" >&2
+  exit 2
+fi
 
 # Every output names the source it measured: the commit, marked when the core has local changes.
 COLLISION_LAB_BENCH_SOURCE="$(git -C "$repo" rev-parse --short HEAD 2>/dev/null || echo unknown)"
