@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <boost/multiprecision/cpp_int.hpp>
@@ -21,6 +22,17 @@ namespace core {
 namespace reference {
 
 using Rational = boost::multiprecision::cpp_rational;
+
+/// A scene of the tests: bodies listed right to left, one restitution e for every pair.
+inline Scene makeScene(std::vector<double> masses, std::vector<double> positions, std::vector<double> velocities,
+                       double e) {
+  Scene s;
+  s.masses = std::move(masses);
+  s.positions = std::move(positions);
+  s.velocities = std::move(velocities);
+  s.restitution = {e};
+  return s;
+}
 
 struct Event {
   std::size_t pair = 0;

@@ -32,18 +32,10 @@ namespace collision_lab {
 namespace core {
 namespace {
 
+using reference::makeScene;
 using reference::Rational;
 
 constexpr double kWall = std::numeric_limits<double>::infinity();
-
-Scene makeScene(std::vector<double> masses, std::vector<double> positions, std::vector<double> velocities, double e) {
-  Scene s;
-  s.masses = std::move(masses);
-  s.positions = std::move(positions);
-  s.velocities = std::move(velocities);
-  s.restitution = {e};
-  return s;
-}
 
 /// The smallest period 2..24 with which the run's last 3 periods of pairs repeat; 0: none.
 std::size_t trailingPeriod(const reference::Run& run) {

@@ -21,16 +21,8 @@ namespace collision_lab {
 namespace core {
 namespace {
 
+using reference::makeScene;
 using reference::Rational;
-
-Scene makeScene(std::vector<double> masses, std::vector<double> positions, std::vector<double> velocities, double e) {
-  Scene s;
-  s.masses = std::move(masses);
-  s.positions = std::move(positions);
-  s.velocities = std::move(velocities);
-  s.restitution = {e};
-  return s;
-}
 
 /// The whole scene (no wall) collapses with impact pattern period `period`.
 void expectWholeGroupCollapses(const Scene& s, std::size_t period, std::uint64_t reference_impacts) {
