@@ -13,6 +13,9 @@
 // And three elastic bodies at an extreme mass ratio, (1e37, 1, inf) (a wall on one side),
 // capped at 10^7 impacts: runLab in summary and in full mode (events none) against the
 // lean loop on the same impacts, with the engine's escalations to 100 digits.
+// Beside both runs, the floor of exactness in double-double: the engine's impact map
+// (impact_rule.h) on double-double velocities, pairs in turn, nothing else; a `why:` line
+// after each missed goal gives that breakdown.
 //
 // Usage: collision_lab_bench_core [--repeats N] [--quick]
 // Goals are printed as measured, never asserted.
@@ -27,8 +30,10 @@
 
 #include "collision_lab/core/analytic.h"
 #include "collision_lab/core/lab_run.h"
+#include "collision_lab/core/nbody/impact_rule.h"
 #include "collision_lab/core/simulation.h"
 #include "closed_form_timing.h"
+#include "double_double.h"  // the engine's working arithmetic (src/core/nbody)
 #include "naive_loop.h"
 #include "timing.h"
 
@@ -46,6 +51,19 @@ struct Method {
   std::uint64_t count = 0;
 };
 
+/// The floor of an exact run in double-double: the engine's impact map on double-double
+/// velocities for `impacts` impacts, pairs in turn from `first` (0: AB, 1: BC); no positions,
+/// bounds, decisions or outputs. Returns its final velocities.
+std::array<double, 3> doubleDoubleImpactMaps(const ThreeBodyScene& scene, std::uint64_t impacts, int first) {
+  using nbody_detail::DD;
+  const std::array<ImpactMap<DD>, 2> maps = {makeImpactMap<DD>(scene.masses[0], scene.masses[1], 1.0),
+                                             makeImpactMap<DD>(scene.masses[1], scene.masses[2], 1.0)};
+  std::array<DD, 3> v = {DD(scene.velocities[0]), DD(scene.velocities[1]), DD(scene.velocities[2])};
+  int p = first;
+  for (std::uint64_t n = 0; n < impacts; ++n, p ^= 1) applyImpactMap(maps[p], v[p], v[p + 1]);
+  return {v[0].hi, v[1].hi, v[2].hi};
+}
+
 ThreeBodyScene heavyLightHeavy(double heavy) {
   ThreeBodyScene scene;
   scene.masses = {heavy, 1.0, heavy};
@@ -59,6 +77,8 @@ struct SceneFigures {
   double lean_ns = 0.0;
   double count_only_ns = 0.0;
   double full_lab_run_ns = 0.0;
+  double summary_ns = 0.0;        // runLab in summary mode
+  double dd_maps_ns = 0.0;        // doubleDoubleImpactMaps alone
 };
 
 SceneFigures benchScene(double heavy, int repeats, bool keep_all) {
@@ -107,6 +127,18 @@ SceneFigures benchScene(double heavy, int repeats, bool keep_all) {
                        doNotOptimize(result.summary.max_prediction_error);
                        return result.summary.collision_count;
                      });
+  RunOptions summary_run = full_run;
+  summary_run.mode = RunMode::kSummaryOnly;
+  methods.emplace_back("core, lab run (mode summary)", [&] {
+                       const auto result = runLab(scene, summary_run);
+                       doNotOptimize(result.summary.final_velocities);
+                       return result.summary.collision_count;
+                     });
+  const int first = firstPair(scene) == Pair::BC ? 1 : 0;
+  methods.emplace_back("double-double impact maps alone", [&] {
+                       doNotOptimize(doubleDoubleImpactMaps(scene, predicted, first));
+                       return predicted;
+                     });
   if (keep_all) {
     methods.emplace_back("core, every event kept (events all)", [&] {
                          const auto result = simulate<double>(scene, all_events);
@@ -135,6 +167,8 @@ SceneFigures benchScene(double heavy, int repeats, bool keep_all) {
                 static_cast<unsigned long long>(method.count), med, best * per, med / lean_ns);
     if (std::strncmp(method.name, "core count-only", 15) == 0) figures.count_only_ns = med;
     if (std::strncmp(method.name, "core, full lab run", 18) == 0) figures.full_lab_run_ns = med;
+    if (std::strncmp(method.name, "core, lab run (mode summary)", 28) == 0) figures.summary_ns = med;
+    if (std::strncmp(method.name, "double-double impact maps", 25) == 0) figures.dd_maps_ns = med;
   }
   std::printf("  (medians of %d round-robin repeats; ns per collision of each method's own count)\n", repeats);
   std::printf("  core escalations in count-only mode: %llu decisions, %llu to 50 digits, %llu to exact rationals\n",
@@ -149,6 +183,7 @@ struct ExtremeFigures {
   double lean_ns = 0.0;
   double summary_ns = 0.0;
   double full_ns = 0.0;
+  double dd_maps_ns = 0.0;  // doubleDoubleImpactMaps alone
   std::uint64_t impacts = 0;
   std::uint64_t escalated = 0;  // decisions taken at 100 digits or more (summary run)
 };
@@ -185,6 +220,11 @@ ExtremeFigures benchExtreme(std::uint64_t impacts, int repeats) {
                        doNotOptimize(result.summary.max_prediction_error);
                        return result.summary.collision_count;
                      });
+  const int first = firstPair(scene) == Pair::BC ? 1 : 0;
+  methods.emplace_back("double-double impact maps alone", [&] {
+                       doNotOptimize(doubleDoubleImpactMaps(scene, impacts, first));
+                       return impacts;
+                     });
   for (int rep = 0; rep < repeats; ++rep) {
     for (auto& method : methods) {
       Stopwatch watch;
@@ -204,6 +244,7 @@ ExtremeFigures benchExtreme(std::uint64_t impacts, int repeats) {
   figures.lean_ns = lean_ns;
   figures.summary_ns = median(methods[1].seconds) * 1e9 / static_cast<double>(methods[1].count);
   figures.full_ns = median(methods[2].seconds) * 1e9 / static_cast<double>(methods[2].count);
+  figures.dd_maps_ns = median(methods[3].seconds) * 1e9 / static_cast<double>(methods[3].count);
   figures.impacts = methods[1].count;
   return figures;
 }
@@ -266,10 +307,20 @@ int main(int argc, char** argv) {
                 "done-when <= 2x: %s)\n", main_ratio, main_ratio <= 1.5 ? "met" : "missed",
                 main_ratio <= 2.0 ? "met" : "missed");
   }
+  // Where the time goes, for a missed goal: the floor that exactness in double-double sets.
+  const auto why = [](const char* what, double lean_ns, double dd_ns, double summary_ns, double full_ns) {
+    std::printf("why: %s: the lean loop %.1f ns per impact; the engine's double-double impact maps alone (velocities, "
+                "nothing else) %.1f ns = %.2fx; the lab run in summary mode (maps on velocities and intercepts, the "
+                "engine's error bounds and range checks) %.1f ns = %.2fx; full mode (each impact against the closed "
+                "form) %.1f ns = %.2fx. (Double-double products use Dekker's splitting: a portable x86-64 build "
+                "has no FMA.)\n",
+                what, lean_ns, dd_ns, dd_ns / lean_ns, summary_ns, summary_ns / lean_ns, full_ns, full_ns / lean_ns);
+  };
   std::printf("goal: full lab run on (%s, 1, %s) (--events none: every impact's velocities against the closed "
               "form, drifts, final state), ns per impact = %.1f against lean double loop = %.1f (%.2fx; goal <= 2x): %s\n",
               quick ? "1e12" : "1e14", quick ? "1e12" : "1e14", large.full_lab_run_ns, large.lean_ns, full_ratio,
               full_ratio <= 2.0 ? "met" : "missed");
+  if (full_ratio > 2.0) why("full lab run", large.lean_ns, large.dd_maps_ns, large.summary_ns, large.full_lab_run_ns);
   const double extreme_ratio = extreme.summary_ns / extreme.lean_ns;
   std::printf("goal: three elastic bodies at an extreme mass ratio, %llu impacts of (1e37, 1, inf), ns per impact = "
               "%.1f (full lab run: %.1f) against lean double loop = %.1f (%.2fx, full %.2fx; goal <= 2x; %llu "
@@ -277,6 +328,9 @@ int main(int argc, char** argv) {
               static_cast<unsigned long long>(extreme.impacts), extreme.summary_ns, extreme.full_ns, extreme.lean_ns,
               extreme_ratio, extreme.full_ns / extreme.lean_ns, static_cast<unsigned long long>(extreme.escalated),
               extreme_ratio <= 2.0 ? "met" : "missed");
+  if (extreme_ratio > 2.0) {
+    why("(1e37, 1, inf)", extreme.lean_ns, extreme.dd_maps_ns, extreme.summary_ns, extreme.full_ns);
+  }
   std::printf("  slowest closed-form query for n <= 1e12: %.1f ns  (goal < 1 us: %s)\n",
               worst_query_ns, worst_query_ns < 1000.0 ? "met" : "missed");
   return 0;

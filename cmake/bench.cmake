@@ -23,7 +23,7 @@ if(NOT COLLISION_LAB_PLOT_PYTHON)
 endif()
 
 add_executable(collision_lab_bench_core bench/bench_core.cpp)
-target_include_directories(collision_lab_bench_core PRIVATE bench/common)
+target_include_directories(collision_lab_bench_core PRIVATE bench/common src/core/nbody)  # src/core/nbody: double-double, the floor measured
 target_link_libraries(collision_lab_bench_core PRIVATE collision_lab_core)
 
 add_executable(collision_lab_bench_nbody bench/bench_nbody.cpp)
