@@ -103,6 +103,11 @@ TEST(NBodyValidation, ValueReasons) {
   expectRejected(s, Reason::kOverflow, "masses");
   // A first contact beyond the range of a double in time.
   expectRejected(Scene{{1, 1}, {1e300, -1e300}, {-1e-300, 0}, {}}, Reason::kOverflow, "positions");
+  // A first contact at t = 1e157 s, well inside the range, that finds A at 1e307 m + 1.7e308 m:
+  // the one approaching pair is timed in double, the position then checked exactly.
+  const Scene far{{1e-100, 1, 1}, {1.7e308, 1e157, 0}, {1e150, -1, 0}, {}};
+  expectRejected(far, Reason::kOverflow, "positions");
+  EXPECT_NE(validate(far)->message.find("would find A at 1.8e+308 m"), std::string::npos) << validate(far)->message;
   // Another pair neither approaching nor tied (failed before: boost's "Divide by zero").
   expectRejected(Scene{{1, 1, 1, 1}, {3, 2, 1, 0}, {-1e-310, 0, 0, 0}, {}}, Reason::kOverflow, "positions");
 }
