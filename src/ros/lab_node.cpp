@@ -129,26 +129,36 @@ std::string utcStamp(const char* format) {
 /// The per-collision messages of one run. Every CollisionEvent is recorded and drawn;
 /// the first max_published also go out on collision_events and, as their plot
 /// projections (live only, never recorded: docs/messages.md), on velocities and
-/// energy_transfers.
+/// energy_transfers. Each is refilled in the node's one message of its kind (buffers),
+/// whose storage is reused from event to event and run to run.
 class EventStream {
  public:
   EventStream(const RunTopics& topics, RunWriter& out, RunObserver* markers, std::uint64_t max_published,
-              const collision_lab::core::Scene& scene)
-      : topics_(topics), out_(out), markers_(markers), max_published_(max_published), converter_(scene) {}
+              const collision_lab::core::Scene& scene, EventMessages& buffers)
+      : topics_(topics), out_(out), markers_(markers), max_published_(max_published), scene_(scene),
+        msg_(buffers) {}
 
   /// An event of the three-body path.
   void operator()(const collision_lab::core::LabEvent& event) {
-    collision_lab::CollisionEvent msg = toCollisionEventMsg(event);
-    if (send(msg)) {
-      topics_.velocities.publish(toVelocitiesMsg(msg));
-      topics_.energies.publish(toEnergyTransferMsg(msg, 0.0));  // elastic: no heat
+    fillCollisionEventMsg(event, msg_.event);
+    if (send(msg_.event)) {
+      fillVelocitiesMsg(msg_.event, msg_.velocities);
+      topics_.velocities.publish(msg_.velocities);
+      fillEnergyTransferMsg(msg_.event, 0.0, msg_.energy);  // elastic: no heat
+      topics_.energies.publish(msg_.energy);
     }
-    out_.record(std::move(msg));
+    out_.record(std::move(msg_.event));
   }
   /// An impact of the event engine.
-  void operator()(const collision_lab::core::ImpactRecord& impact) { sendWithPlots(converter_.impact(impact)); }
+  void operator()(const collision_lab::core::ImpactRecord& impact) {
+    converter().impact(impact, msg_.event);
+    sendWithPlots();
+  }
   /// A collapse the event engine resolved.
-  void operator()(const collision_lab::core::Collapse& collapse) { sendWithPlots(converter_.collapse(collapse)); }
+  void operator()(const collision_lab::core::Collapse& collapse) {
+    converter().collapse(collapse, msg_.event);
+    sendWithPlots();
+  }
 
   std::uint64_t published() const { return published_; }
   /// True when ~max_published_events cut the published stream.
@@ -157,12 +167,19 @@ class EventStream {
   double lastTime() const { return last_time_; }
 
  private:
-  void sendWithPlots(collision_lab::CollisionEvent msg) {
-    if (send(msg)) {
-      topics_.velocities.publish(converter_.velocitiesMsg(msg));
-      topics_.energies.publish(converter_.energyTransferMsg(msg));
+  /// The event engine's converter, made at its first event (the three-body path needs none).
+  SceneEventConverter& converter() {
+    if (!converter_) converter_.emplace(scene_);
+    return *converter_;
+  }
+  void sendWithPlots() {
+    if (send(msg_.event)) {
+      converter_->velocitiesMsg(msg_.event, msg_.velocities);
+      topics_.velocities.publish(msg_.velocities);
+      converter_->energyTransferMsg(msg_.event, msg_.energy);
+      topics_.energies.publish(msg_.energy);
     }
-    out_.record(std::move(msg));
+    out_.record(std::move(msg_.event));
   }
   /// Stamps and draws msg, and publishes it unless the cap is reached; true when
   /// published. The caller records it.
@@ -183,7 +200,9 @@ class EventStream {
   RunWriter& out_;
   RunObserver* markers_;
   std::uint64_t max_published_;
-  SceneEventConverter converter_;
+  const collision_lab::core::Scene& scene_;
+  std::optional<SceneEventConverter> converter_;
+  EventMessages& msg_;
   std::uint64_t published_ = 0;
   bool cut_ = false;
   double last_time_ = 0.0;
@@ -611,7 +630,8 @@ void LabNode::workerLoop() {
       job = std::move(inputs_.front());
       inputs_.pop_front();
     }
-    serve(*job.input, std::move(job.reply));
+    served_input_ = *job.input;  // copy assignment: the buffer keeps its storage
+    serve(served_input_, std::move(job.reply));
   }
 }
 
@@ -639,7 +659,7 @@ std::string LabNode::claimRunId(const std::string& requested, std::string& claim
 }
 
 void LabNode::announce(const collision_lab::InitialConditions& input, const std::string& requested) {
-  collision_lab::AcceptedRun accepted;
+  collision_lab::AcceptedRun& accepted = accepted_msg_;
   accepted.header.stamp = stampNow();
   accepted.run_id = input.run_id;
   accepted.requested_run_id = requested;
@@ -671,7 +691,7 @@ ServeOutcome LabNode::reject(collision_lab::Rejected msg, const std::string& run
   return ServeOutcome{std::nullopt, msg};
 }
 
-void LabNode::serve(collision_lab::InitialConditions input, Reply reply) {
+void LabNode::serve(collision_lab::InitialConditions& input, Reply reply) {
   const std::string requested = input.run_id;
   std::optional<collision_lab::core::ScenePlan> plan;
   if (auto rejection = checkInput(input, params_.max_bodies, plan)) {
@@ -714,14 +734,15 @@ void LabNode::run(collision_lab::InitialConditions& input, const collision_lab::
   options.simulate_to_cap = params_.simulate_to_cap;  // else the model answers over the cap (runScene)
   options.keep_events = false;
   options.cancel = &cancel_;
-  EventStream events(topics_, out, marker_view_.get(), params_.max_published_events, scene);
+  EventStream events(topics_, out, marker_view_.get(), params_.max_published_events, scene, event_messages_);
   core::SceneVisitors visitors;
   visitors.three_body_event = [&events](const core::LabEvent& e) { events(e); };
   visitors.impact = [&events](const core::ImpactRecord& r) { events(r); };
   visitors.collapse = [&events](const core::Collapse& c) { events(c); };  // in order, between the impacts
   const core::SceneRunResult result = runCancellable(input.run_id, plan, options, visitors);
 
-  collision_lab::RunSummary summary = toRunSummaryMsg(result, scene.size(), mode);
+  collision_lab::RunSummary& summary = summary_msg_;
+  fillRunSummaryMsg(result, scene.size(), mode, summary);
   summary.published_events = events.published();
   summary.events_not_published = events.cut();
   summary.requested_run_id = requested_run_id;
@@ -766,7 +787,8 @@ void LabNode::publishStart(RunWriter& out, const collision_lab::InitialCondition
   out.record(input);
   served_inputs_pub_.publish(input);
   if (marker_view_) marker_view_->onInitialConditions(input);
-  collision_lab::Prediction prediction = toPredictionMsg(plan);
+  collision_lab::Prediction& prediction = prediction_msg_;
+  fillPredictionMsg(plan, prediction);
   prediction.timeline_scale = out.timeline().scale();
   out.publish(topics_.predictions, prediction, 0.0);
   out.record(prediction);

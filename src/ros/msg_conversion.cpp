@@ -160,9 +160,17 @@ core::ModelChoice threeBodyRotationModel() {
 
 namespace {
 
-/// The fields every model fills the same way; the rest say "not given".
-collision_lab::Prediction modelPrediction(const core::ModelChoice& model, std::size_t body_count) {
-  collision_lab::Prediction msg;
+/// Resets msg to a default message without giving up its strings' and arrays' storage
+/// (copy assignment from an empty one keeps it; assigning a temporary would not).
+template <class Message>
+void resetKeepingStorage(Message& msg) {
+  static const Message kDefault;
+  msg = kDefault;
+}
+
+/// The fields every model fills the same way, into msg; the rest say "not given".
+void modelPrediction(const core::ModelChoice& model, std::size_t body_count, collision_lab::Prediction& msg) {
+  resetKeepingStorage(msg);
   msg.model = static_cast<std::uint8_t>(model.kind);
   msg.model_name = core::modelKindName(model.kind);
   msg.model_reason = model.reason;
@@ -171,7 +179,6 @@ collision_lab::Prediction modelPrediction(const core::ModelChoice& model, std::s
   msg.first_pair_index = collision_lab::Prediction::PAIR_NONE;
   msg.energy_lost = msg.collapse_time = msg.collapse_position = kNaN;
   msg.critical_restitution = msg.spiral_angle = kNaN;
-  return msg;
 }
 
 /// The rotation model's block of a three-body prediction: its closed form and the paper's
@@ -189,7 +196,7 @@ void addRotationModel(collision_lab::Prediction& msg, const core::AnalyticPredic
   msg.phi_bc = prediction.phi_bc;
   msg.psi = prediction.psi;
   msg.first_pair_index = toPairCode(prediction.first_pair);
-  msg.final_velocities = toVector(prediction.final_velocities);
+  msg.final_velocities.assign(prediction.final_velocities.begin(), prediction.final_velocities.end());
   msg.energy_lost = 0.0;
   msg.collapsed = false;
   msg.critical_restitution = core::criticalRestitution(prediction.angles.alpha);
@@ -199,9 +206,15 @@ void addRotationModel(collision_lab::Prediction& msg, const core::AnalyticPredic
 }  // namespace
 
 collision_lab::Prediction toPredictionMsg(const core::ScenePlan& plan) {
-  collision_lab::Prediction msg = modelPrediction(plan.model, plan.scene.size());
+  collision_lab::Prediction msg;
+  fillPredictionMsg(plan, msg);
+  return msg;
+}
+
+void fillPredictionMsg(const core::ScenePlan& plan, collision_lab::Prediction& msg) {
+  modelPrediction(plan.model, plan.scene.size(), msg);
   if (plan.three_body) addRotationModel(msg, *plan.three_body);
-  if (!plan.prediction) return msg;  // three_body_rotation (above) or event_engine: no closed form of models.h
+  if (!plan.prediction) return;  // three_body_rotation (above) or event_engine: no closed form of models.h
   const core::Prediction& p = *plan.prediction;
   msg.collision_count = p.impact_count.value_or(0);
   msg.collision_count_defined = p.impact_count.has_value();
@@ -220,11 +233,11 @@ collision_lab::Prediction toPredictionMsg(const core::ScenePlan& plan) {
     const std::vector<double>& m = plan.scene.masses;
     msg.alpha = core::alphaOf<double>({m[0], m[1], m[2]});
   }
-  return msg;
 }
 
 collision_lab::Prediction toPredictionMsg(const core::AnalyticPrediction& prediction, const core::ModelChoice& model) {
-  collision_lab::Prediction msg = modelPrediction(model, 3);
+  collision_lab::Prediction msg;
+  modelPrediction(model, 3, msg);
   addRotationModel(msg, prediction);
   return msg;
 }
@@ -245,8 +258,20 @@ collision_lab::core::AnalyticPrediction toPrediction(const collision_lab::Predic
 }
 
 collision_lab::CollisionEvent toCollisionEventMsg(const collision_lab::core::LabEvent& event) {
-  const collision_lab::core::ImpactEvent& e = event.event;
   collision_lab::CollisionEvent msg;
+  fillCollisionEventMsg(event, msg);
+  return msg;
+}
+
+namespace {
+/// values into a message array, keeping its storage.
+void assignArray(std::vector<double>& to, const std::array<double, 3>& values) {
+  to.assign(values.begin(), values.end());
+}
+}  // namespace
+
+void fillCollisionEventMsg(const collision_lab::core::LabEvent& event, collision_lab::CollisionEvent& msg) {
+  const collision_lab::core::ImpactEvent& e = event.event;
   msg.kind = collision_lab::CollisionEvent::KIND_IMPACT;
   msg.index = e.index;
   msg.pair_index = static_cast<std::uint32_t>(e.pair);
@@ -263,18 +288,17 @@ collision_lab::CollisionEvent toCollisionEventMsg(const collision_lab::core::Lab
     msg.pair_energy_transfer[side] = e.energy_transfer[body];
   }
   msg.energy_lost = 0.0;
-  msg.positions = toVector(e.positions);
-  msg.velocities_before = toVector(e.velocities_before);
-  msg.velocities_after = toVector(e.velocities_after);
-  msg.predicted_velocities_after = toVector(event.predicted_velocities_after);
-  msg.paper_velocities_after = toVector(event.paper_velocities_after);
-  msg.energy_transfer = toVector(e.energy_transfer);
-  msg.predicted_energy_transfer = toVector(event.predicted_energy_transfer);
-  msg.paper_energy_transfer = toVector(event.paper_energy_transfer);
-  msg.kinetic_energy_after = toVector(event.kinetic_energy_after);
+  assignArray(msg.positions, e.positions);
+  assignArray(msg.velocities_before, e.velocities_before);
+  assignArray(msg.velocities_after, e.velocities_after);
+  assignArray(msg.predicted_velocities_after, event.predicted_velocities_after);
+  assignArray(msg.paper_velocities_after, event.paper_velocities_after);
+  assignArray(msg.energy_transfer, e.energy_transfer);
+  assignArray(msg.predicted_energy_transfer, event.predicted_energy_transfer);
+  assignArray(msg.paper_energy_transfer, event.paper_energy_transfer);
+  assignArray(msg.kinetic_energy_after, event.kinetic_energy_after);
   msg.total_energy = e.total_energy;
   msg.total_momentum = e.total_momentum;
-  return msg;
 }
 
 collision_lab::core::LabEvent toLabEvent(const collision_lab::CollisionEvent& msg) {
@@ -300,15 +324,37 @@ collision_lab::core::LabEvent toLabEvent(const collision_lab::CollisionEvent& ms
 
 namespace {
 
-/// A plot message of event, its scalar fields left for the caller.
+/// The fields a plot message copies from its event; the rest are the caller's.
 template <class PlotMessage>
-PlotMessage plotMessageOf(const collision_lab::CollisionEvent& event) {
-  PlotMessage msg;
+void fillPlotMessage(const collision_lab::CollisionEvent& event, PlotMessage& msg) {
   msg.header = event.header;
   msg.run_id = event.run_id;
   msg.index = event.index;
   msg.time = event.time;
-  return msg;
+}
+
+/// Velocities of msg.v already set: the rest from event.
+void finishVelocitiesMsg(const collision_lab::CollisionEvent& event, collision_lab::Velocities& msg) {
+  fillPlotMessage(event, msg);
+  const std::array<double, 3> v = toArray(msg.v);
+  msg.v_a = v[0];
+  msg.v_b = v[1];
+  msg.v_c = v[2];
+}
+
+/// EnergyTransfer of msg.delta and msg.kinetic already set: the rest from event.
+void finishEnergyTransferMsg(const collision_lab::CollisionEvent& event, double cumulative_energy_lost,
+                             collision_lab::EnergyTransfer& msg) {
+  fillPlotMessage(event, msg);
+  msg.energy_lost = event.energy_lost;
+  msg.cumulative_energy_lost = cumulative_energy_lost;
+  const std::array<double, 3> d = toArray(msg.delta), k = toArray(msg.kinetic);
+  msg.delta_a = d[0];
+  msg.delta_b = d[1];
+  msg.delta_c = d[2];
+  msg.kinetic_a = k[0];
+  msg.kinetic_b = k[1];
+  msg.kinetic_c = k[2];
 }
 
 }  // namespace
@@ -341,40 +387,45 @@ bool replayEvent(core::BodyStateReplay& replay, const collision_lab::CollisionEv
 }
 
 collision_lab::Velocities toVelocitiesMsg(const collision_lab::CollisionEvent& event, std::vector<double> v) {
-  auto msg = plotMessageOf<collision_lab::Velocities>(event);
+  collision_lab::Velocities msg;
   msg.v = std::move(v);
-  const std::array<double, 3> first_three = toArray(msg.v);
-  msg.v_a = first_three[0];
-  msg.v_b = first_three[1];
-  msg.v_c = first_three[2];
+  finishVelocitiesMsg(event, msg);
   return msg;
 }
 
 collision_lab::EnergyTransfer toEnergyTransferMsg(const collision_lab::CollisionEvent& event,
                                                   std::vector<double> delta, std::vector<double> kinetic,
                                                   double cumulative_energy_lost) {
-  auto msg = plotMessageOf<collision_lab::EnergyTransfer>(event);
+  collision_lab::EnergyTransfer msg;
   msg.delta = std::move(delta);
   msg.kinetic = std::move(kinetic);
-  msg.energy_lost = event.energy_lost;
-  msg.cumulative_energy_lost = cumulative_energy_lost;
-  const std::array<double, 3> d = toArray(msg.delta), k = toArray(msg.kinetic);
-  msg.delta_a = d[0];
-  msg.delta_b = d[1];
-  msg.delta_c = d[2];
-  msg.kinetic_a = k[0];
-  msg.kinetic_b = k[1];
-  msg.kinetic_c = k[2];
+  finishEnergyTransferMsg(event, cumulative_energy_lost, msg);
   return msg;
 }
 
 collision_lab::Velocities toVelocitiesMsg(const collision_lab::CollisionEvent& event) {
-  return toVelocitiesMsg(event, event.velocities_after);
+  collision_lab::Velocities msg;
+  fillVelocitiesMsg(event, msg);
+  return msg;
 }
 
 collision_lab::EnergyTransfer toEnergyTransferMsg(const collision_lab::CollisionEvent& event,
                                                   double cumulative_energy_lost) {
-  return toEnergyTransferMsg(event, event.energy_transfer, event.kinetic_energy_after, cumulative_energy_lost);
+  collision_lab::EnergyTransfer msg;
+  fillEnergyTransferMsg(event, cumulative_energy_lost, msg);
+  return msg;
+}
+
+void fillVelocitiesMsg(const collision_lab::CollisionEvent& event, collision_lab::Velocities& msg) {
+  msg.v = event.velocities_after;
+  finishVelocitiesMsg(event, msg);
+}
+
+void fillEnergyTransferMsg(const collision_lab::CollisionEvent& event, double cumulative_energy_lost,
+                           collision_lab::EnergyTransfer& msg) {
+  msg.delta = event.energy_transfer;
+  msg.kinetic = event.kinetic_energy_after;
+  finishEnergyTransferMsg(event, cumulative_energy_lost, msg);
 }
 
 // ---- SceneEventConverter ----
@@ -385,8 +436,7 @@ static_assert(collision_lab::io::kFullStateMaxBodies == collision_lab::Collision
 SceneEventConverter::SceneEventConverter(const core::Scene& scene)
     : state_(scene), full_state_(scene.size() <= collision_lab::CollisionEvent::FULL_STATE_MAX_BODIES) {}
 
-collision_lab::CollisionEvent SceneEventConverter::toMsg(const collision_lab::io::EventRecord& r) {
-  collision_lab::CollisionEvent msg;
+void SceneEventConverter::toMsg(const collision_lab::io::EventRecord& r, collision_lab::CollisionEvent& msg) {
   msg.kind = r.collapse ? collision_lab::CollisionEvent::KIND_COLLAPSE : collision_lab::CollisionEvent::KIND_IMPACT;
   msg.index = r.index;
   msg.pair_index = static_cast<std::uint32_t>(r.pair_index);
@@ -402,9 +452,19 @@ collision_lab::CollisionEvent SceneEventConverter::toMsg(const collision_lab::io
     msg.pair_energy_transfer[side] = r.pair_energy_transfer[side];
   }
   msg.energy_lost = r.energy_lost;
+  // The rotation model's comparisons belong to three-body events alone.
+  msg.predicted_velocities_after.clear();
+  msg.paper_velocities_after.clear();
+  msg.predicted_energy_transfer.clear();
+  msg.paper_energy_transfer.clear();
   if (!r.full_state) {
+    msg.positions.clear();
+    msg.velocities_before.clear();
+    msg.velocities_after.clear();
+    msg.energy_transfer.clear();
+    msg.kinetic_energy_after.clear();
     msg.total_energy = msg.total_momentum = kNaN;
-    return msg;
+    return;
   }
   const std::size_t n = r.bodies;
   msg.positions.assign(r.positions, r.positions + n);
@@ -414,45 +474,70 @@ collision_lab::CollisionEvent SceneEventConverter::toMsg(const collision_lab::io
   msg.kinetic_energy_after.assign(r.kinetic_energy_after, r.kinetic_energy_after + n);
   msg.total_energy = r.total_energy;
   msg.total_momentum = r.total_momentum;
-  return msg;
 }
 
 collision_lab::CollisionEvent SceneEventConverter::impact(const core::ImpactRecord& record) {
-  return toMsg(state_.impact(record));
+  collision_lab::CollisionEvent msg;
+  impact(record, msg);
+  return msg;
 }
 
 collision_lab::CollisionEvent SceneEventConverter::collapse(const core::Collapse& collapse) {
-  return toMsg(state_.collapse(collapse));
+  collision_lab::CollisionEvent msg;
+  this->collapse(collapse, msg);
+  return msg;
+}
+
+void SceneEventConverter::impact(const core::ImpactRecord& record, collision_lab::CollisionEvent& msg) {
+  toMsg(state_.impact(record), msg);
+}
+
+void SceneEventConverter::collapse(const core::Collapse& collapse, collision_lab::CollisionEvent& msg) {
+  toMsg(state_.collapse(collapse), msg);
 }
 
 collision_lab::Velocities SceneEventConverter::velocitiesMsg(const collision_lab::CollisionEvent& event) const {
-  if (full_state_) return toVelocitiesMsg(event);
-  // Above the limit the arrays stay empty, as the event's; bodies 0, 1, 2 give the scalars.
-  const std::vector<double>& v = state_.replay().velocities();
-  collision_lab::Velocities msg = toVelocitiesMsg(event, {v.begin(), v.begin() + 3});
-  msg.v.clear();
+  collision_lab::Velocities msg;
+  velocitiesMsg(event, msg);
   return msg;
 }
 
 collision_lab::EnergyTransfer SceneEventConverter::energyTransferMsg(const collision_lab::CollisionEvent& event) const {
+  collision_lab::EnergyTransfer msg;
+  energyTransferMsg(event, msg);
+  return msg;
+}
+
+void SceneEventConverter::velocitiesMsg(const collision_lab::CollisionEvent& event, collision_lab::Velocities& msg) const {
+  if (full_state_) return fillVelocitiesMsg(event, msg);
+  // Above the limit the arrays stay empty, as the event's; bodies 0, 1, 2 give the scalars.
+  const std::vector<double>& v = state_.replay().velocities();
+  msg.v.assign(v.begin(), v.begin() + 3);
+  finishVelocitiesMsg(event, msg);
+  msg.v.clear();
+}
+
+void SceneEventConverter::energyTransferMsg(const collision_lab::CollisionEvent& event,
+                                            collision_lab::EnergyTransfer& msg) const {
   const core::BodyStateReplay& replay = state_.replay();
-  if (full_state_) return toEnergyTransferMsg(event, replay.heat());
-  std::vector<double> delta(3), kinetic_after(3);
+  if (full_state_) return fillEnergyTransferMsg(event, replay.heat(), msg);
+  msg.delta.resize(3);
+  msg.kinetic.resize(3);
   for (std::size_t i = 0; i < 3; ++i) {
-    delta[i] = replay.energyGained(i);
-    kinetic_after[i] = replay.kinetic(i);
+    msg.delta[i] = replay.energyGained(i);
+    msg.kinetic[i] = replay.kinetic(i);
   }
-  collision_lab::EnergyTransfer msg = toEnergyTransferMsg(event, std::move(delta), std::move(kinetic_after), replay.heat());
+  finishEnergyTransferMsg(event, replay.heat(), msg);
   msg.delta.clear();
   msg.kinetic.clear();
-  return msg;
 }
 
 namespace {
 
-/// The summary's model fields and the "not given" values of the rest.
-collision_lab::RunSummary modelSummary(const core::ModelChoice& model, std::size_t body_count, core::RunMode mode) {
-  collision_lab::RunSummary msg;
+/// The summary's model fields and the "not given" values of the rest, into msg.
+void modelSummary(const core::ModelChoice& model, std::size_t body_count, core::RunMode mode,
+                  collision_lab::RunSummary& msg) {
+  resetKeepingStorage(msg);
   msg.mode = static_cast<std::uint8_t>(mode);
   msg.model = static_cast<std::uint8_t>(model.kind);
   msg.model_name = core::modelKindName(model.kind);
@@ -460,18 +545,24 @@ collision_lab::RunSummary modelSummary(const core::ModelChoice& model, std::size
   msg.body_count = static_cast<std::uint32_t>(body_count);
   msg.energy_lost = msg.collapse_time = msg.collapse_position = kNaN;
   msg.critical_restitution = msg.spiral_angle = kNaN;
-  return msg;
 }
 
 }  // namespace
 
 collision_lab::RunSummary toRunSummaryMsg(const core::SceneRunResult& result, std::size_t body_count,
                                           core::RunMode mode) {
+  collision_lab::RunSummary msg;
+  fillRunSummaryMsg(result, body_count, mode, msg);
+  return msg;
+}
+
+void fillRunSummaryMsg(const core::SceneRunResult& result, std::size_t body_count, core::RunMode mode,
+                       collision_lab::RunSummary& msg) {
   const core::SceneSimulation& s = result.simulation;
-  collision_lab::RunSummary msg = modelSummary(result.model, body_count, mode);
+  modelSummary(result.model, body_count, mode, msg);
   msg.collision_count = s.impact_count;  // the run's answer, simulated or from the model
   msg.truncated = s.truncated;
-  msg.truncation_reason = s.truncated ? s.stop_message : std::string();
+  if (s.truncated) msg.truncation_reason = s.stop_message;  // else empty (reset above)
   msg.cancelled = s.simulated && s.stop == core::StopReason::kCancelled;
   msg.stop_reason = s.simulated ? core::stopReasonName(s.stop) : "NOT_SIMULATED";
   msg.simulated = s.simulated;
@@ -505,7 +596,6 @@ collision_lab::RunSummary toRunSummaryMsg(const core::SceneRunResult& result, st
     // The model is compared at every reported impact, not only at the end (lab_run.h).
     msg.max_prediction_error = rotation->summary.max_prediction_error;
   }
-  return msg;
 }
 
 collision_lab::Rejected toRejectedMsg(const collision_lab::core::ValidationError& error) {

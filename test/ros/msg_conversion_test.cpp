@@ -1,5 +1,6 @@
 // Message <-> core conversions (no master).
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <optional>
 #include <vector>
@@ -410,6 +411,58 @@ TEST(MsgConversion, PlotTopicsAreTheEventsSimulatedValues) {
   EXPECT_EQ(t.kinetic_a, 0.5);
   EXPECT_EQ(t.kinetic_b, 0.81);
   EXPECT_EQ(t.kinetic_c, 0.06);
+}
+
+/// msg as it goes out on a topic (NaN fields compare equal here, unlike operator==).
+template <class Message>
+std::vector<std::uint8_t> wireBytes(const Message& msg) {
+  std::vector<std::uint8_t> bytes(ros::serialization::serializationLength(msg));
+  ros::serialization::OStream stream(bytes.data(), static_cast<std::uint32_t>(bytes.size()));
+  ros::serialization::serialize(stream, msg);
+  return bytes;
+}
+
+// The node refills one message of each kind for every event (lab_node.cpp's EventStream):
+// a message that carried another event, of the other path or another size, must go out
+// as a fresh conversion of the new one, with nothing left over.
+TEST(MsgConversion, AReusedMessageCarriesItsNewEventAlone) {
+  const std::size_t n = collision_lab::CollisionEvent::FULL_STATE_MAX_BODIES + 1;
+  collision_lab::core::Scene large{std::vector<double>(n, 1.0), {}, std::vector<double>(n, 0.0), {}};
+  for (std::size_t i = 0; i < n; ++i) large.positions.push_back(static_cast<double>(n - i));
+  large.velocities[1] = -1;
+  const collision_lab::core::ImpactRecord impact = record(1, 1, 1.0, static_cast<double>(n - 2), {-1, 0}, {0, -1},
+                                                          {-0.5, 0.5}, 0);
+  SceneEventConverter fresh_converter(large), reused_converter(large);
+  const collision_lab::CollisionEvent fresh = fresh_converter.impact(impact);
+
+  // A three-body event (every array filled, the model's too), then the large scene's
+  // impact (no arrays): the same message as converted fresh.
+  collision_lab::CollisionEvent reused = toCollisionEventMsg(sampleEvent());
+  reused_converter.impact(impact, reused);
+  EXPECT_EQ(wireBytes(reused), wireBytes(fresh));
+  EXPECT_TRUE(reused.predicted_velocities_after.empty());
+  EXPECT_TRUE(reused.positions.empty());
+
+  collision_lab::Velocities velocities = toVelocitiesMsg(toCollisionEventMsg(sampleEvent()));
+  reused_converter.velocitiesMsg(reused, velocities);
+  EXPECT_EQ(wireBytes(velocities), wireBytes(fresh_converter.velocitiesMsg(fresh)));
+  collision_lab::EnergyTransfer energy = toEnergyTransferMsg(toCollisionEventMsg(sampleEvent()), 2.0);
+  reused_converter.energyTransferMsg(reused, energy);
+  EXPECT_EQ(wireBytes(energy), wireBytes(fresh_converter.energyTransferMsg(fresh)));
+
+  // And back: the three-body event into the message of the large scene's.
+  collision_lab::CollisionEvent three_body = fresh;
+  three_body.header.stamp = ros::Time(1700000000, 5);
+  three_body.run_id = "plotted";
+  fillCollisionEventMsg(sampleEvent(), three_body);
+  collision_lab::CollisionEvent expected = toCollisionEventMsg(sampleEvent());
+  expected.header = three_body.header;
+  expected.run_id = three_body.run_id;
+  EXPECT_EQ(wireBytes(three_body), wireBytes(expected));
+  fillVelocitiesMsg(three_body, velocities);
+  EXPECT_EQ(wireBytes(velocities), wireBytes(toVelocitiesMsg(three_body)));
+  fillEnergyTransferMsg(three_body, 0.0, energy);
+  EXPECT_EQ(wireBytes(energy), wireBytes(toEnergyTransferMsg(three_body, 0.0)));
 }
 
 TEST(MsgConversion, RunSummaryPhysicsFields) {

@@ -135,6 +135,14 @@ struct RunTopics {
   ros::Publisher predictions, events, velocities, energies, summaries;
 };
 
+/// The per-collision messages the worker refills for every collision (lab_node.cpp's
+/// EventStream), kept by the node so that their storage is reused from run to run.
+struct EventMessages {
+  collision_lab::CollisionEvent event;
+  collision_lab::Velocities velocities;
+  collision_lab::EnergyTransfer energy;
+};
+
 /// Stamps, publishes and records the messages of one run (lab_node.cpp).
 class RunWriter;
 class RunBagWriter;
@@ -189,9 +197,9 @@ class LabNode {
   void workerLoop();
 
   // ---- The worker's (not thread-safe) ----
-  /// Validates input, assigns its run_id, then runs it or rejects it; reply gets the
-  /// outcome once the run is finished (its bag closed).
-  void serve(collision_lab::InitialConditions input, Reply reply);
+  /// Validates input, assigns its run_id (in input), then runs it or rejects it; reply
+  /// gets the outcome once the run is finished (its bag closed).
+  void serve(collision_lab::InitialConditions& input, Reply reply);
   /// Publishes, records and draws one validated run (its run_id assigned).
   /// requested_run_id: RunSummary.requested_run_id.
   /// claim_error: RunBagBatch::claim_error.
@@ -248,6 +256,12 @@ class LabNode {
   std::string run_id_prefix_;
   std::uint64_t run_counter_ = 0;
   std::unordered_set<std::string> used_run_ids_;
+  // The worker's messages of a run, refilled for every run: their storage is reused.
+  collision_lab::InitialConditions served_input_;
+  collision_lab::AcceptedRun accepted_msg_;
+  collision_lab::Prediction prediction_msg_;
+  EventMessages event_messages_;
+  collision_lab::RunSummary summary_msg_;
 
   // Written by the worker, read by the diagnostics timer.
   std::atomic<std::uint64_t> runs_accepted_{0};

@@ -72,6 +72,9 @@ collision_lab::core::ModelChoice threeBodyRotationModel();
 /// every scene: the model's fields, plus the closed form of models.h or, when the rotation
 /// model answers, its prediction and the paper's printed count. Precondition: !plan.error.
 collision_lab::Prediction toPredictionMsg(const collision_lab::core::ScenePlan& plan);
+/// The same into msg, which may hold an earlier run's: every field is set (header and
+/// run_id to their defaults), and msg's strings and arrays keep their storage.
+void fillPredictionMsg(const collision_lab::core::ScenePlan& plan, collision_lab::Prediction& msg);
 /// The rotation model's prediction alone (three elastic bodies), as toPredictionMsg(plan) gives it.
 collision_lab::Prediction toPredictionMsg(const collision_lab::core::AnalyticPrediction& prediction,
                                           const collision_lab::core::ModelChoice& model = threeBodyRotationModel());
@@ -79,6 +82,10 @@ collision_lab::core::AnalyticPrediction toPrediction(const collision_lab::Predic
 
 /// An event of the three-body path (N = 3, elastic: every array filled).
 collision_lab::CollisionEvent toCollisionEventMsg(const collision_lab::core::LabEvent& event);
+/// The same into msg, which may hold an earlier event: every field but header and run_id
+/// is set, and msg's arrays keep their storage (a publisher reusing one message allocates
+/// nothing per event).
+void fillCollisionEventMsg(const collision_lab::core::LabEvent& event, collision_lab::CollisionEvent& msg);
 /// Inverse of toCollisionEventMsg: the message carries every field of a LabEvent.
 collision_lab::core::LabEvent toLabEvent(const collision_lab::CollisionEvent& msg);
 
@@ -100,6 +107,11 @@ collision_lab::EnergyTransfer toEnergyTransferMsg(const collision_lab::Collision
 collision_lab::Velocities toVelocitiesMsg(const collision_lab::CollisionEvent& event);
 collision_lab::EnergyTransfer toEnergyTransferMsg(const collision_lab::CollisionEvent& event,
                                                   double cumulative_energy_lost);
+/// The same into msg, which may hold an earlier event's: every field is set, and msg's
+/// strings and arrays keep their storage.
+void fillVelocitiesMsg(const collision_lab::CollisionEvent& event, collision_lab::Velocities& msg);
+void fillEnergyTransferMsg(const collision_lab::CollisionEvent& event, double cumulative_energy_lost,
+                           collision_lab::EnergyTransfer& msg);
 
 /// The CollisionEvent of each of the engine's notifications, in the order the engine gives
 /// them (impacts and collapses interleaved, engine.h): a copy of the one event record that
@@ -115,16 +127,24 @@ class SceneEventConverter {
   collision_lab::CollisionEvent impact(const collision_lab::core::ImpactRecord& record);
   /// One resolved inelastic collapse (KIND_COLLAPSE): its bodies move on as one cluster.
   collision_lab::CollisionEvent collapse(const collision_lab::core::Collapse& collapse);
+  /// The same into msg, which may hold an earlier event: every field but header and
+  /// run_id is set, and msg's arrays keep their storage.
+  void impact(const collision_lab::core::ImpactRecord& record, collision_lab::CollisionEvent& msg);
+  void collapse(const collision_lab::core::Collapse& collapse, collision_lab::CollisionEvent& msg);
 
   /// The plot messages of the last event converted: their arrays have length N for
   /// N <= FULL_STATE_MAX_BODIES (O(N) each, the event's own) and are empty above it, like
   /// the event's; the scalar fields (bodies 0, 1, 2) are always filled.
   collision_lab::Velocities velocitiesMsg(const collision_lab::CollisionEvent& event) const;
   collision_lab::EnergyTransfer energyTransferMsg(const collision_lab::CollisionEvent& event) const;
+  /// The same into msg, which may hold an earlier event's: every field is set, and msg's
+  /// strings and arrays keep their storage.
+  void velocitiesMsg(const collision_lab::CollisionEvent& event, collision_lab::Velocities& msg) const;
+  void energyTransferMsg(const collision_lab::CollisionEvent& event, collision_lab::EnergyTransfer& msg) const;
 
  private:
-  /// The message of one record of state_.
-  static collision_lab::CollisionEvent toMsg(const collision_lab::io::EventRecord& record);
+  /// The message of one record of state_, into msg (every field but header and run_id).
+  static void toMsg(const collision_lab::io::EventRecord& record, collision_lab::CollisionEvent& msg);
 
   collision_lab::io::SceneEventState state_;
   bool full_state_;
@@ -137,6 +157,10 @@ class SceneEventConverter {
 /// requested_run_id and student are the node's to fill.
 collision_lab::RunSummary toRunSummaryMsg(const collision_lab::core::SceneRunResult& result,
                                           std::size_t body_count, collision_lab::core::RunMode mode);
+/// The same into msg, which may hold an earlier run's: every field is set (the node's to
+/// their defaults), and msg's strings and arrays keep their storage.
+void fillRunSummaryMsg(const collision_lab::core::SceneRunResult& result, std::size_t body_count,
+                       collision_lab::core::RunMode mode, collision_lab::RunSummary& msg);
 
 collision_lab::Rejected toRejectedMsg(const collision_lab::core::ValidationError& error);
 collision_lab::Rejected toRejectedMsg(NodeReason reason, const std::string& field,
