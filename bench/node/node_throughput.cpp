@@ -20,6 +20,9 @@
 // (its /diagnostics) <= 100 us.
 #include <unistd.h>
 
+#include <fstream>
+#include <sstream>
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -31,7 +34,10 @@
 #include <unordered_map>
 #include <vector>
 
+#include <ros/master.h>
+#include <ros/network.h>
 #include <ros/ros.h>
+#include <xmlrpcpp/XmlRpcClient.h>
 
 #include <diagnostic_msgs/DiagnosticArray.h>
 
@@ -57,6 +63,44 @@ struct TargetResult {
   double rate = 0.0;     ///< runs answered per second [1/s]
   double p50_ms = 0.0, p99_ms = 0.0;
 };
+
+/// The process id of the node that publishes `topic` (the one a target serves), or 0: the
+/// master names the publisher, whose own XML-RPC API gives its pid.
+int pidOfPublisher(const std::string& topic) {
+  XmlRpc::XmlRpcValue args, result, payload;
+  args[0] = ros::this_node::getName();
+  if (!ros::master::execute("getSystemState", args, result, payload, false)) return 0;
+  std::string node;
+  for (int i = 0; i < payload[0].size() && node.empty(); ++i) {  // publishers: [topic, [nodes]]
+    if (std::string(payload[0][i][0]) == topic && payload[0][i][1].size() > 0) node = std::string(payload[0][i][1][0]);
+  }
+  if (node.empty()) return 0;
+  args[1] = node;
+  if (!ros::master::execute("lookupNode", args, result, payload, false)) return 0;
+  std::string host;
+  std::uint32_t port = 0;
+  if (!ros::network::splitURI(std::string(payload), host, port)) return 0;
+  XmlRpc::XmlRpcClient client(host.c_str(), static_cast<int>(port), "/");
+  XmlRpc::XmlRpcValue caller, answer;
+  caller[0] = ros::this_node::getName();
+  if (!client.execute("getPid", caller, answer) || answer.getType() != XmlRpc::XmlRpcValue::TypeArray) return 0;
+  return static_cast<int>(answer[2]);
+}
+
+/// CPU time (user + system, all threads) that process `pid` has used [s]; 0 if unknown.
+double processCpuSeconds(int pid) {
+  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+  std::string line;
+  if (pid <= 0 || !std::getline(stat, line)) return 0.0;
+  std::istringstream fields(line.substr(line.rfind(')') + 2));  // after "pid (comm) "
+  std::string field;
+  unsigned long long utime = 0, stime = 0;
+  for (int k = 3; k <= 15 && fields >> field; ++k) {  // fields 14 and 15: utime, stime in clock ticks
+    if (k == 14) utime = std::stoull(field);
+    if (k == 15) stime = std::stoull(field);
+  }
+  return static_cast<double>(utime + stime) / static_cast<double>(::sysconf(_SC_CLK_TCK));
+}
 
 double percentile(std::vector<double> values, double q) {
   if (values.empty()) return 0.0;
@@ -301,11 +345,19 @@ int main(int argc, char** argv) {
     }
     clients.back()->run(scene, std::min(runs, 50), timeout);  // warm-up: connections, caches, bag directory
   }
+  // Each target's process, for the CPU time it spends per run.
+  std::vector<int> pids;
+  for (const auto& target : targets) {
+    pids.push_back(pidOfPublisher(ros::names::resolve(target + "/" + collision_lab_ros::kRunSummariesTopic)));
+  }
   std::vector<std::vector<TargetResult>> rounds_of(targets.size());
+  std::vector<std::vector<double>> cpu_us_of(targets.size());  // per round [us per run]
   for (int round = 0; round < rounds; ++round) {
     for (std::size_t t = 0; t < targets.size(); ++t) {
       ROS_INFO_STREAM("round " << round + 1 << "/" << rounds << ": " << targets[t] << ", " << runs << " runs");
+      const double cpu_before = processCpuSeconds(pids[t]);
       rounds_of[t].push_back(clients[t]->run(scene, runs, timeout));
+      cpu_us_of[t].push_back(1e6 * (processCpuSeconds(pids[t]) - cpu_before) / runs);
     }
   }
   // Per target and round: its rate over the relay's in the same round (the relay is
@@ -365,6 +417,13 @@ int main(int argc, char** argv) {
                 "rounds %s%%; goal >= 80%%, nothing lost): %s\n",
                 r.target.c_str(), r.rate, relay_rate, rounds, 100 * ratio, percentList(ratios_of[t]).c_str(),
                 ratio >= 0.8 && lossless ? "met" : "missed");
+    if (!(ratio >= 0.8 && lossless) && pids.front() > 0 && pids[t] > 0) {
+      const double node_cpu = median(cpu_us_of[t]), relay_cpu = median(cpu_us_of.front());
+      std::printf("why: CPU time per run, all threads, median of the %d rounds: the lab node %.1f us, the relay %.1f "
+                  "us (%.2fx); the node computes each run (validation, model, simulation, conversion) where the relay "
+                  "only copies; both share the 2 cores with this client and the other targets\n",
+                  rounds, node_cpu, relay_cpu, relay_cpu > 0 ? node_cpu / relay_cpu : 0.0);
+    }
   }
   const std::string recording_target = pnh.param<std::string>("recording_target", "record");
   printRecordingGoal(nh, recording_target, results, targets);
