@@ -69,7 +69,7 @@ struct SceneTables {
 /// exact tier's numbers outgrew kExactBits (an accumulation of impacts not resolved);
 /// kOverBudget: its replay outgrew kExactReplayBudget; kCancelled: the cancel flag was seen inside
 /// a higher tier's work. The last three leave the working tier at its last certified impact.
-enum class StepKind {
+enum class StepKind : std::uint8_t {
   kImpact, kFinished, kMultipleCollision, kAmbiguous, kImprecise, kOutOfRange, kInconsistent, kExhausted,
   kOverBudget, kCancelled
 };
@@ -94,12 +94,18 @@ constexpr std::uint64_t kExactStreak = 256;
 /// the exactness cap above; together, each decision costs at most a constant.
 constexpr double kExactReplayBudget = 1e11;
 
+/// 16 bytes, so that it is returned in registers: every step passes one up through several
+/// calls, and a larger one goes through the stack, where its copies stall on store forwarding.
 struct StepResult {
+  StepResult() = default;
+  StepResult(StepKind k, std::size_t p = 0, double t = 0.0, bool zero = false)
+      : time(t), pair(static_cast<std::uint32_t>(p)), kind(k), at_zero(zero) {}
+  double time = 0.0;      ///< of a multiple collision [s]
+  std::uint32_t pair = 0;  ///< the impact's pair, or the lower pair of a multiple collision (< 2^32, as the tree's leaves)
   StepKind kind = StepKind::kImpact;
-  std::size_t pair = 0;  ///< the impact's pair, or the lower pair of a multiple collision
-  double time = 0.0;     ///< of a multiple collision [s]
   bool at_zero = false;  ///< kAmbiguous on a value exactly 0 at this precision: likely an exact tie
 };
+static_assert(sizeof(StepResult) == 16, "returned in registers");
 
 /// TC: bounds [s] of the time of a body's last impact (-inf: none yet); shared by the tiers.
 struct Clock {
