@@ -215,9 +215,9 @@ class Tier {
   /// time; adopt() then refreshes it.
   template <class From>
   bool follow(const Tier<From>& from, std::size_t m) {
-    const Undo undo = saveFor(m);
+    saveFor(m);
     if (collide(m, nullptr).kind != StepKind::kImpact) {
-      restore(m, undo);
+      restore(m);
       return false;
     }
     if (tables_.ring != 0.0) {  // no clusters on a ring (validate: every e > 0)
@@ -469,6 +469,8 @@ class Tier {
   };
 
   /// What an impact changes besides the tree (a failed step leaves the tree to be rebuilt by adopt()).
+  /// One record per tier, reused (impact() and follow() never nest): a fresh one per impact,
+  /// zero-filled and destroyed, cost about a tenth of an impact.
   struct Undo {
     BodyState i, j;
     double eu, eb, lost, lost_compensation;
@@ -843,26 +845,35 @@ class Tier {
   /// Performs the impact of pair m. When a neighbour then hits at the same instant (a
   /// multiple collision, or a decision this tier cannot take), the impact is undone.
   StepResult impact(std::size_t m, ImpactRecord* record) {
-    const Undo undo = saveFor(m);
+    saveFor(m);
     StepResult r = collide(m, record);
     if (r.kind == StepKind::kImpact) r = scheduleAfter(m);
-    if (r.kind != StepKind::kImpact) restore(m, undo);
+    if (r.kind != StepKind::kImpact) restore(m);
     return r;
   }
 
-  Undo saveFor(std::size_t m) const {
+  /// Records in undo_ what an impact of pair m changes besides the tree.
+  void saveFor(std::size_t m) {
     const std::size_t j = left(m);
-    Undo undo{bodies_[m], bodies_[j], eu_, eb_, lost_, lost_compensation_, now_, bonded_[m], cluster_impacts_,
-              rule_elastic_, {}, {}, S(0), S(0), m, {}};
+    Undo& undo = undo_;
+    undo.i = bodies_[m], undo.j = bodies_[j];
+    undo.eu = eu_, undo.eb = eb_, undo.lost = lost_, undo.lost_compensation = lost_compensation_;
+    undo.now = now_;
+    undo.bonded = bonded_[m];
+    undo.cluster_impacts = cluster_impacts_;
+    undo.rule_elastic = rule_elastic_;
     if (!clocks_.empty()) undo.clock_i = clocks_[m], undo.clock_j = clocks_[j];
     if (!last_exact_.empty()) undo.exact_i = last_exact_[m], undo.exact_j = last_exact_[j];
-    if (tables_.ring != 0.0) return undo;  // no clusters on a ring
+    undo.lo = m;
+    undo.cluster.clear();
+    if (tables_.ring != 0.0) return;  // no clusters on a ring
     const std::size_t lo = clusterLow(m), hi = clusterHigh(m + 1);
     if (lo != m || hi != m + 1) undo.cluster.assign(bodies_.begin() + lo, bodies_.begin() + hi + 1), undo.lo = lo;
-    return undo;
   }
 
-  void restore(std::size_t m, const Undo& undo) {
+  /// Undoes the impact of pair m recorded by saveFor(m).
+  void restore(std::size_t m) {
+    const Undo& undo = undo_;
     const std::size_t j = left(m);
     bodies_[m] = undo.i, bodies_[j] = undo.j;
     std::copy(undo.cluster.begin(), undo.cluster.end(), bodies_.begin() + undo.lo);
@@ -1174,6 +1185,7 @@ class Tier {
   std::uint64_t refinements_ = 0;
   double lost_ = 0.0, lost_compensation_ = 0.0;  ///< kinetic energy lost so far [J]
   Now now_;
+  Undo undo_;  ///< saveFor()'s record of the impact in progress
 };
 
 }  // namespace nbody_detail
