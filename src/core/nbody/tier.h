@@ -59,6 +59,7 @@ struct SceneTables {
   std::vector<double> sqrt_mass;      ///< sqrt(m) [kg^0.5]; 0 for a wall (it carries no error)
   std::vector<double> inv_sqrt_mass;  ///< 1 / sqrt(m) [kg^-0.5]; 0 for a wall
   std::vector<double> loss_factor;    ///< (1 - e^2) mu / 2 per pair [kg]
+  std::vector<double> restitution;    ///< e per pair [1] (scene.restitutionOf, looked up once)
   /// Circumference of a ring [m] (0: none). Pair p's left body is scene.leftOf(p); across
   /// the seam (pair N-1) it is body 0 seen at x - L, so its gap gains L.
   double ring = 0.0;
@@ -904,7 +905,7 @@ class Tier {
       rule = ruleFor(m);
       if (rule.kind != StepKind::kImpact) return {rule.kind, m, lastTime(), rule.at_zero};
     } else {
-      rule.e = tables_.scene.restitutionOf(m);
+      rule.e = tables_.restitution[m];
     }
     const std::size_t lo = tables_.ring != 0.0 ? m : clusterLow(m), hi = tables_.ring != 0.0 ? m + 1 : clusterHigh(m + 1);
     const StepResult r = lo == m && hi == m + 1 ? collideBodies(m, rule, record) : collideClusters(m, lo, hi, rule.e, record);
@@ -927,7 +928,7 @@ class Tier {
   Rule ruleFor(std::size_t m) {
     const Scene& scene = tables_.scene;
     const RestitutionModel& model = scene.restitution_model;
-    const double base = scene.restitutionOf(m);
+    const double base = tables_.restitution[m];
     const auto decided = [&](Decision elastic) {
       switch (elastic) {
         case Decision::kYes: return Rule{StepKind::kImpact, 1.0, base != 1.0, false};
@@ -1096,7 +1097,7 @@ class Tier {
     BodyState& i = bodies_[m];
     BodyState& j = bodies_[left_body];
     // The pair's own map; the model's e, when it differs: the elastic map, or e(v)'s.
-    const bool own = rule.e == tables_.scene.restitutionOf(m);
+    const bool own = rule.e == tables_.restitution[m];
     const Scene& scene = tables_.scene;
     ImpactMap<S> computed;
     const ImpactMap<S>* chosen = own ? &pair.map : (rule.e == 1.0 ? &elastic_maps_[m] : &computed);
