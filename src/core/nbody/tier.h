@@ -113,8 +113,10 @@ struct Clock {
   double lo = -kInf, hi = -kInf;
 };
 
+/// Hidden: the tiers are internal to the library, so their calls bind directly (no PLT)
+/// and stay open to the inliner.
 template <class S>
-class Tier {
+class CL_NBODY_INTERNAL Tier {
  public:
   using Ar = Arithmetic<S>;
 

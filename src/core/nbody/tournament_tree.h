@@ -12,11 +12,18 @@
 #include <limits>
 #include <vector>
 
+// Internal to the library (and header-only): its calls bind directly, not through the PLT.
+#if defined(__GNUC__)
+#define CL_NBODY_INTERNAL __attribute__((visibility("hidden")))
+#else
+#define CL_NBODY_INTERNAL
+#endif
+
 namespace collision_lab {
 namespace core {
 namespace nbody_detail {
 
-class TournamentTree {
+class CL_NBODY_INTERNAL TournamentTree {
  public:
   explicit TournamentTree(std::size_t leaves) {
     const std::size_t blocks = (leaves + kBlock - 1) / kBlock;
