@@ -26,7 +26,8 @@ SceneTables::SceneTables(const Scene& s) : scene(s), pairs(s.contactCount()), ri
   }
   for (std::size_t p = 0; p < pairs; ++p) {
     // The loss at unit approach speed, (1 - e^2) mu / 2: one home for the formula.
-    loss_factor.push_back(impactEnergyLost(s.masses[p], s.masses[s.leftOf(p)], 1.0, s.restitutionOf(p)));
+    restitution.push_back(s.restitutionOf(p));
+    loss_factor.push_back(impactEnergyLost(s.masses[p], s.masses[s.leftOf(p)], 1.0, restitution.back()));
   }
 }
 

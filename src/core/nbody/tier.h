@@ -59,6 +59,7 @@ struct SceneTables {
   std::vector<double> sqrt_mass;      ///< sqrt(m) [kg^0.5]; 0 for a wall (it carries no error)
   std::vector<double> inv_sqrt_mass;  ///< 1 / sqrt(m) [kg^-0.5]; 0 for a wall
   std::vector<double> loss_factor;    ///< (1 - e^2) mu / 2 per pair [kg]
+  std::vector<double> restitution;    ///< e per pair [1] (scene.restitutionOf, looked up once)
   /// Circumference of a ring [m] (0: none). Pair p's left body is scene.leftOf(p); across
   /// the seam (pair N-1) it is body 0 seen at x - L, so its gap gains L.
   double ring = 0.0;
@@ -69,7 +70,7 @@ struct SceneTables {
 /// exact tier's numbers outgrew kExactBits (an accumulation of impacts not resolved);
 /// kOverBudget: its replay outgrew kExactReplayBudget; kCancelled: the cancel flag was seen inside
 /// a higher tier's work. The last three leave the working tier at its last certified impact.
-enum class StepKind {
+enum class StepKind : std::uint8_t {
   kImpact, kFinished, kMultipleCollision, kAmbiguous, kImprecise, kOutOfRange, kInconsistent, kExhausted,
   kOverBudget, kCancelled
 };
@@ -94,20 +95,28 @@ constexpr std::uint64_t kExactStreak = 256;
 /// the exactness cap above; together, each decision costs at most a constant.
 constexpr double kExactReplayBudget = 1e11;
 
+/// 16 bytes, so that it is returned in registers: every step passes one up through several
+/// calls, and a larger one goes through the stack, where its copies stall on store forwarding.
 struct StepResult {
+  StepResult() = default;
+  StepResult(StepKind k, std::size_t p = 0, double t = 0.0, bool zero = false)
+      : time(t), pair(static_cast<std::uint32_t>(p)), kind(k), at_zero(zero) {}
+  double time = 0.0;      ///< of a multiple collision [s]
+  std::uint32_t pair = 0;  ///< the impact's pair, or the lower pair of a multiple collision (< 2^32, as the tree's leaves)
   StepKind kind = StepKind::kImpact;
-  std::size_t pair = 0;  ///< the impact's pair, or the lower pair of a multiple collision
-  double time = 0.0;     ///< of a multiple collision [s]
   bool at_zero = false;  ///< kAmbiguous on a value exactly 0 at this precision: likely an exact tie
 };
+static_assert(sizeof(StepResult) == 16, "returned in registers");
 
 /// TC: bounds [s] of the time of a body's last impact (-inf: none yet); shared by the tiers.
 struct Clock {
   double lo = -kInf, hi = -kInf;
 };
 
+/// Hidden: the tiers are internal to the library, so their calls bind directly (no PLT)
+/// and stay open to the inliner.
 template <class S>
-class Tier {
+class CL_NBODY_INTERNAL Tier {
  public:
   using Ar = Arithmetic<S>;
 
@@ -209,9 +218,9 @@ class Tier {
   /// time; adopt() then refreshes it.
   template <class From>
   bool follow(const Tier<From>& from, std::size_t m) {
-    const Undo undo = saveFor(m);
+    saveFor(m);
     if (collide(m, nullptr).kind != StepKind::kImpact) {
-      restore(m, undo);
+      restore(m);
       return false;
     }
     if (tables_.ring != 0.0) {  // no clusters on a ring (validate: every e > 0)
@@ -463,6 +472,8 @@ class Tier {
   };
 
   /// What an impact changes besides the tree (a failed step leaves the tree to be rebuilt by adopt()).
+  /// One record per tier, reused (impact() and follow() never nest): a fresh one per impact,
+  /// zero-filled and destroyed, cost about a tenth of an impact.
   struct Undo {
     BodyState i, j;
     double eu, eb, lost, lost_compensation;
@@ -837,26 +848,35 @@ class Tier {
   /// Performs the impact of pair m. When a neighbour then hits at the same instant (a
   /// multiple collision, or a decision this tier cannot take), the impact is undone.
   StepResult impact(std::size_t m, ImpactRecord* record) {
-    const Undo undo = saveFor(m);
+    saveFor(m);
     StepResult r = collide(m, record);
     if (r.kind == StepKind::kImpact) r = scheduleAfter(m);
-    if (r.kind != StepKind::kImpact) restore(m, undo);
+    if (r.kind != StepKind::kImpact) restore(m);
     return r;
   }
 
-  Undo saveFor(std::size_t m) const {
+  /// Records in undo_ what an impact of pair m changes besides the tree.
+  void saveFor(std::size_t m) {
     const std::size_t j = left(m);
-    Undo undo{bodies_[m], bodies_[j], eu_, eb_, lost_, lost_compensation_, now_, bonded_[m], cluster_impacts_,
-              rule_elastic_, {}, {}, S(0), S(0), m, {}};
+    Undo& undo = undo_;
+    undo.i = bodies_[m], undo.j = bodies_[j];
+    undo.eu = eu_, undo.eb = eb_, undo.lost = lost_, undo.lost_compensation = lost_compensation_;
+    undo.now = now_;
+    undo.bonded = bonded_[m];
+    undo.cluster_impacts = cluster_impacts_;
+    undo.rule_elastic = rule_elastic_;
     if (!clocks_.empty()) undo.clock_i = clocks_[m], undo.clock_j = clocks_[j];
     if (!last_exact_.empty()) undo.exact_i = last_exact_[m], undo.exact_j = last_exact_[j];
-    if (tables_.ring != 0.0) return undo;  // no clusters on a ring
+    undo.lo = m;
+    undo.cluster.clear();
+    if (tables_.ring != 0.0) return;  // no clusters on a ring
     const std::size_t lo = clusterLow(m), hi = clusterHigh(m + 1);
     if (lo != m || hi != m + 1) undo.cluster.assign(bodies_.begin() + lo, bodies_.begin() + hi + 1), undo.lo = lo;
-    return undo;
   }
 
-  void restore(std::size_t m, const Undo& undo) {
+  /// Undoes the impact of pair m recorded by saveFor(m).
+  void restore(std::size_t m) {
+    const Undo& undo = undo_;
     const std::size_t j = left(m);
     bodies_[m] = undo.i, bodies_[j] = undo.j;
     std::copy(undo.cluster.begin(), undo.cluster.end(), bodies_.begin() + undo.lo);
@@ -887,7 +907,7 @@ class Tier {
       rule = ruleFor(m);
       if (rule.kind != StepKind::kImpact) return {rule.kind, m, lastTime(), rule.at_zero};
     } else {
-      rule.e = tables_.scene.restitutionOf(m);
+      rule.e = tables_.restitution[m];
     }
     const std::size_t lo = tables_.ring != 0.0 ? m : clusterLow(m), hi = tables_.ring != 0.0 ? m + 1 : clusterHigh(m + 1);
     const StepResult r = lo == m && hi == m + 1 ? collideBodies(m, rule, record) : collideClusters(m, lo, hi, rule.e, record);
@@ -910,7 +930,7 @@ class Tier {
   Rule ruleFor(std::size_t m) {
     const Scene& scene = tables_.scene;
     const RestitutionModel& model = scene.restitution_model;
-    const double base = scene.restitutionOf(m);
+    const double base = tables_.restitution[m];
     const auto decided = [&](Decision elastic) {
       switch (elastic) {
         case Decision::kYes: return Rule{StepKind::kImpact, 1.0, base != 1.0, false};
@@ -1079,7 +1099,7 @@ class Tier {
     BodyState& i = bodies_[m];
     BodyState& j = bodies_[left_body];
     // The pair's own map; the model's e, when it differs: the elastic map, or e(v)'s.
-    const bool own = rule.e == tables_.scene.restitutionOf(m);
+    const bool own = rule.e == tables_.restitution[m];
     const Scene& scene = tables_.scene;
     ImpactMap<S> computed;
     const ImpactMap<S>* chosen = own ? &pair.map : (rule.e == 1.0 ? &elastic_maps_[m] : &computed);
@@ -1168,6 +1188,7 @@ class Tier {
   std::uint64_t refinements_ = 0;
   double lost_ = 0.0, lost_compensation_ = 0.0;  ///< kinetic energy lost so far [J]
   Now now_;
+  Undo undo_;  ///< saveFor()'s record of the impact in progress
 };
 
 }  // namespace nbody_detail

@@ -12,11 +12,18 @@
 #include <limits>
 #include <vector>
 
+// Internal to the library (and header-only): its calls bind directly, not through the PLT.
+#if defined(__GNUC__)
+#define CL_NBODY_INTERNAL __attribute__((visibility("hidden")))
+#else
+#define CL_NBODY_INTERNAL
+#endif
+
 namespace collision_lab {
 namespace core {
 namespace nbody_detail {
 
-class TournamentTree {
+class CL_NBODY_INTERNAL TournamentTree {
  public:
   explicit TournamentTree(std::size_t leaves) {
     const std::size_t blocks = (leaves + kBlock - 1) / kBlock;
@@ -61,19 +68,21 @@ class TournamentTree {
   double minKey() const { return nodes_[1].key; }
 
   /// The smallest key of all leaves but `leaf`: the rest of its block, then the sibling
-  /// subtrees along its block's path.
+  /// subtrees along its block's path. Reduced pairwise and in two chains along the path, not
+  /// in one chain of dependent minima (keys are never NaN, so the order does not matter).
   double minKeyExcluding(std::size_t leaf) const {
     const Block& block = blocks_[leaf / kBlock];
-    double best = kNone;
-    for (std::size_t j = 0; j < kBlock; ++j) {
-      const double k = j == leaf % kBlock ? kNone : block.key[j];
-      best = k < best ? k : best;
+    double k[kBlock];
+    for (std::size_t j = 0; j < kBlock; ++j) k[j] = j == leaf % kBlock ? kNone : block.key[j];
+    double even = least(least(least(k[0], k[1]), least(k[2], k[3])), least(least(k[4], k[5]), least(k[6], k[7])));
+    double odd = kNone;
+    std::size_t n = base_ + leaf / kBlock;
+    for (; n > 3; n >>= 2) {
+      even = least(even, nodes_[n ^ 1].key);
+      odd = least(odd, nodes_[(n >> 1) ^ 1].key);
     }
-    for (std::size_t n = base_ + leaf / kBlock; n > 1; n >>= 1) {
-      const double sibling = nodes_[n ^ 1].key;
-      best = sibling < best ? sibling : best;
-    }
-    return best;
+    if (n > 1) even = least(even, nodes_[n ^ 1].key);
+    return least(even, odd);
   }
 
   /// Calls f(leaf) for every leaf whose key is <= threshold (a finite threshold).
@@ -92,6 +101,8 @@ class TournamentTree {
     double key;
     std::uint32_t leaf;
   };
+
+  static double least(double a, double b) { return b < a ? b : a; }
 
   /// Smallest key of a block and its leaf, by a branch-free knockout; ties go to the lower leaf.
   Node blockMinimum(std::size_t b) const {
