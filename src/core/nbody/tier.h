@@ -627,12 +627,13 @@ class CL_NBODY_INTERNAL Tier {
     return {t, error, true};
   }
 
-  /// Pair p's next impact time in S (p approaches).
+  /// Pair p's next impact time in S (p approaches). !ok when it does not (in the exact tier:
+  /// a schedule out of step with the state, which the driver reports as an internal error).
   Precise preciseTime(std::size_t p) {
     ++refinements_;
     const S G = gapOf(p);
     const S A = bodies_[left(p)].v - bodies_[p].v;
-    if constexpr (Ar::kExact) return {G / A, 0.0, true};
+    if constexpr (Ar::kExact) return Ar::sign(A) > 0 ? Precise{G / A, 0.0, true} : Precise{S(), kInf, false};
     const double eG =
         (eb_ * pairScale(p) + 2.02 * Ar::kOpError * (std::fabs(Ar::toDouble(G)) + offset(p))) * kSlack;
     const double eA = (eu_ * pairScale(p) + 1.01 * Ar::kOpError * std::fabs(Ar::toDouble(A))) * kSlack;

@@ -38,11 +38,13 @@ class CL_NBODY_INTERNAL TournamentTree {
   /// Sets a leaf without propagating; call update() or rebuild() afterwards.
   void set(std::size_t leaf, double key) { blocks_[leaf / kBlock].key[leaf % kBlock] = key; }
 
-  /// Propagates the leaves first..last (at most kBlock + 1 apart) to the root. The winner
-  /// climbs in registers and meets only the siblings, which are loaded independently: no
-  /// level waits for the store of the level below.
+  /// Propagates the leaves first..last (first <= last, any span) to the root. Within two
+  /// adjacent blocks (an impact of single bodies) the winner climbs in registers and meets
+  /// only the siblings, which are loaded independently: no level waits for the store of the
+  /// level below. A wider span (a cluster's impact or merge) refreshes every block in it.
   void update(std::size_t first, std::size_t last) {
     std::size_t lo = base_ + first / kBlock, hi = base_ + last / kBlock;
+    if (hi - lo > 1) return updateSpan(lo, hi);
     Node low = blockMinimum(lo - base_);
     nodes_[lo] = low;
     if (hi != lo) {
@@ -130,6 +132,16 @@ class CL_NBODY_INTERNAL TournamentTree {
     const Node parent = candidates[static_cast<std::size_t>(candidates[1].key < winner.key)];
     nodes_[n >> 1] = parent;
     return parent;
+  }
+
+  /// update() for block nodes lo..hi more than one apart: the blocks between them changed
+  /// too, so every node over the span is recomputed, level by level.
+  void updateSpan(std::size_t lo, std::size_t hi) {
+    for (std::size_t n = lo; n <= hi; ++n) nodes_[n] = blockMinimum(n - base_);
+    while (lo > 1) {
+      lo >>= 1, hi >>= 1;
+      for (std::size_t n = lo; n <= hi; ++n) refresh(n);
+    }
   }
 
   template <class F>
