@@ -100,7 +100,7 @@ for format in csv json; do
       fi
       goal_lines+=("goal: ${format^^} output, us per impact = $total against dd to the same file = $anchor (${ratio}x; $bytes_per_impact B per impact, formatting alone $formatting us; $target): $verdict")
       if [[ "$verdict" == missed ]]; then
-        goal_lines+=("why: ${format^^}: of $total us per impact, $none_us us is the run itself (--events none), $formatting us formatting and writing $bytes_per_impact B; dd writes those bytes in $anchor us (cpu of the whole CLI run: $(per_impact "$cpu") us per impact)")
+        goal_lines+=("why: ${format^^}: of $total us per impact, $none_us us is the run that publishes no event (--events none) and $formatting us the events: each built from the engine's impact record in SI units, then formatted and written, $bytes_per_impact B; dd writes those bytes in $anchor us (cpu of the whole CLI run, formatting on worker threads: $(per_impact "$cpu") us per impact)")
       fi
     fi
   done

@@ -2,7 +2,7 @@
 // whose every impact is published, while `rosbag record --lz4` (started here, on the same
 // machine) records the same topics from the network. Both rates are messages written to
 // the bag per second of wall time:
-// - the lab node: the messages in its bag (input, prediction, every event, summary)
+// - the lab node: the messages in its bag (run parameters, input, prediction, every event, summary)
 //   divided by the time from publishing the input to receiving the run's summary, which
 //   the node publishes only once the bag is closed (so it includes simulating, publishing
 //   three topics per impact and writing);
@@ -150,7 +150,8 @@ int main(int argc, char** argv) {
       std::printf("  rosbag record:  %zu messages in its bag, %.2f s from first to last receipt: %.0f msg/s\n",
                   rosbag_messages, rosbag_span, rosbag_rate);
       const double ratio = rosbag_rate > 0 ? node_rate / rosbag_rate : 0.0;
-      const bool complete = node_messages == 3 + summary.collision_count;
+      // The run's bag: its parameters, input, prediction, every event and its summary.
+      const bool complete = node_messages == 4 + summary.collision_count;
       std::printf("goal: lab node recording a long run, messages/s written = %.0f against rosbag record --lz4 on "
                   "the same topics = %.0f (%.0f%%; goal >= 80%%, every message in the bag): %s\n",
                   node_rate, rosbag_rate, 100 * ratio, ratio >= 0.8 && complete ? "met" : "missed");

@@ -226,6 +226,18 @@ double noNegativeZero(long double x) { return x == 0 ? 0.0 : static_cast<double>
 /// value times 2^shift, rounded once to double (never -0).
 double scaled(long double value, int shift) { return noNegativeZero(std::ldexp(value, shift)); }
 
+/// scaled() with the power of two made once: value * 2^shift is exact in long double (whose
+/// exponent range is far wider than any shift of doubles), so the result is scaled()'s,
+/// without a call to ldexp per value.
+class PowerOfTwo {
+ public:
+  explicit PowerOfTwo(int shift) : factor_(std::ldexp(1.0L, shift)) {}
+  double operator()(long double value) const { return noNegativeZero(value * factor_); }
+
+ private:
+  long double factor_;
+};
+
 /// The engine's working units: masses, velocities and positions scaled by exact powers of
 /// two towards 1, so that tiny or huge inputs keep their digits.
 struct WorkingUnits {
@@ -322,9 +334,10 @@ std::optional<SimulationResult> simulateByEngine(const ThreeBodyScene& scene, co
     since_position[k] = working.positions[k];
   }
   const int wall = scene.wallIndex();
-  const auto velocitiesSi = [&velocities, velocity_shift] {
-    return std::array<double, 3>{scaled(velocities[0], -velocity_shift), scaled(velocities[1], -velocity_shift),
-                                 scaled(velocities[2], -velocity_shift)};
+  const PowerOfTwo velocity_si(-velocity_shift), position_si(-position_shift), time_si(time_shift),
+      energy_si(energy_shift), momentum_si(momentum_shift);
+  const auto velocitiesSi = [&velocities, velocity_si] {
+    return std::array<double, 3>{velocity_si(velocities[0]), velocity_si(velocities[1]), velocity_si(velocities[2])};
   };
   ImpactEvent event;
   ImpactVisitor on_impact;
@@ -333,14 +346,14 @@ std::optional<SimulationResult> simulateByEngine(const ThreeBodyScene& scene, co
       const int i = static_cast<int>(record.pair_index);
       event.index = record.index;
       event.pair = i == 0 ? Pair::AB : Pair::BC;
-      event.time = scaled(record.time, time_shift);
-      event.position = scaled(record.position, -position_shift);
+      event.time = time_si(record.time);
+      event.position = position_si(record.position);
       event.velocities_before = velocitiesSi();
       for (int k = 0; k < 3; ++k) {
         const long double elapsed = static_cast<long double>(record.time) - since_time[k];
         const long double position =
             velocities[k] == 0 ? since_position[k] : since_position[k] + velocities[k] * elapsed;
-        event.positions[k] = scaled(position, -position_shift);
+        event.positions[k] = position_si(position);
         event.energy_transfer[k] = 0.0;
       }
       for (int side = 0; side < 2; ++side) {
@@ -353,8 +366,8 @@ std::optional<SimulationResult> simulateByEngine(const ThreeBodyScene& scene, co
       // Elastic: what one body gains the other loses, exactly (a wall's entry is minus the
       // ball's): the finite body's entry, or the left one's, sets both.
       const int side = scene.isWall(i) ? 1 : 0;
-      event.energy_transfer[i + side] = scaled(record.energy_gained[side], energy_shift);
-      event.energy_transfer[i + 1 - side] = scaled(-static_cast<long double>(record.energy_gained[side]), energy_shift);
+      event.energy_transfer[i + side] = energy_si(record.energy_gained[side]);
+      event.energy_transfer[i + 1 - side] = energy_si(-static_cast<long double>(record.energy_gained[side]));
       event.velocities_after = velocitiesSi();
       long double energy = 0, momentum = 0;
       for (int k = 0; k < 3; ++k) {
@@ -362,8 +375,8 @@ std::optional<SimulationResult> simulateByEngine(const ThreeBodyScene& scene, co
         energy += static_cast<long double>(working.masses[k]) * velocities[k] * velocities[k] / 2;
         momentum += static_cast<long double>(working.masses[k]) * velocities[k];
       }
-      event.total_energy = scaled(energy, energy_shift);
-      event.total_momentum = scaled(momentum, momentum_shift);
+      event.total_energy = energy_si(energy);
+      event.total_momentum = momentum_si(momentum);
       visitor(event);
     };
   }
