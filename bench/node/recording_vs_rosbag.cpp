@@ -137,6 +137,9 @@ int main(int argc, char** argv) {
       }, timeout, "rosbag record to write everything");
       kill(recorder, SIGINT);
       waitpid(recorder, nullptr, 0);
+      // The rosbag script may exit before its recorder has closed the bag (renamed the
+      // .active file): reading it earlier throws.
+      waitFor([&] { return fs::exists(rosbag_path) && !fs::exists(active); }, timeout, "rosbag record to close its bag");
       const auto [node_messages, unused] = bagContents(summary.bag_path);
       const auto [rosbag_messages, rosbag_span] = bagContents(rosbag_path);
       const double node_seconds = (finished - start).toSec();
