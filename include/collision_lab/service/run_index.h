@@ -1,0 +1,103 @@
+// The class's run index (docs/web.md, "Runs survive restarts"): one SQLite database,
+// <bag_directory>/runs.sqlite, in WAL mode. The lab node writes it (every run it accepts,
+// starts, finishes or finds interrupted, and every input it rejects); the web node and
+// ~list_runs read it, so a restart of either node lists every run of the day and old links
+// keep working. ROS-free: SQLite and the standard library only; messages are stored as
+// JSON text made by the layer above.
+//
+// Thread-safe: one connection per RunIndex, guarded by a mutex. Several processes may open
+// the same file (WAL: one writer, many readers; a busy timeout absorbs short waits).
+// Every method throws RunIndexError when SQLite fails; the callers log it and go on (the
+// index is a record, never a reason to lose a run).
+#pragma once
+
+#include <cstdint>
+#include <mutex>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+struct sqlite3;
+
+namespace collision_lab::service {
+
+class RunIndexError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// A run's state in the index. A run moves queued -> running -> finished, or to
+/// interrupted when its node died before it finished (found at the next start, or by a
+/// reader that sees its bag closed without a summary).
+enum class RunState { kQueued, kRunning, kFinished, kInterrupted };
+const char* runStateName(RunState state);  ///< "queued", "running", "finished", "interrupted"
+std::optional<RunState> runStateFromName(const std::string& name);
+
+/// One row of the index.
+struct IndexedRun {
+  std::string run_id;            ///< as served (unique)
+  std::string student;           ///< empty: anonymous
+  std::string requested_run_id;  ///< as the input asked for it; may be empty
+  RunState state = RunState::kQueued;
+  double accepted_at = 0.0;  ///< [s] since the epoch (wall time)
+  double started_at = 0.0;   ///< [s] since the epoch; 0 until running
+  double finished_at = 0.0;  ///< [s] since the epoch; 0 until finished or interrupted
+  std::string scene_json;    ///< the served input (InitialConditions) as JSON
+  std::string summary_json;  ///< the RunSummary as JSON once finished; else empty
+  std::string stop_reason;   ///< RunSummary.stop_reason once finished ("INTERRUPTED" when interrupted)
+  std::uint64_t collision_count = 0;  ///< [1] RunSummary.collision_count once finished
+  std::string bag_path;      ///< the run's bag (final name; may still be .active while running); empty: not recorded
+  std::string csv_path;      ///< the events CSV made beside the bag once asked for; empty until then
+};
+
+/// One rejected input.
+struct IndexedRejection {
+  std::int64_t id = 0;  ///< the index's own row number
+  double at = 0.0;      ///< [s] since the epoch
+  std::string student, run_id, reason_name, field, message;
+};
+
+class RunIndex {
+ public:
+  /// Opens (creating when missing) the database at path, in WAL mode, with its tables.
+  explicit RunIndex(const std::string& path);
+  ~RunIndex();
+  RunIndex(const RunIndex&) = delete;
+  RunIndex& operator=(const RunIndex&) = delete;
+
+  /// <bag_directory>/runs.sqlite
+  static std::string defaultPath(const std::string& bag_directory);
+
+  // ---- Writer (the lab node) ----
+  /// A run accepted and queued (its row is created; a row of that run_id is replaced).
+  void accepted(const IndexedRun& run);
+  void started(const std::string& run_id, double at);
+  /// The run's summary is out and its bag closed.
+  void finished(const std::string& run_id, double at, const std::string& summary_json,
+                const std::string& stop_reason, std::uint64_t collision_count, const std::string& bag_path);
+  /// The run will never finish (its node died); summary_json may describe what its bag holds.
+  void interrupted(const std::string& run_id, double at, const std::string& summary_json,
+                   std::uint64_t collision_count, const std::string& bag_path);
+  void rejected(const IndexedRejection& rejection);
+  /// The events CSV made beside the run's bag (the web node, once, on the first download).
+  void setCsvPath(const std::string& run_id, const std::string& csv_path);
+
+  // ---- Readers ----
+  std::optional<IndexedRun> find(const std::string& run_id) const;
+  /// Oldest accepted first; only student's when student is given (empty string: anonymous).
+  /// limit 0: all.
+  std::vector<IndexedRun> list(const std::optional<std::string>& student = std::nullopt, std::size_t limit = 0) const;
+  /// Runs in a state, oldest first (a lab node's start: queued and running ones are interrupted).
+  std::vector<IndexedRun> inState(RunState state) const;
+  /// Newest first, at most limit (0: all); only student's when given.
+  std::vector<IndexedRejection> rejections(const std::optional<std::string>& student = std::nullopt,
+                                           std::size_t limit = 0) const;
+  std::size_t runCount() const;
+
+ private:
+  mutable std::mutex mutex_;
+  sqlite3* db_ = nullptr;
+};
+
+}  // namespace collision_lab::service
