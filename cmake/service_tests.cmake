@@ -4,3 +4,10 @@ catkin_add_gtest(run_index_test test/service/run_index_test.cpp)
 if(TARGET run_index_test)
   target_link_libraries(run_index_test collision_lab_service GTest::gtest_main)
 endif()
+
+# The lab node's side (no master): the bag claim's lock, recovery of a killed writer's
+# .active bag (reindexed with `rosbag reindex`), stale rows ended, ~list_runs' rows.
+catkin_add_gtest(run_index_recorder_test test/ros/run_index_recorder_test.cpp)
+if(TARGET run_index_recorder_test)
+  target_link_libraries(run_index_recorder_test collision_lab_ros GTest::gtest_main)
+endif()
