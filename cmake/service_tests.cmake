@@ -11,3 +11,9 @@ catkin_add_gtest(run_index_recorder_test test/ros/run_index_recorder_test.cpp)
 if(TARGET run_index_recorder_test)
   target_link_libraries(run_index_recorder_test collision_lab_ros GTest::gtest_main)
 endif()
+
+# The real nodes (rostest): a lab node killed with SIGKILL and respawned by roslaunch
+# lists every earlier run and leaves a live node's bag alone.
+add_rostest_gtest(index_restart_test test/ros/index_restart_test.test test/ros/index_restart_test.cpp)
+target_link_libraries(index_restart_test collision_lab_ros ${catkin_LIBRARIES})
+add_dependencies(index_restart_test collision_lab_node)

@@ -2,7 +2,9 @@
 
 #include <sqlite3.h>
 
+#include <chrono>
 #include <filesystem>
+#include <thread>
 #include <utility>
 
 namespace collision_lab::service {
@@ -160,33 +162,50 @@ RunIndex::RunIndex(const std::string& path) : path_(path) {
     db_ = nullptr;
     throw RunIndexError("run index " + path + ": cannot open: " + error);
   }
-  try {
-    sqlite3_busy_timeout(db_, kBusyTimeoutMs);
-    execute("PRAGMA journal_mode=WAL");
-    // WAL's own durability: a commit survives the process (a crash of the node); only a
-    // power cut may lose the last commits.
-    execute("PRAGMA synchronous=NORMAL");
-    Statement version(db_, path_, "PRAGMA user_version");
-    version.step();
-    const std::int64_t found = version.integer(0);
-    if (found > kSchemaVersion) {
-      throw RunIndexError("run index " + path + ": schema version " + std::to_string(found) +
-                          " is newer than this program's " + std::to_string(kSchemaVersion));
-    }
-    execute("BEGIN IMMEDIATE");
+  sqlite3_busy_timeout(db_, kBusyTimeoutMs);
+  // Nodes starting together (labs sharing a folder) meet here: switching to WAL and
+  // creating the tables may answer SQLITE_BUSY at once, without the busy handler (e.g.
+  // while another connection recovers the WAL), so the set-up is tried again until the
+  // busy timeout has passed.
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::milliseconds(kBusyTimeoutMs);
+  for (;;) {
     try {
-      execute(kSchema);
-      execute("PRAGMA user_version=" + std::to_string(kSchemaVersion));
-      execute("COMMIT");
-    } catch (...) {
-      sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
+      initialize();
+      return;
+    } catch (const RunIndexError&) {
+      const int code = sqlite3_errcode(db_) & 0xff;
+      if ((code == SQLITE_BUSY || code == SQLITE_LOCKED) && std::chrono::steady_clock::now() < give_up) {
+        sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        continue;
+      }
+      sqlite3_close(db_);
+      db_ = nullptr;
       throw;
     }
-  } catch (...) {
-    sqlite3_close(db_);
-    db_ = nullptr;
-    throw;
   }
+}
+
+void RunIndex::initialize() {
+  execute("PRAGMA journal_mode=WAL");
+  // WAL's own durability: a commit survives the process (a crash of the node); only a
+  // power cut may lose the last commits.
+  execute("PRAGMA synchronous=NORMAL");
+  std::int64_t found = 0;
+  {  // finalized before the writes below: a finalize resets the connection's error code
+    Statement version(db_, path_, "PRAGMA user_version");
+    version.step();
+    found = version.integer(0);
+  }
+  if (found == kSchemaVersion) return;
+  if (found > kSchemaVersion) {
+    throw RunIndexError("run index " + path_ + ": schema version " + std::to_string(found) +
+                        " is newer than this program's " + std::to_string(kSchemaVersion));
+  }
+  execute("BEGIN IMMEDIATE");
+  execute(kSchema);
+  execute("PRAGMA user_version=" + std::to_string(kSchemaVersion));
+  execute("COMMIT");
 }
 
 RunIndex::~RunIndex() { sqlite3_close(db_); }

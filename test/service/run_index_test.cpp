@@ -233,6 +233,34 @@ TEST_F(RunIndexTest, TwoProcessesShareTheFile) {
   EXPECT_EQ(parent.runCount(), 101u);
 }
 
+TEST_F(RunIndexTest, ProcessesOpeningANewFileTogetherAllSucceed) {
+  // Labs sharing a folder start together: each creates the tables and switches to WAL.
+  constexpr int kProcesses = 8;
+  std::vector<pid_t> children;
+  for (int p = 0; p < kProcesses; ++p) {
+    const pid_t child = ::fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+      int status = 1;
+      try {
+        RunIndex own(path_);
+        own.accepted(queued("p" + std::to_string(p), "ana", p));
+        status = 0;
+      } catch (const std::exception& e) {
+        std::fprintf(stderr, "process %d: %s\n", p, e.what());
+      }
+      ::_exit(status);
+    }
+    children.push_back(child);
+  }
+  for (const pid_t child : children) {
+    int status = 0;
+    ASSERT_EQ(::waitpid(child, &status, 0), child);
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+  }
+  EXPECT_EQ(RunIndex(path_).runCount(), static_cast<std::size_t>(kProcesses));
+}
+
 TEST_F(RunIndexTest, AFileThatIsNoDatabaseIsAnError) {
   fs::create_directories(dir_);
   {

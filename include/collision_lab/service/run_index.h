@@ -99,6 +99,8 @@ class RunIndex {
   std::size_t runCount() const;
 
  private:
+  /// WAL mode and the tables (created when the file has none). Throws RunIndexError.
+  void initialize();
   /// Runs sql (no values: schema and pragmas only).
   void execute(const std::string& sql);
   /// finished() and interrupted(): the run's end, its row created when missing.
