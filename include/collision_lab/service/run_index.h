@@ -47,7 +47,7 @@ struct IndexedRun {
   std::string summary_json;  ///< the RunSummary as JSON once finished; else empty
   std::string stop_reason;   ///< RunSummary.stop_reason once finished ("INTERRUPTED" when interrupted)
   std::uint64_t collision_count = 0;  ///< [1] RunSummary.collision_count once finished
-  std::string bag_path;      ///< the run's bag (final name; may still be .active while running); empty: not recorded
+  std::string bag_path;      ///< the run's final bag (<run_id>.bag) once finished or recovered; empty until then, or when not recorded
   std::string csv_path;      ///< the events CSV made beside the bag once asked for; empty until then
 };
 
