@@ -12,10 +12,13 @@ add_library(collision_lab_ros
   src/ros/bag_reading.cpp
   src/ros/run_recorder.cpp
   src/ros/run_timeline.cpp
+  src/ros/run_index_recorder.cpp
   src/ros/lab_node.cpp)
 target_include_directories(collision_lab_ros PUBLIC include)
 # collision_lab_io: the node reads the presets of ~run_preset.
-target_link_libraries(collision_lab_ros PUBLIC collision_lab_core collision_lab_io ${catkin_LIBRARIES})
+# collision_lab_service: the run index the node writes and ~list_runs reads.
+target_link_libraries(collision_lab_ros PUBLIC collision_lab_core collision_lab_io collision_lab_service
+  nlohmann_json::nlohmann_json ${catkin_LIBRARIES})
 add_dependencies(collision_lab_ros ${PROJECT_NAME}_generate_messages_cpp ${catkin_EXPORTED_TARGETS})
 # The version recorded in every bag (RunParameters.package_version): package.xml's, as
 # catkin_package() read it.

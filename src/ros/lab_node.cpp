@@ -18,6 +18,7 @@
 #include "collision_lab/io/scenario_file.h"
 #include "collision_lab/ros/msg_conversion.h"
 #include "collision_lab/ros/node_constants.h"
+#include "collision_lab/ros/run_index_recorder.h"
 #include "collision_lab/ros/run_recorder.h"
 #include "collision_lab/ros/run_timeline.h"
 
@@ -496,6 +497,9 @@ LabNode::LabNode(ros::NodeHandle nh, ros::NodeHandle private_nh, const RunObserv
   if (params_.publish_markers && make_observer) marker_view_ = make_observer(nh_, private_nh);
 
   run_id_prefix_ = std::string("run_") + utcStamp("%Y%m%d_%H%M%S") + "_";
+  // Before any input is served: the runs of dead nodes are ended (docs/ros.md, "The run index").
+  run_index_ = std::make_unique<RunIndexRecorder>(params_.bag_directory);
+  run_index_->recover();
   if (params_.record) {
     const std::string parameters_topic = nh_.resolveName(kRunParametersTopic);
     bags_ = std::make_unique<RunBagWriter>(
@@ -666,6 +670,7 @@ void LabNode::announce(const collision_lab::InitialConditions& input, const std:
   accepted.student = input.student;
   accepted_pub_.publish(accepted);
   served_runs_.accepted(accepted);
+  run_index_->accepted(accepted, input);
   // As logRun: at INFO for a lab, at DEBUG with ~log_runs false.
   const auto level = params_.log_runs ? ::ros::console::levels::Info : ::ros::console::levels::Debug;
   ROS_LOG_STREAM(level, ROSCONSOLE_DEFAULT_NAME,
@@ -675,7 +680,8 @@ void LabNode::announce(const collision_lab::InitialConditions& input, const std:
 }
 
 bool LabNode::onListRuns(collision_lab::ListRuns::Request& request, collision_lab::ListRuns::Response& response) {
-  response.runs = served_runs_.list(request.student);
+  // The index lists every run of bag_directory, across restarts; without it, this process's.
+  response.runs = run_index_->ok() ? run_index_->list(request.student) : served_runs_.list(request.student);
   return true;
 }
 
@@ -687,6 +693,7 @@ ServeOutcome LabNode::reject(collision_lab::Rejected msg, const std::string& run
                   << (msg.student.empty() ? std::string() : " of student '" + msg.student + "'") << ": "
                   << msg.reason_name << " in field " << msg.field << ": " << msg.message);
   rejected_pub_.publish(msg);
+  run_index_->rejected(msg);
   if (marker_view_) marker_view_->onRejected(msg);
   return ServeOutcome{std::nullopt, msg};
 }
@@ -722,6 +729,7 @@ void LabNode::run(collision_lab::InitialConditions& input, const collision_lab::
   RunWriter out(input.run_id, RunTimeline(start, chooseTimelineScale(firstContactTime(scene))), bags_.get(),
                 claim_error);
   input.header.stamp = start;
+  run_index_->started(input.run_id);
   publishStart(out, input, plan);  // the prediction goes out before the simulation starts
 
   core::SceneRunOptions options;
@@ -820,6 +828,7 @@ void LabNode::finishRun(const collision_lab::RunSummary& summary, const Reply& r
   }
   // The summary goes out last, after everything it counts (and its bag is closed).
   served_runs_.finished(summary);  // before the summary: whoever saw it finds the run finished
+  run_index_->finished(summary);
   topics_.summaries.publish(summary);
   ++runs_accepted_;
   last_compute_time_ = summary.compute_time;

@@ -1,14 +1,17 @@
 #include "collision_lab/ros/run_recorder.h"
 
 #include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <map>
 #include <stdexcept>
 #include <system_error>
 #include <utility>
@@ -30,7 +33,32 @@ int renameNoReplace(const std::string& from, const std::string& to) {
   if (::link(from.c_str(), to.c_str()) != 0) return errno;
   return ::unlink(from.c_str()) == 0 ? 0 : errno;
 }
+
+/// The claims this process holds: a claimed .bag.active path -> the descriptor that holds
+/// its flock(LOCK_EX) until releaseBagClaim (the process's death releases every one).
+std::mutex claims_mutex;
+std::map<std::string, int>& heldClaims() {
+  static std::map<std::string, int> claims;
+  return claims;
+}
 }  // namespace
+
+void releaseBagClaim(const std::string& active_path) {
+  int fd = -1;
+  {
+    std::lock_guard<std::mutex> lock(claims_mutex);
+    const auto it = heldClaims().find(active_path);
+    if (it == heldClaims().end()) return;
+    fd = it->second;
+    heldClaims().erase(it);
+  }
+  ::close(fd);  // releases the flock
+}
+
+bool bagClaimHeld(const std::string& active_path) {
+  std::lock_guard<std::mutex> lock(claims_mutex);
+  return heldClaims().count(active_path) > 0;
+}
 
 std::string bagPath(const std::string& directory, const std::string& run_id) {
   return (fs::path(directory) / (run_id + ".bag")).string();
@@ -45,16 +73,43 @@ BagClaim claimBag(const std::string& directory, const std::string& run_id, std::
   }
   const std::string path = bagPath(directory, run_id);
   const std::string active = path + kActiveSuffix;
-  const int fd = ::open(active.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+  // The .active name appears already locked: the claim file is made and flock'ed under a
+  // private name, then renamed to the .active name without replacing (EEXIST: taken). So a
+  // recovering node (recoverActiveBags) never sees a live claim unlocked.
+  static std::atomic<std::uint64_t> claims_made{0};
+  const std::string pending =
+      active + kClaimInfix + std::to_string(::getpid()) + "." + std::to_string(++claims_made);
+  const int fd = ::open(pending.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
   if (fd < 0) {
-    if (errno == EEXIST) return BagClaim::kTaken;
-    error = "cannot create " + active + ": " + std::strerror(errno);
+    error = "cannot create " + pending + ": " + std::strerror(errno);
     return BagClaim::kFailed;
   }
-  ::close(fd);
-  if (fs::symlink_status(path, ec).type() == fs::file_type::not_found) return BagClaim::kClaimed;
+  if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+    error = "cannot lock " + pending + ": " + std::strerror(errno);
+    ::close(fd);
+    ::unlink(pending.c_str());
+    return BagClaim::kFailed;
+  }
+  const int renamed = renameNoReplace(pending, active);
+  if (renamed != 0) {
+    ::close(fd);
+    ::unlink(pending.c_str());
+    if (renamed == EEXIST) return BagClaim::kTaken;
+    error = "cannot create " + active + ": " + std::strerror(renamed);
+    return BagClaim::kFailed;
+  }
+  if (fs::symlink_status(path, ec).type() == fs::file_type::not_found) {
+    std::lock_guard<std::mutex> lock(claims_mutex);
+    const auto [it, inserted] = heldClaims().emplace(active, fd);
+    if (!inserted) {  // a claim of this process whose file someone removed: keep the new one
+      ::close(it->second);
+      it->second = fd;
+    }
+    return BagClaim::kClaimed;
+  }
   // A finished bag of that name (or its status unknown): give the name up.
   fs::remove(active, ec);
+  ::close(fd);
   return BagClaim::kTaken;
 }
 
@@ -106,13 +161,17 @@ void RunRecorder::open() {
   } catch (const std::exception& e) {
     bag_ = nullptr;
     fail("cannot open bag " + active_path_ + ": " + e.what());
+    releaseBagClaim(active_path_);
   }
 }
 
 RunRecorder::~RunRecorder() { close(); }
 
 bool RunRecorder::close() {
-  if (!bag_) return ok();
+  if (!bag_) {
+    releaseBagClaim(active_path_);
+    return ok();
+  }
   try {
     bag_->close();
   } catch (const std::exception& e) {
@@ -127,6 +186,8 @@ bool RunRecorder::close() {
       fail("cannot rename " + active_path_ + " to " + path_ + ": " + std::strerror(error));
     }
   }
+  // The bag is no longer written: a bag left .active may now be recovered.
+  releaseBagClaim(active_path_);
   return ok();
 }
 

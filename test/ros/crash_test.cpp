@@ -1,7 +1,8 @@
 // kill -9 in the middle of a run (crash_test.test): the bags of finished runs stay
-// intact, the run in progress is left as <run_id>.bag.active and `rosbag reindex`
-// recovers it, and a restarted node never overwrites an existing bag: it serves a taken
-// run_id as <run_id>.2. SIGINT during a burst: every bag handed to the writer is closed
+// intact, the run in progress is left as <run_id>.bag.active, and the restarted node
+// recovers it (reindexed, renamed <run_id>.bag) and lists the run as interrupted with the
+// events its bag holds (the run index, issue 30); it never overwrites an existing bag: it
+// serves a taken run_id as <run_id>.2. SIGINT during a burst: every bag handed to the writer is closed
 // and complete. SIGINT during a run_scene call cancels the run first. A count parameter
 // out of range stops the node at start-up, saying which.
 #include <signal.h>
@@ -25,6 +26,7 @@
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 
+#include "collision_lab/ListRuns.h"
 #include "collision_lab/RunScene.h"
 #include "run_collector.h"
 
@@ -111,26 +113,50 @@ TEST(Crash, KillNineKeepsFinishedBagsAndNeverOverwrites) {
   ASSERT_TRUE(fs::exists(dir + "/long_run.bag.active"));
 
   // The interrupted bag is recoverable up to its last flushed chunk: reindex a copy and
-  // read it.
-  const std::string recovered = dir + "/long_run_recovered.bag";
+  // read it (outside the bag folder: the restarted node recovers the bag itself).
+  char copy_pattern[] = "/tmp/collision_lab_crash_copy_XXXXXX";
+  ASSERT_NE(mkdtemp(copy_pattern), nullptr);
+  const std::string recovered = std::string(copy_pattern) + "/long_run_recovered.bag";
   fs::copy_file(dir + "/long_run.bag.active", recovered);
   ASSERT_EQ(std::system(("rosbag reindex -q " + recovered + " > /dev/null").c_str()), 0);
+  std::size_t events_in_bag = 0;
   {
     rosbag::Bag bag(recovered, rosbag::bagmode::Read);
     EXPECT_EQ(rosbag::View(bag, rosbag::TopicQuery("/crash/initial_conditions")).size(), 1u);
     EXPECT_EQ(rosbag::View(bag, rosbag::TopicQuery("/crash/predictions")).size(), 1u);
-    EXPECT_GT(rosbag::View(bag, rosbag::TopicQuery("/crash/collision_events")).size(), 0u);
+    events_in_bag = rosbag::View(bag, rosbag::TopicQuery("/crash/collision_events")).size();
+    EXPECT_GT(events_in_bag, 0u);
     EXPECT_EQ(rosbag::View(bag, rosbag::TopicQuery("/crash/run_summaries")).size(), 0u);
   }
+  fs::remove_all(copy_pattern);
 
-  // A restarted node serves both run_ids again under the next free suffix, and touches
-  // neither the finished bag nor the interrupted one.
-  const auto active_size = fs::file_size(dir + "/long_run.bag.active");
+  // A restarted node recovers the interrupted bag at start, serves both run_ids again under
+  // the next free suffix, and touches neither the finished bag nor the recovered one.
   {
     const pid_t node = startNode(dir);
     ASSERT_GT(node, 0);
     RunCollector client(kNamespace);
     client.waitForConnection();
+    ASSERT_FALSE(fs::exists(dir + "/long_run.bag.active"));  // recovered before the node serves
+    ASSERT_TRUE(fs::exists(dir + "/long_run.bag"));
+    EXPECT_EQ(messageCount(dir + "/long_run.bag"), 3 + events_in_bag);  // parameters, input, prediction, events
+    // ~list_runs (the run index) lists both runs of the killed node: the finished one, and
+    // the interrupted one with the events its bag holds.
+    const std::string list_service = std::string("/") + kNamespace + "/collision_lab_node/list_runs";
+    ASSERT_TRUE(ros::service::waitForService(list_service, ros::Duration(collision_lab_test::kWaitTimeout)));
+    collision_lab::ListRuns list;
+    ASSERT_TRUE(ros::service::call(list_service, list));
+    ASSERT_EQ(list.response.runs.size(), 2u);
+    EXPECT_EQ(list.response.runs[0].accepted.run_id, "finished");
+    EXPECT_EQ(list.response.runs[0].stop_reason, "FINISHED");
+    EXPECT_EQ(list.response.runs[0].collision_count, 3u);
+    EXPECT_EQ(list.response.runs[1].accepted.run_id, "long_run");
+    EXPECT_TRUE(list.response.runs[1].finished);
+    EXPECT_EQ(list.response.runs[1].stop_reason, "INTERRUPTED");
+    EXPECT_TRUE(list.response.runs[1].truncated);
+    EXPECT_EQ(list.response.runs[1].collision_count, events_in_bag);
+    EXPECT_EQ(list.response.runs[1].bag_path, dir + "/long_run.bag");
+    const auto recovered_size = fs::file_size(dir + "/long_run.bag");
     auto short_run = finished;
     short_run.run_id = "long_run";
     for (const auto& input : {finished, short_run}) {
@@ -142,10 +168,10 @@ TEST(Crash, KillNineKeepsFinishedBagsAndNeverOverwrites) {
       EXPECT_EQ(messageCount(dir + "/" + input.run_id + ".2.bag"), finished_messages);
     }
     stop(node, SIGINT);
+    EXPECT_EQ(fs::file_size(dir + "/long_run.bag"), recovered_size);
   }
   EXPECT_EQ(messageCount(dir + "/finished.bag"), finished_messages);
-  EXPECT_EQ(fs::file_size(dir + "/long_run.bag.active"), active_size);
-  EXPECT_FALSE(fs::exists(dir + "/long_run.bag"));
+  EXPECT_FALSE(fs::exists(dir + "/long_run.bag.active"));
   fs::remove_all(dir);
 }
 

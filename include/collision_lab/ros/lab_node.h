@@ -3,7 +3,9 @@
 // bag per run and feeds the marker view. Inputs come from the topic `initial_conditions`
 // and from the services ~run_scene and ~run_preset; all three take the same path (served,
 // published, recorded, drawn). ~cancel stops the run in progress. Each accepted input is
-// announced on `accepted_runs` with the run_id it got; ~list_runs lists the runs served.
+// announced on `accepted_runs` with the run_id it got; ~list_runs lists the runs of the
+// run index (<bag_directory>/runs.sqlite: every node process's), which the node writes
+// (RunIndexRecorder). At start the node ends the runs of dead nodes in it (recover()).
 //
 // Threading contract:
 // - One worker thread serves every input, from the topic and the services alike, in
@@ -146,6 +148,7 @@ struct EventMessages {
 /// Stamps, publishes and records the messages of one run (lab_node.cpp).
 class RunWriter;
 class RunBagWriter;
+class RunIndexRecorder;
 
 /// The newest kRecordingTimeWindow samples of a duration [s], thread-safe.
 class RecentDurations {
@@ -248,6 +251,8 @@ class LabNode {
   ros::Publisher rejected_pub_;
   ros::Publisher accepted_pub_, served_inputs_pub_;
   ServedRuns served_runs_;
+  /// Writes the run index (<bag_directory>/runs.sqlite) and answers ~list_runs from it.
+  std::unique_ptr<RunIndexRecorder> run_index_;
   /// Publishes /diagnostics; the wall timer forces an update every kDiagnosticsPeriod (the
   /// updater's own rate follows ROS time, which stands still on a replay before its clock).
   diagnostic_updater::Updater diagnostics_;

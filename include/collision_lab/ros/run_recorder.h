@@ -21,6 +21,7 @@
 
 #include <condition_variable>
 #include <cstddef>
+#include <cstdint>
 #include <deque>
 #include <functional>
 #include <memory>
@@ -42,6 +43,10 @@
 
 namespace collision_lab_ros {
 
+/// A claim's file before it takes the .active name: <run_id>.bag.active<kClaimInfix><pid>.<n>
+/// (left only by a claimer that died in between; recoverActiveBags removes it).
+constexpr char kClaimInfix[] = ".claim.";
+
 /// <directory>/<run_id>.bag
 std::string bagPath(const std::string& directory, const std::string& run_id);
 
@@ -53,11 +58,22 @@ enum class BagClaim {
 
 /// Claims <directory>/<run_id>.bag for the caller, race-free against every process that
 /// claims in directory this way: creates directory if needed, creates <run_id>.bag.active
-/// with O_CREAT|O_EXCL (kTaken when it exists), then gives the name up again (removes
-/// the file it just created: kTaken) when a finished <run_id>.bag exists. A finished bag
-/// only appears by its owner's rename of the .active file, which the exclusive create
-/// excludes until then, so after kClaimed no other claimer can get this run_id.
+/// exclusively (kTaken when it exists), then gives the name up again (removes the file it
+/// just created: kTaken) when a finished <run_id>.bag exists. A finished bag only appears
+/// by its owner's rename of the .active file, which the exclusive create excludes until
+/// then, so after kClaimed no other claimer can get this run_id.
+/// Ownership: on kClaimed this process holds flock(LOCK_EX) on the .active file (from
+/// the moment the name exists: it is made locked under a private name, then renamed)
+/// until releaseBagClaim, which RunRecorder calls once the bag is closed or has failed.
+/// The kernel drops the lock when the process dies, so an .active file that
+/// flock(LOCK_EX|LOCK_NB) can take has no live owner (recoverActiveBags).
 BagClaim claimBag(const std::string& directory, const std::string& run_id, std::string& error);
+/// Drops this process's claim lock on active_path (<run_id>.bag.active); nothing when it
+/// holds none. A claimed run that never opens its bag (e.g. cancelled while queued) must
+/// call this, or the lock stays until the process ends.
+void releaseBagClaim(const std::string& active_path);
+/// Whether this process holds the claim lock on active_path.
+bool bagClaimHeld(const std::string& active_path);
 
 /// The connection header a live subscription to topic gives `rosbag record`: topic, type,
 /// md5sum, message_definition, callerid (the publishing node) and latching ("1" or "0").

@@ -47,7 +47,7 @@ struct IndexedRun {
   std::string summary_json;  ///< the RunSummary as JSON once finished; else empty
   std::string stop_reason;   ///< RunSummary.stop_reason once finished ("INTERRUPTED" when interrupted)
   std::uint64_t collision_count = 0;  ///< [1] RunSummary.collision_count once finished
-  std::string bag_path;      ///< the run's bag (final name; may still be .active while running); empty: not recorded
+  std::string bag_path;      ///< the run's final bag (<run_id>.bag) once finished or recovered; empty until then, or when not recorded
   std::string csv_path;      ///< the events CSV made beside the bag once asked for; empty until then
 };
 
@@ -71,12 +71,15 @@ class RunIndex {
 
   // ---- Writer (the lab node) ----
   /// A run accepted and queued (its row is created; a row of that run_id is replaced).
+  /// Only the run's own fields are used: state and times as given (normally kQueued).
   void accepted(const IndexedRun& run);
+  /// A queued run starts (a run in another state is left as it is).
   void started(const std::string& run_id, double at);
   /// The run's summary is out and its bag closed.
   void finished(const std::string& run_id, double at, const std::string& summary_json,
                 const std::string& stop_reason, std::uint64_t collision_count, const std::string& bag_path);
   /// The run will never finish (its node died); summary_json may describe what its bag holds.
+  /// finished() and interrupted() create the run's row when it has none.
   void interrupted(const std::string& run_id, double at, const std::string& summary_json,
                    std::uint64_t collision_count, const std::string& bag_path);
   void rejected(const IndexedRejection& rejection);
@@ -96,6 +99,15 @@ class RunIndex {
   std::size_t runCount() const;
 
  private:
+  /// WAL mode and the tables (created when the file has none). Throws RunIndexError.
+  void initialize();
+  /// Runs sql (no values: schema and pragmas only).
+  void execute(const std::string& sql);
+  /// finished() and interrupted(): the run's end, its row created when missing.
+  void end(const std::string& run_id, RunState state, double at, const std::string& summary_json,
+           const std::string& stop_reason, std::uint64_t collision_count, const std::string& bag_path);
+
+  const std::string path_;  ///< for the errors
   mutable std::mutex mutex_;
   sqlite3* db_ = nullptr;
 };

@@ -1,0 +1,19 @@
+# The run index (no master): persistence, every state change, two connections on one
+# file as two processes.
+catkin_add_gtest(run_index_test test/service/run_index_test.cpp)
+if(TARGET run_index_test)
+  target_link_libraries(run_index_test collision_lab_service GTest::gtest_main)
+endif()
+
+# The lab node's side (no master): the bag claim's lock, recovery of a killed writer's
+# .active bag (reindexed with `rosbag reindex`), stale rows ended, ~list_runs' rows.
+catkin_add_gtest(run_index_recorder_test test/ros/run_index_recorder_test.cpp)
+if(TARGET run_index_recorder_test)
+  target_link_libraries(run_index_recorder_test collision_lab_ros GTest::gtest_main)
+endif()
+
+# The real nodes (rostest): a lab node killed with SIGKILL and respawned by roslaunch
+# lists every earlier run and leaves a live node's bag alone.
+add_rostest_gtest(index_restart_test test/ros/index_restart_test.test test/ros/index_restart_test.cpp)
+target_link_libraries(index_restart_test collision_lab_ros ${catkin_LIBRARIES})
+add_dependencies(index_restart_test collision_lab_node)

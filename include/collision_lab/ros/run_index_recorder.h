@@ -1,0 +1,104 @@
+// The lab node's side of the run index (service/run_index.h, docs/ros.md "The run index"):
+// converts AcceptedRun/InitialConditions, RunSummary and Rejected to the index's rows and
+// JSON, answers ~list_runs from it, and recovers the runs of dead nodes at start.
+//
+// The index is a record, never a reason to lose a run: every RunIndexError is caught and
+// logged (ROS_ERROR), and the run goes on. Thread-safe (RunIndex is).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "collision_lab/AcceptedRun.h"
+#include "collision_lab/InitialConditions.h"
+#include "collision_lab/Rejected.h"
+#include "collision_lab/RunSummary.h"
+#include "collision_lab/ServedRun.h"
+#include "collision_lab/service/run_index.h"
+
+namespace collision_lab_ros {
+
+/// The index's JSON of a served input (IndexedRun::scene_json): masses ("inf" for a wall),
+/// positions, velocities, restitution (null for a non-finite value), max_collisions, mode,
+/// student, run_id.
+std::string inputJson(const collision_lab::InitialConditions& input);
+/// The index's JSON of a summary (IndexedRun::summary_json): the fields the class pages
+/// show, under RunSummary's field names.
+std::string summaryJson(const collision_lab::RunSummary& summary);
+
+/// What a bag holds, read with rosbag::View.
+struct BagContents {
+  std::uint64_t events = 0;       ///< [1] CollisionEvent messages
+  double last_event_time = 0.0;   ///< [s] simulated time of the last one (CollisionEvent.time); 0 without events
+  std::optional<collision_lab::InitialConditions> input;
+  std::optional<collision_lab::RunSummary> summary;  ///< the run's summary, when it was written
+};
+/// Reads the bag at path (indexed: closed, or reindexed). Throws rosbag::BagException.
+BagContents readBagContents(const std::string& path);
+
+/// A bag of a dead owner that recoverActiveBags took.
+struct RecoveredBag {
+  std::string run_id;
+  std::string bag_path;  ///< <run_id>.bag once recovered; empty when the file held no bag (an empty claim, removed)
+  BagContents contents;
+  std::string error;     ///< empty when recovered; else why not (the .active file is left as it was)
+};
+
+/// Recovers every <run_id>.bag.active in directory whose owner is dead, i.e. whose
+/// flock(LOCK_EX|LOCK_NB) this call gets (claimBag: a live owner holds it, so a live
+/// node's bag is never touched, whichever node shares the directory). Each is reindexed
+/// (`rosbag reindex --output-dir`, python3-rosbag: rosbag's C++ API has no reindex) into a
+/// private folder of directory, renamed to <run_id>.bag (never replacing a file) and read;
+/// the .active file is then removed. An empty .active file (a claim whose bag was never
+/// opened) is removed. Claim files of claimers that died before renaming them are removed.
+std::vector<RecoveredBag> recoverActiveBags(const std::string& directory);
+
+/// Whether a live process holds <run_id>.bag.active (its flock cannot be taken).
+bool activeBagOwned(const std::string& active_path);
+
+/// The lab node's writer of the index.
+class RunIndexRecorder {
+ public:
+  /// Opens <bag_directory>/runs.sqlite (creating it and the directory). A failure is
+  /// logged and the recorder records nothing (ok() false): the node serves on.
+  explicit RunIndexRecorder(const std::string& bag_directory);
+  ~RunIndexRecorder();
+
+  bool ok() const { return index_ != nullptr; }
+  const std::string& bagDirectory() const { return bag_directory_; }
+  collision_lab::service::RunIndex* index() { return index_.get(); }
+
+  /// A run accepted and queued; input as served (its run_id assigned).
+  void accepted(const collision_lab::AcceptedRun& run, const collision_lab::InitialConditions& input);
+  /// The run left the queue: a worker computes it.
+  void started(const std::string& run_id);
+  /// Its summary is out (its bag closed).
+  void finished(const collision_lab::RunSummary& summary);
+  void rejected(const collision_lab::Rejected& rejected);
+
+  /// ~list_runs: every run of the index (every node process that wrote bag_directory),
+  /// oldest first, student's only when student is not empty; in ServedRun's format. Empty
+  /// (and logged) when the index cannot be read.
+  std::vector<collision_lab::ServedRun> list(const std::string& student) const;
+
+  /// At the node's start, before it serves: recovers the .active bags of dead owners
+  /// (recoverActiveBags) and records their runs as interrupted (stop reason INTERRUPTED,
+  /// the events the bag holds; finished from its summary when the bag has one), then ends
+  /// every run the index still has queued or running with no live owner: completed as
+  /// finished from its final bag's summary, else interrupted with the events its bag holds
+  /// (none without a bag). Nothing stays "running". Returns the runs it ended.
+  std::size_t recover();
+
+ private:
+  /// Ends run_id from what its bag holds (finished with a summary, else interrupted).
+  void endFromBag(const std::string& run_id, const std::string& bag_path, const BagContents& contents,
+                  const std::string& note);
+
+  std::string bag_directory_;
+  std::unique_ptr<collision_lab::service::RunIndex> index_;
+};
+
+}  // namespace collision_lab_ros

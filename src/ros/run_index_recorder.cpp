@@ -1,0 +1,450 @@
+#include "collision_lab/ros/run_index_recorder.h"
+
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/file.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <utility>
+
+#include <nlohmann/json.hpp>
+#include <ros/console.h>
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+
+#include "collision_lab/CollisionEvent.h"
+#include "collision_lab/ros/run_recorder.h"
+
+extern char** environ;
+
+namespace collision_lab_ros {
+
+namespace fs = std::filesystem;
+using collision_lab::service::IndexedRejection;
+using collision_lab::service::IndexedRun;
+using collision_lab::service::RunIndex;
+using collision_lab::service::RunIndexError;
+using collision_lab::service::RunState;
+using nlohmann::json;
+
+namespace {
+
+constexpr char kActiveSuffix[] = ".bag.active";
+
+/// [s] since the epoch, wall time.
+double wallNow() {
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+/// JSON has no inf or NaN: null.
+json finite(double x) { return std::isfinite(x) ? json(x) : json(nullptr); }
+
+json finiteArray(const std::vector<double>& values) {
+  json out = json::array();
+  for (double v : values) out.push_back(finite(v));
+  return out;
+}
+
+bool endsWith(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+/// A descriptor holding flock(LOCK_EX) on a file, closed (unlocked) on destruction.
+class FileLock {
+ public:
+  /// Opens path and takes its lock without waiting; held() false when another open file
+  /// description holds it (a live owner) or path cannot be opened.
+  explicit FileLock(const std::string& path) : fd_(::open(path.c_str(), O_RDONLY | O_CLOEXEC)) {
+    if (fd_ >= 0 && ::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+      ::close(fd_);
+      fd_ = -1;
+    }
+  }
+  ~FileLock() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  FileLock(const FileLock&) = delete;
+  FileLock& operator=(const FileLock&) = delete;
+  bool held() const { return fd_ >= 0; }
+  /// Whether path still names the locked file (another recoverer may have renamed or
+  /// removed it between our open and our lock).
+  bool stillAt(const std::string& path) const {
+    struct stat by_fd {}, by_name {};
+    return fd_ >= 0 && ::fstat(fd_, &by_fd) == 0 && ::stat(path.c_str(), &by_name) == 0 &&
+           by_fd.st_dev == by_name.st_dev && by_fd.st_ino == by_name.st_ino;
+  }
+  std::uintmax_t size() const {
+    struct stat st {};
+    return ::fstat(fd_, &st) == 0 ? static_cast<std::uintmax_t>(st.st_size) : 0;
+  }
+
+ private:
+  int fd_;
+};
+
+/// Runs `rosbag reindex -q --output-dir out_dir bag` and waits; empty on success, else why not.
+std::string reindexInto(const std::string& bag, const std::string& out_dir) {
+  std::vector<std::string> args{"rosbag", "reindex", "-q", "--output-dir", out_dir, bag};
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  const int spawned = ::posix_spawnp(&pid, "rosbag", nullptr, nullptr, argv.data(), environ);
+  if (spawned != 0) return std::string("cannot run rosbag reindex (python3-rosbag): ") + std::strerror(spawned);
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0) {
+    if (errno != EINTR) return std::string("waiting for rosbag reindex: ") + std::strerror(errno);
+  }
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+    return "rosbag reindex failed (status " + std::to_string(status) + ")";
+  }
+  return {};
+}
+
+/// Renames from to to unless to exists. Returns 0 or an errno.
+int renameNoReplace(const std::string& from, const std::string& to) {
+  if (::renameat2(AT_FDCWD, from.c_str(), AT_FDCWD, to.c_str(), RENAME_NOREPLACE) == 0) return 0;
+  if (errno != EINVAL && errno != ENOSYS) return errno;
+  if (::link(from.c_str(), to.c_str()) != 0) return errno;
+  return ::unlink(from.c_str()) == 0 ? 0 : errno;
+}
+
+/// Recovers one dead owner's active file (locked by the caller) into final.
+RecoveredBag recoverOne(const std::string& directory, const std::string& active, const std::string& run_id,
+                        const FileLock& lock) {
+  RecoveredBag recovered;
+  recovered.run_id = run_id;
+  if (lock.size() == 0) {
+    // A claim whose bag was never opened: nothing to keep.
+    std::error_code ec;
+    fs::remove(active, ec);
+    if (ec) recovered.error = "cannot remove the empty claim " + active + ": " + ec.message();
+    return recovered;
+  }
+  const std::string final_path = bagPath(directory, run_id);
+  // A private folder beside the bags (same file system: the rename below is atomic).
+  const std::string work = (fs::path(directory) / (".recovering." + std::to_string(::getpid()))).string();
+  std::error_code ec;
+  fs::create_directories(work, ec);
+  if (ec) {
+    recovered.error = "cannot create " + work + ": " + ec.message();
+    return recovered;
+  }
+  const std::string reindexed = (fs::path(work) / fs::path(active).filename()).string();
+  std::string error;
+  try {
+    readBagContents(active);  // indexed already: closed, but never renamed
+    fs::copy_file(active, reindexed, fs::copy_options::overwrite_existing);
+  } catch (const std::exception&) {
+    error = reindexInto(active, work);
+  }
+  if (error.empty()) {
+    try {
+      recovered.contents = readBagContents(reindexed);
+    } catch (const std::exception& e) {
+      error = std::string("the reindexed bag cannot be read: ") + e.what();
+    }
+  }
+  if (error.empty()) {
+    const int renamed = renameNoReplace(reindexed, final_path);
+    if (renamed == EEXIST) {
+      error = final_path + " exists: not overwritten; " + active + " is left as it is";
+    } else if (renamed != 0) {
+      error = "cannot rename to " + final_path + ": " + std::strerror(renamed);
+    }
+  }
+  if (error.empty()) {
+    fs::remove(active, ec);
+    recovered.bag_path = final_path;
+  }
+  recovered.error = error;
+  fs::remove_all(work, ec);
+  return recovered;
+}
+
+std::string interruptedJson(const std::string& bag_path, const BagContents& contents, const std::string& note) {
+  return json{{"stop_reason", "INTERRUPTED"},
+              {"truncated", true},
+              {"truncation_reason", note},
+              {"collision_count", contents.events},
+              {"events_in_bag", contents.events},
+              {"last_event_time", contents.last_event_time},
+              {"recorded", !bag_path.empty()}}
+      .dump();
+}
+
+}  // namespace
+
+std::string inputJson(const collision_lab::InitialConditions& in) {
+  json masses = json::array();
+  for (double m : in.masses) masses.push_back(std::isinf(m) && m > 0 ? json("inf") : finite(m));
+  return json{{"run_id", in.run_id},
+              {"student", in.student},
+              {"mode", in.mode},
+              {"masses", masses},
+              {"positions", finiteArray(in.positions)},
+              {"velocities", finiteArray(in.velocities)},
+              {"restitution", finiteArray(in.restitution)},
+              {"restitution_model", in.restitution_model},
+              {"tc", finite(in.tc)},
+              {"elastic_below", finite(in.elastic_below)},
+              {"viscoelastic_speed", finite(in.viscoelastic_speed)},
+              {"ring", finite(in.ring)},
+              {"max_collisions", in.max_collisions},
+              {"max_run_seconds", finite(in.max_run_seconds)},
+              {"max_bag_bytes", in.max_bag_bytes}}
+      .dump();
+}
+
+std::string summaryJson(const collision_lab::RunSummary& s) {
+  return json{{"run_id", s.run_id},
+              {"student", s.student},
+              {"requested_run_id", s.requested_run_id},
+              {"mode", s.mode},
+              {"model", s.model_name},
+              {"model_reason", s.model_reason},
+              {"body_count", s.body_count},
+              {"collision_count", s.collision_count},
+              {"simulated", static_cast<bool>(s.simulated)},
+              {"truncated", static_cast<bool>(s.truncated)},
+              {"truncation_reason", s.truncation_reason},
+              {"cancelled", static_cast<bool>(s.cancelled)},
+              {"stop_reason", s.stop_reason},
+              {"predicted_collision_count",
+               s.predicted_collision_count_defined ? json(s.predicted_collision_count) : json(nullptr)},
+              {"paper_collision_count",
+               s.paper_predicted_collision_count_defined ? json(s.paper_predicted_collision_count) : json(nullptr)},
+              {"infinite_collisions", static_cast<bool>(s.infinite_collisions)},
+              {"final_velocities", finiteArray(s.final_velocities)},
+              {"energy_lost", finite(s.energy_lost)},
+              {"collapsed", static_cast<bool>(s.collapsed)},
+              {"max_prediction_error", finite(s.max_prediction_error)},
+              {"energy_relative_drift", finite(s.energy_relative_drift)},
+              {"momentum_relative_drift", finite(s.momentum_relative_drift)},
+              {"compute_time", finite(s.compute_time)},
+              {"published_events", s.published_events},
+              {"bag_path", s.bag_path},
+              {"recorded", s.recording_ok && !s.bag_path.empty()},
+              {"recording_error", s.recording_error}}
+      .dump();
+}
+
+BagContents readBagContents(const std::string& path) {
+  BagContents contents;
+  rosbag::Bag bag(path, rosbag::bagmode::Read);
+  const rosbag::TypeQuery events_query(std::string(ros::message_traits::datatype<collision_lab::CollisionEvent>()));
+  rosbag::View events(bag, events_query);
+  contents.events = events.size();
+  if (contents.events > 0) {
+    // Only the messages at the last stamp are read: the last event is among them.
+    rosbag::View last(bag, events_query, events.getEndTime(), events.getEndTime());
+    for (const rosbag::MessageInstance& m : last) {
+      if (const auto e = m.instantiate<collision_lab::CollisionEvent>()) contents.last_event_time = e->time;
+    }
+  }
+  rosbag::View rest(bag, rosbag::TypeQuery(std::vector<std::string>{
+                             ros::message_traits::datatype<collision_lab::InitialConditions>(),
+                             ros::message_traits::datatype<collision_lab::RunSummary>()}));
+  for (const rosbag::MessageInstance& m : rest) {
+    if (const auto input = m.instantiate<collision_lab::InitialConditions>()) contents.input = *input;
+    if (const auto summary = m.instantiate<collision_lab::RunSummary>()) contents.summary = *summary;
+  }
+  return contents;
+}
+
+bool activeBagOwned(const std::string& active_path) {
+  if (!fs::exists(active_path)) return false;
+  return !FileLock(active_path).held();
+}
+
+std::vector<RecoveredBag> recoverActiveBags(const std::string& directory) {
+  std::vector<RecoveredBag> recovered;
+  std::error_code ec;
+  std::vector<std::string> actives, stale_claims;
+  for (const auto& entry : fs::directory_iterator(directory, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (endsWith(name, kActiveSuffix)) actives.push_back(entry.path().string());
+    else if (name.find(std::string(kActiveSuffix) + kClaimInfix) != std::string::npos) stale_claims.push_back(entry.path().string());
+  }
+  for (const std::string& claim : stale_claims) {
+    FileLock lock(claim);
+    if (lock.held() && lock.stillAt(claim)) fs::remove(claim, ec);
+  }
+  for (const std::string& active : actives) {
+    FileLock lock(active);
+    if (!lock.held() || !lock.stillAt(active)) continue;  // a live owner's, or another recoverer's
+    const std::string name = fs::path(active).filename().string();
+    recovered.push_back(recoverOne(directory, active, name.substr(0, name.size() - std::strlen(kActiveSuffix)), lock));
+  }
+  return recovered;
+}
+
+RunIndexRecorder::RunIndexRecorder(const std::string& bag_directory) : bag_directory_(bag_directory) {
+  std::error_code ec;
+  fs::create_directories(bag_directory, ec);
+  try {
+    index_ = std::make_unique<RunIndex>(RunIndex::defaultPath(bag_directory));
+  } catch (const RunIndexError& e) {
+    ROS_ERROR_STREAM("the run index is not written (runs are served and recorded in bags as ever): " << e.what());
+  }
+}
+
+RunIndexRecorder::~RunIndexRecorder() = default;
+
+void RunIndexRecorder::accepted(const collision_lab::AcceptedRun& run, const collision_lab::InitialConditions& input) {
+  if (!index_) return;
+  IndexedRun row;
+  row.run_id = run.run_id;
+  row.student = run.student;
+  row.requested_run_id = run.requested_run_id;
+  row.state = RunState::kQueued;
+  row.accepted_at = run.header.stamp.isZero() ? wallNow() : run.header.stamp.toSec();
+  row.scene_json = inputJson(input);
+  try {
+    index_->accepted(row);
+  } catch (const RunIndexError& e) {
+    ROS_ERROR_STREAM("run " << run.run_id << ": not in the run index: " << e.what());
+  }
+}
+
+void RunIndexRecorder::started(const std::string& run_id) {
+  if (!index_) return;
+  try {
+    index_->started(run_id, wallNow());
+  } catch (const RunIndexError& e) {
+    ROS_ERROR_STREAM("run " << run_id << ": its start is not in the run index: " << e.what());
+  }
+}
+
+void RunIndexRecorder::finished(const collision_lab::RunSummary& summary) {
+  if (!index_) return;
+  try {
+    index_->finished(summary.run_id, wallNow(), summaryJson(summary), summary.stop_reason, summary.collision_count,
+                     summary.recording_ok ? summary.bag_path : std::string());
+  } catch (const RunIndexError& e) {
+    ROS_ERROR_STREAM("run " << summary.run_id << ": its end is not in the run index: " << e.what());
+  }
+}
+
+void RunIndexRecorder::rejected(const collision_lab::Rejected& rejected) {
+  if (!index_) return;
+  IndexedRejection row;
+  row.at = rejected.header.stamp.isZero() ? wallNow() : rejected.header.stamp.toSec();
+  row.student = rejected.student;
+  row.run_id = rejected.run_id;
+  row.reason_name = rejected.reason_name;
+  row.field = rejected.field;
+  row.message = rejected.message;
+  try {
+    index_->rejected(row);
+  } catch (const RunIndexError& e) {
+    ROS_ERROR_STREAM("a rejection is not in the run index: " << e.what());
+  }
+}
+
+std::vector<collision_lab::ServedRun> RunIndexRecorder::list(const std::string& student) const {
+  std::vector<collision_lab::ServedRun> served;
+  if (!index_) return served;
+  std::vector<IndexedRun> rows;
+  try {
+    rows = index_->list(student.empty() ? std::nullopt : std::optional<std::string>(student));
+  } catch (const RunIndexError& e) {
+    ROS_ERROR_STREAM("~list_runs: the run index cannot be read: " << e.what());
+    return served;
+  }
+  served.reserve(rows.size());
+  for (const IndexedRun& row : rows) {
+    collision_lab::ServedRun run;
+    run.accepted.header.stamp.fromSec(row.accepted_at);
+    run.accepted.run_id = row.run_id;
+    run.accepted.requested_run_id = row.requested_run_id;
+    run.accepted.student = row.student;
+    run.finished = row.state == RunState::kFinished || row.state == RunState::kInterrupted;
+    run.collision_count = row.collision_count;
+    run.stop_reason = row.stop_reason;
+    run.bag_path = row.bag_path;
+    const json summary = json::parse(row.summary_json, nullptr, false);
+    if (summary.is_object()) {
+      run.truncated = summary.value("truncated", false);
+      run.recording_ok = summary.value("recorded", false);
+    }
+    served.push_back(std::move(run));
+  }
+  return served;
+}
+
+void RunIndexRecorder::endFromBag(const std::string& run_id, const std::string& bag_path, const BagContents& contents,
+                                  const std::string& note) {
+  if (!index_->find(run_id) && contents.input) {
+    // A run the index never saw (its node had no index): its row from the bag's input.
+    IndexedRun row;
+    row.run_id = run_id;
+    row.student = contents.input->student;
+    row.accepted_at = contents.input->header.stamp.toSec();
+    row.scene_json = inputJson(*contents.input);
+    index_->accepted(row);
+  }
+  if (contents.summary) {
+    collision_lab::RunSummary summary = *contents.summary;
+    summary.bag_path = bag_path;
+    summary.recording_ok = !bag_path.empty();
+    index_->finished(run_id, wallNow(), summaryJson(summary), summary.stop_reason, summary.collision_count, bag_path);
+    ROS_INFO_STREAM("run " << run_id << ": completed from its bag's summary (" << note << ")");
+    return;
+  }
+  index_->interrupted(run_id, wallNow(), interruptedJson(bag_path, contents, note), contents.events, bag_path);
+  ROS_WARN_STREAM("run " << run_id << ": interrupted (" << note << "); its bag "
+                  << (bag_path.empty() ? std::string("holds nothing") : bag_path + " holds " + std::to_string(contents.events) + " events"));
+}
+
+std::size_t RunIndexRecorder::recover() {
+  std::size_t ended = 0;
+  for (const RecoveredBag& bag : recoverActiveBags(bag_directory_)) {
+    if (!bag.error.empty()) {
+      ROS_ERROR_STREAM("run " << bag.run_id << ": its bag left .active by a dead node was not recovered: " << bag.error);
+    }
+    if (!index_) continue;
+    try {
+      endFromBag(bag.run_id, bag.bag_path, bag.contents, "its node died; bag recovered from .active");
+      ++ended;
+    } catch (const std::exception& e) {
+      ROS_ERROR_STREAM("run " << bag.run_id << ": not recorded as interrupted: " << e.what());
+    }
+  }
+  if (!index_) return ended;
+  std::vector<IndexedRun> open_runs;
+  try {
+    open_runs = index_->inState(RunState::kRunning);
+    const auto queued = index_->inState(RunState::kQueued);
+    open_runs.insert(open_runs.end(), queued.begin(), queued.end());
+  } catch (const RunIndexError& e) {
+    ROS_ERROR_STREAM("recovery: the run index cannot be read: " << e.what());
+    return ended;
+  }
+  for (const IndexedRun& run : open_runs) {
+    const std::string final_path = bagPath(bag_directory_, run.run_id);
+    if (activeBagOwned(final_path + ".active")) continue;  // a live node's run
+    try {
+      BagContents contents;
+      std::string bag_path;
+      if (fs::exists(final_path)) {
+        contents = readBagContents(final_path);
+        bag_path = final_path;
+      }
+      endFromBag(run.run_id, bag_path, contents, "its node died before the run finished");
+      ++ended;
+    } catch (const std::exception& e) {
+      ROS_ERROR_STREAM("run " << run.run_id << ": not recovered: " << e.what());
+    }
+  }
+  return ended;
+}
+
+}  // namespace collision_lab_ros

@@ -1,0 +1,343 @@
+#include "collision_lab/service/run_index.h"
+
+#include <sqlite3.h>
+
+#include <chrono>
+#include <filesystem>
+#include <thread>
+#include <utility>
+
+namespace collision_lab::service {
+
+namespace {
+
+/// The schema this code writes (PRAGMA user_version). A file of a newer version is refused.
+constexpr int kSchemaVersion = 1;
+/// [ms] a statement waits for another connection's write lock before SQLITE_BUSY.
+constexpr int kBusyTimeoutMs = 10000;
+
+constexpr const char* kSchema = R"sql(
+CREATE TABLE IF NOT EXISTS runs (
+  run_id TEXT PRIMARY KEY NOT NULL,
+  student TEXT NOT NULL DEFAULT '',
+  requested_run_id TEXT NOT NULL DEFAULT '',
+  state TEXT NOT NULL,                      -- queued, running, finished, interrupted
+  accepted_at REAL NOT NULL DEFAULT 0,      -- [s] since the epoch
+  started_at REAL NOT NULL DEFAULT 0,       -- [s] since the epoch; 0 until running
+  finished_at REAL NOT NULL DEFAULT 0,      -- [s] since the epoch; 0 until finished or interrupted
+  scene_json TEXT NOT NULL DEFAULT '',      -- the served InitialConditions as JSON
+  summary_json TEXT NOT NULL DEFAULT '',    -- the RunSummary as JSON once finished
+  stop_reason TEXT NOT NULL DEFAULT '',
+  collision_count INTEGER NOT NULL DEFAULT 0,  -- [1], a uint64 stored as its int64 bits
+  bag_path TEXT NOT NULL DEFAULT '',
+  csv_path TEXT NOT NULL DEFAULT '');
+CREATE INDEX IF NOT EXISTS runs_by_student ON runs(student, accepted_at);
+CREATE INDEX IF NOT EXISTS runs_by_state ON runs(state);
+CREATE TABLE IF NOT EXISTS rejections (
+  id INTEGER PRIMARY KEY AUTOINCREMENT,
+  at REAL NOT NULL,                         -- [s] since the epoch
+  student TEXT NOT NULL DEFAULT '',
+  run_id TEXT NOT NULL DEFAULT '',
+  reason_name TEXT NOT NULL DEFAULT '',
+  field TEXT NOT NULL DEFAULT '',
+  message TEXT NOT NULL DEFAULT '');
+CREATE INDEX IF NOT EXISTS rejections_by_student ON rejections(student, id);
+)sql";
+
+constexpr const char* kRunColumns =
+    "run_id, student, requested_run_id, state, accepted_at, started_at, finished_at, scene_json, summary_json, "
+    "stop_reason, collision_count, bag_path, csv_path";
+
+/// One prepared statement, reset and cleared when it goes out of scope. Every value is
+/// bound, never spliced into the SQL.
+class Statement {
+ public:
+  Statement(sqlite3* db, const std::string& path, const std::string& sql) : db_(db), path_(path) {
+    if (sqlite3_prepare_v2(db, sql.c_str(), static_cast<int>(sql.size()), &stmt_, nullptr) != SQLITE_OK) {
+      fail("preparing '" + sql + "'");
+    }
+  }
+  ~Statement() { sqlite3_finalize(stmt_); }
+  Statement(const Statement&) = delete;
+  Statement& operator=(const Statement&) = delete;
+
+  Statement& bind(int index, const std::string& text) {
+    check(sqlite3_bind_text(stmt_, index, text.data(), static_cast<int>(text.size()), SQLITE_TRANSIENT));
+    return *this;
+  }
+  Statement& bind(int index, double value) {
+    check(sqlite3_bind_double(stmt_, index, value));
+    return *this;
+  }
+  Statement& bind(int index, std::int64_t value) {
+    check(sqlite3_bind_int64(stmt_, index, value));
+    return *this;
+  }
+  /// True while a row is ready; false when done.
+  bool step() {
+    const int rc = sqlite3_step(stmt_);
+    if (rc == SQLITE_ROW) return true;
+    if (rc == SQLITE_DONE) return false;
+    fail("executing '" + std::string(sqlite3_sql(stmt_)) + "'");
+  }
+  void run() {
+    while (step()) {
+    }
+  }
+  std::string text(int column) const {
+    const auto* p = reinterpret_cast<const char*>(sqlite3_column_text(stmt_, column));
+    return p ? std::string(p, static_cast<std::size_t>(sqlite3_column_bytes(stmt_, column))) : std::string();
+  }
+  double real(int column) const { return sqlite3_column_double(stmt_, column); }
+  std::int64_t integer(int column) const { return sqlite3_column_int64(stmt_, column); }
+
+ private:
+  void check(int rc) const {
+    if (rc != SQLITE_OK) fail("binding a value");
+  }
+  [[noreturn]] void fail(const std::string& what) const {
+    throw RunIndexError("run index " + path_ + ": " + what + ": " + sqlite3_errmsg(db_));
+  }
+
+  sqlite3* db_;
+  const std::string& path_;
+  sqlite3_stmt* stmt_ = nullptr;
+};
+
+std::int64_t asStored(std::uint64_t count) { return static_cast<std::int64_t>(count); }
+std::uint64_t asCount(std::int64_t stored) { return static_cast<std::uint64_t>(stored); }
+
+IndexedRun readRun(const Statement& s) {
+  IndexedRun run;
+  run.run_id = s.text(0);
+  run.student = s.text(1);
+  run.requested_run_id = s.text(2);
+  // A state this version does not know (a newer writer) reads as interrupted: not live.
+  run.state = runStateFromName(s.text(3)).value_or(RunState::kInterrupted);
+  run.accepted_at = s.real(4);
+  run.started_at = s.real(5);
+  run.finished_at = s.real(6);
+  run.scene_json = s.text(7);
+  run.summary_json = s.text(8);
+  run.stop_reason = s.text(9);
+  run.collision_count = asCount(s.integer(10));
+  run.bag_path = s.text(11);
+  run.csv_path = s.text(12);
+  return run;
+}
+
+std::string limitClause(std::size_t limit) {
+  return limit == 0 ? std::string() : " LIMIT " + std::to_string(limit);
+}
+
+}  // namespace
+
+const char* runStateName(RunState state) {
+  switch (state) {
+    case RunState::kQueued:
+      return "queued";
+    case RunState::kRunning:
+      return "running";
+    case RunState::kFinished:
+      return "finished";
+    case RunState::kInterrupted:
+      return "interrupted";
+  }
+  return "interrupted";
+}
+
+std::optional<RunState> runStateFromName(const std::string& name) {
+  for (RunState state : {RunState::kQueued, RunState::kRunning, RunState::kFinished, RunState::kInterrupted}) {
+    if (name == runStateName(state)) return state;
+  }
+  return std::nullopt;
+}
+
+RunIndex::RunIndex(const std::string& path) : path_(path) {
+  const int rc = sqlite3_open_v2(path.c_str(), &db_,
+                                 SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_FULLMUTEX, nullptr);
+  if (rc != SQLITE_OK) {
+    const std::string error = db_ ? sqlite3_errmsg(db_) : sqlite3_errstr(rc);
+    sqlite3_close(db_);
+    db_ = nullptr;
+    throw RunIndexError("run index " + path + ": cannot open: " + error);
+  }
+  sqlite3_busy_timeout(db_, kBusyTimeoutMs);
+  // Nodes starting together (labs sharing a folder) meet here: switching to WAL and
+  // creating the tables may answer SQLITE_BUSY at once, without the busy handler (e.g.
+  // while another connection recovers the WAL), so the set-up is tried again until the
+  // busy timeout has passed.
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::milliseconds(kBusyTimeoutMs);
+  for (;;) {
+    try {
+      initialize();
+      return;
+    } catch (const RunIndexError&) {
+      const int code = sqlite3_errcode(db_) & 0xff;
+      if ((code == SQLITE_BUSY || code == SQLITE_LOCKED) && std::chrono::steady_clock::now() < give_up) {
+        sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        continue;
+      }
+      sqlite3_close(db_);
+      db_ = nullptr;
+      throw;
+    }
+  }
+}
+
+void RunIndex::initialize() {
+  execute("PRAGMA journal_mode=WAL");
+  // WAL's own durability: a commit survives the process (a crash of the node); only a
+  // power cut may lose the last commits.
+  execute("PRAGMA synchronous=NORMAL");
+  std::int64_t found = 0;
+  {  // finalized before the writes below: a finalize resets the connection's error code
+    Statement version(db_, path_, "PRAGMA user_version");
+    version.step();
+    found = version.integer(0);
+  }
+  if (found == kSchemaVersion) return;
+  if (found > kSchemaVersion) {
+    throw RunIndexError("run index " + path_ + ": schema version " + std::to_string(found) +
+                        " is newer than this program's " + std::to_string(kSchemaVersion));
+  }
+  execute("BEGIN IMMEDIATE");
+  execute(kSchema);
+  execute("PRAGMA user_version=" + std::to_string(kSchemaVersion));
+  execute("COMMIT");
+}
+
+RunIndex::~RunIndex() { sqlite3_close(db_); }
+
+std::string RunIndex::defaultPath(const std::string& bag_directory) {
+  return (std::filesystem::path(bag_directory) / "runs.sqlite").string();
+}
+
+void RunIndex::execute(const std::string& sql) {
+  char* message = nullptr;
+  if (sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, &message) != SQLITE_OK) {
+    const std::string error = message ? message : sqlite3_errmsg(db_);
+    sqlite3_free(message);
+    throw RunIndexError("run index " + path_ + ": executing '" + sql.substr(0, 60) + "': " + error);
+  }
+}
+
+void RunIndex::accepted(const IndexedRun& run) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  Statement s(db_, path_,
+              std::string("INSERT OR REPLACE INTO runs (") + kRunColumns +
+                  ") VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13)");
+  s.bind(1, run.run_id).bind(2, run.student).bind(3, run.requested_run_id).bind(4, std::string(runStateName(run.state)));
+  s.bind(5, run.accepted_at).bind(6, run.started_at).bind(7, run.finished_at).bind(8, run.scene_json);
+  s.bind(9, run.summary_json).bind(10, run.stop_reason).bind(11, asStored(run.collision_count));
+  s.bind(12, run.bag_path).bind(13, run.csv_path);
+  s.run();
+}
+
+void RunIndex::started(const std::string& run_id, double at) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  // Only a queued run starts: a late call never takes a run back from its end.
+  Statement s(db_, path_, "UPDATE runs SET state = 'running', started_at = ?2 WHERE run_id = ?1 AND state = 'queued'");
+  s.bind(1, run_id).bind(2, at).run();
+}
+
+void RunIndex::finished(const std::string& run_id, double at, const std::string& summary_json,
+                        const std::string& stop_reason, std::uint64_t collision_count, const std::string& bag_path) {
+  end(run_id, RunState::kFinished, at, summary_json, stop_reason, collision_count, bag_path);
+}
+
+void RunIndex::interrupted(const std::string& run_id, double at, const std::string& summary_json,
+                           std::uint64_t collision_count, const std::string& bag_path) {
+  end(run_id, RunState::kInterrupted, at, summary_json, "INTERRUPTED", collision_count, bag_path);
+}
+
+void RunIndex::end(const std::string& run_id, RunState state, double at, const std::string& summary_json,
+                   const std::string& stop_reason, std::uint64_t collision_count, const std::string& bag_path) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  // A run without a row (accepted before its node had the index) gets one, so that no
+  // run's end is lost.
+  Statement s(db_, path_,
+              "INSERT INTO runs (run_id, state, finished_at, summary_json, stop_reason, collision_count, bag_path) "
+              "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7) ON CONFLICT(run_id) DO UPDATE SET state = excluded.state, "
+              "finished_at = excluded.finished_at, summary_json = excluded.summary_json, "
+              "stop_reason = excluded.stop_reason, collision_count = excluded.collision_count, "
+              "bag_path = excluded.bag_path");
+  s.bind(1, run_id).bind(2, std::string(runStateName(state))).bind(3, at).bind(4, summary_json);
+  s.bind(5, stop_reason).bind(6, asStored(collision_count)).bind(7, bag_path);
+  s.run();
+}
+
+void RunIndex::rejected(const IndexedRejection& rejection) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  Statement s(db_, path_,
+              "INSERT INTO rejections (at, student, run_id, reason_name, field, message) VALUES (?1, ?2, ?3, ?4, ?5, ?6)");
+  s.bind(1, rejection.at).bind(2, rejection.student).bind(3, rejection.run_id).bind(4, rejection.reason_name);
+  s.bind(5, rejection.field).bind(6, rejection.message);
+  s.run();
+}
+
+void RunIndex::setCsvPath(const std::string& run_id, const std::string& csv_path) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  Statement s(db_, path_, "UPDATE runs SET csv_path = ?2 WHERE run_id = ?1");
+  s.bind(1, run_id).bind(2, csv_path).run();
+}
+
+std::optional<IndexedRun> RunIndex::find(const std::string& run_id) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  Statement s(db_, path_, std::string("SELECT ") + kRunColumns + " FROM runs WHERE run_id = ?1");
+  s.bind(1, run_id);
+  if (!s.step()) return std::nullopt;
+  return readRun(s);
+}
+
+std::vector<IndexedRun> RunIndex::list(const std::optional<std::string>& student, std::size_t limit) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  Statement s(db_, path_,
+              std::string("SELECT ") + kRunColumns + " FROM runs" + (student ? " WHERE student = ?1" : "") +
+                  " ORDER BY accepted_at, rowid" + limitClause(limit));
+  if (student) s.bind(1, *student);
+  std::vector<IndexedRun> runs;
+  while (s.step()) runs.push_back(readRun(s));
+  return runs;
+}
+
+std::vector<IndexedRun> RunIndex::inState(RunState state) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  Statement s(db_, path_,
+              std::string("SELECT ") + kRunColumns + " FROM runs WHERE state = ?1 ORDER BY accepted_at, rowid");
+  s.bind(1, std::string(runStateName(state)));
+  std::vector<IndexedRun> runs;
+  while (s.step()) runs.push_back(readRun(s));
+  return runs;
+}
+
+std::vector<IndexedRejection> RunIndex::rejections(const std::optional<std::string>& student, std::size_t limit) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  Statement s(db_, path_,
+              std::string("SELECT id, at, student, run_id, reason_name, field, message FROM rejections") +
+                  (student ? " WHERE student = ?1" : "") + " ORDER BY id DESC" + limitClause(limit));
+  if (student) s.bind(1, *student);
+  std::vector<IndexedRejection> found;
+  while (s.step()) {
+    IndexedRejection r;
+    r.id = s.integer(0);
+    r.at = s.real(1);
+    r.student = s.text(2);
+    r.run_id = s.text(3);
+    r.reason_name = s.text(4);
+    r.field = s.text(5);
+    r.message = s.text(6);
+    found.push_back(std::move(r));
+  }
+  return found;
+}
+
+std::size_t RunIndex::runCount() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  Statement s(db_, path_, "SELECT count(*) FROM runs");
+  s.step();
+  return static_cast<std::size_t>(s.integer(0));
+}
+
+}  // namespace collision_lab::service

@@ -1,0 +1,150 @@
+// A lab node killed (SIGKILL) and respawned by roslaunch (index_restart_test.test): its
+// ~list_runs, read from the run index, still lists every run served before the crash, and
+// its start-up recovery does not touch the .bag.active of a live node sharing the folder
+// (lab_b, mid-run), whose run then ends normally with its bag complete.
+#include <signal.h>
+
+#include <filesystem>
+#include <set>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <ros/master.h>
+#include <ros/network.h>
+#include <ros/ros.h>
+#include <xmlrpcpp/XmlRpcClient.h>
+
+#include "collision_lab/Cancel.h"
+#include "collision_lab/ListRuns.h"
+#include "run_collector.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using collision_lab_test::callService;
+using collision_lab_test::makeInput;
+using collision_lab_test::RunCollector;
+using collision_lab_test::waitUntil;
+
+/// The pid of a node, asked through the master (lookupNode) and the node's own XML-RPC
+/// server (getPid); -1 while it is not registered or does not answer.
+int nodePid(const std::string& node) {
+  XmlRpc::XmlRpcValue args, result, payload;
+  args[0] = ros::this_node::getName();
+  args[1] = node;
+  if (!ros::master::execute("lookupNode", args, result, payload, false)) return -1;
+  std::string host;
+  uint32_t port = 0;
+  if (!ros::network::splitURI(static_cast<std::string>(payload), host, port)) return -1;
+  XmlRpc::XmlRpcClient client(host.c_str(), static_cast<int>(port), "/");
+  XmlRpc::XmlRpcValue request, response;
+  request[0] = ros::this_node::getName();
+  if (!client.execute("getPid", request, response) || response.getType() != XmlRpc::XmlRpcValue::TypeArray ||
+      response.size() < 3 || static_cast<int>(response[0]) != 1) {
+    return -1;
+  }
+  return static_cast<int>(response[2]);
+}
+
+std::vector<collision_lab::ServedRun> listRuns(const std::string& lab) {
+  collision_lab::ListRuns list;
+  EXPECT_TRUE(callService("/" + lab + "/collision_lab_node/list_runs", list));
+  return list.response.runs;
+}
+
+const collision_lab::ServedRun* findRun(const std::vector<collision_lab::ServedRun>& runs, const std::string& run_id) {
+  for (const auto& run : runs) {
+    if (run.accepted.run_id == run_id) return &run;
+  }
+  return nullptr;
+}
+
+TEST(IndexRestart, AKilledNodeRespawnsListingEveryRunAndLeavesALiveNodesBagAlone) {
+  ros::NodeHandle private_nh("~");
+  std::string bags;
+  ASSERT_TRUE(private_nh.getParam("bag_directory", bags));
+  RunCollector lab_a("lab_a"), lab_b("lab_b");
+  lab_a.waitForConnection();
+  lab_b.waitForConnection();
+
+  // Three students' pi runs (31 impacts each) on lab_a, before the crash.
+  const std::vector<std::string> students{"ana", "ben", "eva"};
+  for (const auto& student : students) {
+    auto input = makeInput("pi", {100, 1, std::numeric_limits<double>::infinity()}, {2, 1, 0}, {-1, 0, 0});
+    input.student = student;
+    lab_a.publish(input);
+    ASSERT_EQ(lab_a.waitFor(student + ".pi").summaries.at(0).collision_count, 31u);
+  }
+
+  // A long run on lab_b (about 22 million impacts), recording while lab_a crashes.
+  auto long_input = makeInput("long_b", {1e14, 1, 1e14}, {2, 1, 0}, {-1, 0, 0});
+  long_input.max_collisions = 1000000000;
+  lab_b.publish(long_input);
+  const std::string live_active = bags + "/long_b.bag.active";
+  waitUntil([&] {
+    const auto run = lab_b.runs().find("long_b");
+    return run != lab_b.runs().end() && run->second.events.size() >= 1000 && fs::exists(live_active);
+  }, "1,000 impacts of lab_b's long run and its .bag.active");
+
+  const int old_pid = nodePid("/lab_a/collision_lab_node");
+  ASSERT_GT(old_pid, 0);
+  ASSERT_EQ(::kill(old_pid, SIGKILL), 0);
+  // roslaunch respawns it (respawn_delay 1 s); the new process registers again.
+  waitUntil([&] {
+    const int pid = nodePid("/lab_a/collision_lab_node");
+    return pid > 0 && pid != old_pid;
+  }, "roslaunch to respawn /lab_a/collision_lab_node");
+  ASSERT_TRUE(ros::service::waitForService("/lab_a/collision_lab_node/list_runs",
+                                           ros::Duration(collision_lab_test::kWaitTimeout)));
+
+  // The respawned node lists every earlier run, finished, with its bag.
+  const auto runs = listRuns("lab_a");
+  for (const auto& student : students) {
+    const auto* run = findRun(runs, student + ".pi");
+    ASSERT_NE(run, nullptr) << student << ".pi is not listed after the restart";
+    EXPECT_TRUE(run->finished);
+    EXPECT_EQ(run->accepted.student, student);
+    EXPECT_EQ(run->collision_count, 31u);
+    EXPECT_EQ(run->stop_reason, "FINISHED");
+    EXPECT_TRUE(run->recording_ok);
+    EXPECT_EQ(run->bag_path, bags + "/" + student + ".pi.bag");
+  }
+  // ana's alone, by student.
+  collision_lab::ListRuns ana;
+  ana.request.student = "ana";
+  ASSERT_TRUE(callService("/lab_a/collision_lab_node/list_runs", ana));
+  ASSERT_EQ(ana.response.runs.size(), 1u);
+  EXPECT_EQ(ana.response.runs[0].accepted.run_id, "ana.pi");
+
+  // lab_b's run is in the shared index, still running, and its bag was not taken.
+  const auto* live = findRun(runs, "long_b");
+  ASSERT_NE(live, nullptr);
+  ASSERT_FALSE(live->finished) << "lab_b's run ended before lab_a restarted: the test proves nothing";
+  EXPECT_TRUE(fs::exists(live_active));
+  EXPECT_FALSE(fs::exists(bags + "/long_b.bag"));
+
+  // Stopped on lab_b, it ends normally: bag closed by its owner, complete.
+  collision_lab::Cancel cancel;
+  cancel.request.run_id = "long_b";
+  ASSERT_TRUE(callService("/lab_b/collision_lab_node/cancel", cancel));
+  EXPECT_TRUE(cancel.response.ok) << cancel.response.message;
+  const auto& long_out = lab_b.waitFor("long_b");
+  ASSERT_EQ(long_out.summaries.size(), 1u);
+  EXPECT_TRUE(long_out.summaries[0].recording_ok) << long_out.summaries[0].recording_error;
+  EXPECT_TRUE(fs::exists(bags + "/long_b.bag"));
+  EXPECT_FALSE(fs::exists(live_active));
+  const auto after = listRuns("lab_a");
+  const auto* ended = findRun(after, "long_b");
+  ASSERT_NE(ended, nullptr);
+  EXPECT_TRUE(ended->finished);
+  EXPECT_EQ(ended->collision_count, long_out.summaries[0].collision_count);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "index_restart_test");
+  ros::NodeHandle nh;
+  return RUN_ALL_TESTS();
+}

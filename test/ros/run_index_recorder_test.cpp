@@ -1,0 +1,255 @@
+// The lab node's side of the run index, no master: the bag claim's lock (claimBag) held
+// while a bag is written and dropped when it closes; recovery of the .active bag of a
+// writer killed mid-run (reindexed, renamed, counted, indexed as interrupted), never of a
+// live owner's; stale rows ended; ~list_runs' rows from the index.
+#include <sys/file.h>
+#include <sys/wait.h>
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <ros/time.h>
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+
+#include "collision_lab/CollisionEvent.h"
+#include "collision_lab/ros/run_index_recorder.h"
+#include "collision_lab/ros/run_recorder.h"
+
+namespace fs = std::filesystem;
+using collision_lab::service::RunIndex;
+using collision_lab::service::RunState;
+using namespace collision_lab_ros;
+
+namespace {
+
+/// Whether another open file description can take path's flock now.
+bool lockable(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return false;
+  const bool got = ::flock(fd, LOCK_EX | LOCK_NB) == 0;
+  ::close(fd);
+  return got;
+}
+
+collision_lab::InitialConditions input(const std::string& run_id, const std::string& student) {
+  collision_lab::InitialConditions in;
+  in.header.stamp = ros::Time(1000);
+  in.run_id = run_id;
+  in.student = student;
+  in.masses = {100, 1, std::numeric_limits<double>::infinity()};
+  in.positions = {2, 1, 0};
+  in.velocities = {-1, 0, 0};
+  return in;
+}
+
+collision_lab::CollisionEvent event(const std::string& run_id, std::uint64_t k) {
+  collision_lab::CollisionEvent e;
+  e.run_id = run_id;
+  e.index = k;
+  e.time = 0.5 * static_cast<double>(k + 1);
+  e.header.stamp = ros::Time(1000) + ros::Duration(e.time);
+  return e;
+}
+
+class RunIndexRecorderTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ros::Time::init();
+    char pattern[] = "/tmp/run_index_recorder_test_XXXXXX";
+    ASSERT_NE(::mkdtemp(pattern), nullptr);
+    dir_ = pattern;
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  /// A writer process killed mid-run: it claims run_id's bag, writes the input and
+  /// `events` events, and ends without closing the bag (as kill -9 would).
+  void killedWriter(const std::string& run_id, std::uint64_t events) {
+    const pid_t child = ::fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+      RunRecorder* recorder = new RunRecorder(dir_, run_id);  // never destroyed: no close
+      recorder->write("/initial_conditions", ros::Time(1000), input(run_id, "ana"));
+      for (std::uint64_t k = 0; k < events; ++k) {
+        const auto e = event(run_id, k);
+        recorder->write("/collision_events", e.header.stamp, e);
+      }
+      ::_exit(recorder->ok() ? 0 : 1);
+    }
+    int status = 0;
+    ASSERT_EQ(::waitpid(child, &status, 0), child);
+    ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+    ASSERT_TRUE(fs::exists(bagPath(dir_, run_id) + ".active"));
+    ASSERT_FALSE(fs::exists(bagPath(dir_, run_id)));
+  }
+
+  std::string dir_;
+};
+
+TEST_F(RunIndexRecorderTest, AClaimIsLockedUntilItsBagIsClosed) {
+  std::string error;
+  ASSERT_EQ(claimBag(dir_, "r1", error), BagClaim::kClaimed) << error;
+  const std::string active = bagPath(dir_, "r1") + ".active";
+  EXPECT_TRUE(bagClaimHeld(active));
+  EXPECT_FALSE(lockable(active));
+  EXPECT_TRUE(activeBagOwned(active));
+  {
+    rosbag::Bag reused;
+    RunRecorder recorder(dir_, "r1", reused, "");
+    recorder.write("/initial_conditions", ros::Time(1000), input("r1", "ana"));
+    EXPECT_FALSE(lockable(active));  // held while written
+    ASSERT_TRUE(recorder.close()) << recorder.error();
+  }
+  EXPECT_FALSE(bagClaimHeld(active));
+  EXPECT_TRUE(lockable(bagPath(dir_, "r1")));  // the renamed file's lock is gone too
+  // A claim given back (cancelled while queued) drops its lock.
+  ASSERT_EQ(claimBag(dir_, "r2", error), BagClaim::kClaimed) << error;
+  releaseBagClaim(bagPath(dir_, "r2") + ".active");
+  EXPECT_TRUE(lockable(bagPath(dir_, "r2") + ".active"));
+}
+
+TEST_F(RunIndexRecorderTest, ALiveOwnersBagIsNeverTaken) {
+  std::string error;
+  ASSERT_EQ(claimBag(dir_, "live", error), BagClaim::kClaimed) << error;
+  rosbag::Bag reused;
+  RunRecorder recorder(dir_, "live", reused, "");
+  recorder.write("/initial_conditions", ros::Time(1000), input("live", "ana"));
+  EXPECT_TRUE(recoverActiveBags(dir_).empty());
+  EXPECT_TRUE(fs::exists(bagPath(dir_, "live") + ".active"));
+  EXPECT_TRUE(recorder.close()) << recorder.error();
+  EXPECT_TRUE(fs::exists(bagPath(dir_, "live")));
+}
+
+TEST_F(RunIndexRecorderTest, AKilledWritersBagIsReindexedRenamedAndCounted) {
+  constexpr std::uint64_t kWritten = 30000;  // several chunks: most reach the disk before the kill
+  killedWriter("dead", kWritten);
+  {  // unindexed: rosbag's C++ API refuses it
+    rosbag::Bag raw;
+    EXPECT_ANY_THROW(raw.open(bagPath(dir_, "dead") + ".active", rosbag::bagmode::Read));
+  }
+  const auto recovered = recoverActiveBags(dir_);
+  ASSERT_EQ(recovered.size(), 1u);
+  EXPECT_EQ(recovered[0].error, "");
+  EXPECT_EQ(recovered[0].run_id, "dead");
+  EXPECT_EQ(recovered[0].bag_path, bagPath(dir_, "dead"));
+  EXPECT_FALSE(fs::exists(bagPath(dir_, "dead") + ".active"));
+  ASSERT_TRUE(recovered[0].contents.input);
+  EXPECT_EQ(recovered[0].contents.input->student, "ana");
+  EXPECT_FALSE(recovered[0].contents.summary);
+  const std::uint64_t events = recovered[0].contents.events;
+  EXPECT_GT(events, 0u);
+  EXPECT_LE(events, kWritten);
+  EXPECT_EQ(recovered[0].contents.last_event_time, 0.5 * static_cast<double>(events));  // events are written in order
+
+  // The bag reads with rosbag::View and holds that many events, in order.
+  rosbag::Bag bag(bagPath(dir_, "dead"), rosbag::bagmode::Read);
+  rosbag::View view(bag, rosbag::TopicQuery("/collision_events"));
+  std::uint64_t k = 0;
+  for (const auto& m : view) {
+    const auto e = m.instantiate<collision_lab::CollisionEvent>();
+    ASSERT_TRUE(e);
+    ASSERT_EQ(e->index, k++);
+  }
+  EXPECT_EQ(k, events);
+}
+
+TEST_F(RunIndexRecorderTest, RecoveryIndexesTheRunAsInterruptedWithItsEvents) {
+  RunIndexRecorder recorder(dir_);
+  ASSERT_TRUE(recorder.ok());
+  collision_lab::AcceptedRun accepted;
+  accepted.run_id = "dead";
+  accepted.student = "ana";
+  accepted.header.stamp = ros::Time(1000);
+  recorder.accepted(accepted, input("dead", "ana"));
+  recorder.started("dead");
+  killedWriter("dead", 30000);
+  // Another dead run the index never saw: its row comes from the bag's input.
+  killedWriter("unknown", 30000);
+  // Queued rows of dead nodes: one without a bag, one whose final bag has its summary.
+  accepted.run_id = "queued";
+  recorder.accepted(accepted, input("queued", "ana"));
+  accepted.run_id = "done";
+  accepted.student = "ben";
+  recorder.accepted(accepted, input("done", "ben"));
+  recorder.started("done");
+  {
+    RunRecorder done(dir_, "done");
+    collision_lab::RunSummary summary;
+    summary.run_id = "done";
+    summary.stop_reason = "FINISHED";
+    summary.collision_count = 31;
+    summary.header.stamp = ros::Time(1001);
+    done.write("/run_summaries", summary.header.stamp, summary);
+    ASSERT_TRUE(done.close());
+  }
+
+  EXPECT_EQ(recorder.recover(), 4u);
+  RunIndex& index = *recorder.index();
+  const auto dead = index.find("dead");
+  ASSERT_TRUE(dead);
+  EXPECT_EQ(dead->state, RunState::kInterrupted);
+  EXPECT_EQ(dead->stop_reason, "INTERRUPTED");
+  EXPECT_EQ(dead->bag_path, bagPath(dir_, "dead"));
+  rosbag::Bag bag(dead->bag_path, rosbag::bagmode::Read);
+  EXPECT_EQ(dead->collision_count, rosbag::View(bag, rosbag::TopicQuery("/collision_events")).size());
+  EXPECT_GT(dead->collision_count, 0u);
+  EXPECT_NE(dead->summary_json.find("\"events_in_bag\""), std::string::npos) << dead->summary_json;
+
+  const auto unknown = index.find("unknown");
+  ASSERT_TRUE(unknown);
+  EXPECT_EQ(unknown->state, RunState::kInterrupted);
+  EXPECT_EQ(unknown->student, "ana");
+  EXPECT_GT(unknown->collision_count, 0u);
+
+  EXPECT_EQ(index.find("queued")->state, RunState::kInterrupted);
+  EXPECT_EQ(index.find("queued")->collision_count, 0u);
+  EXPECT_EQ(index.find("done")->state, RunState::kFinished);
+  EXPECT_EQ(index.find("done")->stop_reason, "FINISHED");
+  EXPECT_EQ(index.find("done")->collision_count, 31u);
+
+  EXPECT_TRUE(index.inState(RunState::kRunning).empty());
+  EXPECT_TRUE(index.inState(RunState::kQueued).empty());
+
+  // ~list_runs' format, from the index.
+  const auto listed = recorder.list("ben");
+  ASSERT_EQ(listed.size(), 1u);
+  EXPECT_EQ(listed[0].accepted.run_id, "done");
+  EXPECT_TRUE(listed[0].finished);
+  EXPECT_EQ(listed[0].collision_count, 31u);
+  EXPECT_EQ(recorder.list("").size(), 4u);
+}
+
+TEST_F(RunIndexRecorderTest, ALiveNodesQueuedRunIsLeftAlone) {
+  RunIndexRecorder recorder(dir_);
+  collision_lab::AcceptedRun accepted;
+  accepted.run_id = "waiting";
+  recorder.accepted(accepted, input("waiting", ""));
+  std::string error;
+  ASSERT_EQ(claimBag(dir_, "waiting", error), BagClaim::kClaimed) << error;  // its live owner
+  EXPECT_EQ(recorder.recover(), 0u);
+  EXPECT_EQ(recorder.index()->find("waiting")->state, RunState::kQueued);
+  releaseBagClaim(bagPath(dir_, "waiting") + ".active");
+  // Its owner gone (lock dropped) and the claim empty: interrupted, the empty claim removed.
+  EXPECT_EQ(recorder.recover(), 1u);
+  EXPECT_EQ(recorder.index()->find("waiting")->state, RunState::kInterrupted);
+  EXPECT_FALSE(fs::exists(bagPath(dir_, "waiting") + ".active"));
+}
+
+TEST_F(RunIndexRecorderTest, JsonOfInputAndSummary) {
+  const std::string in = inputJson(input("r", "ana"));
+  EXPECT_NE(in.find("\"masses\":[100.0,1.0,\"inf\"]"), std::string::npos) << in;
+  EXPECT_NE(in.find("\"student\":\"ana\""), std::string::npos) << in;
+  collision_lab::RunSummary s;
+  s.collision_count = 31;
+  s.stop_reason = "FINISHED";
+  s.energy_lost = std::nan("");
+  const std::string sum = summaryJson(s);
+  EXPECT_NE(sum.find("\"collision_count\":31"), std::string::npos) << sum;
+  EXPECT_NE(sum.find("\"energy_lost\":null"), std::string::npos) << sum;
+}
+
+}  // namespace
