@@ -1,5 +1,6 @@
 #include "http_server.h"
 
+#include <array>
 #include <optional>
 #include <stdexcept>
 
@@ -158,9 +159,11 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     });
   }
 
+  /// At most kDrainBytes for at most 2 s: enough for the answer to be read, little work.
   void drain() {
-    stream_.async_read_some(net::buffer(discard_), [self = shared_from_this()](error_code ec, std::size_t) {
-      if (ec) return self->close();
+    stream_.async_read_some(net::buffer(discard_), [self = shared_from_this()](error_code ec, std::size_t n) {
+      self->drained_ += n;
+      if (ec || self->drained_ > kDrainBytes) return self->close();
       self->drain();
     });
   }
@@ -222,6 +225,8 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   std::function<StreamStep()> poll_;
   std::chrono::milliseconds interval_{300};
   std::array<char, 4096> discard_{};
+  std::size_t drained_ = 0;  ///< [bytes] discarded after a refusal
+  static constexpr std::size_t kDrainBytes = 4 << 20;
 };
 
 void HttpReply::send(http::response<http::string_body> response) const {
