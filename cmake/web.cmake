@@ -4,6 +4,7 @@
 # have no internet). cpp-httplib (libcpp-httplib-dev) is only the tests' HTTP client.
 # (include, not find_package: bench.cmake finds PkgConfig too, and catkin_lint flags a second find_package.)
 include(FindPkgConfig)
+# The web tests' HTTP client (cmake/web_tests.cmake); the server itself does not use it.
 pkg_check_modules(CPP_HTTPLIB REQUIRED IMPORTED_TARGET cpp-httplib)
 find_package(Threads REQUIRED)
 add_library(collision_lab_web_lib
