@@ -22,6 +22,8 @@
 #include <nlohmann/json.hpp>
 #include <ros/ros.h>
 
+#include <rosgraph_msgs/Log.h>
+
 #include "collision_lab/RunQueue.h"
 #include "run_collector.h"
 // Last: it includes <resolv.h>, whose macro _res breaks Eigen's headers included after it.
@@ -464,6 +466,43 @@ TEST_F(WebAccessTest, EventsCsvIsConvertedOnceBesideTheBagAndStreamed) {
   ASSERT_TRUE(csv);
   EXPECT_EQ(csv->status, 404);
   EXPECT_NE(json::parse(csv->body).at("error").get<std::string>().find("no collision events"), std::string::npos);
+}
+
+TEST_F(WebAccessTest, HugeHeadersAre431AndIdleConnectionsAreClosed) {
+  const std::string huge = rawRequest("127.0.6.1", "GET / HTTP/1.1\r\nHost: 127.0.0.1\r\nX-Padding: " +
+                                                       std::string(32 << 10, 'x') + "\r\n\r\n");
+  EXPECT_EQ(statusOf(huge), 431) << huge.substr(0, 200);
+  // A kept-alive connection is answered, then closed by the server once idle.
+  const int fd = connectFrom("127.0.6.2");
+  ASSERT_GE(fd, 0);
+  ASSERT_TRUE(sendAll(fd, std::string("GET /api/queue HTTP/1.1\r\nHost: 127.0.0.1\r\nX-Class-Code: ") + kCode + "\r\n\r\n"));
+  const std::string answer = readUntilClosed(fd, 60);
+  close(fd);
+  EXPECT_EQ(statusOf(answer), 200) << answer.substr(0, 200);
+  EXPECT_NE(answer.find("\"runs\""), std::string::npos) << "the whole answer came before the close";
+}
+
+TEST_F(WebAccessTest, ARejectedNameIsLoggedInOneShortLine) {
+  ros::NodeHandle nh;
+  std::vector<std::string> lines;
+  ros::Subscriber sub = nh.subscribe<rosgraph_msgs::Log>("/rosout", 100, [&](const rosgraph_msgs::Log::ConstPtr& m) {
+    if (m->name.find("collision_lab_web") != std::string::npos && m->msg.find("a name of") != std::string::npos) {
+      lines.push_back(m->msg);
+    }
+  });
+  ASSERT_TRUE(waitUntil([&] { return sub.getNumPublishers() >= 3; }, "/rosout of this test, the lab node and the web node to connect"));
+  const std::string name(6000, 'n');  // under max_body_bytes, over the 64 characters of a name
+  auto res = client().Post("/api/runs", piScene(name).dump(), "application/json");
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 400);
+  EXPECT_EQ(json::parse(res->body).at("field"), "student");
+  EXPECT_LT(res->body.size(), 200u) << "the answer does not echo the name";
+  ASSERT_TRUE(waitUntil([&] { return !lines.empty(); }, "the refusal to be logged"));
+  ros::WallDuration(1.0).sleep();
+  ros::getGlobalCallbackQueue()->callAvailable();
+  ASSERT_EQ(lines.size(), 1u);
+  EXPECT_LE(lines[0].size(), 250u) << lines[0].substr(0, 300);
+  EXPECT_EQ(lines[0].find(std::string(100, 'n')), std::string::npos) << "the name is not logged";
 }
 
 // Needs the lab node that accepts at arrival and schedules (issue 30's lab-node part): with
