@@ -471,8 +471,13 @@ void WebServer::route(const HttpRequest& request, const Access& access, const Ht
   const auto question = target.find('?');
   const std::string path = target.substr(0, question);
   const std::string query = question == std::string::npos ? std::string() : target.substr(question + 1);
-  const bool get = m.method() == http::verb::get || m.method() == http::verb::head;
+  const bool get = m.method() == http::verb::get;
   const bool post = m.method() == http::verb::post;
+  if (!get && !post) {
+    Response res = errorAnswer(request, 405, "only GET and POST are served");
+    res.set(http::field::allow, "GET, POST");
+    return reply.send(std::move(res));
+  }
   std::smatch match;
   auto page = [&](const std::string& name) {
     reply.send(answer(request, http::status::ok, files_.at("/static/" + name), contentType(name)));
