@@ -24,6 +24,7 @@
 
 #include <rosgraph_msgs/Log.h>
 
+#include "collision_lab/InitialConditions.h"
 #include "collision_lab/RunQueue.h"
 #include "run_collector.h"
 // Last: it includes <resolv.h>, whose macro _res breaks Eigen's headers included after it.
@@ -503,6 +504,28 @@ TEST_F(WebAccessTest, ARejectedNameIsLoggedInOneShortLine) {
   ASSERT_EQ(lines.size(), 1u);
   EXPECT_LE(lines[0].size(), 250u) << lines[0].substr(0, 300);
   EXPECT_EQ(lines[0].find(std::string(100, 'n')), std::string::npos) << "the name is not logged";
+}
+
+TEST_F(WebAccessTest, NoAnswerFromTheLabNodeIs503AfterTheAnswerTimeout) {
+  ros::NodeHandle nh;
+  int received = 0;
+  ros::Subscriber mute = nh.subscribe<collision_lab::InitialConditions>(
+      "/mute/initial_conditions", 10, [&](const collision_lab::InitialConditions::ConstPtr&) { ++received; });
+  std::string url;
+  ASSERT_TRUE(waitUntil([&] { return ros::param::get("/mute/collision_lab_web/url", url); }, "the mute web node's address"));
+  const auto colon = url.rfind(':');
+  httplib::Client c(url.substr(7, colon - 7), std::stoi(url.substr(colon + 1)));
+  c.set_read_timeout(60, 0);
+  ASSERT_TRUE(waitUntil([&] { return mute.getNumPublishers() > 0; }, "the mute web node to publish inputs"));
+  auto res = c.Post("/api/runs", piScene("quinn").dump(), "application/json");
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 503) << res->body;
+  EXPECT_NE(json::parse(res->body).at("error").get<std::string>().find("did not answer"), std::string::npos);
+  EXPECT_TRUE(waitUntil([&] { return received == 1; }, "the input to have been sent"));
+  // The server is free meanwhile and after.
+  auto page = c.Get("/");
+  ASSERT_TRUE(page);
+  EXPECT_EQ(page->status, 200);
 }
 
 // Needs the lab node that accepts at arrival and schedules (issue 30's lab-node part): with
