@@ -440,30 +440,4 @@ std::string htmlEscape(const std::string& text) {
   return out;
 }
 
-std::string eventsCsv(const std::string& bag_path) {
-  namespace fs = std::filesystem;
-  std::string pattern = (fs::temp_directory_path() / "collision_lab_web_csv_XXXXXX").string();
-  if (!mkdtemp(pattern.data())) throw collision_lab_ros::BagCsvError("cannot create a temporary folder");
-  const fs::path dir(pattern);
-  std::string text;
-  try {
-    const auto exported = collision_lab_ros::bagToCsv(bag_path, dir.string());
-    for (const auto& file : exported.files) {
-      if (std::filesystem::path(file.path).filename() == "collision_events.csv") {
-        std::ifstream in(file.path);
-        std::ostringstream buffer;
-        buffer << in.rdbuf();
-        text = buffer.str();
-      }
-    }
-  } catch (...) {
-    std::error_code ignored;
-    fs::remove_all(dir, ignored);
-    throw;
-  }
-  std::error_code ignored;
-  fs::remove_all(dir, ignored);
-  return text;
-}
-
 }  // namespace collision_lab_web

@@ -132,8 +132,4 @@ BagRun readRunFromBag(const std::string& bag_path, std::size_t envelope_vertices
 /// Text safe inside HTML element content and attribute values (& < > " ').
 std::string htmlEscape(const std::string& text);
 
-/// The events CSV of a recorded run: collision_events.csv as bag_to_csv writes it. Throws
-/// collision_lab_ros::BagCsvError.
-std::string eventsCsv(const std::string& bag_path);
-
 }  // namespace collision_lab_web
