@@ -2,11 +2,15 @@
 # client and each safety limit; the pages in a real browser. Included after
 # ros_tests.cmake, which finds rostest.
 add_rostest_gtest(web_test test/ros/web_test.test test/ros/web_test.cpp)
-target_link_libraries(web_test collision_lab_web_lib ${catkin_LIBRARIES})
+target_link_libraries(web_test collision_lab_web_lib PkgConfig::CPP_HTTPLIB ${catkin_LIBRARIES})
 add_dependencies(web_test collision_lab_node collision_lab_web)
+# Its defences and run controls (issue 30): slow and large clients, Origin/Host, codes, stop.
+add_rostest_gtest(web_access_test test/ros/web_access_test.test test/ros/web_access_test.cpp)
+target_link_libraries(web_access_test collision_lab_web_lib PkgConfig::CPP_HTTPLIB ${catkin_LIBRARIES})
+add_dependencies(web_access_test collision_lab_node collision_lab_web)
 # The pages in headless chromium (skipped without it); reads test/ros/web_form_driver.html.
 add_rostest_gtest(web_browser_test test/ros/web_browser_test.test test/ros/web_browser_test.cpp)
-target_link_libraries(web_browser_test collision_lab_web_lib ${catkin_LIBRARIES})
+target_link_libraries(web_browser_test collision_lab_web_lib PkgConfig::CPP_HTTPLIB ${catkin_LIBRARIES})
 add_dependencies(web_browser_test collision_lab_node collision_lab_web)
 target_compile_definitions(web_browser_test PRIVATE COLLISION_LAB_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
 # RunBook with the lab's topics out of order (no master).

@@ -18,7 +18,8 @@ export PATH=/usr/bin:/bin:/usr/sbin:/sbin:$PATH
 # needs the Python messages of other packages to echo /diagnostics and the markers, and
 # rosservice those of std_srvs to pause a replay (/rosbag_play/pause_playback); rviz is
 # opened by the launch files whenever a display is set. The class's web server
-# (docs/web.md) needs cpp-httplib and serves Debian's Chart.js; its browser tests and
+# (docs/web.md) is on Boost.Beast (libboost-dev), its tests' client is cpp-httplib, and it
+# serves Debian's Chart.js; its browser tests and
 # screenshots need chromium (--with-screenshots, as CI).
 packages=(
   build-essential cmake libgtest-dev

@@ -89,8 +89,10 @@ async function sendScene() {
     result.textContent = 'The lab did not answer: ' + err;
     return;
   }
-  if (status === 201) {
-    result.textContent = 'Accepted as run ' + answer.run_id + '.';
+  if (status === 202) {
+    // The student's own key to stop the run (POST /api/runs/<run_id>/stop), kept in this browser.
+    localStorage.setItem('collision_lab_stop_' + answer.run_id, answer.stop_token);
+    result.textContent = 'Accepted as run ' + answer.run_id + ', place in the queue ' + answer.queue_position + '.';
     window.location.href = '/runs/' + encodeURIComponent(answer.run_id);
     return;
   }
@@ -126,10 +128,51 @@ async function startPage() {
   document.body.dataset.ready = 'true';
 }
 
+/// Asks the lab node to stop a run: with the run's stop_token (the student's own run) or, on
+/// the teacher page, with the teacher's login. Returns the server's answer as one line.
+async function stopRun(runId, stopToken) {
+  const body = stopToken ? {stop_token: stopToken} : {};
+  const res = await fetch('/api/runs/' + encodeURIComponent(runId) + '/stop',
+    {method: 'POST', headers: {'Content-Type': 'application/json'}, body: JSON.stringify(body)});
+  const answer = await res.json();
+  return res.status === 200 ? answer.message : 'HTTP ' + res.status + ': ' + answer.error;
+}
+
+function queueTable(queue) {
+  const section = el('section');
+  section.appendChild(el('h2', 'Queue: ' + queue.runs.length + ' runs, ' + queue.workers + ' workers'));
+  const table = el('table');
+  const head = el('tr');
+  for (const h of ['run', 'student', 'lane', 'state', '']) head.appendChild(el('th', h));
+  table.appendChild(head);
+  for (const r of queue.runs) {
+    const tr = el('tr');
+    const td = el('td');
+    td.appendChild(el('a', r.run_id, {href: '/runs/' + encodeURIComponent(r.run_id)}));
+    tr.appendChild(td);
+    tr.appendChild(el('td', r.student));
+    tr.appendChild(el('td', r.lane));
+    tr.appendChild(el('td', r.running ? 'running' : 'waiting'));
+    tr.appendChild(stopCell(r.run_id));
+    table.appendChild(tr);
+  }
+  section.appendChild(table);
+  return section;
+}
+
+function stopCell(runId) {
+  const td = el('td');
+  const button = el('button', 'Stop', {type: 'button', 'data-stop': runId});
+  button.onclick = async () => { button.disabled = true; button.textContent = await stopRun(runId, null); };
+  td.appendChild(button);
+  return td;
+}
+
 async function teacherPage() {
   const box = document.getElementById('students');
   async function refresh() {
     const runs = await (await fetch('/api/runs')).json();
+    const queue = await (await fetch('/api/queue')).json();
     const byStudent = new Map();
     for (const r of runs) {
       const name = r.student || '(anonymous)';
@@ -142,7 +185,7 @@ async function teacherPage() {
       section.appendChild(el('h2', name + ' (' + byStudent.get(name).length + ' runs)'));
       const table = el('table');
       const head = el('tr');
-      for (const h of ['run', 'state', 'bodies', 'collisions', 'model', 'accepted']) head.appendChild(el('th', h));
+      for (const h of ['run', 'state', 'bodies', 'collisions', 'model', 'accepted', '']) head.appendChild(el('th', h));
       table.appendChild(head);
       for (const r of byStudent.get(name)) {
         const tr = el('tr');
@@ -154,15 +197,21 @@ async function teacherPage() {
         tr.appendChild(el('td', r.collisions));
         tr.appendChild(el('td', r.model || ''));
         tr.appendChild(el('td', r.accepted_stamp ? new Date(r.accepted_stamp * 1000).toLocaleTimeString() : ''));
+        tr.appendChild(r.state === 'finished' ? el('td') : stopCell(r.run_id));
         table.appendChild(tr);
       }
       section.appendChild(table);
       parts.push(section);
     }
     if (parts.length === 0) parts.push(el('p', 'No runs yet.'));
+    parts.unshift(queueTable(queue));
     box.replaceChildren(...parts);
     document.body.dataset.runs = String(runs.length);
   }
   await refresh();
   setInterval(refresh, 5000);
 }
+
+// Each page says which it is (body data-page): no inline script (Content-Security-Policy).
+if (document.body.dataset.page === 'start') startPage();
+if (document.body.dataset.page === 'teacher') teacherPage();

@@ -172,7 +172,10 @@ function render(run) {
     firstPlotMs = Math.round(performance.now());
     document.body.dataset.firstPlotMs = String(firstPlotMs);
   }
-  if (run.state === 'finished') document.body.dataset.final = 'true';
+  if (run.state === 'finished') {
+    document.body.dataset.final = 'true';
+    document.getElementById('stop').hidden = true;
+  }
 }
 
 function setupDownloads() {
@@ -199,11 +202,43 @@ async function poll() {
   if (run.state !== 'finished') setTimeout(poll, 1000);
 }
 
+// While queued: the run's place in the lab's queue (GET /api/queue), until it runs.
+async function showQueue() {
+  const place = document.getElementById('queue');
+  if (document.body.dataset.state === 'finished') { place.textContent = ''; return; }
+  const queue = await (await fetch('/api/queue')).json();
+  const waiting = queue.runs.filter((r) => !r.running);
+  const mine = queue.runs.find((r) => r.run_id === runId);
+  if (mine && !mine.running) {
+    place.textContent = 'Waiting: place ' + (waiting.indexOf(mine) + 1) + ' of ' + waiting.length + ' in the ' + mine.lane + ' lane.';
+  } else {
+    place.textContent = '';
+  }
+  if (document.body.dataset.state !== 'finished') setTimeout(showQueue, 2000);
+}
+
+// The Stop button: only in the browser that sent the run (its stop_token in localStorage).
+function setupStop() {
+  const token = localStorage.getItem('collision_lab_stop_' + runId);
+  const button = document.getElementById('stop');
+  if (!token || document.body.dataset.state === 'finished') return;
+  button.hidden = false;
+  button.onclick = async () => {
+    button.disabled = true;
+    const res = await fetch(api + '/stop', {method: 'POST', headers: {'Content-Type': 'application/json'},
+      body: JSON.stringify({stop_token: token})});
+    const answer = await res.json();
+    document.getElementById('stop_result').textContent = res.status === 200 ? answer.message : 'HTTP ' + res.status + ': ' + answer.error;
+  };
+}
+
 async function main() {
   setupDownloads();
   const run = await (await fetch(api)).json();
   render(run);
   if (run.state === 'finished') return;
+  setupStop();
+  showQueue();
   const source = new EventSource(api + '/stream');
   source.addEventListener('run', (e) => render(JSON.parse(e.data)));
   source.addEventListener('final', (e) => { render(JSON.parse(e.data)); source.close(); });

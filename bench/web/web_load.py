@@ -91,7 +91,7 @@ def student(stats, base, k, runs):
         t0 = time.monotonic()
         status, answer = request(stats, f"{base}/api/runs", body)
         stats.add(post_latency=time.monotonic() - t0)
-        if status != 201:
+        if status != 202:
             stats.add(problems=f"load{k:02d} run {r}: HTTP {status} {answer[:120]!r}")
             continue
         run_id = json.loads(answer)["run_id"]

@@ -166,22 +166,31 @@ WebRun& RunBook::runLocked(const std::string& run_id) {
 }
 
 void RunBook::onAccepted(const collision_lab::AcceptedRun& msg) {
-  std::lock_guard<std::mutex> lock(mutex_);
+  std::unique_lock<std::mutex> lock(mutex_);
   WebRun& run = runLocked(msg.run_id);
   run.student = msg.student;
   run.requested_run_id = msg.requested_run_id;
   run.accepted_stamp = msg.header.stamp.toSec();
   ++run.version;
-  auto waiting = waiting_.find(key(msg.student, msg.requested_run_id));
-  if (waiting != waiting_.end()) waiting->second = Submission{msg.run_id, std::nullopt};
   changed_.notify_all();
+  AnswerCallback answer = takeWaitingLocked(msg.student, msg.requested_run_id);
+  lock.unlock();
+  if (answer) answer(Submission{msg.run_id, msg.queue_position, msg.lane, std::nullopt});
 }
 
 void RunBook::onRejected(const collision_lab::Rejected& msg) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  auto waiting = waiting_.find(key(msg.student, msg.run_id));
-  if (waiting != waiting_.end()) waiting->second = Submission{std::nullopt, msg};
-  changed_.notify_all();
+  std::unique_lock<std::mutex> lock(mutex_);
+  AnswerCallback answer = takeWaitingLocked(msg.student, msg.run_id);
+  lock.unlock();
+  if (answer) answer(Submission{std::nullopt, 0, {}, msg});
+}
+
+RunBook::AnswerCallback RunBook::takeWaitingLocked(const std::string& student, const std::string& requested) {
+  auto waiting = waiting_.find(key(student, requested));
+  if (waiting == waiting_.end()) return nullptr;
+  AnswerCallback answer = std::move(waiting->second);
+  waiting_.erase(waiting);
+  return answer;
 }
 
 void RunBook::onServedInput(const collision_lab::InitialConditions& msg) {
@@ -296,26 +305,14 @@ void RunBook::rebuildFromBag(const std::string& run_id, const std::string& bag_p
   changed_.notify_all();
 }
 
-void RunBook::expect(const std::string& student, const std::string& requested) {
+void RunBook::expect(const std::string& student, const std::string& requested, AnswerCallback on_answer) {
   std::lock_guard<std::mutex> lock(mutex_);
-  waiting_[key(student, requested)].reset();
+  waiting_[key(student, requested)] = std::move(on_answer);
 }
 
-std::optional<Submission> RunBook::waitForAnswer(const std::string& student, const std::string& requested,
-                                                 std::chrono::milliseconds timeout) {
-  std::unique_lock<std::mutex> lock(mutex_);
-  const std::string k = key(student, requested);
-  changed_.wait_for(lock, timeout, [&] {
-    auto it = waiting_.find(k);
-    return it == waiting_.end() || it->second.has_value();
-  });
-  auto it = waiting_.find(k);
-  std::optional<Submission> answer;
-  if (it != waiting_.end()) {
-    answer = it->second;
-    waiting_.erase(it);
-  }
-  return answer;
+bool RunBook::forget(const std::string& student, const std::string& requested) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return waiting_.erase(key(student, requested)) > 0;
 }
 
 bool RunBook::has(const std::string& run_id) const {
@@ -441,32 +438,6 @@ std::string htmlEscape(const std::string& text) {
     }
   }
   return out;
-}
-
-std::string eventsCsv(const std::string& bag_path) {
-  namespace fs = std::filesystem;
-  std::string pattern = (fs::temp_directory_path() / "collision_lab_web_csv_XXXXXX").string();
-  if (!mkdtemp(pattern.data())) throw collision_lab_ros::BagCsvError("cannot create a temporary folder");
-  const fs::path dir(pattern);
-  std::string text;
-  try {
-    const auto exported = collision_lab_ros::bagToCsv(bag_path, dir.string());
-    for (const auto& file : exported.files) {
-      if (std::filesystem::path(file.path).filename() == "collision_events.csv") {
-        std::ifstream in(file.path);
-        std::ostringstream buffer;
-        buffer << in.rdbuf();
-        text = buffer.str();
-      }
-    }
-  } catch (...) {
-    std::error_code ignored;
-    fs::remove_all(dir, ignored);
-    throw;
-  }
-  std::error_code ignored;
-  fs::remove_all(dir, ignored);
-  return text;
 }
 
 }  // namespace collision_lab_web

@@ -5,6 +5,8 @@
 #include <ifaddrs.h>
 #include <netinet/in.h>
 
+#include <algorithm>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -12,10 +14,12 @@
 #include <ros/ros.h>
 
 #include "collision_lab/AcceptedRun.h"
+#include "collision_lab/Cancel.h"
 #include "collision_lab/CollisionEvent.h"
 #include "collision_lab/InitialConditions.h"
 #include "collision_lab/Prediction.h"
 #include "collision_lab/Rejected.h"
+#include "collision_lab/RunQueue.h"
 #include "collision_lab/RunSummary.h"
 #include "collision_lab/ros/node_constants.h"
 #include "collision_lab/web/run_book.h"
@@ -26,27 +30,38 @@ namespace {
 using namespace collision_lab_ros;  // topic names and queue sizes
 using collision_lab_web::WebConfig;
 
+/// A non-negative integer parameter (XmlRpc has only int).
+std::size_t sizeParam(const ros::NodeHandle& pnh, const std::string& name, std::size_t fallback) {
+  int value = static_cast<int>(fallback);
+  pnh.param(name, value, value);
+  return static_cast<std::size_t>(std::max(1, value));
+}
+
 WebConfig loadConfig(const ros::NodeHandle& pnh) {
   WebConfig c;
   const std::string package = ros::package::getPath("collision_lab");
-  int port = c.port, max_body = static_cast<int>(c.max_body_bytes), max_bodies = static_cast<int>(c.max_bodies),
-      per_minute = static_cast<int>(c.runs_per_minute), streams = static_cast<int>(c.max_streams);
   pnh.param("bind", c.bind, c.bind);
-  pnh.param("port", port, port);
+  pnh.param("port", c.port, c.port);
   pnh.param("code", c.code, c.code);
-  pnh.param("max_body_bytes", max_body, max_body);
-  pnh.param("max_bodies", max_bodies, max_bodies);
-  pnh.param("runs_per_minute", per_minute, per_minute);
-  pnh.param("max_streams", streams, streams);
+  pnh.param("teacher_code", c.teacher_code, c.teacher_code);
+  pnh.param("allowed_hosts", c.allowed_hosts, c.allowed_hosts);
+  c.max_body_bytes = sizeParam(pnh, "max_body_bytes", c.max_body_bytes);
+  c.max_bodies = sizeParam(pnh, "max_bodies", c.max_bodies);
+  c.runs_per_minute = sizeParam(pnh, "runs_per_minute", c.runs_per_minute);
+  c.runs_per_minute_per_address = sizeParam(pnh, "runs_per_minute_per_address", c.runs_per_minute_per_address);
+  c.max_streams = sizeParam(pnh, "max_streams", c.max_streams);
+  c.code_attempts = sizeParam(pnh, "code_attempts", c.code_attempts);
+  pnh.param("code_lockout", c.code_lockout, c.code_lockout);
   pnh.param("answer_timeout", c.answer_timeout, c.answer_timeout);
+  c.io_threads = sizeParam(pnh, "io_threads", c.io_threads);
+  pnh.param("header_timeout", c.header_timeout, c.header_timeout);
+  pnh.param("body_timeout", c.body_timeout, c.body_timeout);
+  pnh.param("idle_timeout", c.idle_timeout, c.idle_timeout);
+  c.max_connections_per_address = sizeParam(pnh, "max_connections_per_address", c.max_connections_per_address);
+  c.max_connections = sizeParam(pnh, "max_connections", c.max_connections);
   pnh.param("web_root", c.web_root, package + "/web");
   pnh.param("chartjs_path", c.chartjs_path, std::string("/usr/share/javascript/chart.js/chart.min.js"));
   pnh.param("scenario_file", c.scenario_file, package + "/" + kDefaultScenarioFile);
-  c.port = port;
-  c.max_body_bytes = static_cast<std::size_t>(std::max(1, max_body));
-  c.max_bodies = static_cast<std::size_t>(std::max(1, max_bodies));
-  c.runs_per_minute = static_cast<std::size_t>(std::max(1, per_minute));
-  c.max_streams = static_cast<std::size_t>(std::max(1, streams));
   return c;
 }
 
@@ -90,8 +105,26 @@ int main(int argc, char** argv) {
     inputs.publish(stamped);
     return true;
   };
+  // The lab node's ~cancel, by its name (~lab_node, resolved in this node's namespace).
+  std::string lab_node;
+  pnh.param("lab_node", lab_node, std::string("collision_lab_node"));
+  const std::string cancel_service = ros::names::resolve(lab_node) + "/" + kCancelService;
+  auto cancel = [cancel_service](const std::string& run_id,
+                                 const std::string& requested_by) -> std::optional<collision_lab_web::CancelAnswer> {
+    collision_lab::Cancel call;
+    call.request.run_id = run_id;
+    call.request.requested_by = requested_by;
+    if (!ros::service::waitForService(cancel_service, ros::Duration(2.0)) || !ros::service::call(cancel_service, call)) {
+      return std::nullopt;
+    }
+    return collision_lab_web::CancelAnswer{call.response.ok != 0, call.response.message};
+  };
+  auto log = [](const std::string& line) { ROS_WARN_STREAM("collision_lab_web: " << line); };
   try {
-    collision_lab_web::WebServer server(book, config, publish);
+    collision_lab_web::WebServer server(book, config, publish, cancel, log);
+    // The lab node's queue (latched, published when it changes; topic new in 0.7.0).
+    ros::Subscriber queue = nh.subscribe<collision_lab::RunQueue>(
+        "run_queue", 1, [&server](const collision_lab::RunQueue::ConstPtr& msg) { server.setQueue(*msg); });
     server.start();
     std::string urls;
     for (const auto& a : addresses(config.bind)) {
@@ -101,7 +134,8 @@ int main(int argc, char** argv) {
     pnh.setParam("url", "http://" + (config.bind == "0.0.0.0" ? std::string("127.0.0.1") : config.bind) + ":" +
                             std::to_string(server.port()) + "/");
     ROS_INFO_STREAM("Class page: " << urls << (config.bind == "127.0.0.1" ? " (this machine only; web_bind:=0.0.0.0 opens it to the lab's network)" : " (give this address to the class)")
-                                   << (config.code.empty() ? "" : "; sending a scene needs the class code"));
+                                   << (config.code.empty() ? "" : "; every page needs the class code")
+                                   << (config.teacher_code.empty() ? "" : "; the teacher page needs the teacher code"));
     ros::AsyncSpinner spinner(1);
     spinner.start();
     ros::waitForShutdown();

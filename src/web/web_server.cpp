@@ -1,38 +1,68 @@
 #include "collision_lab/web/web_server.h"
 
+#include <arpa/inet.h>
+#include <ifaddrs.h>
 #include <netinet/in.h>
-#include <sys/socket.h>
+#include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <limits>
+#include <random>
+#include <regex>
 #include <sstream>
 #include <stdexcept>
 
+#include <boost/asio/post.hpp>
+#include <boost/asio/steady_timer.hpp>
+#include <boost/asio/thread_pool.hpp>
 #include <nlohmann/json.hpp>
 
 #include "collision_lab/Rejected.h"
 #include "collision_lab/io/scenario_file.h"
 #include "collision_lab/ros/bag_csv.h"
 #include "collision_lab/ros/msg_conversion.h"
-// Last: it includes <resolv.h>, whose macro _res breaks Eigen's headers included after it.
-#include <httplib.h>
+#include "collision_lab/ros/node_constants.h"
+#include "http_server.h"
 
 namespace collision_lab_web {
 
 using nlohmann::json;
+namespace fs = std::filesystem;
+
+/// Threads for what may block (the lab node's ~cancel, a bag's CSV conversion), so that
+/// the I/O threads never do.
+struct BlockingPool {
+  boost::asio::thread_pool pool{2};
+};
+
+struct WebServer::Access {
+  bool student = false;  ///< the class code was given (or none is needed)
+  bool teacher = false;  ///< the teacher code was given (or none is needed)
+};
 
 namespace {
 
+using Response = http::response<http::string_body>;
+
 /// A run_id in a URL: the node's own alphabet (InitialConditions.run_id). Anything else,
 /// '/' and "%2F" included, is no run and gets a 404.
-constexpr char kRunId[] = "([A-Za-z0-9_.\\-]+)";
-/// A live stream sends the run at most this often, and a comment line when idle (so that a
-/// closed tab is noticed and its slot freed).
+const std::string kRunId = "([A-Za-z0-9_.\\-]+)";
+/// A live stream looks at its run this often, sends it when it changed, and a comment line
+/// when idle this long.
 constexpr auto kStreamInterval = std::chrono::milliseconds(300);
 constexpr auto kStreamKeepAlive = std::chrono::seconds(10);
 /// Presets of more bodies than this come without their lists (the form sends their name).
 constexpr std::size_t kPresetSceneMaxBodies = 100;
+constexpr char kClassCookie[] = "collision_lab_class";
+constexpr char kTeacherCookie[] = "collision_lab_teacher";
+/// [s] a login lasts: a school day.
+constexpr int kCookieSeconds = 12 * 3600;
+/// Longest run_id the lab node takes [characters].
+constexpr std::size_t kMaxRunIdLength = 128;
 
 std::string readFile(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -42,15 +72,101 @@ std::string readFile(const std::string& path) {
   return buffer.str();
 }
 
-void sendJson(httplib::Response& res, int status, const json& body) {
-  res.status = status;
-  res.set_content(body.dump(), "application/json");
+std::string randomToken() {
+  std::random_device device;
+  std::string out;
+  const char* hex = "0123456789abcdef";
+  for (int i = 0; i < 8; ++i) {
+    const std::uint32_t word = device();
+    for (int b = 0; b < 8; ++b) out += hex[(word >> (4 * b)) & 0xf];
+  }
+  return out;
 }
 
-void sendError(httplib::Response& res, int status, const std::string& error, const std::string& field = {}) {
+/// Equal without telling by its time how much of a secret matched.
+bool sameSecret(const std::string& a, const std::string& b) {
+  if (a.size() != b.size()) return false;
+  unsigned char diff = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) diff |= static_cast<unsigned char>(a[i] ^ b[i]);
+  return diff == 0;
+}
+
+std::string lower(std::string text) {
+  std::transform(text.begin(), text.end(), text.begin(), [](unsigned char c) { return std::tolower(c); });
+  return text;
+}
+
+/// "name:port", "[v6]:port" or "name" -> the name, lower case, without brackets.
+std::string hostName(const std::string& host) {
+  if (!host.empty() && host.front() == '[') return lower(host.substr(1, host.find(']') - 1));
+  const auto colon = host.find(':');
+  if (colon != std::string::npos && host.find(':', colon + 1) == std::string::npos) return lower(host.substr(0, colon));
+  return lower(host);
+}
+
+std::string cookie(const HttpRequest& request, const std::string& name) {
+  const std::string header(request.message[http::field::cookie]);
+  std::size_t at = 0;
+  while (at < header.size()) {
+    const auto end = std::min(header.find(';', at), header.size());
+    std::string pair = header.substr(at, end - at);
+    pair.erase(0, pair.find_first_not_of(' '));
+    const auto eq = pair.find('=');
+    if (eq != std::string::npos && pair.substr(0, eq) == name) return pair.substr(eq + 1);
+    at = end + 1;
+  }
+  return {};
+}
+
+std::string urlDecode(const std::string& text) {
+  std::string out;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    if (text[i] == '+') {
+      out += ' ';
+    } else if (text[i] == '%' && i + 2 < text.size() && std::isxdigit(static_cast<unsigned char>(text[i + 1])) &&
+               std::isxdigit(static_cast<unsigned char>(text[i + 2]))) {
+      out += static_cast<char>(std::stoi(text.substr(i + 1, 2), nullptr, 16));
+      i += 2;
+    } else {
+      out += text[i];
+    }
+  }
+  return out;
+}
+
+std::optional<std::string> queryParam(const std::string& query, const std::string& name) {
+  std::size_t at = 0;
+  while (at <= query.size()) {
+    const auto end = std::min(query.find('&', at), query.size());
+    const std::string pair = query.substr(at, end - at);
+    const auto eq = pair.find('=');
+    if (pair.substr(0, eq) == name) return eq == std::string::npos ? std::string() : urlDecode(pair.substr(eq + 1));
+    at = end + 1;
+  }
+  return std::nullopt;
+}
+
+Response answer(const HttpRequest& request, http::status status, std::string body, const std::string& type) {
+  Response res(status, request.message.version());
+  res.set(http::field::content_type, type);
+  res.body() = std::move(body);
+  return res;
+}
+
+Response jsonAnswer(const HttpRequest& request, int status, const json& body) {
+  return answer(request, static_cast<http::status>(status), body.dump(), "application/json");
+}
+
+Response errorAnswer(const HttpRequest& request, int status, const std::string& error, const std::string& field = {}) {
   json body = {{"error", error}};
   if (!field.empty()) body["field"] = field;
-  sendJson(res, status, body);
+  return jsonAnswer(request, status, body);
+}
+
+Response redirect(const HttpRequest& request, const std::string& to) {
+  Response res(http::status::see_other, request.message.version());
+  res.set(http::field::location, to);
+  return res;
 }
 
 /// A field's error: the field's name and what is wrong.
@@ -97,110 +213,314 @@ std::string contentType(const std::string& path) {
   return "text/html; charset=utf-8";
 }
 
-/// Debian's cpp-httplib 0.11 is built with a listen backlog of 5: thirty students
-/// connecting at once overflow it, and some connections are dropped or reset. listen()
-/// again on the bound socket (found by its port) sets a backlog of SOMAXCONN.
-void widenBacklog(int port) {
-  for (int fd = 0; fd < 1024; ++fd) {
-    sockaddr_storage address{};
-    socklen_t length = sizeof address;
-    int listening = 0;
-    socklen_t flag_length = sizeof listening;
-    if (getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length) != 0) continue;
-    if (getsockopt(fd, SOL_SOCKET, SO_ACCEPTCONN, &listening, &flag_length) != 0 || !listening) continue;
-    int bound = -1;
-    if (address.ss_family == AF_INET) bound = ntohs(reinterpret_cast<sockaddr_in*>(&address)->sin_port);
-    if (address.ss_family == AF_INET6) bound = ntohs(reinterpret_cast<sockaddr_in6*>(&address)->sin6_port);
-    if (bound == port) ::listen(fd, SOMAXCONN);
+/// The names this machine answers to: its hostname and every address of its interfaces.
+std::set<std::string> machineNames() {
+  std::set<std::string> names;
+  char host[256] = {};
+  if (gethostname(host, sizeof host - 1) == 0 && host[0]) names.insert(lower(host));
+  ifaddrs* list = nullptr;
+  if (getifaddrs(&list) == 0) {
+    for (ifaddrs* a = list; a; a = a->ifa_next) {
+      if (!a->ifa_addr) continue;
+      char text[INET6_ADDRSTRLEN] = {};
+      if (a->ifa_addr->sa_family == AF_INET) {
+        inet_ntop(AF_INET, &reinterpret_cast<sockaddr_in*>(a->ifa_addr)->sin_addr, text, sizeof text);
+      } else if (a->ifa_addr->sa_family == AF_INET6) {
+        inet_ntop(AF_INET6, &reinterpret_cast<sockaddr_in6*>(a->ifa_addr)->sin6_addr, text, sizeof text);
+      } else {
+        continue;
+      }
+      names.insert(lower(text));
+    }
+    freeifaddrs(list);
   }
+  return names;
 }
 
 }  // namespace
 
-WebServer::WebServer(RunBook& book, WebConfig config, Publish publish)
-    : book_(book), config_(std::move(config)), publish_(std::move(publish)), server_(std::make_unique<httplib::Server>()) {
-  for (const char* page : {"index.html", "run.html", "teacher.html", "app.js", "run.js", "style.css"}) {
+WebServer::WebServer(RunBook& book, WebConfig config, Publish publish, Cancel cancel, Log log)
+    : book_(book),
+      config_(std::move(config)),
+      publish_(std::move(publish)),
+      cancel_(std::move(cancel)),
+      log_(std::move(log)),
+      class_cookie_(randomToken()),
+      teacher_cookie_(randomToken()),
+      blocking_(std::make_unique<BlockingPool>()) {
+  for (const char* page : {"index.html", "run.html", "teacher.html", "login.html", "app.js", "run.js", "login.js", "style.css"}) {
     files_[std::string("/static/") + page] = readFile(config_.web_root + "/" + page);
   }
   files_["/static/chart.min.js"] = readFile(config_.chartjs_path);
-  // Threads: one per event stream, plus room for the pages and the API meanwhile.
-  const std::size_t threads = config_.max_streams + 16;
-  server_->new_task_queue = [threads] { return new httplib::ThreadPool(threads); };
-  server_->set_payload_max_length(config_.max_body_bytes);
-  server_->set_keep_alive_timeout(2);
-  routes();
+  hosts_ = machineNames();
+  for (const char* local : {"localhost", "127.0.0.1", "::1"}) hosts_.insert(local);
+  if (config_.bind != "0.0.0.0" && config_.bind != "::") hosts_.insert(lower(config_.bind));
+  for (const auto& host : config_.allowed_hosts) hosts_.insert(hostName(host));
+  HttpLimits limits;
+  limits.io_threads = config_.io_threads;
+  limits.header_timeout = config_.header_timeout;
+  limits.body_timeout = config_.body_timeout;
+  limits.idle_timeout = config_.idle_timeout;
+  limits.max_body_bytes = config_.max_body_bytes;
+  limits.max_connections_per_address = config_.max_connections_per_address;
+  limits.max_connections = config_.max_connections;
+  server_ = std::make_unique<HttpServer>(limits, [this](HttpRequest request, HttpReply reply) {
+    handle(std::move(request), std::move(reply));
+  });
 }
 
 WebServer::~WebServer() { stop(); }
 
 void WebServer::start() {
-  port_ = config_.port == 0 ? server_->bind_to_any_port(config_.bind) : config_.port;
-  if (port_ <= 0 || (config_.port != 0 && !server_->bind_to_port(config_.bind, config_.port))) {
-    throw std::runtime_error("cannot listen on " + config_.bind + ":" + std::to_string(config_.port));
-  }
-  widenBacklog(port_);
-  thread_ = std::thread([this] { server_->listen_after_bind(); });
+  server_->start(config_.bind, config_.port);
+  port_ = server_->port();
 }
 
 void WebServer::stop() {
-  stopping_ = true;
+  // Answers still awaited hold their connections: the book lets them go first.
+  std::set<std::pair<std::string, std::string>> pending;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    pending.swap(pending_);
+  }
+  for (const auto& [student, requested] : pending) book_.forget(student, requested);
+  if (blocking_) blocking_->pool.join();
   if (server_) server_->stop();
-  if (thread_.joinable()) thread_.join();
 }
 
-long WebServer::admit(const std::string& student) {
+void WebServer::setQueue(const collision_lab::RunQueue& queue) {
+  json runs = json::array();
+  for (const auto& r : queue.runs) {
+    runs.push_back({{"run_id", r.run_id},
+                    {"student", r.student},
+                    {"lane", r.lane},
+                    {"running", r.running != 0},
+                    {"predicted_collisions", r.predicted_collisions},
+                    {"body_count", r.body_count}});
+  }
+  const json out = {{"workers", queue.workers},
+                    {"short_lane_workers", queue.short_lane_workers},
+                    {"stamp", queue.header.stamp.toSec()},
+                    {"runs", runs}};
+  std::lock_guard<std::mutex> lock(mutex_);
+  queue_json_ = out.dump();
+}
+
+void WebServer::log(const std::string& line) const {
+  if (!log_) return;
+  std::string shown = line.substr(0, kLogLineBytes);
+  for (char& c : shown) {
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+  }
+  log_(shown);
+}
+
+long WebServer::admit(const std::string& key, std::size_t limit) {
   using Clock = std::chrono::steady_clock;
   const auto now = Clock::now();
-  std::lock_guard<std::mutex> lock(rate_mutex_);
-  auto& sent = sends_[student];
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto& sent = sends_[key];
   while (!sent.empty() && now - sent.front() >= std::chrono::minutes(1)) sent.pop_front();
-  if (sent.size() >= config_.runs_per_minute) {
+  if (sent.size() >= limit) {
     const auto wait = std::chrono::minutes(1) - (now - sent.front());
     return std::max<long>(1, std::chrono::ceil<std::chrono::seconds>(wait).count());
   }
   sent.push_back(now);
+  // Bounded: keys idle for a minute are dropped once the map grows.
+  if (sends_.size() > 4096) {
+    for (auto it = sends_.begin(); it != sends_.end();) {
+      it = (it->second.empty() || now - it->second.back() >= std::chrono::minutes(1)) ? sends_.erase(it) : std::next(it);
+    }
+  }
   return 0;
 }
 
-void WebServer::routes() {
-  httplib::Server& svr = *server_;
-  auto page = [this](const std::string& name) {
-    return [this, name](const httplib::Request&, httplib::Response& res) {
-      res.set_content(files_.at("/static/" + name), contentType(name));
-    };
+long WebServer::lockedOut(const std::string& client) {
+  const auto now = std::chrono::steady_clock::now();
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto it = locked_until_.find(client);
+  if (it == locked_until_.end()) return 0;
+  if (now >= it->second) {
+    locked_until_.erase(it);
+    return 0;
+  }
+  return std::max<long>(1, std::chrono::ceil<std::chrono::seconds>(it->second - now).count());
+}
+
+long WebServer::wrongCode(const std::string& client) {
+  const auto now = std::chrono::steady_clock::now();
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto& wrong = wrong_codes_[client];
+  while (!wrong.empty() && now - wrong.front() >= std::chrono::minutes(1)) wrong.pop_front();
+  wrong.push_back(now);
+  if (wrong.size() < config_.code_attempts) return 0;
+  wrong.clear();
+  wrong_codes_.erase(client);
+  const auto lockout = std::chrono::milliseconds(static_cast<long long>(config_.code_lockout * 1000));
+  locked_until_[client] = now + lockout;
+  if (wrong_codes_.size() > 4096) wrong_codes_.clear();  // bounded; the lockouts stay
+  return std::max<long>(1, std::chrono::ceil<std::chrono::seconds>(lockout).count());
+}
+
+bool WebServer::hostAllowed(const std::string& host) const { return hosts_.count(hostName(host)) > 0; }
+
+bool WebServer::originAllowed(const std::string& origin, const std::string& host) const {
+  const auto scheme = origin.find("://");
+  if (scheme == std::string::npos) return false;
+  const std::string authority = origin.substr(scheme + 3);
+  if (!hostAllowed(authority)) return false;
+  // Same port as the page's: another service on the lab machine is another site.
+  const auto port_of = [](const std::string& text) {
+    const auto close = text.rfind(']');
+    const auto colon = text.rfind(':');
+    if (colon == std::string::npos || (close != std::string::npos && colon < close)) return std::string("80");
+    return text.substr(colon + 1);
   };
-  svr.Get("/", page("index.html"));
-  svr.Get("/teacher", page("teacher.html"));
-  svr.Get("/static/([a-z.]+)", [this](const httplib::Request& req, httplib::Response& res) {
-    auto it = files_.find(req.path);
-    if (it == files_.end()) return sendError(res, 404, "no such file");
-    res.set_header("Cache-Control", "max-age=3600");
-    res.set_content(it->second, contentType(req.path));
-  });
+  return port_of(authority) == (host.empty() ? std::to_string(port_) : port_of(host));
+}
+
+void WebServer::remember(const std::string& run_id, const std::string& token) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (stop_tokens_.emplace(run_id, token).second) token_order_.push_back(run_id);
+  while (token_order_.size() > config_.stop_tokens) {
+    stop_tokens_.erase(token_order_.front());
+    token_order_.pop_front();
+  }
+}
+
+std::optional<std::string> WebServer::stopToken(const std::string& run_id) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto it = stop_tokens_.find(run_id);
+  if (it == stop_tokens_.end()) return std::nullopt;
+  return it->second;
+}
+
+void WebServer::handle(HttpRequest request, HttpReply reply) {
+  const auto& m = request.message;
+  const std::string target(m.target());
+  const std::string path = target.substr(0, target.find('?'));
+  const std::string host(m[http::field::host]);
+  // DNS rebinding: a page of another site whose name now points here says so in Host.
+  if (!host.empty() && !hostAllowed(host)) {
+    log("refused " + request.client + ": foreign Host header");
+    return reply.send(errorAnswer(request, 421, "this server does not serve that host name"));
+  }
+  if (m.method() == http::verb::post) {
+    const std::string origin(m[http::field::origin]);
+    const std::string fetch_site(m["Sec-Fetch-Site"]);
+    if ((!origin.empty() && !originAllowed(origin, host)) || fetch_site == "cross-site") {
+      log("refused " + request.client + ": POST from another site");
+      return reply.send(errorAnswer(request, 403, "requests from other sites are not accepted"));
+    }
+    const std::string type(m[http::field::content_type]);
+    if (!m.body().empty() && lower(type).rfind("application/json", 0) != 0) {
+      return reply.send(errorAnswer(request, 415, "send JSON with Content-Type: application/json"));
+    }
+  }
+
+  // Codes: a presented code that is wrong counts against the address.
+  Access access;
+  access.student = config_.code.empty();
+  access.teacher = config_.teacher_code.empty();
+  std::vector<std::string> presented;
+  const std::string class_header(m["X-Class-Code"]), teacher_header(m["X-Teacher-Code"]);
+  if (!class_header.empty()) presented.push_back(class_header);
+  if (!teacher_header.empty()) presented.push_back(teacher_header);
+  if (m.method() == http::verb::post && path == "/api/runs" && m.body().size() <= config_.max_body_bytes) {
+    const json body = json::parse(m.body(), nullptr, false);
+    if (body.is_object() && body.contains("code") && body["code"].is_string()) presented.push_back(body["code"]);
+  }
+  if (!presented.empty()) {
+    if (const long wait = lockedOut(request.client)) {
+      Response res = errorAnswer(request, 429, "too many wrong codes from your address; try again in " + std::to_string(wait) + " s", "code");
+      res.set(http::field::retry_after, std::to_string(wait));
+      return reply.send(std::move(res));
+    }
+    for (const auto& code : presented) {
+      const bool is_class = !config_.code.empty() && sameSecret(code, config_.code);
+      const bool is_teacher = !config_.teacher_code.empty() && sameSecret(code, config_.teacher_code);
+      if (!is_class && !is_teacher && (!config_.code.empty() || !config_.teacher_code.empty())) {
+        log("wrong code from " + request.client);
+        if (const long wait = wrongCode(request.client)) {
+          Response res = errorAnswer(request, 429, "too many wrong codes from your address; try again in " + std::to_string(wait) + " s", "code");
+          res.set(http::field::retry_after, std::to_string(wait));
+          return reply.send(std::move(res));
+        }
+        return reply.send(errorAnswer(request, 403, "wrong code", "code"));
+      }
+      access.student = access.student || is_class || is_teacher;
+      access.teacher = access.teacher || is_teacher;
+    }
+  }
+  access.student = access.student || sameSecret(cookie(request, kClassCookie), class_cookie_);
+  if (sameSecret(cookie(request, kTeacherCookie), teacher_cookie_)) access.student = access.teacher = true;
+
+  const bool open_route = path == "/login" || path == "/api/login" || path == "/static/style.css" || path == "/static/login.js";
+  if (!access.student && !open_route) {
+    if (m.method() == http::verb::get && path.rfind("/api/", 0) != 0 && path.rfind("/static/", 0) != 0) {
+      return reply.send(redirect(request, "/login"));
+    }
+    return reply.send(errorAnswer(request, 403, "the class code is needed: log in on /login, or send the header X-Class-Code", "code"));
+  }
+  route(request, access, reply);
+}
+
+void WebServer::route(const HttpRequest& request, const Access& access, const HttpReply& reply) {
+  const auto& m = request.message;
+  const std::string target(m.target());
+  const auto question = target.find('?');
+  const std::string path = target.substr(0, question);
+  const std::string query = question == std::string::npos ? std::string() : target.substr(question + 1);
+  const bool get = m.method() == http::verb::get;
+  const bool post = m.method() == http::verb::post;
+  if (!get && !post) {
+    Response res = errorAnswer(request, 405, "only GET and POST are served");
+    res.set(http::field::allow, "GET, POST");
+    return reply.send(std::move(res));
+  }
+  std::smatch match;
+  auto page = [&](const std::string& name) {
+    reply.send(answer(request, http::status::ok, files_.at("/static/" + name), contentType(name)));
+  };
+
+  if (get && path == "/") return page("index.html");
+  if (get && path == "/login") return page("login.html");
+  if (get && path == "/teacher") {
+    if (!access.teacher) return reply.send(redirect(request, "/login?teacher=1"));
+    return page("teacher.html");
+  }
+  if (get && path.rfind("/static/", 0) == 0) {
+    auto it = files_.find(path);
+    if (it == files_.end()) return reply.send(errorAnswer(request, 404, "no such file"));
+    Response res = answer(request, http::status::ok, it->second, contentType(path));
+    res.set(http::field::cache_control, "max-age=3600");
+    return reply.send(std::move(res));
+  }
   // The run page: the run_id goes into the page escaped, in one attribute the scripts read.
-  svr.Get(std::string("/runs/") + kRunId, [this](const httplib::Request& req, httplib::Response& res) {
-    const std::string run_id = req.matches[1];
-    if (!book_.has(run_id)) return sendError(res, 404, "no such run");
+  static const std::regex run_page("/runs/" + kRunId);
+  if (get && std::regex_match(path, match, run_page)) {
+    const std::string run_id = match[1];
+    if (!book_.has(run_id)) return reply.send(errorAnswer(request, 404, "no such run"));
     std::string html = files_.at("/static/run.html");
     const std::string slot = "{{RUN_ID}}";
+    const std::string escaped = htmlEscape(run_id);
     for (auto at = html.find(slot); at != std::string::npos; at = html.find(slot, at)) {
-      const std::string escaped = htmlEscape(run_id);
       html.replace(at, slot.size(), escaped);
       at += escaped.size();
     }
-    res.set_content(html, "text/html; charset=utf-8");
-  });
-
-  svr.Get("/api/presets", [this](const httplib::Request&, httplib::Response& res) {
+    return reply.send(answer(request, http::status::ok, std::move(html), "text/html; charset=utf-8"));
+  }
+  if (post && path == "/api/login") return login(request, reply);
+  if (get && path == "/api/presets") {
     json out = json::array();
     try {
       for (const auto& entry : collision_lab::io::loadScenes(config_.scenario_file)) {
         const auto& s = entry.scene;
         json item = {{"name", entry.name}, {"description", entry.description}, {"bodies", s.masses.size()}};
         if (s.masses.size() <= kPresetSceneMaxBodies) {
-          json m = json::array();
-          for (double x : s.masses) m.push_back(std::isinf(x) ? json("inf") : json(x));
-          item["scene"] = {{"masses", m},
+          json masses = json::array();
+          for (double x : s.masses) masses.push_back(std::isinf(x) ? json("inf") : json(x));
+          item["scene"] = {{"masses", masses},
                            {"positions", s.positions},
                            {"velocities", s.velocities},
                            {"restitution", s.restitution},
@@ -209,185 +529,340 @@ void WebServer::routes() {
         out.push_back(item);
       }
     } catch (const std::exception& e) {
-      return sendError(res, 500, e.what());
+      return reply.send(errorAnswer(request, 500, e.what()));
     }
-    sendJson(res, 200, out);
-  });
+    return reply.send(jsonAnswer(request, 200, out));
+  }
+  if (post && path == "/api/runs") return postRun(request, reply);
+  if (get && path == "/api/runs") {
+    std::optional<std::string> student = queryParam(query, "student");
+    return reply.send(answer(request, http::status::ok, book_.list(student), "application/json"));
+  }
+  if (get && path == "/api/queue") {
+    std::string body;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      body = queue_json_;
+    }
+    if (body.empty()) body = json{{"workers", 0}, {"short_lane_workers", 0}, {"stamp", 0.0}, {"runs", json::array()}}.dump();
+    return reply.send(answer(request, http::status::ok, std::move(body), "application/json"));
+  }
+  static const std::regex run_api("/api/runs/" + kRunId + "(/events\\.csv|/bag|/stream|/stop)?");
+  if (std::regex_match(path, match, run_api)) {
+    const std::string run_id = match[1], what = match[2];
+    if (post && what == "/stop") return stopRun(request, run_id, access, reply);
+    if (get && what.empty()) {
+      const auto run = book_.json(run_id);
+      if (!run) return reply.send(errorAnswer(request, 404, "no such run"));
+      return reply.send(answer(request, http::status::ok, run->first, "application/json"));
+    }
+    if (get && what == "/events.csv") return sendEventsCsv(request, run_id, reply);
+    if (get && what == "/bag") return sendBag(request, run_id, reply);
+    if (get && what == "/stream") return stream(request, run_id, reply);
+  }
+  reply.send(errorAnswer(request, 404, "not found"));
+}
 
-  svr.Post("/api/runs", [this](const httplib::Request& req, httplib::Response& res) {
-    json body;
-    try {
-      body = json::parse(req.body);
-    } catch (const json::exception&) {
-      return sendError(res, 400, "the body is not JSON");
+void WebServer::login(const HttpRequest& request, const HttpReply& reply) {
+  const json body = json::parse(request.message.body(), nullptr, false);
+  if (!body.is_object() || !body.contains("code") || !body["code"].is_string() ||
+      body["code"].get<std::string>().size() > 256) {
+    return reply.send(errorAnswer(request, 400, "send {\"code\": \"...\"}", "code"));
+  }
+  if (const long wait = lockedOut(request.client)) {
+    Response res = errorAnswer(request, 429, "too many wrong codes from your address; try again in " + std::to_string(wait) + " s", "code");
+    res.set(http::field::retry_after, std::to_string(wait));
+    return reply.send(std::move(res));
+  }
+  const std::string code = body["code"];
+  const bool teacher = !config_.teacher_code.empty() && sameSecret(code, config_.teacher_code);
+  const bool student = teacher || (!config_.code.empty() && sameSecret(code, config_.code));
+  if (!student) {
+    log("wrong code at login from " + request.client);
+    if (const long wait = wrongCode(request.client)) {
+      Response res = errorAnswer(request, 429, "too many wrong codes from your address; try again in " + std::to_string(wait) + " s", "code");
+      res.set(http::field::retry_after, std::to_string(wait));
+      return reply.send(std::move(res));
     }
-    if (!body.is_object()) return sendError(res, 400, "the body must be a JSON object");
-    if (!config_.code.empty()) {
-      std::string code = req.get_header_value("X-Class-Code");
-      if (code.empty() && body.contains("code") && body["code"].is_string()) code = body["code"];
-      if (code != config_.code) return sendError(res, 403, "a class code is needed to send a scene", "code");
-    }
-    if (!body.contains("student") || !body["student"].is_string() || body["student"].get<std::string>().empty()) {
-      return sendError(res, 400, "student is required: your name", "student");
-    }
-    const std::string student = body["student"];
-    collision_lab::InitialConditions input;
-    try {
-      if (body.contains("preset")) {
-        if (!body["preset"].is_string()) throw FieldError{"preset", "preset must be a preset's name"};
-        collision_lab::io::SceneEntry entry;
-        try {
-          entry = collision_lab::io::findScene(collision_lab::io::loadScenes(config_.scenario_file), body["preset"]);
-        } catch (const collision_lab::io::ScenarioFileError& e) {
-          throw FieldError{"preset", e.what()};
-        }
-        input = collision_lab_ros::toInitialConditions(entry.scene, collision_lab::core::RunMode::kFull,
-                                                       entry.max_collisions);
-      } else {
-        input.masses = parseList(body, "masses", true);
-        input.positions = parseList(body, "positions", true);
-        input.velocities = parseList(body, "velocities", true);
-        input.restitution = parseList(body, "restitution", false);
+    return reply.send(errorAnswer(request, 403, "wrong code", "code"));
+  }
+  Response res = jsonAnswer(request, 200, {{"role", teacher ? "teacher" : "student"}});
+  const std::string attributes = "; Path=/; Max-Age=" + std::to_string(kCookieSeconds) + "; HttpOnly; SameSite=Strict";
+  res.insert(http::field::set_cookie, std::string(kClassCookie) + "=" + class_cookie_ + attributes);
+  if (teacher) res.insert(http::field::set_cookie, std::string(kTeacherCookie) + "=" + teacher_cookie_ + attributes);
+  reply.send(std::move(res));
+}
+
+void WebServer::postRun(const HttpRequest& request, const HttpReply& reply) {
+  json body = json::parse(request.message.body(), nullptr, false);
+  if (body.is_discarded()) return reply.send(errorAnswer(request, 400, "the body is not JSON"));
+  if (!body.is_object()) return reply.send(errorAnswer(request, 400, "the body must be a JSON object"));
+  if (!body.contains("student") || !body["student"].is_string() || body["student"].get<std::string>().empty()) {
+    return reply.send(errorAnswer(request, 400, "student is required: your name", "student"));
+  }
+  const std::string student = body["student"];
+  if (student.size() > collision_lab_ros::kMaxStudentLength) {
+    log("refused a scene from " + request.client + ": a name of " + std::to_string(student.size()) + " bytes");
+    return reply.send(errorAnswer(request, 400,
+                                  "student is longer than " + std::to_string(collision_lab_ros::kMaxStudentLength) +
+                                      " characters",
+                                  "student"));
+  }
+  collision_lab::InitialConditions input;
+  try {
+    if (body.contains("preset")) {
+      if (!body["preset"].is_string()) throw FieldError{"preset", "preset must be a preset's name"};
+      collision_lab::io::SceneEntry entry;
+      try {
+        entry = collision_lab::io::findScene(collision_lab::io::loadScenes(config_.scenario_file), body["preset"]);
+      } catch (const collision_lab::io::ScenarioFileError& e) {
+        throw FieldError{"preset", e.what()};
       }
-      if (body.contains("max_collisions")) {
-        const json& cap = body["max_collisions"];
-        if (!cap.is_number_unsigned()) throw FieldError{"max_collisions", "max_collisions must be a whole number >= 0"};
-        input.max_collisions = cap.get<std::uint64_t>();
+      input = collision_lab_ros::toInitialConditions(entry.scene, collision_lab::core::RunMode::kFull, entry.max_collisions);
+    } else {
+      input.masses = parseList(body, "masses", true);
+      input.positions = parseList(body, "positions", true);
+      input.velocities = parseList(body, "velocities", true);
+      input.restitution = parseList(body, "restitution", false);
+    }
+    if (body.contains("max_collisions")) {
+      const json& cap = body["max_collisions"];
+      if (!cap.is_number_unsigned()) throw FieldError{"max_collisions", "max_collisions must be a whole number >= 0"};
+      input.max_collisions = cap.get<std::uint64_t>();
+    }
+    if (body.contains("max_run_seconds")) {
+      const json& limit = body["max_run_seconds"];
+      if (!limit.is_number() || !(limit.get<double>() >= 0)) {
+        throw FieldError{"max_run_seconds", "max_run_seconds must be a number of seconds >= 0"};
       }
-      if (body.contains("mode")) {
-        const json& mode = body["mode"];
-        if (!mode.is_number_unsigned() || mode.get<std::uint64_t>() > 255) throw FieldError{"mode", "mode must be 0, 1 or 2"};
-        input.mode = static_cast<std::uint8_t>(mode.get<std::uint64_t>());
+      input.max_run_seconds = limit.get<double>();
+    }
+    if (body.contains("max_bag_bytes")) {
+      const json& limit = body["max_bag_bytes"];
+      if (!limit.is_number_unsigned()) throw FieldError{"max_bag_bytes", "max_bag_bytes must be a whole number >= 0"};
+      input.max_bag_bytes = limit.get<std::uint64_t>();
+    }
+    if (body.contains("mode")) {
+      const json& mode = body["mode"];
+      if (!mode.is_number_unsigned() || mode.get<std::uint64_t>() > 255) throw FieldError{"mode", "mode must be 0, 1 or 2"};
+      input.mode = static_cast<std::uint8_t>(mode.get<std::uint64_t>());
+    }
+    if (body.contains("run_id")) {
+      if (!body["run_id"].is_string() || body["run_id"].get<std::string>().size() > kMaxRunIdLength) {
+        throw FieldError{"run_id", "run_id must be text of at most " + std::to_string(kMaxRunIdLength) + " characters"};
       }
-      if (body.contains("run_id")) {
-        if (!body["run_id"].is_string()) throw FieldError{"run_id", "run_id must be text"};
-        input.run_id = body["run_id"];
+      input.run_id = body["run_id"];
+    }
+  } catch (const FieldError& e) {
+    log("refused a scene from " + request.client + " (" + student + "): " + e.field);
+    return reply.send(errorAnswer(request, 400, e.message, e.field));
+  }
+  if (input.masses.size() > config_.max_bodies) {
+    collision_lab::Rejected r;
+    r.reason = collision_lab::Rejected::TOO_MANY_BODIES;
+    r.reason_name = "TOO_MANY_BODIES";
+    r.field = "masses";
+    r.message = std::to_string(input.masses.size()) + " bodies are more than this lab's max_bodies = " +
+                std::to_string(config_.max_bodies);
+    return reply.send(jsonAnswer(request, 422, rejectionJson(r)));
+  }
+  // Per address and per name: another name does not escape the limit, and sending as a
+  // classmate from elsewhere only spends the classmate's runs as well as one's own.
+  long wait = admit("address " + request.client, config_.runs_per_minute_per_address);
+  std::string which = "runs per address";
+  std::size_t limit = config_.runs_per_minute_per_address;
+  if (!wait) {
+    wait = admit("student " + student, config_.runs_per_minute);
+    which = "runs per student";
+    limit = config_.runs_per_minute;
+  }
+  if (wait) {
+    log("limited " + request.client + " (" + student + "): " + which);
+    Response res = errorAnswer(request, 429, "at most " + std::to_string(limit) + " " + which + " per minute; try again in " +
+                                                  std::to_string(wait) + " s");
+    res.set(http::field::retry_after, std::to_string(wait));
+    return reply.send(std::move(res));
+  }
+  // Each input gets a run_id of its own to ask for, so that its answer is found.
+  if (input.run_id.empty()) input.run_id = "run" + std::to_string(++submissions_);
+  input.student = student;
+  const std::string requested = input.run_id;
+  const std::string token = randomToken();
+  auto timer = std::make_shared<boost::asio::steady_timer>(
+      reply.executor(), std::chrono::milliseconds(static_cast<long long>(config_.answer_timeout * 1000)));
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    pending_.emplace(student, requested);
+  }
+  book_.expect(student, requested, [this, request, reply, timer, token, student, requested](const Submission& answer) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      pending_.erase({student, requested});
+    }
+    boost::asio::post(reply.executor(), [timer] { timer->cancel(); });
+    if (answer.rejected) return reply.send(jsonAnswer(request, 422, rejectionJson(*answer.rejected)));
+    remember(*answer.run_id, token);
+    reply.send(jsonAnswer(request, 202,
+                          {{"run_id", *answer.run_id},
+                           {"url", "/runs/" + *answer.run_id},
+                           {"queue_position", answer.queue_position},
+                           {"lane", answer.lane},
+                           {"stop_token", token}}));
+  });
+  if (!publish_(input)) {
+    if (book_.forget(student, requested)) {
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        pending_.erase({student, requested});
       }
-    } catch (const FieldError& e) {
-      return sendError(res, 400, e.message, e.field);
+      reply.send(errorAnswer(request, 503, "the lab node is not listening; ask the teacher"));
     }
-    if (input.masses.size() > config_.max_bodies) {
-      collision_lab::Rejected r;
-      r.reason = collision_lab::Rejected::TOO_MANY_BODIES;
-      r.reason_name = "TOO_MANY_BODIES";
-      r.field = "masses";
-      r.message = std::to_string(input.masses.size()) + " bodies are more than this lab's max_bodies = " +
-                  std::to_string(config_.max_bodies);
-      return sendJson(res, 422, rejectionJson(r));
+    return;
+  }
+  timer->async_wait([this, request, reply, timer, student, requested](boost::system::error_code ec) {
+    if (ec || !book_.forget(student, requested)) return;  // answered meanwhile
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      pending_.erase({student, requested});
     }
-    if (const long wait = admit(student)) {
-      res.set_header("Retry-After", std::to_string(wait));
-      return sendError(res, 429,
-                       "at most " + std::to_string(config_.runs_per_minute) + " runs per student per minute; try again in " +
-                           std::to_string(wait) + " s");
-    }
-    // Each input gets a run_id of its own to ask for, so that its answer is found.
-    if (input.run_id.empty()) input.run_id = "run" + std::to_string(++submissions_);
-    input.student = student;
-    book_.expect(student, input.run_id);
-    if (!publish_(input)) {
-      book_.waitForAnswer(student, input.run_id, std::chrono::milliseconds(0));
-      return sendError(res, 503, "the lab node is not listening; ask the teacher");
-    }
-    const auto timeout = std::chrono::milliseconds(static_cast<long>(config_.answer_timeout * 1000));
-    const auto answer = book_.waitForAnswer(student, input.run_id, timeout);
-    if (!answer) return sendError(res, 504, "the lab node did not answer in time; it may be busy with a long run");
-    if (answer->rejected) return sendJson(res, 422, rejectionJson(*answer->rejected));
-    sendJson(res, 201, {{"run_id", *answer->run_id}, {"url", "/runs/" + *answer->run_id}});
+    reply.send(errorAnswer(request, 503, "the lab node did not answer; ask the teacher"));
   });
+}
 
-  svr.Get("/api/runs", [this](const httplib::Request& req, httplib::Response& res) {
-    std::optional<std::string> student;
-    if (req.has_param("student")) student = req.get_param_value("student");
-    res.set_content(book_.list(student), "application/json");
-  });
-
-  svr.Get(std::string("/api/runs/") + kRunId, [this](const httplib::Request& req, httplib::Response& res) {
-    const auto run = book_.json(req.matches[1]);
-    if (!run) return sendError(res, 404, "no such run");
-    res.set_content(run->first, "application/json");
-  });
-
-  svr.Get(std::string("/api/runs/") + kRunId + "/events.csv", [this](const httplib::Request& req,
-                                                                     httplib::Response& res) {
-    const std::string run_id = req.matches[1];
-    if (!book_.has(run_id)) return sendError(res, 404, "no such run");
-    if (!book_.finished(run_id)) return sendError(res, 409, "the run is not finished yet");
-    const std::string bag = book_.bagPath(run_id);
-    if (bag.empty()) return sendError(res, 404, "the run was not recorded");
+void WebServer::stopRun(const HttpRequest& request, const std::string& run_id, const Access& access,
+                        const HttpReply& reply) {
+  const auto owner_token = stopToken(run_id);
+  if (!owner_token && !book_.has(run_id)) return reply.send(errorAnswer(request, 404, "no such run"));
+  std::string token(request.message["X-Stop-Token"]);
+  if (token.empty() && !request.message.body().empty()) {
+    const json body = json::parse(request.message.body(), nullptr, false);
+    if (body.is_object() && body.contains("stop_token") && body["stop_token"].is_string()) token = body["stop_token"];
+  }
+  std::string requested_by;
+  if (owner_token && !token.empty() && sameSecret(token, *owner_token)) {
+    requested_by = "its student";
+  } else if (access.teacher && !config_.teacher_code.empty()) {
+    requested_by = "the teacher";
+  } else {
+    log("refused a stop of " + run_id + " from " + request.client);
+    return reply.send(errorAnswer(request, 403, "only the run's student (its stop_token) or the teacher may stop it"));
+  }
+  if (!cancel_) return reply.send(errorAnswer(request, 503, "this server cannot reach the lab node's cancel service"));
+  boost::asio::post(blocking_->pool, [this, request, reply, run_id, requested_by] {
+    std::optional<CancelAnswer> answer;
     try {
-      res.set_content(eventsCsv(bag), "text/csv");
-    } catch (const std::exception& e) {
-      return sendError(res, 500, e.what());
-    }
-    res.set_header("Content-Disposition", "attachment; filename=\"" + run_id + "_events.csv\"");
-  });
-
-  // The bag: only the file its RunSummary names, and only when that file is <run_id>.bag.
-  svr.Get(std::string("/api/runs/") + kRunId + "/bag", [this](const httplib::Request& req, httplib::Response& res) {
-    const std::string run_id = req.matches[1];
-    const std::string bag = book_.bagPath(run_id);
-    const std::string name = run_id + ".bag";
-    if (bag.empty() || bag.size() < name.size() + 1 || bag.compare(bag.size() - name.size() - 1, std::string::npos, "/" + name) != 0) {
-      return sendError(res, 404, "no recorded bag for this run");
-    }
-    try {
-      res.set_content(readFile(bag), "application/octet-stream");
+      answer = cancel_(run_id, requested_by);
     } catch (const std::exception&) {
-      return sendError(res, 404, "the bag is gone");
     }
-    res.set_header("Content-Disposition", "attachment; filename=\"" + name + "\"");
+    if (!answer) return reply.send(errorAnswer(request, 503, "the lab node's cancel service did not answer"));
+    reply.send(jsonAnswer(request, 200, {{"ok", answer->ok}, {"message", answer->message}, {"requested_by", requested_by}}));
   });
+}
 
-  // Server-Sent Events: the run as JSON (as GET /api/runs/<run_id>) whenever it changed,
-  // at most every kStreamInterval; an event `final` ends the stream.
-  svr.Get(std::string("/api/runs/") + kRunId + "/stream", [this](const httplib::Request& req,
-                                                                 httplib::Response& res) {
-    const std::string run_id = req.matches[1];
-    if (!book_.has(run_id)) return sendError(res, 404, "no such run");
-    if (streams_.fetch_add(1) >= config_.max_streams) {
-      --streams_;
-      return sendError(res, 503, "too many live streams at once; the page reloads the run instead");
-    }
-    res.set_header("Cache-Control", "no-cache");
-    auto seen = std::make_shared<std::uint64_t>(0);
-    auto last = std::make_shared<std::chrono::steady_clock::time_point>();
-    res.set_chunked_content_provider(
-        "text/event-stream",
-        [this, run_id, seen, last](std::size_t, httplib::DataSink& sink) {
-          if (stopping_) {
-            sink.done();
-            return true;
-          }
-          const auto [version, finished] = book_.waitForChange(run_id, *seen, kStreamKeepAlive);
-          if (version == *seen) {
-            const std::string ping = ": ping\n\n";
-            return sink.write(ping.data(), ping.size());
-          }
-          const auto since = std::chrono::steady_clock::now() - *last;
-          if (!finished && since < kStreamInterval) std::this_thread::sleep_for(kStreamInterval - since);
-          // Whether the run is final is read before its JSON (and after the pause above): a run
-          // that finishes after this read has a newer version, which wakes the next call.
-          const bool done = book_.finished(run_id);
-          const auto run = book_.json(run_id);
-          if (!run) return false;
-          *seen = run->second;
-          *last = std::chrono::steady_clock::now();
-          const std::string event = std::string("event: ") + (done ? "final" : "run") + "\ndata: " + run->first + "\n\n";
-          if (!sink.write(event.data(), event.size())) return false;
-          if (done) sink.done();
-          return true;
-        },
-        [this](bool) { --streams_; });
-  });
+namespace {
 
-  svr.set_error_handler([](const httplib::Request&, httplib::Response& res) {
-    if (res.body.empty()) {
-      json body = {{"error", res.status == 413 ? "the request body is too large" : "not found"}};
-      if (res.status != 404 && res.status != 413) body["error"] = "HTTP " + std::to_string(res.status);
-      res.set_content(body.dump(), "application/json");
+/// The bag and a file of its folder as an attachment, streamed from disk.
+std::optional<http::response<http::file_body>> fileAnswer(const HttpRequest& request, const std::string& path,
+                                                          const std::string& type, const std::string& name) {
+  http::file_body::value_type file;
+  boost::beast::error_code ec;
+  file.open(path.c_str(), boost::beast::file_mode::scan, ec);
+  if (ec) return std::nullopt;
+  http::response<http::file_body> res(http::status::ok, request.message.version());
+  res.set(http::field::content_type, type);
+  res.set(http::field::content_disposition, "attachment; filename=\"" + name + "\"");
+  res.body() = std::move(file);
+  return res;
+}
+
+}  // namespace
+
+void WebServer::sendEventsCsv(const HttpRequest& request, const std::string& run_id, const HttpReply& reply) {
+  if (!book_.has(run_id)) return reply.send(errorAnswer(request, 404, "no such run"));
+  if (!book_.finished(run_id)) return reply.send(errorAnswer(request, 409, "the run is not finished yet"));
+  const std::string bag = book_.bagPath(run_id);
+  if (bag.empty()) return reply.send(errorAnswer(request, 404, "the run was not recorded"));
+  const std::string name = run_id + "_events.csv";
+  const fs::path csv = fs::path(bag).parent_path() / name;
+  if (auto res = fileAnswer(request, csv.string(), "text/csv", name)) return reply.sendFile(std::move(*res));
+  // Converted once, beside the bag, off the I/O threads; a conversion finished by another
+  // request meanwhile is simply replaced by an identical one.
+  boost::asio::post(blocking_->pool, [this, request, reply, bag, csv, name] {
+    std::string folder = (csv.parent_path() / ("." + name + ".XXXXXX")).string();
+    if (!mkdtemp(folder.data())) return reply.send(errorAnswer(request, 500, "cannot write beside the bag"));
+    bool has_events = false;
+    std::string error;
+    try {
+      const auto exported = collision_lab_ros::bagToCsv(bag, folder);
+      for (const auto& file : exported.files) {
+        if (fs::path(file.path).filename() == "collision_events.csv") {
+          fs::rename(file.path, csv);
+          has_events = true;
+        }
+      }
+    } catch (const std::exception& e) {
+      error = e.what();
     }
+    std::error_code ignored;
+    fs::remove_all(folder, ignored);
+    if (!error.empty()) return reply.send(errorAnswer(request, 500, error));
+    if (!has_events) {
+      return reply.send(errorAnswer(request, 404, "the run has no collision events to export: it was not simulated, or had no impact"));
+    }
+    auto res = fileAnswer(request, csv.string(), "text/csv", name);
+    if (!res) return reply.send(errorAnswer(request, 500, "the converted CSV is gone"));
+    reply.sendFile(std::move(*res));
   });
+}
+
+// The bag: only the file its RunSummary names, and only when that file is <run_id>.bag.
+void WebServer::sendBag(const HttpRequest& request, const std::string& run_id, const HttpReply& reply) {
+  const std::string bag = book_.bagPath(run_id);
+  const std::string name = run_id + ".bag";
+  if (bag.empty() || bag.size() < name.size() + 1 ||
+      bag.compare(bag.size() - name.size() - 1, std::string::npos, "/" + name) != 0) {
+    return reply.send(errorAnswer(request, 404, "no recorded bag for this run"));
+  }
+  auto res = fileAnswer(request, bag, "application/octet-stream", name);
+  if (!res) return reply.send(errorAnswer(request, 404, "the bag is gone"));
+  reply.sendFile(std::move(*res));
+}
+
+// Server-Sent Events: the run as JSON (as GET /api/runs/<run_id>) whenever it changed, at
+// most every kStreamInterval; an event `final` ends the stream. A timer per stream, no thread.
+void WebServer::stream(const HttpRequest& request, const std::string& run_id, const HttpReply& reply) {
+  if (!book_.has(run_id)) return reply.send(errorAnswer(request, 404, "no such run"));
+  if (streams_.fetch_add(1) >= config_.max_streams) {
+    --streams_;
+    return reply.send(errorAnswer(request, 503, "too many live streams at once; the page reloads the run instead"));
+  }
+  // The slot is freed when the stream's poll is released (stream ended or client gone).
+  std::shared_ptr<void> slot(nullptr, [this](void*) { --streams_; });
+  http::response<http::empty_body> header(http::status::ok, request.message.version());
+  header.set(http::field::content_type, "text/event-stream");
+  header.set(http::field::cache_control, "no-cache");
+  auto seen = std::make_shared<std::uint64_t>(0);
+  auto last = std::make_shared<std::chrono::steady_clock::time_point>(std::chrono::steady_clock::now());
+  reply.stream(
+      std::move(header),
+      [this, run_id, slot, seen, last]() -> StreamStep {
+        const auto now = std::chrono::steady_clock::now();
+        const auto version = book_.waitForChange(run_id, *seen, std::chrono::milliseconds(0)).first;
+        if (version == *seen) {
+          if (now - *last < kStreamKeepAlive) return {};
+          *last = now;
+          return {": ping\n\n", false};
+        }
+        // Whether the run is final is read before its JSON: a run that finishes after this
+        // read has a newer version, which the next poll sends.
+        const bool done = book_.finished(run_id);
+        const auto run = book_.json(run_id);
+        if (!run) return {{}, true};
+        *seen = run->second;
+        *last = now;
+        return {std::string("event: ") + (done ? "final" : "run") + "\ndata: " + run->first + "\n\n", done};
+      },
+      kStreamInterval);
 }
 
 }  // namespace collision_lab_web

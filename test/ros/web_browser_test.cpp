@@ -104,7 +104,7 @@ TEST_F(WebBrowserTest, RunPageDrawsItsPlots) {
         return status != 503;  // 503: the lab node is not subscribed yet
       },
       "the lab node to take inputs"));
-  ASSERT_EQ(status, 201) << body;
+  ASSERT_EQ(status, 202) << body;
   const std::string run_id = json::parse(body)["run_id"];
   const std::string page = "http://" + host_ + ":" + std::to_string(port_) + "/runs/" + run_id;
 

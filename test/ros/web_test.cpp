@@ -29,9 +29,11 @@ constexpr char kCode[] = "sesame";
 std::string g_host;
 int g_port = 0;
 
+/// A client of the class: every route needs the class code (here in its header).
 httplib::Client client() {
   httplib::Client c(g_host, g_port);
   c.set_read_timeout(60, 0);
+  c.set_default_headers({{"X-Class-Code", kCode}});
   return c;
 }
 
@@ -78,11 +80,11 @@ class WebTest : public ::testing::Test {
     const auto colon = url.rfind(':');
     g_host = url.substr(7, colon - 7);
     g_port = std::stoi(url.substr(colon + 1));
-    // The lab node subscribes to the web node's input: a POST answered 201 says so.
+    // The lab node subscribes to the web node's input: a POST answered 202 says so.
     waitUntil(
         [] {
           auto res = post(piScene("warmup"));
-          return res && res->status == 201;
+          return res && res->status == 202;
         },
         "the web node to reach the lab node");
   }
@@ -91,7 +93,7 @@ class WebTest : public ::testing::Test {
 TEST_F(WebTest, BrowserRunIsServedRecordedAndListed) {
   auto res = post(piScene("ana"));
   ASSERT_TRUE(res);
-  ASSERT_EQ(res->status, 201) << res->body;
+  ASSERT_EQ(res->status, 202) << res->body;
   const std::string run_id = json::parse(res->body)["run_id"];
   EXPECT_EQ(run_id.rfind("ana.", 0), 0u) << "a student's run is served as <student>.<run_id>";
   const json run = finishedRun(run_id);
@@ -129,7 +131,7 @@ TEST_F(WebTest, BrowserRunIsServedRecordedAndListed) {
 TEST_F(WebTest, LiveStreamEndsWithTheFinalRun) {
   auto res = post(piScene("ben"));
   ASSERT_TRUE(res);
-  ASSERT_EQ(res->status, 201) << res->body;
+  ASSERT_EQ(res->status, 202) << res->body;
   const std::string run_id = json::parse(res->body)["run_id"];
   std::string received;
   auto c = client();
@@ -149,7 +151,7 @@ TEST_F(WebTest, LiveStreamEndsWithTheFinalRun) {
 TEST_F(WebTest, RunBeyondThePublishedEventsIsRebuiltFromItsBag) {
   auto res = post({{"student", "cleo"}, {"code", kCode}, {"preset", "pi_digits_3"}});
   ASSERT_TRUE(res);
-  ASSERT_EQ(res->status, 201) << res->body;
+  ASSERT_EQ(res->status, 202) << res->body;
   const json run = finishedRun(json::parse(res->body)["run_id"]);
   EXPECT_EQ(run.at("summary").at("published_events"), 100) << "the lab node's max_published_events";
   EXPECT_EQ(run.at("collisions"), 314) << "every impact, from the bag";
@@ -176,26 +178,35 @@ TEST_F(WebTest, RejectionCarriesReasonAndField) {
   EXPECT_EQ(json::parse(res->body)["field"], "velocities[1]");
 }
 
-TEST_F(WebTest, ClassCodeIsNeededToSend) {
+TEST_F(WebTest, ClassCodeIsNeededEverywhere) {
   json scene = piScene("eve");
   scene.erase("code");
-  auto res = post(scene);
+  httplib::Client bare(g_host, g_port);  // no X-Class-Code
+  auto res = bare.Post("/api/runs", scene.dump(), "application/json");
   ASSERT_TRUE(res);
   EXPECT_EQ(res->status, 403);
   scene["code"] = "guess";
-  res = post(scene);
+  res = bare.Post("/api/runs", scene.dump(), "application/json");
   ASSERT_TRUE(res);
   EXPECT_EQ(res->status, 403);
   // In a header instead of the body.
   scene.erase("code");
-  res = post(scene, {{"X-Class-Code", kCode}});
+  res = post(scene);
   ASSERT_TRUE(res);
-  EXPECT_EQ(res->status, 201) << res->body;
-  // Reading needs none.
-  auto c = client();
-  auto list = c.Get("/api/runs");
-  ASSERT_TRUE(list);
-  EXPECT_EQ(list->status, 200);
+  EXPECT_EQ(res->status, 202) << res->body;
+  // Reading needs it too: the API answers 403, a page sends to the code page.
+  for (const char* path : {"/api/runs", "/api/queue", "/api/presets", "/static/app.js"}) {
+    auto read = bare.Get(path);
+    ASSERT_TRUE(read) << path;
+    EXPECT_EQ(read->status, 403) << path;
+  }
+  auto page = bare.Get("/");
+  ASSERT_TRUE(page);
+  EXPECT_EQ(page->status, 303);
+  EXPECT_EQ(page->get_header_value("Location"), "/login");
+  auto login_page = bare.Get("/login");
+  ASSERT_TRUE(login_page);
+  EXPECT_EQ(login_page->status, 200);
 }
 
 TEST_F(WebTest, LargeBodyIs413) {
@@ -225,7 +236,7 @@ TEST_F(WebTest, RunsPerStudentPerMinuteIs429ForThatStudentOnly) {
   for (int i = 0; i < 3; ++i) {  // runs_per_minute = 3
     auto res = post(piScene("hal"));
     ASSERT_TRUE(res);
-    EXPECT_EQ(res->status, 201) << res->body;
+    EXPECT_EQ(res->status, 202) << res->body;
   }
   auto res = post(piScene("hal"));
   ASSERT_TRUE(res);
@@ -233,7 +244,7 @@ TEST_F(WebTest, RunsPerStudentPerMinuteIs429ForThatStudentOnly) {
   EXPECT_FALSE(res->get_header_value("Retry-After").empty());
   res = post(piScene("ivy"));
   ASSERT_TRUE(res);
-  EXPECT_EQ(res->status, 201) << "another student is not held back";
+  EXPECT_EQ(res->status, 202) << "another student is not held back";
 }
 
 TEST_F(WebTest, ConcurrentStreamsAreLimited) {

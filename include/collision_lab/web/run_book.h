@@ -55,9 +55,12 @@ struct WebRun {
   double accepted_stamp = 0.0;  ///< [s] since the epoch
 };
 
-/// A submitted input's answer: the run_id it was served under, or its rejection.
+/// A submitted input's answer: the run_id it was served under (with its place in the
+/// queue and lane, AcceptedRun), or its rejection.
 struct Submission {
   std::optional<std::string> run_id;
+  std::uint32_t queue_position = 0;  ///< [1] runs ahead of it when accepted
+  std::string lane;                  ///< "short" or "long"; empty from an older lab node
   std::optional<collision_lab::Rejected> rejected;
 };
 
@@ -78,11 +81,14 @@ class RunBook {
   void onEvent(const collision_lab::CollisionEvent& msg);
   void onSummary(const collision_lab::RunSummary& msg);
 
-  /// Registers an input about to be published under `requested` run_id for `student`, and
-  /// waits up to `timeout` for its AcceptedRun or Rejected. nullopt on timeout.
-  std::optional<Submission> waitForAnswer(const std::string& student, const std::string& requested,
-                                          std::chrono::milliseconds timeout);
-  void expect(const std::string& student, const std::string& requested);
+  /// Registers an input about to be published under `requested` run_id for `student`:
+  /// `on_answer` is called once, on the ROS callback's thread and without the book's lock,
+  /// when its AcceptedRun or Rejected arrives. No thread waits for it.
+  using AnswerCallback = std::function<void(const Submission&)>;
+  void expect(const std::string& student, const std::string& requested, AnswerCallback on_answer);
+  /// Forgets an input still unanswered (its sender gave up): true when it was still
+  /// waiting, and then its callback is never called.
+  bool forget(const std::string& student, const std::string& requested);
 
   bool has(const std::string& run_id) const;
   /// The run as JSON text (docs/web.md), with its version; nullopt for an unknown run_id.
@@ -102,6 +108,8 @@ class RunBook {
   void finishLocked(WebRun& run, const collision_lab::RunSummary& summary);
   void maybeFinishLocked(WebRun& run);
   void rebuildFromBag(const std::string& run_id, const std::string& bag_path);
+  /// Removes and returns the callback waiting for this input's answer (null if none).
+  AnswerCallback takeWaitingLocked(const std::string& student, const std::string& requested);
 
   std::size_t envelope_vertices_;
   mutable std::mutex mutex_;
@@ -109,7 +117,7 @@ class RunBook {
   std::map<std::string, WebRun> runs_;
   std::vector<std::string> order_;  ///< run_ids, oldest first
   /// Inputs published and not yet answered: key student + '\n' + requested run_id.
-  std::map<std::string, std::optional<Submission>> waiting_;
+  std::map<std::string, AnswerCallback> waiting_;
   std::vector<std::thread> rebuilds_;  ///< one per run rebuilt from its bag; joined at the end
 };
 
@@ -123,9 +131,5 @@ BagRun readRunFromBag(const std::string& bag_path, std::size_t envelope_vertices
 
 /// Text safe inside HTML element content and attribute values (& < > " ').
 std::string htmlEscape(const std::string& text);
-
-/// The events CSV of a recorded run: collision_events.csv as bag_to_csv writes it. Throws
-/// collision_lab_ros::BagCsvError.
-std::string eventsCsv(const std::string& bag_path);
 
 }  // namespace collision_lab_web

@@ -1,14 +1,21 @@
-// The class's web server (docs/web.md): pages, a JSON API and live event streams over
-// cpp-httplib. It sends scenes to the lab node as InitialConditions (through `publish`),
-// and shows what the RunBook gathers from the lab node's topics. ROS-free apart from the
-// message types.
+// The class's web server (docs/web.md): pages, a JSON API and live event streams on an
+// asynchronous HTTP server (Boost.Beast, src/web/http_server.h): a few I/O threads serve
+// every connection and stream, and no request holds a thread while it waits. It sends
+// scenes to the lab node as InitialConditions (through `publish`), stops runs through the
+// lab node's ~cancel (through `cancel`), and shows what the RunBook gathers from the lab
+// node's topics. ROS-free apart from the message types.
 //
-// Safety in a classroom: binds 127.0.0.1 unless told otherwise; with a class code set,
-// POST /api/runs needs it (403); limits answer with an HTTP error and touch no one else:
-// request body (413), bodies per scene (422, TOO_MANY_BODIES), runs per student per minute
-// (429), concurrent event streams (503). Pages and files are served from a fixed list
-// loaded at start; a bag is served only from its run's RunSummary.bag_path, never from a
-// path in the URL.
+// Safety in a classroom: binds 127.0.0.1 unless told otherwise. Per connection: header and
+// body deadlines, an idle timeout, header and body size limits whatever the transfer
+// encoding (413); connections per address and in total are capped (503). With a class code
+// set, every route needs it (a cookie after POST /api/login, or the header X-Class-Code);
+// a teacher code guards /teacher and stopping others' runs. Wrong codes are counted per
+// client address: 429, then a lockout that ends by itself. POSTs with a foreign Origin are
+// 403; a Host that is not one of the lab's names is 421 (DNS rebinding). Every answer
+// carries the security headers. Runs per student and per address per minute (429),
+// bodies per scene (422, TOO_MANY_BODIES), concurrent event streams (503). Pages and files
+// are served from a fixed list loaded at start; a bag is served only from its run's
+// RunSummary.bag_path, never from a path in the URL.
 #pragma once
 
 #include <atomic>
@@ -19,66 +26,124 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
+#include <set>
 #include <string>
-#include <thread>
+#include <vector>
 
 #include "collision_lab/InitialConditions.h"
+#include "collision_lab/RunQueue.h"
 #include "collision_lab/web/run_book.h"
 
-namespace httplib {
-class Server;
-}
-
 namespace collision_lab_web {
+
+class HttpServer;
+class HttpReply;
+struct HttpRequest;
+struct BlockingPool;
 
 struct WebConfig {
   std::string bind = "127.0.0.1";
   int port = 8080;  ///< 0: any free port (WebServer::port() says which)
-  std::string code;  ///< class code; empty: none needed
-  std::size_t max_body_bytes = 1 << 20;  ///< [bytes] larger request bodies: 413
+  std::string code;          ///< class code; empty: none needed
+  std::string teacher_code;  ///< teacher code (the teacher page, stopping any run); empty: none needed
+  /// More names the lab is reached by (Host header), besides bind, localhost, 127.0.0.1,
+  /// the machine's hostname and its addresses.
+  std::vector<std::string> allowed_hosts;
+  std::size_t max_body_bytes = 1 << 20;  ///< [bytes] larger request bodies: 413 (chunked too)
   std::size_t max_bodies = 10000;        ///< the lab node's ~max_bodies [1]
   std::size_t runs_per_minute = 10;      ///< per student [1]; more: 429
+  std::size_t runs_per_minute_per_address = 30;  ///< per client address [1]; more: 429
   std::size_t max_streams = 64;          ///< concurrent event streams [1]; more: 503
-  /// How long POST /api/runs waits for the lab node's AcceptedRun or Rejected [s] (runs are
-  /// served one at a time: a long run ahead delays the answer); then 504.
-  double answer_timeout = 30.0;
+  std::size_t code_attempts = 5;         ///< wrong codes per address per minute [1] before the lockout
+  double code_lockout = 60.0;            ///< [s] an address is locked out after too many wrong codes
+  /// How long POST /api/runs waits for the lab node's AcceptedRun or Rejected [s]; then 503.
+  double answer_timeout = 10.0;
+  std::size_t io_threads = 2;            ///< [1] threads serving every connection
+  double header_timeout = 10.0;          ///< [s] to receive a request's whole header
+  double body_timeout = 30.0;            ///< [s] to receive a request's body
+  double idle_timeout = 5.0;             ///< [s] a kept-alive connection may stay idle
+  std::size_t max_connections_per_address = 32;  ///< [1] open connections per client address
+  std::size_t max_connections = 1024;    ///< [1] open connections in total
+  std::size_t stop_tokens = 4096;        ///< [1] runs whose stop_token is remembered (newest)
   std::string web_root;       ///< folder of the pages (the package's web/)
   std::string chartjs_path;   ///< Debian's chart.min.js
   std::string scenario_file;  ///< the presets (config/scenarios.yaml)
+};
+
+/// The lab node's answer to a cancel (srv/Cancel.srv).
+struct CancelAnswer {
+  bool ok = false;
+  std::string message;
 };
 
 class WebServer {
  public:
   /// publish: sends one input to the lab node; false when the lab node is not listening.
   using Publish = std::function<bool(const collision_lab::InitialConditions&)>;
+  /// cancel: asks the lab node to stop run_id for requested_by; nullopt when the lab node
+  /// cannot be reached. May block: it is called on a thread of its own, never an I/O one.
+  using Cancel = std::function<std::optional<CancelAnswer>(const std::string& run_id, const std::string& requested_by)>;
+  /// log: one short line about a refused request (at most kLogLineBytes).
+  using Log = std::function<void(const std::string&)>;
+  static constexpr std::size_t kLogLineBytes = 200;
 
   /// Loads the pages; throws std::runtime_error when one is missing.
-  WebServer(RunBook& book, WebConfig config, Publish publish);
+  WebServer(RunBook& book, WebConfig config, Publish publish, Cancel cancel = {}, Log log = {});
   ~WebServer();
 
-  /// Binds and serves on a thread of its own; throws std::runtime_error when the address
-  /// cannot be bound.
+  /// Binds and serves on its I/O threads; throws std::runtime_error when the address cannot
+  /// be bound.
   void start();
   void stop();
   int port() const { return port_; }
+  /// The lab node's latest queue (its latched `run_queue`), served by GET /api/queue.
+  void setQueue(const collision_lab::RunQueue& queue);
+
+  struct Access;  ///< what a request may do (its codes)
 
  private:
-  void routes();
-  /// Seconds until `student` may send again; 0 (and the send counted) when allowed now.
-  long admit(const std::string& student);
+  void handle(HttpRequest request, HttpReply reply);
+  void route(const HttpRequest& request, const Access& access, const HttpReply& reply);
+  void postRun(const HttpRequest& request, const HttpReply& reply);
+  void stopRun(const HttpRequest& request, const std::string& run_id, const Access& access, const HttpReply& reply);
+  void login(const HttpRequest& request, const HttpReply& reply);
+  void sendEventsCsv(const HttpRequest& request, const std::string& run_id, const HttpReply& reply);
+  void sendBag(const HttpRequest& request, const std::string& run_id, const HttpReply& reply);
+  void stream(const HttpRequest& request, const std::string& run_id, const HttpReply& reply);
+  /// Seconds until `key` may send again under `limit` per minute; 0 (and counted) when now.
+  long admit(const std::string& key, std::size_t limit);
+  /// Seconds the address is still locked out for wrong codes; 0 when it is not.
+  long lockedOut(const std::string& client);
+  /// Counts a wrong code from `client`: seconds of lockout when it is now locked out, else 0.
+  long wrongCode(const std::string& client);
+  bool hostAllowed(const std::string& host) const;
+  bool originAllowed(const std::string& origin, const std::string& host) const;
+  void remember(const std::string& run_id, const std::string& token);
+  std::optional<std::string> stopToken(const std::string& run_id) const;
+  void log(const std::string& line) const;
 
   RunBook& book_;
   WebConfig config_;
   Publish publish_;
-  std::unique_ptr<httplib::Server> server_;
-  std::thread thread_;
+  Cancel cancel_;
+  Log log_;
   int port_ = 0;
   std::map<std::string, std::string> files_;  ///< URL path -> content
+  std::set<std::string> hosts_;               ///< names the lab serves (Host without port)
+  std::string class_cookie_, teacher_cookie_;  ///< random per start: a login's proof
   std::atomic<std::size_t> streams_{0};
-  std::atomic<bool> stopping_{false};
   std::atomic<std::uint64_t> submissions_{0};
-  std::mutex rate_mutex_;
+  mutable std::mutex mutex_;  ///< guards everything below
   std::map<std::string, std::deque<std::chrono::steady_clock::time_point>> sends_;
+  std::map<std::string, std::deque<std::chrono::steady_clock::time_point>> wrong_codes_;
+  std::map<std::string, std::chrono::steady_clock::time_point> locked_until_;
+  std::map<std::string, std::string> stop_tokens_;  ///< run_id -> its owner's secret
+  std::deque<std::string> token_order_;             ///< run_ids of stop_tokens_, oldest first
+  std::set<std::pair<std::string, std::string>> pending_;  ///< (student, requested) POSTs awaiting an answer
+  std::string queue_json_;
+  std::unique_ptr<BlockingPool> blocking_;  ///< cancel calls and CSV conversions
+  std::unique_ptr<HttpServer> server_;
 };
 
 }  // namespace collision_lab_web
