@@ -55,6 +55,7 @@ SMALL_SCENES = [
     ("equal_masses", {"masses": [1, 1, 1], "positions": [2, 1, -1], "velocities": [-1, 0, 1]}, 3),
     ("cradle_5", {"masses": [1, 1, 1, 1, 1], "positions": [4, 3, 2, 1, 0], "velocities": [-1, 0, 0, 0, 0]}, 4),
 ]
+SMALL_KINDS = {name for name, _, _ in SMALL_SCENES}
 GAS = {"preset": "gas_1000"}
 # Asks for 2^64-1 impacts: only the lab's ceilings (max_collisions, max_run_seconds, bag size) end it.
 HUGE = {"masses": [1e16, 1, "inf"], "positions": [2, 1, 0], "velocities": [-1, 0, 0],
@@ -127,6 +128,7 @@ class Stats:
         self.runs = []              # one dict per POST that got a run_id
         self.unanswered_posts = 0   # POSTs with no 2xx/4xx answer after their retries
         self.not_sent = 0           # runs never sent: the phase's time bound ran out
+        self.small_failed = 0       # small scenes of the class phase whose POST got no run_id
         self.problems = []
         self.stops = []             # (status of POST .../stop, final stop_reason)
 
@@ -205,9 +207,11 @@ class Student:
         except ValueError:
             reply = {}
         if status not in (200, 201, 202):
-            if status is None or status >= 500:
-                with self.stats.lock:
+            with self.stats.lock:
+                if status is None or status >= 500:
                     self.stats.unanswered_posts += 1
+                if phase == "class" and kind in SMALL_KINDS:
+                    self.stats.small_failed += 1
             self.stats.problem(f"{self.name} {kind}: HTTP {status} {answer[:100]!r}")
             return
         run = {"run_id": reply.get("run_id"), "student": self.name, "kind": kind, "phase": phase,
@@ -254,7 +258,7 @@ class Attacker:
         self.client, self.args, self.stop = client, args, stop
         self.slow = {"opened": 0, "refused": 0, "closed_after_s": [], "answers": {}, "open_at_end": 0}
         self.page_latency = []     # GET / during the slow attack [s] (None: no answer)
-        self.chunked = []          # (bytes sent, status or "closed", refused before the end)
+        self.chunked = []          # (bytes sent, answer or what happened, refused before the end)
         self.codes = {}
         self.first_lockout = None  # the wrong try that first got a 429
 
@@ -341,8 +345,10 @@ class Attacker:
                 s.settimeout(60)
                 data = s.recv(4096)
                 outcome = data.split(b" ", 2)[1].decode(errors="replace") if data.startswith(b"HTTP/") else "closed"
+            except socket.timeout:
+                outcome = "no answer in 60 s" if sent == sum(map(len, parts)) else "stalled: the server stopped reading"
             except OSError as e:
-                early, outcome = True, outcome or f"closed ({type(e).__name__})"
+                early, outcome = True, outcome or f"closed by the server ({type(e).__name__})"
             finally:
                 s.close()
             self.chunked.append((sent, outcome, early))
@@ -651,13 +657,17 @@ def measure(args, lab, base):
     never_final = [r for r in runs if r["run_id"] and r["final"] not in FINAL_STATES]
     no_run = [r for r in runs if not r["run_id"] or r["final"] == "404"]
     lost = len(never_final) + orphans
-    small = [r["to_final_s"] for r in class_runs if r["kind"] not in ("gas_1000", "huge") and r["to_final_s"] is not None]
+    # A small scene that never reached its final for its student (no run_id, or not final in
+    # time) counts as an infinite time to final.
+    small = [r["to_final_s"] if r["to_final_s"] is not None else float("inf")
+             for r in class_runs if r["kind"] in SMALL_KINDS] + [float("inf")] * stats.small_failed
     posts = [r["post_s"] for r in class_runs]
     p50, p99 = pct(small, 0.5), pct(small, 0.99)
 
     print(f"measured phase: {wall:.1f} s, {len(class_runs)} runs answered with a run_id "
           f"({stats.not_sent} never sent: time bound)")
-    print(f"small scenes, POST sent -> run final: p50 {p50:.3f} s, p99 {p99:.3f} s over {len(small)} runs "
+    print(f"small scenes, POST sent -> run final: p50 {p50:.3f} s, p99 {p99:.3f} s over {len(small)} runs, "
+          f"{sum(1 for x in small if x == float('inf'))} of them never final for their student (counted as infinite) "
           f"(idle lab, the pi scene: median {statistics.median(idle) if idle else float('nan'):.3f} s)")
     print(f"POST answer (202/201): p50 {pct(posts, 0.5) * 1e3:.0f} ms, p99 {pct(posts, 0.99) * 1e3:.0f} ms; "
           f"queue_position max {max((r['queue_position'] or 0 for r in runs), default=0)}; "
