@@ -31,6 +31,7 @@ Usage (Debian's python3; the workspace's devel/setup.bash sourced):
   python3 bench/web/class_load.py --url http://127.0.0.1:8080 --code CODE [--ns /collision_lab]
 """
 import argparse
+import collections
 import http.client
 import json
 import os
@@ -63,9 +64,9 @@ HUGE = {"masses": [1e16, 1, "inf"], "positions": [2, 1, 0], "velocities": [-1, 0
 FINAL_STATES = ("finished", "interrupted")
 # The class's settings that the benchmark sets (launch argument web_<name> or <name> when the
 # launch file has one, else the node's private parameter). A class of 30 sends its runs as
-# fast as they finish, so the per-student rate limit must allow that; long runs are cut
+# fast as they finish, so the per-student and per-address rate limits must allow that; long runs are cut
 # by the lab's time ceiling so that the benchmark ends.
-WEB_SETTINGS = {"runs_per_minute": 600}
+WEB_SETTINGS = {"runs_per_minute": 600, "runs_per_minute_per_address": 600}
 LAB_SETTINGS = {"max_run_seconds": 10}
 GOAL_P99_S = 2.0
 GOAL_BYTES_PER_RUN = 1000
@@ -256,11 +257,18 @@ class Attacker:
 
     def __init__(self, client, args, stop):
         self.client, self.args, self.stop = client, args, stop
+        self.started = time.monotonic()
         self.slow = {"opened": 0, "refused": 0, "closed_after_s": [], "answers": {}, "open_at_end": 0}
-        self.page_latency = []     # GET / during the slow attack [s] (None: no answer)
+        self.page_latency = []     # GET / during the slow attack: (status or None, seconds)
         self.chunked = []          # (bytes sent, answer or what happened, refused before the end)
         self.codes = {}
         self.first_lockout = None  # the wrong try that first got a 429
+
+    def over(self, end):
+        """The slow attack ends at `end`, or when the class is done but not before
+        --slow-min-seconds: long enough for any sensible header timeout to show."""
+        now = time.monotonic()
+        return now >= end or (self.stop.is_set() and now >= self.started + self.args.slow_min_seconds)
 
     def slow_connections(self):
         payload = f"GET / HTTP/1.1\r\nHost: {self.client.host}:{self.client.port}\r\nX-Slow: ".encode()
@@ -277,7 +285,7 @@ class Attacker:
                 self.slow["refused"] += 1
         end = time.monotonic() + self.args.slow_seconds
         next_byte = time.monotonic()
-        while socks and not self.stop.is_set() and time.monotonic() < end:
+        while socks and not self.over(end):
             now = time.monotonic()
             if now >= next_byte:
                 for s, state in list(socks.items()):
@@ -310,11 +318,11 @@ class Attacker:
     def page_probe(self):
         """GET / every 2 s from a student's address while the slow connections hold."""
         end = time.monotonic() + self.args.slow_seconds
-        while not self.stop.is_set() and time.monotonic() < end:
+        while not self.over(end):
             t0 = time.monotonic()
             status, _, _ = self.client.request("GET", "/", "127.0.0.8", timeout=30)
-            self.page_latency.append(time.monotonic() - t0 if status == 200 else None)
-            self.stop.wait(2.0)
+            self.page_latency.append((status, time.monotonic() - t0))
+            time.sleep(2.0)
 
     def chunked_bodies(self):
         chunk = b"a" * 65536
@@ -386,9 +394,17 @@ class Lab:
 
     @staticmethod
     def free_port():
-        with socket.socket() as s:
-            s.bind(("127.0.0.1", 0))
-            return s.getsockname()[1]
+        """A port free on every address, below Linux's ephemeral range (32768-60999), so that no
+        client socket of this benchmark or of anything else takes it before the node binds it."""
+        for _ in range(100):
+            port = random.randrange(20000, 32000)
+            with socket.socket() as s:
+                try:
+                    s.bind(("0.0.0.0", port))
+                    return port
+                except OSError:
+                    continue
+        raise RuntimeError("no free port in 20000-32000")
 
     def master(self):
         return xmlrpc.client.ServerProxy(self.master_uri)
@@ -399,14 +415,18 @@ class Lab:
         self.bags = os.path.join(self.tmp, "bags")
         os.makedirs(self.bags)
         self.code = args.code or f"class{random.randrange(10 ** 6):06d}"
-        master_port, self.web_port = self.free_port(), self.free_port()
-        self.master_uri = f"http://127.0.0.1:{master_port}"
-        env = dict(os.environ, ROS_MASTER_URI=self.master_uri, ROS_LOG_DIR=os.path.join(self.tmp, "log"))
         self.log = open(os.path.join(self.tmp, "launch.log"), "w")
-        self.procs.append(subprocess.Popen(["roscore", "-p", str(master_port)], env=env, stdout=self.log,
-                                           stderr=subprocess.STDOUT, start_new_session=True))
-        if not self.wait(lambda: self.master().getSystemState("/class_load")[0] == 1, 30):
-            raise RuntimeError("the ROS master did not start")
+        for attempt in range(3):  # another program may take the port first
+            master_port, self.web_port = self.free_port(), self.free_port()
+            self.master_uri = f"http://127.0.0.1:{master_port}"
+            env = dict(os.environ, ROS_MASTER_URI=self.master_uri, ROS_LOG_DIR=os.path.join(self.tmp, "log"))
+            core = subprocess.Popen(["roscore", "-p", str(master_port)], env=env, stdout=self.log,
+                                    stderr=subprocess.STDOUT, start_new_session=True)
+            self.procs.append(core)
+            if self.wait(lambda: core.poll() is None and self.master().getSystemState("/class_load")[0] == 1, 30):
+                break
+            if attempt == 2:
+                raise RuntimeError(f"the ROS master did not start; see {self.log.name} (--keep keeps it)")
         listed = subprocess.run(["roslaunch", "--ros-args", "collision_lab", "lab.launch"], env=env,
                                 capture_output=True, text=True, timeout=60).stdout
         launch_args = {line.split()[0].rstrip(":") for line in listed.splitlines() if line.startswith("  ")}
@@ -560,6 +580,8 @@ def main():
     ap.add_argument("--slow-addresses", type=int, default=8, help="loopback addresses they come from (127.0.1.x)")
     ap.add_argument("--slow-interval", type=float, default=4.0, help="one header byte per connection every [s]")
     ap.add_argument("--slow-seconds", type=float, default=120.0, help="the slow attack lasts at most [s]")
+    ap.add_argument("--slow-min-seconds", type=float, default=30.0,
+                    help="and at least this, even when the class is done sooner [s]")
     ap.add_argument("--chunked", type=int, default=4, help="chunked request bodies over the limit, one after the other")
     ap.add_argument("--chunked-bytes", type=int, default=8 << 20, help="bytes in each [bytes]")
     ap.add_argument("--wrong-codes", type=int, default=300, help="POSTs with a wrong class code")
@@ -629,7 +651,7 @@ def measure(args, lab, base):
             stop.wait(1.0)
 
     side = attacker.threads() + [threading.Thread(target=watch_queue, daemon=True)]
-    t0 = time.monotonic()
+    t0 = attacker.started = time.monotonic()
     for t in side:
         t.start()
     run_phase(students, jobs, "class", args.max_seconds)
@@ -701,8 +723,9 @@ def measure(args, lab, base):
     print(f"attacker, slow connections: {attacker.slow['opened']} opened, {attacker.slow['refused']} refused at connect, "
           f"{len(closed)} closed by the server (median after {statistics.median(closed) if closed else float('nan'):.1f} s), "
           f"answers {attacker.slow['answers']}, {attacker.slow['open_at_end']} still open at the end")
-    answered = [x for x in attacker.page_latency if x is not None]
-    print(f"GET / meanwhile: {len(answered)} of {len(attacker.page_latency)} answered 200, "
+    answered = [t for status, t in attacker.page_latency if status == 200]
+    print(f"GET / meanwhile: {len(answered)} of {len(attacker.page_latency)} answered 200 "
+          f"(answers {dict(collections.Counter(str(status) for status, _ in attacker.page_latency))}), "
           f"p50 {pct(answered, 0.5) * 1e3:.0f} ms, max {max(answered, default=float('nan')) * 1e3:.0f} ms")
     refused = sum(1 for _, _, early in attacker.chunked if early)
     print(f"attacker, chunked bodies of {args.chunked_bytes} B: {refused} of {len(attacker.chunked)} refused before "
