@@ -9,7 +9,8 @@ per-address limits see thirty students. Every loop is bounded in count and in ti
 
 Phases:
 1. idle anchor: the pi scene, a few times, on the idle lab (time to final);
-2. warm-up: each student sends --warmup-runs small scenes; then both nodes' VmRSS;
+2. warm-up: each student sends --warmup-runs small scenes, and --warmup-gases gas runs go
+   with them; then both nodes' VmRSS;
 3. the class: each student sends --runs small scenes; meanwhile big jobs (the 1,000-body gas
    preset, and the pi scene at masses (1e16, 1, inf) asking for 2^64-1 impacts; every second
    one of these is stopped by its owner with its stop_token when the API gives one), and an
@@ -515,7 +516,8 @@ class Lab:
 
 
 def plan(args, students):
-    """Each student's jobs per phase: small scenes in turn; the big jobs go first, one per student."""
+    """Each student's jobs per phase: small scenes in turn; the big jobs go first, one per student
+    (the warm-up's gases to the last students, so that memory holds big runs before it is read)."""
     warm = [[] for _ in students]
     main = [[] for _ in students]
     for k in range(len(students)):
@@ -529,6 +531,8 @@ def plan(args, students):
           [("huge", HUGE, None, args.stop_after if i % 2 else None) for i in range(args.huge)]
     for i, job in enumerate(big):
         main[i % len(students)].insert(i // len(students), job)
+    for i in range(args.warmup_gases):
+        warm[(len(students) - 1 - i) % len(students)].insert(0, ("gas_1000", GAS, None, None))
     return warm, main
 
 
@@ -574,6 +578,7 @@ def main():
     ap.add_argument("--ns", default="/collision_lab", help="the lab's namespace")
     ap.add_argument("--students", type=int, default=30)
     ap.add_argument("--warmup-runs", type=int, default=10, help="small runs per student before the first memory reading")
+    ap.add_argument("--warmup-gases", type=int, default=2, help="gas_1000 runs in the warm-up")
     ap.add_argument("--runs", type=int, default=60, help="small runs per student in the measured phase")
     ap.add_argument("--gases", type=int, default=6, help="gas_1000 runs in the measured phase")
     ap.add_argument("--huge", type=int, default=4, help="runs asking for 2^64-1 impacts in the measured phase")
