@@ -13,7 +13,7 @@ Phases:
    with them; then both nodes' VmRSS;
 3. the class: each student sends --runs small scenes; meanwhile big jobs (the 1,000-body gas
    preset, and the pi scene at masses (1e16, 1, inf) asking for 2^64-1 impacts; every second
-   one of these is stopped by its owner with its stop_token when the API gives one), and an
+   one of the latter is stopped by its owner with its stop_token when the API gives one), and an
    attacker: slow connections that send a header byte every 4 s, chunked bodies larger than
    the limit, wrong class codes. Then both nodes' VmRSS again: memory per run is the growth
    divided by the runs of this phase.
