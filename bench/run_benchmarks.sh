@@ -8,7 +8,8 @@
 # and prints the core and N-body speed tables (collision_lab_bench_core, collision_lab_bench_nbody),
 # the granular gases' worst case (collision_lab_bench_gas)
 # the CLI's output speed against dd (bench/bench_output.sh), and the node against a relay that
-# publishes the same messages and against rosbag record (bench/node/*.launch).
+# publishes the same messages and against rosbag record (bench/node/*.launch), and the class
+# service under thirty students with big jobs and an attacker (bench/web/class_load.py, issue 30).
 #
 # Usage: bash bench/run_benchmarks.sh [--quick]
 #   --quick: fewer scenes, dt values, impacts and repeats (a few minutes); every output goes
@@ -40,7 +41,7 @@ export COLLISION_LAB_BENCH_SOURCE
 cmake -S "$repo" -B "$build" -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build "$build" -j2 --target collision_lab_bench_core collision_lab_bench_nbody collision_lab_speed_vs_error \
   collision_lab_hard_cases collision_lab_bench_restitution collision_lab_bench_gas collision_lab_cli collision_lab_node collision_lab_relay_node \
-  collision_lab_node_throughput collision_lab_recording_bench
+  collision_lab_node_throughput collision_lab_recording_bench collision_lab_web
 bin="$build/devel/lib/collision_lab"
 
 if [[ -n "$quick" ]]; then out="$build/bench_quick"; else out="$repo/docs"; fi
@@ -83,6 +84,12 @@ step "node throughput against a relay publishing the same messages" \
   roslaunch -p "$port" "$repo/bench/node/node_throughput.launch" "${node_runs[@]}" bag_directory:="$bags/throughput"
 step "recording a long run against rosbag record" \
   roslaunch -p "$port" "$repo/bench/node/recording_vs_rosbag.launch" bag_directory:="$bags/recording"
+# A class of thirty (lab.launch web:=true, started by the script on free ports with a class code
+# and a bag folder of its own): small scenes' time to final, runs lost, memory per run.
+class_load=()
+[[ -n "$quick" ]] && class_load=(--warmup-runs 3 --runs 15 --gases 2 --huge 2 --slow 40 --wrong-codes 100)
+step "a class of thirty with big jobs and an attacker (issue 30)" \
+  python3 "$repo/bench/web/class_load.py" "${class_load[@]}"
 
 python3 "$repo/bench/goals_table.py" --log "$log" --source "$COLLISION_LAB_BENCH_SOURCE" --out "$out/benchmark_goals.md"
 printf '\n=== Goals (issue 13), each with its anchor from this run\n'
