@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <deque>
 #include <map>
 #include <optional>
@@ -102,10 +103,10 @@ class FairScheduler {
     return std::nullopt;
   }
 
-  /// Every waiting run, short lane first, each lane in its serving order.
-  std::vector<const Entry*> order() const {
+  /// The first `limit` waiting runs, short lane first, each lane in its serving order.
+  std::vector<const Entry*> order(std::size_t limit = std::numeric_limits<std::size_t>::max()) const {
     std::vector<const Entry*> ordered;
-    for (const LaneQueue& lane : lanes_) lane.appendOrder(ordered);
+    for (const LaneQueue& lane : lanes_) lane.appendOrder(ordered, limit);
     return ordered;
   }
 
@@ -187,11 +188,12 @@ class FairScheduler {
       return std::nullopt;
     }
 
-    void appendOrder(std::vector<const Entry*>& ordered) const {
+    void appendOrder(std::vector<const Entry*>& ordered, std::size_t limit) const {
       for (std::size_t round = 0;; ++round) {
         bool any = false;
         for (const std::string& student : turns_) {
           const std::deque<Entry>& queue = queues_.at(student);
+          if (ordered.size() >= limit) return;
           if (round < queue.size()) {
             ordered.push_back(&queue[round]);
             any = true;
