@@ -1044,6 +1044,13 @@ void LabNode::dropWaiting(Job job, const std::string& by) {
   parameters.max_run_seconds = job.limits.max_run_seconds;
   parameters.max_bag_bytes = job.limits.max_bag_bytes;
   out.record(std::move(parameters));
+  // As every run: its prediction, then its summary; every bag holds parameters, input,
+  // prediction and summary.
+  collision_lab::Prediction prediction;
+  fillPredictionMsg(job.plan, prediction);
+  prediction.timeline_scale = out.timeline().scale();
+  out.publish(topics_.predictions, prediction, 0.0);
+  out.record(prediction);
   collision_lab::RunSummary summary;
   unsimulatedSummary(job.plan, job.input, summary);
   summary.collision_count = 0;

@@ -338,5 +338,13 @@ int main(int argc, char** argv) {
   ros::init(argc, argv, "service_test");
   ros::NodeHandle nh;
   ros::Time::init();
+  // The nodes start with the test: wait (generously) until each serves.
+  for (const char* ns : {"ceiling", "limits", "fair"}) {
+    const std::string service = std::string("/") + ns + "/collision_lab_node/run_scene";
+    if (!ros::service::waitForService(service, ros::Duration(60.0))) {
+      std::fprintf(stderr, "%s did not come up\n", service.c_str());
+      return 1;
+    }
+  }
   return RUN_ALL_TESTS();
 }
