@@ -43,8 +43,10 @@ class RunWriter {
 
   const RunTimeline& timeline() const { return timeline_; }
   bool recording() const { return bags_ != nullptr; }
-  /// True once finish() handed the run's summary over.
+  /// True once the run's summary was handed over (finish()) or, not recording, is being
+  /// published (markFinished()).
   bool finished() const { return finished_; }
+  void markFinished() { finished_ = true; }
   /// [bytes] serialized size of the messages recorded so far.
   std::uint64_t recordedBytes() const { return recorded_bytes_; }
   /// [s] of this (the node's) thread spent handing messages over to the bag writer.
@@ -1122,6 +1124,7 @@ void LabNode::publishEnd(RunWriter& out, collision_lab::RunSummary& summary, dou
                     << summary.timeline_scale << ")");
   }
   if (!out.recording()) {
+    out.markFinished();
     finishRun(summary, reply, draws);
     return;
   }
