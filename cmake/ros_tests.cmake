@@ -22,7 +22,7 @@ endif()
 
 find_package(rostest REQUIRED)
 foreach(name node_test nbody_node_test burst_test demo_test crash_test markers_test markers_clock_test class_test
-    shared_folder_test)
+    shared_folder_test service_test memory_test)
   add_rostest_gtest(${name} test/ros/${name}.test test/ros/${name}.cpp)
   target_link_libraries(${name} collision_lab_ros ${catkin_LIBRARIES})
   # The rostests start these nodes.
@@ -49,3 +49,9 @@ foreach(launch_file ${collision_lab_LAUNCH_FILES})
   roslaunch_add_file_check(${launch_file} COLLISION_LAB_STUDENT=ana
     DEPENDENCIES collision_lab_node collision_lab_markers scenario_publisher)
 endforeach()
+
+# The lab node's fair run queue (ROS-free, no master).
+catkin_add_gtest(fair_scheduler_test test/service/fair_scheduler_test.cpp)
+if(TARGET fair_scheduler_test)
+  target_link_libraries(fair_scheduler_test collision_lab_core GTest::gtest_main)
+endif()

@@ -8,9 +8,11 @@
 #include <cstdlib>
 #include <ctime>
 #include <functional>
+#include <new>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
+#include <thread>
 #include <utility>
 
 #include <ros/package.h>
@@ -26,11 +28,15 @@ namespace collision_lab_ros {
 
 /// Stamps the messages of one run on its timeline, publishes them and hands what is
 /// recorded over to the bag writer, in batches of at most kRecordBatchEvents events.
+/// Counts the serialized bytes it records: past max_bag_bytes (0: no limit) it calls
+/// on_bag_limit once (the run is then stopped; what the run still computes is recorded).
 class RunWriter {
  public:
   /// bags may be null (not recording). claim_error: RunBagBatch::claim_error.
-  RunWriter(std::string run_id, RunTimeline timeline, RunBagWriter* bags, std::string claim_error)
-      : run_id_(std::move(run_id)), timeline_(timeline), bags_(bags) {
+  RunWriter(std::string run_id, RunTimeline timeline, RunBagWriter* bags, std::string claim_error,
+            std::uint64_t max_bag_bytes = 0, std::function<void()> on_bag_limit = {})
+      : run_id_(std::move(run_id)), timeline_(timeline), bags_(bags), max_bag_bytes_(max_bag_bytes),
+        on_bag_limit_(std::move(on_bag_limit)) {
     batch_.run_id = run_id_;
     batch_.opens = true;
     batch_.claim_error = std::move(claim_error);
@@ -38,6 +44,12 @@ class RunWriter {
 
   const RunTimeline& timeline() const { return timeline_; }
   bool recording() const { return bags_ != nullptr; }
+  /// True once the run's summary was handed over (finish()) or, not recording, is being
+  /// published (markFinished()).
+  bool finished() const { return finished_; }
+  void markFinished() { finished_ = true; }
+  /// [bytes] serialized size of the messages recorded so far.
+  std::uint64_t recordedBytes() const { return recorded_bytes_; }
   /// [s] of this (the node's) thread spent handing messages over to the bag writer.
   double recordingSeconds() const { return recording_time_.count(); }
 
@@ -58,17 +70,23 @@ class RunWriter {
   void record(collision_lab::RunParameters parameters) {
     if (!bags_) return;
     stamp(parameters, 0.0);
+    count(parameters);
     timed([&] { batch_.parameters = std::move(parameters); });
   }
   /// Record (at their header.stamp): the input, the prediction, each event.
   void record(const collision_lab::InitialConditions& input) {
-    if (bags_) timed([&] { batch_.input = input; });
+    if (!bags_) return;
+    count(input);
+    timed([&] { batch_.input = input; });
   }
   void record(const collision_lab::Prediction& prediction) {
-    if (bags_) timed([&] { batch_.prediction = prediction; });
+    if (!bags_) return;
+    count(prediction);
+    timed([&] { batch_.prediction = prediction; });
   }
   void record(collision_lab::CollisionEvent&& event) {
     if (!bags_) return;
+    count(event);
     timed([&] {
       batch_.events.push_back(std::move(event));
       if (batch_.events.size() >= kRecordBatchEvents) handOver();
@@ -78,6 +96,7 @@ class RunWriter {
   /// calls on_closed with the summary's final recording fields.
   void finish(const collision_lab::RunSummary& summary,
               std::function<void(collision_lab::RunSummary&)> on_closed) {
+    finished_ = true;
     timed([&] {
       batch_.summary = summary;
       batch_.on_closed = std::move(on_closed);
@@ -86,6 +105,14 @@ class RunWriter {
   }
 
  private:
+  template <class Message>
+  void count(const Message& msg) {
+    recorded_bytes_ += ros::serialization::serializationLength(msg);
+    if (max_bag_bytes_ > 0 && recorded_bytes_ > max_bag_bytes_ && !over_limit_) {
+      over_limit_ = true;
+      if (on_bag_limit_) on_bag_limit_();
+    }
+  }
   template <class F>
   void timed(F&& f) {
     const auto start = std::chrono::steady_clock::now();
@@ -103,6 +130,11 @@ class RunWriter {
   RunBagWriter* bags_;
   RunBagBatch batch_;
   std::chrono::duration<double> recording_time_{0.0};
+  std::uint64_t max_bag_bytes_;
+  std::function<void()> on_bag_limit_;
+  std::uint64_t recorded_bytes_ = 0;
+  bool over_limit_ = false;
+  bool finished_ = false;
 };
 
 namespace {
@@ -134,10 +166,12 @@ std::string utcStamp(const char* format) {
 /// whose storage is reused from event to event and run to run.
 class EventStream {
  public:
+  /// fail_at_first_event: the test hook ~fail_runs_of_student (throws std::bad_alloc).
   EventStream(const RunTopics& topics, RunWriter& out, RunObserver* markers, std::uint64_t max_published,
-              const collision_lab::core::Scene& scene, EventMessages& buffers)
+              const collision_lab::core::Scene& scene, EventMessages& buffers, RunProgress& progress,
+              bool fail_at_first_event)
       : topics_(topics), out_(out), markers_(markers), max_published_(max_published), scene_(scene),
-        msg_(buffers) {}
+        msg_(buffers), progress_(progress), fail_(fail_at_first_event) {}
 
   /// An event of the three-body path.
   void operator()(const collision_lab::core::LabEvent& event) {
@@ -161,11 +195,8 @@ class EventStream {
     sendWithPlots();
   }
 
-  std::uint64_t published() const { return published_; }
   /// True when ~max_published_events cut the published stream.
   bool cut() const { return cut_; }
-  /// Simulated time of the last collision [s]; 0 before any.
-  double lastTime() const { return last_time_; }
 
  private:
   /// The event engine's converter, made at its first event (the three-body path needs none).
@@ -185,15 +216,17 @@ class EventStream {
   /// Stamps and draws msg, and publishes it unless the cap is reached; true when
   /// published. The caller records it.
   bool send(collision_lab::CollisionEvent& msg) {
-    last_time_ = msg.time;
-    out_.stamp(msg, last_time_);
+    if (fail_) throw std::bad_alloc();
+    ++progress_.collisions;
+    progress_.last_time = msg.time;
+    out_.stamp(msg, msg.time);
     if (markers_) markers_->onCollisionEvent(msg);
-    if (published_ == max_published_) {
+    if (progress_.published == max_published_) {
       cut_ = true;
       return false;
     }
     topics_.events.publish(msg);
-    ++published_;
+    ++progress_.published;
     return true;
   }
 
@@ -204,9 +237,9 @@ class EventStream {
   const collision_lab::core::Scene& scene_;
   std::optional<SceneEventConverter> converter_;
   EventMessages& msg_;
-  std::uint64_t published_ = 0;
+  RunProgress& progress_;
+  bool fail_;
   bool cut_ = false;
-  double last_time_ = 0.0;
 };
 
 /// The reason to refuse input before simulating it (student, run_id, mode, size, then the
@@ -385,6 +418,29 @@ LabNodeParams LabNodeParams::load(const ros::NodeHandle& private_nh) {
   private_nh.param("scenario_file", params.scenario_file,
                    ros::package::getPath("collision_lab") + "/" + kDefaultScenarioFile);
   params.scenario_file = expandUser(params.scenario_file);
+  const std::uint64_t hardware_threads = std::thread::hardware_concurrency();
+  params.workers = getUint64(private_nh, "workers", std::max(kMinDefaultWorkers, hardware_threads));
+  params.short_lane_workers = getUint64(private_nh, "short_lane_workers", kDefaultShortLaneWorkers);
+  if (params.workers == 0 || params.workers > kMaxWorkers) {
+    throw std::invalid_argument("~workers = " + std::to_string(params.workers) + " is out of range; expected 1 to " +
+                                std::to_string(kMaxWorkers));
+  }
+  if (params.short_lane_workers >= params.workers) {
+    throw std::invalid_argument("~short_lane_workers = " + std::to_string(params.short_lane_workers) +
+                                " must be below ~workers = " + std::to_string(params.workers) +
+                                ": at least one worker takes long runs");
+  }
+  params.lanes.short_max_collisions = getUint64(private_nh, "short_max_collisions", kDefaultShortMaxCollisions);
+  params.lanes.short_max_bodies = getUint64(private_nh, "short_max_bodies", kDefaultShortMaxBodies);
+  private_nh.param("max_run_seconds", params.max_run_seconds, kDefaultMaxRunSeconds);
+  if (!std::isfinite(params.max_run_seconds) || params.max_run_seconds < 0) {
+    std::ostringstream error;
+    error << "~max_run_seconds = " << params.max_run_seconds << " is out of range; expected a finite number of "
+          << "seconds >= 0 (0: no time limit)";
+    throw std::invalid_argument(error.str());
+  }
+  params.max_bag_bytes = getUint64(private_nh, "max_bag_bytes", kDefaultMaxBagBytes);
+  private_nh.param("fail_runs_of_student", params.fail_runs_of_student, std::string());
   return params;
 }
 
@@ -474,6 +530,15 @@ std::vector<collision_lab::ServedRun> ServedRuns::list(const std::string& studen
   return listed;
 }
 
+void RememberedRunIds::add(const std::string& run_id) {
+  if (!ids_.insert(run_id).second) return;
+  order_.push_back(run_id);
+  if (order_.size() > kRunIdsRemembered) {
+    ids_.erase(order_.front());
+    order_.pop_front();
+  }
+}
+
 LabNode::LabNode(ros::NodeHandle nh, ros::NodeHandle private_nh, const RunObserverFactory& make_observer)
     : nh_(nh),
       params_(LabNodeParams::load(private_nh)),
@@ -494,20 +559,29 @@ LabNode::LabNode(ros::NodeHandle nh, ros::NodeHandle private_nh, const RunObserv
       nh_.advertise<collision_lab::Rejected>(kRejectedTopic, kOutputQueueSize, kLatchRejected);
   accepted_pub_ = nh_.advertise<collision_lab::AcceptedRun>(kAcceptedRunsTopic, kOutputQueueSize, kLatchAcceptedRuns);
   served_inputs_pub_ = nh_.advertise<collision_lab::InitialConditions>(kServedInputsTopic, kOutputQueueSize);
+  run_queue_pub_ = nh_.advertise<collision_lab::RunQueue>(kRunQueueTopic, kMarkerQueueSize, kLatchRunQueue);
   if (params_.publish_markers && make_observer) marker_view_ = make_observer(nh_, private_nh);
 
   run_id_prefix_ = std::string("run_") + utcStamp("%Y%m%d_%H%M%S") + "_";
   // Before any input is served: the runs of dead nodes are ended (docs/ros.md, "The run index").
   run_index_ = std::make_unique<RunIndexRecorder>(params_.bag_directory);
   run_index_->recover();
-  if (params_.record) {
-    const std::string parameters_topic = nh_.resolveName(kRunParametersTopic);
-    bags_ = std::make_unique<RunBagWriter>(
-        params_.bag_directory,
-        RunBagWriter::Topics{nh_.resolveName(kInitialConditionsTopic), topics_.predictions.getTopic(),
-                             topics_.events.getTopic(), topics_.summaries.getTopic(), parameters_topic,
-                             ros::this_node::getName(), latchedRecordedTopics(topics_, parameters_topic)},
-        kRecordQueueMessages);
+  const std::string parameters_topic = nh_.resolveName(kRunParametersTopic);
+  const RunBagWriter::Topics bag_topics{nh_.resolveName(kInitialConditionsTopic), topics_.predictions.getTopic(),
+                                        topics_.events.getTopic(), topics_.summaries.getTopic(), parameters_topic,
+                                        ros::this_node::getName(), latchedRecordedTopics(topics_, parameters_topic)};
+  if (params_.record) dropped_bags_ = std::make_unique<RunBagWriter>(params_.bag_directory, bag_topics, kRecordQueueMessages);
+  for (std::uint64_t i = 0; i < params_.workers; ++i) {
+    auto worker = std::make_unique<Worker>();
+    worker->short_only = i < params_.short_lane_workers;
+    if (params_.record) worker->bags = std::make_unique<RunBagWriter>(params_.bag_directory, bag_topics, kRecordQueueMessages);
+    workers_.push_back(std::move(worker));
+  }
+  queue_msg_.workers = static_cast<std::uint32_t>(params_.workers);
+  queue_msg_.short_lane_workers = static_cast<std::uint32_t>(params_.short_lane_workers);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    publishQueue();  // latched: the empty queue, until the first run
   }
 
   diagnostics_.setHardwareID("collision_lab");
@@ -515,7 +589,8 @@ LabNode::LabNode(ros::NodeHandle nh, ros::NodeHandle private_nh, const RunObserv
   diagnostics_timer_ = nh_.createWallTimer(ros::WallDuration(kDiagnosticsPeriod),
                                            [this](const ros::WallTimerEvent&) { diagnostics_.force_update(); });
 
-  worker_ = std::thread(&LabNode::workerLoop, this);
+  for (auto& worker : workers_) worker->thread = std::thread(&LabNode::workerLoop, this, std::ref(*worker));
+  watchdog_ = std::thread(&LabNode::watchdogLoop, this);
   input_sub_ = nh_.subscribe(kInitialConditionsTopic, kInputQueueSize,
                              &LabNode::onInitialConditions, this);
   // The services' own queue: a waiting call never holds up the global queue.
@@ -535,52 +610,47 @@ LabNode::LabNode(ros::NodeHandle nh, ros::NodeHandle private_nh, const RunObserv
                   << ", bags in " << params_.bag_directory << ", max_collisions "
                   << params_.max_collisions << ", max_published_events "
                   << params_.max_published_events << ", max_bodies " << params_.max_bodies
-                  << ", presets from " << params_.scenario_file);
+                  << ", presets from " << params_.scenario_file << "; " << params_.workers << " workers ("
+                  << params_.short_lane_workers << " for short runs only), max_run_seconds "
+                  << params_.max_run_seconds << ", max_bag_bytes " << params_.max_bag_bytes);
 }
 
 LabNode::~LabNode() {
   // Cancel first: shutting a service down waits for its calls in progress, and a call
-  // waits for its run (and for every input queued before it).
+  // waits for its run.
+  std::vector<Scheduler::Entry> waiting;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     stopping_ = true;
-    inputs_.clear();  // breaks the promises of waiting calls
+    waiting = scheduler_.drain();
+    for (auto& worker : workers_) {
+      if (!worker->current.run_id.empty()) stopRun(*worker, StopCause::kShutdown, "the node's shutdown");
+    }
+    publishQueue();
   }
-  {
-    std::lock_guard<std::mutex> lock(running_mutex_);
-    stopping_run_ = true;
-    cancel_ = true;  // the run in progress stops within 1024 impacts, its bag closed
-  }
-  wake_.notify_one();
-  worker_.join();
-  // Calls still in progress end once their run's bag is closed (the writer runs on).
+  wake_.notify_all();
+  watchdog_wake_.notify_all();
+  for (Scheduler::Entry& entry : waiting) dropWaiting(std::move(entry.job), "the node's shutdown");
+  for (auto& worker : workers_) worker->thread.join();
+  watchdog_.join();
+  // Calls still in progress end once their run's bag is closed (the writers run on).
   input_sub_.shutdown();
   run_scene_srv_.shutdown();
   run_preset_srv_.shutdown();
-  bags_.reset();  // writes and closes every bag handed over, then publishes its summary
+  for (auto& worker : workers_) worker->bags.reset();  // writes and closes every bag handed over
+  dropped_bags_.reset();
   cancel_srv_.shutdown();
   list_runs_srv_.shutdown();
   cancel_spinner_.stop();
   service_spinner_.stop();
 }
 
-void LabNode::onInitialConditions(const collision_lab::InitialConditions::ConstPtr& msg) {
-  enqueue(Job{msg, nullptr});
-}
-
-void LabNode::enqueue(Job job) {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (stopping_) return;  // a call's promise breaks as job goes out of scope
-    inputs_.push_back(std::move(job));
-  }
-  wake_.notify_one();
-}
+void LabNode::onInitialConditions(const collision_lab::InitialConditions::ConstPtr& msg) { intake(*msg, nullptr); }
 
 std::optional<ServeOutcome> LabNode::serveAndWait(const collision_lab::InitialConditions& input) {
   auto reply = std::make_shared<std::promise<ServeOutcome>>();
   std::future<ServeOutcome> outcome = reply->get_future();
-  enqueue(Job{boost::make_shared<collision_lab::InitialConditions>(input), std::move(reply)});
+  intake(input, std::move(reply));
   try {
     return outcome.get();
   } catch (const std::future_error&) {
@@ -599,6 +669,8 @@ bool LabNode::onRunScene(collision_lab::RunScene::Request& request,
   input.velocities = request.velocities;
   input.restitution = request.restitution;
   input.max_collisions = request.max_collisions;
+  input.max_run_seconds = request.max_run_seconds;
+  input.max_bag_bytes = request.max_bag_bytes;
   fillResponse(serveAndWait(input), response);
   return true;
 }
@@ -624,19 +696,156 @@ bool LabNode::onRunPreset(collision_lab::RunPreset::Request& request,
   return true;
 }
 
-void LabNode::workerLoop() {
+LabNode::RunLimits LabNode::limitsOf(const collision_lab::InitialConditions& input) const {
+  RunLimits limits;
+  const std::uint64_t ceiling = params_.max_collisions;  // 0: none
+  if (input.max_collisions == 0) {
+    limits.max_collisions = ceiling;
+  } else if (ceiling == 0 || input.max_collisions <= ceiling) {
+    limits.max_collisions = input.max_collisions;
+  } else {
+    limits.max_collisions = ceiling;
+    limits.collision_ceiling = true;
+  }
+  limits.max_run_seconds = params_.max_run_seconds;
+  if (std::isfinite(input.max_run_seconds) && input.max_run_seconds > 0 &&
+      (limits.max_run_seconds == 0 || input.max_run_seconds < limits.max_run_seconds)) {
+    limits.max_run_seconds = input.max_run_seconds;
+    limits.time_from_input = true;
+  }
+  limits.max_bag_bytes = params_.max_bag_bytes;
+  if (input.max_bag_bytes > 0 && (limits.max_bag_bytes == 0 || input.max_bag_bytes < limits.max_bag_bytes)) {
+    limits.max_bag_bytes = input.max_bag_bytes;
+    limits.bag_from_input = true;
+  }
+  return limits;
+}
+
+void LabNode::intake(collision_lab::InitialConditions input, Reply reply) {
+  namespace core = collision_lab::core;
+  const std::string requested = input.run_id;
+  std::optional<core::ScenePlan> plan;
+  if (auto rejection = checkInput(input, params_.max_bodies, plan)) {
+    rejection->student = input.student;
+    ServeOutcome outcome = reject(std::move(*rejection), requested);
+    if (reply) reply->set_value(std::move(outcome));
+    return;
+  }
+  Job job;
+  job.limits = limitsOf(input);
+  const bool predict_only = *toRunMode(input.mode) == core::RunMode::kPredictOnly;
+  const collision_lab::service::Lane lane =
+      collision_lab::service::chooseLane(*plan, predict_only, job.limits.max_collisions, params_.simulate_to_cap, params_.lanes);
+  if (plan->three_body) job.predicted_collisions = plan->three_body->collision_count;
+  if (plan->prediction && plan->prediction->impact_count) job.predicted_collisions = *plan->prediction->impact_count;
+  const std::string base = requestedRunId(input);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (stopping_) return;  // reply's promise breaks: the call answers "shutting down"
+    // Claimed here, before the run_id goes out on any message: the run_id a run reports
+    // names a bag file this node created.
+    input.run_id = base.empty() ? newRunId(job.claim_error) : claimRunId(base, job.claim_error);
+    if (!base.empty() && input.run_id != base) {
+      ROS_WARN_STREAM("run_id '" << base << "' is taken (its bag exists, or this node served "
+                      "it before); serving the run as '" << input.run_id << "'");
+    }
+    job.requested_run_id = input.run_id != requested ? requested : std::string();
+    const std::string run_id = input.run_id;
+    const std::string student = input.student;
+    run_index_->accepted(run_id, student, requested, input);
+    job.input = std::move(input);
+    job.plan = std::move(*plan);
+    job.reply = std::move(reply);
+    const std::size_t position = scheduler_.push(Scheduler::Entry{run_id, student, lane, std::move(job)});
+    announce(run_id, student, requested, position, lane);
+    publishQueue();
+  }
+  wake_.notify_all();
+}
+
+void LabNode::workerLoop(Worker& worker) {
   for (;;) {
-    Job job;
+    std::optional<Scheduler::Entry> entry;
     {
       std::unique_lock<std::mutex> lock(mutex_);
-      wake_.wait(lock, [this] { return stopping_ || !inputs_.empty(); });
+      wake_.wait(lock, [&] { return stopping_ || scheduler_.ready(worker.short_only); });
       if (stopping_) return;
-      job = std::move(inputs_.front());
-      inputs_.pop_front();
+      entry = scheduler_.pop(worker.short_only);
+      const Job& job = entry->job;
+      worker.cancel = false;
+      worker.cause = static_cast<int>(StopCause::kNone);
+      CurrentRun& current = worker.current;
+      current.run_id = entry->run_id;
+      current.student = entry->student;
+      current.lane = entry->lane;
+      current.predicted_collisions = job.predicted_collisions;
+      current.body_count = static_cast<std::uint32_t>(job.plan.scene.size());
+      current.stopped_by.clear();
+      current.deadline.reset();
+      if (job.limits.max_run_seconds > 0) {
+        current.deadline = std::chrono::steady_clock::now() +
+                           std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                               std::chrono::duration<double>(job.limits.max_run_seconds));
+      }
+      worker.draws = marker_view_ && !view_busy_ && marker_view_->follows(entry->run_id);
+      if (worker.draws) view_busy_ = true;
+      publishQueue();
     }
-    served_input_ = *job.input;  // copy assignment: the buffer keeps its storage
-    serve(served_input_, std::move(job.reply));
+    serve(worker, entry->job);
+    std::lock_guard<std::mutex> lock(mutex_);
+    worker.current = CurrentRun();
+    if (worker.draws) view_busy_ = false;
+    worker.draws = false;
+    publishQueue();
   }
+}
+
+void LabNode::watchdogLoop() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  while (!stopping_) {
+    watchdog_wake_.wait_for(lock, std::chrono::duration<double>(kWatchdogPeriod));
+    const auto now = std::chrono::steady_clock::now();
+    for (auto& worker : workers_) {
+      const CurrentRun& current = worker->current;
+      if (!current.run_id.empty() && current.deadline && now >= *current.deadline) {
+        stopRun(*worker, StopCause::kTimeLimit, std::string());
+      }
+    }
+  }
+}
+
+void LabNode::stopRun(Worker& worker, StopCause cause, const std::string& by) {
+  int none = static_cast<int>(StopCause::kNone);
+  if (worker.cause.compare_exchange_strong(none, static_cast<int>(cause))) worker.current.stopped_by = by;
+  worker.cancel = true;  // the run stops within 1024 impacts, at its last certified one
+}
+
+void LabNode::publishQueue() {
+  collision_lab::RunQueue& msg = queue_msg_;
+  msg.header.stamp = stampNow();
+  msg.runs.clear();
+  collision_lab::QueuedRun run;
+  for (const auto& worker : workers_) {
+    const CurrentRun& current = worker->current;
+    if (current.run_id.empty()) continue;
+    run.run_id = current.run_id;
+    run.student = current.student;
+    run.lane = collision_lab::service::laneName(current.lane);
+    run.running = true;
+    run.predicted_collisions = current.predicted_collisions;
+    run.body_count = current.body_count;
+    msg.runs.push_back(run);
+  }
+  for (const Scheduler::Entry* entry : scheduler_.order(kRunQueueListed)) {
+    run.run_id = entry->run_id;
+    run.student = entry->student;
+    run.lane = collision_lab::service::laneName(entry->lane);
+    run.running = false;
+    run.predicted_collisions = entry->job.predicted_collisions;
+    run.body_count = static_cast<std::uint32_t>(entry->job.plan.scene.size());
+    msg.runs.push_back(run);
+  }
+  run_queue_pub_.publish(msg);
 }
 
 std::string LabNode::newRunId(std::string& claim_error) {
@@ -648,9 +857,9 @@ std::string LabNode::newRunId(std::string& claim_error) {
 }
 
 bool LabNode::claim(const std::string& run_id, std::string& claim_error) {
-  if (used_run_ids_.count(run_id) > 0) return false;
+  if (used_run_ids_.contains(run_id)) return false;
   if (params_.record && claimBag(params_.bag_directory, run_id, claim_error) == BagClaim::kTaken) return false;
-  used_run_ids_.insert(run_id);
+  used_run_ids_.add(run_id);
   return true;
 }
 
@@ -662,21 +871,23 @@ std::string LabNode::claimRunId(const std::string& requested, std::string& claim
   return run_id;
 }
 
-void LabNode::announce(const collision_lab::InitialConditions& input, const std::string& requested) {
-  collision_lab::AcceptedRun& accepted = accepted_msg_;
+void LabNode::announce(const std::string& run_id, const std::string& student, const std::string& requested,
+                       std::size_t queue_position, collision_lab::service::Lane lane) {
+  collision_lab::AcceptedRun accepted;
   accepted.header.stamp = stampNow();
-  accepted.run_id = input.run_id;
+  accepted.run_id = run_id;
   accepted.requested_run_id = requested;
-  accepted.student = input.student;
+  accepted.student = student;
+  accepted.queue_position = static_cast<std::uint32_t>(queue_position);
+  accepted.lane = collision_lab::service::laneName(lane);
   accepted_pub_.publish(accepted);
   served_runs_.accepted(accepted);
-  run_index_->accepted(accepted, input);
   // As logRun: at INFO for a lab, at DEBUG with ~log_runs false.
   const auto level = params_.log_runs ? ::ros::console::levels::Info : ::ros::console::levels::Debug;
   ROS_LOG_STREAM(level, ROSCONSOLE_DEFAULT_NAME,
-                 "accepted run " << input.run_id
-                                 << (input.student.empty() ? std::string() : " of student '" + input.student + "'")
-                                 << (requested.empty() || requested == input.run_id ? std::string() : " (asked for '" + requested + "')"));
+                 "accepted run " << run_id << (student.empty() ? std::string() : " of student '" + student + "'")
+                                 << (requested.empty() || requested == run_id ? std::string() : " (asked for '" + requested + "')")
+                                 << ", " << accepted.lane << " lane, " << queue_position << " runs ahead");
 }
 
 bool LabNode::onListRuns(collision_lab::ListRuns::Request& request, collision_lab::ListRuns::Response& response) {
@@ -698,112 +909,220 @@ ServeOutcome LabNode::reject(collision_lab::Rejected msg, const std::string& run
   return ServeOutcome{std::nullopt, msg};
 }
 
-void LabNode::serve(collision_lab::InitialConditions& input, Reply reply) {
-  const std::string requested = input.run_id;
-  std::optional<collision_lab::core::ScenePlan> plan;
-  if (auto rejection = checkInput(input, params_.max_bodies, plan)) {
-    rejection->student = input.student;
-    ServeOutcome outcome = reject(std::move(*rejection), requested);
-    if (reply) reply->set_value(std::move(outcome));
+void LabNode::serve(Worker& worker, Job& job) {
+  const ros::Time start = stampNow();
+  RunWriter out(job.input.run_id, RunTimeline(start, chooseTimelineScale(firstContactTime(job.plan.scene))),
+                worker.bags.get(), job.claim_error, job.limits.max_bag_bytes, [this, &worker] {
+                  std::lock_guard<std::mutex> lock(mutex_);
+                  stopRun(worker, StopCause::kBagLimit, std::string());
+                });
+  job.input.header.stamp = start;
+  RunProgress progress;
+  std::string what;
+  try {
+    run(worker, job, out, progress);
+    return;
+  } catch (const std::exception& e) {
+    what = e.what();
+  } catch (...) {
+    what = "an exception of unknown type";
+  }
+  if (out.finished()) {
+    ROS_ERROR_STREAM("run " << job.input.run_id << ": failed after its summary was handed over: " << what);
     return;
   }
-  // Claimed here, before the run_id goes out on any message: the run_id a run reports
-  // names a bag file this node created.
-  const std::string base = requestedRunId(input);
-  std::string claim_error;
-  input.run_id = base.empty() ? newRunId(claim_error) : claimRunId(base, claim_error);
-  if (!base.empty() && input.run_id != base) {
-    ROS_WARN_STREAM("run_id '" << base << "' is taken (its bag exists, or this node served "
-                    "it before); serving the run as '" << input.run_id << "'");
+  try {
+    failRun(worker, job, out, progress, what);
+  } catch (...) {
+    ROS_ERROR_STREAM("run " << job.input.run_id << ": the worker failed (" << what
+                     << ") and could not report it; the node goes on");
   }
-  announce(input, requested);
-  run(input, *plan, input.run_id != requested ? requested : std::string(), claim_error, std::move(reply));
 }
 
-void LabNode::run(collision_lab::InitialConditions& input, const collision_lab::core::ScenePlan& plan,
-                  const std::string& requested_run_id, const std::string& claim_error, Reply reply) {
+void LabNode::run(Worker& worker, Job& job, RunWriter& out, RunProgress& progress) {
   namespace core = collision_lab::core;
-  const ros::Time start = stampNow();
-  const core::Scene& scene = plan.scene;
+  collision_lab::InitialConditions& input = job.input;
+  const core::ScenePlan& plan = job.plan;
   const core::RunMode mode = *toRunMode(input.mode);
-  RunWriter out(input.run_id, RunTimeline(start, chooseTimelineScale(firstContactTime(scene))), bags_.get(),
-                claim_error);
-  input.header.stamp = start;
   run_index_->started(input.run_id);
-  publishStart(out, input, plan);  // the prediction goes out before the simulation starts
+  publishStart(worker, out, input, plan);  // the prediction goes out before the simulation starts
 
   core::SceneRunOptions options;
-  options.lab.max_collisions = input.max_collisions ? input.max_collisions : params_.max_collisions;
-  out.record(runParameters(params_, options.lab.max_collisions));
+  options.lab.max_collisions = job.limits.max_collisions;
+  collision_lab::RunParameters parameters = runParameters(params_, options.lab.max_collisions);
+  parameters.max_run_seconds = job.limits.max_run_seconds;
+  parameters.max_bag_bytes = job.limits.max_bag_bytes;
+  out.record(std::move(parameters));
   // Events are streamed to the visitors, never kept; asking for them makes a closed-form
   // scene simulated too (its events are published), as the CLI does when it shows events.
   options.lab.events = mode == core::RunMode::kFull ? core::EventPolicy::all() : core::EventPolicy::none();
   options.lab.mode = mode;
   options.simulate_to_cap = params_.simulate_to_cap;  // else the model answers over the cap (runScene)
   options.keep_events = false;
-  options.cancel = &cancel_;
-  EventStream events(topics_, out, marker_view_.get(), params_.max_published_events, scene, event_messages_);
+  options.cancel = &worker.cancel;
+  const bool fail = !params_.fail_runs_of_student.empty() && input.student == params_.fail_runs_of_student;
+  EventStream events(topics_, out, worker.draws ? marker_view_.get() : nullptr, params_.max_published_events,
+                     plan.scene, worker.event_messages, progress, fail);
   core::SceneVisitors visitors;
   visitors.three_body_event = [&events](const core::LabEvent& e) { events(e); };
   visitors.impact = [&events](const core::ImpactRecord& r) { events(r); };
   visitors.collapse = [&events](const core::Collapse& c) { events(c); };  // in order, between the impacts
-  const core::SceneRunResult result = runCancellable(input.run_id, plan, options, visitors);
+  const core::SceneRunResult result = core::runScene(plan, options, visitors);
 
-  collision_lab::RunSummary& summary = summary_msg_;
-  fillRunSummaryMsg(result, scene.size(), mode, summary);
-  summary.published_events = events.published();
+  collision_lab::RunSummary& summary = worker.summary_msg;
+  fillRunSummaryMsg(result, plan.scene.size(), mode, summary);
+  summary.published_events = progress.published;
   summary.events_not_published = events.cut();
-  summary.requested_run_id = requested_run_id;
+  summary.requested_run_id = job.requested_run_id;
   summary.student = input.student;
-  publishEnd(out, summary, events.lastTime(), std::move(reply));
+  applyStopCause(worker, job, summary);
+  publishEnd(out, summary, progress.last_time, std::move(job.reply), worker.draws);
 }
 
-collision_lab::core::SceneRunResult LabNode::runCancellable(const std::string& run_id,
-                                                            const collision_lab::core::ScenePlan& plan,
-                                                            const collision_lab::core::SceneRunOptions& options,
-                                                            const collision_lab::core::SceneVisitors& visitors) {
-  {
-    std::lock_guard<std::mutex> lock(running_mutex_);
-    running_run_id_ = run_id;
-    cancel_ = stopping_run_.load();  // the node's shutdown cancels every run
+void LabNode::applyStopCause(Worker& worker, const Job& job, collision_lab::RunSummary& summary) {
+  const auto cause = static_cast<StopCause>(worker.cause.load());
+  const RunLimits& limits = job.limits;
+  const bool stopped = summary.stop_reason == "CANCELLED";
+  std::ostringstream why;
+  if (stopped && cause == StopCause::kTimeLimit) {
+    summary.stop_reason = "SERVICE_TIME_LIMIT";
+    why << "stopped by the time limit of " << limits.max_run_seconds << " s ("
+        << (limits.time_from_input ? "the input's max_run_seconds" : "the node's ~max_run_seconds") << ") after "
+        << summary.collision_count << " collisions, at its last certified impact";
+  } else if (stopped && cause == StopCause::kBagLimit) {
+    summary.stop_reason = "SERVICE_BAG_LIMIT";
+    why << "stopped when its recorded messages passed the bag limit of " << limits.max_bag_bytes << " bytes ("
+        << (limits.bag_from_input ? "the input's max_bag_bytes" : "the node's ~max_bag_bytes") << ") after "
+        << summary.collision_count << " collisions, at its last certified impact";
+  } else if (stopped && cause == StopCause::kCancel) {
+    std::string by;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      by = worker.current.stopped_by;
+    }
+    why << summary.truncation_reason << " (cancelled by " << by << ")";
+  } else if (summary.stop_reason == "CAP" && limits.collision_ceiling) {
+    summary.stop_reason = "SERVICE_COLLISION_LIMIT";
+    why << "stopped at the node's ~max_collisions = " << limits.max_collisions << ", which lowered the input's "
+        << "max_collisions = " << job.input.max_collisions;
+  } else {
+    return;
   }
-  collision_lab::core::SceneRunResult result = collision_lab::core::runScene(plan, options, visitors);
-  std::lock_guard<std::mutex> lock(running_mutex_);
-  running_run_id_.clear();
-  return result;
+  summary.cancelled = cause == StopCause::kCancel;
+  summary.truncated = true;
+  summary.truncation_reason = why.str();
+}
+
+namespace {
+
+/// The summary of a run that has not computed (its plan's model and prediction only).
+void unsimulatedSummary(const collision_lab::core::ScenePlan& plan, const collision_lab::InitialConditions& input,
+                        collision_lab::RunSummary& summary) {
+  collision_lab::core::SceneRunResult result;
+  result.model = plan.model;
+  result.prediction = plan.prediction;
+  fillRunSummaryMsg(result, plan.scene.size(), *toRunMode(input.mode), summary);
+  summary.student = input.student;
+}
+
+}  // namespace
+
+void LabNode::failRun(Worker& worker, Job& job, RunWriter& out, const RunProgress& progress, const std::string& what) {
+  ROS_ERROR_STREAM("run " << job.input.run_id << ": the worker failed after " << progress.collisions
+                   << " collisions: " << what << "; the run ends WORKER_ERROR and the node goes on");
+  collision_lab::RunSummary& summary = worker.summary_msg;
+  unsimulatedSummary(job.plan, job.input, summary);
+  summary.simulated = true;
+  summary.collision_count = progress.collisions;
+  summary.published_events = progress.published;
+  summary.events_not_published = progress.published < progress.collisions;
+  summary.truncated = true;
+  summary.stop_reason = "WORKER_ERROR";
+  summary.truncation_reason = "the worker failed after " + std::to_string(progress.collisions) +
+                              " collisions: " + what + "; the bag holds the collisions before";
+  summary.requested_run_id = job.requested_run_id;
+  publishEnd(out, summary, progress.last_time, std::move(job.reply), worker.draws);
+}
+
+void LabNode::dropWaiting(Job job, const std::string& by) {
+  const ros::Time start = stampNow();
+  RunWriter out(job.input.run_id, RunTimeline(start, chooseTimelineScale(firstContactTime(job.plan.scene))),
+                dropped_bags_.get(), job.claim_error);
+  job.input.header.stamp = start;
+  out.record(job.input);
+  collision_lab::RunParameters parameters = runParameters(params_, job.limits.max_collisions);
+  parameters.max_run_seconds = job.limits.max_run_seconds;
+  parameters.max_bag_bytes = job.limits.max_bag_bytes;
+  out.record(std::move(parameters));
+  // As every run: its prediction, then its summary; every bag holds parameters, input,
+  // prediction and summary.
+  collision_lab::Prediction prediction;
+  fillPredictionMsg(job.plan, prediction);
+  prediction.timeline_scale = out.timeline().scale();
+  out.publish(topics_.predictions, prediction, 0.0);
+  out.record(prediction);
+  collision_lab::RunSummary summary;
+  unsimulatedSummary(job.plan, job.input, summary);
+  summary.collision_count = 0;
+  summary.cancelled = true;
+  summary.truncated = true;
+  summary.stop_reason = "CANCELLED";
+  summary.truncation_reason = "cancelled by " + by + " before it started";
+  summary.requested_run_id = job.requested_run_id;
+  publishEnd(out, summary, 0.0, std::move(job.reply), false);
 }
 
 bool LabNode::onCancel(collision_lab::Cancel::Request& request, collision_lab::Cancel::Response& response) {
-  std::lock_guard<std::mutex> lock(running_mutex_);
-  if (running_run_id_.empty()) {
-    response.ok = false;
-    response.message = "no run in progress";
-  } else if (!request.run_id.empty() && request.run_id != running_run_id_) {
-    response.ok = false;
-    response.message = "run '" + running_run_id_ + "' is in progress, not '" + request.run_id + "'; nothing stopped";
-  } else {
-    cancel_ = true;
-    response.ok = true;
-    response.message = "run '" + running_run_id_ + "' asked to stop";
+  // Whoever asks is logged and goes into a summary: bounded, like every name.
+  const std::string by = request.requested_by.empty() ? std::string("~cancel") : request.requested_by.substr(0, kMaxStudentLength);
+  std::optional<Scheduler::Entry> waiting;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!request.run_id.empty()) waiting = scheduler_.remove(request.run_id);
+    if (waiting) {
+      publishQueue();
+      response.ok = true;
+      response.message = "run '" + request.run_id + "' was waiting; cancelled before it started";
+    } else {
+      std::vector<std::string> stopped;
+      for (auto& worker : workers_) {
+        const std::string& run_id = worker->current.run_id;
+        if (run_id.empty() || (!request.run_id.empty() && request.run_id != run_id)) continue;
+        stopRun(*worker, StopCause::kCancel, by);
+        stopped.push_back(run_id);
+      }
+      response.ok = !stopped.empty();
+      if (stopped.empty()) {
+        response.message = request.run_id.empty() ? "no run in progress"
+                                                   : "no run '" + request.run_id + "' is waiting or in progress; nothing stopped";
+      } else {
+        response.message = "run";
+        for (std::size_t i = 0; i < stopped.size(); ++i) response.message += (i ? ", '" : " '") + stopped[i] + "'";
+        response.message += " asked to stop";
+      }
+    }
   }
-  ROS_INFO_STREAM("~cancel: " << response.message);
+  if (waiting) dropWaiting(std::move(waiting->job), by);
+  ROS_INFO_STREAM("~cancel (by " << by << "): " << response.message);
   return true;
 }
 
-void LabNode::publishStart(RunWriter& out, const collision_lab::InitialConditions& input,
+void LabNode::publishStart(Worker& worker, RunWriter& out, const collision_lab::InitialConditions& input,
                            const collision_lab::core::ScenePlan& plan) {
   out.record(input);
   served_inputs_pub_.publish(input);
-  if (marker_view_) marker_view_->onInitialConditions(input);
-  collision_lab::Prediction& prediction = prediction_msg_;
+  RunObserver* view = worker.draws ? marker_view_.get() : nullptr;
+  if (view) view->onInitialConditions(input);
+  collision_lab::Prediction& prediction = worker.prediction_msg;
   fillPredictionMsg(plan, prediction);
   prediction.timeline_scale = out.timeline().scale();
   out.publish(topics_.predictions, prediction, 0.0);
   out.record(prediction);
-  if (marker_view_) marker_view_->onPrediction(prediction);
+  if (view) view->onPrediction(prediction);
 }
 
-void LabNode::publishEnd(RunWriter& out, collision_lab::RunSummary& summary, double last_event_time, Reply reply) {
+void LabNode::publishEnd(RunWriter& out, collision_lab::RunSummary& summary, double last_event_time, Reply reply,
+                         bool draws) {
   summary.timeline_scale = out.timeline().scale();
   out.stamp(summary, last_event_time);
   summary.timeline_saturated = out.timeline().saturated();
@@ -813,14 +1132,15 @@ void LabNode::publishEnd(RunWriter& out, collision_lab::RunSummary& summary, dou
                     << summary.timeline_scale << ")");
   }
   if (!out.recording()) {
-    finishRun(summary, reply);
+    out.markFinished();
+    finishRun(summary, reply, draws);
     return;
   }
-  out.finish(summary, [this, reply](collision_lab::RunSummary& closed) { finishRun(closed, reply); });
+  out.finish(summary, [this, reply, draws](collision_lab::RunSummary& closed) { finishRun(closed, reply, draws); });
   recording_times_.add(out.recordingSeconds());
 }
 
-void LabNode::finishRun(const collision_lab::RunSummary& summary, const Reply& reply) {
+void LabNode::finishRun(const collision_lab::RunSummary& summary, const Reply& reply, bool draws) {
   if (params_.record) {
     std::lock_guard<std::mutex> lock(recording_mutex_);
     last_recording_error_ = summary.recording_error;
@@ -832,7 +1152,7 @@ void LabNode::finishRun(const collision_lab::RunSummary& summary, const Reply& r
   topics_.summaries.publish(summary);
   ++runs_accepted_;
   last_compute_time_ = summary.compute_time;
-  if (marker_view_) marker_view_->onRunSummary(summary);
+  if (draws && marker_view_) marker_view_->onRunSummary(summary);
   logRun(summary, params_.log_runs);
   if (reply) reply->set_value(ServeOutcome{summary, {}});
 }
@@ -842,6 +1162,15 @@ void LabNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   status.add("runs accepted", std::to_string(runs_accepted_.load()));
   status.add("runs rejected", std::to_string(runs_rejected_.load()));
   status.add("last run compute time [s]", std::to_string(last_compute_time_.load()));
+  std::size_t waiting = 0, running = 0;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    waiting = scheduler_.size();
+    for (const auto& worker : workers_) running += worker->current.run_id.empty() ? 0 : 1;
+  }
+  status.add("workers", std::to_string(workers_.size()));
+  status.add("runs running", std::to_string(running));
+  status.add("runs waiting", std::to_string(waiting));
   status.add("recording", params_.record ? "on" : "off");
   status.add("bag directory", params_.bag_directory);
   if (params_.record) addRecordingStatus(status);

@@ -298,19 +298,20 @@ RunIndexRecorder::RunIndexRecorder(const std::string& bag_directory) : bag_direc
 
 RunIndexRecorder::~RunIndexRecorder() = default;
 
-void RunIndexRecorder::accepted(const collision_lab::AcceptedRun& run, const collision_lab::InitialConditions& input) {
+void RunIndexRecorder::accepted(const std::string& run_id, const std::string& student, const std::string& requested_run_id,
+                                const collision_lab::InitialConditions& input) {
   if (!index_) return;
   IndexedRun row;
-  row.run_id = run.run_id;
-  row.student = run.student;
-  row.requested_run_id = run.requested_run_id;
+  row.run_id = run_id;
+  row.student = student;
+  row.requested_run_id = requested_run_id;
   row.state = RunState::kQueued;
-  row.accepted_at = run.header.stamp.isZero() ? wallNow() : run.header.stamp.toSec();
+  row.accepted_at = wallNow();
   row.scene_json = inputJson(input);
   try {
     index_->accepted(row);
   } catch (const RunIndexError& e) {
-    ROS_ERROR_STREAM("run " << run.run_id << ": not in the run index: " << e.what());
+    ROS_ERROR_STREAM("run " << run_id << ": not in the run index: " << e.what());
   }
 }
 

@@ -500,7 +500,7 @@ TEST(NBodyNode, CancelStopsARunThatWouldNeverEndAndItsBagIsComplete) {
   endless.max_collisions = std::uint64_t{1} << 62;
   g_to_cap->publish(endless);
   const auto queued = scene("after_endless", {1, 1}, {1, 0}, {-1, 1});
-  g_to_cap->publish(queued);  // waits in the queue meanwhile
+  g_to_cap->publish(queued);  // served by another worker, or after it
   ASSERT_TRUE(waitUntil([] { return g_to_cap->runs().count("endless") && g_to_cap->runs().at("endless").events.size() >= 10; },
                         "the endless run's first collisions"));
 
@@ -508,7 +508,7 @@ TEST(NBodyNode, CancelStopsARunThatWouldNeverEndAndItsBagIsComplete) {
   other.request.run_id = "not_this_one";
   ASSERT_TRUE(callService(kCancel, other));
   EXPECT_FALSE(other.response.ok);
-  EXPECT_EQ(other.response.message, "run 'endless' is in progress, not 'not_this_one'; nothing stopped");
+  EXPECT_EQ(other.response.message, "no run 'not_this_one' is waiting or in progress; nothing stopped");
 
   collision_lab::Cancel cancel;
   cancel.request.run_id = "endless";
@@ -534,7 +534,7 @@ TEST(NBodyNode, CancelStopsARunThatWouldNeverEndAndItsBagIsComplete) {
   std::error_code ec;
   fs::remove(s.bag_path, ec);  // it may be large
 
-  // Nothing lost: the input sent during the run is served after it.
+  // Nothing lost: the input sent during the run is served.
   EXPECT_EQ(g_to_cap->waitFor("after_endless").summaries.size(), 1u);
 }
 

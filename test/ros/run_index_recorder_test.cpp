@@ -160,21 +160,14 @@ TEST_F(RunIndexRecorderTest, AKilledWritersBagIsReindexedRenamedAndCounted) {
 TEST_F(RunIndexRecorderTest, RecoveryIndexesTheRunAsInterruptedWithItsEvents) {
   RunIndexRecorder recorder(dir_);
   ASSERT_TRUE(recorder.ok());
-  collision_lab::AcceptedRun accepted;
-  accepted.run_id = "dead";
-  accepted.student = "ana";
-  accepted.header.stamp = ros::Time(1000);
-  recorder.accepted(accepted, input("dead", "ana"));
+  recorder.accepted("dead", "ana", "", input("dead", "ana"));
   recorder.started("dead");
   killedWriter("dead", 30000);
   // Another dead run the index never saw: its row comes from the bag's input.
   killedWriter("unknown", 30000);
   // Queued rows of dead nodes: one without a bag, one whose final bag has its summary.
-  accepted.run_id = "queued";
-  recorder.accepted(accepted, input("queued", "ana"));
-  accepted.run_id = "done";
-  accepted.student = "ben";
-  recorder.accepted(accepted, input("done", "ben"));
+  recorder.accepted("queued", "ana", "", input("queued", "ana"));
+  recorder.accepted("done", "ben", "", input("done", "ben"));
   recorder.started("done");
   {
     RunRecorder done(dir_, "done");
@@ -225,9 +218,7 @@ TEST_F(RunIndexRecorderTest, RecoveryIndexesTheRunAsInterruptedWithItsEvents) {
 
 TEST_F(RunIndexRecorderTest, ALiveNodesQueuedRunIsLeftAlone) {
   RunIndexRecorder recorder(dir_);
-  collision_lab::AcceptedRun accepted;
-  accepted.run_id = "waiting";
-  recorder.accepted(accepted, input("waiting", ""));
+  recorder.accepted("waiting", "", "", input("waiting", ""));
   std::string error;
   ASSERT_EQ(claimBag(dir_, "waiting", error), BagClaim::kClaimed) << error;  // its live owner
   EXPECT_EQ(recorder.recover(), 0u);

@@ -8,39 +8,50 @@
 // (RunIndexRecorder). At start the node ends the runs of dead nodes in it (recover()).
 //
 // Threading contract:
-// - One worker thread serves every input, from the topic and the services alike, in
-//   arrival order, and does all publishing and recording: a run's messages go out in the
-//   order predictions, (collision_events, velocities, energy_transfers) per collision,
-//   run_summaries, and runs never interleave.
-// - The topic callback (global callback queue, spun by main) only queues the input.
-// - The services run on their own callback queue, spun by kServiceThreads threads of an
-//   AsyncSpinner. A call queues its input like the topic does and blocks only its own
-//   service thread until the worker hands back the outcome (a promise): the worker, topic
-//   inputs, diagnostics and the marker animation (global queue) go on meanwhile. Further
-//   concurrent calls wait in roscpp for a free service thread.
-// - ~cancel and ~list_runs run on a callback queue and thread of their own, so they are
-//   answered while every service thread waits for a run. It sets cancel_, which the run in progress polls
-//   (SceneRunOptions::cancel); running_mutex_ guards which run that is.
-// - With recording on, the worker hands each run's recorded messages over to a bag writer
-//   thread (RunBagWriter; it blocks only while kRecordQueueMessages messages wait). The
-//   writer closes the run's bag, then publishes its summary and answers its service call
+// - Intake at arrival: the thread that receives an input (the topic callback on the global
+//   queue, spun by main, or a service thread) checks it (checkInput, planScene), claims its
+//   run_id and bag, puts it in the FairScheduler and publishes its AcceptedRun (with its
+//   queue_position and lane) at once, all under mutex_, so AcceptedRuns and run_queue
+//   go out in the order of the queue. A rejection is answered on that thread too.
+// - ~workers worker threads (Worker) take the runs from the scheduler, of which the first
+//   ~short_lane_workers take only short runs. Each worker has its own message buffers,
+//   cancel flag and bag writer thread (RunBagWriter: a run's batches stay contiguous), so
+//   runs of different workers interleave on the topics (every message names its run_id);
+//   a run's own messages keep the order predictions, (collision_events, velocities,
+//   energy_transfers) per collision, run_summaries. ros::Publisher is thread-safe.
+// - mutex_ guards the scheduler, the run_id claims, stopping_, every worker's current run
+//   (Worker::current) and the marker view's owner, and is held while run_queue is
+//   published. The marker view (a RunObserver) draws one run at a time: a run draws when
+//   it starts while no other run is drawn and the view follows it; other runs are not
+//   drawn live. Its summary and rejections reach it from other threads (it is
+//   thread-safe).
+// - The services run on their own callback queue, spun by kServiceThreads threads. A call
+//   takes its input in like the topic does and blocks only its own service thread until
+//   the worker hands back the outcome (a promise). Further concurrent calls wait in roscpp.
+// - ~cancel and ~list_runs run on a callback queue and thread of their own. ~cancel takes
+//   a waiting run out of the scheduler (it is answered with a CANCELLED summary and its
+//   bag closed on that thread, through the node's own bag writer) or stops a running one:
+//   stopRun() sets its worker's cancel flag, which the core polls, with a cause. The
+//   watchdog thread does the same with the cause kTimeLimit at a run's deadline, and a
+//   run's RunWriter with kBagLimit when its recorded bytes pass its limit.
+// - Each worker catches every exception around its run: the run ends WORKER_ERROR, its
+//   summary published and its bag closed, and the worker serves the next run.
+// - With recording on, the worker hands each run's recorded messages over to its bag
+//   writer thread (blocking only while kRecordQueueMessages messages wait). The writer
+//   closes the run's bag, then publishes its summary and answers its service call
 //   (finishRun), so a run's summary may follow the next run's first messages; every
 //   summary still follows its own run's messages and its bag is closed when it goes out.
-// - The worker claims each run's bag file (claimBag, exclusive among every process that
-//   shares bag_directory) when it assigns the run_id, before any message names it; the
-//   bag writer only opens, writes and renames files so claimed.
-// - The diagnostics timer (global queue) reads the worker's counters through atomics and
-//   recording_mutex_.
-// - Destruction: queued inputs are dropped (a call waiting for one answers ok = false) and
-//   the run in progress is cancelled first, then the worker is joined (the cancelled run
-//   closes its bag, its summary says cancelled), then the subscription and the services
-//   stop (waiting only for calls whose run is over), the bag writer writes and closes
-//   every bag handed over (publishing their summaries), and the service threads are
-//   stopped. main destroys the node on SIGINT before ros::shutdown(), which would
-//   otherwise first wait for every service call in progress, and so for its whole run.
+// - The diagnostics timer (global queue) reads counters through atomics and mutexes.
+// - Destruction: no input is taken in any more; every waiting run is cancelled (CANCELLED
+//   summary, bag closed, its call answered) and every running one stopped (cause
+//   kShutdown), the workers and the watchdog are joined, then the subscription and the
+//   services stop, the bag writers write and close every bag handed over (publishing their
+//   summaries), and the service threads are stopped. main destroys the node on SIGINT
+//   before ros::shutdown(), which would otherwise first wait for every service call.
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
@@ -66,8 +77,10 @@
 #include "collision_lab/RunScene.h"
 #include "collision_lab/RunSummary.h"
 #include "collision_lab/core/scene_run.h"
+#include "collision_lab/RunQueue.h"
 #include "collision_lab/ros/msg_conversion.h"
 #include "collision_lab/ros/run_observer.h"
+#include "collision_lab/service/fair_scheduler.h"
 
 namespace collision_lab_ros {
 
@@ -84,13 +97,29 @@ struct LabNodeParams {
   std::uint64_t max_bodies = 0;    ///< larger scenes are rejected (TOO_MANY_BODIES)
   double min_free_space_mb = 0.0;  ///< [MB] diagnostics warn below it
   std::string scenario_file;       ///< the presets of ~run_preset
+  /// Worker threads [1] (~workers; default max(2, hardware threads)), of which
+  /// short_lane_workers [1] take only short runs (~short_lane_workers, default 1).
+  std::uint64_t workers = 2;
+  std::uint64_t short_lane_workers = 1;
+  /// What makes a run short (~short_max_collisions, ~short_max_bodies).
+  collision_lab::service::LaneLimits lanes;
+  /// Service ceilings an input may lower, never raise: wall time per run [s]
+  /// (~max_run_seconds; <= 0: none) and recorded bytes per bag [bytes] (~max_bag_bytes; 0: none).
+  double max_run_seconds = 0.0;
+  std::uint64_t max_bag_bytes = 0;
+  /// Test hook (~fail_runs_of_student): a run of this student throws std::bad_alloc from
+  /// its first collision, as a worker that runs out of memory. Empty: none.
+  std::string fail_runs_of_student;
 
   /// Reads ~record, ~bag_directory, ~max_collisions, ~simulate_to_cap, ~max_published_events,
-  /// ~publish_markers, ~log_runs, ~max_bodies, ~min_free_space_mb and ~scenario_file (default: the package's
-  /// config/scenarios.yaml), with the defaults of node_constants.h. Throws
+  /// ~publish_markers, ~log_runs, ~max_bodies, ~min_free_space_mb, ~scenario_file (default: the package's
+  /// config/scenarios.yaml), ~workers, ~short_lane_workers, ~short_max_collisions,
+  /// ~short_max_bodies, ~max_run_seconds, ~max_bag_bytes and ~fail_runs_of_student, with
+  /// the defaults of node_constants.h. Throws
   /// std::invalid_argument, naming the parameter, its value and the accepted range, when a
-  /// count (~max_collisions, ~max_published_events, ~max_bodies) is not a whole number in
-  /// [0, 2^64 - 1].
+  /// count (~max_collisions, ~max_published_events, ~max_bodies, ~workers, ...) is not a
+  /// whole number in [0, 2^64 - 1], when ~workers is 0 or ~short_lane_workers is not below
+  /// ~workers.
   static LabNodeParams load(const ros::NodeHandle& private_nh);
 };
 
@@ -145,6 +174,14 @@ struct EventMessages {
   collision_lab::EnergyTransfer energy;
 };
 
+/// What a run has computed so far, kept outside its EventStream (lab_node.cpp) so that a
+/// run that throws can still report it.
+struct RunProgress {
+  std::uint64_t collisions = 0;  ///< [1] events seen
+  std::uint64_t published = 0;   ///< [1] events published
+  double last_time = 0.0;        ///< simulated time of the last collision [s]
+};
+
 /// Stamps, publishes and records the messages of one run (lab_node.cpp).
 class RunWriter;
 class RunBagWriter;
@@ -170,20 +207,74 @@ struct ServeOutcome {
   collision_lab::Rejected rejected;
 };
 
+/// A bounded memory of run_ids given out (the newest kRunIdsRemembered), so that a
+/// long-running node stays flat in memory; with recording on, the bag folder remembers
+/// every run_id anyway (claimBag).
+class RememberedRunIds {
+ public:
+  bool contains(const std::string& run_id) const { return ids_.count(run_id) > 0; }
+  void add(const std::string& run_id);
+
+ private:
+  std::unordered_set<std::string> ids_;
+  std::deque<std::string> order_;  ///< oldest first
+};
+
 class LabNode {
  public:
   /// make_observer (may be empty) makes the in-process viewer fed when ~publish_markers
   /// is true: collision_lab_node passes the marker view's.
   LabNode(ros::NodeHandle nh, ros::NodeHandle private_nh, const RunObserverFactory& make_observer = {});
-  /// Finishes the run in progress (closing its bag), drops queued inputs.
+  /// Cancels the waiting runs and stops the running ones (closing their bags).
   ~LabNode();
 
  private:
   /// Where a service call waits for its outcome; null for topic inputs.
   using Reply = std::shared_ptr<std::promise<ServeOutcome>>;
+  /// Why a run's cancel flag was set; the first cause wins.
+  enum class StopCause : int { kNone, kCancel, kTimeLimit, kBagLimit, kShutdown };
+  /// A run's limits: the node's ceilings, lowered by the input's own.
+  struct RunLimits {
+    std::uint64_t max_collisions = 0;  ///< [1]; 0: none
+    bool collision_ceiling = false;    ///< the node's ~max_collisions lowered the input's cap
+    double max_run_seconds = 0.0;      ///< [s]; 0: none
+    bool time_from_input = false;      ///< the input's max_run_seconds is the binding one
+    std::uint64_t max_bag_bytes = 0;   ///< [bytes]; 0: none
+    bool bag_from_input = false;       ///< the input's max_bag_bytes is the binding one
+  };
+  /// An accepted run, from intake to its worker.
   struct Job {
-    collision_lab::InitialConditions::ConstPtr input;
+    collision_lab::InitialConditions input;  ///< run_id assigned
+    collision_lab::core::ScenePlan plan;
+    std::string requested_run_id;  ///< RunSummary.requested_run_id: the run_id asked for when not served as it
+    std::string claim_error;       ///< RunBagBatch::claim_error
+    RunLimits limits;
+    std::uint64_t predicted_collisions = 0;  ///< the model's count; 0: none
     Reply reply;
+  };
+  using Scheduler = collision_lab::service::FairScheduler<Job>;
+  /// The run a worker computes (guarded by mutex_).
+  struct CurrentRun {
+    std::string run_id;  ///< empty: idle
+    std::string student;
+    collision_lab::service::Lane lane = collision_lab::service::Lane::kLong;
+    std::uint64_t predicted_collisions = 0;
+    std::uint32_t body_count = 0;
+    std::optional<std::chrono::steady_clock::time_point> deadline;  ///< of ~max_run_seconds
+    std::string stopped_by;  ///< who asked it to stop (~cancel's requested_by)
+  };
+  struct Worker {
+    bool short_only = false;  ///< a short-lane worker
+    std::unique_ptr<RunBagWriter> bags;  ///< null when not recording
+    // The worker's messages of a run, refilled for every run: their storage is reused.
+    collision_lab::Prediction prediction_msg;
+    EventMessages event_messages;
+    collision_lab::RunSummary summary_msg;
+    std::atomic<bool> cancel{false};
+    std::atomic<int> cause{static_cast<int>(StopCause::kNone)};
+    CurrentRun current;
+    bool draws = false;  ///< the current run feeds the marker view
+    std::thread thread;
   };
 
   void onInitialConditions(const collision_lab::InitialConditions::ConstPtr& msg);
@@ -193,53 +284,59 @@ class LabNode {
                    collision_lab::RunPreset::Response& response);
   bool onCancel(collision_lab::Cancel::Request& request, collision_lab::Cancel::Response& response);
   bool onListRuns(collision_lab::ListRuns::Request& request, collision_lab::ListRuns::Response& response);
-  /// Queues input for the worker and waits for its outcome; empty when the node stops
-  /// before serving it.
+  /// Takes input in and waits for its outcome; empty when the node stops before serving it.
   std::optional<ServeOutcome> serveAndWait(const collision_lab::InitialConditions& input);
-  void enqueue(Job job);
-  void workerLoop();
+  /// Intake: checks input, then rejects it (reply answered) or claims its run_id, queues
+  /// it and announces it. On the receiving thread.
+  void intake(collision_lab::InitialConditions input, Reply reply);
+  RunLimits limitsOf(const collision_lab::InitialConditions& input) const;
+  void workerLoop(Worker& worker);
+  void watchdogLoop();
+  /// Sets worker's cancel flag with cause (kept when one is set already). mutex_ held.
+  static void stopRun(Worker& worker, StopCause cause, const std::string& by);
+  /// Publishes run_queue. mutex_ held.
+  void publishQueue();
 
-  // ---- The worker's (not thread-safe) ----
-  /// Validates input, assigns its run_id (in input), then runs it or rejects it; reply
-  /// gets the outcome once the run is finished (its bag closed).
-  void serve(collision_lab::InitialConditions& input, Reply reply);
-  /// Publishes, records and draws one validated run (its run_id assigned).
-  /// requested_run_id: RunSummary.requested_run_id.
-  /// claim_error: RunBagBatch::claim_error.
-  /// Runs the input's plan (core::planScene, made once when the input was checked).
-  void run(collision_lab::InitialConditions& input, const collision_lab::core::ScenePlan& plan,
-           const std::string& requested_run_id, const std::string& claim_error, Reply reply);
-  /// runScene, as the run that ~cancel stops.
-  collision_lab::core::SceneRunResult runCancellable(const std::string& run_id,
-                                                     const collision_lab::core::ScenePlan& plan,
-                                                     const collision_lab::core::SceneRunOptions& options,
-                                                     const collision_lab::core::SceneVisitors& visitors);
+  // ---- A worker's (each on its own Worker) ----
+  /// Runs job, catching every exception (WORKER_ERROR).
+  void serve(Worker& worker, Job& job);
+  /// Publishes, records and draws one accepted run.
+  void run(Worker& worker, Job& job, RunWriter& out, RunProgress& progress);
+  /// Ends a run that threw `what` before its summary was handed over: WORKER_ERROR.
+  void failRun(Worker& worker, Job& job, RunWriter& out, const RunProgress& progress, const std::string& what);
+  /// The stop reason of a service limit or of ~cancel, put into summary.
+  void applyStopCause(Worker& worker, const Job& job, collision_lab::RunSummary& summary);
+  /// Ends a run that never started (cancelled while waiting, or at shutdown): a CANCELLED,
+  /// not simulated summary, its bag written with its input and closed. Any thread.
+  void dropWaiting(Job job, const std::string& by);
   /// Records the input (stamped at the run's start) and publishes the prediction.
-  void publishStart(RunWriter& out, const collision_lab::InitialConditions& input,
+  void publishStart(Worker& worker, RunWriter& out, const collision_lab::InitialConditions& input,
                     const collision_lab::core::ScenePlan& plan);
   /// Stamps the summary and finishes the run: at once when not recording, else on the
   /// bag writer's thread once the bag is closed.
-  void publishEnd(RunWriter& out, collision_lab::RunSummary& summary, double last_event_time, Reply reply);
+  void publishEnd(RunWriter& out, collision_lab::RunSummary& summary, double last_event_time, Reply reply,
+                  bool draws);
   /// Publishes the summary last, counts, draws and logs the run, answers reply. Runs on
   /// the worker (not recording) or on the bag writer's thread.
-  void finishRun(const collision_lab::RunSummary& summary, const Reply& reply);
+  void finishRun(const collision_lab::RunSummary& summary, const Reply& reply, bool draws);
   ServeOutcome reject(collision_lab::Rejected msg, const std::string& run_id);
-  /// Tells the sender which run_id input got (`accepted_runs`, the log) and records the
-  /// run for ~list_runs. requested: the input's run_id as sent.
-  void announce(const collision_lab::InitialConditions& input, const std::string& requested);
-  /// <prefix><counter>, the first one claim() takes.
+  /// Tells the sender which run_id input got, its place in the queue and lane
+  /// (`accepted_runs`, the log) and records the run for ~list_runs. mutex_ held.
+  void announce(const std::string& run_id, const std::string& student, const std::string& requested,
+                std::size_t queue_position, collision_lab::service::Lane lane);
+  /// <prefix><counter>, the first one claim() takes. mutex_ held (as the two below).
   std::string newRunId(std::string& claim_error);
   /// requested, or the first requested.N (N = 2, 3, ...) that claim() takes.
   std::string claimRunId(const std::string& requested, std::string& claim_error);
-  /// Takes run_id for this node's next run. False when this node served it before or,
-  /// recording, when claimBag finds its bag taken (by any process sharing bag_directory).
-  /// True when taken: recording, its .bag.active file is this node's (claimBag), or, when
-  /// claimBag failed for another reason, claim_error says why (the run is served
-  /// unrecorded, recording_ok false).
+  /// Takes run_id for this node's next run. False when this node served it recently
+  /// (RememberedRunIds) or, recording, when claimBag finds its bag taken (by any process
+  /// sharing bag_directory). True when taken: recording, its .bag.active file is this
+  /// node's (claimBag), or, when claimBag failed for another reason, claim_error says why
+  /// (the run is served unrecorded, recording_ok false).
   bool claim(const std::string& run_id, std::string& claim_error);
 
-  /// The status "<node>: lab runs" of /diagnostics: runs accepted and rejected, the last
-  /// run's compute time, the recording state and the free space in bag_directory.
+  /// The status "<node>: lab runs" of /diagnostics: runs accepted and rejected, the queue,
+  /// the last run's compute time, the recording state and the free space in bag_directory.
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
   /// Adds the last recording error and the free space in bag_directory to status.
   void addRecordingStatus(diagnostic_updater::DiagnosticStatusWrapper& status);
@@ -249,7 +346,7 @@ class LabNode {
   ros::Subscriber input_sub_;
   RunTopics topics_;
   ros::Publisher rejected_pub_;
-  ros::Publisher accepted_pub_, served_inputs_pub_;
+  ros::Publisher accepted_pub_, served_inputs_pub_, run_queue_pub_;
   ServedRuns served_runs_;
   /// Writes the run index (<bag_directory>/runs.sqlite) and answers ~list_runs from it.
   std::unique_ptr<RunIndexRecorder> run_index_;
@@ -259,35 +356,31 @@ class LabNode {
   ros::WallTimer diagnostics_timer_;
   std::unique_ptr<RunObserver> marker_view_;
   std::string run_id_prefix_;
-  std::uint64_t run_counter_ = 0;
-  std::unordered_set<std::string> used_run_ids_;
-  // The worker's messages of a run, refilled for every run: their storage is reused.
-  collision_lab::InitialConditions served_input_;
-  collision_lab::AcceptedRun accepted_msg_;
-  collision_lab::Prediction prediction_msg_;
-  EventMessages event_messages_;
-  collision_lab::RunSummary summary_msg_;
+  std::vector<std::string> recorded_latched_topics_;
 
-  // Written by the worker, read by the diagnostics timer.
+  // Counters, read by the diagnostics timer.
   std::atomic<std::uint64_t> runs_accepted_{0};
   std::atomic<std::uint64_t> runs_rejected_{0};
   std::atomic<double> last_compute_time_{0.0};
   std::mutex recording_mutex_;
   std::string last_recording_error_;  ///< empty while recording works
-  RecentDurations recording_times_;   ///< the worker's hand-over time per run [s]
-  /// Writes the bags (null when not recording); on_closed publishes each run's summary.
-  std::unique_ptr<RunBagWriter> bags_;
+  RecentDurations recording_times_;   ///< the workers' hand-over time per run [s]
+  /// Writes the bags of runs that never started (dropWaiting); null when not recording.
+  std::unique_ptr<RunBagWriter> dropped_bags_;
 
+  // Guarded by mutex_.
   std::mutex mutex_;
-  std::condition_variable wake_;
-  std::deque<Job> inputs_;
+  std::condition_variable wake_;  ///< a run waits, or stopping_
+  Scheduler scheduler_;
+  std::uint64_t run_counter_ = 0;
+  RememberedRunIds used_run_ids_;
   bool stopping_ = false;
-  std::thread worker_;
+  bool view_busy_ = false;  ///< a running run feeds the marker view
+  collision_lab::RunQueue queue_msg_;
+  std::vector<std::unique_ptr<Worker>> workers_;
 
-  std::mutex running_mutex_;
-  std::string running_run_id_;  ///< empty when no run is in progress
-  std::atomic<bool> cancel_{false};
-  std::atomic<bool> stopping_run_{false};  ///< set by the destructor: cancel every run
+  std::condition_variable watchdog_wake_;  ///< with mutex_: stopping_
+  std::thread watchdog_;
 
   ros::CallbackQueue service_queue_;
   ros::AsyncSpinner service_spinner_;

@@ -69,6 +69,8 @@ class MarkerView : public RunObserver {
   /// of the current run (a bag played again). A run's other messages may arrive before
   /// its InitialConditions: they wait for it. Thread-safe.
   void onInitialConditions(const collision_lab::InitialConditions& msg) override;
+  /// MarkerViewParams::follows.
+  bool follows(const std::string& run_id) const override { return params_.follows(run_id); }
   void onPrediction(const collision_lab::Prediction& msg) override;
   void onCollisionEvent(const collision_lab::CollisionEvent& msg) override;
   void onRunSummary(const collision_lab::RunSummary& msg) override;

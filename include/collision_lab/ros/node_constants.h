@@ -39,6 +39,12 @@ constexpr bool kLatchRejected = true;
 /// accepted_runs: the newest accepted input's run_id, for a `rostopic echo -n1` just after
 /// a `rostopic pub` (in a busy class, ~list_runs has every run).
 constexpr bool kLatchAcceptedRuns = true;
+/// The runs running and waiting (RunQueue), latched: a late page shows the queue at once.
+constexpr char kRunQueueTopic[] = "run_queue";
+constexpr bool kLatchRunQueue = true;
+/// run_queue lists every running run and at most this many waiting ones (the first to be
+/// served): a burst of thousands of inputs is not republished whole at every change.
+constexpr std::size_t kRunQueueListed = 500;
 /// Bag only (the node does not publish it): the settings of the run (RunParameters),
 /// written first in each bag, latched on replay like the run's other one-shot messages.
 constexpr char kRunParametersTopic[] = "run_parameters";
@@ -47,7 +53,7 @@ constexpr bool kLatchRunParameters = true;
 /// Private services of collision_lab_node (srv/RunScene.srv, srv/RunPreset.srv).
 constexpr char kRunSceneService[] = "run_scene";
 constexpr char kRunPresetService[] = "run_preset";
-/// Stops the run in progress (srv/Cancel.srv); served by a thread of its own.
+/// Stops a running or waiting run (srv/Cancel.srv); served by a thread of its own.
 constexpr char kCancelService[] = "cancel";
 /// Lists the runs served (srv/ListRuns.srv); served by ~cancel's thread (quick answers).
 constexpr char kListRunsService[] = "list_runs";
@@ -57,7 +63,7 @@ constexpr std::size_t kServedRunsKept = 100'000;
 /// InitialConditions.student: at most this many characters.
 constexpr std::size_t kMaxStudentLength = 64;
 /// Service calls served at once; each blocks its thread until its run is over (the runs
-/// themselves are served one at a time by the worker). Further calls wait in roscpp.
+/// themselves are served by the workers). Further calls wait in roscpp.
 constexpr std::uint32_t kServiceThreads = 4;
 /// ~scenario_file default, relative to the package folder.
 constexpr char kDefaultScenarioFile[] = "config/scenarios.yaml";
@@ -80,6 +86,25 @@ constexpr std::uint32_t kOutputQueueSize = 100000;
 constexpr std::uint32_t kMarkerQueueSize = 10;
 
 constexpr std::uint64_t kDefaultMaxCollisions = 10'000'000;
+/// Scheduling (docs/ros.md, "Scheduling and limits"): ~workers defaults to the hardware
+/// threads, at least kMinDefaultWorkers; ~short_lane_workers of them take only short runs.
+constexpr std::uint64_t kMinDefaultWorkers = 2;
+constexpr std::uint64_t kDefaultShortLaneWorkers = 1;
+constexpr std::uint64_t kMaxWorkers = 256;
+/// A run is short when its plan says it computes at most this many impacts [1], or, when
+/// the plan knows no count, when it has at most kDefaultShortMaxBodies bodies [1] and a
+/// cap of at most kDefaultShortMaxCollisions.
+constexpr std::uint64_t kDefaultShortMaxCollisions = 100'000;
+constexpr std::uint64_t kDefaultShortMaxBodies = 100;
+/// Service ceilings an input may lower: wall time per run [s] and recorded bytes per bag
+/// [bytes] (the serialized size of the messages recorded).
+constexpr double kDefaultMaxRunSeconds = 300.0;
+constexpr std::uint64_t kDefaultMaxBagBytes = 2'000'000'000;
+/// How often the watchdog checks the runs' deadlines [s].
+constexpr double kWatchdogPeriod = 0.02;
+/// run_ids a node remembers to refuse again (the newest this many): bounded memory. With
+/// recording on, the bag folder remembers them all (claimBag).
+constexpr std::size_t kRunIdsRemembered = 4096;
 /// ~max_bodies: a larger scene is rejected (TOO_MANY_BODIES), so that a typo in a script
 /// cannot flood a lab machine; a 10,000-body gas still runs.
 constexpr std::uint64_t kDefaultMaxBodies = 10'000;

@@ -1,5 +1,5 @@
 // The lab node's side of the run index (service/run_index.h, docs/ros.md "The run index"):
-// converts AcceptedRun/InitialConditions, RunSummary and Rejected to the index's rows and
+// converts the served InitialConditions, RunSummary and Rejected to the index's rows and
 // JSON, answers ~list_runs from it, and recovers the runs of dead nodes at start.
 //
 // The index is a record, never a reason to lose a run: every RunIndexError is caught and
@@ -12,7 +12,6 @@
 #include <string>
 #include <vector>
 
-#include "collision_lab/AcceptedRun.h"
 #include "collision_lab/InitialConditions.h"
 #include "collision_lab/Rejected.h"
 #include "collision_lab/RunSummary.h"
@@ -71,8 +70,10 @@ class RunIndexRecorder {
   const std::string& bagDirectory() const { return bag_directory_; }
   collision_lab::service::RunIndex* index() { return index_.get(); }
 
-  /// A run accepted and queued; input as served (its run_id assigned).
-  void accepted(const collision_lab::AcceptedRun& run, const collision_lab::InitialConditions& input);
+  /// A run accepted and queued, before any worker can take it; input as served (its
+  /// run_id assigned). requested_run_id: InitialConditions.run_id as sent.
+  void accepted(const std::string& run_id, const std::string& student, const std::string& requested_run_id,
+                const collision_lab::InitialConditions& input);
   /// The run left the queue: a worker computes it.
   void started(const std::string& run_id);
   /// Its summary is out (its bag closed).

@@ -6,6 +6,7 @@
 
 #include <functional>
 #include <memory>
+#include <string>
 
 #include <ros/node_handle.h>
 
@@ -17,10 +18,15 @@
 
 namespace collision_lab_ros {
 
-/// Called from the node's worker and service threads: implementations are thread-safe.
+/// Called from the node's worker, bag writer, topic and service threads: implementations
+/// are thread-safe. The node feeds one run at a time live (the first that starts while no
+/// run is drawn and that the observer follows); a run's summary may come after the next
+/// run has started (its bag closed first).
 class RunObserver {
  public:
   virtual ~RunObserver() = default;
+  /// True when the observer shows runs of run_id (the node does not feed it the others).
+  virtual bool follows(const std::string& run_id) const = 0;
   virtual void onInitialConditions(const collision_lab::InitialConditions& msg) = 0;
   virtual void onPrediction(const collision_lab::Prediction& msg) = 0;
   virtual void onCollisionEvent(const collision_lab::CollisionEvent& msg) = 0;

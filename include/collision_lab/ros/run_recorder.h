@@ -208,7 +208,10 @@ class RunBagWriter {
   const std::size_t max_queued_;
   /// The connection headers of the latched topics (null: not latched), built once.
   const boost::shared_ptr<ros::M_string> parameters_header_, input_header_, prediction_header_, summary_header_;
-  rosbag::Bag bag_;                       ///< the writer thread's, reopened for every run
+  /// The writer thread's, reopened for every run and replaced every kBagReuses runs.
+  std::optional<rosbag::Bag> bag_;
+  std::size_t bag_reuses_ = 0;
+  static constexpr std::size_t kBagReuses = 100;
   std::optional<RunRecorder> recorder_;  ///< the writer thread's: the run being written
 
   std::mutex mutex_;

@@ -1,0 +1,111 @@
+// The lab node's run queue (fair_scheduler.h): round robin across students per lane,
+// queue positions, removal, lanes chosen from the plan. No master needed.
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "collision_lab/service/fair_scheduler.h"
+
+namespace {
+
+using collision_lab::service::chooseLane;
+using collision_lab::service::FairScheduler;
+using collision_lab::service::Lane;
+using collision_lab::service::LaneLimits;
+namespace core = collision_lab::core;
+using Scheduler = FairScheduler<int>;
+
+Scheduler::Entry entry(const std::string& run_id, const std::string& student, Lane lane = Lane::kLong) {
+  return Scheduler::Entry{run_id, student, lane, 0};
+}
+
+std::vector<std::string> popAll(Scheduler& scheduler, bool short_only) {
+  std::vector<std::string> ids;
+  while (auto e = scheduler.pop(short_only)) ids.push_back(e->run_id);
+  return ids;
+}
+
+TEST(FairScheduler, TenthRunOfOneStudentWaitsBehindAClassmatesFirst) {
+  Scheduler scheduler;
+  for (int i = 1; i <= 10; ++i) EXPECT_EQ(scheduler.push(entry("a" + std::to_string(i), "a")), std::size_t(i - 1));
+  // b's first run is served right after a's first.
+  EXPECT_EQ(scheduler.push(entry("b1", "b")), 1u);
+  EXPECT_EQ(scheduler.push(entry("c1", "c")), 2u);
+  EXPECT_EQ(scheduler.push(entry("b2", "b")), 4u);  // a1 b1 c1 a2 | b2
+  std::vector<std::string> order;
+  for (const auto* e : scheduler.order()) order.push_back(e->run_id);
+  const std::vector<std::string> expected{"a1", "b1", "c1", "a2", "b2", "a3", "a4", "a5", "a6", "a7", "a8", "a9", "a10"};
+  EXPECT_EQ(order, expected);
+  EXPECT_EQ(popAll(scheduler, false), expected);
+  EXPECT_EQ(scheduler.size(), 0u);
+}
+
+TEST(FairScheduler, AnonymousInputsCountAsOneStudent) {
+  Scheduler scheduler;
+  scheduler.push(entry("x1", ""));
+  scheduler.push(entry("x2", ""));
+  scheduler.push(entry("s1", "s"));
+  EXPECT_EQ(popAll(scheduler, false), (std::vector<std::string>{"x1", "s1", "x2"}));
+}
+
+TEST(FairScheduler, ShortLaneWorkersTakeOnlyShortRunsAndOthersTakeShortFirst) {
+  Scheduler scheduler;
+  EXPECT_EQ(scheduler.push(entry("long1", "a", Lane::kLong)), 0u);
+  EXPECT_EQ(scheduler.push(entry("short1", "a", Lane::kShort)), 0u);  // positions count per lane
+  EXPECT_TRUE(scheduler.ready(true));
+  EXPECT_EQ(scheduler.pop(true)->run_id, "short1");
+  EXPECT_FALSE(scheduler.ready(true));
+  EXPECT_FALSE(scheduler.pop(true).has_value());
+  scheduler.push(entry("short2", "b", Lane::kShort));
+  EXPECT_EQ(scheduler.pop(false)->run_id, "short2");
+  EXPECT_EQ(scheduler.pop(false)->run_id, "long1");
+}
+
+TEST(FairScheduler, RemoveTakesAWaitingRunOutAndKeepsTheOrder) {
+  Scheduler scheduler;
+  scheduler.push(entry("a1", "a"));
+  scheduler.push(entry("b1", "b"));
+  scheduler.push(entry("a2", "a"));
+  EXPECT_EQ(scheduler.remove("b1")->run_id, "b1");
+  EXPECT_FALSE(scheduler.remove("b1").has_value());
+  EXPECT_FALSE(scheduler.remove("nope").has_value());
+  EXPECT_EQ(popAll(scheduler, false), (std::vector<std::string>{"a1", "a2"}));
+}
+
+TEST(FairScheduler, DrainEmptiesBothLanes) {
+  Scheduler scheduler;
+  scheduler.push(entry("a1", "a", Lane::kShort));
+  scheduler.push(entry("a2", "a", Lane::kLong));
+  EXPECT_EQ(scheduler.drain().size(), 2u);
+  EXPECT_EQ(scheduler.size(), 0u);
+  EXPECT_FALSE(scheduler.ready(false));
+}
+
+core::ScenePlan plan(std::vector<double> masses, std::vector<double> positions, std::vector<double> velocities) {
+  core::Scene scene;
+  scene.masses = std::move(masses);
+  scene.positions = std::move(positions);
+  scene.velocities = std::move(velocities);
+  return core::planScene(scene);
+}
+
+TEST(ChooseLane, FromWhatThePlanKnows) {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  const LaneLimits limits;  // 100,000 impacts, 100 bodies
+  const auto pi31 = plan({100, 1, kInf}, {2, 1, 0}, {-1, 0, 0});
+  ASSERT_FALSE(pi31.error);
+  EXPECT_EQ(chooseLane(pi31, false, 0, false, limits), Lane::kShort);
+  // 3.14e8 impacts: long when simulated to a large cap, short when predict-only or when the
+  // model answers over a smaller cap.
+  const auto pi_big = plan({1e16, 1, kInf}, {2, 1, 0}, {-1, 0, 0});
+  ASSERT_FALSE(pi_big.error);
+  const std::uint64_t all = std::numeric_limits<std::uint64_t>::max();
+  EXPECT_EQ(chooseLane(pi_big, false, all, false, limits), Lane::kLong);
+  EXPECT_EQ(chooseLane(pi_big, true, all, false, limits), Lane::kShort);
+  EXPECT_EQ(chooseLane(pi_big, false, 1000, false, limits), Lane::kShort);
+  EXPECT_EQ(chooseLane(pi_big, false, 1'000'000, true, limits), Lane::kLong);
+}
+
+}  // namespace
