@@ -32,6 +32,7 @@ packages=(
   libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
   rviz
   libcpp-httplib-dev libjs-chart.js
+  libsqlite3-dev
 )
 build=true
 for arg in "$@"; do

@@ -467,6 +467,16 @@ void RunBook::completeFromBag(const std::string& run_id, const std::string& bag_
   changed_.notify_all();
 }
 
+bool RunBook::sourceKnows(const std::string& run_id) const {
+  if (!source_) return false;
+  try {
+    const auto row = source_->find(run_id);
+    return row && ended(row->state);
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
 void RunBook::enforceBudgetLocked(const std::string& keep) {
   if (resident_bytes_ <= options_.memory_budget_bytes) return;
   std::vector<std::pair<std::uint64_t, std::string>> candidates;  // last_used, run_id
@@ -479,7 +489,7 @@ void RunBook::enforceBudgetLocked(const std::string& keep) {
     if (resident_bytes_ <= options_.memory_budget_bytes) break;
     auto it = runs_.find(run_id);
     WebRun& run = it->second;
-    if (source_) {
+    if (sourceKnows(run_id)) {
       order_.erase(run.sequence);  // the source lists it and gives it back
     } else {
       EvictedRun stub;

@@ -467,4 +467,58 @@ TEST(RunBookMemory, WebRecordsKeepNoKeyframes) {
   EXPECT_EQ(json::parse(served(book, "ana.gas")).at("collisions"), 20000);
 }
 
+
+TEST(RunBookMemory, EvictedRunTheIndexDoesNotKnowKeepsAStub) {
+  TempDir dir;
+  auto source = std::make_shared<FakeSource>();  // the index missed this run
+  collision_lab_web::RunBook book(smallBudget(1), source);
+  const ScriptedRun first = scriptedRun("ana", "ana.run1", 1.0e9, 3, 40, dir.path);
+  feed(book, first);
+  const std::string before = served(book, "ana.run1");
+  feed(book, scriptedRun("bo", "bo.run2", 1.0e9 + 1, 3, 40, dir.path));
+  EXPECT_EQ(book.residentRuns(), 1u);
+  const json list = json::parse(book.list(std::nullopt));
+  ASSERT_EQ(list.size(), 2u);
+  EXPECT_EQ(list[0].at("run_id"), "ana.run1");
+  EXPECT_EQ(served(book, "ana.run1"), before);
+}
+
+// A web node started after a day of runs, on the real SQLite index: every run listed, an old
+// link served from its bag.
+TEST(RunBookMemory, RestartedWebNodeServesTheIndexsRuns) {
+  TempDir dir;
+  const std::string index_path = collision_lab::service::RunIndex::defaultPath(dir.path.string());
+  {
+    collision_lab::service::RunIndex index(index_path);  // the lab node's writes
+    for (int k = 1; k <= 30; ++k) {
+      const ScriptedRun run = scriptedRun("s" + std::to_string(k % 5), "run" + std::to_string(k), 1.0e9 + k, 3, 25,
+                                          dir.path);
+      IndexedRun row = rowOf(run, RunState::kQueued);
+      index.accepted(row);
+      index.started(row.run_id, row.accepted_at + 0.5);
+      if (k == 30) {
+        index.interrupted(row.run_id, row.accepted_at + 1, "", 25, run.summary.bag_path);
+      } else {
+        index.finished(row.run_id, row.accepted_at + 1, json({{"model_name", "scripted"}}).dump(), "NO_MORE_COLLISIONS",
+                       25, run.summary.bag_path);
+      }
+    }
+  }
+  collision_lab_web::RunBook book(smallBudget(std::size_t{64} << 20), collision_lab_web::openIndexRunSource(index_path));
+  const json list = json::parse(book.list(std::nullopt));
+  ASSERT_EQ(list.size(), 30u);
+  EXPECT_EQ(list[0].at("run_id"), "run1");
+  EXPECT_EQ(list[0].at("state"), "finished");
+  EXPECT_EQ(list[29].at("state"), "interrupted");
+  EXPECT_EQ(json::parse(book.list(std::string("s1"))).size(), 6u);
+  EXPECT_EQ(book.residentRuns(), 0u);
+  ASSERT_TRUE(book.has("run7"));
+  const json run = json::parse(served(book, "run7"));
+  EXPECT_EQ(run.at("state"), "finished");
+  EXPECT_EQ(run.at("collisions"), 25);
+  EXPECT_EQ(run.at("student"), "s2");
+  EXPECT_EQ(book.bagPath("run7"), (dir.path / "run7.bag").string());
+  EXPECT_EQ(json::parse(served(book, "run30")).at("state"), "interrupted");
+}
+
 }  // namespace

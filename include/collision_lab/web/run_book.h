@@ -15,7 +15,8 @@
 // seen run (an old link after a restart) is found there, the run list is the index's, and
 // runs believed queued or running are reconciled against it: finished there -> completed
 // from the bag; interrupted there -> shown "interrupted" with the events its bag holds.
-// Without one, an evicted run leaves a small stub (its summary) for the list and the reload.
+// An evicted run the RunSource does not know (or with none) leaves a small stub (its
+// summary) for the list and the reload.
 //
 // Thread-safe: the ROS callbacks (one spinner thread) and the HTTP threads share it.
 #pragma once
@@ -75,8 +76,8 @@ struct WebRun {
   std::size_t footprint = 0;    ///< bytes counted against the budget [bytes]
 };
 
-/// What an evicted run leaves when there is no RunSource: enough for the list and to read
-/// it back from its bag.
+/// What an evicted run leaves when the RunSource does not know it (or there is none):
+/// enough for the list and to read it back from its bag.
 struct EvictedRun {
   std::string student, requested_run_id;
   double accepted_stamp = 0.0;  ///< [s] since the epoch
@@ -177,6 +178,8 @@ class RunBook {
   bool load(const std::string& run_id);
   void touchLocked(WebRun& run);
   void countLocked(WebRun& run);
+  /// The RunSource has the run, finished or interrupted (so an evicted run needs no stub).
+  bool sourceKnows(const std::string& run_id) const;
   /// Evicts least recently used finished runs until within the budget; `keep` stays.
   void enforceBudgetLocked(const std::string& keep);
   void reconcileLoop();
@@ -190,7 +193,7 @@ class RunBook {
   std::uint64_t next_sequence_ = 1;
   std::uint64_t use_clock_ = 0;
   std::size_t resident_bytes_ = 0;  ///< sum of runs_' footprints [bytes]
-  std::map<std::string, EvictedRun> evicted_;  ///< only without a RunSource
+  std::map<std::string, EvictedRun> evicted_;  ///< evicted runs the RunSource does not know
   std::set<std::string> loading_;  ///< runs being read back (one load each)
   /// Inputs published and not yet answered: key student + '\n' + requested run_id.
   std::map<std::string, std::optional<Submission>> waiting_;
