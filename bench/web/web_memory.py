@@ -2,9 +2,9 @@
 """Resident memory per run of the class's web node after warm-up (docs/web.md, "Memory and
 restarts"; a measurement, not a test).
 
-Starts its own master (a free port), a lab node recording into a fresh folder and a web node
-with a small ~memory_budget_bytes, so that the warm-up fills the budget. Sends WARMUP small
-runs (the pi scene, 31 impacts) over ROS, waits until the web node has every one finished,
+Starts its own master (a free port) with web_memory.launch: a lab node recording into a fresh
+folder and a web node with a small ~memory_budget_bytes, so that the warm-up fills the budget. Sends WARMUP small
+runs (the pi scene, 31 impacts) as students do (POST /api/runs), waits until the web node has every one finished,
 reads the web node's VmRSS, sends RUNS more, reads it again, then reads a few old runs back
 over HTTP (from their bags). Prints the web node's RSS at each step and
 (RSS after - RSS after warm-up) / RUNS, the figure the issue asks to stay under 1 KB.
@@ -25,10 +25,15 @@ import urllib.request
 import xmlrpc.client
 
 
-def free_port():
-    with socket.socket() as s:
+def free_ports(count):
+    """count distinct free TCP ports."""
+    sockets = [socket.socket() for _ in range(count)]
+    for s in sockets:
         s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
+    ports = [s.getsockname()[1] for s in sockets]
+    for s in sockets:
+        s.close()
+    return ports
 
 
 def rss_kib(pid):
@@ -51,83 +56,75 @@ def main():
     ap.add_argument("--budget", type=int, default=4 << 20, help="web node ~memory_budget_bytes [bytes]")
     args = ap.parse_args()
 
-    master_port, web_port = free_port(), free_port()
+    master_port, web_port = free_ports(2)
     env = dict(os.environ, ROS_MASTER_URI=f"http://127.0.0.1:{master_port}", ROS_HOME=tempfile.mkdtemp())
     os.environ.update(env)
     bags = tempfile.mkdtemp(prefix="web_memory_bags_")
     procs = []
-    log = open(os.path.join(bags, "nodes.log"), "w")
+    log = tempfile.NamedTemporaryFile("w", prefix="web_memory_nodes_", suffix=".log", delete=False)
     try:
-        procs.append(subprocess.Popen(["roscore", "-p", str(master_port)], env=env, stdout=log, stderr=log))
-        time.sleep(3)
+        here = os.path.dirname(os.path.abspath(__file__))
         procs.append(subprocess.Popen(
-            ["rosrun", "collision_lab", "collision_lab_node", "__ns:=/collision_lab", f"_bag_directory:={bags}",
-             "_publish_markers:=false", "_log_runs:=false"], env=env, stdout=log, stderr=log))
-        procs.append(subprocess.Popen(
-            ["rosrun", "collision_lab", "collision_lab_web", "__ns:=/collision_lab", f"_bag_directory:={bags}",
-             f"_port:={web_port}", f"_memory_budget_bytes:={args.budget}"], env=env, stdout=log, stderr=log))
+            ["roslaunch", "-p", str(master_port), os.path.join(here, "web_memory.launch"), f"bags:={bags}",
+             f"port:={web_port}", f"budget:={args.budget}"], env=env, stdout=log, stderr=log))
+        import rosgraph
+        deadline = time.time() + 60
+        while not rosgraph.Master("/web_memory_bench").is_online():
+            if time.time() > deadline or procs[0].poll() is not None:
+                sys.exit(f"no master on port {master_port} (see {log.name})")
+            time.sleep(0.5)
 
-        import rosnode
-        import rospy
-        from collision_lab.msg import InitialConditions, RunSummary
-
-        rospy.init_node("web_memory_bench", anonymous=True, disable_signals=True)
+        
         web_name = "/collision_lab/collision_lab_web"
         deadline = time.time() + 60
         while True:
             try:
-                web_pid = xmlrpc.client.ServerProxy(rosnode.get_api_uri(rospy.get_master(), web_name)).getPid("/b")[2]
+                web_pid = xmlrpc.client.ServerProxy(rosgraph.Master("/web_memory_bench").lookupNode(web_name)).getPid("/b")[2]
                 get_json(f"http://127.0.0.1:{web_port}/api/runs")
                 break
-            except Exception:
+            except Exception as e:
                 if time.time() > deadline:
-                    sys.exit("the web node did not start (see " + log.name + ")")
+                    sys.exit(f"the web node did not start ({e}; see {log.name})")
                 time.sleep(0.5)
 
-        done = set()
-        rospy.Subscriber("/collision_lab/run_summaries", RunSummary, lambda m: done.add(m.run_id), queue_size=10000)
-        pub = rospy.Publisher("/collision_lab/initial_conditions", InitialConditions, queue_size=10000)
-        while pub.get_num_connections() == 0:
-            time.sleep(0.1)
-        time.sleep(1)
+        base = f"http://127.0.0.1:{web_port}"
 
         def send(first, count):
+            """POSTs the runs as students do (one at a time), then waits until the last is finished."""
             for k in range(first, first + count):
-                msg = InitialConditions()
-                msg.header.stamp = rospy.Time.now()
-                msg.run_id = f"mem{k}"
-                msg.student = f"s{k % 30}"
-                msg.masses, msg.positions, msg.velocities = [100.0, 1.0, float("inf")], [2.0, 1.0, 0.0], [-1.0, 0.0, 0.0]
-                pub.publish(msg)
-                while len(done) < k - first - 20 + len(before):  # at most 20 runs in flight
-                    time.sleep(0.002)
-            last = f"mem{first + count - 1}"
+                body = {"student": f"s{k % 30}", "run_id": f"m{k}", "masses": [100, 1, "inf"],
+                        "positions": [2, 1, 0], "velocities": [-1, 0, 0]}
+                req = urllib.request.Request(f"{base}/api/runs", data=json.dumps(body).encode(),
+                                             headers={"Content-Type": "application/json"}, method="POST")
+                with urllib.request.urlopen(req, timeout=60) as r:
+                    ids.append(json.loads(r.read())["run_id"])
+                if k % 250 == 0:
+                    print(f"sent {k + 1}", flush=True)
             end = time.time() + 300
-            while time.time() < end:  # the web node has them all
+            while time.time() < end:
                 try:
-                    if get_json(f"http://127.0.0.1:{web_port}/api/runs/{last}").get("state") == "finished":
+                    if get_json(f"{base}/api/runs/{ids[-1]}").get("state") == "finished":
                         return
                 except Exception:
                     pass
                 time.sleep(0.2)
-            sys.exit("the web node did not finish " + last)
+            sys.exit("the web node did not finish " + ids[-1])
 
+        ids = []
         start_rss = rss_kib(web_pid)
-        before = set(done)
         send(0, args.warmup)
         time.sleep(3)
         warm_rss = rss_kib(web_pid)
-        before = set(done)
         t0 = time.time()
         send(args.warmup, args.runs)
         time.sleep(3)
         end_rss = rss_kib(web_pid)
         elapsed = time.time() - t0
         # Old runs read back from their bags (evicted under the budget).
-        for k in range(0, args.warmup, max(1, args.warmup // 20)):
-            run = get_json(f"http://127.0.0.1:{web_port}/api/runs/mem{k}")
+        for run_id in ids[:args.warmup:max(1, args.warmup // 20)]:
+            run = get_json(f"{base}/api/runs/{run_id}")
             if run.get("state") != "finished" or run.get("collisions") != 31:
-                sys.exit(f"mem{k} read back wrong: {run.get('state')}, {run.get('collisions')} collisions")
+                sys.exit(f"{run_id} read back wrong: {run.get('state')}, {run.get('collisions')} collisions")
         listed = len(get_json(f"http://127.0.0.1:{web_port}/api/runs"))
         total = args.warmup + args.runs
         print(f"web node RSS: start {start_rss} KiB, after {args.warmup} warm-up runs {warm_rss} KiB, "
