@@ -267,6 +267,21 @@ collision_lab::RunSummary summaryFromRow(const collision_lab::service::IndexedRu
   return s;
 }
 
+/// The summary an evicted run's stub gives when its bag has none (an interrupted run).
+collision_lab::RunSummary summaryOfStub(const std::string& run_id, const EvictedRun& stub) {
+  collision_lab::RunSummary s;
+  s.run_id = run_id;
+  s.student = stub.student;
+  s.requested_run_id = stub.requested_run_id;
+  s.model_name = stub.model_name;
+  s.collision_count = stub.collision_count;
+  s.truncated = stub.truncated;
+  s.stop_reason = stub.interrupted ? "INTERRUPTED" : "";
+  s.bag_path = stub.bag_path;
+  s.recording_ok = true;
+  return s;
+}
+
 }  // namespace
 
 WebRun& RunBook::runLocked(const std::string& run_id) {
@@ -496,10 +511,13 @@ void RunBook::enforceBudgetLocked(const std::string& keep) {
       stub.student = run.student;
       stub.requested_run_id = run.requested_run_id;
       stub.accepted_stamp = run.accepted_stamp;
-      stub.bodies = run.record ? run.record->bodies() : 0;
+      stub.model_name = run.summary->model_name;
+      stub.bag_path = run.summary->bag_path;
+      stub.collision_count = run.summary->collision_count;
+      stub.bodies = run.record ? static_cast<std::uint32_t>(run.record->bodies()) : 0;
       stub.interrupted = run.interrupted;
+      stub.truncated = run.summary->truncated;
       stub.sequence = run.sequence;
-      stub.summary = *run.summary;
       evicted_.emplace(run_id, std::move(stub));
     }
     resident_bytes_ -= run.footprint;
@@ -532,7 +550,7 @@ bool RunBook::load(const std::string& run_id) {
     }
   }
   std::string bag;
-  if (stub && stub->summary.recording_ok) bag = stub->summary.bag_path;
+  if (stub) bag = stub->bag_path;  // only runs with a bag are evicted
   if (row && ended(row->state)) bag = row->bag_path;
   std::optional<BagRun> rebuilt;
   std::string error;
@@ -567,7 +585,11 @@ bool RunBook::load(const std::string& run_id) {
     run.accepted_stamp = stub->accepted_stamp;
     run.interrupted = stub->interrupted;
     run.sequence = stub->sequence;
-    run.summary = stub->summary;
+    if (run.record && run.record->summary && !run.interrupted) {
+      run.summary = *run.record->summary;
+    } else {
+      run.summary = summaryOfStub(run_id, *stub);
+    }
     run.finished = true;
     evicted_.erase(run_id);
   } else {
@@ -708,7 +730,7 @@ std::string RunBook::bagPath(const std::string& run_id) const {
     if (it != runs_.end()) {
       summary = it->second.summary;
     } else if (auto stub = evicted_.find(run_id); stub != evicted_.end()) {
-      summary = stub->second.summary;
+      summary = summaryOfStub(run_id, stub->second);
     }
   }
   if (!summary && source_) {
@@ -749,10 +771,10 @@ nlohmann::json listItem(const std::string& run_id, const EvictedRun& stub) {
           {"student", stub.student},
           {"state", stub.interrupted ? "interrupted" : "finished"},
           {"accepted_stamp", stub.accepted_stamp},
-          {"collisions", stub.summary.collision_count},
+          {"collisions", stub.collision_count},
           {"bodies", stub.bodies},
-          {"model", stub.summary.model_name},
-          {"truncated", static_cast<bool>(stub.summary.truncated)}};
+          {"model", stub.model_name},
+          {"truncated", stub.truncated}};
 }
 
 /// A run the web node does not hold, as its index row says.

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 
 #include <atomic>
+#include <iostream>
 #include <filesystem>
 #include <limits>
 #include <map>
@@ -454,6 +455,8 @@ TEST(RunBookMemory, WebRecordsKeepNoKeyframes) {
     rviz.add(e);
     web.add(e);
   }
+  std::cout << "1,000-body gas, 20,000 impacts: rviz record " << rviz.memoryBytes() << " bytes, web record "
+            << web.memoryBytes() << " bytes\n";
   EXPECT_GT(rviz.memoryBytes(), std::size_t{10} << 20);
   EXPECT_LT(web.memoryBytes(), std::size_t{1} << 20);
   EXPECT_EQ(web.collisions(), 20000u);

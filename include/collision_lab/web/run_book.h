@@ -77,14 +77,15 @@ struct WebRun {
 };
 
 /// What an evicted run leaves when the RunSource does not know it (or there is none):
-/// enough for the list and to read it back from its bag.
+/// enough for the list and to read it back from its bag (whose summary it shows again).
 struct EvictedRun {
-  std::string student, requested_run_id;
-  double accepted_stamp = 0.0;  ///< [s] since the epoch
-  std::size_t bodies = 0;       ///< [1]
-  bool interrupted = false;
+  std::string student, requested_run_id, model_name, bag_path;
+  double accepted_stamp = 0.0;        ///< [s] since the epoch
+  std::uint64_t collision_count = 0;  ///< [1]
   std::uint64_t sequence = 0;         ///< its place in the list [1]
-  collision_lab::RunSummary summary;  ///< names the bag
+  std::uint32_t bodies = 0;           ///< [1]
+  bool interrupted = false;
+  bool truncated = false;
 };
 
 struct RunBookOptions {
