@@ -21,6 +21,7 @@ import subprocess
 import sys
 import tempfile
 import time
+import urllib.error
 import urllib.request
 import xmlrpc.client
 
@@ -96,8 +97,15 @@ def main():
                         "positions": [2, 1, 0], "velocities": [-1, 0, 0]}
                 req = urllib.request.Request(f"{base}/api/runs", data=json.dumps(body).encode(),
                                              headers={"Content-Type": "application/json"}, method="POST")
-                with urllib.request.urlopen(req, timeout=60) as r:
-                    ids.append(json.loads(r.read())["run_id"])
+                for attempt in range(120):  # 503 until the lab node listens (its start)
+                    try:
+                        with urllib.request.urlopen(req, timeout=60) as r:
+                            ids.append(json.loads(r.read())["run_id"])
+                        break
+                    except urllib.error.HTTPError as e:
+                        if e.code != 503 or attempt == 119:
+                            raise
+                        time.sleep(0.5)
                 if k % 250 == 0:
                     print(f"sent {k + 1}", flush=True)
             end = time.time() + 300
