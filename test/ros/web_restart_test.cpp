@@ -1,7 +1,9 @@
 // The web node restarted (issue 30: "a restart of the web node lists 2 of 2,143 runs; old
 // links give 404"): the run index and the bags are written as the lab node writes them, the
 // web node is killed (SIGKILL) and respawned by roslaunch; it still lists every run, serves
-// an old run's page and JSON, and its bag.
+// an old run's page and JSON, and its bag. A web node that missed a run's last events and
+// its summary (dropped messages, a paused node) ends it finished or interrupted from the
+// index and the bag: nothing stays "running".
 #include <signal.h>
 
 #include <chrono>
@@ -18,6 +20,7 @@
 #include <rosbag/bag.h>
 #include <xmlrpcpp/XmlRpcClient.h>
 
+#include "collision_lab/AcceptedRun.h"
 #include "collision_lab/CollisionEvent.h"
 #include "collision_lab/InitialConditions.h"
 #include "collision_lab/RunSummary.h"
@@ -170,6 +173,124 @@ TEST(WebRestart, RespawnedWebNodeListsAndServesEveryRun) {
   int respawned = 0;
   waitUntil([&] { return (respawned = webPid()) > 0 && respawned != pid; }, "roslaunch to respawn the web node");
   expectEveryRunServed(webAddress());
+}
+
+
+/// A three-body run's messages and bag: `recorded` of its `collisions` events in the bag,
+/// with the summary when all are.
+struct LateRun {
+  collision_lab::AcceptedRun accepted;
+  collision_lab::InitialConditions input;
+  std::vector<collision_lab::CollisionEvent> events;
+  std::string bag_path;
+};
+
+LateRun lateRun(const std::filesystem::path& dir, const std::string& run_id, std::uint64_t collisions,
+                std::uint64_t recorded) {
+  LateRun run;
+  run.accepted.header.stamp = ros::Time::now();
+  run.accepted.run_id = run_id;
+  run.accepted.student = "late";
+  run.input.run_id = run_id;
+  run.input.student = "late";
+  run.input.masses = {1.0, 2.0, 3.0};
+  run.input.positions = {2.0, 1.0, 0.0};
+  run.input.velocities = {-1.0, 0.0, 1.0};
+  for (std::uint64_t k = 1; k <= collisions; ++k) {
+    collision_lab::CollisionEvent e;
+    e.run_id = run_id;
+    e.index = k;
+    e.pair_index = static_cast<std::uint32_t>(k % 2);
+    e.first_moved = e.pair_index;
+    e.last_moved = e.pair_index + 1;
+    e.time = 0.1 * static_cast<double>(k);
+    e.restitution = 1.0;
+    e.pair_velocities_after = {0.5, -0.5};
+    run.events.push_back(e);
+  }
+  run.bag_path = (dir / (run_id + ".bag")).string();
+  rosbag::Bag bag;
+  bag.open(run.bag_path, rosbag::bagmode::Write);
+  bag.write("/collision_lab/served_inputs", ros::Time(1.0), run.input);
+  for (std::uint64_t k = 0; k < recorded; ++k) bag.write("/collision_lab/collision_events", ros::Time(2.0), run.events[k]);
+  if (recorded == collisions) {
+    collision_lab::RunSummary summary;
+    summary.run_id = run_id;
+    summary.student = "late";
+    summary.collision_count = collisions;
+    summary.published_events = collisions;
+    summary.stop_reason = "NO_MORE_COLLISIONS";
+    summary.recording_ok = true;
+    summary.bag_path = run.bag_path;
+    bag.write("/collision_lab/run_summaries", ros::Time(3.0), summary);
+  }
+  bag.close();
+  return run;
+}
+
+/// The run's JSON once its state is not "running" (generous timeout: the web node checks
+/// every 2 s).
+json settledRun(const std::pair<std::string, int>& address, const std::string& run_id) {
+  json run;
+  waitUntil(
+      [&] {
+        httplib::Client c(address.first, address.second);
+        auto res = c.Get("/api/runs/" + run_id);
+        if (!res || res->status != 200) return false;
+        run = json::parse(res->body);
+        return run.at("state") != "running" && run.at("state") != "queued";
+      },
+      run_id + " to end");
+  return run;
+}
+
+TEST(WebMissedEvents, RunsWhoseEndWasMissedEndFromTheIndex) {
+  ros::NodeHandle nh("/collision_lab"), pnh("~");
+  std::string dir;
+  ASSERT_TRUE(pnh.getParam("bag_directory", dir));
+  std::filesystem::create_directories(dir);
+  const auto address = webAddress();
+  // The lab node's topics, published by the test: the web node gets only the start of each run.
+  auto accepted = nh.advertise<collision_lab::AcceptedRun>("accepted_runs", 10);
+  auto inputs = nh.advertise<collision_lab::InitialConditions>("served_inputs", 10);
+  auto events = nh.advertise<collision_lab::CollisionEvent>("collision_events", 100);
+  waitUntil([&] { return accepted.getNumSubscribers() > 0 && inputs.getNumSubscribers() > 0 &&
+                         events.getNumSubscribers() > 0; }, "the web node to subscribe");
+  const LateRun finished = lateRun(dir, "late.finished", 10, 10);
+  const LateRun interrupted = lateRun(dir, "late.interrupted", 10, 6);  // its node died after 6
+  collision_lab::service::RunIndex index(collision_lab::service::RunIndex::defaultPath(dir));
+  for (const LateRun* run : {&finished, &interrupted}) {
+    collision_lab::service::IndexedRun row;
+    row.run_id = run->input.run_id;
+    row.student = "late";
+    row.state = collision_lab::service::RunState::kQueued;
+    row.accepted_at = run->accepted.header.stamp.toSec();
+    row.bag_path = run->bag_path;
+    index.accepted(row);
+    index.started(row.run_id, row.accepted_at);
+    accepted.publish(run->accepted);
+    inputs.publish(run->input);
+    for (std::size_t k = 0; k < 3; ++k) events.publish(run->events[k]);
+  }
+  waitUntil(
+      [&] {
+        httplib::Client c(address.first, address.second);
+        auto res = c.Get("/api/runs/late.interrupted");
+        return res && res->status == 200 && json::parse(res->body).at("collisions") == 3;
+      },
+      "the web node to see the runs running");
+  EXPECT_EQ(json::parse(httplib::Client(address.first, address.second).Get("/api/runs/late.finished")->body).at("state"),
+            "running");
+  // The rest of the events and the summaries are never delivered; the lab node's index says how they ended.
+  index.finished("late.finished", ros::Time::now().toSec(), "", "NO_MORE_COLLISIONS", 10, finished.bag_path);
+  index.interrupted("late.interrupted", ros::Time::now().toSec(), "", 6, interrupted.bag_path);
+  const json done = settledRun(address, "late.finished");
+  EXPECT_EQ(done.at("state"), "finished");
+  EXPECT_EQ(done.at("collisions"), 10);
+  const json cut = settledRun(address, "late.interrupted");
+  EXPECT_EQ(cut.at("state"), "interrupted");
+  EXPECT_EQ(cut.at("collisions"), 6);
+  EXPECT_EQ(cut.at("summary").at("stop_reason"), "INTERRUPTED");
 }
 
 }  // namespace
