@@ -845,13 +845,16 @@ std::string RunBook::list(const std::optional<std::string>& student) const {
       rows.clear();  // the runs in memory are listed still
     }
   }
+  // The rows' items are made before locking (their scene and summary JSON is parsed).
   std::vector<std::pair<double, nlohmann::json>> items;  // accepted stamp, item
+  items.reserve(rows.size());
+  for (const auto& row : rows) items.emplace_back(row.accepted_at, listItem(row));
   std::lock_guard<std::mutex> lock(mutex_);
   std::set<std::string> listed;
-  for (const auto& row : rows) {
-    auto it = runs_.find(row.run_id);
-    items.emplace_back(row.accepted_at, it != runs_.end() ? listItem(it->second) : listItem(row));
-    listed.insert(row.run_id);
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    auto it = runs_.find(rows[k].run_id);
+    if (it != runs_.end()) items[k].second = listItem(it->second);  // the live state
+    listed.insert(rows[k].run_id);
   }
   // The runs in memory the source does not list (yet), in their order of arrival.
   for (const auto& [sequence, run_id] : order_) {
