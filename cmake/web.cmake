@@ -10,15 +10,16 @@ find_package(Threads REQUIRED)
 add_library(collision_lab_web_lib
   src/web/http_server.cpp
   src/web/run_book.cpp
+  src/web/index_run_source.cpp
   src/web/web_server.cpp)
 target_include_directories(collision_lab_web_lib PUBLIC include)
-target_link_libraries(collision_lab_web_lib PUBLIC collision_lab_ros collision_lab_views collision_lab_tools Threads::Threads)
+target_link_libraries(collision_lab_web_lib PUBLIC collision_lab_ros collision_lab_views collision_lab_tools collision_lab_service Threads::Threads)
 add_executable(collision_lab_web src/web/web_node_main.cpp)
 target_link_libraries(collision_lab_web PRIVATE collision_lab_web_lib)
 set_target_properties(collision_lab_web PROPERTIES
   RUNTIME_OUTPUT_DIRECTORY ${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_BIN_DESTINATION})
 
-install(TARGETS collision_lab_web_lib
+install(TARGETS collision_lab_web_lib collision_lab_service
   ARCHIVE DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
   LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION})
 install(TARGETS collision_lab_web RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})

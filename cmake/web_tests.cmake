@@ -16,3 +16,8 @@ target_compile_definitions(web_browser_test PRIVATE COLLISION_LAB_SOURCE_DIR="${
 # RunBook with the lab's topics out of order (no master).
 catkin_add_gtest(run_book_test test/ros/run_book_test.cpp)
 target_link_libraries(run_book_test collision_lab_web_lib ${catkin_LIBRARIES} GTest::gtest_main)
+# The web node killed and respawned: every run of the run index still listed and served;
+# runs whose end it missed end from the index.
+add_rostest_gtest(web_restart_test test/ros/web_restart_test.test test/ros/web_restart_test.cpp)
+target_link_libraries(web_restart_test collision_lab_web_lib ${catkin_LIBRARIES})
+add_dependencies(web_restart_test collision_lab_web)

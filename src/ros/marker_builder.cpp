@@ -125,6 +125,10 @@ void Envelope::widenColumns() {
   std::fill(columns_.begin() + static_cast<std::ptrdiff_t>(n / 2), columns_.end(), Column{});
 }
 
+std::size_t Envelope::memoryBytes() const {
+  return vertices_.capacity() * sizeof(Vertex) + columns_.capacity() * sizeof(Column);
+}
+
 std::vector<Envelope::Vertex> Envelope::polyline() const {
   if (columns_.empty()) return vertices_;
   std::vector<Vertex> out;
@@ -346,11 +350,46 @@ void RunRecord::add(const collision_lab::CollisionEvent& event) {
   meta.index = event.index;
   meta.time = event.time;
   meta.previous_time = previous_time_;
-  newest_kept_ = keeps(meta);
+  newest_kept_ = limits_.keep_keyframes && keeps(meta);
   if (newest_kept_) {
     keyframes_.push_back(snapshot(event.time));
     if (keyframes_.size() > keyframeLimit()) prune();
   }
+}
+
+std::size_t RunRecord::memoryBytes() const {
+  auto doubles = [](const std::vector<double>& v) { return v.capacity() * sizeof(double); };
+  auto sizes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
+  auto envelopes = [](const std::vector<Envelope>& series) {
+    std::size_t bytes = series.capacity() * sizeof(Envelope);
+    for (const Envelope& e : series) bytes += e.memoryBytes();
+    return bytes;
+  };
+  std::size_t bytes = sizeof(*this);
+  bytes += input_.run_id.capacity() + input_.student.capacity() + input_.header.frame_id.capacity();
+  bytes += doubles(input_.masses) + doubles(input_.positions) + doubles(input_.velocities) +
+           doubles(input_.restitution);
+  // BodyStateReplay: masses, velocities, positions, times and kinetic energies per body,
+  // and the moved bodies' before/gained (at most N each).
+  bytes += 7 * replay_.size() * sizeof(double);
+  for (const Keyframe& f : keyframes_) {
+    bytes += sizeof(Keyframe) + doubles(f.positions) + doubles(f.velocities) + doubles(f.predicted);
+  }
+  bytes += doubles(newest_predicted_) + sizes(tracked_) + sizes(plotted_) + sizes(track_slot_) + sizes(plot_slot_);
+  bytes += envelopes(velocity_) + envelopes(paper_velocity_) + envelopes(body_energy_) + envelopes(worldline_) +
+           envelopes(tracked_velocity_);
+  bytes += energy_.memoryBytes() + momentum_.memoryBytes() + energy_lost_.memoryBytes() + none_.memoryBytes();
+  if (prediction) {
+    bytes += prediction->run_id.capacity() + prediction->model_name.capacity() + prediction->model_reason.capacity() +
+             doubles(prediction->final_velocities);
+  }
+  if (summary) {
+    bytes += summary->run_id.capacity() + summary->student.capacity() + summary->requested_run_id.capacity() +
+             summary->model_name.capacity() + summary->model_reason.capacity() +
+             summary->truncation_reason.capacity() + summary->stop_reason.capacity() +
+             summary->bag_path.capacity() + summary->recording_error.capacity() + doubles(summary->final_velocities);
+  }
+  return bytes;
 }
 
 const std::vector<Keyframe>& RunRecord::keyframes() const {

@@ -1,11 +1,13 @@
 #include "collision_lab/web/run_book.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <set>
 #include <stdexcept>
 #include <thread>
 
@@ -150,29 +152,173 @@ void addPredicted(std::vector<Envelope>& predicted, const RunRecord& record, con
 
 }  // namespace
 
-RunBook::RunBook(std::size_t envelope_vertices) : envelope_vertices_(envelope_vertices) {}
+RunBook::RunBook(std::size_t envelope_vertices)
+    : RunBook(
+          [envelope_vertices] {
+            RunBookOptions options;
+            options.envelope_vertices = envelope_vertices;
+            return options;
+          }(),
+          nullptr) {}
+
+RunBook::RunBook(const RunBookOptions& options, std::shared_ptr<const RunSource> source)
+    : options_(options), source_(std::move(source)) {
+  if (source_ && options_.reconcile_period.count() > 0) reconciler_ = std::thread(&RunBook::reconcileLoop, this);
+}
 
 RunBook::~RunBook() {
-  for (auto& t : rebuilds_) t.join();
+  std::map<std::uint64_t, std::thread> rebuilds;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stopping_ = true;
+  }
+  stop_.notify_all();
+  if (reconciler_.joinable()) reconciler_.join();
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    rebuilds.swap(rebuilds_);
+  }
+  for (auto& [id, thread] : rebuilds) thread.join();
 }
+
+namespace {
+
+/// Heap bytes of a map node and its key beside the value [bytes] (libstdc++: 4 words).
+constexpr std::size_t kMapNodeBytes = 4 * sizeof(void*);
+
+std::size_t doublesBytes(const std::vector<double>& v) { return v.capacity() * sizeof(double); }
+
+std::size_t summaryBytes(const collision_lab::RunSummary& s) {
+  return s.run_id.capacity() + s.student.capacity() + s.requested_run_id.capacity() + s.model_name.capacity() +
+         s.model_reason.capacity() + s.truncation_reason.capacity() + s.stop_reason.capacity() +
+         s.bag_path.capacity() + s.recording_error.capacity() + doublesBytes(s.final_velocities);
+}
+
+std::size_t eventBytes(const collision_lab::CollisionEvent& e) {
+  return sizeof e + e.run_id.capacity() + doublesBytes(e.positions) + doublesBytes(e.velocities_before) +
+         doublesBytes(e.velocities_after) + doublesBytes(e.energy_transfer) + doublesBytes(e.kinetic_energy_after) +
+         doublesBytes(e.predicted_velocities_after) + doublesBytes(e.paper_velocities_after) +
+         doublesBytes(e.predicted_energy_transfer) + doublesBytes(e.paper_energy_transfer);
+}
+
+/// What a run holds in memory: the record (RunRecord::memoryBytes), the closed-form series,
+/// events waiting for the served input, summaries and strings, the map nodes [bytes].
+std::size_t footprintOf(const WebRun& run) {
+  std::size_t bytes = sizeof(WebRun) + 2 * kMapNodeBytes + sizeof(std::uint64_t) + 2 * run.run_id.capacity() +
+                      run.student.capacity() + run.requested_run_id.capacity() + run.bag_error.capacity();
+  if (run.record) bytes += run.record->memoryBytes();
+  bytes += run.predicted.capacity() * sizeof(Envelope);
+  for (const Envelope& e : run.predicted) bytes += e.memoryBytes();
+  bytes += (run.early_events.capacity() - run.early_events.size()) * sizeof(collision_lab::CollisionEvent);
+  for (const auto& e : run.early_events) bytes += eventBytes(e);
+  if (run.early_prediction) bytes += run.early_prediction->model_name.capacity() + run.early_prediction->model_reason.capacity();
+  if (run.pending_summary) bytes += summaryBytes(*run.pending_summary);
+  if (run.summary) bytes += summaryBytes(*run.summary);
+  return bytes;
+}
+
+/// The bag at path, or its ".active" name when only that exists (a run its node left
+/// unfinished, not yet recovered).
+std::string existingBag(const std::string& path) {
+  std::error_code ignored;
+  if (path.empty() || std::filesystem::exists(path, ignored)) return path;
+  const std::string active = path + ".active";
+  return std::filesystem::exists(active, ignored) ? active : path;
+}
+
+/// The index's state as the pages name it (as service::runStateName).
+const char* stateName(collision_lab::service::RunState state) {
+  switch (state) {
+    case collision_lab::service::RunState::kQueued: return "queued";
+    case collision_lab::service::RunState::kRunning: return "running";
+    case collision_lab::service::RunState::kFinished: return "finished";
+    case collision_lab::service::RunState::kInterrupted: return "interrupted";
+  }
+  return "queued";
+}
+
+bool ended(collision_lab::service::RunState state) {
+  return state == collision_lab::service::RunState::kFinished ||
+         state == collision_lab::service::RunState::kInterrupted;
+}
+
+/// The summary an index row gives when the run's bag has none (an interrupted run): its
+/// stop reason, count and bag, and what its summary_json holds of RunSummary's fields.
+collision_lab::RunSummary summaryFromRow(const collision_lab::service::IndexedRun& row) {
+  collision_lab::RunSummary s;
+  s.run_id = row.run_id;
+  s.student = row.student;
+  s.requested_run_id = row.requested_run_id;
+  const bool interrupted = row.state == collision_lab::service::RunState::kInterrupted;
+  s.stop_reason = row.stop_reason.empty() && interrupted ? "INTERRUPTED" : row.stop_reason;
+  s.collision_count = row.collision_count;
+  s.bag_path = row.bag_path;
+  s.recording_ok = !row.bag_path.empty();
+  const json fields = json::parse(row.summary_json, nullptr, false);
+  if (fields.is_object()) {
+    s.model_name = fields.value("model_name", s.model_name);
+    s.model_reason = fields.value("model_reason", s.model_reason);
+    s.truncated = fields.value("truncated", false);
+    s.truncation_reason = fields.value("truncation_reason", s.truncation_reason);
+    s.simulated = fields.value("simulated", false);
+    s.body_count = fields.value("body_count", s.body_count);
+    s.published_events = fields.value("published_events", s.published_events);
+  }
+  return s;
+}
+
+/// The summary an evicted run's stub gives when its bag has none (an interrupted run).
+collision_lab::RunSummary summaryOfStub(const std::string& run_id, const EvictedRun& stub) {
+  collision_lab::RunSummary s;
+  s.run_id = run_id;
+  s.student = stub.student;
+  s.requested_run_id = stub.requested_run_id;
+  s.model_name = stub.model_name;
+  s.collision_count = stub.collision_count;
+  s.truncated = stub.truncated;
+  s.stop_reason = stub.interrupted ? "INTERRUPTED" : "";
+  s.bag_path = stub.bag_path;
+  s.recording_ok = true;
+  return s;
+}
+
+}  // namespace
 
 WebRun& RunBook::runLocked(const std::string& run_id) {
   auto [it, inserted] = runs_.try_emplace(run_id);
+  WebRun& run = it->second;
   if (inserted) {
-    it->second.run_id = run_id;
-    order_.push_back(run_id);
+    run.run_id = run_id;
+    run.sequence = next_sequence_++;
+    order_[run.sequence] = run_id;
+    countLocked(run);
   }
-  return it->second;
+  touchLocked(run);
+  return run;
+}
+
+void RunBook::touchLocked(WebRun& run) {
+  run.touched = std::chrono::steady_clock::now();
+  run.last_used = ++use_clock_;
+}
+
+void RunBook::countLocked(WebRun& run) {
+  resident_bytes_ -= run.footprint;
+  run.footprint = footprintOf(run);
+  resident_bytes_ += run.footprint;
 }
 
 void RunBook::onAccepted(const collision_lab::AcceptedRun& msg) {
   std::unique_lock<std::mutex> lock(mutex_);
-  WebRun& run = runLocked(msg.run_id);
-  run.student = msg.student;
-  run.requested_run_id = msg.requested_run_id;
-  run.accepted_stamp = msg.header.stamp.toSec();
-  ++run.version;
-  changed_.notify_all();
+  if (!evicted_.count(msg.run_id)) {
+    WebRun& run = runLocked(msg.run_id);
+    run.student = msg.student;
+    run.requested_run_id = msg.requested_run_id;
+    run.accepted_stamp = msg.header.stamp.toSec();
+    ++run.version;
+    countLocked(run);
+    changed_.notify_all();
+  }
   AnswerCallback answer = takeWaitingLocked(msg.student, msg.requested_run_id);
   lock.unlock();
   if (answer) answer(Submission{msg.run_id, msg.queue_position, msg.lane, std::nullopt});
@@ -195,19 +341,23 @@ RunBook::AnswerCallback RunBook::takeWaitingLocked(const std::string& student, c
 
 void RunBook::onServedInput(const collision_lab::InitialConditions& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
+  if (evicted_.count(msg.run_id)) return;
   WebRun& run = runLocked(msg.run_id);
-  if (run.record) return;
+  if (run.record || run.rebuilding) return;
   RecordLimits limits;
-  limits.envelope_vertices = envelope_vertices_;
+  limits.envelope_vertices = options_.envelope_vertices;
+  limits.keep_keyframes = false;  // the web never animates the scene
   run.record = std::make_unique<RunRecord>(msg, limits);
-  run.predicted.assign(run.record->plottedBodies().size(), Envelope(envelope_vertices_));
+  run.predicted.assign(run.record->plottedBodies().size(), Envelope(options_.envelope_vertices));
   if (run.student.empty()) run.student = msg.student;
   if (run.early_prediction) run.record->prediction = *run.early_prediction;
+  run.early_prediction.reset();
   for (const auto& e : run.early_events) {
     run.record->add(e);
     addPredicted(run.predicted, *run.record, e);
   }
-  run.early_events.clear();
+  run.early_events = {};
+  countLocked(run);
   maybeFinishLocked(run);
   ++run.version;
   changed_.notify_all();
@@ -215,7 +365,9 @@ void RunBook::onServedInput(const collision_lab::InitialConditions& msg) {
 
 void RunBook::onPrediction(const collision_lab::Prediction& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
+  if (evicted_.count(msg.run_id)) return;
   WebRun& run = runLocked(msg.run_id);
+  if (run.finished || run.rebuilding) return;
   if (run.record) {
     run.record->prediction = msg;
   } else {
@@ -226,7 +378,10 @@ void RunBook::onPrediction(const collision_lab::Prediction& msg) {
 }
 
 void RunBook::onEvent(const collision_lab::CollisionEvent& msg) {
+  /// The footprint of a run in progress is recounted every this many events [1].
+  constexpr std::uint64_t kRecountEvery = 256;
   std::lock_guard<std::mutex> lock(mutex_);
+  if (evicted_.count(msg.run_id)) return;
   WebRun& run = runLocked(msg.run_id);
   if (run.finished || run.rebuilding) return;
   ++run.events_received;
@@ -236,6 +391,7 @@ void RunBook::onEvent(const collision_lab::CollisionEvent& msg) {
   } else if (run.early_events.size() < kEarlyEventsKept) {
     run.early_events.push_back(msg);
   }
+  if (run.events_received % kRecountEvery == 0) countLocked(run);
   maybeFinishLocked(run);
   ++run.version;
   changed_.notify_all();
@@ -243,6 +399,7 @@ void RunBook::onEvent(const collision_lab::CollisionEvent& msg) {
 
 void RunBook::onSummary(const collision_lab::RunSummary& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
+  if (evicted_.count(msg.run_id)) return;
   WebRun& run = runLocked(msg.run_id);
   if (run.finished) return;
   run.pending_summary = msg;
@@ -261,18 +418,10 @@ void RunBook::maybeFinishLocked(WebRun& run) {
   // first. The bag has the whole run. Without a bag, wait for the served input of a run
   // seen accepted (it was published before the summary); a run joined midway ends with
   // its summary alone.
-  if (!run.record && recorded) {
-    run.rebuilding = true;
-    rebuilds_.emplace_back(&RunBook::rebuildFromBag, this, run.run_id, summary.bag_path);
-    return;
-  }
+  if (!run.record && recorded) return startRebuildLocked(run, summary.bag_path);
   if (!run.record && run.accepted_stamp > 0.0) return;
-  if (recorded && run.record && summary.events_not_published) {
-    // The bag holds every event; the topics stopped at ~max_published_events.
-    run.rebuilding = true;
-    rebuilds_.emplace_back(&RunBook::rebuildFromBag, this, run.run_id, summary.bag_path);
-    return;
-  }
+  // The bag holds every event; the topics stopped at ~max_published_events.
+  if (recorded && run.record && summary.events_not_published) return startRebuildLocked(run, summary.bag_path);
   finishLocked(run, summary);
 }
 
@@ -280,29 +429,256 @@ void RunBook::finishLocked(WebRun& run, const collision_lab::RunSummary& summary
   if (run.record) run.record->summary = summary;
   run.summary = summary;
   run.pending_summary.reset();
+  run.early_events = {};
+  run.early_prediction.reset();
   run.rebuilding = false;
   run.finished = true;
+  countLocked(run);
+  enforceBudgetLocked(run.run_id);
 }
 
-void RunBook::rebuildFromBag(const std::string& run_id, const std::string& bag_path) {
+void RunBook::startRebuildLocked(WebRun& run, const std::string& bag_path) {
+  run.rebuilding = true;
+  for (std::uint64_t done : rebuilds_done_) {
+    auto it = rebuilds_.find(done);
+    if (it == rebuilds_.end()) continue;
+    it->second.join();  // it has ended: it listed itself as its last step
+    rebuilds_.erase(it);
+  }
+  rebuilds_done_.clear();
+  const std::uint64_t id = next_rebuild_++;
+  rebuilds_.emplace(id, std::thread(&RunBook::rebuildFromBag, this, id, run.run_id, bag_path));
+}
+
+void RunBook::rebuildFromBag(std::uint64_t rebuild, const std::string& run_id, const std::string& bag_path) {
+  completeFromBag(run_id, bag_path, std::nullopt);
+  std::lock_guard<std::mutex> lock(mutex_);
+  rebuilds_done_.push_back(rebuild);
+}
+
+void RunBook::completeFromBag(const std::string& run_id, const std::string& bag_path,
+                              const std::optional<Completion>& how) {
   std::optional<BagRun> rebuilt;
   std::string error;
   try {
-    rebuilt = readRunFromBag(bag_path, envelope_vertices_);
+    if (bag_path.empty()) throw std::runtime_error("the run was not recorded");
+    rebuilt = readRunFromBag(existingBag(bag_path), options_.envelope_vertices);
   } catch (const std::exception& e) {
     error = e.what();
   }
   std::lock_guard<std::mutex> lock(mutex_);
-  WebRun& run = runLocked(run_id);
+  auto it = runs_.find(run_id);
+  if (it == runs_.end() || it->second.finished) return;  // a rebuilding run is never evicted
+  WebRun& run = it->second;
   if (rebuilt && rebuilt->record) {
     run.record = std::move(rebuilt->record);
     run.predicted = std::move(rebuilt->predicted);
   } else {
     run.bag_error = error.empty() ? "the bag has no InitialConditions" : error;
   }
-  finishLocked(run, *run.pending_summary);
+  collision_lab::RunSummary summary;
+  if (run.pending_summary) {
+    summary = *run.pending_summary;
+  } else if (run.record && run.record->summary) {
+    summary = *run.record->summary;
+  } else if (how) {
+    summary = how->fallback;
+    if (run.record) summary.collision_count = std::max<std::uint64_t>(summary.collision_count, run.record->collisions());
+  }
+  run.interrupted = how && how->interrupted && !run.pending_summary;
+  finishLocked(run, summary);
+  touchLocked(run);
   ++run.version;
   changed_.notify_all();
+}
+
+bool RunBook::sourceKnows(const std::string& run_id) const {
+  if (!source_) return false;
+  try {
+    const auto row = source_->find(run_id);
+    return row && ended(row->state);
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
+void RunBook::enforceBudgetLocked(const std::string& keep) {
+  if (resident_bytes_ <= options_.memory_budget_bytes) return;
+  std::vector<std::pair<std::uint64_t, std::string>> candidates;  // last_used, run_id
+  for (const auto& [run_id, run] : runs_) {
+    const bool has_bag = run.summary && run.summary->recording_ok && !run.summary->bag_path.empty();
+    if (run.finished && !run.rebuilding && has_bag && run_id != keep) candidates.emplace_back(run.last_used, run_id);
+  }
+  std::sort(candidates.begin(), candidates.end());
+  for (const auto& [last_used, run_id] : candidates) {
+    if (resident_bytes_ <= options_.memory_budget_bytes) break;
+    auto it = runs_.find(run_id);
+    WebRun& run = it->second;
+    if (sourceKnows(run_id)) {
+      order_.erase(run.sequence);  // the source lists it and gives it back
+    } else {
+      EvictedRun stub;
+      stub.student = run.student;
+      stub.requested_run_id = run.requested_run_id;
+      stub.accepted_stamp = run.accepted_stamp;
+      stub.model_name = run.summary->model_name;
+      stub.bag_path = run.summary->bag_path;
+      stub.collision_count = run.summary->collision_count;
+      stub.bodies = run.record ? static_cast<std::uint32_t>(run.record->bodies()) : 0;
+      stub.interrupted = run.interrupted;
+      stub.truncated = run.summary->truncated;
+      stub.sequence = run.sequence;
+      evicted_.emplace(run_id, std::move(stub));
+    }
+    resident_bytes_ -= run.footprint;
+    runs_.erase(it);
+  }
+}
+
+bool RunBook::load(const std::string& run_id) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  for (;;) {
+    auto it = runs_.find(run_id);
+    if (it != runs_.end()) {
+      it->second.last_used = ++use_clock_;
+      return true;
+    }
+    if (!loading_.count(run_id)) break;
+    changed_.wait(lock);  // another caller reads it
+  }
+  std::optional<EvictedRun> stub;
+  if (auto s = evicted_.find(run_id); s != evicted_.end()) stub = s->second;
+  loading_.insert(run_id);
+  lock.unlock();
+
+  std::optional<collision_lab::service::IndexedRun> row;
+  if (!stub && source_) {
+    try {
+      row = source_->find(run_id);
+    } catch (const std::exception&) {
+      row.reset();  // unknown for now: the next call asks again
+    }
+  }
+  std::string bag;
+  if (stub) bag = stub->bag_path;  // only runs with a bag are evicted
+  if (row && ended(row->state)) bag = row->bag_path;
+  std::optional<BagRun> rebuilt;
+  std::string error;
+  if (!bag.empty()) {
+    try {
+      rebuilt = readRunFromBag(existingBag(bag), options_.envelope_vertices);
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+  } else if (stub || (row && ended(row->state))) {
+    error = "the run was not recorded";
+  }
+
+  lock.lock();
+  loading_.erase(run_id);
+  changed_.notify_all();
+  if (!stub && !row) return false;
+  if (runs_.count(run_id)) return true;  // its messages arrived meanwhile
+  auto [it, inserted] = runs_.try_emplace(run_id);
+  WebRun& run = it->second;
+  run.run_id = run_id;
+  run.version = 1;
+  if (rebuilt && rebuilt->record) {
+    run.record = std::move(rebuilt->record);
+    run.predicted = std::move(rebuilt->predicted);
+  } else if (!error.empty() || rebuilt) {
+    run.bag_error = error.empty() ? "the bag has no InitialConditions" : error;
+  }
+  if (stub) {
+    run.student = stub->student;
+    run.requested_run_id = stub->requested_run_id;
+    run.accepted_stamp = stub->accepted_stamp;
+    run.interrupted = stub->interrupted;
+    run.sequence = stub->sequence;
+    if (run.record && run.record->summary && !run.interrupted) {
+      run.summary = *run.record->summary;
+    } else {
+      run.summary = summaryOfStub(run_id, *stub);
+    }
+    run.finished = true;
+    evicted_.erase(run_id);
+  } else {
+    run.student = row->student;
+    run.requested_run_id = row->requested_run_id;
+    run.accepted_stamp = row->accepted_at;
+    run.sequence = next_sequence_++;
+    run.started = row->state == collision_lab::service::RunState::kRunning;
+    if (ended(row->state)) {
+      run.interrupted = row->state == collision_lab::service::RunState::kInterrupted;
+      run.summary = run.record && run.record->summary && !run.interrupted ? *run.record->summary : summaryFromRow(*row);
+      if (run.interrupted && run.record) {
+        run.summary->collision_count = std::max<std::uint64_t>(run.summary->collision_count, run.record->collisions());
+      }
+      run.finished = true;
+    }
+  }
+  if (run.record && run.summary) run.record->summary = run.summary;
+  order_[run.sequence] = run_id;
+  touchLocked(run);
+  countLocked(run);
+  enforceBudgetLocked(run_id);
+  return true;
+}
+
+std::size_t RunBook::reconcile() {
+  if (!source_) return 0;
+  std::vector<std::string> candidates;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto now = std::chrono::steady_clock::now();
+    for (const auto& [run_id, run] : runs_) {
+      if (!run.finished && !run.rebuilding && now - run.touched >= options_.reconcile_after) {
+        candidates.push_back(run_id);
+      }
+    }
+  }
+  std::size_t completed = 0;
+  for (const std::string& run_id : candidates) {
+    std::optional<collision_lab::service::IndexedRun> row;
+    try {
+      row = source_->find(run_id);
+    } catch (const std::exception&) {
+      continue;  // asked again at the next pass
+    }
+    if (!row || !ended(row->state)) continue;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      auto it = runs_.find(run_id);
+      if (it == runs_.end() || it->second.finished || it->second.rebuilding) continue;
+      it->second.rebuilding = true;  // the topics' late messages are ignored from now on
+    }
+    Completion how;
+    how.interrupted = row->state == collision_lab::service::RunState::kInterrupted;
+    how.fallback = summaryFromRow(*row);
+    completeFromBag(run_id, row->bag_path, how);
+    ++completed;
+  }
+  return completed;
+}
+
+void RunBook::reconcileLoop() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  while (!stopping_) {
+    if (stop_.wait_for(lock, options_.reconcile_period, [this] { return stopping_; })) break;
+    lock.unlock();
+    reconcile();
+    lock.lock();
+  }
+}
+
+std::size_t RunBook::residentBytes() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return resident_bytes_;
+}
+
+std::size_t RunBook::residentRuns() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return runs_.size();
 }
 
 void RunBook::expect(const std::string& student, const std::string& requested, AnswerCallback on_answer) {
@@ -316,59 +692,142 @@ bool RunBook::forget(const std::string& student, const std::string& requested) {
 }
 
 bool RunBook::has(const std::string& run_id) const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return runs_.count(run_id) > 0;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (runs_.count(run_id) > 0 || evicted_.count(run_id) > 0) return true;
+  }
+  if (!source_) return false;
+  try {
+    return source_->find(run_id).has_value();
+  } catch (const std::exception&) {
+    return false;
+  }
 }
 
 bool RunBook::finished(const std::string& run_id) const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  auto it = runs_.find(run_id);
-  return it != runs_.end() && it->second.finished;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto it = runs_.find(run_id);
+    if (it != runs_.end()) return it->second.finished;
+    if (evicted_.count(run_id) > 0) return true;
+  }
+  if (!source_) return false;
+  try {
+    const auto row = source_->find(run_id);
+    return row && ended(row->state);
+  } catch (const std::exception&) {
+    return false;
+  }
 }
 
 std::string RunBook::bagPath(const std::string& run_id) const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  auto it = runs_.find(run_id);
-  if (it == runs_.end() || !it->second.summary) return {};
-  const auto& s = *it->second.summary;
-  return s.recording_ok ? s.bag_path : std::string();
+  std::optional<collision_lab::RunSummary> summary;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto it = runs_.find(run_id);
+    if (it != runs_.end()) {
+      summary = it->second.summary;
+    } else if (auto stub = evicted_.find(run_id); stub != evicted_.end()) {
+      summary = summaryOfStub(run_id, stub->second);
+    }
+  }
+  if (!summary && source_) {
+    try {
+      const auto row = source_->find(run_id);
+      if (row && ended(row->state)) summary = summaryFromRow(*row);
+    } catch (const std::exception&) {
+      summary.reset();
+    }
+  }
+  if (!summary || !summary->recording_ok) return {};
+  return existingBag(summary->bag_path);
 }
 
 namespace {
 const char* stateOf(const WebRun& run) {
-  if (run.finished) return "finished";
-  return run.record ? "running" : "queued";
+  if (run.finished) return run.interrupted ? "interrupted" : "finished";
+  return run.record || run.started ? "running" : "queued";
+}
+
+nlohmann::json listItem(const WebRun& run) {
+  nlohmann::json item = {{"run_id", run.run_id},
+                         {"student", run.student},
+                         {"state", stateOf(run)},
+                         {"accepted_stamp", run.accepted_stamp},
+                         {"collisions", run.summary ? run.summary->collision_count
+                                                    : (run.record ? run.record->collisions() : 0)}};
+  if (run.record) item["bodies"] = run.record->bodies();
+  if (run.summary) {
+    item["model"] = run.summary->model_name;
+    item["truncated"] = static_cast<bool>(run.summary->truncated);
+  }
+  return item;
+}
+
+nlohmann::json listItem(const std::string& run_id, const EvictedRun& stub) {
+  return {{"run_id", run_id},
+          {"student", stub.student},
+          {"state", stub.interrupted ? "interrupted" : "finished"},
+          {"accepted_stamp", stub.accepted_stamp},
+          {"collisions", stub.collision_count},
+          {"bodies", stub.bodies},
+          {"model", stub.model_name},
+          {"truncated", stub.truncated}};
+}
+
+/// A run the web node does not hold, as its index row says.
+nlohmann::json listItem(const collision_lab::service::IndexedRun& row) {
+  nlohmann::json item = {{"run_id", row.run_id},
+                         {"student", row.student},
+                         {"state", stateName(row.state)},
+                         {"accepted_stamp", row.accepted_at},
+                         {"collisions", row.collision_count}};
+  const nlohmann::json scene = nlohmann::json::parse(row.scene_json, nullptr, false);
+  if (scene.is_object() && scene.contains("masses") && scene["masses"].is_array()) item["bodies"] = scene["masses"].size();
+  if (ended(row.state)) {
+    const collision_lab::RunSummary summary = summaryFromRow(row);
+    item["model"] = summary.model_name;
+    item["truncated"] = static_cast<bool>(summary.truncated);
+  }
+  return item;
 }
 }  // namespace
 
 std::optional<std::pair<std::string, std::uint64_t>> RunBook::json(const std::string& run_id) const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  auto it = runs_.find(run_id);
-  if (it == runs_.end()) return std::nullopt;
-  const WebRun& run = it->second;
-  nlohmann::json out = {{"run_id", run.run_id},
-                        {"student", run.student},
-                        {"requested_run_id", run.requested_run_id},
-                        {"state", stateOf(run)},
-                        {"accepted_stamp", run.accepted_stamp},
-                        {"collisions", run.record ? run.record->collisions() : 0},
-                        {"newest_time", run.record ? run.record->newestTime() : 0.0}};
-  if (run.record) {
-    out["scene"] = sceneJson(run.record->input());
-    if (run.record->prediction) out["prediction"] = predictionJson(*run.record->prediction);
-    out["plots"] = plotsJson(*run.record, run.predicted);
+  // Reading a run back is a cache fill: the book's content does not change.
+  auto* self = const_cast<RunBook*>(this);
+  for (int attempt = 0; attempt < 2; ++attempt) {
+    if (!self->load(run_id)) return std::nullopt;
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto it = runs_.find(run_id);
+    if (it == runs_.end()) continue;  // evicted between the load and now: load it again
+    const WebRun& run = it->second;
+    nlohmann::json out = {{"run_id", run.run_id},
+                          {"student", run.student},
+                          {"requested_run_id", run.requested_run_id},
+                          {"state", stateOf(run)},
+                          {"accepted_stamp", run.accepted_stamp},
+                          {"collisions", run.record ? run.record->collisions() : 0},
+                          {"newest_time", run.record ? run.record->newestTime() : 0.0}};
+    if (run.record) {
+      out["scene"] = sceneJson(run.record->input());
+      if (run.record->prediction) out["prediction"] = predictionJson(*run.record->prediction);
+      out["plots"] = plotsJson(*run.record, run.predicted);
+    }
+    if (run.summary) out["summary"] = summaryJson(*run.summary);
+    if (!run.bag_error.empty()) out["bag_error"] = run.bag_error;
+    return std::make_pair(out.dump(), run.version);
   }
-  if (run.summary) out["summary"] = summaryJson(*run.summary);
-  if (!run.bag_error.empty()) out["bag_error"] = run.bag_error;
-  return std::make_pair(out.dump(), run.version);
+  return std::nullopt;
 }
 
 std::pair<std::uint64_t, bool> RunBook::waitForChange(const std::string& run_id, std::uint64_t seen,
                                                       std::chrono::milliseconds timeout) const {
+  const_cast<RunBook*>(this)->load(run_id);  // a stream of a run not in memory: read it back
   std::unique_lock<std::mutex> lock(mutex_);
   auto current = [&]() -> std::pair<std::uint64_t, bool> {
     auto it = runs_.find(run_id);
-    if (it == runs_.end()) return {0, false};
+    if (it == runs_.end()) return {0, evicted_.count(run_id) > 0};
     return {it->second.version, it->second.finished};
   };
   changed_.wait_for(lock, timeout, [&] { return current().first != seen; });
@@ -376,24 +835,43 @@ std::pair<std::uint64_t, bool> RunBook::waitForChange(const std::string& run_id,
 }
 
 std::string RunBook::list(const std::optional<std::string>& student) const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  nlohmann::json out = nlohmann::json::array();
-  for (const auto& run_id : order_) {
-    const WebRun& run = runs_.at(run_id);
-    if (student && run.student != *student) continue;
-    nlohmann::json item = {{"run_id", run.run_id},
-                           {"student", run.student},
-                           {"state", stateOf(run)},
-                           {"accepted_stamp", run.accepted_stamp},
-                           {"collisions", run.summary ? run.summary->collision_count
-                                                      : (run.record ? run.record->collisions() : 0)}};
-    if (run.record) item["bodies"] = run.record->bodies();
-    if (run.summary) {
-      item["model"] = run.summary->model_name;
-      item["truncated"] = static_cast<bool>(run.summary->truncated);
+  std::vector<collision_lab::service::IndexedRun> rows;
+  if (source_) {
+    try {
+      rows = source_->list(student);
+    } catch (const std::exception&) {
+      rows.clear();  // the runs in memory are listed still
     }
-    out.push_back(item);
   }
+  // The rows' items are made before locking (their scene and summary JSON is parsed).
+  std::vector<std::pair<double, nlohmann::json>> items;  // accepted stamp, item
+  items.reserve(rows.size());
+  for (const auto& row : rows) items.emplace_back(row.accepted_at, listItem(row));
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::set<std::string> listed;
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    auto it = runs_.find(rows[k].run_id);
+    if (it != runs_.end()) items[k].second = listItem(it->second);  // the live state
+    listed.insert(rows[k].run_id);
+  }
+  // The runs in memory the source does not list (yet), in their order of arrival.
+  for (const auto& [sequence, run_id] : order_) {
+    if (listed.count(run_id)) continue;
+    auto it = runs_.find(run_id);
+    if (it != runs_.end()) {
+      if (student && it->second.student != *student) continue;
+      items.emplace_back(it->second.accepted_stamp, listItem(it->second));
+    } else if (auto stub = evicted_.find(run_id); stub != evicted_.end()) {
+      if (student && stub->second.student != *student) continue;
+      items.emplace_back(stub->second.accepted_stamp, listItem(run_id, stub->second));
+    }
+  }
+  if (!rows.empty()) {
+    std::stable_sort(items.begin(), items.end(),
+                     [](const auto& a, const auto& b) { return a.first < b.first; });
+  }
+  nlohmann::json out = nlohmann::json::array();
+  for (auto& [stamp, item] : items) out.push_back(std::move(item));
   return out.dump();
 }
 
@@ -404,6 +882,7 @@ BagRun readRunFromBag(const std::string& bag_path, std::size_t envelope_vertices
   std::optional<collision_lab::Prediction> prediction;
   RecordLimits limits;
   limits.envelope_vertices = envelope_vertices;
+  limits.keep_keyframes = false;  // the web never animates the scene
   for (const rosbag::MessageInstance& m : view) {
     if (auto input = m.instantiate<collision_lab::InitialConditions>()) {
       if (run.record) continue;

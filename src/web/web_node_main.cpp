@@ -6,6 +6,10 @@
 #include <netinet/in.h>
 
 #include <algorithm>
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -22,6 +26,8 @@
 #include "collision_lab/RunQueue.h"
 #include "collision_lab/RunSummary.h"
 #include "collision_lab/ros/node_constants.h"
+#include "collision_lab/ros/run_recorder.h"
+#include "collision_lab/service/run_index.h"
 #include "collision_lab/web/run_book.h"
 #include "collision_lab/web/web_server.h"
 
@@ -65,6 +71,45 @@ WebConfig loadConfig(const ros::NodeHandle& pnh) {
   return c;
 }
 
+/// The lab node's bag folder when it is given none (as the lab node computes it, for the
+/// same namespace): $ROS_HOME/collision_lab/runs followed by the namespace.
+std::string defaultBagDirectory() {
+  const char* ros_home = std::getenv("ROS_HOME");
+  const std::string base = ros_home && *ros_home ? ros_home : expandUser("~/.ros");
+  const std::string& ns = ros::this_node::getNamespace();
+  return base + "/" + kDefaultBagSubdirectory + (ns == "/" ? std::string() : ns);
+}
+
+/// The RunBook's budget and its run index (docs/web.md, "Memory and restarts"): ~memory_budget_bytes
+/// [bytes], ~reconcile_period [s], ~run_index (default <~bag_directory>/runs.sqlite; empty:
+/// none). Without a readable index the book keeps stubs of evicted runs and says so.
+std::unique_ptr<collision_lab_web::RunBook> makeRunBook(const ros::NodeHandle& pnh) {
+  collision_lab_web::RunBookOptions options;
+  int budget = static_cast<int>(options.memory_budget_bytes);
+  double period = 2.0;
+  pnh.param("memory_budget_bytes", budget, budget);
+  pnh.param("reconcile_period", period, period);
+  options.memory_budget_bytes = static_cast<std::size_t>(std::max(1, budget));
+  options.reconcile_period = std::chrono::milliseconds(static_cast<long>(std::max(0.1, period) * 1000.0));
+  options.reconcile_after = options.reconcile_period;
+  std::string bag_directory, index_path;
+  pnh.param("bag_directory", bag_directory, defaultBagDirectory());
+  bag_directory = expandUser(bag_directory);
+  pnh.param("run_index", index_path, collision_lab::service::RunIndex::defaultPath(bag_directory));
+  std::shared_ptr<const collision_lab_web::RunSource> source;
+  if (!index_path.empty()) {
+    try {
+      std::error_code ignored;
+      std::filesystem::create_directories(std::filesystem::path(index_path).parent_path(), ignored);
+      source = collision_lab_web::openIndexRunSource(index_path);
+      ROS_INFO_STREAM("Run index: " << index_path << " (runs of earlier sessions are listed and served)");
+    } catch (const std::exception& e) {
+      ROS_WARN_STREAM("No run index (" << e.what() << "): only the runs seen since this start are listed");
+    }
+  }
+  return std::make_unique<collision_lab_web::RunBook>(options, source);
+}
+
 /// The addresses to give the class: the bound one, or every IPv4 address of the machine
 /// when bound to all (0.0.0.0).
 std::vector<std::string> addresses(const std::string& bind) {
@@ -88,7 +133,8 @@ int main(int argc, char** argv) {
   ros::init(argc, argv, "collision_lab_web");
   ros::NodeHandle nh, pnh("~");
   const WebConfig config = loadConfig(pnh);
-  collision_lab_web::RunBook book;
+  const std::unique_ptr<collision_lab_web::RunBook> book_owner = makeRunBook(pnh);
+  collision_lab_web::RunBook& book = *book_owner;
   ros::Publisher inputs = nh.advertise<collision_lab::InitialConditions>(kInitialConditionsTopic, kInputQueueSize);
   // Sized as the lab node's outputs (node_constants.h): a run's burst of events is never dropped.
   std::vector<ros::Subscriber> subs = {

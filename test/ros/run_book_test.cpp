@@ -1,11 +1,16 @@
 // RunBook (the web server's view of the lab's runs) when the lab node's topics arrive out
 // of order: they are separate connections, so a run's summary may come before its served
-// input. Bags read on many threads at once. No master needed.
+// input. Bags read on many threads at once. Bounded memory: runs evicted under a budget and
+// read back from their bags; the run index (a fake RunSource) for old runs, the list, and
+// the reconciliation of runs whose summary or events were missed. No master needed.
 #include <stdlib.h>
 
 #include <atomic>
+#include <iostream>
 #include <filesystem>
 #include <limits>
+#include <map>
+#include <mutex>
 #include <thread>
 #include <vector>
 
@@ -13,6 +18,7 @@
 #include <nlohmann/json.hpp>
 #include <rosbag/bag.h>
 
+#include "collision_lab/ros/marker_builder.h"
 #include "collision_lab/web/run_book.h"
 
 namespace {
@@ -98,6 +104,424 @@ TEST(RunBook, BagsReadOnManyThreadsAtOnce) {
   for (std::thread& t : threads) t.join();
   EXPECT_EQ(read_with_scene.load(), kThreads * kReadsEach);
   std::filesystem::remove_all(dir);
+}
+
+
+// ---- Bounded memory and the run index ----
+
+using collision_lab::service::IndexedRun;
+using collision_lab::service::RunState;
+
+/// A RunSource of rows set by the test (the run index the lab node writes).
+class FakeSource : public collision_lab_web::RunSource {
+ public:
+  void put(const IndexedRun& row) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    rows_[row.run_id] = row;
+    order_.push_back(row.run_id);
+  }
+  void setState(const std::string& run_id, RunState state) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    rows_.at(run_id).state = state;
+  }
+  std::optional<IndexedRun> find(const std::string& run_id) const override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++finds;
+    auto it = rows_.find(run_id);
+    if (it == rows_.end()) return std::nullopt;
+    return it->second;
+  }
+  std::vector<IndexedRun> list(const std::optional<std::string>& student) const override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::vector<IndexedRun> out;
+    for (const auto& id : order_) {
+      const IndexedRun& row = rows_.at(id);
+      if (!student || row.student == *student) out.push_back(row);
+    }
+    return out;
+  }
+  mutable int finds = 0;
+
+ private:
+  mutable std::mutex mutex_;
+  std::map<std::string, IndexedRun> rows_;
+  std::vector<std::string> order_;
+};
+
+/// A folder removed at the end of the test.
+struct TempDir {
+  TempDir() {
+    char dir_template[] = "/tmp/run_book_test_XXXXXX";
+    EXPECT_NE(mkdtemp(dir_template), nullptr);
+    path = dir_template;
+  }
+  ~TempDir() { std::filesystem::remove_all(path); }
+  std::filesystem::path path;
+};
+
+/// A three-body run: its messages as the lab node publishes (and records) them.
+struct ScriptedRun {
+  collision_lab::AcceptedRun accepted;
+  collision_lab::InitialConditions input;
+  std::vector<collision_lab::CollisionEvent> events;
+  collision_lab::RunSummary summary;
+};
+
+collision_lab::CollisionEvent impact(const std::string& run_id, std::uint64_t index, std::uint32_t pair, double time,
+                                     double va, double vb) {
+  collision_lab::CollisionEvent e;
+  e.run_id = run_id;
+  e.kind = collision_lab::CollisionEvent::KIND_IMPACT;
+  e.index = index;
+  e.pair_index = pair;
+  e.first_moved = pair;
+  e.last_moved = pair + 1;
+  e.time = time;
+  e.restitution = 1.0;
+  e.pair_velocities_after = {va, vb};
+  return e;
+}
+
+/// bodies bodies, `collisions` impacts (velocities swapped pair by pair), recorded in
+/// dir/<run_id>.bag when dir is given.
+ScriptedRun scriptedRun(const std::string& student, const std::string& run_id, double stamp, std::size_t bodies,
+                        std::uint64_t collisions, const std::filesystem::path& dir) {
+  ScriptedRun run;
+  run.accepted.header.stamp.fromSec(stamp);
+  run.accepted.run_id = run_id;
+  run.accepted.student = student;
+  run.input.run_id = run_id;
+  run.input.student = student;
+  for (std::size_t i = 0; i < bodies; ++i) {
+    run.input.masses.push_back(1.0 + static_cast<double>(i % 3));
+    run.input.positions.push_back(static_cast<double>(bodies - i));
+    run.input.velocities.push_back(i % 2 ? 1.0 : -1.0);
+  }
+  for (std::uint64_t k = 1; k <= collisions; ++k) {
+    const auto pair = static_cast<std::uint32_t>((k * 7) % (bodies - 1));
+    run.events.push_back(impact(run_id, k, pair, 0.01 * static_cast<double>(k), 0.5 / static_cast<double>(k),
+                                -0.25 * static_cast<double>(k % 5)));
+  }
+  run.summary.run_id = run_id;
+  run.summary.student = student;
+  run.summary.collision_count = collisions;
+  run.summary.published_events = collisions;
+  run.summary.stop_reason = "NO_MORE_COLLISIONS";
+  run.summary.model_name = "scripted";
+  if (!dir.empty()) {
+    run.summary.recording_ok = true;
+    run.summary.bag_path = (dir / (run_id + ".bag")).string();
+    rosbag::Bag bag;
+    bag.open(run.summary.bag_path, rosbag::bagmode::Write);
+    bag.write("/collision_lab/served_inputs", ros::Time(1.0), run.input);
+    for (const auto& e : run.events) bag.write("/collision_lab/collision_events", ros::Time(2.0), e);
+    bag.write("/collision_lab/run_summaries", ros::Time(3.0), run.summary);
+    bag.close();
+  }
+  return run;
+}
+
+/// Feeds the book a run's messages: all, or the first `events` events and no summary.
+void feed(collision_lab_web::RunBook& book, const ScriptedRun& run, std::optional<std::size_t> events = std::nullopt,
+          bool summary = true) {
+  book.onAccepted(run.accepted);
+  book.onServedInput(run.input);
+  const std::size_t n = events ? std::min(*events, run.events.size()) : run.events.size();
+  for (std::size_t k = 0; k < n; ++k) book.onEvent(run.events[k]);
+  if (summary) book.onSummary(run.summary);
+}
+
+IndexedRun rowOf(const ScriptedRun& run, RunState state) {
+  IndexedRun row;
+  row.run_id = run.input.run_id;
+  row.student = run.input.student;
+  row.state = state;
+  row.accepted_at = run.accepted.header.stamp.toSec();
+  row.scene_json = json({{"masses", run.input.masses}}).dump();
+  if (state == RunState::kFinished) {
+    row.stop_reason = run.summary.stop_reason;
+    row.collision_count = run.summary.collision_count;
+    row.summary_json = json({{"model_name", run.summary.model_name}}).dump();
+  }
+  if (state == RunState::kInterrupted) row.stop_reason = "INTERRUPTED";
+  row.bag_path = run.summary.bag_path;
+  return row;
+}
+
+collision_lab_web::RunBookOptions smallBudget(std::size_t bytes) {
+  collision_lab_web::RunBookOptions options;
+  options.memory_budget_bytes = bytes;
+  options.reconcile_period = std::chrono::milliseconds(0);  // the tests call reconcile()
+  options.reconcile_after = std::chrono::milliseconds(0);
+  return options;
+}
+
+/// A run's JSON without its version: what the page shows.
+std::string served(const collision_lab_web::RunBook& book, const std::string& run_id) {
+  auto text = book.json(run_id);
+  return text ? text->first : std::string();
+}
+
+TEST(RunBookMemory, EvictedRunIsServedAgainFromItsBagWithTheSameContent) {
+  TempDir dir;
+  // Without a RunSource: a stub stays for the list and the reload.
+  collision_lab_web::RunBook book(smallBudget(1), nullptr);
+  const ScriptedRun first = scriptedRun("ana", "ana.run1", 1.0e9, 3, 40, dir.path);
+  feed(book, first);
+  const std::string before = served(book, "ana.run1");
+  ASSERT_FALSE(before.empty());
+  EXPECT_EQ(json::parse(before).at("state"), "finished");
+  const std::string list_before = book.list(std::nullopt);
+  for (int k = 2; k <= 6; ++k) {
+    const std::string id = "bo.run" + std::to_string(k);
+    feed(book, scriptedRun("bo", id, 1.0e9 + k, 3, 40, dir.path));
+  }
+  // A one-byte budget keeps only the newest run.
+  EXPECT_EQ(book.residentRuns(), 1u);
+  EXPECT_TRUE(book.has("ana.run1"));
+  EXPECT_TRUE(book.finished("ana.run1"));
+  EXPECT_EQ(book.bagPath("ana.run1"), first.summary.bag_path);
+  const json list = json::parse(book.list(std::nullopt));
+  ASSERT_EQ(list.size(), 6u);
+  EXPECT_EQ(list[0], json::parse(list_before)[0]) << "an evicted run is listed as before";
+  EXPECT_EQ(served(book, "ana.run1"), before) << "read back from its bag, the same JSON";
+}
+
+TEST(RunBookMemory, EvictedRunIsReadBackThroughTheIndex) {
+  TempDir dir;
+  auto source = std::make_shared<FakeSource>();
+  collision_lab_web::RunBook book(smallBudget(1), source);
+  const ScriptedRun first = scriptedRun("ana", "ana.run1", 1.0e9, 3, 40, dir.path);
+  source->put(rowOf(first, RunState::kFinished));
+  feed(book, first);
+  const std::string before = served(book, "ana.run1");
+  for (int k = 2; k <= 4; ++k) {
+    const ScriptedRun run = scriptedRun("bo", "bo.run" + std::to_string(k), 1.0e9 + k, 3, 40, dir.path);
+    source->put(rowOf(run, RunState::kFinished));
+    feed(book, run);
+  }
+  EXPECT_EQ(book.residentRuns(), 1u);
+  EXPECT_EQ(served(book, "ana.run1"), before);
+}
+
+TEST(RunBookMemory, ConcurrentReadsOfAnOldRunLoadItOnce) {
+  TempDir dir;
+  auto source = std::make_shared<FakeSource>();
+  const ScriptedRun old = scriptedRun("ana", "ana.old", 1.0e9, 3, 200, dir.path);
+  source->put(rowOf(old, RunState::kFinished));
+  collision_lab_web::RunBook book(smallBudget(std::size_t{64} << 20), source);  // a web node just restarted
+  std::vector<std::thread> readers;
+  std::atomic<int> answered{0};
+  for (int t = 0; t < 8; ++t) {
+    readers.emplace_back([&] {
+      if (!served(book, "ana.old").empty()) ++answered;
+    });
+  }
+  for (auto& t : readers) t.join();
+  EXPECT_EQ(answered.load(), 8);
+  EXPECT_EQ(source->finds, 1) << "one load for eight readers";
+  const json run = json::parse(served(book, "ana.old"));
+  EXPECT_EQ(run.at("state"), "finished");
+  EXPECT_EQ(run.at("collisions"), 200);
+  EXPECT_EQ(run.at("summary").at("collision_count"), 200);
+  EXPECT_TRUE(book.finished("ana.old"));
+  EXPECT_EQ(book.bagPath("ana.old"), old.summary.bag_path);
+  EXPECT_FALSE(book.has("nobody.run"));
+}
+
+TEST(RunBookMemory, ListComesFromTheIndexWithLiveState) {
+  TempDir dir;
+  auto source = std::make_shared<FakeSource>();
+  const ScriptedRun old = scriptedRun("ana", "ana.old", 1.0e9, 3, 10, dir.path);
+  const ScriptedRun live = scriptedRun("bo", "bo.live", 1.0e9 + 5, 3, 10, dir.path);
+  const ScriptedRun fresh = scriptedRun("bo", "bo.fresh", 1.0e9 + 9, 3, 10, dir.path);
+  source->put(rowOf(old, RunState::kFinished));  // from before the web node's restart
+  source->put(rowOf(live, RunState::kRunning));
+  collision_lab_web::RunBook book(smallBudget(std::size_t{64} << 20), source);
+  feed(book, live, 4, false);  // in progress: the book knows more than the index
+  feed(book, fresh, 2, false);  // not in the index yet
+  const json all = json::parse(book.list(std::nullopt));
+  ASSERT_EQ(all.size(), 3u);
+  EXPECT_EQ(all[0].at("run_id"), "ana.old");
+  EXPECT_EQ(all[0].at("state"), "finished");
+  EXPECT_EQ(all[0].at("collisions"), 10);
+  EXPECT_EQ(all[0].at("bodies"), 3);
+  EXPECT_EQ(all[0].at("model"), "scripted");
+  EXPECT_EQ(all[1].at("run_id"), "bo.live");
+  EXPECT_EQ(all[1].at("state"), "running");
+  EXPECT_EQ(all[1].at("collisions"), 4) << "live state, not the index's";
+  EXPECT_EQ(all[2].at("run_id"), "bo.fresh");
+  const json bo = json::parse(book.list(std::string("bo")));
+  ASSERT_EQ(bo.size(), 2u);
+  EXPECT_EQ(book.residentRuns(), 2u) << "listing reads no old run back";
+}
+
+TEST(RunBookMemory, MissedSummaryIsCompletedFromTheIndexAndTheBag) {
+  TempDir dir;
+  auto source = std::make_shared<FakeSource>();
+  collision_lab_web::RunBook book(smallBudget(std::size_t{64} << 20), source);
+  const ScriptedRun run = scriptedRun("ana", "ana.run1", 1.0e9, 3, 30, dir.path);
+  source->put(rowOf(run, RunState::kRunning));
+  feed(book, run, 12, false);  // the rest of its events and its summary were dropped
+  EXPECT_EQ(book.reconcile(), 0u) << "still running by the index";
+  EXPECT_FALSE(book.finished("ana.run1"));
+  source->setState("ana.run1", RunState::kFinished);
+  EXPECT_EQ(book.reconcile(), 1u);
+  EXPECT_TRUE(book.finished("ana.run1"));
+  const json out = json::parse(served(book, "ana.run1"));
+  EXPECT_EQ(out.at("state"), "finished");
+  EXPECT_EQ(out.at("collisions"), 30) << "every event, from the bag";
+  EXPECT_EQ(out.at("summary").at("stop_reason"), "NO_MORE_COLLISIONS");
+  // A late event of the completed run changes nothing.
+  book.onEvent(run.events[12]);
+  EXPECT_EQ(json::parse(served(book, "ana.run1")).at("collisions"), 30);
+}
+
+TEST(RunBookMemory, MissedEventsAreCompletedFromTheIndexAndTheBag) {
+  TempDir dir;
+  auto source = std::make_shared<FakeSource>();
+  collision_lab_web::RunBook book(smallBudget(std::size_t{64} << 20), source);
+  const ScriptedRun run = scriptedRun("ana", "ana.run1", 1.0e9, 3, 30, dir.path);
+  source->put(rowOf(run, RunState::kFinished));
+  feed(book, run, 7, true);  // the summary came, 23 of its published events never will
+  EXPECT_FALSE(book.finished("ana.run1")) << "waits for its published events";
+  EXPECT_EQ(book.reconcile(), 1u);
+  const json out = json::parse(served(book, "ana.run1"));
+  EXPECT_EQ(out.at("state"), "finished");
+  EXPECT_EQ(out.at("collisions"), 30);
+}
+
+TEST(RunBookMemory, InterruptedRunShowsTheEventsItsBagHolds) {
+  TempDir dir;
+  auto source = std::make_shared<FakeSource>();
+  collision_lab_web::RunBook book(smallBudget(std::size_t{64} << 20), source);
+  ScriptedRun run = scriptedRun("ana", "ana.run1", 1.0e9, 3, 30, std::filesystem::path());
+  // Its node died after 18 events: the bag has those and no summary.
+  run.summary.bag_path = (dir.path / "ana.run1.bag").string();
+  {
+    rosbag::Bag bag;
+    bag.open(run.summary.bag_path, rosbag::bagmode::Write);
+    bag.write("/collision_lab/served_inputs", ros::Time(1.0), run.input);
+    for (std::size_t k = 0; k < 18; ++k) bag.write("/collision_lab/collision_events", ros::Time(2.0), run.events[k]);
+    bag.close();
+  }
+  source->put(rowOf(run, RunState::kRunning));
+  feed(book, run, 5, false);
+  source->setState("ana.run1", RunState::kInterrupted);
+  std::thread stream([&] {  // a page's live stream of the run gets its final state
+    const auto [version, finished] = book.waitForChange("ana.run1", 0, std::chrono::milliseconds(0));
+    std::pair<std::uint64_t, bool> now{version, finished};
+    while (!now.second) now = book.waitForChange("ana.run1", now.first, std::chrono::seconds(30));
+    EXPECT_TRUE(book.finished("ana.run1"));
+  });
+  EXPECT_EQ(book.reconcile(), 1u);
+  stream.join();
+  const json out = json::parse(served(book, "ana.run1"));
+  EXPECT_EQ(out.at("state"), "interrupted");
+  EXPECT_EQ(out.at("collisions"), 18);
+  EXPECT_EQ(out.at("summary").at("stop_reason"), "INTERRUPTED");
+  EXPECT_EQ(out.at("summary").at("collision_count"), 18);
+  EXPECT_EQ(book.bagPath("ana.run1"), run.summary.bag_path);
+  EXPECT_EQ(json::parse(book.list(std::nullopt))[0].at("state"), "interrupted");
+}
+
+TEST(RunBookMemory, PeriodicReconciliationEndsARunWithoutBeingAsked) {
+  TempDir dir;
+  auto source = std::make_shared<FakeSource>();
+  collision_lab_web::RunBookOptions options;
+  options.reconcile_period = std::chrono::milliseconds(20);
+  options.reconcile_after = std::chrono::milliseconds(0);
+  collision_lab_web::RunBook book(options, source);
+  const ScriptedRun run = scriptedRun("ana", "ana.run1", 1.0e9, 3, 30, dir.path);
+  source->put(rowOf(run, RunState::kFinished));
+  feed(book, run, 3, false);
+  std::pair<std::uint64_t, bool> now{0, false};
+  for (int k = 0; k < 100 && !now.second; ++k) now = book.waitForChange("ana.run1", now.first, std::chrono::seconds(1));
+  EXPECT_TRUE(now.second) << "the periodic check completed it";
+  EXPECT_EQ(json::parse(served(book, "ana.run1")).at("collisions"), 30);
+}
+
+TEST(RunBookMemory, WebRecordsKeepNoKeyframes) {
+  // A 1,000-body gas: the marker view's record keeps about a thousand full states; the
+  // web's keeps none, and its footprint is a small fraction.
+  const ScriptedRun gas = scriptedRun("ana", "ana.gas", 1.0e9, 1000, 20000, std::filesystem::path());
+  collision_lab_ros::RecordLimits rviz_limits;
+  rviz_limits.envelope_vertices = 1024;
+  collision_lab_ros::RunRecord rviz(gas.input, rviz_limits);
+  collision_lab_ros::RecordLimits web_limits = rviz_limits;
+  web_limits.keep_keyframes = false;
+  collision_lab_ros::RunRecord web(gas.input, web_limits);
+  for (const auto& e : gas.events) {
+    rviz.add(e);
+    web.add(e);
+  }
+  std::cout << "1,000-body gas, 20,000 impacts: rviz record " << rviz.memoryBytes() << " bytes, web record "
+            << web.memoryBytes() << " bytes\n";
+  EXPECT_GT(rviz.memoryBytes(), std::size_t{10} << 20);
+  EXPECT_LT(web.memoryBytes(), std::size_t{1} << 20);
+  EXPECT_EQ(web.collisions(), 20000u);
+  const auto web_energy = web.energy().polyline(), rviz_energy = rviz.energy().polyline();
+  ASSERT_EQ(web_energy.size(), rviz_energy.size()) << "the same plots";
+  for (std::size_t k = 0; k < web_energy.size(); ++k) EXPECT_EQ(web_energy[k].y, rviz_energy[k].y);
+
+  collision_lab_web::RunBook book(smallBudget(std::size_t{64} << 20), nullptr);
+  feed(book, gas);
+  EXPECT_LT(book.residentBytes(), std::size_t{1} << 20);
+  EXPECT_EQ(json::parse(served(book, "ana.gas")).at("collisions"), 20000);
+}
+
+
+TEST(RunBookMemory, EvictedRunTheIndexDoesNotKnowKeepsAStub) {
+  TempDir dir;
+  auto source = std::make_shared<FakeSource>();  // the index missed this run
+  collision_lab_web::RunBook book(smallBudget(1), source);
+  const ScriptedRun first = scriptedRun("ana", "ana.run1", 1.0e9, 3, 40, dir.path);
+  feed(book, first);
+  const std::string before = served(book, "ana.run1");
+  feed(book, scriptedRun("bo", "bo.run2", 1.0e9 + 1, 3, 40, dir.path));
+  EXPECT_EQ(book.residentRuns(), 1u);
+  const json list = json::parse(book.list(std::nullopt));
+  ASSERT_EQ(list.size(), 2u);
+  EXPECT_EQ(list[0].at("run_id"), "ana.run1");
+  EXPECT_EQ(served(book, "ana.run1"), before);
+}
+
+// A web node started after a day of runs, on the real SQLite index: every run listed, an old
+// link served from its bag.
+TEST(RunBookMemory, RestartedWebNodeServesTheIndexsRuns) {
+  TempDir dir;
+  const std::string index_path = collision_lab::service::RunIndex::defaultPath(dir.path.string());
+  {
+    collision_lab::service::RunIndex index(index_path);  // the lab node's writes
+    for (int k = 1; k <= 30; ++k) {
+      const ScriptedRun run = scriptedRun("s" + std::to_string(k % 5), "run" + std::to_string(k), 1.0e9 + k, 3, 25,
+                                          dir.path);
+      IndexedRun row = rowOf(run, RunState::kQueued);
+      index.accepted(row);
+      index.started(row.run_id, row.accepted_at + 0.5);
+      if (k == 30) {
+        index.interrupted(row.run_id, row.accepted_at + 1, "", 25, run.summary.bag_path);
+      } else {
+        index.finished(row.run_id, row.accepted_at + 1, json({{"model_name", "scripted"}}).dump(), "NO_MORE_COLLISIONS",
+                       25, run.summary.bag_path);
+      }
+    }
+  }
+  collision_lab_web::RunBook book(smallBudget(std::size_t{64} << 20), collision_lab_web::openIndexRunSource(index_path));
+  const json list = json::parse(book.list(std::nullopt));
+  ASSERT_EQ(list.size(), 30u);
+  EXPECT_EQ(list[0].at("run_id"), "run1");
+  EXPECT_EQ(list[0].at("state"), "finished");
+  EXPECT_EQ(list[29].at("state"), "interrupted");
+  EXPECT_EQ(json::parse(book.list(std::string("s1"))).size(), 6u);
+  EXPECT_EQ(book.residentRuns(), 0u);
+  ASSERT_TRUE(book.has("run7"));
+  const json run = json::parse(served(book, "run7"));
+  EXPECT_EQ(run.at("state"), "finished");
+  EXPECT_EQ(run.at("collisions"), 25);
+  EXPECT_EQ(run.at("student"), "s2");
+  EXPECT_EQ(book.bagPath("run7"), (dir.path / "run7.bag").string());
+  EXPECT_EQ(json::parse(served(book, "run30")).at("state"), "interrupted");
 }
 
 }  // namespace

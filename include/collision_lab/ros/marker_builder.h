@@ -73,6 +73,8 @@ class Envelope {
   /// Bounds of y over every vertex ever added (+inf / -inf when none is finite).
   double minY() const { return min_y_; }
   double maxY() const { return max_y_; }
+  /// Heap bytes held (vertices and columns, by capacity) [bytes].
+  std::size_t memoryBytes() const;
 
  private:
   struct Column {
@@ -115,6 +117,10 @@ struct RecordLimits {
   /// Keyframes hold N values each: at most this many values in all, so a 1,000-body gas
   /// keeps about a thousand states [1].
   std::size_t keyframe_values = std::size_t{1} << 21;
+  /// False: no keyframes are kept (keyframes() then has the newest state only). For a
+  /// reader that never animates the scene, such as the web node, whose plots need only the
+  /// envelopes; a 1,000-body gas then costs kilobytes instead of megabytes.
+  bool keep_keyframes = true;
 };
 
 /// Bodies whose worldlines the x-t diagram draws (all of them up to this N; beyond, this
@@ -190,6 +196,9 @@ class RunRecord {
   const Envelope& energyLost() const { return energy_lost_; }
   /// Total kinetic energy of the finite masses at the start [J].
   double startEnergy() const { return start_energy_; }
+  /// Bytes the record holds, itself included: its input, the replay's state, the kept
+  /// keyframes and every envelope, vectors counted by capacity [bytes].
+  std::size_t memoryBytes() const;
 
  private:
   /// Empty when i has no slot or `series` is not kept.

@@ -3,10 +3,20 @@
 // accepted_runs and rejected. Every run the node serves is here, whoever sent it (a
 // browser, rostopic pub, a service call), keyed by its served run_id.
 //
-// Big runs stay light: each run keeps a marker view's RunRecord (marker_builder.h), whose
-// series are min/max envelopes per column, so the JSON of a run has at most a few thousand
-// points whatever its count. Events beyond the node's ~max_published_events are not
-// published; when a summary says so, the run is rebuilt from its bag (readRunFromBag).
+// Big runs stay light: each run keeps a marker view's RunRecord (marker_builder.h) without
+// the rviz keyframes, whose series are min/max envelopes per column, so the JSON of a run
+// has at most a few thousand points whatever its count. Events beyond the node's
+// ~max_published_events are not published; when a summary says so, the run is rebuilt from
+// its bag (readRunFromBag).
+//
+// Bounded memory (RunBookOptions::memory_budget_bytes): the runs held stay within a byte
+// budget; the least recently used finished runs with a bag are evicted and read back from
+// their bag when asked for again. With a RunSource (the run index), an evicted or never
+// seen run (an old link after a restart) is found there, the run list is the index's, and
+// runs believed queued or running are reconciled against it: finished there -> completed
+// from the bag; interrupted there -> shown "interrupted" with the events its bag holds.
+// An evicted run the RunSource does not know (or with none) leaves a small stub (its
+// summary) for the list and the reload.
 //
 // Thread-safe: the ROS callbacks (one spinner thread) and the HTTP threads share it.
 #pragma once
@@ -20,6 +30,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <string>
 #include <thread>
 #include <vector>
@@ -31,6 +42,7 @@
 #include "collision_lab/Rejected.h"
 #include "collision_lab/RunSummary.h"
 #include "collision_lab/ros/marker_builder.h"
+#include "collision_lab/web/run_source.h"
 
 namespace collision_lab_web {
 
@@ -50,9 +62,43 @@ struct WebRun {
   std::optional<collision_lab::RunSummary> summary;  ///< once finished
   bool rebuilding = false;
   bool finished = false;
+  /// Finished because its node died (the index says interrupted): summary describes what
+  /// its bag holds, stop reason INTERRUPTED.
+  bool interrupted = false;
+  /// Running by the index, before (or without) its served input: after a restart.
+  bool started = false;
   std::string bag_error;  ///< why the rebuild from the bag failed (the live record stays)
   std::uint64_t version = 0;  ///< bumped on every change (event streams wait on it)
   double accepted_stamp = 0.0;  ///< [s] since the epoch
+  std::uint64_t sequence = 0;   ///< arrival order in the book [1]
+  std::uint64_t last_used = 0;  ///< the book's use clock at the last read or change [1]
+  std::chrono::steady_clock::time_point touched;  ///< the last message or completion
+  std::size_t footprint = 0;    ///< bytes counted against the budget [bytes]
+};
+
+/// What an evicted run leaves when the RunSource does not know it (or there is none):
+/// enough for the list and to read it back from its bag (whose summary it shows again).
+struct EvictedRun {
+  std::string student, requested_run_id, model_name, bag_path;
+  double accepted_stamp = 0.0;        ///< [s] since the epoch
+  std::uint64_t collision_count = 0;  ///< [1]
+  std::uint64_t sequence = 0;         ///< its place in the list [1]
+  std::uint32_t bodies = 0;           ///< [1]
+  bool interrupted = false;
+  bool truncated = false;
+};
+
+struct RunBookOptions {
+  std::size_t envelope_vertices = 1024;  ///< points per plotted series at most (RecordLimits) [1]
+  /// The runs held in memory stay within this (web node ~memory_budget_bytes) [bytes]. A
+  /// run without a bag is never evicted (it could not be read back); a run alone larger
+  /// than the budget is kept while it is the newest.
+  std::size_t memory_budget_bytes = std::size_t{64} << 20;
+  /// The reconciliation against the RunSource runs this often on a thread of its own; 0:
+  /// only when reconcile() is called [ms].
+  std::chrono::milliseconds reconcile_period{2000};
+  /// A run is reconciled once no message of it arrived for this long [ms].
+  std::chrono::milliseconds reconcile_after{2000};
 };
 
 /// A submitted input's answer: the run_id it was served under (with its place in the
@@ -68,7 +114,9 @@ class RunBook {
  public:
   /// envelope_vertices: points per plotted series at most (RecordLimits).
   explicit RunBook(std::size_t envelope_vertices = 1024);
-  /// Waits for the rebuilds from bags in progress.
+  /// source: where evicted and unknown runs are found (null: none).
+  RunBook(const RunBookOptions& options, std::shared_ptr<const RunSource> source);
+  /// Stops the reconciliation; waits for the rebuilds from bags in progress.
   ~RunBook();
   RunBook(const RunBook&) = delete;
   RunBook& operator=(const RunBook&) = delete;
@@ -90,35 +138,81 @@ class RunBook {
   /// waiting, and then its callback is never called.
   bool forget(const std::string& student, const std::string& requested);
 
+  /// Known in memory, as an evicted stub or to the RunSource.
   bool has(const std::string& run_id) const;
   /// The run as JSON text (docs/web.md), with its version; nullopt for an unknown run_id.
+  /// A run not in memory is loaded first (from its bag when finished or interrupted; its
+  /// state as the index says otherwise); concurrent loads of one run read its bag once.
   std::optional<std::pair<std::string, std::uint64_t>> json(const std::string& run_id) const;
   /// Waits until the run's version differs from `seen` or `timeout` passes; returns the
-  /// current version (0 for an unknown run) and whether the run is finished.
+  /// current version (0 for a run not in memory) and whether the run is finished (an
+  /// interrupted run is finished too).
   std::pair<std::uint64_t, bool> waitForChange(const std::string& run_id, std::uint64_t seen,
                                                std::chrono::milliseconds timeout) const;
-  /// Every run (student empty: everyone's), oldest first, as a JSON array text.
+  /// Every run (student empty: everyone's), oldest first, as a JSON array text. With a
+  /// RunSource: every run it lists, with the live state of the runs in memory.
   std::string list(const std::optional<std::string>& student) const;
-  /// The run's bag (RunSummary.bag_path) once it is finished and recorded; empty otherwise.
+  /// The run's bag (RunSummary.bag_path) once it is finished (or interrupted) and
+  /// recorded; empty otherwise.
   std::string bagPath(const std::string& run_id) const;
   bool finished(const std::string& run_id) const;
 
+  /// One reconciliation pass (what the periodic thread does): every run in memory not
+  /// finished, with no message for reconcile_after, that the RunSource says finished or
+  /// interrupted is completed from its bag. Returns how many runs it completed [1].
+  std::size_t reconcile();
+  /// Bytes the runs in memory hold, as counted against the budget [bytes].
+  std::size_t residentBytes() const;
+  /// Runs held in memory [1].
+  std::size_t residentRuns() const;
+
  private:
+  /// How a run is to be completed from its bag when no summary came by the topics.
+  struct Completion {
+    bool interrupted = false;
+    collision_lab::RunSummary fallback;  ///< when the bag has no summary
+  };
+
   WebRun& runLocked(const std::string& run_id);
   void finishLocked(WebRun& run, const collision_lab::RunSummary& summary);
   void maybeFinishLocked(WebRun& run);
-  void rebuildFromBag(const std::string& run_id, const std::string& bag_path);
+  void startRebuildLocked(WebRun& run, const std::string& bag_path);
+  void rebuildFromBag(std::uint64_t rebuild, const std::string& run_id, const std::string& bag_path);
+  /// Reads the bag and completes the run (its pending summary, else the bag's, else the
+  /// completion's fallback).
+  void completeFromBag(const std::string& run_id, const std::string& bag_path, const std::optional<Completion>& how);
+  /// Makes the run resident (from a stub or the RunSource); false when unknown.
+  bool load(const std::string& run_id);
+  void touchLocked(WebRun& run);
+  void countLocked(WebRun& run);
+  /// The RunSource has the run, finished or interrupted (so an evicted run needs no stub).
+  bool sourceKnows(const std::string& run_id) const;
+  /// Evicts least recently used finished runs until within the budget; `keep` stays.
+  void enforceBudgetLocked(const std::string& keep);
+  void reconcileLoop();
   /// Removes and returns the callback waiting for this input's answer (null if none).
   AnswerCallback takeWaitingLocked(const std::string& student, const std::string& requested);
 
-  std::size_t envelope_vertices_;
+  RunBookOptions options_;
+  std::shared_ptr<const RunSource> source_;
   mutable std::mutex mutex_;
   mutable std::condition_variable changed_;
   std::map<std::string, WebRun> runs_;
-  std::vector<std::string> order_;  ///< run_ids, oldest first
+  std::map<std::uint64_t, std::string> order_;  ///< sequence -> run_id, oldest first
+  std::uint64_t next_sequence_ = 1;
+  std::uint64_t use_clock_ = 0;
+  std::size_t resident_bytes_ = 0;  ///< sum of runs_' footprints [bytes]
+  std::map<std::string, EvictedRun> evicted_;  ///< evicted runs the RunSource does not know
+  std::set<std::string> loading_;  ///< runs being read back (one load each)
   /// Inputs published and not yet answered: key student + '\n' + requested run_id.
   std::map<std::string, AnswerCallback> waiting_;
-  std::vector<std::thread> rebuilds_;  ///< one per run rebuilt from its bag; joined at the end
+  /// Rebuilds from bags in progress, and those done (joined at the next rebuild).
+  std::map<std::uint64_t, std::thread> rebuilds_;
+  std::vector<std::uint64_t> rebuilds_done_;
+  std::uint64_t next_rebuild_ = 0;
+  bool stopping_ = false;
+  std::condition_variable stop_;
+  std::thread reconciler_;
 };
 
 /// A run rebuilt from a bag: its served InitialConditions, Prediction, every
