@@ -197,7 +197,7 @@ async function teacherPage() {
         tr.appendChild(el('td', r.collisions));
         tr.appendChild(el('td', r.model || ''));
         tr.appendChild(el('td', r.accepted_stamp ? new Date(r.accepted_stamp * 1000).toLocaleTimeString() : ''));
-        tr.appendChild(r.state === 'finished' ? el('td') : stopCell(r.run_id));
+        tr.appendChild(r.state === 'finished' || r.state === 'interrupted' ? el('td') : stopCell(r.run_id));
         table.appendChild(tr);
       }
       section.appendChild(table);

@@ -137,12 +137,15 @@ function nonBackgroundPixels(canvas) {
   return count;
 }
 
+// A run that will change no more: finished, or interrupted (its lab node died during it).
+const ended = (state) => state === 'finished' || state === 'interrupted';
+
 function render(run) {
   const status = document.getElementById('status');
   const who = run.student ? ' by ' + run.student : '';
   const count = run.summary ? run.summary.collision_count : run.collisions;
   status.textContent = run.state + who + ': ' + fmt(count) + ' collisions' +
-    (run.state !== 'finished' && run.prediction && run.prediction.collision_count !== null ? ' of ' + fmt(run.prediction.collision_count) + ' predicted' : '') +
+    (!ended(run.state) && run.prediction && run.prediction.collision_count !== null ? ' of ' + fmt(run.prediction.collision_count) + ' predicted' : '') +
     (run.summary && run.summary.published_events < run.summary.collision_count ? ' (plots from the bag: every collision)' : '');
   document.body.dataset.state = run.state;
   if (!run.scene) return;
@@ -172,7 +175,7 @@ function render(run) {
     firstPlotMs = Math.round(performance.now());
     document.body.dataset.firstPlotMs = String(firstPlotMs);
   }
-  if (run.state === 'finished') {
+  if (ended(run.state)) {
     document.body.dataset.final = 'true';
     document.getElementById('stop').hidden = true;
   }
@@ -199,13 +202,13 @@ function setupDownloads() {
 async function poll() {
   const run = await (await fetch(api)).json();
   render(run);
-  if (run.state !== 'finished') setTimeout(poll, 1000);
+  if (!ended(run.state)) setTimeout(poll, 1000);
 }
 
 // While queued: the run's place in the lab's queue (GET /api/queue), until it runs.
 async function showQueue() {
   const place = document.getElementById('queue');
-  if (document.body.dataset.state === 'finished') { place.textContent = ''; return; }
+  if (ended(document.body.dataset.state)) { place.textContent = ''; return; }
   const queue = await (await fetch('/api/queue')).json();
   const waiting = queue.runs.filter((r) => !r.running);
   const mine = queue.runs.find((r) => r.run_id === runId);
@@ -214,14 +217,14 @@ async function showQueue() {
   } else {
     place.textContent = '';
   }
-  if (document.body.dataset.state !== 'finished') setTimeout(showQueue, 2000);
+  if (!ended(document.body.dataset.state)) setTimeout(showQueue, 2000);
 }
 
 // The Stop button: only in the browser that sent the run (its stop_token in localStorage).
 function setupStop() {
   const token = localStorage.getItem('collision_lab_stop_' + runId);
   const button = document.getElementById('stop');
-  if (!token || document.body.dataset.state === 'finished') return;
+  if (!token || ended(document.body.dataset.state)) return;
   button.hidden = false;
   button.onclick = async () => {
     button.disabled = true;
@@ -236,7 +239,7 @@ async function main() {
   setupDownloads();
   const run = await (await fetch(api)).json();
   render(run);
-  if (run.state === 'finished') return;
+  if (ended(run.state)) return;
   setupStop();
   showQueue();
   const source = new EventSource(api + '/stream');
