@@ -19,5 +19,5 @@ target_link_libraries(run_book_test collision_lab_web_lib ${catkin_LIBRARIES} GT
 # The web node killed and respawned: every run of the run index still listed and served;
 # runs whose end it missed end from the index.
 add_rostest_gtest(web_restart_test test/ros/web_restart_test.test test/ros/web_restart_test.cpp)
-target_link_libraries(web_restart_test collision_lab_web_lib ${catkin_LIBRARIES})
-add_dependencies(web_restart_test collision_lab_web)
+target_link_libraries(web_restart_test collision_lab_web_lib PkgConfig::CPP_HTTPLIB ${catkin_LIBRARIES})
+add_dependencies(web_restart_test collision_lab_node collision_lab_web)
