@@ -199,6 +199,8 @@ Table<collision_lab::InitialConditions> initialConditionsTable() {
       .field("viscoelastic_speed", &M::viscoelastic_speed, "_m_s")
       .field("ring", &M::ring, "_m")
       .field("max_collisions", &M::max_collisions)
+      .field("max_run_seconds", &M::max_run_seconds, "_s")
+      .field("max_bag_bytes", &M::max_bag_bytes, "_bytes")
       .field("student", &M::student)
       .elsewhere(kBodiesFile, {{"mass_kg", "masses"}, {"x_m", "positions"}, {"v_m_s", "velocities"}});
   return t;
@@ -358,7 +360,9 @@ Table<collision_lab::RunParameters> runParametersTable() {
       .field("node_name", &M::node_name)
       .field("max_collisions", &M::max_collisions)
       .field("max_published_events", &M::max_published_events)
-      .field("max_bodies", &M::max_bodies);
+      .field("max_bodies", &M::max_bodies)
+      .field("max_run_seconds", &M::max_run_seconds, "_s")
+      .field("max_bag_bytes", &M::max_bag_bytes, "_bytes");
   return t;
 }
 
