@@ -42,7 +42,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 std::string g_bag_directory;         // the node's ~bag_directory
-std::string g_faulty_bag_directory;  // the faulty node's: a regular file, not a folder
+std::string g_faulty_bag_directory;  // the faulty node's: under /dev/null, never a folder
 RunCollector* g_node = nullptr;      // namespace collision_lab
 RunCollector* g_faulty = nullptr;    // namespace collision_lab_faulty
 constexpr char kRunScene[] = "/collision_lab/collision_lab_node/run_scene";
@@ -753,9 +753,8 @@ int main(int argc, char** argv) {
     ADD_FAILURE() << "~bag_directory and ~faulty_bag_directory must be set";
     return 1;
   }
-  // The faulty node's bag directory is a regular file: no bag can be created there.
-  fs::create_directories(fs::path(g_faulty_bag_directory).parent_path());
-  std::ofstream(g_faulty_bag_directory) << "not a directory\n";
+  // The faulty node's bag directory lies under /dev/null (node_test.test): no folder, and so
+  // no bag, can ever be made there, whichever process starts first.
 
   RunCollector node("collision_lab"), faulty("collision_lab_faulty");
   g_node = &node;
