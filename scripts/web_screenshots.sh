@@ -23,7 +23,7 @@ out=docs/screenshots
 send() {  # student preset -> run_id (retries until the lab node listens)
   local answer
   for _ in $(seq 100); do
-    answer=$(curl -s -X POST -d "{\"student\":\"$1\",\"preset\":\"$2\"}" "$url/api/runs" || true)
+    answer=$(curl -s -X POST -H "Content-Type: application/json" -d "{\"student\":\"$1\",\"preset\":\"$2\"}" "$url/api/runs" || true)
     case "$answer" in *run_id*) echo "$answer" | sed -E 's/.*"run_id":"([^"]*)".*/\1/'; return ;; esac
     sleep 0.2
   done
