@@ -146,7 +146,8 @@ std::string studentProblem(const std::string& student);
 /// served as <that>.N.
 std::string requestedRunId(const collision_lab::InitialConditions& input);
 
-/// The runs a node accepted, the newest kServedRunsKept of them, for ~list_runs.
+/// The runs a node accepted, the newest kServedRunsKept of them: ~list_runs's answer when
+/// the run index cannot be opened.
 /// Thread-safe: the worker adds each run as it accepts it, and whichever thread publishes
 /// a run's summary completes it.
 class ServedRuns {

@@ -57,9 +57,10 @@ constexpr char kRunPresetService[] = "run_preset";
 constexpr char kCancelService[] = "cancel";
 /// Lists the runs served (srv/ListRuns.srv); served by ~cancel's thread (quick answers).
 constexpr char kListRunsService[] = "list_runs";
-/// ~list_runs keeps the newest this many runs (a few hundred bytes each): a term of a
-/// class, and bounded memory under the benchmarks' millions of runs.
-constexpr std::size_t kServedRunsKept = 100'000;
+/// ~list_runs lists from the run index; only when the index cannot be opened does it list
+/// the runs the node keeps in memory, the newest this many (about 300 bytes each): a
+/// class's last runs, and the node's memory flat after its first few hundred runs.
+constexpr std::size_t kServedRunsKept = 200;
 /// InitialConditions.student: at most this many characters.
 constexpr std::size_t kMaxStudentLength = 64;
 /// Service calls served at once; each blocks its thread until its run is over (the runs
