@@ -14,6 +14,8 @@ std::mutex& pluginLoaderMutex() {
 
 }  // namespace
 
+std::unique_lock<std::mutex> lockBagLifecycle() { return std::unique_lock<std::mutex>(pluginLoaderMutex()); }
+
 void LockedBagDeleter::operator()(rosbag::Bag* bag) const {
   std::lock_guard<std::mutex> lock(pluginLoaderMutex());
   delete bag;

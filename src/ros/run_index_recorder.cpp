@@ -20,6 +20,7 @@
 #include <rosbag/view.h>
 
 #include "collision_lab/CollisionEvent.h"
+#include "collision_lab/ros/bag_reading.h"
 #include "collision_lab/ros/run_recorder.h"
 
 extern char** environ;
@@ -238,18 +239,18 @@ std::string summaryJson(const collision_lab::RunSummary& s) {
 
 BagContents readBagContents(const std::string& path) {
   BagContents contents;
-  rosbag::Bag bag(path, rosbag::bagmode::Read);
+  const ReadableBag bag = openBagForReading(path);
   const rosbag::TypeQuery events_query(std::string(ros::message_traits::datatype<collision_lab::CollisionEvent>()));
-  rosbag::View events(bag, events_query);
+  rosbag::View events(*bag, events_query);
   contents.events = events.size();
   if (contents.events > 0) {
     // Only the messages at the last stamp are read: the last event is among them.
-    rosbag::View last(bag, events_query, events.getEndTime(), events.getEndTime());
+    rosbag::View last(*bag, events_query, events.getEndTime(), events.getEndTime());
     for (const rosbag::MessageInstance& m : last) {
       if (const auto e = m.instantiate<collision_lab::CollisionEvent>()) contents.last_event_time = e->time;
     }
   }
-  rosbag::View rest(bag, rosbag::TypeQuery(std::vector<std::string>{
+  rosbag::View rest(*bag, rosbag::TypeQuery(std::vector<std::string>{
                              ros::message_traits::datatype<collision_lab::InitialConditions>(),
                              ros::message_traits::datatype<collision_lab::RunSummary>()}));
   for (const rosbag::MessageInstance& m : rest) {

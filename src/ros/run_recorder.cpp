@@ -1,5 +1,7 @@
 #include "collision_lab/ros/run_recorder.h"
 
+#include "collision_lab/ros/bag_reading.h"
+
 #include <fcntl.h>
 #include <sys/file.h>
 #include <unistd.h>
@@ -122,6 +124,7 @@ std::string expandUser(const std::string& path) {
 RunRecorder::RunRecorder(const std::string& directory, const std::string& run_id)
     : path_(bagPath(directory, run_id)), active_path_(path_ + kActiveSuffix) {
   try {
+    const auto lifecycle = lockBagLifecycle();
     owned_ = std::make_unique<rosbag::Bag>();
   } catch (const std::exception& e) {
     fail(std::string("cannot create a bag: ") + e.what());
@@ -156,6 +159,7 @@ RunRecorder::RunRecorder(const std::string& directory, const std::string& run_id
 
 void RunRecorder::open() {
   try {
+    const auto lifecycle = lockBagLifecycle();
     bag_->setCompression(rosbag::compression::LZ4);
     bag_->open(active_path_, rosbag::bagmode::Write);
   } catch (const std::exception& e) {
@@ -165,7 +169,11 @@ void RunRecorder::open() {
   }
 }
 
-RunRecorder::~RunRecorder() { close(); }
+RunRecorder::~RunRecorder() {
+  close();
+  const auto lifecycle = lockBagLifecycle();
+  owned_.reset();
+}
 
 bool RunRecorder::close() {
   if (!bag_) {
@@ -173,6 +181,7 @@ bool RunRecorder::close() {
     return ok();
   }
   try {
+    const auto lifecycle = lockBagLifecycle();
     bag_->close();
   } catch (const std::exception& e) {
     fail(std::string("closing the bag failed: ") + e.what());
@@ -208,6 +217,9 @@ RunBagWriter::~RunBagWriter() {
   }
   changed_.notify_all();
   thread_.join();
+  recorder_.reset();
+  const auto lifecycle = lockBagLifecycle();
+  bag_.reset();
 }
 
 void RunBagWriter::push(RunBagBatch batch) {
@@ -260,6 +272,7 @@ void RunBagWriter::write(RunBagBatch& batch) {
     // messages, about 38 KB per run of the node): a new one every kBagReuses bags keeps
     // the writer's memory flat.
     if (!bag_ || ++bag_reuses_ == kBagReuses) {
+      const auto lifecycle = lockBagLifecycle();
       bag_.reset();
       bag_.emplace();
       bag_reuses_ = 0;

@@ -73,6 +73,38 @@ TEST_F(RunRecorderTest, WritesUnderActiveNameAndRenamesOnClose) {
   EXPECT_EQ(m.instantiate<collision_lab::RunSummary>()->collision_count, 7u);
 }
 
+// The lab node records on one bag writer thread per worker: bags made, opened, closed and
+// destroyed on several threads at once must not race in pluginlib's class loader (a fresh
+// rosbag::Bag per run, unlocked, crashed the node with SIGSEGV).
+TEST_F(RunRecorderTest, BagsRecordedOnManyThreadsAtOnceAreAllComplete) {
+  constexpr int kThreads = 6;
+  constexpr int kBagsEach = 40;
+  std::vector<std::thread> threads;
+  for (int t = 0; t < kThreads; ++t) {
+    threads.emplace_back([this, t] {
+      for (int k = 0; k < kBagsEach; ++k) {
+        collision_lab::RunSummary summary;
+        summary.run_id = "t" + std::to_string(t) + "_" + std::to_string(k);
+        summary.collision_count = static_cast<std::uint64_t>(k);
+        RunRecorder recorder(dir_, summary.run_id);
+        recorder.write("/collision_lab/run_summaries", ros::Time(1.0 + k), summary);
+        recorder.close();
+      }
+    });
+  }
+  for (std::thread& t : threads) t.join();
+  for (int t = 0; t < kThreads; ++t) {
+    for (int k = 0; k < kBagsEach; ++k) {
+      const std::string path = dir_ + "/t" + std::to_string(t) + "_" + std::to_string(k) + ".bag";
+      ASSERT_TRUE(fs::exists(path)) << path;
+      rosbag::Bag bag(path, rosbag::bagmode::Read);
+      rosbag::View view(bag);
+      ASSERT_EQ(view.size(), 1u) << path;
+      EXPECT_EQ(view.begin()->instantiate<collision_lab::RunSummary>()->collision_count, static_cast<std::uint64_t>(k));
+    }
+  }
+}
+
 TEST_F(RunRecorderTest, UncreatableDirectoryIsReportedNotThrown) {
   std::ofstream(dir_ + "/file") << "x";
   RunRecorder recorder(dir_ + "/file/bags", "r1");

@@ -1,14 +1,17 @@
-// Bags opened for reading on any thread.
+// Bags on any thread.
 //
 // rosbag::Bag loads its encryptor plugin through pluginlib when it is made and opened, and
 // unloads it when it is destroyed; pluginlib's class loader is not thread-safe, so bags made
 // on several threads at once crash the process (the web node, rebuilding runs while HTTP
-// threads export CSVs, did). Every bag that a multi-threaded process reads comes from
-// openBagForReading, which makes, opens and destroys it under one process-wide lock; reading
-// the opened bag needs no lock.
+// threads export CSVs, did; so did the lab node's bag writers, one per worker). Every bag
+// of a multi-threaded process is made, opened, closed and destroyed under one process-wide
+// lock (lockBagLifecycle): bags read come from openBagForReading, which does so; the
+// recorder (run_recorder.cpp) takes the lock itself. Reading or writing an open bag needs no
+// lock.
 #pragma once
 
 #include <memory>
+#include <mutex>
 #include <string>
 
 namespace rosbag {
@@ -17,7 +20,10 @@ class Bag;
 
 namespace collision_lab_ros {
 
-/// Destroys a bag under the lock of openBagForReading.
+/// The process-wide lock around making, opening, closing and destroying a rosbag::Bag.
+std::unique_lock<std::mutex> lockBagLifecycle();
+
+/// Destroys a bag under lockBagLifecycle.
 struct LockedBagDeleter {
   void operator()(rosbag::Bag* bag) const;
 };
