@@ -1,5 +1,8 @@
 #include "collision_lab/ros/bag_reading.h"
 
+#include <malloc.h>
+#include <sys/stat.h>
+
 #include <mutex>
 
 #include <rosbag/bag.h>
@@ -19,6 +22,13 @@ std::unique_lock<std::mutex> lockBagLifecycle() { return std::unique_lock<std::m
 void LockedBagDeleter::operator()(rosbag::Bag* bag) const {
   std::lock_guard<std::mutex> lock(pluginLoaderMutex());
   delete bag;
+}
+
+void releaseMemoryAfterBag(const std::string& bag_path) {
+  struct stat info {};
+  if (::stat(bag_path.c_str(), &info) == 0 && static_cast<unsigned long long>(info.st_size) >= kReleaseAfterBagBytes) {
+    malloc_trim(0);
+  }
 }
 
 ReadableBag openBagForReading(const std::string& bag_path) {

@@ -299,6 +299,7 @@ void RunBagWriter::write(RunBagBatch& batch) {
   summary.recording_ok = recorder_->ok();
   summary.recording_error = recorder_->error();
   recorder_.reset();
+  releaseMemoryAfterBag(summary.bag_path);
   // Taken out first: when it throws, recover() must not call it again.
   const auto on_closed = std::exchange(batch.on_closed, nullptr);
   if (on_closed) on_closed(summary);

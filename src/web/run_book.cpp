@@ -466,6 +466,7 @@ void RunBook::completeFromBag(const std::string& run_id, const std::string& bag_
   } catch (const std::exception& e) {
     error = e.what();
   }
+  collision_lab_ros::releaseMemoryAfterBag(bag_path);
   std::lock_guard<std::mutex> lock(mutex_);
   auto it = runs_.find(run_id);
   if (it == runs_.end() || it->second.finished) return;  // a rebuilding run is never evicted
@@ -570,6 +571,7 @@ bool RunBook::load(const std::string& run_id) {
     } catch (const std::exception& e) {
       error = e.what();
     }
+    collision_lab_ros::releaseMemoryAfterBag(bag);
   } else if (stub || (row && ended(row->state))) {
     error = "the run was not recorded";
   }

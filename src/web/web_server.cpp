@@ -24,6 +24,7 @@
 #include "collision_lab/Rejected.h"
 #include "collision_lab/io/scenario_file.h"
 #include "collision_lab/ros/bag_csv.h"
+#include "collision_lab/ros/bag_reading.h"
 #include "collision_lab/ros/msg_conversion.h"
 #include "collision_lab/ros/node_constants.h"
 #include "http_server.h"
@@ -803,6 +804,7 @@ void WebServer::sendEventsCsv(const HttpRequest& request, const std::string& run
     } catch (const std::exception& e) {
       error = e.what();
     }
+    collision_lab_ros::releaseMemoryAfterBag(bag);
     std::error_code ignored;
     fs::remove_all(folder, ignored);
     if (!error.empty()) return reply.send(errorAnswer(request, 500, error));

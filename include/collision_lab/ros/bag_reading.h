@@ -29,6 +29,14 @@ struct LockedBagDeleter {
 };
 using ReadableBag = std::unique_ptr<rosbag::Bag, LockedBagDeleter>;
 
+/// Writing or reading a long run's bag grows the heap by hundreds of MB (rosbag indexes
+/// every message), and glibc keeps the freed pages: after a bag of at least
+/// kReleaseAfterBagBytes, releaseMemoryAfterBag returns them to the system (malloc_trim), so
+/// a node's resident memory does not keep a big run's high-water mark. Call it once the bag
+/// is closed; smaller bags cost nothing.
+constexpr unsigned long long kReleaseAfterBagBytes = 16ULL << 20;  ///< [bytes]
+void releaseMemoryAfterBag(const std::string& bag_path);
+
 /// The bag at bag_path, open for reading. Throws rosbag::BagException (a
 /// std::runtime_error) when it cannot be opened.
 ReadableBag openBagForReading(const std::string& bag_path);
