@@ -21,3 +21,8 @@ target_link_libraries(run_book_test collision_lab_web_lib ${catkin_LIBRARIES} GT
 add_rostest_gtest(web_restart_test test/ros/web_restart_test.test test/ros/web_restart_test.cpp)
 target_link_libraries(web_restart_test collision_lab_web_lib PkgConfig::CPP_HTTPLIB ${catkin_LIBRARIES})
 add_dependencies(web_restart_test collision_lab_node collision_lab_web)
+# The real lab and web nodes together: a paused web node misses events, the lab node is
+# killed mid-run and respawned; every run ends finished or interrupted, none stays running.
+add_rostest_gtest(web_lab_recovery_test test/ros/web_lab_recovery_test.test test/ros/web_lab_recovery_test.cpp)
+target_link_libraries(web_lab_recovery_test collision_lab_web_lib PkgConfig::CPP_HTTPLIB ${catkin_LIBRARIES})
+add_dependencies(web_lab_recovery_test collision_lab_node collision_lab_web)

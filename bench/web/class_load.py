@@ -9,8 +9,8 @@ per-address limits see thirty students. Every loop is bounded in count and in ti
 
 Phases:
 1. idle anchor: the pi scene, a few times, on the idle lab (time to final);
-2. warm-up: each student sends --warmup-runs small scenes, and --warmup-gases gas runs go
-   with them; then both nodes' VmRSS;
+2. warm-up: each student sends --warmup-runs small scenes, and --warmup-gases gas runs and
+   --warmup-huge runs asking for 2^64-1 impacts go with them; then both nodes' VmRSS;
 3. the class: each student sends --runs small scenes; meanwhile big jobs (the 1,000-body gas
    preset, and the pi scene at masses (1e16, 1, inf) asking for 2^64-1 impacts; every second
    one of the latter is stopped by its owner with its stop_token when the API gives one), and an
@@ -533,6 +533,8 @@ def plan(args, students):
         main[i % len(students)].insert(i // len(students), job)
     for i in range(args.warmup_gases):
         warm[(len(students) - 1 - i) % len(students)].insert(0, ("gas_1000", GAS, None, None))
+    for i in range(args.warmup_huge):
+        warm[i % len(students)].insert(0, ("huge", HUGE, None, args.stop_after if i % 2 else None))
     return warm, main
 
 
@@ -579,6 +581,8 @@ def main():
     ap.add_argument("--students", type=int, default=30)
     ap.add_argument("--warmup-runs", type=int, default=10, help="small runs per student before the first memory reading")
     ap.add_argument("--warmup-gases", type=int, default=2, help="gas_1000 runs in the warm-up")
+    ap.add_argument("--warmup-huge", type=int, default=2,
+                    help="runs asking for 2^64-1 impacts in the warm-up (a node's memory is read after it has seen every kind of run)")
     ap.add_argument("--runs", type=int, default=60, help="small runs per student in the measured phase")
     ap.add_argument("--gases", type=int, default=6, help="gas_1000 runs in the measured phase")
     ap.add_argument("--huge", type=int, default=4, help="runs asking for 2^64-1 impacts in the measured phase")
