@@ -120,6 +120,8 @@ class BagCsvTest : public testing::Test {
     input.header.stamp = start;
     input.run_id = "csv_run";
     input.student = "ana";
+    input.max_run_seconds = 2.5;
+    input.max_bag_bytes = 1000000;
     input.mode = collision_lab::InitialConditions::MODE_FULL;
     input.masses = {{1e4, 1, kInf}};
     input.positions = {{2, 1, 0}};
@@ -221,9 +223,10 @@ TEST_F(BagCsvTest, OneCsvPerTopicWithUnitsAndExactNumbers) {
   ASSERT_EQ(input.size(), 2u);
   EXPECT_EQ(input[0], split("stamp_s,run_id,time_s,mode,masses_kg,positions_m,velocities_m_s,restitution,"
                             "restitution_model,tc_s,elastic_below_m_s,viscoelastic_speed_m_s,ring_m,"
-                            "max_collisions,student"));
+                            "max_collisions,max_run_seconds_s,max_bag_bytes_bytes,student"));
   EXPECT_EQ(input[1], (std::vector<std::string>{"1700000000.000000005", "csv_run", "0", "full", "10000;1;inf",
-                                                 "2;1;0", "-1;0;0", "", "0", "0", "0", "0", "0", "0", "ana"}));
+                                                 "2;1;0", "-1;0;0", "", "0", "0", "0", "0", "0", "0", "2.5",
+                                                 "1000000", "ana"}));
 
   // The masses, positions and velocities of the input are the start's rows (index 0).
   const Table bodies = readCsv(dir_ + "/csv/bodies.csv");
