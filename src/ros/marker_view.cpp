@@ -141,12 +141,12 @@ void MarkerView::onRejected(const collision_lab::Rejected& msg) {
   rejected_ = msg;
 }
 
-FrameClock MarkerView::frameClock(const RunRecord& run, const ros::WallTime& run_start, const ros::WallTime& now) const {
+FrameClock MarkerView::frameClock(const RunRecord& run, const ros::WallTime& run_start, const ros::WallTime& now) {
   FrameClock clock;
   if (params_.clock == MarkerViewParams::Clock::kRos) {
     const double scale = run.prediction ? run.prediction->timeline_scale : 0.0;
     const double t = replay_ && ros::Time::isSimTime()
-                         ? replayedTime(run, ros::Time::now())
+                         ? replay_clock_.at(run, ros::Time::now(), (now - run_start).toSec())
                          : simulatedTimeOnTimeline(ros::Time::now(), run.input().header.stamp, scale);
     clock.t = std::min(t, endTime(run));
     clock.description = "ROS clock" + std::string(ros::Time::isSimTime() ? " (bag)" : "");
@@ -215,6 +215,7 @@ void MarkerView::onTimer(const ros::WallTimerEvent&) {
     // two together, and every static message (the latched one too) is a whole picture.
     if (run_changed_) {
       animated = deleteAllMarkers(params_.frame_id);
+      replay_clock_.reset();
       banner_shown_ = hint_shown_ = false;
     }
     rebuild_static = run_changed_ || (run_ && static_dirty_);

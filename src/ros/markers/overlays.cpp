@@ -44,7 +44,9 @@ std::vector<Marker> framedText(const std::string& frame_id, const std::string& n
 }  // namespace
 
 std::vector<Marker> rejectedBanner(const collision_lab::Rejected& rejected, const std::string& frame_id) {
-  const std::string run = rejected.run_id.empty() ? "an input" : "run '" + rejected.run_id + "'";
+  // Whose input and which run, as far as the message tells (either may be empty).
+  std::string run = rejected.run_id.empty() ? "an input" : "run '" + rejected.run_id + "'";
+  if (!rejected.student.empty()) run += " of student '" + rejected.student + "'";
   return framedText(frame_id, ns::kRejected, kBannerBottomY,
                     "REJECTED " + run + ": " + rejected.reason_name + " in " + rejected.field + "\n" +
                         rejected.message,

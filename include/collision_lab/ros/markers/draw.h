@@ -43,6 +43,10 @@ std::string format(const char* fmt, double value);
 std::string withSign(const char* fmt, double value);
 /// 31415 -> "31,415".
 std::string withSeparators(std::uint64_t n);
+/// A position [m] on an axis, one style for every view: four significant digits, no exponent
+/// from 1,000 on ("1,060", "-61.06", "0.6058"); a '+' before a positive value when signed_
+/// (beside negative ones).
+std::string positionText(double x, bool signed_);
 /// The longest line of s and the number of its lines [characters, lines].
 std::pair<std::size_t, std::size_t> textExtent(const std::string& s);
 /// Estimated size of s on screen at text height `size` [rviz units] (rviz's font, see
