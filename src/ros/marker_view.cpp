@@ -191,7 +191,9 @@ void MarkerView::addOverlays(visualization_msgs::MarkerArray& animated) {
                         const std::vector<visualization_msgs::Marker>& markers) {
     if (shown) out.insert(out.end(), markers.begin(), markers.end());
     if (was_shown && !shown) {
-      for (int id : {markers::kFramedText, markers::kFramedBox}) out.push_back(deleteMarker(ns, id, params_.frame_id));
+      for (int id : {markers::kFramedText, markers::kFramedBox, markers::kFramedTextBold}) {
+        out.push_back(deleteMarker(ns, id, params_.frame_id));
+      }
     }
     was_shown = shown;
   };

@@ -420,6 +420,30 @@ TEST(MarkerBuilder, RejectionBannerNamesTheRunAndTheStudent) {
   EXPECT_EQ(text->text.rfind("REJECTED run 'pi_try': ", 0), 0u) << text->text;
 }
 
+TEST(MarkerBuilder, HintIsDrawnBoldSoThatItsUnderscoresShow) {
+  // The hint is a command to copy, "/collision_lab/initial_conditions": rviz draws an
+  // underscore a pixel thin and faint. It is drawn twice, a pixel apart, both over the panel.
+  // (Failed before: one text, its underscores nearly invisible in the screenshot.)
+  MarkerArray array;
+  array.markers = hintMarkers("rostopic pub -1 /collision_lab/initial_conditions", "f");
+  expectFitForRviz(array);
+  const Marker* text = find(array, markers::ns::kHint, markers::kFramedText);
+  const Marker* bold = find(array, markers::ns::kHint, markers::kFramedTextBold);
+  const Marker* panel = find(array, markers::ns::kHint, markers::kFramedBox);
+  ASSERT_TRUE(text && bold && panel);
+  EXPECT_EQ(bold->text, text->text);
+  EXPECT_EQ(bold->pose.position.x, text->pose.position.x);
+  EXPECT_NEAR(text->pose.position.y - bold->pose.position.y, markers::layout::kBoldDy, 1e-12);
+  EXPECT_LT(markers::layout::kBoldDy * 46, 1.5);  // about a pixel at rviz/collision_lab.rviz's scale
+  EXPECT_GT(bold->pose.position.z, panel->pose.position.z);
+  // The banner is not bold.
+  collision_lab::Rejected rejected;
+  rejected.reason_name = "EMPTY_SCENE";
+  MarkerArray banner;
+  banner.markers = rejectedBanner(rejected, "f");
+  EXPECT_FALSE(find(banner, markers::ns::kRejected, markers::kFramedTextBold));
+}
+
 TEST(MarkerBuilder, RejectionBannerHoldsItsWholeTextOnAnOpaquePanelOverThePanelTitles) {
   // A message wider than the screen. (Failed before: the text ran out of its frame, the
   // frame had no background, and it lay on the panels' titles.)

@@ -326,7 +326,8 @@ visualization_msgs::MarkerArray buildAnimatedMarkers(const RunRecord& run, const
 /// (markers/ids.h: ns kRejected, ids kFramedText, kFramedBox).
 std::vector<visualization_msgs::Marker> rejectedBanner(const collision_lab::Rejected& rejected,
                                                        const std::string& frame_id);
-/// Before the first run: how to send one, `command` (ns kHint, the same ids).
+/// Before the first run: how to send one, `command` (ns kHint, the same ids and
+/// kFramedTextBold: the text is drawn bold, so that its underscores show).
 std::vector<visualization_msgs::Marker> hintMarkers(const std::string& command, const std::string& frame_id);
 /// Deletes the marker ns/id (when a banner or hint is no longer shown).
 visualization_msgs::Marker deleteMarker(const std::string& ns, int id, const std::string& frame_id);

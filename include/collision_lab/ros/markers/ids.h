@@ -190,6 +190,7 @@ enum MarkerId : int {
   // ns "rejected" and "hint": a framed text
   kFramedText = 0,
   kFramedBox = 1,
+  kFramedTextBold = 2,  ///< the hint: its text again, a pixel lower (bold)
 };
 
 }  // namespace collision_lab_ros::markers

@@ -40,8 +40,10 @@ constexpr double kHintY = 1.5;
 
 // ---- text heights, depths ----
 constexpr double kTextSize = 0.32, kSmallTextSize = 0.29, kTitleSize = 0.38;
-/// Large: an underscore one pixel thin would vanish, and the hint is a command to copy.
+/// Large, and bold (drawn twice, kBoldDy apart): rviz draws an underscore a pixel thin and
+/// faint, and the hint is a command to copy.
 constexpr double kHintTextSize = 0.44;
+constexpr double kBoldDy = 0.022;  ///< about one pixel at the config's 46 px per unit
 constexpr double kTextZ = 0.2;  ///< texts over everything
 constexpr double kDotZ = 0.05;  ///< dots over lines
 
