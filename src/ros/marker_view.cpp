@@ -162,8 +162,13 @@ FrameClock MarkerView::frameClock(const RunRecord& run, const ros::WallTime& run
   }
   const TimeWarp warp(run);
   const double loop = autoLoopDuration(run.collisions());
-  const double phase = std::min(std::fmod(elapsed, loop + kMarkerEndHold) / loop, 1.0);
+  const double into = std::fmod(elapsed, loop + kMarkerEndHold);
+  const double phase = std::min(into / loop, 1.0);
   clock.t = warp.timeAt(phase);
+  if (into >= loop) {
+    clock.description = "held at the end";  // not "sim time x0"
+    return clock;
+  }
   char rate[64];
   std::snprintf(rate, sizeof rate, "sim time x%.2g", warp.rateAt(phase) / loop);
   clock.description = rate;

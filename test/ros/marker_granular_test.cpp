@@ -237,6 +237,13 @@ TEST(MarkerGranular, PanelTitlesKeepClearOfTheirTopValues) {
   }
   const auto* momentum = find(fixed, ids::ns::kConserved, ids::kConservedMomentum + ids::kFrameLabel);
   EXPECT_NE(momentum->text.find("a wall takes some"), std::string::npos) << momentum->text;
+  // The scene's "x range" note keeps clear of the end labels under the walls, and of the
+  // x-t diagram's title. (Failed on the first try of this change: the note moved onto the
+  // right end label, which sits lower under a wall.)
+  const auto animated = buildAnimatedMarkers(r.record, FrameClock{endTime(r.record), "test"}, "f");
+  const auto* note = find(animated, ids::ns::kLabels, ids::kSceneRangeNote);
+  ASSERT_TRUE(note);
+  marker_checks::expectTextClear(*note, -10.7, 16.3, {&fixed, &animated});
 }
 
 // Drifts are written with their sign: rviz draws '-' thin, and "4e-19" without one read as a
@@ -256,6 +263,14 @@ TEST(MarkerGranular, DriftsAreSigned) {
   char expected[32];
   std::snprintf(expected, sizeof expected, "drift -%.2g", 3.95e-19);
   EXPECT_NE(momentum->text.find(expected), std::string::npos) << momentum->text;
+  // Both labels bold: drawn again a pixel lower, so that the minus signs show.
+  for (const int base : {ids::kConservedEnergy, ids::kConservedMomentum}) {
+    const auto* label = find(fixed, ids::ns::kConserved, base + ids::kFrameLabel);
+    const auto* bold = find(fixed, ids::ns::kConserved, base + ids::kFrameLabelBold);
+    ASSERT_TRUE(bold) << base;
+    EXPECT_EQ(bold->text, label->text);
+    EXPECT_NEAR(label->pose.position.y - bold->pose.position.y, layout::kBoldDy, 1e-12);
+  }
 }
 
 // A ring of 1,000 m, 20 bodies 50 m apart: every body is drawn at its position in [0, 1,000)
@@ -305,6 +320,7 @@ TEST(MarkerGranular, ARingOf1000mIsDrawnFrom0To1000m) {
     const auto* note = find(frame, ids::ns::kLabels, ids::kSceneRangeNote);
     ASSERT_TRUE(note);
     EXPECT_EQ(note->text, "a ring of 1,000 m: its ends meet");
+    EXPECT_TRUE(marker_checks::apart(marker_checks::textBox(*note), marker_checks::textBox(*max)));
   }
   EXPECT_GT(seam_crossings_seen, 0u) << "some body must be seen near the seam";
   expectFit(r.record);

@@ -240,7 +240,14 @@ void addFrame(const Canvas& c, const std::string& ns, int base, const Axes& axes
     c.add(c.text(ns, base + kFrameBottomValue, b.left + kValueLabelDx, b.bottom, value(axes.y0), kSmallTextSize));
   }
   if (zero_inside) c.add(c.text(ns, base + kFrameZeroLabel, b.left + kZeroLabelDx, zero, "0", kSmallTextSize));
-  c.add(c.text(ns, base + kFrameLabel, b.midX(), b.top + kFrameLabelDy, label, kSmallTextSize));
+  // Bold (drawn twice, a pixel apart): rviz draws '-' a pixel thin and faint, and the
+  // labels carry signed drifts in e-notation ("drift -3.9e-19").
+  Marker title = c.text(ns, base + kFrameLabel, b.midX(), b.top + kFrameLabelDy, label, kSmallTextSize);
+  Marker again = title;
+  again.id = base + kFrameLabelBold;
+  again.pose.position.y -= kBoldDy;
+  c.add(std::move(title));
+  c.add(std::move(again));
 }
 
 void addSeries(const Canvas& c, const std::string& ns, int id, const Polyline& poly, const Axes& axes,

@@ -251,10 +251,14 @@ void drawBodies(const Canvas& c, const SceneState& state) {
     const SceneAxis axis = bodiesAxis(c.run, state);
     drawManyBodies(c, state, axis);
     addRangeLabels(c, ns::kLabels, kSceneNowMin, kSceneNowMax, axis);
+    // What the axis spans, in the right end label's row, left of it.
     const double ring = c.run.input().ring;
-    c.add(c.text(ns::kLabels, kSceneRangeNote, kSceneRight + kSceneRangeNoteDx, kSceneY + kSceneRangeNoteDy,
-                 ring > 0 ? "a ring of " + positionText(ring, false) + " m: its ends meet" : "x range: the bodies now",
-                 kSmallTextSize, color(kLabelGrey)));
+    const std::string note =
+        ring > 0 ? "a ring of " + positionText(ring, false) + " m: its ends meet" : "x range: the bodies now";
+    const PlacedText right = endLabels(c.run, axis)[1];
+    const double note_x = right.x - textWidth(right.text, kSmallTextSize) / 2 - kSceneRangeNoteGap -
+                          textWidth(note, kSmallTextSize) / 2;
+    c.add(c.text(ns::kLabels, kSceneRangeNote, note_x, right.y, note, kSmallTextSize, color(kLabelGrey)));
   } else {
     drawLabelledBodies(c, state, sceneAxis(c.run));
   }

@@ -102,7 +102,7 @@ struct Axes {
 /// [lo, hi] widened to include `always` and padded; [-1, 1] around it when empty.
 std::pair<double, double> paddedRange(double lo, double hi, double always = 0.0);
 /// The frame, a zero line when 0 is inside, values at the bottom, top and zero, and a
-/// label over the panel (ids base + kFrame*).
+/// bold label over the panel (ids base + kFrame*).
 void addFrame(const Canvas& c, const std::string& ns, int base, const Axes& axes, const std::string& label);
 /// A series' steps as a LINE_STRIP, plus a dot at its start (id + kSeriesStartDot) when
 /// the known part is too short to see on the axis.

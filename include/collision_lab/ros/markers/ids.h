@@ -54,6 +54,7 @@ enum MarkerId : int {
   kFrameBottomValue = 2,
   kFrameZeroLabel = 3,
   kFrameLabel = 4,
+  kFrameLabelBold = 5,  ///< the label again, a pixel lower (bold)
   /// A series' start dot (when its known part is too short to see): the series' id + this.
   kSeriesStartDot = 1000,
 

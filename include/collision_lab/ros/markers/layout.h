@@ -175,8 +175,8 @@ constexpr double kWorldPeriodsDy = -0.35;  ///< the periods so far, under the le
 constexpr double kStepsPeriodsDx = -1.2;  ///< from the velocity box's right edge
 /// A periodic motion is drawn over one period once the run lasts this many periods.
 constexpr double kPeriodsToFold = 2.0;
-/// Large scenes: "x range: the bodies now" under the scene's right end label.
-constexpr double kSceneRangeNoteDx = -2.0, kSceneRangeNoteDy = -1.15;
+/// Large scenes: "x range: the bodies now" left of the scene's right end label, this far.
+constexpr double kSceneRangeNoteGap = 1.0;
 /// Large scenes: a worldline drawn up to now keeps first, lowest, highest, last x per row.
 constexpr int kWorldRows = 240;
 constexpr double kWorldNowDotSize = 0.16;
