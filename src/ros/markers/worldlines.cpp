@@ -219,10 +219,11 @@ void drawWorldlines(const Canvas& c) {
                large ? "x-t diagram (worldlines), up to now" : "x-t diagram (worldlines)", kTextSize));
   bool exact = true;
   for (std::size_t i : tracked) exact = exact && c.run.worldline(i).exact();
-  std::string legend = exact ? "exact" : "min/max of x per time column";
+  // Short enough to stay on screen in one line (the inexact legend ran off its right edge).
+  std::string legend = exact ? "exact" : "min/max of x per row";
   if (tracked.size() < c.run.bodies()) {
-    legend += ";  " + withSeparators(tracked.size()) + " of " + withSeparators(c.run.bodies()) +
-              " bodies, coloured by v at the start";
+    legend += "; " + withSeparators(tracked.size()) + " of " + withSeparators(c.run.bodies()) +
+              " bodies, colour: v at the start";
   }
   // One line: a second would run into the "t [s]" label over the box.
   if (ghostScene(c.run)) legend += ";  grey dashes: ghosts x_i + v_i t, passing through";
