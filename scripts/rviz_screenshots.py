@@ -64,6 +64,11 @@ def loop_seconds(collisions):
     return AUTO_LOOP * (1.0 + math.log10(1.0 + collisions) / 6.0)
 
 
+def view_collisions(summary):
+    """The collisions the view animates: none of a run that was not simulated."""
+    return summary.collision_count if summary.simulated else 0
+
+
 def shoot_end(display, name, sent, finished, collisions):
     """Waits for a hold of the last frame that begins after the run finished, and grabs it
     1 s into the hold. The loop starts when the view gets the run's input (about `sent`)."""
@@ -112,7 +117,7 @@ def main():
         answer = run_preset(name=name, **fields)
         if not answer.ok:
             sys.exit("rviz_screenshots.py: %s: %s" % (name, answer.message))
-        shoot_end(display, file, sent, time.time(), answer.summary.collision_count)
+        shoot_end(display, file, sent, time.time(), view_collisions(answer.summary))
         return answer
 
     def scene(file, **fields):
@@ -120,7 +125,7 @@ def main():
         answer = run_scene(**fields)
         if not answer.ok:
             sys.exit("rviz_screenshots.py: %s: %s" % (file, answer.message))
-        shoot_end(display, file, sent, time.time(), answer.summary.collision_count)
+        shoot_end(display, file, sent, time.time(), view_collisions(answer.summary))
         return answer
 
     inf = float("inf")
