@@ -12,6 +12,7 @@
 
 #include "collision_lab/core/nbody/engine.h"
 #include "collision_lab/ros/marker_builder.h"
+#include "collision_lab/ros/markers/draw.h"
 #include "collision_lab/ros/markers/ids.h"
 #include "collision_lab/ros/markers/layout.h"
 #include "marker_test_checks.h"
@@ -317,6 +318,9 @@ TEST(MarkerGranular, ARingOf1000mIsDrawnFrom0To1000m) {
     EXPECT_EQ(max->text, "x = 1,000 m");
     EXPECT_EQ(world_min->text, "0");
     EXPECT_EQ(world_max->text, "1,000");
+    // The x-t diagram's end values inside its width ("+1.06e+03" ran off its right edge).
+    EXPECT_GE(marker_checks::textBox(*world_min).left, layout::kWorldBox.left - 1e-9);
+    EXPECT_LE(marker_checks::textBox(*world_max).right, layout::kWorldBox.right + 1e-9);
     const auto* note = find(frame, ids::ns::kLabels, ids::kSceneRangeNote);
     ASSERT_TRUE(note);
     EXPECT_EQ(note->text, "a ring of 1,000 m: its ends meet");
@@ -443,6 +447,22 @@ TEST(MarkerGranular, ClusterRingsKeepClearOfTheAxisLabels) {
     }
   }
   EXPECT_GT(near_the_end, 0u) << "the ring must reach over the left label's columns";
+}
+
+// One number style for positions on every axis: four significant digits, no exponent from
+// 1,000 on, separators; the sign where asked. (Before: "%.4g" in the scene, "1060", and
+// "%.3g" in the x-t diagram, "+1.06e+03", for the same 1,059.6 m.)
+TEST(MarkerGranular, PositionsHaveOneNumberStyle) {
+  using collision_lab_ros::markers::positionText;
+  EXPECT_EQ(positionText(1059.6, true), "+1,060");
+  EXPECT_EQ(positionText(1059.6, false), "1,060");
+  EXPECT_EQ(positionText(-61.0583, true), "-61.06");
+  EXPECT_EQ(positionText(-0.60583, false), "-0.6058");
+  EXPECT_EQ(positionText(1000.0, false), "1,000");
+  EXPECT_EQ(positionText(213.4e6, true), "+213,400,000");
+  EXPECT_EQ(positionText(-194.83e6, true), "-194,800,000");
+  EXPECT_EQ(positionText(0.0, true), "0");
+  EXPECT_EQ(positionText(2.147, true), "+2.147");
 }
 
 }  // namespace
