@@ -9,7 +9,8 @@ run's last frame. Needs rviz, xvfb and imagemagick (setup_debian.sh --with-scree
 Usage, after `source build_ros/devel/setup.bash`:
   python3 scripts/rviz_screenshots.py [shot ...]      (no shot: all of them but box_to_cap)
   python3 scripts/rviz_screenshots.py --simulate-to-cap box_to_cap
-(the node's ~simulate_to_cap, so that the box goes on to its cap of 100,000 impacts)
+(the node's ~simulate_to_cap, so that the box goes on to its cap of 100,000 impacts).
+KEEP_TMP=1 keeps the temporary folder (the processes' logs, the last raw grab) and prints it.
 """
 import math
 import os
