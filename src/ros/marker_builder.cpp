@@ -439,9 +439,18 @@ SceneState stateOf(const Keyframe& frame) {
   return s;
 }
 
-/// Free flight from `from` to time t (exact while no pair meets).
-SceneState flown(SceneState from, double t) {
-  for (std::size_t i = 0; i < from.positions.size(); ++i) from.positions[i] += from.velocities[i] * (t - from.time);
+/// Free flight from `from` to time t (exact while no pair meets); on a ring of circumference
+/// `ring` [m] (> 0) each position wrapped into [0, ring), as the messages report them.
+SceneState flown(SceneState from, double t, double ring) {
+  for (std::size_t i = 0; i < from.positions.size(); ++i) {
+    double& x = from.positions[i];
+    x += from.velocities[i] * (t - from.time);
+    if (ring > 0) {
+      x = std::fmod(x, ring);
+      if (x < 0) x += ring;
+      if (x >= ring) x = 0.0;  // -tiny + ring rounds to ring
+    }
+  }
   from.time = t;
   return from;
 }
@@ -477,9 +486,9 @@ SceneState stateAt(const RunRecord& run, double t) {
     base = stateOf(*(after - 1));
     valid_until = after == frames.end() ? openEnd(run, base) : (after - 1)->valid_until;
   }
-  if (t <= valid_until) return flown(base, t);
+  if (t <= valid_until) return flown(base, t, run.input().ring);
   // t falls where no exact state is kept: show the nearest instant that is known.
-  if (after == frames.end() || t - valid_until <= after->time - t) return flown(base, valid_until);
+  if (after == frames.end() || t - valid_until <= after->time - t) return flown(base, valid_until, run.input().ring);
   return stateOf(*after);
 }
 
@@ -541,6 +550,24 @@ double simulatedTimeOnTimeline(const ros::Time& now, const ros::Time& start, dou
 double replayedTime(const RunRecord& run, const ros::Time& now) {
   const double scale = run.prediction ? run.prediction->timeline_scale : 0.0;
   return std::max(simulatedTimeOnTimeline(now, run.input().header.stamp, scale), run.newestTime());
+}
+
+double ReplayClock::at(const RunRecord& run, const ros::Time& now, double wall) {
+  const double end = endTime(run);
+  const double on_bag_clock = std::min(replayedTime(run, now), end);
+  if (!run.summary) {
+    summary_seen_.reset();
+    return on_bag_clock;
+  }
+  if (!summary_seen_) summary_seen_ = Instant{on_bag_clock, wall};
+  const Instant& seen = *summary_seen_;
+  // The pace so far, or the timeline's (rate 1) when nothing has been played yet.
+  const double scale = run.prediction && std::isfinite(run.prediction->timeline_scale) &&
+                               run.prediction->timeline_scale > 0
+                           ? run.prediction->timeline_scale
+                           : 1.0;
+  const double pace = seen.t > 0 && seen.wall > 0 ? seen.t / seen.wall : 1.0 / scale;
+  return std::min(std::max(on_bag_clock, seen.t + std::max(wall - seen.wall, 0.0) * pace), end);
 }
 
 // ---- the pictures: one function per view (src/ros/markers/) ----

@@ -288,6 +288,29 @@ double simulatedTimeOnTimeline(const ros::Time& now, const ros::Time& start, dou
 /// fall just before its collision's time: the received collision has happened.
 double replayedTime(const RunRecord& run, const ros::Time& now);
 
+/// The clock of a run replayed by `rosbag play --clock`: replayedTime while the bag plays, and
+/// on from there to endTime(run), as the live view goes, once the run's RunSummary has come.
+/// A bag's last message is its RunSummary, stamped at the last collision, and rosbag play's
+/// clock stops with it: without this the replay would end frozen at the last impact, before
+/// the bodies' final free flight. After the summary the replay goes on in wall time, at the
+/// pace the bag played at so far (simulated s per wall s), or on the ROS clock where that is
+/// ahead (a bag that goes on).
+class ReplayClock {
+ public:
+  /// Simulated time [s] to show at ROS time `now`, `wall` seconds [s] after the run's
+  /// InitialConditions arrived; never past endTime(run).
+  double at(const RunRecord& run, const ros::Time& now, double wall);
+  /// A new run (or the same bag played again): forget where the last one stopped.
+  void reset() { summary_seen_.reset(); }
+
+ private:
+  struct Instant {
+    double t;     ///< simulated [s]
+    double wall;  ///< since the InitialConditions arrived [s]
+  };
+  std::optional<Instant> summary_seen_;  ///< the first frame after the RunSummary came
+};
+
 /// One frame's time line for the status text.
 struct FrameClock {
   double t = 0.0;           ///< simulated time requested [s]
@@ -299,11 +322,12 @@ visualization_msgs::MarkerArray buildStaticMarkers(const RunRecord& run, const s
 /// The parts that move with simulated time (bodies, labels, cursors, bars).
 visualization_msgs::MarkerArray buildAnimatedMarkers(const RunRecord& run, const FrameClock& clock,
                                                      const std::string& frame_id);
-/// A banner for a rejected input: its reason, field and message (markers/ids.h: ns kRejected,
-/// ids kFramedText, kFramedBox).
+/// A banner for a rejected input: its run_id and student, reason, field and message
+/// (markers/ids.h: ns kRejected, ids kFramedText, kFramedBox).
 std::vector<visualization_msgs::Marker> rejectedBanner(const collision_lab::Rejected& rejected,
                                                        const std::string& frame_id);
-/// Before the first run: how to send one, `command` (ns kHint, the same ids).
+/// Before the first run: how to send one, `command` (ns kHint, the same ids and
+/// kFramedTextBold: the text is drawn bold, so that its underscores show).
 std::vector<visualization_msgs::Marker> hintMarkers(const std::string& command, const std::string& frame_id);
 /// Deletes the marker ns/id (when a banner or hint is no longer shown).
 visualization_msgs::Marker deleteMarker(const std::string& ns, int id, const std::string& frame_id);
