@@ -26,8 +26,3 @@ add_dependencies(web_restart_test collision_lab_node collision_lab_web)
 add_rostest_gtest(web_lab_recovery_test test/ros/web_lab_recovery_test.test test/ros/web_lab_recovery_test.cpp)
 target_link_libraries(web_lab_recovery_test collision_lab_web_lib PkgConfig::CPP_HTTPLIB ${catkin_LIBRARIES})
 add_dependencies(web_lab_recovery_test collision_lab_node collision_lab_web)
-# docs/web.md's commands run as written (roslaunch, curl) against the lab and web nodes the
-# page starts, each output as the page shows it (a Python unittest; its own master and ports).
-catkin_run_tests_target(doc web_md_commands web_md_commands.xml
-  COMMAND "/usr/bin/python3 ${PROJECT_SOURCE_DIR}/test/docs/web_md_commands_test.py --doc ${PROJECT_SOURCE_DIR}/docs/web.md --setup ${CATKIN_DEVEL_PREFIX}/setup.bash --gtest_output=xml:${CATKIN_TEST_RESULTS_DIR}/${PROJECT_NAME}/web_md_commands.xml"
-  DEPENDENCIES collision_lab_node collision_lab_web)
