@@ -128,6 +128,20 @@ TEST_F(WebTest, BrowserRunIsServedRecordedAndListed) {
   EXPECT_NE(page->body.find("data-run-id=\"" + run_id + "\""), std::string::npos);
 }
 
+TEST_F(WebTest, RunIdsAreNumberedPerStudent) {
+  // Classmates' runs do not share numbers: each student's n-th run is <student>.run<n>.
+  const auto send = [](const std::string& student) {
+    auto res = post(piScene(student));
+    EXPECT_TRUE(res);
+    if (!res) return std::string();
+    EXPECT_EQ(res->status, 202) << res->body;
+    return json::parse(res->body).value("run_id", std::string());
+  };
+  EXPECT_EQ(send("flo"), "flo.run1");
+  EXPECT_EQ(send("gus"), "gus.run1");
+  EXPECT_EQ(send("flo"), "flo.run2");
+}
+
 TEST_F(WebTest, LiveStreamEndsWithTheFinalRun) {
   auto res = post(piScene("ben"));
   ASSERT_TRUE(res);
