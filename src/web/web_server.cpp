@@ -548,6 +548,11 @@ void WebServer::route(const HttpRequest& request, const Access& access, const Ht
     std::optional<std::string> student = queryParam(query, "student");
     return reply.send(answer(request, http::status::ok, book_.list(student), "application/json"));
   }
+  if (get && path == "/api/rejections") {
+    if (!access.teacher) return reply.send(errorAnswer(request, 403, "only the teacher sees the rejected inputs", "code"));
+    std::optional<std::string> student = queryParam(query, "student");
+    return reply.send(answer(request, http::status::ok, book_.rejections(student), "application/json"));
+  }
   if (get && path == "/api/queue") {
     std::string body;
     {
@@ -714,7 +719,16 @@ void WebServer::postRun(const HttpRequest& request, const HttpReply& reply) {
       pending_.erase({student, requested});
     }
     boost::asio::post(reply.executor(), [timer] { timer->cancel(); });
-    if (answer.rejected) return reply.send(jsonAnswer(request, 422, rejectionJson(*answer.rejected)));
+    if (answer.rejected) {
+      // A rejected send is no run: its number goes to the student's next send (unless a
+      // later send of theirs took a higher one meanwhile).
+      if (const auto number = runNumber(student + "." + requested, student)) {
+        std::lock_guard<std::mutex> lock(mutex_);
+        std::uint64_t& highest = runs_numbered_[student];
+        if (highest == *number) --highest;
+      }
+      return reply.send(jsonAnswer(request, 422, rejectionJson(*answer.rejected)));
+    }
     if (const auto number = runNumber(*answer.run_id, student)) {
       std::lock_guard<std::mutex> lock(mutex_);
       std::uint64_t& highest = runs_numbered_[student];
