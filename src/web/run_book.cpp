@@ -836,6 +836,22 @@ std::pair<std::uint64_t, bool> RunBook::waitForChange(const std::string& run_id,
   return current();
 }
 
+std::string RunBook::rejections(const std::optional<std::string>& student) const {
+  nlohmann::json out = nlohmann::json::array();
+  if (!source_) return out.dump();
+  std::vector<collision_lab::service::IndexedRejection> rows;
+  try {
+    rows = source_->rejections(student, kRejectionsListed);
+  } catch (const std::exception&) {
+    return out.dump();  // the index cannot be read now: the next call asks again
+  }
+  for (const auto& r : rows) {
+    out.push_back({{"at", r.at}, {"student", r.student}, {"run_id", r.run_id}, {"reason_name", r.reason_name},
+                   {"field", r.field}, {"message", r.message}});
+  }
+  return out.dump();
+}
+
 std::string RunBook::list(const std::optional<std::string>& student) const {
   std::vector<collision_lab::service::IndexedRun> rows;
   if (source_) {

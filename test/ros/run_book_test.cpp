@@ -140,12 +140,28 @@ class FakeSource : public collision_lab_web::RunSource {
     }
     return out;
   }
+  std::vector<collision_lab::service::IndexedRejection> rejections(const std::optional<std::string>& student,
+                                                                  std::size_t limit) const override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    asked_limit = limit;
+    std::vector<collision_lab::service::IndexedRejection> out;
+    for (const auto& r : rejections_) {
+      if (!student || r.student == *student) out.push_back(r);
+    }
+    return out;
+  }
+  void reject(const collision_lab::service::IndexedRejection& r) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    rejections_.push_back(r);
+  }
   mutable int finds = 0;
+  mutable std::size_t asked_limit = 0;
 
  private:
   mutable std::mutex mutex_;
   std::map<std::string, IndexedRun> rows_;
   std::vector<std::string> order_;
+  std::vector<collision_lab::service::IndexedRejection> rejections_;
 };
 
 /// A folder removed at the end of the test.
@@ -525,3 +541,31 @@ TEST(RunBookMemory, RestartedWebNodeServesTheIndexsRuns) {
 }
 
 }  // namespace
+
+TEST(RunBookRejections, ListsTheIndexsRejectionsAsJson) {
+  auto source = std::make_shared<FakeSource>();
+  collision_lab::service::IndexedRejection r;
+  r.at = 1.8e9;
+  r.student = "ben";
+  r.run_id = "pi_rviz";
+  r.reason_name = "NON_POSITIVE_MASS";
+  r.field = "masses[0]";
+  r.message = "m_A is -1 kg; a mass must be positive";
+  source->reject(r);
+  r.student = "ana";
+  source->reject(r);
+  collision_lab_web::RunBook book(smallBudget(1), source);
+  const json bens = json::parse(book.rejections(std::string("ben")));
+  ASSERT_EQ(bens.size(), 1u);
+  EXPECT_EQ(bens[0].at("student"), "ben");
+  EXPECT_EQ(bens[0].at("run_id"), "pi_rviz");
+  EXPECT_EQ(bens[0].at("reason_name"), "NON_POSITIVE_MASS");
+  EXPECT_EQ(bens[0].at("field"), "masses[0]");
+  EXPECT_EQ(bens[0].at("message"), "m_A is -1 kg; a mass must be positive");
+  EXPECT_DOUBLE_EQ(bens[0].at("at").get<double>(), 1.8e9);
+  EXPECT_EQ(json::parse(book.rejections(std::nullopt)).size(), 2u);
+  EXPECT_EQ(source->asked_limit, collision_lab_web::RunBook::kRejectionsListed);
+  // Without a run index there is nothing to list.
+  collision_lab_web::RunBook alone(smallBudget(1), nullptr);
+  EXPECT_EQ(json::parse(alone.rejections(std::nullopt)).size(), 0u);
+}

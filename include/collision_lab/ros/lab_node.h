@@ -143,8 +143,11 @@ std::string runIdProblem(const std::string& run_id);
 std::string studentProblem(const std::string& student);
 /// The run_id an input asks for: <student>.<run_id>, <student> when it names no run_id,
 /// or run_id when it names no student (empty: the node assigns one). A taken one is then
-/// served as <that>.N.
+/// served as <that>.N, except a numbered run (numberedRunId): that one as the next free number.
 std::string requestedRunId(const collision_lab::InitialConditions& input);
+/// A numbered run, "run<n>" or "<prefix>.run<n>" (the web node numbers each student's runs
+/// so): its name up to the number ("ben.run") and n; nullopt for any other run_id.
+std::optional<std::pair<std::string, std::uint64_t>> numberedRunId(const std::string& run_id);
 
 /// The runs a node accepted, the newest kServedRunsKept of them: ~list_runs's answer when
 /// the run index cannot be opened.
