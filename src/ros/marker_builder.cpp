@@ -181,6 +181,7 @@ RunRecord::RunRecord(const collision_lab::InitialConditions& input, const Record
       limits_(limits),
       replay_(input.masses, input.positions, input.velocities, input.ring),
       first_collapse_time_(std::nan("")),
+      first_collapse_position_(std::nan("")),
       min_velocity_(kInf),
       max_velocity_(-kInf) {
   // An input of unequal lengths (the node rejects those) is cut to its shortest list.
@@ -341,7 +342,11 @@ void RunRecord::add(const collision_lab::CollisionEvent& event) {
   newest_is_collapse_ = collapse;
   has_newest_ = true;
   newest_predicted_ = event.predicted_velocities_after;
-  if (collapse && collapses_++ == 0) first_collapse_time_ = event.time;
+  if (collapse && collapses_++ == 0) {
+    first_collapse_time_ = event.time;
+    first_collapse_position_ = event.position;
+    first_collapse_bodies_ = {event.first_moved, event.last_moved};
+  }
   apply(event);
   if (bucket_ == 0 && event.time > 0) {
     bucket_ = powerOfTwoAtMost(event.time / static_cast<double>(keyframeLimit()));

@@ -29,6 +29,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <ros/time.h>
@@ -163,6 +164,9 @@ class RunRecord {
   /// Collapses applied [1] and the first one's time [s] (NaN when none).
   std::uint32_t collapses() const { return collapses_; }
   double firstCollapseTime() const { return first_collapse_time_; }
+  /// The first collapse's point [m] (NaN when none) and bodies, first .. last [1].
+  double firstCollapsePosition() const { return first_collapse_position_; }
+  std::pair<std::size_t, std::size_t> firstCollapseBodies() const { return first_collapse_bodies_; }
   /// Time of the newest collision added [s] (0 before the first).
   double newestTime() const { return newest_time_; }
   /// Bounds of every finite velocity any body has had so far, the start's included [m/s]:
@@ -229,6 +233,8 @@ class RunRecord {
   std::uint64_t missed_ = 0, malformed_ = 0;
   std::uint32_t collapses_ = 0;
   double first_collapse_time_;
+  double first_collapse_position_;
+  std::pair<std::size_t, std::size_t> first_collapse_bodies_{0, 0};
   std::vector<std::size_t> tracked_, plotted_;
   std::vector<int> track_slot_, plot_slot_;  ///< body -> its series, -1 for none
   std::vector<Envelope> velocity_, paper_velocity_, body_energy_, worldline_;
