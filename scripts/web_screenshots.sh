@@ -64,14 +64,12 @@ shoot_views() {
   local run
   run=$(send_body '{"student":"eve","masses":[100,1,"inf"],"positions":[2,1,0],"velocities":[-1,0,0],"max_collisions":10}')
   wait_finished "$run"; shoot "/runs/$run" web_view_not_simulated.png 1250
-  run=$(send_body '{"student":"eve","preset":"pi_digits_4","max_collisions":100}')
-  wait_finished "$run"; shoot "/runs/$run" web_view_truncated.png 1250
   run=$(send eve collapse_equal); wait_finished "$run"; shoot "/runs/$run" web_view_collapse.png 1250
   run=$(send eve two_carts); wait_finished "$run"; shoot "/runs/$run" web_view_two_carts.png 1250
   run=$(send_body '{"student":"eve","preset":"granular_ring","max_collisions":5000}')
   wait_finished "$run"; shoot "/runs/$run" web_view_ring.png 1250
   run=$(send_body '{"student":"eve","preset":"granular_box_1000","max_collisions":5000}')
-  wait_finished "$run"; shoot "/runs/$run" web_view_box.png 1250
+  wait_finished "$run"; shoot "/runs/$run" web_view_box_truncated.png 1250  # the box stops at the lab's cap
 }
 if [ "${1:-}" = --views ]; then shoot_views; exit 0; fi
 

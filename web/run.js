@@ -176,7 +176,8 @@ function summaryRows(run) {
 // and which bodies each plot shows.
 function showFacts(view) {
   const facts = document.getElementById('view_facts');
-  const items = view ? [view.title, view.not_simulated, view.truncated, view.collapse, view.ring, view.box, view.note] : [];
+  // The note repeats a cut's sentence when there is one: said once.
+  const items = view ? [view.title, view.not_simulated, view.note ? '' : view.truncated, view.collapse, view.ring, view.box, view.note] : [];
   facts.replaceChildren(...items.filter((text) => text).map((text) => el('li', text)));
   document.getElementById('velocity_legend').textContent = view ? 'Bodies shown: ' + view.velocity_legend + '.' : '';
   document.getElementById('xt_legend').textContent = view ? 'Bodies shown: ' + view.worldline_legend + '.' : '';

@@ -71,10 +71,8 @@ std::string titleOf(const RunRecord& run) {
 /// One sentence for a run cut short: "stopped at the cap ...", never twice "truncated".
 std::string truncationSentence(const std::string& reason) {
   std::string s = reason;
-  const std::string marker = " (truncated)";  // the summary's own word, said once by the view
-  if (s.size() >= marker.size() && s.compare(s.size() - marker.size(), marker.size(), marker) == 0) {
-    s.resize(s.size() - marker.size());
-  }
+  const std::string marker = " (truncated)";  // the summary's own word: the view says it once
+  for (auto at = s.find(marker); at != std::string::npos; at = s.find(marker)) s.erase(at, marker.size());
   while (!s.empty() && (s.back() == '.' || s.back() == ' ')) s.pop_back();
   if (s.rfind("stopped", 0) != 0) s = "stopped: " + s;
   return s + ".";

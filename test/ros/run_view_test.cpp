@@ -86,11 +86,11 @@ TEST(RunView, TruncatedRunSaysSoInOneSentence) {
   RunRecord run(input({1, 1}, {1, 0}, {-1, 1}));
   auto s = simulatedSummary(1000);
   s.truncated = true;
-  s.truncation_reason = "stopped at the cap of 1000 impacts (truncated)";
+  s.truncation_reason = "stopped at the cap of 1000 impacts (truncated); two walls keep the bodies colliding";
   run.summary = s;
   const auto view = makeRunView(run);
   EXPECT_EQ(view.state, "truncated");
-  EXPECT_EQ(view.truncated, "stopped at the cap of 1000 impacts.");
+  EXPECT_EQ(view.truncated, "stopped at the cap of 1000 impacts; two walls keep the bodies colliding.");
   EXPECT_EQ(view.note.find("(truncated"), std::string::npos) << view.note;
   EXPECT_EQ(view.note, collision_lab_ros::markers::runNote(run));  // rviz's note is the view's
 }
