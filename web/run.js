@@ -172,6 +172,27 @@ function summaryRows(run) {
   return rows;
 }
 
+// A gas: T(t) on log-log axes with Haff's law T0/(1 + t/tau)^2 fitted (the view's numbers,
+// rviz's too). Points at t = 0 or T = 0 cannot be drawn on log axes: left out. For tests,
+// <body> gets data-temperature-points and data-haff-tau [s].
+function drawTemperature(view) {
+  document.getElementById('temperature_box').hidden = false;
+  const points = view.temperature.filter((q) => q[0] > 0 && q[1] > 0).map((q) => ({x: q[0], y: q[1]}));
+  const c = chart('temperature', 't [s]', 'T [J]');
+  c.options.scales.x.type = 'logarithmic';
+  c.options.scales.y.type = 'logarithmic';
+  const sets = [{label: 'T(t)', data: points, borderColor: totalColours[0]}];
+  if (view.haff) {
+    const fit = points.map((p) => ({x: p.x, y: view.haff.t0 / Math.pow(1 + p.x / view.haff.tau, 2)}));
+    sets.push({label: "Haff's law", data: fit, borderColor: totalColours[1], borderDash: [6, 4]});
+    document.body.dataset.haffTau = String(view.haff.tau);
+  }
+  c.data.datasets = sets;
+  c.update('none');
+  document.getElementById('temperature_legend').textContent = view.temperature_legend;
+  document.body.dataset.temperaturePoints = String(points.length);
+}
+
 // The view's facts: what was simulated and what not, a cut, a collapse, a ring or a box,
 // and which bodies each plot shows.
 function showFacts(view) {
@@ -237,6 +258,7 @@ function render(run) {
     t.options.scales.x.max = view.ring_circumference;
   }
   t.update('none');
+  if (view && view.gas) drawTemperature(view);
   const tbody = document.querySelector('#summary tbody');
   tbody.replaceChildren(...summaryRows(run).map((row) => {
     const tr = el('tr');

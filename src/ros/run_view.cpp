@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "collision_lab/core/nbody/scene.h"
+#include "collision_lab/core/nbody/temperature.h"
 #include "collision_lab/ros/markers/draw.h"
 #include "collision_lab/ros/markers/layout.h"
 
@@ -21,13 +22,18 @@ bool notSimulated(const RunRecord& run) {
   return run.input().mode == InitialConditions::MODE_PREDICT_ONLY || (run.summary && !run.summary->simulated);
 }
 
+/// Many bodies, inelastic: a granular gas (in a box, on a ring or free), with a T(t) view.
+bool isGas(const RunRecord& run) {
+  const auto& e = run.input().restitution;
+  const bool inelastic = std::any_of(e.begin(), e.end(), [](double r) { return r < 1.0; });
+  return run.bodies() > kMaxPlottedBodies && inelastic;
+}
+
 std::string kindOf(const RunRecord& run) {
   if (run.input().ring > 0) return "ring";
   const std::size_t n = run.bodies();
   if (n >= 3 && run.isWall(0) && run.isWall(n - 1) && n > 3) return "box";
-  const auto& e = run.input().restitution;
-  const bool inelastic = std::any_of(e.begin(), e.end(), [](double r) { return r < 1.0; });
-  if (n > kMaxPlottedBodies && inelastic) return "gas";
+  if (isGas(run)) return "gas";
   return n == 3 ? "three_body" : "line";
 }
 
@@ -222,6 +228,23 @@ RunView makeRunView(const RunRecord& run) {
   view.worldline_legend = legendOf(run.trackedBodies().size(), run.bodies());
   view.velocity_legend = legendOf(view.velocity_bodies.size(), run.bodies());
 
+  view.gas = isGas(run);
+  if (view.gas) {
+    std::vector<collision_lab::core::TemperatureSample> samples;
+    for (const auto& v : run.temperature().polyline()) {
+      view.temperature.emplace_back(v.x, v.y);
+      samples.push_back({0, v.x, v.y});
+    }
+    const auto fit = collision_lab::core::fitHaff(samples);
+    view.haff_ok = fit.ok && std::isfinite(fit.tau);
+    view.haff_t0 = fit.t0;
+    view.haff_tau = fit.tau;
+    view.temperature_legend = "T = sum m (v - V)^2 / N" +
+        (view.haff_ok ? "; Haff's law T0/(1 + t/tau)^2 fitted: T0 = " + format("%.4g J", fit.t0) +
+                            ", tau = " + format("%.4g s", fit.tau)
+                      : std::string("; Haff's law: no fit (no cooling seen)"));
+  }
+
   view.end_time = endTime(run);
   view.title = titleOf(run);
   view.note = noteOf(run, view);
@@ -313,6 +336,14 @@ nlohmann::json viewJson(const RunView& view) {
           {"worldline_legend", view.worldline_legend},
           {"velocity_bodies", bodies(view.velocity_bodies)},
           {"velocity_legend", view.velocity_legend},
+          {"gas", view.gas},
+          {"temperature", [&] {
+             nlohmann::json points = nlohmann::json::array();
+             for (const auto& [t, T] : view.temperature) points.push_back({t, T});
+             return points;
+           }()},
+          {"haff", view.haff_ok ? nlohmann::json{{"t0", view.haff_t0}, {"tau", view.haff_tau}} : nlohmann::json(nullptr)},
+          {"temperature_legend", view.temperature_legend},
           {"end_time", std::isfinite(view.end_time) ? nlohmann::json(view.end_time) : nlohmann::json(nullptr)}};
 }
 

@@ -169,8 +169,15 @@ TEST(RunView, BoxOfManyBodiesNamesTheShownBodies) {
   m.front() = m.back() = kInf;
   for (std::size_t i = 0; i < x.size(); ++i) x[i] = static_cast<double>(x.size() - 1 - i);
   v[1] = -1.0;
-  RunRecord run(input(m, x, v));
+  auto in = input(m, x, v);
+  in.restitution.assign(in.restitution.size(), 0.9);  // a granular gas in a box
+  RunRecord run(in);
   const auto view = makeRunView(run);
+  EXPECT_TRUE(view.gas);
+  ASSERT_FALSE(view.temperature.empty());
+  // T = (sum m v^2 - P^2 / M) / N over the 1,000 finite masses [J].
+  EXPECT_DOUBLE_EQ(view.temperature.front().first, 0.0);
+  EXPECT_NEAR(view.temperature.front().second, (1.0 - 1.0 / 1000) / 1000, 1e-15);
   EXPECT_EQ(view.kind, "box");
   EXPECT_EQ(view.box, "box: walls at both ends");
   EXPECT_EQ(view.worldline_legend, "24 of 1,002 bodies, evenly spaced, the outermost two included");

@@ -251,6 +251,10 @@ TEST_F(RunPageViewTest, BoxOfManyBodiesHasItsLegend) {
   const std::string dom = finalPage({{"student", "view"}, {"preset", "granular_box_1000"}, {"max_collisions", 2000}});
   EXPECT_NE(dom.find("box: walls at both ends"), std::string::npos) << dom.substr(0, 2000);
   EXPECT_NE(dom.find("24 of 1,002 bodies, evenly spaced, the outermost two included"), std::string::npos);
+  // A gas (e = 0.9): T(t) on log-log axes with Haff's law fitted.
+  EXPECT_NE(dom.find("Haff's law T0/(1 + t/tau)^2 fitted: T0 = "), std::string::npos);
+  EXPECT_GT(bodyData(dom, "temperature-points"), 10.0);
+  EXPECT_GT(bodyData(dom, "haff-tau"), 0.0);
 }
 
 int main(int argc, char** argv) {

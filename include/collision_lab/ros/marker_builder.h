@@ -198,6 +198,9 @@ class RunRecord {
   const Envelope& energy() const { return energy_; }
   const Envelope& momentum() const { return momentum_; }
   const Envelope& energyLost() const { return energy_lost_; }
+  /// Granular temperature T = (1/N) sum m (v - V)^2 of the finite masses [J] against time
+  /// [s] (core::granularTemperature, from the running energy and momentum): the gas's T(t).
+  const Envelope& temperature() const { return temperature_; }
   /// Total kinetic energy of the finite masses at the start [J].
   double startEnergy() const { return start_energy_; }
   /// Bytes the record holds, itself included: its input, the replay's state, the kept
@@ -239,7 +242,10 @@ class RunRecord {
   std::vector<int> track_slot_, plot_slot_;  ///< body -> its series, -1 for none
   std::vector<Envelope> velocity_, paper_velocity_, body_energy_, worldline_;
   std::vector<Envelope> tracked_velocity_;  ///< empty unless no body is plotted
-  Envelope energy_, momentum_, energy_lost_, none_;
+  Envelope energy_, momentum_, energy_lost_, temperature_, none_;
+  double finite_mass_ = 0.0;         ///< [kg]
+  std::size_t finite_bodies_ = 0;    ///< [1]
+  double temperatureNow() const;
   double start_energy_ = 0.0;
   double min_velocity_, max_velocity_;
 };

@@ -26,8 +26,10 @@ struct ViewBody {
 };
 
 struct RunView {
-  /// "ring", "box", "gas" (many bodies, inelastic), "three_body" or "line".
+  /// "ring", "box", "gas" (many bodies, inelastic, no walls), "three_body" or "line".
   std::string kind;
+  /// Many bodies, inelastic (in a box, on a ring or free): the T(t) view below is filled.
+  bool gas = false;
   std::string title;  ///< rviz's title line
   std::string note;   ///< rviz's note: how the run ended or why it is not drawn whole ("" when none)
 
@@ -63,6 +65,14 @@ struct RunView {
   /// Bodies with a worldline on the x-t diagram and with their own velocity steps, and why.
   std::vector<ViewBody> worldline_bodies, velocity_bodies;
   std::string worldline_legend, velocity_legend;
+
+  /// A gas: its granular temperature T(t) (t [s], T [J]) and Haff's law T0 / (1 + t/tau)^2
+  /// fitted to it (core::fitHaff; haff_ok false when it cannot be fitted), with its legend.
+  std::vector<std::pair<double, double>> temperature;
+  bool haff_ok = false;
+  double haff_t0 = 0.0;   ///< [J]
+  double haff_tau = 0.0;  ///< [s]
+  std::string temperature_legend;
 
   /// The x-t diagram's end time [s]: the run's end (endTime), every worldline reaches it.
   double end_time = 0.0;
