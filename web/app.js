@@ -9,10 +9,24 @@ function el(tag, text, attrs) {
   return node;
 }
 
+// Body names and colours as every view has them: core::bodyName ("A".."Z", then "#26",
+// ...) and rviz's palette from the server (GET /api/body_colours), never a list of our own.
+let bodyPalette = [];
+const bodyLetter = (i) => (i < 26 ? String.fromCharCode(65 + i) : '#' + i);
+
+function nameCell(td, i) {
+  td.textContent = bodyLetter(i);
+  td.title = 'body ' + bodyLetter(i) + ' (masses[' + i + '])';
+  td.className = 'body_name';
+  if (bodyPalette.length > 0) td.style.color = bodyPalette[i % bodyPalette.length];
+}
+
 function bodyRow(mass, position, velocity) {
   const rows = document.querySelector('#bodies tbody');
   const tr = el('tr');
-  tr.appendChild(el('td', rows.children.length));
+  const name = el('td');
+  nameCell(name, rows.children.length);
+  tr.appendChild(name);
   for (const [name, value] of [['mass', mass], ['position', position], ['velocity', velocity]]) {
     const td = el('td');
     td.appendChild(el('input', null, {type: 'text', name: name, value: value === undefined ? '' : String(value)}));
@@ -27,7 +41,7 @@ function bodyRow(mass, position, velocity) {
 }
 
 function renumber() {
-  document.querySelectorAll('#bodies tbody tr').forEach((tr, i) => { tr.firstChild.textContent = i; });
+  document.querySelectorAll('#bodies tbody tr').forEach((tr, i) => nameCell(tr.firstChild, i));
 }
 
 let loadedPreset = null;  // a preset too large for the form is sent by name
@@ -109,6 +123,8 @@ async function startPage() {
   document.getElementById('student').value = localStorage.getItem('collision_lab_student') || '';
   document.getElementById('add').onclick = () => { loadedPreset = null; document.getElementById('preset_note').textContent = ''; bodyRow('1', '', '0'); };
   document.getElementById('send').onclick = sendScene;
+  bodyPalette = (await (await fetch('/api/body_colours')).json()).palette;
+  renumber();
   const presets = await (await fetch('/api/presets')).json();
   const tbody = document.querySelector('#presets tbody');
   for (const p of presets) {

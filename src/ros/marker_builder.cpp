@@ -181,6 +181,7 @@ RunRecord::RunRecord(const collision_lab::InitialConditions& input, const Record
       limits_(limits),
       replay_(input.masses, input.positions, input.velocities, input.ring),
       first_collapse_time_(std::nan("")),
+      first_collapse_position_(std::nan("")),
       min_velocity_(kInf),
       max_velocity_(-kInf) {
   // An input of unequal lengths (the node rejects those) is cut to its shortest list.
@@ -196,7 +197,7 @@ RunRecord::RunRecord(const collision_lab::InitialConditions& input, const Record
   paper_velocity_.assign(plotted_.size(), empty);
   body_energy_.assign(plotted_.size(), empty);
   worldline_.assign(tracked_.size(), empty);
-  energy_ = momentum_ = energy_lost_ = none_ = empty;
+  energy_ = momentum_ = energy_lost_ = temperature_ = none_ = empty;
   for (std::size_t i = 0; i < n; ++i) widenVelocityRange(input_.velocities[i]);
   for (std::size_t k = 0; k < plotted_.size(); ++k) {
     const std::size_t i = plotted_[k];
@@ -212,6 +213,10 @@ RunRecord::RunRecord(const collision_lab::InitialConditions& input, const Record
   energy_.add(0.0, start_energy_);
   momentum_.add(0.0, replay_.momentum());
   energy_lost_.add(0.0, 0.0);
+  for (double m : input_.masses) {
+    if (std::isfinite(m)) finite_mass_ += m, ++finite_bodies_;
+  }
+  temperature_.add(0.0, temperatureNow());
 }
 
 bool RunRecord::isWall(std::size_t i) const { return i < bodies() && replay_.isWall(i); }
@@ -303,6 +308,13 @@ void RunRecord::apply(const collision_lab::CollisionEvent& event) {
   energy_.step(k, replay_.totalKineticEnergy());
   momentum_.step(k, replay_.momentum());
   energy_lost_.step(k, replay_.heat());
+  temperature_.add(event.time, temperatureNow());
+}
+
+double RunRecord::temperatureNow() const {
+  if (finite_bodies_ == 0 || !(finite_mass_ > 0)) return 0.0;
+  const double p = replay_.momentum();
+  return std::max(0.0, (2 * replay_.totalKineticEnergy() - p * p / finite_mass_) / static_cast<double>(finite_bodies_));
 }
 
 Keyframe RunRecord::snapshot(double time) const {
@@ -341,7 +353,11 @@ void RunRecord::add(const collision_lab::CollisionEvent& event) {
   newest_is_collapse_ = collapse;
   has_newest_ = true;
   newest_predicted_ = event.predicted_velocities_after;
-  if (collapse && collapses_++ == 0) first_collapse_time_ = event.time;
+  if (collapse && collapses_++ == 0) {
+    first_collapse_time_ = event.time;
+    first_collapse_position_ = event.position;
+    first_collapse_bodies_ = {event.first_moved, event.last_moved};
+  }
   apply(event);
   if (bucket_ == 0 && event.time > 0) {
     bucket_ = powerOfTwoAtMost(event.time / static_cast<double>(keyframeLimit()));
@@ -378,7 +394,8 @@ std::size_t RunRecord::memoryBytes() const {
   bytes += doubles(newest_predicted_) + sizes(tracked_) + sizes(plotted_) + sizes(track_slot_) + sizes(plot_slot_);
   bytes += envelopes(velocity_) + envelopes(paper_velocity_) + envelopes(body_energy_) + envelopes(worldline_) +
            envelopes(tracked_velocity_);
-  bytes += energy_.memoryBytes() + momentum_.memoryBytes() + energy_lost_.memoryBytes() + none_.memoryBytes();
+  bytes += energy_.memoryBytes() + momentum_.memoryBytes() + energy_lost_.memoryBytes() + temperature_.memoryBytes() +
+           none_.memoryBytes();
   if (prediction) {
     bytes += prediction->run_id.capacity() + prediction->model_name.capacity() + prediction->model_reason.capacity() +
              doubles(prediction->final_velocities);

@@ -26,7 +26,9 @@
 #include "collision_lab/ros/bag_csv.h"
 #include "collision_lab/ros/bag_reading.h"
 #include "collision_lab/ros/msg_conversion.h"
+#include "collision_lab/ros/markers/layout.h"
 #include "collision_lab/ros/node_constants.h"
+#include "collision_lab/ros/run_view.h"
 #include "http_server.h"
 
 namespace collision_lab_web {
@@ -554,6 +556,14 @@ void WebServer::route(const HttpRequest& request, const Access& access, const Ht
       return reply.send(errorAnswer(request, 500, e.what()));
     }
     return reply.send(jsonAnswer(request, 200, out));
+  }
+  if (get && path == "/api/body_colours") {
+    // rviz's palette, body i in palette[i % size] (RunView's colours), for the start page's form.
+    json palette = json::array();
+    for (std::size_t i = 0; i < collision_lab_ros::markers::layout::kPaletteSize; ++i) {
+      palette.push_back(collision_lab_ros::bodyColourHex(i));
+    }
+    return reply.send(jsonAnswer(request, 200, json{{"palette", palette}}));
   }
   if (post && path == "/api/runs") return postRun(request, reply);
   if (get && path == "/api/runs") {

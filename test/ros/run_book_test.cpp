@@ -19,6 +19,8 @@
 #include <rosbag/bag.h>
 
 #include "collision_lab/ros/marker_builder.h"
+#include "collision_lab/ros/markers/draw.h"
+#include "collision_lab/ros/run_view.h"
 #include "collision_lab/web/run_book.h"
 
 namespace {
@@ -569,3 +571,58 @@ TEST(RunBookRejections, ListsTheIndexsRejectionsAsJson) {
   collision_lab_web::RunBook alone(smallBudget(1), nullptr);
   EXPECT_EQ(json::parse(alone.rejections(std::nullopt)).size(), 0u);
 }
+
+namespace {
+
+// The page and rviz get the same view description for the same run: the web JSON's view
+// texts equal rviz's title and note (marker builder) for the same messages.
+TEST(RunBookView, PageAndRvizGetTheSameViewDescription) {
+  collision_lab::InitialConditions input;
+  input.run_id = "ana.run1";
+  input.student = "ana";
+  input.masses = {1.0, 1.0, 1.0};
+  input.positions = {2.0, 1.0, 0.0};
+  input.velocities = {-1.0, 0.0, 1.0};
+  input.restitution = {0.05, 0.05};
+  input.max_collisions = 1000;
+  collision_lab::Prediction prediction;
+  prediction.run_id = "ana.run1";
+  prediction.model_name = "three_body_spiral";
+  prediction.model = collision_lab::Prediction::MODEL_THREE_BODY_SPIRAL;
+  prediction.collapsed = true;
+  prediction.collapse_time = 3.5;
+  prediction.infinite_collisions = true;
+  collision_lab::CollisionEvent collapse;
+  collapse.run_id = "ana.run1";
+  collapse.kind = collision_lab::CollisionEvent::KIND_COLLAPSE;
+  collapse.first_moved = 0;
+  collapse.last_moved = 2;
+  collapse.time = 3.5;
+  collapse.position = 1.0;
+  collapse.pair_velocities_after = {0.0, 0.0};
+  collision_lab::RunSummary summary;
+  summary.run_id = "ana.run1";
+  summary.student = "ana";
+  summary.simulated = true;
+  summary.collapsed = true;
+  summary.collapse_count = 1;
+  summary.recording_ok = false;
+
+  collision_lab_web::RunBook book;
+  book.onServedInput(input);
+  book.onPrediction(prediction);
+  book.onEvent(collapse);
+  book.onSummary(summary);
+  const json view = runJson(book, "ana.run1").at("view");
+
+  collision_lab_ros::RunRecord rviz(input);
+  rviz.prediction = prediction;
+  rviz.add(collapse);
+  rviz.summary = summary;
+  EXPECT_EQ(view.at("title"), collision_lab_ros::markers::runTitle(rviz));
+  EXPECT_EQ(view.at("note"), collision_lab_ros::markers::runNote(rviz));
+  EXPECT_EQ(view.at("collapse"), "collapse at t = 3.5 s, x = 1 m, bodies A..C");
+  EXPECT_EQ(view.at("worldline_bodies").at(0).at("colour"), collision_lab_ros::bodyColourHex(0));
+}
+
+}  // namespace

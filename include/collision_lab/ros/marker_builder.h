@@ -29,6 +29,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <ros/time.h>
@@ -163,6 +164,9 @@ class RunRecord {
   /// Collapses applied [1] and the first one's time [s] (NaN when none).
   std::uint32_t collapses() const { return collapses_; }
   double firstCollapseTime() const { return first_collapse_time_; }
+  /// The first collapse's point [m] (NaN when none) and bodies, first .. last [1].
+  double firstCollapsePosition() const { return first_collapse_position_; }
+  std::pair<std::size_t, std::size_t> firstCollapseBodies() const { return first_collapse_bodies_; }
   /// Time of the newest collision added [s] (0 before the first).
   double newestTime() const { return newest_time_; }
   /// Bounds of every finite velocity any body has had so far, the start's included [m/s]:
@@ -194,6 +198,9 @@ class RunRecord {
   const Envelope& energy() const { return energy_; }
   const Envelope& momentum() const { return momentum_; }
   const Envelope& energyLost() const { return energy_lost_; }
+  /// Granular temperature T = (1/N) sum m (v - V)^2 of the finite masses [J] against time
+  /// [s] (core::granularTemperature, from the running energy and momentum): the gas's T(t).
+  const Envelope& temperature() const { return temperature_; }
   /// Total kinetic energy of the finite masses at the start [J].
   double startEnergy() const { return start_energy_; }
   /// Bytes the record holds, itself included: its input, the replay's state, the kept
@@ -229,11 +236,16 @@ class RunRecord {
   std::uint64_t missed_ = 0, malformed_ = 0;
   std::uint32_t collapses_ = 0;
   double first_collapse_time_;
+  double first_collapse_position_;
+  std::pair<std::size_t, std::size_t> first_collapse_bodies_{0, 0};
   std::vector<std::size_t> tracked_, plotted_;
   std::vector<int> track_slot_, plot_slot_;  ///< body -> its series, -1 for none
   std::vector<Envelope> velocity_, paper_velocity_, body_energy_, worldline_;
   std::vector<Envelope> tracked_velocity_;  ///< empty unless no body is plotted
-  Envelope energy_, momentum_, energy_lost_, none_;
+  Envelope energy_, momentum_, energy_lost_, temperature_, none_;
+  double finite_mass_ = 0.0;         ///< [kg]
+  std::size_t finite_bodies_ = 0;    ///< [1]
+  double temperatureNow() const;
   double start_energy_ = 0.0;
   double min_velocity_, max_velocity_;
 };
