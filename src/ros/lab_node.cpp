@@ -865,15 +865,18 @@ std::string LabNode::newRunId(std::string& claim_error) {
   return run_id;
 }
 
+bool LabNode::servedBefore(const std::string& run_id) {
+  if (!run_index_->ok()) return false;
+  try {
+    return run_index_->index()->find(run_id).has_value();
+  } catch (const collision_lab::service::RunIndexError& e) {
+    ROS_WARN_STREAM("the run index cannot tell whether run_id '" << run_id << "' was served: " << e.what());
+    return false;
+  }
+}
+
 bool LabNode::claim(const std::string& run_id, std::string& claim_error) {
   if (used_run_ids_.contains(run_id)) return false;
-  if (run_index_->ok()) {
-    try {
-      if (run_index_->index()->find(run_id)) return false;  // served before, by this node or an earlier one
-    } catch (const collision_lab::service::RunIndexError& e) {
-      ROS_WARN_STREAM("the run index cannot tell whether run_id '" << run_id << "' was served: " << e.what());
-    }
-  }
   if (params_.record && claimBag(params_.bag_directory, run_id, claim_error) == BagClaim::kTaken) return false;
   used_run_ids_.add(run_id);
   return true;
@@ -882,8 +885,9 @@ bool LabNode::claim(const std::string& run_id, std::string& claim_error) {
 std::string LabNode::claimRunId(const std::string& requested, std::string& claim_error) {
   if (const auto series = numberedRunId(requested)) {  // a student's n-th run: the next free number
     std::uint64_t n = series->second;
-    while (!claim(series->first + std::to_string(n), claim_error)) ++n;
-    return series->first + std::to_string(n);
+    const auto numbered = [&] { return series->first + std::to_string(n); };
+    while (servedBefore(numbered()) || !claim(numbered(), claim_error)) ++n;
+    return numbered();
   }
   std::string run_id = requested;
   for (std::uint64_t n = 2; !claim(run_id, claim_error); ++n) {
