@@ -591,7 +591,8 @@ double ReplayClock::at(const RunRecord& run, const ros::Time& now, double wall) 
 
 visualization_msgs::MarkerArray buildStaticMarkers(const RunRecord& run, const std::string& frame_id) {
   visualization_msgs::MarkerArray array;
-  const markers::Canvas canvas{run, frame_id, array.markers};
+  const RunView view = makeRunView(run);
+  const markers::Canvas canvas{run, view, frame_id, array.markers};
   markers::drawTitle(canvas);
   markers::drawSceneAxis(canvas);
   markers::drawWedge(canvas);
@@ -607,7 +608,8 @@ visualization_msgs::MarkerArray buildStaticMarkers(const RunRecord& run, const s
 visualization_msgs::MarkerArray buildAnimatedMarkers(const RunRecord& run, const FrameClock& clock,
                                                      const std::string& frame_id) {
   visualization_msgs::MarkerArray array;
-  const markers::Canvas canvas{run, frame_id, array.markers};
+  const RunView view = makeRunView(run);
+  const markers::Canvas canvas{run, view, frame_id, array.markers};
   const SceneState state = stateAt(run, clock.t);
   markers::drawBodies(canvas, state);
   markers::drawMagnifier(canvas, state);
