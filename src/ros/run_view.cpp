@@ -231,11 +231,8 @@ RunView makeRunView(const RunRecord& run) {
   view.end_time = endTime(run);
   view.gas = isGas(run);
   if (view.gas) {
-    std::vector<collision_lab::core::TemperatureSample> samples;
-    for (const auto& v : run.temperature().polyline()) {
-      view.temperature.emplace_back(v.x, v.y);
-      samples.push_back({0, v.x, v.y});
-    }
+    const auto samples = run.temperature();
+    for (const auto& sample : samples) view.temperature.emplace_back(sample.time, sample.temperature);
     const auto fit = collision_lab::core::fitHaff(samples);
     view.haff_ok = fit.ok && std::isfinite(fit.tau);
     view.haff_t0 = fit.t0;

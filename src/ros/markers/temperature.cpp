@@ -105,7 +105,7 @@ void drawTemperature(const Canvas& c) {
     c.addLines(haff);
   }
   // The colours' key, then the view's legend (the page's words).
-  const std::string legend = "white: T(t);  cyan: Haff's law fitted on ln T.\n" + c.view.temperature_legend;
+  const std::string legend = "white: T,  cyan: Haff's fit.  " + c.view.temperature_legend;
   c.add(c.text(ns::kTemperature, kTemperatureLegend, kBarsBox.midX(), kTemperatureLegendY,
                wrapped(legend, kSmallTextSize, kLeftTextWidth), kSmallTextSize, color(kLabelGrey)));
 }
