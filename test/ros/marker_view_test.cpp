@@ -119,8 +119,19 @@ void expectRvizDrawsTheView(const RunRecord& run) {
       EXPECT_TRUE(find(animated, ids::ns::kWorldlinesNow, ids::kWorldNowLines + static_cast<int>(k))) << k;
     }
     EXPECT_FALSE(find(animated, ids::ns::kWorldlinesNow, ids::kWorldNowLines + static_cast<int>(view.worldline_bodies.size())));
+    // One velocity series per body the view names, and no more.
+    for (std::size_t k = 0; k < view.velocity_bodies.size(); ++k) {
+      EXPECT_TRUE(find(fixed, ids::ns::kPlot, ids::kPlotTracked + static_cast<int>(k))) << k;
+    }
+    EXPECT_FALSE(find(fixed, ids::ns::kPlot, ids::kPlotTracked + static_cast<int>(view.velocity_bodies.size())));
     if (!view.ring.empty()) {
       EXPECT_EQ(textOf(animated, ids::ns::kLabels, ids::kSceneRangeNote), "a " + view.ring + ": its ends meet");
+    }
+  }
+  if (run.bodies() <= kMaxPlottedBodies) {
+    // Few bodies: each velocity series named as the view names its body.
+    for (const ViewBody& body : view.velocity_bodies) {
+      EXPECT_EQ(textOf(fixed, ids::ns::kPlot, ids::kPlotSeriesNames + static_cast<int>(body.index)), "v_" + body.name);
     }
   }
   if (view.gas) {
