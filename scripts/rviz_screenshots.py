@@ -89,7 +89,7 @@ def main():
 
     to_cap = "--simulate-to-cap" in sys.argv[1:]
     wanted = set(sys.argv[1:]) - {"--simulate-to-cap"}
-    shots = ["hint", "not_simulated", "box", "collapse", "cluster", "ring", "gas", "rejected", "replay"]
+    shots = ["hint", "not_simulated", "box", "collapse", "cluster", "ring", "gas", "granular_gas", "rejected", "replay"]
     if to_cap:
         shots = ["box_to_cap"]
     if wanted - set(shots):
@@ -150,6 +150,13 @@ def main():
             preset("granular_ring", "granular_ring_end.png")
         elif shot == "gas":
             preset("gas_1000", "nbody_gas_1000_end.png")
+        elif shot == "granular_gas":
+            # A free granular gas: 100 bodies of 1 and 2 kg, 1 m apart, seeded velocities in
+            # [-1, 1] m/s, e = 0.9, no walls: T(t) and Haff's fit until it stops colliding.
+            rng = random.Random(31)
+            scene("granular_gas_100_end.png", run_id="granular_gas_100", masses=[1 + i % 2 for i in range(100)],
+                  positions=[99.0 - i for i in range(100)], velocities=[rng.uniform(-1, 1) for _ in range(100)],
+                  restitution=[0.9], max_collisions=100000)
         elif shot == "rejected":
             answer = run_scene(run_id="seven", student="ben", masses=[4, 1, 4, 1, 4, 1, 4],
                                positions=[0, 1, 2, 3, 4, 5, 6], velocities=[-1, 0, 0, 0, 0, 0, 1])

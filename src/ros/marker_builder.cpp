@@ -197,7 +197,8 @@ RunRecord::RunRecord(const collision_lab::InitialConditions& input, const Record
   paper_velocity_.assign(plotted_.size(), empty);
   body_energy_.assign(plotted_.size(), empty);
   worldline_.assign(tracked_.size(), empty);
-  energy_ = momentum_ = energy_lost_ = temperature_ = none_ = empty;
+  energy_ = momentum_ = energy_lost_ = none_ = empty;
+  temperature_ = {};
   for (std::size_t i = 0; i < n; ++i) widenVelocityRange(input_.velocities[i]);
   for (std::size_t k = 0; k < plotted_.size(); ++k) {
     const std::size_t i = plotted_[k];
@@ -216,7 +217,7 @@ RunRecord::RunRecord(const collision_lab::InitialConditions& input, const Record
   for (double m : input_.masses) {
     if (std::isfinite(m)) finite_mass_ += m, ++finite_bodies_;
   }
-  temperature_.add(0.0, temperatureNow());
+  temperature_.add({0, 0.0, temperatureNow()});
 }
 
 bool RunRecord::isWall(std::size_t i) const { return i < bodies() && replay_.isWall(i); }
@@ -308,7 +309,7 @@ void RunRecord::apply(const collision_lab::CollisionEvent& event) {
   energy_.step(k, replay_.totalKineticEnergy());
   momentum_.step(k, replay_.momentum());
   energy_lost_.step(k, replay_.heat());
-  temperature_.add(event.time, temperatureNow());
+  temperature_.add({event.index, event.time, temperatureNow()});
 }
 
 double RunRecord::temperatureNow() const {
@@ -394,8 +395,8 @@ std::size_t RunRecord::memoryBytes() const {
   bytes += doubles(newest_predicted_) + sizes(tracked_) + sizes(plotted_) + sizes(track_slot_) + sizes(plot_slot_);
   bytes += envelopes(velocity_) + envelopes(paper_velocity_) + envelopes(body_energy_) + envelopes(worldline_) +
            envelopes(tracked_velocity_);
-  bytes += energy_.memoryBytes() + momentum_.memoryBytes() + energy_lost_.memoryBytes() + temperature_.memoryBytes() +
-           none_.memoryBytes();
+  bytes += energy_.memoryBytes() + momentum_.memoryBytes() + energy_lost_.memoryBytes() + none_.memoryBytes() +
+           temperature_.samples().capacity() * sizeof(collision_lab::core::TemperatureSample);
   if (prediction) {
     bytes += prediction->run_id.capacity() + prediction->model_name.capacity() + prediction->model_reason.capacity() +
              doubles(prediction->final_velocities);
@@ -591,7 +592,8 @@ double ReplayClock::at(const RunRecord& run, const ros::Time& now, double wall) 
 
 visualization_msgs::MarkerArray buildStaticMarkers(const RunRecord& run, const std::string& frame_id) {
   visualization_msgs::MarkerArray array;
-  const markers::Canvas canvas{run, frame_id, array.markers};
+  const RunView view = makeRunView(run);
+  const markers::Canvas canvas{run, view, frame_id, array.markers};
   markers::drawTitle(canvas);
   markers::drawSceneAxis(canvas);
   markers::drawWedge(canvas);
@@ -607,7 +609,8 @@ visualization_msgs::MarkerArray buildStaticMarkers(const RunRecord& run, const s
 visualization_msgs::MarkerArray buildAnimatedMarkers(const RunRecord& run, const FrameClock& clock,
                                                      const std::string& frame_id) {
   visualization_msgs::MarkerArray array;
-  const markers::Canvas canvas{run, frame_id, array.markers};
+  const RunView view = makeRunView(run);
+  const markers::Canvas canvas{run, view, frame_id, array.markers};
   const SceneState state = stateAt(run, clock.t);
   markers::drawBodies(canvas, state);
   markers::drawMagnifier(canvas, state);

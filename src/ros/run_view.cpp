@@ -228,13 +228,11 @@ RunView makeRunView(const RunRecord& run) {
   view.worldline_legend = legendOf(run.trackedBodies().size(), run.bodies());
   view.velocity_legend = legendOf(view.velocity_bodies.size(), run.bodies());
 
+  view.end_time = endTime(run);
   view.gas = isGas(run);
   if (view.gas) {
-    std::vector<collision_lab::core::TemperatureSample> samples;
-    for (const auto& v : run.temperature().polyline()) {
-      view.temperature.emplace_back(v.x, v.y);
-      samples.push_back({0, v.x, v.y});
-    }
+    const auto samples = run.temperature();
+    for (const auto& sample : samples) view.temperature.emplace_back(sample.time, sample.temperature);
     const auto fit = collision_lab::core::fitHaff(samples);
     view.haff_ok = fit.ok && std::isfinite(fit.tau);
     view.haff_t0 = fit.t0;
@@ -243,9 +241,13 @@ RunView makeRunView(const RunRecord& run) {
         (view.haff_ok ? "; Haff's law T0/(1 + t/tau)^2 fitted: T0 = " + format("%.4g J", fit.t0) +
                             ", tau = " + format("%.4g s", fit.tau)
                       : std::string("; Haff's law: no fit (no cooling seen)"));
+    // T held from the last collision to the run's end: no collision changes it in the free
+    // flight after it (the fit above is to the collisions' values only).
+    if (!view.temperature.empty() && std::isfinite(view.end_time) && view.end_time > view.temperature.back().first) {
+      view.temperature.emplace_back(view.end_time, view.temperature.back().second);
+    }
   }
 
-  view.end_time = endTime(run);
   view.title = titleOf(run);
   view.note = noteOf(run, view);
   return view;

@@ -274,7 +274,8 @@ TEST(MarkerNBody, BallBetweenTwoWallsBouncesAtEverySecond) {
   EXPECT_EQ(at.positions[0], 1.0);
   EXPECT_EQ(at.positions[2], 0.0);
   // Infinitely many predicted, 1,000 simulated (the cap): at t = 15.9 s 16 bounces are
-  // behind, "of 1,000 simulated"; never a finite count "predicted".
+  // behind, and the run's counter (the view's) says 1,000, truncated; never a finite count
+  // "predicted".
   collision_lab::Prediction infinite;
   infinite.model = collision_lab::Prediction::MODEL_TWO_WALLS_INFINITE;
   infinite.infinite_collisions = true;
@@ -285,11 +286,13 @@ TEST(MarkerNBody, BallBetweenTwoWallsBouncesAtEverySecond) {
     return m ? m->text : std::string("(none)");
   };
   ASSERT_TRUE(r.run.summary && r.run.summary->truncated);
-  EXPECT_NE(status().find("collisions 16 of 1,000 simulated"), std::string::npos) << status();
+  EXPECT_NE(status().find("collisions 16     run: 1,000 collisions, truncated"), std::string::npos) << status();
   EXPECT_EQ(status().find("predicted"), std::string::npos) << status();
   const auto summary = r.run.summary;
   r.run.summary.reset();  // still running: the prediction is infinitely many
-  EXPECT_NE(status().find("collisions 16 (infinitely many predicted)"), std::string::npos) << status();
+  EXPECT_NE(status().find("collisions 16     run: 1,000 collisions so far (infinitely many predicted), running"),
+            std::string::npos)
+      << status();
   r.run.summary = summary;
   // The walls are walls (cubes), not spheres.
   const auto animated = buildAnimatedMarkers(r.run, FrameClock{10.0, "test"}, "f");
@@ -364,8 +367,8 @@ std::string statusAt(const RunRecord& run, double t) {
 
 TEST(MarkerNBody, StatusClaimsOnlyACountTheModelPredicted) {
   // The event engine predicts no count: while the run is coming in, the status says how
-  // many collisions were received, never "predicted". (Failed before: "(N predicted)", N
-  // being the count received so far.)
+  // many collisions were received (the view's counter), never "predicted". (Failed before:
+  // "(N predicted)", N being the count received so far.)
   NBodyRun r = sevenBodies();
   const std::uint64_t n = r.run.collisions();
   ASSERT_GT(n, 2u);
@@ -378,16 +381,19 @@ TEST(MarkerNBody, StatusClaimsOnlyACountTheModelPredicted) {
   const double first = r.events.front().time;
   const std::string shown = "collisions " + std::to_string(stateAt(r.run, first).collisions);
   ASSERT_LT(stateAt(r.run, first).collisions, n);
-  EXPECT_NE(statusAt(r.run, first).find(shown + " (" + std::to_string(n) + " received so far)"), std::string::npos)
+  EXPECT_NE(statusAt(r.run, first).find(shown + "     run: " + std::to_string(n) + " collisions so far, running"),
+            std::string::npos)
       << statusAt(r.run, first);
   EXPECT_EQ(statusAt(r.run, first).find("predicted"), std::string::npos) << statusAt(r.run, first);
-  // A model that predicts the count: "(n predicted)".
+  // A model that predicts the count: "n of n + 1 collisions predicted".
   collision_lab::Prediction ghosts;
   ghosts.model = collision_lab::Prediction::MODEL_GHOSTS;
   ghosts.collision_count_defined = true;
   ghosts.collision_count = n + 1;
   r.run.prediction = ghosts;
-  EXPECT_NE(statusAt(r.run, first).find(shown + " (" + std::to_string(n + 1) + " predicted)"), std::string::npos)
+  EXPECT_NE(statusAt(r.run, first).find(shown + "     run: " + std::to_string(n) + " of " + std::to_string(n + 1) +
+                                        " collisions predicted, running"),
+            std::string::npos)
       << statusAt(r.run, first);
 }
 

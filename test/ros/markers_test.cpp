@@ -63,7 +63,7 @@ TEST(Markers, HintRejectionAndTheTrueCountOnALongRun) {
   EXPECT_NE(watcher.banner.find("bad_order"), std::string::npos) << watcher.banner;
 
   inputs.publish(input("pi_digits_5_markers", 1.0e8, {2.0, 1.0, 0.0}));
-  const std::string done = "collisions 31,415 of 31,415";
+  const std::string done = "collisions 31,415     run: 31,415 collisions, finished";
   ASSERT_TRUE(spinUntil([&] { return watcher.status.find(done) != std::string::npos; }, kTimeout))
       << "the counter never reached the true count; last shown: " << watcher.status;
   EXPECT_EQ(watcher.largest_count, 31415);
@@ -112,7 +112,7 @@ TEST(Markers, ALateSummaryOfTheRunBeforeDoesNotTakeTheViewBack) {
   inputs.publish(input("right_after", 100.0, {2.0, 1.0, 0.0}));
   ASSERT_TRUE(spinUntil([&] { return summaries.count("long_before") && summaries.count("right_after"); }, kTimeout))
       << "both runs' summaries never came";
-  const std::string done = "collisions 31 of 31";
+  const std::string done = "collisions 31     run: 31 collisions, finished";
   ASSERT_TRUE(spinUntil([&] { return watcher.status.find(done) != std::string::npos; }, kTimeout))
       << "the view left the newest run; last shown: " << watcher.status << " / " << title;
   ASSERT_TRUE(spinUntil([&] { return title.find("simulated 31,") == std::string::npos &&
@@ -187,7 +187,7 @@ TEST(Markers, AViewThatFollowsAStudentShowsTheirRunsAndKeepsTheirRejection) {
   auto anas_run = input("anas_run", 100.0, {2.0, 1.0, 0.0});
   anas_run.student = "ana";
   inputs.publish(anas_run);
-  ASSERT_TRUE(spinUntil([&] { return watcher.status.find("collisions 31 of 31") != std::string::npos; }, kTimeout))
+  ASSERT_TRUE(spinUntil([&] { return watcher.status.find("collisions 31     run: 31 collisions, finished") != std::string::npos; }, kTimeout))
       << "ana's run never drawn; last shown: " << watcher.status;
   EXPECT_FALSE(banner_visible) << "the rejection stayed over ana's next run";
   bool titled = false;

@@ -41,6 +41,7 @@
 #include "collision_lab/Rejected.h"
 #include "collision_lab/RunSummary.h"
 #include "collision_lab/core/nbody/body_state_replay.h"
+#include "collision_lab/core/nbody/temperature.h"
 #include "collision_lab/ros/node_constants.h"
 
 namespace collision_lab_ros {
@@ -199,8 +200,11 @@ class RunRecord {
   const Envelope& momentum() const { return momentum_; }
   const Envelope& energyLost() const { return energy_lost_; }
   /// Granular temperature T = (1/N) sum m (v - V)^2 of the finite masses [J] against time
-  /// [s] (core::granularTemperature, from the running energy and momentum): the gas's T(t).
-  const Envelope& temperature() const { return temperature_; }
+  /// [s] (core::granularTemperature, from the running energy and momentum) after each
+  /// collision: the gas's T(t), thinned evenly in log t (core::LogTimeSamples: the start,
+  /// 50 per decade of time and the newest), so that a log-log plot and Haff's fit see the
+  /// early cooling of a run that lasts 1e7 s.
+  std::vector<collision_lab::core::TemperatureSample> temperature() const { return temperature_.samples(); }
   /// Total kinetic energy of the finite masses at the start [J].
   double startEnergy() const { return start_energy_; }
   /// Bytes the record holds, itself included: its input, the replay's state, the kept
@@ -242,7 +246,8 @@ class RunRecord {
   std::vector<int> track_slot_, plot_slot_;  ///< body -> its series, -1 for none
   std::vector<Envelope> velocity_, paper_velocity_, body_energy_, worldline_;
   std::vector<Envelope> tracked_velocity_;  ///< empty unless no body is plotted
-  Envelope energy_, momentum_, energy_lost_, temperature_, none_;
+  Envelope energy_, momentum_, energy_lost_, none_;
+  collision_lab::core::LogTimeSamples temperature_;
   double finite_mass_ = 0.0;         ///< [kg]
   std::size_t finite_bodies_ = 0;    ///< [1]
   double temperatureNow() const;

@@ -66,8 +66,9 @@ struct RunView {
   std::vector<ViewBody> worldline_bodies, velocity_bodies;
   std::string worldline_legend, velocity_legend;
 
-  /// A gas: its granular temperature T(t) (t [s], T [J]) and Haff's law T0 / (1 + t/tau)^2
-  /// fitted to it (core::fitHaff; haff_ok false when it cannot be fitted), with its legend.
+  /// A gas: its granular temperature T(t) (t [s], T [J]), from the start to end_time (held
+  /// after the last collision), and Haff's law T0 / (1 + t/tau)^2 fitted to it (core::fitHaff;
+  /// haff_ok false when it cannot be fitted), with its legend. rviz's T(t) panel draws these.
   std::vector<std::pair<double, double>> temperature;
   bool haff_ok = false;
   double haff_t0 = 0.0;   ///< [J]

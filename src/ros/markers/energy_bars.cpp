@@ -17,7 +17,7 @@ double barX(std::size_t i, std::size_t n) { return kBarsBox.left + (static_cast<
 }  // namespace
 
 void drawEnergyBarsAxis(const Canvas& c) {
-  if (temperatureView(c.run)) return;
+  if (c.view.gas) return;
   Marker axis = c.lines(ns::kEnergy, kEnergyAxis, Marker::LINE_LIST, kAxisWidth, color(kGrey));
   axis.points = {point(kBarsBox.left, kBarsBox.bottom), point(kBarsBox.right, kBarsBox.bottom)};
   c.add(axis);
@@ -34,7 +34,7 @@ void drawEnergyBarsAxis(const Canvas& c) {
 }
 
 void drawEnergyBars(const Canvas& c, const SceneState& state) {
-  if (temperatureView(c.run)) return;
+  if (c.view.gas) return;
   const std::size_t n = c.run.bodies();
   std::vector<double> kinetic(n, 0.0);
   double total = 0.0;

@@ -16,12 +16,6 @@ bool simulatedStepByStep(const RunRecord& run) {
 
 }  // namespace
 
-std::uint64_t expectedCollisions(const RunRecord& run) {
-  if (run.summary && run.summary->simulated && !run.summary->truncated) return run.summary->collision_count;
-  if (run.prediction && run.prediction->collision_count_defined) return std::max<std::uint64_t>(run.prediction->collision_count, run.collisions());
-  return run.collisions();
-}
-
 std::uint64_t Period::inPeriod(double t, std::uint64_t collisions) const {
   const std::uint64_t behind = before(t) * impacts;
   return std::min(impacts, collisions > behind ? collisions - behind : 0);
@@ -41,9 +35,9 @@ std::string periodsSoFar(const Period& period, double t) {
   return "periods so far: " + withSeparators(period.before(t));
 }
 
-double indexAxisEnd(const RunRecord& run) {
+double indexAxisEnd(const RunRecord& run, const RunView& view) {
   if (const auto period = periodOf(run)) return static_cast<double>(period->impacts) + 1.0;
-  const std::uint64_t n = simulatedStepByStep(run) ? run.collisions() : expectedCollisions(run);
+  const std::uint64_t n = simulatedStepByStep(run) ? run.collisions() : view.expected.value_or(run.collisions());
   return static_cast<double>(n) + 1.0;
 }
 
@@ -63,22 +57,15 @@ std::string runTitle(const RunRecord& run) { return makeRunView(run).title; }
 
 std::string runNote(const RunRecord& run) { return makeRunView(run).note; }
 
-std::string statusLine(const RunRecord& run, const SceneState& state, const FrameClock& clock) {
-  std::string s = format("t = %.6g s", state.time) + "     collisions " + withSeparators(state.collisions);
-  // "of N" only for what is known: the whole run, or what a cut-short run simulated;
-  // "predicted" only for a count the model predicted.
-  const bool count_predicted = run.prediction && run.prediction->collision_count_defined &&
-                               !run.prediction->infinite_collisions;
-  if (run.finished()) {
-    s += " of " + withSeparators(run.collisions());
-  } else if (run.summary && run.summary->simulated) {
-    s += " of " + withSeparators(run.summary->collision_count) + " simulated";
-  } else if (run.prediction && run.prediction->infinite_collisions) {
-    s += " (infinitely many predicted)";
-  } else if (count_predicted && expectedCollisions(run) > state.collisions) {
-    s += " (" + withSeparators(expectedCollisions(run)) + " predicted)";
-  } else if (run.collisions() > state.collisions) {
-    s += " (" + withSeparators(run.collisions()) + " received so far)";
+std::string statusLine(const RunView& view, const SceneState& state, const FrameClock& clock) {
+  std::string s = format("t = %.6g s", state.time);
+  // The collisions behind now (a replay passes them one by one), then the run's counter,
+  // collapse, ring and box as the page says them; a run not simulated has no collisions to
+  // count.
+  if (view.not_simulated.empty()) s += "     collisions " + withSeparators(state.collisions);
+  s += "     run: " + view.counter;
+  for (const std::string* fact : {&view.collapse, &view.ring, &view.box}) {
+    if (!fact->empty()) s += ";  " + *fact;
   }
   if (!clock.description.empty()) s += "     " + clock.description;
   return s;

@@ -233,7 +233,7 @@ SceneAxis bodiesAxis(const RunRecord& run, const SceneState& state) {
 }
 
 void drawTitle(const Canvas& c) {
-  c.add(c.text(ns::kTitle, kTitleText, kCentreX, kTitleY, runTitle(c.run), kTitleSize));
+  c.add(c.text(ns::kTitle, kTitleText, kCentreX, kTitleY, c.view.title, kTitleSize));
 }
 
 void drawSceneAxis(const Canvas& c) {
@@ -241,7 +241,7 @@ void drawSceneAxis(const Canvas& c) {
   axis.points = {point(kSceneLeft, kSceneY), point(kSceneRight, kSceneY)};
   c.add(axis);
   if (!largeScene(c.run)) addRangeLabels(c, ns::kScene, kSceneMinLabel, kSceneMaxLabel, sceneAxis(c.run));
-  const std::string note = runNote(c.run);
+  const std::string& note = c.view.note;
   if (!note.empty()) c.add(c.text(ns::kScene, kSceneNote, kCentreX, kNoteY, note, kTextSize, color(kAmber)));
   if (largeScene(c.run)) drawColourLegend(c);
 }
@@ -252,9 +252,7 @@ void drawBodies(const Canvas& c, const SceneState& state) {
     drawManyBodies(c, state, axis);
     addRangeLabels(c, ns::kLabels, kSceneNowMin, kSceneNowMax, axis);
     // What the axis spans, in the right end label's row, left of it.
-    const double ring = c.run.input().ring;
-    const std::string note =
-        ring > 0 ? "a ring of " + positionText(ring, false) + " m: its ends meet" : "x range: the bodies now";
+    const std::string note = c.view.ring.empty() ? "x range: the bodies now" : "a " + c.view.ring + ": its ends meet";
     const PlacedText right = endLabels(c.run, axis)[1];
     const double note_x = right.x - textWidth(right.text, kSmallTextSize) / 2 - kSceneRangeNoteGap -
                           textWidth(note, kSmallTextSize) / 2;
@@ -265,7 +263,7 @@ void drawBodies(const Canvas& c, const SceneState& state) {
 }
 
 void drawStatus(const Canvas& c, const SceneState& state, const FrameClock& clock) {
-  c.add(c.text(ns::kLabels, kStatus, kCentreX, kStatusY, statusLine(c.run, state, clock), kTextSize));
+  c.add(c.text(ns::kLabels, kStatus, kCentreX, kStatusY, statusLine(c.view, state, clock), kTextSize));
 }
 
 }  // namespace collision_lab_ros::markers

@@ -31,8 +31,9 @@ const Envelope& stepsOf(const RunRecord& run, std::size_t i) {
 /// motion's first period only (a thousand periods would fill the panel with steps thinner
 /// than a pixel).
 Polyline shownSteps(const RunRecord& run, const Envelope& e) {
-  if (!periodOf(run)) return withTail(e, static_cast<double>(run.collisions()) + 1);
-  const double end = indexAxisEnd(run);
+  const std::optional<Period> period = periodOf(run);
+  if (!period) return withTail(e, static_cast<double>(run.collisions()) + 1);
+  const double end = static_cast<double>(period->impacts) + 1.0;
   Polyline poly;
   for (const auto& v : e.polyline()) {
     if (v.x < end) poly.push_back(v);
@@ -64,23 +65,25 @@ std::pair<double, double> velocityRange(const RunRecord& run, const std::vector<
   return paddedRange(lo, hi);
 }
 
-/// One panel for all plotted bodies, or (three bodies) B on its own (top) when it dwarfs
-/// A and C.
-std::vector<VelocityPanel> velocityPanels(const RunRecord& run) {
-  const double x1 = indexAxisEnd(run);
+/// One panel for the bodies the view shows (RunView::velocity_bodies), or (three bodies) B
+/// on its own (top) when it dwarfs A and C.
+std::vector<VelocityPanel> velocityPanels(const Canvas& c) {
+  const RunRecord& run = c.run;
+  const double x1 = indexAxisEnd(run, c.view);
   const auto panel = [&](const Box& box, const std::vector<std::size_t>& bodies) {
     const auto [y0, y1] = velocityRange(run, bodies);
     return VelocityPanel{Axes{box, 0.0, x1, y0, y1}, bodies};
   };
-  if (largeScene(run)) return {panel(kVelocityBox, run.trackedBodies())};
-  if (run.bodies() != 3) return {panel(kVelocityBox, run.plottedBodies())};
+  std::vector<std::size_t> shown;
+  for (const ViewBody& body : c.view.velocity_bodies) shown.push_back(body.index);
+  if (run.bodies() != 3) return {panel(kVelocityBox, shown)};
   const double others = std::max(largestSpeed(run.velocity(0)), largestSpeed(run.velocity(2)));
   if (largestSpeed(run.velocity(1)) > kOwnScaleFactor * others) {
     const double middle = kVelocityBox.midY();
     return {panel({kVelocityBox.left, kVelocityBox.right, middle + kOwnPanelGap / 2, kVelocityBox.top}, {1}),
             panel({kVelocityBox.left, kVelocityBox.right, kVelocityBox.bottom, middle - kOwnPanelGap / 2}, {0, 2})};
   }
-  return {panel(kVelocityBox, {0, 1, 2})};
+  return {panel(kVelocityBox, shown)};
 }
 
 /// The paper's series of body i where it differs from the simulated one; true when some
@@ -151,22 +154,22 @@ void addVelocityLegend(const Canvas& c, bool own_scale, const PaperShown& paper)
   if (const auto period = periodOf(c.run)) {
     legend += "   periodic: one period drawn (" + withSeparators(period->impacts) + " impacts)";
   }
-  if (largeScene(c.run)) {
-    legend = withSeparators(c.run.trackedBodies().size()) + " of " + withSeparators(c.run.bodies()) +
-             " bodies (those of the x-t diagram), coloured by v at the start";
-  }
+  // Many bodies: which ones, as the page says it (their colour is v at the start, as in the
+  // x-t diagram and the scene's colour bar).
+  if (largeScene(c.run)) legend = c.view.velocity_legend;
   c.add(c.text(ns::kPlot, kPlotLegend, kVelocityBox.midX(), kLegendY, legend, kSmallTextSize, color(kLabelGrey)));
-  const auto& plotted = c.run.plottedBodies();
-  for (std::size_t k = 0; k < plotted.size(); ++k) {
-    c.add(c.text(ns::kPlot, kPlotSeriesNames + static_cast<int>(plotted[k]), kVelocityBox.right + kSeriesNameDx,
-                 kVelocityBox.top - kSeriesNamePitch * static_cast<double>(k), "v_" + bodyName(plotted[k]),
-                 plotted.size() <= 3 ? kTextSize : kSmallTextSize, particleColor(plotted[k])));
+  if (largeScene(c.run)) return;
+  const auto& shown = c.view.velocity_bodies;
+  for (std::size_t k = 0; k < shown.size(); ++k) {
+    const int id = kPlotSeriesNames + static_cast<int>(shown[k].index);
+    c.add(c.text(ns::kPlot, id, kVelocityBox.right + kSeriesNameDx, kVelocityBox.top - kSeriesNamePitch * static_cast<double>(k),
+                 "v_" + shown[k].name, shown.size() <= 3 ? kTextSize : kSmallTextSize, particleColor(shown[k].index)));
   }
 }
 
 void addConservedPlot(const Canvas& c, const Envelope& series, const Box& box, int base, const std::string& label) {
   const auto [y0, y1] = paddedRange(series.minY(), series.maxY());
-  const Axes axes{box, 0.0, indexAxisEnd(c.run), y0, y1};
+  const Axes axes{box, 0.0, indexAxisEnd(c.run, c.view), y0, y1};
   addFrame(c, ns::kConserved, base, axes, label);
   addSeries(c, ns::kConserved, base + kConservedSeries, shownSteps(c.run, series), axes, color(kWhite), kConservedWidth);
   addIndexAxisLabels(c, ns::kConserved, base + kConservedIndexLabels, axes);
@@ -180,7 +183,7 @@ void addEnergyPlot(const Canvas& c, const std::string& label) {
   double hi = std::max(run.energy().maxY(), run.energyLost().maxY());
   for (std::size_t i : run.plottedBodies()) lo = std::min(lo, run.bodyEnergy(i).minY()), hi = std::max(hi, run.bodyEnergy(i).maxY());
   const auto [y0, y1] = paddedRange(lo, hi);
-  const Axes axes{kEnergyBox, 0.0, indexAxisEnd(run), y0, y1};
+  const Axes axes{kEnergyBox, 0.0, indexAxisEnd(run, c.view), y0, y1};
   addFrame(c, ns::kConserved, kConservedEnergy, axes, label);
   for (std::size_t i : run.plottedBodies()) {
     addSeries(c, ns::kConserved, kConservedEnergy + kConservedBodies + static_cast<int>(i),
@@ -198,7 +201,7 @@ void addEnergyPlot(const Canvas& c, const std::string& label) {
 }  // namespace
 
 void drawVelocitySteps(const Canvas& c) {
-  const auto panels = velocityPanels(c.run);
+  const auto panels = velocityPanels(c);
   PaperShown paper;
   for (std::size_t p = 0; p < panels.size(); ++p) addVelocityPanel(c, panels[p], static_cast<int>(p), panels.size(), paper);
   addIndexAxisLabels(c, ns::kPlot, kPlotIndexLabels, panels.back().axes);
@@ -223,7 +226,7 @@ void drawConservedSteps(const Canvas& c) {
 void drawStepsCursor(const Canvas& c, const SceneState& state) {
   // The current step [k, k+1] of the index plots, across the velocity, energy and momentum
   // plots; a periodic motion's step within its period, and the periods so far.
-  const Axes index{kVelocityBox, 0.0, indexAxisEnd(c.run), 0.0, 1.0};
+  const Axes index{kVelocityBox, 0.0, indexAxisEnd(c.run, c.view), 0.0, 1.0};
   const std::optional<Period> period = periodOf(c.run);
   const std::uint64_t step = period ? period->inPeriod(state.time, state.collisions) : state.collisions;
   const double cx = index.toX(static_cast<double>(step) + 0.5);

@@ -1,9 +1,8 @@
-// Large inelastic scenes (a granular gas), in the kinetic energy bars' place: the granular
-// temperature T(t) on log-log axes (static: from the kept exact states, core::
-// granularTemperature) beside Haff's law T0 / (1 + t/tau)^2 fitted to it (core::fitHaff:
-// T0 and tau, least squares on ln T), labelled with tau, both to the run's end; and T now, as a dot on the curve
-// and a line of text with the kinetic energy now (animated). What the core computes; this
-// file only draws it.
+// Large inelastic scenes (a granular gas), in the kinetic energy bars' place: the view's
+// granular temperature T(t) (RunView::temperature, to the run's end) on log-log axes beside
+// Haff's law T0 / (1 + t/tau)^2 fitted to it (RunView::haff_t0, haff_tau), with the view's
+// legend: what the page draws too. And T now, as a dot on the curve and a line of text with
+// the kinetic energy now (animated, from the state shown).
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -17,34 +16,7 @@ using namespace layout;
 
 namespace {
 
-std::vector<double> massesOf(const RunRecord& run) {
-  return std::vector<double>(run.input().masses.begin(), run.input().masses.end());
-}
-
-/// T just after each kept state, and at the start, thinned to 50 per decade of time.
-std::vector<collision_lab::core::TemperatureSample> temperatureSamples(const RunRecord& run) {
-  const std::vector<double> masses = massesOf(run);
-  collision_lab::core::LogTimeSamples thin;
-  const auto& in = run.input();
-  thin.add({0, 0.0, collision_lab::core::granularTemperature(masses, {in.velocities.begin(), in.velocities.end()})});
-  for (const Keyframe& f : run.keyframes()) {
-    thin.add({f.index, f.time, collision_lab::core::granularTemperature(masses, f.velocities)});
-  }
-  return thin.samples();
-}
-
-/// The samples, and T held from the last one to the run's end (endTime): no collision
-/// changes it in the free flight after the last one. What the curve draws and its axes hold.
-std::vector<collision_lab::core::TemperatureSample> toRunEnd(const RunRecord& run,
-                                                             std::vector<collision_lab::core::TemperatureSample> samples) {
-  const double end = endTime(run);
-  if (!samples.empty() && end > samples.back().time) {
-    collision_lab::core::TemperatureSample held = samples.back();
-    held.time = end;
-    samples.push_back(held);
-  }
-  return samples;
-}
+using Samples = std::vector<std::pair<double, double>>;  ///< (t [s], T [J])
 
 /// log10 t across, log10 T up: the samples at t > 0 with T > 0 (a decade at least each way).
 struct LogAxes {
@@ -54,15 +26,15 @@ struct LogAxes {
   double toY(double temperature) const { return axes.toY(std::log10(temperature)); }
 };
 
-LogAxes logAxes(const std::vector<collision_lab::core::TemperatureSample>& samples) {
+LogAxes logAxes(const Samples& samples) {
   double t0 = std::numeric_limits<double>::infinity(), t1 = 0.0, lo = t0, hi = 0.0;
-  for (const auto& s : samples) {
-    if (!(s.time > 0 && s.temperature > 0)) continue;
-    t0 = std::min(t0, s.time), t1 = std::max(t1, s.time);
-    lo = std::min(lo, s.temperature), hi = std::max(hi, s.temperature);
+  for (const auto& [time, temperature] : samples) {
+    if (!(time > 0 && temperature > 0)) continue;
+    t0 = std::min(t0, time), t1 = std::max(t1, time);
+    lo = std::min(lo, temperature), hi = std::max(hi, temperature);
   }
   // The start's T is the top of the curve, though it has no place on a log time axis.
-  if (!samples.empty() && samples.front().temperature > 0) hi = std::max(hi, samples.front().temperature);
+  if (!samples.empty() && samples.front().second > 0) hi = std::max(hi, samples.front().second);
   LogAxes out;
   out.ok = t1 > 0 && hi > 0;
   if (!out.ok) return out;
@@ -79,18 +51,12 @@ std::string decade(double exponent) { return format("%g", std::pow(10.0, exponen
 
 }  // namespace
 
-bool temperatureView(const RunRecord& run) {
-  const auto& e = run.input().restitution;
-  return largeScene(run) && std::any_of(e.begin(), e.end(), [](double value) { return value < 1.0; });
-}
-
 void drawTemperature(const Canvas& c) {
-  if (!temperatureView(c.run)) return;
+  if (!c.view.gas) return;
   const Box& b = kTemperatureBox;
   c.add(c.text(ns::kTemperature, kTemperatureTitle, kBarsBox.midX(), kBarsBox.top + kBarsTitleDy,
                "granular temperature T(t) [J], log-log", kTextSize));
-  const auto samples = temperatureSamples(c.run);
-  const auto drawn = toRunEnd(c.run, samples);
+  const Samples& drawn = c.view.temperature;
   const LogAxes log = logAxes(drawn);
   if (!log.ok) {
     c.add(c.text(ns::kTemperature, kTemperatureLegend, b.midX(), b.midY(), "no collision yet", kSmallTextSize,
@@ -120,34 +86,33 @@ void drawTemperature(const Canvas& c) {
 
   // T over the fit (and thicker): where the two agree, the white line is the one seen.
   Marker series = c.lines(ns::kTemperature, kTemperatureSeries, Marker::LINE_STRIP, kTemperatureWidth, color(kWhite));
-  for (const auto& s : drawn) {
-    if (s.time > 0 && s.temperature > 0) series.points.push_back(point(log.toX(s.time), log.toY(s.temperature), kDotZ));
+  double last = a.x0;  // log10 of the curve's last time [s]
+  for (const auto& [time, temperature] : drawn) {
+    if (!(time > 0 && temperature > 0)) continue;
+    series.points.push_back(point(log.toX(time), log.toY(temperature), kDotZ));
+    last = std::log10(time);
   }
   c.addLines(series);
 
-  const collision_lab::core::HaffFit fit = collision_lab::core::fitHaff(samples);
-  std::string legend = "white: T = sum m (v - V)^2 / N\ncyan: Haff's law T0/(1 + t/tau)^2 fitted on ln T:\n";
-  if (fit.ok && std::isfinite(fit.tau)) {
+  if (c.view.haff_ok) {
     // From the axis' start to the run's end, not beyond: the law is fitted to this run.
     Marker haff = c.lines(ns::kTemperature, kTemperatureHaff, Marker::LINE_STRIP, kCursorWidth, color(kHaffCyan));
-    const double last = std::log10(drawn.back().time);
     for (int k = 0; k <= kHaffSegments; ++k) {
       const double t = std::pow(10.0, a.x0 + (last - a.x0) * k / kHaffSegments);
-      const double value = fit.t0 / ((1 + t / fit.tau) * (1 + t / fit.tau));
+      const double value = c.view.haff_t0 / ((1 + t / c.view.haff_tau) * (1 + t / c.view.haff_tau));
       if (value > 0) haff.points.push_back(point(log.toX(t), log.toY(value)));
     }
     c.addLines(haff);
-    legend += format("tau = %.3g s", fit.tau) + format(", T0 = %.3g J", fit.t0);
-  } else {
-    legend += fit.ok ? "T does not fall" : "too few states";
   }
+  // The colours' key, then the view's legend (the page's words).
+  const std::string legend = "white: T,  cyan: Haff's fit.  " + c.view.temperature_legend;
   c.add(c.text(ns::kTemperature, kTemperatureLegend, kBarsBox.midX(), kTemperatureLegendY,
                wrapped(legend, kSmallTextSize, kLeftTextWidth), kSmallTextSize, color(kLabelGrey)));
 }
 
 void drawTemperatureNow(const Canvas& c, const SceneState& state) {
-  if (!temperatureView(c.run)) return;
-  const std::vector<double> masses = massesOf(c.run);
+  if (!c.view.gas) return;
+  const std::vector<double> masses(c.run.input().masses.begin(), c.run.input().masses.end());
   const double now = collision_lab::core::granularTemperature(masses, state.velocities);
   double energy = 0.0;  // [J] of the finite masses shown
   for (std::size_t i = 0; i < masses.size() && i < state.velocities.size(); ++i) {
@@ -157,7 +122,7 @@ void drawTemperatureNow(const Canvas& c, const SceneState& state) {
                format("now: T = %.3g J,  E = ", now) + format("%.3g J", energy) +
                    format(" of %.3g J", c.run.startEnergy()),
                kSmallTextSize));
-  const LogAxes log = logAxes(toRunEnd(c.run, temperatureSamples(c.run)));
+  const LogAxes log = logAxes(c.view.temperature);
   if (!(log.ok && state.time > 0 && now > 0)) {
     c.add(deleteMarker(ns::kTemperatureNow, kTemperatureNowDot, c.frame_id));
     return;

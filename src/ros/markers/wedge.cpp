@@ -135,14 +135,14 @@ bool inelastic(const collision_lab::InitialConditions& input) {
   return restitutionOf(input, 0) < 1 || restitutionOf(input, 1) < 1;
 }
 
-/// The legend's line on e: the spiral, or the collapse with r_c.
-std::string restitutionLegend(const RunRecord& run) {
+/// The legend's line on e: the spiral, or (the view names a collapse) the collapse with r_c.
+std::string restitutionLegend(const Canvas& c) {
+  const RunRecord& run = c.run;
   const double e0 = restitutionOf(run.input(), 0), e1 = restitutionOf(run.input(), 1);
   std::string s = e0 == e1 ? format("e = %.4g", e0) : format("e_AB = %.4g", e0) + format(", e_BC = %.4g", e1);
   const double r_c = run.prediction ? run.prediction->critical_restitution : std::nan("");
   if (std::isfinite(r_c)) s += format(", r_c = %.4g", r_c);
-  const bool collapsed = (run.prediction && run.prediction->collapsed) || run.collapses() > 0;
-  s += collapsed ? ": collapse; violet: eigen-directions" : ": a spiral (shrinks each cycle)";
+  s += !c.view.collapse.empty() ? ": collapse; violet: eigen-directions" : ": a spiral (shrinks each cycle)";
   return s;
 }
 
@@ -160,7 +160,7 @@ void addWedgeLegend(const Canvas& c, const std::vector<const Keyframe*>& shown, 
   if (collapses > 0) which += collapses == 1 ? " and a collapse" : " and " + withSeparators(collapses) + " collapses";
   c.add(c.text(ns::kWedge, kWedgeKey, kWedgeX, kLegendY, wrapped("orange: u_perp after " + which, kSmallTextSize, kLeftTextWidth),
                kSmallTextSize, color(kLabelGrey)));
-  const std::string rest = lossy       ? "yellow: its direction; " + restitutionLegend(run)
+  const std::string rest = lossy       ? "yellow: its direction; " + restitutionLegend(c)
                            : predicted ? "violet: closed form"
                                        : "";
   if (rest.empty()) return;
@@ -197,7 +197,7 @@ void drawWedge(const Canvas& c) {
   const bool lossy = inelastic(run.input());
   if (lossy) {
     addDirections(c, wedge, shown);
-    if ((run.prediction && run.prediction->collapsed) || run.collapses() > 0) addEigenDirections(c, wedge);
+    if (!c.view.collapse.empty()) addEigenDirections(c, wedge);
   }
   c.addLines(path);
   c.add(sim);

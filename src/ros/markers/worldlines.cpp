@@ -50,11 +50,14 @@ void addWorldRange(const Canvas& c, const std::string& ns, int end_id, int min_i
                kSmallTextSize));
 }
 
-/// Large scenes: the tracked worldlines from 0 to now, and the axes that hold them (time up
-/// to now; positions over the worldlines so far and the bodies now).
-WorldAxes axesUpToNow(const RunRecord& run, const SceneState& state, std::vector<Polyline>& lines) {
+/// Large scenes: the shown bodies' worldlines (RunView::worldline_bodies) from 0 to now, and
+/// the axes that hold them (time up to now; positions over the worldlines so far and the
+/// bodies now).
+WorldAxes axesUpToNow(const Canvas& c, const SceneState& state, std::vector<Polyline>& lines) {
+  const RunRecord& run = c.run;
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-  for (std::size_t i : run.trackedBodies()) {
+  for (const ViewBody& body : c.view.worldline_bodies) {
+    const std::size_t i = body.index;
     Polyline poly;
     for (const auto& v : run.worldline(i).polyline()) {
       if (v.x >= state.time) break;
@@ -99,7 +102,8 @@ Polyline perRow(const Polyline& poly, double end, int rows) {
 /// worldlines: the worldline's colour shows between the dashes.
 void addGhosts(const Canvas& c, const std::string& ns, int id, const WorldAxes& axes) {
   Marker ghosts = c.lines(ns, id, Marker::LINE_LIST, kGhostWidth, color(kGhostGrey));
-  for (std::size_t i : c.run.trackedBodies()) {
+  for (const ViewBody& body : c.view.worldline_bodies) {
+    const std::size_t i = body.index;
     const double x = c.run.input().positions[i], v = c.run.input().velocities[i];
     // Inside the box while scene.min <= x + v t <= scene.max.
     double t_end = axes.end;
@@ -194,7 +198,7 @@ void drawWorldlines(const Canvas& c) {
   frame.points = {point(b.left, b.bottom), point(b.right, b.bottom), point(b.left, b.bottom), point(b.left, b.top)};
   c.add(frame);
   addWorldUnits(c);
-  const auto& tracked = c.run.trackedBodies();
+  const auto& shown = c.view.worldline_bodies;
   const bool large = largeScene(c.run);
   // Large scenes draw the worldlines up to now, every frame (drawWorldlinesCursor).
   // A periodic motion: its first period, the rest repeats it (a thousand periods would
@@ -203,8 +207,8 @@ void drawWorldlines(const Canvas& c) {
   if (!large) {
     const WorldAxes axes = wholeRunAxes(c.run);
     const SceneState last = stateAt(c.run, axes.end);
-    for (std::size_t k = 0; k < tracked.size(); ++k) {
-      const std::size_t i = tracked[k];
+    for (std::size_t k = 0; k < shown.size(); ++k) {
+      const std::size_t i = shown[k].index;
       Polyline poly;
       for (const auto& v : c.run.worldline(i).polyline()) {
         if (v.x < axes.end) poly.push_back(v);
@@ -218,24 +222,24 @@ void drawWorldlines(const Canvas& c) {
   c.add(c.text(ns::kWorldlines, kWorldTitle, b.midX(), kPanelTitleY,
                large ? "x-t diagram (worldlines), up to now" : "x-t diagram (worldlines)", kTextSize));
   bool exact = true;
-  for (std::size_t i : tracked) exact = exact && c.run.worldline(i).exact();
-  // Short enough to stay on screen in one line (the inexact legend ran off its right edge).
+  for (const ViewBody& body : shown) exact = exact && c.run.worldline(body.index).exact();
   std::string legend = exact ? "exact" : "min/max of x per row";
-  if (tracked.size() < c.run.bodies()) {
-    legend += "; " + withSeparators(tracked.size()) + " of " + withSeparators(c.run.bodies()) +
-              " bodies, colour: v at the start";
-  }
-  // One line: a second would run into the "t [s]" label over the box.
+  // Many bodies: which ones, as the page says it, coloured by v at the start.
+  if (large) legend += "; " + c.view.worldline_legend + "; colour: v at the start";
   if (ghostScene(c.run)) legend += ";  grey dashes: ghosts x_i + v_i t, passing through";
   if (mayCluster(c.run)) legend += ";  amber: clusters, moving as one";
   if (period) legend = format("periodic: one period drawn, T = %.4g s; now at t mod T", period->time);
-  c.add(c.text(ns::kWorldlines, kWorldLegend, b.midX(), kLegendY, legend, kSmallTextSize, color(kLabelGrey)));
+  // Its first line under the title, the others down into the box's top margin, clear of the
+  // "t [s]" label at the box's left.
+  legend = wrapped(legend, kSmallTextSize, b.right - b.left - 2 * kWorldLegendInset);
+  const double below = (static_cast<double>(textExtent(legend).second) - 1) * kHalfLineHeight * kSmallTextSize;
+  c.add(c.text(ns::kWorldlines, kWorldLegend, b.midX(), kLegendY - below, legend, kSmallTextSize, color(kLabelGrey)));
 }
 
 void drawWorldlinesCursor(const Canvas& c, const SceneState& state) {
   const bool large = largeScene(c.run);
   std::vector<Polyline> lines;
-  const WorldAxes world = large ? axesUpToNow(c.run, state, lines) : wholeRunAxes(c.run);
+  const WorldAxes world = large ? axesUpToNow(c, state, lines) : wholeRunAxes(c.run);
   const std::optional<Period> period = large ? std::nullopt : periodOf(c.run);
   // A periodic motion: now within its period, and how many periods are behind.
   const double t_now = period ? std::fmod(state.time, period->time) : state.time;
@@ -247,7 +251,7 @@ void drawWorldlinesCursor(const Canvas& c, const SceneState& state) {
   }
   if (large) {
     for (std::size_t k = 0; k < lines.size(); ++k) {
-      addWorldline(c, ns::kWorldlinesNow, kWorldNowLines + static_cast<int>(k), c.run.trackedBodies()[k],
+      addWorldline(c, ns::kWorldlinesNow, kWorldNowLines + static_cast<int>(k), c.view.worldline_bodies[k].index,
                    perRow(lines[k], world.end, kWorldRows), world);
     }
     if (ghostScene(c.run)) addGhosts(c, ns::kWorldlinesNow, kWorldNowGhosts, world);
@@ -258,7 +262,8 @@ void drawWorldlinesCursor(const Canvas& c, const SceneState& state) {
   now.points = {point(kWorldBox.left, world.toY(t_now)), point(kWorldBox.right, world.toY(t_now))};
   c.add(now);
   Marker bodies = c.dots(ns::kWorldlinesNow, kWorldNowBodies, kWorldNowDotSize, color(kWhite));
-  for (std::size_t i : c.run.trackedBodies()) {
+  for (const ViewBody& body : c.view.worldline_bodies) {
+    const std::size_t i = body.index;
     bodies.points.push_back(point(world.toX(state.positions[i]), world.toY(t_now), kDotZ));
   }
   c.add(bodies);

@@ -17,6 +17,7 @@
 #include "collision_lab/ros/marker_builder.h"
 #include "collision_lab/ros/markers/ids.h"
 #include "collision_lab/ros/markers/layout.h"
+#include "collision_lab/ros/run_view.h"
 
 namespace collision_lab_ros::markers {
 
@@ -68,9 +69,12 @@ SideView sideView(const RunRecord& run);
 /// More bodies than each can be labelled: colour by velocity, sums in the plots.
 bool largeScene(const RunRecord& run);
 
-/// Where a view draws: the run, the frame of its markers, and the array it appends to.
+/// Where a view draws: the run, its view description (the texts, the bodies shown and the
+/// T(t) the page shows too: the views draw these, never their own), the frame of its
+/// markers, and the array it appends to.
 struct Canvas {
   const RunRecord& run;
+  const RunView& view;
   const std::string& frame_id;
   std::vector<Marker>& out;
 
@@ -119,8 +123,6 @@ std::vector<const Keyframe*> thinned(const std::vector<Keyframe>& frames, std::s
 void addIndexAxisLabels(const Canvas& c, const std::string& ns, int base, const Axes& axes);
 
 // ---- facts of the run ----
-/// Collisions the run is known to have, as far as the messages tell [1].
-std::uint64_t expectedCollisions(const RunRecord& run);
 /// A periodic motion, drawn over one period (x-t diagram and index plots): a ball between two
 /// walls at rest, all impacts elastic, once the run lasts layout::kPeriodsToFold periods.
 struct Period {
@@ -137,15 +139,16 @@ std::string periodsSoFar(const Period& period, double t);
 /// The collision index axis runs to this [1]: one past the last drawn step, or past the
 /// predicted count when the collisions are not shown one by one; one past a period's
 /// impacts for a periodic motion.
-double indexAxisEnd(const RunRecord& run);
+double indexAxisEnd(const RunRecord& run, const RunView& view);
 /// Velocities after all the collisions when the steps do not get there: the summary's
 /// (simulated or, when not simulated, predicted) or the prediction's, at index n.
 std::optional<std::pair<std::uint64_t, std::vector<double>>> finalVelocitiesNotDrawn(const RunRecord& run);
 std::string runTitle(const RunRecord& run);
 /// What the picture does not show, in one line (empty when it shows the whole run).
 std::string runNote(const RunRecord& run);
-/// The status line: time, collisions, the clock.
-std::string statusLine(const RunRecord& run, const SceneState& state, const FrameClock& clock);
+/// The status line: the time and the collisions behind now, the run's counter, collapse,
+/// ring and box (RunView's texts), the clock.
+std::string statusLine(const RunView& view, const SceneState& state, const FrameClock& clock);
 
 /// The scene's position axis [m] on screen.
 struct SceneAxis {
@@ -166,9 +169,6 @@ std::vector<std::pair<std::size_t, std::size_t>> clustersOf(const RunRecord& run
                                                             const std::vector<double>& v);
 /// False when the run cannot have a cluster (no collapse so far and no pair with e = 0).
 bool mayCluster(const RunRecord& run);
-/// A large scene with a restitution below 1 (a granular gas): T(t) takes the kinetic
-/// energy bars' place (markers/temperature.cpp).
-bool temperatureView(const RunRecord& run);
 
 // ---- the views (static: when a message arrives; animated: every frame) ----
 void drawTitle(const Canvas& c);
@@ -179,7 +179,7 @@ void drawConservedSteps(const Canvas& c);
 void drawWorldlines(const Canvas& c);
 void drawEnergyBarsAxis(const Canvas& c);
 void drawSideViewAxes(const Canvas& c);  ///< the velocity profile or the histogram, when not the wedge
-void drawTemperature(const Canvas& c);   ///< T(t) and Haff's law, when temperatureView
+void drawTemperature(const Canvas& c);   ///< T(t) and Haff's law of a gas (RunView::gas)
 
 void drawBodies(const Canvas& c, const SceneState& state);
 void drawMagnifier(const Canvas& c, const SceneState& state);

@@ -171,6 +171,9 @@ constexpr double kWallLineWidth = 0.08, kBodyLineWidth = 0.03;
 constexpr double kWorldZeroDx = -0.3, kWorldEndDx = -0.55, kWorldUnitDx = -0.45, kWorldUnitDy = 0.3;
 constexpr double kWorldPositionDy = -0.3;
 constexpr double kWorldPeriodsDy = -0.35;  ///< the periods so far, under the legend
+/// The x-t legend's lines keep this far inside the box's sides [rviz units]: its second
+/// line passes right of the "t [s]" label.
+constexpr double kWorldLegendInset = 0.2;
 /// The index plots' periods so far: in the same row, right of the frame's label.
 constexpr double kStepsPeriodsDx = -1.2;  ///< from the velocity box's right edge
 /// A periodic motion is drawn over one period once the run lasts this many periods.
