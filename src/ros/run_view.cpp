@@ -239,10 +239,11 @@ RunView makeRunView(const RunRecord& run) {
     view.haff_ok = fit.ok && std::isfinite(fit.tau);
     view.haff_t0 = fit.t0;
     view.haff_tau = fit.tau;
-    view.temperature_legend = "T = sum m (v - V)^2 / N" +
-        (view.haff_ok ? "; Haff's law T0/(1 + t/tau)^2 fitted: T0 = " + format("%.4g J", fit.t0) +
-                            ", tau = " + format("%.4g s", fit.tau)
-                      : std::string("; Haff's law: no fit (no cooling seen)"));
+    // What T is, in a student's words, is the page's caption; this says what the lines are.
+    view.temperature_legend =
+        view.haff_ok ? "Haff's law T = T₀ / (1 + t/τ)² fitted: T₀ = " + format("%.4g J", fit.t0) + ", τ = " +
+                           format("%.4g s", fit.tau)
+                     : std::string("Haff's law: no fit (no cooling seen)");
   }
 
   view.end_time = endTime(run);
