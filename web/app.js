@@ -219,12 +219,13 @@ function studentSection(name, runs, rejections) {
     section.appendChild(el('h3', 'Rejected inputs, newest first'));
     const table = el('table', null, {'data-rejections': name});
     const head = el('tr');
-    for (const h of ['when', 'run_id asked for', 'reason', 'field', 'message']) head.appendChild(el('th', h));
+    for (const h of ['when', 'run_id asked for', 'refused by', 'reason', 'field', 'message']) head.appendChild(el('th', h));
     table.appendChild(head);
     for (const r of rejections) {
       const tr = el('tr');
       tr.appendChild(el('td', new Date(r.at * 1000).toLocaleTimeString()));
-      tr.appendChild(el('td', r.run_id));
+      tr.appendChild(el('td', r.run_id));  // only what the student typed: empty for the page's own numbering
+      tr.appendChild(el('td', r.by || 'lab node'));
       tr.appendChild(el('td', r.reason_name));
       tr.appendChild(el('td', r.field));
       tr.appendChild(el('td', r.message));
@@ -243,7 +244,7 @@ async function teacherPage() {
     const queue = await (await fetch('/api/queue')).json();
     const byStudent = new Map();
     const of = (student) => {
-      const name = student || '(anonymous)';
+      const name = student || '(no name)';
       if (!byStudent.has(name)) byStudent.set(name, {runs: [], rejections: []});
       return byStudent.get(name);
     };

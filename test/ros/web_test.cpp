@@ -218,6 +218,8 @@ TEST_F(WebTest, TheTeacherSeesEachStudentsRejectedInputs) {
   ASSERT_EQ(rejections.size(), 2u) << rejections.dump();
   for (const json& r : rejections) {
     EXPECT_EQ(r.at("student"), "jo");
+    EXPECT_EQ(r.at("run_id"), "") << "jo typed no run_id (the page numbered the send): " << r.dump();
+    EXPECT_EQ(r.at("by"), "lab node");
     EXPECT_EQ(r.at("reason_name"), "POSITIONS_NOT_ORDERED");
     EXPECT_EQ(r.at("field").get<std::string>().rfind("positions", 0), 0u) << r.dump();
     EXPECT_FALSE(r.at("message").get<std::string>().empty());
@@ -231,6 +233,46 @@ TEST_F(WebTest, TheTeacherSeesEachStudentsRejectedInputs) {
   auto other = client().Get("/api/rejections?student=nobody");
   ASSERT_TRUE(other);
   EXPECT_EQ(json::parse(other->body).size(), 0u);
+}
+
+// The web node's own refusals (400, 413, 415, 429) never reach the lab node's run index:
+// the web node lists them beside the lab's rejections, per student where the body named one.
+TEST_F(WebTest, TheTeacherSeesTheWebNodesOwnRefusals) {
+  json bad = piScene("kim");
+  bad["velocities"] = {-1, "fast", 0};
+  bad["run_id"] = "mine";  // typed: listed as asked for
+  auto res = post(bad);
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 400) << res->body;
+  res = client().Post("/api/runs", piScene("kim").dump(), "text/plain");
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 415) << res->body;
+  json large = piScene("kim");
+  large["padding"] = std::string(10000, 'x');  // over max_body_bytes = 8192: never read
+  res = post(large);
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 413);
+
+  auto listed = client().Get("/api/rejections?student=kim");
+  ASSERT_TRUE(listed);
+  ASSERT_EQ(listed->status, 200);
+  const json kim = json::parse(listed->body);
+  ASSERT_EQ(kim.size(), 2u) << kim.dump();
+  EXPECT_EQ(kim[0].at("reason_name"), "HTTP 415") << "newest first";
+  EXPECT_EQ(kim[0].at("run_id"), "");
+  EXPECT_NE(kim[0].at("message").get<std::string>().find("Content-Type: application/json"), std::string::npos);
+  EXPECT_EQ(kim[1].at("reason_name"), "HTTP 400");
+  EXPECT_EQ(kim[1].at("run_id"), "mine");
+  EXPECT_EQ(kim[1].at("field"), "velocities[1]");
+  for (const json& r : kim) {
+    EXPECT_EQ(r.at("by"), "web node");
+    EXPECT_GT(r.at("at").get<double>(), 1.6e9) << "a wall time [s since the epoch]";
+  }
+  // The 413's body was never read: listed without a student.
+  const json all = json::parse(client().Get("/api/rejections")->body);
+  bool too_large = false;
+  for (const json& r : all) too_large = too_large || (r.at("reason_name") == "HTTP 413" && r.at("student") == "");
+  EXPECT_TRUE(too_large) << all.dump();
 }
 
 TEST_F(WebTest, ClassCodeIsNeededEverywhere) {
