@@ -128,6 +128,29 @@ TEST_F(WebTest, BrowserRunIsServedRecordedAndListed) {
   EXPECT_NE(page->body.find("data-run-id=\"" + run_id + "\""), std::string::npos);
 }
 
+// A run the model answered has no collision events: its events CSV is a 404 that says why
+// (docs/web.md), not an empty file served with 200.
+TEST_F(WebTest, EventsCsvOfARunNotSimulatedIs404WithItsReason) {
+  json capped = piScene("nan");
+  capped["max_collisions"] = 10;  // below the 31 predicted: the model answers
+  json predict_only = piScene("nan");
+  predict_only["mode"] = 1;
+  for (const json& scene : {capped, predict_only}) {
+    auto res = post(scene);
+    ASSERT_TRUE(res);
+    ASSERT_EQ(res->status, 202) << res->body;
+    const std::string run_id = json::parse(res->body)["run_id"];
+    const json run = finishedRun(run_id);
+    ASSERT_FALSE(run.at("view").at("not_simulated").get<std::string>().empty()) << run.at("view").dump();
+    auto csv = client().Get(("/api/runs/" + run_id + "/events.csv").c_str());
+    ASSERT_TRUE(csv);
+    EXPECT_EQ(csv->status, 404) << run_id << ": " << csv->body.size() << " bytes: " << csv->body;
+    const json error = json::parse(csv->body, nullptr, false);
+    ASSERT_TRUE(error.is_object()) << csv->body;
+    EXPECT_NE(error.value("error", "").find("not simulated"), std::string::npos) << csv->body;
+  }
+}
+
 TEST_F(WebTest, RunIdsAreNumberedPerStudent) {
   // Classmates' runs do not share numbers: each student's n-th run is <student>.run<n>.
   const auto send = [](const std::string& student) {
