@@ -748,6 +748,17 @@ void WebServer::postRun(const HttpRequest& request, const HttpReply& reply) {
   }
   input.student = student;
   const std::string requested = input.run_id;
+  // A send that makes no run (rejected, or unanswered: 503) gives its number back to the
+  // student's next send, unless a later send of theirs took a higher one meanwhile. Should
+  // the lab node run an unanswered one after all, it serves the next send as the next free
+  // number: nothing is overwritten.
+  const auto give_back_number = [this, student, requested] {
+    if (const auto number = runNumber(student + "." + requested, student)) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      std::uint64_t& highest = runs_numbered_[student];
+      if (highest == *number) --highest;
+    }
+  };
   const std::string token = randomToken();
   auto timer = std::make_shared<boost::asio::steady_timer>(
       reply.executor(), std::chrono::milliseconds(static_cast<long long>(config_.answer_timeout * 1000)));
@@ -755,20 +766,15 @@ void WebServer::postRun(const HttpRequest& request, const HttpReply& reply) {
     std::lock_guard<std::mutex> lock(mutex_);
     pending_.emplace(student, requested);
   }
-  book_.expect(student, requested, [this, request, reply, timer, token, student, requested, numbered](const Submission& answer) {
+  book_.expect(student, requested, [this, request, reply, timer, token, student, requested, numbered,
+                                    give_back_number](const Submission& answer) {
     {
       std::lock_guard<std::mutex> lock(mutex_);
       pending_.erase({student, requested});
     }
     boost::asio::post(reply.executor(), [timer] { timer->cancel(); });
     if (answer.rejected) {
-      // A rejected send is no run: its number goes to the student's next send (unless a
-      // later send of theirs took a higher one meanwhile).
-      if (const auto number = runNumber(student + "." + requested, student)) {
-        std::lock_guard<std::mutex> lock(mutex_);
-        std::uint64_t& highest = runs_numbered_[student];
-        if (highest == *number) --highest;
-      }
+      give_back_number();
       if (numbered) {
         std::lock_guard<std::mutex> lock(mutex_);
         numbered_rejections_.push_back({wallSeconds(), student, requested, {}, {}, {}});
@@ -795,16 +801,18 @@ void WebServer::postRun(const HttpRequest& request, const HttpReply& reply) {
         std::lock_guard<std::mutex> lock(mutex_);
         pending_.erase({student, requested});
       }
+      give_back_number();
       reply.send(errorAnswer(request, 503, "the lab node is not listening; ask the teacher"));
     }
     return;
   }
-  timer->async_wait([this, request, reply, timer, student, requested](boost::system::error_code ec) {
+  timer->async_wait([this, request, reply, timer, student, requested, give_back_number](boost::system::error_code ec) {
     if (ec || !book_.forget(student, requested)) return;  // answered meanwhile
     {
       std::lock_guard<std::mutex> lock(mutex_);
       pending_.erase({student, requested});
     }
+    give_back_number();
     reply.send(errorAnswer(request, 503, "the lab node did not answer; ask the teacher"));
   });
 }
