@@ -223,6 +223,9 @@ function showNotSimulated(run, view) {
   const hide = Boolean(view && view.not_simulated);
   box.hidden = !hide;
   ['velocity', 'energy', 'xt'].forEach((id) => { document.getElementById(id + '_box').hidden = hide; });
+  // Nor downloads of what does not exist: the plots' PNGs and the events CSV (a 404).
+  document.querySelectorAll('button[data-plot]').forEach((b) => { b.hidden = hide; });
+  document.getElementById('dl_csv').hidden = hide;
   if (!hide) return false;
   const p = run.prediction;
   let answer = 'The model (' + (p ? p.model : 'none') + ') answered: ';

@@ -228,6 +228,9 @@ TEST_F(RunPageViewTest, NotSimulatedRunIsShownAsNotSimulated) {
   EXPECT_NE(dom.find("<div id=\"not_simulated_box\"><h2>"), std::string::npos) << "the box is hidden";
   EXPECT_NE(dom.find("Nothing to plot, since this run was not simulated: "), std::string::npos);
   EXPECT_NE(dom.find("answered: 31 collisions; final velocities A "), std::string::npos) << dom.substr(0, 3000);
+  // No download of what does not exist: the events CSV (a 404) and the plots' PNGs.
+  EXPECT_TRUE(std::regex_search(dom, std::regex("<a id=\"dl_csv\"[^>]* hidden")));
+  EXPECT_TRUE(std::regex_search(dom, std::regex("<button type=\"button\" data-plot=\"velocity\" hidden")));
 }
 
 // Mode predict: the same, whatever the cap.
