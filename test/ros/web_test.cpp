@@ -362,6 +362,12 @@ TEST_F(WebTest, RunsPerStudentPerMinuteIs429ForThatStudentOnly) {
   ASSERT_TRUE(res);
   EXPECT_EQ(res->status, 429);
   EXPECT_FALSE(res->get_header_value("Retry-After").empty());
+  // The teacher sees it, under hal, with its reason.
+  const json listed = json::parse(client().Get("/api/rejections?student=hal")->body);
+  ASSERT_EQ(listed.size(), 1u) << listed.dump();
+  EXPECT_EQ(listed[0].at("reason_name"), "HTTP 429");
+  EXPECT_EQ(listed[0].at("by"), "web node");
+  EXPECT_NE(listed[0].at("message").get<std::string>().find("runs per student per minute"), std::string::npos);
   res = post(piScene("ivy"));
   ASSERT_TRUE(res);
   EXPECT_EQ(res->status, 202) << "another student is not held back";
