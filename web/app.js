@@ -53,7 +53,7 @@ function loadPreset(p) {
   note.textContent = '';
   if (!p.scene) {
     loadedPreset = p.name;
-    note.textContent = 'Preset ' + p.name + ' (' + p.bodies + ' bodies) is sent as it is; edit a smaller one to change it.';
+    note.textContent = 'Preset ' + p.name + ' (' + counted(p.bodies, 'body', 'bodies') + ') is sent as it is; edit a smaller one to change it.';
   } else {
     const s = p.scene;
     s.masses.forEach((m, i) => bodyRow(m, s.positions[i], s.velocities[i]));
@@ -156,7 +156,8 @@ async function stopRun(runId, stopToken) {
 
 function queueTable(queue) {
   const section = el('section');
-  section.appendChild(el('h2', 'Queue: ' + queue.runs.length + ' runs, ' + queue.workers + ' workers'));
+  section.appendChild(el('h2', 'Queue: ' + counted(queue.runs.length, 'run', 'runs') + ', ' +
+                         counted(queue.workers, 'worker', 'workers')));
   const table = el('table');
   const head = el('tr');
   for (const h of ['run', 'student', 'lane', 'state', '']) head.appendChild(el('th', h));

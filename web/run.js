@@ -361,7 +361,7 @@ async function showQueue() {
   const waiting = queue.runs.filter((r) => !r.running);
   const mine = queue.runs.find((r) => r.run_id === runId);
   if (mine && !mine.running) {
-    place.textContent = 'Waiting: place ' + (waiting.indexOf(mine) + 1) + ' of ' + waiting.length + ' in the ' + mine.lane + ' lane.';
+    place.textContent = 'Waiting: place ' + fmt(waiting.indexOf(mine) + 1) + ' of ' + fmt(waiting.length) + ' in the ' + mine.lane + ' lane.';
   } else {
     place.textContent = '';
   }
