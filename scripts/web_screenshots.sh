@@ -4,7 +4,8 @@
 # finished gas and the teacher page. Starts lab.launch web:=true on a master of its own
 # (bags in a temporary folder) and shoots with headless chromium.
 # Usage (after setup_debian.sh --with-screenshots): bash scripts/web_screenshots.sh [--views]
-# (--views: only the run page of each scene kind, web_view_*.png)
+# (--views: only the run page of each scene kind, web_view_*.png, and the teacher page with
+# rejections, web_teacher_rejections.png)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 export PATH=/usr/bin:/bin:$PATH
@@ -70,6 +71,17 @@ shoot_views() {
   wait_finished "$run"; shoot "/runs/$run" web_view_ring.png 1250
   run=$(send_body '{"student":"eve","preset":"granular_box_1000","max_collisions":5000}')
   wait_finished "$run"; shoot "/runs/$run" web_view_box_truncated.png 1250  # the box stops at the lab's cap
+  # The teacher page with rejections: the lab node's (a numbered send: no run_id asked for)
+  # and the web node's own (400 with a typed run_id, 415, 413).
+  curl -s -o /dev/null -X POST -H "Content-Type: application/json" \
+    -d '{"student":"ben","masses":[1,1],"positions":[0,1],"velocities":[0,0]}' "$url/api/runs"
+  curl -s -o /dev/null -X POST -H "Content-Type: application/json" \
+    -d '{"student":"ben","run_id":"mine","masses":[1,"heavy"],"positions":[1,0],"velocities":[0,0]}' "$url/api/runs"
+  curl -s -o /dev/null -X POST -d '{"student":"ben","preset":"pi_digits_2"}' "$url/api/runs"
+  head -c 2000000 /dev/zero | tr '\0' ' ' | curl -s -o /dev/null -X POST -H "Content-Type: application/json" \
+    --data-binary @- "$url/api/runs"
+  sleep 1
+  shoot /teacher web_teacher_rejections.png 1400
 }
 if [ "${1:-}" = --views ]; then shoot_views; exit 0; fi
 

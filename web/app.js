@@ -53,7 +53,7 @@ function loadPreset(p) {
   note.textContent = '';
   if (!p.scene) {
     loadedPreset = p.name;
-    note.textContent = 'Preset ' + p.name + ' (' + p.bodies + ' bodies) is sent as it is; edit a smaller one to change it.';
+    note.textContent = 'Preset ' + p.name + ' (' + counted(p.bodies, 'body', 'bodies') + ') is sent as it is; edit a smaller one to change it.';
   } else {
     const s = p.scene;
     s.masses.forEach((m, i) => bodyRow(m, s.positions[i], s.velocities[i]));
@@ -156,7 +156,8 @@ async function stopRun(runId, stopToken) {
 
 function queueTable(queue) {
   const section = el('section');
-  section.appendChild(el('h2', 'Queue: ' + queue.runs.length + ' runs, ' + queue.workers + ' workers'));
+  section.appendChild(el('h2', 'Queue: ' + counted(queue.runs.length, 'run', 'runs') + ', ' +
+                         counted(queue.workers, 'worker', 'workers')));
   const table = el('table');
   const head = el('tr');
   for (const h of ['run', 'student', 'lane', 'state', '']) head.appendChild(el('th', h));
@@ -219,12 +220,13 @@ function studentSection(name, runs, rejections) {
     section.appendChild(el('h3', 'Rejected inputs, newest first'));
     const table = el('table', null, {'data-rejections': name});
     const head = el('tr');
-    for (const h of ['when', 'run_id asked for', 'reason', 'field', 'message']) head.appendChild(el('th', h));
+    for (const h of ['when', 'run_id asked for', 'refused by', 'reason', 'field', 'message']) head.appendChild(el('th', h));
     table.appendChild(head);
     for (const r of rejections) {
       const tr = el('tr');
       tr.appendChild(el('td', new Date(r.at * 1000).toLocaleTimeString()));
-      tr.appendChild(el('td', r.run_id));
+      tr.appendChild(el('td', r.run_id));  // only what the student typed: empty for the page's own numbering
+      tr.appendChild(el('td', r.by || 'lab node'));
       tr.appendChild(el('td', r.reason_name));
       tr.appendChild(el('td', r.field));
       tr.appendChild(el('td', r.message));
@@ -243,7 +245,7 @@ async function teacherPage() {
     const queue = await (await fetch('/api/queue')).json();
     const byStudent = new Map();
     const of = (student) => {
-      const name = student || '(anonymous)';
+      const name = student || '(no name)';
       if (!byStudent.has(name)) byStudent.set(name, {runs: [], rejections: []});
       return byStudent.get(name);
     };

@@ -37,8 +37,23 @@ function fmt(x, digits) {
   // No e-notation that wraps: "1.2e-7" becomes "1.2×10⁻⁷" (one word, no break).
   const m = /^(-?[\d.]+)e([+-]\d+)$/.exec(text);
   if (!m) return text;
+  return m[1] + '×10' + superscript(Number(m[2]));
+}
+
+function superscript(n) {
   const sup = {'-': '⁻', '0': '⁰', '1': '¹', '2': '²', '3': '³', '4': '⁴', '5': '⁵', '6': '⁶', '7': '⁷', '8': '⁸', '9': '⁹'};
-  return m[1] + '×10' + String(Number(m[2])).split('').map((c) => sup[c]).join('');
+  return String(n).split('').map((c) => sup[c]).join('');
+}
+
+// A log axis's labels: 1, 2 and 5 x 10^n when the axis spans at most 3 decades, else the
+// decades only (the other ticks keep their grid line, unlabelled), so that labels never
+// crowd. Plain numbers from 0.01 to 1,000, else "2×10⁻⁵".
+function logTickLabel(value, span) {
+  const n = Math.floor(Math.log10(value) + 1e-9);
+  const mantissa = Math.round(value / Math.pow(10, n));
+  if (!(span > 3 ? mantissa === 1 : [1, 2, 5].includes(mantissa))) return '';
+  if (n >= -2 && n <= 3) return fmt(Number((mantissa * Math.pow(10, n)).toPrecision(1)));
+  return (mantissa === 1 ? '' : mantissa + '×') + '10' + superscript(n);
 }
 
 function xy(points) { return points.map((p) => ({x: p[0], y: p[1]})); }
@@ -188,9 +203,43 @@ function drawTemperature(view) {
     document.body.dataset.haffTau = String(view.haff.tau);
   }
   c.data.datasets = sets;
+  const decades = (values) => Math.log10(Math.max(...values) / Math.min(...values));
+  const spanX = decades(points.map((p) => p.x)), spanY = decades(points.map((p) => p.y));
+  c.options.scales.x.ticks = {autoSkip: false, maxRotation: 0, callback: (value) => logTickLabel(value, spanX)};
+  c.options.scales.y.ticks = {autoSkip: false, callback: (value) => logTickLabel(value, spanY)};
   c.update('none');
   document.getElementById('temperature_legend').textContent = view.temperature_legend;
   document.body.dataset.temperaturePoints = String(points.length);
+  // For tests: the labels drawn on each axis, '|'-separated.
+  const labels = (axis) => c.scales[axis].ticks.map((t) => t.label).filter((l) => l !== '').join('|');
+  document.body.dataset.temperatureTicksX = labels('x');
+  document.body.dataset.temperatureTicksY = labels('y');
+}
+
+// A run that was not simulated has no simulated series: no empty chart is drawn, but what
+// was not simulated and why (the view's not_simulated) and the model's answer.
+function showNotSimulated(run, view) {
+  const box = document.getElementById('not_simulated_box');
+  const hide = Boolean(view && view.not_simulated);
+  box.hidden = !hide;
+  ['velocity', 'energy', 'xt'].forEach((id) => { document.getElementById(id + '_box').hidden = hide; });
+  // Nor downloads of what does not exist: the plots' PNGs and the events CSV (a 404).
+  document.querySelectorAll('button[data-plot]').forEach((b) => { b.hidden = hide; });
+  document.getElementById('dl_csv').hidden = hide;
+  if (!hide) return false;
+  const p = run.prediction;
+  let answer = 'The model (' + (p ? p.model : 'none') + ') answered: ';
+  if (view.infinitely_many_predicted) answer += 'infinitely many collisions';
+  else if (view.predicted_collisions !== null && view.predicted_collisions !== undefined) answer += plural(view.predicted_collisions, 'collision');
+  else answer += 'no count';
+  const finals = p ? p.final_velocities : [];
+  const named = finals.map((v, i) => (v === null || v === undefined ? null : bodyName(i) + ' ' + fmt(v, 9) + ' m/s')).filter((t) => t);
+  if (named.length > 0 && named.length <= 10) answer += '; final velocities ' + named.join(', ');
+  document.getElementById('not_simulated_reason').textContent =
+    'Nothing to plot, since this run was not simulated: ' + view.not_simulated.replace(/^not simulated: /, '') + '.';
+  document.getElementById('model_answer').textContent = answer + '. The summary below has its numbers.';
+  document.body.dataset.plotsHidden = 'velocity energy xt';
+  return true;
 }
 
 // The view's facts: what was simulated and what not, a cut, a collapse, a ring or a box,
@@ -236,6 +285,7 @@ function render(run) {
   showFacts(view);
   drawScene(run.scene);
   document.getElementById('model').textContent = run.prediction ? 'Model: ' + run.prediction.model + '. ' + run.prediction.model_reason : '';
+  const notSimulated = showNotSimulated(run, view);
   const v = chart('velocity', 'collision index', 'velocity [m/s]');
   v.data.datasets = velocityDatasets(run);
   v.options.plugins.legend.display = v.data.datasets.length <= 12;
@@ -265,8 +315,10 @@ function render(run) {
     row.forEach((cell) => tr.appendChild(el(tr.children.length === 0 ? 'th' : 'td', fmt(cell, 9))));
     return tr;
   }));
-  const drawn = ['velocity', 'energy', 'xt'].map((id) => id + ':' + nonBackgroundPixels(document.getElementById(id)));
-  document.body.dataset.plots = drawn.join(' ');
+  if (!notSimulated) {
+    const drawn = ['velocity', 'energy', 'xt'].map((id) => id + ':' + nonBackgroundPixels(document.getElementById(id)));
+    document.body.dataset.plots = drawn.join(' ');
+  }
   if (firstPlotMs === null) {
     firstPlotMs = Math.round(performance.now());
     document.body.dataset.firstPlotMs = String(firstPlotMs);
@@ -309,7 +361,7 @@ async function showQueue() {
   const waiting = queue.runs.filter((r) => !r.running);
   const mine = queue.runs.find((r) => r.run_id === runId);
   if (mine && !mine.running) {
-    place.textContent = 'Waiting: place ' + (waiting.indexOf(mine) + 1) + ' of ' + waiting.length + ' in the ' + mine.lane + ' lane.';
+    place.textContent = 'Waiting: place ' + fmt(waiting.indexOf(mine) + 1) + ' of ' + fmt(waiting.length) + ' in the ' + mine.lane + ' lane.';
   } else {
     place.textContent = '';
   }

@@ -7,6 +7,7 @@
 #include <optional>
 #include <string>
 
+#include "collision_lab/core/count_text.h"
 #include "collision_lab/core/nbody/engine.h"
 #include "collision_lab/core/paper.h"
 #include "collision_lab/core/precision.h"
@@ -469,13 +470,13 @@ void simulateBesidePrediction(const ThreeBodyScene& scene, const RunOptions& opt
   summary.truncated = simulation.truncated;
   summary.cancelled = simulation.cancelled;
   if (simulation.cancelled) {
-    summary.truncation_reason = "cancelled after " + std::to_string(simulation.collision_count) + " of " +
-                                std::to_string(result.prediction.collision_count) + " predicted";
+    summary.truncation_reason = "cancelled after " + countText(simulation.collision_count) + " of " +
+                                countText(result.prediction.collision_count) + " predicted";
   } else if (!stopped_otherwise.empty()) {
     summary.truncation_reason = stopped_otherwise;
   } else if (simulation.truncated) {
-    summary.truncation_reason = "stopped at max_collisions = " + std::to_string(options.max_collisions) + " of " +
-                                std::to_string(result.prediction.collision_count) + " predicted";
+    summary.truncation_reason = "stopped at max_collisions = " + countText(options.max_collisions) + " of " +
+                                countText(result.prediction.collision_count) + " predicted";
   }
   summary.final_velocities = simulation.final_velocities;
   summary.energy_relative_drift = simulation.energy_relative_drift;

@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cmath>
 
+#include "collision_lab/core/count_text.h"
+
 namespace collision_lab {
 namespace core {
 
@@ -85,8 +87,8 @@ SceneSimulation fromEngine(EngineResult&& engine) {
 SceneSimulation overCap(const Prediction& prediction, std::uint64_t cap) {
   SceneSimulation simulation = fromPrediction(prediction);
   simulation.stop_message = std::string("answered by the closed form of ") + modelKindName(prediction.kind) + ": " +
-                            std::to_string(*prediction.impact_count) + " impacts predicted, more than the cap of " +
-                            std::to_string(cap) + "; nothing simulated (simulating up to the cap must be asked for)";
+                            countText(*prediction.impact_count) + " impacts predicted, more than the cap of " +
+                            countText(cap) + "; nothing simulated (simulating up to the cap must be asked for)";
   return simulation;
 }
 

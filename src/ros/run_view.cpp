@@ -237,10 +237,12 @@ RunView makeRunView(const RunRecord& run) {
     view.haff_ok = fit.ok && std::isfinite(fit.tau);
     view.haff_t0 = fit.t0;
     view.haff_tau = fit.tau;
-    view.temperature_legend = "T = sum m (v - V)^2 / N" +
-        (view.haff_ok ? "; Haff's law T0/(1 + t/tau)^2 fitted: T0 = " + format("%.4g J", fit.t0) +
-                            ", tau = " + format("%.4g s", fit.tau)
-                      : std::string("; Haff's law: no fit (no cooling seen)"));
+    // What T is, in a student's words, is the page's caption; this says what the lines are.
+    // No subscript digits: rviz's font has code points below 1000 only (tau and the square do).
+    view.temperature_legend =
+        view.haff_ok ? "Haff's law T = T0 / (1 + t/τ)² fitted: T0 = " + format("%.4g J", fit.t0) + ", τ = " +
+                           format("%.4g s", fit.tau)
+                     : std::string("Haff's law: no fit (no cooling seen)");
     // T held from the last collision to the run's end: no collision changes it in the free
     // flight after it (the fit above is to the collisions' values only).
     if (!view.temperature.empty() && std::isfinite(view.end_time) && view.end_time > view.temperature.back().first) {

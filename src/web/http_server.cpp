@@ -52,6 +52,7 @@ std::string cannedAnswer(int status, const std::string& reason, const std::strin
 struct HttpServer::Shared {
   HttpLimits limits;
   Handler handler;
+  HttpServer::Refused refused;
   std::mutex mutex;
   std::map<std::string, std::size_t> per_address;  ///< open connections by client address [1]
   std::size_t total = 0;                            ///< open connections [1]
@@ -148,6 +149,10 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   /// Answers with one of the server's own errors, then stops sending and discards what the
   /// client still sends for a moment, so that it reads the answer rather than a reset.
   void refuse(int status, const char* reason, const char* error) {
+    if (shared_->refused && parser_) {
+      const auto& header = parser_->get();
+      shared_->refused(client_, std::string(header.method_string()), std::string(header.target()), status, error);
+    }
     auto text = std::make_shared<std::string>(cannedAnswer(status, reason, error));
     stream_.expires_after(duration(shared_->limits.write_timeout));
     net::async_write(stream_, net::buffer(*text), [self = shared_from_this(), text](error_code ec, std::size_t) {
@@ -245,6 +250,8 @@ void HttpReply::stream(http::response<http::empty_body> header, std::function<St
 }
 
 net::any_io_executor HttpReply::executor() const { return session_->executor(); }
+
+void HttpServer::onRefused(Refused refused) { shared_->refused = std::move(refused); }
 
 HttpServer::HttpServer(HttpLimits limits, Handler handler)
     : shared_(std::make_shared<Shared>()), acceptor_(net::make_strand(ioc_)) {

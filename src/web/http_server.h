@@ -90,6 +90,12 @@ class HttpServer {
   HttpServer(const HttpServer&) = delete;
   HttpServer& operator=(const HttpServer&) = delete;
 
+  /// Told of each request the server refuses itself (413 too large, 431, 408), before the
+  /// handler could see it: its client address, method, target and the status. Set before start.
+  using Refused = std::function<void(const std::string& client, const std::string& method, const std::string& target,
+                                     int status, const std::string& error)>;
+  void onRefused(Refused refused);
+
   /// Binds (port 0: any free port) and starts the I/O threads; throws std::runtime_error
   /// when the address cannot be bound.
   void start(const std::string& bind, int port);

@@ -170,6 +170,11 @@ Response jsonAnswer(const HttpRequest& request, int status, const json& body) {
 }
 
 /// At most `limit` characters of a client's text for a message: printable ASCII, others as '?'.
+/// Now as a wall time [s since the epoch], as the run index stamps rejections.
+double wallSeconds() {
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
 std::string printableExcerpt(const std::string& text, std::size_t limit) {
   std::string out;
   for (const char c : text.substr(0, limit)) out += c >= 0x20 && c < 0x7f ? c : '?';
@@ -285,6 +290,12 @@ WebServer::WebServer(RunBook& book, WebConfig config, Publish publish, Cancel ca
   limits.max_connections = config_.max_connections;
   server_ = std::make_unique<HttpServer>(limits, [this](HttpRequest request, HttpReply reply) {
     handle(std::move(request), std::move(reply));
+  });
+  server_->onRefused([this](const std::string&, const std::string& method, const std::string& target, int status,
+                            const std::string& error) {
+    if (method == "POST" && target.substr(0, target.find('?')) == "/api/runs") {
+      refusedSend({}, "HTTP " + std::to_string(status), error);
+    }
   });
 }
 
@@ -435,10 +446,11 @@ void WebServer::handle(HttpRequest request, HttpReply reply) {
     // another site can send text/plain or a form encoding without asking first, not JSON.
     const std::string type(m[http::field::content_type]);
     if (!m.body().empty() && lower(type).rfind("application/json", 0) != 0) {
-      return reply.send(errorAnswer(request, 415,
-                                    "send the body as JSON with the header Content-Type: application/json (curl: -H "
-                                    "'Content-Type: application/json'); this request's Content-Type: " +
-                                        (type.empty() ? std::string("none") : printableExcerpt(type, 80))));
+      const std::string error = "send the body as JSON with the header Content-Type: application/json (curl: -H "
+                                "'Content-Type: application/json'); this request's Content-Type: " +
+                                (type.empty() ? std::string("none") : printableExcerpt(type, 80));
+      if (path == "/api/runs") refusedSend(m.body(), "HTTP 415", error);
+      return reply.send(errorAnswer(request, 415, error));
     }
   }
 
@@ -573,7 +585,7 @@ void WebServer::route(const HttpRequest& request, const Access& access, const Ht
   if (get && path == "/api/rejections") {
     if (!access.teacher) return reply.send(errorAnswer(request, 403, "only the teacher sees the rejected inputs", "code"));
     std::optional<std::string> student = queryParam(query, "student");
-    return reply.send(answer(request, http::status::ok, book_.rejections(student), "application/json"));
+    return reply.send(answer(request, http::status::ok, rejectionsJson(student), "application/json"));
   }
   if (get && path == "/api/queue") {
     std::string body;
@@ -631,19 +643,25 @@ void WebServer::login(const HttpRequest& request, const HttpReply& reply) {
 }
 
 void WebServer::postRun(const HttpRequest& request, const HttpReply& reply) {
-  json body = json::parse(request.message.body(), nullptr, false);
-  if (body.is_discarded()) return reply.send(errorAnswer(request, 400, "the body is not JSON"));
-  if (!body.is_object()) return reply.send(errorAnswer(request, 400, "the body must be a JSON object"));
+  const std::string& text = request.message.body();
+  // Each refusal here is listed on the teacher page too (refusedSend).
+  const auto refuse = [&](int status, const std::string& error, const std::string& field = {}) {
+    refusedSend(text, "HTTP " + std::to_string(status), error, field);
+    return errorAnswer(request, status, error, field);
+  };
+  json body = json::parse(text, nullptr, false);
+  if (body.is_discarded()) return reply.send(refuse(400, "the body is not JSON"));
+  if (!body.is_object()) return reply.send(refuse(400, "the body must be a JSON object"));
   if (!body.contains("student") || !body["student"].is_string() || body["student"].get<std::string>().empty()) {
-    return reply.send(errorAnswer(request, 400, "student is required: your name", "student"));
+    return reply.send(refuse(400, "student is required: your name", "student"));
   }
   const std::string student = body["student"];
   if (student.size() > collision_lab_ros::kMaxStudentLength) {
     log("refused a scene from " + request.client + ": a name of " + std::to_string(student.size()) + " bytes");
-    return reply.send(errorAnswer(request, 400,
-                                  "student is longer than " + std::to_string(collision_lab_ros::kMaxStudentLength) +
-                                      " characters",
-                                  "student"));
+    return reply.send(refuse(400,
+                             "student is longer than " + std::to_string(collision_lab_ros::kMaxStudentLength) +
+                                 " characters",
+                             "student"));
   }
   collision_lab::InitialConditions input;
   try {
@@ -692,7 +710,7 @@ void WebServer::postRun(const HttpRequest& request, const HttpReply& reply) {
     }
   } catch (const FieldError& e) {
     log("refused a scene from " + request.client + " (" + student + "): " + e.field);
-    return reply.send(errorAnswer(request, 400, e.message, e.field));
+    return reply.send(refuse(400, e.message, e.field));
   }
   if (input.masses.size() > config_.max_bodies) {
     collision_lab::Rejected r;
@@ -701,6 +719,7 @@ void WebServer::postRun(const HttpRequest& request, const HttpReply& reply) {
     r.field = "masses";
     r.message = std::to_string(input.masses.size()) + " bodies are more than this lab's max_bodies = " +
                 std::to_string(config_.max_bodies);
+    refusedSend(text, r.reason_name, r.message, r.field);
     return reply.send(jsonAnswer(request, 422, rejectionJson(r)));
   }
   // Per address and per name: another name does not escape the limit, and sending as a
@@ -715,19 +734,31 @@ void WebServer::postRun(const HttpRequest& request, const HttpReply& reply) {
   }
   if (wait) {
     log("limited " + request.client + " (" + student + "): " + which);
-    Response res = errorAnswer(request, 429, "at most " + std::to_string(limit) + " " + which + " per minute; try again in " +
-                                                  std::to_string(wait) + " s");
+    Response res = refuse(429, "at most " + std::to_string(limit) + " " + which + " per minute; try again in " +
+                                   std::to_string(wait) + " s");
     res.set(http::field::retry_after, std::to_string(wait));
     return reply.send(std::move(res));
   }
   // Each input gets a run_id of its own to ask for, so that its answer is found: the
   // student's next run number.
-  if (input.run_id.empty()) {
+  const bool numbered = input.run_id.empty();
+  if (numbered) {
     std::lock_guard<std::mutex> lock(mutex_);
     input.run_id = "run" + std::to_string(++runs_numbered_[student]);
   }
   input.student = student;
   const std::string requested = input.run_id;
+  // A send that makes no run (rejected, or unanswered: 503) gives its number back to the
+  // student's next send, unless a later send of theirs took a higher one meanwhile. Should
+  // the lab node run an unanswered one after all, it serves the next send as the next free
+  // number: nothing is overwritten.
+  const auto give_back_number = [this, student, requested] {
+    if (const auto number = runNumber(student + "." + requested, student)) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      std::uint64_t& highest = runs_numbered_[student];
+      if (highest == *number) --highest;
+    }
+  };
   const std::string token = randomToken();
   auto timer = std::make_shared<boost::asio::steady_timer>(
       reply.executor(), std::chrono::milliseconds(static_cast<long long>(config_.answer_timeout * 1000)));
@@ -735,19 +766,19 @@ void WebServer::postRun(const HttpRequest& request, const HttpReply& reply) {
     std::lock_guard<std::mutex> lock(mutex_);
     pending_.emplace(student, requested);
   }
-  book_.expect(student, requested, [this, request, reply, timer, token, student, requested](const Submission& answer) {
+  book_.expect(student, requested, [this, request, reply, timer, token, student, requested, numbered,
+                                    give_back_number](const Submission& answer) {
     {
       std::lock_guard<std::mutex> lock(mutex_);
       pending_.erase({student, requested});
     }
     boost::asio::post(reply.executor(), [timer] { timer->cancel(); });
     if (answer.rejected) {
-      // A rejected send is no run: its number goes to the student's next send (unless a
-      // later send of theirs took a higher one meanwhile).
-      if (const auto number = runNumber(student + "." + requested, student)) {
+      give_back_number();
+      if (numbered) {
         std::lock_guard<std::mutex> lock(mutex_);
-        std::uint64_t& highest = runs_numbered_[student];
-        if (highest == *number) --highest;
+        numbered_rejections_.push_back({wallSeconds(), student, requested, {}, {}, {}});
+        if (numbered_rejections_.size() > kRefusalsKept) numbered_rejections_.pop_front();
       }
       return reply.send(jsonAnswer(request, 422, rejectionJson(*answer.rejected)));
     }
@@ -770,18 +801,63 @@ void WebServer::postRun(const HttpRequest& request, const HttpReply& reply) {
         std::lock_guard<std::mutex> lock(mutex_);
         pending_.erase({student, requested});
       }
+      give_back_number();
       reply.send(errorAnswer(request, 503, "the lab node is not listening; ask the teacher"));
     }
     return;
   }
-  timer->async_wait([this, request, reply, timer, student, requested](boost::system::error_code ec) {
+  timer->async_wait([this, request, reply, timer, student, requested, give_back_number](boost::system::error_code ec) {
     if (ec || !book_.forget(student, requested)) return;  // answered meanwhile
     {
       std::lock_guard<std::mutex> lock(mutex_);
       pending_.erase({student, requested});
     }
+    give_back_number();
     reply.send(errorAnswer(request, 503, "the lab node did not answer; ask the teacher"));
   });
+}
+
+void WebServer::refusedSend(const std::string& body, const std::string& reason_name, const std::string& error,
+                            const std::string& field) {
+  Refusal refusal{wallSeconds(), {}, {}, reason_name, field, error};
+  const json parsed = json::parse(body, nullptr, false);
+  const auto text = [&](const char* key) {
+    return parsed.is_object() && parsed.contains(key) && parsed[key].is_string()
+               ? printableExcerpt(parsed[key].get<std::string>(), 200)
+               : std::string();
+  };
+  refusal.student = text("student");
+  refusal.run_id = text("run_id");
+  std::lock_guard<std::mutex> lock(mutex_);
+  refusals_.push_back(std::move(refusal));
+  if (refusals_.size() > kRefusalsKept) refusals_.pop_front();
+}
+
+std::string WebServer::rejectionsJson(const std::optional<std::string>& student) const {
+  json rows = json::parse(book_.rejections(student), nullptr, false);
+  if (!rows.is_array()) rows = json::array();
+  // A numbered send's rejection is found by its student and run_id, answered within this
+  // long of the index's stamp [s]; a typed run_id like it, long after, stays shown.
+  constexpr double kSameSend = 30;
+  std::lock_guard<std::mutex> lock(mutex_);
+  for (json& row : rows) {
+    row["by"] = "lab node";
+    for (const Refusal& r : numbered_rejections_) {
+      if (r.student == row.value("student", "") && r.run_id == row.value("run_id", "") &&
+          std::abs(r.at - row.value("at", 0.0)) < kSameSend) {
+        row["run_id"] = "";
+        break;
+      }
+    }
+  }
+  for (const Refusal& r : refusals_) {
+    if (student && r.student != *student) continue;
+    rows.push_back({{"at", r.at}, {"student", r.student}, {"run_id", r.run_id}, {"reason_name", r.reason_name},
+                    {"field", r.field}, {"message", r.message}, {"by", "web node"}});
+  }
+  std::stable_sort(rows.begin(), rows.end(),
+                   [](const json& a, const json& b) { return a.value("at", 0.0) > b.value("at", 0.0); });
+  return rows.dump();
 }
 
 void WebServer::stopRun(const HttpRequest& request, const std::string& run_id, const Access& access,

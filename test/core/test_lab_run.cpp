@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "collision_lab/core/count_text.h"
 #include "collision_lab/core/lab_run.h"
 #include "collision_lab/core/paper.h"
 #include "rational_reference.h"
@@ -103,7 +104,7 @@ TEST(LabRunCancel, AFlagSetDuringTheRunStopsItWithinACheckIntervalWithThePartial
     EXPECT_LT(count, kSetAt + 1024) << events;
     EXPECT_TRUE(result.summary.truncated);
     EXPECT_TRUE(result.summary.cancelled);
-    EXPECT_NE(result.summary.truncation_reason.find("cancelled after " + std::to_string(count) + " of 2221441"),
+    EXPECT_NE(result.summary.truncation_reason.find("cancelled after " + countText(count) + " of 2,221,441"),
               std::string::npos)
         << result.summary.truncation_reason;
     // Reference: the textbook impact rule applied `count` times at 50 digits.

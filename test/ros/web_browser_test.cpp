@@ -221,6 +221,23 @@ TEST_F(RunPageViewTest, NotSimulatedRunIsShownAsNotSimulated) {
                                      {"velocities", {-1, 0, 0}}, {"max_collisions", 10}});
   EXPECT_NE(dom.find("not simulated: "), std::string::npos) << dom.substr(0, 2000);
   EXPECT_EQ(dom.find("finished: 31 collisions"), std::string::npos);
+  // No empty chart (an axis from -1 to 1 with nothing on it): the plots are hidden, and in
+  // their place why nothing was simulated and the model's answer.
+  EXPECT_NE(dom.find("data-plots-hidden=\"velocity energy xt\""), std::string::npos);
+  EXPECT_EQ(dom.find("data-plots=\""), std::string::npos) << "a plot was drawn";
+  EXPECT_NE(dom.find("<div id=\"not_simulated_box\"><h2>"), std::string::npos) << "the box is hidden";
+  EXPECT_NE(dom.find("Nothing to plot, since this run was not simulated: "), std::string::npos);
+  EXPECT_NE(dom.find("answered: 31 collisions; final velocities A "), std::string::npos) << dom.substr(0, 3000);
+  // No download of what does not exist: the events CSV (a 404) and the plots' PNGs.
+  EXPECT_TRUE(std::regex_search(dom, std::regex("<a id=\"dl_csv\"[^>]* hidden")));
+  EXPECT_TRUE(std::regex_search(dom, std::regex("<button type=\"button\" data-plot=\"velocity\" hidden")));
+}
+
+// Mode predict: the same, whatever the cap.
+TEST_F(RunPageViewTest, PredictOnlyRunDrawsNoEmptyChart) {
+  const std::string dom = finalPage({{"student", "view"}, {"preset", "pi_digits_2"}, {"mode", 1}});
+  EXPECT_NE(dom.find("data-plots-hidden=\"velocity energy xt\""), std::string::npos) << dom.substr(0, 2000);
+  EXPECT_NE(dom.find("answered: 31 collisions"), std::string::npos);
 }
 
 TEST_F(RunPageViewTest, CollapseIsNamed) {
@@ -252,9 +269,29 @@ TEST_F(RunPageViewTest, BoxOfManyBodiesHasItsLegend) {
   EXPECT_NE(dom.find("box: walls at both ends"), std::string::npos) << dom.substr(0, 2000);
   EXPECT_NE(dom.find("24 of 1,002 bodies, evenly spaced, the outermost two included"), std::string::npos);
   // A gas (e = 0.9): T(t) on log-log axes with Haff's law fitted.
-  EXPECT_NE(dom.find("Haff's law T0/(1 + t/tau)^2 fitted: T0 = "), std::string::npos);
+  EXPECT_NE(dom.find("Haff's law T = T0 / (1 + t/τ)² fitted: T0 = "), std::string::npos);
   EXPECT_GT(bodyData(dom, "temperature-points"), 10.0);
   EXPECT_GT(bodyData(dom, "haff-tau"), 0.0);
+  // T said in a student's words, not as "T = sum m (v - V)^2 / N".
+  EXPECT_NE(dom.find("twice the mean kinetic energy of the bodies' motion relative to their centre of mass [J]"),
+            std::string::npos);
+  EXPECT_EQ(dom.find("sum m (v - V)^2"), std::string::npos);
+  // The log axes' labels: 1, 2 or 5 times a power of ten (or decades only), never e-notation.
+  for (const char* axis : {"x", "y"}) {
+    std::smatch m;
+    const std::string name = std::string("data-temperature-ticks-") + axis + "=\"([^\"]*)\"";
+    ASSERT_TRUE(std::regex_search(dom, m, std::regex(name))) << axis;
+    std::istringstream labels(m[1].str());
+    std::string label;
+    int count = 0;
+    while (std::getline(labels, label, '|')) {
+      ++count;
+      EXPECT_EQ(label.find('e'), std::string::npos) << axis << ": " << label;
+      EXPECT_TRUE(std::regex_match(label, std::regex("([125]×)?10[⁻⁰¹²³⁴⁵⁶⁷⁸⁹]+|0\\.0[125]|0\\.[125]|[125]|[125]0|[125]00|[125],000")))
+          << axis << ": " << label;
+    }
+    EXPECT_GE(count, 2) << axis << ": " << m[1];
+  }
 }
 
 int main(int argc, char** argv) {

@@ -128,6 +128,29 @@ TEST_F(WebTest, BrowserRunIsServedRecordedAndListed) {
   EXPECT_NE(page->body.find("data-run-id=\"" + run_id + "\""), std::string::npos);
 }
 
+// A run the model answered has no collision events: its events CSV is a 404 that says why
+// (docs/web.md), not an empty file served with 200.
+TEST_F(WebTest, EventsCsvOfARunNotSimulatedIs404WithItsReason) {
+  json capped = piScene("nan");
+  capped["max_collisions"] = 10;  // below the 31 predicted: the model answers
+  json predict_only = piScene("nan");
+  predict_only["mode"] = 1;
+  for (const json& scene : {capped, predict_only}) {
+    auto res = post(scene);
+    ASSERT_TRUE(res);
+    ASSERT_EQ(res->status, 202) << res->body;
+    const std::string run_id = json::parse(res->body)["run_id"];
+    const json run = finishedRun(run_id);
+    ASSERT_FALSE(run.at("view").at("not_simulated").get<std::string>().empty()) << run.at("view").dump();
+    auto csv = client().Get(("/api/runs/" + run_id + "/events.csv").c_str());
+    ASSERT_TRUE(csv);
+    EXPECT_EQ(csv->status, 404) << run_id << ": " << csv->body.size() << " bytes: " << csv->body;
+    const json error = json::parse(csv->body, nullptr, false);
+    ASSERT_TRUE(error.is_object()) << csv->body;
+    EXPECT_NE(error.value("error", "").find("not simulated"), std::string::npos) << csv->body;
+  }
+}
+
 TEST_F(WebTest, RunIdsAreNumberedPerStudent) {
   // Classmates' runs do not share numbers: each student's n-th run is <student>.run<n>.
   const auto send = [](const std::string& student) {
@@ -218,6 +241,8 @@ TEST_F(WebTest, TheTeacherSeesEachStudentsRejectedInputs) {
   ASSERT_EQ(rejections.size(), 2u) << rejections.dump();
   for (const json& r : rejections) {
     EXPECT_EQ(r.at("student"), "jo");
+    EXPECT_EQ(r.at("run_id"), "") << "jo typed no run_id (the page numbered the send): " << r.dump();
+    EXPECT_EQ(r.at("by"), "lab node");
     EXPECT_EQ(r.at("reason_name"), "POSITIONS_NOT_ORDERED");
     EXPECT_EQ(r.at("field").get<std::string>().rfind("positions", 0), 0u) << r.dump();
     EXPECT_FALSE(r.at("message").get<std::string>().empty());
@@ -231,6 +256,46 @@ TEST_F(WebTest, TheTeacherSeesEachStudentsRejectedInputs) {
   auto other = client().Get("/api/rejections?student=nobody");
   ASSERT_TRUE(other);
   EXPECT_EQ(json::parse(other->body).size(), 0u);
+}
+
+// The web node's own refusals (400, 413, 415, 429) never reach the lab node's run index:
+// the web node lists them beside the lab's rejections, per student where the body named one.
+TEST_F(WebTest, TheTeacherSeesTheWebNodesOwnRefusals) {
+  json bad = piScene("kim");
+  bad["velocities"] = {-1, "fast", 0};
+  bad["run_id"] = "mine";  // typed: listed as asked for
+  auto res = post(bad);
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 400) << res->body;
+  res = client().Post("/api/runs", piScene("kim").dump(), "text/plain");
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 415) << res->body;
+  json large = piScene("kim");
+  large["padding"] = std::string(10000, 'x');  // over max_body_bytes = 8192: never read
+  res = post(large);
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 413);
+
+  auto listed = client().Get("/api/rejections?student=kim");
+  ASSERT_TRUE(listed);
+  ASSERT_EQ(listed->status, 200);
+  const json kim = json::parse(listed->body);
+  ASSERT_EQ(kim.size(), 2u) << kim.dump();
+  EXPECT_EQ(kim[0].at("reason_name"), "HTTP 415") << "newest first";
+  EXPECT_EQ(kim[0].at("run_id"), "");
+  EXPECT_NE(kim[0].at("message").get<std::string>().find("Content-Type: application/json"), std::string::npos);
+  EXPECT_EQ(kim[1].at("reason_name"), "HTTP 400");
+  EXPECT_EQ(kim[1].at("run_id"), "mine");
+  EXPECT_EQ(kim[1].at("field"), "velocities[1]");
+  for (const json& r : kim) {
+    EXPECT_EQ(r.at("by"), "web node");
+    EXPECT_GT(r.at("at").get<double>(), 1.6e9) << "a wall time [s since the epoch]";
+  }
+  // The 413's body was never read: listed without a student.
+  const json all = json::parse(client().Get("/api/rejections")->body);
+  bool too_large = false;
+  for (const json& r : all) too_large = too_large || (r.at("reason_name") == "HTTP 413" && r.at("student") == "");
+  EXPECT_TRUE(too_large) << all.dump();
 }
 
 TEST_F(WebTest, ClassCodeIsNeededEverywhere) {
@@ -297,6 +362,12 @@ TEST_F(WebTest, RunsPerStudentPerMinuteIs429ForThatStudentOnly) {
   ASSERT_TRUE(res);
   EXPECT_EQ(res->status, 429);
   EXPECT_FALSE(res->get_header_value("Retry-After").empty());
+  // The teacher sees it, under hal, with its reason.
+  const json listed = json::parse(client().Get("/api/rejections?student=hal")->body);
+  ASSERT_EQ(listed.size(), 1u) << listed.dump();
+  EXPECT_EQ(listed[0].at("reason_name"), "HTTP 429");
+  EXPECT_EQ(listed[0].at("by"), "web node");
+  EXPECT_NE(listed[0].at("message").get<std::string>().find("runs per student per minute"), std::string::npos);
   res = post(piScene("ivy"));
   ASSERT_TRUE(res);
   EXPECT_EQ(res->status, 202) << "another student is not held back";

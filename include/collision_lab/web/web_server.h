@@ -122,6 +122,13 @@ class WebServer {
   void remember(const std::string& run_id, const std::string& token);
   std::optional<std::string> stopToken(const std::string& run_id) const;
   void log(const std::string& line) const;
+  /// Notes a send to POST /api/runs that this node refused itself (400, 413, 415, 422, 429),
+  /// with the student and run_id its body named, when it could be read.
+  void refusedSend(const std::string& body, const std::string& reason_name, const std::string& error,
+                   const std::string& field = {});
+  /// GET /api/rejections: the lab node's rejections (the run index) and this node's own
+  /// refusals, newest first; a run_id this node numbered itself is shown empty.
+  std::string rejectionsJson(const std::optional<std::string>& student) const;
 
   RunBook& book_;
   WebConfig config_;
@@ -144,6 +151,18 @@ class WebServer {
   /// node serves a taken "run<n>" as the next free number, so numbers stay per student and
   /// unique across restarts of either node.
   std::map<std::string, std::uint64_t> runs_numbered_;
+  /// A refused send as the teacher page lists it; `at` [s since the epoch].
+  struct Refusal {
+    double at = 0;
+    std::string student, run_id, reason_name, field, message;
+  };
+  /// This node's own refusals of sends, newest last, at most kRefusalsKept: in memory only
+  /// (the run index is the lab node's file; these never reached the lab node).
+  std::deque<Refusal> refusals_;
+  /// The lab node's rejections of sends this node numbered itself (no run_id typed), newest
+  /// last, at most kRefusalsKept: their index rows show no run_id asked for.
+  std::deque<Refusal> numbered_rejections_;
+  static constexpr std::size_t kRefusalsKept = 1000;
   std::string queue_json_;
   std::unique_ptr<BlockingPool> blocking_;  ///< cancel calls and CSV conversions
   std::unique_ptr<HttpServer> server_;

@@ -10,6 +10,7 @@
 #include <optional>
 #include <string>
 
+#include "collision_lab/core/count_text.h"
 #include "elastic_triple.h"
 #include "tier.h"
 
@@ -374,7 +375,7 @@ std::string indexRanges(const std::vector<std::size_t>& indices) {
 }
 
 std::string stopMessage(const Scene& scene, const EngineResult& result, bool exhausted, const ExactProgress& exact) {
-  const std::string count = std::to_string(result.impact_count);
+  const std::string count = countText(result.impact_count);
   switch (result.stop) {
     case StopReason::kFinished: {
       std::string text = "no pair approaches any more after " + count + " impacts: the run is complete";
@@ -384,10 +385,10 @@ std::string stopMessage(const Scene& scene, const EngineResult& result, bool exh
                 formatValue(c.position) + " m, and move on as one";
       }
       if (result.cluster_impacts > 0) {
-        text += "; " + std::to_string(result.cluster_impacts) + " impacts hit a cluster as one body of its total mass";
+        text += "; " + countText(result.cluster_impacts) + " impacts hit a cluster as one body of its total mass";
       }
       if (result.rule_elastic_impacts > 0) {
-        text += "; " + std::to_string(result.rule_elastic_impacts) + " impacts made elastic by the " +
+        text += "; " + countText(result.rule_elastic_impacts) + " impacts made elastic by the " +
                 restitutionModelName(scene.restitution_model.kind) + " restitution model";
       }
       return text;

@@ -25,6 +25,7 @@
 #include <limits>
 #include <string>
 
+#include "collision_lab/core/count_text.h"
 #include "collision_lab/core/nbody/engine.h"
 #include "reference.h"
 
@@ -223,7 +224,7 @@ TEST(CollapseChain, EightBodiesCrowdingWithoutAPatternStopHonestly) {
   ASSERT_FALSE(run.crowding_bodies.empty());
   EXPECT_GE(run.crowding_bodies.front(), lo);
   EXPECT_LE(run.crowding_bodies.back(), hi);
-  EXPECT_NE(run.stop_message.find("stopped after " + std::to_string(run.impact_count) + " impacts at the exactness cap"),
+  EXPECT_NE(run.stop_message.find("stopped after " + countText(run.impact_count) + " impacts at the exactness cap"),
             std::string::npos);
   EXPECT_NE(run.stop_message.find("--restitution-model tc"), std::string::npos);
 }

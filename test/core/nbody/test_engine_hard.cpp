@@ -298,7 +298,7 @@ TEST(NBodyEngineContract, ProgressAndCancellation) {
   // The partial summary is a real state: momentum and energy still balance.
   EXPECT_LT(run.momentum_relative_drift, 1e-14);
   EXPECT_LT(run.energy_relative_drift, 1e-14);
-  EXPECT_NE(run.stop_message.find("cancelled after 3072 impacts"), std::string::npos) << run.stop_message;
+  EXPECT_NE(run.stop_message.find("cancelled after 3,072 impacts"), std::string::npos) << run.stop_message;
 }
 
 TEST(NBodyEngineContract, KeepsOnlyTheEventsAskedFor) {

@@ -8,6 +8,7 @@
 #include <atomic>
 #include <string>
 
+#include "collision_lab/core/count_text.h"
 #include "collision_lab/core/nbody/engine.h"
 #include "granular_gas.h"
 
@@ -47,7 +48,7 @@ TEST(NBodyGasBudget, HundredBodyGasEndsWithAReasonAndBalancesEnergy) {
     EXPECT_GT(run.impact_count, 0u);
     ASSERT_FALSE(run.crowding_bodies.empty()) << label;
     EXPECT_LT(run.crowding_bodies.back(), s.size());
-    EXPECT_NE(label.find("stopped after " + std::to_string(run.impact_count) +
+    EXPECT_NE(label.find("stopped after " + countText(run.impact_count) +
                          (run.stop == StopReason::kCap ? " impacts at the exactness cap" : " certified impacts")),
               std::string::npos);
     EXPECT_NE(label.find("bodies " + std::to_string(run.crowding_bodies.front())), std::string::npos);
@@ -71,7 +72,7 @@ TEST(NBodyGasBudget, CancelReachesTheExactReplay) {
   EXPECT_GT(run.impact_count, 4000u);
   EXPECT_LT(run.impact_count, 5120u);
   EXPECT_GT(run.escalations.exact_rational, 0u);
-  EXPECT_NE(run.stop_message.find("cancelled after " + std::to_string(run.impact_count) + " impacts"),
+  EXPECT_NE(run.stop_message.find("cancelled after " + countText(run.impact_count) + " impacts"),
             std::string::npos);
 }
 
