@@ -26,3 +26,7 @@ add_dependencies(web_restart_test collision_lab_node collision_lab_web)
 add_rostest_gtest(web_lab_recovery_test test/ros/web_lab_recovery_test.test test/ros/web_lab_recovery_test.cpp)
 target_link_libraries(web_lab_recovery_test collision_lab_web_lib PkgConfig::CPP_HTTPLIB ${catkin_LIBRARIES})
 add_dependencies(web_lab_recovery_test collision_lab_node collision_lab_web)
+# A live run past the lab's ~max_published_events: RunProgress moves the page's counter.
+add_rostest_gtest(web_progress_test test/ros/web_progress_test.test test/ros/web_progress_test.cpp)
+target_link_libraries(web_progress_test collision_lab_web_lib PkgConfig::CPP_HTTPLIB ${catkin_LIBRARIES})
+add_dependencies(web_progress_test collision_lab_node collision_lab_web)

@@ -159,18 +159,40 @@ std::string utcStamp(const char* format) {
   return buffer;
 }
 
+/// What of a run's collisions goes out on the topics (LabNodeParams).
+struct PublishLimits {
+  std::uint64_t max_published = 0;          ///< [1] collisions published one by one
+  double progress_period = 0.0;             ///< [s] of wall time between two RunProgress
+  std::uint64_t progress_every_events = 0;  ///< [1] test hook: instead of the period, when > 0
+};
+
+/// Fills the state of every body after event from replay (for scenes above
+/// CollisionEvent.FULL_STATE_MAX_BODIES, whose events carry none): positions at the event's
+/// time, velocities and kinetic energies after it, the totals. Keeps event's storage.
+void fillFullState(const collision_lab::core::BodyStateReplay& replay, collision_lab::CollisionEvent& event) {
+  event.positions.resize(replay.size());
+  for (std::size_t i = 0; i < replay.size(); ++i) event.positions[i] = replay.position(i, event.time);
+  event.velocities_after = replay.velocities();
+  event.kinetic_energy_after = replay.kineticEnergies();
+  event.total_energy = replay.totalKineticEnergy();
+  event.total_momentum = replay.momentum();
+}
+
 /// The per-collision messages of one run. Every CollisionEvent is recorded and drawn;
 /// the first max_published also go out on collision_events and, as their plot
 /// projections (live only, never recorded: docs/messages.md), on velocities and
-/// energy_transfers. Each is refilled in the node's one message of its kind (buffers),
-/// whose storage is reused from event to event and run to run.
+/// energy_transfers. Past them, a RunProgress (live only) goes out at the first collision
+/// not published and then at most every progress_period of wall time: a clock check per
+/// collision, no allocation once its message has grown to the scene's size. Each is
+/// refilled in the node's one message of its kind (buffers), whose storage is reused from
+/// event to event and run to run.
 class EventStream {
  public:
   /// fail_at_first_event: the test hook ~fail_runs_of_student (throws std::bad_alloc).
-  EventStream(const RunTopics& topics, RunWriter& out, RunObserver* markers, std::uint64_t max_published,
+  EventStream(const RunTopics& topics, RunWriter& out, RunObserver* markers, const PublishLimits& limits,
               const collision_lab::core::Scene& scene, EventMessages& buffers, RunProgress& progress,
               bool fail_at_first_event)
-      : topics_(topics), out_(out), markers_(markers), max_published_(max_published), scene_(scene),
+      : topics_(topics), out_(out), markers_(markers), limits_(limits), scene_(scene),
         msg_(buffers), progress_(progress), fail_(fail_at_first_event) {}
 
   /// An event of the three-body path.
@@ -213,15 +235,16 @@ class EventStream {
     }
     out_.record(std::move(msg_.event));
   }
-  /// Stamps and draws msg, and publishes it unless the cap is reached; true when
-  /// published. The caller records it.
+  /// Stamps and draws msg, and publishes it unless the cap is reached (then, when due, the
+  /// run's progress); true when published. The caller records it.
   bool send(collision_lab::CollisionEvent& msg) {
     if (fail_) throw std::bad_alloc();
     ++progress_.collisions;
     progress_.last_time = msg.time;
     out_.stamp(msg, msg.time);
     if (markers_) markers_->onCollisionEvent(msg);
-    if (progress_.published == max_published_) {
+    if (progress_.published == limits_.max_published) {
+      if (progressDue()) publishProgress(msg);
       cut_ = true;
       return false;
     }
@@ -229,17 +252,44 @@ class EventStream {
     ++progress_.published;
     return true;
   }
+  /// At the first collision not published; then after progress_every_events more, or
+  /// without that hook once progress_period has passed since the last RunProgress.
+  bool progressDue() {
+    if (!cut_) return true;
+    if (limits_.progress_every_events > 0) return ++unpublished_since_progress_ >= limits_.progress_every_events;
+    return std::chrono::steady_clock::now() >= next_progress_;
+  }
+  void publishProgress(const collision_lab::CollisionEvent& msg) {
+    unpublished_since_progress_ = 0;
+    next_progress_ = std::chrono::steady_clock::now() +
+                     std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                         std::chrono::duration<double>(limits_.progress_period));
+    collision_lab::RunProgress& p = msg_.progress;
+    p.header = msg.header;
+    p.run_id = msg.run_id;
+    p.collisions = msg.index;
+    p.time = msg.time;
+    p.published = progress_.published;
+    p.latest_event = msg;
+    // The three-body path is elastic; the event engine's replay has the heat and, above
+    // FULL_STATE_MAX_BODIES, the state the event leaves out.
+    p.energy_lost = converter_ ? converter_->replay().heat() : 0.0;
+    if (converter_ && p.latest_event.positions.empty()) fillFullState(converter_->replay(), p.latest_event);
+    topics_.progress.publish(p);
+  }
 
   const RunTopics& topics_;
   RunWriter& out_;
   RunObserver* markers_;
-  std::uint64_t max_published_;
+  PublishLimits limits_;
   const collision_lab::core::Scene& scene_;
   std::optional<SceneEventConverter> converter_;
   EventMessages& msg_;
   RunProgress& progress_;
   bool fail_;
   bool cut_ = false;
+  std::uint64_t unpublished_since_progress_ = 0;  ///< [1] since the last RunProgress
+  std::chrono::steady_clock::time_point next_progress_;
 };
 
 /// The reason to refuse input before simulating it (student, run_id, mode, size, then the
@@ -411,6 +461,14 @@ LabNodeParams LabNodeParams::load(const ros::NodeHandle& private_nh) {
   private_nh.param("simulate_to_cap", params.simulate_to_cap, false);
   params.max_published_events =
       getUint64(private_nh, "max_published_events", kDefaultMaxPublishedEvents);
+  private_nh.param("progress_period", params.progress_period, kDefaultProgressPeriod);
+  if (!std::isfinite(params.progress_period) || params.progress_period <= 0) {
+    std::ostringstream error;
+    error << "~progress_period = " << params.progress_period << " is out of range; expected a finite number of "
+          << "seconds > 0";
+    throw std::invalid_argument(error.str());
+  }
+  params.progress_every_events = getUint64(private_nh, "progress_every_events", 0);
   private_nh.param("publish_markers", params.publish_markers, true);
   private_nh.param("log_runs", params.log_runs, true);
   params.max_bodies = getUint64(private_nh, "max_bodies", kDefaultMaxBodies);
@@ -561,6 +619,7 @@ LabNode::LabNode(ros::NodeHandle nh, ros::NodeHandle private_nh, const RunObserv
       nh_.advertise<collision_lab::Velocities>(kVelocitiesTopic, kOutputQueueSize);
   topics_.energies =
       nh_.advertise<collision_lab::EnergyTransfer>(kEnergyTransfersTopic, kOutputQueueSize);
+  topics_.progress = nh_.advertise<collision_lab::RunProgress>(kRunProgressTopic, kOutputQueueSize);
   topics_.summaries = nh_.advertise<collision_lab::RunSummary>(
       kRunSummariesTopic, kOutputQueueSize, kLatchRunSummaries);
   rejected_pub_ =
@@ -986,8 +1045,9 @@ void LabNode::run(Worker& worker, Job& job, RunWriter& out, RunProgress& progres
   options.keep_events = false;
   options.cancel = &worker.cancel;
   const bool fail = !params_.fail_runs_of_student.empty() && input.student == params_.fail_runs_of_student;
-  EventStream events(topics_, out, worker.draws ? marker_view_.get() : nullptr, params_.max_published_events,
-                     plan.scene, worker.event_messages, progress, fail);
+  const PublishLimits limits{params_.max_published_events, params_.progress_period, params_.progress_every_events};
+  EventStream events(topics_, out, worker.draws ? marker_view_.get() : nullptr, limits, plan.scene,
+                     worker.event_messages, progress, fail);
   core::SceneVisitors visitors;
   visitors.three_body_event = [&events](const core::LabEvent& e) { events(e); };
   visitors.impact = [&events](const core::ImpactRecord& r) { events(r); };

@@ -290,9 +290,13 @@ void RunRecord::widenVelocityRange(double v) {
 }
 
 void RunRecord::apply(const collision_lab::CollisionEvent& event) {
-  const std::size_t n = bodies();
   replayEvent(replay_, event);  // it fits: wellFormed
   for (std::size_t k = 0; k < replay_.movedCount(); ++k) recordMove((replay_.firstMoved() + k) % replay_.size(), event.time);
+  stepSeries(event);
+}
+
+void RunRecord::stepSeries(const collision_lab::CollisionEvent& event) {
+  const std::size_t n = bodies();
   const double k = static_cast<double>(newest_index_);
   // The plotted bodies (at most kMaxPlottedBodies) have a step at every event.
   for (std::size_t slot = 0; slot < plotted_.size(); ++slot) {
@@ -341,12 +345,39 @@ void RunRecord::add(const collision_lab::CollisionEvent& event) {
   const std::uint64_t expected = collapse ? newest_index_ : newest_index_ + 1;
   if (event.index < expected || (collapse && event.index == newest_index_ && newest_is_collapse_ && has_newest_)) return;
   missed_ += event.index - expected;
-  if (provisional_) keyframes_.pop_back(), provisional_ = false;
   // The newest kept state is exact up to this event, unless events are missing or the
   // infinitely many impacts of a collapse lie between.
+  makeNewest(event, event.index == expected && !collapse);
+  apply(event);
+  keepNewest(event);
+}
+
+void RunRecord::addSample(const collision_lab::CollisionEvent& event, double heat) {
+  if (event.index <= newest_index_ && has_newest_) return;
+  const std::size_t n = bodies();
+  if (!wellFormed(event) || event.positions.size() != n || event.velocities_after.size() != n) {
+    ++malformed_;
+    return;
+  }
+  if (!sampled_) sampled_after_ = newest_index_;
+  sampled_ = true;
+  const bool collapse = event.kind == collision_lab::CollisionEvent::KIND_COLLAPSE;
+  const std::uint64_t expected = collapse ? newest_index_ : newest_index_ + 1;
+  sampled_collisions_ += event.index - std::min(event.index, expected);
+  makeNewest(event, false);
+  replay_.restart(event.positions, event.velocities_after, event.time, heat);
+  for (std::size_t body : tracked_) recordMove(body, event.time);
+  for (double v : event.velocities_after) widenVelocityRange(v);
+  stepSeries(event);
+  keepNewest(event);
+}
+
+void RunRecord::makeNewest(const collision_lab::CollisionEvent& event, bool follows) {
+  const bool collapse = event.kind == collision_lab::CollisionEvent::KIND_COLLAPSE;
+  if (provisional_) keyframes_.pop_back(), provisional_ = false;
   if (newest_kept_) {
     Keyframe& before = keyframes_.back();
-    before.valid_until = event.index == expected && !collapse ? event.time : before.time;
+    before.valid_until = follows ? event.time : before.time;
   }
   previous_time_ = has_newest_ ? newest_time_ : 0.0;
   newest_index_ = event.index;
@@ -359,7 +390,9 @@ void RunRecord::add(const collision_lab::CollisionEvent& event) {
     first_collapse_position_ = event.position;
     first_collapse_bodies_ = {event.first_moved, event.last_moved};
   }
-  apply(event);
+}
+
+void RunRecord::keepNewest(const collision_lab::CollisionEvent& event) {
   if (bucket_ == 0 && event.time > 0) {
     bucket_ = powerOfTwoAtMost(event.time / static_cast<double>(keyframeLimit()));
   }
@@ -422,7 +455,7 @@ bool RunRecord::finished() const {
   if (summary) {
     return summary->simulated && !summary->truncated && summary->collision_count == collisions();
   }
-  return prediction && input_.mode == collision_lab::InitialConditions::MODE_FULL &&
+  return prediction && !sampled_ && input_.mode == collision_lab::InitialConditions::MODE_FULL &&
          prediction->collision_count_defined && !prediction->infinite_collisions &&
          prediction->collision_count == collisions();
 }

@@ -89,6 +89,9 @@ std::string noteOf(const RunRecord& run, const RunView& view) {
   if (run.missedCollisions() > 0) {
     note += withSeparators(run.missedCollisions()) + " collision messages missing; ";
   }
+  // Past ~max_published_events the web node gets sampled states (RunProgress) only.
+  const std::string sampled = "the plots are sampled past the first " + collisionsText(run.sampledAfter()) + " published";
+  if (run.sampled() && run.summary) note += sampled + " (the run has no bag to draw every collision from); ";
   if (!view.truncated.empty()) {
     note += view.truncated + " Shown up to the last known state.";
   } else if (run.input().mode == InitialConditions::MODE_PREDICT_ONLY) {
@@ -99,7 +102,8 @@ std::string noteOf(const RunRecord& run, const RunView& view) {
   } else if (run.input().mode == InitialConditions::MODE_SUMMARY_ONLY) {
     note += "summary-only run: shown up to the first contact; the plots show the final velocities.";
   } else if (!run.finished()) {
-    note += "run in progress: shown up to the last collision received.";
+    note += run.sampled() ? "run in progress: " + sampled + "; the whole run is drawn from its bag when it ends."
+                          : "run in progress: shown up to the last collision received.";
   }
   return note;
 }

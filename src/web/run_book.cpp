@@ -414,6 +414,17 @@ void RunBook::onEvent(const collision_lab::CollisionEvent& msg) {
   changed_.notify_all();
 }
 
+void RunBook::onProgress(const collision_lab::RunProgress& msg) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (evicted_.count(msg.run_id)) return;
+  WebRun& run = runLocked(msg.run_id);
+  if (run.finished || run.rebuilding || !run.record) return;
+  run.record->addSample(msg.latest_event, msg.energy_lost);
+  addPredicted(run.predicted, *run.record, msg.latest_event);  // the closed form's sample too
+  ++run.version;
+  changed_.notify_all();
+}
+
 void RunBook::onSummary(const collision_lab::RunSummary& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
   if (evicted_.count(msg.run_id)) return;

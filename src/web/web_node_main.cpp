@@ -149,6 +149,7 @@ int main(int argc, char** argv) {
       nh.subscribe(kServedInputsTopic, kOutputQueueSize, &collision_lab_web::RunBook::onServedInput, &book),
       nh.subscribe(kPredictionsTopic, kOutputQueueSize, &collision_lab_web::RunBook::onPrediction, &book),
       nh.subscribe(kCollisionEventsTopic, kOutputQueueSize, &collision_lab_web::RunBook::onEvent, &book),
+      nh.subscribe(kRunProgressTopic, kOutputQueueSize, &collision_lab_web::RunBook::onProgress, &book),
       nh.subscribe(kRunSummariesTopic, kOutputQueueSize, &collision_lab_web::RunBook::onSummary, &book)};
   auto publish = [&inputs](const collision_lab::InitialConditions& input) {
     if (inputs.getNumSubscribers() == 0) return false;

@@ -459,6 +459,25 @@ TEST(LabNode, EventsBeyondThePublishCapAreRecordedOnly) {
   for (std::size_t k = 0; k < events.size(); ++k) EXPECT_EQ(events[k].index, k + 1);
   // The bag-only collisions sit on the run's timeline too.
   expectBagOnTimeline(summary.bag_path, 1.0);
+
+  // Past the cap, run_progress (live only) says how far the run got: first at collision 51,
+  // with its state, then at most every ~progress_period (0.1 s) of wall time.
+  ASSERT_FALSE(out.progress.empty());
+  const collision_lab::RunProgress& first = out.progress.front();
+  EXPECT_EQ(first.collisions, 51u);
+  EXPECT_EQ(first.published, 50u);
+  EXPECT_EQ(first.latest_event.index, 51u);
+  EXPECT_EQ(first.latest_event.velocities_after, events[50].velocities_after);
+  EXPECT_EQ(first.latest_event.positions, events[50].positions);
+  EXPECT_EQ(first.latest_event.header.stamp, events[50].header.stamp);
+  EXPECT_DOUBLE_EQ(first.time, events[50].time);
+  for (std::size_t k = 1; k < out.progress.size(); ++k) {
+    EXPECT_GT(out.progress[k].collisions, out.progress[k - 1].collisions);
+    EXPECT_LE(out.progress[k].collisions, 314u);
+  }
+  for (const rosbag::ConnectionInfo* connection : rosbag::View(bag).getConnections()) {
+    EXPECT_EQ(connection->topic.find("run_progress"), std::string::npos) << "live only, not recorded";
+  }
 }
 
 // ---- Recording faults: everything is still published, the summary says why ----

@@ -2,7 +2,8 @@
 // of order: they are separate connections, so a run's summary may come before its served
 // input. Bags read on many threads at once. Bounded memory: runs evicted under a budget and
 // read back from their bags; the run index (a fake RunSource) for old runs, the list, and
-// the reconciliation of runs whose summary or events were missed. No master needed.
+// the reconciliation of runs whose summary or events were missed. A live run past the lab's
+// published-event cap, from its RunProgress samples. No master needed.
 #include <stdlib.h>
 
 #include <atomic>
@@ -20,6 +21,7 @@
 
 #include "collision_lab/ros/marker_builder.h"
 #include "collision_lab/ros/markers/draw.h"
+#include "collision_lab/ros/msg_conversion.h"
 #include "collision_lab/ros/run_view.h"
 #include "collision_lab/web/run_book.h"
 
@@ -623,6 +625,129 @@ TEST(RunBookView, PageAndRvizGetTheSameViewDescription) {
   EXPECT_EQ(view.at("note"), collision_lab_ros::markers::runNote(rviz));
   EXPECT_EQ(view.at("collapse"), "collapse at t = 3.5 s, x = 1 m, bodies A..C");
   EXPECT_EQ(view.at("worldline_bodies").at(0).at("colour"), collision_lab_ros::bodyColourHex(0));
+}
+
+}  // namespace
+
+// ---- A live run past the lab's published-event cap (RunProgress) ----
+
+namespace {
+
+/// The pi billiard (masses 1e4, 1, inf: 314 impacts) as the lab node sends it: its served
+/// input, prediction and every CollisionEvent, from the core (not from the code under test).
+struct PiRun {
+  collision_lab::InitialConditions input;
+  collision_lab::Prediction prediction;
+  std::vector<collision_lab::CollisionEvent> events;
+};
+
+PiRun piRun(const std::string& run_id) {
+  collision_lab::core::ThreeBodyScene scene;
+  scene.masses = {1e4, 1.0, std::numeric_limits<double>::infinity()};
+  scene.positions = {2.0, 1.0, 0.0};
+  scene.velocities = {-1.0, 0.0, 0.0};
+  PiRun run;
+  run.input = collision_lab_ros::toInitialConditions(scene, collision_lab::core::RunMode::kFull, 10'000);
+  run.input.run_id = run_id;
+  const collision_lab::core::ScenePlan plan = collision_lab::core::planScene(collision_lab_ros::toScene(run.input));
+  run.prediction = collision_lab_ros::toPredictionMsg(plan);
+  run.prediction.run_id = run_id;
+  collision_lab::core::SceneRunOptions options;
+  options.lab.mode = collision_lab::core::RunMode::kFull;
+  options.lab.max_collisions = 10'000;
+  collision_lab::core::SceneVisitors visitors;
+  visitors.three_body_event = [&](const collision_lab::core::LabEvent& e) {
+    run.events.push_back(collision_lab_ros::toCollisionEventMsg(e));
+    run.events.back().run_id = run_id;
+  };
+  collision_lab::core::runScene(plan, options, visitors);
+  return run;
+}
+
+/// What the lab node publishes on run_progress at event e (elastic: no heat).
+collision_lab::RunProgress progressAt(const collision_lab::CollisionEvent& e, std::uint64_t published) {
+  collision_lab::RunProgress p;
+  p.run_id = e.run_id;
+  p.collisions = e.index;
+  p.time = e.time;
+  p.published = published;
+  p.latest_event = e;
+  return p;
+}
+
+// The web node sees the first 100 events (the lab's ~max_published_events), then samples
+// at 200 and 300: the counter, the note and the plots follow the samples, and nothing
+// counts as missing (issue 31: the counter froze at the cap until the summary).
+TEST(RunBookProgress, SamplesPastTheCapMoveTheCounterAndThePlots) {
+  const PiRun pi = piRun("ana.run1");
+  ASSERT_EQ(pi.events.size(), 314u) << "pi's digits: 314 impacts";
+  collision_lab_web::RunBook book;
+  book.onServedInput(pi.input);
+  book.onPrediction(pi.prediction);
+  for (std::size_t k = 0; k < 100; ++k) book.onEvent(pi.events[k]);
+  EXPECT_EQ(runJson(book, "ana.run1").at("collisions"), 100);
+
+  book.onProgress(progressAt(pi.events[199], 100));
+  book.onProgress(progressAt(pi.events[299], 100));
+  const json run = runJson(book, "ana.run1");
+  EXPECT_EQ(run.at("state"), "running");
+  EXPECT_EQ(run.at("collisions"), 300) << "the progress message's count, not the published events'";
+  EXPECT_DOUBLE_EQ(run.at("newest_time").get<double>(), pi.events[299].time);
+  const json& view = run.at("view");
+  EXPECT_EQ(view.at("collisions_so_far"), 300);
+  EXPECT_EQ(view.at("counter"), "300 of 314 collisions predicted, running");
+  const std::string note = view.at("note");
+  EXPECT_NE(note.find("sampled past the first 100 collisions published"), std::string::npos) << note;
+  EXPECT_EQ(note.find("missing"), std::string::npos) << "samples are no lost messages: " << note;
+  // Each plot ends at the sample, with its values (the JSON's six significant digits).
+  for (const json& series : run.at("plots").at("velocity")) {
+    const std::size_t body = series.at("body");
+    const json& last = series.at("points").back();
+    EXPECT_EQ(last[0], 300) << "body " << body;
+    EXPECT_NEAR(last[1].get<double>(), pi.events[299].velocities_after[body], 1e-5) << "body " << body;
+  }
+  EXPECT_NEAR(run.at("plots").at("energy").back()[1].get<double>(), pi.events[299].total_energy,
+              1e-5 * pi.events[299].total_energy);
+  for (const json& line : run.at("plots").at("worldlines")) {
+    const std::size_t body = line.at("body");
+    const json& last = line.at("points").back();
+    EXPECT_NEAR(last[0].get<double>(), pi.events[299].time, 1e-5 * pi.events[299].time) << "body " << body;
+    EXPECT_NEAR(last[1].get<double>(), pi.events[299].positions[body], 1e-5) << "body " << body;
+  }
+}
+
+// A sample past a gap restarts the record's replay from its state: published events after
+// it continue from the exact state, as if every collision had been received.
+TEST(RunRecordSample, ReplayGoesOnFromTheSampledState) {
+  const PiRun pi = piRun("ana.run1");
+  ASSERT_EQ(pi.events.size(), 314u);
+  collision_lab_ros::RunRecord whole(pi.input), sampled(pi.input);
+  for (const auto& e : pi.events) whole.add(e);
+  for (std::size_t k = 0; k < 10; ++k) sampled.add(pi.events[k]);
+  sampled.addSample(pi.events[149], 0.0);
+  EXPECT_TRUE(sampled.sampled());
+  EXPECT_EQ(sampled.sampledAfter(), 10u);
+  EXPECT_EQ(sampled.sampledCollisions(), 139u) << "collisions 11..149, known by count";
+  EXPECT_EQ(sampled.missedCollisions(), 0u);
+  EXPECT_EQ(sampled.collisions(), 150u);
+  sampled.addSample(pi.events[149], 0.0);  // the same sample again: ignored
+  EXPECT_EQ(sampled.collisions(), 150u);
+  for (std::size_t k = 150; k < pi.events.size(); ++k) sampled.add(pi.events[k]);
+  EXPECT_EQ(sampled.collisions(), 314u);
+  EXPECT_EQ(sampled.missedCollisions(), 0u);
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_NEAR(sampled.velocity(i).last().y, whole.velocity(i).last().y, 1e-9) << "body " << i;
+    EXPECT_NEAR(sampled.worldline(i).last().y, whole.worldline(i).last().y, 1e-9) << "body " << i;
+  }
+  EXPECT_NEAR(sampled.energy().last().y, whole.energy().last().y, 1e-9);
+
+  // A sample without every body's state cannot move the plots: counted as malformed.
+  collision_lab::CollisionEvent bare = pi.events[313];
+  bare.positions.clear();
+  collision_lab_ros::RunRecord record(pi.input);
+  record.addSample(bare, 0.0);
+  EXPECT_EQ(record.malformedEvents(), 1u);
+  EXPECT_EQ(record.collisions(), 0u);
 }
 
 }  // namespace

@@ -23,6 +23,7 @@
 #include "collision_lab/InitialConditions.h"
 #include "collision_lab/Prediction.h"
 #include "collision_lab/Rejected.h"
+#include "collision_lab/RunProgress.h"
 #include "collision_lab/RunSummary.h"
 #include "collision_lab/Velocities.h"
 #include "collision_lab/ros/node_constants.h"
@@ -55,12 +56,15 @@ struct RunOutputs {
   std::vector<collision_lab::EnergyTransfer> energies;
   std::vector<collision_lab::RunSummary> summaries;
   std::vector<collision_lab::Rejected> rejections;
+  std::vector<collision_lab::RunProgress> progress;
 
-  /// A rejection, or a summary with every per-collision message it announces.
+  /// A rejection, or a summary with every per-collision message it announces (and, past
+  /// ~max_published_events, the RunProgress of the first collision not published).
   bool complete() const {
     if (!rejections.empty()) return true;
     if (summaries.empty() || predictions.empty()) return false;
     const std::uint64_t n = summaries.front().published_events;
+    if (summaries.front().events_not_published && progress.empty()) return false;
     return events.size() >= n && velocities.size() >= n && energies.size() >= n;
   }
 };
@@ -78,6 +82,7 @@ class RunCollector {
     subscribe<collision_lab::EnergyTransfer>(kEnergyTransfersTopic, &RunOutputs::energies);
     subscribe<collision_lab::RunSummary>(kRunSummariesTopic, &RunOutputs::summaries);
     subscribe<collision_lab::Rejected>(kRejectedTopic, &RunOutputs::rejections);
+    subscribe<collision_lab::RunProgress>(kRunProgressTopic, &RunOutputs::progress);
   }
 
   /// Returns once the node subscribes to our input and all its outputs reach us.

@@ -74,6 +74,7 @@
 #include "collision_lab/ListRuns.h"
 #include "collision_lab/Rejected.h"
 #include "collision_lab/RunPreset.h"
+#include "collision_lab/RunProgress.h"
 #include "collision_lab/RunScene.h"
 #include "collision_lab/RunSummary.h"
 #include "collision_lab/core/scene_run.h"
@@ -92,6 +93,11 @@ struct LabNodeParams {
   /// answers at once: core::SceneRunOptions::simulate_to_cap).
   bool simulate_to_cap = false;
   std::uint64_t max_published_events = 0;
+  /// Past max_published_events, a RunProgress goes out on run_progress at most this often
+  /// [s] of wall time (~progress_period), and, when progress_every_events > 0 (a test hook,
+  /// ~progress_every_events), every that many unpublished collisions [1] instead.
+  double progress_period = 0.0;
+  std::uint64_t progress_every_events = 0;
   bool publish_markers = true;
   bool log_runs = true;            ///< one INFO line per served run (else DEBUG)
   std::uint64_t max_bodies = 0;    ///< larger scenes are rejected (TOO_MANY_BODIES)
@@ -112,6 +118,7 @@ struct LabNodeParams {
   std::string fail_runs_of_student;
 
   /// Reads ~record, ~bag_directory, ~max_collisions, ~simulate_to_cap, ~max_published_events,
+  /// ~progress_period, ~progress_every_events,
   /// ~publish_markers, ~log_runs, ~max_bodies, ~min_free_space_mb, ~scenario_file (default: the package's
   /// config/scenarios.yaml), ~workers, ~short_lane_workers, ~short_max_collisions,
   /// ~short_max_bodies, ~max_run_seconds, ~max_bag_bytes and ~fail_runs_of_student, with
@@ -167,7 +174,7 @@ class ServedRuns {
 
 /// The publishers of a run's outputs, in the order a run uses them.
 struct RunTopics {
-  ros::Publisher predictions, events, velocities, energies, summaries;
+  ros::Publisher predictions, events, velocities, energies, summaries, progress;
 };
 
 /// The per-collision messages the worker refills for every collision (lab_node.cpp's
@@ -176,6 +183,7 @@ struct EventMessages {
   collision_lab::CollisionEvent event;
   collision_lab::Velocities velocities;
   collision_lab::EnergyTransfer energy;
+  collision_lab::RunProgress progress;
 };
 
 /// What a run has computed so far, kept outside its EventStream (lab_node.cpp) so that a

@@ -150,6 +150,14 @@ class RunRecord {
   /// the count of the impacts before it) is applied once. An event naming bodies the scene
   /// does not have is counted in malformedEvents() and ignored.
   void add(const collision_lab::CollisionEvent& event);
+  /// A sampled state past a gap (a RunProgress's latest_event, the web node's live view past
+  /// ~max_published_events): the counter and clock move to it, the replay goes on from its
+  /// state (positions and velocities_after of every body, heat so far [J]) and every series
+  /// gets one point, drawn straight from the state before; the collisions between are known
+  /// by count only (sampledCollisions()), not missed. An index not past the newest is
+  /// ignored; a sample without the state of every body, or naming bodies the scene does not
+  /// have, is counted in malformedEvents() and ignored.
+  void addSample(const collision_lab::CollisionEvent& event, double heat);
 
   const collision_lab::InitialConditions& input() const { return input_; }
   std::optional<collision_lab::Prediction> prediction;
@@ -162,6 +170,11 @@ class RunRecord {
   std::uint64_t collisions() const { return newest_index_; }
   std::uint64_t missedCollisions() const { return missed_; }
   std::uint64_t malformedEvents() const { return malformed_; }
+  /// True once a sample was added: the series are decimated past sampledAfter(), the
+  /// newest collision received one by one [1]; sampledCollisions() lie between samples [1].
+  bool sampled() const { return sampled_; }
+  std::uint64_t sampledAfter() const { return sampled_after_; }
+  std::uint64_t sampledCollisions() const { return sampled_collisions_; }
   /// Collapses applied [1] and the first one's time [s] (NaN when none).
   std::uint32_t collapses() const { return collapses_; }
   double firstCollapseTime() const { return first_collapse_time_; }
@@ -217,6 +230,13 @@ class RunRecord {
   bool wellFormed(const collision_lab::CollisionEvent& event) const;
   /// Applies the event to the replay and the series.
   void apply(const collision_lab::CollisionEvent& event);
+  /// Makes event the newest collision (its index, time, kind and collapse): the kept state
+  /// before it is exact up to its time only when `follows` (no collision between).
+  void makeNewest(const collision_lab::CollisionEvent& event, bool follows);
+  /// One step of every per-collision series at the newest collision, from the replay.
+  void stepSeries(const collision_lab::CollisionEvent& event);
+  /// Keeps the newest state as a keyframe when the stride and buckets say so.
+  void keepNewest(const collision_lab::CollisionEvent& event);
   /// Adds the moved body's new state (from the replay) to its worldline and velocity range.
   void recordMove(std::size_t body, double time);
   void widenVelocityRange(double v);
@@ -238,6 +258,8 @@ class RunRecord {
   std::uint64_t stride_ = 1;   ///< keeps indices that are multiples of it
   double bucket_ = 0.0;        ///< [s]; 0 until the first collision at t > 0
   std::uint64_t missed_ = 0, malformed_ = 0;
+  bool sampled_ = false;
+  std::uint64_t sampled_after_ = 0, sampled_collisions_ = 0;
   std::uint32_t collapses_ = 0;
   double first_collapse_time_;
   double first_collapse_position_;

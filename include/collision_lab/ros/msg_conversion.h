@@ -141,6 +141,8 @@ class SceneEventConverter {
   /// strings and arrays keep their storage.
   void velocitiesMsg(const collision_lab::CollisionEvent& event, collision_lab::Velocities& msg) const;
   void energyTransferMsg(const collision_lab::CollisionEvent& event, collision_lab::EnergyTransfer& msg) const;
+  /// The state after the last event converted, every body's for any N (RunProgress's).
+  const collision_lab::core::BodyStateReplay& replay() const { return state_.replay(); }
 
  private:
   /// The message of one record of state_, into msg (every field but header and run_id).

@@ -13,6 +13,8 @@ constexpr char kCollisionEventsTopic[] = "collision_events";
 constexpr char kVelocitiesTopic[] = "velocities";
 constexpr char kEnergyTransfersTopic[] = "energy_transfers";
 constexpr char kRunSummariesTopic[] = "run_summaries";
+/// Live only, not latched, never recorded: a run's RunProgress past ~max_published_events.
+constexpr char kRunProgressTopic[] = "run_progress";
 constexpr char kRejectedTopic[] = "rejected";
 /// One AcceptedRun per accepted input: the run_id it got.
 constexpr char kAcceptedRunsTopic[] = "accepted_runs";
@@ -112,6 +114,9 @@ constexpr std::uint64_t kDefaultMaxBodies = 10'000;
 /// Per run; beyond it, events go to the bag only. Keeps a 2-million-collision run from
 /// putting 6 million messages on the network.
 constexpr std::uint64_t kDefaultMaxPublishedEvents = 10'000;
+/// Past it, a run's progress (RunProgress) goes out at most this often [s] of wall time:
+/// a live counter at 10 Hz, a few hundred bytes each for small scenes.
+constexpr double kDefaultProgressPeriod = 0.1;
 /// Recording: a run's events go to the bag writer thread in batches of this many (a
 /// long run never sits whole in memory), and the worker blocks while this many recorded
 /// messages wait to be written (about 40 MB for three bodies): backpressure, never loss.

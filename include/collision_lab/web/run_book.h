@@ -40,6 +40,7 @@
 #include "collision_lab/InitialConditions.h"
 #include "collision_lab/Prediction.h"
 #include "collision_lab/Rejected.h"
+#include "collision_lab/RunProgress.h"
 #include "collision_lab/RunSummary.h"
 #include "collision_lab/ros/marker_builder.h"
 #include "collision_lab/web/run_source.h"
@@ -127,6 +128,10 @@ class RunBook {
   void onServedInput(const collision_lab::InitialConditions& msg);
   void onPrediction(const collision_lab::Prediction& msg);
   void onEvent(const collision_lab::CollisionEvent& msg);
+  /// A run past ~max_published_events: its sampled state goes into the record
+  /// (RunRecord::addSample), so the live counter and plots move on until the summary's
+  /// rebuild from the bag replaces them. Ignored before the run's served input.
+  void onProgress(const collision_lab::RunProgress& msg);
   void onSummary(const collision_lab::RunSummary& msg);
 
   /// Registers an input about to be published under `requested` run_id for `student`:

@@ -34,6 +34,29 @@ BodyStateReplay::BodyStateReplay(std::vector<double> masses, std::vector<double>
 BodyStateReplay::BodyStateReplay(const Scene& scene)
     : BodyStateReplay(scene.masses, scene.positions, scene.velocities, scene.ring) {}
 
+bool BodyStateReplay::restart(const std::vector<double>& positions, const std::vector<double>& velocities,
+                              double time, double heat) {
+  if (positions.size() != size() || velocities.size() != size()) return false;
+  energy_ = Sum();
+  momentum_ = Sum();
+  heat_ = Sum();
+  heat_.add(heat);
+  for (std::size_t i = 0; i < size(); ++i) {
+    points_[i] = positions[i];
+    velocities_[i] = velocities[i];
+    since_[i] = time;
+    kinetic_[i] = kineticEnergy(masses_[i], velocities_[i]);
+    energy_.add(kinetic_[i]);
+    if (!isWall(i)) momentum_.add(masses_[i] * velocities_[i]);
+  }
+  time_ = time;
+  last_heat_ = 0.0;
+  first_moved_ = 0;
+  before_.clear();
+  gained_.clear();
+  return true;
+}
+
 bool BodyStateReplay::isWall(std::size_t body) const { return std::isinf(masses_[body]); }
 
 double BodyStateReplay::position(std::size_t body, double t) const {

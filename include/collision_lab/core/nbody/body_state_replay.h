@@ -40,6 +40,13 @@ class BodyStateReplay {
   /// changes, when first_body < last_body < size() does not hold.
   bool apply(const Collapse& collapse);
 
+  /// Goes on from a state known at `time` [s] past notifications not applied (a sampled
+  /// state): body i at positions[i] [m] with velocities[i] [m/s], heat so far [J]; the totals
+  /// are summed again and the last notification is none. False, and nothing changes, when a
+  /// list's length is not size().
+  bool restart(const std::vector<double>& positions, const std::vector<double>& velocities, double time,
+               double heat);
+
   std::size_t size() const { return velocities_.size(); }
   double mass(std::size_t body) const { return masses_[body]; }
   const std::vector<double>& masses() const { return masses_; }
