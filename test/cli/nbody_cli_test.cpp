@@ -84,6 +84,19 @@ std::uint64_t inversionsByLoop(const std::vector<double>& v) {
   return count;
 }
 
+// Four bodies with --restitution 0, by hand: m = (1, 2, 3, 4) kg, v = (-1, 0, 0, 1) m/s all
+// meet and stick: momentum 3 kg m/s over 10 kg, 0.3 m/s; three impacts; heat 2.5 - 0.45 J.
+TEST(NBodyCli, EveryPairStickingIsTheStickyModel) {
+  const Json doc = runJson({"--masses", "1,2,3,4", "--positions", "3,2,1,0", "--velocities", "-1,0,0,1",
+                            "--restitution", "0"});
+  const Json& summary = doc.at("summary");
+  EXPECT_EQ(summary.at("model"), "sticky");
+  EXPECT_EQ(summary.at("collision_count"), 3);
+  EXPECT_EQ(summary.at("predicted_collision_count"), 3);
+  EXPECT_EQ(summary.at("matches_prediction"), true);
+  EXPECT_EQ(doubles(summary.at("final_velocities")), (std::vector<double>(4, 0.3)));
+}
+
 // Two carts, by hand: m = (3, 1) kg, x = (1, 0) m, v = (-1, 1) m/s. They close at 2 m/s over
 // 1 m: t = 0.5 s at x = 0.5 m. V = (3*(-1) + 1*1)/4 = -0.5 m/s, v' = 2V - v = (0, -2) m/s.
 // A's energy goes from 1.5 J to 0, B's from 0.5 J to 2 J.
