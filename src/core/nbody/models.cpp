@@ -4,8 +4,6 @@
 #include <cmath>
 #include <functional>
 
-#include "collision_lab/core/nbody/impact_rule.h"
-#include "double_double.h"
 #include "spiral.h"
 
 namespace collision_lab {
@@ -236,22 +234,35 @@ Prediction predictTwoWalls(const Scene& scene) {
 }
 
 Prediction predictTwoBody(const Scene& scene) {
-  using nbody_detail::DD;
+  using spiral_detail::Rational;
   Prediction prediction = base(ModelKind::kTwoBody, scene);
   const auto& x = scene.positions;
   const auto& v = scene.velocities;
   prediction.final_velocities = v;
   prediction.impact_count = 0;
   if (!(v[0] < v[1])) return prediction;
-  // Differences of doubles are exact in double-double, so time and place round once or twice.
-  const DD time = (DD(x[0]) - DD(x[1])) / (DD(v[1]) - DD(v[0]));
-  const std::size_t slow = std::fabs(v[0]) <= std::fabs(v[1]) ? 0 : 1;
-  const ImpactOutcome outcome = impact(scene.masses[0], scene.masses[1], v[0], v[1], scene.restitutionOf(0));
+  // Everything exactly in rationals from the input doubles, each result rounded once, so any
+  // mass ratio is exact. The centre-of-mass velocity V is a wall's velocity when one is a
+  // wall; v' = (1 + e) V - e v; heat = mu (1 - e^2) (v_1 - v_0)^2 / 2, mu the reduced mass.
+  const double e = scene.restitutionOf(0);
+  const Rational v0 = v[0], v1 = v[1], re = e;
+  Rational centre, reduced;
+  if (scene.isWall(0) || scene.isWall(1)) {
+    const std::size_t wall = scene.isWall(0) ? 0 : 1;
+    centre = Rational(v[wall]);
+    reduced = Rational(scene.masses[1 - wall]);
+  } else {
+    const Rational m0 = scene.masses[0], m1 = scene.masses[1];
+    centre = (m0 * v0 + m1 * v1) / (m0 + m1);
+    reduced = m0 * m1 / (m0 + m1);
+  }
+  const Rational time = (Rational(x[0]) - x[1]) / (v1 - v0);
   prediction.impact_count = 1;
-  prediction.impact_time = time.hi;
-  prediction.impact_position = (DD(x[slow]) + time * v[slow]).hi;
-  prediction.final_velocities = {outcome.velocity_i, outcome.velocity_j};
-  prediction.energy_lost = outcome.energy_lost;
+  prediction.impact_time = static_cast<double>(time);
+  prediction.impact_position = static_cast<double>(Rational(x[0]) + time * v0);
+  prediction.final_velocities = {scene.isWall(0) ? v[0] : static_cast<double>((1 + re) * centre - re * v0),
+                                 scene.isWall(1) ? v[1] : static_cast<double>((1 + re) * centre - re * v1)};
+  prediction.energy_lost = static_cast<double>(reduced * (1 - re * re) * (v1 - v0) * (v1 - v0) / 2);
   return prediction;
 }
 
