@@ -97,6 +97,20 @@ TEST(NBodyCli, EveryPairStickingIsTheStickyModel) {
   EXPECT_EQ(doubles(summary.at("final_velocities")), (std::vector<double>(4, 0.3)));
 }
 
+// Two bodies at any mass ratio (issue 32): 1e-300 kg at -1 m/s bounces elastically off
+// 1e300 kg at +1 m/s: v' = 2V - v rounds to (3, 1) m/s; they meet at t = 0.5 s, x = 0.5 m.
+TEST(NBodyCli, TwoBodiesAtAnyMassRatioAreAccepted) {
+  const Json doc = runJson({"--masses", "1e-300,1e300", "--positions", "1,0", "--velocities", "-1,1"});
+  const Json& summary = doc.at("summary");
+  EXPECT_EQ(summary.at("model"), "two_body");
+  EXPECT_EQ(summary.at("collision_count"), 1);
+  EXPECT_EQ(summary.at("matches_prediction"), true);
+  EXPECT_EQ(doubles(summary.at("final_velocities")), (std::vector<double>{3, 1}));
+  ASSERT_EQ(doc.at("events").size(), 1u);
+  EXPECT_EQ(doc.at("events")[0].at("time"), 0.5);
+  EXPECT_EQ(doc.at("events")[0].at("position"), 0.5);
+}
+
 // Two carts, by hand: m = (3, 1) kg, x = (1, 0) m, v = (-1, 1) m/s. They close at 2 m/s over
 // 1 m: t = 0.5 s at x = 0.5 m. V = (3*(-1) + 1*1)/4 = -0.5 m/s, v' = 2V - v = (0, -2) m/s.
 // A's energy goes from 1.5 J to 0, B's from 0.5 J to 2 J.
