@@ -111,6 +111,7 @@ SceneSimulation simulateScene(const Scene& scene, const SceneRunOptions& options
   engine_options.max_impacts = lab.max_collisions;
   // Impacts that never end are shown, not counted: a display's worth unless asked for more.
   const bool endless = prediction && (prediction->kind == ModelKind::kTwoWallsInfinite ||
+                                      prediction->kind == ModelKind::kBoxInfinite ||
                                       (prediction->kind == ModelKind::kGhosts && prediction->infinite));  // a ring
   if (endless && !options.simulate_to_cap) {
     engine_options.max_impacts = std::min(lab.max_collisions, kInfiniteRunDisplayCap);

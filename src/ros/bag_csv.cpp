@@ -417,14 +417,14 @@ class BodiesCsv {
       : file_((fs::path(out_dir) / kBodiesFile).string(),
               {"run_id", "index", "time_s", "body", "body_name", "moved", "mass_kg", "x_m", "v_before_m_s", "v_m_s",
                "energy_transfer_J", "kinetic_J", "predicted_v_m_s", "paper_v_m_s", "predicted_energy_transfer_J",
-               "paper_energy_transfer_J"}) {}
+               "paper_energy_transfer_J", "kind"}) {}
 
   void add(const collision_lab::InitialConditions& m) {
     const std::size_t n = std::min({m.masses.size(), m.positions.size(), m.velocities.size()});
     const core::BodyStateReplay& replay =
         runs_.insert_or_assign(m.run_id, core::BodyStateReplay(m.masses, m.positions, m.velocities, m.ring)).first->second;
     for (std::size_t i = 0; i < n; ++i) {
-      BodyRow r(0, 0.0, i, false);
+      BodyRow r(0, 0.0, std::nullopt, i, false);
       r.mass = m.masses[i], r.x = m.positions[i], r.v = m.velocities[i];
       r.kinetic = replay.kinetic(i);
       write(m.run_id, r);
@@ -450,10 +450,12 @@ class BodiesCsv {
 
  private:
   struct BodyRow {
-    BodyRow(std::uint64_t index, double time, std::size_t body, bool moved)
-        : index(index), time(time), body(body), moved(moved) {}
+    BodyRow(std::uint64_t index, double time, std::optional<std::uint8_t> kind, std::size_t body, bool moved)
+        : index(index), time(time), kind(kind), body(body), moved(moved) {}
     std::uint64_t index;
     double time;
+    /// The event's CollisionEvent::kind (impact, collapse); none for the start's rows.
+    std::optional<std::uint8_t> kind;
     std::size_t body;
     bool moved;
     std::optional<double> mass, x, v_before, v, energy_transfer, kinetic, predicted_v, paper_v, predicted_energy,
@@ -468,7 +470,7 @@ class BodiesCsv {
       // A ring's seam event wraps: first_moved..N-1, then 0..last_moved.
       const bool moved = m.first_moved <= m.last_moved ? m.first_moved <= i && i <= m.last_moved
                                                        : i >= m.first_moved || i <= m.last_moved;
-      BodyRow r(m.index, m.time, i, moved);
+      BodyRow r(m.index, m.time, m.kind, i, moved);
       if (known) r.mass = state->mass(i);
       r.x = at(m.positions, i), r.v_before = at(m.velocities_before, i), r.v = m.velocities_after[i];
       r.energy_transfer = at(m.energy_transfer, i), r.kinetic = at(m.kinetic_energy_after, i);
@@ -485,7 +487,7 @@ class BodiesCsv {
     if (!replayEvent(state, m)) return;
     for (std::size_t k = 0; k < state.movedCount(); ++k) {
       const std::size_t i = (state.firstMoved() + k) % state.size();  // a ring's seam wraps
-      BodyRow r(m.index, m.time, i, true);
+      BodyRow r(m.index, m.time, m.kind, i, true);
       r.mass = state.mass(i), r.x = state.position(i, m.time), r.v_before = state.velocityBefore(i);
       r.v = state.velocities()[i], r.kinetic = state.kinetic(i), r.energy_transfer = state.energyGained(i);
       write(m.run_id, r);
@@ -503,6 +505,12 @@ class BodiesCsv {
                               &r.paper_v, &r.predicted_energy, &r.paper_energy}) {
       o << ',';
       writeCell(o, *value);
+    }
+    o << ',';
+    if (r.kind) {
+      writeKind(o, *r.kind);
+    } else {
+      o << "start";
     }
     o << '\n';
   }

@@ -62,8 +62,7 @@ static_assert(collision_lab::Prediction::MODEL_NO_COLLISIONS == static_cast<std:
               collision_lab::Prediction::MODEL_GHOSTS == static_cast<std::uint8_t>(core::ModelKind::kGhosts) &&
               collision_lab::Prediction::MODEL_EVENT_ENGINE == static_cast<std::uint8_t>(core::ModelKind::kEventEngine) &&
               collision_lab::Prediction::MODEL_THREE_BODY_SPIRAL ==
-                  static_cast<std::uint8_t>(core::ModelKind::kThreeBodySpiral) &&
-              collision_lab::Prediction::MODEL_STICKY == static_cast<std::uint8_t>(core::ModelKind::kSticky),
+                  static_cast<std::uint8_t>(core::ModelKind::kThreeBodySpiral),
               "Prediction::MODEL_* must match collision_lab::core::ModelKind");
 
 const char* nodeReasonName(NodeReason reason) {

@@ -59,8 +59,9 @@ Row row(const std::string& scene, const collision_lab::RunScene::Response& respo
   const std::string collisions = std::to_string(s.collision_count) + (s.collapsed ? "+c" : "") +
                                  (s.cancelled ? " (cancelled)" : s.truncated ? "*" : "") +
                                  (s.simulated ? "" : " (n/s)");
-  // Infinitely many: a body between two walls, or the spiral's predicted collapse.
-  const bool infinite = s.model == collision_lab::Prediction::MODEL_TWO_WALLS_INFINITE ||
+  // Infinitely many: bodies between two walls (a ball or a box), a ring of ghosts, or the
+  // spiral's predicted collapse.
+  const bool infinite = s.infinite_collisions ||
                         (s.model == collision_lab::Prediction::MODEL_THREE_BODY_SPIRAL && s.collapsed);
   const std::string predicted = s.predicted_collision_count_defined ? std::to_string(s.predicted_collision_count)
                                 : infinite                           ? "inf"

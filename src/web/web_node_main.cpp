@@ -135,7 +135,13 @@ int main(int argc, char** argv) {
   const WebConfig config = loadConfig(pnh);
   const std::unique_ptr<collision_lab_web::RunBook> book_owner = makeRunBook(pnh);
   collision_lab_web::RunBook& book = *book_owner;
-  ros::Publisher inputs = nh.advertise<collision_lab::InitialConditions>(kInitialConditionsTopic, kInputQueueSize);
+  // Runs are taken (not 503) once the lab node subscribes: said in the log, for the teacher.
+  ros::Publisher inputs = nh.advertise<collision_lab::InitialConditions>(
+      kInitialConditionsTopic, kInputQueueSize,
+      [](const ros::SingleSubscriberPublisher& p) { ROS_INFO_STREAM("Class page ready: " << p.getSubscriberName() << " takes the runs"); },
+      [](const ros::SingleSubscriberPublisher& p) {
+        ROS_WARN_STREAM("collision_lab_web: " << p.getSubscriberName() << " no longer takes runs; a POST gets 503 until a lab node is back");
+      });
   // Sized as the lab node's outputs (node_constants.h): a run's burst of events is never dropped.
   std::vector<ros::Subscriber> subs = {
       nh.subscribe(kAcceptedRunsTopic, kOutputQueueSize, &collision_lab_web::RunBook::onAccepted, &book),

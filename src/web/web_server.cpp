@@ -158,6 +158,13 @@ Response jsonAnswer(const HttpRequest& request, int status, const json& body) {
   return answer(request, static_cast<http::status>(status), body.dump(), "application/json");
 }
 
+/// At most `limit` characters of a client's text for a message: printable ASCII, others as '?'.
+std::string printableExcerpt(const std::string& text, std::size_t limit) {
+  std::string out;
+  for (const char c : text.substr(0, limit)) out += c >= 0x20 && c < 0x7f ? c : '?';
+  return text.size() > limit ? out + "..." : out;
+}
+
 Response errorAnswer(const HttpRequest& request, int status, const std::string& error, const std::string& field = {}) {
   json body = {{"error", error}};
   if (!field.empty()) body["field"] = field;
@@ -413,9 +420,14 @@ void WebServer::handle(HttpRequest request, HttpReply reply) {
       log("refused " + request.client + ": POST from another site");
       return reply.send(errorAnswer(request, 403, "requests from other sites are not accepted"));
     }
+    // Only JSON, whatever its size (the body limit applies to every type alike): a form of
+    // another site can send text/plain or a form encoding without asking first, not JSON.
     const std::string type(m[http::field::content_type]);
     if (!m.body().empty() && lower(type).rfind("application/json", 0) != 0) {
-      return reply.send(errorAnswer(request, 415, "send JSON with Content-Type: application/json"));
+      return reply.send(errorAnswer(request, 415,
+                                    "send the body as JSON with the header Content-Type: application/json (curl: -H "
+                                    "'Content-Type: application/json'); this request's Content-Type: " +
+                                        (type.empty() ? std::string("none") : printableExcerpt(type, 80))));
     }
   }
 

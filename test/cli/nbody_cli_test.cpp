@@ -255,6 +255,22 @@ TEST(NBodyCli, BallBetweenWallsStopsAtTheCapMarkedTruncated) {
   EXPECT_EQ(doubles(odd.at("summary").at("final_velocities")), (std::vector<double>{0, -1, 0}));
 }
 
+// The granular box (1,000 bodies between two walls) is a box, not a ball between two walls:
+// its model says so, and that the engine simulates its endless impacts up to the cap.
+TEST(NBodyCli, AGranularBoxIsNamedABoxAndSimulatedToTheCap) {
+  const Json preset = runPreset("granular_box_1000", {"--events", "none"});
+  const Json& summary = preset.at("summary");
+  EXPECT_EQ(summary.at("model"), "box_infinite");
+  const std::string reason = summary.at("model_reason");
+  EXPECT_NE(reason.find("a box: walls at both ends"), std::string::npos) << reason;
+  EXPECT_NE(reason.find("confine the bodies between them"), std::string::npos) << reason;
+  EXPECT_NE(reason.find("the exact event engine simulates them up to the run's cap"), std::string::npos) << reason;
+  EXPECT_EQ(summary.at("predicted_infinite"), true);
+  EXPECT_EQ(summary.at("truncated"), true);
+  EXPECT_EQ(summary.at("stop_reason"), "CAP");
+  EXPECT_EQ(summary.at("collision_count"), 1000);
+}
+
 // Three bodies with walls at both ends were rejected (TWO_WALLS) and are valid now: B at
 // 1 m, +1 m/s, between walls at 2 m and 0 m hits A at t = 1 s, C at t = 3 s, A at t = 5 s.
 TEST(NBodyCli, ThreeBodiesBetweenTwoWallsAreAnsweredNotRejected) {

@@ -233,9 +233,9 @@ TEST_F(BagCsvTest, OneCsvPerTopicWithUnitsAndExactNumbers) {
   ASSERT_EQ(bodies.size(), 10u);
   EXPECT_EQ(bodies[0], split("run_id,index,time_s,body,body_name,moved,mass_kg,x_m,v_before_m_s,v_m_s,"
                              "energy_transfer_J,kinetic_J,predicted_v_m_s,paper_v_m_s,"
-                             "predicted_energy_transfer_J,paper_energy_transfer_J"));
-  EXPECT_EQ(bodies[1], split("csv_run,0,0,0,A,false,10000,2,,-1,,5000,,,,"));
-  EXPECT_EQ(bodies[3], split("csv_run,0,0,2,C,false,inf,0,,0,,0,,,,"));  // -0.0 as 0; a wall has no kinetic energy
+                             "predicted_energy_transfer_J,paper_energy_transfer_J,kind"));
+  EXPECT_EQ(bodies[1], split("csv_run,0,0,0,A,false,10000,2,,-1,,5000,,,,,start"));
+  EXPECT_EQ(bodies[3], split("csv_run,0,0,2,C,false,inf,0,,0,,0,,,,,start"));  // -0.0 as 0; a wall has no kinetic energy
 
   const Table prediction = readCsv(dir_ + "/csv/predictions.csv");
   EXPECT_EQ(number(prediction, 1, "alpha_rad"), 1.0 / 3.0);
@@ -355,8 +355,8 @@ TEST_F(BagCsvTest, FiveBodiesWithRestitutionEveryBodyAfterEveryImpact) {
   const Table bodies = readCsv(dir_ + "/csv/bodies.csv");
   ASSERT_EQ(bodies.size(), 1u + 3 * 5);
   // Impact 2: rows 11..15 (bodies 0..4).
-  EXPECT_EQ(bodies[11], split("cradle,2,2.3333333333333335,0,A,false,1,2.6666666666666665,-0.25,-0.25,0,0.03125,,,,"));
-  EXPECT_EQ(bodies[13], split("cradle,2,2.3333333333333335,2,C,true,1,2,0,-0.5625,0.158203125,0.158203125,,,,"));
+  EXPECT_EQ(bodies[11], split("cradle,2,2.3333333333333335,0,A,false,1,2.6666666666666665,-0.25,-0.25,0,0.03125,,,,,impact"));
+  EXPECT_EQ(bodies[13], split("cradle,2,2.3333333333333335,2,C,true,1,2,0,-0.5625,0.158203125,0.158203125,,,,,impact"));
   EXPECT_EQ(cell(bodies, 15, "body_name"), "E");
   // Each impact's heat is what the bodies lost together.
   for (std::size_t event = 1; event <= 2; ++event) {
@@ -417,8 +417,8 @@ TEST_F(BagCsvTest, OverSixtyFourBodiesTheMovedBodiesAreRebuiltFromThePairFields)
   // The starts (70 and 65 rows) and the moved bodies: 2 + 3, then 2 + 3.
   ASSERT_EQ(bodies.size(), 1u + 70 + 5 + 65 + 5);
   const std::size_t big = 1 + 70;  // impact 1 of "big"
-  EXPECT_EQ(bodies[big], split("big,1,1,0,A,true,1,68,-1,-0.5,-0.375,0.125,,,,"));
-  EXPECT_EQ(bodies[big + 1], split("big,1,1,1,B,true,1,68,0,-0.5,0.125,0.125,,,,"));
+  EXPECT_EQ(bodies[big], split("big,1,1,0,A,true,1,68,-1,-0.5,-0.375,0.125,,,,,impact"));
+  EXPECT_EQ(bodies[big + 1], split("big,1,1,1,B,true,1,68,0,-0.5,0.125,0.125,,,,,impact"));
   const double third = 1.0 / 3.0, kinetic = 0.5 * third * third;
   for (std::size_t body = 0; body < 3; ++body) {
     const std::size_t row = big + 2 + body;
@@ -431,6 +431,9 @@ TEST_F(BagCsvTest, OverSixtyFourBodiesTheMovedBodiesAreRebuiltFromThePairFields)
   }
   const std::size_t collapse = big + 5 + 65 + 2;  // the collapse's rows, after impact 1 of "collapse"
   EXPECT_EQ(number(bodies, collapse - 1, "v_m_s"), -0.525);  // impact 1's body B
+  // The impact and the collapse share index 1; the column kind tells them apart.
+  EXPECT_EQ(cell(bodies, collapse - 1, "index") + " " + cell(bodies, collapse - 1, "kind"), "1 impact");
+  EXPECT_EQ(cell(bodies, collapse, "index") + " " + cell(bodies, collapse, "kind"), "1 collapse");
   EXPECT_EQ(number(bodies, collapse - 1, "energy_transfer_J"), 0.5 * 0.525 * 0.525);
   for (std::size_t body = 0; body < 3; ++body) {
     EXPECT_EQ(cell(bodies, collapse + body, "body"), std::to_string(body));

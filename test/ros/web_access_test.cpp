@@ -243,6 +243,20 @@ TEST_F(WebAccessTest, ForeignOriginAndHostAreRefused) {
   res = c.Post("/api/runs", piScene("oli").dump(), "text/plain");
   ASSERT_TRUE(res);
   EXPECT_EQ(res->status, 415) << res->body;
+  // curl's -d without -H: a form encoding. The answer says which header to send.
+  res = c.Post("/api/runs", piScene("oli").dump(), "application/x-www-form-urlencoded");
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 415) << res->body;
+  EXPECT_EQ(json::parse(res->body).at("error"),
+            "send the body as JSON with the header Content-Type: application/json (curl: -H 'Content-Type: "
+            "application/json'); this request's Content-Type: application/x-www-form-urlencoded");
+  // No Content-Type at all.
+  const std::string body = piScene("oli").dump();
+  const std::string untyped = rawRequest("127.0.0.1", "POST /api/runs HTTP/1.1\r\nHost: 127.0.0.1\r\nX-Class-Code: " +
+                                                          std::string(kCode) + "\r\nContent-Length: " +
+                                                          std::to_string(body.size()) + "\r\nConnection: close\r\n\r\n" + body);
+  EXPECT_EQ(statusOf(untyped), 415) << untyped.substr(0, 300);
+  EXPECT_NE(untyped.find("this request's Content-Type: none"), std::string::npos) << untyped.substr(0, 400);
   // The page's own origin.
   res = c.Post("/api/runs", {{"Origin", "http://" + g_host + ":" + std::to_string(g_port)}}, piScene("oli").dump(),
                "application/json");

@@ -9,7 +9,8 @@
 //  - bodies.csv, tidy, one row per body and event: the start (index 0, from
 //    InitialConditions) and the bodies after each CollisionEvent. Up to
 //    CollisionEvent::FULL_STATE_MAX_BODIES bodies the event carries every body and every
-//    body has a row (column moved: whether the event moved it); above, the event carries
+//    body has a row (column moved: whether the event moved it; the last column, kind, says
+//    start, impact or collapse: a collapse keeps its last impact's index); above, the event carries
 //    the pair fields only, and the rows are those of the bodies it moved (first_moved ..
 //    last_moved), rebuilt by the core's replay of the run (core::BodyStateReplay): velocity
 //    from pair_velocities_after, position = the contact point, velocity before, kinetic

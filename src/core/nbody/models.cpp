@@ -72,6 +72,10 @@ std::string modelReason(ModelKind kind, const Scene& scene) {
     case ModelKind::kTwoWallsInfinite:
       return "two walls that do not move apart confine the bodies, and with every e > 0 they collide forever: "
              "infinitely many impacts (a run stops at its cap)";
+    case ModelKind::kBoxInfinite:
+      return "a box: walls at both ends that do not move apart confine the bodies between them, and with every "
+             "e > 0 they collide forever: infinitely many impacts, with no count to predict; the exact event engine "
+             "simulates them up to the run's cap";
     case ModelKind::kTwoBody: return "two bodies meet at most once: one impact in closed form";
     case ModelKind::kThreeBodyRotation:
       return "three elastic bodies: the paper's rotation model gives the exact count and state in O(1)";
@@ -120,7 +124,7 @@ std::string modelReason(ModelKind kind, const Scene& scene) {
 ModelKind chooseKind(const Scene& scene) {
   const std::size_t n = scene.size();
   if (n == 1 || !anyApproaching(scene)) return ModelKind::kNoCollisions;
-  if (confinedForever(scene)) return ModelKind::kTwoWallsInfinite;
+  if (confinedForever(scene)) return n == 3 ? ModelKind::kTwoWallsInfinite : ModelKind::kBoxInfinite;
   if (restitutionModelActs(scene)) return ModelKind::kEventEngine;
   if (scene.isRing()) return equalFiniteMasses(scene) && scene.isElastic() ? ModelKind::kGhosts : ModelKind::kEventEngine;
   if (n == 2) return ModelKind::kTwoBody;
@@ -210,6 +214,7 @@ const char* modelKindName(ModelKind kind) {
     case ModelKind::kGhosts: return "ghosts";
     case ModelKind::kEventEngine: return "event_engine";
     case ModelKind::kThreeBodySpiral: return "three_body_spiral";
+    case ModelKind::kBoxInfinite: return "box_infinite";
     case ModelKind::kSticky: return "sticky";
   }
   return "unknown";
@@ -228,7 +233,7 @@ Prediction predictNoCollisions(const Scene& scene) {
 }
 
 Prediction predictTwoWalls(const Scene& scene) {
-  Prediction prediction = base(ModelKind::kTwoWallsInfinite, scene);
+  Prediction prediction = base(chooseKind(scene), scene);
   prediction.infinite = true;
   return prediction;
 }
@@ -408,7 +413,8 @@ Prediction predictThreeBodySpiral(const Scene& scene) {
 std::optional<Prediction> predict(const Scene& scene) {
   switch (chooseKind(scene)) {
     case ModelKind::kNoCollisions: return predictNoCollisions(scene);
-    case ModelKind::kTwoWallsInfinite: return predictTwoWalls(scene);
+    case ModelKind::kTwoWallsInfinite:
+    case ModelKind::kBoxInfinite: return predictTwoWalls(scene);
     case ModelKind::kTwoBody: return predictTwoBody(scene);
     case ModelKind::kGhosts: return predictGhosts(scene);
     case ModelKind::kThreeBodySpiral: return predictThreeBodySpiral(scene);

@@ -48,7 +48,10 @@ TEST(NBodyModels, ChoosesTheCheapestExactModel) {
   EXPECT_EQ(kind(scene({kInf, 1, 3}, {2, 1, 0}, {0, 0, 0.5}, {0.5})), ModelKind::kThreeBodySpiral);  // a wall
   EXPECT_EQ(kind(scene({kInf, 1, 3}, {2, 1, 0}, {0, 0, 0.5}, {0.5, 0.4})), ModelKind::kThreeBodySpiral);  // two e
   EXPECT_EQ(kind(scene({kInf, 1, kInf}, {2, 1, 0}, {0, 1, 0})), ModelKind::kTwoWallsInfinite);
-  EXPECT_EQ(kind(scene({kInf, 1, 1, kInf}, {3, 2, 1, 0}, {0, 1, 0, 0.5}, {0.9})), ModelKind::kTwoWallsInfinite);
+  // Two or more bodies between the walls: a box, named as one.
+  EXPECT_EQ(kind(scene({kInf, 1, 1, kInf}, {3, 2, 1, 0}, {0, 1, 0, 0.5}, {0.9})), ModelKind::kBoxInfinite);
+  EXPECT_STREQ(modelKindName(ModelKind::kBoxInfinite), "box_infinite");
+  EXPECT_STREQ(modelKindName(ModelKind::kTwoWallsInfinite), "two_walls_infinite");
   EXPECT_EQ(kind(scene({kInf, 1, kInf}, {2, 1, 0}, {1, 3, -1})), ModelKind::kEventEngine);  // walls move apart
   EXPECT_EQ(kind(scene({kInf, 1, 1, kInf}, {3, 2, 1, 0}, {0, 1, 0, 0}, {1, 0, 1})), ModelKind::kEventEngine);  // e = 0 sticks
   EXPECT_EQ(kind(scene({1, 1, 1, 1, 1}, {4, 3, 2, 1, 0}, {-1, 0, 0, 0, 0})), ModelKind::kGhosts);

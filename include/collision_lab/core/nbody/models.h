@@ -1,7 +1,11 @@
 // The model each scene needs: the cheapest one that is exact for it, and why.
 //   no_collisions        N = 1, or no pair approaches: nothing happens, O(N)
-//   two_walls_infinite   walls at both ends that do not move apart, every e > 0: the bodies
-//                        between them collide forever (the run stops at its cap)
+//   two_walls_infinite   one body between walls at both ends that do not move apart, every
+//                        e > 0: it bounces between them forever (the run stops at its cap)
+//   box_infinite         two or more bodies in a box: walls at both ends that do not move
+//                        apart, every e > 0: the bodies collide forever; nothing is
+//                        predicted but that, and the exact event engine simulates the first
+//                        impacts (a display's worth, or up to the cap with simulate_to_cap)
 //   two_body             N = 2: at most one impact, closed form
 //   three_body_rotation  N = 3, elastic: the paper's rotation model (the three-body analytic
 //                        core answers; nothing is predicted here)
@@ -46,7 +50,8 @@ enum class ModelKind : std::uint8_t {
   kGhosts = 4,
   kEventEngine = 5,
   kThreeBodySpiral = 6,
-  kSticky = 7,
+  kBoxInfinite = 7,
+  kSticky = 8,
 };
 
 /// Machine-readable name, e.g. "three_body_rotation".
@@ -80,6 +85,7 @@ struct Prediction {
 
 /// Each requires the scene its model is chosen for (chooseModel) and validate() passed.
 Prediction predictNoCollisions(const Scene& scene);
+/// two_walls_infinite or box_infinite: infinitely many impacts, nothing else predicted.
 Prediction predictTwoWalls(const Scene& scene);
 Prediction predictTwoBody(const Scene& scene);
 Prediction predictGhosts(const Scene& scene);
