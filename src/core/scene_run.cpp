@@ -103,7 +103,9 @@ SceneSimulation simulateScene(const Scene& scene, const SceneRunOptions& options
   const bool wants_events = lab.mode == RunMode::kFull && lab.events.kind != EventPolicy::Kind::kNone;
   // Nothing approaching: there is nothing to simulate, events or not.
   const bool nothing_happens = prediction && prediction->kind == ModelKind::kNoCollisions;
-  if (prediction && !prediction->infinite && !over_cap && (!wants_events || nothing_happens)) {
+  // The sticky count assumes that no three bodies meet at once; only the engine can tell.
+  const bool count_certain = prediction && prediction->kind != ModelKind::kSticky;
+  if (prediction && !prediction->infinite && !over_cap && ((!wants_events && count_certain) || nothing_happens)) {
     return fromPrediction(*prediction);
   }
 

@@ -101,7 +101,8 @@ std::string modelReason(ModelKind kind, const Scene& scene) {
       return "every pair sticks (e = 0): a body that hits a group joins it, so the final groups are the blocks of the "
              "weighted isotonic regression of the initial velocities (pool-adjacent-violators, O(N)), each at its "
              "momentum over its mass (a wall's group at rest with the wall); each impact joins two groups, so the count "
-             "is N - groups (defined when no three bodies meet at once)";
+             "is N - groups when no three bodies meet at once; the engine runs to tell (three bodies meeting at once stop it "
+             "with MULTIPLE_COLLISION)";
     case ModelKind::kEventEngine: break;
   }
   if (restitutionModelActs(scene)) {

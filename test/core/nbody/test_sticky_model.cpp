@@ -9,6 +9,7 @@
 
 #include "collision_lab/core/nbody/engine.h"
 #include "collision_lab/core/nbody/models.h"
+#include "collision_lab/core/scene_run.h"
 #include "random_scenes.h"
 #include "reference.h"
 
@@ -55,6 +56,25 @@ TEST(StickyModel, WallHoldsItsGroupAtRest) {
   EXPECT_EQ(p.impact_count, std::uint64_t{2});
   EXPECT_EQ(p.final_velocities, (std::vector<double>{0, 0, 0, -1}));
   EXPECT_DOUBLE_EQ(p.energy_lost, 0.5 + 0.25);
+}
+
+TEST(StickyModel, ThreeBodiesMeetingAtOnceAreToldByTheEngineNotCountedByTheModel) {
+  // A (x = 2, v = -1) and C (x = 0, v = +1) reach B (x = 1, at rest) at t = 1 s together;
+  // D waits at x = -10. The model's N - groups = 3 assumes pairwise meetings: the run, even
+  // with no events asked for, must say that three bodies met at once, as the engine does.
+  const Scene scene = reference::makeScene({1, 1, 1, 1}, {2, 1, 0, -10}, {-1, 0, 1, 0}, 0.0);
+  ASSERT_FALSE(validate(scene));
+  const ScenePlan plan = planScene(scene);
+  ASSERT_FALSE(plan.error);
+  ASSERT_EQ(plan.model.kind, ModelKind::kSticky);
+  for (const RunMode mode : {RunMode::kFull, RunMode::kSummaryOnly}) {
+    SceneRunOptions options;
+    options.lab.mode = mode;
+    options.lab.events = EventPolicy::none();
+    const SceneRunResult run = runScene(plan, options);
+    EXPECT_TRUE(run.simulation.simulated);
+    EXPECT_EQ(run.simulation.stop, StopReason::kMultipleCollision) << run.simulation.stop_message;
+  }
 }
 
 TEST(StickyModel, AgreesWithTheExactReferenceOnSeededScenes) {
