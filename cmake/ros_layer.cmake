@@ -27,6 +27,7 @@ target_compile_definitions(collision_lab_ros PRIVATE COLLISION_LAB_VERSION="${co
 add_library(collision_lab_views
   src/ros/marker_builder.cpp
   src/ros/marker_view.cpp
+  src/ros/run_view.cpp  # the view description rviz and the web page share
   # the rviz views, one file each, and what they share (include/.../ros/markers/)
   src/ros/markers/draw.cpp
   src/ros/markers/run_facts.cpp

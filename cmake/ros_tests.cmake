@@ -4,7 +4,8 @@ catkin_add_gtest(ros_layer_unit_test
   test/ros/run_recorder_test.cpp
   test/ros/marker_builder_test.cpp
   test/ros/marker_nbody_test.cpp
-  test/ros/marker_granular_test.cpp)
+  test/ros/marker_granular_test.cpp
+  test/ros/run_view_test.cpp)
 if(TARGET ros_layer_unit_test)
   target_link_libraries(ros_layer_unit_test collision_lab_views GTest::gtest_main)
 endif()

@@ -19,8 +19,8 @@ export PATH=/usr/bin:/bin:/usr/sbin:/sbin:$PATH
 # rosservice those of std_srvs to pause a replay (/rosbag_play/pause_playback); rviz is
 # opened by the launch files whenever a display is set. The class's web server
 # (docs/web.md) is on Boost.Beast (libboost-dev), its tests' client is cpp-httplib, and it
-# serves Debian's Chart.js; its browser tests and
-# screenshots need chromium (--with-screenshots, as CI).
+# serves Debian's Chart.js; docs/web.md's commands (run as written by a test) use curl;
+# its browser tests and screenshots need chromium (--with-screenshots, as CI).
 packages=(
   build-essential cmake libgtest-dev
   ros-core-dev rosout rosbash python3-rostest
@@ -34,6 +34,7 @@ packages=(
   rviz
   libcpp-httplib-dev libjs-chart.js
   libsqlite3-dev
+  curl
 )
 build=true
 for arg in "$@"; do

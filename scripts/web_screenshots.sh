@@ -3,7 +3,8 @@
 # a live run (the 1,000-body gas while it runs), the finished 31,415-impact pi run, the
 # finished gas and the teacher page. Starts lab.launch web:=true on a master of its own
 # (bags in a temporary folder) and shoots with headless chromium.
-# Usage (after setup_debian.sh --with-screenshots): bash scripts/web_screenshots.sh
+# Usage (after setup_debian.sh --with-screenshots): bash scripts/web_screenshots.sh [--views]
+# (--views: only the run page of each scene kind, web_view_*.png)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 export PATH=/usr/bin:/bin:$PATH
@@ -21,13 +22,16 @@ url=http://127.0.0.1:$web_port
 out=docs/screenshots
 
 send() {  # student preset -> run_id (retries until the lab node listens)
+  send_body "{\"student\":\"$1\",\"preset\":\"$2\"}"
+}
+send_body() {  # JSON body of POST /api/runs -> run_id
   local answer
   for _ in $(seq 100); do
-    answer=$(curl -s -X POST -H "Content-Type: application/json" -d "{\"student\":\"$1\",\"preset\":\"$2\"}" "$url/api/runs" || true)
+    answer=$(curl -s -X POST -H "Content-Type: application/json" -d "$1" "$url/api/runs" || true)
     case "$answer" in *run_id*) echo "$answer" | sed -E 's/.*"run_id":"([^"]*)".*/\1/'; return ;; esac
     sleep 0.2
   done
-  echo "web_screenshots.sh: no answer to $1's $2: $answer" >&2; exit 1
+  echo "web_screenshots.sh: no answer to $1: $answer" >&2; exit 1
 }
 wait_finished() {
   until curl -s "$url/api/runs/$1" | grep -q '"state":"finished"'; do sleep 0.5; done
@@ -53,6 +57,21 @@ shoot_live() {  # page file
   wait "$browser" "$xvfb" 2>/dev/null || true
   echo "wrote $out/$2"
 }
+
+# The run page of each scene kind (issue 31; docs/web.md "What the run page shows"). Only
+# these with --views.
+shoot_views() {
+  local run
+  run=$(send_body '{"student":"eve","masses":[100,1,"inf"],"positions":[2,1,0],"velocities":[-1,0,0],"max_collisions":10}')
+  wait_finished "$run"; shoot "/runs/$run" web_view_not_simulated.png 1250
+  run=$(send eve collapse_equal); wait_finished "$run"; shoot "/runs/$run" web_view_collapse.png 1250
+  run=$(send eve two_carts); wait_finished "$run"; shoot "/runs/$run" web_view_two_carts.png 1250
+  run=$(send_body '{"student":"eve","preset":"granular_ring","max_collisions":5000}')
+  wait_finished "$run"; shoot "/runs/$run" web_view_ring.png 1250
+  run=$(send_body '{"student":"eve","preset":"granular_box_1000","max_collisions":5000}')
+  wait_finished "$run"; shoot "/runs/$run" web_view_box_truncated.png 1250  # the box stops at the lab's cap
+}
+if [ "${1:-}" = --views ]; then shoot_views; exit 0; fi
 
 pi=$(send ana pi_digits_5)
 wait_finished "$pi"

@@ -9,10 +9,24 @@ function el(tag, text, attrs) {
   return node;
 }
 
+// Body names and colours as every view has them: core::bodyName ("A".."Z", then "#26",
+// ...) and rviz's palette from the server (GET /api/body_colours), never a list of our own.
+let bodyPalette = [];
+const bodyLetter = (i) => (i < 26 ? String.fromCharCode(65 + i) : '#' + i);
+
+function nameCell(td, i) {
+  td.textContent = bodyLetter(i);
+  td.title = 'body ' + bodyLetter(i) + ' (masses[' + i + '])';
+  td.className = 'body_name';
+  if (bodyPalette.length > 0) td.style.color = bodyPalette[i % bodyPalette.length];
+}
+
 function bodyRow(mass, position, velocity) {
   const rows = document.querySelector('#bodies tbody');
   const tr = el('tr');
-  tr.appendChild(el('td', rows.children.length));
+  const name = el('td');
+  nameCell(name, rows.children.length);
+  tr.appendChild(name);
   for (const [name, value] of [['mass', mass], ['position', position], ['velocity', velocity]]) {
     const td = el('td');
     td.appendChild(el('input', null, {type: 'text', name: name, value: value === undefined ? '' : String(value)}));
@@ -27,7 +41,7 @@ function bodyRow(mass, position, velocity) {
 }
 
 function renumber() {
-  document.querySelectorAll('#bodies tbody tr').forEach((tr, i) => { tr.firstChild.textContent = i; });
+  document.querySelectorAll('#bodies tbody tr').forEach((tr, i) => nameCell(tr.firstChild, i));
 }
 
 let loadedPreset = null;  // a preset too large for the form is sent by name
@@ -109,6 +123,8 @@ async function startPage() {
   document.getElementById('student').value = localStorage.getItem('collision_lab_student') || '';
   document.getElementById('add').onclick = () => { loadedPreset = null; document.getElementById('preset_note').textContent = ''; bodyRow('1', '', '0'); };
   document.getElementById('send').onclick = sendScene;
+  bodyPalette = (await (await fetch('/api/body_colours')).json()).palette;
+  renumber();
   const presets = await (await fetch('/api/presets')).json();
   const tbody = document.querySelector('#presets tbody');
   for (const p of presets) {
@@ -168,45 +184,80 @@ function stopCell(runId) {
   return td;
 }
 
+/// A count as people read it: "31,415".
+function countText(n) { return Number(n).toLocaleString('en-US'); }
+/// "1 run", "2 runs", "31,415 collisions".
+function counted(n, one, many) { return countText(n) + ' ' + (Number(n) === 1 ? one : many); }
+
+/// The teacher's view of one student: their runs, then their rejected inputs (who, when,
+/// the reason, the field and the message), each with its count.
+function studentSection(name, runs, rejections) {
+  const section = el('section', null, {'data-student': name});
+  section.appendChild(el('h2', name + ' (' + counted(runs.length, 'run', 'runs') + ', ' +
+                         counted(rejections.length, 'rejected input', 'rejected inputs') + ')'));
+  if (runs.length) {
+    const table = el('table', null, {'data-runs': name});
+    const head = el('tr');
+    for (const h of ['run', 'state', 'bodies', 'collisions', 'model', 'accepted', '']) head.appendChild(el('th', h));
+    table.appendChild(head);
+    for (const r of runs) {
+      const tr = el('tr');
+      const td = el('td');
+      td.appendChild(el('a', r.run_id, {href: '/runs/' + encodeURIComponent(r.run_id)}));
+      tr.appendChild(td);
+      tr.appendChild(el('td', r.state + (r.truncated ? ' (truncated)' : '')));
+      tr.appendChild(el('td', r.bodies === undefined ? '' : countText(r.bodies)));
+      tr.appendChild(el('td', r.collisions === undefined ? '' : countText(r.collisions)));
+      tr.appendChild(el('td', r.model || ''));
+      tr.appendChild(el('td', r.accepted_stamp ? new Date(r.accepted_stamp * 1000).toLocaleTimeString() : ''));
+      tr.appendChild(r.state === 'finished' || r.state === 'interrupted' ? el('td') : stopCell(r.run_id));
+      table.appendChild(tr);
+    }
+    section.appendChild(table);
+  }
+  if (rejections.length) {
+    section.appendChild(el('h3', 'Rejected inputs, newest first'));
+    const table = el('table', null, {'data-rejections': name});
+    const head = el('tr');
+    for (const h of ['when', 'run_id asked for', 'reason', 'field', 'message']) head.appendChild(el('th', h));
+    table.appendChild(head);
+    for (const r of rejections) {
+      const tr = el('tr');
+      tr.appendChild(el('td', new Date(r.at * 1000).toLocaleTimeString()));
+      tr.appendChild(el('td', r.run_id));
+      tr.appendChild(el('td', r.reason_name));
+      tr.appendChild(el('td', r.field));
+      tr.appendChild(el('td', r.message));
+      table.appendChild(tr);
+    }
+    section.appendChild(table);
+  }
+  return section;
+}
+
 async function teacherPage() {
   const box = document.getElementById('students');
   async function refresh() {
     const runs = await (await fetch('/api/runs')).json();
+    const rejections = await (await fetch('/api/rejections')).json();
     const queue = await (await fetch('/api/queue')).json();
     const byStudent = new Map();
-    for (const r of runs) {
-      const name = r.student || '(anonymous)';
-      if (!byStudent.has(name)) byStudent.set(name, []);
-      byStudent.get(name).push(r);
-    }
+    const of = (student) => {
+      const name = student || '(anonymous)';
+      if (!byStudent.has(name)) byStudent.set(name, {runs: [], rejections: []});
+      return byStudent.get(name);
+    };
+    for (const r of runs) of(r.student).runs.push(r);
+    for (const r of rejections) of(r.student).rejections.push(r);
     const parts = [];
     for (const name of [...byStudent.keys()].sort()) {
-      const section = el('section');
-      section.appendChild(el('h2', name + ' (' + byStudent.get(name).length + ' runs)'));
-      const table = el('table');
-      const head = el('tr');
-      for (const h of ['run', 'state', 'bodies', 'collisions', 'model', 'accepted', '']) head.appendChild(el('th', h));
-      table.appendChild(head);
-      for (const r of byStudent.get(name)) {
-        const tr = el('tr');
-        const td = el('td');
-        td.appendChild(el('a', r.run_id, {href: '/runs/' + encodeURIComponent(r.run_id)}));
-        tr.appendChild(td);
-        tr.appendChild(el('td', r.state + (r.truncated ? ' (truncated)' : '')));
-        tr.appendChild(el('td', r.bodies === undefined ? '' : r.bodies));
-        tr.appendChild(el('td', r.collisions));
-        tr.appendChild(el('td', r.model || ''));
-        tr.appendChild(el('td', r.accepted_stamp ? new Date(r.accepted_stamp * 1000).toLocaleTimeString() : ''));
-        tr.appendChild(r.state === 'finished' || r.state === 'interrupted' ? el('td') : stopCell(r.run_id));
-        table.appendChild(tr);
-      }
-      section.appendChild(table);
-      parts.push(section);
+      parts.push(studentSection(name, byStudent.get(name).runs, byStudent.get(name).rejections));
     }
     if (parts.length === 0) parts.push(el('p', 'No runs yet.'));
     parts.unshift(queueTable(queue));
     box.replaceChildren(...parts);
     document.body.dataset.runs = String(runs.length);
+    document.body.dataset.rejections = String(rejections.length);
   }
   await refresh();
   setInterval(refresh, 5000);

@@ -2,12 +2,24 @@
 // sends decimated series (min/max per column), never every event. When the plots have
 // been drawn, <body> gets data-plots (non-background pixels per plot) and
 // data-first-plot-ms (time from navigation to the first drawn plot) for tests and
-// measurements.
+// measurements. What the page says and which bodies it names and colours come from the run's
+// view description (run.view, the server's RunView, the same as rviz's): the page decides
+// nothing on its own. For tests, <body> also gets data-view-end (the run's end [s]),
+// data-xt-end (the latest time any x-t line reaches [s]) and data-xt-max-jump (the largest
+// x step between two vertices of one x-t segment [m]; on a ring below half its length).
 'use strict';
 
 const runId = document.body.dataset.runId;
 const api = '/api/runs/' + encodeURIComponent(runId);
-const colors = ['#1f77b4', '#d62728', '#2ca02c', '#9467bd', '#ff7f0e', '#8c564b', '#e377c2', '#7f7f7f', '#bcbd22', '#17becf'];
+// Totals (not bodies) in neutral colours; bodies in rviz's colours, from the view.
+const totalColours = ['#333333', '#b8860b'];
+let viewBodies = new Map();  // body index -> {name, colour}, from run.view
+
+// core::bodyName: "A".."Z", then "#26", "#27", ...
+const letterName = (i) => (i < 26 ? String.fromCharCode(65 + i) : '#' + i);
+const bodyName = (i) => (viewBodies.has(i) ? viewBodies.get(i).name : letterName(i));
+const bodyColour = (i) => (viewBodies.has(i) ? viewBodies.get(i).colour : '#aaaaaa');
+const plural = (n, word) => fmt(n) + ' ' + word + (n === 1 ? '' : 's');
 const charts = {};
 let firstPlotMs = null;
 
@@ -21,7 +33,12 @@ function fmt(x, digits) {
   if (x === null || x === undefined) return '-';
   if (typeof x !== 'number') return String(x);
   if (Number.isInteger(x) && Math.abs(x) < 1e15) return x.toLocaleString('en-US');
-  return Number(x.toPrecision(digits || 6)).toString();
+  const text = Number(x.toPrecision(digits || 6)).toString();
+  // No e-notation that wraps: "1.2e-7" becomes "1.2×10⁻⁷" (one word, no break).
+  const m = /^(-?[\d.]+)e([+-]\d+)$/.exec(text);
+  if (!m) return text;
+  const sup = {'-': '⁻', '0': '⁰', '1': '¹', '2': '²', '3': '³', '4': '⁴', '5': '⁵', '6': '⁶', '7': '⁷', '8': '⁸', '9': '⁹'};
+  return m[1] + '×10' + String(Number(m[2])).split('').map((c) => sup[c]).join('');
 }
 
 function xy(points) { return points.map((p) => ({x: p[0], y: p[1]})); }
@@ -58,22 +75,29 @@ function drawScene(scene) {
   for (let i = 0; i < n; ++i) {
     const m = scene.masses[i];
     const cx = px(x[i]);
-    g.fillStyle = colors[i % colors.length];
+    g.fillStyle = bodyColour(i);
     if (m === 'inf') {
       g.fillRect(cx - 3, y0 - 40, 6, 45);
     } else {
       const r = n > 50 ? 2 : 5 + 12 * (mMax > mMin ? Math.log(m / mMin) / Math.log(mMax / mMin) : 0.5);
       g.beginPath(); g.arc(cx, y0 - r, r, 0, 2 * Math.PI); g.fill();
       const v = scene.velocities[i];
-      if (n <= 10 && v !== 0) {
+      if (n <= 10 && v !== 0) {  // the velocity arrow, with its head
+        const ay = y0 - 2 * r - 6, tip = cx + Math.sign(v) * 25;
         g.strokeStyle = g.fillStyle;
-        g.beginPath(); g.moveTo(cx, y0 - 2 * r - 6); g.lineTo(cx + Math.sign(v) * 25, y0 - 2 * r - 6); g.stroke();
+        g.beginPath(); g.moveTo(cx, ay); g.lineTo(tip, ay); g.stroke();
+        g.beginPath(); g.moveTo(tip, ay); g.lineTo(tip - Math.sign(v) * 6, ay - 4); g.lineTo(tip - Math.sign(v) * 6, ay + 4); g.closePath(); g.fill();
       }
+    }
+    if (n > 10 && viewBodies.has(i)) {  // many bodies: the shown ones are named
+      g.fillStyle = '#222';
+      g.font = '10px sans-serif';
+      g.fillText(bodyName(i), cx - g.measureText(bodyName(i)).width / 2, y0 + 14);
     }
     if (n <= 10) {
       g.fillStyle = '#222';
       g.font = '11px sans-serif';
-      const label = (m === 'inf' ? 'wall' : fmt(m, 3) + ' kg') + ', ' + fmt(scene.velocities[i], 3) + ' m/s';
+      const label = bodyName(i) + ': ' + (m === 'inf' ? 'wall' : fmt(m, 3) + ' kg') + ', ' + fmt(scene.velocities[i], 3) + ' m/s';
       const at = (text) => Math.max(2, Math.min(canvas.width - g.measureText(text).width - 2, cx - g.measureText(text).width / 2));
       g.fillText(label, at(label), y0 + 18);
       g.fillText(fmt(x[i], 4) + ' m', at(fmt(x[i], 4) + ' m'), y0 + 31);
@@ -84,49 +108,100 @@ function drawScene(scene) {
 function velocityDatasets(run) {
   const p = run.plots;
   const sets = [];
-  const name = (i) => (run.scene.masses.length <= 3 ? 'ABC'[i] : 'body ' + i);
-  p.velocity.forEach((s, k) => sets.push({label: 'v ' + name(s.body) + ' simulated', data: xy(s.points), borderColor: colors[k % 10], stepped: false}));
-  p.predicted_velocity.forEach((s, k) => sets.push({label: 'v ' + name(s.body) + ' closed form', data: xy(s.points), borderColor: colors[k % 10], borderDash: [6, 4]}));
-  p.paper_velocity.forEach((s, k) => sets.push({label: 'v ' + name(s.body) + ' paper (2.15)/(2.16)', data: xy(s.points), borderColor: colors[k % 10], borderDash: [2, 3]}));
+  const name = bodyName;
+  const colour = (s) => bodyColour(s.body);
+  p.velocity.forEach((s) => sets.push({label: 'v ' + name(s.body) + ' simulated', data: xy(s.points), borderColor: colour(s), stepped: false}));
+  p.predicted_velocity.forEach((s) => sets.push({label: 'v ' + name(s.body) + ' closed form', data: xy(s.points), borderColor: colour(s), borderDash: [6, 4]}));
+  p.paper_velocity.forEach((s) => sets.push({label: 'v ' + name(s.body) + ' paper (2.15)/(2.16)', data: xy(s.points), borderColor: colour(s), borderDash: [2, 3]}));
   // Other models give the final velocities only: drawn beside the end of the run.
   const fin = run.prediction && p.predicted_velocity.length === 0 ? run.prediction.final_velocities : [];
   if (fin.length > 0) {
     const end = Math.max(1, run.collisions);
-    p.velocity.forEach((s, k) => {
+    p.velocity.forEach((s) => {
       const v = fin[s.body];
-      if (v !== null && v !== undefined) sets.push({label: 'v ' + name(s.body) + ' predicted final', data: [{x: end, y: v}, {x: end * 1.08 + 0.5, y: v}], borderColor: colors[k % 10], borderDash: [6, 4], borderWidth: 3});
+      if (v !== null && v !== undefined) sets.push({label: 'v ' + name(s.body) + ' predicted final', data: [{x: end, y: v}, {x: end * 1.08 + 0.5, y: v}], borderColor: colour(s), borderDash: [6, 4], borderWidth: 3});
     });
   }
   return sets;
 }
 
+// The x-t lines: every tracked body to the run's end, one dataset per segment (a ring's
+// lines are cut at its seam); the legend names each body once.
 function xtDatasets(run) {
-  return run.plots.worldlines.map((s, k) => ({label: 'body ' + s.body, data: s.points.map((q) => ({x: q[1], y: q[0]})), borderColor: colors[k % 10]}));
+  const lines = run.plots.worldline_segments ||
+    run.plots.worldlines.map((s) => ({body: s.body, segments: [s.points]}));
+  const sets = [];
+  let end = 0, maxJump = 0;
+  lines.forEach((line) => line.segments.forEach((segment, k) => {
+    segment.forEach((q, j) => {
+      end = Math.max(end, q[0]);
+      if (j > 0) maxJump = Math.max(maxJump, Math.abs(q[1] - segment[j - 1][1]));
+    });
+    sets.push({label: k === 0 ? bodyName(line.body) : '', data: segment.map((q) => ({x: q[1], y: q[0]})), borderColor: bodyColour(line.body)});
+  }));
+  document.body.dataset.xtEnd = String(end);
+  document.body.dataset.xtMaxJump = String(maxJump);
+  return sets;
 }
 
 function summaryRows(run) {
   const s = run.summary, p = run.prediction;
+  const view = run.view || {};
   const rows = [];
-  const count = s ? s.collision_count : run.collisions;
+  // A run that was not simulated claims no simulated value: its counts are the model's.
+  const simulated = view.simulated_collisions !== null && view.simulated_collisions !== undefined;
+  const count = simulated ? view.simulated_collisions : (run.view ? null : (s ? s.collision_count : run.collisions));
   rows.push(['collisions', count, p ? (p.infinite_collisions ? 'infinitely many' : p.collision_count) : null,
     p ? p.paper_collision_count : null]);
   const heat = run.plots.heat;  // while running: the heat so far
-  rows.push(['heat [J]', s ? s.energy_lost : (heat.length ? heat[heat.length - 1][1] : null), p ? p.energy_lost : null, null]);
+  const notSimulated = Boolean(view.not_simulated);
+  rows.push(['heat [J]', notSimulated ? null : (s ? s.energy_lost : (heat.length ? heat[heat.length - 1][1] : null)), p ? p.energy_lost : null, null]);
   const n = run.scene.masses.length;
   if (n <= 10) {
     const paperFinal = run.plots.paper_final_velocities || [];
     for (let i = 0; i < n; ++i) {
-      const bodyName = n <= 3 ? 'ABC'[i] : 'body ' + i;
-      rows.push(['final v ' + bodyName + ' [m/s]', s ? s.final_velocities[i] : null, p ? p.final_velocities[i] : null,
+      rows.push(['final v ' + bodyName(i) + ' [m/s]', s && !notSimulated ? s.final_velocities[i] : null, p ? p.final_velocities[i] : null,
         paperFinal.length === n ? paperFinal[i] : null]);
     }
   }
   if (s) {
-    rows.push(['max prediction error [1]', s.max_prediction_error, null, null]);
-    rows.push(['energy drift [1]', s.energy_relative_drift, null, null]);
-    rows.push(['stop reason', s.stop_reason + (s.truncated ? ' (truncated: ' + s.truncation_reason + ')' : ''), null, null]);
+    rows.push(['max prediction error (ratio)', s.max_prediction_error, null, null]);
+    rows.push(['energy drift (ratio)', s.energy_relative_drift, null, null]);
+    rows.push(['stop reason', s.stop_reason + (view.truncated ? ': ' + view.truncated : ''), null, null]);
   }
   return rows;
+}
+
+// A gas: T(t) on log-log axes with Haff's law T0/(1 + t/tau)^2 fitted (the view's numbers,
+// rviz's too). Points at t = 0 or T = 0 cannot be drawn on log axes: left out. For tests,
+// <body> gets data-temperature-points and data-haff-tau [s].
+function drawTemperature(view) {
+  document.getElementById('temperature_box').hidden = false;
+  const points = view.temperature.filter((q) => q[0] > 0 && q[1] > 0).map((q) => ({x: q[0], y: q[1]}));
+  const c = chart('temperature', 't [s]', 'T [J]');
+  c.options.scales.x.type = 'logarithmic';
+  c.options.scales.y.type = 'logarithmic';
+  const sets = [{label: 'T(t)', data: points, borderColor: totalColours[0]}];
+  if (view.haff) {
+    const fit = points.map((p) => ({x: p.x, y: view.haff.t0 / Math.pow(1 + p.x / view.haff.tau, 2)}));
+    sets.push({label: "Haff's law", data: fit, borderColor: totalColours[1], borderDash: [6, 4]});
+    document.body.dataset.haffTau = String(view.haff.tau);
+  }
+  c.data.datasets = sets;
+  c.update('none');
+  document.getElementById('temperature_legend').textContent = view.temperature_legend;
+  document.body.dataset.temperaturePoints = String(points.length);
+}
+
+// The view's facts: what was simulated and what not, a cut, a collapse, a ring or a box,
+// and which bodies each plot shows.
+function showFacts(view) {
+  const facts = document.getElementById('view_facts');
+  // The note repeats a cut's sentence when there is one: said once.
+  const items = view ? [view.title, view.not_simulated, view.note ? '' : view.truncated, view.collapse, view.ring, view.box, view.note] : [];
+  facts.replaceChildren(...items.filter((text) => text).map((text) => el('li', text)));
+  document.getElementById('velocity_legend').textContent = view ? 'Bodies shown: ' + view.velocity_legend + '.' : '';
+  document.getElementById('xt_legend').textContent = view ? 'Bodies shown: ' + view.worldline_legend + '.' : '';
 }
 
 function nonBackgroundPixels(canvas) {
@@ -143,26 +218,47 @@ const ended = (state) => state === 'finished' || state === 'interrupted';
 function render(run) {
   const status = document.getElementById('status');
   const who = run.student ? ' by ' + run.student : '';
-  const count = run.summary ? run.summary.collision_count : run.collisions;
-  status.textContent = run.state + who + ': ' + fmt(count) + ' collisions' +
-    (!ended(run.state) && run.prediction && run.prediction.collision_count !== null ? ' of ' + fmt(run.prediction.collision_count) + ' predicted' : '') +
-    (run.summary && run.summary.published_events < run.summary.collision_count ? ' (plots from the bag: every collision)' : '');
+  const view = run.view;
+  if (view) {
+    viewBodies = new Map();
+    view.worldline_bodies.concat(view.velocity_bodies).forEach((b) => viewBodies.set(b.index, b));
+    // The counter and state word are the view's (rviz's) own.
+    status.textContent = run.state + who + ': ' + view.counter;
+  } else {
+    const count = run.summary ? run.summary.collision_count : run.collisions;
+    status.textContent = run.state + who + ': ' + plural(count, 'collision');
+  }
+  if (run.summary && run.summary.published_events < run.summary.collision_count && run.summary.simulated) {
+    status.textContent += ' (plots from the bag: every collision)';
+  }
   document.body.dataset.state = run.state;
   if (!run.scene) return;
+  showFacts(view);
   drawScene(run.scene);
   document.getElementById('model').textContent = run.prediction ? 'Model: ' + run.prediction.model + '. ' + run.prediction.model_reason : '';
-  const v = chart('velocity', 'collision index [1]', 'velocity [m/s]');
+  const v = chart('velocity', 'collision index', 'velocity [m/s]');
   v.data.datasets = velocityDatasets(run);
   v.options.plugins.legend.display = v.data.datasets.length <= 12;
   v.update('none');
-  const e = chart('energy', 'collision index [1]', 'energy [J]');
-  e.data.datasets = [{label: 'kinetic energy', data: xy(run.plots.energy), borderColor: colors[0]},
-    {label: 'heat so far', data: xy(run.plots.heat), borderColor: colors[1]}];
+  const e = chart('energy', 'collision index', 'energy [J]');
+  e.data.datasets = [{label: 'kinetic energy', data: xy(run.plots.energy), borderColor: totalColours[0]},
+    {label: 'heat so far', data: xy(run.plots.heat), borderColor: totalColours[1]}];
   e.update('none');
   const t = chart('xt', 'x [m]', 't [s]');
   t.data.datasets = xtDatasets(run);
-  t.options.plugins.legend.display = t.data.datasets.length <= 12;
+  t.options.plugins.legend.display = (run.plots.worldlines || []).length <= 12;
+  t.options.plugins.legend.labels.filter = (item) => item.text !== '';
+  if (view && view.end_time !== null) {
+    t.options.scales.y.min = 0;
+    t.options.scales.y.max = view.end_time;
+    document.body.dataset.viewEnd = String(view.end_time);
+  }
+  if (view && view.ring_circumference > 0) {
+    t.options.scales.x.min = 0;
+    t.options.scales.x.max = view.ring_circumference;
+  }
   t.update('none');
+  if (view && view.gas) drawTemperature(view);
   const tbody = document.querySelector('#summary tbody');
   tbody.replaceChildren(...summaryRows(run).map((row) => {
     const tr = el('tr');

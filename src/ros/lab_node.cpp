@@ -493,6 +493,14 @@ std::string studentProblem(const std::string& student) {
   return {};
 }
 
+std::optional<std::pair<std::string, std::uint64_t>> numberedRunId(const std::string& run_id) {
+  const std::size_t digits = run_id.find_last_not_of("0123456789") + 1;
+  if (digits == run_id.size() || run_id.size() - digits > 18) return std::nullopt;
+  if (digits < 3 || run_id.compare(digits - 3, 3, "run") != 0) return std::nullopt;
+  if (digits > 3 && run_id[digits - 4] != '.') return std::nullopt;
+  return std::make_pair(run_id.substr(0, digits), std::stoull(run_id.substr(digits)));
+}
+
 std::string requestedRunId(const collision_lab::InitialConditions& input) {
   if (input.student.empty()) return input.run_id;
   return input.run_id.empty() ? input.student : input.student + "." + input.run_id;
@@ -749,7 +757,8 @@ void LabNode::intake(collision_lab::InitialConditions input, Reply reply) {
       ROS_WARN_STREAM("run_id '" << base << "' is taken (its bag exists, or this node served "
                       "it before); serving the run as '" << input.run_id << "'");
     }
-    job.requested_run_id = input.run_id != requested ? requested : std::string();
+    // Taken only when served under another name than the one asked for (<student>.<run_id>).
+    job.requested_run_id = input.run_id != base ? requested : std::string();
     const std::string run_id = input.run_id;
     const std::string student = input.student;
     run_index_->accepted(run_id, student, requested, input);
@@ -856,6 +865,16 @@ std::string LabNode::newRunId(std::string& claim_error) {
   return run_id;
 }
 
+bool LabNode::servedBefore(const std::string& run_id) {
+  if (!run_index_->ok()) return false;
+  try {
+    return run_index_->index()->find(run_id).has_value();
+  } catch (const collision_lab::service::RunIndexError& e) {
+    ROS_WARN_STREAM("the run index cannot tell whether run_id '" << run_id << "' was served: " << e.what());
+    return false;
+  }
+}
+
 bool LabNode::claim(const std::string& run_id, std::string& claim_error) {
   if (used_run_ids_.contains(run_id)) return false;
   if (params_.record && claimBag(params_.bag_directory, run_id, claim_error) == BagClaim::kTaken) return false;
@@ -864,6 +883,12 @@ bool LabNode::claim(const std::string& run_id, std::string& claim_error) {
 }
 
 std::string LabNode::claimRunId(const std::string& requested, std::string& claim_error) {
+  if (const auto series = numberedRunId(requested)) {  // a student's n-th run: the next free number
+    std::uint64_t n = series->second;
+    const auto numbered = [&] { return series->first + std::to_string(n); };
+    while (servedBefore(numbered()) || !claim(numbered(), claim_error)) ++n;
+    return numbered();
+  }
   std::string run_id = requested;
   for (std::uint64_t n = 2; !claim(run_id, claim_error); ++n) {
     run_id = requested + "." + std::to_string(n);

@@ -181,6 +181,7 @@ RunRecord::RunRecord(const collision_lab::InitialConditions& input, const Record
       limits_(limits),
       replay_(input.masses, input.positions, input.velocities, input.ring),
       first_collapse_time_(std::nan("")),
+      first_collapse_position_(std::nan("")),
       min_velocity_(kInf),
       max_velocity_(-kInf) {
   // An input of unequal lengths (the node rejects those) is cut to its shortest list.
@@ -196,7 +197,7 @@ RunRecord::RunRecord(const collision_lab::InitialConditions& input, const Record
   paper_velocity_.assign(plotted_.size(), empty);
   body_energy_.assign(plotted_.size(), empty);
   worldline_.assign(tracked_.size(), empty);
-  energy_ = momentum_ = energy_lost_ = none_ = empty;
+  energy_ = momentum_ = energy_lost_ = temperature_ = none_ = empty;
   for (std::size_t i = 0; i < n; ++i) widenVelocityRange(input_.velocities[i]);
   for (std::size_t k = 0; k < plotted_.size(); ++k) {
     const std::size_t i = plotted_[k];
@@ -212,6 +213,10 @@ RunRecord::RunRecord(const collision_lab::InitialConditions& input, const Record
   energy_.add(0.0, start_energy_);
   momentum_.add(0.0, replay_.momentum());
   energy_lost_.add(0.0, 0.0);
+  for (double m : input_.masses) {
+    if (std::isfinite(m)) finite_mass_ += m, ++finite_bodies_;
+  }
+  temperature_.add(0.0, temperatureNow());
 }
 
 bool RunRecord::isWall(std::size_t i) const { return i < bodies() && replay_.isWall(i); }
@@ -303,6 +308,13 @@ void RunRecord::apply(const collision_lab::CollisionEvent& event) {
   energy_.step(k, replay_.totalKineticEnergy());
   momentum_.step(k, replay_.momentum());
   energy_lost_.step(k, replay_.heat());
+  temperature_.add(event.time, temperatureNow());
+}
+
+double RunRecord::temperatureNow() const {
+  if (finite_bodies_ == 0 || !(finite_mass_ > 0)) return 0.0;
+  const double p = replay_.momentum();
+  return std::max(0.0, (2 * replay_.totalKineticEnergy() - p * p / finite_mass_) / static_cast<double>(finite_bodies_));
 }
 
 Keyframe RunRecord::snapshot(double time) const {
@@ -341,7 +353,11 @@ void RunRecord::add(const collision_lab::CollisionEvent& event) {
   newest_is_collapse_ = collapse;
   has_newest_ = true;
   newest_predicted_ = event.predicted_velocities_after;
-  if (collapse && collapses_++ == 0) first_collapse_time_ = event.time;
+  if (collapse && collapses_++ == 0) {
+    first_collapse_time_ = event.time;
+    first_collapse_position_ = event.position;
+    first_collapse_bodies_ = {event.first_moved, event.last_moved};
+  }
   apply(event);
   if (bucket_ == 0 && event.time > 0) {
     bucket_ = powerOfTwoAtMost(event.time / static_cast<double>(keyframeLimit()));
@@ -378,7 +394,8 @@ std::size_t RunRecord::memoryBytes() const {
   bytes += doubles(newest_predicted_) + sizes(tracked_) + sizes(plotted_) + sizes(track_slot_) + sizes(plot_slot_);
   bytes += envelopes(velocity_) + envelopes(paper_velocity_) + envelopes(body_energy_) + envelopes(worldline_) +
            envelopes(tracked_velocity_);
-  bytes += energy_.memoryBytes() + momentum_.memoryBytes() + energy_lost_.memoryBytes() + none_.memoryBytes();
+  bytes += energy_.memoryBytes() + momentum_.memoryBytes() + energy_lost_.memoryBytes() + temperature_.memoryBytes() +
+           none_.memoryBytes();
   if (prediction) {
     bytes += prediction->run_id.capacity() + prediction->model_name.capacity() + prediction->model_reason.capacity() +
              doubles(prediction->final_velocities);
@@ -439,9 +456,18 @@ SceneState stateOf(const Keyframe& frame) {
   return s;
 }
 
-/// Free flight from `from` to time t (exact while no pair meets).
-SceneState flown(SceneState from, double t) {
-  for (std::size_t i = 0; i < from.positions.size(); ++i) from.positions[i] += from.velocities[i] * (t - from.time);
+/// Free flight from `from` to time t (exact while no pair meets); on a ring of circumference
+/// `ring` [m] (> 0) each position wrapped into [0, ring), as the messages report them.
+SceneState flown(SceneState from, double t, double ring) {
+  for (std::size_t i = 0; i < from.positions.size(); ++i) {
+    double& x = from.positions[i];
+    x += from.velocities[i] * (t - from.time);
+    if (ring > 0) {
+      x = std::fmod(x, ring);
+      if (x < 0) x += ring;
+      if (x >= ring) x = 0.0;  // -tiny + ring rounds to ring
+    }
+  }
   from.time = t;
   return from;
 }
@@ -477,9 +503,9 @@ SceneState stateAt(const RunRecord& run, double t) {
     base = stateOf(*(after - 1));
     valid_until = after == frames.end() ? openEnd(run, base) : (after - 1)->valid_until;
   }
-  if (t <= valid_until) return flown(base, t);
+  if (t <= valid_until) return flown(base, t, run.input().ring);
   // t falls where no exact state is kept: show the nearest instant that is known.
-  if (after == frames.end() || t - valid_until <= after->time - t) return flown(base, valid_until);
+  if (after == frames.end() || t - valid_until <= after->time - t) return flown(base, valid_until, run.input().ring);
   return stateOf(*after);
 }
 
@@ -541,6 +567,24 @@ double simulatedTimeOnTimeline(const ros::Time& now, const ros::Time& start, dou
 double replayedTime(const RunRecord& run, const ros::Time& now) {
   const double scale = run.prediction ? run.prediction->timeline_scale : 0.0;
   return std::max(simulatedTimeOnTimeline(now, run.input().header.stamp, scale), run.newestTime());
+}
+
+double ReplayClock::at(const RunRecord& run, const ros::Time& now, double wall) {
+  const double end = endTime(run);
+  const double on_bag_clock = std::min(replayedTime(run, now), end);
+  if (!run.summary) {
+    summary_seen_.reset();
+    return on_bag_clock;
+  }
+  if (!summary_seen_) summary_seen_ = Instant{on_bag_clock, wall};
+  const Instant& seen = *summary_seen_;
+  // The pace so far, or the timeline's (rate 1) when nothing has been played yet.
+  const double scale = run.prediction && std::isfinite(run.prediction->timeline_scale) &&
+                               run.prediction->timeline_scale > 0
+                           ? run.prediction->timeline_scale
+                           : 1.0;
+  const double pace = seen.t > 0 && seen.wall > 0 ? seen.t / seen.wall : 1.0 / scale;
+  return std::min(std::max(on_bag_clock, seen.t + std::max(wall - seen.wall, 0.0) * pace), end);
 }
 
 // ---- the pictures: one function per view (src/ros/markers/) ----

@@ -141,12 +141,12 @@ void MarkerView::onRejected(const collision_lab::Rejected& msg) {
   rejected_ = msg;
 }
 
-FrameClock MarkerView::frameClock(const RunRecord& run, const ros::WallTime& run_start, const ros::WallTime& now) const {
+FrameClock MarkerView::frameClock(const RunRecord& run, const ros::WallTime& run_start, const ros::WallTime& now) {
   FrameClock clock;
   if (params_.clock == MarkerViewParams::Clock::kRos) {
     const double scale = run.prediction ? run.prediction->timeline_scale : 0.0;
     const double t = replay_ && ros::Time::isSimTime()
-                         ? replayedTime(run, ros::Time::now())
+                         ? replay_clock_.at(run, ros::Time::now(), (now - run_start).toSec())
                          : simulatedTimeOnTimeline(ros::Time::now(), run.input().header.stamp, scale);
     clock.t = std::min(t, endTime(run));
     clock.description = "ROS clock" + std::string(ros::Time::isSimTime() ? " (bag)" : "");
@@ -162,8 +162,13 @@ FrameClock MarkerView::frameClock(const RunRecord& run, const ros::WallTime& run
   }
   const TimeWarp warp(run);
   const double loop = autoLoopDuration(run.collisions());
-  const double phase = std::min(std::fmod(elapsed, loop + kMarkerEndHold) / loop, 1.0);
+  const double into = std::fmod(elapsed, loop + kMarkerEndHold);
+  const double phase = std::min(into / loop, 1.0);
   clock.t = warp.timeAt(phase);
+  if (into >= loop) {
+    clock.description = "held at the end";  // not "sim time x0"
+    return clock;
+  }
   char rate[64];
   std::snprintf(rate, sizeof rate, "sim time x%.2g", warp.rateAt(phase) / loop);
   clock.description = rate;
@@ -191,7 +196,9 @@ void MarkerView::addOverlays(visualization_msgs::MarkerArray& animated) {
                         const std::vector<visualization_msgs::Marker>& markers) {
     if (shown) out.insert(out.end(), markers.begin(), markers.end());
     if (was_shown && !shown) {
-      for (int id : {markers::kFramedText, markers::kFramedBox}) out.push_back(deleteMarker(ns, id, params_.frame_id));
+      for (int id : {markers::kFramedText, markers::kFramedBox, markers::kFramedTextBold}) {
+        out.push_back(deleteMarker(ns, id, params_.frame_id));
+      }
     }
     was_shown = shown;
   };
@@ -215,6 +222,7 @@ void MarkerView::onTimer(const ros::WallTimerEvent&) {
     // two together, and every static message (the latched one too) is a whole picture.
     if (run_changed_) {
       animated = deleteAllMarkers(params_.frame_id);
+      replay_clock_.reset();
       banner_shown_ = hint_shown_ = false;
     }
     rebuild_static = run_changed_ || (run_ && static_dirty_);

@@ -275,6 +275,9 @@ void RunIndex::rejected(const IndexedRejection& rejection) {
   s.bind(1, rejection.at).bind(2, rejection.student).bind(3, rejection.run_id).bind(4, rejection.reason_name);
   s.bind(5, rejection.field).bind(6, rejection.message);
   s.run();
+  // Bounded: a student's loop of bad sends cannot grow the file without end.
+  Statement trim(db_, path_, "DELETE FROM rejections WHERE id <= last_insert_rowid() - ?1");
+  trim.bind(1, static_cast<std::int64_t>(kRejectionsKept)).run();
 }
 
 void RunIndex::setCsvPath(const std::string& run_id, const std::string& csv_path) {

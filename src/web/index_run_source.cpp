@@ -17,6 +17,10 @@ class IndexRunSource : public RunSource {
   std::vector<collision_lab::service::IndexedRun> list(const std::optional<std::string>& student) const override {
     return index_.list(student);
   }
+  std::vector<collision_lab::service::IndexedRejection> rejections(const std::optional<std::string>& student,
+                                                                  std::size_t limit) const override {
+    return index_.rejections(student, limit);
+  }
 
  private:
   collision_lab::service::RunIndex index_;

@@ -17,6 +17,7 @@
 
 #include "collision_lab/ros/bag_csv.h"
 #include "collision_lab/ros/bag_reading.h"
+#include "collision_lab/ros/run_view.h"
 
 namespace collision_lab_web {
 
@@ -105,6 +106,22 @@ json summaryJson(const collision_lab::RunSummary& s) {
           {"published_events", s.published_events},
           {"compute_time", exactNumber(s.compute_time)},
           {"recorded", s.recording_ok && !s.bag_path.empty()}};
+}
+
+/// The x-t diagram's lines to the run's end, cut at a ring's seam (RunView's
+/// worldlineSegments): [{body, segments: [[[t [s], x [m]], ...], ...]}].
+json worldlineSegmentsJson(const RunRecord& record, double end_time) {
+  json lines = json::array();
+  for (const auto& line : collision_lab_ros::worldlineSegments(record, end_time)) {
+    json segments = json::array();
+    for (const auto& segment : line.segments) {
+      json vertices = json::array();
+      for (const auto& [t, x] : segment) vertices.push_back(json::array({number(t), number(x)}));
+      segments.push_back(vertices);
+    }
+    lines.push_back({{"body", line.body}, {"segments", segments}});
+  }
+  return lines;
 }
 
 /// The plotted series: at most a few thousand points whatever the count.
@@ -815,6 +832,9 @@ std::optional<std::pair<std::string, std::uint64_t>> RunBook::json(const std::st
       out["scene"] = sceneJson(run.record->input());
       if (run.record->prediction) out["prediction"] = predictionJson(*run.record->prediction);
       out["plots"] = plotsJson(*run.record, run.predicted);
+      const auto view = collision_lab_ros::makeRunView(*run.record);
+      out["view"] = collision_lab_ros::viewJson(view);
+      out["plots"]["worldline_segments"] = worldlineSegmentsJson(*run.record, view.end_time);
     }
     if (run.summary) out["summary"] = summaryJson(*run.summary);
     if (!run.bag_error.empty()) out["bag_error"] = run.bag_error;
@@ -834,6 +854,22 @@ std::pair<std::uint64_t, bool> RunBook::waitForChange(const std::string& run_id,
   };
   changed_.wait_for(lock, timeout, [&] { return current().first != seen; });
   return current();
+}
+
+std::string RunBook::rejections(const std::optional<std::string>& student) const {
+  nlohmann::json out = nlohmann::json::array();
+  if (!source_) return out.dump();
+  std::vector<collision_lab::service::IndexedRejection> rows;
+  try {
+    rows = source_->rejections(student, kRejectionsListed);
+  } catch (const std::exception&) {
+    return out.dump();  // the index cannot be read now: the next call asks again
+  }
+  for (const auto& r : rows) {
+    out.push_back({{"at", r.at}, {"student", r.student}, {"run_id", r.run_id}, {"reason_name", r.reason_name},
+                   {"field", r.field}, {"message", r.message}});
+  }
+  return out.dump();
 }
 
 std::string RunBook::list(const std::optional<std::string>& student) const {

@@ -26,7 +26,9 @@
 #include "collision_lab/ros/bag_csv.h"
 #include "collision_lab/ros/bag_reading.h"
 #include "collision_lab/ros/msg_conversion.h"
+#include "collision_lab/ros/markers/layout.h"
 #include "collision_lab/ros/node_constants.h"
+#include "collision_lab/ros/run_view.h"
 #include "http_server.h"
 
 namespace collision_lab_web {
@@ -71,6 +73,15 @@ std::string readFile(const std::string& path) {
   std::ostringstream buffer;
   buffer << in.rdbuf();
   return buffer.str();
+}
+
+/// n of a run served as "<student>.run<n>" (the student's n-th run); nullopt for any other id.
+std::optional<std::uint64_t> runNumber(const std::string& run_id, const std::string& student) {
+  const std::string prefix = student + ".run";
+  if (run_id.size() <= prefix.size() || run_id.compare(0, prefix.size(), prefix) != 0) return std::nullopt;
+  const std::string digits = run_id.substr(prefix.size());
+  if (digits.size() > 18 || digits.find_first_not_of("0123456789") != std::string::npos) return std::nullopt;
+  return std::stoull(digits);
 }
 
 std::string randomToken() {
@@ -546,10 +557,23 @@ void WebServer::route(const HttpRequest& request, const Access& access, const Ht
     }
     return reply.send(jsonAnswer(request, 200, out));
   }
+  if (get && path == "/api/body_colours") {
+    // rviz's palette, body i in palette[i % size] (RunView's colours), for the start page's form.
+    json palette = json::array();
+    for (std::size_t i = 0; i < collision_lab_ros::markers::layout::kPaletteSize; ++i) {
+      palette.push_back(collision_lab_ros::bodyColourHex(i));
+    }
+    return reply.send(jsonAnswer(request, 200, json{{"palette", palette}}));
+  }
   if (post && path == "/api/runs") return postRun(request, reply);
   if (get && path == "/api/runs") {
     std::optional<std::string> student = queryParam(query, "student");
     return reply.send(answer(request, http::status::ok, book_.list(student), "application/json"));
+  }
+  if (get && path == "/api/rejections") {
+    if (!access.teacher) return reply.send(errorAnswer(request, 403, "only the teacher sees the rejected inputs", "code"));
+    std::optional<std::string> student = queryParam(query, "student");
+    return reply.send(answer(request, http::status::ok, book_.rejections(student), "application/json"));
   }
   if (get && path == "/api/queue") {
     std::string body;
@@ -696,8 +720,12 @@ void WebServer::postRun(const HttpRequest& request, const HttpReply& reply) {
     res.set(http::field::retry_after, std::to_string(wait));
     return reply.send(std::move(res));
   }
-  // Each input gets a run_id of its own to ask for, so that its answer is found.
-  if (input.run_id.empty()) input.run_id = "run" + std::to_string(++submissions_);
+  // Each input gets a run_id of its own to ask for, so that its answer is found: the
+  // student's next run number.
+  if (input.run_id.empty()) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    input.run_id = "run" + std::to_string(++runs_numbered_[student]);
+  }
   input.student = student;
   const std::string requested = input.run_id;
   const std::string token = randomToken();
@@ -713,7 +741,21 @@ void WebServer::postRun(const HttpRequest& request, const HttpReply& reply) {
       pending_.erase({student, requested});
     }
     boost::asio::post(reply.executor(), [timer] { timer->cancel(); });
-    if (answer.rejected) return reply.send(jsonAnswer(request, 422, rejectionJson(*answer.rejected)));
+    if (answer.rejected) {
+      // A rejected send is no run: its number goes to the student's next send (unless a
+      // later send of theirs took a higher one meanwhile).
+      if (const auto number = runNumber(student + "." + requested, student)) {
+        std::lock_guard<std::mutex> lock(mutex_);
+        std::uint64_t& highest = runs_numbered_[student];
+        if (highest == *number) --highest;
+      }
+      return reply.send(jsonAnswer(request, 422, rejectionJson(*answer.rejected)));
+    }
+    if (const auto number = runNumber(*answer.run_id, student)) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      std::uint64_t& highest = runs_numbered_[student];
+      highest = std::max(highest, *number);
+    }
     remember(*answer.run_id, token);
     reply.send(jsonAnswer(request, 202,
                           {{"run_id", *answer.run_id},

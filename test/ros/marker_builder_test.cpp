@@ -299,6 +299,42 @@ TEST(MarkerBuilder, ReplayNeverShowsATimeBeforeTheNewestCollisionReceived) {
   EXPECT_EQ(stateAt(replay, replayedTime(replay, ros::Time(1003, 995'000'000))).collisions, 3u);
 }
 
+TEST(MarkerBuilder, ReplayGoesOnToTheRunsEndOnceTheBagsClockHasStopped) {
+  // The same run as above (collisions at t = 1, 1.5 and 2 s, stamped at 2 bag s per simulated
+  // s from 1000 s); its summary is the bag's last message, stamped at the last collision
+  // (1004 s), where rosbag play's clock stops. The live view goes on to endTime = 2.5 s (25 %
+  // past the last collision): A and C have parted from B. (Failed before: the replay stayed at
+  // the last impact, 2 s, with A and B at one point.)
+  const Fed fed = feed({1, 1, 1}, {2, 1, -1}, {-1, 0, 1});
+  collision_lab::InitialConditions input = fed.run.input();
+  input.header.stamp = ros::Time(1000, 0);
+  RunRecord replay(input);
+  replay.prediction = fed.run.prediction;
+  replay.prediction->timeline_scale = 2.0;
+  for (const auto& event : fed.events) replay.add(event);
+  const double end = endTime(fed.run);
+  ASSERT_DOUBLE_EQ(end, 2.5);
+  const ros::Time stopped(1004, 0);
+  ReplayClock clock;
+  // Before the summary the bag may be paused: the clock holds.
+  EXPECT_DOUBLE_EQ(clock.at(replay, stopped, 4.0), 2.0);
+  EXPECT_DOUBLE_EQ(clock.at(replay, stopped, 4.2), 2.0);
+  EXPECT_DOUBLE_EQ(replayedTime(replay, stopped), 2.0);  // where the replay ended before
+  // The summary has come 4 wall s into the replay, at t = 2 s: 0.5 simulated s per wall s.
+  replay.summary = fed.run.summary;
+  EXPECT_DOUBLE_EQ(clock.at(replay, stopped, 4.0), 2.0);
+  EXPECT_DOUBLE_EQ(clock.at(replay, stopped, 4.5), 2.25);
+  EXPECT_DOUBLE_EQ(clock.at(replay, stopped, 30.0), end);
+  const SceneState last = stateAt(replay, clock.at(replay, stopped, 30.0));
+  EXPECT_EQ(last.collisions, 3u);
+  EXPECT_GT(last.positions[0] - last.positions[1], 0.4);  // A and B apart again
+  // A ROS clock ahead of the wall-time pace (a bag that goes on) is followed, up to the end.
+  EXPECT_DOUBLE_EQ(clock.at(replay, ros::Time(1004, 600'000'000), 4.5), 2.3);
+  // A new run starts afresh.
+  clock.reset();
+  EXPECT_DOUBLE_EQ(clock.at(replay, stopped, 10.0), 2.0);
+}
+
 TEST(MarkerBuilder, WarpPlaysDenseBurstsInSlowMotion) {
   const Fed fed = feed({1e8, 1, kInf}, {2, 1, 0}, {-1, 0, 0});
   const TimeWarp warp(fed.run);
@@ -353,6 +389,59 @@ TEST(MarkerBuilder, EveryViewFitsRvizForEveryCount) {
       expectOneMarkerPerId(animated);
     }
   }
+}
+
+TEST(MarkerBuilder, RejectionBannerNamesTheRunAndTheStudent) {
+  // (Failed before: the banner named the run only, so a class could not tell whose it was.)
+  collision_lab::Rejected rejected;
+  rejected.run_id = "pi_try";
+  rejected.student = "ben";
+  rejected.reason_name = "POSITIONS_NOT_ORDERED";
+  rejected.field = "positions";
+  rejected.message = "positions must be strictly decreasing";
+  MarkerArray array;
+  array.markers = rejectedBanner(rejected, "f");
+  const Marker* text = find(array, markers::ns::kRejected, markers::kFramedText);
+  ASSERT_TRUE(text);
+  EXPECT_EQ(text->text.rfind("REJECTED run 'pi_try' of student 'ben': POSITIONS_NOT_ORDERED in positions", 0), 0u)
+      << text->text;
+  // Without a run_id (the node could not read one): still whose.
+  rejected.run_id.clear();
+  array.markers = rejectedBanner(rejected, "f");
+  text = find(array, markers::ns::kRejected, markers::kFramedText);
+  ASSERT_TRUE(text);
+  EXPECT_EQ(text->text.rfind("REJECTED an input of student 'ben': ", 0), 0u) << text->text;
+  // Without a student: the run alone, as before.
+  rejected.run_id = "pi_try";
+  rejected.student.clear();
+  array.markers = rejectedBanner(rejected, "f");
+  text = find(array, markers::ns::kRejected, markers::kFramedText);
+  ASSERT_TRUE(text);
+  EXPECT_EQ(text->text.rfind("REJECTED run 'pi_try': ", 0), 0u) << text->text;
+}
+
+TEST(MarkerBuilder, HintIsDrawnBoldSoThatItsUnderscoresShow) {
+  // The hint is a command to copy, "/collision_lab/initial_conditions": rviz draws an
+  // underscore a pixel thin and faint. It is drawn twice, a pixel apart, both over the panel.
+  // (Failed before: one text, its underscores nearly invisible in the screenshot.)
+  MarkerArray array;
+  array.markers = hintMarkers("rostopic pub -1 /collision_lab/initial_conditions", "f");
+  expectFitForRviz(array);
+  const Marker* text = find(array, markers::ns::kHint, markers::kFramedText);
+  const Marker* bold = find(array, markers::ns::kHint, markers::kFramedTextBold);
+  const Marker* panel = find(array, markers::ns::kHint, markers::kFramedBox);
+  ASSERT_TRUE(text && bold && panel);
+  EXPECT_EQ(bold->text, text->text);
+  EXPECT_EQ(bold->pose.position.x, text->pose.position.x);
+  EXPECT_NEAR(text->pose.position.y - bold->pose.position.y, markers::layout::kBoldDy, 1e-12);
+  EXPECT_LT(markers::layout::kBoldDy * 46, 1.5);  // about a pixel at rviz/collision_lab.rviz's scale
+  EXPECT_GT(bold->pose.position.z, panel->pose.position.z);
+  // The banner is not bold.
+  collision_lab::Rejected rejected;
+  rejected.reason_name = "EMPTY_SCENE";
+  MarkerArray banner;
+  banner.markers = rejectedBanner(rejected, "f");
+  EXPECT_FALSE(find(banner, markers::ns::kRejected, markers::kFramedTextBold));
 }
 
 TEST(MarkerBuilder, RejectionBannerHoldsItsWholeTextOnAnOpaquePanelOverThePanelTitles) {

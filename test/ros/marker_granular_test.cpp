@@ -12,6 +12,7 @@
 
 #include "collision_lab/core/nbody/engine.h"
 #include "collision_lab/ros/marker_builder.h"
+#include "collision_lab/ros/markers/draw.h"
 #include "collision_lab/ros/markers/ids.h"
 #include "collision_lab/ros/markers/layout.h"
 #include "marker_test_checks.h"
@@ -183,6 +184,152 @@ TEST(MarkerGranular, GasShowsTOnLogLogAxesWithHaffsLaw) {
   expectFit(r.record);
 }
 
+// The box gas cut at 2,000 impacts ends at t = endTime(run), between two decades of the time
+// axis. T(t) and Haff's fit are drawn up to that end and no further, and T lies over the fit.
+// (Failed before: the fit ran on to the axis' end, the next decade, as for granular_box_1000
+// cut at 1,000 impacts: drawn to 10 s for a run that ended at 3.84 s; T ended at the last
+// kept state, and lay under the fit.)
+TEST(MarkerGranular, TemperatureAndHaffsFitEndAtTheRunsEnd) {
+  const Scene scene = boxGas();
+  const GranularRun r = runScene(scene, 2000);
+  ASSERT_EQ(r.result.impact_count, 2000u) << r.result.stop_message;
+  const auto fixed = buildStaticMarkers(r.record, "f");
+  const auto* series = find(fixed, ids::ns::kTemperature, ids::kTemperatureSeries);
+  const auto* haff = find(fixed, ids::ns::kTemperature, ids::kTemperatureHaff);
+  const auto* first = find(fixed, ids::ns::kTemperature, ids::kTemperatureTimeMin);
+  const auto* last = find(fixed, ids::ns::kTemperature, ids::kTemperatureTimeMax);
+  ASSERT_TRUE(series && haff && first && last);
+  const auto& box = layout::kTemperatureBox;
+  const double x0 = exponentOf(first->text), x1 = exponentOf(last->text);
+  const double end = endTime(r.record);
+  const double end_x = box.left + (std::log10(end) - x0) / (x1 - x0) * (box.right - box.left);
+  ASSERT_LT(end_x, box.right - 0.1) << "the run must end inside the axis' last decade";
+  EXPECT_NEAR(series->points.back().x, end_x, 1e-9);
+  EXPECT_NEAR(haff->points.back().x, end_x, 1e-9);
+  for (const auto& p : haff->points) EXPECT_LE(p.x, end_x + 1e-9);
+  // T held from the last impact to the end: the free flight does not change it.
+  const double t_end = temperatureOf(scene, r.result.final_velocities);
+  const double y0 = exponentOf(find(fixed, ids::ns::kTemperature, ids::kTemperatureMin)->text);
+  const double y1 = exponentOf(find(fixed, ids::ns::kTemperature, ids::kTemperatureMax)->text);
+  EXPECT_NEAR(series->points.back().y, box.bottom + (std::log10(t_end) - y0) / (y1 - y0) * (box.top - box.bottom), 1e-9);
+  // T over the fit, and thicker than it.
+  EXPECT_GT(series->points.front().z + series->pose.position.z, haff->points.front().z + haff->pose.position.z);
+  EXPECT_GT(series->scale.x, haff->scale.x);
+  // T now's dot at the end lies on the curve's end.
+  const auto animated = buildAnimatedMarkers(r.record, FrameClock{end, "test"}, "f");
+  const auto* dot = find(animated, ids::ns::kTemperatureNow, ids::kTemperatureNowDot);
+  ASSERT_TRUE(dot && !dot->points.empty());
+  EXPECT_NEAR(dot->points[0].x, end_x, 1e-9);
+}
+
+// Every frame's top value keeps clear of its label over it: the box gas's momentum panel is
+// labelled "p [kg m/s] of the finite masses vs collision index; a wall takes some", as wide
+// as the panel. (Failed before: its top value, 96.9 in granular_box_1000, touched the label.)
+TEST(MarkerGranular, PanelTitlesKeepClearOfTheirTopValues) {
+  GranularRun r = runScene(boxGas(), 2000);
+  r.record.summary->momentum_relative_drift = std::nan("");  // as the node sends with walls
+  const auto fixed = buildStaticMarkers(r.record, "f");
+  for (int base : {ids::kConservedEnergy, ids::kConservedMomentum}) {
+    const auto* label = find(fixed, ids::ns::kConserved, base + ids::kFrameLabel);
+    const auto* top = find(fixed, ids::ns::kConserved, base + ids::kFrameTopValue);
+    ASSERT_TRUE(label && top) << base;
+    EXPECT_TRUE(marker_checks::apart(marker_checks::textBox(*label), marker_checks::textBox(*top)))
+        << "'" << top->text << "' touches '" << label->text << "'";
+  }
+  const auto* momentum = find(fixed, ids::ns::kConserved, ids::kConservedMomentum + ids::kFrameLabel);
+  EXPECT_NE(momentum->text.find("a wall takes some"), std::string::npos) << momentum->text;
+  // The scene's "x range" note keeps clear of the end labels under the walls, and of the
+  // x-t diagram's title. (Failed on the first try of this change: the note moved onto the
+  // right end label, which sits lower under a wall.)
+  const auto animated = buildAnimatedMarkers(r.record, FrameClock{endTime(r.record), "test"}, "f");
+  const auto* note = find(animated, ids::ns::kLabels, ids::kSceneRangeNote);
+  ASSERT_TRUE(note);
+  marker_checks::expectTextClear(*note, -10.7, 16.3, {&fixed, &animated});
+}
+
+// Drifts are written with their sign: rviz draws '-' thin, and "4e-19" without one read as a
+// positive drift. (Failed before for the positive: "drift 8.4e-17" had no sign beside it.)
+TEST(MarkerGranular, DriftsAreSigned) {
+  Scene scene;
+  scene.masses = {1, 2, 1, 2}, scene.positions = {7.5, 5, 3, 1}, scene.velocities = {1, 0, 0, 0};
+  scene.restitution = {0.9}, scene.ring = 8;
+  GranularRun r = runScene(scene, 20);
+  r.record.summary->energy_relative_drift = 8.4e-17;
+  r.record.summary->momentum_relative_drift = -3.95e-19;
+  const auto fixed = buildStaticMarkers(r.record, "f");
+  const auto* energy = find(fixed, ids::ns::kConserved, ids::kConservedEnergy + ids::kFrameLabel);
+  const auto* momentum = find(fixed, ids::ns::kConserved, ids::kConservedMomentum + ids::kFrameLabel);
+  ASSERT_TRUE(energy && momentum);
+  EXPECT_NE(energy->text.find("drift +8.4e-17"), std::string::npos) << energy->text;
+  char expected[32];
+  std::snprintf(expected, sizeof expected, "drift -%.2g", 3.95e-19);
+  EXPECT_NE(momentum->text.find(expected), std::string::npos) << momentum->text;
+  // Both labels bold: drawn again a pixel lower, so that the minus signs show.
+  for (const int base : {ids::kConservedEnergy, ids::kConservedMomentum}) {
+    const auto* label = find(fixed, ids::ns::kConserved, base + ids::kFrameLabel);
+    const auto* bold = find(fixed, ids::ns::kConserved, base + ids::kFrameLabelBold);
+    ASSERT_TRUE(bold) << base;
+    EXPECT_EQ(bold->text, label->text);
+    EXPECT_NEAR(label->pose.position.y - bold->pose.position.y, layout::kBoldDy, 1e-12);
+  }
+}
+
+// A ring of 1,000 m, 20 bodies 50 m apart: every body is drawn at its position in [0, 1,000)
+// m, on a scene axis from 0 to 1,000 m (its ends named so), as is the x-t diagram's axis.
+// (Failed before: a body flying across the seam between two collisions was drawn past
+// 1,000 m, and both axes ran over the bodies' padded spread, "x = -53.4 m" to "+1059 m".)
+TEST(MarkerGranular, ARingOf1000mIsDrawnFrom0To1000m) {
+  Scene scene;
+  std::uint64_t seed = 31;
+  for (int i = 0; i < 20; ++i) {
+    seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+    scene.masses.push_back(i % 2 ? 2.0 : 1.0);
+    scene.positions.push_back(975.0 - 50.0 * i);
+    scene.velocities.push_back(static_cast<double>(seed >> 11) / 9007199254740992.0 * 20 - 10);
+  }
+  scene.restitution = {0.9}, scene.ring = 1000;
+  const GranularRun r = runScene(scene, 300);
+  ASSERT_EQ(r.result.impact_count, 300u) << r.result.stop_message;
+  const double end = endTime(r.record);
+  std::size_t seam_crossings_seen = 0;
+  for (int k = 0; k <= 40; ++k) {
+    const double t = end * k / 40;
+    const SceneState state = stateAt(r.record, t);
+    for (double x : state.positions) {
+      EXPECT_GE(x, 0.0) << "t = " << t;
+      EXPECT_LT(x, 1000.0) << "t = " << t;
+    }
+    const auto frame = buildAnimatedMarkers(r.record, FrameClock{t, "test"}, "f");
+    for (int c = 0; c < layout::kMassClasses; ++c) {
+      const auto* bodies = find(frame, ids::ns::kBodies, ids::kBodyClass + c);
+      if (!bodies || bodies->action != visualization_msgs::Marker::ADD) continue;
+      for (const auto& p : bodies->points) {
+        EXPECT_GE(p.x, layout::kSceneLeft - 1e-9);
+        EXPECT_LE(p.x, layout::kSceneRight + 1e-9);
+        if (p.x < layout::kSceneLeft + 0.5 || p.x > layout::kSceneRight - 0.5) ++seam_crossings_seen;
+      }
+    }
+    const auto* min = find(frame, ids::ns::kLabels, ids::kSceneNowMin);
+    const auto* max = find(frame, ids::ns::kLabels, ids::kSceneNowMax);
+    const auto* world_min = find(frame, ids::ns::kWorldlinesNow, ids::kWorldNowPositionMin);
+    const auto* world_max = find(frame, ids::ns::kWorldlinesNow, ids::kWorldNowPositionMax);
+    ASSERT_TRUE(min && max && world_min && world_max);
+    EXPECT_EQ(min->text, "x = 0 m");
+    EXPECT_EQ(max->text, "x = 1,000 m");
+    EXPECT_EQ(world_min->text, "0");
+    EXPECT_EQ(world_max->text, "1,000");
+    // The x-t diagram's end values inside its width ("+1.06e+03" ran off its right edge).
+    EXPECT_GE(marker_checks::textBox(*world_min).left, layout::kWorldBox.left - 1e-9);
+    EXPECT_LE(marker_checks::textBox(*world_max).right, layout::kWorldBox.right + 1e-9);
+    const auto* note = find(frame, ids::ns::kLabels, ids::kSceneRangeNote);
+    ASSERT_TRUE(note);
+    EXPECT_EQ(note->text, "a ring of 1,000 m: its ends meet");
+    EXPECT_TRUE(marker_checks::apart(marker_checks::textBox(*note), marker_checks::textBox(*max)));
+  }
+  EXPECT_GT(seam_crossings_seen, 0u) << "some body must be seen near the seam";
+  expectFit(r.record);
+}
+
 TEST(MarkerGranular, AnElasticGasKeepsItsEnergyTotals) {
   Scene scene = boxGas();
   scene.restitution = {};
@@ -269,6 +416,53 @@ TEST(MarkerGranular, ClustersAreDrawnJoined) {
   const auto* none = find(early, ids::ns::kClusters, ids::kClusterLines);
   EXPECT_TRUE(!none || none->action == visualization_msgs::Marker::DELETE);
   expectFit(r.record);
+}
+
+// cluster_collapse_5 ends as one cluster at the scene axis' left end, where its ring lies
+// around it: the ring keeps clear of the axis' end labels. (Failed before: the ring covered
+// "x = -0.8849 m", as it covered "x = -0.6058 m" in the issue.)
+TEST(MarkerGranular, ClusterRingsKeepClearOfTheAxisLabels) {
+  const Scene scene{{1, 1, 1, 1, 1}, {4, 3, 2, 1, 0}, {-1, 0, 0, 0, 0}, {0.05}};
+  const GranularRun r = runScene(scene, 1000);
+  const auto fixed = buildStaticMarkers(r.record, "f");
+  std::vector<marker_checks::TextBox> labels;
+  for (int id : {ids::kSceneMinLabel, ids::kSceneMaxLabel}) {
+    const auto* label = find(fixed, ids::ns::kScene, id);
+    ASSERT_TRUE(label);
+    labels.push_back(marker_checks::textBox(*label));
+  }
+  const double end = endTime(r.record), half_width = layout::kClusterRingWidth / 2;
+  std::size_t near_the_end = 0;
+  for (int k = 0; k <= 50; ++k) {
+    const auto frame = buildAnimatedMarkers(r.record, FrameClock{end * k / 50, "test"}, "f");
+    const auto* rings = find(frame, ids::ns::kClusters, ids::kClusterRings);
+    if (!rings || rings->action != visualization_msgs::Marker::ADD) continue;
+    for (const auto& p : rings->points) {
+      if (p.x < labels[0].right) ++near_the_end;
+      for (const auto& box : labels) {
+        const bool inside = p.x > box.left - half_width && p.x < box.right + half_width &&
+                            p.y > box.bottom - half_width && p.y < box.top + half_width;
+        EXPECT_FALSE(inside) << "ring point (" << p.x << ", " << p.y << ") at t = " << end * k / 50;
+      }
+    }
+  }
+  EXPECT_GT(near_the_end, 0u) << "the ring must reach over the left label's columns";
+}
+
+// One number style for positions on every axis: four significant digits, no exponent from
+// 1,000 on, separators; the sign where asked. (Before: "%.4g" in the scene, "1060", and
+// "%.3g" in the x-t diagram, "+1.06e+03", for the same 1,059.6 m.)
+TEST(MarkerGranular, PositionsHaveOneNumberStyle) {
+  using collision_lab_ros::markers::positionText;
+  EXPECT_EQ(positionText(1059.6, true), "+1,060");
+  EXPECT_EQ(positionText(1059.6, false), "1,060");
+  EXPECT_EQ(positionText(-61.0583, true), "-61.06");
+  EXPECT_EQ(positionText(-0.60583, false), "-0.6058");
+  EXPECT_EQ(positionText(1000.0, false), "1,000");
+  EXPECT_EQ(positionText(213.4e6, true), "+213,400,000");
+  EXPECT_EQ(positionText(-194.83e6, true), "-194,800,000");
+  EXPECT_EQ(positionText(0.0, true), "0");
+  EXPECT_EQ(positionText(2.147, true), "+2.147");
 }
 
 }  // namespace

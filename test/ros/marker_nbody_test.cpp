@@ -770,4 +770,62 @@ TEST(MarkerNBody, ThousandBodyGasRebuiltFromPairFieldsAlone) {
   expectViewsFit(r.run);
 }
 
+// One naming and one colour per body in every view (issue 31): body i is core::bodyName(i)
+// ("A", "B", ...) wherever a text names it, and is drawn in the palette's colour i
+// (layout::kParticleRgb: A red, B green, C blue, ...) wherever it has a colour of its own:
+// the scene's sphere, its tag and velocity, the velocity steps and their names, the energy
+// steps, the worldlines, the kinetic energy bars and their names, the velocities now.
+TEST(MarkerNBody, EveryViewNamesAndColoursABodyTheSameWay) {
+  const NBodyRun r = runScene(scene({1, 2, 3, 2, 1}, {4, 3, 2, 1, 0}, {-1, 0, 0, 0, 1}), false);
+  ASSERT_GE(r.result.impact_count, 2u);
+  const auto fixed = buildStaticMarkers(r.run, "f");
+  const auto animated = buildAnimatedMarkers(r.run, FrameClock{0.5 * endTime(r.run), "test"}, "f");
+  namespace ns = markers::ns;
+  const auto expectColour = [](const std_msgs::ColorRGBA& c, std::size_t i, const std::string& where) {
+    const auto& rgb = markers::layout::kParticleRgb[i];
+    EXPECT_NEAR(c.r, rgb.r, 1e-6) << where << ", body " << i;
+    EXPECT_NEAR(c.g, rgb.g, 1e-6) << where << ", body " << i;
+    EXPECT_NEAR(c.b, rgb.b, 1e-6) << where << ", body " << i;
+  };
+  const std::vector<std::string> names{"A", "B", "C", "D", "E"};
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    const int b = static_cast<int>(i);
+    const auto* sphere = find(animated, ns::kBodies, markers::kBody + b);
+    const auto* tag = find(animated, ns::kLabels, markers::kBodyTag + b);
+    const auto* row = find(animated, ns::kLabels, markers::kVelocityRow + b);
+    const auto* steps = find(fixed, ns::kPlot, markers::kPlotSeries + b);
+    const auto* steps_name = find(fixed, ns::kPlot, markers::kPlotSeriesNames + b);
+    const auto* energy = find(fixed, ns::kConserved, markers::kConservedEnergy + markers::kConservedBodies + b);
+    const auto* worldline = find(fixed, ns::kWorldlines, markers::kWorldLines + b);
+    const auto* bar = find(animated, ns::kEnergyBars, markers::kEnergyBar + b);
+    const auto* bar_name = find(fixed, ns::kEnergy, markers::kEnergyBodyNames + b);
+    ASSERT_TRUE(sphere && tag && row && steps && steps_name && energy && worldline && bar && bar_name) << i;
+    EXPECT_EQ(tag->text, names[i]);
+    EXPECT_EQ(row->text.rfind("v_" + names[i] + " = ", 0), 0u) << row->text;
+    EXPECT_EQ(steps_name->text, "v_" + names[i]);
+    EXPECT_EQ(bar_name->text, names[i]);
+    expectColour(sphere->color, i, "scene");
+    expectColour(steps->color, i, "velocity steps");
+    expectColour(steps_name->color, i, "velocity steps' name");
+    expectColour(energy->color, i, "energy steps");
+    expectColour(worldline->color, i, "worldline");
+    expectColour(bar->color, i, "energy bar");
+    expectColour(bar_name->color, i, "energy bar's name");
+  }
+  // The velocities now: one dot per body, E (left) to A (right), each in its colour.
+  const auto* now = find(animated, ns::kVelocitiesNow, markers::kSideBars);
+  ASSERT_TRUE(now);
+  ASSERT_EQ(now->colors.size(), names.size());
+  for (std::size_t i = 0; i < names.size(); ++i) expectColour(now->colors[i], i, "velocities now");
+  // No text says "body 0" (or any body's index) where it names a body.
+  for (const auto* array : {&fixed, &animated}) {
+    for (const auto& m : array->markers) {
+      if (m.type != visualization_msgs::Marker::TEXT_VIEW_FACING) continue;
+      for (const char* index_name : {"body 0", "body 1", "body 2", "body 3", "body 4"}) {
+        EXPECT_EQ(m.text.find(index_name), std::string::npos) << m.ns << "/" << m.id << " '" << m.text << "'";
+      }
+    }
+  }
+}
+
 }  // namespace

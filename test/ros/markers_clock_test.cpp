@@ -140,20 +140,31 @@ TEST(MarkersClock, AnimationFollowsTheBagClock) {
   EXPECT_NE(watcher.status.find("collisions 3 of 3"), std::string::npos) << watcher.status;
 }
 
-TEST(MarkersClock, ReplayEndsOnTheLastCollisionThoughTheClockLagsIt) {
-  // The clock stops 5 ms of bag time (2.5 ms simulated) short of the last collision's stamp
-  // (t = 2 s): the replay still ends showing all three collisions, from t = 2 s. (Failed
-  // before: "t = 1.9975 s  collisions 2 of 3" for ever.)
+TEST(MarkersClock, ReplayGoesOnToTheRunsEndThoughTheClockStopsShortOfTheLastCollision) {
+  // As when rosbag play says "Done.": the clock stops with the last message, the summary,
+  // stamped at the last collision (t = 2 s), and here 5 ms of bag time (2.5 ms simulated)
+  // short of it. The replay still shows all three collisions, and goes on from there in wall
+  // time to the run's end, t = 2.5 s, as the live view does, the clock standing still.
+  // (Failed before issue 31: held at "t = 2 s" for ever, A and B at one point; and before
+  // that: "t = 1.9975 s  collisions 2 of 3" for ever.)
   ros::NodeHandle nh("collision_lab");
   AnimationWatcher watcher(nh);
   Player player(nh);
   ASSERT_TRUE(spinUntil([&] { return player.connected(); }, kTimeout)) << "collision_lab_markers never subscribed";
-  player.load("lagging_clock_run", kStart + ros::Duration(1000.0));  // after the other test's clock
+  const ros::Time start = kStart + ros::Duration(1000.0);  // after the other test's clock
+  player.load("stopped_clock_run", start);
+  // Played at a pace a wall clock can follow: up to t = 1.75 s, a second of wall time, then
+  // the rest at once.
+  player.play(start + ros::Duration(kScale * 1.75));
+  ASSERT_TRUE(spinUntil([&] { return timeShown(watcher.status) == "t = 1.75"; }, kTimeout))
+      << "last shown: " << watcher.status;
+  ros::WallDuration(1.0).sleep();
   player.play(std::nullopt, ros::Duration(0.005));
-  // (The latched frame of the run before shows t = 2.5 s.)
-  ASSERT_TRUE(spinUntil([&] { return timeShown(watcher.status) == "t = 2"; }, kTimeout))
+  ASSERT_TRUE(spinUntil([&] { return timeShown(watcher.status) == "t = 2.5"; }, kTimeout))
       << "last shown: " << watcher.status;
   EXPECT_NE(watcher.status.find("collisions 3 of 3"), std::string::npos) << watcher.status;
+  EXPECT_EQ(ros::Time::now(), start + ros::Duration(kScale * 2.0) - ros::Duration(0.005))
+      << "the clock must have stood still short of the last collision";
 }
 
 }  // namespace

@@ -19,6 +19,8 @@
 #include <rosbag/bag.h>
 
 #include "collision_lab/ros/marker_builder.h"
+#include "collision_lab/ros/markers/draw.h"
+#include "collision_lab/ros/run_view.h"
 #include "collision_lab/web/run_book.h"
 
 namespace {
@@ -140,12 +142,28 @@ class FakeSource : public collision_lab_web::RunSource {
     }
     return out;
   }
+  std::vector<collision_lab::service::IndexedRejection> rejections(const std::optional<std::string>& student,
+                                                                  std::size_t limit) const override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    asked_limit = limit;
+    std::vector<collision_lab::service::IndexedRejection> out;
+    for (const auto& r : rejections_) {
+      if (!student || r.student == *student) out.push_back(r);
+    }
+    return out;
+  }
+  void reject(const collision_lab::service::IndexedRejection& r) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    rejections_.push_back(r);
+  }
   mutable int finds = 0;
+  mutable std::size_t asked_limit = 0;
 
  private:
   mutable std::mutex mutex_;
   std::map<std::string, IndexedRun> rows_;
   std::vector<std::string> order_;
+  std::vector<collision_lab::service::IndexedRejection> rejections_;
 };
 
 /// A folder removed at the end of the test.
@@ -522,6 +540,89 @@ TEST(RunBookMemory, RestartedWebNodeServesTheIndexsRuns) {
   EXPECT_EQ(run.at("student"), "s2");
   EXPECT_EQ(book.bagPath("run7"), (dir.path / "run7.bag").string());
   EXPECT_EQ(json::parse(served(book, "run30")).at("state"), "interrupted");
+}
+
+}  // namespace
+
+TEST(RunBookRejections, ListsTheIndexsRejectionsAsJson) {
+  auto source = std::make_shared<FakeSource>();
+  collision_lab::service::IndexedRejection r;
+  r.at = 1.8e9;
+  r.student = "ben";
+  r.run_id = "pi_rviz";
+  r.reason_name = "NON_POSITIVE_MASS";
+  r.field = "masses[0]";
+  r.message = "m_A is -1 kg; a mass must be positive";
+  source->reject(r);
+  r.student = "ana";
+  source->reject(r);
+  collision_lab_web::RunBook book(smallBudget(1), source);
+  const json bens = json::parse(book.rejections(std::string("ben")));
+  ASSERT_EQ(bens.size(), 1u);
+  EXPECT_EQ(bens[0].at("student"), "ben");
+  EXPECT_EQ(bens[0].at("run_id"), "pi_rviz");
+  EXPECT_EQ(bens[0].at("reason_name"), "NON_POSITIVE_MASS");
+  EXPECT_EQ(bens[0].at("field"), "masses[0]");
+  EXPECT_EQ(bens[0].at("message"), "m_A is -1 kg; a mass must be positive");
+  EXPECT_DOUBLE_EQ(bens[0].at("at").get<double>(), 1.8e9);
+  EXPECT_EQ(json::parse(book.rejections(std::nullopt)).size(), 2u);
+  EXPECT_EQ(source->asked_limit, collision_lab_web::RunBook::kRejectionsListed);
+  // Without a run index there is nothing to list.
+  collision_lab_web::RunBook alone(smallBudget(1), nullptr);
+  EXPECT_EQ(json::parse(alone.rejections(std::nullopt)).size(), 0u);
+}
+
+namespace {
+
+// The page and rviz get the same view description for the same run: the web JSON's view
+// texts equal rviz's title and note (marker builder) for the same messages.
+TEST(RunBookView, PageAndRvizGetTheSameViewDescription) {
+  collision_lab::InitialConditions input;
+  input.run_id = "ana.run1";
+  input.student = "ana";
+  input.masses = {1.0, 1.0, 1.0};
+  input.positions = {2.0, 1.0, 0.0};
+  input.velocities = {-1.0, 0.0, 1.0};
+  input.restitution = {0.05, 0.05};
+  input.max_collisions = 1000;
+  collision_lab::Prediction prediction;
+  prediction.run_id = "ana.run1";
+  prediction.model_name = "three_body_spiral";
+  prediction.model = collision_lab::Prediction::MODEL_THREE_BODY_SPIRAL;
+  prediction.collapsed = true;
+  prediction.collapse_time = 3.5;
+  prediction.infinite_collisions = true;
+  collision_lab::CollisionEvent collapse;
+  collapse.run_id = "ana.run1";
+  collapse.kind = collision_lab::CollisionEvent::KIND_COLLAPSE;
+  collapse.first_moved = 0;
+  collapse.last_moved = 2;
+  collapse.time = 3.5;
+  collapse.position = 1.0;
+  collapse.pair_velocities_after = {0.0, 0.0};
+  collision_lab::RunSummary summary;
+  summary.run_id = "ana.run1";
+  summary.student = "ana";
+  summary.simulated = true;
+  summary.collapsed = true;
+  summary.collapse_count = 1;
+  summary.recording_ok = false;
+
+  collision_lab_web::RunBook book;
+  book.onServedInput(input);
+  book.onPrediction(prediction);
+  book.onEvent(collapse);
+  book.onSummary(summary);
+  const json view = runJson(book, "ana.run1").at("view");
+
+  collision_lab_ros::RunRecord rviz(input);
+  rviz.prediction = prediction;
+  rviz.add(collapse);
+  rviz.summary = summary;
+  EXPECT_EQ(view.at("title"), collision_lab_ros::markers::runTitle(rviz));
+  EXPECT_EQ(view.at("note"), collision_lab_ros::markers::runNote(rviz));
+  EXPECT_EQ(view.at("collapse"), "collapse at t = 3.5 s, x = 1 m, bodies A..C");
+  EXPECT_EQ(view.at("worldline_bodies").at(0).at("colour"), collision_lab_ros::bodyColourHex(0));
 }
 
 }  // namespace

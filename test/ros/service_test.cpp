@@ -105,6 +105,25 @@ TEST(Service, TheNodesMaxCollisionsIsACeilingAClientMayOnlyLower) {
   EXPECT_EQ(pi.response.summary.stop_reason, "FINISHED");
 }
 
+TEST(Service, AStudentsRunIdIsTakenOnlyWhenItWasServedBefore) {
+  // A student's run_id is served as <student>.<run_id>: that prefix is no sign of a taken id.
+  auto first = piScene("pi_rviz", 100, kAll);
+  first.request.student = "ben";
+  ASSERT_TRUE(callService("/ceiling/collision_lab_node/run_scene", first));
+  ASSERT_TRUE(first.response.ok) << first.response.message;
+  EXPECT_EQ(first.response.summary.run_id, "ben.pi_rviz");
+  EXPECT_EQ(first.response.summary.requested_run_id, "");
+  EXPECT_EQ(first.response.message.find("was taken"), std::string::npos) << first.response.message;
+  // The same id again is taken: served under the next free name, and said so.
+  auto again = piScene("pi_rviz", 100, kAll);
+  again.request.student = "ben";
+  ASSERT_TRUE(callService("/ceiling/collision_lab_node/run_scene", again));
+  ASSERT_TRUE(again.response.ok) << again.response.message;
+  EXPECT_EQ(again.response.summary.run_id, "ben.pi_rviz.2");
+  EXPECT_EQ(again.response.summary.requested_run_id, "pi_rviz");
+  EXPECT_NE(again.response.message.find("run_id 'pi_rviz' was taken"), std::string::npos) << again.response.message;
+}
+
 // ---- The time and bag budgets (node ~max_run_seconds 1, ~max_collisions 1e15) ----
 
 TEST(Service, ARunPastItsTimeBudgetStopsWithItsBagComplete) {

@@ -6,6 +6,7 @@
 //    result: 31 collisions simulated and 31 predicted (m_A/m_B = 100 against a wall: the
 //    first two digits of pi).
 // Skipped, with a line saying so, when chromium is not installed.
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -19,6 +20,7 @@
 #include <nlohmann/json.hpp>
 #include <ros/ros.h>
 
+#include "collision_lab/ros/run_view.h"
 #include "run_collector.h"
 // Last: it includes <resolv.h>, whose macro _res breaks Eigen's headers included after it.
 #include <httplib.h>
@@ -123,11 +125,12 @@ TEST_F(WebBrowserTest, RunPageDrawsItsPlots) {
     std::cout << "ImageMagick is not installed: the screenshot's colours are not counted\n";
     return;
   }
-  // The light ball's velocity steps are drawn in #d62728: 31 jumps between about +-10 m/s
-  // are thousands of pixels; the scene's dot of that colour is about a hundred.
-  const long red = std::stol("0" + output("convert " + shot + " -alpha off -fuzz 10% -fill black +opaque '#d62728' "
-                                          "-fill white -opaque '#d62728' -format '%[fx:round(mean*w*h)]' info:"));
-  EXPECT_GT(red, 1000) << "the velocity plot looks blank: " << red << " pixels of body B's colour";
+  // The light ball B's velocity steps are drawn in B's colour (rviz's, from the view): 31
+  // jumps between about +-10 m/s are thousands of pixels; the scene's dot is about a hundred.
+  const std::string b = collision_lab_ros::bodyColourHex(1);
+  const long pixels_of_b = std::stol("0" + output("convert " + shot + " -alpha off -fuzz 10% -fill black +opaque '" + b +
+                                                  "' -fill white -opaque '" + b + "' -format '%[fx:round(mean*w*h)]' info:"));
+  EXPECT_GT(pixels_of_b, 1000) << "the velocity plot looks blank: " << pixels_of_b << " pixels of body B's colour";
 }
 
 TEST_F(WebBrowserTest, FormSendsASceneAndSeesTheResult) {
@@ -172,6 +175,87 @@ TEST_F(WebBrowserTest, FormSendsASceneAndSeesTheResult) {
 }
 
 }  // namespace
+
+/// A number in a data-<name>="..." attribute of the page's <body> (NaN when absent).
+double bodyData(const std::string& dom, const std::string& name) {
+  std::smatch m;
+  if (!std::regex_search(dom, m, std::regex("data-" + name + "=\"([^\"]*)\""))) return std::nan("");
+  return std::stod(m[1].str());
+}
+
+class RunPageViewTest : public WebBrowserTest {
+ protected:
+  /// Sends `scene` and returns the final run page's DOM.
+  std::string finalPage(const json& scene) {
+    httplib::Client c(host_, port_);
+    c.set_read_timeout(60, 0);
+    int status = 0;
+    std::string body;
+    EXPECT_TRUE(waitUntil(
+        [&] {
+          auto res = c.Post("/api/runs", scene.dump(), "application/json");
+          if (!res) return false;
+          status = res->status, body = res->body;
+          return status != 503;
+        },
+        "the lab node to take inputs"));
+    EXPECT_EQ(status, 202) << body;
+    if (status != 202) return "";
+    const std::string run_id = json::parse(body)["run_id"];
+    const std::string page = "http://" + host_ + ":" + std::to_string(port_) + "/runs/" + run_id;
+    std::string dom;
+    waitUntil(
+        [&] {
+          dom = chromium("--dump-dom", page);
+          return dom.find("data-final=\"true\"") != std::string::npos;
+        },
+        "the run page to be final");
+    return dom;
+  }
+};
+
+// The pi scene with a cap below its 31 impacts is answered by the model: the page says
+// "not simulated" and claims no simulated count or "finished: 31 collisions".
+TEST_F(RunPageViewTest, NotSimulatedRunIsShownAsNotSimulated) {
+  const std::string dom = finalPage({{"student", "view"}, {"masses", {100, 1, "inf"}}, {"positions", {2, 1, 0}},
+                                     {"velocities", {-1, 0, 0}}, {"max_collisions", 10}});
+  EXPECT_NE(dom.find("not simulated: "), std::string::npos) << dom.substr(0, 2000);
+  EXPECT_EQ(dom.find("finished: 31 collisions"), std::string::npos);
+}
+
+TEST_F(RunPageViewTest, CollapseIsNamed) {
+  const std::string dom = finalPage({{"student", "view"}, {"preset", "collapse_equal"}});
+  EXPECT_NE(dom.find("collapse at t = "), std::string::npos) << dom.substr(0, 2000);
+}
+
+// The two carts part after their impact at t = 0.5 s: every x-t line reaches the run's end.
+TEST_F(RunPageViewTest, WorldlinesReachTheRunsEnd) {
+  const std::string dom = finalPage({{"student", "view"}, {"preset", "two_carts"}});
+  const double end = bodyData(dom, "view-end"), reached = bodyData(dom, "xt-end");
+  ASSERT_TRUE(std::isfinite(end)) << dom.substr(0, 2000);
+  EXPECT_GT(end, 0.5);
+  EXPECT_DOUBLE_EQ(reached, end);
+}
+
+// A ring is named, its lines are cut at the seam, and the 24 bodies shown have a legend.
+TEST_F(RunPageViewTest, RingIsNamedAndCutAtTheSeam) {
+  const std::string dom = finalPage({{"student", "view"}, {"preset", "granular_ring"}, {"max_collisions", 2000}});
+  EXPECT_NE(dom.find("ring of 1,000 m"), std::string::npos) << dom.substr(0, 2000);
+  EXPECT_NE(dom.find("24 of 1,000 bodies, evenly spaced, the outermost two included"), std::string::npos);
+  const double jump = bodyData(dom, "xt-max-jump");
+  ASSERT_TRUE(std::isfinite(jump));
+  EXPECT_LT(jump, 500.0) << "an x-t segment spans the seam";
+}
+
+TEST_F(RunPageViewTest, BoxOfManyBodiesHasItsLegend) {
+  const std::string dom = finalPage({{"student", "view"}, {"preset", "granular_box_1000"}, {"max_collisions", 2000}});
+  EXPECT_NE(dom.find("box: walls at both ends"), std::string::npos) << dom.substr(0, 2000);
+  EXPECT_NE(dom.find("24 of 1,002 bodies, evenly spaced, the outermost two included"), std::string::npos);
+  // A gas (e = 0.9): T(t) on log-log axes with Haff's law fitted.
+  EXPECT_NE(dom.find("Haff's law T0/(1 + t/tau)^2 fitted: T0 = "), std::string::npos);
+  EXPECT_GT(bodyData(dom, "temperature-points"), 10.0);
+  EXPECT_GT(bodyData(dom, "haff-tau"), 0.0);
+}
 
 int main(int argc, char** argv) {
   testing::InitGoogleTest(&argc, argv);

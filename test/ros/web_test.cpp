@@ -128,6 +128,20 @@ TEST_F(WebTest, BrowserRunIsServedRecordedAndListed) {
   EXPECT_NE(page->body.find("data-run-id=\"" + run_id + "\""), std::string::npos);
 }
 
+TEST_F(WebTest, RunIdsAreNumberedPerStudent) {
+  // Classmates' runs do not share numbers: each student's n-th run is <student>.run<n>.
+  const auto send = [](const std::string& student) {
+    auto res = post(piScene(student));
+    EXPECT_TRUE(res);
+    if (!res) return std::string();
+    EXPECT_EQ(res->status, 202) << res->body;
+    return json::parse(res->body).value("run_id", std::string());
+  };
+  EXPECT_EQ(send("flo"), "flo.run1");
+  EXPECT_EQ(send("gus"), "gus.run1");
+  EXPECT_EQ(send("flo"), "flo.run2");
+}
+
 TEST_F(WebTest, LiveStreamEndsWithTheFinalRun) {
   auto res = post(piScene("ben"));
   ASSERT_TRUE(res);
@@ -176,6 +190,47 @@ TEST_F(WebTest, RejectionCarriesReasonAndField) {
   ASSERT_TRUE(res);
   EXPECT_EQ(res->status, 400);
   EXPECT_EQ(json::parse(res->body)["field"], "velocities[1]");
+}
+
+TEST_F(WebTest, TheTeacherSeesEachStudentsRejectedInputs) {
+  json bad = piScene("jo");
+  bad["positions"] = {0, 1, 2};  // not strictly decreasing
+  for (int k = 0; k < 2; ++k) {
+    auto res = post(bad);
+    ASSERT_TRUE(res);
+    EXPECT_EQ(res->status, 422) << res->body;
+  }
+  // Rejected sends are no runs: the student's first run is still run1.
+  auto good = post(piScene("jo"));
+  ASSERT_TRUE(good);
+  ASSERT_EQ(good->status, 202) << good->body;
+  EXPECT_EQ(json::parse(good->body).at("run_id"), "jo.run1");
+
+  json rejections;
+  waitUntil(
+      [&] {
+        auto res = client().Get("/api/rejections?student=jo");
+        if (!res || res->status != 200) return false;
+        rejections = json::parse(res->body);
+        return rejections.size() >= 2;
+      },
+      "the lab node's rejections in the run index");
+  ASSERT_EQ(rejections.size(), 2u) << rejections.dump();
+  for (const json& r : rejections) {
+    EXPECT_EQ(r.at("student"), "jo");
+    EXPECT_EQ(r.at("reason_name"), "POSITIONS_NOT_ORDERED");
+    EXPECT_EQ(r.at("field").get<std::string>().rfind("positions", 0), 0u) << r.dump();
+    EXPECT_FALSE(r.at("message").get<std::string>().empty());
+    EXPECT_GT(r.at("at").get<double>(), 1.6e9) << "a wall time [s since the epoch]";
+  }
+  EXPECT_GE(rejections[0].at("at").get<double>(), rejections[1].at("at").get<double>()) << "newest first";
+  // Everyone's, with jo's among them; another student's filter leaves jo's out.
+  auto all = client().Get("/api/rejections");
+  ASSERT_TRUE(all);
+  EXPECT_GE(json::parse(all->body).size(), 2u);
+  auto other = client().Get("/api/rejections?student=nobody");
+  ASSERT_TRUE(other);
+  EXPECT_EQ(json::parse(other->body).size(), 0u);
 }
 
 TEST_F(WebTest, ClassCodeIsNeededEverywhere) {

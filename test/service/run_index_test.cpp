@@ -144,6 +144,22 @@ TEST_F(RunIndexTest, ListsOldestFirstAndByStudent) {
   EXPECT_EQ(index.list(std::nullopt, 2).size(), 2u);
 }
 
+TEST_F(RunIndexTest, KeepsOnlyTheNewestRejections) {
+  RunIndex index(path_);
+  const std::size_t sent = RunIndex::kRejectionsKept + 2;
+  for (std::size_t k = 0; k < sent; ++k) {
+    IndexedRejection r;
+    r.at = static_cast<double>(k);
+    r.student = "loop";
+    r.run_id = "r" + std::to_string(k);
+    index.rejected(r);
+  }
+  const auto kept = index.rejections();
+  ASSERT_EQ(kept.size(), RunIndex::kRejectionsKept);
+  EXPECT_EQ(kept.front().run_id, "r" + std::to_string(sent - 1));
+  EXPECT_EQ(kept.back().run_id, "r2") << "the two oldest are dropped";
+}
+
 TEST_F(RunIndexTest, KeepsRejectionsNewestFirst) {
   RunIndex index(path_);
   for (int k = 0; k < 3; ++k) {

@@ -143,8 +143,11 @@ std::string runIdProblem(const std::string& run_id);
 std::string studentProblem(const std::string& student);
 /// The run_id an input asks for: <student>.<run_id>, <student> when it names no run_id,
 /// or run_id when it names no student (empty: the node assigns one). A taken one is then
-/// served as <that>.N.
+/// served as <that>.N, except a numbered run (numberedRunId): that one as the next free number.
 std::string requestedRunId(const collision_lab::InitialConditions& input);
+/// A numbered run, "run<n>" or "<prefix>.run<n>" (the web node numbers each student's runs
+/// so): its name up to the number ("ben.run") and n; nullopt for any other run_id.
+std::optional<std::pair<std::string, std::uint64_t>> numberedRunId(const std::string& run_id);
 
 /// The runs a node accepted, the newest kServedRunsKept of them: ~list_runs's answer when
 /// the run index cannot be opened.
@@ -327,8 +330,12 @@ class LabNode {
                 std::size_t queue_position, collision_lab::service::Lane lane);
   /// <prefix><counter>, the first one claim() takes. mutex_ held (as the two below).
   std::string newRunId(std::string& claim_error);
-  /// requested, or the first requested.N (N = 2, 3, ...) that claim() takes.
+  /// requested, or the first requested.N (N = 2, 3, ...) that claim() takes. A student's
+  /// n-th run (<student>.run<n>, numbered by the web node from 1 after each restart) goes
+  /// on to the first number the run index does not know either (servedBefore).
   std::string claimRunId(const std::string& requested, std::string& claim_error);
+  /// True when the run index lists run_id: served by this node or an earlier one.
+  bool servedBefore(const std::string& run_id);
   /// Takes run_id for this node's next run. False when this node served it recently
   /// (RememberedRunIds) or, recording, when claimBag finds its bag taken (by any process
   /// sharing bag_directory). True when taken: recording, its .bag.active file is this

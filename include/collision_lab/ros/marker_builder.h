@@ -29,6 +29,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <ros/time.h>
@@ -163,6 +164,9 @@ class RunRecord {
   /// Collapses applied [1] and the first one's time [s] (NaN when none).
   std::uint32_t collapses() const { return collapses_; }
   double firstCollapseTime() const { return first_collapse_time_; }
+  /// The first collapse's point [m] (NaN when none) and bodies, first .. last [1].
+  double firstCollapsePosition() const { return first_collapse_position_; }
+  std::pair<std::size_t, std::size_t> firstCollapseBodies() const { return first_collapse_bodies_; }
   /// Time of the newest collision added [s] (0 before the first).
   double newestTime() const { return newest_time_; }
   /// Bounds of every finite velocity any body has had so far, the start's included [m/s]:
@@ -194,6 +198,9 @@ class RunRecord {
   const Envelope& energy() const { return energy_; }
   const Envelope& momentum() const { return momentum_; }
   const Envelope& energyLost() const { return energy_lost_; }
+  /// Granular temperature T = (1/N) sum m (v - V)^2 of the finite masses [J] against time
+  /// [s] (core::granularTemperature, from the running energy and momentum): the gas's T(t).
+  const Envelope& temperature() const { return temperature_; }
   /// Total kinetic energy of the finite masses at the start [J].
   double startEnergy() const { return start_energy_; }
   /// Bytes the record holds, itself included: its input, the replay's state, the kept
@@ -229,11 +236,16 @@ class RunRecord {
   std::uint64_t missed_ = 0, malformed_ = 0;
   std::uint32_t collapses_ = 0;
   double first_collapse_time_;
+  double first_collapse_position_;
+  std::pair<std::size_t, std::size_t> first_collapse_bodies_{0, 0};
   std::vector<std::size_t> tracked_, plotted_;
   std::vector<int> track_slot_, plot_slot_;  ///< body -> its series, -1 for none
   std::vector<Envelope> velocity_, paper_velocity_, body_energy_, worldline_;
   std::vector<Envelope> tracked_velocity_;  ///< empty unless no body is plotted
-  Envelope energy_, momentum_, energy_lost_, none_;
+  Envelope energy_, momentum_, energy_lost_, temperature_, none_;
+  double finite_mass_ = 0.0;         ///< [kg]
+  std::size_t finite_bodies_ = 0;    ///< [1]
+  double temperatureNow() const;
   double start_energy_ = 0.0;
   double min_velocity_, max_velocity_;
 };
@@ -288,6 +300,29 @@ double simulatedTimeOnTimeline(const ros::Time& now, const ros::Time& start, dou
 /// fall just before its collision's time: the received collision has happened.
 double replayedTime(const RunRecord& run, const ros::Time& now);
 
+/// The clock of a run replayed by `rosbag play --clock`: replayedTime while the bag plays, and
+/// on from there to endTime(run), as the live view goes, once the run's RunSummary has come.
+/// A bag's last message is its RunSummary, stamped at the last collision, and rosbag play's
+/// clock stops with it: without this the replay would end frozen at the last impact, before
+/// the bodies' final free flight. After the summary the replay goes on in wall time, at the
+/// pace the bag played at so far (simulated s per wall s), or on the ROS clock where that is
+/// ahead (a bag that goes on).
+class ReplayClock {
+ public:
+  /// Simulated time [s] to show at ROS time `now`, `wall` seconds [s] after the run's
+  /// InitialConditions arrived; never past endTime(run).
+  double at(const RunRecord& run, const ros::Time& now, double wall);
+  /// A new run (or the same bag played again): forget where the last one stopped.
+  void reset() { summary_seen_.reset(); }
+
+ private:
+  struct Instant {
+    double t;     ///< simulated [s]
+    double wall;  ///< since the InitialConditions arrived [s]
+  };
+  std::optional<Instant> summary_seen_;  ///< the first frame after the RunSummary came
+};
+
 /// One frame's time line for the status text.
 struct FrameClock {
   double t = 0.0;           ///< simulated time requested [s]
@@ -299,11 +334,12 @@ visualization_msgs::MarkerArray buildStaticMarkers(const RunRecord& run, const s
 /// The parts that move with simulated time (bodies, labels, cursors, bars).
 visualization_msgs::MarkerArray buildAnimatedMarkers(const RunRecord& run, const FrameClock& clock,
                                                      const std::string& frame_id);
-/// A banner for a rejected input: its reason, field and message (markers/ids.h: ns kRejected,
-/// ids kFramedText, kFramedBox).
+/// A banner for a rejected input: its run_id and student, reason, field and message
+/// (markers/ids.h: ns kRejected, ids kFramedText, kFramedBox).
 std::vector<visualization_msgs::Marker> rejectedBanner(const collision_lab::Rejected& rejected,
                                                        const std::string& frame_id);
-/// Before the first run: how to send one, `command` (ns kHint, the same ids).
+/// Before the first run: how to send one, `command` (ns kHint, the same ids and
+/// kFramedTextBold: the text is drawn bold, so that its underscores show).
 std::vector<visualization_msgs::Marker> hintMarkers(const std::string& command, const std::string& frame_id);
 /// Deletes the marker ns/id (when a banner or hint is no longer shown).
 visualization_msgs::Marker deleteMarker(const std::string& ns, int id, const std::string& frame_id);

@@ -10,7 +10,9 @@
 //   "ros":  follows ROS time on the run's timeline, simulated t =
 //           (ros::Time::now() - InitialConditions stamp) / Prediction.timeline_scale, so
 //           that rosbag play --clock drives it: rate (-r), pause (space) and step (s);
-//           a replay never shows a time before the newest collision received (replayedTime).
+//           a replay never shows a time before the newest collision received (replayedTime),
+//           and goes on to the run's end like the live view once the bag's clock has stopped
+//           at its RunSummary (ReplayClock).
 // The default is "ros" under use_sim_time, "wall" otherwise.
 //
 // Which runs it shows (~follow_run_id, ~follow_student): by default whichever run is
@@ -97,8 +99,9 @@ class MarkerView : public RunObserver {
   /// goes out only once its bag is closed, which can be after the next run has started.
   /// Such a message must not switch the view back. Call with mutex_ held.
   bool stale(const std::string& run_id) const { return has_run_id_ && run_id != run_id_ && run_id == left_run_id_; }
-  /// The animation's clock for run, started (wall clock) at run_start. Needs no lock.
-  FrameClock frameClock(const RunRecord& run, const ros::WallTime& run_start, const ros::WallTime& now) const;
+  /// The animation's clock for run, started (wall clock) at run_start. Needs no lock (the
+  /// timer's alone: it moves replay_clock_ on).
+  FrameClock frameClock(const RunRecord& run, const ros::WallTime& run_start, const ros::WallTime& now);
   std::string hintText() const;
   /// The banner and hint markers of this frame (adds, or deletes of ones shown before).
   void addOverlays(visualization_msgs::MarkerArray& animated);
@@ -124,6 +127,8 @@ class MarkerView : public RunObserver {
 
   /// The timer's copy of run_, taken under mutex_ when run_ changed and drawn without it.
   std::optional<RunRecord> drawn_run_;
+  /// A replay's clock past the bag's end (the timer's alone).
+  ReplayClock replay_clock_;
 };
 
 }  // namespace collision_lab_ros

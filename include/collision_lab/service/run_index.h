@@ -82,7 +82,9 @@ class RunIndex {
   /// finished() and interrupted() create the run's row when it has none.
   void interrupted(const std::string& run_id, double at, const std::string& summary_json,
                    std::uint64_t collision_count, const std::string& bag_path);
+  /// A rejected input; only the newest kRejectionsKept are kept.
   void rejected(const IndexedRejection& rejection);
+  static constexpr std::size_t kRejectionsKept = 100000;
   /// The events CSV made beside the run's bag (the web node, once, on the first download).
   void setCsvPath(const std::string& run_id, const std::string& csv_path);
 

@@ -152,6 +152,11 @@ class RunBook {
   /// Every run (student empty: everyone's), oldest first, as a JSON array text. With a
   /// RunSource: every run it lists, with the live state of the runs in memory.
   std::string list(const std::optional<std::string>& student) const;
+  /// The lab node's rejected inputs (student empty: everyone's), newest first, at most
+  /// kRejectionsListed, as a JSON array text of {at [s since the epoch], student, run_id,
+  /// reason_name, field, message}. Empty without a RunSource (the index keeps them).
+  std::string rejections(const std::optional<std::string>& student) const;
+  static constexpr std::size_t kRejectionsListed = 1000;
   /// The run's bag (RunSummary.bag_path) once it is finished (or interrupted) and
   /// recorded; empty otherwise.
   std::string bagPath(const std::string& run_id) const;

@@ -22,6 +22,9 @@ class RunSource {
   virtual std::optional<collision_lab::service::IndexedRun> find(const std::string& run_id) const = 0;
   /// Every run (only student's when given), oldest accepted first.
   virtual std::vector<collision_lab::service::IndexedRun> list(const std::optional<std::string>& student) const = 0;
+  /// The lab node's rejected inputs (only student's when given), newest first, at most limit.
+  virtual std::vector<collision_lab::service::IndexedRejection> rejections(const std::optional<std::string>& student,
+                                                                          std::size_t limit) const = 0;
 };
 
 /// The SQLite run index at path (<bag_directory>/runs.sqlite) as a RunSource. Opening

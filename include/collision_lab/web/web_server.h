@@ -133,7 +133,6 @@ class WebServer {
   std::set<std::string> hosts_;               ///< names the lab serves (Host without port)
   std::string class_cookie_, teacher_cookie_;  ///< random per start: a login's proof
   std::atomic<std::size_t> streams_{0};
-  std::atomic<std::uint64_t> submissions_{0};
   mutable std::mutex mutex_;  ///< guards everything below
   std::map<std::string, std::deque<std::chrono::steady_clock::time_point>> sends_;
   std::map<std::string, std::deque<std::chrono::steady_clock::time_point>> wrong_codes_;
@@ -141,6 +140,10 @@ class WebServer {
   std::map<std::string, std::string> stop_tokens_;  ///< run_id -> its owner's secret
   std::deque<std::string> token_order_;             ///< run_ids of stop_tokens_, oldest first
   std::set<std::pair<std::string, std::string>> pending_;  ///< (student, requested) POSTs awaiting an answer
+  /// student -> the highest n of the runs "<student>.run<n>" asked for or served [1]. The lab
+  /// node serves a taken "run<n>" as the next free number, so numbers stay per student and
+  /// unique across restarts of either node.
+  std::map<std::string, std::uint64_t> runs_numbered_;
   std::string queue_json_;
   std::unique_ptr<BlockingPool> blocking_;  ///< cancel calls and CSV conversions
   std::unique_ptr<HttpServer> server_;

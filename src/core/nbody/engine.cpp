@@ -79,7 +79,7 @@ class Driver {
       const std::size_t pair = k < recorded ? crowd_[k] : undecided_pair_;
       if (pair == kNone) continue;
       bodies.push_back(pair);
-      bodies.push_back(pair + 1);
+      bodies.push_back(tables_.scene.leftOf(pair));  // body 0 across a ring's seam
     }
     std::sort(bodies.begin(), bodies.end());
     bodies.erase(std::unique(bodies.begin(), bodies.end()), bodies.end());
@@ -211,7 +211,7 @@ class Driver {
         r.kind == StepKind::kAmbiguous && higher.kind == StepKind::kImpact && t.follow(*tier<H>(), higher.pair);
     if (!followed) t.adopt(*tier<H>());
     if (record && higher.kind == StepKind::kImpact) {  // publish what this tier now holds
-      record->velocities_after = {t.velocity(higher.pair), t.velocity(higher.pair + 1)};
+      record->velocities_after = {t.velocity(higher.pair), t.velocity(tables_.scene.leftOf(higher.pair))};
     }
     return higher;
   }

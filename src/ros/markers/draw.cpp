@@ -57,6 +57,21 @@ std::string withSeparators(std::uint64_t n) {
   return out;
 }
 
+std::string positionText(double x, bool signed_) {
+  const double size = std::abs(x);
+  std::string digits;
+  if (size >= 1000 && size < 1e15) {
+    // Four significant digits, the rest zeros: 1059.6 -> "1,060".
+    const double unit = std::pow(10.0, std::floor(std::log10(size)) - 3);
+    digits = withSeparators(static_cast<std::uint64_t>(std::round(size / unit) * unit));
+  } else {
+    digits = format("%.4g", size);
+  }
+  if (x == 0 || std::isnan(x) || digits == "0") return digits;
+  if (x < 0) return "-" + digits;
+  return signed_ ? "+" + digits : digits;
+}
+
 std::pair<std::size_t, std::size_t> textExtent(const std::string& s) {
   std::size_t longest = 0, lines_count = 1, start = 0;
   for (std::size_t end = s.find('\n'); ; end = s.find('\n', start)) {
@@ -218,12 +233,21 @@ void addFrame(const Canvas& c, const std::string& ns, int base, const Axes& axes
   const bool top_shown = !zero_inside || b.top - zero > kLabelClearance;
   const bool bottom_shown = !zero_inside || zero - b.bottom > kLabelClearance;
   const auto value = [&](double y) { return bottom_shown && axes.y0 < 0 ? withSign("%.3g", y) : format("%.3g", y); };
-  if (top_shown) c.add(c.text(ns, base + kFrameTopValue, b.left + kValueLabelDx, b.top, value(axes.y1), kSmallTextSize));
+  if (top_shown) {
+    c.add(c.text(ns, base + kFrameTopValue, b.left + kValueLabelDx, b.top + kTopValueDy, value(axes.y1), kSmallTextSize));
+  }
   if (bottom_shown) {
     c.add(c.text(ns, base + kFrameBottomValue, b.left + kValueLabelDx, b.bottom, value(axes.y0), kSmallTextSize));
   }
   if (zero_inside) c.add(c.text(ns, base + kFrameZeroLabel, b.left + kZeroLabelDx, zero, "0", kSmallTextSize));
-  c.add(c.text(ns, base + kFrameLabel, b.midX(), b.top + kFrameLabelDy, label, kSmallTextSize));
+  // Bold (drawn twice, a pixel apart): rviz draws '-' a pixel thin and faint, and the
+  // labels carry signed drifts in e-notation ("drift -3.9e-19").
+  Marker title = c.text(ns, base + kFrameLabel, b.midX(), b.top + kFrameLabelDy, label, kSmallTextSize);
+  Marker again = title;
+  again.id = base + kFrameLabelBold;
+  again.pose.position.y -= kBoldDy;
+  c.add(std::move(title));
+  c.add(std::move(again));
 }
 
 void addSeries(const Canvas& c, const std::string& ns, int id, const Polyline& poly, const Axes& axes,

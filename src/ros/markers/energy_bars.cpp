@@ -44,7 +44,7 @@ void drawEnergyBars(const Canvas& c, const SceneState& state) {
   }
   if (largeScene(c.run)) {
     c.add(c.text(ns::kEnergyBars, kEnergyTotals, kBarsBox.midX(), kBarsBox.midY(),
-                 format("all %.0f bodies: ", static_cast<double>(n)) + format("%.5g J", total) +
+                 "all " + withSeparators(n) + " bodies: " + format("%.5g J", total) +
                      format("\nat the start: %.5g J", c.run.startEnergy()),
                  kTextSize));
     return;

@@ -16,9 +16,9 @@ using namespace markers::layout;
 /// vertex), over every view: the text is wrapped to fit the screen, and the panel fits the
 /// text. The panel also makes rviz 1.14 draw a text that comes alone: an array of only
 /// TEXT_VIEW_FACING markers is received but not drawn. `y` is the panel's centre, or with
-/// `grow_up` its bottom edge.
+/// `grow_up` its bottom edge; `bold` draws the text twice, a pixel apart (id kFramedTextBold).
 std::vector<Marker> framedText(const std::string& frame_id, const std::string& ns, double y, const std::string& text,
-                               const std_msgs::ColorRGBA& c, double size, bool grow_up = false) {
+                               const std_msgs::ColorRGBA& c, double size, bool grow_up = false, bool bold = false) {
   const std::string s = wrapped(text, size, 2 * (kMaxHalfFrameWidth - kFrameMarginX) / kFramedWidthFactor);
   const double half_width = kFramedWidthFactor * textWidth(s, size) / 2 + kFrameMarginX;
   const double half_height = textHeight(s, size) / 2 + kFrameMarginY;
@@ -38,13 +38,19 @@ std::vector<Marker> framedText(const std::string& frame_id, const std::string& n
   rectangle(l, b, l + w, t, c), rectangle(r - w, b, r, t, c);
   Marker label = textMarker(frame_id, ns, kFramedText, kCentreX, y, s, size, c);
   label.pose.position.z = kOverlayZ + kOverlayTextDz;
-  return {label, panel};
+  if (!bold) return {label, panel};
+  Marker again = label;
+  again.id = kFramedTextBold;
+  again.pose.position.y -= kBoldDy;
+  return {label, again, panel};
 }
 
 }  // namespace
 
 std::vector<Marker> rejectedBanner(const collision_lab::Rejected& rejected, const std::string& frame_id) {
-  const std::string run = rejected.run_id.empty() ? "an input" : "run '" + rejected.run_id + "'";
+  // Whose input and which run, as far as the message tells (either may be empty).
+  std::string run = rejected.run_id.empty() ? "an input" : "run '" + rejected.run_id + "'";
+  if (!rejected.student.empty()) run += " of student '" + rejected.student + "'";
   return framedText(frame_id, ns::kRejected, kBannerBottomY,
                     "REJECTED " + run + ": " + rejected.reason_name + " in " + rejected.field + "\n" +
                         rejected.message,
@@ -52,7 +58,7 @@ std::vector<Marker> rejectedBanner(const collision_lab::Rejected& rejected, cons
 }
 
 std::vector<Marker> hintMarkers(const std::string& command, const std::string& frame_id) {
-  return framedText(frame_id, ns::kHint, kHintY, command, color(kWhite), kHintTextSize);
+  return framedText(frame_id, ns::kHint, kHintY, command, color(kWhite), kHintTextSize, false, true);
 }
 
 }  // namespace collision_lab_ros

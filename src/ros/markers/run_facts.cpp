@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "collision_lab/ros/markers/draw.h"
+#include "collision_lab/ros/run_view.h"
 
 namespace collision_lab_ros::markers {
 
@@ -57,55 +58,10 @@ std::optional<std::pair<std::uint64_t, std::vector<double>>> finalVelocitiesNotD
   return std::nullopt;
 }
 
-std::string runTitle(const RunRecord& run) {
-  std::string title = "run " + run.input().run_id;
-  if (run.bodies() != 3) title += ",  " + withSeparators(run.bodies()) + " bodies";
-  if (run.prediction) {
-    const auto& p = *run.prediction;
-    if (p.model != collision_lab::Prediction::MODEL_THREE_BODY_ROTATION) title += " (" + p.model_name + ")";
-    if (p.collapsed) {
-      title += ":  predicted collapse at t = " + format("%.6g s", p.collapse_time);
-    } else if (p.infinite_collisions) {
-      title += ":  predicted: infinitely many collisions";
-    } else if (p.collision_count_defined) {
-      title += ":  predicted " + withSeparators(p.collision_count) + " collisions";
-    }
-    if (p.model == collision_lab::Prediction::MODEL_THREE_BODY_ROTATION) {
-      title += p.paper_collision_count_defined
-                   ? "  (paper's eq. 3.22: " + std::to_string(p.paper_collision_count) + ")"
-                   : "  (paper's eq. 3.22: undefined)";
-    }
-  }
-  if (run.summary) {
-    title += run.summary->simulated ? ",  simulated " + withSeparators(run.summary->collision_count)
-                                    : ",  not simulated";
-    if (run.summary->truncated) title += " (truncated)";
-    if (run.summary->collapse_count > 0) title += " + " + withSeparators(run.summary->collapse_count) + " collapse(s)";
-  }
-  return title;
-}
+// The title and the note are the run's view description (RunView), the page's texts too.
+std::string runTitle(const RunRecord& run) { return makeRunView(run).title; }
 
-std::string runNote(const RunRecord& run) {
-  std::string note;
-  if (run.missedCollisions() > 0) {
-    note += withSeparators(run.missedCollisions()) + " collision messages missing; ";
-  }
-  if (run.summary && run.summary->truncated) {
-    const std::string& reason = run.summary->truncation_reason;
-    note += (reason.rfind("stopped", 0) == 0 ? "" : "stopped: ") + reason + ". Shown up to the last known state.";
-  } else if (run.input().mode == collision_lab::InitialConditions::MODE_PREDICT_ONLY) {
-    note += "predict-only run: shown up to the first contact; the plots show the closed form's final velocities.";
-  } else if (run.summary && !run.summary->simulated &&
-             run.input().mode != collision_lab::InitialConditions::MODE_PREDICT_ONLY) {
-    note += "answered by the model (more collisions predicted than the cap): shown up to the first contact; the "
-            "plots show the closed form's final velocities.";
-  } else if (run.input().mode == collision_lab::InitialConditions::MODE_SUMMARY_ONLY) {
-    note += "summary-only run: shown up to the first contact; the plots show the final velocities.";
-  } else if (!run.finished()) {
-    note += "run in progress: shown up to the last collision received.";
-  }
-  return note;
-}
+std::string runNote(const RunRecord& run) { return makeRunView(run).note; }
 
 std::string statusLine(const RunRecord& run, const SceneState& state, const FrameClock& clock) {
   std::string s = format("t = %.6g s", state.time) + "     collisions " + withSeparators(state.collisions);

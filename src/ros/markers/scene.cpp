@@ -62,9 +62,7 @@ std::array<PlacedText, 2> endLabels(const RunRecord& run, const SceneAxis& axis)
   const auto y = [](bool wall) {
     return wall ? kSceneY - kWallHeight / 2 - kWallLabelDy : kSceneY + kSceneLabelDy;
   };
-  const auto value = [&axis](double x) {
-    return "x = " + (axis.min < 0 ? withSign("%.4g", x) : format("%.4g", x)) + " m";
-  };
+  const auto value = [&axis](double x) { return "x = " + positionText(x, axis.min < 0) + " m"; };
   return {PlacedText{value(axis.min), kSceneLeft + kSceneLabelDx, y(run.isWall(run.bodies() - 1))},
           PlacedText{value(axis.max), kSceneRight - kSceneLabelDx, y(run.isWall(0))}};
 }
@@ -216,6 +214,7 @@ double SceneAxis::toX(double position) const {
 }
 
 SceneAxis sceneAxis(const RunRecord& run) {
+  if (run.input().ring > 0) return {0.0, run.input().ring};  // the positions lie in [0, L)
   // The outermost bodies bound the others (they never pass each other); both are tracked.
   double lo = kInf, hi = -kInf;
   for (std::size_t i : run.trackedBodies()) {
@@ -230,7 +229,7 @@ SceneAxis sceneAxis(const RunRecord& run) {
 }
 
 SceneAxis bodiesAxis(const RunRecord& run, const SceneState& state) {
-  return largeScene(run) ? bodiesNow(state) : sceneAxis(run);
+  return largeScene(run) && !(run.input().ring > 0) ? bodiesNow(state) : sceneAxis(run);
 }
 
 void drawTitle(const Canvas& c) {
@@ -249,11 +248,17 @@ void drawSceneAxis(const Canvas& c) {
 
 void drawBodies(const Canvas& c, const SceneState& state) {
   if (largeScene(c.run)) {
-    const SceneAxis axis = bodiesNow(state);
+    const SceneAxis axis = bodiesAxis(c.run, state);
     drawManyBodies(c, state, axis);
     addRangeLabels(c, ns::kLabels, kSceneNowMin, kSceneNowMax, axis);
-    c.add(c.text(ns::kLabels, kSceneRangeNote, kSceneRight + kSceneRangeNoteDx, kSceneY + kSceneRangeNoteDy,
-                 "x range: the bodies now", kSmallTextSize, color(kLabelGrey)));
+    // What the axis spans, in the right end label's row, left of it.
+    const double ring = c.run.input().ring;
+    const std::string note =
+        ring > 0 ? "a ring of " + positionText(ring, false) + " m: its ends meet" : "x range: the bodies now";
+    const PlacedText right = endLabels(c.run, axis)[1];
+    const double note_x = right.x - textWidth(right.text, kSmallTextSize) / 2 - kSceneRangeNoteGap -
+                          textWidth(note, kSmallTextSize) / 2;
+    c.add(c.text(ns::kLabels, kSceneRangeNote, note_x, right.y, note, kSmallTextSize, color(kLabelGrey)));
   } else {
     drawLabelledBodies(c, state, sceneAxis(c.run));
   }

@@ -211,9 +211,10 @@ void drawConservedSteps(const Canvas& c) {
   if (!c.run.plottedBodies().empty()) energy += ", colours per body";
   std::string p = "p [kg m/s] of the finite masses vs collision index";
   if (c.run.summary && c.run.summary->simulated) {
-    energy += format(";  drift %.2g", c.run.summary->energy_relative_drift);
+    // Signed always: rviz draws '-' thin, beside a '+' it still reads as a sign.
+    energy += ";  drift " + withSign("%.2g", c.run.summary->energy_relative_drift);
     const double drift = c.run.summary->momentum_relative_drift;
-    p += std::isnan(drift) ? "; a wall takes some" : format(";  drift %.2g", drift);
+    p += std::isnan(drift) ? "; a wall takes some" : ";  drift " + withSign("%.2g", drift);
   }
   addEnergyPlot(c, energy);
   addConservedPlot(c, c.run.momentum(), kMomentumBox, kConservedMomentum, p);

@@ -1,7 +1,7 @@
 // Large inelastic scenes (a granular gas), in the kinetic energy bars' place: the granular
 // temperature T(t) on log-log axes (static: from the kept exact states, core::
 // granularTemperature) beside Haff's law T0 / (1 + t/tau)^2 fitted to it (core::fitHaff:
-// T0 and tau, least squares on ln T), labelled with tau; and T now, as a dot on the curve
+// T0 and tau, least squares on ln T), labelled with tau, both to the run's end; and T now, as a dot on the curve
 // and a line of text with the kinetic energy now (animated). What the core computes; this
 // file only draws it.
 #include <algorithm>
@@ -31,6 +31,19 @@ std::vector<collision_lab::core::TemperatureSample> temperatureSamples(const Run
     thin.add({f.index, f.time, collision_lab::core::granularTemperature(masses, f.velocities)});
   }
   return thin.samples();
+}
+
+/// The samples, and T held from the last one to the run's end (endTime): no collision
+/// changes it in the free flight after the last one. What the curve draws and its axes hold.
+std::vector<collision_lab::core::TemperatureSample> toRunEnd(const RunRecord& run,
+                                                             std::vector<collision_lab::core::TemperatureSample> samples) {
+  const double end = endTime(run);
+  if (!samples.empty() && end > samples.back().time) {
+    collision_lab::core::TemperatureSample held = samples.back();
+    held.time = end;
+    samples.push_back(held);
+  }
+  return samples;
 }
 
 /// log10 t across, log10 T up: the samples at t > 0 with T > 0 (a decade at least each way).
@@ -77,7 +90,8 @@ void drawTemperature(const Canvas& c) {
   c.add(c.text(ns::kTemperature, kTemperatureTitle, kBarsBox.midX(), kBarsBox.top + kBarsTitleDy,
                "granular temperature T(t) [J], log-log", kTextSize));
   const auto samples = temperatureSamples(c.run);
-  const LogAxes log = logAxes(samples);
+  const auto drawn = toRunEnd(c.run, samples);
+  const LogAxes log = logAxes(drawn);
   if (!log.ok) {
     c.add(c.text(ns::kTemperature, kTemperatureLegend, b.midX(), b.midY(), "no collision yet", kSmallTextSize,
                  color(kLabelGrey)));
@@ -104,20 +118,23 @@ void drawTemperature(const Canvas& c) {
   c.add(c.text(ns::kTemperature, kTemperatureMin, b.left + kValueLabelDx, b.bottom, decade(a.y0), kSmallTextSize));
   c.add(c.text(ns::kTemperature, kTemperatureMax, b.left + kValueLabelDx, b.top, decade(a.y1), kSmallTextSize));
 
-  Marker series = c.lines(ns::kTemperature, kTemperatureSeries, Marker::LINE_STRIP, kSeriesWidth, color(kWhite));
-  for (const auto& s : samples) {
-    if (s.time > 0 && s.temperature > 0) series.points.push_back(point(log.toX(s.time), log.toY(s.temperature)));
+  // T over the fit (and thicker): where the two agree, the white line is the one seen.
+  Marker series = c.lines(ns::kTemperature, kTemperatureSeries, Marker::LINE_STRIP, kTemperatureWidth, color(kWhite));
+  for (const auto& s : drawn) {
+    if (s.time > 0 && s.temperature > 0) series.points.push_back(point(log.toX(s.time), log.toY(s.temperature), kDotZ));
   }
   c.addLines(series);
 
   const collision_lab::core::HaffFit fit = collision_lab::core::fitHaff(samples);
   std::string legend = "white: T = sum m (v - V)^2 / N\ncyan: Haff's law T0/(1 + t/tau)^2 fitted on ln T:\n";
   if (fit.ok && std::isfinite(fit.tau)) {
-    Marker haff = c.lines(ns::kTemperature, kTemperatureHaff, Marker::LINE_STRIP, kSeriesWidth, color(kHaffCyan));
+    // From the axis' start to the run's end, not beyond: the law is fitted to this run.
+    Marker haff = c.lines(ns::kTemperature, kTemperatureHaff, Marker::LINE_STRIP, kCursorWidth, color(kHaffCyan));
+    const double last = std::log10(drawn.back().time);
     for (int k = 0; k <= kHaffSegments; ++k) {
-      const double t = std::pow(10.0, a.x0 + (a.x1 - a.x0) * k / kHaffSegments);
+      const double t = std::pow(10.0, a.x0 + (last - a.x0) * k / kHaffSegments);
       const double value = fit.t0 / ((1 + t / fit.tau) * (1 + t / fit.tau));
-      if (value > 0) haff.points.push_back(point(log.toX(t), log.toY(value), kDotZ));
+      if (value > 0) haff.points.push_back(point(log.toX(t), log.toY(value)));
     }
     c.addLines(haff);
     legend += format("tau = %.3g s", fit.tau) + format(", T0 = %.3g J", fit.t0);
@@ -140,7 +157,7 @@ void drawTemperatureNow(const Canvas& c, const SceneState& state) {
                format("now: T = %.3g J,  E = ", now) + format("%.3g J", energy) +
                    format(" of %.3g J", c.run.startEnergy()),
                kSmallTextSize));
-  const LogAxes log = logAxes(temperatureSamples(c.run));
+  const LogAxes log = logAxes(toRunEnd(c.run, temperatureSamples(c.run)));
   if (!(log.ok && state.time > 0 && now > 0)) {
     c.add(deleteMarker(ns::kTemperatureNow, kTemperatureNowDot, c.frame_id));
     return;

@@ -40,9 +40,14 @@ void addWorldUnits(const Canvas& c) {
 void addWorldRange(const Canvas& c, const std::string& ns, int end_id, int min_id, int max_id, const WorldAxes& axes) {
   const Box& b = kWorldBox;
   c.add(c.text(ns, end_id, b.left + kWorldEndDx, b.top, format("%.3g", axes.end), kSmallTextSize));
-  const auto value = [&axes](double x) { return axes.scene.min < 0 ? withSign("%.3g", x) : format("%.3g", x); };
-  c.add(c.text(ns, min_id, b.left, b.bottom + kWorldPositionDy, value(axes.scene.min), kSmallTextSize));
-  c.add(c.text(ns, max_id, b.right, b.bottom + kWorldPositionDy, value(axes.scene.max), kSmallTextSize));
+  // The scene's number style; the ends' texts within the box's width (the right one would
+  // otherwise run off the screen).
+  const std::string min = positionText(axes.scene.min, axes.scene.min < 0);
+  const std::string max = positionText(axes.scene.max, axes.scene.min < 0);
+  c.add(c.text(ns, min_id, b.left + textWidth(min, kSmallTextSize) / 2, b.bottom + kWorldPositionDy, min,
+               kSmallTextSize));
+  c.add(c.text(ns, max_id, b.right - textWidth(max, kSmallTextSize) / 2, b.bottom + kWorldPositionDy, max,
+               kSmallTextSize));
 }
 
 /// Large scenes: the tracked worldlines from 0 to now, and the axes that hold them (time up
@@ -63,7 +68,8 @@ WorldAxes axesUpToNow(const RunRecord& run, const SceneState& state, std::vector
     if (std::isfinite(x)) lo = std::min(lo, x), hi = std::max(hi, x);
   }
   const auto [min, max] = paddedRange(lo, hi, lo);
-  return WorldAxes{SceneAxis{min, max}, state.time > 0 ? state.time : 1.0};
+  const double ring = run.input().ring;
+  return WorldAxes{ring > 0 ? SceneAxis{0.0, ring} : SceneAxis{min, max}, state.time > 0 ? state.time : 1.0};
 }
 
 /// At most the first, lowest, highest and last vertex of each of `rows` equal rows of time
@@ -213,10 +219,11 @@ void drawWorldlines(const Canvas& c) {
                large ? "x-t diagram (worldlines), up to now" : "x-t diagram (worldlines)", kTextSize));
   bool exact = true;
   for (std::size_t i : tracked) exact = exact && c.run.worldline(i).exact();
-  std::string legend = exact ? "exact" : "min/max of x per time column";
+  // Short enough to stay on screen in one line (the inexact legend ran off its right edge).
+  std::string legend = exact ? "exact" : "min/max of x per row";
   if (tracked.size() < c.run.bodies()) {
-    legend += ";  " + withSeparators(tracked.size()) + " of " + withSeparators(c.run.bodies()) +
-              " bodies, coloured by v at the start";
+    legend += "; " + withSeparators(tracked.size()) + " of " + withSeparators(c.run.bodies()) +
+              " bodies, colour: v at the start";
   }
   // One line: a second would run into the "t [s]" label over the box.
   if (ghostScene(c.run)) legend += ";  grey dashes: ghosts x_i + v_i t, passing through";

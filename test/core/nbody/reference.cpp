@@ -141,6 +141,58 @@ Run simulate(const Scene& scene, std::uint64_t max_impacts) {
   return run;
 }
 
+RingRun simulateRing(const Scene& scene, std::uint64_t max_impacts) {
+  const std::size_t n = scene.masses.size();
+  if (!(scene.ring > 0) || n < 2) throw std::invalid_argument("simulateRing: not a ring");
+  std::vector<Rational> m, x, v, e;
+  for (std::size_t k = 0; k < n; ++k) {
+    m.emplace_back(scene.masses[k]);
+    x.emplace_back(scene.positions[k]);
+    v.emplace_back(scene.velocities[k]);
+    const double ek = scene.restitution.empty() ? 1.0
+                                                : (scene.restitution.size() == 1 ? scene.restitution[0] : scene.restitution[k]);
+    if (!(ek > 0)) throw std::invalid_argument("simulateRing: e = 0 on a ring");
+    e.emplace_back(ek);
+  }
+  const Rational length(scene.ring);
+  const auto left = [n](std::size_t p) { return p + 1 == n ? std::size_t{0} : p + 1; };
+  RingRun run;
+  Rational now = 0;
+  while (run.events.size() < max_impacts) {
+    std::optional<Rational> soonest;
+    std::size_t hit = 0, ties = 0;
+    for (std::size_t p = 0; p < n; ++p) {
+      const std::size_t l = left(p);
+      if (!(v[l] > v[p])) continue;
+      const Rational gap = x[p] - x[l] + (l == 0 ? length : Rational(0));
+      const Rational delay = gap / (v[l] - v[p]);
+      if (!soonest || delay < *soonest) {
+        soonest = delay;
+        hit = p;
+        ties = 0;
+      } else if (delay == *soonest) {
+        ++ties;
+      }
+    }
+    if (!soonest) break;
+    if (ties > 0) {
+      run.multiple = true;
+      break;
+    }
+    for (std::size_t k = 0; k < n; ++k) x[k] += v[k] * *soonest;
+    now += *soonest;
+    const std::size_t l = left(hit);
+    const Rational total = m[hit] + m[l];
+    const Rational centre = (m[hit] * v[hit] + m[l] * v[l]) / total;
+    const Rational relative = v[hit] - v[l];
+    v[hit] = centre - e[hit] * m[l] * relative / total;
+    v[l] = centre + e[hit] * m[hit] * relative / total;
+    run.events.push_back({hit, now, v[hit], v[l]});
+  }
+  run.velocities = v;
+  return run;
+}
+
 double limitOfImpactTimes(const Run& run, std::size_t period) {
   const auto& ev = run.events;
   const std::size_t n = ev.size();

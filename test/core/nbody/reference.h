@@ -57,6 +57,25 @@ struct Run {
 /// collision: the run ends before it. Precondition: validate(scene) passed.
 Run simulate(const Scene& scene, std::uint64_t max_impacts);
 
+/// An impact of a ring, with the velocities the pair's two bodies leave with.
+struct RingEvent {
+  std::size_t pair = 0;  ///< contact pair: body pair and body (pair + 1) mod N
+  Rational time;         ///< [s]
+  Rational after_right, after_left;  ///< of body pair and of its left body [m/s]
+};
+
+/// A ring (scene.ring = L > 0, every e > 0, no walls) walked event by event in rationals:
+/// contact pair N-1 joins body N-1 and body 0 seen at x_0 - L. Written without the cluster
+/// rule (a ring has no e = 0) and with positions never wrapped, so the seam is just the
+/// offset L in one gap. Stops at the cap, when no pair approaches, or before a tie of two
+/// pairs (which `multiple` then says).
+struct RingRun {
+  std::vector<RingEvent> events;
+  bool multiple = false;
+  std::vector<Rational> velocities;  ///< at the end [m/s]
+};
+RingRun simulateRing(const Scene& scene, std::uint64_t max_impacts);
+
 /// The collapse time [s] of a run that its cap ended inside an inelastic collapse: Aitken's
 /// limit, in rationals, of every `period`-th exact impact time (the same step of a repeating
 /// pattern: every second for three bodies), which converge geometrically (docs/physics.md,

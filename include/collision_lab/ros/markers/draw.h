@@ -43,6 +43,10 @@ std::string format(const char* fmt, double value);
 std::string withSign(const char* fmt, double value);
 /// 31415 -> "31,415".
 std::string withSeparators(std::uint64_t n);
+/// A position [m] on an axis, one style for every view: four significant digits, no exponent
+/// from 1,000 on ("1,060", "-61.06", "0.6058"); a '+' before a positive value when signed_
+/// (beside negative ones).
+std::string positionText(double x, bool signed_);
 /// The longest line of s and the number of its lines [characters, lines].
 std::pair<std::size_t, std::size_t> textExtent(const std::string& s);
 /// Estimated size of s on screen at text height `size` [rviz units] (rviz's font, see
@@ -98,7 +102,7 @@ struct Axes {
 /// [lo, hi] widened to include `always` and padded; [-1, 1] around it when empty.
 std::pair<double, double> paddedRange(double lo, double hi, double always = 0.0);
 /// The frame, a zero line when 0 is inside, values at the bottom, top and zero, and a
-/// label over the panel (ids base + kFrame*).
+/// bold label over the panel (ids base + kFrame*).
 void addFrame(const Canvas& c, const std::string& ns, int base, const Axes& axes, const std::string& label);
 /// A series' steps as a LINE_STRIP, plus a dot at its start (id + kSeriesStartDot) when
 /// the known part is too short to see on the axis.

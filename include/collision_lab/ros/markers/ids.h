@@ -54,6 +54,7 @@ enum MarkerId : int {
   kFrameBottomValue = 2,
   kFrameZeroLabel = 3,
   kFrameLabel = 4,
+  kFrameLabelBold = 5,  ///< the label again, a pixel lower (bold)
   /// A series' start dot (when its known part is too short to see): the series' id + this.
   kSeriesStartDot = 1000,
 
@@ -190,6 +191,7 @@ enum MarkerId : int {
   // ns "rejected" and "hint": a framed text
   kFramedText = 0,
   kFramedBox = 1,
+  kFramedTextBold = 2,  ///< the hint: its text again, a pixel lower (bold)
 };
 
 }  // namespace collision_lab_ros::markers

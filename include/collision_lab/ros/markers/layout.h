@@ -40,8 +40,10 @@ constexpr double kHintY = 1.5;
 
 // ---- text heights, depths ----
 constexpr double kTextSize = 0.32, kSmallTextSize = 0.29, kTitleSize = 0.38;
-/// Large: an underscore one pixel thin would vanish, and the hint is a command to copy.
+/// Large, and bold (drawn twice, kBoldDy apart): rviz draws an underscore a pixel thin and
+/// faint, and the hint is a command to copy.
 constexpr double kHintTextSize = 0.44;
+constexpr double kBoldDy = 0.022;  ///< about one pixel at the config's 46 px per unit
 constexpr double kTextZ = 0.2;  ///< texts over everything
 constexpr double kDotZ = 0.05;  ///< dots over lines
 
@@ -79,7 +81,9 @@ constexpr double kCursorWidth = 0.02;
 // ---- plots (frames, steps, index axis) ----
 constexpr double kValueLabelDx = -0.55;  ///< a frame's top and bottom values, left of it
 constexpr double kZeroLabelDx = -0.3;
-constexpr double kFrameLabelDy = 0.22;  ///< a frame's label, over it
+/// A frame's label over it, and its top value a little under the top: a label as wide as
+/// the frame keeps clear of that value.
+constexpr double kFrameLabelDy = 0.3, kTopValueDy = -0.08;
 constexpr double kLabelClearance = 0.3;  ///< an end value closer than this to zero gives way
 constexpr double kRangePadding = 0.06;  ///< of the data's range, at each end
 constexpr double kStartDotSize = 0.16;
@@ -100,7 +104,8 @@ constexpr double kPaperScaleFactor = 4.0;
 constexpr std::size_t kMaxPredictedDots = 200;
 
 // ---- the scene and its magnifier ----
-constexpr double kSceneLabelDx = 0.9, kSceneLabelDy = -0.5;
+/// The axis' end labels, under it and under a cluster's ring around a body on it.
+constexpr double kSceneLabelDx = 0.9, kSceneLabelDy = -0.82;
 constexpr double kWallLabelDy = 0.25;  ///< an end label under a wall, from the wall's foot
 constexpr double kSmallestBody = 0.35, kBodyGrowth = 0.55;  ///< diameter over the mass decades
 constexpr double kWallWidth = 0.2, kWallHeight = 1.8, kWallDepth = 0.3;
@@ -170,8 +175,8 @@ constexpr double kWorldPeriodsDy = -0.35;  ///< the periods so far, under the le
 constexpr double kStepsPeriodsDx = -1.2;  ///< from the velocity box's right edge
 /// A periodic motion is drawn over one period once the run lasts this many periods.
 constexpr double kPeriodsToFold = 2.0;
-/// Large scenes: "x range: the bodies now" under the scene's right end label.
-constexpr double kSceneRangeNoteDx = -2.0, kSceneRangeNoteDy = -0.85;
+/// Large scenes: "x range: the bodies now" left of the scene's right end label, this far.
+constexpr double kSceneRangeNoteGap = 1.0;
 /// Large scenes: a worldline drawn up to now keeps first, lowest, highest, last x per row.
 constexpr int kWorldRows = 240;
 constexpr double kWorldNowDotSize = 0.16;
@@ -192,6 +197,7 @@ constexpr double kTemperatureNowY = -6.45;    ///< T and E now, under the time a
 constexpr double kTickLength = 0.1;
 constexpr int kHaffSegments = 64;
 constexpr Rgba kHaffCyan{0.3, 0.85, 1.0};
+constexpr double kTemperatureWidth = 0.05;  ///< T(t), over the thinner fit
 
 // ---- clusters: bodies moving together ----
 constexpr Rgba kClusterAmber{1.0, 0.75, 0.2, 0.9};

@@ -1,0 +1,100 @@
+// One description of a run's views, computed once from a RunRecord for rviz and for the
+// class page (the web node's run JSON, part "view"): what was simulated, what the model
+// answered, what was not simulated and why, the scene's kind, the counter, and which bodies
+// each plot shows, with their names (core::bodyName) and colours (rviz's palette). rviz's
+// title, note and status line and the page's texts are these texts: neither decides alone.
+// Uses only what a RunRecord has without keyframes (the web node keeps none): its input,
+// prediction, summary, counts and envelopes.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "collision_lab/ros/marker_builder.h"
+
+namespace collision_lab_ros {
+
+/// A body a plot shows: its index in masses[], its name and its colour.
+struct ViewBody {
+  std::size_t index = 0;
+  std::string name;    ///< "A", "B", ... (core::bodyName)
+  std::string colour;  ///< "#rrggbb", rviz's palette (layout::kParticleRgb)
+};
+
+struct RunView {
+  /// "ring", "box", "gas" (many bodies, inelastic, no walls), "three_body" or "line".
+  std::string kind;
+  /// Many bodies, inelastic (in a box, on a ring or free): the T(t) view below is filled.
+  bool gas = false;
+  std::string title;  ///< rviz's title line
+  std::string note;   ///< rviz's note: how the run ended or why it is not drawn whole ("" when none)
+
+  /// True when collisions were simulated one by one and published (mode full, simulated).
+  bool simulated = false;
+  /// Simulated collisions [1]; empty when the run was not simulated.
+  std::optional<std::uint64_t> simulated_collisions;
+  /// Collisions the model predicted [1]; empty when it has no finite count.
+  std::optional<std::uint64_t> predicted_collisions;
+  bool infinitely_many_predicted = false;
+  /// "" or "not simulated: <why>".
+  std::string not_simulated;
+  /// "" or one sentence: "stopped at the cap of 10 collisions."
+  std::string truncated;
+
+  /// A collapse: named with its time, point and bodies ("" when none).
+  std::string collapse;
+  double collapse_time = 0.0;      ///< [s]
+  double collapse_position = 0.0;  ///< [m]
+
+  /// "ring of 1,000 m" ("" when not a ring), its circumference [m] (0 when none).
+  std::string ring;
+  double ring_circumference = 0.0;
+  /// "box: walls at both ends" ("" when not a box).
+  std::string box;
+
+  /// The counter: collisions so far and expected, with the state word.
+  std::uint64_t collisions_so_far = 0;        ///< [1]
+  std::optional<std::uint64_t> expected;      ///< [1]; empty when unknown or infinite
+  std::string state;                           ///< "running", "finished", "not simulated", "truncated"
+  std::string counter;                         ///< e.g. "31 collisions, finished"
+
+  /// Bodies with a worldline on the x-t diagram and with their own velocity steps, and why.
+  std::vector<ViewBody> worldline_bodies, velocity_bodies;
+  std::string worldline_legend, velocity_legend;
+
+  /// A gas: its granular temperature T(t) (t [s], T [J]) and Haff's law T0 / (1 + t/tau)^2
+  /// fitted to it (core::fitHaff; haff_ok false when it cannot be fitted), with its legend.
+  std::vector<std::pair<double, double>> temperature;
+  bool haff_ok = false;
+  double haff_t0 = 0.0;   ///< [J]
+  double haff_tau = 0.0;  ///< [s]
+  std::string temperature_legend;
+
+  /// The x-t diagram's end time [s]: the run's end (endTime), every worldline reaches it.
+  double end_time = 0.0;
+};
+
+/// "1 collision", "31,415 collisions".
+std::string collisionsText(std::uint64_t n);
+/// "#rrggbb" of rviz's colour of body i.
+std::string bodyColourHex(std::size_t i);
+
+RunView makeRunView(const RunRecord& run);
+
+/// One worldline to draw: body `body`'s (t [s], x [m]) polylines, each continuous. They run
+/// from 0 to end_time (after its last impact a body flies freely to the run's end); on a
+/// ring they lie in [0, L) and are cut at the seam, so no segment spans it.
+struct WorldlineSegments {
+  std::size_t body = 0;
+  std::vector<std::vector<std::pair<double, double>>> segments;
+};
+/// The x-t diagram's lines for the tracked bodies (RunRecord::trackedBodies).
+std::vector<WorldlineSegments> worldlineSegments(const RunRecord& run, double end_time);
+/// The view as the run JSON's "view" object (the same fields, the same texts).
+nlohmann::json viewJson(const RunView& view);
+
+}  // namespace collision_lab_ros

@@ -1,0 +1,350 @@
+#include "collision_lab/ros/run_view.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "collision_lab/core/nbody/scene.h"
+#include "collision_lab/core/nbody/temperature.h"
+#include "collision_lab/ros/markers/draw.h"
+#include "collision_lab/ros/markers/layout.h"
+
+namespace collision_lab_ros {
+
+using collision_lab::InitialConditions;
+using collision_lab::Prediction;
+using markers::format;
+using markers::withSeparators;
+
+namespace {
+
+bool notSimulated(const RunRecord& run) {
+  return run.input().mode == InitialConditions::MODE_PREDICT_ONLY || (run.summary && !run.summary->simulated);
+}
+
+/// Many bodies, inelastic: a granular gas (in a box, on a ring or free), with a T(t) view.
+bool isGas(const RunRecord& run) {
+  const auto& e = run.input().restitution;
+  const bool inelastic = std::any_of(e.begin(), e.end(), [](double r) { return r < 1.0; });
+  return run.bodies() > kMaxPlottedBodies && inelastic;
+}
+
+std::string kindOf(const RunRecord& run) {
+  if (run.input().ring > 0) return "ring";
+  const std::size_t n = run.bodies();
+  if (n >= 3 && run.isWall(0) && run.isWall(n - 1) && n > 3) return "box";
+  if (isGas(run)) return "gas";
+  return n == 3 ? "three_body" : "line";
+}
+
+/// "A..C" for bodies first .. last.
+std::string bodyRange(std::size_t first, std::size_t last) {
+  if (first == last) return "body " + collision_lab::core::bodyName(first);
+  return "bodies " + collision_lab::core::bodyName(first) + ".." + collision_lab::core::bodyName(last);
+}
+
+std::string titleOf(const RunRecord& run) {
+  std::string title = "run " + run.input().run_id;
+  if (run.bodies() != 3) title += ",  " + withSeparators(run.bodies()) + " bodies";
+  if (run.prediction) {
+    const auto& p = *run.prediction;
+    if (p.model != Prediction::MODEL_THREE_BODY_ROTATION) title += " (" + p.model_name + ")";
+    if (p.collapsed) {
+      title += ":  predicted collapse at t = " + format("%.6g s", p.collapse_time);
+    } else if (p.infinite_collisions) {
+      title += ":  predicted: infinitely many collisions";
+    } else if (p.collision_count_defined) {
+      title += ":  predicted " + collisionsText(p.collision_count);
+    }
+    if (p.model == Prediction::MODEL_THREE_BODY_ROTATION) {
+      title += p.paper_collision_count_defined
+                   ? "  (paper's eq. 3.22: " + std::to_string(p.paper_collision_count) + ")"
+                   : "  (paper's eq. 3.22: undefined)";
+    }
+  }
+  if (run.summary) {
+    title += run.summary->simulated ? ",  simulated " + withSeparators(run.summary->collision_count)
+                                    : ",  not simulated";
+    if (run.summary->truncated) title += " (truncated)";
+    if (run.summary->collapse_count > 0) {
+      title += " + " + withSeparators(run.summary->collapse_count) +
+               (run.summary->collapse_count == 1 ? " collapse" : " collapses");
+    }
+  }
+  return title;
+}
+
+/// One sentence for a run cut short: "stopped at the cap ...", never twice "truncated".
+std::string truncationSentence(const std::string& reason) {
+  std::string s = reason;
+  const std::string marker = " (truncated)";  // the summary's own word: the view says it once
+  for (auto at = s.find(marker); at != std::string::npos; at = s.find(marker)) s.erase(at, marker.size());
+  while (!s.empty() && (s.back() == '.' || s.back() == ' ')) s.pop_back();
+  if (s.rfind("stopped", 0) != 0) s = "stopped: " + s;
+  return s + ".";
+}
+
+std::string noteOf(const RunRecord& run, const RunView& view) {
+  std::string note;
+  if (run.missedCollisions() > 0) {
+    note += withSeparators(run.missedCollisions()) + " collision messages missing; ";
+  }
+  if (!view.truncated.empty()) {
+    note += view.truncated + " Shown up to the last known state.";
+  } else if (run.input().mode == InitialConditions::MODE_PREDICT_ONLY) {
+    note += "predict-only run: shown up to the first contact; the plots show the closed form's final velocities.";
+  } else if (run.summary && !run.summary->simulated) {
+    note += "answered by the model (more collisions predicted than the cap): shown up to the first contact; the "
+            "plots show the closed form's final velocities.";
+  } else if (run.input().mode == InitialConditions::MODE_SUMMARY_ONLY) {
+    note += "summary-only run: shown up to the first contact; the plots show the final velocities.";
+  } else if (!run.finished()) {
+    note += "run in progress: shown up to the last collision received.";
+  }
+  return note;
+}
+
+std::vector<ViewBody> viewBodies(const std::vector<std::size_t>& indices) {
+  std::vector<ViewBody> out;
+  for (std::size_t i : indices) out.push_back({i, collision_lab::core::bodyName(i), bodyColourHex(i)});
+  return out;
+}
+
+/// "all 3 bodies" or "24 of 1,002 bodies, evenly spaced, the outermost two included".
+std::string legendOf(std::size_t shown, std::size_t all) {
+  if (shown == 0) return "no single bodies: the plot shows sums over all " + withSeparators(all) + " bodies";
+  if (shown >= all) return all == 1 ? "the only body" : "all " + withSeparators(all) + " bodies";
+  return withSeparators(shown) + " of " + withSeparators(all) + " bodies, evenly spaced, the outermost two included";
+}
+
+}  // namespace
+
+std::string collisionsText(std::uint64_t n) {
+  return withSeparators(n) + (n == 1 ? " collision" : " collisions");
+}
+
+std::string bodyColourHex(std::size_t i) {
+  const auto& c = markers::layout::kParticleRgb[i % markers::layout::kPaletteSize];
+  auto byte = [](double v) { return static_cast<unsigned>(std::lround(std::clamp(v, 0.0, 1.0) * 255)); };
+  char buffer[8];
+  std::snprintf(buffer, sizeof buffer, "#%02x%02x%02x", byte(c.r), byte(c.g), byte(c.b));
+  return buffer;
+}
+
+RunView makeRunView(const RunRecord& run) {
+  RunView view;
+  const auto& in = run.input();
+  view.kind = kindOf(run);
+  view.simulated = in.mode == InitialConditions::MODE_FULL && !notSimulated(run);
+
+  if (run.summary && run.summary->simulated) view.simulated_collisions = run.summary->collision_count;
+  else if (!notSimulated(run)) view.simulated_collisions = run.collisions();
+  if (run.prediction && run.prediction->collision_count_defined && !run.prediction->infinite_collisions) {
+    view.predicted_collisions = run.prediction->collision_count;
+  } else if (run.summary && run.summary->predicted_collision_count_defined && !run.summary->infinite_collisions) {
+    view.predicted_collisions = run.summary->predicted_collision_count;
+  }
+  view.infinitely_many_predicted = (run.prediction && run.prediction->infinite_collisions) ||
+                                   (run.summary && run.summary->infinite_collisions);
+
+  if (notSimulated(run)) {
+    std::string why;
+    if (in.mode == InitialConditions::MODE_PREDICT_ONLY) {
+      why = "predict-only run, the model answered";
+    } else if (run.summary && !run.summary->truncation_reason.empty()) {
+      why = run.summary->truncation_reason;
+    } else {
+      why = "more collisions predicted than the cap of " + withSeparators(in.max_collisions) +
+            ", the model answered";
+    }
+    while (!why.empty() && why.back() == '.') why.pop_back();
+    view.not_simulated = "not simulated: " + why;
+  } else if (run.summary && run.summary->truncated) {
+    view.truncated = truncationSentence(run.summary->truncation_reason);
+  }
+
+  // A collapse: the first collapse event received, else the summary's or the model's.
+  const bool collapsed_event = run.collapses() > 0;
+  const bool collapsed = collapsed_event || (run.summary && run.summary->collapsed) ||
+                         (run.prediction && run.prediction->collapsed);
+  if (collapsed) {
+    std::pair<std::size_t, std::size_t> bodies{0, run.bodies() ? run.bodies() - 1 : 0};
+    if (collapsed_event) {
+      view.collapse_time = run.firstCollapseTime();
+      view.collapse_position = run.firstCollapsePosition();
+      bodies = run.firstCollapseBodies();
+    } else if (run.summary && run.summary->collapsed) {
+      view.collapse_time = run.summary->collapse_time;
+      view.collapse_position = run.summary->collapse_position;
+    } else {
+      view.collapse_time = run.prediction->collapse_time;
+      view.collapse_position = run.prediction->collapse_position;
+    }
+    view.collapse = "collapse at t = " + format("%.6g s", view.collapse_time) + ", x = " +
+                    format("%.6g m", view.collapse_position) + ", " + bodyRange(bodies.first, bodies.second);
+  }
+
+  if (in.ring > 0) {
+    view.ring_circumference = in.ring;
+    view.ring = "ring of " + (in.ring == std::floor(in.ring) && in.ring < 1e15
+                                  ? withSeparators(static_cast<std::uint64_t>(in.ring))
+                                  : format("%.6g", in.ring)) +
+                " m";
+  }
+  if (view.kind == "box") view.box = "box: walls at both ends";
+
+  view.collisions_so_far = run.collisions();
+  if (run.summary && run.summary->simulated && !run.summary->truncated) {
+    view.expected = run.summary->collision_count;
+  } else if (view.predicted_collisions) {
+    view.expected = std::max<std::uint64_t>(*view.predicted_collisions, run.collisions());
+  }
+  if (!view.not_simulated.empty()) view.state = "not simulated";
+  else if (!view.truncated.empty()) view.state = "truncated";
+  else if (run.summary) view.state = "finished";
+  else view.state = "running";
+  if (!view.not_simulated.empty()) {
+    view.counter = view.not_simulated;
+    if (view.predicted_collisions) view.counter += "; predicted " + collisionsText(*view.predicted_collisions);
+    else if (view.infinitely_many_predicted) view.counter += "; predicted infinitely many collisions";
+  } else {
+    const std::uint64_t shown = view.simulated_collisions.value_or(run.collisions());
+    view.counter = collisionsText(shown);
+    if (view.state == "running") {
+      view.counter = withSeparators(run.collisions()) + " collisions so far";
+      if (view.expected && *view.expected > run.collisions()) {
+        view.counter = withSeparators(run.collisions()) + " of " + collisionsText(*view.expected) + " predicted";
+      } else if (view.infinitely_many_predicted) {
+        view.counter += " (infinitely many predicted)";
+      }
+    }
+    if (!view.collapse.empty() && view.state != "running") view.counter += " + 1 collapse";
+    view.counter += ", " + view.state;
+  }
+
+  view.worldline_bodies = viewBodies(run.trackedBodies());
+  const bool per_body = !run.plottedBodies().empty();
+  view.velocity_bodies = viewBodies(per_body ? run.plottedBodies() : run.trackedBodies());
+  view.worldline_legend = legendOf(run.trackedBodies().size(), run.bodies());
+  view.velocity_legend = legendOf(view.velocity_bodies.size(), run.bodies());
+
+  view.gas = isGas(run);
+  if (view.gas) {
+    std::vector<collision_lab::core::TemperatureSample> samples;
+    for (const auto& v : run.temperature().polyline()) {
+      view.temperature.emplace_back(v.x, v.y);
+      samples.push_back({0, v.x, v.y});
+    }
+    const auto fit = collision_lab::core::fitHaff(samples);
+    view.haff_ok = fit.ok && std::isfinite(fit.tau);
+    view.haff_t0 = fit.t0;
+    view.haff_tau = fit.tau;
+    view.temperature_legend = "T = sum m (v - V)^2 / N" +
+        (view.haff_ok ? "; Haff's law T0/(1 + t/tau)^2 fitted: T0 = " + format("%.4g J", fit.t0) +
+                            ", tau = " + format("%.4g s", fit.tau)
+                      : std::string("; Haff's law: no fit (no cooling seen)"));
+  }
+
+  view.end_time = endTime(run);
+  view.title = titleOf(run);
+  view.note = noteOf(run, view);
+  return view;
+}
+
+std::vector<WorldlineSegments> worldlineSegments(const RunRecord& run, double end_time) {
+  const double ring = run.input().ring;
+  auto wrap = [ring](double x) {
+    if (!(ring > 0)) return x;
+    const double w = std::fmod(x, ring);
+    return w < 0 ? w + ring : w;
+  };
+  const auto& frames = run.keyframes();
+  std::vector<WorldlineSegments> out;
+  for (std::size_t i : run.trackedBodies()) {
+    WorldlineSegments line{i, {{}}};
+    auto add = [&](double t, double x) {
+      auto& segment = line.segments.back();
+      if (!segment.empty() && ring > 0) {
+        const auto [t0, x0] = segment.back();
+        if (std::abs(x - x0) > ring / 2) {  // crossed the seam: cut there
+          const bool rightwards = x < x0;
+          const double dx = rightwards ? x + ring - x0 : x - ring - x0;
+          const double at = t0 + (rightwards ? ring - x0 : -x0) / dx * (t - t0);
+          segment.emplace_back(at, rightwards ? ring : 0.0);
+          line.segments.push_back({{at, rightwards ? 0.0 : ring}});
+        }
+      }
+      line.segments.back().emplace_back(t, x);
+    };
+    for (const auto& v : run.worldline(i).polyline()) add(v.x, wrap(v.y));
+    // Free flight from the newest state to the run's end (every seam crossing on the way).
+    if (!frames.empty() && i < frames.back().positions.size() && std::isfinite(end_time)) {
+      const Keyframe& newest = frames.back();
+      double t = newest.time, x = newest.positions[i];
+      const double v = newest.velocities[i];
+      if (line.segments.back().empty() || line.segments.back().back().first < t) add(t, wrap(x));
+      if (ring > 0 && v != 0 && std::isfinite(v)) {
+        x = wrap(x);
+        while (t < end_time) {
+          const double to_seam = (v > 0 ? ring - x : -x) / v;
+          if (t + to_seam >= end_time) break;
+          t += to_seam;
+          line.segments.back().emplace_back(t, v > 0 ? ring : 0.0);
+          x = v > 0 ? 0.0 : ring;
+          line.segments.push_back({{t, x}});
+          if (line.segments.size() > 10000) break;  // a bound on the lines of one body
+        }
+        line.segments.back().emplace_back(end_time, wrap(x + v * (end_time - t)));
+      } else if (end_time > t && std::isfinite(v)) {
+        line.segments.back().emplace_back(end_time, x + v * (end_time - t));
+      }
+    }
+    out.push_back(std::move(line));
+  }
+  return out;
+}
+
+nlohmann::json viewJson(const RunView& view) {
+  auto bodies = [](const std::vector<ViewBody>& list) {
+    nlohmann::json out = nlohmann::json::array();
+    for (const auto& b : list) out.push_back({{"index", b.index}, {"name", b.name}, {"colour", b.colour}});
+    return out;
+  };
+  auto optional = [](const std::optional<std::uint64_t>& n) { return n ? nlohmann::json(*n) : nlohmann::json(nullptr); };
+  return {{"kind", view.kind},
+          {"title", view.title},
+          {"note", view.note},
+          {"simulated", view.simulated},
+          {"simulated_collisions", optional(view.simulated_collisions)},
+          {"predicted_collisions", optional(view.predicted_collisions)},
+          {"infinitely_many_predicted", view.infinitely_many_predicted},
+          {"not_simulated", view.not_simulated},
+          {"truncated", view.truncated},
+          {"collapse", view.collapse},
+          {"collapse_time", view.collapse.empty() ? nlohmann::json(nullptr) : nlohmann::json(view.collapse_time)},
+          {"collapse_position",
+           view.collapse.empty() || !std::isfinite(view.collapse_position) ? nlohmann::json(nullptr)
+                                                                          : nlohmann::json(view.collapse_position)},
+          {"ring", view.ring},
+          {"ring_circumference", view.ring_circumference},
+          {"box", view.box},
+          {"collisions_so_far", view.collisions_so_far},
+          {"expected_collisions", optional(view.expected)},
+          {"state", view.state},
+          {"counter", view.counter},
+          {"worldline_bodies", bodies(view.worldline_bodies)},
+          {"worldline_legend", view.worldline_legend},
+          {"velocity_bodies", bodies(view.velocity_bodies)},
+          {"velocity_legend", view.velocity_legend},
+          {"gas", view.gas},
+          {"temperature", [&] {
+             nlohmann::json points = nlohmann::json::array();
+             for (const auto& [t, T] : view.temperature) points.push_back({t, T});
+             return points;
+           }()},
+          {"haff", view.haff_ok ? nlohmann::json{{"t0", view.haff_t0}, {"tau", view.haff_tau}} : nlohmann::json(nullptr)},
+          {"temperature_legend", view.temperature_legend},
+          {"end_time", std::isfinite(view.end_time) ? nlohmann::json(view.end_time) : nlohmann::json(nullptr)}};
+}
+
+}  // namespace collision_lab_ros

@@ -1,0 +1,190 @@
+// RunView, the view description rviz and the page share, on small RunRecords built from
+// hand-made messages (no master): each scene kind of issue 31.
+#include <cmath>
+#include <limits>
+
+#include <gtest/gtest.h>
+
+#include "collision_lab/ros/markers/draw.h"
+#include "collision_lab/ros/run_view.h"
+
+namespace {
+
+using collision_lab::CollisionEvent;
+using collision_lab::InitialConditions;
+using collision_lab_ros::makeRunView;
+using collision_lab_ros::RunRecord;
+
+const double kInf = std::numeric_limits<double>::infinity();
+
+InitialConditions input(std::vector<double> m, std::vector<double> x, std::vector<double> v) {
+  InitialConditions in;
+  in.run_id = "test";
+  in.masses = m;
+  in.positions = x;
+  in.velocities = v;
+  in.restitution.assign(m.size() > 1 ? m.size() - 1 : 0, 1.0);
+  in.max_collisions = 1000;
+  return in;
+}
+
+CollisionEvent impact(std::uint64_t index, std::uint32_t pair, double t, double x, double v_right, double v_left) {
+  CollisionEvent e;
+  e.kind = CollisionEvent::KIND_IMPACT;
+  e.index = index;
+  e.pair_index = pair;
+  e.first_moved = pair;
+  e.last_moved = pair + 1;
+  e.time = t;
+  e.position = x;
+  e.restitution = 1.0;
+  e.pair_velocities_after = {v_right, v_left};
+  return e;
+}
+
+collision_lab::RunSummary simulatedSummary(std::uint64_t count) {
+  collision_lab::RunSummary s;
+  s.run_id = "test";
+  s.simulated = true;
+  s.collision_count = count;
+  s.stop_reason = "FINISHED";
+  return s;
+}
+
+TEST(RunView, CountsAreWrittenForPeople) {
+  EXPECT_EQ(collision_lab_ros::collisionsText(1), "1 collision");
+  EXPECT_EQ(collision_lab_ros::collisionsText(31415), "31,415 collisions");
+  EXPECT_EQ(collision_lab_ros::bodyColourHex(0), "#f24040");  // rviz's red for A
+}
+
+TEST(RunView, NotSimulatedRunClaimsNoSimulatedCount) {
+  auto in = input({100, 1, kInf}, {2, 1, 0}, {-1, 0, 0});
+  in.max_collisions = 10;
+  RunRecord run(in);
+  collision_lab::Prediction p;
+  p.model = collision_lab::Prediction::MODEL_THREE_BODY_ROTATION;
+  p.collision_count = 31;
+  p.collision_count_defined = true;
+  run.prediction = p;
+  collision_lab::RunSummary s;
+  s.simulated = false;
+  s.stop_reason = "NOT_SIMULATED";
+  s.collision_count = 31;  // the model's count, not a simulated one
+  run.summary = s;
+  const auto view = makeRunView(run);
+  EXPECT_EQ(view.state, "not simulated");
+  EXPECT_EQ(view.not_simulated.rfind("not simulated: ", 0), 0u) << view.not_simulated;
+  EXPECT_FALSE(view.simulated);
+  EXPECT_FALSE(view.simulated_collisions.has_value());
+  ASSERT_TRUE(view.predicted_collisions.has_value());
+  EXPECT_EQ(*view.predicted_collisions, 31u);
+  EXPECT_EQ(view.counter.find("finished"), std::string::npos) << view.counter;
+  EXPECT_NE(view.counter.find("predicted 31 collisions"), std::string::npos) << view.counter;
+}
+
+TEST(RunView, TruncatedRunSaysSoInOneSentence) {
+  RunRecord run(input({1, 1}, {1, 0}, {-1, 1}));
+  auto s = simulatedSummary(1000);
+  s.truncated = true;
+  s.truncation_reason = "stopped at the cap of 1000 impacts (truncated); two walls keep the bodies colliding";
+  run.summary = s;
+  const auto view = makeRunView(run);
+  EXPECT_EQ(view.state, "truncated");
+  EXPECT_EQ(view.truncated, "stopped at the cap of 1000 impacts; two walls keep the bodies colliding.");
+  EXPECT_EQ(view.note.find("(truncated"), std::string::npos) << view.note;
+  EXPECT_EQ(view.note, collision_lab_ros::markers::runNote(run));  // rviz's note is the view's
+}
+
+TEST(RunView, CollapseIsNamedWithTimePointAndBodies) {
+  auto in = input({1, 1, 1}, {2, 1, 0}, {-1, 0, 1});
+  in.restitution = {0.05, 0.05};
+  RunRecord run(in);
+  CollisionEvent collapse;
+  collapse.kind = CollisionEvent::KIND_COLLAPSE;
+  collapse.index = 0;
+  collapse.first_moved = 0;
+  collapse.last_moved = 2;
+  collapse.time = 3.5;
+  collapse.position = 1.25;
+  collapse.pair_velocities_after = {0.0, 0.0};
+  run.add(collapse);
+  auto s = simulatedSummary(0);
+  s.collapsed = true;
+  s.collapse_count = 1;
+  run.summary = s;
+  const auto view = makeRunView(run);
+  EXPECT_EQ(view.collapse, "collapse at t = 3.5 s, x = 1.25 m, bodies A..C");
+  EXPECT_NE(view.title.find("+ 1 collapse"), std::string::npos) << view.title;
+  EXPECT_EQ(view.title.find("collapse(s)"), std::string::npos) << view.title;
+}
+
+TEST(RunView, WorldlinesReachTheRunsEnd) {
+  // Two carts meet at t = 0.5 s and part: the diagram goes on past the impact.
+  RunRecord run(input({1, 1}, {1, 0}, {-1, 1}));
+  run.add(impact(1, 0, 0.5, 0.5, 1.0, -1.0));
+  run.summary = simulatedSummary(1);
+  const auto view = makeRunView(run);
+  ASSERT_GT(view.end_time, 0.5);
+  EXPECT_EQ(view.counter, "1 collision, finished");
+  const auto lines = collision_lab_ros::worldlineSegments(run, view.end_time);
+  ASSERT_EQ(lines.size(), 2u);
+  for (const auto& line : lines) {
+    ASSERT_FALSE(line.segments.back().empty());
+    EXPECT_DOUBLE_EQ(line.segments.back().back().first, view.end_time) << "body " << line.body;
+  }
+  EXPECT_NEAR(lines[0].segments.back().back().second, 0.5 + (view.end_time - 0.5), 1e-12);
+  EXPECT_EQ(view.worldline_legend, "all 2 bodies");
+  ASSERT_EQ(view.worldline_bodies.size(), 2u);
+  EXPECT_EQ(view.worldline_bodies[1].name, "B");
+  EXPECT_EQ(view.worldline_bodies[1].colour, collision_lab_ros::bodyColourHex(1));
+}
+
+TEST(RunView, RingIsNamedAndItsWorldlinesAreCutAtTheSeam) {
+  auto in = input({1, 1}, {900, 100}, {-300, 300});  // they meet across the seam at x = 0
+  in.ring = 1000;
+  RunRecord run(in);
+  run.add(impact(1, 0, 0.5 / 3, 0.0, 300.0, -300.0));
+  run.summary = simulatedSummary(1);
+  const auto view = makeRunView(run);
+  EXPECT_EQ(view.kind, "ring");
+  EXPECT_EQ(view.ring, "ring of 1,000 m");
+  const auto lines = collision_lab_ros::worldlineSegments(run, view.end_time);
+  std::size_t segments = 0;
+  for (const auto& line : lines) {
+    segments += line.segments.size();
+    EXPECT_DOUBLE_EQ(line.segments.back().back().first, view.end_time);
+    for (const auto& segment : line.segments) {
+      for (std::size_t k = 0; k < segment.size(); ++k) {
+        EXPECT_GE(segment[k].second, 0.0);
+        EXPECT_LE(segment[k].second, 1000.0);
+        if (k > 0) EXPECT_LE(std::abs(segment[k].second - segment[k - 1].second), 500.0) << "spans the seam";
+      }
+    }
+  }
+  EXPECT_GT(segments, lines.size()) << "no worldline was cut at the seam";
+}
+
+TEST(RunView, BoxOfManyBodiesNamesTheShownBodies) {
+  std::vector<double> m(1002, 1.0), x(1002), v(1002, 0.0);
+  m.front() = m.back() = kInf;
+  for (std::size_t i = 0; i < x.size(); ++i) x[i] = static_cast<double>(x.size() - 1 - i);
+  v[1] = -1.0;
+  auto in = input(m, x, v);
+  in.restitution.assign(in.restitution.size(), 0.9);  // a granular gas in a box
+  RunRecord run(in);
+  const auto view = makeRunView(run);
+  EXPECT_TRUE(view.gas);
+  ASSERT_FALSE(view.temperature.empty());
+  // T = (sum m v^2 - P^2 / M) / N over the 1,000 finite masses [J].
+  EXPECT_DOUBLE_EQ(view.temperature.front().first, 0.0);
+  EXPECT_NEAR(view.temperature.front().second, (1.0 - 1.0 / 1000) / 1000, 1e-15);
+  EXPECT_EQ(view.kind, "box");
+  EXPECT_EQ(view.box, "box: walls at both ends");
+  EXPECT_EQ(view.worldline_legend, "24 of 1,002 bodies, evenly spaced, the outermost two included");
+  ASSERT_EQ(view.worldline_bodies.size(), 24u);
+  EXPECT_EQ(view.worldline_bodies.front().name, "A");
+  EXPECT_EQ(view.worldline_bodies.back().name, "#1001");
+  EXPECT_EQ(view.state, "running");
+}
+
+}  // namespace
