@@ -222,6 +222,10 @@ SceneRunResult runScene(const ScenePlan& plan, const SceneRunOptions& options, c
     if (!options.keep_events) lab.events = EventPolicy::none();
     lab.skip_simulation_over_cap = !options.simulate_to_cap;
     lab.cancel = options.cancel;
+    if (visitors.progress) {
+      lab.progress = visitors.progress;
+      lab.progress_interval = options.progress_interval;
+    }
     result.three_body =
         runLab(toThreeBodyScene(plan.scene), lab, *plan.three_body, visitors.three_body_event);
     result.simulation = fromThreeBody(*result.three_body, plan.scene, lab.max_collisions);
