@@ -549,6 +549,41 @@ TEST(OneRun, ABatchKeepsTheEventsOfEveryScene) {
   }
 }
 
+// The batch format does not depend on what the scenes are: a file of three-body scenes
+// gives the same table columns and the same JSON entries as the same file with a four-body
+// scene added (failed before: three bodies alone got another table, with final v_A, and JSON
+// summaries without model).
+TEST(OneRun, ABatchHasOneFormatWhateverItsScenes) {
+  const std::string three =
+      "pi31:\n  masses: [100, 1, .inf]\n  positions: [2, 1, 0]\n  velocities: [-1, 0, 0]\n"
+      "equal:\n  masses: [1, 1, 1]\n  positions: [2, 1, -1]\n  velocities: [-1, 0, 1]\n";
+  const TempFile only_three(three);
+  const TempFile with_four(three + "four:\n  masses: [1, 2, 3, 4]\n  positions: [3, 2, 1, 0]\n  velocities: [-1, 0, 0, 1]\n");
+  const CliOutput table_three = run({"--scenario", only_three.path()});
+  const CliOutput table_four = run({"--scenario", with_four.path()});
+  ASSERT_EQ(table_three.exit_code, 0) << table_three.err;
+  ASSERT_EQ(table_four.exit_code, 0) << table_four.err;
+  const std::vector<std::string> rows_three = linesOf(table_three.out), rows_four = linesOf(table_four.out);
+  ASSERT_EQ(rows_three.size() + 1, rows_four.size());
+  for (std::size_t k = 0; k < rows_three.size(); ++k) {
+    EXPECT_EQ(rows_three[k], rows_four[k < 3 ? k : k + 1]) << "line " << k;  // row 3: the four-body scene
+  }
+  EXPECT_EQ(rows_four[3].rfind("four ", 0), 0u) << rows_four[3];
+  Json json_three = runJson({"--scenario", only_three.path()});
+  Json json_four = runJson({"--scenario", with_four.path()});
+  ASSERT_EQ(json_three.at("scenarios").size(), 2u);
+  ASSERT_EQ(json_four.at("scenarios").size(), 3u);
+  EXPECT_EQ(json_three.at("units"), json_four.at("units"));
+  for (std::size_t k = 0; k < 2; ++k) {
+    Json& a = json_three.at("scenarios")[k];
+    Json& b = json_four.at("scenarios")[k];
+    EXPECT_EQ(a.at("summary").at("model"), "three_body_rotation");
+    a.at("summary").erase("compute_time_s");  // wall time
+    b.at("summary").erase("compute_time_s");
+    EXPECT_EQ(a.dump(1), b.dump(1)) << "scene " << k;
+  }
+}
+
 // 10,000 equal masses with seeded velocities: the ghosts model predicts the inversions,
 // more than the default cap of 10^7, so the model answers at once, events asked for or not
 // (the final velocities are the initial ones sorted, fastest on the right).
