@@ -24,7 +24,7 @@ void ProgressLine::maybeDraw(std::uint64_t index, double time) {
   last_draw_ = now;
   drawn_ = true;
   const double seconds = std::chrono::duration<double>(now - start_).count();
-  if (expected_ == 0) {  // the event engine: no count known in advance
+  if (expected_ == 0) {  // no count known in advance: the engine's impacts and time
     std::fprintf(terminal_, "\rcollision_lab_cli: %llu impacts, simulated t = %.6g s, %.3g impacts/s, %.1f s (Ctrl-C stops)\033[K",
                  static_cast<unsigned long long>(index), time, static_cast<double>(index) / seconds, seconds);
   } else {

@@ -14,16 +14,12 @@ class ProgressLine {
   ProgressLine(std::FILE* terminal, std::uint64_t expected);
   ~ProgressLine();  ///< erases the line, if one was drawn
 
-  /// Called for every collision; reads the clock only every 2^16 collisions, and draws
-  /// from one second after the start, at most five times a second.
-  void onCollision(std::uint64_t index) {
-    if ((index & 0xFFFF) == 0) maybeDraw(index, -1.0);
-  }
-  /// Called by the event engine every few impacts: impacts so far and simulated time [s].
+  /// Called by the run every few impacts: impacts so far and simulated time [s] (NaN when
+  /// the run takes no impact times). Draws from one second after the start, at most five
+  /// times a second.
   void onEngineProgress(std::uint64_t impacts, double time) { maybeDraw(impacts, time); }
 
  private:
-  /// `time` [s] is the simulated time, or negative when not known.
   void maybeDraw(std::uint64_t index, double time);
 
   std::FILE* terminal_;

@@ -67,7 +67,8 @@ core::RunOptions optionsFor(const CliRequest& request, const io::SceneEntry& ent
 }
 
 /// Runs a validated scene with a progress line on a terminal and Ctrl-C for the engine.
-/// `visitors` see the shown events; the run itself keeps none.
+/// `visitors` see the shown events; the run itself keeps none. The progress line only
+/// watches (visitors.progress): in a terminal or a pipe the run takes the same path.
 core::SceneRunResult runWithProgress(const core::ScenePlan& plan, const core::RunOptions& shown, bool simulate_to_cap,
                                      core::SceneVisitors visitors) {
   core::SceneRunOptions options;
@@ -80,11 +81,6 @@ core::SceneRunResult runWithProgress(const core::ScenePlan& plan, const core::Ru
     progress.emplace(stderr, plan.three_body ? std::min(plan.three_body->collision_count, shown.max_collisions) : 0);
     options.progress_interval = std::uint64_t{1} << 16;
     visitors.progress = [&](const core::EngineProgress& p) { progress->onEngineProgress(p.impacts, p.time); };
-    const core::LabEventVisitor on_event = visitors.three_body_event;
-    visitors.three_body_event = [&, on_event](const core::LabEvent& event) {
-      if (on_event) on_event(event);
-      progress->onCollision(event.event.index);
-    };
   }
   return core::runScene(plan, options, visitors);
 }

@@ -263,10 +263,12 @@ struct WorkingUnits {
 /// rounded) and drifts, as simulateByEngine gives them; no final time or positions. restart() is called before
 /// each pass over the impacts (at most two); after each impact n, visit(n, v) sees the
 /// velocities [m/s] that simulateByEngine's event would carry. Returns nothing when the run
-/// cannot be taken this way (then the engine runs it).
+/// cannot be taken this way (then the engine runs it). `progress` (RunOptions) sees every
+/// progress_interval-th impact, with no time (NaN).
 template <class Restart, class Visit>
 std::optional<SimulationResult> simulateKnownCount(const ThreeBodyScene& scene, std::uint64_t count,
-                                                   const SimulationOptions& options, Restart&& restart, Visit&& visit) {
+                                                   const SimulationOptions& options, const ProgressCallback& progress,
+                                                   std::uint64_t progress_interval, Restart&& restart, Visit&& visit) {
   if (scene.isWall(0) && scene.isWall(2)) return std::nullopt;
   const std::optional<Pair> first = firstPair(scene);
   if (count > 0 && !first) return std::nullopt;
@@ -282,9 +284,13 @@ std::optional<SimulationResult> simulateKnownCount(const ThreeBodyScene& scene, 
     const double x = v * to_si;
     return std::fabs(x) >= std::numeric_limits<double>::min() ? x : scaled(v, -shift);
   };
+  const std::uint64_t every = progress ? progress_interval : 0;
   const std::optional<nbody_detail::ElasticTripleRun> run = nbody_detail::runElasticTriple(
       units.scene, count, first == Pair::BC ? 1 : 0, options.max_collisions, options.cancel, restart,
-      [&](std::uint64_t n, const std::array<double, 3>& v) { visit(n, std::array<double, 3>{si(v[0]), si(v[1]), si(v[2])}); });
+      [&](std::uint64_t n, const std::array<double, 3>& v) {
+        visit(n, std::array<double, 3>{si(v[0]), si(v[1]), si(v[2])});
+        if (every != 0 && n % every == 0) progress(EngineProgress{n, std::numeric_limits<double>::quiet_NaN()});
+      });
   if (!run) return std::nullopt;
   SimulationResult result;
   result.collision_count = run->impact_count;
@@ -314,6 +320,7 @@ std::optional<SimulationResult> simulateKnownCount(const ThreeBodyScene& scene, 
 /// were then visited. A run the engine ended otherwise than finished, capped or cancelled
 /// is truncated, with the engine's sentence in `stopped_otherwise`.
 std::optional<SimulationResult> simulateByEngine(const ThreeBodyScene& scene, const SimulationOptions& options,
+                                                 const ProgressCallback& progress, std::uint64_t progress_interval,
                                                  const EventVisitor& visitor, std::uint64_t& told,
                                                  std::string& stopped_otherwise) {
   const WorkingUnits units(scene);
@@ -325,7 +332,7 @@ std::optional<SimulationResult> simulateByEngine(const ThreeBodyScene& scene, co
   const Scene& working = units.scene;
   EngineOptions engine_options;
   engine_options.max_impacts = options.max_collisions;
-  engine_options.progress_interval = 0;
+  engine_options.progress_interval = progress ? progress_interval : 0;
   engine_options.cancel = options.cancel;
   SimulationResult result;
   // In working units: velocities, and where body k was (since_position) at since_time[k].
@@ -381,7 +388,9 @@ std::optional<SimulationResult> simulateByEngine(const ThreeBodyScene& scene, co
       visitor(event);
     };
   }
-  EngineResult engine = runEngine(working, engine_options, on_impact);
+  ProgressCallback progress_si;  // the engine's times are in working units
+  if (progress) progress_si = [&](const EngineProgress& p) { progress(EngineProgress{p.impacts, time_si(p.time)}); };
+  EngineResult engine = runEngine(working, engine_options, on_impact, progress_si);
   told = engine.impact_count;
   if (engine.stop == StopReason::kOutOfRange) return std::nullopt;
   result.collision_count = engine.impact_count;
@@ -437,7 +446,7 @@ void simulateBesidePrediction(const ThreeBodyScene& scene, const RunOptions& opt
     if (options.mode == RunMode::kFull) {
       std::optional<ClosedFormInTurn> predicted;
       by_engine = simulateKnownCount(
-          scene, result.prediction.collision_count, simulation_options,
+          scene, result.prediction.collision_count, simulation_options, options.progress, options.progress_interval,
           [&] {
             predicted.emplace(model);
             max_error_sq = 0.0;
@@ -446,12 +455,16 @@ void simulateBesidePrediction(const ThreeBodyScene& scene, const RunOptions& opt
             max_error_sq = std::max(max_error_sq, relative_error.squared(v, predicted->velocitiesAfter(n)));
           });
     } else {
-      by_engine = simulateKnownCount(scene, result.prediction.collision_count, simulation_options, [] {},
+      by_engine = simulateKnownCount(scene, result.prediction.collision_count, simulation_options, options.progress,
+                                     options.progress_interval, [] {},
                                      [](std::uint64_t, const std::array<double, 3>&) {});
     }
     if (!by_engine) max_error_sq = 0.0;  // the engine measures it again
   }
-  if (!by_engine) by_engine = simulateByEngine(scene, simulation_options, enrich, told, stopped_otherwise);
+  if (!by_engine) {
+    by_engine = simulateByEngine(scene, simulation_options, options.progress, options.progress_interval, enrich, told,
+                                 stopped_otherwise);
+  }
   if (!by_engine) {
     // Beyond the engine's range: the three-body simulator (exact decisions, velocities to a
     // few units in the last place) runs it, telling only the impacts after those told.

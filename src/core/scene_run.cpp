@@ -51,13 +51,37 @@ SceneSimulation notSimulated(const std::optional<Prediction>& prediction) {
   return simulation;
 }
 
-/// max |v_sim - v_pred| / max |v_0| (1 when every v_0 is 0 and any differs).
-double relativeVelocityError(const std::vector<double>& simulated, const std::vector<double>& predicted,
-                             const std::vector<double>& initial) {
-  double error = 0.0, scale = 0.0;
-  for (std::size_t i = 0; i < simulated.size(); ++i) error = std::max(error, std::fabs(simulated[i] - predicted[i]));
-  for (double v : initial) scale = std::max(scale, std::fabs(v));
-  return scale > 0.0 ? error / scale : error;
+/// max_prediction_error's one meaning at one state: |S (v_sim - v_pred)| / |S v_0| with
+/// S = diag(sqrt(m)) over the finite bodies and v_0 in the frame of the first wall (if any),
+/// the relative error in the energy norm (1 when |S v_0| is 0 and any differs). Masses are
+/// taken relative to the largest and velocities to the largest difference, so that nothing
+/// overflows or underflows.
+double energyNormError(const Scene& scene, const std::vector<double>& simulated, const std::vector<double>& predicted) {
+  std::optional<double> frame;
+  double mass_max = 0.0, scale = 0.0;
+  for (std::size_t i = 0; i < scene.size(); ++i) {
+    if (scene.isWall(i)) {
+      if (!frame) frame = scene.velocities[i];
+      continue;
+    }
+    mass_max = std::max(mass_max, scene.masses[i]);
+  }
+  const double frame_velocity = frame.value_or(0.0);
+  for (std::size_t i = 0; i < scene.size(); ++i) {
+    if (scene.isWall(i)) continue;
+    scale = std::max({scale, std::fabs(simulated[i] - predicted[i]), std::fabs(scene.velocities[i] - frame_velocity)});
+  }
+  if (scale == 0.0 || !std::isfinite(scale)) return scale == 0.0 ? 0.0 : std::numeric_limits<double>::quiet_NaN();
+  double error_sq = 0.0, initial_sq = 0.0;
+  for (std::size_t i = 0; i < scene.size(); ++i) {
+    if (scene.isWall(i)) continue;
+    const double weight = scene.masses[i] / mass_max;
+    const double d = (simulated[i] - predicted[i]) / scale, v = (scene.velocities[i] - frame_velocity) / scale;
+    error_sq += weight * d * d;
+    initial_sq += weight * v * v;
+  }
+  if (initial_sq == 0.0) return error_sq > 0.0 ? 1.0 : 0.0;
+  return std::sqrt(error_sq / initial_sq);
 }
 
 SceneSimulation fromEngine(EngineResult&& engine) {
@@ -105,7 +129,9 @@ SceneSimulation simulateScene(const Scene& scene, const SceneRunOptions& options
   const bool wants_events = lab.mode == RunMode::kFull && lab.events.kind != EventPolicy::Kind::kNone;
   // Nothing approaching: there is nothing to simulate, events or not.
   const bool nothing_happens = prediction && prediction->kind == ModelKind::kNoCollisions;
-  if (prediction && !prediction->infinite && !over_cap && (!wants_events || nothing_happens)) {
+  // The sticky count assumes that no three bodies meet at once; only the engine can tell.
+  const bool count_certain = prediction && prediction->kind != ModelKind::kSticky;
+  if (prediction && !prediction->infinite && !over_cap && ((!wants_events && count_certain) || nothing_happens)) {
     return fromPrediction(*prediction);
   }
 
@@ -133,8 +159,7 @@ SceneSimulation simulateScene(const Scene& scene, const SceneRunOptions& options
       runEngine(scene, engine_options, on_impact, visitors.progress, full ? visitors.collapse : CollapseVisitor{}));
   simulation.impacts = std::move(kept);
   if (prediction && prediction->impact_count && simulation.stop == StopReason::kFinished) {
-    simulation.max_prediction_error =
-        relativeVelocityError(simulation.final_velocities, prediction->final_velocities, scene.velocities);
+    simulation.max_prediction_error = energyNormError(scene, simulation.final_velocities, prediction->final_velocities);
     simulation.matches_prediction = simulation.impact_count == *prediction->impact_count;
   }
   return simulation;
@@ -184,10 +209,9 @@ SceneSimulation fromThreeBody(const RunResult& run, const Scene& scene, std::uin
   simulation.energy_lost = 0.0;  // elastic
   simulation.energy_relative_drift = summary.energy_relative_drift;
   simulation.momentum_relative_drift = summary.momentum_relative_drift;
+  // The rotation model predicts every impact: its error is the largest over them all.
+  if (summary.simulated) simulation.max_prediction_error = summary.max_prediction_error;
   if (summary.simulated && !summary.truncated) {
-    const std::array<double, 3>& predicted = run.prediction.final_velocities;
-    simulation.max_prediction_error = relativeVelocityError(
-        simulation.final_velocities, std::vector<double>(predicted.begin(), predicted.end()), scene.velocities);
     simulation.matches_prediction = summary.collision_count == run.prediction.collision_count;
   }
   return simulation;
@@ -222,6 +246,10 @@ SceneRunResult runScene(const ScenePlan& plan, const SceneRunOptions& options, c
     if (!options.keep_events) lab.events = EventPolicy::none();
     lab.skip_simulation_over_cap = !options.simulate_to_cap;
     lab.cancel = options.cancel;
+    if (visitors.progress) {
+      lab.progress = visitors.progress;
+      lab.progress_interval = options.progress_interval;
+    }
     result.three_body =
         runLab(toThreeBodyScene(plan.scene), lab, *plan.three_body, visitors.three_body_event);
     result.simulation = fromThreeBody(*result.three_body, plan.scene, lab.max_collisions);

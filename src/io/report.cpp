@@ -257,67 +257,6 @@ class CsvWriter : public RunReportWriter {
   EventPipeline events_;
 };
 
-// ---------------------------------------------------------------------------------------
-// Batches.
-
-void writeBatchTable(const std::vector<SceneOutcome>& outcomes, std::ostream& out) {
-  std::size_t name_width = 8;
-  for (const SceneOutcome& outcome : outcomes) name_width = std::max(name_width, outcome.scene.name.size());
-  out << padRight("scenario", name_width) << padLeft("collisions", 12) << padLeft("predicted", 12)
-      << padLeft("paper (3.22)", 14) << padLeft("most possible", 15) << padLeft("final v_A [m/s]", 18)
-      << padLeft("final v_B [m/s]", 18) << padLeft("final v_C [m/s]", 18) << padLeft("max pred err", 14)
-      << "  truncated\n";
-  for (const SceneOutcome& outcome : outcomes) {
-    const core::AnalyticPrediction& p = outcome.result.prediction;
-    const core::LabRunSummary& s = outcome.result.summary;
-    out << padRight(outcome.scene.name, name_width)
-        << padLeft(s.simulated ? std::to_string(s.collision_count) : "-", 12)
-        << padLeft(std::to_string(p.collision_count), 12) << padLeft(paperCountText(p), 14)
-        << padLeft(std::to_string(p.max_possible_collision_count), 15);
-    const std::array<double, 3>& final_velocities = s.simulated ? s.final_velocities : p.final_velocities;
-    for (double v : final_velocities) out << padLeft(humanText(v, kSummaryDigits), 18);
-    out << padLeft(s.simulated ? humanText(s.max_prediction_error, 3) : "-", 14) << "  "
-        << (s.truncated ? "yes" : "no") << "\n";
-  }
-  out << "\ncollisions: simulated; predicted: the correct closed form; paper (3.22): the paper's printed n_max;"
-         "\nfinal velocities: simulated (predicted when not simulated); max pred err: |S (v_sim - v_pred)| / |S v0|, S = diag(sqrt m) (energy norm)\n";
-}
-
-void writeBatchCsv(const std::vector<SceneOutcome>& outcomes, std::ostream& out) {
-  out << "scenario,collision_count,truncated,predicted_collision_count,paper_predicted_collision_count,"
-         "max_possible_collision_count,final_v_A_m_s,final_v_B_m_s,final_v_C_m_s,predicted_final_v_A_m_s,"
-         "predicted_final_v_B_m_s,predicted_final_v_C_m_s,max_prediction_error,energy_relative_drift,"
-         "momentum_relative_drift\n";
-  for (const SceneOutcome& outcome : outcomes) {
-    const core::AnalyticPrediction& p = outcome.result.prediction;
-    const core::LabRunSummary& s = outcome.result.summary;
-    out << outcome.scene.name << "," << s.collision_count << "," << (s.truncated ? "true" : "false") << ","
-        << p.collision_count << "," << (p.paper_collision_count ? std::to_string(*p.paper_collision_count) : "")
-        << "," << p.max_possible_collision_count;
-    for (double v : s.final_velocities) out << "," << roundTripText(v);
-    for (double v : p.final_velocities) out << "," << roundTripText(v);
-    out << "," << roundTripText(s.max_prediction_error) << "," << roundTripText(s.energy_relative_drift) << ","
-        << roundTripText(s.momentum_relative_drift) << "\n";
-  }
-}
-
-void writeBatchJson(const std::vector<SceneOutcome>& outcomes, std::ostream& out) {
-  out << "{\"units\": " << jsonText(unitsJson()) << ",\n\"scenarios\": [";
-  bool first = true;
-  for (const SceneOutcome& outcome : outcomes) {
-    Json events = Json::array();
-    for (const core::LabEvent& lab : outcome.result.events) events.push_back(eventJson(lab));
-    Json entry;
-    entry["scene"] = sceneJson(outcome.scene);
-    entry["options"] = optionsJson(outcome.options);
-    entry["events"] = std::move(events);
-    entry["summary"] = summaryJson(outcome.result);
-    out << (first ? "\n" : ",\n") << jsonText(entry);
-    first = false;
-  }
-  out << "\n]}\n";
-}
-
 }  // namespace
 
 std::optional<ReportFormat> parseReportFormat(const std::string& text) {
@@ -655,14 +594,6 @@ std::unique_ptr<RunReportWriter> makeRunReportWriter(ReportFormat format, std::o
     case ReportFormat::kTable: break;
   }
   return std::make_unique<TableWriter>(out);
-}
-
-void writeBatchReport(ReportFormat format, const std::vector<SceneOutcome>& outcomes, std::ostream& out) {
-  switch (format) {
-    case ReportFormat::kJson: writeBatchJson(outcomes, out); return;
-    case ReportFormat::kCsv: writeBatchCsv(outcomes, out); return;
-    case ReportFormat::kTable: writeBatchTable(outcomes, out); return;
-  }
 }
 
 }  // namespace io

@@ -737,14 +737,6 @@ std::unique_ptr<RunReportWriter> makeThreeBodyReportWriter(ReportFormat format, 
 }
 
 void writeSceneBatchReport(ReportFormat format, const std::vector<SceneBatchOutcome>& outcomes, std::ostream& out) {
-  if (format == ReportFormat::kCsv) return writeSceneBatchCsv(outcomes, out);  // one header, whatever the scenes
-  const bool all_three_body = std::all_of(outcomes.begin(), outcomes.end(),
-                                          [](const SceneBatchOutcome& o) { return o.result.three_body.has_value(); });
-  if (all_three_body) {
-    std::vector<SceneOutcome> three_body;
-    for (const auto& o : outcomes) three_body.push_back({toNamedScene(o.entry), o.options, *o.result.three_body});
-    return writeBatchReport(format, three_body, out);
-  }
   switch (format) {
     case ReportFormat::kJson: writeSceneBatchJson(outcomes, out); return;
     case ReportFormat::kCsv: writeSceneBatchCsv(outcomes, out); return;

@@ -593,8 +593,6 @@ void fillRunSummaryMsg(const core::SceneRunResult& result, std::size_t body_coun
     msg.paper_predicted_collision_count = p.paper_collision_count.value_or(0);
     msg.critical_restitution = core::criticalRestitution(p.angles.alpha);
     msg.spiral_angle = p.angles.theta;
-    // The model is compared at every reported impact, not only at the end (lab_run.h).
-    msg.max_prediction_error = rotation->summary.max_prediction_error;
   }
 }
 

@@ -1,10 +1,12 @@
 #include "cli_process.h"
 
 #include <fcntl.h>
+#include <poll.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -20,6 +22,10 @@ std::string readWhole(const std::string& path) {
   return content.str();
 }
 
+/// runProgram, with stderr the slave side of a pseudo-terminal when `terminal` is true.
+CliOutput runChild(const std::string& program_path, const std::vector<std::string>& args, const std::string& cwd,
+                   const std::string& stdin_path, const std::string& stdout_path, bool terminal);
+
 }  // namespace
 
 CliOutput runCli(const std::vector<std::string>& args, const std::string& cwd, const std::string& stdin_path,
@@ -27,8 +33,19 @@ CliOutput runCli(const std::vector<std::string>& args, const std::string& cwd, c
   return runProgram(COLLISION_LAB_CLI_PATH, args, cwd, stdin_path, stdout_path);
 }
 
+CliOutput runCliOnTerminal(const std::vector<std::string>& args, const std::string& cwd) {
+  return runChild(COLLISION_LAB_CLI_PATH, args, cwd, "/dev/null", "", true);
+}
+
 CliOutput runProgram(const std::string& program_path, const std::vector<std::string>& args, const std::string& cwd,
                      const std::string& stdin_path, const std::string& stdout_path) {
+  return runChild(program_path, args, cwd, stdin_path, stdout_path, false);
+}
+
+namespace {
+
+CliOutput runChild(const std::string& program_path, const std::vector<std::string>& args, const std::string& cwd,
+                   const std::string& stdin_path, const std::string& stdout_path, bool terminal) {
   char dir_template[] = "/tmp/collision_lab_cli_test_XXXXXX";
   const char* dir = mkdtemp(dir_template);
   if (dir == nullptr) throw std::runtime_error("mkdtemp failed");
@@ -42,13 +59,23 @@ CliOutput runProgram(const std::string& program_path, const std::vector<std::str
   for (std::string& arg : owned) argv.push_back(arg.data());
   argv.push_back(nullptr);
 
+  int master = -1;
+  std::string slave_path;
+  if (terminal) {
+    master = posix_openpt(O_RDWR | O_NOCTTY);
+    if (master < 0 || grantpt(master) != 0 || unlockpt(master) != 0 || ptsname(master) == nullptr) {
+      throw std::runtime_error("no pseudo-terminal");
+    }
+    slave_path = ptsname(master);
+  }
   const pid_t pid = fork();
   if (pid < 0) throw std::runtime_error("fork failed");
   if (pid == 0) {
     const int in_fd = open(stdin_path.c_str(), O_RDONLY);
     const int out_fd = stdout_path.empty() ? open(out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600)
                                            : open(stdout_path.c_str(), O_WRONLY);
-    const int err_fd = open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
+    const int err_fd = terminal ? open(slave_path.c_str(), O_RDWR | O_NOCTTY)
+                                : open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
     if (in_fd < 0 || out_fd < 0 || err_fd < 0 || dup2(in_fd, 0) < 0 || dup2(out_fd, 1) < 0 ||
         dup2(err_fd, 2) < 0 || chdir(cwd.c_str()) != 0) {
       _exit(126);
@@ -56,19 +83,39 @@ CliOutput runProgram(const std::string& program_path, const std::vector<std::str
     execv(argv[0], argv.data());
     _exit(127);
   }
+  CliOutput result;
+  if (terminal) {  // drain the terminal while the child runs, so that it never blocks on it
+    char buffer[4096];
+    for (;;) {
+      pollfd watched{master, POLLIN, 0};
+      if (poll(&watched, 1, 100) > 0) {
+        const ssize_t n = read(master, buffer, sizeof buffer);
+        if (n > 0) {
+          result.err.append(buffer, static_cast<std::size_t>(n));
+        } else if (n == 0 || errno != EINTR) {
+          break;  // EIO: the child closed the terminal
+        }
+      } else {
+        siginfo_t exited{};
+        if (waitid(P_PID, static_cast<id_t>(pid), &exited, WEXITED | WNOHANG | WNOWAIT) == 0 && exited.si_pid == pid) break;
+      }
+    }
+  }
   int status = 0;
   while (waitpid(pid, &status, 0) < 0) {
     if (errno != EINTR) throw std::runtime_error("waitpid failed");
   }
-  CliOutput result;
+  if (terminal) close(master);
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   if (stdout_path.empty()) result.out = readWhole(out_path);
-  result.err = readWhole(err_path);
+  if (!terminal) result.err = readWhole(err_path);
   unlink(out_path.c_str());
   unlink(err_path.c_str());
   rmdir(dir);
   return result;
 }
+
+}  // namespace
 
 std::vector<std::string> linesOf(const std::string& text) {
   std::vector<std::string> lines;

@@ -22,6 +22,10 @@ CliOutput runCli(const std::vector<std::string>& args, const std::string& cwd,
 CliOutput runProgram(const std::string& program, const std::vector<std::string>& args, const std::string& cwd,
                      const std::string& stdin_path = "/dev/null", const std::string& stdout_path = "");
 
+/// As runCli, with stderr a pseudo-terminal (where the CLI draws its progress line);
+/// `err` holds what was written there.
+CliOutput runCliOnTerminal(const std::vector<std::string>& args, const std::string& cwd);
+
 /// The lines of `text` (a final newline does not start another line).
 std::vector<std::string> linesOf(const std::string& text);
 

@@ -239,6 +239,23 @@ TEST(CliTable, NamesTheTierItsEscalatedDecisionsAreTakenAt) {
   EXPECT_EQ(table.out.find("50 digits"), std::string::npos) << table.out;
 }
 
+TEST(CliTerminal, ARunTakesTheSamePathInATerminalAsInAPipe) {
+  // As above, AB touches at exactly zero approach speed after 2 collisions: the event
+  // engine takes that decision at 100 digits, while a run that shows no event needs no
+  // decision (the count is known). A terminal on stderr (the progress line) must not change
+  // which: the run, its numbers and its escalations are the same in a terminal and a pipe.
+  const std::vector<std::string> args = {"--masses", "3,1,0.5", "--positions", "2,1,0", "--velocities", "-1,0,0",
+                                         "--events", "none", "--format", "json"};
+  const CliOutput pipe = run(args);
+  const CliOutput terminal = runCliOnTerminal(args, COLLISION_LAB_SOURCE_DIR);
+  ASSERT_EQ(pipe.exit_code, 0) << pipe.err;
+  ASSERT_EQ(terminal.exit_code, 0) << terminal.err;
+  Json in_pipe = Json::parse(pipe.out), in_terminal = Json::parse(terminal.out);
+  EXPECT_EQ(in_pipe.at("summary").at("escalation").at("high_precision"), 0);
+  for (Json* doc : {&in_pipe, &in_terminal}) doc->at("summary").erase("compute_time_s");  // wall time
+  EXPECT_EQ(in_terminal.dump(2), in_pipe.dump(2));
+}
+
 TEST(CliCsv, HeaderOneRowPerEventAndSummaryComments) {
   const CliOutput result =
       run({"--masses", "1,1,1", "--positions", "2,1,-1", "--velocities", "-1,0,1", "--format", "csv"});

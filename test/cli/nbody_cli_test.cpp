@@ -84,6 +84,33 @@ std::uint64_t inversionsByLoop(const std::vector<double>& v) {
   return count;
 }
 
+// Four bodies with --restitution 0, by hand: m = (1, 2, 3, 4) kg, v = (-1, 0, 0, 1) m/s all
+// meet and stick: momentum 3 kg m/s over 10 kg, 0.3 m/s; three impacts; heat 2.5 - 0.45 J.
+TEST(NBodyCli, EveryPairStickingIsTheStickyModel) {
+  const Json doc = runJson({"--masses", "1,2,3,4", "--positions", "3,2,1,0", "--velocities", "-1,0,0,1",
+                            "--restitution", "0"});
+  const Json& summary = doc.at("summary");
+  EXPECT_EQ(summary.at("model"), "sticky");
+  EXPECT_EQ(summary.at("collision_count"), 3);
+  EXPECT_EQ(summary.at("predicted_collision_count"), 3);
+  EXPECT_EQ(summary.at("matches_prediction"), true);
+  EXPECT_EQ(doubles(summary.at("final_velocities")), (std::vector<double>(4, 0.3)));
+}
+
+// Two bodies at any mass ratio (issue 32): 1e-300 kg at -1 m/s bounces elastically off
+// 1e300 kg at +1 m/s: v' = 2V - v rounds to (3, 1) m/s; they meet at t = 0.5 s, x = 0.5 m.
+TEST(NBodyCli, TwoBodiesAtAnyMassRatioAreAccepted) {
+  const Json doc = runJson({"--masses", "1e-300,1e300", "--positions", "1,0", "--velocities", "-1,1"});
+  const Json& summary = doc.at("summary");
+  EXPECT_EQ(summary.at("model"), "two_body");
+  EXPECT_EQ(summary.at("collision_count"), 1);
+  EXPECT_EQ(summary.at("matches_prediction"), true);
+  EXPECT_EQ(doubles(summary.at("final_velocities")), (std::vector<double>{3, 1}));
+  ASSERT_EQ(doc.at("events").size(), 1u);
+  EXPECT_EQ(doc.at("events")[0].at("time"), 0.5);
+  EXPECT_EQ(doc.at("events")[0].at("position"), 0.5);
+}
+
 // Two carts, by hand: m = (3, 1) kg, x = (1, 0) m, v = (-1, 1) m/s. They close at 2 m/s over
 // 1 m: t = 0.5 s at x = 0.5 m. V = (3*(-1) + 1*1)/4 = -0.5 m/s, v' = 2V - v = (0, -2) m/s.
 // A's energy goes from 1.5 J to 0, B's from 0.5 J to 2 J.
@@ -519,6 +546,41 @@ TEST(OneRun, ABatchKeepsTheEventsOfEveryScene) {
       EXPECT_EQ(events[k].at("pair_index"), k);
     }
     EXPECT_EQ(scenes[s].at("summary").at("collision_count"), s + 2);
+  }
+}
+
+// The batch format does not depend on what the scenes are: a file of three-body scenes
+// gives the same table columns and the same JSON entries as the same file with a four-body
+// scene added (failed before: three bodies alone got another table, with final v_A, and JSON
+// summaries without model).
+TEST(OneRun, ABatchHasOneFormatWhateverItsScenes) {
+  const std::string three =
+      "pi31:\n  masses: [100, 1, .inf]\n  positions: [2, 1, 0]\n  velocities: [-1, 0, 0]\n"
+      "equal:\n  masses: [1, 1, 1]\n  positions: [2, 1, -1]\n  velocities: [-1, 0, 1]\n";
+  const TempFile only_three(three);
+  const TempFile with_four(three + "four:\n  masses: [1, 2, 3, 4]\n  positions: [3, 2, 1, 0]\n  velocities: [-1, 0, 0, 1]\n");
+  const CliOutput table_three = run({"--scenario", only_three.path()});
+  const CliOutput table_four = run({"--scenario", with_four.path()});
+  ASSERT_EQ(table_three.exit_code, 0) << table_three.err;
+  ASSERT_EQ(table_four.exit_code, 0) << table_four.err;
+  const std::vector<std::string> rows_three = linesOf(table_three.out), rows_four = linesOf(table_four.out);
+  ASSERT_EQ(rows_three.size() + 1, rows_four.size());
+  for (std::size_t k = 0; k < rows_three.size(); ++k) {
+    EXPECT_EQ(rows_three[k], rows_four[k < 3 ? k : k + 1]) << "line " << k;  // row 3: the four-body scene
+  }
+  EXPECT_EQ(rows_four[3].rfind("four ", 0), 0u) << rows_four[3];
+  Json json_three = runJson({"--scenario", only_three.path()});
+  Json json_four = runJson({"--scenario", with_four.path()});
+  ASSERT_EQ(json_three.at("scenarios").size(), 2u);
+  ASSERT_EQ(json_four.at("scenarios").size(), 3u);
+  EXPECT_EQ(json_three.at("units"), json_four.at("units"));
+  for (std::size_t k = 0; k < 2; ++k) {
+    Json& a = json_three.at("scenarios")[k];
+    Json& b = json_four.at("scenarios")[k];
+    EXPECT_EQ(a.at("summary").at("model"), "three_body_rotation");
+    a.at("summary").erase("compute_time_s");  // wall time
+    b.at("summary").erase("compute_time_s");
+    EXPECT_EQ(a.dump(1), b.dump(1)) << "scene " << k;
   }
 }
 

@@ -2,7 +2,10 @@
 // engine runs, cancellation. Counts are derived by hand in the comments.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cmath>
+#include <limits>
 #include <vector>
 
 #include "collision_lab/core/scene_run.h"
@@ -128,6 +131,29 @@ TEST(SceneRun, GhostsRunTheEngineOnlyWhenEventsAreAsked) {
   ASSERT_TRUE(simulated.simulation.matches_prediction.has_value());
   EXPECT_TRUE(*simulated.simulation.matches_prediction);
   EXPECT_EQ(simulated.simulation.max_prediction_error, 0.0);
+}
+
+// max_prediction_error has one meaning (docs/cli.md): for the rotation model, the largest
+// energy-norm error over every impact, also for a run cut at the cap; the scene's summary
+// and the model's own carry the same number (failed before: the scene's summary compared
+// the end only, in another norm, and was NaN when cut).
+TEST(SceneRun, ThePredictionErrorOfThreeBodiesIsTheModelsOverEveryImpact) {
+  core::Scene pi;
+  pi.masses = {1e4, 1, std::numeric_limits<double>::infinity()};
+  pi.positions = {2, 1, 0};
+  pi.velocities = {-1, 0, 0};
+  for (const std::uint64_t cap : {std::uint64_t{1000}, std::uint64_t{100}}) {
+    core::SceneRunOptions options = withEvents(core::EventPolicy::all());
+    options.lab.max_collisions = cap;
+    options.simulate_to_cap = true;
+    const core::SceneRunResult run = core::runScene(core::planScene(pi), options);
+    ASSERT_TRUE(run.three_body);
+    EXPECT_EQ(run.simulation.impact_count, std::min<std::uint64_t>(cap, 314));
+    const double model = run.three_body->summary.max_prediction_error;
+    EXPECT_TRUE(std::isfinite(model));
+    EXPECT_LT(model, 1e-12);
+    EXPECT_EQ(run.simulation.max_prediction_error, model);
+  }
 }
 
 // A ball between walls would collide forever; a set cancel flag stops the engine at once,

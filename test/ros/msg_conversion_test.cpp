@@ -477,14 +477,13 @@ TEST(MsgConversion, RunSummaryPhysicsFields) {
   s.stop = collision_lab::core::StopReason::kCap;
   s.stop_message = "cap";
   s.final_velocities = {1, 2, 3};
-  s.max_prediction_error = 0.25;  // the end's comparison, replaced by the model's
+  s.max_prediction_error = 1e-15;  // the rotation model's, over every impact (runScene)
   s.energy_relative_drift = 2e-16;
   s.momentum_relative_drift = std::nan("");
   result.compute_time_s = 0.5;
   collision_lab::core::RunResult rotation;
   rotation.prediction.collision_count = 11;
   rotation.prediction.angles = {M_PI / 3, 0.5, M_PI - M_PI / 3};
-  rotation.summary.max_prediction_error = 1e-15;
   result.three_body = rotation;
   const auto msg = toRunSummaryMsg(result, 3, collision_lab::core::RunMode::kFull);
   EXPECT_EQ(msg.collision_count, 10u);

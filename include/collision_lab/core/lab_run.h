@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "collision_lab/core/analytic.h"
+#include "collision_lab/core/nbody/engine.h"
 #include "collision_lab/core/scene.h"
 #include "collision_lab/core/simulation.h"
 
@@ -65,6 +66,11 @@ struct RunOptions {
   /// When set (by a signal handler or another thread), the simulation stops within 1024
   /// collisions, marked truncated and cancelled.
   const std::atomic<bool>* cancel = nullptr;
+  /// Called every progress_interval impacts (0: never) with the impacts so far and the
+  /// time of the last impact [s], NaN where the run takes no impact times (the known-count
+  /// path). It only watches: with it or without, the run takes the same path.
+  ProgressCallback progress;
+  std::uint64_t progress_interval = 0;
 };
 
 /// A run that was not simulated (predict-only, or skipped over the cap) measured nothing:

@@ -84,10 +84,14 @@ struct SceneSimulation {
   std::uint64_t rule_elastic_impacts = 0;
   double energy_relative_drift = 0.0;    ///< as EngineResult; NaN when not simulated
   double momentum_relative_drift = 0.0;  ///< as EngineResult; NaN when not simulated or with a wall
-  /// Simulated and predicted with a finite count: the engine's count equals it and
-  /// max |v_sim - v_pred| / max |v_0| is max_prediction_error. Empty otherwise.
+  /// Simulated to the end and predicted with a finite count: the engine's count equals it.
+  /// Empty otherwise.
   std::optional<bool> matches_prediction;
-  double max_prediction_error = std::numeric_limits<double>::quiet_NaN();  ///< [1], NaN: not compared
+  /// [1] The largest |S (v_sim - v_pred)| / |S v_0| (S = diag(sqrt(m)) over the finite
+  /// bodies, v_0 in the first wall's frame: the relative error in the energy norm) over the
+  /// states the model predicts: every impact for the rotation model (three elastic bodies),
+  /// the end of a finished run for any other closed form. NaN: not compared.
+  double max_prediction_error = std::numeric_limits<double>::quiet_NaN();
   Escalations escalations;
   /// The impacts that options.lab.events selects, in order, when options.keep_events (the
   /// collapses between them are in `collapses`, each after impacts_before impacts).

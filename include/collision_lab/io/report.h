@@ -63,16 +63,5 @@ class RunReportWriter {
 
 std::unique_ptr<RunReportWriter> makeRunReportWriter(ReportFormat format, std::ostream& out);
 
-/// One scene of a batch and its finished run (events as its RunOptions kept them).
-struct SceneOutcome {
-  NamedScene scene;
-  core::RunOptions options;  ///< as run (a scene's own max_collisions applied)
-  core::RunResult result;
-};
-
-/// Several scenes: table and CSV give one summary row per scene; JSON gives
-/// {"units", "scenarios": [{"scene", "options", "events", "summary"}, ...]}.
-void writeBatchReport(ReportFormat format, const std::vector<SceneOutcome>& outcomes, std::ostream& out);
-
 }  // namespace io
 }  // namespace collision_lab

@@ -69,11 +69,10 @@ struct SceneBatchOutcome {
   core::SceneRunResult result;
 };
 
-/// Several scenes of any size. CSV gives one row per scene with one header whatever the
-/// scenes (scenario, bodies, model, collision count and predicted count, truncated, energy
-/// lost). When every scene took the three-body path, table and JSON are writeBatchReport's;
-/// otherwise the table gives the CSV's columns and JSON gives
-/// {"units", "scenarios": [{"scene", "options", "events", "summary"}, ...]}.
+/// Several scenes of any size, in one format whatever the scenes are: table and CSV give one
+/// row per scene (scenario, bodies, model, collision count and predicted count, truncated,
+/// energy lost); JSON gives {"units", "scenarios": [{"scene", "options", "events",
+/// "summary"}, ...]}, each scene's summary as its single-scene report has it.
 void writeSceneBatchReport(ReportFormat format, const std::vector<SceneBatchOutcome>& outcomes, std::ostream& out);
 
 }  // namespace io

@@ -107,7 +107,7 @@ class Driver {
     if (tables_.ring != 0.0 || tables_.scene.restitution_model.kind != RestitutionModelKind::kConstant) return {};
     if (alternating_ < 8) return groupCollapse(result);
     const std::size_t p = std::min(last_, before_last_), q = std::max(last_, before_last_);
-    const auto found = fast_->collapseCandidate(p, q, last_ == p);
+    const auto found = collapseCandidate(p, q, last_ == p);
     if (!found) return {};
     return resolve(*found, result);
   }
@@ -129,6 +129,20 @@ class Driver {
       const auto found = exact_->groupCollapseCandidate(pattern);
       return found ? resolve(*found, result) : StepResult{};
     }
+    return {};
+  }
+
+  /// The three-cluster collapse test (Tier::collapseCandidate) in double-double, or, where
+  /// its bounds do not pin the approach speeds (extreme mass ratios), in the most precise
+  /// tier that stands at the same impact (it took the last step; none: no answer yet).
+  std::optional<Tier<DD>::CollapseFound> collapseCandidate(std::size_t p, std::size_t q, bool q_next) const {
+    if (fast_->pinsApproaches(p, q)) return fast_->collapseCandidate(p, q, q_next);
+    const auto convert = [](const auto& found) -> std::optional<Tier<DD>::CollapseFound> {
+      if (!found) return {};
+      return Tier<DD>::CollapseFound{found->first, found->last, found->time, found->position};
+    };
+    if (exact_ && exact_->count() == fast_->count()) return convert(exact_->collapseCandidate(p, q, q_next));
+    if (high_ && high_->count() == fast_->count()) return convert(high_->collapseCandidate(p, q, q_next));
     return {};
   }
 

@@ -10,8 +10,10 @@ namespace core {
 
 double impactEnergyLost(double m_i, double m_j, double approach, double e) {
   if (e == 1.0) return 0.0;
-  // mu = m_i m_j / (m_i + m_j), without overflow or inf / inf; a wall leaves the other mass.
-  const double mu = std::isinf(m_i) ? m_j : (std::isinf(m_j) ? m_i : m_i / (1.0 + m_i / m_j));
+  // mu = m_i m_j / (m_i + m_j), without overflow or inf / inf; a wall leaves the other mass,
+  // and so does a mass heavier past the double range's ratio (m_i / m_j = inf: mu = m_j).
+  const double ratio = m_i / m_j;
+  const double mu = std::isinf(m_i) ? m_j : std::isinf(m_j) ? m_i : std::isinf(ratio) ? m_j : m_i / (1.0 + ratio);
   return 0.5 * (1.0 - e) * (1.0 + e) * mu * approach * approach;
 }
 

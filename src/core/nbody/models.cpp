@@ -4,8 +4,6 @@
 #include <cmath>
 #include <functional>
 
-#include "collision_lab/core/nbody/impact_rule.h"
-#include "double_double.h"
 #include "spiral.h"
 
 namespace collision_lab {
@@ -53,6 +51,13 @@ bool confinedForever(const Scene& scene) {
   return true;
 }
 
+bool everyPairSticks(const Scene& scene) {
+  for (std::size_t p = 0; p < scene.pairCount(); ++p) {
+    if (scene.restitutionOf(p) != 0.0) return false;
+  }
+  return true;
+}
+
 bool equalFiniteMasses(const Scene& scene) {
   if (scene.wallCount() > 0) return false;
   return std::all_of(scene.masses.begin(), scene.masses.end(), [&](double m) { return m == scene.masses[0]; });
@@ -92,6 +97,12 @@ std::string modelReason(ModelKind kind, const Scene& scene) {
              (scene.wallCount() == 1 ? "; the wall is the outer body of infinite mass (k = 1 + e at the wall, "
                                        "cos^2 alpha = m/(m_B + m) of the two bodies), and a collapse ends on the wall"
                                      : "");
+    case ModelKind::kSticky:
+      return "every pair sticks (e = 0): a body that hits a group joins it, so the final groups are the blocks of the "
+             "weighted isotonic regression of the initial velocities (pool-adjacent-violators, O(N)), each at its "
+             "momentum over its mass (a wall's group at rest with the wall); each impact joins two groups, so the count "
+             "is N - groups when no three bodies meet at once; the engine runs to tell (three bodies meeting at once stop it "
+             "with MULTIPLE_COLLISION)";
     case ModelKind::kEventEngine: break;
   }
   if (restitutionModelActs(scene)) {
@@ -125,6 +136,9 @@ ModelKind chooseKind(const Scene& scene) {
     return ModelKind::kThreeBodySpiral;
   }
   if (equalFiniteMasses(scene) && scene.isElastic()) return ModelKind::kGhosts;
+  if (everyPairSticks(scene) && !(scene.wallCount() == 2 && scene.velocities.back() > scene.velocities.front())) {
+    return ModelKind::kSticky;  // two walls that close in would squeeze a group between them
+  }
   return ModelKind::kEventEngine;
 }
 
@@ -202,6 +216,7 @@ const char* modelKindName(ModelKind kind) {
     case ModelKind::kEventEngine: return "event_engine";
     case ModelKind::kThreeBodySpiral: return "three_body_spiral";
     case ModelKind::kBoxInfinite: return "box_infinite";
+    case ModelKind::kSticky: return "sticky";
   }
   return "unknown";
 }
@@ -225,22 +240,35 @@ Prediction predictTwoWalls(const Scene& scene) {
 }
 
 Prediction predictTwoBody(const Scene& scene) {
-  using nbody_detail::DD;
+  using spiral_detail::Rational;
   Prediction prediction = base(ModelKind::kTwoBody, scene);
   const auto& x = scene.positions;
   const auto& v = scene.velocities;
   prediction.final_velocities = v;
   prediction.impact_count = 0;
   if (!(v[0] < v[1])) return prediction;
-  // Differences of doubles are exact in double-double, so time and place round once or twice.
-  const DD time = (DD(x[0]) - DD(x[1])) / (DD(v[1]) - DD(v[0]));
-  const std::size_t slow = std::fabs(v[0]) <= std::fabs(v[1]) ? 0 : 1;
-  const ImpactOutcome outcome = impact(scene.masses[0], scene.masses[1], v[0], v[1], scene.restitutionOf(0));
+  // Everything exactly in rationals from the input doubles, each result rounded once, so any
+  // mass ratio is exact. The centre-of-mass velocity V is a wall's velocity when one is a
+  // wall; v' = (1 + e) V - e v; heat = mu (1 - e^2) (v_1 - v_0)^2 / 2, mu the reduced mass.
+  const double e = scene.restitutionOf(0);
+  const Rational v0 = v[0], v1 = v[1], re = e;
+  Rational centre, reduced;
+  if (scene.isWall(0) || scene.isWall(1)) {
+    const std::size_t wall = scene.isWall(0) ? 0 : 1;
+    centre = Rational(v[wall]);
+    reduced = Rational(scene.masses[1 - wall]);
+  } else {
+    const Rational m0 = scene.masses[0], m1 = scene.masses[1];
+    centre = (m0 * v0 + m1 * v1) / (m0 + m1);
+    reduced = m0 * m1 / (m0 + m1);
+  }
+  const Rational time = (Rational(x[0]) - x[1]) / (v1 - v0);
   prediction.impact_count = 1;
-  prediction.impact_time = time.hi;
-  prediction.impact_position = (DD(x[slow]) + time * v[slow]).hi;
-  prediction.final_velocities = {outcome.velocity_i, outcome.velocity_j};
-  prediction.energy_lost = outcome.energy_lost;
+  prediction.impact_time = static_cast<double>(time);
+  prediction.impact_position = static_cast<double>(Rational(x[0]) + time * v0);
+  prediction.final_velocities = {scene.isWall(0) ? v[0] : static_cast<double>((1 + re) * centre - re * v0),
+                                 scene.isWall(1) ? v[1] : static_cast<double>((1 + re) * centre - re * v1)};
+  prediction.energy_lost = static_cast<double>(reduced * (1 - re * re) * (v1 - v0) * (v1 - v0) / 2);
   return prediction;
 }
 
@@ -254,6 +282,59 @@ Prediction predictGhosts(const Scene& scene) {
   prediction.final_velocities = scene.velocities;
   // The fastest rightward ends on the right, at index 0.
   std::sort(prediction.final_velocities.begin(), prediction.final_velocities.end(), std::greater<double>());
+  return prediction;
+}
+
+Prediction predictSticky(const Scene& scene) {
+  using spiral_detail::Rational;
+  Prediction prediction = base(ModelKind::kSticky, scene);
+  /// A group of adjacent bodies first..last: its momentum [kg m/s] and mass [kg] exactly, or
+  /// the velocity [m/s] of the wall it holds (infinite mass).
+  struct Group {
+    std::size_t first, last;
+    Rational momentum, mass;
+    std::optional<double> wall_velocity;
+  };
+  // v_A < v_B (A of lower index, on the right) means B catches A up.
+  const auto approaches = [](const Group& a, const Group& b) {
+    if (a.wall_velocity && b.wall_velocity) return *a.wall_velocity < *b.wall_velocity;
+    if (a.wall_velocity) return Rational(*a.wall_velocity) * b.mass < b.momentum;
+    if (b.wall_velocity) return a.momentum < Rational(*b.wall_velocity) * a.mass;
+    return a.momentum * b.mass < b.momentum * a.mass;
+  };
+  std::vector<Group> groups;
+  for (std::size_t i = 0; i < scene.size(); ++i) {
+    Group g{i, i, 0, 0, std::nullopt};
+    if (scene.isWall(i)) {
+      g.wall_velocity = scene.velocities[i];
+    } else {
+      g.mass = scene.masses[i];
+      g.momentum = Rational(scene.masses[i]) * scene.velocities[i];
+    }
+    while (!groups.empty() && approaches(groups.back(), g)) {  // they meet and stick: pool them
+      Group& right = groups.back();
+      g.first = right.first;
+      g.momentum += right.momentum, g.mass += right.mass;
+      if (right.wall_velocity) g.wall_velocity = right.wall_velocity;  // chooseKind: never two walls in one group
+      groups.pop_back();
+    }
+    groups.push_back(std::move(g));
+  }
+  prediction.impact_count = scene.size() - groups.size();
+  prediction.final_velocities.resize(scene.size());
+  Rational heat = 0;
+  for (const Group& g : groups) {
+    const Rational velocity = g.wall_velocity ? Rational(*g.wall_velocity) : g.momentum / g.mass;
+    const double rounded = static_cast<double>(velocity);
+    for (std::size_t i = g.first; i <= g.last; ++i) {
+      prediction.final_velocities[i] = scene.isWall(i) ? scene.velocities[i] : rounded;
+      if (!scene.isWall(i)) {  // the body's kinetic energy in its group's frame turns into heat
+        const Rational relative = Rational(scene.velocities[i]) - velocity;
+        heat += Rational(scene.masses[i]) * relative * relative / 2;
+      }
+    }
+  }
+  prediction.energy_lost = static_cast<double>(heat);
   return prediction;
 }
 
@@ -338,6 +419,7 @@ std::optional<Prediction> predict(const Scene& scene) {
     case ModelKind::kTwoBody: return predictTwoBody(scene);
     case ModelKind::kGhosts: return predictGhosts(scene);
     case ModelKind::kThreeBodySpiral: return predictThreeBodySpiral(scene);
+    case ModelKind::kSticky: return predictSticky(scene);
     case ModelKind::kThreeBodyRotation:
     case ModelKind::kEventEngine: break;
   }

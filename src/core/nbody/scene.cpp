@@ -94,6 +94,7 @@ std::optional<ValidationError> checkMasses(const Scene& scene) {
     return makeError(Reason::kTwoWalls, "masses", "both bodies are walls (inf) with no body between them; give one a finite mass");
   }
   if (n == 3 && scene.isElastic() && !scene.isRing()) return std::nullopt;  // the rotation model: any ratio
+  if (n == 2 && !scene.isRing()) return std::nullopt;  // two bodies: one impact in closed form at any ratio
   double lightest = kInf, heaviest = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
     if (scene.isWall(i)) continue;

@@ -243,6 +243,14 @@ class CL_NBODY_INTERNAL Tier {
     double time = 0.0, position = 0.0;
   };
 
+  /// The bounds of the approach speeds of pairs p and q are within 2^-30 of their size: tight
+  /// enough for collapseCandidate()'s tests. Double-double misses it where the masses span
+  /// more than about 2^60: its error bound, in the energy norm, is of the heavy bodies' scale.
+  bool pinsApproaches(std::size_t p, std::size_t q) const {
+    const Approx a = approach(p), c = approach(q);
+    return a.error + c.error <= 0x1p-30 * (std::fabs(a.value) + std::fabs(c.value));
+  }
+
   /// Pairs p < q alternate with a cluster between them: do the three clusters collapse
   /// (spiral.h, dominates() or, next to r_c, ConeTest: every later check provably stays
   /// positive), and does nothing outside reach them before the collapse time? `q_next`: q hits next (else p). e < 1 on
@@ -264,9 +272,8 @@ class CL_NBODY_INTERNAL Tier {
       }
     }
     if (cycle.wall_a && cycle.wall_c) return {};
+    if (!pinsApproaches(p, q)) return {};
     const Approx a = approach(p), c = approach(q);
-    const double size = std::fabs(a.value) + std::fabs(c.value);
-    if (!(a.error + c.error <= 0x1p-30 * size)) return {};
     const int pair = q_next ? 1 : 0;  // next to r_c, dominance may take ever more cycles: the exact test
     if (!spiral_detail::dominates(cycle, pair, a.value, c.value) &&
         !(spiral_detail::nearDoubleEigenvalue(cycle) &&

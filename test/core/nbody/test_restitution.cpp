@@ -188,6 +188,38 @@ TEST(Restitution, ZeroRestitutionSticksAndTheClusterIsHitAsOneBody) {
   EXPECT_NEAR(hit.energy_lost + 0.5 * 3 * 0.02 * 0.02 + 0.5 * 0.06 * 0.06, 0.5 + 0.5, 1e-14);
 }
 
+// Issue 32: a light body squeezed between two heavy ones (masses R, 1, R) collapses for every
+// e below r_c = 1 - 2 sqrt(2 / R) + O(1/R). Beyond R of about 2^60 double-double's bounds do not
+// pin the light body's speed, and the run used to stop at PRECISION_BUDGET (R = 1e60, e = 0.5:
+// 208 impacts, not collapsed). The collapse time is the limit of the exact impact times; the
+// point is the centre of mass then; the end velocity momentum over mass; the heat the kinetic
+// energy about the centre of mass (all in rationals, from the scene's doubles).
+TEST(Restitution, HeavyLightHeavyCollapsesAtEveryMassRatio) {
+  using reference::Rational;
+  for (const double ratio : {1e20, 1e40, 1e60, 1e100}) {
+    for (const double e : {0.1, 0.5}) {  // nearer r_c the reference needs more than its 80 impacts
+      const Scene s{{ratio, 1, ratio}, {2, 1, 0}, {-1, 0, 0.5}, {e}};
+      const std::string label = "R = " + std::to_string(ratio) + ", e = " + std::to_string(e);
+      Rational mass = 0, momentum = 0, moment = 0, energy = 0;
+      for (std::size_t k = 0; k < 3; ++k) {
+        const Rational m(s.masses[k]), x(s.positions[k]), v(s.velocities[k]);
+        mass += m, momentum += m * v, moment += m * x, energy += m * v * v / 2;
+      }
+      const double time = reference::collapseTime(s);
+      const double position = static_cast<double>(Rational((moment + momentum * Rational(time)) / mass));
+      const double heat = static_cast<double>(Rational(energy - momentum * momentum / (2 * mass)));
+      const double velocity = static_cast<double>(Rational(momentum / mass));
+      const EngineResult run = runEngine(s);
+      ASSERT_TRUE(run.collapsed) << label << ": " << run.stop_message;
+      EXPECT_EQ(run.stop, StopReason::kFinished) << label;
+      EXPECT_NEAR(*run.collapse_time, time, 1e-13 * time) << label;
+      EXPECT_NEAR(*run.collapse_position, position, 1e-13) << label;
+      EXPECT_NEAR(run.energy_lost, heat, 1e-13 * heat) << label;
+      for (std::size_t k = 0; k < 3; ++k) EXPECT_EQ(run.final_velocities[k], velocity) << label << ", body " << k;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace core
 }  // namespace collision_lab

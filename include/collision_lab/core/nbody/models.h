@@ -51,6 +51,7 @@ enum class ModelKind : std::uint8_t {
   kEventEngine = 5,
   kThreeBodySpiral = 6,
   kBoxInfinite = 7,
+  kSticky = 8,
 };
 
 /// Machine-readable name, e.g. "three_body_rotation".
@@ -88,6 +89,12 @@ Prediction predictNoCollisions(const Scene& scene);
 Prediction predictTwoWalls(const Scene& scene);
 Prediction predictTwoBody(const Scene& scene);
 Prediction predictGhosts(const Scene& scene);
+/// Every pair e = 0, no ring: the final groups are the blocks of the weighted isotonic
+/// regression of the initial velocities (pool-adjacent-violators, O(N)); each group moves at
+/// sum m v / sum m (a wall's group at the wall's velocity), computed exactly and rounded once.
+/// Each impact merges two groups, so the count is N - groups; the heat [J] is the kinetic
+/// energy each group loses in its own frame, exact and rounded once.
+Prediction predictSticky(const Scene& scene);
 /// No impact_count when the walk cannot decide within 2^26 impacts (or, for a borderline
 /// decision, within the 3000 impacts walked in rationals); the reason then says so.
 Prediction predictThreeBodySpiral(const Scene& scene);
