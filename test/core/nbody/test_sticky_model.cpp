@@ -59,10 +59,12 @@ TEST(StickyModel, WallHoldsItsGroupAtRest) {
 }
 
 TEST(StickyModel, ThreeBodiesMeetingAtOnceAreToldByTheEngineNotCountedByTheModel) {
-  // A (x = 2, v = -1) and C (x = 0, v = +1) reach B (x = 1, at rest) at t = 1 s together;
-  // D waits at x = -10. The model's N - groups = 3 assumes pairwise meetings: the run, even
-  // with no events asked for, must say that three bodies met at once, as the engine does.
-  const Scene scene = reference::makeScene({1, 1, 1, 1}, {2, 1, 0, -10}, {-1, 0, 1, 0}, 0.0);
+  // D (x = 0, v = 2) sticks to C (x = 1) at t = 0.5 s; C and D move on at 1 m/s and reach
+  // B (x = 2, at rest) at t = 1.5 s, when A (x = 3.5, v = -1) reaches it too. The model's
+  // N - groups = 3 assumes pairwise meetings: the run, even with no events asked for, must
+  // say that three bodies met at once, as the engine does. (A triple at the first impact
+  // is refused by validate; this one comes later.)
+  const Scene scene = reference::makeScene({1, 1, 1, 1}, {3.5, 2, 1, 0}, {-1, 0, 0, 2}, 0.0);
   ASSERT_FALSE(validate(scene));
   const ScenePlan plan = planScene(scene);
   ASSERT_FALSE(plan.error);
@@ -74,6 +76,7 @@ TEST(StickyModel, ThreeBodiesMeetingAtOnceAreToldByTheEngineNotCountedByTheModel
     const SceneRunResult run = runScene(plan, options);
     EXPECT_TRUE(run.simulation.simulated);
     EXPECT_EQ(run.simulation.stop, StopReason::kMultipleCollision) << run.simulation.stop_message;
+    EXPECT_EQ(run.simulation.impact_count, 1u);
   }
 }
 
