@@ -389,10 +389,11 @@ std::string indexRanges(const std::vector<std::size_t>& indices) {
 }
 
 std::string stopMessage(const Scene& scene, const EngineResult& result, bool exhausted, const ExactProgress& exact) {
-  const std::string count = countText(result.impact_count);
+  // "1 impact", "31,415 impacts".
+  const std::string impacts = countText(result.impact_count) + (result.impact_count == 1 ? " impact" : " impacts");
   switch (result.stop) {
     case StopReason::kFinished: {
-      std::string text = "no pair approaches any more after " + count + " impacts: the run is complete";
+      std::string text = "no pair approaches any more after " + impacts + ": the run is complete";
       for (const Collapse& c : result.collapses) {
         text += "; bodies " + bodyName(c.first_body) + " to " + bodyName(c.last_body) +
                 " collapsed (infinitely many impacts) at t = " + formatValue(c.time) + " s, x = " +
@@ -409,7 +410,7 @@ std::string stopMessage(const Scene& scene, const EngineResult& result, bool exh
     }
     case StopReason::kCap:
       if (exhausted) {
-        return "stopped after " + count + " impacts at the exactness cap (truncated): the impacts accumulate, each " +
+        return "stopped after " + impacts + " at the exactness cap (truncated): the impacts accumulate, each " +
                "needing exact arithmetic of more than " + std::to_string(kExactBits) +
                " bits: a collapse of a kind the engine does not resolve (engine.h, Collapse), or a spiral just above "
                "its critical restitution, whose approach speeds shrink by ever more bits (the three_body_spiral "
@@ -418,26 +419,26 @@ std::string stopMessage(const Scene& scene, const EngineResult& result, bool exh
                " (indices from 0); a model of the physics there goes on: --restitution-model tc or "
                "--restitution-model viscoelastic";
       }
-      return "stopped at the cap of " + count + " impacts (truncated)" +
+      return "stopped at the cap of " + impacts + " (truncated)" +
              (scene.wallCount() == 2 ? "; two walls keep the bodies between them colliding forever" : "");
-    case StopReason::kCancelled: return "cancelled after " + count + " impacts (truncated)";
+    case StopReason::kCancelled: return "cancelled after " + impacts + " (truncated)";
     case StopReason::kMultipleCollision: {
       const MultipleCollision& c = *result.multiple_collision;
       return bodyName(c.first_body) + ", " + bodyName(scene.leftOf(c.first_body)) + " and " +
              bodyName(scene.leftOf(scene.leftOf(c.first_body))) +
-             " meet at the same instant t = " + formatValue(c.time) + " s after " + count +
-             " impacts: a multiple collision, whose outcome point masses do not define, so the run ends here";
+             " meet at the same instant t = " + formatValue(c.time) + " s after " + impacts +
+             ": a multiple collision, whose outcome point masses do not define, so the run ends here";
     }
     case StopReason::kOutOfRange:
-      return "after " + count + " impacts the next one would leave the safe range of a double (above 2^900 in m, s "
+      return "after " + impacts + " the next one would leave the safe range of a double (above 2^900 in m, s "
              "or m/s); rescale the units";
     case StopReason::kInternalError:
-      return "the engine's precision tiers disagreed after " + count + " impacts (a bug, please report it); "
+      return "the engine's precision tiers disagreed after " + impacts + " (a bug, please report it); "
              "the run ends here";
     case StopReason::kPrecisionBudget:
-      return "stopped after " + count + " certified impacts (truncated): the next decision needs exact arithmetic, "
+      return "stopped after " + countText(result.impact_count) + " certified impacts (truncated): the next decision needs exact arithmetic, "
              "whose numbers grow with every impact of the run; its exact replay reached the work budget after " +
-             std::to_string(exact.count) + " impacts, with numbers of " + std::to_string(exact.bits) +
+             countText(exact.count) + " impacts, with numbers of " + countText(exact.bits) +
              " bits, so the next impact cannot be decided; the impacts crowd among bodies " +
              indexRanges(result.crowding_bodies) +
              " (indices from 0), as on the way to an inelastic collapse that the engine does not resolve; "
