@@ -14,11 +14,12 @@ const api = '/api/runs/' + encodeURIComponent(runId);
 // Totals (not bodies) in neutral colours; bodies in rviz's colours, from the view.
 const totalColours = ['#333333', '#b8860b'];
 let viewBodies = new Map();  // body index -> {name, colour}, from run.view
+let viewColours = [];  // body i's "#rrggbb" (run.view.body_colours): what rviz draws for it
 
 // core::bodyName: "A".."Z", then "#26", "#27", ...
 const letterName = (i) => (i < 26 ? String.fromCharCode(65 + i) : '#' + i);
 const bodyName = (i) => (viewBodies.has(i) ? viewBodies.get(i).name : letterName(i));
-const bodyColour = (i) => (viewBodies.has(i) ? viewBodies.get(i).colour : '#aaaaaa');
+const bodyColour = (i) => viewColours[i] || (viewBodies.has(i) ? viewBodies.get(i).colour : '#aaaaaa');
 const plural = (n, word) => fmt(n) + ' ' + word + (n === 1 ? '' : 's');
 const charts = {};
 let firstPlotMs = null;
@@ -251,6 +252,8 @@ function showFacts(view) {
   facts.replaceChildren(...items.filter((text) => text).map((text) => el('li', text)));
   document.getElementById('velocity_legend').textContent = view ? 'Bodies shown: ' + view.velocity_legend + '.' : '';
   document.getElementById('xt_legend').textContent = view ? 'Bodies shown: ' + view.worldline_legend + '.' : '';
+  // Many bodies: what their colours mean (few: each is named in its colour).
+  document.getElementById('colour_legend').textContent = view && view.colour_legend ? view.colour_legend[0].toUpperCase() + view.colour_legend.slice(1) + '.' : '';
 }
 
 function nonBackgroundPixels(canvas) {
@@ -271,6 +274,7 @@ function render(run) {
   if (view) {
     viewBodies = new Map();
     view.worldline_bodies.concat(view.velocity_bodies).forEach((b) => viewBodies.set(b.index, b));
+    viewColours = view.body_colours || [];
     // The counter and state word are the view's (rviz's) own.
     status.textContent = run.state + who + ': ' + view.counter;
   } else {
