@@ -58,7 +58,7 @@ std::string titleOf(const RunRecord& run) {
     }
     if (p.model == Prediction::MODEL_THREE_BODY_ROTATION) {
       title += p.paper_collision_count_defined
-                   ? "  (paper's eq. 3.22: " + std::to_string(p.paper_collision_count) + ")"
+                   ? "  (paper's eq. 3.22: " + withSeparators(p.paper_collision_count) + ")"
                    : "  (paper's eq. 3.22: undefined)";
     }
   }

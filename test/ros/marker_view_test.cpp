@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <regex>
 #include <set>
 #include <limits>
 #include <string>
@@ -233,6 +234,16 @@ std::size_t expectBodiesInTheViewsColours(const RunRecord& run) {
   return checked;
 }
 
+/// No text writes four digits or more without thousands separators ("1002", "3000"): every
+/// count, and every number before a decimal point, is written for people (names such as the
+/// run id "box_1002" and "#1001" aside).
+void expectCountsWithSeparators(const visualization_msgs::MarkerArray& array) {
+  static const std::regex bare("(^|[^0-9.,_A-Za-z#])[0-9]{4,}");
+  for (const Marker& m : array.markers) {
+    if (m.type == Marker::TEXT_VIEW_FACING) EXPECT_FALSE(std::regex_search(m.text, bare)) << m.ns << "/" << m.id << ": " << m.text;
+  }
+}
+
 Scene scene(std::vector<double> m, std::vector<double> x, std::vector<double> v, std::vector<double> e = {}) {
   Scene s;
   s.masses = m, s.positions = x, s.velocities = v, s.restitution = e;
@@ -388,6 +399,8 @@ TEST(MarkerView, ManyBodiesAreDrawnInTheViewsColours) {
   EXPECT_NE(view.colour_legend.find("blue: moving left"), std::string::npos) << view.colour_legend;
   EXPECT_NE(view.colour_legend.find("red: moving right"), std::string::npos) << view.colour_legend;
   EXPECT_GE(expectBodiesInTheViewsColours(r.record), 1000u);
+  expectCountsWithSeparators(buildStaticMarkers(r.record, "f"));
+  expectCountsWithSeparators(buildAnimatedMarkers(r.record, FrameClock{endTime(r.record), ""}, "f"));
   // Twelve bodies on a ring: the map too (more bodies than the palette has colours).
   Scene ring = manyBodies(12, 900.0, 7);
   for (std::size_t i = 0; i < ring.positions.size(); ++i) ring.positions[i] = 900.0 - 75.0 * static_cast<double>(i);
