@@ -6,7 +6,8 @@
 // view description (run.view, the server's RunView, the same as rviz's): the page decides
 // nothing on its own. For tests, <body> also gets data-view-end (the run's end [s]),
 // data-xt-end (the latest time any x-t line reaches [s]) and data-xt-max-jump (the largest
-// x step between two vertices of one x-t segment [m]; on a ring below half its length).
+// x step between two vertices of one x-t segment [m]; on a ring below half its length) and
+// data-scene-colours (how many colours the sketch drew its bodies in).
 'use strict';
 
 const runId = document.body.dataset.runId;
@@ -88,10 +89,12 @@ function drawScene(scene) {
   g.beginPath(); g.moveTo(10, y0); g.lineTo(canvas.width - 10, y0); g.stroke();
   const finite = scene.masses.filter((m) => typeof m === 'number');
   const mMin = Math.min(...finite), mMax = Math.max(...finite);
+  const colours = new Set();
   for (let i = 0; i < n; ++i) {
     const m = scene.masses[i];
     const cx = px(x[i]);
     g.fillStyle = bodyColour(i);
+    colours.add(bodyColour(i));
     if (m === 'inf') {
       g.fillRect(cx - 3, y0 - 40, 6, 45);
     } else {
@@ -119,6 +122,7 @@ function drawScene(scene) {
       g.fillText(fmt(x[i], 4) + ' m', at(fmt(x[i], 4) + ' m'), y0 + 31);
     }
   }
+  document.body.dataset.sceneColours = colours.size;
 }
 
 function velocityDatasets(run) {
