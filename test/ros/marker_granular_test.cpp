@@ -46,9 +46,12 @@ double temperatureOf(const Scene& scene, const std::vector<double>& v) {
   return sum / n;
 }
 
-/// "0.01" -> -2: a decade's label.
+/// "0.01" -> -2, "10,000" -> 4, "10^6" -> 6: a decade's label (never e-notation).
 double exponentOf(const std::string& label) {
-  const double exponent = std::log10(std::stod(label));
+  EXPECT_EQ(label.find('e'), std::string::npos) << label;
+  std::string digits;
+  for (char c : label) if (c != ',') digits += c;
+  const double exponent = label.rfind("10^", 0) == 0 ? std::stod(label.substr(3)) : std::log10(std::stod(digits));
   EXPECT_NEAR(exponent, std::round(exponent), 1e-12) << label;
   return exponent;
 }

@@ -182,9 +182,10 @@ void drawColourLegend(const Canvas& c) {
     bar.colors.push_back(velocityColor(-v_max + (k + 0.5) * 2 * v_max / kColourBarSteps, v_max));
   }
   c.add(bar);
-  c.add(c.text(ns::kScene, kColourMin, b.left - kColourLabelDx, b.midY(), format("%.3g m/s", -v_max), kSmallTextSize,
+  // The ends in the legend's numbers.
+  c.add(c.text(ns::kScene, kColourMin, b.left - kColourLabelDx, b.midY(), "-" + numberText(v_max) + " m/s", kSmallTextSize,
                color(kLabelGrey)));
-  c.add(c.text(ns::kScene, kColourMax, b.right + kColourLabelDx, b.midY(), format("+%.3g m/s", v_max), kSmallTextSize,
+  c.add(c.text(ns::kScene, kColourMax, b.right + kColourLabelDx, b.midY(), "+" + numberText(v_max) + " m/s", kSmallTextSize,
                color(kLabelGrey)));
   c.add(c.text(ns::kScene, kColourCaption, b.midX(), b.top + kFrameLabelDy,
                c.view.colour_legend + "; size: mass (log)", kSmallTextSize,
