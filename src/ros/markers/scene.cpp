@@ -188,8 +188,11 @@ void drawColourLegend(const Canvas& c) {
   c.add(c.text(ns::kScene, kColourMax, b.right + kColourLabelDx, b.midY(), "+" + numberText(v_max) + " m/s", kSmallTextSize,
                color(kLabelGrey)));
   c.add(c.text(ns::kScene, kColourCaption, b.midX(), b.top + kFrameLabelDy,
-               c.view.colour_legend + "; size: mass (log)", kSmallTextSize,
-               color(kLabelGrey)));
+               c.view.colour_legend, kSmallTextSize, color(kLabelGrey)));
+  // Beside the bar, so that the caption above stays clear of the walls.
+  const std::string size = "size: mass (log)";
+  c.add(c.text(ns::kScene, kColourSize, b.right + 2 * kColourLabelDx + textWidth(size, kSmallTextSize) / 2, b.midY(),
+               size, kSmallTextSize, color(kLabelGrey)));
 }
 
 /// Large scenes: the bodies' spread now, so a gas that ends 1e8 m wide still shows its first
