@@ -89,7 +89,8 @@ def main():
 
     to_cap = "--simulate-to-cap" in sys.argv[1:]
     wanted = set(sys.argv[1:]) - {"--simulate-to-cap"}
-    shots = ["hint", "not_simulated", "box", "collapse", "cluster", "ring", "gas", "granular_gas", "rejected", "replay"]
+    shots = ["hint", "not_simulated", "pi", "walls", "box", "collapse", "cluster", "ring", "gas", "granular_gas",
+             "rejected", "replay"]
     if to_cap:
         shots = ["box_to_cap"]
     if wanted - set(shots):
@@ -137,6 +138,11 @@ def main():
             # The pi scene with a cap of 10: 31 predicted, over the cap, so not simulated.
             scene("kind_not_simulated_pi_cap_10.png", run_id="pi_cap_10", masses=[100, 1, inf],
                   positions=[2, 1, 0], velocities=[-1, 0, 0], max_collisions=10)
+        elif shot == "pi":
+            preset("pi_digits_2", "collisions_31_pi_digits_2.png")
+        elif shot == "walls":
+            # Infinitely many predicted: cut at the node's cap of 1,000 impacts, one period drawn.
+            preset("ball_between_walls", "nbody_ball_between_walls_end.png")
         elif shot == "box":
             # Two walls: without simulate_to_cap the node stops after the first 1,000 impacts.
             preset("granular_box_1000", "granular_box_1000_cap_1000_end.png")

@@ -6,7 +6,8 @@
 // view description (run.view, the server's RunView, the same as rviz's): the page decides
 // nothing on its own. For tests, <body> also gets data-view-end (the run's end [s]),
 // data-xt-end (the latest time any x-t line reaches [s]) and data-xt-max-jump (the largest
-// x step between two vertices of one x-t segment [m]; on a ring below half its length).
+// x step between two vertices of one x-t segment [m]; on a ring below half its length) and
+// data-scene-colours (how many colours the sketch drew its bodies in).
 'use strict';
 
 const runId = document.body.dataset.runId;
@@ -14,11 +15,12 @@ const api = '/api/runs/' + encodeURIComponent(runId);
 // Totals (not bodies) in neutral colours; bodies in rviz's colours, from the view.
 const totalColours = ['#333333', '#b8860b'];
 let viewBodies = new Map();  // body index -> {name, colour}, from run.view
+let viewColours = [];  // body i's "#rrggbb" (run.view.body_colours): what rviz draws for it
 
 // core::bodyName: "A".."Z", then "#26", "#27", ...
 const letterName = (i) => (i < 26 ? String.fromCharCode(65 + i) : '#' + i);
 const bodyName = (i) => (viewBodies.has(i) ? viewBodies.get(i).name : letterName(i));
-const bodyColour = (i) => (viewBodies.has(i) ? viewBodies.get(i).colour : '#aaaaaa');
+const bodyColour = (i) => viewColours[i] || (viewBodies.has(i) ? viewBodies.get(i).colour : '#aaaaaa');
 const plural = (n, word) => fmt(n) + ' ' + word + (n === 1 ? '' : 's');
 const charts = {};
 let firstPlotMs = null;
@@ -87,10 +89,12 @@ function drawScene(scene) {
   g.beginPath(); g.moveTo(10, y0); g.lineTo(canvas.width - 10, y0); g.stroke();
   const finite = scene.masses.filter((m) => typeof m === 'number');
   const mMin = Math.min(...finite), mMax = Math.max(...finite);
+  const colours = new Set();
   for (let i = 0; i < n; ++i) {
     const m = scene.masses[i];
     const cx = px(x[i]);
     g.fillStyle = bodyColour(i);
+    colours.add(bodyColour(i));
     if (m === 'inf') {
       g.fillRect(cx - 3, y0 - 40, 6, 45);
     } else {
@@ -118,6 +122,7 @@ function drawScene(scene) {
       g.fillText(fmt(x[i], 4) + ' m', at(fmt(x[i], 4) + ' m'), y0 + 31);
     }
   }
+  document.body.dataset.sceneColours = colours.size;
 }
 
 function velocityDatasets(run) {
@@ -251,6 +256,8 @@ function showFacts(view) {
   facts.replaceChildren(...items.filter((text) => text).map((text) => el('li', text)));
   document.getElementById('velocity_legend').textContent = view ? 'Bodies shown: ' + view.velocity_legend + '.' : '';
   document.getElementById('xt_legend').textContent = view ? 'Bodies shown: ' + view.worldline_legend + '.' : '';
+  // Many bodies: what their colours mean (few: each is named in its colour).
+  document.getElementById('colour_legend').textContent = view && view.colour_legend ? view.colour_legend[0].toUpperCase() + view.colour_legend.slice(1) + '.' : '';
 }
 
 function nonBackgroundPixels(canvas) {
@@ -271,6 +278,7 @@ function render(run) {
   if (view) {
     viewBodies = new Map();
     view.worldline_bodies.concat(view.velocity_bodies).forEach((b) => viewBodies.set(b.index, b));
+    viewColours = view.body_colours || [];
     // The counter and state word are the view's (rviz's) own.
     status.textContent = run.state + who + ': ' + view.counter;
   } else {

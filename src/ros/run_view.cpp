@@ -58,7 +58,7 @@ std::string titleOf(const RunRecord& run) {
     }
     if (p.model == Prediction::MODEL_THREE_BODY_ROTATION) {
       title += p.paper_collision_count_defined
-                   ? "  (paper's eq. 3.22: " + std::to_string(p.paper_collision_count) + ")"
+                   ? "  (paper's eq. 3.22: " + withSeparators(p.paper_collision_count) + ")"
                    : "  (paper's eq. 3.22: undefined)";
     }
   }
@@ -95,10 +95,11 @@ std::string noteOf(const RunRecord& run, const RunView& view) {
   if (!view.truncated.empty()) {
     note += view.truncated + " Shown up to the last known state.";
   } else if (run.input().mode == InitialConditions::MODE_PREDICT_ONLY) {
-    note += "predict-only run: shown up to the first contact; the plots show the closed form's final velocities.";
+    note += "predict-only run, no collision simulated (an animation stops at the first contact): the final "
+            "velocities shown are the closed form's.";
   } else if (run.summary && !run.summary->simulated) {
-    note += "answered by the model (more collisions predicted than the cap): shown up to the first contact; the "
-            "plots show the closed form's final velocities.";
+    note += "answered by the model (more collisions predicted than the cap), no collision simulated (an animation "
+            "stops at the first contact): the final velocities shown are the closed form's.";
   } else if (run.input().mode == InitialConditions::MODE_SUMMARY_ONLY) {
     note += "summary-only run: shown up to the first contact; the plots show the final velocities.";
   } else if (!run.finished()) {
@@ -108,10 +109,41 @@ std::string noteOf(const RunRecord& run, const RunView& view) {
   return note;
 }
 
-std::vector<ViewBody> viewBodies(const std::vector<std::size_t>& indices) {
+std::vector<ViewBody> viewBodies(const std::vector<std::size_t>& indices, const RunView& view) {
   std::vector<ViewBody> out;
-  for (std::size_t i : indices) out.push_back({i, collision_lab::core::bodyName(i), bodyColourHex(i)});
+  for (std::size_t i : indices) out.push_back({i, collision_lab::core::bodyName(i), view.body_colours.at(i)});
   return out;
+}
+
+std::string hexOf(double r, double g, double b) {
+  auto byte = [](double v) { return static_cast<unsigned>(std::lround(std::clamp(v, 0.0, 1.0) * 255)); };
+  char buffer[8];
+  std::snprintf(buffer, sizeof buffer, "#%02x%02x%02x", byte(r), byte(g), byte(b));
+  return buffer;
+}
+
+/// RunView's colours (see RunView::body_colours): the palette by index while it has a
+/// colour for every body, else the start velocity's on a diverging map; walls grey.
+void decideColours(const RunRecord& run, RunView& view) {
+  namespace layout = markers::layout;
+  const std::size_t n = run.bodies();
+  view.colour_by_start_velocity = n > layout::kPaletteSize;
+  if (view.colour_by_start_velocity) view.colour_scale = markers::velocityScale(run);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (run.isWall(i)) {
+      view.body_colours.push_back(hexOf(layout::kGrey.r, layout::kGrey.g, layout::kGrey.b));
+    } else if (view.colour_by_start_velocity) {
+      const auto c = markers::velocityColor(run.input().velocities[i], view.colour_scale);
+      view.body_colours.push_back(hexOf(c.r, c.g, c.b));
+    } else {
+      view.body_colours.push_back(bodyColourHex(i));
+    }
+  }
+  if (view.colour_by_start_velocity) {
+    const std::string v = numberText(view.colour_scale);
+    view.colour_legend = "colour: velocity at the start, blue: moving left (deepest at -" + v +
+                         " m/s), white: at rest, red: moving right (deepest at +" + v + " m/s)";
+  }
 }
 
 /// "all 3 bodies" or "24 of 1,002 bodies, evenly spaced, the outermost two included".
@@ -129,10 +161,14 @@ std::string collisionsText(std::uint64_t n) {
 
 std::string bodyColourHex(std::size_t i) {
   const auto& c = markers::layout::kParticleRgb[i % markers::layout::kPaletteSize];
-  auto byte = [](double v) { return static_cast<unsigned>(std::lround(std::clamp(v, 0.0, 1.0) * 255)); };
-  char buffer[8];
-  std::snprintf(buffer, sizeof buffer, "#%02x%02x%02x", byte(c.r), byte(c.g), byte(c.b));
-  return buffer;
+  return hexOf(c.r, c.g, c.b);
+}
+
+std::string numberText(double value) {
+  const std::string text = format("%.4g", value);
+  const auto e = text.find('e');
+  if (e == std::string::npos) return text;
+  return text.substr(0, e) + "×10^" + std::to_string(std::stoi(text.substr(e + 1)));
 }
 
 RunView makeRunView(const RunRecord& run) {
@@ -226,9 +262,10 @@ RunView makeRunView(const RunRecord& run) {
     view.counter += ", " + view.state;
   }
 
-  view.worldline_bodies = viewBodies(run.trackedBodies());
+  decideColours(run, view);
+  view.worldline_bodies = viewBodies(run.trackedBodies(), view);
   const bool per_body = !run.plottedBodies().empty();
-  view.velocity_bodies = viewBodies(per_body ? run.plottedBodies() : run.trackedBodies());
+  view.velocity_bodies = viewBodies(per_body ? run.plottedBodies() : run.trackedBodies(), view);
   view.worldline_legend = legendOf(run.trackedBodies().size(), run.bodies());
   view.velocity_legend = legendOf(view.velocity_bodies.size(), run.bodies());
 
@@ -244,8 +281,8 @@ RunView makeRunView(const RunRecord& run) {
     // What T is, in a student's words, is the page's caption; this says what the lines are.
     // No subscript digits: rviz's font has code points below 1000 only (tau and the square do).
     view.temperature_legend =
-        view.haff_ok ? "Haff's law T = T0 / (1 + t/τ)² fitted: T0 = " + format("%.4g J", fit.t0) + ", τ = " +
-                           format("%.4g s", fit.tau)
+        view.haff_ok ? "Haff's law T = T0 / (1 + t/τ)² fitted: T0 = " + numberText(fit.t0) + " J, τ = " +
+                           numberText(fit.tau) + " s"
                      : std::string("Haff's law: no fit (no cooling seen)");
     // T held from the last collision to the run's end: no collision changes it in the free
     // flight after it (the fit above is to the collisions' values only).
@@ -344,6 +381,10 @@ nlohmann::json viewJson(const RunView& view) {
           {"worldline_legend", view.worldline_legend},
           {"velocity_bodies", bodies(view.velocity_bodies)},
           {"velocity_legend", view.velocity_legend},
+          {"colour_by_start_velocity", view.colour_by_start_velocity},
+          {"colour_scale", view.colour_scale},
+          {"body_colours", view.body_colours},
+          {"colour_legend", view.colour_legend},
           {"gas", view.gas},
           {"temperature", [&] {
              nlohmann::json points = nlohmann::json::array();

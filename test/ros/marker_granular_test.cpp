@@ -3,6 +3,7 @@
 // The runs come from the core's engine; the CollisionEvent messages (pair fields only, as
 // the node sends for large N) are built here from its records. References: the engine's
 // final state through this test's own sums, and hand-derived collapse times.
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -45,9 +46,12 @@ double temperatureOf(const Scene& scene, const std::vector<double>& v) {
   return sum / n;
 }
 
-/// "0.01" -> -2: a decade's label.
+/// "0.01" -> -2, "10,000" -> 4, "10^6" -> 6: a decade's label (never e-notation).
 double exponentOf(const std::string& label) {
-  const double exponent = std::log10(std::stod(label));
+  EXPECT_EQ(label.find('e'), std::string::npos) << label;
+  std::string digits;
+  for (char c : label) if (c != ',') digits += c;
+  const double exponent = label.rfind("10^", 0) == 0 ? std::stod(label.substr(3)) : std::log10(std::stod(digits));
   EXPECT_NEAR(exponent, std::round(exponent), 1e-12) << label;
   return exponent;
 }
@@ -92,13 +96,18 @@ TEST(MarkerGranular, GasShowsTOnLogLogAxesWithHaffsLaw) {
   // The gas cools: T at the end is below T at the start, and the curve falls overall.
   EXPECT_LT(t_end, temperatureOf(scene, scene.velocities));
   EXPECT_LT(series->points.back().y, series->points.front().y);
-  // Haff's law beside it, labelled with its tau.
+  // Haff's law beside it, labelled with its tau, in numbers for people (no e-notation).
   const auto* haff = find(fixed, ids::ns::kTemperature, ids::kTemperatureHaff);
   ASSERT_TRUE(haff);
   EXPECT_GT(haff->points.size(), 10u);
   const auto* legend = find(fixed, ids::ns::kTemperature, ids::kTemperatureLegend);
   ASSERT_TRUE(legend);
-  EXPECT_NE(legend->text.find("tau = "), std::string::npos) << legend->text;
+  EXPECT_NE(legend->text.find("τ = "), std::string::npos) << legend->text;
+  for (std::size_t at = legend->text.find('e'); at != std::string::npos; at = legend->text.find('e', at + 1)) {
+    const bool exponent = at > 0 && std::isdigit(static_cast<unsigned char>(legend->text[at - 1])) &&
+                          at + 1 < legend->text.size() && (legend->text[at + 1] == '+' || legend->text[at + 1] == '-');
+    EXPECT_FALSE(exponent) << "e-notation: " << legend->text;
+  }
   // T now, in the animated view, after the last impact.
   const auto animated = buildAnimatedMarkers(r.record, FrameClock{1e30, "test"}, "f");
   const auto* now = find(animated, ids::ns::kTemperatureNow, ids::kTemperatureNowText);

@@ -787,11 +787,13 @@ TEST(MarkerNBody, EveryViewNamesAndColoursABodyTheSameWay) {
   const auto fixed = buildStaticMarkers(r.run, "f");
   const auto animated = buildAnimatedMarkers(r.run, FrameClock{0.5 * endTime(r.run), "test"}, "f");
   namespace ns = markers::ns;
+  // The palette's colour as the view's bytes (RunView::body_colours, the page's hex): within
+  // half a byte of layout::kParticleRgb.
   const auto expectColour = [](const std_msgs::ColorRGBA& c, std::size_t i, const std::string& where) {
     const auto& rgb = markers::layout::kParticleRgb[i];
-    EXPECT_NEAR(c.r, rgb.r, 1e-6) << where << ", body " << i;
-    EXPECT_NEAR(c.g, rgb.g, 1e-6) << where << ", body " << i;
-    EXPECT_NEAR(c.b, rgb.b, 1e-6) << where << ", body " << i;
+    EXPECT_NEAR(c.r, rgb.r, 0.5 / 255 + 1e-6) << where << ", body " << i;
+    EXPECT_NEAR(c.g, rgb.g, 0.5 / 255 + 1e-6) << where << ", body " << i;
+    EXPECT_NEAR(c.b, rgb.b, 0.5 / 255 + 1e-6) << where << ", body " << i;
   };
   const std::vector<std::string> names{"A", "B", "C", "D", "E"};
   for (std::size_t i = 0; i < names.size(); ++i) {

@@ -4,6 +4,9 @@
 // same RunRecord. No master: the runs are hand-made messages or the core engine's.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <regex>
+#include <set>
 #include <limits>
 #include <string>
 #include <vector>
@@ -40,8 +43,15 @@ std::string textOf(const visualization_msgs::MarkerArray& array, const std::stri
   return m ? unwrapped(m->text) : "(no marker " + ns + "/" + std::to_string(id) + ")";
 }
 
-/// "0.01" -> -2: a decade's label on the T(t) panel.
-double exponentOf(const std::string& label) { return std::log10(std::stod(label)); }
+/// "0.01" -> -2, "10,000" -> 4, "10^6" -> 6: a decade's label on the T(t) panel (never
+/// e-notation).
+double exponentOf(const std::string& label) {
+  EXPECT_EQ(label.find('e'), std::string::npos) << label;
+  if (label.rfind("10^", 0) == 0) return std::stod(label.substr(3));
+  std::string digits;
+  for (char c : label) if (c != ',') digits += c;
+  return std::log10(std::stod(digits));
+}
 
 /// The T(t) panel draws RunView::temperature (its points at t > 0, T > 0, in order, on the
 /// log-log axes its labels name) and Haff's law with RunView's T0 and tau, with its legend.
@@ -141,6 +151,104 @@ void expectRvizDrawsTheView(const RunRecord& run) {
   }
   marker_checks::expectTextsOnScreen(fixed);
   marker_checks::expectTextsOnScreen(animated);
+}
+
+/// "#rrggbb" of a colour rviz draws; fails unless each channel is a whole byte (r/255), as
+/// the view's hex says it.
+std::string hexOf(const std_msgs::ColorRGBA& c) {
+  std::string out = "#";
+  for (double channel : {c.r, c.g, c.b}) {
+    const double byte = channel * 255.0;
+    EXPECT_NEAR(byte, std::round(byte), 1e-3) << "not a whole byte: " << channel;
+    char hex[3];
+    std::snprintf(hex, sizeof hex, "%02x", static_cast<unsigned>(std::lround(byte)));
+    out += hex;
+  }
+  return out;
+}
+
+/// Every body rviz draws, in every panel, is in the view's colour of that body (the one
+/// the page draws): the scene's bodies and walls, the tags and velocity row, the magnifier,
+/// the energy bars and their names, the velocity profile's dots, the velocity and energy
+/// series and their names, the x-t diagram's worldlines. Returns how many it checked.
+std::size_t expectBodiesInTheViewsColours(const RunRecord& run) {
+  const RunView view = makeRunView(run);
+  SCOPED_TRACE(view.kind + ": " + view.title);
+  const std::size_t n = run.bodies();
+  EXPECT_EQ(view.body_colours.size(), n);
+  for (const auto* list : {&view.worldline_bodies, &view.velocity_bodies}) {
+    for (const ViewBody& body : *list) EXPECT_EQ(body.colour, view.body_colours.at(body.index)) << body.name;
+  }
+  const auto fixed = buildStaticMarkers(run, "f");
+  const auto animated = buildAnimatedMarkers(run, FrameClock{endTime(run), ""}, "f");
+  std::size_t checked = 0;
+  const auto expectBody = [&](const visualization_msgs::MarkerArray& array, const std::string& ns, int id,
+                              std::size_t i) {
+    const Marker* m = find(array, ns, id);
+    if (m && m->action == Marker::ADD) {
+      EXPECT_EQ(hexOf(m->color), view.body_colours.at(i)) << ns << "/" << id << ": body " << i;
+      ++checked;
+    }
+  };
+  if (n <= kMaxPlottedBodies) {
+    for (std::size_t i = 0; i < n; ++i) {
+      const int b = static_cast<int>(i);
+      expectBody(animated, ids::ns::kBodies, ids::kBody + b, i);
+      expectBody(animated, ids::ns::kZoom, ids::kZoomBody + b, i);
+      expectBody(animated, ids::ns::kEnergyBars, ids::kEnergyBar + b, i);
+      expectBody(fixed, ids::ns::kEnergy, ids::kEnergyBodyNames + b, i);
+      expectBody(fixed, ids::ns::kPlot, ids::kPlotSeriesNames + b, i);
+      for (int p = 0; p < 2; ++p) expectBody(fixed, ids::ns::kPlot, ids::kPlotPanelStride * p + ids::kPlotSeries + b, i);
+      expectBody(fixed, ids::ns::kConserved, ids::kConservedEnergy + ids::kConservedBodies + b, i);
+    }
+    for (std::size_t k = 0; k < view.worldline_bodies.size(); ++k) {
+      expectBody(fixed, ids::ns::kWorldlines, ids::kWorldLines + static_cast<int>(k), view.worldline_bodies[k].index);
+    }
+    if (const Marker* dots = find(animated, ids::ns::kVelocitiesNow, ids::kSideBars)) {
+      EXPECT_EQ(dots->colors.size(), n);
+      for (std::size_t i = 0; i < dots->colors.size(); ++i) {
+        EXPECT_EQ(hexOf(dots->colors[i]), view.body_colours.at(i)) << "profile dot of body " << i;
+        ++checked;
+      }
+    }
+  } else {
+    // The scene's dots, one list per mass class: together, the finite bodies' colours.
+    std::vector<std::string> drawn, expected;
+    for (int k = 0; k < layout::kMassClasses; ++k) {
+      if (const Marker* m = find(animated, ids::ns::kBodies, ids::kBodyClass + k)) {
+        for (const auto& c : m->colors) drawn.push_back(hexOf(c));
+      }
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!std::isinf(run.input().masses[i])) expected.push_back(view.body_colours[i]);
+    }
+    std::sort(drawn.begin(), drawn.end()), std::sort(expected.begin(), expected.end());
+    EXPECT_EQ(drawn, expected) << "the scene's bodies";
+    checked += drawn.size();
+    if (run.isWall(0)) expectBody(animated, ids::ns::kBodies, ids::kBodyWall, 0);
+    if (run.isWall(n - 1)) expectBody(animated, ids::ns::kBodies, ids::kBodyWall + 1, n - 1);
+    for (std::size_t k = 0; k < view.worldline_bodies.size(); ++k) {
+      expectBody(animated, ids::ns::kWorldlinesNow, ids::kWorldNowLines + static_cast<int>(k),
+                 view.worldline_bodies[k].index);
+    }
+    for (std::size_t k = 0; k < view.velocity_bodies.size(); ++k) {
+      expectBody(fixed, ids::ns::kPlot, ids::kPlotTracked + static_cast<int>(k), view.velocity_bodies[k].index);
+    }
+    // The scene's colour bar says what the colours mean, in the view's words.
+    const std::string caption = textOf(fixed, ids::ns::kScene, ids::kColourCaption);
+    EXPECT_NE(caption.find(view.colour_legend), std::string::npos) << caption;
+  }
+  return checked;
+}
+
+/// No text writes four digits or more without thousands separators ("1002", "3000"): every
+/// count, and every number before a decimal point, is written for people (names such as the
+/// run id "box_1002" and "#1001" aside).
+void expectCountsWithSeparators(const visualization_msgs::MarkerArray& array) {
+  static const std::regex bare("(^|[^0-9.,_A-Za-z#])[0-9]{4,}");
+  for (const Marker& m : array.markers) {
+    if (m.type == Marker::TEXT_VIEW_FACING) EXPECT_FALSE(std::regex_search(m.text, bare)) << m.ns << "/" << m.id << ": " << m.text;
+  }
 }
 
 Scene scene(std::vector<double> m, std::vector<double> x, std::vector<double> v, std::vector<double> e = {}) {
@@ -248,6 +356,10 @@ TEST(MarkerView, FreeGasDrawsTheViewsTemperature) {
   for (const auto& [t, T] : view.temperature) early += t > 0 && t < view.end_time * 1e-3 ? 1 : 0;
   EXPECT_GE(early, 20u);
   expectRvizDrawsTheView(r.record);
+  // Its time axis ends at a decade beyond 10^5 s, named without e-notation. (Failed before:
+  // "1e+08", as in granular_gas_100_end.png.)
+  const std::string last = textOf(buildStaticMarkers(r.record, "f"), ids::ns::kTemperature, ids::kTemperatureTimeMax);
+  EXPECT_EQ(last.rfind("10^", 0), 0u) << last;
 }
 
 // Two carts: a line of few bodies, where the status says the view's counter too.
@@ -255,6 +367,58 @@ TEST(MarkerView, FewBodiesSayTheViewsCounter) {
   const auto r = runScene(scene({1, 1}, {1, 0}, {-1, 1}, {0.8}), 100, "carts");
   ASSERT_EQ(makeRunView(r.record).counter, "1 collision, finished");
   expectRvizDrawsTheView(r.record);
+}
+
+// One colour per body (issue 31): few bodies in rviz's palette by index (A red, B green, C
+// blue, walls grey), in every panel as the view says. (Failed before: rviz drew the pi
+// scene's wall C grey where the view, and so the page, said blue.)
+TEST(MarkerView, FewBodiesAreDrawnInTheViewsColours) {
+  const auto pi = runScene(scene({100, 1, kInf}, {2, 1, 0}, {-1, 0, 0}, {1.0}), 100, "pi");
+  ASSERT_EQ(pi.result.impact_count, 31u);
+  const RunView view = makeRunView(pi.record);
+  EXPECT_FALSE(view.colour_by_start_velocity);
+  EXPECT_EQ(view.colour_legend, "");
+  EXPECT_EQ(view.body_colours, (std::vector<std::string>{bodyColourHex(0), bodyColourHex(1), "#999999"}));
+  EXPECT_GE(expectBodiesInTheViewsColours(pi.record), 10u);
+  // Ten bodies, the palette's size: each its own palette colour.
+  const auto ten = runScene(manyBodies(10, 10.0, 3), 200, "ten");
+  const RunView ten_view = makeRunView(ten.record);
+  EXPECT_FALSE(ten_view.colour_by_start_velocity);
+  EXPECT_EQ(std::set<std::string>(ten_view.body_colours.begin(), ten_view.body_colours.end()).size(), 10u);
+  EXPECT_GE(expectBodiesInTheViewsColours(ten.record), 50u);
+}
+
+// Many bodies: beyond the palette, each body's colour is its start velocity's, the same in
+// the scene, the x-t diagram and the velocity plot, so that a 1,002-body box has no ten
+// repeating colours. (Failed before: the view said the palette by index, rviz drew the
+// start velocity's colour, and the scene's bodies their velocity now.)
+TEST(MarkerView, ManyBodiesAreDrawnInTheViewsColours) {
+  Scene box = manyBodies(1000, 1000.0, 11);
+  box.masses.insert(box.masses.begin(), kInf), box.positions.insert(box.positions.begin(), 1001.0);
+  box.velocities.insert(box.velocities.begin(), 0.0);
+  box.masses.push_back(kInf), box.positions.push_back(-1.0), box.velocities.push_back(0.0);
+  box.restitution = {0.9};
+  const auto r = runScene(box, 3000, "box_1002");
+  const RunView view = makeRunView(r.record);
+  ASSERT_EQ(view.kind, "box");
+  EXPECT_TRUE(view.colour_by_start_velocity);
+  EXPECT_EQ(view.body_colours.front(), "#999999");  // the walls
+  EXPECT_EQ(view.body_colours.back(), "#999999");
+  std::set<std::string> shown;
+  for (const ViewBody& body : view.worldline_bodies) shown.insert(body.colour);
+  EXPECT_GT(shown.size(), 10u) << "the shown bodies repeat ten colours";
+  EXPECT_NE(view.colour_legend.find("blue: moving left"), std::string::npos) << view.colour_legend;
+  EXPECT_NE(view.colour_legend.find("red: moving right"), std::string::npos) << view.colour_legend;
+  EXPECT_GE(expectBodiesInTheViewsColours(r.record), 1000u);
+  expectCountsWithSeparators(buildStaticMarkers(r.record, "f"));
+  expectCountsWithSeparators(buildAnimatedMarkers(r.record, FrameClock{endTime(r.record), ""}, "f"));
+  // Twelve bodies on a ring: the map too (more bodies than the palette has colours).
+  Scene ring = manyBodies(12, 900.0, 7);
+  for (std::size_t i = 0; i < ring.positions.size(); ++i) ring.positions[i] = 900.0 - 75.0 * static_cast<double>(i);
+  ring.ring = 1000.0;
+  const auto on_ring = runScene(ring, 300, "ring");
+  EXPECT_TRUE(makeRunView(on_ring.record).colour_by_start_velocity);
+  EXPECT_GE(expectBodiesInTheViewsColours(on_ring.record), 12u);
 }
 
 }  // namespace

@@ -6,7 +6,10 @@
 // published-event cap, from its RunProgress samples. No master needed.
 #include <stdlib.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cmath>
+#include <cstdio>
 #include <iostream>
 #include <filesystem>
 #include <limits>
@@ -625,6 +628,56 @@ TEST(RunBookView, PageAndRvizGetTheSameViewDescription) {
   EXPECT_EQ(view.at("note"), collision_lab_ros::markers::runNote(rviz));
   EXPECT_EQ(view.at("collapse"), "collapse at t = 3.5 s, x = 1 m, bodies A..C");
   EXPECT_EQ(view.at("worldline_bodies").at(0).at("colour"), collision_lab_ros::bodyColourHex(0));
+}
+
+// One colour per body (issue 31): the run JSON's view gives, for a scene of more bodies
+// than rviz's palette has colours, the hex of exactly what rviz draws for each body (its
+// start velocity's colour), for the page to draw. (Failed before: the JSON said the palette
+// by index, rviz drew the start velocity's colour.)
+TEST(RunBookView, PageAndRvizGetTheSameBodyColours) {
+  collision_lab::InitialConditions input;
+  input.run_id = "ana.run2";
+  input.student = "ana";
+  for (int i = 0; i < 12; ++i) {
+    input.masses.push_back(1.0);
+    input.positions.push_back(12.0 - i);
+    input.velocities.push_back(i % 3 == 0 ? -1.0 : i % 3 == 1 ? 0.5 : 0.0);
+  }
+  input.restitution = {1.0};
+  input.max_collisions = 1000;
+  collision_lab_web::RunBook book;
+  book.onServedInput(input);
+  const json view = runJson(book, "ana.run2").at("view");
+  collision_lab_ros::RunRecord rviz(input);
+  const auto drawn = collision_lab_ros::buildAnimatedMarkers(rviz, collision_lab_ros::FrameClock{0.0, ""}, "f");
+  const auto hex = [](const std_msgs::ColorRGBA& c) {
+    char out[8];
+    std::snprintf(out, sizeof out, "#%02x%02x%02x", static_cast<unsigned>(std::lround(c.r * 255)),
+                  static_cast<unsigned>(std::lround(c.g * 255)), static_cast<unsigned>(std::lround(c.b * 255)));
+    return std::string(out);
+  };
+  ASSERT_EQ(view.at("body_colours").size(), 12u);
+  EXPECT_TRUE(view.at("colour_by_start_velocity").get<bool>());
+  EXPECT_NE(view.at("colour_legend").get<std::string>().find("blue: moving left"), std::string::npos);
+  // The worldlines and velocity series the view names are in the bodies' colours.
+  for (const char* list : {"worldline_bodies", "velocity_bodies"}) {
+    ASSERT_FALSE(view.at(list).empty()) << list;
+    for (const auto& body : view.at(list)) {
+      EXPECT_EQ(body.at("colour"), view.at("body_colours").at(body.at("index").get<std::size_t>())) << list;
+    }
+  }
+  // rviz's scene at the start: all bodies of 1 kg in one list, in body order, each in the
+  // colour the page gets.
+  std::vector<std::string> scene;
+  for (const auto& m : drawn.markers) {
+    if (m.ns == collision_lab_ros::markers::ns::kBodies && m.action == visualization_msgs::Marker::ADD) {
+      for (const auto& c : m.colors) scene.push_back(hex(c));
+    }
+  }
+  EXPECT_EQ(scene, view.at("body_colours").get<std::vector<std::string>>());
+  // Bodies at rest are white, moving left blue, moving right red: three colours, not twelve.
+  EXPECT_EQ(view.at("body_colours").at(2), "#ffffff");
+  EXPECT_NE(view.at("body_colours").at(0), view.at("body_colours").at(1));
 }
 
 }  // namespace

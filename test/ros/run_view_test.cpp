@@ -57,6 +57,14 @@ TEST(RunView, CountsAreWrittenForPeople) {
   EXPECT_EQ(collision_lab_ros::bodyColourHex(0), "#f24040");  // rviz's red for A
 }
 
+// Numbers for people, in rviz's font too: no e-notation that wraps, no superscript digits.
+TEST(RunView, NumbersAreWrittenWithoutENotation) {
+  EXPECT_EQ(collision_lab_ros::numberText(2.119e8), "2.119×10^8");
+  EXPECT_EQ(collision_lab_ros::numberText(1.2e-7), "1.2×10^-7");
+  EXPECT_EQ(collision_lab_ros::numberText(0.0065), "0.0065");
+  EXPECT_EQ(collision_lab_ros::numberText(12.0), "12");
+}
+
 TEST(RunView, NotSimulatedRunClaimsNoSimulatedCount) {
   auto in = input({100, 1, kInf}, {2, 1, 0}, {-1, 0, 0});
   in.max_collisions = 10;
@@ -80,6 +88,11 @@ TEST(RunView, NotSimulatedRunClaimsNoSimulatedCount) {
   EXPECT_EQ(*view.predicted_collisions, 31u);
   EXPECT_EQ(view.counter.find("finished"), std::string::npos) << view.counter;
   EXPECT_NE(view.counter.find("predicted 31 collisions"), std::string::npos) << view.counter;
+  // The note is true on the page (no plots, the model's answer) and in rviz (the closed
+  // form's final velocities as dots). (Failed before: "the plots show ...".)
+  EXPECT_EQ(view.note.find("plots"), std::string::npos) << view.note;
+  EXPECT_NE(view.note.find("no collision simulated"), std::string::npos) << view.note;
+  EXPECT_NE(view.note.find("the final velocities shown are the closed form's"), std::string::npos) << view.note;
 }
 
 TEST(RunView, TruncatedRunSaysSoInOneSentence) {

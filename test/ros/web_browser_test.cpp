@@ -268,6 +268,11 @@ TEST_F(RunPageViewTest, BoxOfManyBodiesHasItsLegend) {
   const std::string dom = finalPage({{"student", "view"}, {"preset", "granular_box_1000"}, {"max_collisions", 2000}});
   EXPECT_NE(dom.find("box: walls at both ends"), std::string::npos) << dom.substr(0, 2000);
   EXPECT_NE(dom.find("24 of 1,002 bodies, evenly spaced, the outermost two included"), std::string::npos);
+  // One colour per body, rviz's (the view's): each body's start velocity's, not ten
+  // repeating ones, and the page says what they mean. (Failed before: the sketch drew the
+  // shown bodies in the palette's ten colours, the others grey.)
+  EXPECT_NE(dom.find("Colour: velocity at the start, blue: moving left"), std::string::npos);
+  EXPECT_GT(bodyData(dom, "scene-colours"), 100.0);
   // A gas (e = 0.9): T(t) on log-log axes with Haff's law fitted.
   EXPECT_NE(dom.find("Haff's law T = T0 / (1 + t/τ)² fitted: T0 = "), std::string::npos);
   EXPECT_GT(bodyData(dom, "temperature-points"), 10.0);

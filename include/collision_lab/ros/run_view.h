@@ -22,7 +22,7 @@ namespace collision_lab_ros {
 struct ViewBody {
   std::size_t index = 0;
   std::string name;    ///< "A", "B", ... (core::bodyName)
-  std::string colour;  ///< "#rrggbb", rviz's palette (layout::kParticleRgb)
+  std::string colour;  ///< "#rrggbb", RunView::body_colours[index]: what rviz draws for it
 };
 
 struct RunView {
@@ -62,6 +62,19 @@ struct RunView {
   std::string state;                           ///< "running", "finished", "not simulated", "truncated"
   std::string counter;                         ///< e.g. "31 collisions, finished"
 
+  /// One colour per body, decided here for every view (rviz draws these bytes exactly,
+  /// r/255; the page these hexes): while rviz's palette has a colour for every body of the
+  /// scene (at most layout::kPaletteSize bodies), body i has palette colour i (A red, B green,
+  /// C blue, ...); beyond that, its velocity at the start on a diverging map (blue: moving
+  /// left at colour_scale or faster, white: at rest, red: moving right at colour_scale), so
+  /// that no two bodies far apart share a colour by their index. Walls are grey either way.
+  bool colour_by_start_velocity = false;
+  double colour_scale = 0.0;  ///< [m/s] the map's ends: the start's largest |v| (0 with the palette)
+  std::vector<std::string> body_colours;  ///< "#rrggbb" of body i, one per body of the scene
+  /// What the colours mean, as rviz and the page both say it ("" with the palette: each body
+  /// is named in its colour where it is drawn).
+  std::string colour_legend;
+
   /// Bodies with a worldline on the x-t diagram and with their own velocity steps, and why.
   std::vector<ViewBody> worldline_bodies, velocity_bodies;
   std::string worldline_legend, velocity_legend;
@@ -81,8 +94,11 @@ struct RunView {
 
 /// "1 collision", "31,415 collisions".
 std::string collisionsText(std::uint64_t n);
-/// "#rrggbb" of rviz's colour of body i.
+/// "#rrggbb" of rviz's palette colour i (layout::kParticleRgb, repeating).
 std::string bodyColourHex(std::size_t i);
+/// A number for people: "%.4g" without e-notation ("0.0065", "2.119 × 10^8"): rviz's font
+/// has code points below 1000 only, so no superscript digits.
+std::string numberText(double value);
 
 RunView makeRunView(const RunRecord& run);
 

@@ -53,10 +53,10 @@ void drawClusters(const Canvas& c, const SceneState& state) {
     }
     if (k < kMaxClusterNames) {
       names += (k ? ", " : "") + bodyName(first) + (last == first + 1 ? "+" : "..") + bodyName(last) +
-               format(" (%.0f)", static_cast<double>(last - first + 1));
+               " (" + withSeparators(last - first + 1) + ")";
     }
   }
-  if (clusters.size() > kMaxClusterNames) names += format(" and %.0f more", static_cast<double>(clusters.size() - kMaxClusterNames));
+  if (clusters.size() > kMaxClusterNames) names += " and " + withSeparators(clusters.size() - kMaxClusterNames) + " more";
   if (clusters.empty()) {
     c.add(deleteMarker(ns::kClusters, kClusterRings, c.frame_id));
     c.add(deleteMarker(ns::kClusters, kClusterLabel, c.frame_id));

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <stdexcept>
 
 #include "collision_lab/core/nbody/scene.h"
 
@@ -17,9 +18,16 @@ std_msgs::ColorRGBA color(const Rgba& c) {
   return out;
 }
 
-std_msgs::ColorRGBA particleColor(std::size_t i, double lighten) {
-  const Rgba& c = kParticleRgb[i % kPaletteSize];
-  return color({c.r + (1 - c.r) * lighten, c.g + (1 - c.g) * lighten, c.b + (1 - c.b) * lighten});
+std_msgs::ColorRGBA bodyColor(const RunView& view, std::size_t i, double lighten) {
+  unsigned r = 0, g = 0, b = 0;
+  if (i >= view.body_colours.size() || std::sscanf(view.body_colours[i].c_str(), "#%02x%02x%02x", &r, &g, &b) != 3) {
+    throw std::logic_error("the view has no colour of body " + bodyName(i));
+  }
+  const auto channel = [lighten](unsigned byte) {
+    const double c = byte / 255.0;
+    return lighten == 0.0 ? c : c + (1 - c) * lighten;
+  };
+  return color({channel(r), channel(g), channel(b)});
 }
 
 std_msgs::ColorRGBA velocityColor(double v, double v_max) {

@@ -26,7 +26,7 @@ void drawEnergyBarsAxis(const Canvas& c) {
     for (std::size_t i = 0; i < n; ++i) {
       const bool wall = isWall(c.run.input(), i);
       c.add(c.text(ns::kEnergy, kEnergyBodyNames + static_cast<int>(i), barX(i, n), kBarsBox.bottom + kBarNameDy,
-                   wall && n <= 3 ? bodyName(i) + " (wall)" : bodyName(i), kSmallTextSize, particleColor(i)));
+                   wall && n <= 3 ? bodyName(i) + " (wall)" : bodyName(i), kSmallTextSize, bodyColor(c.view, i)));
     }
   }
   c.add(c.text(ns::kEnergy, kEnergyTitle, kBarsBox.midX(), kBarsBox.top + kBarsTitleDy,
@@ -55,7 +55,7 @@ void drawEnergyBars(const Canvas& c, const SceneState& state) {
     Marker bar = c.base(ns::kEnergyBars, kEnergyBar + static_cast<int>(i), Marker::CUBE);
     bar.pose.position = point(barX(i, n), kBarsBox.bottom + h / 2);
     bar.scale.x = kBarWidth * pitch(n), bar.scale.y = h, bar.scale.z = kBarDepth;
-    bar.color = particleColor(i);
+    bar.color = bodyColor(c.view, i);
     c.add(bar);
     // Values wider than the pitch alternate between two heights, so neighbours stay apart.
     const std::string value = format("%.3g", kinetic[i]);

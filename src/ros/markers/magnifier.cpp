@@ -40,7 +40,7 @@ Marker zoomBody(const Canvas& c, const ZoomWindow& window, std::size_t i, double
   body.scale.x = wall ? kZoomWallWidth : (small ? kZoomLightSize : kZoomHeavySize);
   body.scale.y = wall ? kZoomWallHeight : body.scale.x;
   body.scale.z = body.scale.x;
-  body.color = wall ? color(kGrey) : particleColor(i);
+  body.color = bodyColor(c.view, i);
   return body;
 }
 

@@ -31,22 +31,23 @@ double massShare(double m, const std::pair<double, double>& range) {
   return std::clamp(std::log10(m / range.first) / decades, 0.0, 1.0);
 }
 
-/// A wall as a slab on its outer side of x (body 0 on the right).
-Marker wallMarker(const Canvas& c, int id, bool right, double x) {
+/// Wall i as a slab on its outer side of x (body 0 on the right).
+Marker wallMarker(const Canvas& c, int id, std::size_t i, double x) {
+  const bool right = i == 0;
   Marker m = c.base(ns::kBodies, id, Marker::CUBE);
   m.pose.position = point(x + (right ? kWallWidth / 2 : -kWallWidth / 2), kSceneY);
   m.scale.x = kWallWidth, m.scale.y = kWallHeight, m.scale.z = kWallDepth;
-  m.color = color(kGrey);
+  m.color = bodyColor(c.view, i);
   return m;
 }
 
 /// A body as a sphere sized by its mass.
 Marker bodyMarker(const Canvas& c, std::size_t i, double x, const std::pair<double, double>& range) {
-  if (isWall(c.run.input(), i)) return wallMarker(c, kBody + static_cast<int>(i), i == 0, x);
+  if (isWall(c.run.input(), i)) return wallMarker(c, kBody + static_cast<int>(i), i, x);
   Marker m = c.base(ns::kBodies, kBody + static_cast<int>(i), Marker::SPHERE);
   m.pose.position = point(x, kSceneY);
   m.scale.x = m.scale.y = m.scale.z = kSmallestBody + kBodyGrowth * massShare(c.run.input().masses[i], range);
-  m.color = particleColor(i);
+  m.color = bodyColor(c.view, i);
   return m;
 }
 
@@ -133,19 +134,19 @@ void drawLabelledBodies(const Canvas& c, const SceneState& state, const SceneAxi
     c.add(bodyMarker(c, i, x[i], range));
     // A short tag beside the body, the value in a fixed row.
     c.add(c.text(ns::kLabels, kBodyTag + static_cast<int>(i), tags[i].first, tags[i].second, tagOf(c.run, i),
-                 kTextSize, particleColor(i, kTagLighten)));
+                 kTextSize, bodyColor(c.view, i, kTagLighten)));
     const double row_x = kCentreX + pitch * (static_cast<double>(i) - (static_cast<double>(n) - 1) / 2);
     c.add(c.text(ns::kLabels, kVelocityRow + static_cast<int>(i), row_x, kVelocityRowY,
                  "v_" + bodyName(i) + " = " + withSign(fmt, state.velocities[i]) + " m/s",
                  n <= 3 ? kTextSize : kSmallTextSize,
-                 particleColor(i, kTagLighten)));
+                 bodyColor(c.view, i, kTagLighten)));
   }
 }
 
-/// Many bodies: one list per mass class, each body coloured by its velocity; walls as walls.
+/// Many bodies: one list per mass class, each body in its colour (its start velocity's);
+/// walls as walls.
 void drawManyBodies(const Canvas& c, const SceneState& state, const SceneAxis& axis) {
   const auto range = massRange(c.run.input());
-  const double v_max = velocityScale(c.run);
   std::vector<Marker> classes;
   for (int k = 0; k < kMassClasses; ++k) {
     Marker m = c.dots(ns::kBodies, kBodyClass + k, kManyBodySize + kManyBodyGrowth * k, color(kWhite));
@@ -155,12 +156,12 @@ void drawManyBodies(const Canvas& c, const SceneState& state, const SceneAxis& a
   for (std::size_t i = 0; i < n; ++i) {
     const double x = axis.toX(state.positions[i]);
     if (isWall(c.run.input(), i)) {
-      c.add(wallMarker(c, kBodyWall + (i == 0 ? 0 : 1), i == 0, x));
+      c.add(wallMarker(c, kBodyWall + (i == 0 ? 0 : 1), i, x));
       continue;
     }
     const int k = std::min(kMassClasses - 1, static_cast<int>(massShare(c.run.input().masses[i], range) * kMassClasses));
     classes[static_cast<std::size_t>(k)].points.push_back(point(x, kSceneY));
-    classes[static_cast<std::size_t>(k)].colors.push_back(velocityColor(state.velocities[i], v_max));
+    classes[static_cast<std::size_t>(k)].colors.push_back(bodyColor(c.view, i));
   }
   for (Marker& m : classes) {
     if (m.points.empty()) c.add(deleteMarker(ns::kBodies, m.id, c.frame_id));
@@ -168,9 +169,10 @@ void drawManyBodies(const Canvas& c, const SceneState& state, const SceneAxis& a
   }
 }
 
-/// The legend of the colour by velocity: a bar from -v_max to +v_max.
+/// The legend of the colour by the start velocity: a bar from -v_max to +v_max, and the
+/// view's words for it.
 void drawColourLegend(const Canvas& c) {
-  const double v_max = velocityScale(c.run);
+  const double v_max = c.view.colour_scale;
   const Box& b = kColourBarBox;
   Marker bar = c.base(ns::kScene, kColourBar, Marker::CUBE_LIST);
   const double step = (b.right - b.left) / kColourBarSteps;
@@ -180,13 +182,17 @@ void drawColourLegend(const Canvas& c) {
     bar.colors.push_back(velocityColor(-v_max + (k + 0.5) * 2 * v_max / kColourBarSteps, v_max));
   }
   c.add(bar);
-  c.add(c.text(ns::kScene, kColourMin, b.left - kColourLabelDx, b.midY(), format("%.3g m/s", -v_max), kSmallTextSize,
+  // The ends in the legend's numbers.
+  c.add(c.text(ns::kScene, kColourMin, b.left - kColourLabelDx, b.midY(), "-" + numberText(v_max) + " m/s", kSmallTextSize,
                color(kLabelGrey)));
-  c.add(c.text(ns::kScene, kColourMax, b.right + kColourLabelDx, b.midY(), format("+%.3g m/s", v_max), kSmallTextSize,
+  c.add(c.text(ns::kScene, kColourMax, b.right + kColourLabelDx, b.midY(), "+" + numberText(v_max) + " m/s", kSmallTextSize,
                color(kLabelGrey)));
   c.add(c.text(ns::kScene, kColourCaption, b.midX(), b.top + kFrameLabelDy,
-               "colour: velocity v [m/s] (clipped at the start's largest |v|); size: mass (log)", kSmallTextSize,
-               color(kLabelGrey)));
+               c.view.colour_legend, kSmallTextSize, color(kLabelGrey)));
+  // Beside the bar, so that the caption above stays clear of the walls.
+  const std::string size = "size: mass (log)";
+  c.add(c.text(ns::kScene, kColourSize, b.right + 2 * kColourLabelDx + textWidth(size, kSmallTextSize) / 2, b.midY(),
+               size, kSmallTextSize, color(kLabelGrey)));
 }
 
 /// Large scenes: the bodies' spread now, so a gas that ends 1e8 m wide still shows its first
@@ -243,7 +249,7 @@ void drawSceneAxis(const Canvas& c) {
   if (!largeScene(c.run)) addRangeLabels(c, ns::kScene, kSceneMinLabel, kSceneMaxLabel, sceneAxis(c.run));
   const std::string& note = c.view.note;
   if (!note.empty()) c.add(c.text(ns::kScene, kSceneNote, kCentreX, kNoteY, note, kTextSize, color(kAmber)));
-  if (largeScene(c.run)) drawColourLegend(c);
+  if (c.view.colour_by_start_velocity) drawColourLegend(c);
 }
 
 void drawBodies(const Canvas& c, const SceneState& state) {

@@ -100,7 +100,7 @@ bool addPaperSeries(const Canvas& c, const Axes& axes, std::size_t i, int id) {
 /// when the steps do not get there), as dots on the steps; true when there are any.
 bool addPredictedDots(const Canvas& c, const Axes& axes, std::size_t i, int id) {
   const auto final_v = finalVelocitiesNotDrawn(c.run);
-  Marker predicted = c.dots(ns::kPlot, id, kPredictedDotSize, particleColor(i, kDotLighten));
+  Marker predicted = c.dots(ns::kPlot, id, kPredictedDotSize, bodyColor(c.view, i, kDotLighten));
   for (const Keyframe* f : thinned(c.run.keyframes(), kMaxPredictedDots)) {
     if (i < f->predicted.size() && f->index + 0.5 < axes.x1) predicted.points.push_back(point(axes.toX(f->index + 0.5), axes.toY(f->predicted[i]), kDotZ));
   }
@@ -121,18 +121,18 @@ void addVelocityPanel(const Canvas& c, const VelocityPanel& panel, int p, std::s
   const std::string label = panels == 1 ? "v [m/s]" : p == 0 ? "v_B [m/s]" : "v_A, v_C [m/s]";
   addFrame(c, ns::kPlot, base + kPlotFrame, panel.axes, label);
   if (largeScene(c.run)) {
-    // The tracked bodies' steps, coloured by their start velocity as in the x-t diagram; no
+    // The tracked bodies' steps, in their colours (the view's, as in the x-t diagram); no
     // closed form or paper's series for many bodies.
     for (std::size_t k = 0; k < panel.bodies.size(); ++k) {
       const std::size_t i = panel.bodies[k];
       addSeries(c, ns::kPlot, kPlotTracked + static_cast<int>(k), shownSteps(c.run, stepsOf(c.run, i)), panel.axes,
-                velocityColor(c.run.input().velocities[i], velocityScale(c.run)), kCursorWidth);
+                bodyColor(c.view, i), kCursorWidth);
     }
     return;
   }
   for (std::size_t i : panel.bodies) {
     const int b = static_cast<int>(i);
-    addSeries(c, ns::kPlot, base + kPlotSeries + b, shownSteps(c.run, c.run.velocity(i)), panel.axes, particleColor(i));
+    addSeries(c, ns::kPlot, base + kPlotSeries + b, shownSteps(c.run, c.run.velocity(i)), panel.axes, bodyColor(c.view, i));
     paper.dots = addPredictedDots(c, panel.axes, i, base + kPlotPredicted + b) || paper.dots;
     paper.any = paper.any || !c.run.paperVelocity(i).empty();
     paper.off_scale = addPaperSeries(c, panel.axes, i, base + kPlotPaper + b) || paper.off_scale;
@@ -154,8 +154,7 @@ void addVelocityLegend(const Canvas& c, bool own_scale, const PaperShown& paper)
   if (const auto period = periodOf(c.run)) {
     legend += "   periodic: one period drawn (" + withSeparators(period->impacts) + " impacts)";
   }
-  // Many bodies: which ones, as the page says it (their colour is v at the start, as in the
-  // x-t diagram and the scene's colour bar).
+  // Many bodies: which ones, as the page says it (their colours: the scene's colour bar).
   if (largeScene(c.run)) legend = c.view.velocity_legend;
   c.add(c.text(ns::kPlot, kPlotLegend, kVelocityBox.midX(), kLegendY, legend, kSmallTextSize, color(kLabelGrey)));
   if (largeScene(c.run)) return;
@@ -163,7 +162,7 @@ void addVelocityLegend(const Canvas& c, bool own_scale, const PaperShown& paper)
   for (std::size_t k = 0; k < shown.size(); ++k) {
     const int id = kPlotSeriesNames + static_cast<int>(shown[k].index);
     c.add(c.text(ns::kPlot, id, kVelocityBox.right + kSeriesNameDx, kVelocityBox.top - kSeriesNamePitch * static_cast<double>(k),
-                 "v_" + shown[k].name, shown.size() <= 3 ? kTextSize : kSmallTextSize, particleColor(shown[k].index)));
+                 "v_" + shown[k].name, shown.size() <= 3 ? kTextSize : kSmallTextSize, bodyColor(c.view, shown[k].index)));
   }
 }
 
@@ -187,7 +186,7 @@ void addEnergyPlot(const Canvas& c, const std::string& label) {
   addFrame(c, ns::kConserved, kConservedEnergy, axes, label);
   for (std::size_t i : run.plottedBodies()) {
     addSeries(c, ns::kConserved, kConservedEnergy + kConservedBodies + static_cast<int>(i),
-              shownSteps(run, run.bodyEnergy(i)), axes, particleColor(i), kCursorWidth);
+              shownSteps(run, run.bodyEnergy(i)), axes, bodyColor(c.view, i), kCursorWidth);
   }
   addSeries(c, ns::kConserved, kConservedEnergy + kConservedSeries, shownSteps(run, run.energy()), axes, color(kWhite),
             kConservedWidth);

@@ -46,8 +46,13 @@ LogAxes logAxes(const Samples& samples) {
   return out;
 }
 
-/// 10^exponent as "0.01", "1", "1e+05".
-std::string decade(double exponent) { return format("%g", std::pow(10.0, exponent)); }
+/// 10^exponent as "0.01", "1", "10,000", "10^6", "10^-5": no e-notation (rviz's font has no
+/// superscript digits but ² and ³).
+std::string decade(double exponent) {
+  const std::string text = format("%g", std::pow(10.0, exponent));
+  if (text.find('e') != std::string::npos) return format("10^%.0f", exponent);
+  return exponent >= 3 ? withSeparators(static_cast<std::uint64_t>(std::pow(10.0, exponent) + 0.5)) : text;
+}
 
 }  // namespace
 

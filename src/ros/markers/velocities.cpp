@@ -80,7 +80,7 @@ void drawProfileNow(const Canvas& c, const SceneState& state) {
   for (std::size_t i = 0; i < n; ++i) {
     // Body 0 (the rightmost) on the right, as in the scene.
     dots.points.push_back(point(axes.toX(static_cast<double>(n - 1 - i)), axes.toY(state.velocities[i]), kDotZ));
-    dots.colors.push_back(isWall(c.run.input(), i) ? color(kGrey) : particleColor(i));
+    dots.colors.push_back(bodyColor(c.view, i));
   }
   if (!dots.points.empty()) c.add(dots);
 }

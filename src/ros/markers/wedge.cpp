@@ -155,8 +155,8 @@ void addWedgeLegend(const Canvas& c, const std::vector<const Keyframe*>& shown, 
   const auto collapses = static_cast<std::uint64_t>(
       std::count_if(shown.begin(), shown.end(), [](const Keyframe* f) { return f->collapse; }));
   const std::uint64_t impacts = shown.size() - collapses;
-  std::string which = impacts == run.collisions() ? (collapses > 0 ? withSeparators(impacts) + " collisions" : "each collision")
-                                                  : withSeparators(impacts) + " of " + withSeparators(run.collisions()) + " collisions";
+  std::string which = impacts == run.collisions() ? (collapses > 0 ? collisionsText(impacts) : "each collision")
+                                                  : withSeparators(impacts) + " of " + collisionsText(run.collisions());
   if (collapses > 0) which += collapses == 1 ? " and a collapse" : " and " + withSeparators(collapses) + " collapses";
   c.add(c.text(ns::kWedge, kWedgeKey, kWedgeX, kLegendY, wrapped("orange: u_perp after " + which, kSmallTextSize, kLeftTextWidth),
                kSmallTextSize, color(kLabelGrey)));

@@ -123,16 +123,13 @@ void addGhosts(const Canvas& c, const std::string& ns, int id, const WorldAxes& 
   c.addLines(ghosts);
 }
 
-/// Body i's worldline (time up, position across): grey and thick for a wall, else its colour
-/// (large scenes: its start velocity's). On a ring the positions are wrapped into [0, L), so
+/// Body i's worldline (time up, position across) in its colour (the view's), thick for a wall. On a ring the positions are wrapped into [0, L), so
 /// a step across the seam is cut there: drawn to one edge of [0, L) and on from the other,
 /// each step taken the shorter way round (a body moves less than L/2 between two vertices).
 void addWorldline(const Canvas& c, const std::string& ns, int id, std::size_t i, const Polyline& poly,
                   const WorldAxes& axes) {
   const bool wall = isWall(c.run.input(), i);
-  const auto colour = wall ? color(kGrey)
-                           : largeScene(c.run) ? velocityColor(c.run.input().velocities[i], velocityScale(c.run))
-                                               : particleColor(i);
+  const auto colour = bodyColor(c.view, i);
   const double ring = c.run.input().ring;
   Marker line =
       c.lines(ns, id, ring > 0 ? Marker::LINE_LIST : Marker::LINE_STRIP, wall ? kWallLineWidth : kBodyLineWidth, colour);

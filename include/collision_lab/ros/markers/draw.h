@@ -28,9 +28,9 @@ using Polyline = std::vector<Envelope::Vertex>;
 
 // ---- primitives ----
 std_msgs::ColorRGBA color(const Rgba& c);
-/// Body i's colour (a palette of layout::kPaletteSize), lightened towards white by
-/// `lighten` (0..1).
-std_msgs::ColorRGBA particleColor(std::size_t i, double lighten = 0.0);
+/// Body i's colour as the view decided it (RunView::body_colours: the same bytes the page
+/// draws), lightened towards white by `lighten` (0..1) for texts.
+std_msgs::ColorRGBA bodyColor(const RunView& view, std::size_t i, double lighten = 0.0);
 /// Velocity v [m/s] on a diverging map: blue at -v_max, white at 0, red at +v_max
 /// (clipped beyond).
 std_msgs::ColorRGBA velocityColor(double v, double v_max);
@@ -61,12 +61,13 @@ std::string wrapped(const std::string& s, double size, double width);
 std::array<double, 3> toArray3(const std::vector<double>& a);
 bool isWall(const collision_lab::InitialConditions& input, std::size_t i);
 /// Largest |v| [m/s] of the finite bodies at the start (1 when all are at rest): the
-/// scale of the colour by velocity.
+/// scale of the colour by velocity (RunView::colour_scale).
 double velocityScale(const RunRecord& run);
 /// Which view takes the wedge's place (markers/ids.h: ns kWedge or kVelocities).
 enum class SideView { kWedge, kVelocityProfile, kHistogram };
 SideView sideView(const RunRecord& run);
-/// More bodies than each can be labelled: colour by velocity, sums in the plots.
+/// More bodies than each can be labelled: sums in the plots (and, as RunView decides it,
+/// colours by the start velocity).
 bool largeScene(const RunRecord& run);
 
 /// Where a view draws: the run, its view description (the texts, the bodies shown and the

@@ -46,7 +46,8 @@ enum MarkerId : int {
   kColourBar = 5,  ///< large scenes: the colour by velocity's legend
   kColourMin = 6,
   kColourMax = 7,
-  kColourCaption = 8,
+  kColourCaption = 8,  ///< what the colours mean: RunView::colour_legend
+  kColourSize = 9,     ///< "size: mass (log)", right of the bar
 
   // a plot frame (addFrame): base + these
   kFrameLines = 0,
