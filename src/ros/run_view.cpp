@@ -142,7 +142,7 @@ void decideColours(const RunRecord& run, RunView& view) {
   if (view.colour_by_start_velocity) {
     const std::string v = numberText(view.colour_scale);
     view.colour_legend = "colour: velocity at the start, blue: moving left (deepest at -" + v +
-                         " m/s), white: at rest, red: moving right (deepest at +" + v + " m/s)";
+                         " m/s), purple: at rest, red: moving right (deepest at +" + v + " m/s)";
   }
 }
 

@@ -675,8 +675,9 @@ TEST(RunBookView, PageAndRvizGetTheSameBodyColours) {
     }
   }
   EXPECT_EQ(scene, view.at("body_colours").get<std::vector<std::string>>());
-  // Bodies at rest are white, moving left blue, moving right red: three colours, not twelve.
-  EXPECT_EQ(view.at("body_colours").at(2), "#ffffff");
+  // Bodies at rest are purple (layout::kRestPurple: 0.62, 0.42, 0.72), moving left blue,
+  // moving right red: three colours, not twelve.
+  EXPECT_EQ(view.at("body_colours").at(2), "#9e6bb8");
   EXPECT_NE(view.at("body_colours").at(0), view.at("body_colours").at(1));
 }
 

@@ -66,7 +66,7 @@ struct RunView {
   /// r/255; the page these hexes): while rviz's palette has a colour for every body of the
   /// scene (at most layout::kPaletteSize bodies), body i has palette colour i (A red, B green,
   /// C blue, ...); beyond that, its velocity at the start on a diverging map (blue: moving
-  /// left at colour_scale or faster, white: at rest, red: moving right at colour_scale), so
+  /// left at colour_scale or faster, purple: at rest, red: moving right at colour_scale), so
   /// that no two bodies far apart share a colour by their index. Walls are grey either way.
   bool colour_by_start_velocity = false;
   double colour_scale = 0.0;  ///< [m/s] the map's ends: the start's largest |v| (0 with the palette)

@@ -34,7 +34,8 @@ std_msgs::ColorRGBA velocityColor(double v, double v_max) {
   const double f = std::isfinite(v) && v_max > 0 ? std::clamp(v / v_max, -1.0, 1.0) : 0.0;
   const Rgba& end = f < 0 ? kSlowBlue : kFastRed;
   const double a = std::abs(f);
-  return color({1 + (end.r - 1) * a, 1 + (end.g - 1) * a, 1 + (end.b - 1) * a});
+  const Rgba& rest = kRestPurple;
+  return color({rest.r + (end.r - rest.r) * a, rest.g + (end.g - rest.g) * a, rest.b + (end.b - rest.b) * a});
 }
 
 std::string bodyName(std::size_t i) { return collision_lab::core::bodyName(i); }

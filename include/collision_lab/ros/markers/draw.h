@@ -31,7 +31,7 @@ std_msgs::ColorRGBA color(const Rgba& c);
 /// Body i's colour as the view decided it (RunView::body_colours: the same bytes the page
 /// draws), lightened towards white by `lighten` (0..1) for texts.
 std_msgs::ColorRGBA bodyColor(const RunView& view, std::size_t i, double lighten = 0.0);
-/// Velocity v [m/s] on a diverging map: blue at -v_max, white at 0, red at +v_max
+/// Velocity v [m/s] on a diverging map: blue at -v_max, purple at 0, red at +v_max
 /// (clipped beyond).
 std_msgs::ColorRGBA velocityColor(double v, double v_max);
 /// "A", "B", ... (core::bodyName).

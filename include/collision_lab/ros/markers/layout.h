@@ -53,9 +53,11 @@ constexpr std::size_t kPaletteSize = 10;
 constexpr Rgba kParticleRgb[kPaletteSize] = {
     {0.95, 0.25, 0.25}, {0.25, 0.8, 0.3}, {0.3, 0.55, 1.0}, {1.0, 0.75, 0.2}, {0.75, 0.45, 1.0},
     {0.2, 0.85, 0.85},  {1.0, 0.5, 0.75}, {0.65, 0.8, 0.25}, {1.0, 0.55, 0.3}, {0.6, 0.6, 0.95}};
-/// The ends of the diverging colour map of velocity (white at 0).
+/// The diverging colour map of velocity: its ends, and purple at rest, seen on rviz's dark
+/// background and on the page's white one alike (white at rest vanished on the page).
 constexpr Rgba kSlowBlue{0.2, 0.4, 1.0};
 constexpr Rgba kFastRed{1.0, 0.2, 0.15};
+constexpr Rgba kRestPurple{0.62, 0.42, 0.72};
 constexpr Rgba kWhite{0.95, 0.95, 0.95};
 constexpr Rgba kGrey{0.6, 0.6, 0.6};
 /// Small grey text lighter than lines: rviz draws a minus sign one pixel thin.
