@@ -156,6 +156,8 @@ class CL_NBODY_INTERNAL Tier {
   }
 
   bool pending() const { return tree_.minKey() < kInf; }
+  /// A lower bound of the next impact's time [s] (inf: none is due).
+  double nextTimeLowerBound() const { return tree_.minKey(); }
   std::uint64_t count() const { return count_; }
   std::uint64_t refinements() const { return refinements_; }
   std::uint64_t clusterImpacts() const { return cluster_impacts_; }
