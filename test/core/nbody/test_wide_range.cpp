@@ -66,6 +66,20 @@ TEST(WideRange, AFourBodyChainWithImpactsAfter2To900SecondsRunsToTheEnd) {
   EXPECT_LE(run.energy_relative_drift, 1e-15);
 }
 
+// A pair whose approach would end only far beyond 2^900 s (C and D creep at 1e-300 m/s
+// across 1e210 m) waits, parked; the impacts before it run, and here it never comes. It
+// used to stop the run at once, OUT_OF_RANGE.
+TEST(WideRange, APairApproachingBeyondTheRangeDoesNotStopTheImpactsBeforeIt) {
+  const Scene scene = reference::makeScene({1, 2, 3, 4}, {1, 0, -1e210, -2e210}, {-1, 0, 1e-300, 2e-300}, 1.0);
+  ASSERT_FALSE(validate(scene)) << validate(scene)->message;
+  const reference::Run exact = reference::simulate(scene, 1000);
+  ASSERT_FALSE(exact.truncated);
+  const EngineResult run = runKeepingEvents(scene);
+  EXPECT_EQ(run.stop, StopReason::kFinished) << run.stop_message;
+  EXPECT_EQ(run.impact_count, exact.events.size());
+  expectCloseToReference(scene, run, exact, "creeping pair");
+}
+
 // The same chain inelastic (e = 0.5), so the heat is scaled back too.
 TEST(WideRange, AnInelasticChainAfter2To900SecondsKeepsItsHeat) {
   const Scene scene = reference::makeScene({1, 2, 3, 4}, {1, 0, -1e210, -2e210}, {-1e-61, 0, 1e-61, 2e-61}, 0.5);
