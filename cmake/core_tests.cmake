@@ -43,7 +43,8 @@ catkin_add_gtest(collision_lab_nbody_tests
   test/core/nbody/test_sticking_clusters.cpp
   test/core/nbody/test_sticky_model.cpp
   test/core/nbody/test_two_body_any_ratio.cpp
-  test/core/nbody/test_ring_events.cpp)
+  test/core/nbody/test_ring_events.cpp
+  test/core/nbody/test_wide_range.cpp)
 if(TARGET collision_lab_nbody_tests)
   target_link_libraries(collision_lab_nbody_tests collision_lab_test_support GTest::gtest_main)
 endif()

@@ -14,6 +14,7 @@
 #include "float_ops.h"
 #include "impact_energy.h"
 #include "nbody/elastic_triple.h"
+#include "nbody/units.h"
 
 namespace collision_lab {
 namespace core {
@@ -221,41 +222,14 @@ class LabEvents {
   std::array<double, 3> previous_before_;
 };
 
-/// A double that is never -0 (outputs must not show "-0").
-double noNegativeZero(long double x) { return x == 0 ? 0.0 : static_cast<double>(x); }
-
-/// value times 2^shift, rounded once to double (never -0).
-double scaled(long double value, int shift) { return noNegativeZero(std::ldexp(value, shift)); }
-
-/// scaled() with the power of two made once: value * 2^shift is exact in long double (whose
-/// exponent range is far wider than any shift of doubles), so the result is scaled()'s,
-/// without a call to ldexp per value.
-class PowerOfTwo {
- public:
-  explicit PowerOfTwo(int shift) : factor_(std::ldexp(1.0L, shift)) {}
-  double operator()(long double value) const { return noNegativeZero(value * factor_); }
-
- private:
-  long double factor_;
-};
-
-/// The engine's working units: masses, velocities and positions scaled by exact powers of
-/// two towards 1, so that tiny or huge inputs keep their digits.
-struct WorkingUnits {
-  explicit WorkingUnits(const ThreeBodyScene& si)
-      : mass_shift(detail::shiftTowardsOne(si.masses)),
-        velocity_shift(detail::shiftTowardsOne(si.velocities)),
-        position_shift(detail::shiftTowardsOne(si.positions)),
-        scene{std::vector<double>(3), std::vector<double>(3), std::vector<double>(3), {}} {
-    for (int k = 0; k < 3; ++k) {
-      scene.masses[k] = std::ldexp(si.masses[k], mass_shift);
-      scene.positions[k] = std::ldexp(si.positions[k], position_shift);
-      scene.velocities[k] = std::ldexp(si.velocities[k], velocity_shift);
-    }
-  }
-  int mass_shift, velocity_shift, position_shift;
+/// The scene of the engine for three bodies.
+Scene asScene(const ThreeBodyScene& triple) {
   Scene scene;
-};
+  scene.masses.assign(triple.masses.begin(), triple.masses.end());
+  scene.positions.assign(triple.positions.begin(), triple.positions.end());
+  scene.velocities.assign(triple.velocities.begin(), triple.velocities.end());
+  return scene;
+}
 
 /// The run of three elastic bodies whose count the closed form gives (`count`), without the
 /// engine's queue or any decision (nbody/elastic_triple.h), for a run that publishes no
@@ -272,7 +246,7 @@ std::optional<SimulationResult> simulateKnownCount(const ThreeBodyScene& scene, 
   if (scene.isWall(0) && scene.isWall(2)) return std::nullopt;
   const std::optional<Pair> first = firstPair(scene);
   if (count > 0 && !first) return std::nullopt;
-  const WorkingUnits units(scene);
+  const nbody_detail::WorkingUnits units(asScene(scene));  // the engine's units (nbody/units.h)
   for (int p = 0; p < 2; ++p) {  // a heavy body's coefficient must not underflow
     const double light = std::min(units.scene.masses[p], units.scene.masses[p + 1]);
     const double heavy = std::max(units.scene.masses[p], units.scene.masses[p + 1]);
@@ -280,9 +254,10 @@ std::optional<SimulationResult> simulateKnownCount(const ThreeBodyScene& scene, 
   }
   const int shift = units.velocity_shift;
   const double to_si = std::ldexp(1.0, -shift);
-  const auto si = [to_si, shift](double v) {  // scaled(v, -shift), without ldexp where exact
+  const nbody_detail::PowerOfTwo velocity_si(-shift);
+  const auto si = [to_si, velocity_si](double v) {  // velocity_si(v), without long double where exact
     const double x = v * to_si;
-    return std::fabs(x) >= std::numeric_limits<double>::min() ? x : scaled(v, -shift);
+    return std::fabs(x) >= std::numeric_limits<double>::min() ? x : velocity_si(v);
   };
   const std::uint64_t every = progress ? progress_interval : 0;
   const std::optional<nbody_detail::ElasticTripleRun> run = nbody_detail::runElasticTriple(
@@ -300,7 +275,7 @@ std::optional<SimulationResult> simulateKnownCount(const ThreeBodyScene& scene, 
   EngineResult drift;
   drift.final_velocities.assign(run->final_velocities.begin(), run->final_velocities.end());
   nbody_detail::fillEngineDrift(units.scene, drift);
-  for (int k = 0; k < 3; ++k) result.final_velocities[k] = scaled(run->final_velocities[k], -shift);
+  for (int k = 0; k < 3; ++k) result.final_velocities[k] = velocity_si(run->final_velocities[k]);
   result.energy_relative_drift = drift.energy_relative_drift;
   result.momentum_relative_drift = drift.momentum_relative_drift;
   result.escalation.decisions = run->impact_count + 1;
@@ -308,45 +283,29 @@ std::optional<SimulationResult> simulateKnownCount(const ThreeBodyScene& scene, 
 }
 
 /// The three bodies' run by the exact event engine (nbody/engine.h), the one simulator of
-/// every scene: exact decisions and correctly rounded values, told as ImpactEvents. The
-/// engine runs in exact power-of-two units (masses, velocities and positions near 1, as the
-/// three-body simulator's working units), so that tiny or huge inputs keep their digits;
-/// values are scaled back with one rounding. An impact's pair comes from the engine's
-/// record; the third body's position at that time is computed here from its last impact
-/// (to rounding, in long double), and the totals after it from the velocities. Escalations:
-/// one decision per impact and the final one.
-/// Returns nothing when the engine stopped because a value would leave its safe range
-/// (2^900), which the three-body simulator's working units reach beyond: `told` impacts
-/// were then visited. A run the engine ended otherwise than finished, capped or cancelled
-/// is truncated, with the engine's sentence in `stopped_otherwise`.
+/// every scene: exact decisions and correctly rounded values, told as ImpactEvents (the
+/// engine runs in its working units, nbody/units.h, and gives SI values). An impact's pair
+/// comes from the engine's record; the third body's position at that time is computed here
+/// from its last impact (to rounding, in long double), and the totals after it from the
+/// velocities. Escalations: one decision per impact and the final one.
+/// Returns nothing when the engine stopped because a value would leave the range of a double
+/// (an impact after the largest double [s], which the three-body simulator reports as
+/// infinite): `told` impacts were then visited. A run the engine ended otherwise than
+/// finished, capped or cancelled is truncated, with the engine's sentence in `stopped_otherwise`.
 std::optional<SimulationResult> simulateByEngine(const ThreeBodyScene& scene, const SimulationOptions& options,
                                                  const ProgressCallback& progress, std::uint64_t progress_interval,
                                                  const EventVisitor& visitor, std::uint64_t& told,
                                                  std::string& stopped_otherwise) {
-  const WorkingUnits units(scene);
-  const int mass_shift = units.mass_shift, velocity_shift = units.velocity_shift;
-  const int position_shift = units.position_shift;
-  const int time_shift = velocity_shift - position_shift;  // to SI
-  const int energy_shift = -(mass_shift + 2 * velocity_shift);
-  const int momentum_shift = -(mass_shift + velocity_shift);
-  const Scene& working = units.scene;
   EngineOptions engine_options;
   engine_options.max_impacts = options.max_collisions;
   engine_options.progress_interval = progress ? progress_interval : 0;
   engine_options.cancel = options.cancel;
   SimulationResult result;
-  // In working units: velocities, and where body k was (since_position) at since_time[k].
-  std::array<double, 3> velocities{}, since_position{}, since_time{};
-  for (int k = 0; k < 3; ++k) {
-    velocities[k] = working.velocities[k];
-    since_position[k] = working.positions[k];
-  }
+  // Velocities, and where body k was (since_position) at since_time[k].
+  const auto positive = [](long double x) { return x == 0 ? 0.0 : static_cast<double>(x); };  // never -0
+  std::array<double, 3> velocities{}, since_position = scene.positions, since_time{};
+  for (int k = 0; k < 3; ++k) velocities[k] = positive(scene.velocities[k]);
   const int wall = scene.wallIndex();
-  const PowerOfTwo velocity_si(-velocity_shift), position_si(-position_shift), time_si(time_shift),
-      energy_si(energy_shift), momentum_si(momentum_shift);
-  const auto velocitiesSi = [&velocities, velocity_si] {
-    return std::array<double, 3>{velocity_si(velocities[0]), velocity_si(velocities[1]), velocity_si(velocities[2])};
-  };
   ImpactEvent event;
   ImpactVisitor on_impact;
   if (visitor) {
@@ -354,14 +313,14 @@ std::optional<SimulationResult> simulateByEngine(const ThreeBodyScene& scene, co
       const int i = static_cast<int>(record.pair_index);
       event.index = record.index;
       event.pair = i == 0 ? Pair::AB : Pair::BC;
-      event.time = time_si(record.time);
-      event.position = position_si(record.position);
-      event.velocities_before = velocitiesSi();
+      event.time = record.time;
+      event.position = record.position;
+      event.velocities_before = velocities;
       for (int k = 0; k < 3; ++k) {
         const long double elapsed = static_cast<long double>(record.time) - since_time[k];
         const long double position =
             velocities[k] == 0 ? since_position[k] : since_position[k] + velocities[k] * elapsed;
-        event.positions[k] = position_si(position);
+        event.positions[k] = positive(position);
         event.energy_transfer[k] = 0.0;
       }
       for (int side = 0; side < 2; ++side) {
@@ -374,23 +333,21 @@ std::optional<SimulationResult> simulateByEngine(const ThreeBodyScene& scene, co
       // Elastic: what one body gains the other loses, exactly (a wall's entry is minus the
       // ball's): the finite body's entry, or the left one's, sets both.
       const int side = scene.isWall(i) ? 1 : 0;
-      event.energy_transfer[i + side] = energy_si(record.energy_gained[side]);
-      event.energy_transfer[i + 1 - side] = energy_si(-static_cast<long double>(record.energy_gained[side]));
-      event.velocities_after = velocitiesSi();
+      event.energy_transfer[i + side] = record.energy_gained[side];
+      event.energy_transfer[i + 1 - side] = positive(-static_cast<long double>(record.energy_gained[side]));
+      event.velocities_after = velocities;
       long double energy = 0, momentum = 0;
       for (int k = 0; k < 3; ++k) {
         if (k == wall) continue;
-        energy += static_cast<long double>(working.masses[k]) * velocities[k] * velocities[k] / 2;
-        momentum += static_cast<long double>(working.masses[k]) * velocities[k];
+        energy += static_cast<long double>(scene.masses[k]) * velocities[k] * velocities[k] / 2;
+        momentum += static_cast<long double>(scene.masses[k]) * velocities[k];
       }
-      event.total_energy = energy_si(energy);
-      event.total_momentum = momentum_si(momentum);
+      event.total_energy = positive(energy);
+      event.total_momentum = positive(momentum);
       visitor(event);
     };
   }
-  ProgressCallback progress_si;  // the engine's times are in working units
-  if (progress) progress_si = [&](const EngineProgress& p) { progress(EngineProgress{p.impacts, time_si(p.time)}); };
-  EngineResult engine = runEngine(working, engine_options, on_impact, progress_si);
+  EngineResult engine = runEngine(asScene(scene), engine_options, on_impact, progress);
   told = engine.impact_count;
   if (engine.stop == StopReason::kOutOfRange) return std::nullopt;
   result.collision_count = engine.impact_count;
@@ -401,10 +358,10 @@ std::optional<SimulationResult> simulateByEngine(const ThreeBodyScene& scene, co
   }
   result.first_pair = firstPair(scene);
   for (int k = 0; k < 3; ++k) {
-    result.final_velocities[k] = scaled(engine.final_velocities[k], -velocity_shift);
-    result.final_positions[k] = scaled(engine.final_positions[k], -position_shift);
+    result.final_velocities[k] = engine.final_velocities[k];
+    result.final_positions[k] = engine.final_positions[k];
   }
-  result.final_time = scaled(engine.final_time, time_shift);
+  result.final_time = engine.final_time;
   result.energy_relative_drift = engine.energy_relative_drift;
   result.momentum_relative_drift = engine.momentum_relative_drift;
   result.escalation.decisions = engine.impact_count + 1;

@@ -1,8 +1,10 @@
 // One lab run: prediction first, then the simulation with every event put beside the
 // closed-form prediction and the paper's printed formulas. The simulation is the exact
 // event engine's (nbody/engine.h), as for every scene: exact decisions and correctly
-// rounded velocities. Only a run whose values leave the engine's safe range (2^900) is
-// finished by the three-body simulator (simulation.h; exact decisions, velocities within a
+// rounded velocities, in the engine's working units wherever the scene lies in the double
+// range. Only a run the engine stops as out of range (an impact after the largest double, or
+// scales spread wider than its working units bring into range) is finished by the
+// three-body simulator (simulation.h; exact decisions, velocities within a
 // few units in the last place), which reaches to the largest double. Shared by the CLI, the ROS
 // node and the benchmarks, so all of them report the same numbers.
 #pragma once

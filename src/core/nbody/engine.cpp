@@ -13,6 +13,7 @@
 #include "collision_lab/core/count_text.h"
 #include "elastic_triple.h"
 #include "tier.h"
+#include "units.h"
 
 namespace collision_lab {
 namespace core {
@@ -388,7 +389,8 @@ std::string indexRanges(const std::vector<std::size_t>& indices) {
   return text;
 }
 
-std::string stopMessage(const Scene& scene, const EngineResult& result, bool exhausted, const ExactProgress& exact) {
+std::string stopMessage(const Scene& scene, const EngineResult& result, bool exhausted, bool beyond_doubles,
+                        const ExactProgress& exact) {
   // "1 impact", "31,415 impacts".
   const std::string impacts = countText(result.impact_count) + (result.impact_count == 1 ? " impact" : " impacts");
   switch (result.stop) {
@@ -430,8 +432,15 @@ std::string stopMessage(const Scene& scene, const EngineResult& result, bool exh
              ": a multiple collision, whose outcome point masses do not define, so the run ends here";
     }
     case StopReason::kOutOfRange:
-      return "after " + impacts + " the next one would leave the safe range of a double (above 2^900 in m, s "
-             "or m/s); rescale the units";
+      if (beyond_doubles) {
+        return "stopped after " + impacts + " (truncated): the next impact comes after t = " +
+               formatValue(std::numeric_limits<double>::max()) +
+               " s, the largest double, so its time cannot be written; a longer unit of time brings it into range";
+      }
+      return "stopped after " + impacts + " (truncated): the next one would take a time, position or velocity "
+             "beyond 2^900 in the run's working units (the powers of two of m, m/s and kg that bring the scene's "
+             "largest position, velocity and mass near 1): the scene's own scales spread wider than one change of "
+             "units brings into the range of a double";
     case StopReason::kInternalError:
       return "the engine's precision tiers disagreed after " + impacts + " (a bug, please report it); "
              "the run ends here";
@@ -485,15 +494,37 @@ const char* stopReasonName(StopReason reason) {
   return "UNKNOWN";
 }
 
-EngineResult runEngine(const Scene& scene, const EngineOptions& options, const ImpactVisitor& visitor,
+EngineResult runEngine(const Scene& si_scene, const EngineOptions& options, const ImpactVisitor& visitor,
                        const ProgressCallback& progress, const CollapseVisitor& on_collapse) {
   using namespace nbody_detail;
+  // The run takes place in working units (units.h); every value leaves it in SI.
+  const WorkingUnits units(si_scene);
+  const Scene& scene = units.scene;
+  const ToSi si(units);
+  // The largest working time [s * 2^timeShift] whose SI value a double holds (inf: any).
+  constexpr double kLargest = std::numeric_limits<double>::max();
+  const double time_limit = static_cast<double>(std::ldexp(static_cast<long double>(kLargest), units.timeShift()));
+  const auto toSiRecord = [&si](ImpactRecord& record) {
+    record.time = si.time(record.time);
+    record.position = si.position(record.position);
+    for (double& v : record.velocities_before) v = si.velocity(v);
+    for (double& v : record.velocities_after) v = si.velocity(v);
+    for (double& e : record.energy_gained) e = si.energy(e);
+    record.energy_lost = si.energy(record.energy_lost);
+  };
+  const auto toSiCollapse = [&si](Collapse c) {
+    c.time = si.time(c.time);
+    c.position = si.position(c.position);
+    c.velocity = si.velocity(c.velocity);
+    return c;
+  };
   EngineResult result;
   Driver driver(scene, options.cancel);
   StepResult r = driver.start();
   const bool wants_records = static_cast<bool>(visitor) || options.keep_events > 0;
   ImpactRecord record;
   std::uint64_t& count = result.impact_count;
+  bool beyond_doubles = false;  // the next impact's time [s] is beyond the largest double
   while (r.kind == StepKind::kImpact) {
     if (!driver.fast().pending()) break;
     if (count == options.max_impacts) {
@@ -504,11 +535,18 @@ EngineResult runEngine(const Scene& scene, const EngineOptions& options, const I
       result.stop = StopReason::kCancelled;
       break;
     }
+    // An impact whose time [s] no double holds cannot be published: the run stops before it.
+    if (!(driver.fast().nextTimeLowerBound() <= time_limit)) {
+      result.stop = StopReason::kOutOfRange;
+      beyond_doubles = true;
+      break;
+    }
     r = driver.step(wants_records ? &record : nullptr);
     if (r.kind != StepKind::kImpact) break;
     ++count;
     if (wants_records) {
       record.index = count;
+      if (!units.identity()) toSiRecord(record);
       if (visitor) visitor(record);
       if (count <= options.keep_events) result.events.push_back(record);
     }
@@ -518,31 +556,40 @@ EngineResult runEngine(const Scene& scene, const EngineOptions& options, const I
       r = collapse;
       break;
     }
-    if (on_collapse && result.collapses.size() > collapses) on_collapse(result.collapses.back());
+    if (on_collapse && result.collapses.size() > collapses) on_collapse(toSiCollapse(result.collapses.back()));
     if (progress && options.progress_interval > 0 && count % options.progress_interval == 0) {
-      progress(EngineProgress{count, driver.fast().lastTime()});
+      progress(EngineProgress{count, si.time(driver.fast().lastTime())});
     }
   }
   if (result.stop == StopReason::kFinished) finish(r, result);
+  // Out of range: the double format cannot hold the run's next values; impacts were due.
   result.truncated = result.stop == StopReason::kCap || result.stop == StopReason::kCancelled ||
-                     result.stop == StopReason::kPrecisionBudget;
+                     result.stop == StopReason::kPrecisionBudget || result.stop == StopReason::kOutOfRange;
   if (result.stop == StopReason::kPrecisionBudget || r.kind == StepKind::kExhausted) {
     result.crowding_bodies = driver.crowdingBodies();
   }
   result.final_time = driver.fast().lastTime();
   result.collapsed = !result.collapses.empty();
-  if (result.collapsed) {
-    result.collapse_time = result.collapses.front().time;
-    result.collapse_position = result.collapses.front().position;
-    result.final_time = std::max(result.final_time, result.collapses.back().time);
-  }
+  if (result.collapsed) result.final_time = std::max(result.final_time, result.collapses.back().time);
   result.cluster_impacts = driver.fast().clusterImpacts();
   result.rule_elastic_impacts = driver.fast().ruleElastic();
   driver.fast().state(result.final_time, result.final_positions, result.final_velocities);
   result.energy_lost = driver.fast().energyLost();
   result.escalations = driver.escalations();
-  fillDrift(scene, result);
-  result.stop_message = stopMessage(scene, result, r.kind == StepKind::kExhausted, driver.exactProgress());
+  fillDrift(scene, result);  // relative: the same in any units
+  // Back to SI.
+  result.final_time = si.time(result.final_time);
+  for (double& x : result.final_positions) x = si.position(x);
+  for (double& v : result.final_velocities) v = si.velocity(v);
+  result.energy_lost = si.energy(result.energy_lost);
+  for (Collapse& c : result.collapses) c = toSiCollapse(c);
+  if (result.collapsed) {
+    result.collapse_time = result.collapses.front().time;
+    result.collapse_position = result.collapses.front().position;
+  }
+  if (result.multiple_collision) result.multiple_collision->time = si.time(result.multiple_collision->time);
+  result.stop_message =
+      stopMessage(si_scene, result, r.kind == StepKind::kExhausted, beyond_doubles, driver.exactProgress());
   return result;
 }
 

@@ -156,6 +156,8 @@ class CL_NBODY_INTERNAL Tier {
   }
 
   bool pending() const { return tree_.minKey() < kInf; }
+  /// A lower bound of the next impact's time [s] (inf: none is due).
+  double nextTimeLowerBound() const { return tree_.minKey(); }
   std::uint64_t count() const { return count_; }
   std::uint64_t refinements() const { return refinements_; }
   std::uint64_t clusterImpacts() const { return cluster_impacts_; }
@@ -169,6 +171,7 @@ class CL_NBODY_INTERNAL Tier {
   StepResult step(ImpactRecord* record) {
     std::size_t next = tree_.minLeaf();
     if (!(tree_.minKey() < kInf)) return {StepKind::kFinished, 0, lastTime()};
+    if (!(tree_.minKey() < kMaxMagnitude)) return {StepKind::kOutOfRange, next, lastTime()};  // a parked pair is next
     if (!(pairs_[next].upper < tree_.minKeyExcluding(next))) {
       const StepResult r = resolveNext(next);
       if (r.kind != StepKind::kImpact) return r;
@@ -711,9 +714,21 @@ class CL_NBODY_INTERNAL Tier {
     if (!(yes || no)) return scheduleCarefully(p, a);
     double bounds[2][2] = {{kInf, kInf}, {0.0, 0.0}};  // [yes][lower, upper]
     coarseBounds(a, g, bounds[1][0], bounds[1][1]);
-    if (yes && !(bounds[1][1] < kMaxMagnitude)) return {StepKind::kOutOfRange, p, lastTime()};
+    if (yes && !(bounds[1][1] < kMaxMagnitude) && !park(bounds[1][0], bounds[1][1])) {
+      return {StepKind::kOutOfRange, p, lastTime()};
+    }
     setSchedule(p, bounds[yes][0], bounds[yes][1]);
     return {};
+  }
+
+  /// A pair whose impact comes at 2^900 or later (its lower bound says so) is parked there:
+  /// key kMaxMagnitude, no upper bound. It stops the run (out of range) only when it is
+  /// next; impacts before it go on. False, changing nothing, when its bounds straddle 2^900.
+  static bool park(double& lower, double& upper) {
+    if (!(lower >= kMaxMagnitude)) return false;
+    lower = kMaxMagnitude;
+    upper = kInf;
+    return true;
   }
 
   /// The rare case: the approach speed or the time is too close to call in double.
@@ -728,7 +743,7 @@ class CL_NBODY_INTERNAL Tier {
         if (!precise.ok) return {StepKind::kAmbiguous, p, lastTime()};
         const double estimate = Ar::toDouble(precise.value);
         widenBounds(estimate, precise.error + Ar::kToDoubleError * std::fabs(estimate), lower, upper);
-        if (!(upper < kMaxMagnitude)) return {StepKind::kOutOfRange, p, lastTime()};
+        if (!(upper < kMaxMagnitude) && !park(lower, upper)) return {StepKind::kOutOfRange, p, lastTime()};
         break;
       }
     }

@@ -41,6 +41,11 @@
 // pairs at the same instant are all performed; two impacts sharing a body at the same
 // instant are a multiple collision, which ends the run (its outcome is undefined for
 // point masses). Nothing is stored per impact unless asked, so memory is O(N).
+// Units. Each run takes place in working units: masses, positions and velocities scaled by
+// the exact powers of two that bring the scene's largest of each near 1 (src/core/nbody/
+// units.h). That changes no decision and no rounding, keeps every number of a run inside the
+// tiers' range (2^900) wherever the scene lies in the double range, and every value the
+// engine gives (records, collapses, progress, result) is in SI, rounded once.
 #pragma once
 
 #include <array>
@@ -85,7 +90,9 @@ enum class StopReason : std::uint8_t {
   kCap = 1,                ///< max_impacts reached, or the exactness cap of an unresolved accumulation (truncated)
   kCancelled = 2,          ///< the cancel flag was set (truncated)
   kMultipleCollision = 3,  ///< two impacts sharing a body at the same instant
-  kOutOfRange = 4,         ///< a time, position or velocity left the safe range of a double
+  /// The next impact's time is beyond the largest double, or the scene's scales spread wider
+  /// than the working units ("Units" above) bring into the tiers' range (truncated).
+  kOutOfRange = 4,
   kInternalError = 5,      ///< the tiers disagreed (a bug; reported, never hidden)
   /// A decision needed exact arithmetic beyond its budget (tier.h, kExactReplayBudget): the run
   /// stops at its last certified impact, naming the crowding bodies (truncated).
@@ -155,7 +162,7 @@ struct Collapse {
 
 struct EngineResult {
   std::uint64_t impact_count = 0;
-  bool truncated = false;  ///< stopped by the cap or by cancellation: more impacts were due
+  bool truncated = false;  ///< stopped with more impacts due: cap, cancelled, precision budget or out of range
   StopReason stop = StopReason::kFinished;
   std::string stop_message;  ///< one sentence: why the run ended
   std::optional<MultipleCollision> multiple_collision;
