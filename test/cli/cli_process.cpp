@@ -64,9 +64,16 @@ CliOutput runChild(const std::string& program_path, const std::vector<std::strin
   if (terminal) {
     master = posix_openpt(O_RDWR | O_NOCTTY);
     if (master < 0 || grantpt(master) != 0 || unlockpt(master) != 0 || ptsname(master) == nullptr) {
-      throw std::runtime_error("no pseudo-terminal");
+      if (master >= 0) close(master);
+      throw NoPseudoTerminal("no pseudo-terminal (is /dev/pts mounted?)");
     }
     slave_path = ptsname(master);
+    const int slave = open(slave_path.c_str(), O_RDWR | O_NOCTTY);  // the child's stderr, tried first
+    if (slave < 0) {
+      close(master);
+      throw NoPseudoTerminal("cannot open the pseudo-terminal " + slave_path + " (is /dev/pts mounted?)");
+    }
+    close(slave);
   }
   const pid_t pid = fork();
   if (pid < 0) throw std::runtime_error("fork failed");

@@ -1,6 +1,7 @@
 // Runs the built collision_lab_cli as a child process and captures what it prints.
 #pragma once
 
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,12 @@ CliOutput runCli(const std::vector<std::string>& args, const std::string& cwd,
 /// As runCli, but runs the executable `program` (e.g. a copy of the CLI elsewhere).
 CliOutput runProgram(const std::string& program, const std::vector<std::string>& args, const std::string& cwd,
                      const std::string& stdin_path = "/dev/null", const std::string& stdout_path = "");
+
+/// Thrown by runCliOnTerminal where the system has no pseudo-terminals (a chroot without
+/// /dev/pts mounted, as the fresh-Debian check's).
+struct NoPseudoTerminal : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
 
 /// As runCli, with stderr a pseudo-terminal (where the CLI draws its progress line);
 /// `err` holds what was written there.

@@ -247,7 +247,12 @@ TEST(CliTerminal, ARunTakesTheSamePathInATerminalAsInAPipe) {
   const std::vector<std::string> args = {"--masses", "3,1,0.5", "--positions", "2,1,0", "--velocities", "-1,0,0",
                                          "--events", "none", "--format", "json"};
   const CliOutput pipe = run(args);
-  const CliOutput terminal = runCliOnTerminal(args, COLLISION_LAB_SOURCE_DIR);
+  CliOutput terminal;
+  try {
+    terminal = runCliOnTerminal(args, COLLISION_LAB_SOURCE_DIR);
+  } catch (const NoPseudoTerminal& e) {
+    GTEST_SKIP() << e.what() << ": a real machine has them; a chroot may not";
+  }
   ASSERT_EQ(pipe.exit_code, 0) << pipe.err;
   ASSERT_EQ(terminal.exit_code, 0) << terminal.err;
   Json in_pipe = Json::parse(pipe.out), in_terminal = Json::parse(terminal.out);
