@@ -37,7 +37,8 @@ double toDouble(const T& value) {
 }
 
 /// Does every value survive scaling by 2^shift and back unchanged?
-inline bool scalesExactly(const std::array<double, 3>& values, int shift) {
+template <class Values>
+bool scalesExactly(const Values& values, int shift) {
   for (double x : values) {
     if (std::ldexp(std::ldexp(x, shift), -shift) != x) return false;
   }
@@ -46,8 +47,10 @@ inline bool scalesExactly(const std::array<double, 3>& values, int shift) {
 
 /// The shift that brings the largest finite |value| to [1/2, 1), or as close as it goes
 /// without rounding any value (scaling down can push low bits below the smallest
-/// subnormal). Infinities (walls) are left out; they stay infinite.
-inline int shiftTowardsOne(const std::array<double, 3>& values) {
+/// subnormal). Infinities (walls) are left out; they stay infinite. Values: any range of
+/// doubles (three bodies' array, a scene's vector).
+template <class Values>
+int shiftTowardsOne(const Values& values) {
   double largest = 0.0;
   for (double x : values) {
     if (std::isfinite(x)) largest = std::fabs(x) > largest ? std::fabs(x) : largest;

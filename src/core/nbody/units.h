@@ -14,32 +14,11 @@
 #include <vector>
 
 #include "collision_lab/core/nbody/scene.h"
+#include "../float_ops.h"
 
 namespace collision_lab {
 namespace core {
 namespace nbody_detail {
-
-/// The shift that brings the largest finite |value| to [1/2, 1), or as close as it goes
-/// without rounding any of `values` (scaling down can push low bits below the smallest
-/// subnormal). Infinities (walls) are left out; they stay infinite.
-inline int shiftTowardsOne(const std::vector<double>& values) {
-  double largest = 0.0;
-  for (double x : values) {
-    if (std::isfinite(x)) largest = std::fabs(x) > largest ? std::fabs(x) : largest;
-  }
-  if (largest == 0.0) return 0;
-  int exponent = 0;
-  std::frexp(largest, &exponent);  // largest = f 2^exponent, f in [1/2, 1)
-  int shift = -exponent;
-  const auto exact = [&values](int s) {
-    for (double x : values) {
-      if (std::ldexp(std::ldexp(x, s), -s) != x) return false;
-    }
-    return true;
-  };
-  while (shift < 0 && !exact(shift)) ++shift;
-  return shift;
-}
 
 /// x * 2^shift, rounded once, never -0: one multiplication by a double (exact, or rounded
 /// once where the product is subnormal), or in long double where 2^shift is no double.
@@ -69,9 +48,9 @@ struct WorkingUnits {
   explicit WorkingUnits(const Scene& si) : scene(si) {
     std::vector<double> lengths = si.positions;
     lengths.push_back(si.ring);
-    mass_shift = shiftTowardsOne(si.masses);
-    velocity_shift = shiftTowardsOne(si.velocities);
-    position_shift = shiftTowardsOne(lengths);
+    mass_shift = detail::shiftTowardsOne(si.masses);
+    velocity_shift = detail::shiftTowardsOne(si.velocities);
+    position_shift = detail::shiftTowardsOne(lengths);
     const RestitutionModel& model = si.restitution_model;
     // The model's parameter must scale exactly too; where it cannot, the run keeps SI units.
     const auto keeps = [](double x, int s) { return std::ldexp(std::ldexp(x, s), -s) == x; };
