@@ -1,0 +1,497 @@
+"""collision_lab.plot: the views of a run that the class page and rviz draw, with matplotlib.
+
+steps(run)        velocities after each impact against the impact number, beside the model's
+                  predicted values (the closed form after every impact for three elastic
+                  bodies and the paper's printed eqs. (2.15)/(2.16); else the predicted final
+                  velocities);
+xt(run)           worldlines: position x [m] across, time t [s] up (as the page draws them),
+                  every line to the run's end; on a ring cut at the seam;
+energy(run)       per-body kinetic energy (or energy transfer per impact), the total and the
+                  heat so far;
+temperature(run)  granular temperature T(t) on log-log axes with Haff's law fitted, as the
+                  CLI's --temperature-csv computes it (from the run's events, or from that
+                  CSV file).
+
+Each takes `ax=None` (a new figure) and returns the matplotlib Axes. Colours are the views'
+(docs/web.md, "Bodies: names and colours"): up to 10 bodies the palette by index (A red,
+B green, C blue, ...); beyond, the start velocity on the map blue (moving left) -> purple
+(at rest) -> red (moving right), scaled by the largest start speed; walls grey. Works with any
+backend (Agg included): pyplot is imported only to make a figure when no `ax` is given.
+"""
+import math
+
+import numpy as np
+
+# rviz's layout::kParticleRgb, kGrey and the velocity map's ends (include/collision_lab/ros/markers/layout.h).
+PALETTE = ((0.95, 0.25, 0.25), (0.25, 0.8, 0.3), (0.3, 0.55, 1.0), (1.0, 0.75, 0.2), (0.75, 0.45, 1.0),
+           (0.2, 0.85, 0.85), (1.0, 0.5, 0.75), (0.65, 0.8, 0.25), (1.0, 0.55, 0.3), (0.6, 0.6, 0.95))
+WALL_GREY = (0.6, 0.6, 0.6)
+MOVING_LEFT_BLUE = (0.2, 0.4, 1.0)
+AT_REST_PURPLE = (0.62, 0.42, 0.72)
+MOVING_RIGHT_RED = (1.0, 0.2, 0.15)
+# Bodies with their own velocity and energy lines (all up to this N), and bodies with a
+# worldline (beyond this N, this many evenly spaced, the outermost two included): rviz's.
+MAX_PLOTTED_BODIES = 10
+MAX_TRACKED_BODIES = 24
+# The views' end of a finished run: this times the last event's time (rviz's kEndMargin).
+END_MARGIN = 1.25
+# A ring's worldline is cut at the seam into at most this many pieces (rviz's bound).
+MAX_RING_PIECES = 10000
+# The CLI's thinning of T(t) for the fit: the first sample of every 1/50 of a decade of time.
+SAMPLES_PER_DECADE = 50
+
+
+def _new_axes(ax, size=(7.0, 4.2)):
+    if ax is not None:
+        return ax
+    import matplotlib.pyplot as plt
+    _, ax = plt.subplots(figsize=size, layout='constrained')
+    return ax
+
+
+def _is_wall(run):
+    return ~np.isfinite(np.asarray(run.masses, dtype=float))
+
+
+def velocity_colour(v, v_max):
+    """The start-velocity map's colour (r, g, b) of velocity v [m/s] on the scale v_max [m/s]."""
+    f = float(np.clip(v / v_max, -1.0, 1.0)) if np.isfinite(v) and v_max > 0 else 0.0
+    end = MOVING_LEFT_BLUE if f < 0 else MOVING_RIGHT_RED
+    a = abs(f)
+    return tuple(r + (e - r) * a for r, e in zip(AT_REST_PURPLE, end))
+
+
+def velocity_scale(run):
+    """The largest start speed of a body that is not a wall [m/s] (1 when all rest)."""
+    v = np.abs(np.asarray(run.initial_velocities, dtype=float)[~_is_wall(run)])
+    v_max = float(v.max()) if v.size else 0.0
+    return v_max if v_max > 0 and math.isfinite(v_max) else 1.0
+
+
+def body_colours(run):
+    """One (r, g, b) per body, as the page and rviz colour them (module docstring)."""
+    walls = _is_wall(run)
+    n = len(walls)
+    by_velocity = n > len(PALETTE)
+    v_max = velocity_scale(run) if by_velocity else 1.0
+    colours = []
+    for i in range(n):
+        if walls[i]:
+            colours.append(WALL_GREY)
+        elif by_velocity:
+            colours.append(velocity_colour(run.initial_velocities[i], v_max))
+        else:
+            colours.append(PALETTE[i])
+    return colours
+
+
+def evenly_spaced(count, n):
+    """n evenly spaced indices of 0 .. count - 1, the first and last included (all if count <= n)."""
+    if count <= n:
+        return list(range(count))
+    return [j * (count - 1) // (n - 1) for j in range(n)]
+
+
+def _count_text(n, word='collision'):
+    return '{:,} {}{}'.format(int(n), word, '' if n == 1 else 's')
+
+
+def title_of(run, view):
+    """'<view>: <model>, <count> [, truncated][, collapse at t = ...]'."""
+    s = run.summary
+    parts = [s.get('model', run.model)]
+    if s.get('simulated', True):
+        parts.append(_count_text(s.get('collision_count', 0)) + (' (truncated)' if s.get('truncated') else ''))
+    else:
+        predicted = s.get('predicted_collision_count')
+        parts.append('not simulated' + ('' if predicted is None else ', predicted ' + _count_text(predicted)))
+    if s.get('collapsed'):
+        parts.append('collapse at t = %.4g s' % s['collapse_time'])
+    if run.scene.get('ring'):
+        parts.append('ring of %g m' % run.scene['ring'])
+    return '%s\n%s' % (view, ', '.join(parts))
+
+
+def _require_events(run, view):
+    if len(run.events.get('time', ())) == 0 and run.summary.get('collision_count', 0) > 0:
+        raise ValueError('plot.%s needs the run\'s events: run it with events=\'all\' (this run has %s and none '
+                         'recorded)' % (view, _count_text(run.summary['collision_count'])))
+
+
+def _impacts_and_velocities(run):
+    """(impact number [1], velocities [m/s]) at the start (0) and after every event."""
+    ev = run.events
+    index = np.concatenate([[0], np.asarray(ev.get('index', []), dtype=float)])
+    v0 = np.asarray(run.initial_velocities, dtype=float)[None, :]
+    after = np.asarray(ev.get('velocities_after', np.empty((0, v0.shape[1]))), dtype=float)
+    return index, np.vstack([v0, after])
+
+
+def _mark_collapses(ax, run):
+    ev = run.events
+    kinds = np.asarray(ev.get('kind', []))
+    for k in np.flatnonzero(kinds == 'collapse'):
+        ax.axvline(ev['index'][k], color='0.35', lw=0.8, ls=':')
+        ax.annotate('collapse (t = %.4g s)' % ev['time'][k], (ev['index'][k], 1.0), xycoords=('data', 'axes fraction'),
+                    xytext=(-4, -4), textcoords='offset points', ha='right', va='top', fontsize=8, color='0.3')
+
+
+def _legend(ax, n_lines):
+    if 0 < n_lines <= 14:
+        ax.legend(fontsize=8, loc='best', ncol=2 if n_lines > 7 else 1)
+
+
+def _given(values):
+    """values, or None when absent or NaN throughout (the model does not give them)."""
+    return None if values is None or np.all(np.isnan(values)) else values
+
+
+def steps(run, ax=None, bodies=None):
+    """Velocities after each impact [m/s] against the impact number, as steps, with the
+    model's prediction: the closed form after every impact (dashed) and the paper's printed
+    eqs. (2.15)/(2.16) (dotted) where the model gives them, else the predicted final
+    velocities (a thick dashed stub past the last impact). bodies: indices to draw
+    (default: all up to 10 bodies, else 24 evenly spaced). Returns the Axes."""
+    _require_events(run, 'steps')
+    ax = _new_axes(ax)
+    colours = body_colours(run)
+    n = len(colours)
+    if bodies is None:
+        bodies = evenly_spaced(n, MAX_PLOTTED_BODIES if n <= MAX_PLOTTED_BODIES else MAX_TRACKED_BODIES)
+    index, v = _impacts_and_velocities(run)
+    last = index[-1] if index.size else 0
+    # The state after the last impact is held for one more impact's width.
+    held = np.append(index, last + 1)
+    v = np.vstack([v, v[-1:]])
+    ev = run.events
+    predicted = _given(ev.get('predicted_velocities_after'))
+    paper = _given(ev.get('paper_velocities_after'))
+    labelled = n <= MAX_PLOTTED_BODIES
+    lines = 0
+    for i in bodies:
+        name = run.names[i]
+        ax.step(held, v[:, i], where='post', color=colours[i], lw=1.6,
+                label=('v_%s simulated' % name) if labelled else None)
+        lines += labelled
+        if predicted is not None:
+            ax.plot(index[1:], predicted[:, i], ls='none', marker='o', ms=5, mfc='none', mec=colours[i],
+                    label=('v_%s closed form' % name) if labelled and i == bodies[0] else None)
+        if paper is not None:
+            ax.plot(index[1:], paper[:, i], ls='none', marker='x', ms=5, color=colours[i], alpha=0.8,
+                    label=("paper's eqs. (2.15)/(2.16)") if labelled and i == bodies[0] else None)
+    if predicted is None:
+        final = run.summary.get('predicted_final_velocities')
+        if final is not None:
+            stub = max(1.0, 0.08 * last)
+            for j, i in enumerate(bodies):
+                if final[i] is not None:
+                    ax.plot([last, last + stub], [final[i], final[i]], color=colours[i], lw=3, ls='--',
+                            label='predicted final' if labelled and j == 0 else None)
+    lines += (predicted is not None) + (paper is not None)
+    _mark_collapses(ax, run)
+    ax.set_xlabel('impact number [1] (0: the start)')
+    ax.set_ylabel('velocity after the impact [m/s]')
+    ax.set_title(title_of(run, 'velocities after each impact'), fontsize=10)
+    if last <= 40:
+        ax.xaxis.get_major_locator().set_params(integer=True)
+    ax.grid(alpha=0.3)
+    _legend(ax, lines)
+    return ax
+
+
+def end_time(run):
+    """The views' end [s]: 1.25 x the last event's time; with no event, the time the widest
+    gap takes at the largest speed (rviz's endTime for a finished run)."""
+    t = np.asarray(run.events.get('time', []), dtype=float)
+    if t.size and t[-1] > 0:
+        return END_MARGIN * float(t[-1])
+    x = np.asarray(run.initial_positions, dtype=float)
+    v = np.asarray(run.initial_velocities, dtype=float)
+    gap = float(np.max(x[:-1] - x[1:])) if x.size > 1 else 0.0
+    speed = float(np.max(np.abs(v[np.isfinite(v)]))) if v.size else 0.0
+    return gap / speed if speed > 0 and gap > 0 else 1.0
+
+
+def worldline(run, i, t_end=None):
+    """(t [s], x [m]) of body i at the start, at every event and at t_end (free flight from
+    the last event); on a ring x is unwrapped (continuous, not taken modulo L)."""
+    ev = run.events
+    t_end = end_time(run) if t_end is None else t_end
+    t = np.concatenate([[0.0], np.asarray(ev.get('time', []), dtype=float)])
+    x = np.concatenate([[run.initial_positions[i]], np.asarray(ev['positions'])[:, i] if len(t) > 1 else []])
+    v = np.concatenate([[run.initial_velocities[i]], np.asarray(ev['velocities_after'])[:, i] if len(t) > 1 else []])
+    ring = run.scene.get('ring')
+    if ring:
+        # Free flight between events: unwrap each event's x to the multiple of L nearest
+        # the flown position.
+        for k in range(1, len(x)):
+            flown = x[k - 1] + v[k - 1] * (t[k] - t[k - 1])
+            x[k] += ring * np.round((flown - x[k]) / ring)
+    if t_end > t[-1]:
+        t = np.append(t, t_end)
+        x = np.append(x, x[-1] + v[-1] * (t_end - t[-2]))
+    return t, x
+
+
+def ring_segments(t, x, ring, max_pieces=MAX_RING_PIECES):
+    """The unwrapped line (t, x) cut where it crosses the seam: a list of (t, x) pieces with
+    x in [0, L], each piece ending and the next starting at the crossing; at most max_pieces
+    (rviz's bound on the lines of one body): the line stops at the last crossing kept."""
+    pieces, piece_t, piece_x = [], [t[0]], [x[0] % ring]
+    turn = math.floor(x[0] / ring)
+    for k in range(1, len(t)):
+        x0, x1, t0, t1 = x[k - 1], x[k], t[k - 1], t[k]
+        target = math.floor(x1 / ring)
+        while turn != target:  # every seam crossing on the way, in order
+            if len(pieces) + 1 >= max_pieces:
+                return pieces
+            up = target > turn
+            seam = (turn + 1) * ring if up else turn * ring
+            at = t0 + (seam - x0) / (x1 - x0) * (t1 - t0)
+            piece_t.append(at), piece_x.append(ring if up else 0.0)
+            pieces.append((np.array(piece_t), np.array(piece_x)))
+            piece_t, piece_x = [at], [0.0 if up else ring]
+            turn += 1 if up else -1
+        piece_t.append(t1), piece_x.append(x1 - turn * ring)
+    pieces.append((np.array(piece_t), np.array(piece_x)))
+    return pieces
+
+
+def xt(run, ax=None, bodies=None):
+    """Worldlines: position x [m] across, time t [s] up, every line (walls and bodies that
+    never collide included) to the run's end; on a ring x in [0, L) with each line cut at
+    the seam. bodies: indices (default: all up to 24 bodies, else 24 evenly spaced, the
+    outermost two included). Returns the Axes."""
+    _require_events(run, 'xt')
+    ax = _new_axes(ax, size=(6.0, 5.0))
+    colours = body_colours(run)
+    n = len(colours)
+    if bodies is None:
+        bodies = evenly_spaced(n, MAX_TRACKED_BODIES)
+    t_end = end_time(run)
+    ring = run.scene.get('ring')
+    labelled = n <= MAX_PLOTTED_BODIES
+    for i in bodies:
+        t, x = worldline(run, i, t_end)
+        pieces = ring_segments(t, x, ring) if ring else [(t, x)]
+        for k, (pt, px) in enumerate(pieces):
+            ax.plot(px, pt, color=colours[i], lw=1.4 if n <= MAX_PLOTTED_BODIES else 0.9,
+                    label=(run.names[i] + (' (wall)' if not np.isfinite(run.masses[i]) else ''))
+                    if labelled and k == 0 else None)
+    ev = run.events
+    kinds = np.asarray(ev.get('kind', []))
+    for k in np.flatnonzero(kinds == 'collapse'):
+        ax.plot(ev['position'][k], ev['time'][k], marker='*', ms=12, color='k', ls='none',
+                label='collapse' if labelled else None)
+    ax.set_ylim(0, t_end)
+    if ring:
+        ax.set_xlim(0, ring)
+    ax.set_xlabel('position x [m]' + (' on the ring (0 and L are the seam)' if ring else ''))
+    ax.set_ylabel('time t [s]')
+    shown = 'all %d bodies' % n if len(bodies) == n else '%d of %s bodies, evenly spaced' % (len(bodies), '{:,}'.format(n))
+    ax.set_title(title_of(run, 'worldlines (%s)' % shown), fontsize=10)
+    ax.grid(alpha=0.3)
+    if labelled:
+        ax.legend(fontsize=8, loc='best')
+    return ax
+
+
+def energy(run, ax=None, transfer=False):
+    """Energies [J] against the impact number. transfer=False: each body's kinetic energy
+    after each impact (up to 10 bodies), the total kinetic energy and the heat so far
+    (the energy lost by inelastic impacts, summed). transfer=True: the energy each body
+    gained at each impact (dots), beside the closed form's and the paper's printed
+    transfer where the model gives them. Returns the Axes."""
+    _require_events(run, 'energy')
+    ax = _new_axes(ax)
+    colours = body_colours(run)
+    n = len(colours)
+    ev = run.events
+    index = np.concatenate([[0], np.asarray(ev.get('index', []), dtype=float)])
+    finite = ~_is_wall(run)
+    m = np.asarray(run.masses, dtype=float)
+    v0 = np.asarray(run.initial_velocities, dtype=float)
+    ke0 = np.where(finite, 0.5 * np.where(finite, m, 0.0) * v0 ** 2, 0.0)
+    lines = 0
+    if transfer:
+        de = np.asarray(ev['energy_transfer'])
+        for i in range(min(n, MAX_PLOTTED_BODIES)):
+            if not finite[i]:
+                continue
+            ax.plot(index[1:], de[:, i], ls='none', marker='o', ms=4, color=colours[i],
+                    label='dE_%s simulated' % run.names[i])
+            lines += 1
+        for key, style, label in (('predicted_energy_transfer', dict(marker='s', mfc='none', ms=7), 'closed form'),
+                                  ('paper_energy_transfer', dict(marker='x', ms=6), "paper's eqs. (4.4)-(4.7)")):
+            if _given(ev.get(key)) is not None:
+                for i in range(min(n, MAX_PLOTTED_BODIES)):
+                    ax.plot(index[1:], ev[key][:, i], ls='none', color=colours[i], alpha=0.8,
+                            label=label if i == 0 else None, **style)
+                lines += 1
+        ax.axhline(0, color='0.5', lw=0.6)
+        ax.set_ylabel('energy gained at the impact [J]')
+        view = 'energy transfer per impact'
+    else:
+        if n <= MAX_PLOTTED_BODIES:
+            ke = np.vstack([ke0[None, :], np.asarray(ev['kinetic_energy_after']).reshape(-1, n)])
+            for i in range(n):
+                if finite[i]:
+                    ax.step(index, ke[:, i], where='post', color=colours[i], lw=1.2,
+                            label='kinetic energy of %s' % run.names[i])
+                    lines += 1
+        total = np.concatenate([[ke0.sum()], np.asarray(ev.get('total_energy', []), dtype=float)])
+        heat = np.concatenate([[0.0], np.cumsum(np.nan_to_num(np.asarray(ev.get('energy_lost', []), dtype=float)))])
+        ax.step(index, total, where='post', color='k', lw=2, label='total kinetic energy')
+        ax.step(index, heat, where='post', color='0.45', lw=1.5, ls='--', label='heat so far')
+        lines += 2
+        ax.set_ylabel('energy [J]')
+        view = 'energies after each impact'
+    _mark_collapses(ax, run)
+    ax.set_xlabel('impact number [1] (0: the start)')
+    ax.set_title(title_of(run, view), fontsize=10)
+    ax.grid(alpha=0.3)
+    _legend(ax, lines)
+    return ax
+
+
+def granular_temperature(masses, velocities):
+    """T = (1/N) sum m_i (v_i - V)^2 [J] over the N finite masses, V their centre-of-mass
+    velocity (core::granularTemperature): twice the mean kinetic energy of the bodies' motion
+    relative to their centre of mass. velocities: one row per state (2-D) or one state."""
+    m = np.asarray(masses, dtype=float)
+    finite = np.isfinite(m)
+    v = np.atleast_2d(np.asarray(velocities, dtype=float))[:, finite]
+    m = m[finite]
+    if m.size == 0:
+        return np.zeros(v.shape[0])
+    centre = (v @ m) / m.sum()
+    return ((v - centre[:, None]) ** 2 @ m) / m.size
+
+
+def temperature_samples(run):
+    """T(t) as the CLI's --temperature-csv samples it: (impacts [1], t [s], T [J]) at the start,
+    after every k-th impact (k = max(1, N/8)), after every collapse and after the last event."""
+    _require_events(run, 'temperature')
+    ev = run.events
+    n = len(run.masses)
+    stride = max(1, n // 8)
+    index = np.asarray(ev['index'], dtype=np.int64)
+    keep = (index % stride == 0) | (np.asarray(ev['kind']) == 'collapse')
+    if keep.size:
+        keep[-1] = True
+    rows = np.flatnonzero(keep)
+    T = granular_temperature(run.masses, np.asarray(ev['velocities_after'])[rows])
+    T0 = granular_temperature(run.masses, run.initial_velocities)
+    return (np.concatenate([[0], index[rows]]), np.concatenate([[0.0], np.asarray(ev['time'])[rows]]),
+            np.concatenate([T0, T]))
+
+
+def thin_log_time(t):
+    """Indices of the samples the CLI fits (core::LogTimeSamples): the first of every
+    1/50 decade of time (the start's t = 0 kept), and the newest."""
+    kept, last_bin, newest = [], -math.inf, None
+    for k, tk in enumerate(t):
+        b = math.floor(math.log10(tk) * SAMPLES_PER_DECADE) if tk > 0 else -math.inf
+        if not kept or b > last_bin:
+            kept.append(k)
+            last_bin, newest = b, None
+        else:
+            newest = k
+    return kept + ([newest] if newest is not None else [])
+
+
+def _haff_cost(t, log_T, u):
+    r = log_T + 2 * np.log1p(t / math.exp(u))
+    log_t0 = r.mean()
+    return float(((r - log_t0) ** 2).sum()), log_t0
+
+
+def fit_haff(t, T):
+    """Haff's law T(t) = t0 / (1 + t/tau)^2 fitted by least squares on ln T, as core::fitHaff:
+    a grid of 0.05 decades in tau over [1e-6, 1e6] x the last time, then golden sections.
+    Returns dict(t0 [J], tau [s] (inf: no cooling seen), rms_ln_error [1], samples [1]) or
+    None with fewer than two usable samples (finite t >= 0, T > 0) or none after t = 0."""
+    t = np.asarray(t, dtype=float)
+    T = np.asarray(T, dtype=float)
+    use = np.isfinite(t) & (t >= 0) & np.isfinite(T) & (T > 0)
+    t, log_T = t[use], np.log(T[use])
+    if t.size < 2 or not t.max() > 0:
+        return None
+    steps_ = 12 * 20
+    lo = math.log(t.max()) - 6 * math.log(10.0)
+    du = 12 * math.log(10.0) / steps_
+    costs = [_haff_cost(t, log_T, lo + k * du)[0] for k in range(steps_ + 1)]
+    best = int(np.argmin(costs))
+    if best == steps_:
+        log_t0 = log_T.mean()
+        cost = float(((log_T - log_t0) ** 2).sum())
+        tau = math.inf
+    else:
+        phi = (math.sqrt(5.0) - 1) / 2
+        a, b = lo + max(best - 1, 0) * du, lo + min(best + 1, steps_) * du
+        c, d = b - phi * (b - a), a + phi * (b - a)
+        fc, fd = _haff_cost(t, log_T, c)[0], _haff_cost(t, log_T, d)[0]
+        while b - a > 1e-13 * max(1.0, abs(a)):
+            if fc < fd:
+                b, d, fd = d, c, fc
+                c = b - phi * (b - a)
+                fc = _haff_cost(t, log_T, c)[0]
+            else:
+                a, c, fc = c, d, fd
+                d = a + phi * (b - a)
+                fd = _haff_cost(t, log_T, d)[0]
+        u = (a + b) / 2
+        cost, log_t0 = _haff_cost(t, log_T, u)
+        tau = math.exp(u)
+    return {'t0': math.exp(log_t0), 'tau': tau, 'rms_ln_error': math.sqrt(cost / t.size), 'samples': int(t.size)}
+
+
+def read_temperature_csv(path):
+    """The CLI's --temperature-csv file (run(..., temperature_csv=path) writes it): (a pandas
+    DataFrame impacts [1], time_s [s], temperature_J [J]; the fit dict t0_J, tau_s,
+    rms_ln_error, samples, or None when the file says there is none)."""
+    import pandas as pd
+    table = pd.read_csv(path, comment='#')
+    fit = {}
+    with open(path) as f:
+        for line in f:
+            if line.startswith('# haff_fit,'):
+                key, _, value = line[len('# haff_fit,'):].strip().partition(',')
+                if key in ('t0_J', 'tau_s', 'rms_ln_error', 'samples'):
+                    fit[key] = float(value)
+    return table, ({'t0': fit['t0_J'], 'tau': fit['tau_s'], 'rms_ln_error': fit['rms_ln_error'],
+                    'samples': int(fit['samples'])} if 't0_J' in fit else None)
+
+
+def temperature(run, ax=None, csv=None):
+    """Granular temperature T(t) [J] on log-log axes with Haff's law T0 / (1 + t/tau)^2 fitted
+    (dashed), as the CLI's --temperature-csv computes it. csv: the path of that file (from
+    run(..., events='none', temperature_csv=path): no events needed); else T is computed from
+    the run's events, sampled and fitted as the CLI does. The start (t = 0) cannot sit on a
+    log axis: its T0 is a horizontal tick at the left edge. Returns the Axes."""
+    ax = _new_axes(ax)
+    if csv is not None:
+        table, fit = read_temperature_csv(csv)
+        t, T = table['time_s'].to_numpy(), table['temperature_J'].to_numpy()
+    else:
+        _, t, T = temperature_samples(run)
+        thinned = thin_log_time(t)
+        fit = fit_haff(t[thinned], T[thinned])
+    after = t > 0
+    ax.loglog(t[after], T[after], color='C0', lw=1.4, drawstyle='steps-post',
+              label='T(t) simulated (held between samples)')
+    ax.plot([t[after].min() if after.any() else 1.0], [T[0]], marker='<', color='C0', ms=8, ls='none',
+            label='T at the start: %.4g J' % T[0])
+    if fit is not None and math.isfinite(fit['tau']):
+        tt = np.geomspace(t[after].min(), t.max(), 200)
+        ax.loglog(tt, fit['t0'] / (1 + tt / fit['tau']) ** 2, color='C3', ls='--', lw=1.6,
+                  label="Haff's law fitted: T0 = %.3g J, tau = %.3g s (rms in ln T: %.2g)"
+                  % (fit['t0'], fit['tau'], fit['rms_ln_error']))
+        ax.loglog(tt, fit['t0'] * (fit['tau'] / tt) ** 2, color='0.6', ls=':', lw=1, label='its tail, T0 (tau/t)^2')
+        ax.set_ylim(T[T > 0].min() / 2, T.max() * 2)
+    ax.set_xlabel('time t [s]')
+    ax.set_ylabel('granular temperature T [J]')
+    ax.set_title(title_of(run, 'granular temperature T = (1/N) sum m_i (v_i - V)^2'), fontsize=10)
+    ax.grid(alpha=0.3, which='both')
+    ax.legend(fontsize=8, loc='lower left')
+    return ax
