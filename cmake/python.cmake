@@ -18,3 +18,6 @@ set_target_properties(collision_lab_python_core PROPERTIES
   BUILD_RPATH ${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_LIB_DESTINATION}
   INSTALL_RPATH ${CMAKE_INSTALL_PREFIX}/${CATKIN_PACKAGE_LIB_DESTINATION})
 install(TARGETS collision_lab_python_core LIBRARY DESTINATION ${CATKIN_PACKAGE_PYTHON_DESTINATION})
+
+# collision_lab_sweep: the sweep for batch systems (--shard I/N, --merge; docs/python.md).
+catkin_install_python(PROGRAMS scripts/collision_lab_sweep DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})

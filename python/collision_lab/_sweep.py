@@ -70,6 +70,15 @@ def run_chunk(jobs, workers=1):
     return _core.run_many_json(jobs, workers)
 
 
+def sweep_table(rows, parameter_names):
+    """The DataFrame of rows (dicts: the parameters, then summary_row's columns): the
+    parameters, the summary columns in the order they first appear, the error columns."""
+    import pandas as pd
+    table = pd.DataFrame(rows)
+    rest = [c for c in table.columns if c not in parameter_names and c not in ERROR_COLUMNS]
+    return table[list(parameter_names) + rest + list(ERROR_COLUMNS)]
+
+
 def sweep(scenes=None, *, grid=None, base=None, client=None, workers=None, chunk_size=None, **options):
     """Runs many scenes and returns their summaries as a pandas DataFrame, one row per scene
     in the input's order.
@@ -88,7 +97,6 @@ def sweep(scenes=None, *, grid=None, base=None, client=None, workers=None, chunk
     per worker thread) to the cluster, which runs the same C++ function: the table equals
     the local one bit for bit except compute_time_s, the wall time of each run.
     """
-    import pandas as pd
     options.setdefault('events', 'none')
     parameters, made = scene_list(scenes, grid, base)
     jobs = [scene_job(scene, options) for scene in made]
@@ -101,9 +109,8 @@ def sweep(scenes=None, *, grid=None, base=None, client=None, workers=None, chunk
         chunks = [jobs[i:i + chunk_size] for i in range(0, len(jobs), chunk_size)]
         futures = client.map(run_chunk, chunks, pure=False)
         reports = [report for chunk in client.gather(futures) for report in chunk]
-    table = pd.DataFrame([summary_row(text) for text in reports])
-    summary_columns = [c for c in table.columns if c not in ERROR_COLUMNS]
+    rows = [summary_row(text) for text in reports]
     for name, values in parameters:
-        table[name] = values
-    names = [name for name, _ in parameters]
-    return table[names + [c for c in summary_columns if c not in names] + list(ERROR_COLUMNS)]
+        for row, value in zip(rows, values):
+            row[name] = value
+    return sweep_table(rows, [name for name, _ in parameters])
