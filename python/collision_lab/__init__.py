@@ -1,0 +1,18 @@
+"""collision_lab in Python: the exact engine in process (docs/python.md).
+
+run() and predict() run one scene as collision_lab_cli does (its JSON report, as dicts and
+numpy arrays); sweep() runs many, on every core or on a Dask cluster; read_bag() opens a
+run the ROS node recorded. collision_lab.msg holds the package's ROS messages.
+"""
+from pkgutil import extend_path
+
+# In a catkin devel space the package has two folders: this source folder and the devel
+# space's (the built _core, the generated msg). A process that finds this one first (it
+# inherits the sys.path that the devel __init__ extends, as a Dask worker does) gets both.
+__path__ = extend_path(__path__, __name__)
+
+from ._run import Run, SceneError, body_name, predict, run
+from ._sweep import sweep
+from ._bag import read_bag
+
+__all__ = ['Run', 'SceneError', 'body_name', 'predict', 'read_bag', 'run', 'sweep']

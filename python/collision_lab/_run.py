@@ -1,0 +1,190 @@
+"""One scene run in process: collision_lab.run, predict, SceneError and the Run object.
+
+The C++ part (collision_lab._core) is collision_lab_cli's own parser, core run and JSON
+report writer: a Run's summary, scene, options and events are the CLI's JSON, key for key
+and value for value.
+"""
+import json
+import math
+
+import numpy as np
+
+from . import _core
+
+# Summary keys that are the model's answer (mode 'predict' gives them without a run).
+_PREDICTION_KEYS = ('model', 'model_reason', 'count_formula', 'max_possible_collision_count',
+                    'critical_restitution', 'spiral_angle', 'theta', 'alpha', 'omega', 'psi',
+                    'paper_phi_bc')
+# Per-event values with one number per body ([m], [m/s], [J]).
+_BODY_ARRAYS = ('positions', 'velocities_before', 'velocities_after', 'energy_transfer',
+                'kinetic_energy_after')
+# Per-body arrays of the three-body model, present where the model gives them.
+_MODEL_ARRAYS = ('predicted_velocities_after', 'paper_velocities_after',
+                 'predicted_energy_transfer', 'paper_energy_transfer')
+# Per-event scalars: name -> numpy dtype (units in docs/python.md).
+_SCALARS = (('index', np.int64), ('pair_index', np.int64), ('time', float), ('position', float),
+            ('restitution', float), ('energy_lost', float), ('total_energy', float),
+            ('total_momentum', float), ('first_moved', np.int64), ('last_moved', np.int64),
+            ('cluster_impact', bool))
+
+
+class SceneError(ValueError):
+    """A scene or option the engine rejects: the CLI's JSON error (--format json).
+
+    reason: e.g. 'POSITIONS_COINCIDENT'; code: its number; field: e.g. 'masses[1]';
+    message: one sentence saying what is wrong.
+    """
+
+    def __init__(self, reason, code, field, message):
+        super().__init__('invalid %s (%s): %s' % (field, reason, message))
+        self.reason = reason
+        self.code = code
+        self.field = field
+        self.message = message
+
+
+def body_name(index):
+    """The core's name of body `index` (0-based): A..Z, then #26, #27, ..."""
+    return chr(ord('A') + index) if index < 26 else '#%d' % index
+
+
+def _number_list(values):
+    """Numbers as the CLI's comma list; repr round-trips every double (inf, -inf, nan too)."""
+    if np.ndim(values) == 0:
+        values = [values]
+    return ','.join(repr(float(v)) for v in values)
+
+
+def scene_arguments(masses, positions, velocities, restitution=1.0, *, ring=None,
+                    restitution_model='constant', tc=None, elastic_below=None,
+                    viscoelastic_speed=None, max_collisions=10_000_000, simulate_to_cap=False,
+                    events='all', mode='full', temperature_csv=None):
+    """collision_lab_cli's arguments for these keyword arguments (see run())."""
+    args = ['--masses', _number_list(masses), '--positions', _number_list(positions),
+            '--velocities', _number_list(velocities),
+            '--max-collisions', str(int(max_collisions)), '--events', str(events), '--mode', str(mode)]
+    # The defaults are the CLI's without the option (its report then shows no restitution list).
+    if np.ndim(restitution) != 0 or float(restitution) != 1.0:
+        args += ['--restitution', _number_list(restitution)]
+    if restitution_model != 'constant':
+        args += ['--restitution-model', str(restitution_model)]
+    for option, value in (('--ring', ring), ('--tc', tc), ('--elastic-below', elastic_below),
+                          ('--viscoelastic-speed', viscoelastic_speed)):
+        if value is not None:
+            args += [option, _number_list(value)]
+    if temperature_csv is not None:
+        args += ['--temperature-csv', str(temperature_csv)]
+    if simulate_to_cap:
+        args.append('--simulate-to-cap')
+    return args
+
+
+def parse_report(text):
+    """The JSON report as a dict; raises SceneError for the CLI's JSON error document."""
+    report = json.loads(text)
+    if 'error' in report:
+        error = report['error']
+        raise SceneError(error['reason'], error['code'], error['field'], error['message'])
+    return report
+
+
+def _float_rows(rows, bodies):
+    """events x bodies floats; NaN where the JSON has null (a whole null row: all NaN)."""
+    out = np.full((len(rows), bodies), np.nan)
+    for i, row in enumerate(rows):
+        if row is not None:
+            out[i, :len(row)] = [np.nan if v is None else v for v in row]
+    return out
+
+
+def _events_arrays(events, bodies):
+    arrays = {'kind': np.array([e['kind'] for e in events], dtype=str),
+              'pair': np.array([e['pair'] for e in events], dtype=str)}
+    for key, dtype in _SCALARS:
+        values = [e[key] for e in events]
+        arrays[key] = (np.array(values, dtype=dtype) if dtype is not float
+                       else np.array([np.nan if v is None else v for v in values], dtype=float))
+    for key in _BODY_ARRAYS:
+        arrays[key] = _float_rows([e[key] for e in events], bodies)
+    for key in _MODEL_ARRAYS:
+        rows = [e.get(key) for e in events]
+        if any(row is not None for row in rows):
+            arrays[key] = _float_rows(rows, bodies)
+    return arrays
+
+
+class Run:
+    """One scene's run: the CLI's JSON report, with the events as numpy arrays.
+
+    summary, scene, options, units: the report's objects as dicts (null -> None).
+    model, model_reason: the model that answered, and why. prediction: the model's answer
+    (the summary's predicted_* and model fields; equal to predict()). events: dict of numpy
+    arrays, one entry per event in order (see docs/python.md for the keys and units).
+    names: the bodies' names; masses [kg] (inf: a wall), initial_positions [m],
+    initial_velocities [m/s]: numpy arrays.
+    """
+
+    def __init__(self, report, masses, positions, velocities):
+        self.report = report
+        self.summary = report['summary']
+        self.scene = report['scene']
+        self.options = report['options']
+        self.units = report['units']
+        self.model = self.summary.get('model', '')
+        self.model_reason = self.summary.get('model_reason', '')
+        self.prediction = prediction_of(self.summary)
+        self.masses = np.asarray(masses, dtype=float)
+        self.initial_positions = np.asarray(positions, dtype=float)
+        self.initial_velocities = np.asarray(velocities, dtype=float)
+        self.names = [body_name(i) for i in range(len(self.masses))]
+        self.events = _events_arrays(report.get('events', []), len(self.masses))
+
+    def to_pandas(self):
+        """One row per event: the scalar fields, then v_A, v_B, ... (velocities after [m/s])
+        and x_A, x_B, ... (positions at the event [m])."""
+        import pandas as pd
+        columns = {key: self.events[key] for key in ('kind', 'pair') + tuple(k for k, _ in _SCALARS)}
+        for i, name in enumerate(self.names):
+            columns['v_' + name] = self.events['velocities_after'][:, i]
+        for i, name in enumerate(self.names):
+            columns['x_' + name] = self.events['positions'][:, i]
+        return pd.DataFrame(columns)
+
+    def __repr__(self):
+        return '<collision_lab.Run %d bodies, model %s, %s collisions>' % (
+            len(self.masses), self.model, self.summary.get('collision_count'))
+
+
+def prediction_of(summary):
+    """The summary's fields that are the model's answer (predicted_*, model, ...)."""
+    return {key: value for key, value in summary.items()
+            if key in _PREDICTION_KEYS or 'predicted' in key}
+
+
+def run(masses, positions, velocities, restitution=1.0, *, ring=None, restitution_model='constant',
+        tc=None, elastic_below=None, viscoelastic_speed=None, max_collisions=10_000_000,
+        simulate_to_cap=False, events='all', mode='full', name='', temperature_csv=None):
+    """Runs one scene in process (as collision_lab_cli --format json) and returns a Run.
+
+    masses [kg] (inf: a wall, first or last), positions [m] strictly decreasing, velocities
+    [m/s], one per body, right to left. restitution [1]: one e, or one per pair.
+    ring: circumference L [m] (no walls). restitution_model: 'constant', 'tc' (tc [s]),
+    'threshold' (elastic_below [m/s]) or 'viscoelastic' (viscoelastic_speed [m/s]).
+    max_collisions: the cap; simulate_to_cap: simulate up to it even when the model
+    answers. events: 'all', 'none' or 'first:N'. mode: 'full', 'predict' or 'summary'.
+    name: the scene's name. temperature_csv: a path to write T(t) [J] to, as the CLI's.
+    The GIL is released while it runs; Ctrl-C stops it (KeyboardInterrupt).
+    Raises SceneError for a scene or option the CLI rejects.
+    """
+    args = scene_arguments(masses, positions, velocities, restitution, ring=ring,
+                           restitution_model=restitution_model, tc=tc, elastic_below=elastic_below,
+                           viscoelastic_speed=viscoelastic_speed, max_collisions=max_collisions,
+                           simulate_to_cap=simulate_to_cap, events=events, mode=mode,
+                           temperature_csv=temperature_csv)
+    return Run(parse_report(_core.run_json(args, name)), masses, positions, velocities)
+
+
+def predict(masses, positions, velocities, restitution=1.0, **options):
+    """The model's answer alone (mode 'predict', no events): Run.prediction's dict."""
+    options.update(mode='predict', events='none')
+    return run(masses, positions, velocities, restitution, **options).prediction

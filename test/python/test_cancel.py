@@ -1,0 +1,43 @@
+"""Ctrl-C during a run: the engine's cancel flag stops it and KeyboardInterrupt is raised.
+The run would take hours uncancelled (3.1e10 impacts), so returning at all is the check."""
+import _thread
+import os
+import signal
+import threading
+
+import pytest
+
+import collision_lab
+
+INF = float('inf')
+
+
+def long_run():
+    # m_A/m_B = 1e20: 31,415,926,535 impacts, simulated one by one up to the cap.
+    collision_lab.run([1e20, 1, INF], [2, 1, 0], [-1, 0, 0], simulate_to_cap=True, events='none',
+                      max_collisions=10 ** 12)
+
+
+@pytest.mark.parametrize('interrupt', [_thread.interrupt_main, lambda: os.kill(os.getpid(), signal.SIGINT)],
+                         ids=['interrupt_main', 'SIGINT'])
+def test_ctrl_c_cancels_a_long_run(interrupt):
+    timer = threading.Timer(0.5, interrupt)
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            long_run()
+    finally:
+        timer.cancel()
+    # The module still works afterwards.
+    assert collision_lab.run([100, 1, INF], [2, 1, 0], [-1, 0, 0]).summary['collision_count'] == 31
+
+
+def test_ctrl_c_cancels_a_sweep():
+    timer = threading.Timer(0.5, _thread.interrupt_main)
+    timer.start()
+    scene = dict(masses=[1e20, 1, INF], positions=[2, 1, 0], velocities=[-1, 0, 0])
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            collision_lab.sweep([scene] * 4, workers=2, simulate_to_cap=True, max_collisions=10 ** 12)
+    finally:
+        timer.cancel()

@@ -1,0 +1,128 @@
+"""collision_lab.run and predict against collision_lab_cli's JSON, value for value, on a
+scene of every model; the events as numpy arrays and a DataFrame."""
+import math
+
+import numpy as np
+import pytest
+
+import collision_lab
+
+INF = float('inf')
+
+# (model, run()'s arguments, the CLI's arguments for the same scene, written by hand)
+SCENES = [
+    ('no_collisions', dict(masses=[1, 2, 3], positions=[2, 1, 0], velocities=[1, 0, -1]),
+     '--masses 1,2,3 --positions 2,1,0 --velocities 1,0,-1'),
+    ('two_body', dict(masses=[3, 1], positions=[1, 0], velocities=[-1, 1]),
+     '--masses 3,1 --positions 1,0 --velocities -1,1'),
+    ('three_body_rotation', dict(masses=[100, 1, INF], positions=[2, 1, 0], velocities=[-1, 0, 0]),
+     '--masses 100,1,inf --positions 2,1,0 --velocities -1,0,0'),
+    ('three_body_spiral', dict(masses=[1, 1, 1], positions=[2, 1, 0], velocities=[-1, 0, 0], restitution=0.05),
+     '--masses 1,1,1 --positions 2,1,0 --velocities -1,0,0 --restitution 0.05'),
+    ('ghosts', dict(masses=[1, 1, 1, 1], positions=[3, 2, 1, 0], velocities=[-1, 0, 0, 1]),
+     '--masses 1,1,1,1 --positions 3,2,1,0 --velocities -1,0,0,1'),
+    ('sticky', dict(masses=[1, 2, 3, 4], positions=[3, 2, 1, 0], velocities=[-1, 0, 0, 1], restitution=0),
+     '--masses 1,2,3,4 --positions 3,2,1,0 --velocities -1,0,0,1 --restitution 0'),
+    ('two_walls_infinite', dict(masses=[INF, 1, INF], positions=[1, 0.5, 0], velocities=[0, 1, 0]),
+     '--masses inf,1,inf --positions 1,0.5,0 --velocities 0,1,0'),
+    ('box_infinite', dict(masses=[INF, 1, 2, INF], positions=[3, 2, 1, 0], velocities=[0, 1, -1, 0],
+                          restitution=0.5, max_collisions=200),
+     '--masses inf,1,2,inf --positions 3,2,1,0 --velocities 0,1,-1,0 --restitution 0.5 --max-collisions 200'),
+    ('event_engine', dict(masses=[1, 2, 3, 4, 5], positions=[4, 3, 2, 1, 0], velocities=[-1, 0.5, 0, 0.2, 1]),
+     '--masses 1,2,3,4,5 --positions 4,3,2,1,0 --velocities -1,0.5,0,0.2,1'),
+    ('event_engine', dict(masses=[1, 2, 3], positions=[3, 2, 1], velocities=[1, 0, -1], ring=10),
+     '--masses 1,2,3 --positions 3,2,1 --velocities 1,0,-1 --ring 10'),
+    ('event_engine', dict(masses=[1, 2, 3, 1.5, 1], positions=[4, 3, 2, 1, 0], velocities=[-1, 0.5, 0, 0.2, 1],
+                          restitution=0.8, restitution_model='tc', tc=1e-3, ring=10, max_collisions=500),
+     '--masses 1,2,3,1.5,1 --positions 4,3,2,1,0 --velocities -1,0.5,0,0.2,1 --restitution 0.8 '
+     '--restitution-model tc --tc 0.001 --ring 10 --max-collisions 500'),
+    ('event_engine', dict(masses=[1, 2, 3, 4], positions=[3, 2, 1, 0], velocities=[-1, 0, 0, 1],
+                          events='first:3', simulate_to_cap=True, mode='summary'),
+     '--masses 1,2,3,4 --positions 3,2,1,0 --velocities -1,0,0,1 --events first:3 --simulate-to-cap '
+     '--mode summary'),
+    ('three_body_rotation', dict(masses=[1e4, 1, INF], positions=[2, 1, 0], velocities=[-1, 0, 0], mode='predict'),
+     '--masses 10000,1,inf --positions 2,1,0 --velocities -1,0,0 --mode predict'),
+]
+
+
+def without_wall_time(report):
+    """The report without compute_time_s, the run's wall time."""
+    summary = dict(report['summary'])
+    del summary['compute_time_s']
+    return dict(report, summary=summary)
+
+
+def nan_for_null(rows):
+    return np.array([[np.nan if v is None else v for v in row] for row in rows], dtype=float)
+
+
+@pytest.mark.parametrize('model,kwargs,cli_args', SCENES, ids=[s[0] for s in SCENES])
+def test_run_equals_cli_json(cli, model, kwargs, cli_args):
+    expected = cli(cli_args.split())
+    run = collision_lab.run(**kwargs)
+    assert run.model == expected['summary']['model'] == model
+    assert without_wall_time(run.report) == without_wall_time(expected)
+    assert run.summary.keys() == expected['summary'].keys()
+    assert run.scene == expected['scene'] and run.options == expected['options'] and run.units == expected['units']
+    assert run.model_reason == expected['summary']['model_reason']
+    events = expected['events']
+    assert list(run.events['kind']) == [e['kind'] for e in events]
+    for key in ('index', 'pair_index', 'time', 'position', 'restitution', 'energy_lost', 'total_energy',
+                'total_momentum'):
+        assert run.events[key].tolist() == [e[key] for e in events], key
+    for key in ('positions', 'velocities_before', 'velocities_after', 'energy_transfer', 'kinetic_energy_after'):
+        assert run.events[key].shape == (len(events), len(kwargs['masses']))
+        if events:
+            np.testing.assert_array_equal(run.events[key], nan_for_null([e[key] for e in events]))
+    table = run.to_pandas()
+    assert len(table) == len(events)
+    names = [collision_lab.body_name(i) for i in range(len(kwargs['masses']))]
+    assert run.names == names
+    for i, name in enumerate(names):
+        assert table['v_' + name].tolist() == run.events['velocities_after'][:, i].tolist()
+        assert table['x_' + name].tolist() == run.events['positions'][:, i].tolist()
+    np.testing.assert_array_equal(run.masses, np.array(kwargs['masses'], dtype=float))
+
+
+def test_pi_billiard_counts_and_three_body_arrays():
+    for heavy, count in ((100, 31), (1e4, 314), (1e6, 3141)):
+        run = collision_lab.run([heavy, 1, INF], [2, 1, 0], [-1, 0, 0])
+        assert run.summary['collision_count'] == count
+        assert len(run.events['time']) == count
+    # The rotation model's velocities at each impact are given beside the simulated ones.
+    assert run.events['predicted_velocities_after'].shape == (3141, 3)
+    np.testing.assert_allclose(run.events['predicted_velocities_after'], run.events['velocities_after'],
+                               rtol=0, atol=1e-9)
+
+
+def test_spiral_collapse_is_an_event():
+    run = collision_lab.run([1, 1, 1], [2, 1, 0], [-1, 0, 0], 0.05)
+    assert run.events['kind'].tolist() == ['impact'] * 8 + ['collapse']
+    assert run.summary['collapsed'] is True
+    assert run.summary['collapse_time'] == 3.5
+    np.testing.assert_allclose(run.events['velocities_after'][-1], [-1 / 3] * 3, rtol=1e-15)
+
+
+def test_prediction_equals_predict():
+    for args in (([100, 1, INF], [2, 1, 0], [-1, 0, 0]), ([1, 1, 1, 1], [3, 2, 1, 0], [-1, 0, 0, 1])):
+        run = collision_lab.run(*args)
+        assert run.prediction == collision_lab.predict(*args)
+        assert run.prediction['model'] == run.model
+    assert collision_lab.predict([1e6, 1, INF], [2, 1, 0], [-1, 0, 0])['predicted_collision_count'] == 3141
+
+
+def test_body_names_past_z():
+    n = 30
+    run = collision_lab.run([1.0] * n, list(range(n, 0, -1)), [0.0] * (n - 1) + [-1.0], events='none')
+    assert run.names[:2] == ['A', 'B'] and run.names[25] == 'Z' and run.names[26] == '#26'
+    assert list(run.to_pandas().columns[-2:]) == ['x_#28', 'x_#29']
+
+
+def test_temperature_csv_as_the_cli(cli, tmp_path):
+    ours, theirs = tmp_path / 'ours.csv', tmp_path / 'cli.csv'
+    collision_lab.run([1, 2, 1.5, 1], [3, 2, 1, 0], [-1, 0.5, 0, 1], 0.9, ring=10, max_collisions=300,
+                      events='none', temperature_csv=str(ours))
+    cli(('--masses 1,2,1.5,1 --positions 3,2,1,0 --velocities -1,0.5,0,1 --restitution 0.9 --ring 10 '
+         '--max-collisions 300 --events none --temperature-csv %s' % theirs).split())
+    assert ours.read_text() == theirs.read_text()
+    assert ours.read_text().count('\n') > 10
