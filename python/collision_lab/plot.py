@@ -85,6 +85,12 @@ def body_colours(run):
     return colours
 
 
+def hex_colour(rgb):
+    """'#rrggbb' of (r, g, b) in [0, 1], bytes rounded half away from zero as the page's
+    view.body_colours are."""
+    return '#' + ''.join('%02x' % int(math.floor(min(max(c, 0.0), 1.0) * 255 + 0.5)) for c in rgb[:3])
+
+
 def evenly_spaced(count, n):
     """n evenly spaced indices of 0 .. count - 1, the first and last included (all if count <= n)."""
     if count <= n:
@@ -487,7 +493,6 @@ def temperature(run, ax=None, csv=None):
         ax.loglog(tt, fit['t0'] / (1 + tt / fit['tau']) ** 2, color='C3', ls='--', lw=1.6,
                   label="Haff's law fitted: T0 = %.3g J, tau = %.3g s (rms in ln T: %.2g)"
                   % (fit['t0'], fit['tau'], fit['rms_ln_error']))
-        ax.loglog(tt, fit['t0'] * (fit['tau'] / tt) ** 2, color='0.6', ls=':', lw=1, label='its tail, T0 (tau/t)^2')
         ax.set_ylim(T[T > 0].min() / 2, T.max() * 2)
     ax.set_xlabel('time t [s]')
     ax.set_ylabel('granular temperature T [J]')
