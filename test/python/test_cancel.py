@@ -1,4 +1,5 @@
-"""Ctrl-C during a run: the engine's cancel flag stops it and KeyboardInterrupt is raised.
+"""Ctrl-C during a run: the engine's cancel flag stops it and KeyboardInterrupt is raised;
+the GIL is free while a run goes on.
 The run would take hours uncancelled (3.1e10 impacts), so returning at all is the check."""
 import _thread
 import os
@@ -41,3 +42,25 @@ def test_ctrl_c_cancels_a_sweep():
             collision_lab.sweep([scene] * 4, workers=2, simulate_to_cap=True, max_collisions=10 ** 12)
     finally:
         timer.cancel()
+
+
+def test_the_gil_is_released_during_a_run():
+    # The main thread counts while another thread runs 3,141,592 impacts one by one; with
+    # the GIL held it could not count until the run is over.
+    counted = []
+    done = threading.Event()
+
+    def run_then_stop():
+        summary = collision_lab.run([1e12, 1, INF], [2, 1, 0], [-1, 0, 0], simulate_to_cap=True,
+                                    events='none', max_collisions=10 ** 12).summary
+        counted.append(summary['collision_count'])
+        done.set()
+
+    worker = threading.Thread(target=run_then_stop)
+    count = 0
+    worker.start()
+    while not done.is_set():
+        count += 1
+    worker.join()
+    assert counted == [3141592]
+    assert count > 1000
