@@ -13,6 +13,15 @@ import collision_lab
 INF = float('inf')
 
 
+@pytest.fixture(autouse=True)
+def ctrl_c_raises():
+    """Python's own SIGINT handler, also where the test was started with SIGINT ignored (a
+    background job of a script), which Python would keep."""
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, previous)
+
+
 def long_run():
     # m_A/m_B = 1e20: 31,415,926,535 impacts, simulated one by one up to the cap.
     collision_lab.run([1e20, 1, INF], [2, 1, 0], [-1, 0, 0], simulate_to_cap=True, events='none',
