@@ -85,6 +85,23 @@ class ReadBag(unittest.TestCase):
         self.assertEqual(bag.model, 'event_engine')
         self.assertEqual(bag.events['positions'].shape, (bag.summary['collision_count'], 5))
 
+    def test_many_bodies_beyond_the_full_state(self):
+        # CollisionEvent carries per-body arrays up to FULL_STATE_MAX_BODIES (64) bodies:
+        # beyond, read_bag's per-body arrays are NaN, the scalars still the run's.
+        n = 70
+        scene = dict(masses=[1.0 + (i % 3) for i in range(n)], positions=[float(n - i) for i in range(n)],
+                     velocities=[-1.0] + [0.0] * (n - 2) + [1.0])
+        summary, path = self.recorded('many', scene)
+        bag = collision_lab.read_bag(path)
+        run = collision_lab.run(scene['masses'], scene['positions'], scene['velocities'])
+        events = summary.collision_count
+        self.assertGreater(events, 0)
+        self.assertEqual(bag.events['positions'].shape, (events, n))
+        self.assertTrue(np.isnan(bag.events['velocities_after']).all())
+        for key in ('index', 'pair_index', 'time', 'position', 'total_energy'):
+            np.testing.assert_array_equal(bag.events[key], run.events[key], err_msg=key)
+        self.assertEqual(bag.names[-1], '#69')
+
 
 if __name__ == '__main__':
     import rosunit
