@@ -19,5 +19,6 @@ set_target_properties(collision_lab_python_core PROPERTIES
   INSTALL_RPATH ${CMAKE_INSTALL_PREFIX}/${CATKIN_PACKAGE_LIB_DESTINATION})
 install(TARGETS collision_lab_python_core LIBRARY DESTINATION ${CATKIN_PACKAGE_PYTHON_DESTINATION})
 
-# collision_lab_sweep: the sweep for batch systems (--shard I/N, --merge; docs/python.md).
+# collision_lab_sweep: python3 -m collision_lab.batch (--shard I/N, --merge; docs/python.md). Not
+# executable in the source tree, so that rosrun finds only the devel space's or the install's.
 catkin_install_python(PROGRAMS scripts/collision_lab_sweep DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})

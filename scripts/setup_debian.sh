@@ -21,6 +21,8 @@ export PATH=/usr/bin:/bin:/usr/sbin:/sbin:$PATH
 # (docs/web.md) is on Boost.Beast (libboost-dev), its tests' client is cpp-httplib, and it
 # serves Debian's Chart.js; docs/web.md's commands (run as written by a test) use curl;
 # its browser tests and screenshots need chromium (--with-screenshots, as CI).
+# The Python module (docs/python.md): pybind11, numpy, pandas, Dask's distributed, pytest;
+# the notebooks: matplotlib, nbclient, nbformat, ipykernel.
 packages=(
   build-essential cmake libgtest-dev
   ros-core-dev rosout rosbash python3-rostest
@@ -35,6 +37,8 @@ packages=(
   libcpp-httplib-dev libjs-chart.js
   libsqlite3-dev
   curl
+  pybind11-dev python3-numpy python3-pandas python3-distributed python3-pytest python3-yaml
+  python3-matplotlib python3-nbclient python3-nbformat python3-ipykernel
 )
 build=true
 for arg in "$@"; do

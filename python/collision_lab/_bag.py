@@ -80,7 +80,8 @@ def _summary(msg, prediction):
                # The bag's own: whose run, and where it was recorded.
                'run_id': msg.run_id, 'student': msg.student, 'bag_path': msg.bag_path}
     if prediction is not None:
-        summary['predicted_final_velocities'] = _values(prediction.final_velocities)
+        # Empty when the model gives none: the CLI's null.
+        summary['predicted_final_velocities'] = _values(prediction.final_velocities) or None
         summary['max_possible_collision_count'] = prediction.max_possible_collision_count
         summary['predicted_first_pair'] = _PAIRS_PREDICTED.get(prediction.first_pair_index)
     return summary

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <memory>
 #include <ostream>
 #include <string_view>
 #include <vector>
@@ -70,7 +71,8 @@ class TextSink {
   static constexpr std::size_t kChunk = std::size_t{1} << 18;
 
   explicit TextSink(std::ostream& out, bool auto_flush = true)
-      : out_(out), auto_flush_(auto_flush), buffer_(kChunk + kSlack), csv_(writeCsvNumber), json_(writeJsonNumber) {}
+      : out_(out), auto_flush_(auto_flush), buffer_(new char[kChunk + kSlack]), capacity_(kChunk + kSlack),
+        csv_(writeCsvNumber), json_(writeJsonNumber) {}
   ~TextSink() { flush(); }
   TextSink(const TextSink&) = delete;
   TextSink& operator=(const TextSink&) = delete;
@@ -86,17 +88,17 @@ class TextSink {
   }
   void count(std::uint64_t value) {
     room(24);
-    size_ = static_cast<std::size_t>(std::to_chars(at(), at() + 24, value).ptr - buffer_.data());
+    size_ = static_cast<std::size_t>(std::to_chars(at(), at() + 24, value).ptr - buffer_.get());
   }
   /// writeCsvNumber's text.
   void csvNumber(double value) {
     room(kNumberTextMax + 1);
-    size_ = static_cast<std::size_t>(csv_.write(at(), value) - buffer_.data());
+    size_ = static_cast<std::size_t>(csv_.write(at(), value) - buffer_.get());
   }
   /// writeJsonNumber's text.
   void jsonNumber(double value) {
     room(kNumberTextMax + 1);
-    size_ = static_cast<std::size_t>(json_.write(at(), value) - buffer_.data());
+    size_ = static_cast<std::size_t>(json_.write(at(), value) - buffer_.get());
   }
 
   /// `key` (e.g. ",\"time\":") and the value as jsonNumber.
@@ -120,7 +122,7 @@ class TextSink {
     if (size_ >= kChunk) flush();
   }
   void flush() {
-    if (size_ > 0) out_.write(buffer_.data(), static_cast<std::streamsize>(size_));
+    if (size_ > 0) out_.write(buffer_.get(), static_cast<std::streamsize>(size_));
     size_ = 0;
   }
   /// Drops the text not yet written (after a failure, so that it is never written late).
@@ -129,16 +131,23 @@ class TextSink {
  private:
   static constexpr std::size_t kSlack = std::size_t{1} << 16;
 
-  char* at() { return buffer_.data() + size_; }
+  char* at() { return buffer_.get() + size_; }
   void room(std::size_t bytes) {
-    if (size_ + bytes <= buffer_.size()) return;
+    if (size_ + bytes <= capacity_) return;
     if (auto_flush_) flush();
-    if (size_ + bytes > buffer_.size()) buffer_.resize(std::max(2 * buffer_.size(), size_ + bytes));
+    if (size_ + bytes <= capacity_) return;
+    capacity_ = std::max(2 * capacity_, size_ + bytes);
+    std::unique_ptr<char[]> grown(new char[capacity_]);
+    std::memcpy(grown.get(), buffer_.get(), size_);
+    buffer_ = std::move(grown);
   }
 
   std::ostream& out_;
   bool auto_flush_;
-  std::vector<char> buffer_;
+  // Not zeroed (new char[], not a vector): a small report touches only the pages it
+  // writes, which makes a run's report cheap for callers that run many small scenes.
+  std::unique_ptr<char[]> buffer_;
+  std::size_t capacity_;
   std::size_t size_ = 0;
   NumberTextCache csv_;
   NumberTextCache json_;

@@ -30,6 +30,14 @@ SCENES = [
      '--masses inf,1,2,inf --positions 3,2,1,0 --velocities 0,1,-1,0 --restitution 0.5 --max-collisions 200'),
     ('event_engine', dict(masses=[1, 2, 3, 4, 5], positions=[4, 3, 2, 1, 0], velocities=[-1, 0.5, 0, 0.2, 1]),
      '--masses 1,2,3,4,5 --positions 4,3,2,1,0 --velocities -1,0.5,0,0.2,1'),
+    # Numbers of 16 and 17 significant digits arrive as the same doubles.
+    ('event_engine', dict(masses=[0.3333333333333333, 1.4142135623730951, 3.141592653589793, 2.718281828459045],
+                          positions=[3.3000000000000003, 2.1, 1.05, 0.0],
+                          velocities=[-0.14285714285714285, 0.2, 1e-300, 0.3333333333333333],
+                          restitution=0.91370000000000001),
+     '--masses 0.3333333333333333,1.4142135623730951,3.141592653589793,2.718281828459045 '
+     '--positions 3.3000000000000003,2.1,1.05,0 --velocities -0.14285714285714285,0.2,1e-300,0.3333333333333333 '
+     '--restitution 0.9137'),
     ('event_engine', dict(masses=[1, 2, 3], positions=[3, 2, 1], velocities=[1, 0, -1], ring=10),
      '--masses 1,2,3 --positions 3,2,1 --velocities 1,0,-1 --ring 10'),
     ('event_engine', dict(masses=[1, 2, 3, 1.5, 1], positions=[4, 3, 2, 1, 0], velocities=[-1, 0.5, 0, 0.2, 1],

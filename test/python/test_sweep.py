@@ -114,9 +114,10 @@ def read_lines(path):
 def test_shell_shards_merged_equal_the_unsharded_sweep(tmp_path):
     (tmp_path / 'sweep.yaml').write_text(SWEEP_YAML)
     tool = sweep_tool()
-    # As docs/python.md's loop, GNU parallel's and Slurm's array stand-in: 3 shards, one merge.
+    # As docs/python.md's loop, GNU parallel's and Slurm's array stand-in: 3 shards, one merge;
+    # the module's form and the installed program's.
     script = ('set -e\n'
-              'for i in 0 1 2; do "$TOOL" sweep.yaml --shard $i/3 -o shard_$i.jsonl; done\n'
+              'for i in 0 1 2; do python3 -m collision_lab.batch sweep.yaml --shard $i/3 -o shard_$i.jsonl; done\n'
               '"$TOOL" sweep.yaml --merge shard_*.jsonl -o merged.jsonl\n'
               '"$TOOL" sweep.yaml --merge shard_*.jsonl -o merged.csv\n'
               '"$TOOL" sweep.yaml -o whole.jsonl --workers 2\n')
