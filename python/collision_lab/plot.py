@@ -176,12 +176,13 @@ def steps(run, ax=None, bodies=None):
     lines = 0
     for i in bodies:
         name = run.names[i]
+        wall = '' if np.isfinite(run.masses[i]) else ' (wall)'
         ax.step(held, v[:, i], where='post', color=colours[i], lw=1.6,
-                label=('v_%s simulated' % name) if labelled else None)
+                label=('v_%s simulated%s' % (name, wall)) if labelled else None)
         lines += labelled
         if predicted is not None:
             ax.plot(index[1:], predicted[:, i], ls='none', marker='o', ms=5, mfc='none', mec=colours[i],
-                    label=('v_%s closed form' % name) if labelled and i == bodies[0] else None)
+                    label='closed form, after each impact' if labelled and i == bodies[0] else None)
         if paper is not None:
             ax.plot(index[1:], paper[:, i], ls='none', marker='x', ms=5, color=colours[i], alpha=0.8,
                     label=("paper's eqs. (2.15)/(2.16)") if labelled and i == bodies[0] else None)
