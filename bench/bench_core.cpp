@@ -17,7 +17,9 @@
 // (impact_rule.h) on double-double velocities, pairs in turn, nothing else; a `why:` line
 // after each missed goal gives that breakdown.
 //
-// Usage: collision_lab_bench_core [--repeats N] [--quick]
+// Usage: collision_lab_bench_core [--repeats N] [--quick] [--count-only]
+//   --count-only: only the lean loop and the lab runs that publish no event (full and
+//   summary mode) on (1e14, 1, 1e14).
 // Goals are printed as measured, never asserted.
 #include <cstdio>
 #include <cstdlib>
@@ -81,7 +83,9 @@ struct SceneFigures {
   double dd_maps_ns = 0.0;        // doubleDoubleImpactMaps alone
 };
 
-SceneFigures benchScene(double heavy, int repeats, bool keep_all) {
+/// `lab_only`: the lean loop and the lab runs that publish no event (full and summary mode)
+/// alone, for a quick before/after of the count-only path.
+SceneFigures benchScene(double heavy, int repeats, bool keep_all, bool lab_only = false) {
   const ThreeBodyScene scene = heavyLightHeavy(heavy);
   const std::uint64_t predicted = predictedCollisionCount(scene);
   std::printf("\nScene: masses (%g, 1, %g), positions (1, 0, -1) m, v = (-1, 0, 0) m/s; "
@@ -113,18 +117,20 @@ SceneFigures benchScene(double heavy, int repeats, bool keep_all) {
                        return run.collision_count;
                      });
   Escalations escalation;
-  methods.emplace_back("engine count-only (runEngine)", [&] {
-                       const EngineResult result = runEngine(engine_scene, engine_options);
-                       escalation = result.escalations;
-                       doNotOptimize(result.final_velocities.data());
-                       return result.impact_count;
-                     });
-  methods.emplace_back("core, every event visited", [&] {
-                       std::uint64_t seen = 0;
-                       const auto result = runLab(scene, full_run, [&](const LabEvent&) { ++seen; });
-                       doNotOptimize(seen);
-                       return result.summary.collision_count;
-                     });
+  if (!lab_only) {
+    methods.emplace_back("engine count-only (runEngine)", [&] {
+                         const EngineResult result = runEngine(engine_scene, engine_options);
+                         escalation = result.escalations;
+                         doNotOptimize(result.final_velocities.data());
+                         return result.impact_count;
+                       });
+    methods.emplace_back("core, every event visited", [&] {
+                         std::uint64_t seen = 0;
+                         const auto result = runLab(scene, full_run, [&](const LabEvent&) { ++seen; });
+                         doNotOptimize(seen);
+                         return result.summary.collision_count;
+                       });
+  }
   // As `collision_lab_cli --mode full --events none` runs it: no event handed out.
   methods.emplace_back("core, full lab run (mode full)", [&] {
                        const auto result = runLab(scene, full_run);
@@ -139,11 +145,13 @@ SceneFigures benchScene(double heavy, int repeats, bool keep_all) {
                        return result.summary.collision_count;
                      });
   const int first = firstPair(scene) == Pair::BC ? 1 : 0;
-  methods.emplace_back("double-double impact maps alone", [&] {
-                       doNotOptimize(doubleDoubleImpactMaps(scene, predicted, first));
-                       return predicted;
-                     });
-  if (keep_all) {
+  if (!lab_only) {
+    methods.emplace_back("double-double impact maps alone", [&] {
+                         doNotOptimize(doubleDoubleImpactMaps(scene, predicted, first));
+                         return predicted;
+                       });
+  }
+  if (keep_all && !lab_only) {
     methods.emplace_back("core, every event kept (events all)", [&] {
                          const auto result = runLab(scene, all_events);
                          doNotOptimize(result.events.data());
@@ -175,7 +183,7 @@ SceneFigures benchScene(double heavy, int repeats, bool keep_all) {
     if (std::strncmp(method.name, "double-double impact maps", 25) == 0) figures.dd_maps_ns = med;
   }
   std::printf("  (medians of %d round-robin repeats; ns per collision of each method's own count)\n", repeats);
-  std::printf("  engine escalations (runEngine): %llu refinements, %llu to 100 digits, %llu to exact rationals\n",
+  if (!lab_only) std::printf("  engine escalations (runEngine): %llu refinements, %llu to 100 digits, %llu to exact rationals\n",
               static_cast<unsigned long long>(escalation.refinements),
               static_cast<unsigned long long>(escalation.high_precision),
               static_cast<unsigned long long>(escalation.exact_rational));
@@ -283,16 +291,23 @@ double benchClosedForm(int repeats) {
 
 int main(int argc, char** argv) {
   int repeats = 5;
-  bool quick = false;
+  bool quick = false, count_only = false;
   for (int i = 1; i < argc; ++i) {
     if (std::strcmp(argv[i], "--repeats") == 0 && i + 1 < argc) {
       repeats = std::max(1, std::atoi(argv[++i]));
     } else if (std::strcmp(argv[i], "--quick") == 0) {
       quick = true;
+    } else if (std::strcmp(argv[i], "--count-only") == 0) {
+      count_only = true;
     } else {
-      std::fprintf(stderr, "usage: %s [--repeats N] [--quick]\n", argv[0]);
+      std::fprintf(stderr, "usage: %s [--repeats N] [--quick] [--count-only]\n", argv[0]);
       return 2;
     }
+  }
+  if (count_only) {  // the runs that publish no event, on (1e14, 1, 1e14), beside the lean loop
+    std::printf("collision_lab_bench_core --count-only: ns per collision, medians of %d repeats\n", repeats);
+    benchScene(1e14, repeats, false, true);
+    return 0;
   }
   if (quick) repeats = std::min(repeats, 3);
   const char* source = std::getenv("COLLISION_LAB_BENCH_SOURCE");

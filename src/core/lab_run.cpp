@@ -252,9 +252,10 @@ Scene asScene(const ThreeBodyScene& triple) {
 }
 
 /// The run of three elastic bodies whose count the closed form gives (`count`), without the
-/// engine's queue or any decision (nbody/elastic_triple.h), for a run that publishes no
-/// event: its count, final velocities (the engine's bit for bit, or certified correctly
-/// rounded) and drifts, as simulateByEngine gives them; no final time or positions. restart() is called before
+/// engine's queue or any decision (nbody/elastic_triple.h), the summary of every run that
+/// can be had so: its count, final velocities (the engine's bit for bit, or certified
+/// correctly rounded) and drifts, as simulateByEngine gives them; no final time or
+/// positions. An impact that may come after the largest double [s] declines it. restart() is called before
 /// each pass over the impacts (at most two); after each impact n, visit(n, v) sees the
 /// velocities [m/s] that simulateByEngine's event would carry. Returns nothing when the run
 /// cannot be taken this way (then the engine runs it). `progress` (RunOptions) sees every
@@ -280,8 +281,11 @@ std::optional<SimulationResult> simulateKnownCount(const ThreeBodyScene& scene, 
     return std::fabs(x) >= std::numeric_limits<double>::min() ? x : velocity_si(v);
   };
   const std::uint64_t every = progress ? progress_interval : 0;
+  // The largest working time whose SI value a double holds (as runEngine bounds it).
+  const double time_limit = static_cast<double>(
+      std::ldexp(static_cast<long double>(std::numeric_limits<double>::max()), units.timeShift()));
   const std::optional<nbody_detail::ElasticTripleRun> run = nbody_detail::runElasticTriple(
-      units.scene, count, first == Pair::BC ? 1 : 0, options.max_collisions, options.cancel, restart,
+      units.scene, count, first == Pair::BC ? 1 : 0, options.max_collisions, time_limit, options.cancel, restart,
       [&](std::uint64_t n, const std::array<double, 3>& v) {
         visit(n, std::array<double, 3>{si(v[0]), si(v[1]), si(v[2])});
         if (every != 0 && n % every == 0) progress(EngineProgress{n, std::numeric_limits<double>::quiet_NaN()});
@@ -405,32 +409,41 @@ void simulateBesidePrediction(const ThreeBodyScene& scene, const RunOptions& opt
     };
   }
   std::string stopped_otherwise;
-  std::optional<SimulationResult> by_engine;
-  // No event published: only the count, the final state, the drifts and (in full mode) the
-  // largest prediction error are needed, which the known count gives without the engine.
+  // The summary comes from the known count wherever it can be had, with events or without:
+  // events only watch (the engine's run publishes them), so a run's summary, its escalations
+  // included, is the same whatever it shows. The count, the final state, the drifts and (in
+  // full mode) the largest prediction error need no decision.
   const bool publishes = options.mode == RunMode::kFull && (visitor || options.events.kind != EventPolicy::Kind::kNone);
-  if (!publishes) {
-    if (options.mode == RunMode::kFull) {
-      std::optional<ClosedFormInTurn> predicted;
-      by_engine = simulateKnownCount(
-          scene, result.prediction.collision_count, simulation_options, options.progress, options.progress_interval,
-          [&] {
-            predicted.emplace(model);
-            max_error_sq = 0.0;
-          },
-          [&](std::uint64_t n, const std::array<double, 3>& v) {
-            max_error_sq = std::max(max_error_sq, relative_error.squared(v, predicted->velocitiesAfter(n)));
-          });
-    } else {
-      by_engine = simulateKnownCount(scene, result.prediction.collision_count, simulation_options, options.progress,
-                                     options.progress_interval, [] {},
-                                     [](std::uint64_t, const std::array<double, 3>&) {});
-    }
-    if (!by_engine) max_error_sq = 0.0;  // the engine measures it again
+  const ProgressCallback known_progress = publishes ? ProgressCallback{} : options.progress;  // else the engine's
+  double known_error_sq = 0.0;
+  std::optional<SimulationResult> known;
+  if (options.mode == RunMode::kFull) {
+    std::optional<ClosedFormInTurn> predicted;
+    known = simulateKnownCount(
+        scene, result.prediction.collision_count, simulation_options, known_progress, options.progress_interval,
+        [&] {
+          predicted.emplace(model);
+          known_error_sq = 0.0;
+        },
+        [&](std::uint64_t n, const std::array<double, 3>& v) {
+          known_error_sq = std::max(known_error_sq, relative_error.squared(v, predicted->velocitiesAfter(n)));
+        });
+  } else {
+    known = simulateKnownCount(scene, result.prediction.collision_count, simulation_options, known_progress,
+                               options.progress_interval, [] {}, [](std::uint64_t, const std::array<double, 3>&) {});
   }
-  if (!by_engine) {
+  std::optional<SimulationResult> by_engine;
+  if (publishes || !known) {
     by_engine = simulateByEngine(scene, simulation_options, options.progress, options.progress_interval, enrich,
                                  stopped_otherwise);
+  }
+  // The engine's run is the summary where the known count declined, or where the engine
+  // published fewer impacts (cancelled while it published them).
+  const bool from_known = known && (!by_engine || by_engine->collision_count == known->collision_count);
+  if (from_known) {
+    by_engine = known;
+    max_error_sq = known_error_sq;
+    stopped_otherwise.clear();
   }
   const SimulationResult& simulation = *by_engine;
   summary.max_prediction_error = relative_error.fromSquared(max_error_sq);

@@ -235,16 +235,39 @@ TEST(CliTable, AlignedColumnsWithUnitsAndThePapersValuesLabelled) {
 
 TEST(CliTable, NamesTheTierItsEscalatedDecisionsAreTakenAt) {
   // Masses (3, 1, 0.5), v = (-1, 0, 0): psi / alpha is exactly 3, so after 2 collisions the
-  // pair AB touches at exactly zero approach speed (physics.md), a decision that double
-  // cannot take: it goes to the first escalation tier, 100 digits (nbody/tier.h).
+  // pair AB touches at exactly zero approach speed (physics.md). The summary comes from the
+  // known count, which needs no decision (the engine that publishes the events would take
+  // that one at 100 digits): the table names the tier with its count, 0.
   const std::vector<std::string> scene = {"--masses", "3,1,0.5", "--positions", "2,1,0", "--velocities", "-1,0,0"};
   const Json json = runJson(scene);
   ASSERT_EQ(json["summary"]["collision_count"], 2);
-  ASSERT_GE(json["summary"]["escalation"]["high_precision"].get<int>(), 1);
+  ASSERT_EQ(json["summary"]["escalation"]["high_precision"].get<int>(), 0);
   const CliOutput table = run(scene);
   ASSERT_EQ(table.exit_code, 0) << table.err;
   EXPECT_NE(table.out.find(" taken at 100 digits or more, "), std::string::npos) << table.out;
   EXPECT_EQ(table.out.find("50 digits"), std::string::npos) << table.out;
+}
+
+TEST(CliJson, ARunGivesTheSameSummaryWithAndWithoutEvents) {
+  // Events only watch: the summary, escalations included, is the same whether the run
+  // publishes its events or not. (3, 1, 0.5) used to take 1 decision at 100 digits with
+  // events (the engine decides the grazing contact) and none without (the known count).
+  const std::vector<std::vector<std::string>> scenes = {
+      {"--masses", "100,1,inf", "--positions", "2,1,0", "--velocities", "-1,0,0"},      // 31
+      {"--masses", "10000,1,inf", "--positions", "2,1,0", "--velocities", "-1,0,0"},    // 314
+      {"--masses", "3,1,0.5", "--positions", "2,1,0", "--velocities", "-1,0,0"},        // grazing
+      {"--masses", "inf,1,3", "--positions", "2,1,0", "--velocities", "0.25,0,1"},      // a moving wall
+      {"--masses", "1,1,1", "--positions", "2,1,0", "--velocities=-1,-5e-324,0"},       // stops out of range
+  };
+  for (const auto& scene : scenes) {
+    std::vector<std::string> with_events = scene, without = scene;
+    with_events.insert(with_events.end(), {"--events", "all"});
+    without.insert(without.end(), {"--events", "none"});
+    Json all = runJson(with_events), none = runJson(without);
+    for (Json* doc : {&all, &none}) doc->at("summary").erase("compute_time_s");  // wall time
+    EXPECT_EQ(all.at("summary").dump(), none.at("summary").dump()) << scene[1];
+    EXPECT_EQ(all.at("events").size(), all.at("summary").at("collision_count").get<std::size_t>()) << scene[1];
+  }
 }
 
 TEST(CliTerminal, ARunTakesTheSamePathInATerminalAsInAPipe) {
