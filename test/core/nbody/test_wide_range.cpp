@@ -236,6 +236,23 @@ TEST(WideRange, ASubnormalApproachSpeedWaitsUntilItsImpactIsNext) {
       << run.stop_message;
 }
 
+// Equal masses 1 m apart, C creeping towards B at 2^-901 m/s: in the units that bring the
+// largest position and speed near 1, pair BC's impact would come exactly at 2^900, where
+// the tiers end; its bounds straddle that limit. It used to stop the run at once. Now A
+// meets B, B meets C, and B, creeping at 2^-901 m/s, reaches A after 2^901 s (6.7e271 s,
+// which a double holds): three impacts, against the exact reference.
+TEST(WideRange, APairWhoseTimeBoundsStraddle2To900RunsToTheEnd) {
+  const Scene scene = reference::makeScene({1, 1, 1}, {2, 1, 0}, {-1, 0, 0x1p-901}, 1.0);
+  ASSERT_FALSE(validate(scene)) << validate(scene)->message;
+  const reference::Run exact = reference::simulate(scene, 1000);
+  ASSERT_FALSE(exact.truncated);
+  ASSERT_EQ(exact.events.size(), 3u);
+  EXPECT_GT(static_cast<double>(exact.events[2].time), k2To900);
+  const EngineResult run = runKeepingEvents(scene);
+  EXPECT_EQ(run.stop, StopReason::kFinished) << run.stop_message;
+  expectCloseToReference(scene, run, exact, "straddling 2^900");
+}
+
 // A pair approaching at 5e-324 m/s whose impact never comes first: the run is not stopped
 // for it (it used to stop at the start). B meets C after A meets B.
 TEST(WideRange, ASubnormalApproachSpeedThatNeverComesFirstStopsNothing) {
