@@ -48,3 +48,11 @@ catkin_add_gtest(collision_lab_nbody_tests
 if(TARGET collision_lab_nbody_tests)
   target_link_libraries(collision_lab_nbody_tests collision_lab_test_support GTest::gtest_main)
 endif()
+
+# The fuzz corpora replayed through the fuzz targets' entry points (no libFuzzer needed).
+catkin_add_gtest(collision_lab_fuzz_corpus_test test/core/fuzz_corpus_test.cpp fuzz/core_fuzzer.cpp fuzz/nbody_fuzzer.cpp)
+if(TARGET collision_lab_fuzz_corpus_test)
+  target_link_libraries(collision_lab_fuzz_corpus_test collision_lab_core GTest::gtest_main)
+  target_compile_definitions(collision_lab_fuzz_corpus_test PRIVATE COLLISION_LAB_FUZZ_REPLAY
+                             COLLISION_LAB_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+endif()

@@ -13,3 +13,11 @@ target_link_libraries(collision_lab_core_fuzzer collision_lab_core)
 target_compile_options(collision_lab_core_fuzzer PRIVATE -fsanitize=fuzzer ${COLLISION_LAB_FUZZ_FLAGS})
 target_link_options(collision_lab_core_fuzzer PRIVATE -fsanitize=fuzzer,address,undefined)
 install(TARGETS collision_lab_core_fuzzer RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
+
+# The N-body path of every front end (planScene, runScene with the event visitors): any N,
+# walls, rings, per-pair restitution and the restitution models.
+add_executable(collision_lab_nbody_fuzzer fuzz/nbody_fuzzer.cpp)
+target_link_libraries(collision_lab_nbody_fuzzer collision_lab_core)
+target_compile_options(collision_lab_nbody_fuzzer PRIVATE -fsanitize=fuzzer ${COLLISION_LAB_FUZZ_FLAGS})
+target_link_options(collision_lab_nbody_fuzzer PRIVATE -fsanitize=fuzzer,address,undefined)
+install(TARGETS collision_lab_nbody_fuzzer RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})

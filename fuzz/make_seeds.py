@@ -1,8 +1,13 @@
 #!/usr/bin/env python3
-"""Writes the seed corpus of fuzz/core_fuzzer.cpp into fuzz/corpus/core (deterministic).
+"""Writes the seed corpora of fuzz/core_fuzzer.cpp (fuzz/corpus/core) and of
+fuzz/nbody_fuzzer.cpp (fuzz/corpus/nbody), deterministically.
 
-Each seed is one scene from shared/physics.md's hard cases or the bad-input catalogue,
-in the byte layout documented at the top of core_fuzzer.cpp. Run from anywhere:
+Each core seed is one scene from shared/physics.md's hard cases or the bad-input catalogue,
+in the byte layout documented at the top of core_fuzzer.cpp (its bits 0-1, once the
+working precision, now mean: bit 0 a visitor watches every event, bit 1 unused; the seeds
+keep their bytes). Each N-body seed is a scene in nbody_fuzzer.cpp's layout: rings with
+events (issue 32's crash among them), walls, per-pair restitution, the restitution models.
+Run from anywhere:
     python3 fuzz/make_seeds.py
 """
 import math
@@ -108,13 +113,71 @@ SEEDS = {
 }
 
 
-def main():
-    folder = os.path.join(os.path.dirname(os.path.abspath(__file__)), "corpus", "core")
+NBODY_EVENTS = {"none": 0, "all": 1, "first3": 2}
+NBODY_MODEL = {"constant": 0, "tc": 1, "threshold": 2, "viscoelastic": 3}
+NBODY_CAP = {0: 0, 1: 1, 10: 2, 100: 3, 1500: 4}
+
+
+def nbody(masses, positions, velocities, restitution=(1.0,), ring=None, model="constant", parameter=None,
+          events="all", cap=1500, to_cap=False):
+    """An N-body scene (2..8 bodies) in nbody_fuzzer.cpp's layout, every value a raw double."""
+    n = len(masses)
+    per_pair = len(restitution) > 1
+    assert len(restitution) in ((n if ring else n - 1) if per_pair else 1,)
+    header = bytes([NBODY_EVENTS[events] | int(ring is not None) << 2 | NBODY_MODEL[model] << 3 | int(per_pair) << 5
+                    | int(to_cap) << 6, n - 2, NBODY_CAP[cap]])
+    values = [*masses, *positions, *velocities, *restitution]
+    if ring is not None:
+        values.append(ring)
+    if model != "constant":
+        values.append(parameter)
+    return header + struct.pack(f"<{len(values)}d", *values)
+
+
+NBODY_SEEDS = {
+    # Issue 32: a 4-body inelastic ring that crashed (SIGSEGV) with events, and the 3-body ring
+    # whose seam event published 2.42e198 m/s.
+    "ring_crash_issue32_events_all": nbody((2.0, 0.75, 2.5, 2.75), (3.1875, 2.671875, 1.328125, 0.625),
+                                           (0.75, -0.7109375, -0.98828125, -0.6796875), (0.40625,), ring=3.40625,
+                                           to_cap=True),
+    "ring_crash_issue32_events_none": nbody((2.0, 0.75, 2.5, 2.75), (3.1875, 2.671875, 1.328125, 0.625),
+                                            (0.75, -0.7109375, -0.98828125, -0.6796875), (0.40625,), ring=3.40625,
+                                            events="none", to_cap=True),
+    "ring_seam_issue32": nbody((1.75, 2.75, 3.0), (2.09375, 1.796875, 0.59375), (0.0234375, 0.21875, -0.2265625),
+                               (0.875, 0.8125, 0.46875), ring=3.609375, to_cap=True),
+    "ring_elastic_first3": nbody((1, 2, 3, 4), (3.5, 2.5, 1.5, 0.5), (1, -1, 0.5, -0.5), ring=4.0, events="first3"),
+    "ring_two_bodies": nbody((1, 3), (1.5, 0.5), (1, -1), (0.5,), ring=2.0),
+    "ring_tc": nbody((1, 1, 1, 1, 1), (4.5, 3.5, 2.5, 1.5, 0.5), (1, -1, 1, -1, 0.5), (0.5,), ring=5.0, model="tc",
+                     parameter=0.01, cap=1500, to_cap=True),
+    # 100 impacts: 1500 took 96 s here, too slow for a seed.
+    "ring_viscoelastic": nbody((1, 2, 1, 2), (3.5, 2.5, 1.5, 0.5), (1, -1, 1, -1), ring=4.0, model="viscoelastic",
+                               parameter=10.0, cap=100, to_cap=True),
+    "box_inelastic": nbody((INF, 1, 2, 3, INF), (4, 3, 2, 1, 0), (0, 1, -1, 0.5, 0), (0.5,), cap=1500, to_cap=True),
+    "box_threshold": nbody((INF, 1, 1, INF), (3, 2, 1, 0), (0, 1, -1, 0), (0.5,), model="threshold", parameter=0.1,
+                           cap=1500, to_cap=True),
+    "heavy_light_heavy_1e60": nbody((1e60, 1, 1e60), (2, 1, 0), (-1, 0, 0.5), (0.5,)),
+    "three_elastic_out_of_range": nbody((1, 1, 1), (2, 1, 0), (-1, -5e-324, 0)),
+    "three_elastic_grazing": nbody((3, 1, 0.5), (2, 1, 0), (-1, 0, 0)),
+    "chain_after_2_900": nbody((1, 2, 3, 4), (1, 0, -1e210, -2e210), (-1e-61, 0, 1e-61, 2e-61)),
+    "sticky_chain": nbody((1, 2, 3, 4, 5), (4, 3, 2, 1, 0), (1, 0.5, 0, -0.5, -1), (0.0,)),
+    "two_bodies_any_ratio": nbody((1e-300, 1e300), (1, 0), (-1, 1), (0.5,)),
+    "per_pair_restitution": nbody((1, 2, 3, 4), (3, 2, 1, 0), (-1, 0, 0, 1), (1.0, 0.5, 0.0)),
+    "bad_ring_wall": nbody((INF, 1, 1), (2.5, 1.5, 0.5), (0, 1, -1), ring=3.0),
+}
+
+
+def write(folder_name, seeds):
+    folder = os.path.join(os.path.dirname(os.path.abspath(__file__)), "corpus", folder_name)
     os.makedirs(folder, exist_ok=True)
-    for name, data in SEEDS.items():
+    for name, data in seeds.items():
         with open(os.path.join(folder, name), "wb") as f:
             f.write(data)
-    print(f"{len(SEEDS)} seeds in {folder}")
+    print(f"{len(seeds)} seeds in {folder}")
+
+
+def main():
+    write("core", SEEDS)
+    write("nbody", NBODY_SEEDS)
 
 
 if __name__ == "__main__":

@@ -1,6 +1,7 @@
 #include "collision_lab/core/lab_run.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -222,6 +223,25 @@ class LabEvents {
   std::array<double, 3> previous_before_;
 };
 
+/// The limits of one simulation of the three bodies.
+struct SimulationOptions {
+  std::uint64_t max_collisions = 10'000'000;  ///< stops the run cleanly; marks it truncated
+  /// When set, the run stops within 1024 collisions, marked truncated and cancelled.
+  const std::atomic<bool>* cancel = nullptr;
+};
+
+/// What one simulation of the three bodies measured.
+struct SimulationResult {
+  std::uint64_t collision_count = 0;
+  bool truncated = false;                    ///< more impacts were due: the cap, a cancel or a stop
+  bool cancelled = false;                    ///< stopped by SimulationOptions::cancel
+  StopReason stop = StopReason::kFinished;   ///< the engine's reason
+  std::array<double, 3> final_velocities{};  ///< [m/s]
+  double energy_relative_drift = 0.0;        ///< |E_end - E_0| / E_0, in the wall's frame
+  double momentum_relative_drift = 0.0;      ///< |p_end - p_0| / sum |m v|; NaN with a wall
+  EscalationStats escalation;
+};
+
 /// The scene of the engine for three bodies.
 Scene asScene(const ThreeBodyScene& triple) {
   Scene scene;
@@ -232,9 +252,10 @@ Scene asScene(const ThreeBodyScene& triple) {
 }
 
 /// The run of three elastic bodies whose count the closed form gives (`count`), without the
-/// engine's queue or any decision (nbody/elastic_triple.h), for a run that publishes no
-/// event: its count, final velocities (the engine's bit for bit, or certified correctly
-/// rounded) and drifts, as simulateByEngine gives them; no final time or positions. restart() is called before
+/// engine's queue or any decision (nbody/elastic_triple.h), the summary of every run that
+/// can be had so: its count, final velocities (the engine's bit for bit, or certified
+/// correctly rounded) and drifts, as simulateByEngine gives them; no final time or
+/// positions. An impact that may come after the largest double [s] declines it. restart() is called before
 /// each pass over the impacts (at most two); after each impact n, visit(n, v) sees the
 /// velocities [m/s] that simulateByEngine's event would carry. Returns nothing when the run
 /// cannot be taken this way (then the engine runs it). `progress` (RunOptions) sees every
@@ -260,8 +281,11 @@ std::optional<SimulationResult> simulateKnownCount(const ThreeBodyScene& scene, 
     return std::fabs(x) >= std::numeric_limits<double>::min() ? x : velocity_si(v);
   };
   const std::uint64_t every = progress ? progress_interval : 0;
+  // The largest working time whose SI value a double holds (as runEngine bounds it).
+  const double time_limit = static_cast<double>(
+      std::ldexp(static_cast<long double>(std::numeric_limits<double>::max()), units.timeShift()));
   const std::optional<nbody_detail::ElasticTripleRun> run = nbody_detail::runElasticTriple(
-      units.scene, count, first == Pair::BC ? 1 : 0, options.max_collisions, options.cancel, restart,
+      units.scene, count, first == Pair::BC ? 1 : 0, options.max_collisions, time_limit, options.cancel, restart,
       [&](std::uint64_t n, const std::array<double, 3>& v) {
         visit(n, std::array<double, 3>{si(v[0]), si(v[1]), si(v[2])});
         if (every != 0 && n % every == 0) progress(EngineProgress{n, std::numeric_limits<double>::quiet_NaN()});
@@ -271,7 +295,7 @@ std::optional<SimulationResult> simulateKnownCount(const ThreeBodyScene& scene, 
   result.collision_count = run->impact_count;
   result.truncated = run->capped || run->cancelled;
   result.cancelled = run->cancelled;
-  result.first_pair = first;
+  result.stop = run->cancelled ? StopReason::kCancelled : run->capped ? StopReason::kCap : StopReason::kFinished;
   EngineResult drift;
   drift.final_velocities.assign(run->final_velocities.begin(), run->final_velocities.end());
   nbody_detail::fillEngineDrift(units.scene, drift);
@@ -287,15 +311,12 @@ std::optional<SimulationResult> simulateKnownCount(const ThreeBodyScene& scene, 
 /// engine runs in its working units, nbody/units.h, and gives SI values). An impact's pair
 /// comes from the engine's record; the third body's position at that time is computed here
 /// from its last impact (to rounding, in long double), and the totals after it from the
-/// velocities. Escalations: one decision per impact and the final one.
-/// Returns nothing when the engine stopped because a value would leave the range of a double
-/// (an impact after the largest double [s], which the three-body simulator reports as
-/// infinite): `told` impacts were then visited. A run the engine ended otherwise than
-/// finished, capped or cancelled is truncated, with the engine's sentence in `stopped_otherwise`.
-std::optional<SimulationResult> simulateByEngine(const ThreeBodyScene& scene, const SimulationOptions& options,
-                                                 const ProgressCallback& progress, std::uint64_t progress_interval,
-                                                 const EventVisitor& visitor, std::uint64_t& told,
-                                                 std::string& stopped_otherwise) {
+/// velocities. Escalations: one decision per impact and the final one. A run the engine
+/// ended otherwise than finished, capped or cancelled (out of range: the next impact comes
+/// after the largest double) is truncated, with the engine's sentence in `stopped_otherwise`.
+SimulationResult simulateByEngine(const ThreeBodyScene& scene, const SimulationOptions& options,
+                                  const ProgressCallback& progress, std::uint64_t progress_interval,
+                                  const EventVisitor& visitor, std::string& stopped_otherwise) {
   EngineOptions engine_options;
   engine_options.max_impacts = options.max_collisions;
   engine_options.progress_interval = progress ? progress_interval : 0;
@@ -348,20 +369,14 @@ std::optional<SimulationResult> simulateByEngine(const ThreeBodyScene& scene, co
     };
   }
   EngineResult engine = runEngine(asScene(scene), engine_options, on_impact, progress);
-  told = engine.impact_count;
-  if (engine.stop == StopReason::kOutOfRange) return std::nullopt;
   result.collision_count = engine.impact_count;
   result.truncated = engine.truncated || engine.stop != StopReason::kFinished;
   result.cancelled = engine.stop == StopReason::kCancelled;
+  result.stop = engine.stop;
   if (engine.stop != StopReason::kFinished && engine.stop != StopReason::kCap && !result.cancelled) {
     stopped_otherwise = engine.stop_message;
   }
-  result.first_pair = firstPair(scene);
-  for (int k = 0; k < 3; ++k) {
-    result.final_velocities[k] = engine.final_velocities[k];
-    result.final_positions[k] = engine.final_positions[k];
-  }
-  result.final_time = engine.final_time;
+  for (int k = 0; k < 3; ++k) result.final_velocities[k] = engine.final_velocities[k];
   result.energy_relative_drift = engine.energy_relative_drift;
   result.momentum_relative_drift = engine.momentum_relative_drift;
   result.escalation.decisions = engine.impact_count + 1;
@@ -394,44 +409,41 @@ void simulateBesidePrediction(const ThreeBodyScene& scene, const RunOptions& opt
     };
   }
   std::string stopped_otherwise;
-  std::uint64_t told = 0;
-  std::optional<SimulationResult> by_engine;
-  // No event published: only the count, the final state, the drifts and (in full mode) the
-  // largest prediction error are needed, which the known count gives without the engine.
+  // The summary comes from the known count wherever it can be had, with events or without:
+  // events only watch (the engine's run publishes them), so a run's summary, its escalations
+  // included, is the same whatever it shows. The count, the final state, the drifts and (in
+  // full mode) the largest prediction error need no decision.
   const bool publishes = options.mode == RunMode::kFull && (visitor || options.events.kind != EventPolicy::Kind::kNone);
-  if (!publishes) {
-    if (options.mode == RunMode::kFull) {
-      std::optional<ClosedFormInTurn> predicted;
-      by_engine = simulateKnownCount(
-          scene, result.prediction.collision_count, simulation_options, options.progress, options.progress_interval,
-          [&] {
-            predicted.emplace(model);
-            max_error_sq = 0.0;
-          },
-          [&](std::uint64_t n, const std::array<double, 3>& v) {
-            max_error_sq = std::max(max_error_sq, relative_error.squared(v, predicted->velocitiesAfter(n)));
-          });
-    } else {
-      by_engine = simulateKnownCount(scene, result.prediction.collision_count, simulation_options, options.progress,
-                                     options.progress_interval, [] {},
-                                     [](std::uint64_t, const std::array<double, 3>&) {});
-    }
-    if (!by_engine) max_error_sq = 0.0;  // the engine measures it again
+  const ProgressCallback known_progress = publishes ? ProgressCallback{} : options.progress;  // else the engine's
+  double known_error_sq = 0.0;
+  std::optional<SimulationResult> known;
+  if (options.mode == RunMode::kFull) {
+    std::optional<ClosedFormInTurn> predicted;
+    known = simulateKnownCount(
+        scene, result.prediction.collision_count, simulation_options, known_progress, options.progress_interval,
+        [&] {
+          predicted.emplace(model);
+          known_error_sq = 0.0;
+        },
+        [&](std::uint64_t n, const std::array<double, 3>& v) {
+          known_error_sq = std::max(known_error_sq, relative_error.squared(v, predicted->velocitiesAfter(n)));
+        });
+  } else {
+    known = simulateKnownCount(scene, result.prediction.collision_count, simulation_options, known_progress,
+                               options.progress_interval, [] {}, [](std::uint64_t, const std::array<double, 3>&) {});
   }
-  if (!by_engine) {
-    by_engine = simulateByEngine(scene, simulation_options, options.progress, options.progress_interval, enrich, told,
+  std::optional<SimulationResult> by_engine;
+  if (publishes || !known) {
+    by_engine = simulateByEngine(scene, simulation_options, options.progress, options.progress_interval, enrich,
                                  stopped_otherwise);
   }
-  if (!by_engine) {
-    // Beyond the engine's range: the three-body simulator (exact decisions, velocities to a
-    // few units in the last place) runs it, telling only the impacts after those told.
-    EventVisitor rest;
-    if (enrich) {
-      rest = [&enrich, told](const ImpactEvent& event) {
-        if (event.index > told) enrich(event);
-      };
-    }
-    by_engine = simulate(scene, simulation_options, options.precision, rest);
+  // The engine's run is the summary where the known count declined, or where the engine
+  // published fewer impacts (cancelled while it published them).
+  const bool from_known = known && (!by_engine || by_engine->collision_count == known->collision_count);
+  if (from_known) {
+    by_engine = known;
+    max_error_sq = known_error_sq;
+    stopped_otherwise.clear();
   }
   const SimulationResult& simulation = *by_engine;
   summary.max_prediction_error = relative_error.fromSquared(max_error_sq);
@@ -439,6 +451,7 @@ void simulateBesidePrediction(const ThreeBodyScene& scene, const RunOptions& opt
   summary.collision_count = simulation.collision_count;
   summary.truncated = simulation.truncated;
   summary.cancelled = simulation.cancelled;
+  summary.stop = simulation.stop;
   if (simulation.cancelled) {
     summary.truncation_reason = "cancelled after " + countText(simulation.collision_count) + " of " +
                                 countText(result.prediction.collision_count) + " predicted";

@@ -74,7 +74,8 @@ template <ElasticTriplePass kPass, class Visit>
 __attribute__((flatten))  // the impact maps and the bounds inline into the loop
 #endif
 std::optional<ElasticTripleRun> runElasticTriplePass(const Scene& scene, std::uint64_t count, std::size_t first_pair,
-                                                     std::uint64_t cap, const std::atomic<bool>* cancel, Visit& visit) {
+                                                     std::uint64_t cap, double time_limit, const std::atomic<bool>* cancel,
+                                                     Visit& visit) {
   constexpr bool kReplica = kPass == ElasticTriplePass::kReplica;
   constexpr double kEta = kDoubleDoubleOpError;  // one double-double operation, relative
   constexpr double kSlack = 1.0 + 0x1p-40;       // the rounding of evaluating a bound in double
@@ -82,6 +83,9 @@ std::optional<ElasticTripleRun> runElasticTriplePass(const Scene& scene, std::ui
   // The engine's safe range (tier.h, kMaxMagnitude); 2^10 below it for intercepts in double.
   constexpr double kRange = kReplica ? 0x1p900 : 0x1p890;
   constexpr double kGuard = 0x1p-43;  // the engine's precision guard (2^-42), halved
+  // An impact time |intercept difference| / |approach speed| near time_limit or beyond: the
+  // engine decides whether the double format holds it (a generous margin: it only declines).
+  const double time_bound = time_limit * (1 - 0x1p-20);
   std::array<double, 3> sqrt_mass{};  // 0 for a wall, as tier.h's tables
   for (int k = 0; k < 3; ++k) sqrt_mass[k] = scene.isWall(k) ? 0.0 : std::sqrt(scene.masses[k]);
   struct PairTables {
@@ -145,10 +149,12 @@ std::optional<ElasticTripleRun> runElasticTriplePass(const Scene& scene, std::ui
       }
       const double magnitude = std::fabs(b[p].hi) + std::fabs(b[p + 1].hi) + std::fabs(vi.hi) + std::fabs(vj.hi);
       if (!(magnitude < kRange)) return std::nullopt;
+      if (!(std::fabs(db.difference.hi) < time_bound * std::fabs(dv.difference.hi))) return std::nullopt;
     } else {
       double& ei = error[p];
       double& ej = error[p + 1];
       const double difference_error = (ei + ej + kEta * std::fabs(dv.difference.hi)) * kSlack + kTinyError;
+      if (!(std::fabs(b_double[p + 1] - b_double[p]) < time_bound * std::fabs(dv.difference.hi))) return std::nullopt;
       if (map.exchange) {  // a swap rounds nothing
         std::swap(ei, ej);
         std::swap(b_double[p], b_double[p + 1]);
@@ -185,7 +191,8 @@ std::optional<ElasticTripleRun> runElasticTriplePass(const Scene& scene, std::ui
 }
 
 /// Runs scene (three bodies, every e = 1, no ring; at most one wall), whose exact count is
-/// `count` with first pair `first_pair` (0: AB, 1: BC), up to `cap` impacts; the cancel flag
+/// `count` with first pair `first_pair` (0: AB, 1: BC), up to `cap` impacts, every impact
+/// before `time_limit` [the scene's units of time; inf: any] (else it declines); the cancel flag
 /// (may be null) is read every 1024 impacts, as the engine does. First as the engine's
 /// replica, which stops where the engine's precision guard may fire; then, if it stopped,
 /// certified. restart() is called before each pass; after impact n, visit(n, v) sees the
@@ -193,14 +200,15 @@ std::optional<ElasticTripleRun> runElasticTriplePass(const Scene& scene, std::ui
 /// nothing when the engine must run it (then visit has seen an unfinished pass).
 template <class Restart, class Visit>
 std::optional<ElasticTripleRun> runElasticTriple(const Scene& scene, std::uint64_t count, std::size_t first_pair,
-                                                 std::uint64_t cap, const std::atomic<bool>* cancel, Restart&& restart,
-                                                 Visit&& visit) {
+                                                 std::uint64_t cap, double time_limit, const std::atomic<bool>* cancel,
+                                                 Restart&& restart, Visit&& visit) {
   restart();
-  if (auto run = runElasticTriplePass<ElasticTriplePass::kReplica>(scene, count, first_pair, cap, cancel, visit)) {
+  if (auto run = runElasticTriplePass<ElasticTriplePass::kReplica>(scene, count, first_pair, cap, time_limit, cancel,
+                                                                   visit)) {
     return run;
   }
   restart();
-  return runElasticTriplePass<ElasticTriplePass::kCertified>(scene, count, first_pair, cap, cancel, visit);
+  return runElasticTriplePass<ElasticTriplePass::kCertified>(scene, count, first_pair, cap, time_limit, cancel, visit);
 }
 
 }  // namespace nbody_detail

@@ -4,11 +4,13 @@
 // length / velocity), and every operation of the engine is homogeneous in them. So one
 // exact change of units, by powers of two, changes no rounding (short of subnormals, which
 // it avoids): each scene runs in units that bring its largest mass, position and velocity
-// to [1/2, 1), which keeps the numbers of a run far inside the tiers' range (tier.h,
+// to [1/2, 1), then shift lengths or velocities where its times would leave the range
+// (balanceTimes), which keeps the numbers of a run far inside the tiers' range (tier.h,
 // kMaxMagnitude) wherever the scene lies in the double range. Values go back to SI once,
 // on output.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -51,6 +53,7 @@ struct WorkingUnits {
     mass_shift = detail::shiftTowardsOne(si.masses);
     velocity_shift = detail::shiftTowardsOne(si.velocities);
     position_shift = detail::shiftTowardsOne(lengths);
+    balanceTimes(si, lengths);
     const RestitutionModel& model = si.restitution_model;
     // The model's parameter must scale exactly too; where it cannot, the run keeps SI units.
     const auto keeps = [](double x, int s) { return std::ldexp(std::ldexp(x, s), -s) == x; };
@@ -65,6 +68,65 @@ struct WorkingUnits {
     scene.restitution_model.tc = std::ldexp(model.tc, timeShift());
     scene.restitution_model.elastic_below = std::ldexp(model.elastic_below, velocity_shift);
     scene.restitution_model.viscoelastic_speed = std::ldexp(model.viscoelastic_speed, velocity_shift);
+  }
+
+  /// Brings the scene's time scales into the tiers' range where its lengths and speeds alone
+  /// do not (tier.h, 2^900), by exact shifts:
+  /// - the shortest time, its smallest gap over its largest speed, above 2^-kShortestTime,
+  ///   where double-double keeps its digits: a gap of a few subnormal metres beside
+  ///   positions of 1e62 m (lengths that cannot shift down) must not make times subnormal.
+  ///   Lengths shift up while they stay below 2^kLongestLength and the longest time below
+  ///   2^kLongestTime where it was; then velocities shift back towards SI.
+  /// - the longest time, its extent over its smallest speed (a body's, or a neighbour pair's
+  ///   difference), below 2^kLongestTime: velocities shift up while they stay below
+  ///   2^kFastest and m v^2 below 2^(2 kFastest) (energies in range), and the shortest time
+  ///   above 2^-kShortestTime. A
+  ///   body creeping at 5e-324 m/s, or a pair whose impact would come 2^901 s away, then
+  ///   runs inside the tiers' range.
+  /// Nothing changes where both are in range.
+  void balanceTimes(const Scene& si, const std::vector<double>& lengths) {
+    constexpr int kShortestTime = 850, kLongestLength = 400, kLongestTime = 800, kFastest = 450;
+    constexpr int kNone = std::numeric_limits<int>::max();
+    int extent = -kNone, fastest = -kNone, slowest = kNone, shortest_gap = kNone;
+    for (double x : lengths) {
+      if (std::isfinite(x) && x != 0) extent = std::max(extent, std::ilogb(x));
+    }
+    const auto slow = [&slowest](double speed) {
+      if (std::isfinite(speed) && speed != 0) slowest = std::min(slowest, std::ilogb(speed));
+    };
+    for (std::size_t i = 0; i < si.velocities.size(); ++i) {
+      const double v = si.velocities[i];
+      if (!std::isfinite(v) || v == 0) continue;
+      fastest = std::max(fastest, std::ilogb(v));
+      slow(v);
+      if (i + 1 < si.velocities.size()) slow(v - si.velocities[i + 1]);
+    }
+    for (std::size_t i = 0; i + 1 < si.positions.size(); ++i) {
+      const double gap = si.positions[i] - si.positions[i + 1];  // exact where it matters: small
+      if (std::isfinite(gap) && gap != 0) shortest_gap = std::min(shortest_gap, std::ilogb(gap));
+    }
+    if (extent == -kNone || fastest == -kNone || shortest_gap == kNone) return;
+    const auto shortestTime = [&] { return shortest_gap + position_shift - (fastest + velocity_shift); };
+    const auto longestTime = [&] { return extent + position_shift - (slowest + velocity_shift); };
+    if (const int need = -kShortestTime - shortestTime(); need > 0) {
+      // The longest time is an estimate; where it is already past the tiers' range it is no bound.
+      const int longest = longestTime();
+      const int room = std::min(kLongestLength - (extent + position_shift),
+                                longest <= kLongestTime ? kLongestTime - longest : kNone);
+      const int lengths_up = std::max(0, std::min(need, room));
+      position_shift += lengths_up;
+      velocity_shift -= std::max(0, std::min(need - lengths_up, velocity_shift));
+      return;
+    }
+    if (const int need = longestTime() - kLongestTime; need > 0) {
+      int heaviest = -kNone;  // a kinetic energy m v^2 must stay below 2^(2 kFastest) too
+      for (double m : si.masses) {
+        if (std::isfinite(m) && m != 0) heaviest = std::max(heaviest, std::ilogb(m) + mass_shift);
+      }
+      const int fastest_allowed = std::min(kFastest, heaviest == -kNone ? kFastest : kFastest - heaviest / 2);
+      const int room = std::min(fastest_allowed - (fastest + velocity_shift), shortestTime() + kShortestTime);
+      velocity_shift += std::max(0, std::min(need, room));
+    }
   }
 
   /// The shifts of derived quantities: time = length / velocity, energy = m v^2, p = m v.

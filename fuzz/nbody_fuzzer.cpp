@@ -1,0 +1,151 @@
+// libFuzzer target over the N-body path every front end takes: planScene (validation, model,
+// prediction) and runScene (the event engine), with the event visitors on: any number of
+// bodies, walls, rings, per-pair restitution and the restitution models.
+//
+// Contract: for ANY bytes, nothing crashes, throws, or trips ASan/UBSan; for a scene that
+// planScene accepts, the invariants checked below hold, and a violation aborts with a
+// one-line reason (so libFuzzer saves the input as a crash).
+//
+// Input layout (fuzz/make_seeds.py writes the committed seeds in it):
+//   byte 0   options: bits 0-1 events (none, all, first 3, none), bit 2 ring, bits 3-4
+//            restitution model (constant, tc, threshold, viscoelastic), bit 5 one
+//            restitution per pair (else one for every pair), bit 6 simulate to the cap
+//   byte 1   bodies N = 2 + byte % 7
+//   byte 2   max_collisions: kCaps[byte % kCaps.size()]
+//   then little-endian IEEE doubles (any bit pattern): N masses, N positions, N velocities,
+//   the restitution (one, or one per pair: N - 1 on a line, N on a ring), the ring's
+//   circumference (ring only), the model's parameter (tc, threshold or viscoelastic only).
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <vector>
+
+#include "collision_lab/core/scene_run.h"
+
+namespace cl = collision_lab::core;
+
+namespace {
+
+/// Collision caps: small enough that one iteration stays in milliseconds; 1500 as the
+/// issue's ring crash.
+constexpr std::uint64_t kCaps[] = {0, 1, 10, 100, 1500};
+
+#define FUZZ_CHECK(condition, what)                                                                 \
+  do {                                                                                              \
+    if (!(condition)) {                                                                             \
+      std::fprintf(stderr, "invariant violated: %s (%s, line %d)\n", what, #condition, __LINE__); \
+      std::abort();                                                                                 \
+    }                                                                                               \
+  } while (0)
+
+class Reader {
+ public:
+  Reader(const std::uint8_t* data, std::size_t size) : data_(data), size_(size) {}
+  bool has(std::size_t bytes) const { return size_ - at_ >= bytes; }
+  std::uint8_t byte() { return data_[at_++]; }
+  double value() {
+    std::uint64_t bits = 0;
+    for (int k = 0; k < 8; ++k) bits |= std::uint64_t{data_[at_++]} << (8 * k);
+    double x;
+    std::memcpy(&x, &bits, sizeof x);
+    return x;
+  }
+  std::vector<double> values(std::size_t n) {
+    std::vector<double> out(n);
+    for (double& x : out) x = value();
+    return out;
+  }
+
+ private:
+  const std::uint8_t* data_;
+  std::size_t size_;
+  std::size_t at_ = 0;
+};
+
+bool finite(const std::vector<double>& values) {
+  for (double x : values) {
+    if (!std::isfinite(x)) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+/// One input (the libFuzzer entry below, and the corpus replay test).
+int collisionLabNbodyFuzzOne(const std::uint8_t* data, std::size_t size) {
+  Reader in(data, size);
+  if (!in.has(3)) return 0;
+  const std::uint8_t flags = in.byte();
+  const std::size_t n = 2 + in.byte() % 7;
+  const std::uint64_t cap = kCaps[in.byte() % (sizeof kCaps / sizeof kCaps[0])];
+  const bool ring = flags & 0x4;
+  const int model = (flags >> 3) & 0x3;
+  const std::size_t restitutions = (flags & 0x20) ? (ring ? n : n - 1) : 1;
+  if (!in.has(8 * (3 * n + restitutions + (ring ? 1 : 0) + (model != 0 ? 1 : 0)))) return 0;
+  cl::Scene scene;
+  scene.masses = in.values(n);
+  scene.positions = in.values(n);
+  scene.velocities = in.values(n);
+  scene.restitution = in.values(restitutions);
+  if (ring) scene.ring = in.value();
+  switch (model) {
+    case 1: scene.restitution_model.kind = cl::RestitutionModelKind::kTc; scene.restitution_model.tc = in.value(); break;
+    case 2:
+      scene.restitution_model.kind = cl::RestitutionModelKind::kThreshold;
+      scene.restitution_model.elastic_below = in.value();
+      break;
+    case 3:
+      scene.restitution_model.kind = cl::RestitutionModelKind::kViscoelastic;
+      scene.restitution_model.viscoelastic_speed = in.value();
+      break;
+    default: break;
+  }
+
+  const cl::ScenePlan plan = cl::planScene(scene);
+  if (plan.error) {
+    FUZZ_CHECK(!plan.error->message.empty(), "a rejection has a message");
+    return 0;
+  }
+  cl::SceneRunOptions options;
+  options.lab.max_collisions = cap;
+  const int events = flags & 0x3;
+  options.lab.events = events == 1 ? cl::EventPolicy::all() : events == 2 ? cl::EventPolicy::firstN(3) : cl::EventPolicy::none();
+  options.simulate_to_cap = flags & 0x40;
+  std::uint64_t impacts = 0, three_body_events = 0;
+  cl::SceneVisitors visitors;
+  visitors.impact = [&](const cl::ImpactRecord& record) {
+    FUZZ_CHECK(record.index == ++impacts, "impacts numbered 1, 2, ... in order");
+    FUZZ_CHECK(record.pair_index < (ring ? n : n - 1), "an impact's pair exists");
+    FUZZ_CHECK(record.first_moved < n && record.last_moved < n, "an impact moves bodies that exist");
+    FUZZ_CHECK(ring || record.first_moved <= record.last_moved, "on a line, the moved bodies are in order");
+    FUZZ_CHECK(std::isfinite(record.time) && std::isfinite(record.position), "finite impact time and point");
+    FUZZ_CHECK(std::isfinite(record.velocities_after[0]) || std::isinf(scene.masses[record.pair_index]),
+               "finite velocities after an impact");
+  };
+  visitors.three_body_event = [&](const cl::LabEvent& lab) {
+    FUZZ_CHECK(lab.event.index == ++three_body_events, "three-body events numbered 1, 2, ...");
+    FUZZ_CHECK(std::isfinite(lab.event.time), "finite three-body event time");
+  };
+  const cl::SceneRunResult result = cl::runScene(plan, options, visitors);
+  const cl::SceneSimulation& sim = result.simulation;
+  FUZZ_CHECK(!sim.stop_message.empty(), "every run says why it ended");
+  FUZZ_CHECK(sim.stop != cl::StopReason::kInternalError, "the tiers never disagree");
+  FUZZ_CHECK(sim.final_velocities.size() == n, "one final velocity per body");
+  FUZZ_CHECK(!sim.simulated || sim.impact_count <= cap, "a simulation stops at the cap");
+  if (sim.simulated && !result.three_body) {
+    FUZZ_CHECK(impacts == sim.impact_count, "the visitor sees every impact");
+  }
+  if (sim.stop == cl::StopReason::kFinished && sim.simulated) {
+    FUZZ_CHECK(finite(sim.final_velocities), "finite final velocities of a finished run");
+  }
+  return 0;
+}
+
+#ifndef COLLISION_LAB_FUZZ_REPLAY
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  return collisionLabNbodyFuzzOne(data, size);
+}
+#endif
