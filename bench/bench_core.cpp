@@ -1,7 +1,7 @@
 // collision_lab_bench_core: speed of the core (issue 2, "Speed").
 //
-// Prints ns per collision for simulate<double> in count-only mode (EventPolicy::none(),
-// no visitor), with every event visited but not stored, and with every event kept
+// Prints ns per collision for the event engine run directly (runEngine, nothing visited),
+// for the lab run with every event visited but not stored and with every event kept
 // (EventPolicy::all()), and the full lab run (runLab in full mode with events none, as
 // `collision_lab_cli --mode full --events none`: every impact's velocities against the
 // closed form, the drifts and the final state), next to
@@ -31,7 +31,7 @@
 #include "collision_lab/core/analytic.h"
 #include "collision_lab/core/lab_run.h"
 #include "collision_lab/core/nbody/impact_rule.h"
-#include "collision_lab/core/simulation.h"
+#include "collision_lab/core/nbody/engine.h"
 #include "closed_form_timing.h"
 #include "double_double.h"  // the engine's working arithmetic (src/core/nbody)
 #include "naive_loop.h"
@@ -86,41 +86,45 @@ SceneFigures benchScene(double heavy, int repeats, bool keep_all) {
   const std::uint64_t predicted = predictedCollisionCount(scene);
   std::printf("\nScene: masses (%g, 1, %g), positions (1, 0, -1) m, v = (-1, 0, 0) m/s; "
               "predicted collisions %llu\n", heavy, heavy, static_cast<unsigned long long>(predicted));
-  SimulationOptions count_only;
-  count_only.max_collisions = 1'000'000'000;
-  count_only.events = EventPolicy::none();
-  SimulationOptions all_events = count_only;
+  constexpr std::uint64_t kMaxCollisions = 1'000'000'000;
+  Scene engine_scene;
+  engine_scene.masses.assign(scene.masses.begin(), scene.masses.end());
+  engine_scene.positions.assign(scene.positions.begin(), scene.positions.end());
+  engine_scene.velocities.assign(scene.velocities.begin(), scene.velocities.end());
+  EngineOptions engine_options;
+  engine_options.max_impacts = kMaxCollisions;
+  engine_options.progress_interval = 0;
+  RunOptions full_run;
+  full_run.max_collisions = kMaxCollisions;
+  full_run.events = EventPolicy::none();
+  full_run.mode = RunMode::kFull;
+  RunOptions all_events = full_run;
   all_events.events = EventPolicy::all();
 
   std::vector<Method> methods;
   methods.emplace_back("lean double loop (t, x, v)", [&] {
-                       const auto run = naiveEventLoop<double, true>(scene, count_only.max_collisions);
+                       const auto run = naiveEventLoop<double, true>(scene, kMaxCollisions);
                        doNotOptimize(run.positions);
                        return run.collision_count;
                      });
   methods.emplace_back("velocity-only double loop", [&] {
-                       const auto run = naiveEventLoop<double, false>(scene, count_only.max_collisions);
+                       const auto run = naiveEventLoop<double, false>(scene, kMaxCollisions);
                        doNotOptimize(run.velocities);
                        return run.collision_count;
                      });
-  EscalationStats escalation;
-  methods.emplace_back("core count-only (events none)", [&] {
-                       const auto result = simulate<double>(scene, count_only);
-                       escalation = result.escalation;
-                       doNotOptimize(result.final_velocities);
-                       return result.collision_count;
+  Escalations escalation;
+  methods.emplace_back("engine count-only (runEngine)", [&] {
+                       const EngineResult result = runEngine(engine_scene, engine_options);
+                       escalation = result.escalations;
+                       doNotOptimize(result.final_velocities.data());
+                       return result.impact_count;
                      });
   methods.emplace_back("core, every event visited", [&] {
                        std::uint64_t seen = 0;
-                       const auto result =
-                           simulate<double>(scene, count_only, [&](const ImpactEvent&) { ++seen; });
+                       const auto result = runLab(scene, full_run, [&](const LabEvent&) { ++seen; });
                        doNotOptimize(seen);
-                       return result.collision_count;
+                       return result.summary.collision_count;
                      });
-  RunOptions full_run;
-  full_run.max_collisions = count_only.max_collisions;
-  full_run.events = EventPolicy::none();
-  full_run.mode = RunMode::kFull;
   // As `collision_lab_cli --mode full --events none` runs it: no event handed out.
   methods.emplace_back("core, full lab run (mode full)", [&] {
                        const auto result = runLab(scene, full_run);
@@ -141,9 +145,9 @@ SceneFigures benchScene(double heavy, int repeats, bool keep_all) {
                      });
   if (keep_all) {
     methods.emplace_back("core, every event kept (events all)", [&] {
-                         const auto result = simulate<double>(scene, all_events);
+                         const auto result = runLab(scene, all_events);
                          doNotOptimize(result.events.data());
-                         return result.collision_count;
+                         return result.summary.collision_count;
                        });
   }
   for (int rep = 0; rep < repeats; ++rep) {
@@ -165,14 +169,14 @@ SceneFigures benchScene(double heavy, int repeats, bool keep_all) {
     for (double s : method.seconds) best = std::min(best, s);
     std::printf("  %-38s %12llu %10.2f %10.2f %14.2f\n", method.name,
                 static_cast<unsigned long long>(method.count), med, best * per, med / lean_ns);
-    if (std::strncmp(method.name, "core count-only", 15) == 0) figures.count_only_ns = med;
+    if (std::strncmp(method.name, "engine count-only", 17) == 0) figures.count_only_ns = med;
     if (std::strncmp(method.name, "core, full lab run", 18) == 0) figures.full_lab_run_ns = med;
     if (std::strncmp(method.name, "core, lab run (mode summary)", 28) == 0) figures.summary_ns = med;
     if (std::strncmp(method.name, "double-double impact maps", 25) == 0) figures.dd_maps_ns = med;
   }
   std::printf("  (medians of %d round-robin repeats; ns per collision of each method's own count)\n", repeats);
-  std::printf("  core escalations in count-only mode: %llu decisions, %llu to 50 digits, %llu to exact rationals\n",
-              static_cast<unsigned long long>(escalation.decisions),
+  std::printf("  engine escalations (runEngine): %llu refinements, %llu to 100 digits, %llu to exact rationals\n",
+              static_cast<unsigned long long>(escalation.refinements),
               static_cast<unsigned long long>(escalation.high_precision),
               static_cast<unsigned long long>(escalation.exact_rational));
   return figures;
@@ -303,7 +307,7 @@ int main(int argc, char** argv) {
 
   std::printf("\nGoals (measured, not asserted)\n");
   if (!quick) {
-    std::printf("  core count-only / lean loop on (1e14, 1, 1e14): %.2fx  (target <= 1.5x: %s; "
+    std::printf("  engine count-only (runEngine) / lean loop on (1e14, 1, 1e14): %.2fx  (target <= 1.5x: %s; "
                 "done-when <= 2x: %s)\n", main_ratio, main_ratio <= 1.5 ? "met" : "missed",
                 main_ratio <= 2.0 ? "met" : "missed");
   }

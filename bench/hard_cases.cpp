@@ -1,9 +1,10 @@
 // collision_lab_hard_cases (issue 4, "Hard cases and precision"): one row per hard case of
 // shared/physics.md plus seeded random scenes. For each: the count and velocity error of
 // naive fixed-precision loops (double-only, long-double-only, 50-digit-only: no error
-// bounds, no escalation; bench/common/naive_loop.h) and of the core (adaptive double,
-// long double, 50 digits), how often the core escalated (SimulationResult::escalation)
-// and what that cost against the double-only loop. Also the closed-form query time.
+// bounds, no escalation; bench/common/naive_loop.h) and of the core (the exact event
+// engine, runEngine, in count-only mode: adaptive precision from double-double up to exact
+// rationals), how often the engine escalated (EngineResult::escalations) and what that
+// cost against the double-only loop. Also the closed-form query time.
 //
 // Reference: exact::simulate (rationals) when the count is at most a few thousand;
 // beyond that the exact count (predictedCollisionCount) and the closed form evaluated at
@@ -31,9 +32,10 @@
 
 #include "closed_form_timing.h"
 #include "collision_lab/core/analytic.h"
+#include "collision_lab/core/events.h"
 #include "collision_lab/core/exact.h"
+#include "collision_lab/core/nbody/engine.h"
 #include "collision_lab/core/precision.h"
-#include "collision_lab/core/simulation.h"
 #include "exact_trajectory.h"
 #include "naive_loop.h"
 #include "report.h"
@@ -142,22 +144,32 @@ Outcome naiveOutcome(const ThreeBodyScene& scene) {
   return out;
 }
 
-SimulationOptions countOnly() {
-  SimulationOptions options;
-  options.max_collisions = kSimulationLimit;
-  options.events = EventPolicy::none();
-  return options;
+/// The engine's run of three bodies, count-only (no event visited or kept).
+EngineResult engineRun(const ThreeBodyScene& scene, std::uint64_t keep_events = 0) {
+  Scene engine_scene;
+  engine_scene.masses.assign(scene.masses.begin(), scene.masses.end());
+  engine_scene.positions.assign(scene.positions.begin(), scene.positions.end());
+  engine_scene.velocities.assign(scene.velocities.begin(), scene.velocities.end());
+  EngineOptions options;
+  options.max_impacts = kSimulationLimit;
+  options.keep_events = keep_events;
+  options.progress_interval = 0;
+  return runEngine(engine_scene, options);
 }
 
-template <class Scalar>
+/// The core: the exact event engine (keeping its first record, for the first pair).
 Outcome coreOutcome(const ThreeBodyScene& scene) {
-  const SimulationResult result = simulate<Scalar>(scene, countOnly());
+  const EngineResult result = engineRun(scene, 1);
   Outcome out;
   out.ran = true;
-  out.count = result.collision_count;
-  out.first_pair = result.first_pair;
-  out.velocities = result.final_velocities;
-  out.escalation = result.escalation;
+  out.count = result.impact_count;
+  if (!result.events.empty()) out.first_pair = result.events.front().pair_index == 0 ? Pair::AB : Pair::BC;
+  for (int i = 0; i < 3; ++i) out.velocities[i] = result.final_velocities[i];
+  // As the lab run counts them: a decision per impact and the final one; escalated ones
+  // taken at 100 digits or more, of which exact.
+  out.escalation.decisions = result.impact_count + 1;
+  out.escalation.high_precision = result.escalations.high_precision + result.escalations.exact_rational;
+  out.escalation.exact_rational = result.escalations.exact_rational;
   return out;
 }
 
@@ -168,9 +180,7 @@ std::vector<Method> methods() {
        naiveOutcome<double, ImpulseForm::kCentreOfMass>},
       {"long-double-only", false, false, naiveOutcome<long double>},
       {"50-digit-only", true, false, naiveOutcome<HighPrecision>},
-      {"adaptive (core, double)", false, true, coreOutcome<double>},
-      {"core, long double", false, false, coreOutcome<long double>},
-      {"core, 50 digits", true, false, coreOutcome<HighPrecision>},
+      {"adaptive (core: the exact event engine)", false, true, coreOutcome},
   };
 }
 
@@ -322,7 +332,7 @@ int main(int argc, char** argv) {
   errors << "\n|---|---|---|---|---|";
   for (std::size_t i = 0; i < method_list.size(); ++i) errors << "---|";
   errors << '\n';
-  costs << "| case | N | decisions | to 50 digits | to exact rational | adaptive time [s] | "
+  costs << "| case | N | decisions | to 100 digits or more | to exact rational | adaptive time [s] | "
            "double-only time [s] | adaptive / double-only |\n|---|---|---|---|---|---|---|---|\n";
 
   std::vector<std::string> adaptive_failures;
@@ -368,7 +378,7 @@ int main(int argc, char** argv) {
     // Long runs: the single isolated run's time; short ones: a median of repeats.
     const bool isolated = ref.count > kIsolateAbove;
     const double t_adaptive = isolated ? adaptive.seconds : medianSeconds([&] {
-      doNotOptimize(simulate<double>(scene, countOnly()).collision_count);
+      doNotOptimize(engineRun(scene).impact_count);
     }, repeats);
     const double t_naive = isolated ? outcomes.front().seconds : medianSeconds([&] {
       doNotOptimize(naiveEventLoop<double, false>(scene, kSimulationLimit).collision_count);
@@ -383,7 +393,7 @@ int main(int argc, char** argv) {
   random_table << "| family | scenes | exact-N range | method | wrong count (or first pair) | max velocity error "
                   "(right-count scenes) |\n|---|---|---|---|---|---|\n";
   std::ostringstream random_costs;
-  random_costs << "| family | scenes | decisions | to 50 digits | to exact rational | scenes escalated | "
+  random_costs << "| family | scenes | decisions | to 100 digits or more | to exact rational | scenes escalated | "
                   "adaptive / double-only (all scenes) | escalation cost (estimate) |\n|---|---|---|---|---|---|---|---|\n";
   std::vector<double> escalation_costs;
   for (const auto& family : randomFamilies()) {
@@ -429,7 +439,7 @@ int main(int argc, char** argv) {
     // fit t = a + b N over the scenes that did not escalate predicts for them.
     std::vector<double> t_core(scenes.size()), t_naive(scenes.size());
     for (std::size_t k = 0; k < scenes.size(); ++k) {
-      t_core[k] = medianSeconds([&] { doNotOptimize(simulate<double>(scenes[k], countOnly()).collision_count); }, repeats);
+      t_core[k] = medianSeconds([&] { doNotOptimize(engineRun(scenes[k]).impact_count); }, repeats);
       t_naive[k] = medianSeconds([&] {
         doNotOptimize(naiveEventLoop<double, false>(scenes[k], kSimulationLimit).collision_count);
       }, repeats);
@@ -438,8 +448,8 @@ int main(int argc, char** argv) {
     double sn = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
     std::vector<bool> did_escalate(scenes.size());
     for (std::size_t k = 0; k < scenes.size(); ++k) {
-      const auto result = simulate<double>(scenes[k], countOnly());
-      did_escalate[k] = result.escalation.high_precision + result.escalation.exact_rational > 0;
+      const EngineResult result = engineRun(scenes[k]);
+      did_escalate[k] = result.escalations.high_precision + result.escalations.exact_rational > 0;
       sum_core += t_core[k];
       sum_naive += t_naive[k];
       if (!did_escalate[k]) {
@@ -496,7 +506,9 @@ int main(int argc, char** argv) {
         "*double-only* writes the impulse with mass fractions, v_l += 2 m_r/(m_l+m_r) (v_r - v_l); "
         "the *centre-of-mass* variant writes v' = 2 v_cm - v. Both are exact in real arithmetic "
         "and round differently, which is why they fail on different cases. "
-        "The core columns are `simulate<Scalar>` in count-only mode.\n\n"
+        "The core column is the exact event engine (`runEngine`, nbody/engine.h) in count-only mode, "
+        "the one simulator of every run (the old three-body loop `simulate<Scalar>` and its long double "
+        "and 50-digit columns were removed with `--precision`).\n\n"
      << "## Goals (measured, not asserted)\n\n";
   if (adaptive_failures.empty()) {
     md << "- Adaptive precision: count and first-pair error 0 on every hard case and every random scene: **met**.\n";

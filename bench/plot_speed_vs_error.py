@@ -23,9 +23,6 @@ from matplotlib.lines import Line2D  # noqa: E402
 
 FLOOR = 1e-17  # where exact zeros are drawn
 STYLE = OrderedDict([
-    ("event_double", dict(color="#1b7837", marker="o", label="event_double (ours)")),
-    ("event_long_double", dict(color="#5aae61", marker="s", label="event_long_double (ours)")),
-    ("event_high", dict(color="#00441b", marker="D", label="event_high, 50 digits (ours)")),
     ("closed_form", dict(color="#2166ac", marker="*", label="closed_form (ours, no positions)")),
     ("nbody_engine", dict(color="#35978f", marker="P", label="nbody_engine, exact N-body engine (ours)")),
     ("model", dict(color="#4393c3", marker="X", label="model, closed form of the scene (ours, no positions)")),

@@ -2,10 +2,9 @@
 // timed and measured against the exact reference, written as CSV, Markdown and a PNG plot.
 //
 // Scenes: three-body elastic scenes, and N-body and restitution scenes (the presets of
-// config/scenarios.yaml where they exist). Methods: event_double, event_long_double,
-// event_high (the core's three-body event simulation) and closed_form (its count and O(1)
-// state after n collisions) on the three-body scenes; nbody_engine (the exact N-body engine,
-// runEngine) on every scene and model (the closed-form model that answers the scene,
+// config/scenarios.yaml where they exist). Methods: closed_form (the three-body count and
+// O(1) state after n collisions) on the three-body scenes; nbody_engine (the exact event
+// engine, runEngine, the one simulator of every run) on every scene and model (the closed-form model that answers the scene,
 // models.h) where one does; fixed_step (a hand-written time-stepping loop) and every real
 // engine this build found (Bullet, ODE, Box2D, restitution set per pair), each swept over dt.
 // Reference: exact rationals (an independent GMP trajectory, bench/common; on the
@@ -32,7 +31,6 @@
 #include "collision_lab/core/nbody/body_state_replay.h"
 #include "collision_lab/core/nbody/engine.h"
 #include "collision_lab/core/nbody/models.h"
-#include "collision_lab/core/simulation.h"
 #include "exact_trajectory.h"
 #include "report.h"
 #include "stepped.h"
@@ -52,7 +50,7 @@ struct BenchScene {
   std::string name;
   std::string description;
   Scene scene;                          ///< the N-body form, run by every method
-  std::optional<ThreeBodyScene> three;  ///< the three-body elastic form: event_* and closed_form
+  std::optional<ThreeBodyScene> three;  ///< the three-body elastic form: closed_form
   double end_time = kThreeBodyEndTime;  ///< every method is compared at this instant [s]
   bool in_quick = true;
   std::string preset;                     ///< the config/scenarios.yaml scene it follows, if any
@@ -250,26 +248,6 @@ Row makeRow(const std::string& method, const BenchScene& s, const std::string& p
   return row;
 }
 
-Row runEvent(Precision precision, const BenchScene& s, const Reference& ref, bool quick) {
-  SimulationOptions options;
-  options.max_collisions = 10'000'000;
-  options.events = EventPolicy::none();
-  SimulationResult result;
-  // A visitor makes the core track positions (final_positions at final_time).
-  auto work = [&] { result = simulate(*s.three, options, precision, [](const ImpactEvent&) {}); };
-  int runs = 0;
-  const double time = medianTime(work, quick, &runs);
-  std::vector<double> x_end(3), v(3);
-  for (int i = 0; i < 3; ++i) {
-    v[i] = result.final_velocities[i];
-    x_end[i] = result.final_positions[i] + result.final_velocities[i] * (s.end_time - result.final_time);
-  }
-  const std::string name = std::string("event_") +
-                           (precision == Precision::kDouble ? "double"
-                            : precision == Precision::kLongDouble ? "long_double" : "high");
-  return makeRow(name, s, precisionName(precision), ref, time, runs, result.collision_count, v, x_end);
-}
-
 Row runClosedForm(const BenchScene& s, const Reference& ref, bool quick) {
   std::uint64_t count = 0;
   std::vector<double> v(3);
@@ -348,12 +326,12 @@ std::string toCsv(const std::vector<Row>& rows) {
 }
 
 bool isOurs(const std::string& method) {
-  return method.rfind("event_", 0) == 0 || method == "closed_form" || method == "nbody_engine" || method == "model";
+  return method == "closed_form" || method == "nbody_engine" || method == "model";
 }
 
-/// Our method every stepping method is compared with: event_double on the three-body
-/// scenes, nbody_engine on the others.
-std::string anchorOf(const BenchScene& s) { return s.three ? "event_double" : "nbody_engine"; }
+/// Our method every stepping method is compared with: the event engine, which simulates
+/// every scene.
+std::string anchorOf(const BenchScene&) { return "nbody_engine"; }
 
 const Row* findRow(const std::vector<Row>& rows, const std::string& scene, const std::string& method) {
   for (const auto& r : rows) {
@@ -389,7 +367,7 @@ std::string doneWhen(const std::vector<Row>& rows, const std::vector<BenchScene>
       << ").\n";
   out << "- Cost for a stepping method to reach our accuracy on each scene (count error 0, "
          "velocity error <= max(1e-12, ours), position error <= max(1e-9 m, ours); ours = "
-         "event_double on the three-body scenes, nbody_engine on the others), as a multiple "
+         "nbody_engine, the event engine that simulates every scene), as a multiple "
          "of our time (goal: >= 100x or never):\n\n";
   out << "| scene |";
   for (const auto& m : stepped) out << ' ' << m.name << " |";
@@ -434,8 +412,7 @@ std::string doneWhen(const std::vector<Row>& rows, const std::vector<BenchScene>
 std::string summary(const std::vector<Row>& rows, const std::vector<BenchScene>& scenes,
                     const std::vector<Reference>& refs, const std::vector<SteppedMethod>& stepped) {
   std::ostringstream out;
-  out << "## Summary\n\nOurs (event_double on the three-body scenes, nbody_engine on the N-body and "
-         "restitution scenes) against the smallest trajectory error each stepping method "
+  out << "## Summary\n\nOurs (nbody_engine: the event engine, which simulates every scene) against the smallest trajectory error each stepping method "
          "reached over its dt sweep: *position error [m] (count error) at dt, time*.\n\n"
       << "| scene | exact N | ours: method, time, velocity err, position err [m] |";
   for (const auto& m : stepped) out << " best " << m.name << " |";
@@ -564,10 +541,9 @@ std::string toMarkdown(const std::vector<Row>& rows, const std::vector<BenchScen
          "against physics.md or the preset where one is known.\n\n";
   out << scenesTable(scenes, refs);
   out << "## Methods and every setting\n\n"
-      << "- **event_double, event_long_double, event_high** (three-body scenes): the core's event-driven "
-         "simulation, `simulate(scene, options, Precision)`, with a no-op visitor so it "
-         "tracks positions; positions at t_end are final_positions + final_velocities "
-         "(t_end - final_time).\n"
+      << "- The three-body loop `simulate(scene, options, Precision)` (event_double, event_long_double, "
+         "event_high) was removed with `--precision`: the event engine (nbody_engine below) simulates "
+         "every scene.\n"
       << "- **closed_form** (three-body scenes): `predictedCollisionCount(scene)`, then "
          "`AnalyticModel<double>(scene).velocitiesAfter(count)`; the time includes both.\n"
       << "- **nbody_engine** (every scene): the exact N-body engine, `runEngine(scene, options, visitor)` "
@@ -667,7 +643,6 @@ int main(int argc, char** argv) {
                    total.seconds());
     };
     if (s.three) {
-      for (Precision p : {Precision::kDouble, Precision::kLongDouble, Precision::kHigh}) add(runEvent(p, s, ref, quick));
       add(runClosedForm(s, ref, quick));
     }
     add(runNbodyEngine(s, ref, quick));

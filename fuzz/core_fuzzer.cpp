@@ -1,14 +1,15 @@
-// libFuzzer target over the ROS-free core: validation, prediction, simulation, the
-// closed-form model, the lab run and the paper's printed formulas.
+// libFuzzer target over the ROS-free core: validation, prediction, the lab run (the event
+// engine's simulation), the closed-form model and the paper's printed formulas.
 //
 // Contract: for ANY bytes, nothing crashes, throws, or trips ASan/UBSan; for a scene that
 // validate() accepts, the invariants checked below hold, and a violation aborts with a
 // one-line reason (so libFuzzer saves the input as a crash).
 //
 // Input layout (fuzz/make_seeds.py writes the committed seeds in it):
-//   byte 0   options: bits 0-1 precision (0 double, 1 long double, 2 high, 3 double),
-//            bits 2-3 kept events (none, all, first 3, none), bit 4 encoding (0 raw,
-//            1 compact), bit 5 runLab skips the simulation over the cap, bits 6-7 run mode
+//   byte 0   options: bit 0 a visitor watches every event (bit 1 unused; bits 0-1 chose
+//            the working precision, since removed), bits 2-3 kept events (none, all,
+//            first 3, none), bit 4 encoding (0 raw, 1 compact), bit 5 runLab skips the
+//            simulation over the cap, bits 6-7 run mode
 //   byte 1   max_collisions: kCaps[byte % kCaps.size()]
 //   then 9 values, masses A B C, positions A B C, velocities A B C, each either
 //     raw:     8 bytes, a little-endian IEEE double (any bit pattern, NaN and inf too), or
@@ -29,7 +30,6 @@
 #include "collision_lab/core/lab_run.h"
 #include "collision_lab/core/paper.h"
 #include "collision_lab/core/scene.h"
-#include "collision_lab/core/simulation.h"
 
 namespace cl = collision_lab::core;
 
@@ -37,7 +37,7 @@ namespace {
 
 /// Collision caps: small enough that one iteration stays in milliseconds.
 constexpr std::array<std::uint64_t, 10> kCaps = {0, 1, 2, 3, 5, 10, 100, 1000, 10000, 100000};
-/// Caps for the slower paths (events kept, higher precision, runLab's per-event model).
+/// Caps for the slower paths (events kept or visited, runLab's per-event model).
 constexpr std::uint64_t kSlowPathCap = 2000;
 /// Runs short enough to cross-check against exact rationals (their cost grows about
 /// cubically: 40 collisions of a scene mixing 1e30 kg and 1e-139 m/s take 1.3 s).
@@ -53,9 +53,6 @@ constexpr std::uint64_t kExactCrossCheckLimit = 20;
 ///  - mass ratios between ~1e24 and the validated limit 1e100: the double error bound
 ///    exceeds the approach speeds, so every decision goes to the 100-digit closed form
 ///    (O(1), tens of microseconds each). Such runs are capped at kQuadraticCap here.
-///  - a later contact whose approach speed is below ~1e-300 of the gap's scale comes at
-///    a time beyond the double range (inf); validation can only check the first contact.
-///    Event checks stop there.
 constexpr double kQuadraticMassRatio = 1e24;
 constexpr std::uint64_t kQuadraticCap = 5;
 
@@ -162,15 +159,24 @@ void checkEscaped(const std::array<double, 3>& v, const VelocityScales& scales, 
   FUZZ_CHECK(v[cl::kC] - v[cl::kB] <= allowance(cl::kB) + allowance(cl::kC), "B and C still approach at the end");
 }
 
-/// The engine's own rounding bound: 64 eps per impact (simulation.cpp, kBoundFactor).
+/// A generous bound on the rounding of a run's velocities: 64 eps per impact.
 double engineTolerance(std::uint64_t count) { return 64 * std::numeric_limits<double>::epsilon() * double(count + 2); }
 
-void checkSimulation(const cl::ThreeBodyScene& scene, const cl::SimulationResult& sim, const cl::AnalyticPrediction& prediction,
+void checkSimulation(const cl::ThreeBodyScene& scene, const cl::RunResult& run, const cl::AnalyticPrediction& prediction,
                      std::uint64_t cap) {
-  FUZZ_CHECK(sim.first_pair == prediction.first_pair, "simulation and prediction disagree on the first pair");
-  FUZZ_CHECK(sim.truncated == (prediction.collision_count > cap), "truncated iff the predicted count exceeds the cap");
-  FUZZ_CHECK(sim.collision_count == std::min(prediction.collision_count, cap),
-             "simulated count == predictedCollisionCount (capped)");
+  const cl::LabRunSummary& sim = run.summary;
+  // The one honest early stop: the next impact comes after the largest double.
+  const bool out_of_range = sim.stop == cl::StopReason::kOutOfRange;
+  FUZZ_CHECK(sim.stop == cl::StopReason::kFinished || sim.stop == cl::StopReason::kCap || out_of_range,
+             "a three-body run finishes, reaches the cap or stops out of range");
+  FUZZ_CHECK(sim.truncated == (prediction.collision_count > cap || out_of_range),
+             "truncated iff the predicted count exceeds the cap or the next impact is out of range");
+  if (out_of_range) {
+    FUZZ_CHECK(sim.collision_count < std::min(prediction.collision_count, cap), "an out-of-range stop comes early");
+  } else {
+    FUZZ_CHECK(sim.collision_count == std::min(prediction.collision_count, cap),
+               "simulated count == predictedCollisionCount (capped)");
+  }
   FUZZ_CHECK(allFinite(sim.final_velocities), "finite final velocities");
   FUZZ_CHECK(std::isfinite(sim.energy_relative_drift), "finite energy drift");
   const int wall = scene.wallIndex();
@@ -178,11 +184,12 @@ void checkSimulation(const cl::ThreeBodyScene& scene, const cl::SimulationResult
   if (!sim.truncated) checkEscaped(sim.final_velocities, velocityScales(scene), engineTolerance(sim.collision_count));
   std::uint64_t index = 0;
   double time = 0.0;
-  for (const cl::ImpactEvent& event : sim.events) {
+  for (const cl::LabEvent& lab : run.events) {
+    const cl::ImpactEvent& event = lab.event;
     FUZZ_CHECK(event.index == ++index, "events numbered 1, 2, ...");
     FUZZ_CHECK(allFinite(event.velocities_after), "finite event velocities");
-    if (skipKnownIssues() && !(std::isfinite(event.time) && allFinite(event.positions))) break;
-    FUZZ_CHECK(event.pair == ((index % 2 == 1) ? *sim.first_pair : cl::otherPair(*sim.first_pair)), "pairs alternate");
+    FUZZ_CHECK(event.pair == ((index % 2 == 1) ? *prediction.first_pair : cl::otherPair(*prediction.first_pair)),
+               "pairs alternate from the predicted first pair");
     FUZZ_CHECK(std::isfinite(event.time) && event.time >= time, "event times finite and non-decreasing");
     FUZZ_CHECK(allFinite(event.positions), "finite event positions");
     time = event.time;
@@ -270,15 +277,18 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   checkModel(scene, prediction);
   exercisePaper(scene, prediction.collision_count);
 
-  const int precision_bits = flags & 0x3;  // Precision is kDouble, kLongDouble, kHigh = 0, 1, 2
-  const auto precision = precision_bits == 3 ? cl::Precision::kDouble : static_cast<cl::Precision>(precision_bits);
+  const bool watched = flags & 0x1;
   const int events = (flags >> 2) & 0x3;
-  cl::SimulationOptions options;
+  cl::RunOptions options;
   options.events = events == 1 ? cl::EventPolicy::all() : events == 2 ? cl::EventPolicy::firstN(3) : cl::EventPolicy::none();
-  const bool slow_path = precision != cl::Precision::kDouble || events == 1;
+  const bool slow_path = watched || events == 1;
   options.max_collisions = std::min({cap, slow_path ? kSlowPathCap : cap, known_issue_cap});
-  const cl::SimulationResult sim = cl::simulate(scene, options, precision);
+  std::uint64_t watched_events = 0;
+  cl::LabEventVisitor watch;
+  if (watched) watch = [&watched_events](const cl::LabEvent&) { ++watched_events; };
+  const cl::RunResult sim = cl::runLab(scene, options, watch);
   checkSimulation(scene, sim, prediction, options.max_collisions);
+  if (watched) FUZZ_CHECK(watched_events == sim.summary.collision_count, "the visitor sees every impact");
 
   if (prediction.collision_count <= kExactCrossCheckLimit) {
     const cl::exact::Run truth = cl::exact::simulate(scene, kExactCrossCheckLimit + 1);
@@ -289,13 +299,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   cl::RunOptions run_options;
   run_options.max_collisions = std::min({cap, kSlowPathCap, known_issue_cap});
   run_options.mode = static_cast<cl::RunMode>((flags >> 6) % 3);
-  run_options.precision = precision;
   run_options.skip_simulation_over_cap = flags & 0x20;
   run_options.events = cl::EventPolicy::firstN(3);
   const cl::RunResult run = cl::runLab(scene, run_options);
   FUZZ_CHECK(allFinite(run.summary.final_velocities), "finite lab-run final velocities");
   FUZZ_CHECK(run.summary.truncated == (run_options.mode != cl::RunMode::kPredictOnly &&
-                                       prediction.collision_count > run_options.max_collisions),
-             "a lab run is truncated iff it simulates and the prediction exceeds the cap");
+                                       (prediction.collision_count > run_options.max_collisions ||
+                                        run.summary.stop == cl::StopReason::kOutOfRange)),
+             "a lab run is truncated iff it simulates and the prediction exceeds the cap, or it stops out of range");
   return 0;
 }

@@ -96,7 +96,7 @@ core::Scene readBodies(const std::string& path) {
 struct RawOptions {
   std::string masses, positions, velocities, bodies, restitution;
   std::string restitution_model, tc, elastic_below, viscoelastic_speed, ring;
-  std::string max_collisions, events, format = "table", precision = "double", mode = "full";
+  std::string max_collisions, events, format = "table", precision, mode = "full";
   std::string scenario, name, temperature_csv;
   bool list = false;
   bool simulate_to_cap = false;
@@ -104,21 +104,22 @@ struct RawOptions {
   bool restitution_given = false;
   bool max_collisions_given = false, events_given = false, scenario_given = false, name_given = false;
   bool temperature_csv_given = false;
+  bool precision_given = false;
 };
 
-/// Format, precision, mode and collision cap.
+/// Format, mode and collision cap; --precision, removed, is refused.
 void readRunOptions(const RawOptions& raw, CliRequest& request) {
   const auto format = io::parseReportFormat(raw.format);
   if (!format) {
     throw makeCliError(CliReason::kInvalidOption, "format", "'" + raw.format + "' is not table, json or csv");
   }
   request.format = *format;
-  const auto precision = core::parsePrecision(raw.precision);
-  if (!precision) {
+  if (raw.precision_given) {
     throw makeCliError(CliReason::kInvalidOption, "precision",
-                       "'" + raw.precision + "' is not double, long_double or high");
+                       "--precision was removed: every run is exact (the event engine decides every impact as exact "
+                       "rational arithmetic would and rounds its values once), so there is no working precision to "
+                       "choose; drop the option");
   }
-  request.options.precision = *precision;
   const auto mode = io::parseRunMode(raw.mode);
   if (!mode) {
     throw makeCliError(CliReason::kInvalidOption, "mode", "'" + raw.mode + "' is not full, predict or summary");
@@ -315,7 +316,8 @@ void declareOptions(CLI::App& app, RawOptions& raw) {
   app.add_option(
       "--events", raw.events, "events to print: all|none|first:N (default all; none when running every scenario)");
   app.add_option("--format", raw.format, "table|json|csv (default table)");
-  app.add_option("--precision", raw.precision, "working precision: double|long_double|high (default double)");
+  // Removed (every run is exact); kept only to refuse it with its reason, hidden from --help.
+  app.add_option("--precision", raw.precision)->group("");
   app.add_option("--mode", raw.mode, "full|predict|summary (default full)");
   app.add_option("--scenario", raw.scenario, "scenario file (YAML); without --name runs every scene in it");
   app.add_option("--name", raw.name, "scene of the scenario file (default file: the package's presets)");
@@ -336,6 +338,7 @@ void markGiven(const CLI::App& app, RawOptions& raw) {
   raw.scenario_given = app.count("--scenario") > 0;
   raw.name_given = app.count("--name") > 0;
   raw.temperature_csv_given = app.count("--temperature-csv") > 0;
+  raw.precision_given = app.count("--precision") > 0;
 }
 
 CliRequest parseCommandLine(const std::vector<std::string>& args, const std::string& default_scenario_path) {

@@ -1,6 +1,7 @@
 #include "collision_lab/core/lab_run.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -222,6 +223,25 @@ class LabEvents {
   std::array<double, 3> previous_before_;
 };
 
+/// The limits of one simulation of the three bodies.
+struct SimulationOptions {
+  std::uint64_t max_collisions = 10'000'000;  ///< stops the run cleanly; marks it truncated
+  /// When set, the run stops within 1024 collisions, marked truncated and cancelled.
+  const std::atomic<bool>* cancel = nullptr;
+};
+
+/// What one simulation of the three bodies measured.
+struct SimulationResult {
+  std::uint64_t collision_count = 0;
+  bool truncated = false;                    ///< more impacts were due: the cap, a cancel or a stop
+  bool cancelled = false;                    ///< stopped by SimulationOptions::cancel
+  StopReason stop = StopReason::kFinished;   ///< the engine's reason
+  std::array<double, 3> final_velocities{};  ///< [m/s]
+  double energy_relative_drift = 0.0;        ///< |E_end - E_0| / E_0, in the wall's frame
+  double momentum_relative_drift = 0.0;      ///< |p_end - p_0| / sum |m v|; NaN with a wall
+  EscalationStats escalation;
+};
+
 /// The scene of the engine for three bodies.
 Scene asScene(const ThreeBodyScene& triple) {
   Scene scene;
@@ -271,7 +291,7 @@ std::optional<SimulationResult> simulateKnownCount(const ThreeBodyScene& scene, 
   result.collision_count = run->impact_count;
   result.truncated = run->capped || run->cancelled;
   result.cancelled = run->cancelled;
-  result.first_pair = first;
+  result.stop = run->cancelled ? StopReason::kCancelled : run->capped ? StopReason::kCap : StopReason::kFinished;
   EngineResult drift;
   drift.final_velocities.assign(run->final_velocities.begin(), run->final_velocities.end());
   nbody_detail::fillEngineDrift(units.scene, drift);
@@ -287,15 +307,12 @@ std::optional<SimulationResult> simulateKnownCount(const ThreeBodyScene& scene, 
 /// engine runs in its working units, nbody/units.h, and gives SI values). An impact's pair
 /// comes from the engine's record; the third body's position at that time is computed here
 /// from its last impact (to rounding, in long double), and the totals after it from the
-/// velocities. Escalations: one decision per impact and the final one.
-/// Returns nothing when the engine stopped because a value would leave the range of a double
-/// (an impact after the largest double [s], which the three-body simulator reports as
-/// infinite): `told` impacts were then visited. A run the engine ended otherwise than
-/// finished, capped or cancelled is truncated, with the engine's sentence in `stopped_otherwise`.
-std::optional<SimulationResult> simulateByEngine(const ThreeBodyScene& scene, const SimulationOptions& options,
-                                                 const ProgressCallback& progress, std::uint64_t progress_interval,
-                                                 const EventVisitor& visitor, std::uint64_t& told,
-                                                 std::string& stopped_otherwise) {
+/// velocities. Escalations: one decision per impact and the final one. A run the engine
+/// ended otherwise than finished, capped or cancelled (out of range: the next impact comes
+/// after the largest double) is truncated, with the engine's sentence in `stopped_otherwise`.
+SimulationResult simulateByEngine(const ThreeBodyScene& scene, const SimulationOptions& options,
+                                  const ProgressCallback& progress, std::uint64_t progress_interval,
+                                  const EventVisitor& visitor, std::string& stopped_otherwise) {
   EngineOptions engine_options;
   engine_options.max_impacts = options.max_collisions;
   engine_options.progress_interval = progress ? progress_interval : 0;
@@ -348,20 +365,14 @@ std::optional<SimulationResult> simulateByEngine(const ThreeBodyScene& scene, co
     };
   }
   EngineResult engine = runEngine(asScene(scene), engine_options, on_impact, progress);
-  told = engine.impact_count;
-  if (engine.stop == StopReason::kOutOfRange) return std::nullopt;
   result.collision_count = engine.impact_count;
   result.truncated = engine.truncated || engine.stop != StopReason::kFinished;
   result.cancelled = engine.stop == StopReason::kCancelled;
+  result.stop = engine.stop;
   if (engine.stop != StopReason::kFinished && engine.stop != StopReason::kCap && !result.cancelled) {
     stopped_otherwise = engine.stop_message;
   }
-  result.first_pair = firstPair(scene);
-  for (int k = 0; k < 3; ++k) {
-    result.final_velocities[k] = engine.final_velocities[k];
-    result.final_positions[k] = engine.final_positions[k];
-  }
-  result.final_time = engine.final_time;
+  for (int k = 0; k < 3; ++k) result.final_velocities[k] = engine.final_velocities[k];
   result.energy_relative_drift = engine.energy_relative_drift;
   result.momentum_relative_drift = engine.momentum_relative_drift;
   result.escalation.decisions = engine.impact_count + 1;
@@ -394,7 +405,6 @@ void simulateBesidePrediction(const ThreeBodyScene& scene, const RunOptions& opt
     };
   }
   std::string stopped_otherwise;
-  std::uint64_t told = 0;
   std::optional<SimulationResult> by_engine;
   // No event published: only the count, the final state, the drifts and (in full mode) the
   // largest prediction error are needed, which the known count gives without the engine.
@@ -419,19 +429,8 @@ void simulateBesidePrediction(const ThreeBodyScene& scene, const RunOptions& opt
     if (!by_engine) max_error_sq = 0.0;  // the engine measures it again
   }
   if (!by_engine) {
-    by_engine = simulateByEngine(scene, simulation_options, options.progress, options.progress_interval, enrich, told,
+    by_engine = simulateByEngine(scene, simulation_options, options.progress, options.progress_interval, enrich,
                                  stopped_otherwise);
-  }
-  if (!by_engine) {
-    // Beyond the engine's range: the three-body simulator (exact decisions, velocities to a
-    // few units in the last place) runs it, telling only the impacts after those told.
-    EventVisitor rest;
-    if (enrich) {
-      rest = [&enrich, told](const ImpactEvent& event) {
-        if (event.index > told) enrich(event);
-      };
-    }
-    by_engine = simulate(scene, simulation_options, options.precision, rest);
   }
   const SimulationResult& simulation = *by_engine;
   summary.max_prediction_error = relative_error.fromSquared(max_error_sq);
@@ -439,6 +438,7 @@ void simulateBesidePrediction(const ThreeBodyScene& scene, const RunOptions& opt
   summary.collision_count = simulation.collision_count;
   summary.truncated = simulation.truncated;
   summary.cancelled = simulation.cancelled;
+  summary.stop = simulation.stop;
   if (simulation.cancelled) {
     summary.truncation_reason = "cancelled after " + countText(simulation.collision_count) + " of " +
                                 countText(result.prediction.collision_count) + " predicted";

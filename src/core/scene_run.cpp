@@ -182,18 +182,13 @@ AnalyticPrediction rotationPrediction(const Prediction& prediction) {
 }
 
 /// The three-body run's summary as every scene's: the engine simulated it (lab_run.h).
-SceneSimulation fromThreeBody(const RunResult& run, const Scene& scene, std::uint64_t cap) {
+SceneSimulation fromThreeBody(const RunResult& run) {
   const LabRunSummary& summary = run.summary;
   SceneSimulation simulation;
   simulation.simulated = summary.simulated;
   simulation.impact_count = summary.collision_count;
   simulation.truncated = summary.truncated;
-  // Truncated short of the cap and not cancelled: the engine reported an internal error (a
-  // multiple collision cannot follow a valid start of three bodies).
-  simulation.stop = summary.cancelled                      ? StopReason::kCancelled
-                    : !summary.truncated                   ? StopReason::kFinished
-                    : summary.collision_count >= cap ? StopReason::kCap
-                                                           : StopReason::kInternalError;
+  simulation.stop = summary.stop;  // the engine's reason
   if (!summary.simulated) {
     simulation.stop_message = "answered by the closed form of three_body_rotation: nothing simulated";
   } else if (summary.truncated) {
@@ -245,7 +240,7 @@ SceneRunResult runScene(const ScenePlan& plan, const SceneRunOptions& options, c
     }
     result.three_body =
         runLab(toThreeBodyScene(plan.scene), lab, rotationPrediction(*plan.prediction), visitors.three_body_event);
-    result.simulation = fromThreeBody(*result.three_body, plan.scene, lab.max_collisions);
+    result.simulation = fromThreeBody(*result.three_body);
   } else {
     result.simulation = simulateScene(plan.scene, options, result.prediction, visitors);
   }

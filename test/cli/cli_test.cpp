@@ -87,12 +87,20 @@ TEST(CliJson, PiDigitsFromTheCommandLineWithAnInfiniteMass) {
   EXPECT_TRUE(doc.at("summary").at("momentum_relative_drift").is_null());
 }
 
-TEST(CliJson, EveryPrecisionGivesTheExactCount) {
+TEST(CliJson, TheRemovedPrecisionOptionFailsClearly) {
+  // Every run is exact: --precision, which chose the working precision of the old
+  // three-body simulator, was removed, and says so in one line (exit 2).
   for (const char* precision : {"double", "long_double", "high"}) {
-    const Json doc = runPreset("pi_digits_3", {"--events", "none", "--precision", precision});
-    EXPECT_EQ(doc.at("summary").at("collision_count"), 314) << precision;
-    EXPECT_EQ(doc.at("options").at("precision"), precision);
+    const CliOutput result = run({"--name", "pi_digits_3", "--events", "none", "--precision", precision});
+    EXPECT_EQ(result.exit_code, 2) << precision;
+    EXPECT_TRUE(result.out.empty()) << result.out;
+    EXPECT_EQ(linesOf(result.err).size(), 1u) << result.err;
+    EXPECT_NE(result.err.find("--precision was removed: every run is exact"), std::string::npos) << result.err;
   }
+  // The JSON keeps its "precision" key, with the value it always had.
+  const Json doc = runPreset("pi_digits_3", {"--events", "none"});
+  EXPECT_EQ(doc.at("summary").at("collision_count"), 314);
+  EXPECT_EQ(doc.at("options").at("precision"), "double");
 }
 
 TEST(CliJson, HardPresetsMatchExactArithmetic) {
@@ -228,7 +236,7 @@ TEST(CliTable, AlignedColumnsWithUnitsAndThePapersValuesLabelled) {
 TEST(CliTable, NamesTheTierItsEscalatedDecisionsAreTakenAt) {
   // Masses (3, 1, 0.5), v = (-1, 0, 0): psi / alpha is exactly 3, so after 2 collisions the
   // pair AB touches at exactly zero approach speed (physics.md), a decision that double
-  // cannot take: it goes to the first escalation tier, 100 digits (simulation.h).
+  // cannot take: it goes to the first escalation tier, 100 digits (nbody/tier.h).
   const std::vector<std::string> scene = {"--masses", "3,1,0.5", "--positions", "2,1,0", "--velocities", "-1,0,0"};
   const Json json = runJson(scene);
   ASSERT_EQ(json["summary"]["collision_count"], 2);
@@ -386,10 +394,16 @@ TEST(CliDoubleRange, ASubnormalSpeedOfTheOtherPairIsNoReasonToReject) {
   EXPECT_NEAR(v[0], 1.0 / 3, 1e-15);    // exact: 1/3
   EXPECT_NEAR(v[1], 2.0 / 15, 1e-15);   // 2/15
   EXPECT_NEAR(v[2], -8.0 / 15, 1e-15);  // -8/15 + 1e-324
+  // The third impact comes at 2.02e323 s, beyond a double: the run stops honestly after the
+  // second, truncated (it used to publish the third with a null time).
   const Json three = runJson({"--masses", "1,1,1", "--positions", "2,1,0", "--velocities=-1,-5e-324,0"});
-  EXPECT_EQ(three.at("summary").at("collision_count"), 3);
-  EXPECT_TRUE(three.at("events")[2].at("time").is_null());  // 2.02e323 s: beyond a double
-  EXPECT_NEAR(three.at("events")[2].at("position").get<double>(), 0.0, 2e-9);  // where B rests (length scale 2 m)
+  EXPECT_EQ(three.at("summary").at("collision_count"), 2);
+  EXPECT_EQ(three.at("summary").at("predicted_collision_count"), 3);
+  EXPECT_EQ(three.at("summary").at("truncated"), true);
+  EXPECT_NE(three.at("summary").at("truncation_reason").get<std::string>().find(
+                "the next impact comes after t = 1.7976931348623157e+308 s"),
+            std::string::npos);
+  EXPECT_EQ(three.at("events").size(), 2u);
 }
 
 TEST(CliDoubleRange, CountsPast2To53AreJsonIntegers) {
@@ -422,20 +436,22 @@ TEST(CliDoubleRange, PositionsOfImpactsShorterThanTheSmallestDouble) {
   EXPECT_EQ(events[2].at("time"), 0.0);  // 1e-350 s rounds to 0
 }
 
-TEST(CliDoubleRange, SubnormalApproachSpeedInEveryPrecision) {
-  for (const char* precision : {"double", "long_double", "high"}) {
-    const Json doc = runJson({"--masses", "3e-300,1e-300,5e-301", "--positions", "2e-200,1e-200,0", "--velocities",
-                              "-1e-300,0,0", "--precision", precision});
-    const Json& third = doc.at("events").at(2);
-    EXPECT_NEAR(third.at("time").get<double>() / 4.8256457640483526e+116, 1.0, 1e-9) << precision;
-    EXPECT_NEAR(third.at("position").get<double>() / -2.4128228820241767e-184, 1.0, 1e-9) << precision;
-  }
+TEST(CliDoubleRange, SubnormalApproachSpeed) {
+  const Json doc = runJson({"--masses", "3e-300,1e-300,5e-301", "--positions", "2e-200,1e-200,0", "--velocities",
+                            "-1e-300,0,0"});
+  const Json& third = doc.at("events").at(2);
+  EXPECT_NEAR(third.at("time").get<double>() / 4.8256457640483526e+116, 1.0, 1e-9);
+  EXPECT_NEAR(third.at("position").get<double>() / -2.4128228820241767e-184, 1.0, 1e-9);
 }
 
 TEST(CliDoubleRange, ExtremeMassRatiosAreRun) {
+  // The second impact comes after the largest double: the run stops honestly after the first.
   const Json doc = runJson({"--masses", "1e-300,1,inf", "--positions", "2,1,0", "--velocities", "-1e-140,0,0"});
-  EXPECT_EQ(doc.at("summary").at("collision_count"), 2);
+  EXPECT_EQ(doc.at("summary").at("collision_count"), 1);
   EXPECT_EQ(doc.at("summary").at("predicted_collision_count"), 2);
+  EXPECT_EQ(doc.at("summary").at("truncated"), true);
+  EXPECT_NE(doc.at("summary").at("truncation_reason").get<std::string>().find("1.7976931348623157e+308 s, the largest double"),
+            std::string::npos);
 }
 
 // ---------------------------------------------------------------------------------------

@@ -8,9 +8,10 @@
 #include <random>
 
 #include "collision_lab/core/analytic.h"
-#include "collision_lab/core/simulation.h"
+#include "collision_lab/core/lab_run.h"
 #include "rational_reference.h"
 #include "scenes.h"
+#include "simulated_run.h"
 
 namespace collision_lab {
 namespace core {
@@ -69,17 +70,16 @@ TEST(ClosedForm, MatchesExactStateAfterEveryCollision) {
 
 TEST(ClosedForm, AgreesWithSimulationUpToAMillionCollisions) {
   const ThreeBodyScene scene{{2e11, 1, 3e11}, {2, 1, 0}, {-1, 0.5, 0.2}};
-  SimulationOptions options;
   double worst = 0.0;
   const AnalyticModel<long double> model(scene);
-  const SimulationResult result = simulate<double>(scene, options, [&](const ImpactEvent& e) {
+  const LabRunSummary result = testing_support::simulateThreeBodies(scene, EventPolicy::none(), 10'000'000, [&](const ImpactEvent& e) {
     if (e.index % 997 != 0) return;
     const auto predicted = model.velocitiesAfter(e.index);
     const std::array<reference::Q, 3> p{reference::Q(static_cast<double>(predicted(0))),
                                         reference::Q(static_cast<double>(predicted(1))),
                                         reference::Q(static_cast<double>(predicted(2)))};
     worst = std::max(worst, energyNormError(scene, e.velocities_after, p));
-  });
+  }).summary;
   EXPECT_GT(result.collision_count, 500000u);
   EXPECT_LT(result.collision_count, 1500000u);
   EXPECT_EQ(predictedCollisionCount(scene), result.collision_count);
@@ -165,7 +165,7 @@ TEST(Count, ExactUpToMassRatio1e20) {
   EXPECT_EQ(countFromFirstPrinciples(ThreeBodyScene{{1, 1, 1}, {2, 1, 0}, {-1, 0.3, 0.2}}), 2u);
   EXPECT_EQ(countFromFirstPrinciples(ThreeBodyScene{{1e12, 1, 1e12}, {2, 1, 0}, {-1, 0, 0}}), 2221441u);
   const ThreeBodyScene simulated{{1e12, 1, 0.5e12}, {2, 1, 0}, {-1, 0, 0}};
-  EXPECT_EQ(predictedCollisionCount(simulated), simulate<double>(simulated, {}).collision_count);
+  EXPECT_EQ(predictedCollisionCount(simulated), testing_support::simulateThreeBodies(simulated).summary.collision_count);
 }
 
 TEST(Count, FloorExceptWhenPsiOverAlphaIsAnInteger) {
@@ -217,9 +217,7 @@ TEST(EnergyTransfer, ClosedFormMatchesSimulatedEvents) {
     for (int j = 0; j < 3; ++j) {
       if (!scene.isWall(j)) energy += 0.5 * scene.masses[j] * scene.velocities[j] * scene.velocities[j];
     }
-    SimulationOptions options;
-    options.events = EventPolicy::all();
-    const SimulationResult result = simulate<double>(scene, options);
+    const auto result = testing_support::simulateThreeBodies(scene, EventPolicy::all());
     for (const ImpactEvent& e : result.events) {
       const auto predicted = model.energyTransfer(e.index);
       for (int j = 0; j < 3; ++j) {

@@ -1,4 +1,4 @@
-// The adaptive double engine against exact rational arithmetic on the same doubles: the
+// The three-body run (runLab: the event engine) against exact rational arithmetic on the same doubles: the
 // independent reference of rational_reference.h, which shares no code with core::exact.
 // core::exact (the engine's own exact fallback) is tested against that reference too.
 #include <gtest/gtest.h>
@@ -11,10 +11,10 @@
 
 #include "collision_lab/core/analytic.h"
 #include "collision_lab/core/exact.h"
-#include "collision_lab/core/precision.h"
-#include "collision_lab/core/simulation.h"
+#include "collision_lab/core/lab_run.h"
 #include "rational_reference.h"
 #include "scenes.h"
+#include "simulated_run.h"
 
 namespace collision_lab {
 namespace core {
@@ -23,6 +23,8 @@ namespace {
 using testing_support::energyNormError;
 using testing_support::kInf;
 using testing_support::randomScene;
+using testing_support::simulateThreeBodies;
+using testing_support::SimulatedRun;
 
 /// What the tests compare of a run, from the independent rational reference.
 struct Truth {
@@ -46,28 +48,31 @@ Truth truth(const ThreeBodyScene& scene, bool with_positions = true) {
 }
 
 struct Observed {
-  SimulationResult result;
+  LabRunSummary result;
   std::vector<Pair> pairs;
 };
 
-template <class Scalar = double>
+/// The run with every impact visited (the engine's decisions).
 Observed run(const ThreeBodyScene& scene, std::uint64_t max_collisions = 10'000'000) {
   Observed observed;
-  SimulationOptions options;
-  options.max_collisions = max_collisions;
-  observed.result = simulate<Scalar>(scene, options, [&](const ImpactEvent& e) { observed.pairs.push_back(e.pair); });
+  observed.result = simulateThreeBodies(scene, EventPolicy::none(), max_collisions, [&](const ImpactEvent& e) {
+                      observed.pairs.push_back(e.pair);
+                    }).summary;
   return observed;
 }
+
+/// The count-only run: no event published.
+LabRunSummary countOnly(const ThreeBodyScene& scene) { return simulateThreeBodies(scene).summary; }
 
 void expectMatchesExact(const ThreeBodyScene& scene, double tolerance = 1e-13, bool with_positions = true) {
   const Truth reference = truth(scene, with_positions);
   const Observed observed = run(scene);
   EXPECT_EQ(observed.result.collision_count, reference.collision_count);
   EXPECT_EQ(observed.pairs, reference.pairs);
-  EXPECT_EQ(observed.result.first_pair, reference.first_pair);
+  EXPECT_EQ(observed.pairs.empty() ? std::nullopt : std::optional<Pair>(observed.pairs.front()), reference.first_pair);
   EXPECT_LE(energyNormError(scene, observed.result.final_velocities, reference.final_velocities), tolerance);
-  // Count-only mode models velocities alone and must agree too.
-  EXPECT_EQ(simulate<double>(scene, {}).collision_count, reference.collision_count);
+  // Count-only mode must agree too.
+  EXPECT_EQ(countOnly(scene).collision_count, reference.collision_count);
   EXPECT_EQ(predictedCollisionCount(scene), reference.collision_count);
 }
 
@@ -198,21 +203,9 @@ TEST(ExactAgreement, WallsMovingAndResting) {
   expectMatchesExact(ThreeBodyScene{{3, 1, kInf}, {2, 1, 0}, {-1, 0.5, -0.125}});
 }
 
-TEST(ExactAgreement, OtherPrecisionsAgreeOnCountsAndPairs) {
-  std::mt19937_64 rng(7);
-  for (int i = 0; i < 40; ++i) {
-    const ThreeBodyScene scene = randomScene(rng);
-    const Truth reference = truth(scene);
-    EXPECT_EQ(run<long double>(scene).pairs, reference.pairs);
-    const Observed high = run<HighPrecision>(scene);
-    EXPECT_EQ(high.pairs, reference.pairs);
-    EXPECT_LE(energyNormError(scene, high.result.final_velocities, reference.final_velocities), 1e-15);
-  }
-}
-
 TEST(Conservation, EnergyAndMomentumOverLongRuns) {
   for (const ThreeBodyScene& scene : {ThreeBodyScene{{1e6, 1, 1e6}, {2, 1, 0}, {-1, 0, 0}}, ThreeBodyScene{{1e8, 3, 1e9}, {2, 1, 0}, {-1, 0.5, 0.25}}}) {
-    const SimulationResult result = simulate<double>(scene, {});
+    const LabRunSummary result = countOnly(scene);
     EXPECT_GT(result.collision_count, 1000u);
     EXPECT_LE(result.energy_relative_drift, 1e-12);
     EXPECT_LE(result.momentum_relative_drift, 1e-12);
@@ -221,9 +214,7 @@ TEST(Conservation, EnergyAndMomentumOverLongRuns) {
   const ThreeBodyScene scene{{1, 2, 3}, {2, 1, 0}, {-1, 0.3, 0.7}};
   const double energy = 0.5 * (1 * 1 + 2 * 0.09 + 3 * 0.49);
   const double momentum = -1 + 2 * 0.3 + 3 * 0.7;
-  SimulationOptions options;
-  options.events = EventPolicy::all();
-  const SimulationResult result = simulate<double>(scene, options);
+  const SimulatedRun result = simulateThreeBodies(scene, EventPolicy::all());
   ASSERT_FALSE(result.events.empty());
   for (const ImpactEvent& e : result.events) {
     EXPECT_NEAR(e.total_energy, energy, 1e-14);
@@ -234,11 +225,10 @@ TEST(Conservation, EnergyAndMomentumOverLongRuns) {
 
 TEST(Events, PoliciesCapsAndTimes) {
   const ThreeBodyScene scene{{100, 1, kInf}, {3, 2, 0}, {-1, 0, 0}};
-  SimulationOptions options;
-  options.events = EventPolicy::firstN(5);
   std::uint64_t visited = 0;
-  const SimulationResult first5 = simulate<double>(scene, options, [&](const ImpactEvent&) { ++visited; });
-  EXPECT_EQ(first5.collision_count, 31u);
+  const SimulatedRun first5 =
+      simulateThreeBodies(scene, EventPolicy::firstN(5), 10'000'000, [&](const ImpactEvent&) { ++visited; });
+  EXPECT_EQ(first5.summary.collision_count, 31u);
   EXPECT_EQ(visited, 31u);
   ASSERT_EQ(first5.events.size(), 5u);
   // First impact: A (x = 3, v = -1) reaches B (x = 2, at rest) at t = 1, x = 2.
@@ -249,30 +239,29 @@ TEST(Events, PoliciesCapsAndTimes) {
   for (std::size_t i = 1; i < first5.events.size(); ++i) EXPECT_GT(first5.events[i].time, first5.events[i - 1].time);
   EXPECT_DOUBLE_EQ(first5.events[1].position, 0.0);
 
-  options.events = EventPolicy::none();
-  options.max_collisions = 10;
-  const SimulationResult capped = simulate<double>(scene, options);
-  EXPECT_TRUE(capped.truncated);
-  EXPECT_EQ(capped.collision_count, 10u);
+  const SimulatedRun capped = simulateThreeBodies(scene, EventPolicy::none(), 10);
+  EXPECT_TRUE(capped.summary.truncated);
+  EXPECT_EQ(capped.summary.collision_count, 10u);
   EXPECT_TRUE(capped.events.empty());
-  options.max_collisions = 31;
-  EXPECT_FALSE(simulate<double>(scene, options).truncated);  // exactly the count is not truncation
+  // Exactly the count is not truncation.
+  EXPECT_FALSE(simulateThreeBodies(scene, EventPolicy::none(), 31).summary.truncated);
 }
 
 TEST(PiDigits, BySimulation) {
   const std::vector<std::pair<double, std::uint64_t>> digits = {{1e2, 31}, {1e4, 314}, {1e6, 3141}, {1e8, 31415}};
   for (const auto& [ratio, expected] : digits) {
     const ThreeBodyScene scene{{ratio, 1, kInf}, {2, 1, 0}, {-1, 0, 0}};
-    EXPECT_EQ(simulate<double>(scene, {}).collision_count, expected);
+    EXPECT_EQ(countOnly(scene).collision_count, expected);
     EXPECT_EQ(predictedCollisionCount(scene), expected);
   }
   const ThreeBodyScene small{{1e4, 1, kInf}, {2, 1, 0}, {-1, 0, 0}};
   expectMatchesExact(small);
   // 3141 impacts with a light body 1000 times faster at its peak than at the end.
   const ThreeBodyScene pi_1e6{{1e6, 1, kInf}, {2, 1, 0}, {-1, 0, 0}};
-  const SimulationResult high = simulate<HighPrecision>(pi_1e6, {});
-  const SimulationResult fast = simulate<double>(pi_1e6, {});
-  for (int i = 0; i < 3; ++i) EXPECT_NEAR(fast.final_velocities[i], high.final_velocities[i], 1e-12) << i;
+  const AnalyticModel<HighPrecision> closed_form(pi_1e6);  // 50 digits
+  const auto exact = closed_form.velocitiesAfter(3141);
+  const LabRunSummary fast = countOnly(pi_1e6);
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(fast.final_velocities[i], static_cast<double>(exact(i)), 1e-12) << i;
 }
 
 /// Reference for long runs that shares no code with the engine or AnalyticModel: the
@@ -311,7 +300,7 @@ FiftyDigitRun fiftyDigitLoop(const ThreeBodyScene& scene) {
 
 TEST(HeavyLightHeavy, MillionsOfCollisionsStayAccurate) {
   const ThreeBodyScene scene{{1e12, 1, 1e12}, {2, 1, 0}, {-1, 0, 0}};
-  const SimulationResult fast = simulate<double>(scene, {});
+  const LabRunSummary fast = countOnly(scene);
   const FiftyDigitRun reference = fiftyDigitLoop(scene);
   EXPECT_EQ(reference.count, 2221441u);  // physics.md, hard cases
   EXPECT_EQ(fast.collision_count, reference.count);

@@ -10,8 +10,9 @@
 #include "collision_lab/core/analytic.h"
 #include "collision_lab/core/exact.h"
 #include "collision_lab/core/paper.h"
-#include "collision_lab/core/simulation.h"
+#include "collision_lab/core/lab_run.h"
 #include "scenes.h"
+#include "simulated_run.h"
 
 namespace collision_lab {
 namespace core {
@@ -70,7 +71,7 @@ TEST(PaperErrata, ClosedFormVelocities215AreWrong) {
 TEST(PaperErrata, CollisionCount322IsEvenForNonIntegerArguments) {
   // Equal masses (-1, 0, 1) with AB first: 3 collisions; (3.22) cannot give an odd number.
   const ThreeBodyScene scene{{1, 1, 1}, {3, 2, 0}, {-1, 0, 1}};
-  ASSERT_EQ(simulate<double>(scene, {}).collision_count, 3u);
+  ASSERT_EQ(testing_support::simulateThreeBodies(scene).summary.collision_count, 3u);
   const auto printed = paper::collisionCount(scene);
   ASSERT_TRUE(printed.has_value());
   EXPECT_NE(*printed, 3);
@@ -94,10 +95,8 @@ TEST(PaperErrata, EnergyTransfer44UsesTheWrongAverage) {
   // (4.4) with v_k against the initial vbar_AB differs from the true change once
   // v_A + v_B has changed, i.e. from the second AB impact on (collision 3).
   const ThreeBodyScene scene{{1, 2, 3}, {3, 2, 0}, {-1, 0.3, 0.7}};
-  SimulationOptions options;
-  options.events = EventPolicy::all();
-  const SimulationResult result = simulate<double>(scene, options);
-  ASSERT_GE(result.collision_count, 3u);
+  const auto result = testing_support::simulateThreeBodies(scene, EventPolicy::all());
+  ASSERT_GE(result.summary.collision_count, 3u);
   const ImpactEvent& first = result.events[0];
   const auto printed_first =
       paper::energyTransfer(scene, 1, first.pair, first.velocities_before, scene.velocities);

@@ -1,12 +1,10 @@
 // One lab run: prediction first, then the simulation with every event put beside the
 // closed-form prediction and the paper's printed formulas. The simulation is the exact
 // event engine's (nbody/engine.h), as for every scene: exact decisions and correctly
-// rounded velocities, in the engine's working units wherever the scene lies in the double
-// range. Only a run the engine stops as out of range (an impact after the largest double, or
-// scales spread wider than its working units bring into range) is finished by the
-// three-body simulator (simulation.h; exact decisions, velocities within a
-// few units in the last place), which reaches to the largest double. Shared by the CLI, the ROS
-// node and the benchmarks, so all of them report the same numbers.
+// rounded velocities, in the engine's working units, to the ends of the double range. A run
+// whose next impact no double can hold (after the largest double, 1.8e308 s) stops honestly
+// at its last certified impact, truncated, as every engine run does (OUT_OF_RANGE). Shared
+// by the CLI, the ROS node and the benchmarks, so all of them report the same numbers.
 #pragma once
 
 #include <array>
@@ -19,7 +17,7 @@
 #include "collision_lab/core/analytic.h"
 #include "collision_lab/core/nbody/engine.h"
 #include "collision_lab/core/scene.h"
-#include "collision_lab/core/simulation.h"
+#include "collision_lab/core/events.h"
 
 namespace collision_lab {
 namespace core {
@@ -59,9 +57,6 @@ struct RunOptions {
   std::uint64_t max_collisions = 10'000'000;
   EventPolicy events = EventPolicy::all();  ///< which LabEvents RunResult keeps
   RunMode mode = RunMode::kFull;
-  /// Working precision of the three-body simulator (simulation.h), which finishes a run
-  /// whose values leave the event engine's range; the engine simulates every run first.
-  Precision precision = Precision::kDouble;
   /// When the predicted count exceeds max_collisions, answer at once from the closed form
   /// (simulated false, its count and final velocities) instead of simulating up to the cap.
   bool skip_simulation_over_cap = false;
@@ -83,6 +78,8 @@ struct LabRunSummary {
   bool truncated = false;
   std::string truncation_reason;            ///< empty unless truncated
   bool cancelled = false;                   ///< truncated by RunOptions::cancel
+  /// Why the simulation ended: the engine's reason (kFinished when not simulated).
+  StopReason stop = StopReason::kFinished;
   bool simulated = false;                   ///< false for predict-only and over-cap runs
   std::array<double, 3> final_velocities{}; ///< simulated, else the closed form's after the predicted count [m/s]
   /// max over reported states of |S (v_sim - v_pred)| / |S v_0|, S = diag(sqrt(m)):

@@ -1,45 +1,21 @@
-// Every precision of the three-body core in one place: the working precisions a run can
-// choose (and their names), and the tiers a decision escalates to when the working
-// precision cannot take it (see simulation.h and analytic.h).
+// The floating types of the three-body closed form in one place: 50 digits where double's
+// range does not reach, and the tiers a decision escalates to when a narrower type cannot
+// take it (analytic.h). Every run is simulated by the exact event engine (nbody/engine.h),
+// which has its own tiers (nbody/tier.h).
 #pragma once
 
 #include <cstdint>
-#include <optional>
-#include <string>
 
 #include <boost/multiprecision/cpp_bin_float.hpp>
 
 namespace collision_lab {
 namespace core {
 
-// ---- working precisions ----
-
-/// The high-precision working type: 50 decimal digits, header-only.
+/// 50 decimal digits, header-only: the closed form's type where double's exponent range
+/// does not reach (analytic.h).
 using HighPrecision = boost::multiprecision::cpp_bin_float_50;
 
-/// Runtime choice of the working precision: double, long double or HighPrecision.
-enum class Precision { kDouble, kLongDouble, kHigh };
-
-/// "double", "long_double" or "high": the names of the CLI, the scenario files and the
-/// ROS parameters.
-inline const char* precisionName(Precision p) {
-  switch (p) {
-    case Precision::kDouble: return "double";
-    case Precision::kLongDouble: return "long_double";
-    case Precision::kHigh: return "high";
-  }
-  return "unknown";
-}
-
-/// The precision named `name` (precisionName's spelling); empty for any other text.
-inline std::optional<Precision> parsePrecision(const std::string& name) {
-  for (Precision p : {Precision::kDouble, Precision::kLongDouble, Precision::kHigh}) {
-    if (name == precisionName(p)) return p;
-  }
-  return std::nullopt;
-}
-
-// ---- escalation tiers, above every working precision ----
+// ---- escalation tiers, above 50 digits ----
 
 /// First tier: 100 digits, for the closed-form state (or a short replay) when the working
 /// precision cannot tell a sign, and for resynchronizing long runs.

@@ -38,8 +38,7 @@ namespace core {
 constexpr std::uint64_t kInfiniteRunDisplayCap = 1000;
 
 struct SceneRunOptions {
-  /// Cap, event policy, mode and precision. The precision applies to the three-body
-  /// simulator only (RunOptions::precision); max_collisions caps the engine.
+  /// Cap, event policy and mode; max_collisions caps the engine.
   /// When lab.events asks for any event (in full mode), a closed-form scene is simulated
   /// too, and the simulation is checked against the prediction.
   RunOptions lab;

@@ -25,8 +25,7 @@ namespace io {
 
 enum class ReportFormat { kTable, kJson, kCsv };
 
-/// Option spellings shared by the CLI's parser and the reports that echo them (a
-/// precision's are core::precisionName and core::parsePrecision).
+/// Option spellings shared by the CLI's parser and the reports that echo them.
 std::optional<ReportFormat> parseReportFormat(const std::string& text);   ///< table|json|csv
 std::optional<core::RunMode> parseRunMode(const std::string& text);             ///< full|predict|summary
 /// all | none | first:N (N a non-negative integer).
@@ -42,6 +41,8 @@ std::string jsonText(const Json& json);
 Json unitsJson();
 /// name, description, masses, positions, velocities, walls (["A"], ["C"] or []).
 Json sceneJson(const NamedScene& scene);
+/// max_collisions, events, mode, and "precision": always "double", kept for readers of the
+/// format (every run is exact; --precision was removed).
 Json optionsJson(const core::RunOptions& options);
 /// One event in the one event record of every scene (docs/cli.md "Events"): the
 /// simulation's full state, the closed-form prediction and the paper's printed values.

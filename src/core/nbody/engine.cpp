@@ -95,6 +95,14 @@ class Driver {
 
   const Tier<DD>& fast() const { return *fast_; }
 
+  /// A lower bound [s] of the next impact's time after the working tier's last impact, from
+  /// the exact tier brought to the same count (a pair it parks has its exact time, rounded
+  /// down, as key): what an out-of-range stop says. 0 when the exact replay cannot be had.
+  double exactNextTimeLowerBound() {
+    if (advanceTo<Rational>(fast_->count()).kind != StepKind::kImpact) return 0.0;
+    return exact_->nextTimeLowerBound();
+  }
+
   /// After the impact of `pair`: when two pairs have alternated for 8 impacts, asks the
   /// working tier whether their three clusters collapse, and resolves a collapse in every
   /// tier (each applies it when it reaches this impact count, replays included).
@@ -562,6 +570,12 @@ EngineResult runEngine(const Scene& si_scene, const EngineOptions& options, cons
     }
   }
   if (result.stop == StopReason::kFinished) finish(r, result);
+  // A tier's out-of-range step bounds the next impact's time from below; where that bound
+  // does not tell, the exact tier's does (once, at the stop): beyond the largest double?
+  if (r.kind == StepKind::kOutOfRange && !beyond_doubles &&
+      (!(r.time <= time_limit) || !(driver.exactNextTimeLowerBound() <= time_limit))) {
+    beyond_doubles = true;
+  }
   // Out of range: the double format cannot hold the run's next values; impacts were due.
   result.truncated = result.stop == StopReason::kCap || result.stop == StopReason::kCancelled ||
                      result.stop == StopReason::kPrecisionBudget || result.stop == StopReason::kOutOfRange;

@@ -101,7 +101,9 @@ struct StepResult {
   StepResult() = default;
   StepResult(StepKind k, std::size_t p = 0, double t = 0.0, bool zero = false)
       : time(t), pair(static_cast<std::uint32_t>(p)), kind(k), at_zero(zero) {}
-  double time = 0.0;      ///< of a multiple collision [s]
+  /// Of a multiple collision [s]; of kOutOfRange, a lower bound of the next impact's time
+  /// [s] (0 when none is known).
+  double time = 0.0;
   std::uint32_t pair = 0;  ///< the impact's pair, or the lower pair of a multiple collision (< 2^32, as the tree's leaves)
   StepKind kind = StepKind::kImpact;
   bool at_zero = false;  ///< kAmbiguous on a value exactly 0 at this precision: likely an exact tie
@@ -171,7 +173,7 @@ class CL_NBODY_INTERNAL Tier {
   StepResult step(ImpactRecord* record) {
     std::size_t next = tree_.minLeaf();
     if (!(tree_.minKey() < kInf)) return {StepKind::kFinished, 0, lastTime()};
-    if (!(tree_.minKey() < kMaxMagnitude)) return {StepKind::kOutOfRange, next, lastTime()};  // a parked pair is next
+    if (parked(next)) return {StepKind::kOutOfRange, next, tree_.minKey()};  // may come at 2^900 or later
     if (!(pairs_[next].upper < tree_.minKeyExcluding(next))) {
       const StepResult r = resolveNext(next);
       if (r.kind != StepKind::kImpact) return r;
@@ -714,21 +716,34 @@ class CL_NBODY_INTERNAL Tier {
     if (!(yes || no)) return scheduleCarefully(p, a);
     double bounds[2][2] = {{kInf, kInf}, {0.0, 0.0}};  // [yes][lower, upper]
     coarseBounds(a, g, bounds[1][0], bounds[1][1]);
-    if (yes && !(bounds[1][1] < kMaxMagnitude) && !park(bounds[1][0], bounds[1][1])) {
-      return {StepKind::kOutOfRange, p, lastTime()};
+    if (yes && !(bounds[1][1] < kMaxMagnitude)) {
+      park(p, std::fmax(bounds[1][0], safeLowerBound(a, g)));
+      return {};
     }
     setSchedule(p, bounds[yes][0], bounds[yes][1]);
     return {};
   }
 
-  /// A pair whose impact comes at 2^900 or later (its lower bound says so) is parked there:
-  /// key kMaxMagnitude, no upper bound. It stops the run (out of range) only when it is
-  /// next; impacts before it go on. False, changing nothing, when its bounds straddle 2^900.
-  static bool park(double& lower, double& upper) {
-    if (!(lower >= kMaxMagnitude)) return false;
-    lower = kMaxMagnitude;
-    upper = kInf;
-    return true;
+  /// A pair whose impact may come at 2^900 or later (its upper bound says so), beyond the
+  /// tiers' range, is parked: no upper bound (kInf), and as key a lower bound of its time
+  /// (at most the largest double; 0 when none is known). It stops the run (out of range)
+  /// only when it may be next: impacts certainly before it go on (step, resolveNext,
+  /// reschedule). `lower` may be NaN (no bound).
+  void park(std::size_t p, double lower) {
+    setSchedule(p, lower >= 0 ? std::min(lower, std::numeric_limits<double>::max()) : 0.0, kInf);
+  }
+  /// Is pair p parked (due, with no upper bound)?
+  bool parked(std::size_t p) const { return pairs_[p].upper == kInf && tree_.key(p) < kInf; }
+
+  /// A lower bound [s] of the time G / A of an approaching pair from its double
+  /// approximations, where the quotient may overflow (a subnormal approach speed): inf is
+  /// a true bound there (the time is beyond the largest double). 0 when G's bound is not
+  /// positive.
+  static double safeLowerBound(const Approx& a, const Approx& g) {
+    const double gap = g.value - g.error;       // rounds by half an ulp at most
+    const double speed = a.value + a.error;     // likewise (exact when subnormal)
+    if (!(gap > 0) || !(speed > 0)) return 0.0;
+    return gap / speed * (1 - 0x1p-40);         // covers the three roundings
   }
 
   /// The rare case: the approach speed or the time is too close to call in double.
@@ -743,7 +758,14 @@ class CL_NBODY_INTERNAL Tier {
         if (!precise.ok) return {StepKind::kAmbiguous, p, lastTime()};
         const double estimate = Ar::toDouble(precise.value);
         widenBounds(estimate, precise.error + Ar::kToDoubleError * std::fabs(estimate), lower, upper);
-        if (!(upper < kMaxMagnitude) && !park(lower, upper)) return {StepKind::kOutOfRange, p, lastTime()};
+        if (!(lower >= 0)) {  // the estimate overflowed: inf here when the time is beyond the largest double
+          const double below = Ar::toDouble(S(precise.value - S(precise.error)));
+          if (below > 0) lower = below * (1 - 0x1p-50);
+        }
+        if (!(upper < kMaxMagnitude)) {
+          park(p, std::fmax(lower, safeLowerBound(a, gap(p))));
+          return {};
+        }
         break;
       }
     }
@@ -756,6 +778,7 @@ class CL_NBODY_INTERNAL Tier {
   StepResult reschedule(std::size_t q, std::size_t m) {
     const StepResult r = schedule(q);
     if (r.kind != StepKind::kImpact || !(tree_.key(q) <= now_.upper)) return r;
+    if (parked(q)) return {StepKind::kOutOfRange, q, lastTime()};  // cannot be ordered within the tiers' range
     switch (compare(preciseNow(), preciseTime(q))) {
       case Order::kLess: return {};
       case Order::kEqual: return {StepKind::kMultipleCollision, std::min(q, m), lastTime()};
@@ -771,6 +794,9 @@ class CL_NBODY_INTERNAL Tier {
   StepResult resolveNext(std::size_t root) {
     std::vector<std::size_t> candidates;
     tree_.forEachAtMost(pairs_[root].upper, [&](std::size_t p) { candidates.push_back(p); });
+    for (std::size_t p : candidates) {
+      if (parked(p)) return {StepKind::kOutOfRange, p, lastTime()};  // may come first, beyond the tiers' range
+    }
     std::vector<Precise> times;
     std::size_t best = 0;
     for (std::size_t k = 0; k < candidates.size(); ++k) {

@@ -9,6 +9,7 @@
 // on output.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -51,6 +52,7 @@ struct WorkingUnits {
     mass_shift = detail::shiftTowardsOne(si.masses);
     velocity_shift = detail::shiftTowardsOne(si.velocities);
     position_shift = detail::shiftTowardsOne(lengths);
+    lengthenShortTimes(si, lengths);
     const RestitutionModel& model = si.restitution_model;
     // The model's parameter must scale exactly too; where it cannot, the run keeps SI units.
     const auto keeps = [](double x, int s) { return std::ldexp(std::ldexp(x, s), -s) == x; };
@@ -65,6 +67,42 @@ struct WorkingUnits {
     scene.restitution_model.tc = std::ldexp(model.tc, timeShift());
     scene.restitution_model.elastic_below = std::ldexp(model.elastic_below, velocity_shift);
     scene.restitution_model.viscoelastic_speed = std::ldexp(model.viscoelastic_speed, velocity_shift);
+  }
+
+  /// Keeps the scene's shortest time, its smallest gap over its largest speed, above
+  /// 2^-kShortestTime in working units, where double-double keeps its digits: a gap of a few
+  /// subnormal metres beside positions of 1e62 m (lengths that cannot shift down) must not
+  /// make times subnormal. First lengths shift up (exact), while they stay below
+  /// 2^kLongestLength and the longest time (extent over smallest speed) below
+  /// 2^kLongestTime where it was; then velocities shift back towards SI (exact). Nothing
+  /// changes where the shortest time is in range.
+  void lengthenShortTimes(const Scene& si, const std::vector<double>& lengths) {
+    constexpr int kShortestTime = 850, kLongestLength = 400, kLongestTime = 850;
+    constexpr int kNone = std::numeric_limits<int>::max();
+    int extent = -kNone, fastest = -kNone, slowest = kNone, shortest_gap = kNone;
+    for (double x : lengths) {
+      if (std::isfinite(x) && x != 0) extent = std::max(extent, std::ilogb(x));
+    }
+    for (double v : si.velocities) {
+      if (!std::isfinite(v) || v == 0) continue;
+      fastest = std::max(fastest, std::ilogb(v));
+      slowest = std::min(slowest, std::ilogb(v));
+    }
+    for (std::size_t i = 0; i + 1 < si.positions.size(); ++i) {
+      const double gap = si.positions[i] - si.positions[i + 1];  // exact where it matters: small
+      if (std::isfinite(gap) && gap != 0) shortest_gap = std::min(shortest_gap, std::ilogb(gap));
+    }
+    if (extent == -kNone || fastest == -kNone || shortest_gap == kNone) return;
+    int need = -kShortestTime - (shortest_gap + position_shift - (fastest + velocity_shift));
+    if (need <= 0) return;
+    // The longest time is an estimate; where it is already past the tiers' range it is no bound.
+    const int longest_time = extent + position_shift - (slowest + velocity_shift);
+    const int room = std::min(kLongestLength - (extent + position_shift),
+                              longest_time <= kLongestTime ? kLongestTime - longest_time : kNone);
+    const int lengths_up = std::max(0, std::min(need, room));
+    position_shift += lengths_up;
+    need -= lengths_up;
+    velocity_shift -= std::max(0, std::min(need, velocity_shift));
   }
 
   /// The shifts of derived quantities: time = length / velocity, energy = m v^2, p = m v.

@@ -214,18 +214,39 @@ TEST(WideRange, AnImpactAfterTheLargestDoubleStopsTheRunTruncated) {
   EXPECT_EQ(run.final_velocities, (std::vector<double>{-1e-10, 0, 0, -1}));
 }
 
-// A scene whose own scales spread beyond what one change of units brings into range (a
-// velocity of 5e-324 m/s beside 1 m/s on a metre's scale): pair BC's schedule, 2e323 s
-// away, is beyond the tiers' range from the start, so the run stops there, truncated,
-// saying so (the three-body lab run then finishes it in the three-body simulator).
-TEST(WideRange, ASpreadOfScalesBeyondOneChangeOfUnitsStopsTheRunTruncated) {
+// A velocity of 5e-324 m/s beside 1 m/s on a metre's scale: pair BC's schedule, 2e323 s
+// away, is beyond the tiers' range from the start. It waits (parked) while A and B, then B
+// and C, meet; the third impact, A creeping to B at rest, comes after the largest double:
+// the run stops there, truncated, saying so. It used to stop at the start.
+TEST(WideRange, ASubnormalApproachSpeedWaitsUntilItsImpactIsNext) {
   const Scene scene = reference::makeScene({1, 1, 1}, {2, 1, 0}, {-1, -5e-324, 0}, 1.0);
   ASSERT_FALSE(validate(scene)) << validate(scene)->message;
   const EngineResult run = runKeepingEvents(scene);
   EXPECT_EQ(run.stop, StopReason::kOutOfRange);
   EXPECT_TRUE(run.truncated);
-  EXPECT_EQ(run.impact_count, 0u);
-  EXPECT_NE(run.stop_message.find("spread wider than one change of units"), std::string::npos) << run.stop_message;
+  ASSERT_EQ(run.impact_count, 2u);
+  // Equal masses exchange velocities: AB at t = 1 (x = 1), BC at t = 2 (x = 0), exactly.
+  EXPECT_EQ(run.events[0].time, 1.0);
+  EXPECT_EQ(run.events[0].position, 1.0);
+  EXPECT_EQ(run.events[1].time, 2.0);
+  EXPECT_EQ(run.events[1].position, 0.0);
+  EXPECT_EQ(run.final_velocities, (std::vector<double>{-5e-324, 0, -1}));
+  EXPECT_NE(run.stop_message.find("the next impact comes after t = 1.7976931348623157e+308 s, the largest double"),
+            std::string::npos)
+      << run.stop_message;
+}
+
+// A pair approaching at 5e-324 m/s whose impact never comes first: the run is not stopped
+// for it (it used to stop at the start). B meets C after A meets B.
+TEST(WideRange, ASubnormalApproachSpeedThatNeverComesFirstStopsNothing) {
+  const Scene scene = reference::makeScene({1, 2, 3}, {2, 1, 0}, {-1, 0, 5e-324}, 1.0);
+  ASSERT_FALSE(validate(scene)) << validate(scene)->message;
+  const reference::Run exact = reference::simulate(scene, 1000);
+  ASSERT_FALSE(exact.truncated);
+  ASSERT_EQ(exact.events.size(), 2u);
+  const EngineResult run = runKeepingEvents(scene);
+  EXPECT_EQ(run.stop, StopReason::kFinished) << run.stop_message;
+  expectCloseToReference(scene, run, exact, "subnormal approach");
 }
 
 }  // namespace
