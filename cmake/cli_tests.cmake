@@ -15,6 +15,7 @@ catkin_add_gtest(collision_lab_cli_test
   test/cli/nbody_cli_test.cpp
   test/cli/collapse_cli_test.cpp
   test/cli/temperature_cli_test.cpp
+  test/cli/three_body_report_test.cpp
   test/cli/cli_process.cpp)
 if(TARGET collision_lab_cli_test)
   # collapse_cli_test checks the CLI against the exact rational reference of the test support.

@@ -78,7 +78,8 @@ core::SceneRunResult runWithProgress(const core::ScenePlan& plan, const core::Ru
   options.cancel = &g_cancel;
   std::optional<ProgressLine> progress;
   if (shown.mode != core::RunMode::kPredictOnly && isatty(STDERR_FILENO)) {
-    progress.emplace(stderr, plan.three_body ? std::min(plan.three_body->collision_count, shown.max_collisions) : 0);
+    const std::uint64_t predicted = plan.prediction && plan.prediction->impact_count ? *plan.prediction->impact_count : 0;
+    progress.emplace(stderr, std::min(predicted, shown.max_collisions));
     options.progress_interval = std::uint64_t{1} << 16;
     visitors.progress = [&](const core::EngineProgress& p) { progress->onEngineProgress(p.impacts, p.time); };
   }
@@ -117,7 +118,7 @@ void runEntry(const CliRequest& request, const io::SceneEntry& given) {
   const auto nbody = io::makeSceneReportWriter(request.format, std::cout);
   // The three-body model's extras (its prediction, the closed form at each impact) have
   // their report; every other scene the scene report.
-  const bool is_three_body = plan.three_body.has_value();
+  const bool is_three_body = plan.prediction && core::hasRotationValues(*plan.prediction);
   if (is_three_body) {
     three_body->begin(io::toNamedScene(entry), shown);
   } else {

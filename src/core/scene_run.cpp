@@ -11,16 +11,6 @@ namespace core {
 
 namespace {
 
-bool allOnes(const std::vector<double>& restitution) {
-  return std::all_of(restitution.begin(), restitution.end(), [](double e) { return e == 1.0; });
-}
-
-/// Three bodies with e = 1 throughout, as the three-body path takes them.
-bool isElasticTriple(const Scene& scene) {
-  return scene.masses.size() == 3 && scene.positions.size() == 3 && scene.velocities.size() == 3 &&
-         scene.restitution.size() <= 2 && allOnes(scene.restitution);
-}
-
 /// What the closed form alone says, for a finite prediction that no event needs checking
 /// (or that is over the cap).
 SceneSimulation fromPrediction(const Prediction& prediction) {
@@ -176,12 +166,19 @@ ThreeBodyScene toThreeBodyScene(const Scene& scene) {
   return triple;
 }
 
-/// True when the three-body model answers: three elastic bodies that
-/// validate(ThreeBodyScene) accepts. Precondition: validate(scene) passed.
-bool usesThreeBodyPath(const Scene& scene) {
-  // Not on a ring, nor under e(v) (which acts on elastic scenes too).
-  if (scene.isRing() || scene.restitution_model.kind == RestitutionModelKind::kViscoelastic) return false;
-  return isElasticTriple(scene) && !validate(toThreeBodyScene(scene));
+/// The rotation model's prediction in the three-body run's terms (lab_run.h), as
+/// predictThreeBodyRotation gave it.
+AnalyticPrediction rotationPrediction(const Prediction& prediction) {
+  AnalyticPrediction rotation;
+  rotation.collision_count = prediction.impact_count.value_or(0);
+  rotation.paper_collision_count = prediction.paper_impact_count;
+  rotation.max_possible_collision_count = prediction.max_possible_impact_count.value_or(0);
+  rotation.angles = {prediction.alpha.value_or(0.0), prediction.theta.value_or(0.0), prediction.omega.value_or(0.0)};
+  rotation.phi_bc = prediction.phi_bc.value_or(0.0);
+  rotation.psi = prediction.psi.value_or(0.0);
+  if (prediction.first_pair_index) rotation.first_pair = *prediction.first_pair_index == 0 ? Pair::AB : Pair::BC;
+  for (std::size_t i = 0; i < 3; ++i) rotation.final_velocities[i] = prediction.final_velocities.at(i);
+  return rotation;
 }
 
 /// The three-body run's summary as every scene's: the engine simulated it (lab_run.h).
@@ -220,11 +217,7 @@ ScenePlan planScene(Scene scene) {
   plan.error = validate(scene);
   if (!plan.error) {
     plan.model = chooseModel(scene);
-    if (usesThreeBodyPath(scene)) {
-      plan.three_body = predict(toThreeBodyScene(scene));
-    } else {
-      plan.prediction = predict(scene);
-    }
+    plan.prediction = predict(scene);
   }
   plan.scene = std::move(scene);
   plan.plan_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -236,7 +229,7 @@ SceneRunResult runScene(const ScenePlan& plan, const SceneRunOptions& options, c
   SceneRunResult result;
   result.model = plan.model;
   result.prediction = plan.prediction;
-  if (plan.three_body) {
+  if (plan.prediction && hasRotationValues(*plan.prediction)) {
     RunOptions lab = options.lab;
     if (!options.keep_events) lab.events = EventPolicy::none();
     lab.skip_simulation_over_cap = !options.simulate_to_cap;
@@ -246,7 +239,7 @@ SceneRunResult runScene(const ScenePlan& plan, const SceneRunOptions& options, c
       lab.progress_interval = options.progress_interval;
     }
     result.three_body =
-        runLab(toThreeBodyScene(plan.scene), lab, *plan.three_body, visitors.three_body_event);
+        runLab(toThreeBodyScene(plan.scene), lab, rotationPrediction(*plan.prediction), visitors.three_body_event);
     result.simulation = fromThreeBody(*result.three_body);
   } else {
     result.simulation = simulateScene(plan.scene, options, result.prediction, visitors);

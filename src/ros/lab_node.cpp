@@ -803,7 +803,6 @@ void LabNode::intake(collision_lab::InitialConditions input, Reply reply) {
   const bool predict_only = *toRunMode(input.mode) == core::RunMode::kPredictOnly;
   const collision_lab::service::Lane lane =
       collision_lab::service::chooseLane(*plan, predict_only, job.limits.max_collisions, params_.simulate_to_cap, params_.lanes);
-  if (plan->three_body) job.predicted_collisions = plan->three_body->collision_count;
   if (plan->prediction && plan->prediction->impact_count) job.predicted_collisions = *plan->prediction->impact_count;
   const std::string base = requestedRunId(input);
   {

@@ -13,8 +13,6 @@ namespace core = collision_lab::core;
 
 namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr char kThreeBodyRotationReason[] =
-    "three elastic bodies: the paper's rotation by 2 alpha per AB+BC cycle, corrected";
 
 double valueOr(const std::optional<double>& value) { return value.value_or(kNaN); }
 }  // namespace
@@ -154,10 +152,6 @@ std::optional<collision_lab::core::Pair> toPair(std::uint32_t code) {
   }
 }
 
-core::ModelChoice threeBodyRotationModel() {
-  return {core::ModelKind::kThreeBodyRotation, kThreeBodyRotationReason};
-}
-
 namespace {
 
 /// Resets msg to a default message without giving up its strings' and arrays' storage
@@ -181,28 +175,6 @@ void modelPrediction(const core::ModelChoice& model, std::size_t body_count, col
   msg.critical_restitution = msg.spiral_angle = kNaN;
 }
 
-/// The rotation model's block of a three-body prediction: its closed form and the paper's
-/// printed count.
-void addRotationModel(collision_lab::Prediction& msg, const core::AnalyticPrediction& prediction) {
-  msg.collision_count = prediction.collision_count;
-  msg.collision_count_defined = true;
-  msg.infinite_collisions = false;
-  msg.paper_collision_count_defined = prediction.paper_collision_count.has_value();
-  msg.paper_collision_count = prediction.paper_collision_count.value_or(0);
-  msg.max_possible_collision_count = prediction.max_possible_collision_count;
-  msg.alpha = prediction.angles.alpha;
-  msg.theta = prediction.angles.theta;
-  msg.omega = prediction.angles.omega;
-  msg.phi_bc = prediction.phi_bc;
-  msg.psi = prediction.psi;
-  msg.first_pair_index = toPairCode(prediction.first_pair);
-  msg.final_velocities.assign(prediction.final_velocities.begin(), prediction.final_velocities.end());
-  msg.energy_lost = 0.0;
-  msg.collapsed = false;
-  msg.critical_restitution = core::criticalRestitution(prediction.angles.alpha);
-  msg.spiral_angle = prediction.angles.theta;
-}
-
 }  // namespace
 
 collision_lab::Prediction toPredictionMsg(const core::ScenePlan& plan) {
@@ -213,8 +185,7 @@ collision_lab::Prediction toPredictionMsg(const core::ScenePlan& plan) {
 
 void fillPredictionMsg(const core::ScenePlan& plan, collision_lab::Prediction& msg) {
   modelPrediction(plan.model, plan.scene.size(), msg);
-  if (plan.three_body) addRotationModel(msg, *plan.three_body);
-  if (!plan.prediction) return;  // three_body_rotation (above) or event_engine: no closed form of models.h
+  if (!plan.prediction) return;  // event_engine: no closed form
   const core::Prediction& p = *plan.prediction;
   msg.collision_count = p.impact_count.value_or(0);
   msg.collision_count_defined = p.impact_count.has_value();
@@ -222,6 +193,14 @@ void fillPredictionMsg(const core::ScenePlan& plan, collision_lab::Prediction& m
   if (p.kind == core::ModelKind::kTwoBody && p.impact_count == std::uint64_t{1}) {
     msg.first_pair_index = collision_lab::Prediction::PAIR_AB;
   }
+  if (p.first_pair_index) msg.first_pair_index = static_cast<std::uint32_t>(*p.first_pair_index);
+  msg.paper_collision_count_defined = p.paper_impact_count.has_value();
+  msg.paper_collision_count = p.paper_impact_count.value_or(0);
+  msg.max_possible_collision_count = p.max_possible_impact_count.value_or(0);
+  msg.theta = valueOr(p.theta);
+  msg.omega = valueOr(p.omega);
+  msg.phi_bc = valueOr(p.phi_bc);
+  msg.psi = valueOr(p.psi);
   msg.final_velocities = p.final_velocities;
   if (!p.final_velocities.empty()) msg.energy_lost = p.energy_lost;
   msg.collapsed = p.collapsed;
@@ -229,32 +208,11 @@ void fillPredictionMsg(const core::ScenePlan& plan, collision_lab::Prediction& m
   msg.collapse_position = valueOr(p.collapse_position);
   msg.critical_restitution = valueOr(p.critical_restitution);
   msg.spiral_angle = valueOr(p.spiral_angle);
+  msg.alpha = valueOr(p.alpha);
   if (plan.model.kind == core::ModelKind::kThreeBodySpiral) {  // the opening angle of the three masses
     const std::vector<double>& m = plan.scene.masses;
     msg.alpha = core::alphaOf<double>({m[0], m[1], m[2]});
   }
-}
-
-collision_lab::Prediction toPredictionMsg(const core::AnalyticPrediction& prediction, const core::ModelChoice& model) {
-  collision_lab::Prediction msg;
-  modelPrediction(model, 3, msg);
-  addRotationModel(msg, prediction);
-  return msg;
-}
-
-collision_lab::core::AnalyticPrediction toPrediction(const collision_lab::Prediction& msg) {
-  collision_lab::core::AnalyticPrediction prediction;
-  prediction.collision_count = msg.collision_count;
-  if (msg.paper_collision_count_defined) prediction.paper_collision_count = msg.paper_collision_count;
-  prediction.max_possible_collision_count = msg.max_possible_collision_count;
-  prediction.angles.alpha = msg.alpha;
-  prediction.angles.theta = msg.theta;
-  prediction.angles.omega = msg.omega;
-  prediction.phi_bc = msg.phi_bc;
-  prediction.psi = msg.psi;
-  prediction.first_pair = toPair(msg.first_pair_index);
-  prediction.final_velocities = toArray(msg.final_velocities);
-  return prediction;
 }
 
 collision_lab::CollisionEvent toCollisionEventMsg(const collision_lab::core::LabEvent& event) {
@@ -572,6 +530,8 @@ void fillRunSummaryMsg(const core::SceneRunResult& result, std::size_t body_coun
     msg.infinite_collisions = p->infinite;
     msg.critical_restitution = valueOr(p->critical_restitution);
     msg.spiral_angle = valueOr(p->spiral_angle);
+    msg.paper_predicted_collision_count_defined = p->paper_impact_count.has_value();
+    msg.paper_predicted_collision_count = p->paper_impact_count.value_or(0);
   }
   msg.final_velocities = s.final_velocities;
   msg.energy_lost = s.energy_lost;
@@ -585,15 +545,6 @@ void fillRunSummaryMsg(const core::SceneRunResult& result, std::size_t body_coun
   msg.energy_relative_drift = s.energy_relative_drift;
   msg.momentum_relative_drift = s.momentum_relative_drift;
   msg.compute_time = result.compute_time_s;
-  if (const auto& rotation = result.three_body) {  // the rotation model's block
-    const core::AnalyticPrediction& p = rotation->prediction;
-    msg.predicted_collision_count = p.collision_count;
-    msg.predicted_collision_count_defined = true;
-    msg.paper_predicted_collision_count_defined = p.paper_collision_count.has_value();
-    msg.paper_predicted_collision_count = p.paper_collision_count.value_or(0);
-    msg.critical_restitution = core::criticalRestitution(p.angles.alpha);
-    msg.spiral_angle = p.angles.theta;
-  }
 }
 
 collision_lab::Rejected toRejectedMsg(const collision_lab::core::ValidationError& error) {

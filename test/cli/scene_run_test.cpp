@@ -50,10 +50,9 @@ TEST(SceneRun, TheRunTakesTheModelAndPredictionOfItsPlan) {
   EXPECT_EQ(answered.simulation.impact_count, 7u);
 
   core::ScenePlan triple = core::planScene({{1, 1, 1}, {2, 1, -1}, {-1, 0, 1}, {}});
-  ASSERT_TRUE(triple.three_body);
-  EXPECT_FALSE(triple.prediction);
-  EXPECT_EQ(triple.three_body->collision_count, 3u);  // shared/physics.md
-  triple.three_body->collision_count = 5;
+  ASSERT_TRUE(triple.prediction && triple.prediction->impact_count);
+  EXPECT_EQ(*triple.prediction->impact_count, 3u);  // shared/physics.md
+  triple.prediction->impact_count = 5;
   const core::SceneRunResult run = core::runScene(triple, predict_only);
   ASSERT_TRUE(run.three_body);
   EXPECT_EQ(run.three_body->summary.collision_count, 5u);
@@ -61,7 +60,7 @@ TEST(SceneRun, TheRunTakesTheModelAndPredictionOfItsPlan) {
   const core::ScenePlan rejected = core::planScene({{1, 1}, {0, 1}, {1, 0}, {}});
   ASSERT_TRUE(rejected.error);
   EXPECT_EQ(rejected.error->reason, core::Reason::kPositionsNotOrdered);
-  EXPECT_FALSE(rejected.three_body || rejected.prediction);
+  EXPECT_FALSE(rejected.prediction);
 }
 
 // One run result (issue 20): the simulation summary is filled for three bodies too, with
@@ -112,7 +111,7 @@ TEST(SceneRun, OneValidationGivesOneReasonWhateverNAndE) {
   EXPECT_EQ(core::planScene(five).error->reason, core::Reason::kWallNotAtEnd);
   const core::Scene two_walls{{INFINITY, 1, INFINITY}, {2, 1, 0}, {0, 1, 0}, {}};
   EXPECT_FALSE(core::planScene(two_walls).error);
-  EXPECT_FALSE(core::planScene(two_walls).three_body);
+  EXPECT_EQ(core::planScene(two_walls).model.kind, core::ModelKind::kTwoWallsInfinite);
 }
 
 // The cradle: 4 impacts (shared/physics.md). Without events the closed form answers alone.
@@ -247,3 +246,61 @@ TEST(SceneRun, TheEngineKeepsTheEventsAskedFor) {
 }
 
 }  // namespace
+
+// One prediction type (issue 32): the rotation model's prediction is a core::Prediction like
+// every model's, with the paper's count, the bound ceil(pi / alpha), the angles and the first
+// pair. Pi billiard (100, 1, inf): 31 impacts (shared/physics.md); alpha = atan(1/10) since
+// m_B / m_A = 1/100 with the wall C; at most ceil(pi / alpha) = 32; A meets B first.
+TEST(SceneRun, TheRotationModelPredictsInTheOnePredictionType) {
+  const double inf = std::numeric_limits<double>::infinity();
+  const core::ScenePlan plan = core::planScene({{100, 1, inf}, {2, 1, 0}, {-1, 0, 0}, {}});
+  ASSERT_FALSE(plan.error);
+  ASSERT_EQ(plan.model.kind, core::ModelKind::kThreeBodyRotation);
+  ASSERT_TRUE(plan.prediction);
+  const core::Prediction& p = *plan.prediction;
+  EXPECT_EQ(p.kind, core::ModelKind::kThreeBodyRotation);
+  ASSERT_TRUE(p.impact_count);
+  EXPECT_EQ(*p.impact_count, 31u);
+  ASSERT_TRUE(p.max_possible_impact_count && p.alpha && p.theta && p.omega && p.first_pair_index);
+  EXPECT_EQ(*p.max_possible_impact_count, 32u);
+  EXPECT_NEAR(*p.alpha, std::atan(0.1), 1e-15);
+  EXPECT_NEAR(*p.theta, 2 * std::atan(0.1), 1e-15);
+  EXPECT_NEAR(*p.omega, M_PI - std::atan(0.1), 1e-15);
+  EXPECT_EQ(*p.first_pair_index, 0u);
+  EXPECT_EQ(p.energy_lost, 0.0);
+  ASSERT_EQ(p.final_velocities.size(), 3u);
+  const core::SceneRunResult run = core::runScene(plan, withEvents(core::EventPolicy::none()));
+  EXPECT_EQ(run.simulation.impact_count, 31u);
+  ASSERT_TRUE(run.prediction && run.prediction->impact_count);
+  EXPECT_EQ(*run.prediction->impact_count, 31u);
+}
+
+// One answer to "which model?" (issue 32): three elastic bodies whose momentum in the wall's
+// frame overflows a double are beyond the rotation model's range. validate(Scene) accepts
+// them (every value in the lab frame is a double), and the plan's model says what runs them:
+// the engine, not the rotation model. B (1 kg at 1e154 m/s) meets the wall C at -1e154 m/s:
+// m (v_B - v_C)^2 = 4e308 overflows. A (0.5 kg) moves with the wall.
+TEST(SceneRun, ThreeElasticBodiesBeyondTheRotationRangeAreTheEnginesInThePlan) {
+  const double inf = std::numeric_limits<double>::infinity();
+  const core::Scene scene{{0.5, 1, inf}, {2, 1, 0}, {-1e154, 1e154, -1e154}, {}};
+  const core::ScenePlan plan = core::planScene(scene);
+  ASSERT_FALSE(plan.error) << plan.error->message;
+  EXPECT_EQ(plan.model.kind, core::ModelKind::kEventEngine);
+  EXPECT_EQ(core::chooseModel(scene).kind, core::ModelKind::kEventEngine);
+  EXPECT_FALSE(plan.prediction);
+  const core::SceneRunResult run = core::runScene(plan, withEvents(core::EventPolicy::none()));
+  EXPECT_TRUE(run.simulation.simulated);
+  EXPECT_FALSE(run.three_body);
+}
+
+// Three elastic bodies that never meet keep the rotation model's values beside the model's
+// answer (the CLI and the node print them): count 0, the bound and the angles.
+TEST(SceneRun, ThreeElasticBodiesThatNeverMeetKeepTheRotationValues) {
+  const core::ScenePlan plan = core::planScene({{1, 1, 1}, {3, 2, 1}, {1, 0, -1}, {}});
+  ASSERT_FALSE(plan.error);
+  EXPECT_EQ(plan.model.kind, core::ModelKind::kNoCollisions);
+  ASSERT_TRUE(plan.prediction && plan.prediction->impact_count && plan.prediction->max_possible_impact_count);
+  EXPECT_EQ(*plan.prediction->impact_count, 0u);
+  EXPECT_EQ(*plan.prediction->max_possible_impact_count, 3u);  // equal masses: alpha = pi/3
+  EXPECT_FALSE(plan.prediction->first_pair_index);
+}

@@ -315,35 +315,50 @@ TEST(MsgConversion, PairCodes) {
   EXPECT_FALSE(toPair(collision_lab::Prediction::PAIR_NONE));
 }
 
-TEST(MsgConversion, PredictionRoundTrip) {
-  collision_lab::core::AnalyticPrediction p;
-  p.collision_count = 2221441;
-  p.paper_collision_count = -3;
-  p.max_possible_collision_count = 2221442;
-  p.angles = {0.1, 0.2, M_PI - 0.1};
+// Every field a prediction gives reaches the message as it is, whichever model gave it; a
+// field it does not give says so (NaN, PAIR_NONE, not defined).
+TEST(MsgConversion, EveryPredictionFieldReachesTheMessage) {
+  collision_lab::core::ScenePlan plan;
+  plan.model = {collision_lab::core::ModelKind::kThreeBodyRotation, "rotation"};
+  plan.scene.masses.assign(3, 1.0);
+  collision_lab::core::Prediction p;
+  p.kind = collision_lab::core::ModelKind::kThreeBodyRotation;
+  p.impact_count = 2221441;
+  p.paper_impact_count = -3;
+  p.max_possible_impact_count = 2221442;
+  p.alpha = 0.1;
+  p.theta = p.spiral_angle = 0.2;
+  p.omega = M_PI - 0.1;
   p.phi_bc = 0.3;
   p.psi = 4.5;
-  p.first_pair = collision_lab::core::Pair::BC;
+  p.critical_restitution = 0.8;
+  p.first_pair_index = 1;
   p.final_velocities = {1, -2, 3};
-  const collision_lab::core::AnalyticPrediction back = toPrediction(toPredictionMsg(p));
-  EXPECT_EQ(back.collision_count, p.collision_count);
-  EXPECT_EQ(back.paper_collision_count, p.paper_collision_count);
-  EXPECT_EQ(back.max_possible_collision_count, p.max_possible_collision_count);
-  EXPECT_EQ(back.angles.alpha, p.angles.alpha);
-  EXPECT_EQ(back.angles.theta, p.angles.theta);
-  EXPECT_EQ(back.angles.omega, p.angles.omega);
-  EXPECT_EQ(back.phi_bc, p.phi_bc);
-  EXPECT_EQ(back.psi, p.psi);
-  EXPECT_EQ(back.first_pair, p.first_pair);
-  EXPECT_EQ(back.final_velocities, p.final_velocities);
+  plan.prediction = p;
+  auto msg = toPredictionMsg(plan);
+  EXPECT_EQ(msg.collision_count, 2221441u);
+  EXPECT_TRUE(msg.collision_count_defined);
+  EXPECT_TRUE(msg.paper_collision_count_defined);
+  EXPECT_EQ(msg.paper_collision_count, -3);
+  EXPECT_EQ(msg.max_possible_collision_count, 2221442u);
+  EXPECT_EQ(msg.alpha, 0.1);
+  EXPECT_EQ(msg.theta, 0.2);
+  EXPECT_EQ(msg.omega, M_PI - 0.1);
+  EXPECT_EQ(msg.phi_bc, 0.3);
+  EXPECT_EQ(msg.psi, 4.5);
+  EXPECT_EQ(msg.critical_restitution, 0.8);
+  EXPECT_EQ(msg.spiral_angle, 0.2);
+  EXPECT_EQ(msg.first_pair_index, collision_lab::Prediction::PAIR_BC);
+  EXPECT_EQ(msg.final_velocities, (std::vector<double>{1, -2, 3}));
+  EXPECT_EQ(msg.energy_lost, 0.0);
 
-  p.paper_collision_count.reset();
-  p.first_pair.reset();
-  const auto msg = toPredictionMsg(p);
+  plan.prediction->paper_impact_count.reset();
+  plan.prediction->first_pair_index.reset();
+  plan.prediction->phi_bc.reset();
+  msg = toPredictionMsg(plan);
   EXPECT_FALSE(msg.paper_collision_count_defined);
   EXPECT_EQ(msg.first_pair_index, collision_lab::Prediction::PAIR_NONE);
-  EXPECT_FALSE(toPrediction(msg).paper_collision_count);
-  EXPECT_FALSE(toPrediction(msg).first_pair);
+  EXPECT_TRUE(std::isnan(msg.phi_bc));
 }
 
 collision_lab::core::LabEvent sampleEvent() {
@@ -481,10 +496,14 @@ TEST(MsgConversion, RunSummaryPhysicsFields) {
   s.energy_relative_drift = 2e-16;
   s.momentum_relative_drift = std::nan("");
   result.compute_time_s = 0.5;
-  collision_lab::core::RunResult rotation;
-  rotation.prediction.collision_count = 11;
-  rotation.prediction.angles = {M_PI / 3, 0.5, M_PI - M_PI / 3};
-  result.three_body = rotation;
+  collision_lab::core::Prediction rotation;
+  rotation.kind = collision_lab::core::ModelKind::kThreeBodyRotation;
+  rotation.impact_count = 11;
+  rotation.alpha = M_PI / 3;
+  rotation.theta = rotation.spiral_angle = 0.5;
+  rotation.omega = M_PI - M_PI / 3;
+  rotation.max_possible_impact_count = 12;
+  result.prediction = rotation;
   const auto msg = toRunSummaryMsg(result, 3, collision_lab::core::RunMode::kFull);
   EXPECT_EQ(msg.collision_count, 10u);
   EXPECT_TRUE(msg.truncated);
@@ -685,6 +704,39 @@ TEST(CountParameter, AnythingElseIsAnErrorNamingTheParameterTheValueAndTheRange)
             std::string("~max_bodies = 1e+30 is out of range; ") + kCountParameterRange);
   EXPECT_EQ(countParameter("max_bodies", kInf).error,
             std::string("~max_bodies = inf is out of range; ") + kCountParameterRange);
+}
+
+// One prediction type (issue 32): the rotation model's block of the Prediction message comes
+// from the plan's core::Prediction, copied field by field without naming the model. Pi
+// billiard (100, 1, inf): 31 impacts, at most ceil(pi / alpha) = 32 with alpha = atan(1/10),
+// A and B first; psi = pi and no paper count or phi_BC (the paper's formulas are undefined
+// with the wall C), as the CLI prints them.
+TEST(MsgConversion, TheRotationModelsPredictionIsThePlans) {
+  const double inf = std::numeric_limits<double>::infinity();
+  const collision_lab::core::ScenePlan plan = collision_lab::core::planScene({{100, 1, inf}, {2, 1, 0}, {-1, 0, 0}, {}});
+  ASSERT_FALSE(plan.error);
+  const collision_lab::Prediction msg = toPredictionMsg(plan);
+  const double alpha = std::atan(0.1);
+  EXPECT_EQ(msg.model, collision_lab::Prediction::MODEL_THREE_BODY_ROTATION);
+  EXPECT_EQ(msg.collision_count, 31u);
+  EXPECT_TRUE(msg.collision_count_defined);
+  EXPECT_FALSE(msg.infinite_collisions);
+  EXPECT_EQ(msg.max_possible_collision_count, 32u);
+  EXPECT_FALSE(msg.paper_collision_count_defined);
+  EXPECT_EQ(msg.first_pair_index, collision_lab::Prediction::PAIR_AB);
+  EXPECT_NEAR(msg.alpha, alpha, 1e-15);
+  EXPECT_NEAR(msg.theta, 2 * alpha, 1e-15);
+  EXPECT_NEAR(msg.omega, M_PI - alpha, 1e-15);
+  EXPECT_NEAR(msg.psi, M_PI, 1e-15);
+  EXPECT_TRUE(std::isnan(msg.phi_bc));
+  const double root = std::tan(M_PI / 4 - alpha / 2);
+  EXPECT_NEAR(msg.critical_restitution, root * root, 1e-15);
+  EXPECT_NEAR(msg.spiral_angle, 2 * alpha, 1e-15);
+  EXPECT_EQ(msg.energy_lost, 0.0);
+  EXPECT_FALSE(msg.collapsed);
+  ASSERT_EQ(msg.final_velocities.size(), 3u);
+  EXPECT_NEAR(msg.final_velocities[0], 0.9988575955631184, 1e-12);
+  EXPECT_EQ(msg.final_velocities[2], 0.0);
 }
 
 }  // namespace

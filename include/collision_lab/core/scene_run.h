@@ -3,9 +3,9 @@
 // the model's prediction, once; runScene runs that plan and gives one result whose
 // simulation summary is filled for every scene. ROS-free.
 //
-// Three elastic bodies that the three-body path accepts (validate(ThreeBodyScene)) are
-// handed to runLab, which simulates them with the same event engine and puts the paper's
-// rotation model beside every impact.
+// Three elastic bodies that the rotation model answers (chooseModel: three_body_rotation)
+// are handed to runLab, which simulates them with the same event engine and puts the
+// paper's rotation model beside every impact.
 // Every other scene is answered by its model (models.h): a closed form alone when no event
 // is asked for and the prediction is finite; otherwise the exact event engine, whose
 // summary is put beside the prediction.
@@ -99,7 +99,7 @@ struct SceneSimulation {
 
 struct SceneRunResult {
   ModelChoice model;                       ///< which model answered, and why (one line): the plan's
-  std::optional<Prediction> prediction;    ///< the plan's closed form (not three_body_rotation, event_engine)
+  std::optional<Prediction> prediction;    ///< the plan's closed form (empty for event_engine)
   /// The three-body model's extras, when it answered (three elastic bodies): its prediction,
   /// the closed form and the paper's values at every impact, its own summary.
   std::optional<RunResult> three_body;
@@ -117,11 +117,8 @@ struct ScenePlan {
   /// every restitution; the message never repeats the field). Nothing below is set then.
   std::optional<ValidationError> error;
   ModelChoice model;
-  /// The chosen model's closed form (models.h); empty for three_body_rotation and event_engine.
+  /// The chosen model's closed form (models.h); empty for event_engine.
   std::optional<Prediction> prediction;
-  /// three_body_rotation: the rotation model's prediction (lab_run.h), which the run puts
-  /// beside every impact. Empty for every other model.
-  std::optional<AnalyticPrediction> three_body;
   double plan_time_s = 0.0;  ///< wall time of validation, choice and prediction [s]
 };
 

@@ -64,22 +64,13 @@ std::optional<collision_lab::core::RunMode> toRunMode(std::uint8_t mode);
 std::uint32_t toPairCode(const std::optional<collision_lab::core::Pair>& pair);
 std::optional<collision_lab::core::Pair> toPair(std::uint32_t code);
 
-/// The model of three elastic bodies with a generic reason, for callers without the scene
-/// (the node passes chooseModel's, as the CLI prints it).
-collision_lab::core::ModelChoice threeBodyRotationModel();
-
 /// The plan's model and prediction (core::planScene), as published before the run, for
-/// every scene: the model's fields, plus the closed form of models.h or, when the rotation
-/// model answers, its prediction and the paper's printed count. Precondition: !plan.error.
+/// every scene: the model's fields, plus its prediction (models.h), every field it gives
+/// copied, none named by model. Precondition: !plan.error.
 collision_lab::Prediction toPredictionMsg(const collision_lab::core::ScenePlan& plan);
 /// The same into msg, which may hold an earlier run's: every field is set (header and
 /// run_id to their defaults), and msg's strings and arrays keep their storage.
 void fillPredictionMsg(const collision_lab::core::ScenePlan& plan, collision_lab::Prediction& msg);
-/// The rotation model's prediction alone (three elastic bodies), as toPredictionMsg(plan) gives it.
-collision_lab::Prediction toPredictionMsg(const collision_lab::core::AnalyticPrediction& prediction,
-                                          const collision_lab::core::ModelChoice& model = threeBodyRotationModel());
-collision_lab::core::AnalyticPrediction toPrediction(const collision_lab::Prediction& msg);
-
 /// An event of the three-body path (N = 3, elastic: every array filled).
 collision_lab::CollisionEvent toCollisionEventMsg(const collision_lab::core::LabEvent& event);
 /// The same into msg, which may hold an earlier event: every field but header and run_id

@@ -41,7 +41,6 @@ inline std::optional<std::uint64_t> plannedImpacts(const core::ScenePlan& plan, 
   if (predict_only) return 0;
   const bool capped = cap > 0;
   std::optional<std::uint64_t> count;
-  if (plan.three_body) count = plan.three_body->collision_count;
   if (plan.prediction && plan.prediction->impact_count) count = plan.prediction->impact_count;
   if (plan.prediction && plan.prediction->infinite) {
     // Over any cap: the model answers unless the run simulates to its cap.

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <functional>
 
+#include "collision_lab/core/lab_run.h"
+#include "collision_lab/core/wedge.h"
 #include "spiral.h"
 
 namespace collision_lab {
@@ -23,6 +25,34 @@ bool anyApproaching(const Scene& scene) {
 bool restitutionModelActs(const Scene& scene) {
   const RestitutionModelKind kind = scene.restitution_model.kind;
   return kind == RestitutionModelKind::kViscoelastic || (kind != RestitutionModelKind::kConstant && !scene.isElastic());
+}
+
+/// The rotation model's own range: every finite body's momentum and kinetic energy in the
+/// wall's frame (the lab frame without a wall), and the bounds it forms from them, are doubles.
+bool rotationInRange(const Scene& scene) {
+  std::optional<double> frame;
+  for (std::size_t i = 0; i < scene.size(); ++i) {
+    if (scene.isWall(i)) frame = scene.velocities[i];
+  }
+  const double frame_velocity = frame.value_or(0.0);
+  for (std::size_t i = 0; i < scene.size(); ++i) {
+    if (scene.isWall(i)) continue;
+    const double m = scene.masses[i], v = scene.velocities[i], relative = v - frame_velocity;
+    if (!std::isfinite(relative) || !std::isfinite(m * v) || !std::isfinite(m * relative * relative) ||
+        !std::isfinite(m * (4.0 * std::fabs(v) + 4.0 * std::fabs(frame_velocity)))) {
+      return false;
+    }
+  }
+  for (std::size_t p = 0; p + 1 < scene.size(); ++p) {
+    if (!std::isfinite(2.0 * (std::fabs(scene.velocities[p]) + std::fabs(scene.velocities[p + 1])))) return false;
+  }
+  return true;
+}
+
+/// Three elastic bodies, at most one wall, not on a ring: the rotation model's scenes when
+/// they lie in its range (rotationInRange).
+bool isElasticTriple(const Scene& scene) {
+  return scene.size() == 3 && !scene.isRing() && scene.isElastic() && scene.wallCount() < 2;
 }
 
 std::string restitutionModelText(const Scene& scene) {
@@ -109,6 +139,10 @@ std::string modelReason(ModelKind kind, const Scene& scene) {
     return "the restitution of each impact follows " + restitutionModelText(scene) +
            ": no count formula exists, so the exact event engine simulates every impact";
   }
+  if (isElasticTriple(scene)) {
+    return "three elastic bodies whose momenta or kinetic energies in the wall's frame overflow a double, beyond the "
+           "rotation model's range: the exact event engine simulates every impact";
+  }
   if (scene.isRing()) {
     return "no count formula exists for " + std::to_string(scene.size()) +
            " bodies on a ring with these masses and restitution: the exact event engine simulates every impact "
@@ -129,7 +163,7 @@ ModelKind chooseKind(const Scene& scene) {
   if (restitutionModelActs(scene)) return ModelKind::kEventEngine;
   if (scene.isRing()) return equalFiniteMasses(scene) && scene.isElastic() ? ModelKind::kGhosts : ModelKind::kEventEngine;
   if (n == 2) return ModelKind::kTwoBody;
-  if (n == 3 && scene.isElastic() && scene.wallCount() < 2) return ModelKind::kThreeBodyRotation;
+  if (isElasticTriple(scene)) return rotationInRange(scene) ? ModelKind::kThreeBodyRotation : ModelKind::kEventEngine;
   if (n == 3 && scene.wallCount() < 2 && !scene.isWall(1) &&
       (scene.restitutionOf(0) == scene.restitutionOf(1) ||
        (scene.restitutionOf(0) > 0.0 && scene.restitutionOf(1) > 0.0))) {
@@ -411,16 +445,50 @@ Prediction predictThreeBodySpiral(const Scene& scene) {
   return prediction;
 }
 
+Prediction predictThreeBodyRotation(const Scene& scene) {
+  Prediction prediction = base(ModelKind::kThreeBodyRotation, scene);
+  ThreeBodyScene triple;
+  for (int i = 0; i < 3; ++i) {
+    triple.masses[i] = scene.masses[i];
+    triple.positions[i] = scene.positions[i];
+    triple.velocities[i] = scene.velocities[i];
+  }
+  const AnalyticPrediction rotation = predict(triple);
+  prediction.impact_count = rotation.collision_count;
+  prediction.final_velocities.assign(rotation.final_velocities.begin(), rotation.final_velocities.end());
+  prediction.energy_lost = 0.0;  // elastic
+  prediction.critical_restitution = criticalRestitution(rotation.angles.alpha);
+  prediction.spiral_angle = rotation.angles.theta;
+  prediction.paper_impact_count = rotation.paper_collision_count;
+  prediction.max_possible_impact_count = rotation.max_possible_collision_count;
+  prediction.alpha = rotation.angles.alpha;
+  prediction.theta = rotation.angles.theta;
+  prediction.omega = rotation.angles.omega;
+  prediction.phi_bc = rotation.phi_bc;
+  prediction.psi = rotation.psi;
+  if (rotation.first_pair) prediction.first_pair_index = static_cast<std::size_t>(pairIndex(*rotation.first_pair));
+  return prediction;
+}
+
 std::optional<Prediction> predict(const Scene& scene) {
   switch (chooseKind(scene)) {
-    case ModelKind::kNoCollisions: return predictNoCollisions(scene);
+    case ModelKind::kNoCollisions:
+      if (isElasticTriple(scene) && rotationInRange(scene)) {
+        // Three elastic bodies that never meet: the rotation model's values describe them too
+        // (its count 0, its angles and the paper's values), and its run reports them.
+        Prediction prediction = predictThreeBodyRotation(scene);
+        prediction.kind = ModelKind::kNoCollisions;
+        prediction.reason = modelReason(ModelKind::kNoCollisions, scene);
+        return prediction;
+      }
+      return predictNoCollisions(scene);
     case ModelKind::kTwoWallsInfinite:
     case ModelKind::kBoxInfinite: return predictTwoWalls(scene);
     case ModelKind::kTwoBody: return predictTwoBody(scene);
     case ModelKind::kGhosts: return predictGhosts(scene);
     case ModelKind::kThreeBodySpiral: return predictThreeBodySpiral(scene);
     case ModelKind::kSticky: return predictSticky(scene);
-    case ModelKind::kThreeBodyRotation:
+    case ModelKind::kThreeBodyRotation: return predictThreeBodyRotation(scene);
     case ModelKind::kEventEngine: break;
   }
   return std::nullopt;

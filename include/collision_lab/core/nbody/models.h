@@ -7,8 +7,10 @@
 //                        predicted but that, and the exact event engine simulates the first
 //                        impacts (a display's worth, or up to the cap with simulate_to_cap)
 //   two_body             N = 2: at most one impact, closed form
-//   three_body_rotation  N = 3, elastic: the paper's rotation model (the three-body analytic
-//                        core answers; nothing is predicted here)
+//   three_body_rotation  N = 3, elastic, at most one wall, every momentum and kinetic energy in
+//                        the wall's frame a double: the paper's rotation model (analytic.h);
+//                        its count and final velocities in closed form, the paper's values
+//                        beside them
 //   ghosts               equal masses, elastic, no walls: the bodies exchange velocities, so
 //                        they move like ghosts passing through each other; the count is the
 //                        number of inversions, O(N log N), and the final velocities are the
@@ -31,6 +33,7 @@
 // ROS-free; every function here never throws for a validated scene (short of memory).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -81,6 +84,18 @@ struct Prediction {
   bool collapsed = false;                      ///< inelastic collapse (then infinite is true)
   std::optional<double> collapse_time;         ///< [s] since the start
   std::optional<double> collapse_position;     ///< where the three meet [m]
+  // three_body_rotation (three elastic bodies) also gives critical_restitution (of its
+  // alpha) and spiral_angle (theta = 2 alpha, the rotation per AB+BC cycle), and:
+  std::optional<std::int64_t> paper_impact_count;          ///< the paper's eq. (3.22) as printed; empty where undefined
+  std::optional<std::uint64_t> max_possible_impact_count;  ///< ceil(pi / alpha): no start of these masses has more, exact
+  std::optional<double> alpha;   ///< opening angle of the escape cone, atan(sqrt(m_B M / (m_A m_C))) [rad]
+  std::optional<double> theta;   ///< 2 alpha [rad]
+  std::optional<double> omega;   ///< pi - alpha, the angle between the normals n_AB and n_BC [rad]
+  std::optional<double> phi_bc;  ///< the paper's phi_BC, eq. (3.21) [rad]; NaN where undefined
+  std::optional<double> psi;     ///< angle of u_perp from r_BC [rad]
+  /// The pair p (bodies p and p + 1) that meets first, decided exactly; empty when no pair
+  /// approaches or the model does not say.
+  std::optional<std::size_t> first_pair_index;
 };
 
 /// Each requires the scene its model is chosen for (chooseModel) and validate() passed.
@@ -99,8 +114,18 @@ Prediction predictSticky(const Scene& scene);
 /// decision, within the 3000 impacts walked in rationals); the reason then says so.
 Prediction predictThreeBodySpiral(const Scene& scene);
 
-/// The prediction of chooseModel(scene)'s model. Empty for three_body_rotation (the
-/// three-body analytic model answers) and for event_engine (no formula: run the engine).
+/// The prediction carries the rotation model's values (three elastic bodies): their run puts
+/// the closed form and the paper's values beside every impact.
+inline bool hasRotationValues(const Prediction& prediction) { return prediction.max_possible_impact_count.has_value(); }
+
+/// Three elastic bodies (three_body_rotation): the rotation model's closed form (analytic.h)
+/// and the paper's printed values, all exact decisions for the given doubles.
+Prediction predictThreeBodyRotation(const Scene& scene);
+
+/// The prediction of chooseModel(scene)'s model. Empty for event_engine (no formula: run
+/// the engine). Three elastic bodies that never meet (no_collisions) also get the rotation
+/// model's values (count 0, angles, the paper's values; its final velocities).
+/// hasRotationValues tells a prediction that carries them.
 std::optional<Prediction> predict(const Scene& scene);
 
 /// Equal masses on a ring (elastic): the number of crossings of the ghosts (each moving at
