@@ -7,10 +7,8 @@ find_package(Python3 REQUIRED COMPONENTS Interpreter Development)
 find_package(pybind11 REQUIRED)
 pybind11_add_module(collision_lab_python_core MODULE
   src/python/core_module.cpp
-  src/python/scene_driver.cpp
-  src/cli/command_line.cpp
-  src/cli/temperature_csv.cpp)
-target_link_libraries(collision_lab_python_core PRIVATE collision_lab_io CLI11::CLI11)
+  src/python/scene_driver.cpp)
+target_link_libraries(collision_lab_python_core PRIVATE collision_lab_cli_runner)
 set_target_properties(collision_lab_python_core PROPERTIES
   OUTPUT_NAME _core
   LIBRARY_OUTPUT_DIRECTORY ${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_PYTHON_DESTINATION}

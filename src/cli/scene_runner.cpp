@@ -66,18 +66,18 @@ core::RunOptions optionsFor(const CliRequest& request, const io::SceneEntry& ent
   return options;
 }
 
-/// Runs a validated scene with a progress line on a terminal and Ctrl-C for the engine.
-/// `visitors` see the shown events; the run itself keeps none. The progress line only
-/// watches (visitors.progress): in a terminal or a pipe the run takes the same path.
-core::SceneRunResult runWithProgress(const core::ScenePlan& plan, const core::RunOptions& shown, bool simulate_to_cap,
-                                     core::SceneVisitors visitors) {
+/// Runs a validated scene, stopped when `cancel` is set. With `progress_line`, a progress
+/// line on a terminal (stderr): it only watches (visitors.progress), so in a terminal or a
+/// pipe the run takes the same path. `visitors` see the shown events; the run keeps none.
+core::SceneRunResult runShown(const core::ScenePlan& plan, const core::RunOptions& shown, bool simulate_to_cap,
+                              core::SceneVisitors visitors, const std::atomic<bool>* cancel, bool progress_line) {
   core::SceneRunOptions options;
   options.lab = shown;
   options.simulate_to_cap = simulate_to_cap;
   options.keep_events = false;  // streamed to the report, not kept
-  options.cancel = &g_cancel;
+  options.cancel = cancel;
   std::optional<ProgressLine> progress;
-  if (shown.mode != core::RunMode::kPredictOnly && isatty(STDERR_FILENO)) {
+  if (progress_line && shown.mode != core::RunMode::kPredictOnly && isatty(STDERR_FILENO)) {
     const std::uint64_t predicted = plan.prediction && plan.prediction->impact_count ? *plan.prediction->impact_count : 0;
     progress.emplace(stderr, std::min(predicted, shown.max_collisions));
     options.progress_interval = std::uint64_t{1} << 16;
@@ -107,15 +107,18 @@ core::SceneVisitors showEvents(const core::RunOptions& shown, io::RunReportWrite
 
 }  // namespace
 
-void runEntry(const CliRequest& request, const io::SceneEntry& given) {
-  const InterruptGuard interrupt_guard;  // from the first byte out, so Ctrl-C never cuts a report
+namespace {
+
+/// runEntry and reportEntry: the report of one scene to `out`.
+void writeEntry(const CliRequest& request, const io::SceneEntry& given, std::ostream& out,
+                const std::atomic<bool>* cancel, bool progress_line) {
   const io::SceneEntry entry = withRequestRestitution(request, given);
   const core::ScenePlan plan = planOrThrow(entry);
   std::optional<TemperatureCsv> temperature;  // opened before any report: a bad path is bad input
   if (request.temperature_csv) temperature.emplace(*request.temperature_csv, entry.scene);
   const core::RunOptions shown = optionsFor(request, entry);
-  const auto three_body = io::makeThreeBodyReportWriter(request.format, std::cout, plan.model);
-  const auto nbody = io::makeSceneReportWriter(request.format, std::cout);
+  const auto three_body = io::makeThreeBodyReportWriter(request.format, out, plan.model);
+  const auto nbody = io::makeSceneReportWriter(request.format, out);
   // The three-body model's extras (its prediction, the closed form at each impact) have
   // their report; every other scene the scene report.
   const bool is_three_body = plan.prediction && core::hasRotationValues(*plan.prediction);
@@ -132,13 +135,25 @@ void runEntry(const CliRequest& request, const io::SceneEntry& given) {
     visitors = temperature->feeding(std::move(visitors));
     run.events = core::EventPolicy::all();
   }
-  const core::SceneRunResult result = runWithProgress(plan, run, request.simulate_to_cap, visitors);
+  const core::SceneRunResult result = runShown(plan, run, request.simulate_to_cap, visitors, cancel, progress_line);
   if (temperature) temperature->finish();
   if (is_three_body) {
     three_body->end(*result.three_body);
   } else {
     nbody->end(result);
   }
+}
+
+}  // namespace
+
+void runEntry(const CliRequest& request, const io::SceneEntry& entry) {
+  const InterruptGuard interrupt_guard;  // from the first byte out, so Ctrl-C never cuts a report
+  writeEntry(request, entry, std::cout, &g_cancel, true);
+}
+
+void reportEntry(const CliRequest& request, const io::SceneEntry& entry, std::ostream& out,
+                 const std::atomic<bool>* cancel) {
+  writeEntry(request, entry, out, cancel, false);
 }
 
 void runEntries(const CliRequest& request, const std::vector<io::SceneEntry>& given) {
