@@ -400,7 +400,9 @@ inline Walk closedFormWalk(const Cycle& cy, const ConeTest& cone, int first, con
       cycles = log((f(f0) - a) / -a) / log(l1 / l2);
     }
     const F n = ceil(cycles);
-    if (n - cycles < F(1e-40) * (1 + n) || n > F(std::ldexp(1.0, 60))) undecided = true;
+    // Also undecided where the double-valued inputs leave the formula no finite answer (NaN
+    // or a negative count, from subnormal scales): the walk does not decide then.
+    if (!(n >= 0 && n <= F(std::ldexp(1.0, 60))) || n - cycles < F(1e-40) * (1 + n)) undecided = true;
     return undecided ? 0 : static_cast<std::uint64_t>(n);
   };
   const std::uint64_t nf = first_fail(k.f0, k.f1), ng = first_fail(k.g0, k.g1);
