@@ -25,6 +25,7 @@
 #include <cstring>
 #include <limits>
 
+#include "fuzz_input.h"
 #include "collision_lab/core/analytic.h"
 #include "collision_lab/core/exact.h"
 #include "collision_lab/core/lab_run.h"
@@ -64,41 +65,7 @@ bool skipKnownIssues() {
   return skip;
 }
 
-#define FUZZ_CHECK(condition, what)                                                   \
-  do {                                                                                \
-    if (!(condition)) {                                                               \
-      std::fprintf(stderr, "invariant violated: %s (%s, line %d)\n", what, #condition, __LINE__); \
-      std::abort();                                                                   \
-    }                                                                                 \
-  } while (0)
-
-class Reader {
- public:
-  Reader(const std::uint8_t* data, std::size_t size) : data_(data), size_(size) {}
-  bool has(std::size_t n) const { return size_ - pos_ >= n; }
-  std::uint8_t byte() { return data_[pos_++]; }
-  double rawDouble() {
-    std::uint64_t bits = 0;
-    for (int i = 0; i < 8; ++i) bits |= std::uint64_t(byte()) << (8 * i);
-    double value;
-    std::memcpy(&value, &bits, sizeof value);
-    return value;
-  }
-  double compactDouble() {
-    const auto mantissa = static_cast<std::int16_t>(byte() | (byte() << 8));
-    const auto exponent = static_cast<std::int16_t>(byte() | (byte() << 8)) % 340;
-    if (mantissa == -32768) return std::numeric_limits<double>::infinity();
-    if (mantissa == -32767) return -std::numeric_limits<double>::infinity();
-    if (mantissa == -32766) return std::numeric_limits<double>::quiet_NaN();
-    // Divide for negative exponents so that e.g. 3 * 10^-1 is the double nearest 0.3.
-    return exponent >= 0 ? mantissa * std::pow(10.0, exponent) : mantissa / std::pow(10.0, -exponent);
-  }
-
- private:
-  const std::uint8_t* data_;
-  std::size_t size_;
-  std::size_t pos_ = 0;
-};
+using collision_lab::fuzz::Reader;
 
 bool allFinite(const std::array<double, 3>& v) {
   return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]);

@@ -23,6 +23,7 @@
 #include <cstring>
 #include <vector>
 
+#include "fuzz_input.h"
 #include "collision_lab/core/scene_run.h"
 
 namespace cl = collision_lab::core;
@@ -33,37 +34,7 @@ namespace {
 /// issue's ring crash.
 constexpr std::uint64_t kCaps[] = {0, 1, 10, 100, 1500};
 
-#define FUZZ_CHECK(condition, what)                                                                 \
-  do {                                                                                              \
-    if (!(condition)) {                                                                             \
-      std::fprintf(stderr, "invariant violated: %s (%s, line %d)\n", what, #condition, __LINE__); \
-      std::abort();                                                                                 \
-    }                                                                                               \
-  } while (0)
-
-class Reader {
- public:
-  Reader(const std::uint8_t* data, std::size_t size) : data_(data), size_(size) {}
-  bool has(std::size_t bytes) const { return size_ - at_ >= bytes; }
-  std::uint8_t byte() { return data_[at_++]; }
-  double value() {
-    std::uint64_t bits = 0;
-    for (int k = 0; k < 8; ++k) bits |= std::uint64_t{data_[at_++]} << (8 * k);
-    double x;
-    std::memcpy(&x, &bits, sizeof x);
-    return x;
-  }
-  std::vector<double> values(std::size_t n) {
-    std::vector<double> out(n);
-    for (double& x : out) x = value();
-    return out;
-  }
-
- private:
-  const std::uint8_t* data_;
-  std::size_t size_;
-  std::size_t at_ = 0;
-};
+using collision_lab::fuzz::Reader;
 
 bool finite(const std::vector<double>& values) {
   for (double x : values) {
@@ -86,20 +57,20 @@ int collisionLabNbodyFuzzOne(const std::uint8_t* data, std::size_t size) {
   const std::size_t restitutions = (flags & 0x20) ? (ring ? n : n - 1) : 1;
   if (!in.has(8 * (3 * n + restitutions + (ring ? 1 : 0) + (model != 0 ? 1 : 0)))) return 0;
   cl::Scene scene;
-  scene.masses = in.values(n);
-  scene.positions = in.values(n);
-  scene.velocities = in.values(n);
-  scene.restitution = in.values(restitutions);
-  if (ring) scene.ring = in.value();
+  scene.masses = in.rawDoubles(n);
+  scene.positions = in.rawDoubles(n);
+  scene.velocities = in.rawDoubles(n);
+  scene.restitution = in.rawDoubles(restitutions);
+  if (ring) scene.ring = in.rawDouble();
   switch (model) {
-    case 1: scene.restitution_model.kind = cl::RestitutionModelKind::kTc; scene.restitution_model.tc = in.value(); break;
+    case 1: scene.restitution_model.kind = cl::RestitutionModelKind::kTc; scene.restitution_model.tc = in.rawDouble(); break;
     case 2:
       scene.restitution_model.kind = cl::RestitutionModelKind::kThreshold;
-      scene.restitution_model.elastic_below = in.value();
+      scene.restitution_model.elastic_below = in.rawDouble();
       break;
     case 3:
       scene.restitution_model.kind = cl::RestitutionModelKind::kViscoelastic;
-      scene.restitution_model.viscoelastic_speed = in.value();
+      scene.restitution_model.viscoelastic_speed = in.rawDouble();
       break;
     default: break;
   }

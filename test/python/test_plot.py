@@ -1,7 +1,6 @@
 """collision_lab.plot: the views' colours, worldlines to the run's end (cut at a ring's seam),
 and T(t) with Haff's fit equal to the CLI's --temperature-csv (the C++ reference)."""
 import math
-import os
 import subprocess
 
 import matplotlib
@@ -83,15 +82,7 @@ def test_granular_temperature_by_hand():
     assert plot.granular_temperature([1, 3, math.inf], [1, -1, 0])[0] == pytest.approx(1.5)
 
 
-def _cli():
-    for prefix in os.environ.get('CMAKE_PREFIX_PATH', '').split(':'):
-        path = os.path.join(prefix, 'lib', 'collision_lab', 'collision_lab_cli')
-        if prefix and os.access(path, os.X_OK):
-            return path
-    raise RuntimeError('collision_lab_cli not found: source build_ros/devel/setup.bash first')
-
-
-def test_temperature_and_haff_fit_equal_the_clis(tmp_path):
+def test_temperature_and_haff_fit_equal_the_clis(tmp_path, cli_path):
     rng = np.random.default_rng(7)
     n = 12
     masses, velocities = rng.uniform(1, 2, n), rng.uniform(-1, 1, n)
@@ -99,7 +90,7 @@ def test_temperature_and_haff_fit_equal_the_clis(tmp_path):
     run = cl.run(masses, positions, velocities, 0.9, ring=12.0, restitution_model='tc', tc=0.001, max_collisions=300,
                  simulate_to_cap=True)
     csv = tmp_path / 'T.csv'
-    subprocess.run([_cli(), '--masses', ','.join(map(repr, masses)), '--positions', ','.join(map(repr, positions)),
+    subprocess.run([cli_path, '--masses', ','.join(map(repr, masses)), '--positions', ','.join(map(repr, positions)),
                     '--velocities=' + ','.join(map(repr, velocities)), '--restitution', '0.9', '--ring', '12',
                     '--restitution-model', 'tc', '--tc', '0.001', '--max-collisions', '300', '--simulate-to-cap',
                     '--events', 'none', '--temperature-csv', str(csv)], check=True, capture_output=True)

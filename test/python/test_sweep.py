@@ -96,14 +96,6 @@ options:
 """
 
 
-def sweep_tool():
-    for prefix in os.environ.get('CMAKE_PREFIX_PATH', '').split(':'):
-        path = os.path.join(prefix, 'lib', 'collision_lab', 'collision_lab_sweep')
-        if prefix and os.access(path, os.X_OK):
-            return path
-    raise RuntimeError('collision_lab_sweep not found: source the workspace first')
-
-
 def read_lines(path):
     rows = [json.loads(line) for line in open(path)]
     for row in rows:
@@ -111,9 +103,9 @@ def read_lines(path):
     return rows
 
 
-def test_shell_shards_merged_equal_the_unsharded_sweep(tmp_path):
+def test_shell_shards_merged_equal_the_unsharded_sweep(tmp_path, sweep_tool):
     (tmp_path / 'sweep.yaml').write_text(SWEEP_YAML)
-    tool = sweep_tool()
+    tool = sweep_tool
     # As docs/python.md's loop, GNU parallel's and Slurm's array stand-in: 3 shards, one merge;
     # the module's form and the installed program's.
     script = ('set -e\n'
@@ -141,9 +133,9 @@ def test_shell_shards_merged_equal_the_unsharded_sweep(tmp_path):
     assert all(isinstance(row['collision_count'], int) for row in merged)
 
 
-def test_merge_refuses_a_missing_shard(tmp_path):
+def test_merge_refuses_a_missing_shard(tmp_path, sweep_tool):
     (tmp_path / 'sweep.yaml').write_text(SWEEP_YAML)
-    tool = sweep_tool()
+    tool = sweep_tool
     subprocess.run([tool, 'sweep.yaml', '--shard', '0/2', '-o', 'a.jsonl'], cwd=tmp_path, check=True)
     done = subprocess.run([tool, 'sweep.yaml', '--merge', 'a.jsonl', '-o', 'm.jsonl'], cwd=tmp_path,
                           capture_output=True, text=True)
