@@ -177,13 +177,6 @@ std::vector<SceneEntry> loadScenes(const std::string& path) {
   return scenes;
 }
 
-bool isThreeBodyEntry(const SceneEntry& entry) {
-  const core::Scene& scene = entry.scene;
-  return scene.masses.size() == 3 && scene.positions.size() == 3 && scene.velocities.size() == 3 &&
-         !(scene.isWall(0) && scene.isWall(2)) &&
-         std::all_of(scene.restitution.begin(), scene.restitution.end(), [](double e) { return e == 1.0; });
-}
-
 NamedScene toNamedScene(const SceneEntry& entry) {
   NamedScene named{entry.name, entry.description, {}, entry.max_collisions};
   for (int i = 0; i < 3; ++i) {
@@ -192,18 +185,6 @@ NamedScene toNamedScene(const SceneEntry& entry) {
     named.scene.velocities[i] = entry.scene.velocities[i];
   }
   return named;
-}
-
-std::vector<NamedScene> loadScenarioFile(const std::string& path, std::vector<std::string>* skipped) {
-  std::vector<NamedScene> scenes;
-  for (const SceneEntry& entry : loadScenes(path)) {
-    if (isThreeBodyEntry(entry)) {
-      scenes.push_back(toNamedScene(entry));
-    } else if (skipped) {
-      skipped->push_back(entry.name);
-    }
-  }
-  return scenes;
 }
 
 namespace {
@@ -217,10 +198,6 @@ Entry findByName(const std::vector<Entry>& scenes, const std::string& name) {
   throw ScenarioFileError("no scenario named '" + name + "' (known: " + known + ")");
 }
 }  // namespace
-
-NamedScene findScenario(const std::vector<NamedScene>& scenes, const std::string& name) {
-  return findByName(scenes, name);
-}
 
 SceneEntry findScene(const std::vector<SceneEntry>& scenes, const std::string& name) {
   return findByName(scenes, name);

@@ -43,19 +43,10 @@ struct ScenarioFileError : std::runtime_error {
 /// Does not validate the physics (core::planScene validates each scene).
 std::vector<SceneEntry> loadScenes(const std::string& path);
 
-/// True for an entry that the three-body path takes: three bodies, elastic, not walls at
-/// both ends (that scene is answered by the N-body models).
-bool isThreeBodyEntry(const SceneEntry& entry);
-/// The entry as a three-body scene. Precondition: isThreeBodyEntry(entry).
+/// The entry as a three-body scene. Precondition: the entry has three bodies.
 NamedScene toNamedScene(const SceneEntry& entry);
 
-/// The three-body entries of a scenario file, in file order (for front ends that take only
-/// three bodies, such as the ROS node until issue 12). The names of the other entries go to
-/// `skipped` when given. Throws ScenarioFileError.
-std::vector<NamedScene> loadScenarioFile(const std::string& path, std::vector<std::string>* skipped = nullptr);
-
 /// The entry called `name`; throws ScenarioFileError listing the known names if absent.
-NamedScene findScenario(const std::vector<NamedScene>& scenes, const std::string& name);
 SceneEntry findScene(const std::vector<SceneEntry>& scenes, const std::string& name);
 
 }  // namespace io
