@@ -11,22 +11,24 @@ function el(tag, text, attrs) {
 
 // Body names and colours as every view has them: core::bodyName ("A".."Z", then "#26",
 // ...) and rviz's palette from the server (GET /api/body_colours), never a list of our own.
+// The views colour by index only while the palette has a colour for every body; above that
+// they colour each body by its start velocity (RunView), so the form names them uncoloured.
 let bodyPalette = [];
 const bodyLetter = (i) => (i < 26 ? String.fromCharCode(65 + i) : '#' + i);
 
-function nameCell(td, i) {
+function nameCell(td, i, bodies) {
   td.textContent = bodyLetter(i);
-  td.title = 'body ' + bodyLetter(i) + ' (masses[' + i + '])';
   td.className = 'body_name';
-  if (bodyPalette.length > 0) td.style.color = bodyPalette[i % bodyPalette.length];
+  const byVelocity = bodyPalette.length > 0 && bodies > bodyPalette.length;
+  td.style.color = bodyPalette.length > 0 && !byVelocity ? bodyPalette[i] : '';
+  td.title = 'body ' + bodyLetter(i) + ' (masses[' + i + '])' +
+      (byVelocity ? ': with more than ' + bodyPalette.length + ' bodies the views colour each body by its start velocity' : '');
 }
 
 function bodyRow(mass, position, velocity) {
   const rows = document.querySelector('#bodies tbody');
   const tr = el('tr');
-  const name = el('td');
-  nameCell(name, rows.children.length);
-  tr.appendChild(name);
+  tr.appendChild(el('td'));
   for (const [name, value] of [['mass', mass], ['position', position], ['velocity', velocity]]) {
     const td = el('td');
     td.appendChild(el('input', null, {type: 'text', name: name, value: value === undefined ? '' : String(value)}));
@@ -38,10 +40,16 @@ function bodyRow(mass, position, velocity) {
   td.appendChild(remove);
   tr.appendChild(td);
   rows.appendChild(tr);
+  renumber();
 }
 
 function renumber() {
-  document.querySelectorAll('#bodies tbody tr').forEach((tr, i) => nameCell(tr.firstChild, i));
+  const rows = document.querySelectorAll('#bodies tbody tr');
+  rows.forEach((tr, i) => nameCell(tr.firstChild, i, rows.length));
+  const byVelocity = bodyPalette.length > 0 && rows.length > bodyPalette.length;
+  document.getElementById('colour_note').textContent = byVelocity
+    ? 'More than ' + bodyPalette.length + ' bodies: the run\'s views colour each body by its start velocity (blue: moving left, purple: at rest, red: moving right).'
+    : '';
 }
 
 let loadedPreset = null;  // a preset too large for the form is sent by name

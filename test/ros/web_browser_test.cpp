@@ -172,6 +172,17 @@ TEST_F(WebBrowserTest, FormSendsASceneAndSeesTheResult) {
   EXPECT_NE(result.find("run_id=formbot."), std::string::npos) << result;
   EXPECT_NE(result.find("collisions|31|31|"), std::string::npos) << result;
   EXPECT_EQ(result.find("plots=velocity:0"), std::string::npos) << result;
+  // The form names bodies in the colours the views will draw: rviz's palette by index for 3
+  // bodies (A red, B green, C blue: three different colours), none for 11, which the views
+  // colour by start velocity.
+  std::smatch colours;
+  ASSERT_TRUE(std::regex_search(result, colours, std::regex("colours3=(rgb[^;]*);(rgb[^;]*);(rgb[^\\n]*)\\n"))) << result;
+  EXPECT_NE(colours[1], colours[2]);
+  EXPECT_NE(colours[2], colours[3]);
+  EXPECT_NE(colours[1], colours[3]);
+  std::string uncoloured = "colours11=none";
+  for (int i = 1; i < 11; ++i) uncoloured += ";none";
+  EXPECT_NE(result.find(uncoloured + "\n"), std::string::npos) << result;
 }
 
 }  // namespace
