@@ -50,7 +50,7 @@ std::string titleOf(const RunRecord& run) {
     const auto& p = *run.prediction;
     if (p.model != Prediction::MODEL_THREE_BODY_ROTATION) title += " (" + p.model_name + ")";
     if (p.collapsed) {
-      title += ":  predicted collapse at t = " + format("%.6g s", p.collapse_time);
+      title += ":  predicted collapse at t = " + numberText(p.collapse_time, 6) + " s";
     } else if (p.infinite_collisions) {
       title += ":  predicted: infinitely many collisions";
     } else if (p.collision_count_defined) {
@@ -164,8 +164,10 @@ std::string bodyColourHex(std::size_t i) {
   return hexOf(c.r, c.g, c.b);
 }
 
-std::string numberText(double value) {
-  const std::string text = format("%.4g", value);
+std::string numberText(double value, int significant_digits) {
+  char buffer[40];
+  std::snprintf(buffer, sizeof buffer, "%.*g", significant_digits, value);
+  const std::string text = buffer;
   const auto e = text.find('e');
   if (e == std::string::npos) return text;
   return text.substr(0, e) + "×10^" + std::to_string(std::stoi(text.substr(e + 1)));

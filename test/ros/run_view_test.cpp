@@ -63,6 +63,17 @@ TEST(RunView, NumbersAreWrittenWithoutENotation) {
   EXPECT_EQ(collision_lab_ros::numberText(1.2e-7), "1.2×10^-7");
   EXPECT_EQ(collision_lab_ros::numberText(0.0065), "0.0065");
   EXPECT_EQ(collision_lab_ros::numberText(12.0), "12");
+  EXPECT_EQ(collision_lab_ros::numberText(1.31316e8, 6), "1.31316×10^8");
+  EXPECT_EQ(collision_lab_ros::numberText(0.25, 6), "0.25");
+}
+
+// rviz's status line names a long run's time in the same style (it used "t = 1.31316e+08 s").
+TEST(RunView, StatusLineTimeHasNoENotation) {
+  collision_lab_ros::SceneState state;
+  state.time = 1.31316e8;
+  const std::string line = collision_lab_ros::markers::statusLine(collision_lab_ros::RunView{}, state, {});
+  EXPECT_EQ(line.rfind("t = 1.31316×10^8 s", 0), 0u) << line;
+  EXPECT_EQ(line.find("e+"), std::string::npos) << line;
 }
 
 TEST(RunView, NotSimulatedRunClaimsNoSimulatedCount) {

@@ -96,9 +96,9 @@ struct RunView {
 std::string collisionsText(std::uint64_t n);
 /// "#rrggbb" of rviz's palette colour i (layout::kParticleRgb, repeating).
 std::string bodyColourHex(std::size_t i);
-/// A number for people: "%.4g" without e-notation ("0.0065", "2.119 × 10^8"): rviz's font
-/// has code points below 1000 only, so no superscript digits.
-std::string numberText(double value);
+/// A number for people: `significant_digits` digits ("%.4g") without e-notation ("0.0065",
+/// "2.119×10^8"): rviz's font has code points below 1000 only, so no superscript digits.
+std::string numberText(double value, int significant_digits = 4);
 
 RunView makeRunView(const RunRecord& run);
 

@@ -58,7 +58,7 @@ std::string runTitle(const RunRecord& run) { return makeRunView(run).title; }
 std::string runNote(const RunRecord& run) { return makeRunView(run).note; }
 
 std::string statusLine(const RunView& view, const SceneState& state, const FrameClock& clock) {
-  std::string s = format("t = %.6g s", state.time);
+  std::string s = "t = " + numberText(state.time, 6) + " s";
   // The collisions behind now (a replay passes them one by one), then the run's counter,
   // collapse, ring and box as the page says them; a run not simulated has no collisions to
   // count.

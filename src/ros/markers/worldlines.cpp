@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "collision_lab/ros/markers/draw.h"
+#include "collision_lab/ros/run_view.h"
 
 namespace collision_lab_ros::markers {
 
@@ -39,7 +40,7 @@ void addWorldUnits(const Canvas& c) {
 /// The axes' ends: the time at the top [s], the positions at the bottom [m] (ids in `ns`).
 void addWorldRange(const Canvas& c, const std::string& ns, int end_id, int min_id, int max_id, const WorldAxes& axes) {
   const Box& b = kWorldBox;
-  c.add(c.text(ns, end_id, b.left + kWorldEndDx, b.top, format("%.3g", axes.end), kSmallTextSize));
+  c.add(c.text(ns, end_id, b.left + kWorldEndDx, b.top, numberText(axes.end, 3), kSmallTextSize));
   // The scene's number style; the ends' texts within the box's width (the right one would
   // otherwise run off the screen).
   const std::string min = positionText(axes.scene.min, axes.scene.min < 0);
