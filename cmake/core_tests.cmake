@@ -44,9 +44,12 @@ catkin_add_gtest(collision_lab_nbody_tests
   test/core/nbody/test_sticky_model.cpp
   test/core/nbody/test_two_body_any_ratio.cpp
   test/core/nbody/test_ring_events.cpp
-  test/core/nbody/test_wide_range.cpp)
+  test/core/nbody/test_wide_range.cpp
+  test/core/nbody/test_fma_path.cpp)
 if(TARGET collision_lab_nbody_tests)
   target_link_libraries(collision_lab_nbody_tests collision_lab_test_support GTest::gtest_main)
+  # test_fma_path.cpp compares the engine's internal double-double instances.
+  target_include_directories(collision_lab_nbody_tests PRIVATE src/core/nbody)
 endif()
 
 # The fuzz corpora replayed through the fuzz targets' entry points (no libFuzzer needed).

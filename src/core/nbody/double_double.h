@@ -8,6 +8,14 @@
 //   dd / dd (DWDivDW2, Alg. 17)          15u^2 + 56u^3
 // so every operation has a relative error below kDoubleDoubleOpError = 16u^2, away from
 // underflow. Internal to the engine; not installed.
+//
+// Two instances of one arithmetic: DD (portable x86-64: Dekker's product with Veltkamp
+// splitting) and DDFma (the same algorithms with the exact product from one FMA, for code
+// compiled for an FMA target: nbody/fma_path.h). Only the exact two-product differs in code,
+// and it is the same value either way (p and p's exact rounding error), so both compute the
+// same bits. Everything else is one formula (the dd * dd cross term is Alg. 10's without
+// FMA in both). The build keeps the compiler from fusing anything else (-ffp-contract=off):
+// a fused a*b+c would break the error-free transforms.
 #pragma once
 
 #include <cmath>
@@ -26,78 +34,89 @@ namespace nbody_detail {
 /// Relative error bound of one double-double operation (see above).
 constexpr double kDoubleDoubleOpError = 16.0 * 0x1p-106;
 
-struct DD {
-  double hi = 0.0;
-  double lo = 0.0;
+template <bool kFma>
+struct BasicDD;
 
-  DD() = default;
-  DD(double value) : hi(value), lo(0.0) {}  // NOLINT: exact, so implicit like a widening
-  DD(double h, double l, int /*normalized*/) : hi(h), lo(l) {}
-};
+/// Portable: every platform, every build.
+using DD = BasicDD<false>;
+/// The same values from an FMA's exact product; only in code compiled for FMA (fma_path.h).
+using DDFma = BasicDD<true>;
 
-CL_DD_INLINE DD twoSum(double a, double b) {
+template <bool kFma = false>
+CL_DD_INLINE BasicDD<kFma> twoSum(double a, double b) {
   const double s = a + b;
   const double bb = s - a;
-  return DD(s, (a - (s - bb)) + (b - bb), 0);
+  return BasicDD<kFma>(s, (a - (s - bb)) + (b - bb), 0);
 }
 
 /// Precondition: |a| >= |b| or a == 0.
-CL_DD_INLINE DD fastTwoSum(double a, double b) {
+template <bool kFma = false>
+CL_DD_INLINE BasicDD<kFma> fastTwoSum(double a, double b) {
   const double s = a + b;
-  return DD(s, b - (s - a), 0);
+  return BasicDD<kFma>(s, b - (s - a), 0);
 }
 
-CL_DD_INLINE DD twoProd(double a, double b) {
+/// p = fl(a b) and its exact error: the same two doubles either way.
+template <bool kFma = false>
+CL_DD_INLINE BasicDD<kFma> twoProd(double a, double b) {
   const double p = a * b;
-#if defined(__FMA__) || defined(FP_FAST_FMA)
-  return DD(p, std::fma(a, b, -p), 0);
-#else
-  // Dekker's product with Veltkamp splitting (exact while |a|, |b| < 2^996).
-  constexpr double kSplit = 134217729.0;  // 2^27 + 1
-  const double ca = kSplit * a, cb = kSplit * b;
-  const double ah = ca - (ca - a), al = a - ah;
-  const double bh = cb - (cb - b), bl = b - bh;
-  return DD(p, ((ah * bh - p) + ah * bl + al * bh) + al * bl, 0);
-#endif
+  if constexpr (kFma) {
+    return BasicDD<kFma>(p, __builtin_fma(a, b, -p), 0);
+  } else {
+    // Dekker's product with Veltkamp splitting (exact while |a|, |b| < 2^996).
+    constexpr double kSplit = 134217729.0;  // 2^27 + 1
+    const double ca = kSplit * a, cb = kSplit * b;
+    const double ah = ca - (ca - a), al = a - ah;
+    const double bh = cb - (cb - b), bl = b - bh;
+    return BasicDD<kFma>(p, ((ah * bh - p) + ah * bl + al * bh) + al * bl, 0);
+  }
 }
 
-CL_DD_INLINE DD operator+(const DD& x, const DD& y) {
-  const DD s = twoSum(x.hi, y.hi);
-  const DD t = twoSum(x.lo, y.lo);
-  const DD v = fastTwoSum(s.hi, s.lo + t.hi);
-  return fastTwoSum(v.hi, t.lo + v.lo);
-}
+template <bool kFma>
+struct BasicDD {
+  double hi = 0.0;
+  double lo = 0.0;
 
-CL_DD_INLINE DD operator-(const DD& x) { return DD(-x.hi, -x.lo, 0); }
-CL_DD_INLINE DD operator-(const DD& x, const DD& y) { return x + (-y); }
+  BasicDD() = default;
+  BasicDD(double value) : hi(value), lo(0.0) {}  // NOLINT: exact, so implicit like a widening
+  BasicDD(double h, double l, int /*normalized*/) : hi(h), lo(l) {}
 
-CL_DD_INLINE DD operator*(const DD& x, double y) {
-  const DD c = twoProd(x.hi, y);
-  const DD t = fastTwoSum(c.hi, x.lo * y);
-  return fastTwoSum(t.hi, t.lo + c.lo);
-}
+  friend CL_DD_INLINE BasicDD operator+(const BasicDD& x, const BasicDD& y) {
+    const BasicDD s = twoSum<kFma>(x.hi, y.hi);
+    const BasicDD t = twoSum<kFma>(x.lo, y.lo);
+    const BasicDD v = fastTwoSum<kFma>(s.hi, s.lo + t.hi);
+    return fastTwoSum<kFma>(v.hi, t.lo + v.lo);
+  }
 
-CL_DD_INLINE DD operator*(const DD& x, const DD& y) {
-  const DD c = twoProd(x.hi, y.hi);
-#if defined(__FMA__) || defined(FP_FAST_FMA)
-  const double cross = std::fma(x.lo, y.hi, std::fma(x.hi, y.lo, x.lo * y.lo));
-#else
-  const double cross = x.hi * y.lo + x.lo * y.hi;
-#endif
-  return fastTwoSum(c.hi, c.lo + cross);
-}
+  friend CL_DD_INLINE BasicDD operator-(const BasicDD& x) { return BasicDD(-x.hi, -x.lo, 0); }
+  friend CL_DD_INLINE BasicDD operator-(const BasicDD& x, const BasicDD& y) { return x + (-y); }
 
-CL_DD_INLINE DD operator/(const DD& x, const DD& y) {
-  const double th = x.hi / y.hi;
-  const DD r = y * th;
-  const DD pi = twoSum(x.hi, -r.hi);
-  const double delta = pi.hi + ((pi.lo - r.lo) + x.lo);
-  return fastTwoSum(th, delta / y.hi);
-}
+  friend CL_DD_INLINE BasicDD operator*(const BasicDD& x, double y) {
+    const BasicDD c = twoProd<kFma>(x.hi, y);
+    const BasicDD t = fastTwoSum<kFma>(c.hi, x.lo * y);
+    return fastTwoSum<kFma>(t.hi, t.lo + c.lo);
+  }
 
-CL_DD_INLINE bool operator<(const DD& x, const DD& y) { return x.hi < y.hi || (x.hi == y.hi && x.lo < y.lo); }
-CL_DD_INLINE bool operator>(const DD& x, const DD& y) { return y < x; }
-CL_DD_INLINE bool operator==(const DD& x, const DD& y) { return x.hi == y.hi && x.lo == y.lo; }
+  friend CL_DD_INLINE BasicDD operator*(const BasicDD& x, const BasicDD& y) {
+    const BasicDD c = twoProd<kFma>(x.hi, y.hi);
+    const double cross = x.hi * y.lo + x.lo * y.hi;
+    return fastTwoSum<kFma>(c.hi, c.lo + cross);
+  }
+
+  friend CL_DD_INLINE BasicDD operator/(const BasicDD& x, const BasicDD& y) {
+    const double th = x.hi / y.hi;
+    const BasicDD r = y * th;
+    const BasicDD pi = twoSum<kFma>(x.hi, -r.hi);
+    const double delta = pi.hi + ((pi.lo - r.lo) + x.lo);
+    return fastTwoSum<kFma>(th, delta / y.hi);
+  }
+
+  friend CL_DD_INLINE bool operator<(const BasicDD& x, const BasicDD& y) {
+    return x.hi < y.hi || (x.hi == y.hi && x.lo < y.lo);
+  }
+  friend CL_DD_INLINE bool operator>(const BasicDD& x, const BasicDD& y) { return y < x; }
+  friend CL_DD_INLINE bool operator==(const BasicDD& x, const BasicDD& y) { return x.hi == y.hi && x.lo == y.lo; }
+};
 
 }  // namespace nbody_detail
 }  // namespace core

@@ -35,6 +35,7 @@
 #include "collision_lab/core/nbody/impact_rule.h"
 #include "collision_lab/core/nbody/scene.h"
 #include "double_double.h"
+#include "fma_path.h"
 
 namespace collision_lab {
 namespace core {
@@ -54,7 +55,8 @@ struct ElasticTripleRun {
 
 /// Is `hi + lo` within `error` of x certainly rounded to hi (x strictly inside hi's rounding
 /// cell)? hi + lo is a normalized double-double.
-inline bool roundsTo(const DD& value, double error) {
+template <class W>
+CL_DD_INLINE bool roundsTo(const W& value, double error) {
   if (error == 0.0) return true;  // exact: hi is nearest to hi + lo
   if (value.hi == 0.0) return false;
   constexpr double kMargin = 1.0 - 0x1p-20;  // covers the rounding of lo +- error
@@ -67,15 +69,13 @@ inline bool roundsTo(const DD& value, double error) {
 /// and the certified one (componentwise bounds; the intercepts in double, for the range).
 enum class ElasticTriplePass { kReplica, kCertified };
 
-/// One pass; empty when it cannot answer (kReplica: the guard may fire; kCertified: not
-/// certified; either: out of range).
-template <ElasticTriplePass kPass, class Visit>
-#if defined(__GNUC__)
-__attribute__((flatten))  // the impact maps and the bounds inline into the loop
-#endif
-std::optional<ElasticTripleRun> runElasticTriplePass(const Scene& scene, std::uint64_t count, std::size_t first_pair,
-                                                     std::uint64_t cap, double time_limit, const std::atomic<bool>* cancel,
-                                                     Visit& visit) {
+/// One pass in double-double W (DD or DDFma: the same bits); empty when it cannot answer
+/// (kReplica: the guard may fire; kCertified: not certified; either: out of range).
+template <ElasticTriplePass kPass, class W, class Visit>
+CL_DD_INLINE std::optional<ElasticTripleRun> elasticTriplePass(const Scene& scene, std::uint64_t count,
+                                                              std::size_t first_pair, std::uint64_t cap,
+                                                              double time_limit, const std::atomic<bool>* cancel,
+                                                              Visit& visit) {
   constexpr bool kReplica = kPass == ElasticTriplePass::kReplica;
   constexpr double kEta = kDoubleDoubleOpError;  // one double-double operation, relative
   constexpr double kSlack = 1.0 + 0x1p-40;       // the rounding of evaluating a bound in double
@@ -89,7 +89,7 @@ std::optional<ElasticTripleRun> runElasticTriplePass(const Scene& scene, std::ui
   std::array<double, 3> sqrt_mass{};  // 0 for a wall, as tier.h's tables
   for (int k = 0; k < 3; ++k) sqrt_mass[k] = scene.isWall(k) ? 0.0 : std::sqrt(scene.masses[k]);
   struct PairTables {
-    ImpactMap<DD> map;
+    ImpactMap<W> map;
     double gain;      // |c_h|, 0 for a wall
     double s_h, s_l;  // sqrt of the heavier and lighter mass, 0 for a wall
     double scale;     // 1/sqrt(m_p) + 1/sqrt(m_p+1), a wall counting 0
@@ -97,14 +97,14 @@ std::optional<ElasticTripleRun> runElasticTriplePass(const Scene& scene, std::ui
   std::array<PairTables, 2> pairs;
   for (int p = 0; p < 2; ++p) {
     PairTables& pair = pairs[p];
-    pair.map = makeImpactMap<DD>(scene.masses[p], scene.masses[p + 1], 1.0);
+    pair.map = makeImpactMap<W>(scene.masses[p], scene.masses[p + 1], 1.0);
     pair.gain = std::fabs(pair.map.heavy_gain.hi);
     pair.s_h = sqrt_mass[pair.map.heavy_is_i ? p : p + 1];
     pair.s_l = sqrt_mass[pair.map.heavy_is_i ? p + 1 : p];
     pair.scale = (sqrt_mass[p] > 0 ? 1 / sqrt_mass[p] : 0.0) + (sqrt_mass[p + 1] > 0 ? 1 / sqrt_mass[p + 1] : 0.0);
   }
   // tier.h, rho(): the engine's bound on one impact's mass-weighted rounding.
-  const auto rho = [](const PairTables& pair, const ImpactChange<DD>& change, const DD& q_i, const DD& q_j) {
+  const auto rho = [](const PairTables& pair, const ImpactChange<W>& change, const W& q_i, const W& q_j) {
     if (pair.map.exchange) return 0.0;
     const double q_h = std::fabs((pair.map.heavy_is_i ? q_i : q_j).hi);
     const double q_l = std::fabs((pair.map.heavy_is_i ? q_j : q_i).hi);
@@ -112,8 +112,8 @@ std::optional<ElasticTripleRun> runElasticTriplePass(const Scene& scene, std::ui
     return 2 * kEta * (pair.s_h * (q_h + 8 * inc) + pair.s_l * (q_l + q_h + 8 * inc + 2 * d)) +
            (pair.s_h + pair.s_l) * 0x1p-1000;
   };
-  std::array<DD, 3> v = {DD(scene.velocities[0]), DD(scene.velocities[1]), DD(scene.velocities[2])};
-  std::array<DD, 3> b = {DD(scene.positions[0]), DD(scene.positions[1]), DD(scene.positions[2])};  // kReplica
+  std::array<W, 3> v = {W(scene.velocities[0]), W(scene.velocities[1]), W(scene.velocities[2])};
+  std::array<W, 3> b = {W(scene.positions[0]), W(scene.positions[1]), W(scene.positions[2])};  // kReplica
   std::array<double, 3> b_double = {scene.positions[0], scene.positions[1], scene.positions[2]};  // kCertified
   std::array<double, 3> error{};  // E_k [m/s] (kCertified); the inputs are exact
   // The engine's mass-weighted bounds (tier.h; kReplica), from what its start adds when it
@@ -134,13 +134,13 @@ std::optional<ElasticTripleRun> runElasticTriplePass(const Scene& scene, std::ui
       break;
     }
     const PairTables& pair = pairs[p];
-    const ImpactMap<DD>& map = pair.map;
-    DD& vi = v[p];
-    DD& vj = v[p + 1];
-    const ImpactChange<DD> dv = applyImpactMap(map, vi, vj);
+    const ImpactMap<W>& map = pair.map;
+    W& vi = v[p];
+    W& vj = v[p + 1];
+    const ImpactChange<W> dv = applyImpactMap(map, vi, vj);
     if constexpr (kReplica) {
       const double eu_before = eu, eb_before = eb;
-      const ImpactChange<DD> db = applyImpactMap(map, b[p], b[p + 1]);
+      const ImpactChange<W> db = applyImpactMap(map, b[p], b[p + 1]);
       eu += rho(pair, dv, vi, vj);
       eb += rho(pair, db, b[p], b[p + 1]);
       if (!(eu_before * pair.scale <= kGuard * std::fabs(dv.difference.hi) &&
@@ -161,8 +161,8 @@ std::optional<ElasticTripleRun> runElasticTriplePass(const Scene& scene, std::ui
       } else {
         double& eh = map.heavy_is_i ? ei : ej;
         double& el = map.heavy_is_i ? ej : ei;
-        const DD& heavy = map.heavy_is_i ? vi : vj;
-        const DD& light = map.heavy_is_i ? vj : vi;
+        const W& heavy = map.heavy_is_i ? vi : vj;
+        const W& light = map.heavy_is_i ? vj : vi;
         if (pair.s_h != 0.0) {  // not a wall: the increment g d rounds, and g itself (4 eta covers both)
           const double increment_error =
               (pair.gain * difference_error + 4 * kEta * std::fabs(dv.heavy_increment.hi)) * kSlack + kTinyError;
@@ -190,6 +190,39 @@ std::optional<ElasticTripleRun> runElasticTriplePass(const Scene& scene, std::ui
   return run;
 }
 
+/// elasticTriplePass, portable: the impact maps and the bounds inline into the loop.
+template <ElasticTriplePass kPass, class Visit>
+CL_FLATTEN std::optional<ElasticTripleRun> runElasticTriplePass(const Scene& scene, std::uint64_t count,
+                                                                std::size_t first_pair, std::uint64_t cap,
+                                                                double time_limit,
+                                                                const std::atomic<bool>* cancel, Visit& visit) {
+  return elasticTriplePass<kPass, DD>(scene, count, first_pair, cap, time_limit, cancel, visit);
+}
+
+#if CL_HAS_FMA_PATH
+/// elasticTriplePass compiled for FMA (fma_path.h): the same bits, faster products.
+template <ElasticTriplePass kPass, class Visit>
+CL_FLATTEN CL_FMA_TARGET std::optional<ElasticTripleRun> runElasticTriplePassFma(
+    const Scene& scene, std::uint64_t count, std::size_t first_pair, std::uint64_t cap, double time_limit,
+    const std::atomic<bool>* cancel, Visit& visit) {
+  return elasticTriplePass<kPass, DDFma>(scene, count, first_pair, cap, time_limit, cancel, visit);
+}
+#endif
+
+/// One pass, on the FMA path where fmaPathEnabled() (the same bits either way).
+template <ElasticTriplePass kPass, class Visit>
+std::optional<ElasticTripleRun> runElasticTriplePassOnPath(const Scene& scene, std::uint64_t count,
+                                                           std::size_t first_pair, std::uint64_t cap,
+                                                           double time_limit, const std::atomic<bool>* cancel,
+                                                           Visit& visit) {
+#if CL_HAS_FMA_PATH
+  if (fmaPathEnabled()) {
+    return runElasticTriplePassFma<kPass>(scene, count, first_pair, cap, time_limit, cancel, visit);
+  }
+#endif
+  return runElasticTriplePass<kPass>(scene, count, first_pair, cap, time_limit, cancel, visit);
+}
+
 /// Runs scene (three bodies, every e = 1, no ring; at most one wall), whose exact count is
 /// `count` with first pair `first_pair` (0: AB, 1: BC), up to `cap` impacts, every impact
 /// before `time_limit` [the scene's units of time; inf: any] (else it declines); the cancel flag
@@ -203,12 +236,13 @@ std::optional<ElasticTripleRun> runElasticTriple(const Scene& scene, std::uint64
                                                  std::uint64_t cap, double time_limit, const std::atomic<bool>* cancel,
                                                  Restart&& restart, Visit&& visit) {
   restart();
-  if (auto run = runElasticTriplePass<ElasticTriplePass::kReplica>(scene, count, first_pair, cap, time_limit, cancel,
-                                                                   visit)) {
+  if (auto run = runElasticTriplePassOnPath<ElasticTriplePass::kReplica>(scene, count, first_pair, cap, time_limit,
+                                                                         cancel, visit)) {
     return run;
   }
   restart();
-  return runElasticTriplePass<ElasticTriplePass::kCertified>(scene, count, first_pair, cap, time_limit, cancel, visit);
+  return runElasticTriplePassOnPath<ElasticTriplePass::kCertified>(scene, count, first_pair, cap, time_limit, cancel,
+                                                                   visit);
 }
 
 }  // namespace nbody_detail

@@ -1,0 +1,33 @@
+// The FMA path: where the CPU has fused multiply-add, the engine's hot loops run an
+// instance compiled for it (target "fma"), chosen at run time; the portable instance stays
+// for every other CPU and build. Both compute the same bits (double_double.h: only the exact
+// two-product differs in code). COLLISION_LAB_NO_FMA=1 in the environment keeps a process
+// on the portable path (benchmarks and the test that compares the two). Internal to the
+// engine; not installed.
+#pragma once
+
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+#define CL_HAS_FMA_PATH 1
+#define CL_FMA_TARGET __attribute__((target("fma")))
+#else
+#define CL_HAS_FMA_PATH 0
+#define CL_FMA_TARGET
+#endif
+
+#if defined(__GNUC__)
+#define CL_FLATTEN __attribute__((flatten))  // every call inlined: the loop in one function
+#else
+#define CL_FLATTEN
+#endif
+
+namespace collision_lab {
+namespace core {
+namespace nbody_detail {
+
+/// Does this process take the FMA path? The CPU has FMA and COLLISION_LAB_NO_FMA is unset,
+/// empty or "0". Decided once per process.
+bool fmaPathEnabled();
+
+}  // namespace nbody_detail
+}  // namespace core
+}  // namespace collision_lab
