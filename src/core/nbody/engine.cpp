@@ -46,10 +46,14 @@ struct NextTier<Float100> {
   using type = Rational;
 };
 
-/// Where the exact tier stands: its impacts and the bits of its last impact's numbers.
+/// Where the exact tier stands: its impacts and the bits of its last impact's numbers; and
+/// how its budget stopped the run, if it did.
 struct ExactProgress {
   std::uint64_t count = 0;
   unsigned bits = 0;
+  std::uint64_t replay_target = 0;  ///< the impact a replay stopped for its budget had to reach
+  std::uint64_t streak = 0;         ///< exact impacts in a row when the exactness cap stopped the run
+  bool predicted = false;           ///< stopped on the forecast (tier.h, WorkForecast), not on the budget spent
 };
 
 /// Owns the tiers: the double-double one always, the others from their first use on. A
@@ -58,7 +62,9 @@ struct ExactProgress {
 class Driver {
  public:
   /// `cancel` (may be null) is read before every step of the exact tier, whose replays can be long.
-  Driver(const Scene& scene, const std::atomic<bool>* cancel) : tables_(scene), cancel_(cancel) {}
+  Driver(const Scene& scene, const EngineOptions& options)
+      : tables_(scene), cancel_(options.cancel), budget_(options.exact_work_budget),
+        forecast_(options.forecast_exact_work) {}
 
   StepResult start() { return startOrEscalate<DD>(); }
   StepResult step(ImpactRecord* record) {
@@ -66,6 +72,12 @@ class Driver {
     const std::uint64_t escalated = exact + escalations_.high_precision;
     const StepResult r = stepOrEscalate<DD>(record);
     exact_streak_ = escalations_.exact_rational > exact ? exact_streak_ + 1 : 0;
+    if (exact_streak_ == 0) {
+      streak_work_ = {};
+    } else if (exact_ && exact_->count() == fast_->count()) {
+      const double bits = exact_->exactBits();
+      streak_work_.add(bits * bits);
+    }
     if (r.kind == StepKind::kImpact && escalations_.exact_rational + escalations_.high_precision > escalated) {
       crowd_[crowd_next_++ % crowd_.size()] = r.pair;
     }
@@ -89,7 +101,12 @@ class Driver {
   }
   /// Where the exact tier stands (zeros when it never ran).
   ExactProgress exactProgress() const {
-    return exact_ ? ExactProgress{exact_->count(), exact_->exactBits()} : ExactProgress{};
+    ExactProgress progress = budget_stop_;
+    if (exact_) {
+      progress.count = exact_->count();
+      progress.bits = exact_->exactBits();
+    }
+    return progress;
   }
   static constexpr std::size_t kCrowdWindow = 32;
 
@@ -203,7 +220,20 @@ class Driver {
   StepResult stepOrEscalate(ImpactRecord* record) {
     Tier<S>& t = *tier<S>();
     const std::uint64_t count = t.count();
-    if (exact_streak_ >= kExactStreak && t.oversized()) return {StepKind::kExhausted, 0, t.lastTime()};
+    if (exact_streak_ >= kExactStreak && t.oversized()) {
+      budget_stop_.streak = exact_streak_;
+      return {StepKind::kExhausted, 0, t.lastTime()};
+    }
+    // The cap foreseen: the exact steps in a row, each dearer than the last, would spend the
+    // budget before the cap.
+    if constexpr (Arithmetic<S>::kExact) {
+      if (forecast_ && exact_streak_ < kExactStreak && t.oversized() &&
+          streak_work_.predicted(kExactStreak - exact_streak_) > budget_) {
+        budget_stop_.streak = exact_streak_;
+        budget_stop_.predicted = true;
+        return {StepKind::kExhausted, 0, t.lastTime()};
+      }
+    }
     if constexpr (Arithmetic<S>::kExact) {
       if (cancel_ && cancel_->load(std::memory_order_relaxed)) return {StepKind::kCancelled, 0, t.lastTime()};
     }
@@ -263,15 +293,20 @@ class Driver {
     const auto failed = [](const StepResult& r) {
       return stopsRun(r) ? r : StepResult{StepKind::kInconsistent, r.pair, r.time};
     };
-    double cost = 0.0;  // of this replay in the exact tier [bit^2]
+    WorkForecast work;  // of this replay in the exact tier [bit^2]
     for (;;) {
       const StepResult c = catchUp<S>();
       if (c.kind != StepKind::kImpact) return failed(c);
       if (tier<S>()->count() == target) return {};
       if constexpr (Arithmetic<S>::kExact) {
         const double bits = tier<S>()->exactBits();
-        cost += bits * bits;
-        if (cost > kExactReplayBudget) return {StepKind::kOverBudget, 0, tier<S>()->lastTime()};
+        work.add(bits * bits);
+        const bool spent = work.total() > budget_;
+        if (spent || (forecast_ && work.predicted(target - tier<S>()->count()) > budget_)) {
+          budget_stop_.replay_target = target;
+          budget_stop_.predicted = !spent;
+          return {StepKind::kOverBudget, 0, tier<S>()->lastTime()};
+        }
       }
       const StepResult r = stepOrEscalate<S>(nullptr);
       if (r.kind != StepKind::kImpact) return failed(r);
@@ -329,6 +364,8 @@ class Driver {
   std::size_t last_ = kNone, before_last_ = kNone;  ///< pairs of the last two impacts
   std::uint64_t alternating_ = 0;                   ///< impacts alternating between them
   std::uint64_t exact_streak_ = 0;                  ///< impacts in a row that needed the exact tier
+  WorkForecast streak_work_;                        ///< the exact tier's work on those impacts [bit^2]
+  ExactProgress budget_stop_;                       ///< how the exact tier's budget stopped the run
   std::array<std::size_t, kCrowdWindow> crowd_{};   ///< pairs of the last impacts that escalated (a ring)
   std::size_t crowd_next_ = 0;                      ///< impacts that escalated so far
   std::size_t undecided_pair_ = kNone;              ///< the pair of the last decision double-double could not take
@@ -336,6 +373,8 @@ class Driver {
   static constexpr std::uint64_t kGroupStreak = 16;
   SceneTables tables_;
   const std::atomic<bool>* cancel_;
+  double budget_;   ///< EngineOptions::exact_work_budget [bit^2]
+  bool forecast_;   ///< EngineOptions::forecast_exact_work
   std::unique_ptr<Tier<DD>> fast_;
   std::unique_ptr<Tier<Float100>> high_;
   std::unique_ptr<Tier<Rational>> exact_;
@@ -420,8 +459,14 @@ std::string stopMessage(const Scene& scene, const EngineResult& result, bool exh
     }
     case StopReason::kCap:
       if (exhausted) {
-        return "stopped after " + impacts + " at the exactness cap (truncated): the impacts accumulate, each " +
-               "needing exact arithmetic of more than " + std::to_string(kExactBits) +
+        const std::string foreseen =
+            exact.predicted ? ", foreseen after " + countText(exact.streak) + " exact impacts in a row: the " +
+                                  countText(kExactStreak - exact.streak) +
+                                  " more up to the cap would, at the work of the last ones (numbers of " +
+                                  countText(exact.bits) + " bits), spend more than the work budget of one decision"
+                            : std::string();
+        return "stopped after " + impacts + " at the exactness cap (truncated)" + foreseen +
+               ": the impacts accumulate, each needing exact arithmetic of more than " + std::to_string(kExactBits) +
                " bits: a collapse of a kind the engine does not resolve (engine.h, Collapse), or a spiral just above "
                "its critical restitution, whose approach speeds shrink by ever more bits (the three_body_spiral "
                "model counts it); the impacts crowd among bodies " +
@@ -454,9 +499,14 @@ std::string stopMessage(const Scene& scene, const EngineResult& result, bool exh
              "the run ends here";
     case StopReason::kPrecisionBudget:
       return "stopped after " + countText(result.impact_count) + " certified impacts (truncated): the next decision needs exact arithmetic, "
-             "whose numbers grow with every impact of the run; its exact replay reached the work budget after " +
-             countText(exact.count) + " impacts, with numbers of " + countText(exact.bits) +
-             " bits, so the next impact cannot be decided; the impacts crowd among bodies " +
+             "whose numbers grow with every impact of the run; its exact replay " +
+             (exact.predicted ? "would exceed the work budget: after " + countText(exact.count) + " of the " +
+                                    countText(exact.replay_target) + " impacts to replay, with numbers of " +
+                                    countText(exact.bits) + " bits, the work so far and that of its last impacts " +
+                                    "foresee more than the budget"
+                              : "reached the work budget after " + countText(exact.count) +
+                                    " impacts, with numbers of " + countText(exact.bits) + " bits") +
+             ", so the next impact cannot be decided; the impacts crowd among bodies " +
              indexRanges(result.crowding_bodies) +
              " (indices from 0), as on the way to an inelastic collapse that the engine does not resolve; "
              "a model of the physics there goes on: --restitution-model tc or --restitution-model viscoelastic";
@@ -527,7 +577,7 @@ EngineResult runEngine(const Scene& si_scene, const EngineOptions& options, cons
     return c;
   };
   EngineResult result;
-  Driver driver(scene, options.cancel);
+  Driver driver(scene, options);
   StepResult r = driver.start();
   const bool wants_records = static_cast<bool>(visitor) || options.keep_events > 0;
   ImpactRecord record;

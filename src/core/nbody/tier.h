@@ -68,7 +68,7 @@ struct SceneTables {
 /// kAmbiguous: a decision this tier cannot take; kImprecise: its state no longer pins down
 /// the time of the impact it was about to perform (the precision guard); kExhausted: the
 /// exact tier's numbers outgrew kExactBits (an accumulation of impacts not resolved);
-/// kOverBudget: its replay outgrew kExactReplayBudget; kCancelled: the cancel flag was seen inside
+/// kOverBudget: its replay outgrew the exactness budget; kCancelled: the cancel flag was seen inside
 /// a higher tier's work. The last three leave the working tier at its last certified impact.
 enum class StepKind : std::uint8_t {
   kImpact, kFinished, kMultipleCollision, kAmbiguous, kImprecise, kOutOfRange, kInconsistent, kExhausted,
@@ -83,17 +83,52 @@ enum class StepKind : std::uint8_t {
 constexpr unsigned kExactBits = 2048;
 constexpr std::uint64_t kExactStreak = 256;
 
-/// The exactness budget: the bound on the work of one exact decision (10^11 bit^2: the proof of a
-/// four-body group collapse needs more than 10^10). A rational's size
-/// grows with the impacts in its causal past (each adds the bits of a mass sum), so the
-/// exact tier's replay up to a decision deep into a long run with double inputs (a crowding
-/// cluster in a gas) costs more with every impact, without bound. The cost of a replay is
-/// counted as the sum over its impacts of the squared bits of the largest denominator the
-/// impact leaves (the work of one rational operation grows about so); a decision whose replay
-/// would exceed kExactReplayBudget [bit^2] is not taken: the run stops at its last certified
-/// impact (StopReason::kPrecisionBudget). The exact tier's own runs of steps are bounded by
-/// the exactness cap above; together, each decision costs at most a constant.
-constexpr double kExactReplayBudget = 1e11;
+/// The exactness budget (EngineOptions::exact_work_budget, 10^11 bit^2 by default: the proof
+/// of a four-body group collapse needs more than 10^10): the bound on the work of one exact
+/// decision. A rational's size grows with the impacts in its causal past (each adds the bits
+/// of a mass sum), so the exact tier's replay up to a decision deep into a long run with
+/// double inputs (a crowding cluster in a gas) costs more with every impact, without bound.
+/// The cost of a replay is counted as the sum over its impacts of the squared bits of the
+/// largest denominator the impact leaves (the work of one rational operation grows about
+/// so); a decision whose replay would exceed the budget is not taken: the run stops at its
+/// last certified impact (StopReason::kPrecisionBudget). The exact tier's own runs of steps
+/// are bounded by the exactness cap above; together, each decision costs at most a constant.
+
+/// The predicted budget. The work of an accumulation's exact steps grows with every impact,
+/// so a replay, or a run of exact steps towards the exactness cap, that is heading past
+/// the budget is seen long before it gets there: its work so far plus the impacts
+/// still due (to the replay's target; to kExactStreak in a row) at the mean work of its last
+/// kWorkWindow impacts. When that exceeds the budget, the run stops at once, at its last
+/// certified impact, having spent a fraction of it: a replay where the spent budget would
+/// have stopped it (the same impacts; earlier only where an accumulation's numbers shrink
+/// again); a run of exact steps before the exactness cap, which it would have reached some
+/// impacts later. Either way the impacts are a prefix of the longer run's. The forecast
+/// counts work (squared bits), never time, so the stop is the same on every machine.
+constexpr std::size_t kWorkWindow = 32;
+
+/// Work counted impact by impact [bit^2], with the forecast above.
+class WorkForecast {
+ public:
+  void add(double work) {
+    total_ += work;
+    window_[added_ % kWorkWindow] = work;
+    ++added_;
+  }
+  double total() const { return total_; }
+  /// The work so far plus `remaining` impacts at the mean of the last kWorkWindow (the work
+  /// so far until that many were counted).
+  double predicted(std::uint64_t remaining) const {
+    if (added_ < kWorkWindow) return total_;
+    double recent = 0.0;
+    for (double w : window_) recent += w;
+    return total_ + static_cast<double>(remaining) * (recent / static_cast<double>(kWorkWindow));
+  }
+
+ private:
+  std::array<double, kWorkWindow> window_{};
+  double total_ = 0.0;
+  std::uint64_t added_ = 0;
+};
 
 /// 16 bytes, so that it is returned in registers: every step passes one up through several
 /// calls, and a larger one goes through the stack, where its copies stall on store forwarding.

@@ -6,7 +6,9 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cstring>
 #include <string>
+#include <vector>
 
 #include "collision_lab/core/count_text.h"
 #include "collision_lab/core/nbody/engine.h"
@@ -74,6 +76,71 @@ TEST(NBodyGasBudget, CancelReachesTheExactReplay) {
   EXPECT_GT(run.escalations.exact_rational, 0u);
   EXPECT_NE(run.stop_message.find("cancelled after " + countText(run.impact_count) + " impacts"),
             std::string::npos);
+}
+
+/// A run's impacts as published: pair, time and velocities after, bit for bit.
+struct Published {
+  std::vector<std::size_t> pairs;
+  std::vector<double> values;
+  bool operator==(const Published& o) const {
+    return pairs == o.pairs && values.size() == o.values.size() &&
+           std::memcmp(values.data(), o.values.data(), values.size() * sizeof(double)) == 0;
+  }
+};
+
+EngineResult runRecorded(const Scene& s, const EngineOptions& options, Published& out) {
+  return runEngine(s, options, [&out](const ImpactRecord& r) {
+    out.pairs.push_back(r.pair_index);
+    out.values.push_back(r.time);
+    out.values.push_back(r.velocities_after[0]);
+    out.values.push_back(r.velocities_after[1]);
+  });
+}
+
+// Issue 34: the budget is foreseen from the work's growth, so a run stops long before it
+// would have spent it, with the impacts it would have published.
+TEST(NBodyGasBudget, TheForecastStopsWithTheSameImpactsForLessWork) {
+  {
+    // A replay that cannot be afforded (a budget of 10^9 bit^2, so that spending it is quick
+    // too): the same stop, the same impacts, a shorter replay.
+    const Scene s = granularGas(100, 0.5, kSeed);
+    EngineOptions spend;
+    spend.exact_work_budget = 1e9;
+    spend.forecast_exact_work = false;
+    EngineOptions foresee = spend;
+    foresee.forecast_exact_work = true;
+    Published spent, foreseen;
+    const EngineResult a = runRecorded(s, spend, spent);
+    const EngineResult b = runRecorded(s, foresee, foreseen);
+    ASSERT_EQ(a.stop, StopReason::kPrecisionBudget) << a.stop_message;
+    ASSERT_EQ(b.stop, StopReason::kPrecisionBudget) << b.stop_message;
+    EXPECT_EQ(b.impact_count, a.impact_count);
+    EXPECT_TRUE(foreseen == spent);
+    EXPECT_EQ(b.final_velocities, a.final_velocities);
+    EXPECT_LT(b.escalations.replayed_impacts, a.escalations.replayed_impacts);
+    EXPECT_NE(a.stop_message.find("its exact replay reached the work budget after"), std::string::npos) << a.stop_message;
+    EXPECT_NE(b.stop_message.find("its exact replay would exceed the work budget: after"), std::string::npos)
+        << b.stop_message;
+  }
+  {
+    // Exact impacts in a row, each dearer than the last, towards the exactness cap (256 in a
+    // row; at e = 0.1 they cost 38 s of exact arithmetic before the forecast): the run stops
+    // at the cap foreseen, and its impacts are those the run without the forecast publishes.
+    const Scene s = granularGas(100, 0.1, kSeed);
+    Published foreseen, spent;
+    const EngineResult b = runRecorded(s, EngineOptions{}, foreseen);
+    ASSERT_EQ(b.stop, StopReason::kCap) << b.stop_message;
+    EXPECT_TRUE(b.truncated);
+    EXPECT_NE(b.stop_message.find("impacts at the exactness cap (truncated), foreseen after"), std::string::npos)
+        << b.stop_message;
+    EngineOptions spend;
+    spend.forecast_exact_work = false;
+    spend.max_impacts = b.impact_count;
+    const EngineResult a = runRecorded(s, spend, spent);
+    EXPECT_EQ(a.impact_count, b.impact_count);
+    EXPECT_TRUE(foreseen == spent);
+    EXPECT_EQ(b.final_velocities, a.final_velocities);
+  }
 }
 
 }  // namespace

@@ -10,7 +10,7 @@
 //      replays the run from the start (or from where it last stopped) to that impact and
 //      takes the step; the working tier then follows that step in O(1);
 //   2. what 100 digits cannot decide, exact rationals decide the same way, within a work
-//      budget per decision (tier.h, kExactReplayBudget: a run beyond it stops at its last
+//      budget per decision (EngineOptions::exact_work_budget: a run beyond it stops at its last
 //      certified impact, kPrecisionBudget; the cancel flag is read at each exact step). A value exactly
 //      0 in double-double (in practice an exact tie: equal velocities or simultaneous
 //      impacts, from inputs such as small integers, where rationals stay small) goes
@@ -94,7 +94,7 @@ enum class StopReason : std::uint8_t {
   /// than the working units ("Units" above) bring into the tiers' range (truncated).
   kOutOfRange = 4,
   kInternalError = 5,      ///< the tiers disagreed (a bug; reported, never hidden)
-  /// A decision needed exact arithmetic beyond its budget (tier.h, kExactReplayBudget): the run
+  /// A decision needed exact arithmetic beyond its budget (EngineOptions::exact_work_budget): the run
   /// stops at its last certified impact, naming the crowding bodies (truncated).
   kPrecisionBudget = 6,
 };
@@ -116,6 +116,15 @@ struct EngineOptions {
   /// or sooner inside a long exact-tier replay (read before each of its steps), marked
   /// truncated, with the summary of what was done.
   const std::atomic<bool>* cancel = nullptr;
+  /// The work of one exact decision [bit^2, the squared bits of each replayed impact's
+  /// numbers, summed]: a decision that needs more stops the run at its last certified impact
+  /// (kPrecisionBudget). The default is the engine's (10^11: a four-body group collapse's
+  /// proof needs 10^10); a smaller one stops sooner.
+  double exact_work_budget = 1e11;
+  /// Stop as soon as that work is foreseen (its growth so far, extrapolated), not when it is
+  /// spent: the same stop, or (never seen) an earlier one with the same impacts before it.
+  /// False only to measure what the forecast saves (the benchmarks, its test).
+  bool forecast_exact_work = true;
 };
 
 /// How often the engine had to leave its working precision.
