@@ -41,7 +41,7 @@ Timed timedRun(const Scene& scene, const EngineOptions& options) {
 void hundredBodyGoal(bool quick) {
   std::printf("The 100-body gas (seed 1), with the forecast of the exact work budget%s\n",
               quick ? "" : ", and without it (the anchor)");
-  double worst = 0.0;
+  double worst = 0.0, worst_spent = 0.0;
   for (const double e : {0.1, 0.3, 0.5}) {
     const Scene scene = testing_support::granularGas(100, e, 1);
     const Timed foreseen = timedRun(scene, EngineOptions{});
@@ -52,6 +52,7 @@ void hundredBodyGoal(bool quick) {
       EngineOptions spend;
       spend.forecast_exact_work = false;
       const Timed spent = timedRun(scene, spend);
+      worst_spent = std::max(worst_spent, spent.seconds);
       std::printf("; the budget spent first: %llu impacts, %s, %.2f s (%.1fx)",
                   static_cast<unsigned long long>(spent.run.impact_count), stopReasonName(spent.run.stop),
                   spent.seconds, spent.seconds / foreseen.seconds);
@@ -59,8 +60,16 @@ void hundredBodyGoal(bool quick) {
     std::printf("\n");
     std::fflush(stdout);
   }
-  std::printf("goal: the 100-body gas answered at e = 0.1, 0.3 and 0.5, the slowest in s = %.2f (goal <= 5 s): %s\n",
-              worst, worst <= 5.0 ? "met" : "missed");
+  if (quick) {
+    std::printf("goal: the 100-body gas (seed 1) answered at e = 0.1, 0.3 and 0.5, the slowest in s = %.2f against "
+                "the runs spending the budget first = not run with --quick (goal <= 5 s): %s\n",
+                worst, worst <= 5.0 ? "met" : "missed");
+  } else {
+    std::printf("goal: the 100-body gas (seed 1) answered at e = 0.1, 0.3 and 0.5, the slowest in s = %.2f against "
+                "the same runs spending the exact work budget first, the slowest in s = %.2f (%.1fx faster; goal <= "
+                "5 s): %s\n",
+                worst, worst_spent, worst_spent / worst, worst <= 5.0 ? "met" : "missed");
+  }
 }
 
 }  // namespace

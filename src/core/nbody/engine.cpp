@@ -436,6 +436,13 @@ std::string indexRanges(const std::vector<std::size_t>& indices) {
   return text;
 }
 
+/// The models that carry a run past an accumulation of constant-e impacts (none to name
+/// when the scene already has a velocity-dependent model).
+std::string modelAdvice(const Scene& scene) {
+  if (scene.restitution_model.kind != RestitutionModelKind::kConstant) return "";
+  return "; a model of the physics there goes on: --restitution-model tc or --restitution-model viscoelastic";
+}
+
 std::string stopMessage(const Scene& scene, const EngineResult& result, bool exhausted, bool beyond_doubles,
                         const ExactProgress& exact) {
   // "1 impact", "31,415 impacts".
@@ -459,20 +466,20 @@ std::string stopMessage(const Scene& scene, const EngineResult& result, bool exh
     }
     case StopReason::kCap:
       if (exhausted) {
-        const std::string foreseen =
-            exact.predicted ? ", foreseen after " + countText(exact.streak) + " exact impacts in a row: the " +
-                                  countText(kExactStreak - exact.streak) +
-                                  " more up to the cap would, at the work of the last ones (numbers of " +
-                                  countText(exact.bits) + " bits), spend more than the work budget of one decision"
-                            : std::string();
+        std::string foreseen;
+        if (exact.predicted) {
+          foreseen = ", foreseen after " + countText(exact.streak) + " exact impacts in a row: the " +
+                     countText(kExactStreak - exact.streak) +
+                     " more up to the cap would, at the work of the last ones (numbers of " + countText(exact.bits) +
+                     " bits), spend more than the work budget of one decision";
+        }
         return "stopped after " + impacts + " at the exactness cap (truncated)" + foreseen +
                ": the impacts accumulate, each needing exact arithmetic of more than " + std::to_string(kExactBits) +
                " bits: a collapse of a kind the engine does not resolve (engine.h, Collapse), or a spiral just above "
                "its critical restitution, whose approach speeds shrink by ever more bits (the three_body_spiral "
                "model counts it); the impacts crowd among bodies " +
                indexRanges(result.crowding_bodies) +
-               " (indices from 0); a model of the physics there goes on: --restitution-model tc or "
-               "--restitution-model viscoelastic";
+               " (indices from 0)" + modelAdvice(scene);
       }
       return "stopped at the cap of " + impacts + " (truncated)" +
              (scene.wallCount() == 2 ? "; two walls keep the bodies between them colliding forever" : "");
@@ -508,8 +515,8 @@ std::string stopMessage(const Scene& scene, const EngineResult& result, bool exh
                                     " impacts, with numbers of " + countText(exact.bits) + " bits") +
              ", so the next impact cannot be decided; the impacts crowd among bodies " +
              indexRanges(result.crowding_bodies) +
-             " (indices from 0), as on the way to an inelastic collapse that the engine does not resolve; "
-             "a model of the physics there goes on: --restitution-model tc or --restitution-model viscoelastic";
+             " (indices from 0), as on the way to an inelastic collapse that the engine does not resolve" +
+             modelAdvice(scene);
   }
   return "";
 }
