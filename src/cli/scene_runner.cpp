@@ -92,11 +92,13 @@ core::SceneVisitors showEvents(const core::RunOptions& shown, io::RunReportWrite
   core::SceneVisitors visitors;
   if (shown.events.kind == core::EventPolicy::Kind::kNone) return visitors;
   const core::EventPolicy policy = shown.events;
-  visitors.three_body_event = [&three_body, policy](const core::LabEvent& event) {
-    if (policy.keeps(event.event.index)) three_body.event(event);
-  };
-  visitors.impact = [&nbody, policy](const core::ImpactRecord& impact) {
-    if (policy.keeps(impact.index)) nbody.impact(impact);
+  visitors.impact = [&three_body, &nbody, policy](const core::ImpactRecord& impact) {
+    if (!policy.keeps(impact.index)) return;
+    if (impact.model) {
+      three_body.event(impact);
+    } else {
+      nbody.impact(impact);
+    }
   };
   visitors.collapse = [&nbody, policy](const core::Collapse& collapse) {
     if (policy.keepsAfter(collapse.impacts_before)) nbody.collapse(collapse);

@@ -239,7 +239,7 @@ SceneRunResult runScene(const ScenePlan& plan, const SceneRunOptions& options, c
       lab.progress_interval = options.progress_interval;
     }
     result.three_body =
-        runLab(toThreeBodyScene(plan.scene), lab, rotationPrediction(*plan.prediction), visitors.three_body_event);
+        runLab(toThreeBodyScene(plan.scene), lab, rotationPrediction(*plan.prediction), visitors.impact);
     result.simulation = fromThreeBody(*result.three_body);
   } else {
     result.simulation = simulateScene(plan.scene, options, result.prediction, visitors);

@@ -74,16 +74,16 @@ class TableWriter : public RunReportWriter {
          << " collisions\n";
   }
 
-  void event(const core::LabEvent& lab) override {
+  void event(const core::ImpactRecord& impact) override {
     if (!header_written_) writeEventHeader();
-    const core::ImpactEvent& e = lab.event;
-    out_ << padLeft(std::to_string(e.index), 9) << padLeft(core::pairName(e.pair), 5);
-    writeNumber(e.time);
-    writeNumber(e.position);
-    for (double v : e.velocities_after) writeNumber(v);
-    for (double de : e.energy_transfer) writeNumber(de);
-    writeNumber(maxAbsDifference(e.velocities_after, lab.predicted_velocities_after));
-    writeNumber(maxAbsDifference(e.velocities_after, lab.paper_velocities_after));
+    const core::ImpactModelValues& m = *impact.model;
+    out_ << padLeft(std::to_string(impact.index), 9) << padLeft(core::pairName(impact.pair_index), 5);
+    writeNumber(impact.time);
+    writeNumber(impact.position);
+    for (double v : m.velocities_after) writeNumber(v);
+    for (double de : m.energy_transfer) writeNumber(de);
+    writeNumber(maxAbsDifference(m.velocities_after, m.predicted_velocities_after));
+    writeNumber(maxAbsDifference(m.velocities_after, m.paper_velocities_after));
     out_ << "\n";
   }
 
@@ -172,8 +172,8 @@ class JsonWriter : public RunReportWriter {
          << ",\n\"units\": " << jsonText(unitsJson()) << ",\n\"events\": [";
   }
 
-  void event(const core::LabEvent& lab) override {
-    events_.push(lab);
+  void event(const core::ImpactRecord& impact) override {
+    events_.push(impact);
     any_event_ = true;
   }
 
@@ -222,8 +222,8 @@ void writeCsvComments(std::ostream& out, const std::string& prefix, const Json& 
 }
 
 /// One event row, in the columns of kEventCsvHeader.
-void writeEventCsv(TextSink& sink, const core::LabEvent& lab, bool /*first*/) {
-  report_text::writeEventRecordCsv(sink, report_text::eventRecord(lab));
+void writeEventCsv(TextSink& sink, const core::ImpactRecord& impact, bool /*first*/) {
+  report_text::writeEventRecordCsv(sink, report_text::eventRecord(impact));
 }
 
 class CsvWriter : public RunReportWriter {
@@ -245,7 +245,7 @@ class CsvWriter : public RunReportWriter {
     out_ << report_text::kEventCsvHeader << "\n";
   }
 
-  void event(const core::LabEvent& lab) override { events_.push(lab); }
+  void event(const core::ImpactRecord& impact) override { events_.push(impact); }
 
   void end(const core::RunResult& result) override {
     events_.finish();
@@ -332,47 +332,47 @@ Json optionsJson(const core::RunOptions& options) {
               {"precision", "double"}};  // kept for readers of the format: every run is exact
 }
 
-Json eventJson(const core::LabEvent& lab) {
+Json eventJson(const core::ImpactRecord& impact) {
   std::ostringstream text;
   {
     TextSink sink(text);
-    report_text::writeEventJson(sink, lab);
+    report_text::writeEventJson(sink, impact);
   }
   return Json::parse(text.str());
 }
 
 namespace report_text {
 
-EventRecord eventRecord(const core::LabEvent& lab) {
-  const core::ImpactEvent& e = lab.event;
-  const std::size_t p = static_cast<std::size_t>(core::pairIndex(e.pair));
+EventRecord eventRecord(const core::ImpactRecord& impact) {
+  const core::ImpactModelValues& m = *impact.model;
+  const std::size_t p = impact.pair_index;
   EventRecord r;
-  r.index = e.index;
+  r.index = impact.index;
   r.pair_index = p;
-  r.time = e.time;
-  r.position = e.position;
+  r.time = impact.time;
+  r.position = impact.position;
   r.restitution = 1.0;  // the three-body path answers elastic scenes only
-  r.first_moved = p;
-  r.last_moved = p + 1;
+  r.first_moved = impact.first_moved;
+  r.last_moved = impact.last_moved;
   for (std::size_t side = 0; side < 2; ++side) {
-    r.pair_velocities_before[side] = e.velocities_before[p + side];
-    r.pair_velocities_after[side] = e.velocities_after[p + side];
-    r.pair_energy_transfer[side] = e.energy_transfer[p + side];
+    r.pair_velocities_before[side] = m.velocities_before[p + side];
+    r.pair_velocities_after[side] = m.velocities_after[p + side];
+    r.pair_energy_transfer[side] = m.energy_transfer[p + side];
   }
-  r.energy_lost = 0.0;
+  r.energy_lost = impact.energy_lost;
   r.full_state = true;
   r.bodies = 3;
-  r.positions = e.positions.data();
-  r.velocities_before = e.velocities_before.data();
-  r.velocities_after = e.velocities_after.data();
-  r.energy_transfer = e.energy_transfer.data();
-  r.kinetic_energy_after = lab.kinetic_energy_after.data();
-  r.total_energy = e.total_energy;
-  r.total_momentum = e.total_momentum;
-  r.predicted_velocities_after = &lab.predicted_velocities_after;
-  r.predicted_energy_transfer = &lab.predicted_energy_transfer;
-  r.paper_velocities_after = &lab.paper_velocities_after;
-  r.paper_energy_transfer = &lab.paper_energy_transfer;
+  r.positions = m.positions.data();
+  r.velocities_before = m.velocities_before.data();
+  r.velocities_after = m.velocities_after.data();
+  r.energy_transfer = m.energy_transfer.data();
+  r.kinetic_energy_after = m.kinetic_energy_after.data();
+  r.total_energy = m.total_energy;
+  r.total_momentum = m.total_momentum;
+  r.predicted_velocities_after = &m.predicted_velocities_after;
+  r.predicted_energy_transfer = &m.predicted_energy_transfer;
+  r.paper_velocities_after = &m.paper_velocities_after;
+  r.paper_energy_transfer = &m.paper_energy_transfer;
   return r;
 }
 
@@ -544,11 +544,11 @@ void writeEventRecordCsv(TextSink& sink, const EventRecord& r) {
   sink.put('\n');
 }
 
-void writeEventJson(TextSink& sink, const core::LabEvent& lab) { writeEventRecordJson(sink, eventRecord(lab)); }
+void writeEventJson(TextSink& sink, const core::ImpactRecord& impact) { writeEventRecordJson(sink, eventRecord(impact)); }
 
-void writeEventJsonLine(TextSink& sink, const core::LabEvent& lab, bool first) {
+void writeEventJsonLine(TextSink& sink, const core::ImpactRecord& impact, bool first) {
   sink.put(first ? "\n" : ",\n");
-  writeEventJson(sink, lab);
+  writeEventJson(sink, impact);
 }
 
 }  // namespace report_text

@@ -42,9 +42,10 @@ inline std::string padRight(const std::string& text, std::size_t width) {
 /// A double for JSON: never a negative zero (NaN and infinities become null when dumped).
 inline Json number(double value) { return Json(value == 0 ? 0.0 : value); }
 
-/// The record of a three-body event (full state and the model's block from the event).
-/// `positions` etc. point into `lab`, which must outlive the record.
-EventRecord eventRecord(const core::LabEvent& lab);
+/// The record of an impact with a model block (its full state and the model's values).
+/// `positions` etc. point into `impact`, which must outlive the record. Precondition:
+/// impact.model.
+EventRecord eventRecord(const core::ImpactRecord& impact);
 /// The record as one compact JSON object.
 void writeEventRecordJson(TextSink& sink, const EventRecord& record);
 /// The record as one CSV row (with its line break), in the columns of kEventCsvHeader.
@@ -53,11 +54,11 @@ void writeEventRecordCsv(TextSink& sink, const EventRecord& record);
 /// separated by ';'.
 extern const char* const kEventCsvHeader;
 
-/// eventJson(lab) as compact JSON text (its keys in its order, numbers as writeJsonNumber),
+/// eventJson(impact) as compact JSON text (its keys in its order, numbers as writeJsonNumber),
 /// written without building a document.
-void writeEventJson(TextSink& sink, const core::LabEvent& lab);
+void writeEventJson(TextSink& sink, const core::ImpactRecord& impact);
 /// The same as a line of the "events" array: "\n" before the first event, ",\n" before others.
-void writeEventJsonLine(TextSink& sink, const core::LabEvent& lab, bool first);
+void writeEventJsonLine(TextSink& sink, const core::ImpactRecord& impact, bool first);
 
 }  // namespace report_text
 }  // namespace io

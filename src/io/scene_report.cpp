@@ -56,6 +56,10 @@ EventRecord SceneEventState::impact(const core::ImpactRecord& impact) {
   }
   r.energy_lost = impact.energy_lost;
   replay_.apply(impact);
+  if (impact.model) {
+    fillFromModel(r, *impact.model);
+    return r;
+  }
   fill(r);
   if (full_state_ && !r.cluster_impact) {
     // Two single bodies: their entries are the engine's gains, as the pair's fields.
@@ -63,6 +67,24 @@ EventRecord SceneEventState::impact(const core::ImpactRecord& impact) {
     gain_[left] = r.pair_energy_transfer[1];
   }
   return r;
+}
+
+void SceneEventState::fillFromModel(EventRecord& r, const core::ImpactModelValues& m) {
+  const std::size_t p = r.pair_index;
+  for (std::size_t side = 0; side < 2; ++side) r.pair_energy_transfer[side] = m.energy_transfer[p + side];
+  r.full_state = true;
+  r.bodies = m.positions.size();
+  r.positions = m.positions.data();
+  r.velocities_before = m.velocities_before.data();
+  r.velocities_after = m.velocities_after.data();
+  r.energy_transfer = m.energy_transfer.data();
+  r.kinetic_energy_after = m.kinetic_energy_after.data();
+  r.total_energy = m.total_energy;
+  r.total_momentum = m.total_momentum;
+  r.predicted_velocities_after = &m.predicted_velocities_after;
+  r.predicted_energy_transfer = &m.predicted_energy_transfer;
+  r.paper_velocities_after = &m.paper_velocities_after;
+  r.paper_energy_transfer = &m.paper_energy_transfer;
 }
 
 EventRecord SceneEventState::collapse(const core::Collapse& collapse) {
@@ -553,7 +575,7 @@ class ThreeBodyModelWriter : public RunReportWriter {
          << ",\n\"units\": " << jsonText(unitsJson()) << ",\n\"events\": [";
   }
 
-  void event(const core::LabEvent& event) override {
+  void event(const core::ImpactRecord& event) override {
     if (format_ != ReportFormat::kJson) return inner_->event(event);
     events_->push(event);
     any_event_ = true;
@@ -652,7 +674,7 @@ void writeSceneBatchJson(const std::vector<SceneBatchOutcome>& outcomes, std::os
     entry["options"] = optionsJson(outcome.options);
     entry["events"] = Json::array();
     if (r.three_body) {
-      for (const core::LabEvent& lab : r.three_body->events) entry["events"].push_back(eventJson(lab));
+      for (const core::ImpactRecord& impact : r.three_body->events) entry["events"].push_back(eventJson(impact));
       entry["summary"] = summaryJson(*r.three_body);
       entry["summary"]["model"] = core::modelKindName(r.model.kind);
       entry["summary"]["model_reason"] = r.model.reason;

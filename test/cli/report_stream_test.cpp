@@ -48,23 +48,23 @@ bool samePrinted(double printed, double core_value) {
 const std::vector<std::size_t> kImpactNumberColumns = {5, 6, 7, 11, 12, 13, 14, 15, 16, 17, 18, 19,
                                                        20, 21, 22, 23, 24, 25, 26, 27, 28};
 
-std::vector<double> csvRowValues(const core::LabEvent& lab) {
-  const core::ImpactEvent& e = lab.event;
-  const std::size_t p = core::pairIndex(e.pair);
-  std::vector<double> values = {e.time, e.position, 1.0};  // restitution: elastic
-  for (const auto* group : {&e.velocities_before, &e.velocities_after, &e.energy_transfer}) {
+std::vector<double> csvRowValues(const core::ImpactRecord& impact) {
+  const core::ImpactModelValues& m = *impact.model;
+  const std::size_t p = impact.pair_index;
+  std::vector<double> values = {impact.time, impact.position, 1.0};  // restitution: elastic
+  for (const auto* group : {&m.velocities_before, &m.velocities_after, &m.energy_transfer}) {
     values.push_back((*group)[p]);
     values.push_back((*group)[p + 1]);
   }
   values.push_back(0.0);  // energy lost
-  for (const auto* group : {&e.positions, &e.velocities_before, &e.velocities_after, &e.energy_transfer,
-                            &lab.kinetic_energy_after}) {
+  for (const auto* group : {&m.positions, &m.velocities_before, &m.velocities_after, &m.energy_transfer,
+                            &m.kinetic_energy_after}) {
     values.insert(values.end(), group->begin(), group->end());
   }
-  values.push_back(e.total_energy);
-  values.push_back(e.total_momentum);
-  for (const auto* group : {&lab.predicted_velocities_after, &lab.predicted_energy_transfer,
-                            &lab.paper_velocities_after, &lab.paper_energy_transfer}) {
+  values.push_back(m.total_energy);
+  values.push_back(m.total_momentum);
+  for (const auto* group : {&m.predicted_velocities_after, &m.predicted_energy_transfer,
+                            &m.paper_velocities_after, &m.paper_energy_transfer}) {
     values.insert(values.end(), group->begin(), group->end());
   }
   return values;
@@ -93,7 +93,7 @@ std::string report(const LabRun& run, io::ReportFormat format, bool with_model) 
   const auto writer = with_model ? io::makeThreeBodyReportWriter(format, out, core::chooseModel(scene))
                                  : io::makeRunReportWriter(format, out);
   writer->begin(run.named, run.options);
-  for (const core::LabEvent& event : run.result.events) writer->event(event);
+  for (const core::ImpactRecord& event : run.result.events) writer->event(event);
   writer->end(run.result);
   return out.str();
 }
@@ -122,7 +122,7 @@ std::vector<double> csvNumbers(const std::vector<std::string>& fields, const std
   return values;
 }
 
-void expectCsvCarriesEvents(const std::string& text, const std::vector<core::LabEvent>& events) {
+void expectCsvCarriesEvents(const std::string& text, const std::vector<core::ImpactRecord>& events) {
   std::istringstream in(text);
   std::string line;
   std::size_t row = 0;
@@ -135,12 +135,12 @@ void expectCsvCarriesEvents(const std::string& text, const std::vector<core::Lab
       continue;
     }
     ASSERT_LT(row, events.size());
-    const core::LabEvent& lab = events[row++];
+    const core::ImpactRecord& lab = events[row++];
     const std::vector<std::string> fields = split(line, ',');
     ASSERT_EQ(fields.size(), 29u) << line;
     ASSERT_EQ(fields[0], "impact");
-    ASSERT_EQ(fields[1], std::to_string(lab.event.index));
-    ASSERT_EQ(fields[2], core::pairName(lab.event.pair));
+    ASSERT_EQ(fields[1], std::to_string(lab.index));
+    ASSERT_EQ(fields[2], core::pairName(lab.pair_index));
     const std::vector<double> expected = csvRowValues(lab);
     const std::vector<double> printed = csvNumbers(fields, kImpactNumberColumns);
     ASSERT_EQ(printed.size(), expected.size()) << line;
@@ -222,9 +222,9 @@ void expectJsonEvents(const std::string& text, const std::vector<io::Json>& expe
   }
 }
 
-void expectJsonCarriesEvents(const std::string& text, const std::vector<core::LabEvent>& events) {
+void expectJsonCarriesEvents(const std::string& text, const std::vector<core::ImpactRecord>& events) {
   std::vector<io::Json> expected;
-  for (const core::LabEvent& event : events) expected.push_back(io::eventJson(event));
+  for (const core::ImpactRecord& event : events) expected.push_back(io::eventJson(event));
   expectJsonEvents(text, expected);
 }
 
@@ -343,19 +343,19 @@ TEST(ReportStream, NBodyImpactsAndCollapsesCarryTheEngineValues) {
 // ---- A failure on a report thread (src/io/event_pipeline.h) ----
 
 /// Writes each event's time as a line, and throws at time 2500.
-void formatOrThrow(io::TextSink& sink, const core::LabEvent& lab, bool) {
-  if (lab.event.time == 2500) throw std::runtime_error("injected failure at t = 2500");
-  sink.count(static_cast<std::uint64_t>(lab.event.time));
+void formatOrThrow(io::TextSink& sink, const core::ImpactRecord& lab, bool) {
+  if (lab.time == 2500) throw std::runtime_error("injected failure at t = 2500");
+  sink.count(static_cast<std::uint64_t>(lab.time));
   sink.put('\n');
 }
 
 TEST(EventPipeline, AWorkerFailureIsReportedByFinishAndTheRunGoesOn) {
   std::ostringstream out;
   io::EventPipeline pipeline(out, formatOrThrow);
-  core::LabEvent lab;
+  core::ImpactRecord lab;
   // 10 blocks of 1024 events: the run's pushes must not wait for ever behind the failed one.
   for (int i = 0; i < 10240; ++i) {
-    lab.event.time = i;
+    lab.time = i;
     pipeline.push(lab);
   }
   try {

@@ -72,15 +72,16 @@ class Player {
     prediction.header.stamp = start;
     prediction.timeline_scale = kScale;
     queue(prediction_, prediction);
+    SceneEventConverter converter(plan.scene);
     for (const auto& e : result.events) {
-      auto msg = toCollisionEventMsg(e);
+      auto msg = converter.impact(e);
       msg.run_id = run_id;
-      msg.header.stamp = start + ros::Duration(kScale * e.event.time);
+      msg.header.stamp = start + ros::Duration(kScale * e.time);
       queue(events_, msg);
     }
     auto summary = toRunSummaryMsg(run, 3, collision_lab::core::RunMode::kFull);
     summary.run_id = run_id;
-    summary.header.stamp = start + ros::Duration(kScale * result.events.back().event.time);
+    summary.header.stamp = start + ros::Duration(kScale * result.events.back().time);
     queue(summary_, summary);
   }
 

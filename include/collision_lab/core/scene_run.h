@@ -124,8 +124,9 @@ struct ScenePlan {
 
 /// What runScene calls back. Each may be empty.
 struct SceneVisitors {
-  LabEventVisitor three_body_event;  ///< every event of the three-body path (full mode)
-  ImpactVisitor impact;              ///< every impact of the event engine (full mode)
+  /// Every impact (full mode), in order; a model that answers impact by impact (the
+  /// rotation model) fills its block (ImpactRecord::model).
+  ImpactVisitor impact;
   /// Every collapse the event engine resolves (full mode), in order with the impacts
   /// (CollapseVisitor: right after the record of impact impacts_before).
   CollapseVisitor collapse;

@@ -44,9 +44,10 @@ Json sceneJson(const NamedScene& scene);
 /// max_collisions, events, mode, and "precision": always "double", kept for readers of the
 /// format (every run is exact; --precision was removed).
 Json optionsJson(const core::RunOptions& options);
-/// One event in the one event record of every scene (docs/cli.md "Events"): the
-/// simulation's full state, the closed-form prediction and the paper's printed values.
-Json eventJson(const core::LabEvent& event);
+/// One impact with a model block in the one event record of every scene (docs/cli.md
+/// "Events"): the simulation's full state, the closed-form prediction and the paper's
+/// printed values. Precondition: impact.model.
+Json eventJson(const core::ImpactRecord& impact);
 /// The summary of a run next to its predictions (see docs/cli_section.md for the keys).
 Json summaryJson(const core::RunResult& result);
 /// {"error": {"reason", "code", "field", "message"}}.
@@ -58,7 +59,7 @@ class RunReportWriter {
  public:
   virtual ~RunReportWriter() = default;
   virtual void begin(const NamedScene& scene, const core::RunOptions& options) = 0;
-  virtual void event(const core::LabEvent& event) = 0;
+  virtual void event(const core::ImpactRecord& event) = 0;
   virtual void end(const core::RunResult& result) = 0;
 };
 
