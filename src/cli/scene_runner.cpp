@@ -140,7 +140,7 @@ void writeEntry(const CliRequest& request, const io::SceneEntry& given, std::ost
   const core::SceneRunResult result = runShown(plan, run, request.simulate_to_cap, visitors, cancel, progress_line);
   if (temperature) temperature->finish();
   if (is_three_body) {
-    three_body->end(*result.three_body);
+    three_body->end(result);
   } else {
     nbody->end(result);
   }

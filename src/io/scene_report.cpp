@@ -581,7 +581,7 @@ class ThreeBodyModelWriter : public RunReportWriter {
     any_event_ = true;
   }
 
-  void end(const core::RunResult& result) override {
+  void end(const core::SceneRunResult& result) override {
     if (format_ == ReportFormat::kJson) {
       events_->finish();
       Json summary = summaryJson(result);
@@ -622,13 +622,6 @@ struct BatchRow {
 BatchRow batchRow(const SceneBatchOutcome& outcome) {
   const core::SceneRunResult& r = outcome.result;
   BatchRow row{outcome.entry.name, core::modelKindName(r.model.kind), outcome.entry.scene.size(), "-", "-", false, 0.0};
-  if (r.three_body) {
-    const core::LabRunSummary& s = r.three_body->summary;
-    row.simulated = std::to_string(s.collision_count);
-    row.predicted = std::to_string(r.three_body->prediction.collision_count);
-    row.truncated = s.truncated;
-    return row;
-  }
   const core::SceneSimulation& s = r.simulation;
   if (s.simulated || (r.prediction && r.prediction->impact_count)) row.simulated = std::to_string(s.impact_count);
   if (r.prediction && r.prediction->infinite) row.predicted = "inf";
@@ -670,33 +663,35 @@ void writeSceneBatchJson(const std::vector<SceneBatchOutcome>& outcomes, std::os
   for (const auto& outcome : outcomes) {
     const core::SceneRunResult& r = outcome.result;
     Json entry;
-    entry["scene"] = r.three_body ? sceneJson(toNamedScene(outcome.entry)) : sceneEntryJson(outcome.entry);
+    // A run whose prediction carries the rotation model's values has the three-body
+    // report's scene and summary.
+    const bool rotation = r.prediction && core::hasRotationValues(*r.prediction);
+    entry["scene"] = rotation ? sceneJson(toNamedScene(outcome.entry)) : sceneEntryJson(outcome.entry);
     entry["options"] = optionsJson(outcome.options);
     entry["events"] = Json::array();
-    if (r.three_body) {
-      for (const core::ImpactRecord& impact : r.three_body->events) entry["events"].push_back(eventJson(impact));
-      entry["summary"] = summaryJson(*r.three_body);
+    // The kept impacts, each collapse after the impact it follows (as the stream shows
+    // them); every collapse before the last kept impact updates the bodies' state.
+    SceneEventJson records(outcome.entry.scene);
+    std::size_t next_collapse = 0;
+    const auto collapsesUpTo = [&](std::uint64_t impacts) {
+      for (; next_collapse < r.simulation.collapses.size() &&
+             r.simulation.collapses[next_collapse].impacts_before <= impacts;
+           ++next_collapse) {
+        const core::Collapse& c = r.simulation.collapses[next_collapse];
+        Json json = records.collapse(c);
+        if (outcome.options.events.keepsAfter(c.impacts_before)) entry["events"].push_back(std::move(json));
+      }
+    };
+    for (const core::ImpactRecord& impact : r.simulation.impacts) {
+      collapsesUpTo(impact.index - 1);
+      entry["events"].push_back(records.impact(impact));
+    }
+    collapsesUpTo(r.simulation.impact_count);
+    if (rotation) {
+      entry["summary"] = summaryJson(r);
       entry["summary"]["model"] = core::modelKindName(r.model.kind);
       entry["summary"]["model_reason"] = r.model.reason;
     } else {
-      // The kept impacts, each collapse after the impact it follows (as the stream shows
-      // them); every collapse before the last kept impact updates the bodies' state.
-      SceneEventJson records(outcome.entry.scene);
-      std::size_t next_collapse = 0;
-      const auto collapsesUpTo = [&](std::uint64_t impacts) {
-        for (; next_collapse < r.simulation.collapses.size() &&
-               r.simulation.collapses[next_collapse].impacts_before <= impacts;
-             ++next_collapse) {
-          const core::Collapse& c = r.simulation.collapses[next_collapse];
-          Json json = records.collapse(c);
-          if (outcome.options.events.keepsAfter(c.impacts_before)) entry["events"].push_back(std::move(json));
-        }
-      };
-      for (const core::ImpactRecord& impact : r.simulation.impacts) {
-        collapsesUpTo(impact.index - 1);
-        entry["events"].push_back(records.impact(impact));
-      }
-      collapsesUpTo(r.simulation.impact_count);
       entry["summary"] = sceneSummaryJson(r);
     }
     out << (first ? "\n" : ",\n") << jsonText(entry);

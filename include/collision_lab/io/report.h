@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "collision_lab/core/lab_run.h"
+#include "collision_lab/core/scene_run.h"
 #include "collision_lab/io/scenario_file.h"
 
 namespace collision_lab {
@@ -48,8 +49,12 @@ Json optionsJson(const core::RunOptions& options);
 /// "Events"): the simulation's full state, the closed-form prediction and the paper's
 /// printed values. Precondition: impact.model.
 Json eventJson(const core::ImpactRecord& impact);
-/// The summary of a run next to its predictions (see docs/cli_section.md for the keys).
-Json summaryJson(const core::RunResult& result);
+/// The summary of a run next to its predictions (see docs/cli_section.md for the keys), for
+/// a run whose prediction carries the rotation model's values (core::hasRotationValues).
+/// "escalation.decisions": one sign decision per impact and a final one (0 when not
+/// simulated); "high_precision" counts the decisions taken at 100 digits or more, the
+/// exact ones ("exact_rational") among them.
+Json summaryJson(const core::SceneRunResult& result);
 /// {"error": {"reason", "code", "field", "message"}}.
 Json errorJson(const std::string& reason, int code, const std::string& field, const std::string& message);
 
@@ -60,7 +65,7 @@ class RunReportWriter {
   virtual ~RunReportWriter() = default;
   virtual void begin(const NamedScene& scene, const core::RunOptions& options) = 0;
   virtual void event(const core::ImpactRecord& event) = 0;
-  virtual void end(const core::RunResult& result) = 0;
+  virtual void end(const core::SceneRunResult& result) = 0;
 };
 
 std::unique_ptr<RunReportWriter> makeRunReportWriter(ReportFormat format, std::ostream& out);
