@@ -14,12 +14,31 @@
 #include "collision_lab/core/nbody/engine.h"
 #include "collision_lab/core/nbody/scene.h"
 
+#include <memory>
+#include <ostream>
+
 #include "collision_lab/io/event_record.h"  // EventRecord, SceneEventState
 #include "collision_lab/io/report.h"  // Json
 #include "text_sink.h"
 
 namespace collision_lab {
 namespace io {
+
+/// The layout of a run whose prediction carries the rotation model's values
+/// (core::hasRotationValues): its scene, event table and summary beside the closed form and
+/// the paper's values (docs/cli.md). The scene report (scene_report.h) writes through it for
+/// such a run: begin(), then event() for each event to show, then end(); nothing is kept per
+/// event.
+class RunReportWriter {
+ public:
+  virtual ~RunReportWriter() = default;
+  virtual void begin(const NamedScene& scene, const core::RunOptions& options) = 0;
+  virtual void event(const core::ImpactRecord& event) = 0;
+  virtual void end(const core::SceneRunResult& result) = 0;
+};
+
+std::unique_ptr<RunReportWriter> makeRunReportWriter(ReportFormat format, std::ostream& out);
+
 namespace report_text {
 
 /// Compact text for people, `digits` significant digits; -0 is shown as 0, any NaN as nan.

@@ -227,7 +227,18 @@ void writeBodyRows(std::ostream& out, std::size_t n, const std::vector<std::stri
   }
 }
 
-class SceneTableWriter : public SceneReportWriter {
+/// The layout of one scene's report in one format (the scene report of every run whose
+/// prediction has no rotation values): SceneReportWriter's calls, the model given.
+class SceneLayout {
+ public:
+  virtual ~SceneLayout() = default;
+  virtual void begin(const SceneEntry& entry, const core::RunOptions& options, const core::ModelChoice& model) = 0;
+  virtual void impact(const core::ImpactRecord& impact) = 0;
+  virtual void collapse(const core::Collapse& collapse) = 0;
+  virtual void end(const core::SceneRunResult& result) = 0;
+};
+
+class SceneTableWriter : public SceneLayout {
  public:
   explicit SceneTableWriter(std::ostream& out) : out_(out) {}
 
@@ -441,7 +452,7 @@ void writeSummaryJson(std::ostream& out, const core::SceneRunResult& result) {
   out << "}";
 }
 
-class SceneJsonWriter : public SceneReportWriter {
+class SceneJsonWriter : public SceneLayout {
  public:
   explicit SceneJsonWriter(std::ostream& out) : out_(out), sink_(out) {}
 
@@ -512,7 +523,7 @@ void writeCsvNumbers(std::ostream& out, const char* key, const std::vector<doubl
   out << "\n";
 }
 
-class SceneCsvWriter : public SceneReportWriter {
+class SceneCsvWriter : public SceneLayout {
  public:
   explicit SceneCsvWriter(std::ostream& out) : out_(out), sink_(out) {}
 
@@ -556,7 +567,9 @@ class SceneCsvWriter : public SceneReportWriter {
 };
 
 // ---------------------------------------------------------------------------------------
-// Three-body reports with the model.
+// The layout of a run with the rotation model's values, with the model stated: the JSON
+// summary gets "model" and "model_reason", CSV two "# summary.model..." lines, the table a
+// "model:" line.
 
 class ThreeBodyModelWriter : public RunReportWriter {
  public:
@@ -739,7 +752,9 @@ Json sceneSummaryJson(const core::SceneRunResult& result) {
   return json;
 }
 
-std::unique_ptr<SceneReportWriter> makeSceneReportWriter(ReportFormat format, std::ostream& out) {
+namespace {
+
+std::unique_ptr<SceneLayout> makeSceneLayout(ReportFormat format, std::ostream& out) {
   switch (format) {
     case ReportFormat::kJson: return std::make_unique<SceneJsonWriter>(out);
     case ReportFormat::kCsv: return std::make_unique<SceneCsvWriter>(out);
@@ -748,9 +763,52 @@ std::unique_ptr<SceneReportWriter> makeSceneReportWriter(ReportFormat format, st
   return std::make_unique<SceneTableWriter>(out);
 }
 
-std::unique_ptr<RunReportWriter> makeThreeBodyReportWriter(ReportFormat format, std::ostream& out,
-                                                           const core::ModelChoice& model) {
-  return std::make_unique<ThreeBodyModelWriter>(format, out, model);
+/// The one scene report: the layout chosen in begin() by what the plan's prediction holds.
+/// Every event is handed on as it is, its model block with it.
+class SceneReport : public SceneReportWriter {
+ public:
+  SceneReport(ReportFormat format, std::ostream& out) : format_(format), out_(out) {}
+
+  void begin(const SceneEntry& entry, const core::RunOptions& options, const core::ModelChoice& model,
+             const std::optional<core::Prediction>& prediction) override {
+    if (prediction && core::hasRotationValues(*prediction)) {
+      rotation_ = std::make_unique<ThreeBodyModelWriter>(format_, out_, model);
+      rotation_->begin(toNamedScene(entry), options);
+    } else {
+      scene_ = makeSceneLayout(format_, out_);
+      scene_->begin(entry, options, model);
+    }
+  }
+  void impact(const core::ImpactRecord& impact) override {
+    if (rotation_) {
+      rotation_->event(impact);
+    } else {
+      scene_->impact(impact);
+    }
+  }
+  /// Elastic runs (those with rotation values) have none.
+  void collapse(const core::Collapse& collapse) override {
+    if (scene_) scene_->collapse(collapse);
+  }
+  void end(const core::SceneRunResult& result) override {
+    if (rotation_) {
+      rotation_->end(result);
+    } else {
+      scene_->end(result);
+    }
+  }
+
+ private:
+  ReportFormat format_;
+  std::ostream& out_;
+  std::unique_ptr<RunReportWriter> rotation_;  ///< from begin(), with rotation values
+  std::unique_ptr<SceneLayout> scene_;         ///< from begin(), otherwise
+};
+
+}  // namespace
+
+std::unique_ptr<SceneReportWriter> makeSceneReportWriter(ReportFormat format, std::ostream& out) {
+  return std::make_unique<SceneReport>(format, out);
 }
 
 void writeSceneBatchReport(ReportFormat format, const std::vector<SceneBatchOutcome>& outcomes, std::ostream& out) {

@@ -23,6 +23,7 @@
 #include "collision_lab/io/report.h"
 #include "collision_lab/io/scene_report.h"
 #include "event_pipeline.h"
+#include "report_text.h"
 
 namespace {
 
@@ -72,37 +73,43 @@ std::vector<double> csvRowValues(const core::ImpactRecord& impact) {
 
 struct LabRun {
   io::NamedScene named;
+  core::Scene result_scene;
   core::RunOptions options;
   core::SceneRunResult result;
   const std::vector<core::ImpactRecord>& events() const { return result.simulation.impacts; }
 };
 
 LabRun runScene(const core::ThreeBodyScene& scene) {
-  LabRun run{{"stream", "", scene}, {}, {}};
+  LabRun run{{"stream", "", scene},
+             {{scene.masses.begin(), scene.masses.end()},
+              {scene.positions.begin(), scene.positions.end()},
+              {scene.velocities.begin(), scene.velocities.end()},
+              {}},
+             {},
+             {}};
   run.options.events = core::EventPolicy::all();
   core::SceneRunOptions options;
   options.lab = run.options;
-  run.result = core::runScene(
-      core::planScene({{scene.masses.begin(), scene.masses.end()},
-                       {scene.positions.begin(), scene.positions.end()},
-                       {scene.velocities.begin(), scene.velocities.end()},
-                       {}}),
-      options);
+  run.result = core::runScene(core::planScene(run.result_scene), options);
   return run;
 }
 
-/// The report as the CLI writes it (with the model) or as report.h's plain writer does.
+/// The report as the CLI writes it (the scene report, which states the model) or as its
+/// three-body layout alone does (report_text.h).
 std::string report(const LabRun& run, io::ReportFormat format, bool with_model) {
   std::ostringstream out;
-  const core::Scene scene{{run.named.scene.masses.begin(), run.named.scene.masses.end()},
-                          {run.named.scene.positions.begin(), run.named.scene.positions.end()},
-                          {run.named.scene.velocities.begin(), run.named.scene.velocities.end()},
-                          {}};
-  const auto writer = with_model ? io::makeThreeBodyReportWriter(format, out, core::chooseModel(scene))
-                                 : io::makeRunReportWriter(format, out);
-  writer->begin(run.named, run.options);
-  for (const core::ImpactRecord& event : run.events()) writer->event(event);
-  writer->end(run.result);
+  if (with_model) {
+    const io::SceneEntry entry{run.named.name, run.named.description, run.result_scene, 0};
+    const auto writer = io::makeSceneReportWriter(format, out);
+    writer->begin(entry, run.options, run.result.model, run.result.prediction);
+    for (const core::ImpactRecord& event : run.events()) writer->impact(event);
+    writer->end(run.result);
+  } else {
+    const auto writer = io::makeRunReportWriter(format, out);
+    writer->begin(run.named, run.options);
+    for (const core::ImpactRecord& event : run.events()) writer->event(event);
+    writer->end(run.result);
+  }
   return out.str();
 }
 
@@ -285,8 +292,9 @@ SceneReports sceneReports(const core::Scene& scene) {
   const core::ModelChoice model = core::chooseModel(scene);
   const auto csv_writer = io::makeSceneReportWriter(io::ReportFormat::kCsv, csv);
   const auto json_writer = io::makeSceneReportWriter(io::ReportFormat::kJson, json);
-  csv_writer->begin(entry, options.lab, model);
-  json_writer->begin(entry, options.lab, model);
+  const core::ScenePlan plan = core::planScene(scene);
+  csv_writer->begin(entry, options.lab, model, plan.prediction);
+  json_writer->begin(entry, options.lab, model, plan.prediction);
   io::SceneEventJson records(scene);
   core::SceneVisitors visitors;
   visitors.impact = [&](const core::ImpactRecord& r) {

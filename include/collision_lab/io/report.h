@@ -58,17 +58,5 @@ Json summaryJson(const core::SceneRunResult& result);
 /// {"error": {"reason", "code", "field", "message"}}.
 Json errorJson(const std::string& reason, int code, const std::string& field, const std::string& message);
 
-/// Writes the report of one run while it runs, so that millions of events need no memory:
-/// begin(), then event() for each event to show, then end().
-class RunReportWriter {
- public:
-  virtual ~RunReportWriter() = default;
-  virtual void begin(const NamedScene& scene, const core::RunOptions& options) = 0;
-  virtual void event(const core::ImpactRecord& event) = 0;
-  virtual void end(const core::SceneRunResult& result) = 0;
-};
-
-std::unique_ptr<RunReportWriter> makeRunReportWriter(ReportFormat format, std::ostream& out);
-
 }  // namespace io
 }  // namespace collision_lab
