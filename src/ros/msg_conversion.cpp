@@ -4,7 +4,6 @@
 #include <cmath>
 #include <limits>
 
-#include "collision_lab/core/wedge.h"
 
 namespace collision_lab_ros {
 
@@ -209,10 +208,6 @@ void fillPredictionMsg(const core::ScenePlan& plan, collision_lab::Prediction& m
   msg.critical_restitution = valueOr(p.critical_restitution);
   msg.spiral_angle = valueOr(p.spiral_angle);
   msg.alpha = valueOr(p.alpha);
-  if (plan.model.kind == core::ModelKind::kThreeBodySpiral) {  // the opening angle of the three masses
-    const std::vector<double>& m = plan.scene.masses;
-    msg.alpha = core::alphaOf<double>({m[0], m[1], m[2]});
-  }
 }
 
 namespace {

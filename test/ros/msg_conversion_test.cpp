@@ -544,6 +544,17 @@ TEST(MsgConversion, RunSummaryPhysicsFields) {
   EXPECT_EQ(msg.mode, collision_lab::InitialConditions::MODE_FULL);
 }
 
+// The spiral's opening angle is its prediction's (the core's), copied like every field
+// (failed before: the prediction had none and the conversion computed it for that model).
+TEST(MsgConversion, TheSpiralsOpeningAngleComesFromItsPrediction) {
+  const collision_lab::core::ScenePlan plan = collision_lab::core::planScene({{1, 1, 1}, {2, 1, 0}, {-1, 0, 0.5}, {0.5}});
+  ASSERT_FALSE(plan.error);
+  ASSERT_EQ(plan.model.kind, collision_lab::core::ModelKind::kThreeBodySpiral);
+  ASSERT_TRUE(plan.prediction && plan.prediction->alpha);
+  EXPECT_NEAR(*plan.prediction->alpha, M_PI / 3, 1e-15);  // equal masses: alpha = pi/3
+  EXPECT_EQ(toPredictionMsg(plan).alpha, *plan.prediction->alpha);
+}
+
 TEST(MsgConversion, ThreeEqualMassesTakeTheOnePathToThreeImpacts) {
   // Three equal masses, the outer ones approaching the middle one: 3 impacts (shared/physics.md),
   // the outer velocities exchanged; the rotation model answers, and its block rides along.
