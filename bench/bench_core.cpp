@@ -173,7 +173,7 @@ SceneFigures benchScene(double heavy, int repeats, bool keep_all, bool lab_only 
                        });
     methods.emplace_back("core, every event visited", [&] {
                          std::uint64_t seen = 0;
-                         const auto result = runLab(scene, full_run, [&](const LabEvent&) { ++seen; });
+                         const auto result = runLab(scene, full_run, [&](const ImpactRecord&) { ++seen; });
                          doNotOptimize(seen);
                          return result.summary.collision_count;
                        });

@@ -151,14 +151,15 @@ void checkSimulation(const cl::ThreeBodyScene& scene, const cl::RunResult& run, 
   if (!sim.truncated) checkEscaped(sim.final_velocities, velocityScales(scene), engineTolerance(sim.collision_count));
   std::uint64_t index = 0;
   double time = 0.0;
-  for (const cl::LabEvent& lab : run.events) {
-    const cl::ImpactEvent& event = lab.event;
+  for (const cl::ImpactRecord& event : run.events) {
     FUZZ_CHECK(event.index == ++index, "events numbered 1, 2, ...");
-    FUZZ_CHECK(allFinite(event.velocities_after), "finite event velocities");
-    FUZZ_CHECK(event.pair == ((index % 2 == 1) ? *prediction.first_pair : cl::otherPair(*prediction.first_pair)),
+    FUZZ_CHECK(event.model.has_value(), "every event has its model block");
+    FUZZ_CHECK(allFinite(event.model->velocities_after), "finite event velocities");
+    const cl::Pair pair = (index % 2 == 1) ? *prediction.first_pair : cl::otherPair(*prediction.first_pair);
+    FUZZ_CHECK(event.pair_index == static_cast<std::size_t>(cl::pairIndex(pair)),
                "pairs alternate from the predicted first pair");
     FUZZ_CHECK(std::isfinite(event.time) && event.time >= time, "event times finite and non-decreasing");
-    FUZZ_CHECK(allFinite(event.positions), "finite event positions");
+    FUZZ_CHECK(allFinite(event.model->positions), "finite event positions");
     time = event.time;
   }
 }
@@ -261,8 +262,8 @@ int collisionLabCoreFuzzOne(const std::uint8_t* data, std::size_t size) {
   const bool slow_path = watched || events == 1;
   options.max_collisions = std::min({cap, slow_path ? kSlowPathCap : cap, known_issue_cap});
   std::uint64_t watched_events = 0;
-  cl::LabEventVisitor watch;
-  if (watched) watch = [&watched_events](const cl::LabEvent&) { ++watched_events; };
+  cl::ImpactVisitor watch;
+  if (watched) watch = [&watched_events](const cl::ImpactRecord&) { ++watched_events; };
   const cl::RunResult sim = cl::runLab(scene, options, watch);
   checkSimulation(scene, sim, prediction, options.max_collisions);
   if (watched) FUZZ_CHECK(watched_events == sim.summary.collision_count, "the visitor sees every impact");

@@ -86,20 +86,16 @@ core::SceneRunResult runShown(const core::ScenePlan& plan, const core::RunOption
   return core::runScene(plan, options, visitors);
 }
 
-/// The visitors that hand the shown events to the writer of their path.
-core::SceneVisitors showEvents(const core::RunOptions& shown, io::RunReportWriter& three_body,
-                               io::SceneReportWriter& nbody) {
+/// The visitors that hand the shown events to the report.
+core::SceneVisitors showEvents(const core::RunOptions& shown, io::SceneReportWriter& report) {
   core::SceneVisitors visitors;
   if (shown.events.kind == core::EventPolicy::Kind::kNone) return visitors;
   const core::EventPolicy policy = shown.events;
-  visitors.three_body_event = [&three_body, policy](const core::LabEvent& event) {
-    if (policy.keeps(event.event.index)) three_body.event(event);
+  visitors.impact = [&report, policy](const core::ImpactRecord& impact) {
+    if (policy.keeps(impact.index)) report.impact(impact);
   };
-  visitors.impact = [&nbody, policy](const core::ImpactRecord& impact) {
-    if (policy.keeps(impact.index)) nbody.impact(impact);
-  };
-  visitors.collapse = [&nbody, policy](const core::Collapse& collapse) {
-    if (policy.keepsAfter(collapse.impacts_before)) nbody.collapse(collapse);
+  visitors.collapse = [&report, policy](const core::Collapse& collapse) {
+    if (policy.keepsAfter(collapse.impacts_before)) report.collapse(collapse);
   };
   // The event engine runs to the end even when only the first N impacts are shown.
   return visitors;
@@ -117,17 +113,9 @@ void writeEntry(const CliRequest& request, const io::SceneEntry& given, std::ost
   std::optional<TemperatureCsv> temperature;  // opened before any report: a bad path is bad input
   if (request.temperature_csv) temperature.emplace(*request.temperature_csv, entry.scene);
   const core::RunOptions shown = optionsFor(request, entry);
-  const auto three_body = io::makeThreeBodyReportWriter(request.format, out, plan.model);
-  const auto nbody = io::makeSceneReportWriter(request.format, out);
-  // The three-body model's extras (its prediction, the closed form at each impact) have
-  // their report; every other scene the scene report.
-  const bool is_three_body = plan.prediction && core::hasRotationValues(*plan.prediction);
-  if (is_three_body) {
-    three_body->begin(io::toNamedScene(entry), shown);
-  } else {
-    nbody->begin(entry, shown, plan.model);
-  }
-  core::SceneVisitors visitors = showEvents(shown, *three_body, *nbody);
+  const auto report = io::makeSceneReportWriter(request.format, out);
+  report->begin(entry, shown, plan.model, plan.prediction);
+  core::SceneVisitors visitors = showEvents(shown, *report);
   core::RunOptions run = shown;
   if (temperature) {
     // T(t) needs every impact: the run is simulated even where the closed form alone would
@@ -137,11 +125,7 @@ void writeEntry(const CliRequest& request, const io::SceneEntry& given, std::ost
   }
   const core::SceneRunResult result = runShown(plan, run, request.simulate_to_cap, visitors, cancel, progress_line);
   if (temperature) temperature->finish();
-  if (is_three_body) {
-    three_body->end(*result.three_body);
-  } else {
-    nbody->end(result);
-  }
+  report->end(result);
 }
 
 }  // namespace

@@ -47,19 +47,17 @@ core::SceneVisitors TemperatureCsv::feeding(core::SceneVisitors visitors) {
   const core::ImpactVisitor impact = visitors.impact;
   visitors.impact = [this, impact](const core::ImpactRecord& record) {
     if (impact) impact(record);
-    sampler_.onImpact(record);
+    if (const auto& model = record.model) {  // every body's velocity after it, as the run computed it
+      const auto& v = model->velocities_after;
+      write({record.index, record.time, core::granularTemperature(masses_, {v.begin(), v.end()})});
+    } else {
+      sampler_.onImpact(record);
+    }
   };
   const core::CollapseVisitor collapse = visitors.collapse;
   visitors.collapse = [this, collapse](const core::Collapse& notice) {
     if (collapse) collapse(notice);
     sampler_.onCollapse(notice);
-  };
-  // Three elastic bodies (the rotation model): every event carries all three velocities.
-  const core::LabEventVisitor event = visitors.three_body_event;
-  visitors.three_body_event = [this, event](const core::LabEvent& lab) {
-    if (event) event(lab);
-    const auto& v = lab.event.velocities_after;
-    write({lab.event.index, lab.event.time, core::granularTemperature(masses_, {v.begin(), v.end()})});
   };
   return visitors;
 }

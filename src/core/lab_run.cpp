@@ -89,16 +89,16 @@ class ClosedFormInTurn {
     return sequence_ ? toArray(sequence_->velocitiesAfter(n)) : model_.velocitiesAfter(n);
   }
 
-  void describe(std::uint64_t n, LabEvent& lab) {
+  void describe(std::uint64_t n, ImpactModelValues& values) {
     if (!sequence_) {
-      lab.predicted_velocities_after = model_.velocitiesAfter(n);
-      lab.predicted_energy_transfer = model_.energyTransfer(n);
+      values.predicted_velocities_after = model_.velocitiesAfter(n);
+      values.predicted_energy_transfer = model_.energyTransfer(n);
       return;
     }
     if (n == 0 || n - 1 != last_) previous_ = sequence_->velocitiesAfter(n - 1);
     const Eigen::Vector3d after = sequence_->velocitiesAfter(n);
-    lab.predicted_velocities_after = toArray(after);
-    lab.predicted_energy_transfer = energyTransfer(n);
+    values.predicted_velocities_after = toArray(after);
+    values.predicted_energy_transfer = energyTransfer(n);
     previous_ = after;
     last_ = n;
   }
@@ -194,25 +194,25 @@ void describeNotSimulated(RunResult& result) {
   summary.momentum_relative_drift = kNotMeasured;
 }
 
-/// Simulated collisions beside the closed form and the paper's printed formulas, in turn.
-class LabEvents {
+/// Simulated impacts beside the closed form and the paper's printed formulas, in turn.
+class ModelBesideImpacts {
  public:
-  explicit LabEvents(const ThreeBodyScene& scene, const ClosedForm& model)
+  explicit ModelBesideImpacts(const ThreeBodyScene& scene, const ClosedForm& model)
       : scene_(scene), wall_(scene.wallIndex()), closed_form_(model), paper_(scene), previous_before_(scene.velocities) {}
 
-  /// The next event; `event` is collision previous + 1. The paper's BC energy formulas
-  /// refer to the velocities before the collision before it, which this keeps.
-  void describe(const ImpactEvent& event, LabEvent& lab) {
-    closed_form_.describe(event.index, lab);
-    lab.paper_velocities_after = paper_.velocitiesAfter(event.index);
-    lab.paper_energy_transfer =
-        paper::energyTransfer(scene_, event.index, event.pair, event.velocities_before, previous_before_);
+  /// Fills the model's values of the next impact, collision previous + 1, whose state
+  /// (`values`' velocities) is filled. The paper's BC energy formulas refer to the
+  /// velocities before the collision before it, which this keeps.
+  void describe(std::uint64_t index, Pair pair, ImpactModelValues& values) {
+    closed_form_.describe(index, values);
+    values.paper_velocities_after = paper_.velocitiesAfter(index);
+    values.paper_energy_transfer =
+        paper::energyTransfer(scene_, index, pair, values.velocities_before, previous_before_);
     for (int i = 0; i < 3; ++i) {
-      const double v = event.velocities_after[i];
-      lab.kinetic_energy_after[i] = i == wall_ ? 0.0 : scene_.masses[i] * v * v / 2;
+      const double v = values.velocities_after[i];
+      values.kinetic_energy_after[i] = i == wall_ ? 0.0 : scene_.masses[i] * v * v / 2;
     }
-    previous_before_ = event.velocities_before;
-    lab.event = event;  // last: the engine has only just written it (store forwarding)
+    previous_before_ = values.velocities_before;
   }
 
  private:
@@ -307,16 +307,16 @@ std::optional<SimulationResult> simulateKnownCount(const ThreeBodyScene& scene, 
 }
 
 /// The three bodies' run by the exact event engine (nbody/engine.h), the one simulator of
-/// every scene: exact decisions and correctly rounded values, told as ImpactEvents (the
-/// engine runs in its working units, nbody/units.h, and gives SI values). An impact's pair
-/// comes from the engine's record; the third body's position at that time is computed here
-/// from its last impact (to rounding, in long double), and the totals after it from the
-/// velocities. Escalations: one decision per impact and the final one. A run the engine
+/// every scene: exact decisions and correctly rounded values, told as the engine's records
+/// (the engine runs in its working units, nbody/units.h, and gives SI values) with the
+/// state of every body in their model block (ImpactModelValues): the third body's position
+/// at that time is computed here from its last impact (to rounding, in long double), and the
+/// totals after it from the velocities; the visitor adds the model's values. Escalations: one decision per impact and the final one. A run the engine
 /// ended otherwise than finished, capped or cancelled (out of range: the next impact comes
 /// after the largest double) is truncated, with the engine's sentence in `stopped_otherwise`.
 SimulationResult simulateByEngine(const ThreeBodyScene& scene, const SimulationOptions& options,
                                   const ProgressCallback& progress, std::uint64_t progress_interval,
-                                  const EventVisitor& visitor, std::string& stopped_otherwise) {
+                                  const std::function<void(ImpactRecord&)>& visitor, std::string& stopped_otherwise) {
   EngineOptions engine_options;
   engine_options.max_impacts = options.max_collisions;
   engine_options.progress_interval = progress ? progress_interval : 0;
@@ -327,44 +327,41 @@ SimulationResult simulateByEngine(const ThreeBodyScene& scene, const SimulationO
   std::array<double, 3> velocities{}, since_position = scene.positions, since_time{};
   for (int k = 0; k < 3; ++k) velocities[k] = positive(scene.velocities[k]);
   const int wall = scene.wallIndex();
-  ImpactEvent event;
+  ImpactRecord event;
   ImpactVisitor on_impact;
   if (visitor) {
     on_impact = [&](const ImpactRecord& record) {
       const int i = static_cast<int>(record.pair_index);
-      event.index = record.index;
-      event.pair = i == 0 ? Pair::AB : Pair::BC;
-      event.time = record.time;
-      event.position = record.position;
-      event.velocities_before = velocities;
+      event = record;
+      ImpactModelValues& state = event.model.emplace();
+      state.velocities_before = velocities;
       for (int k = 0; k < 3; ++k) {
         const long double elapsed = static_cast<long double>(record.time) - since_time[k];
         const long double position =
             velocities[k] == 0 ? since_position[k] : since_position[k] + velocities[k] * elapsed;
-        event.positions[k] = positive(position);
-        event.energy_transfer[k] = 0.0;
+        state.positions[k] = positive(position);
       }
       for (int side = 0; side < 2; ++side) {
         const int body = i + side;
         velocities[body] = record.velocities_after[side];
-        event.positions[body] = event.position;
+        state.positions[body] = record.position;
         since_position[body] = record.position;
         since_time[body] = record.time;
       }
       // Elastic: what one body gains the other loses, exactly (a wall's entry is minus the
       // ball's): the finite body's entry, or the left one's, sets both.
       const int side = scene.isWall(i) ? 1 : 0;
-      event.energy_transfer[i + side] = record.energy_gained[side];
-      event.energy_transfer[i + 1 - side] = positive(-static_cast<long double>(record.energy_gained[side]));
-      event.velocities_after = velocities;
+      state.energy_transfer[i + side] = record.energy_gained[side];
+      state.energy_transfer[i + 1 - side] = positive(-static_cast<long double>(record.energy_gained[side]));
+      state.velocities_after = velocities;
       long double energy = 0, momentum = 0;
       for (int k = 0; k < 3; ++k) {
         if (k == wall) continue;
         energy += static_cast<long double>(scene.masses[k]) * velocities[k] * velocities[k] / 2;
         momentum += static_cast<long double>(scene.masses[k]) * velocities[k];
       }
-      event.total_energy = positive(energy);
-      event.total_momentum = positive(momentum);
+      state.total_energy = positive(energy);
+      state.total_momentum = positive(momentum);
       visitor(event);
     };
   }
@@ -388,7 +385,7 @@ SimulationResult simulateByEngine(const ThreeBodyScene& scene, const SimulationO
 
 /// Simulates, in full mode with every event put beside the prediction, and measures how
 /// far the simulation is from the closed form.
-void simulateBesidePrediction(const ThreeBodyScene& scene, const RunOptions& options, const LabEventVisitor& visitor,
+void simulateBesidePrediction(const ThreeBodyScene& scene, const RunOptions& options, const ImpactVisitor& visitor,
                               RunResult& result) {
   LabRunSummary& summary = result.summary;
   const EnergyNormError relative_error(scene);
@@ -396,16 +393,17 @@ void simulateBesidePrediction(const ThreeBodyScene& scene, const RunOptions& opt
   SimulationOptions simulation_options;
   simulation_options.max_collisions = options.max_collisions;
   simulation_options.cancel = options.cancel;
-  EventVisitor enrich;
-  LabEvents lab_events(scene, model);
-  LabEvent lab;
+  std::function<void(ImpactRecord&)> enrich;
+  ModelBesideImpacts beside(scene, model);
   double max_error_sq = 0.0;
   if (options.mode == RunMode::kFull) {
-    enrich = [&](const ImpactEvent& event) {
-      lab_events.describe(event, lab);
-      max_error_sq = std::max(max_error_sq, relative_error.squared(event.velocities_after, lab.predicted_velocities_after));
-      if (visitor) visitor(lab);
-      if (options.events.keeps(event.index)) result.events.push_back(lab);
+    enrich = [&](ImpactRecord& event) {
+      ImpactModelValues& values = *event.model;
+      beside.describe(event.index, event.pair_index == 0 ? Pair::AB : Pair::BC, values);
+      max_error_sq =
+          std::max(max_error_sq, relative_error.squared(values.velocities_after, values.predicted_velocities_after));
+      if (visitor) visitor(event);
+      if (options.events.keeps(event.index)) result.events.push_back(event);
     };
   }
   std::string stopped_otherwise;
@@ -486,7 +484,7 @@ AnalyticPrediction predict(const ThreeBodyScene& scene) {
   return prediction;
 }
 
-RunResult runLab(const ThreeBodyScene& scene, const RunOptions& options, const LabEventVisitor& visitor) {
+RunResult runLab(const ThreeBodyScene& scene, const RunOptions& options, const ImpactVisitor& visitor) {
   const auto started = std::chrono::steady_clock::now();
   RunResult result = runLab(scene, options, predict(scene), visitor);
   result.summary.compute_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
@@ -494,7 +492,7 @@ RunResult runLab(const ThreeBodyScene& scene, const RunOptions& options, const L
 }
 
 RunResult runLab(const ThreeBodyScene& scene, const RunOptions& options, const AnalyticPrediction& prediction,
-                 const LabEventVisitor& visitor) {
+                 const ImpactVisitor& visitor) {
   const auto started = std::chrono::steady_clock::now();
   RunResult result;
   result.prediction = prediction;

@@ -181,8 +181,9 @@ AnalyticPrediction rotationPrediction(const Prediction& prediction) {
   return rotation;
 }
 
-/// The three-body run's summary as every scene's: the engine simulated it (lab_run.h).
-SceneSimulation fromThreeBody(const RunResult& run) {
+/// The three-body run's summary as every scene's: the engine simulated it (lab_run.h); its
+/// kept impacts move into the simulation.
+SceneSimulation fromThreeBody(RunResult&& run) {
   const LabRunSummary& summary = run.summary;
   SceneSimulation simulation;
   simulation.simulated = summary.simulated;
@@ -206,6 +207,10 @@ SceneSimulation fromThreeBody(const RunResult& run) {
   if (summary.simulated && !summary.truncated) {
     simulation.matches_prediction = summary.collision_count == run.prediction.collision_count;
   }
+  // The engine's replays: the summary counts the exact ones among those at 100 digits or more.
+  simulation.escalations.high_precision = summary.escalation.high_precision - summary.escalation.exact_rational;
+  simulation.escalations.exact_rational = summary.escalation.exact_rational;
+  simulation.impacts = std::move(run.events);
   return simulation;
 }
 
@@ -238,15 +243,13 @@ SceneRunResult runScene(const ScenePlan& plan, const SceneRunOptions& options, c
       lab.progress = visitors.progress;
       lab.progress_interval = options.progress_interval;
     }
-    result.three_body =
-        runLab(toThreeBodyScene(plan.scene), lab, rotationPrediction(*plan.prediction), visitors.three_body_event);
-    result.simulation = fromThreeBody(*result.three_body);
+    result.simulation =
+        fromThreeBody(runLab(toThreeBodyScene(plan.scene), lab, rotationPrediction(*plan.prediction), visitors.impact));
   } else {
     result.simulation = simulateScene(plan.scene, options, result.prediction, visitors);
   }
   result.compute_time_s =
       plan.plan_time_s + std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (result.three_body) result.three_body->summary.compute_time_s = result.compute_time_s;
   return result;
 }
 

@@ -13,7 +13,7 @@
 #include <thread>
 #include <vector>
 
-#include "collision_lab/core/lab_run.h"
+#include "collision_lab/core/nbody/engine.h"
 #include "text_sink.h"
 
 namespace collision_lab {
@@ -30,7 +30,7 @@ namespace io {
 class EventPipeline {
  public:
   /// Appends one event's text; `first` is true for the run's first event only.
-  using Format = void (*)(TextSink& sink, const core::LabEvent& event, bool first);
+  using Format = void (*)(TextSink& sink, const core::ImpactRecord& event, bool first);
 
   EventPipeline(std::ostream& out, Format format) : out_(out), format_(format) {
     for (Block& block : blocks_) {
@@ -43,7 +43,7 @@ class EventPipeline {
   EventPipeline(const EventPipeline&) = delete;
   EventPipeline& operator=(const EventPipeline&) = delete;
 
-  void push(const core::LabEvent& event) {
+  void push(const core::ImpactRecord& event) {
     current_->events.push_back(event);
     if (current_->events.size() == kBlockEvents) {
       submit(current_);
@@ -62,7 +62,7 @@ class EventPipeline {
   static constexpr std::size_t kBlockEvents = 1024;
   static constexpr std::size_t kBlocks = 4;
   struct Block {
-    std::vector<core::LabEvent> events;
+    std::vector<core::ImpactRecord> events;
     std::uint64_t sequence = 0;
   };
 

@@ -43,10 +43,32 @@ double maxAbsDifference(const std::array<double, 3>& a, const std::array<double,
   return result;
 }
 
-std::string paperCountText(const core::AnalyticPrediction& prediction) {
-  return prediction.paper_collision_count ? std::to_string(*prediction.paper_collision_count)
-                                          : std::string("undefined");
+std::string paperCountText(const core::Prediction& prediction) {
+  return prediction.paper_impact_count ? std::to_string(*prediction.paper_impact_count) : std::string("undefined");
 }
+
+std::array<double, 3> array3Of(const std::vector<double>& values) { return {values.at(0), values.at(1), values.at(2)}; }
+
+/// The run's summary in the terms of the three-body reports: its prediction (with the
+/// rotation model's values) and simulation.
+struct ThreeBodySummary {
+  explicit ThreeBodySummary(const core::SceneRunResult& result)
+      : p(result.prediction.value()), s(result.simulation), compute_time_s(result.compute_time_s) {}
+
+  const core::Prediction& p;
+  const core::SceneSimulation& s;
+  double compute_time_s;
+
+  std::uint64_t predictedCount() const { return p.impact_count.value_or(0); }
+  bool cancelled() const { return s.stop == core::StopReason::kCancelled; }
+  std::string truncationReason() const { return s.truncated ? s.stop_message : std::string(); }
+  std::optional<core::Pair> firstPair() const {
+    if (!p.first_pair_index) return std::nullopt;
+    return *p.first_pair_index == 0 ? core::Pair::AB : core::Pair::BC;
+  }
+  std::uint64_t decisions() const { return s.simulated ? s.impact_count + 1 : 0; }
+  std::uint64_t highPrecision() const { return s.escalations.high_precision + s.escalations.exact_rational; }
+};
 
 // ---------------------------------------------------------------------------------------
 // Table: for people. Event rows use 7 significant digits, the summary 10; JSON and CSV
@@ -74,39 +96,41 @@ class TableWriter : public RunReportWriter {
          << " collisions\n";
   }
 
-  void event(const core::LabEvent& lab) override {
+  void event(const core::ImpactRecord& impact) override {
     if (!header_written_) writeEventHeader();
-    const core::ImpactEvent& e = lab.event;
-    out_ << padLeft(std::to_string(e.index), 9) << padLeft(core::pairName(e.pair), 5);
-    writeNumber(e.time);
-    writeNumber(e.position);
-    for (double v : e.velocities_after) writeNumber(v);
-    for (double de : e.energy_transfer) writeNumber(de);
-    writeNumber(maxAbsDifference(e.velocities_after, lab.predicted_velocities_after));
-    writeNumber(maxAbsDifference(e.velocities_after, lab.paper_velocities_after));
+    const core::ImpactModelValues& m = *impact.model;
+    out_ << padLeft(std::to_string(impact.index), 9) << padLeft(core::pairName(impact.pair_index), 5);
+    writeNumber(impact.time);
+    writeNumber(impact.position);
+    for (double v : m.velocities_after) writeNumber(v);
+    for (double de : m.energy_transfer) writeNumber(de);
+    writeNumber(maxAbsDifference(m.velocities_after, m.predicted_velocities_after));
+    writeNumber(maxAbsDifference(m.velocities_after, m.paper_velocities_after));
     out_ << "\n";
   }
 
-  void end(const core::RunResult& result) override {
-    const core::AnalyticPrediction& p = result.prediction;
-    const core::LabRunSummary& s = result.summary;
+  void end(const core::SceneRunResult& result) override {
+    const ThreeBodySummary summary(result);
+    const core::Prediction& p = summary.p;
+    const core::SceneSimulation& s = summary.s;
     const auto simulated = [&](const std::string& text) { return s.simulated ? text : std::string("-"); };
     out_ << "\n";
     writeSummaryRow("Summary", "simulation", "prediction", "paper, as printed");
-    writeSummaryRow("collisions", simulated(std::to_string(s.collision_count)), std::to_string(p.collision_count),
+    writeSummaryRow("collisions", simulated(std::to_string(s.impact_count)), std::to_string(summary.predictedCount()),
                     "eq. 3.22: " + paperCountText(p));
     writeSummaryRow("most possible collisions", "",
-                    std::to_string(p.max_possible_collision_count) + " = ceil(pi/alpha)", "");
-    writeSummaryRow("first pair", "", p.first_pair ? core::pairName(*p.first_pair) : "none", "");
+                    std::to_string(p.max_possible_impact_count.value_or(0)) + " = ceil(pi/alpha)", "");
+    const std::optional<core::Pair> first = summary.firstPair();
+    writeSummaryRow("first pair", "", first ? core::pairName(*first) : "none", "");
     for (int i = 0; i < 3; ++i) {
       writeSummaryRow(std::string("final v_") + kParticleNames[i] + " [m/s]",
-                      simulated(humanText(s.final_velocities[i], kSummaryDigits)),
-                      humanText(p.final_velocities[i], kSummaryDigits), "");
+                      simulated(humanText(s.final_velocities.at(i), kSummaryDigits)),
+                      humanText(p.final_velocities.at(i), kSummaryDigits), "");
     }
-    out_ << "\nangles [rad]: alpha " << humanText(p.angles.alpha, kSummaryDigits) << ", theta = 2 alpha "
-         << humanText(p.angles.theta, kSummaryDigits) << ", Omega = pi - alpha "
-         << humanText(p.angles.omega, kSummaryDigits) << ", psi " << humanText(p.psi, kSummaryDigits)
-         << ", paper's phi_BC (eq. 3.21) " << humanText(p.phi_bc, kSummaryDigits) << "\n";
+    out_ << "\nangles [rad]: alpha " << humanText(p.alpha.value_or(0.0), kSummaryDigits) << ", theta = 2 alpha "
+         << humanText(p.theta.value_or(0.0), kSummaryDigits) << ", Omega = pi - alpha "
+         << humanText(p.omega.value_or(0.0), kSummaryDigits) << ", psi " << humanText(p.psi.value_or(0.0), kSummaryDigits)
+         << ", paper's phi_BC (eq. 3.21) " << humanText(p.phi_bc.value_or(0.0), kSummaryDigits) << "\n";
     if (s.simulated) {
       out_ << "checks: max prediction error " << humanText(s.max_prediction_error, 3)
            << " (|S (v_sim - v_pred)| / |S v0|, S = diag(sqrt m): energy norm), relative energy drift " << humanText(s.energy_relative_drift, 3)
@@ -119,10 +143,10 @@ class TableWriter : public RunReportWriter {
       out_ << "not simulated: the closed form answers (predict-only, or more collisions predicted than the cap; "
               "--simulate-to-cap simulates up to it)\n";
     }
-    out_ << "truncated: " << (s.truncated ? "yes, " + s.truncation_reason : std::string("no")) << "\n";
-    out_ << "precision: " << s.escalation.decisions << " decisions, " << s.escalation.high_precision
-         << " taken at 100 digits or more, " << s.escalation.exact_rational << " by exact rationals; compute time "
-         << humanText(s.compute_time_s, 3) << " s\n";
+    out_ << "truncated: " << (s.truncated ? "yes, " + summary.truncationReason() : std::string("no")) << "\n";
+    out_ << "precision: " << summary.decisions() << " decisions, " << summary.highPrecision()
+         << " taken at 100 digits or more, " << s.escalations.exact_rational << " by exact rationals; compute time "
+         << humanText(summary.compute_time_s, 3) << " s\n";
   }
 
  private:
@@ -172,12 +196,12 @@ class JsonWriter : public RunReportWriter {
          << ",\n\"units\": " << jsonText(unitsJson()) << ",\n\"events\": [";
   }
 
-  void event(const core::LabEvent& lab) override {
-    events_.push(lab);
+  void event(const core::ImpactRecord& impact) override {
+    events_.push(impact);
     any_event_ = true;
   }
 
-  void end(const core::RunResult& result) override {
+  void end(const core::SceneRunResult& result) override {
     events_.finish();
     out_ << (any_event_ ? "\n]" : "]") << ",\n\"summary\": " << jsonText(summaryJson(result)) << "}\n";
   }
@@ -222,8 +246,8 @@ void writeCsvComments(std::ostream& out, const std::string& prefix, const Json& 
 }
 
 /// One event row, in the columns of kEventCsvHeader.
-void writeEventCsv(TextSink& sink, const core::LabEvent& lab, bool /*first*/) {
-  report_text::writeEventRecordCsv(sink, report_text::eventRecord(lab));
+void writeEventCsv(TextSink& sink, const core::ImpactRecord& impact, bool /*first*/) {
+  report_text::writeEventRecordCsv(sink, report_text::eventRecord(impact));
 }
 
 class CsvWriter : public RunReportWriter {
@@ -245,9 +269,9 @@ class CsvWriter : public RunReportWriter {
     out_ << report_text::kEventCsvHeader << "\n";
   }
 
-  void event(const core::LabEvent& lab) override { events_.push(lab); }
+  void event(const core::ImpactRecord& impact) override { events_.push(impact); }
 
-  void end(const core::RunResult& result) override {
+  void end(const core::SceneRunResult& result) override {
     events_.finish();
     writeCsvComments(out_, "summary.", summaryJson(result));
   }
@@ -332,47 +356,47 @@ Json optionsJson(const core::RunOptions& options) {
               {"precision", "double"}};  // kept for readers of the format: every run is exact
 }
 
-Json eventJson(const core::LabEvent& lab) {
+Json eventJson(const core::ImpactRecord& impact) {
   std::ostringstream text;
   {
     TextSink sink(text);
-    report_text::writeEventJson(sink, lab);
+    report_text::writeEventJson(sink, impact);
   }
   return Json::parse(text.str());
 }
 
 namespace report_text {
 
-EventRecord eventRecord(const core::LabEvent& lab) {
-  const core::ImpactEvent& e = lab.event;
-  const std::size_t p = static_cast<std::size_t>(core::pairIndex(e.pair));
+EventRecord eventRecord(const core::ImpactRecord& impact) {
+  const core::ImpactModelValues& m = *impact.model;
+  const std::size_t p = impact.pair_index;
   EventRecord r;
-  r.index = e.index;
+  r.index = impact.index;
   r.pair_index = p;
-  r.time = e.time;
-  r.position = e.position;
+  r.time = impact.time;
+  r.position = impact.position;
   r.restitution = 1.0;  // the three-body path answers elastic scenes only
-  r.first_moved = p;
-  r.last_moved = p + 1;
+  r.first_moved = impact.first_moved;
+  r.last_moved = impact.last_moved;
   for (std::size_t side = 0; side < 2; ++side) {
-    r.pair_velocities_before[side] = e.velocities_before[p + side];
-    r.pair_velocities_after[side] = e.velocities_after[p + side];
-    r.pair_energy_transfer[side] = e.energy_transfer[p + side];
+    r.pair_velocities_before[side] = m.velocities_before[p + side];
+    r.pair_velocities_after[side] = m.velocities_after[p + side];
+    r.pair_energy_transfer[side] = m.energy_transfer[p + side];
   }
-  r.energy_lost = 0.0;
+  r.energy_lost = impact.energy_lost;
   r.full_state = true;
   r.bodies = 3;
-  r.positions = e.positions.data();
-  r.velocities_before = e.velocities_before.data();
-  r.velocities_after = e.velocities_after.data();
-  r.energy_transfer = e.energy_transfer.data();
-  r.kinetic_energy_after = lab.kinetic_energy_after.data();
-  r.total_energy = e.total_energy;
-  r.total_momentum = e.total_momentum;
-  r.predicted_velocities_after = &lab.predicted_velocities_after;
-  r.predicted_energy_transfer = &lab.predicted_energy_transfer;
-  r.paper_velocities_after = &lab.paper_velocities_after;
-  r.paper_energy_transfer = &lab.paper_energy_transfer;
+  r.positions = m.positions.data();
+  r.velocities_before = m.velocities_before.data();
+  r.velocities_after = m.velocities_after.data();
+  r.energy_transfer = m.energy_transfer.data();
+  r.kinetic_energy_after = m.kinetic_energy_after.data();
+  r.total_energy = m.total_energy;
+  r.total_momentum = m.total_momentum;
+  r.predicted_velocities_after = &m.predicted_velocities_after;
+  r.predicted_energy_transfer = &m.predicted_energy_transfer;
+  r.paper_velocities_after = &m.paper_velocities_after;
+  r.paper_energy_transfer = &m.paper_energy_transfer;
   return r;
 }
 
@@ -544,43 +568,43 @@ void writeEventRecordCsv(TextSink& sink, const EventRecord& r) {
   sink.put('\n');
 }
 
-void writeEventJson(TextSink& sink, const core::LabEvent& lab) { writeEventRecordJson(sink, eventRecord(lab)); }
+void writeEventJson(TextSink& sink, const core::ImpactRecord& impact) { writeEventRecordJson(sink, eventRecord(impact)); }
 
-void writeEventJsonLine(TextSink& sink, const core::LabEvent& lab, bool first) {
+void writeEventJsonLine(TextSink& sink, const core::ImpactRecord& impact, bool first) {
   sink.put(first ? "\n" : ",\n");
-  writeEventJson(sink, lab);
+  writeEventJson(sink, impact);
 }
 
 }  // namespace report_text
 
-Json summaryJson(const core::RunResult& result) {
-  const core::AnalyticPrediction& p = result.prediction;
-  const core::LabRunSummary& s = result.summary;
-  return Json{{"collision_count", s.collision_count},
+Json summaryJson(const core::SceneRunResult& result) {
+  const ThreeBodySummary summary(result);
+  const core::Prediction& p = summary.p;
+  const core::SceneSimulation& s = summary.s;
+  return Json{{"collision_count", s.impact_count},
               {"truncated", s.truncated},
-              {"cancelled", s.cancelled},
-              {"truncation_reason", s.truncation_reason},
+              {"cancelled", summary.cancelled()},
+              {"truncation_reason", summary.truncationReason()},
               {"simulated", s.simulated},
-              {"final_velocities", array3(s.final_velocities)},
-              {"predicted_collision_count", p.collision_count},
-              {"paper_predicted_collision_count",
-               p.paper_collision_count ? Json(*p.paper_collision_count) : Json(nullptr)},
-              {"max_possible_collision_count", p.max_possible_collision_count},
-              {"predicted_first_pair", optionalPair(p.first_pair)},
-              {"predicted_final_velocities", array3(p.final_velocities)},
-              {"theta", number(p.angles.theta)},
-              {"alpha", number(p.angles.alpha)},
-              {"omega", number(p.angles.omega)},
-              {"psi", number(p.psi)},
-              {"paper_phi_bc", number(p.phi_bc)},
+              {"final_velocities", array3(array3Of(s.final_velocities))},
+              {"predicted_collision_count", summary.predictedCount()},
+              {"paper_predicted_collision_count", p.paper_impact_count ? Json(*p.paper_impact_count) : Json(nullptr)},
+              {"max_possible_collision_count", p.max_possible_impact_count.value_or(0)},
+              {"predicted_first_pair", optionalPair(summary.firstPair())},
+              {"predicted_final_velocities", array3(array3Of(p.final_velocities))},
+              {"theta", number(p.theta.value_or(0.0))},
+              {"alpha", number(p.alpha.value_or(0.0))},
+              {"omega", number(p.omega.value_or(0.0))},
+              {"psi", number(p.psi.value_or(0.0))},
+              {"paper_phi_bc", number(p.phi_bc.value_or(0.0))},
               {"max_prediction_error", number(s.max_prediction_error)},
               {"energy_relative_drift", number(s.energy_relative_drift)},
               {"momentum_relative_drift", number(s.momentum_relative_drift)},
-              {"compute_time_s", number(s.compute_time_s)},
+              {"compute_time_s", number(summary.compute_time_s)},
               {"escalation",
-               {{"decisions", s.escalation.decisions},
-                {"high_precision", s.escalation.high_precision},
-                {"exact_rational", s.escalation.exact_rational}}}};
+               {{"decisions", summary.decisions()},
+                {"high_precision", summary.highPrecision()},
+                {"exact_rational", s.escalations.exact_rational}}}};
 }
 
 Json errorJson(const std::string& reason, int code, const std::string& field, const std::string& message) {

@@ -14,12 +14,31 @@
 #include "collision_lab/core/nbody/engine.h"
 #include "collision_lab/core/nbody/scene.h"
 
+#include <memory>
+#include <ostream>
+
 #include "collision_lab/io/event_record.h"  // EventRecord, SceneEventState
 #include "collision_lab/io/report.h"  // Json
 #include "text_sink.h"
 
 namespace collision_lab {
 namespace io {
+
+/// The layout of a run whose prediction carries the rotation model's values
+/// (core::hasRotationValues): its scene, event table and summary beside the closed form and
+/// the paper's values (docs/cli.md). The scene report (scene_report.h) writes through it for
+/// such a run: begin(), then event() for each event to show, then end(); nothing is kept per
+/// event.
+class RunReportWriter {
+ public:
+  virtual ~RunReportWriter() = default;
+  virtual void begin(const NamedScene& scene, const core::RunOptions& options) = 0;
+  virtual void event(const core::ImpactRecord& event) = 0;
+  virtual void end(const core::SceneRunResult& result) = 0;
+};
+
+std::unique_ptr<RunReportWriter> makeRunReportWriter(ReportFormat format, std::ostream& out);
+
 namespace report_text {
 
 /// Compact text for people, `digits` significant digits; -0 is shown as 0, any NaN as nan.
@@ -42,9 +61,10 @@ inline std::string padRight(const std::string& text, std::size_t width) {
 /// A double for JSON: never a negative zero (NaN and infinities become null when dumped).
 inline Json number(double value) { return Json(value == 0 ? 0.0 : value); }
 
-/// The record of a three-body event (full state and the model's block from the event).
-/// `positions` etc. point into `lab`, which must outlive the record.
-EventRecord eventRecord(const core::LabEvent& lab);
+/// The record of an impact with a model block (its full state and the model's values).
+/// `positions` etc. point into `impact`, which must outlive the record. Precondition:
+/// impact.model.
+EventRecord eventRecord(const core::ImpactRecord& impact);
 /// The record as one compact JSON object.
 void writeEventRecordJson(TextSink& sink, const EventRecord& record);
 /// The record as one CSV row (with its line break), in the columns of kEventCsvHeader.
@@ -53,11 +73,11 @@ void writeEventRecordCsv(TextSink& sink, const EventRecord& record);
 /// separated by ';'.
 extern const char* const kEventCsvHeader;
 
-/// eventJson(lab) as compact JSON text (its keys in its order, numbers as writeJsonNumber),
+/// eventJson(impact) as compact JSON text (its keys in its order, numbers as writeJsonNumber),
 /// written without building a document.
-void writeEventJson(TextSink& sink, const core::LabEvent& lab);
+void writeEventJson(TextSink& sink, const core::ImpactRecord& impact);
 /// The same as a line of the "events" array: "\n" before the first event, ",\n" before others.
-void writeEventJsonLine(TextSink& sink, const core::LabEvent& lab, bool first);
+void writeEventJsonLine(TextSink& sink, const core::ImpactRecord& impact, bool first);
 
 }  // namespace report_text
 }  // namespace io

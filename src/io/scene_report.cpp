@@ -56,6 +56,10 @@ EventRecord SceneEventState::impact(const core::ImpactRecord& impact) {
   }
   r.energy_lost = impact.energy_lost;
   replay_.apply(impact);
+  if (impact.model) {
+    fillFromModel(r, *impact.model);
+    return r;
+  }
   fill(r);
   if (full_state_ && !r.cluster_impact) {
     // Two single bodies: their entries are the engine's gains, as the pair's fields.
@@ -63,6 +67,24 @@ EventRecord SceneEventState::impact(const core::ImpactRecord& impact) {
     gain_[left] = r.pair_energy_transfer[1];
   }
   return r;
+}
+
+void SceneEventState::fillFromModel(EventRecord& r, const core::ImpactModelValues& m) {
+  const std::size_t p = r.pair_index;
+  for (std::size_t side = 0; side < 2; ++side) r.pair_energy_transfer[side] = m.energy_transfer[p + side];
+  r.full_state = true;
+  r.bodies = m.positions.size();
+  r.positions = m.positions.data();
+  r.velocities_before = m.velocities_before.data();
+  r.velocities_after = m.velocities_after.data();
+  r.energy_transfer = m.energy_transfer.data();
+  r.kinetic_energy_after = m.kinetic_energy_after.data();
+  r.total_energy = m.total_energy;
+  r.total_momentum = m.total_momentum;
+  r.predicted_velocities_after = &m.predicted_velocities_after;
+  r.predicted_energy_transfer = &m.predicted_energy_transfer;
+  r.paper_velocities_after = &m.paper_velocities_after;
+  r.paper_energy_transfer = &m.paper_energy_transfer;
 }
 
 EventRecord SceneEventState::collapse(const core::Collapse& collapse) {
@@ -205,7 +227,18 @@ void writeBodyRows(std::ostream& out, std::size_t n, const std::vector<std::stri
   }
 }
 
-class SceneTableWriter : public SceneReportWriter {
+/// The layout of one scene's report in one format (the scene report of every run whose
+/// prediction has no rotation values): SceneReportWriter's calls, the model given.
+class SceneLayout {
+ public:
+  virtual ~SceneLayout() = default;
+  virtual void begin(const SceneEntry& entry, const core::RunOptions& options, const core::ModelChoice& model) = 0;
+  virtual void impact(const core::ImpactRecord& impact) = 0;
+  virtual void collapse(const core::Collapse& collapse) = 0;
+  virtual void end(const core::SceneRunResult& result) = 0;
+};
+
+class SceneTableWriter : public SceneLayout {
  public:
   explicit SceneTableWriter(std::ostream& out) : out_(out) {}
 
@@ -419,7 +452,7 @@ void writeSummaryJson(std::ostream& out, const core::SceneRunResult& result) {
   out << "}";
 }
 
-class SceneJsonWriter : public SceneReportWriter {
+class SceneJsonWriter : public SceneLayout {
  public:
   explicit SceneJsonWriter(std::ostream& out) : out_(out), sink_(out) {}
 
@@ -490,7 +523,7 @@ void writeCsvNumbers(std::ostream& out, const char* key, const std::vector<doubl
   out << "\n";
 }
 
-class SceneCsvWriter : public SceneReportWriter {
+class SceneCsvWriter : public SceneLayout {
  public:
   explicit SceneCsvWriter(std::ostream& out) : out_(out), sink_(out) {}
 
@@ -534,7 +567,9 @@ class SceneCsvWriter : public SceneReportWriter {
 };
 
 // ---------------------------------------------------------------------------------------
-// Three-body reports with the model.
+// The layout of a run with the rotation model's values, with the model stated: the JSON
+// summary gets "model" and "model_reason", CSV two "# summary.model..." lines, the table a
+// "model:" line.
 
 class ThreeBodyModelWriter : public RunReportWriter {
  public:
@@ -553,13 +588,13 @@ class ThreeBodyModelWriter : public RunReportWriter {
          << ",\n\"units\": " << jsonText(unitsJson()) << ",\n\"events\": [";
   }
 
-  void event(const core::LabEvent& event) override {
+  void event(const core::ImpactRecord& event) override {
     if (format_ != ReportFormat::kJson) return inner_->event(event);
     events_->push(event);
     any_event_ = true;
   }
 
-  void end(const core::RunResult& result) override {
+  void end(const core::SceneRunResult& result) override {
     if (format_ == ReportFormat::kJson) {
       events_->finish();
       Json summary = summaryJson(result);
@@ -600,13 +635,6 @@ struct BatchRow {
 BatchRow batchRow(const SceneBatchOutcome& outcome) {
   const core::SceneRunResult& r = outcome.result;
   BatchRow row{outcome.entry.name, core::modelKindName(r.model.kind), outcome.entry.scene.size(), "-", "-", false, 0.0};
-  if (r.three_body) {
-    const core::LabRunSummary& s = r.three_body->summary;
-    row.simulated = std::to_string(s.collision_count);
-    row.predicted = std::to_string(r.three_body->prediction.collision_count);
-    row.truncated = s.truncated;
-    return row;
-  }
   const core::SceneSimulation& s = r.simulation;
   if (s.simulated || (r.prediction && r.prediction->impact_count)) row.simulated = std::to_string(s.impact_count);
   if (r.prediction && r.prediction->infinite) row.predicted = "inf";
@@ -648,33 +676,35 @@ void writeSceneBatchJson(const std::vector<SceneBatchOutcome>& outcomes, std::os
   for (const auto& outcome : outcomes) {
     const core::SceneRunResult& r = outcome.result;
     Json entry;
-    entry["scene"] = r.three_body ? sceneJson(toNamedScene(outcome.entry)) : sceneEntryJson(outcome.entry);
+    // A run whose prediction carries the rotation model's values has the three-body
+    // report's scene and summary.
+    const bool rotation = r.prediction && core::hasRotationValues(*r.prediction);
+    entry["scene"] = rotation ? sceneJson(toNamedScene(outcome.entry)) : sceneEntryJson(outcome.entry);
     entry["options"] = optionsJson(outcome.options);
     entry["events"] = Json::array();
-    if (r.three_body) {
-      for (const core::LabEvent& lab : r.three_body->events) entry["events"].push_back(eventJson(lab));
-      entry["summary"] = summaryJson(*r.three_body);
+    // The kept impacts, each collapse after the impact it follows (as the stream shows
+    // them); every collapse before the last kept impact updates the bodies' state.
+    SceneEventJson records(outcome.entry.scene);
+    std::size_t next_collapse = 0;
+    const auto collapsesUpTo = [&](std::uint64_t impacts) {
+      for (; next_collapse < r.simulation.collapses.size() &&
+             r.simulation.collapses[next_collapse].impacts_before <= impacts;
+           ++next_collapse) {
+        const core::Collapse& c = r.simulation.collapses[next_collapse];
+        Json json = records.collapse(c);
+        if (outcome.options.events.keepsAfter(c.impacts_before)) entry["events"].push_back(std::move(json));
+      }
+    };
+    for (const core::ImpactRecord& impact : r.simulation.impacts) {
+      collapsesUpTo(impact.index - 1);
+      entry["events"].push_back(records.impact(impact));
+    }
+    collapsesUpTo(r.simulation.impact_count);
+    if (rotation) {
+      entry["summary"] = summaryJson(r);
       entry["summary"]["model"] = core::modelKindName(r.model.kind);
       entry["summary"]["model_reason"] = r.model.reason;
     } else {
-      // The kept impacts, each collapse after the impact it follows (as the stream shows
-      // them); every collapse before the last kept impact updates the bodies' state.
-      SceneEventJson records(outcome.entry.scene);
-      std::size_t next_collapse = 0;
-      const auto collapsesUpTo = [&](std::uint64_t impacts) {
-        for (; next_collapse < r.simulation.collapses.size() &&
-               r.simulation.collapses[next_collapse].impacts_before <= impacts;
-             ++next_collapse) {
-          const core::Collapse& c = r.simulation.collapses[next_collapse];
-          Json json = records.collapse(c);
-          if (outcome.options.events.keepsAfter(c.impacts_before)) entry["events"].push_back(std::move(json));
-        }
-      };
-      for (const core::ImpactRecord& impact : r.simulation.impacts) {
-        collapsesUpTo(impact.index - 1);
-        entry["events"].push_back(records.impact(impact));
-      }
-      collapsesUpTo(r.simulation.impact_count);
       entry["summary"] = sceneSummaryJson(r);
     }
     out << (first ? "\n" : ",\n") << jsonText(entry);
@@ -722,7 +752,9 @@ Json sceneSummaryJson(const core::SceneRunResult& result) {
   return json;
 }
 
-std::unique_ptr<SceneReportWriter> makeSceneReportWriter(ReportFormat format, std::ostream& out) {
+namespace {
+
+std::unique_ptr<SceneLayout> makeSceneLayout(ReportFormat format, std::ostream& out) {
   switch (format) {
     case ReportFormat::kJson: return std::make_unique<SceneJsonWriter>(out);
     case ReportFormat::kCsv: return std::make_unique<SceneCsvWriter>(out);
@@ -731,9 +763,52 @@ std::unique_ptr<SceneReportWriter> makeSceneReportWriter(ReportFormat format, st
   return std::make_unique<SceneTableWriter>(out);
 }
 
-std::unique_ptr<RunReportWriter> makeThreeBodyReportWriter(ReportFormat format, std::ostream& out,
-                                                           const core::ModelChoice& model) {
-  return std::make_unique<ThreeBodyModelWriter>(format, out, model);
+/// The one scene report: the layout chosen in begin() by what the plan's prediction holds.
+/// Every event is handed on as it is, its model block with it.
+class SceneReport : public SceneReportWriter {
+ public:
+  SceneReport(ReportFormat format, std::ostream& out) : format_(format), out_(out) {}
+
+  void begin(const SceneEntry& entry, const core::RunOptions& options, const core::ModelChoice& model,
+             const std::optional<core::Prediction>& prediction) override {
+    if (prediction && core::hasRotationValues(*prediction)) {
+      rotation_ = std::make_unique<ThreeBodyModelWriter>(format_, out_, model);
+      rotation_->begin(toNamedScene(entry), options);
+    } else {
+      scene_ = makeSceneLayout(format_, out_);
+      scene_->begin(entry, options, model);
+    }
+  }
+  void impact(const core::ImpactRecord& impact) override {
+    if (rotation_) {
+      rotation_->event(impact);
+    } else {
+      scene_->impact(impact);
+    }
+  }
+  /// Elastic runs (those with rotation values) have none.
+  void collapse(const core::Collapse& collapse) override {
+    if (scene_) scene_->collapse(collapse);
+  }
+  void end(const core::SceneRunResult& result) override {
+    if (rotation_) {
+      rotation_->end(result);
+    } else {
+      scene_->end(result);
+    }
+  }
+
+ private:
+  ReportFormat format_;
+  std::ostream& out_;
+  std::unique_ptr<RunReportWriter> rotation_;  ///< from begin(), with rotation values
+  std::unique_ptr<SceneLayout> scene_;         ///< from begin(), otherwise
+};
+
+}  // namespace
+
+std::unique_ptr<SceneReportWriter> makeSceneReportWriter(ReportFormat format, std::ostream& out) {
+  return std::make_unique<SceneReport>(format, out);
 }
 
 void writeSceneBatchReport(ReportFormat format, const std::vector<SceneBatchOutcome>& outcomes, std::ostream& out) {

@@ -195,18 +195,7 @@ class EventStream {
       : topics_(topics), out_(out), markers_(markers), limits_(limits), scene_(scene),
         msg_(buffers), progress_(progress), fail_(fail_at_first_event) {}
 
-  /// An event of the three-body path.
-  void operator()(const collision_lab::core::LabEvent& event) {
-    fillCollisionEventMsg(event, msg_.event);
-    if (send(msg_.event)) {
-      fillVelocitiesMsg(msg_.event, msg_.velocities);
-      topics_.velocities.publish(msg_.velocities);
-      fillEnergyTransferMsg(msg_.event, 0.0, msg_.energy);  // elastic: no heat
-      topics_.energies.publish(msg_.energy);
-    }
-    out_.record(std::move(msg_.event));
-  }
-  /// An impact of the event engine.
+  /// An impact, with its model block where it has one.
   void operator()(const collision_lab::core::ImpactRecord& impact) {
     converter().impact(impact, msg_.event);
     sendWithPlots();
@@ -221,7 +210,7 @@ class EventStream {
   bool cut() const { return cut_; }
 
  private:
-  /// The event engine's converter, made at its first event (the three-body path needs none).
+  /// The converter, made at the run's first event.
   SceneEventConverter& converter() {
     if (!converter_) converter_.emplace(scene_);
     return *converter_;
@@ -271,10 +260,9 @@ class EventStream {
     p.time = msg.time;
     p.published = progress_.published;
     p.latest_event = msg;
-    // The three-body path is elastic; the event engine's replay has the heat and, above
-    // FULL_STATE_MAX_BODIES, the state the event leaves out.
-    p.energy_lost = converter_ ? converter_->replay().heat() : 0.0;
-    if (converter_ && p.latest_event.positions.empty()) fillFullState(converter_->replay(), p.latest_event);
+    // The replay has the heat and, above FULL_STATE_MAX_BODIES, the state the event leaves out.
+    p.energy_lost = converter_->replay().heat();
+    if (p.latest_event.positions.empty()) fillFullState(converter_->replay(), p.latest_event);
     topics_.progress.publish(p);
   }
 
@@ -1048,7 +1036,6 @@ void LabNode::run(Worker& worker, Job& job, RunWriter& out, RunProgress& progres
   EventStream events(topics_, out, worker.draws ? marker_view_.get() : nullptr, limits, plan.scene,
                      worker.event_messages, progress, fail);
   core::SceneVisitors visitors;
-  visitors.three_body_event = [&events](const core::LabEvent& e) { events(e); };
   visitors.impact = [&events](const core::ImpactRecord& r) { events(r); };
   visitors.collapse = [&events](const core::Collapse& c) { events(c); };  // in order, between the impacts
   const core::SceneRunResult result = core::runScene(plan, options, visitors);

@@ -4,7 +4,6 @@
 #include <cmath>
 #include <limits>
 
-#include "collision_lab/core/wedge.h"
 
 namespace collision_lab_ros {
 
@@ -209,75 +208,6 @@ void fillPredictionMsg(const core::ScenePlan& plan, collision_lab::Prediction& m
   msg.critical_restitution = valueOr(p.critical_restitution);
   msg.spiral_angle = valueOr(p.spiral_angle);
   msg.alpha = valueOr(p.alpha);
-  if (plan.model.kind == core::ModelKind::kThreeBodySpiral) {  // the opening angle of the three masses
-    const std::vector<double>& m = plan.scene.masses;
-    msg.alpha = core::alphaOf<double>({m[0], m[1], m[2]});
-  }
-}
-
-collision_lab::CollisionEvent toCollisionEventMsg(const collision_lab::core::LabEvent& event) {
-  collision_lab::CollisionEvent msg;
-  fillCollisionEventMsg(event, msg);
-  return msg;
-}
-
-namespace {
-/// values into a message array, keeping its storage.
-void assignArray(std::vector<double>& to, const std::array<double, 3>& values) {
-  to.assign(values.begin(), values.end());
-}
-}  // namespace
-
-void fillCollisionEventMsg(const collision_lab::core::LabEvent& event, collision_lab::CollisionEvent& msg) {
-  const collision_lab::core::ImpactEvent& e = event.event;
-  msg.kind = collision_lab::CollisionEvent::KIND_IMPACT;
-  msg.index = e.index;
-  msg.pair_index = static_cast<std::uint32_t>(e.pair);
-  msg.time = e.time;
-  msg.position = e.position;
-  msg.restitution = 1.0;
-  msg.first_moved = msg.pair_index;
-  msg.last_moved = msg.pair_index + 1;
-  msg.cluster_impact = false;
-  for (std::size_t side = 0; side < 2; ++side) {
-    const std::size_t body = msg.pair_index + side;
-    msg.pair_velocities_before[side] = e.velocities_before[body];
-    msg.pair_velocities_after[side] = e.velocities_after[body];
-    msg.pair_energy_transfer[side] = e.energy_transfer[body];
-  }
-  msg.energy_lost = 0.0;
-  assignArray(msg.positions, e.positions);
-  assignArray(msg.velocities_before, e.velocities_before);
-  assignArray(msg.velocities_after, e.velocities_after);
-  assignArray(msg.predicted_velocities_after, event.predicted_velocities_after);
-  assignArray(msg.paper_velocities_after, event.paper_velocities_after);
-  assignArray(msg.energy_transfer, e.energy_transfer);
-  assignArray(msg.predicted_energy_transfer, event.predicted_energy_transfer);
-  assignArray(msg.paper_energy_transfer, event.paper_energy_transfer);
-  assignArray(msg.kinetic_energy_after, event.kinetic_energy_after);
-  msg.total_energy = e.total_energy;
-  msg.total_momentum = e.total_momentum;
-}
-
-collision_lab::core::LabEvent toLabEvent(const collision_lab::CollisionEvent& msg) {
-  collision_lab::core::LabEvent event;
-  collision_lab::core::ImpactEvent& e = event.event;
-  e.index = msg.index;
-  e.pair = toPair(msg.pair_index).value_or(collision_lab::core::Pair::AB);
-  e.time = msg.time;
-  e.position = msg.position;
-  e.positions = toArray(msg.positions);
-  e.velocities_before = toArray(msg.velocities_before);
-  e.velocities_after = toArray(msg.velocities_after);
-  e.energy_transfer = toArray(msg.energy_transfer);
-  e.total_energy = msg.total_energy;
-  e.total_momentum = msg.total_momentum;
-  event.predicted_velocities_after = toArray(msg.predicted_velocities_after);
-  event.paper_velocities_after = toArray(msg.paper_velocities_after);
-  event.predicted_energy_transfer = toArray(msg.predicted_energy_transfer);
-  event.paper_energy_transfer = toArray(msg.paper_energy_transfer);
-  event.kinetic_energy_after = toArray(msg.kinetic_energy_after);
-  return event;
 }
 
 namespace {
@@ -410,11 +340,18 @@ void SceneEventConverter::toMsg(const collision_lab::io::EventRecord& r, collisi
     msg.pair_energy_transfer[side] = r.pair_energy_transfer[side];
   }
   msg.energy_lost = r.energy_lost;
-  // The rotation model's comparisons belong to three-body events alone.
-  msg.predicted_velocities_after.clear();
-  msg.paper_velocities_after.clear();
-  msg.predicted_energy_transfer.clear();
-  msg.paper_energy_transfer.clear();
+  // The model block's values where the impact has one; empty arrays otherwise.
+  const auto copy = [](const std::array<double, 3>* values, std::vector<double>& to) {
+    if (values) {
+      to.assign(values->begin(), values->end());
+    } else {
+      to.clear();
+    }
+  };
+  copy(r.predicted_velocities_after, msg.predicted_velocities_after);
+  copy(r.paper_velocities_after, msg.paper_velocities_after);
+  copy(r.predicted_energy_transfer, msg.predicted_energy_transfer);
+  copy(r.paper_energy_transfer, msg.paper_energy_transfer);
   if (!r.full_state) {
     msg.positions.clear();
     msg.velocities_before.clear();

@@ -569,18 +569,33 @@ TEST(OneRun, ABatchHasOneFormatWhateverItsScenes) {
     EXPECT_EQ(rows_three[k], rows_four[k < 3 ? k : k + 1]) << "line " << k;  // row 3: the four-body scene
   }
   EXPECT_EQ(rows_four[3].rfind("four ", 0), 0u) << rows_four[3];
-  Json json_three = runJson({"--scenario", only_three.path()});
-  Json json_four = runJson({"--scenario", with_four.path()});
-  ASSERT_EQ(json_three.at("scenarios").size(), 2u);
-  ASSERT_EQ(json_four.at("scenarios").size(), 3u);
-  EXPECT_EQ(json_three.at("units"), json_four.at("units"));
-  for (std::size_t k = 0; k < 2; ++k) {
-    Json& a = json_three.at("scenarios")[k];
-    Json& b = json_four.at("scenarios")[k];
-    EXPECT_EQ(a.at("summary").at("model"), "three_body_rotation");
-    a.at("summary").erase("compute_time_s");  // wall time
-    b.at("summary").erase("compute_time_s");
-    EXPECT_EQ(a.dump(1), b.dump(1)) << "scene " << k;
+  const CliOutput csv_three = run({"--scenario", only_three.path(), "--format", "csv"});
+  const CliOutput csv_four = run({"--scenario", with_four.path(), "--format", "csv"});
+  const std::vector<std::string> csv_rows_three = linesOf(csv_three.out), csv_rows_four = linesOf(csv_four.out);
+  ASSERT_EQ(csv_rows_three.size(), 3u);  // the header and a row per scene
+  ASSERT_EQ(csv_rows_four.size(), 4u);
+  for (std::size_t k = 0; k < 3; ++k) EXPECT_EQ(csv_rows_three[k], csv_rows_four[k]) << "CSV line " << k;
+  // With every event kept too: each impact's model block is in the three-body entries' events.
+  for (const char* events : {"none", "all"}) {
+    SCOPED_TRACE(events);
+    Json json_three = runJson({"--scenario", only_three.path(), "--events", events});
+    Json json_four = runJson({"--scenario", with_four.path(), "--events", events});
+    ASSERT_EQ(json_three.at("scenarios").size(), 2u);
+    ASSERT_EQ(json_four.at("scenarios").size(), 3u);
+    EXPECT_EQ(json_three.at("units"), json_four.at("units"));
+    for (std::size_t k = 0; k < 2; ++k) {
+      Json& a = json_three.at("scenarios")[k];
+      Json& b = json_four.at("scenarios")[k];
+      EXPECT_EQ(a.at("summary").at("model"), "three_body_rotation");
+      const Json& shown = a.at("events");
+      EXPECT_EQ(shown.size(), std::string(events) == "all" ? a.at("summary").at("collision_count").get<std::size_t>() : 0u);
+      for (const Json& event : shown) EXPECT_TRUE(event.at("predicted_velocities_after").is_array()) << event;
+      a.at("summary").erase("compute_time_s");  // wall time
+      b.at("summary").erase("compute_time_s");
+      EXPECT_EQ(a.dump(1), b.dump(1)) << "scene " << k;
+    }
+    EXPECT_TRUE(json_four.at("scenarios")[2].at("events").empty() ||
+                json_four.at("scenarios")[2].at("events")[0].at("predicted_velocities_after").is_null());
   }
 }
 

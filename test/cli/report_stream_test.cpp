@@ -1,7 +1,7 @@
 // The streamed three-body reports (io/report.h, io/scene_report.h) carry the core's event
 // values bit for bit: whole CSV and JSON runs of thousands of impacts (several buffer
 // chunks) are parsed back, by strtod and by nlohmann::json, and compared with the events
-// that the core keeps in its RunResult.
+// that the core's run keeps (SceneSimulation::impacts, each with its model block).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -23,6 +23,7 @@
 #include "collision_lab/io/report.h"
 #include "collision_lab/io/scene_report.h"
 #include "event_pipeline.h"
+#include "report_text.h"
 
 namespace {
 
@@ -48,23 +49,23 @@ bool samePrinted(double printed, double core_value) {
 const std::vector<std::size_t> kImpactNumberColumns = {5, 6, 7, 11, 12, 13, 14, 15, 16, 17, 18, 19,
                                                        20, 21, 22, 23, 24, 25, 26, 27, 28};
 
-std::vector<double> csvRowValues(const core::LabEvent& lab) {
-  const core::ImpactEvent& e = lab.event;
-  const std::size_t p = core::pairIndex(e.pair);
-  std::vector<double> values = {e.time, e.position, 1.0};  // restitution: elastic
-  for (const auto* group : {&e.velocities_before, &e.velocities_after, &e.energy_transfer}) {
+std::vector<double> csvRowValues(const core::ImpactRecord& impact) {
+  const core::ImpactModelValues& m = *impact.model;
+  const std::size_t p = impact.pair_index;
+  std::vector<double> values = {impact.time, impact.position, 1.0};  // restitution: elastic
+  for (const auto* group : {&m.velocities_before, &m.velocities_after, &m.energy_transfer}) {
     values.push_back((*group)[p]);
     values.push_back((*group)[p + 1]);
   }
   values.push_back(0.0);  // energy lost
-  for (const auto* group : {&e.positions, &e.velocities_before, &e.velocities_after, &e.energy_transfer,
-                            &lab.kinetic_energy_after}) {
+  for (const auto* group : {&m.positions, &m.velocities_before, &m.velocities_after, &m.energy_transfer,
+                            &m.kinetic_energy_after}) {
     values.insert(values.end(), group->begin(), group->end());
   }
-  values.push_back(e.total_energy);
-  values.push_back(e.total_momentum);
-  for (const auto* group : {&lab.predicted_velocities_after, &lab.predicted_energy_transfer,
-                            &lab.paper_velocities_after, &lab.paper_energy_transfer}) {
+  values.push_back(m.total_energy);
+  values.push_back(m.total_momentum);
+  for (const auto* group : {&m.predicted_velocities_after, &m.predicted_energy_transfer,
+                            &m.paper_velocities_after, &m.paper_energy_transfer}) {
     values.insert(values.end(), group->begin(), group->end());
   }
   return values;
@@ -72,29 +73,43 @@ std::vector<double> csvRowValues(const core::LabEvent& lab) {
 
 struct LabRun {
   io::NamedScene named;
+  core::Scene result_scene;
   core::RunOptions options;
-  core::RunResult result;
+  core::SceneRunResult result;
+  const std::vector<core::ImpactRecord>& events() const { return result.simulation.impacts; }
 };
 
 LabRun runScene(const core::ThreeBodyScene& scene) {
-  LabRun run{{"stream", "", scene}, {}, {}};
+  LabRun run{{"stream", "", scene},
+             {{scene.masses.begin(), scene.masses.end()},
+              {scene.positions.begin(), scene.positions.end()},
+              {scene.velocities.begin(), scene.velocities.end()},
+              {}},
+             {},
+             {}};
   run.options.events = core::EventPolicy::all();
-  run.result = core::runLab(scene, run.options);
+  core::SceneRunOptions options;
+  options.lab = run.options;
+  run.result = core::runScene(core::planScene(run.result_scene), options);
   return run;
 }
 
-/// The report as the CLI writes it (with the model) or as report.h's plain writer does.
+/// The report as the CLI writes it (the scene report, which states the model) or as its
+/// three-body layout alone does (report_text.h).
 std::string report(const LabRun& run, io::ReportFormat format, bool with_model) {
   std::ostringstream out;
-  const core::Scene scene{{run.named.scene.masses.begin(), run.named.scene.masses.end()},
-                          {run.named.scene.positions.begin(), run.named.scene.positions.end()},
-                          {run.named.scene.velocities.begin(), run.named.scene.velocities.end()},
-                          {}};
-  const auto writer = with_model ? io::makeThreeBodyReportWriter(format, out, core::chooseModel(scene))
-                                 : io::makeRunReportWriter(format, out);
-  writer->begin(run.named, run.options);
-  for (const core::LabEvent& event : run.result.events) writer->event(event);
-  writer->end(run.result);
+  if (with_model) {
+    const io::SceneEntry entry{run.named.name, run.named.description, run.result_scene, 0};
+    const auto writer = io::makeSceneReportWriter(format, out);
+    writer->begin(entry, run.options, run.result.model, run.result.prediction);
+    for (const core::ImpactRecord& event : run.events()) writer->impact(event);
+    writer->end(run.result);
+  } else {
+    const auto writer = io::makeRunReportWriter(format, out);
+    writer->begin(run.named, run.options);
+    for (const core::ImpactRecord& event : run.events()) writer->event(event);
+    writer->end(run.result);
+  }
   return out.str();
 }
 
@@ -122,7 +137,7 @@ std::vector<double> csvNumbers(const std::vector<std::string>& fields, const std
   return values;
 }
 
-void expectCsvCarriesEvents(const std::string& text, const std::vector<core::LabEvent>& events) {
+void expectCsvCarriesEvents(const std::string& text, const std::vector<core::ImpactRecord>& events) {
   std::istringstream in(text);
   std::string line;
   std::size_t row = 0;
@@ -135,12 +150,12 @@ void expectCsvCarriesEvents(const std::string& text, const std::vector<core::Lab
       continue;
     }
     ASSERT_LT(row, events.size());
-    const core::LabEvent& lab = events[row++];
+    const core::ImpactRecord& lab = events[row++];
     const std::vector<std::string> fields = split(line, ',');
     ASSERT_EQ(fields.size(), 29u) << line;
     ASSERT_EQ(fields[0], "impact");
-    ASSERT_EQ(fields[1], std::to_string(lab.event.index));
-    ASSERT_EQ(fields[2], core::pairName(lab.event.pair));
+    ASSERT_EQ(fields[1], std::to_string(lab.index));
+    ASSERT_EQ(fields[2], core::pairName(lab.pair_index));
     const std::vector<double> expected = csvRowValues(lab);
     const std::vector<double> printed = csvNumbers(fields, kImpactNumberColumns);
     ASSERT_EQ(printed.size(), expected.size()) << line;
@@ -222,9 +237,9 @@ void expectJsonEvents(const std::string& text, const std::vector<io::Json>& expe
   }
 }
 
-void expectJsonCarriesEvents(const std::string& text, const std::vector<core::LabEvent>& events) {
+void expectJsonCarriesEvents(const std::string& text, const std::vector<core::ImpactRecord>& events) {
   std::vector<io::Json> expected;
-  for (const core::LabEvent& event : events) expected.push_back(io::eventJson(event));
+  for (const core::ImpactRecord& event : events) expected.push_back(io::eventJson(event));
   expectJsonEvents(text, expected);
 }
 
@@ -233,14 +248,14 @@ TEST(ReportStream, CsvAndJsonCarryEveryEventValueBitForBit) {
   // (m_A + m_B + m_C) / (m_A m_C))) = atan(sqrt(2.00000001e-8)), pi / alpha = 22214.4), about
   // 11 MB of CSV: many blocks of the pipeline, formatted by its workers, written in order.
   const LabRun run = runScene({{1e8, 1, 1e8}, {2, 1, 0}, {-1, 0, 0}});
-  ASSERT_EQ(run.result.events.size(), 22214u);
+  ASSERT_EQ(run.events().size(), 22214u);
   for (bool with_model : {false, true}) {
     SCOPED_TRACE(with_model ? "with the model" : "report.h writer");
     const std::string csv = report(run, io::ReportFormat::kCsv, with_model);
     EXPECT_GT(csv.size(), std::size_t{10} << 20);
-    expectCsvCarriesEvents(csv, run.result.events);
+    expectCsvCarriesEvents(csv, run.events());
     const std::string json = report(run, io::ReportFormat::kJson, with_model);
-    expectJsonCarriesEvents(json, run.result.events);
+    expectJsonCarriesEvents(json, run.events());
     expectShortestJsonNumbers(json, 400);
   }
 }
@@ -249,10 +264,10 @@ TEST(ReportStream, WallsZerosAndUndefinedPaperValues) {
   // A wall at C: the wall's values, exact zeros and the paper's undefined expressions (NaN,
   // infinities) print as the conventions say and read back.
   const LabRun run = runScene({{100, 1, std::numeric_limits<double>::infinity()}, {2, 1, 0}, {-1, -0.0, 0}});
-  ASSERT_EQ(run.result.events.size(), 31u);  // m_A / m_B = 100: 31 collisions (shared/physics.md)
+  ASSERT_EQ(run.events().size(), 31u);  // m_A / m_B = 100: 31 collisions (shared/physics.md)
   for (bool with_model : {false, true}) {
-    expectCsvCarriesEvents(report(run, io::ReportFormat::kCsv, with_model), run.result.events);
-    expectJsonCarriesEvents(report(run, io::ReportFormat::kJson, with_model), run.result.events);
+    expectCsvCarriesEvents(report(run, io::ReportFormat::kCsv, with_model), run.events());
+    expectJsonCarriesEvents(report(run, io::ReportFormat::kJson, with_model), run.events());
   }
 }
 
@@ -277,8 +292,9 @@ SceneReports sceneReports(const core::Scene& scene) {
   const core::ModelChoice model = core::chooseModel(scene);
   const auto csv_writer = io::makeSceneReportWriter(io::ReportFormat::kCsv, csv);
   const auto json_writer = io::makeSceneReportWriter(io::ReportFormat::kJson, json);
-  csv_writer->begin(entry, options.lab, model);
-  json_writer->begin(entry, options.lab, model);
+  const core::ScenePlan plan = core::planScene(scene);
+  csv_writer->begin(entry, options.lab, model, plan.prediction);
+  json_writer->begin(entry, options.lab, model, plan.prediction);
   io::SceneEventJson records(scene);
   core::SceneVisitors visitors;
   visitors.impact = [&](const core::ImpactRecord& r) {
@@ -343,19 +359,19 @@ TEST(ReportStream, NBodyImpactsAndCollapsesCarryTheEngineValues) {
 // ---- A failure on a report thread (src/io/event_pipeline.h) ----
 
 /// Writes each event's time as a line, and throws at time 2500.
-void formatOrThrow(io::TextSink& sink, const core::LabEvent& lab, bool) {
-  if (lab.event.time == 2500) throw std::runtime_error("injected failure at t = 2500");
-  sink.count(static_cast<std::uint64_t>(lab.event.time));
+void formatOrThrow(io::TextSink& sink, const core::ImpactRecord& lab, bool) {
+  if (lab.time == 2500) throw std::runtime_error("injected failure at t = 2500");
+  sink.count(static_cast<std::uint64_t>(lab.time));
   sink.put('\n');
 }
 
 TEST(EventPipeline, AWorkerFailureIsReportedByFinishAndTheRunGoesOn) {
   std::ostringstream out;
   io::EventPipeline pipeline(out, formatOrThrow);
-  core::LabEvent lab;
+  core::ImpactRecord lab;
   // 10 blocks of 1024 events: the run's pushes must not wait for ever behind the failed one.
   for (int i = 0; i < 10240; ++i) {
-    lab.event.time = i;
+    lab.time = i;
     pipeline.push(lab);
   }
   try {

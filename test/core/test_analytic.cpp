@@ -72,7 +72,7 @@ TEST(ClosedForm, AgreesWithSimulationUpToAMillionCollisions) {
   const ThreeBodyScene scene{{2e11, 1, 3e11}, {2, 1, 0}, {-1, 0.5, 0.2}};
   double worst = 0.0;
   const AnalyticModel<long double> model(scene);
-  const LabRunSummary result = testing_support::simulateThreeBodies(scene, EventPolicy::none(), 10'000'000, [&](const ImpactEvent& e) {
+  const LabRunSummary result = testing_support::simulateThreeBodies(scene, EventPolicy::none(), 10'000'000, [&](const testing_support::ThreeBodyImpact& e) {
     if (e.index % 997 != 0) return;
     const auto predicted = model.velocitiesAfter(e.index);
     const std::array<reference::Q, 3> p{reference::Q(static_cast<double>(predicted(0))),
@@ -218,7 +218,7 @@ TEST(EnergyTransfer, ClosedFormMatchesSimulatedEvents) {
       if (!scene.isWall(j)) energy += 0.5 * scene.masses[j] * scene.velocities[j] * scene.velocities[j];
     }
     const auto result = testing_support::simulateThreeBodies(scene, EventPolicy::all());
-    for (const ImpactEvent& e : result.events) {
+    for (const testing_support::ThreeBodyImpact& e : result.events) {
       const auto predicted = model.energyTransfer(e.index);
       for (int j = 0; j < 3; ++j) {
         EXPECT_NEAR(predicted[j], e.energy_transfer[j], 1e-10 * std::max(1.0, energy)) << i << " event " << e.index;

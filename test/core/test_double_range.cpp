@@ -20,6 +20,7 @@
 #include "collision_lab/core/analytic.h"
 #include "collision_lab/core/lab_run.h"
 #include "rational_reference.h"
+#include "simulated_run.h"
 
 namespace collision_lab {
 namespace core {
@@ -32,7 +33,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 
 struct Observed {
   LabRunSummary summary;
-  std::vector<ImpactEvent> events;
+  std::vector<testing_support::ThreeBodyImpact> events;
 };
 
 /// The run of `scene` with every event published (the engine's path; RunOptions' defaults).
@@ -40,7 +41,7 @@ Observed run(const ThreeBodyScene& scene) {
   const RunResult result = runLab(scene, RunOptions{});
   Observed observed;
   observed.summary = result.summary;
-  for (const LabEvent& lab : result.events) observed.events.push_back(lab.event);
+  for (const ImpactRecord& record : result.events) observed.events.push_back(testing_support::threeBodyImpact(record));
   return observed;
 }
 
@@ -126,7 +127,7 @@ bool expectExactRun(const ThreeBodyScene& scene, const reference::Run& truth, bo
   Wide extent = 0;
   for (double x : scene.positions) extent = std::max(extent, Wide(std::fabs(x)));
   for (std::size_t k = 0; k < publishable; ++k) {
-    const ImpactEvent& e = observed.events[k];
+    const testing_support::ThreeBodyImpact& e = observed.events[k];
     const reference::Impact& t = truth.impacts[k];
     SCOPED_TRACE(::testing::Message() << "impact " << k + 1);
     EXPECT_EQ(e.pair, t.pair);
@@ -356,7 +357,7 @@ TEST(DoubleRange, TimesBelowTheSmallestDoubleKeepPositionsRight) {
   ASSERT_EQ(observed.events.size(), 3u);
   EXPECT_NEAR(observed.events[1].position, 1.5454545454545453e-200, 1e-209);
   EXPECT_NEAR(observed.events[2].position, 1.2857142857142857e-200, 1e-209);
-  for (const ImpactEvent& e : observed.events) EXPECT_EQ(e.time, 0.0);
+  for (const testing_support::ThreeBodyImpact& e : observed.events) EXPECT_EQ(e.time, 0.0);
 }
 
 TEST(DoubleRange, ASubnormalApproachSpeedKeepsTheEventTimeExact) {

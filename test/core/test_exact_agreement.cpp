@@ -55,7 +55,7 @@ struct Observed {
 /// The run with every impact visited (the engine's decisions).
 Observed run(const ThreeBodyScene& scene, std::uint64_t max_collisions = 10'000'000) {
   Observed observed;
-  observed.result = simulateThreeBodies(scene, EventPolicy::none(), max_collisions, [&](const ImpactEvent& e) {
+  observed.result = simulateThreeBodies(scene, EventPolicy::none(), max_collisions, [&](const testing_support::ThreeBodyImpact& e) {
                       observed.pairs.push_back(e.pair);
                     }).summary;
   return observed;
@@ -225,7 +225,7 @@ TEST(Conservation, EnergyAndMomentumOverLongRuns) {
   const double momentum = -1 + 2 * 0.3 + 3 * 0.7;
   const SimulatedRun result = simulateThreeBodies(scene, EventPolicy::all());
   ASSERT_FALSE(result.events.empty());
-  for (const ImpactEvent& e : result.events) {
+  for (const testing_support::ThreeBodyImpact& e : result.events) {
     EXPECT_NEAR(e.total_energy, energy, 1e-14);
     EXPECT_NEAR(e.total_momentum, momentum, 1e-14);
     EXPECT_NEAR(e.energy_transfer[0] + e.energy_transfer[1] + e.energy_transfer[2], 0.0, 1e-14);
@@ -236,7 +236,7 @@ TEST(Events, PoliciesCapsAndTimes) {
   const ThreeBodyScene scene{{100, 1, kInf}, {3, 2, 0}, {-1, 0, 0}};
   std::uint64_t visited = 0;
   const SimulatedRun first5 =
-      simulateThreeBodies(scene, EventPolicy::firstN(5), 10'000'000, [&](const ImpactEvent&) { ++visited; });
+      simulateThreeBodies(scene, EventPolicy::firstN(5), 10'000'000, [&](const testing_support::ThreeBodyImpact&) { ++visited; });
   EXPECT_EQ(first5.summary.collision_count, 31u);
   EXPECT_EQ(visited, 31u);
   ASSERT_EQ(first5.events.size(), 5u);

@@ -122,9 +122,9 @@ TEST(FullRunAccuracy, RecurrenceStaysWithin1e13OfTheClosedFormOver2e7Impacts) {
   RunOptions options;
   options.max_collisions = 30'000'000;
   options.events = EventPolicy::none();
-  const RunResult result = runLab(kHeavyLightHeavy, options, [&](const LabEvent& lab) {
-    const auto sample = samples.find(lab.event.index);
-    if (sample != samples.end()) sample->second = lab.predicted_velocities_after;
+  const RunResult result = runLab(kHeavyLightHeavy, options, [&](const ImpactRecord& lab) {
+    const auto sample = samples.find(lab.index);
+    if (sample != samples.end()) sample->second = lab.model->predicted_velocities_after;
   });
   ASSERT_FALSE(result.summary.truncated);
   ASSERT_EQ(result.summary.collision_count, expected_count);

@@ -96,8 +96,8 @@ TEST(LabRunCancel, AFlagSetDuringTheRunStopsItWithinACheckIntervalWithThePartial
     RunOptions options;
     options.cancel = &cancel;
     options.events = events ? EventPolicy::all() : EventPolicy::none();
-    const RunResult result = runLab(scene, options, [&](const LabEvent& lab) {
-      if (lab.event.index == kSetAt) cancel = true;
+    const RunResult result = runLab(scene, options, [&](const ImpactRecord& lab) {
+      if (lab.index == kSetAt) cancel = true;
     });
     const std::uint64_t count = result.summary.collision_count;
     EXPECT_GE(count, kSetAt) << events;
@@ -130,16 +130,16 @@ TEST(EnergyTransferPerImpact, NonParticipantsAndRestingWallsGainExactlyZero) {
                              ThreeBodyScene{{0.3, 0.7, 0.11}, {0.9, 0.2, -0.4}, {-0.3, 0.1, 0.25}}}) {
     const RunResult result = runAll(scene);
     ASSERT_FALSE(result.events.empty());
-    for (const LabEvent& lab : result.events) {
-      const int outsider = lab.event.pair == Pair::AB ? kC : kA;
-      for (const auto* gains : {&lab.event.energy_transfer, &lab.predicted_energy_transfer, &lab.paper_energy_transfer}) {
-        EXPECT_EQ((*gains)[outsider], 0.0) << lab.event.index;
-        EXPECT_FALSE(std::signbit((*gains)[outsider])) << lab.event.index;
+    for (const ImpactRecord& lab : result.events) {
+      const int outsider = (lab.pair_index == 0 ? Pair::AB : Pair::BC) == Pair::AB ? kC : kA;
+      for (const auto* gains : {&lab.model->energy_transfer, &lab.model->predicted_energy_transfer, &lab.model->paper_energy_transfer}) {
+        EXPECT_EQ((*gains)[outsider], 0.0) << lab.index;
+        EXPECT_FALSE(std::signbit((*gains)[outsider])) << lab.index;
       }
-      if (scene.isWall(kC) && lab.event.pair == Pair::BC) {
+      if (scene.isWall(kC) && (lab.pair_index == 0 ? Pair::AB : Pair::BC) == Pair::BC) {
         // The ball bounces off a resting wall with its speed: nobody gains anything.
-        for (double gained : lab.event.energy_transfer) EXPECT_EQ(gained, 0.0) << lab.event.index;
-        for (double gained : lab.predicted_energy_transfer) EXPECT_EQ(gained, 0.0) << lab.event.index;
+        for (double gained : lab.model->energy_transfer) EXPECT_EQ(gained, 0.0) << lab.index;
+        for (double gained : lab.model->predicted_energy_transfer) EXPECT_EQ(gained, 0.0) << lab.index;
       }
     }
   }
@@ -154,13 +154,13 @@ TEST(EnergyTransferPerImpact, ThePairsEntriesAreExactOppositesAndExact) {
     double energy = 0;
     for (int i = 0; i < 3; ++i) energy += scene.masses[i] * scene.velocities[i] * scene.velocities[i] / 2;
     for (std::size_t k = 0; k < truth.impacts.size(); ++k) {
-      const LabEvent& lab = result.events[k];
-      const int left = lab.event.pair == Pair::AB ? kA : kB;
-      EXPECT_EQ(lab.event.energy_transfer[left], -lab.event.energy_transfer[left + 1]) << k;
-      EXPECT_EQ(lab.predicted_energy_transfer[left], -lab.predicted_energy_transfer[left + 1]) << k;
+      const ImpactRecord& lab = result.events[k];
+      const int left = (lab.pair_index == 0 ? Pair::AB : Pair::BC) == Pair::AB ? kA : kB;
+      EXPECT_EQ(lab.model->energy_transfer[left], -lab.model->energy_transfer[left + 1]) << k;
+      EXPECT_EQ(lab.model->predicted_energy_transfer[left], -lab.model->predicted_energy_transfer[left + 1]) << k;
       for (int i : {left, left + 1}) {
-        EXPECT_NEAR(lab.event.energy_transfer[i], exactGain(scene, truth, k, i), 1e-12 * energy) << k;
-        EXPECT_NEAR(lab.predicted_energy_transfer[i], exactGain(scene, truth, k, i), 1e-12 * energy) << k;
+        EXPECT_NEAR(lab.model->energy_transfer[i], exactGain(scene, truth, k, i), 1e-12 * energy) << k;
+        EXPECT_NEAR(lab.model->predicted_energy_transfer[i], exactGain(scene, truth, k, i), 1e-12 * energy) << k;
       }
     }
   }
@@ -174,14 +174,14 @@ TEST(EnergyTransferPerImpact, AMovingWallsEntryIsMinusWhatTheBallGains) {
   ASSERT_EQ(result.events.size(), truth.impacts.size());
   int wall_impacts = 0;
   for (std::size_t k = 0; k < truth.impacts.size(); ++k) {
-    const LabEvent& lab = result.events[k];
-    if (lab.event.pair != Pair::AB) continue;
+    const ImpactRecord& lab = result.events[k];
+    if ((lab.pair_index == 0 ? Pair::AB : Pair::BC) != Pair::AB) continue;
     ++wall_impacts;
     const double ball = exactGain(scene, truth, k, kB);
     EXPECT_NE(ball, 0.0);
-    EXPECT_NEAR(lab.event.energy_transfer[kB], ball, 1e-15 * std::fabs(ball) + 1e-300) << k;
-    EXPECT_EQ(lab.event.energy_transfer[kA], -lab.event.energy_transfer[kB]) << k;
-    EXPECT_EQ(lab.predicted_energy_transfer[kA], -lab.predicted_energy_transfer[kB]) << k;
+    EXPECT_NEAR(lab.model->energy_transfer[kB], ball, 1e-15 * std::fabs(ball) + 1e-300) << k;
+    EXPECT_EQ(lab.model->energy_transfer[kA], -lab.model->energy_transfer[kB]) << k;
+    EXPECT_EQ(lab.model->predicted_energy_transfer[kA], -lab.model->predicted_energy_transfer[kB]) << k;
   }
   EXPECT_GE(wall_impacts, 1);
 }
@@ -207,21 +207,21 @@ TEST(NegativeZeros, NoneInEventsPredictionsOrSummaries) {
   for (const ThreeBodyScene& scene : {ThreeBodyScene{{100, 1, kInf}, {2, 1, 0}, {-1, -0.0, -0.0}}, ThreeBodyScene{{1, 1, 1}, {2, 1, 0}, {-1, 0, 0}},
                              ThreeBodyScene{{kInf, 1, 1}, {2, 1, 0}, {-0.0, 0.5, -1}}, ThreeBodyScene{{3, 1, 0.5}, {2, 1, 0}, {-1, 0, 0}}}) {
     const RunResult result = runAll(scene);
-    for (const LabEvent& lab : result.events) {
-      const std::uint64_t k = lab.event.index;
-      EXPECT_FALSE(isNegativeZero(lab.event.time)) << k;
-      EXPECT_FALSE(isNegativeZero(lab.event.position)) << k;
-      EXPECT_FALSE(isNegativeZero(lab.event.total_energy)) << k;
-      EXPECT_FALSE(isNegativeZero(lab.event.total_momentum)) << k;
-      expectNoNegativeZero(lab.event.positions, "positions", k);
-      expectNoNegativeZero(lab.event.velocities_before, "velocities_before", k);
-      expectNoNegativeZero(lab.event.velocities_after, "velocities_after", k);
-      expectNoNegativeZero(lab.event.energy_transfer, "energy_transfer", k);
-      expectNoNegativeZero(lab.predicted_velocities_after, "predicted_velocities_after", k);
-      expectNoNegativeZero(lab.paper_velocities_after, "paper_velocities_after", k);
-      expectNoNegativeZero(lab.predicted_energy_transfer, "predicted_energy_transfer", k);
-      expectNoNegativeZero(lab.paper_energy_transfer, "paper_energy_transfer", k);
-      expectNoNegativeZero(lab.kinetic_energy_after, "kinetic_energy_after", k);
+    for (const ImpactRecord& lab : result.events) {
+      const std::uint64_t k = lab.index;
+      EXPECT_FALSE(isNegativeZero(lab.time)) << k;
+      EXPECT_FALSE(isNegativeZero(lab.position)) << k;
+      EXPECT_FALSE(isNegativeZero(lab.model->total_energy)) << k;
+      EXPECT_FALSE(isNegativeZero(lab.model->total_momentum)) << k;
+      expectNoNegativeZero(lab.model->positions, "positions", k);
+      expectNoNegativeZero(lab.model->velocities_before, "velocities_before", k);
+      expectNoNegativeZero(lab.model->velocities_after, "velocities_after", k);
+      expectNoNegativeZero(lab.model->energy_transfer, "energy_transfer", k);
+      expectNoNegativeZero(lab.model->predicted_velocities_after, "predicted_velocities_after", k);
+      expectNoNegativeZero(lab.model->paper_velocities_after, "paper_velocities_after", k);
+      expectNoNegativeZero(lab.model->predicted_energy_transfer, "predicted_energy_transfer", k);
+      expectNoNegativeZero(lab.model->paper_energy_transfer, "paper_energy_transfer", k);
+      expectNoNegativeZero(lab.model->kinetic_energy_after, "kinetic_energy_after", k);
     }
     expectNoNegativeZero(result.summary.final_velocities, "summary final_velocities", 0);
     expectNoNegativeZero(result.prediction.final_velocities, "predicted final_velocities", 0);

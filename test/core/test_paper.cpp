@@ -97,11 +97,11 @@ TEST(PaperErrata, EnergyTransfer44UsesTheWrongAverage) {
   const ThreeBodyScene scene{{1, 2, 3}, {3, 2, 0}, {-1, 0.3, 0.7}};
   const auto result = testing_support::simulateThreeBodies(scene, EventPolicy::all());
   ASSERT_GE(result.summary.collision_count, 3u);
-  const ImpactEvent& first = result.events[0];
+  const testing_support::ThreeBodyImpact& first = result.events[0];
   const auto printed_first =
       paper::energyTransfer(scene, 1, first.pair, first.velocities_before, scene.velocities);
   EXPECT_NEAR(printed_first[0], first.energy_transfer[0], 1e-12);  // right at k = 0
-  const ImpactEvent& third = result.events[2];
+  const testing_support::ThreeBodyImpact& third = result.events[2];
   ASSERT_EQ(third.pair, Pair::AB);
   const auto printed_third =
       paper::energyTransfer(scene, 3, third.pair, third.velocities_before, result.events[1].velocities_before);

@@ -74,21 +74,21 @@ TEST(ThreeBodyRounding, FinalAndEventVelocitiesAreTheCorrectlyRoundedExactOnesAn
     SceneRunOptions options;
     options.lab.events = EventPolicy::all();
     const SceneRunResult run = runScene(planScene(general(scene)), options);
-    ASSERT_TRUE(run.three_body) << describe(scene);
-    const RunResult& result = *run.three_body;
-    ASSERT_EQ(result.summary.collision_count, truth.impacts.size()) << describe(scene);
+    ASSERT_TRUE(run.prediction && hasRotationValues(*run.prediction)) << describe(scene);
+    const SceneSimulation& result = run.simulation;
+    ASSERT_EQ(result.impact_count, truth.impacts.size()) << describe(scene);
     const EngineResult engine = runEngine(general(scene));
     ASSERT_EQ(engine.impact_count, truth.impacts.size()) << describe(scene);
     for (int i = 0; i < 3; ++i) {
-      EXPECT_TRUE(correctlyRounded(result.summary.final_velocities[i], truth.final_velocities[i]))
-          << describe(scene) << " body " << i << ": " << result.summary.final_velocities[i];
-      EXPECT_EQ(result.summary.final_velocities[i], engine.final_velocities[i]) << describe(scene) << i;
+      EXPECT_TRUE(correctlyRounded(result.final_velocities[i], truth.final_velocities[i]))
+          << describe(scene) << " body " << i << ": " << result.final_velocities[i];
+      EXPECT_EQ(result.final_velocities[i], engine.final_velocities[i]) << describe(scene) << i;
     }
-    ASSERT_EQ(result.events.size(), truth.impacts.size());
+    ASSERT_EQ(result.impacts.size(), truth.impacts.size());
     for (std::size_t k = 0; k < truth.impacts.size(); ++k) {
-      EXPECT_EQ(result.events[k].event.pair, truth.impacts[k].pair) << describe(scene) << k;
+      EXPECT_EQ(result.impacts[k].pair_index, static_cast<std::size_t>(pairIndex(truth.impacts[k].pair))) << describe(scene) << k;
       for (int i = 0; i < 3; ++i) {
-        EXPECT_TRUE(correctlyRounded(result.events[k].event.velocities_after[i], truth.impacts[k].velocities[i]))
+        EXPECT_TRUE(correctlyRounded(result.impacts[k].model->velocities_after[i], truth.impacts[k].velocities[i]))
             << describe(scene) << " impact " << k + 1 << " body " << i;
       }
     }
@@ -125,26 +125,26 @@ TEST(ThreeBodyRounding, RunsWithoutEventsAreTheEnginesAndNeverEscalateAtExtremeM
     with_events.lab.max_collisions = c.cap;
     with_events.simulate_to_cap = true;
     const SceneRunResult published = runScene(planScene(general(c.scene)), with_events);
-    ASSERT_TRUE(published.three_body) << describe(c.scene);
+    ASSERT_TRUE(published.prediction && hasRotationValues(*published.prediction)) << describe(c.scene);
+    const SceneSimulation& all = published.simulation;
     for (const RunMode mode : {RunMode::kFull, RunMode::kSummaryOnly}) {
       SceneRunOptions options = with_events;
       options.lab.events = EventPolicy::none();
       options.lab.mode = mode;
       const SceneRunResult run = runScene(planScene(general(c.scene)), options);
-      ASSERT_TRUE(run.three_body) << describe(c.scene);
-      const LabRunSummary& summary = run.three_body->summary;
-      ASSERT_EQ(summary.collision_count, truth.impacts.size()) << describe(c.scene);
+      const SceneSimulation& summary = run.simulation;
+      ASSERT_EQ(summary.impact_count, truth.impacts.size()) << describe(c.scene);
       EXPECT_EQ(summary.truncated, truth.truncated) << describe(c.scene);
-      EXPECT_EQ(summary.escalation.high_precision, 0u) << describe(c.scene);
-      EXPECT_EQ(summary.escalation.decisions, summary.collision_count + 1) << describe(c.scene);
+      EXPECT_EQ(summary.escalations.high_precision, 0u) << describe(c.scene);
+      EXPECT_EQ(summary.escalations.exact_rational, 0u) << describe(c.scene);
       for (int i = 0; i < 3; ++i) {
         EXPECT_TRUE(correctlyRounded(summary.final_velocities[i], truth.final_velocities[i]))
             << describe(c.scene) << " body " << i << ": " << summary.final_velocities[i];
-        EXPECT_EQ(summary.final_velocities[i], published.three_body->summary.final_velocities[i]) << describe(c.scene);
+        EXPECT_EQ(summary.final_velocities[i], all.final_velocities[i]) << describe(c.scene);
       }
-      EXPECT_EQ(summary.energy_relative_drift, published.three_body->summary.energy_relative_drift) << describe(c.scene);
+      EXPECT_EQ(summary.energy_relative_drift, all.energy_relative_drift) << describe(c.scene);
       if (mode == RunMode::kFull) {
-        EXPECT_EQ(summary.max_prediction_error, published.three_body->summary.max_prediction_error)
+        EXPECT_EQ(summary.max_prediction_error, all.max_prediction_error)
             << describe(c.scene);
       }
     }

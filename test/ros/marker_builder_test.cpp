@@ -63,8 +63,9 @@ Fed feed(const Array3& masses, const Array3& positions, const Array3& velocities
   options.lab.events = collision_lab::core::EventPolicy::none();
   options.simulate_to_cap = !o.skip_simulation_over_cap;
   collision_lab::core::SceneVisitors visitors;
-  visitors.three_body_event = [&](const collision_lab::core::LabEvent& e) {
-    const auto msg = toCollisionEventMsg(e);
+  SceneEventConverter converter(plan.scene);
+  visitors.impact = [&](const collision_lab::core::ImpactRecord& e) {
+    const auto msg = converter.impact(e);
     fed.run.add(msg);
     if (o.keep_events) fed.events.push_back(msg);
   };

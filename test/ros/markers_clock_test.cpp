@@ -66,21 +66,21 @@ class Player {
     collision_lab::core::SceneRunOptions options;
     options.lab.events = collision_lab::core::EventPolicy::all();
     const collision_lab::core::SceneRunResult run = collision_lab::core::runScene(plan, options);
-    const collision_lab::core::RunResult& result = *run.three_body;
     auto prediction = toPredictionMsg(plan);
     prediction.run_id = run_id;
     prediction.header.stamp = start;
     prediction.timeline_scale = kScale;
     queue(prediction_, prediction);
-    for (const auto& e : result.events) {
-      auto msg = toCollisionEventMsg(e);
+    SceneEventConverter converter(plan.scene);
+    for (const auto& e : run.simulation.impacts) {
+      auto msg = converter.impact(e);
       msg.run_id = run_id;
-      msg.header.stamp = start + ros::Duration(kScale * e.event.time);
+      msg.header.stamp = start + ros::Duration(kScale * e.time);
       queue(events_, msg);
     }
     auto summary = toRunSummaryMsg(run, 3, collision_lab::core::RunMode::kFull);
     summary.run_id = run_id;
-    summary.header.stamp = start + ros::Duration(kScale * result.events.back().event.time);
+    summary.header.stamp = start + ros::Duration(kScale * run.simulation.impacts.back().time);
     queue(summary_, summary);
   }
 

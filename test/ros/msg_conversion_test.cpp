@@ -361,50 +361,73 @@ TEST(MsgConversion, EveryPredictionFieldReachesTheMessage) {
   EXPECT_TRUE(std::isnan(msg.phi_bc));
 }
 
-collision_lab::core::LabEvent sampleEvent() {
-  collision_lab::core::LabEvent e;
-  e.event.index = 42;
-  e.event.pair = collision_lab::core::Pair::BC;
-  e.event.time = 1.5;
-  e.event.position = -0.25;
-  e.event.positions = {1, -0.25, -0.25};
-  e.event.velocities_before = {-1, 0.5, 1};
-  e.event.velocities_after = {-1, 0.9, 0.2};
-  e.event.energy_transfer = {0, 0.1, -0.1};
-  e.event.total_energy = 3.25;
-  e.event.total_momentum = -0.5;
-  e.predicted_velocities_after = {-1, 0.9000001, 0.2};
-  e.paper_velocities_after = {7, 8, 9};
-  e.predicted_energy_transfer = {0, 0.11, -0.11};
-  e.paper_energy_transfer = {0, 0.2, -0.2};
-  e.kinetic_energy_after = {0.5, 0.81, 0.06};
+/// Three bodies and an impact of theirs with its model block (every value distinct).
+const collision_lab::core::Scene kThreeBodies{{1, 1, 1}, {2, 1, 0}, {-1, 0.5, 1}, {}};
+
+collision_lab::core::ImpactRecord sampleEvent() {
+  collision_lab::core::ImpactRecord e;
+  e.index = 42;
+  e.pair_index = 1;
+  e.time = 1.5;
+  e.position = -0.25;
+  e.velocities_before = {0.5, 1};
+  e.velocities_after = {0.9, 0.2};
+  e.energy_gained = {0.1, -0.1};
+  e.first_moved = 1;
+  e.last_moved = 2;
+  collision_lab::core::ImpactModelValues& m = e.model.emplace();
+  m.positions = {1, -0.25, -0.25};
+  m.velocities_before = {-1, 0.5, 1};
+  m.velocities_after = {-1, 0.9, 0.2};
+  m.energy_transfer = {0, 0.1, -0.1};
+  m.total_energy = 3.25;
+  m.total_momentum = -0.5;
+  m.predicted_velocities_after = {-1, 0.9000001, 0.2};
+  m.paper_velocities_after = {7, 8, 9};
+  m.predicted_energy_transfer = {0, 0.11, -0.11};
+  m.paper_energy_transfer = {0, 0.2, -0.2};
+  m.kinetic_energy_after = {0.5, 0.81, 0.06};
   return e;
 }
 
-TEST(MsgConversion, CollisionEventRoundTrip) {
-  const collision_lab::core::LabEvent e = sampleEvent();
-  const auto msg = toCollisionEventMsg(e);
+/// The message of sampleEvent(), converted as the node converts it.
+collision_lab::CollisionEvent sampleMsg() { return SceneEventConverter(kThreeBodies).impact(sampleEvent()); }
+
+std::vector<double> vectorOf(const std::array<double, 3>& values) { return {values.begin(), values.end()}; }
+
+TEST(MsgConversion, AnImpactsModelBlockIsCopiedAsItIs) {
+  const collision_lab::core::ImpactRecord e = sampleEvent();
+  const collision_lab::core::ImpactModelValues& m = *e.model;
+  const auto msg = sampleMsg();
+  EXPECT_EQ(msg.kind, collision_lab::CollisionEvent::KIND_IMPACT);
   EXPECT_EQ(msg.pair_index, collision_lab::CollisionEvent::PAIR_BC);
-  const collision_lab::core::LabEvent back = toLabEvent(msg);
-  EXPECT_EQ(back.event.index, e.event.index);
-  EXPECT_EQ(back.event.pair, e.event.pair);
-  EXPECT_EQ(back.event.time, e.event.time);
-  EXPECT_EQ(back.event.position, e.event.position);
-  EXPECT_EQ(back.event.positions, e.event.positions);
-  EXPECT_EQ(back.event.velocities_before, e.event.velocities_before);
-  EXPECT_EQ(back.event.velocities_after, e.event.velocities_after);
-  EXPECT_EQ(back.event.energy_transfer, e.event.energy_transfer);
-  EXPECT_EQ(back.event.total_energy, e.event.total_energy);
-  EXPECT_EQ(back.event.total_momentum, e.event.total_momentum);
-  EXPECT_EQ(back.predicted_velocities_after, e.predicted_velocities_after);
-  EXPECT_EQ(back.paper_velocities_after, e.paper_velocities_after);
-  EXPECT_EQ(back.predicted_energy_transfer, e.predicted_energy_transfer);
-  EXPECT_EQ(back.paper_energy_transfer, e.paper_energy_transfer);
-  EXPECT_EQ(back.kinetic_energy_after, e.kinetic_energy_after);
+  EXPECT_EQ(msg.index, e.index);
+  EXPECT_EQ(msg.time, e.time);
+  EXPECT_EQ(msg.position, e.position);
+  EXPECT_EQ(msg.pair_velocities_after[0], 0.9);
+  EXPECT_EQ(msg.pair_energy_transfer[1], -0.1);
+  EXPECT_EQ(msg.positions, vectorOf(m.positions));
+  EXPECT_EQ(msg.velocities_before, vectorOf(m.velocities_before));
+  EXPECT_EQ(msg.velocities_after, vectorOf(m.velocities_after));
+  EXPECT_EQ(msg.energy_transfer, vectorOf(m.energy_transfer));
+  EXPECT_EQ(msg.total_energy, m.total_energy);
+  EXPECT_EQ(msg.total_momentum, m.total_momentum);
+  EXPECT_EQ(msg.predicted_velocities_after, vectorOf(m.predicted_velocities_after));
+  EXPECT_EQ(msg.paper_velocities_after, vectorOf(m.paper_velocities_after));
+  EXPECT_EQ(msg.predicted_energy_transfer, vectorOf(m.predicted_energy_transfer));
+  EXPECT_EQ(msg.paper_energy_transfer, vectorOf(m.paper_energy_transfer));
+  EXPECT_EQ(msg.kinetic_energy_after, vectorOf(m.kinetic_energy_after));
+  // Without the block, the same impact's model arrays are empty.
+  collision_lab::core::ImpactRecord plain = e;
+  plain.model.reset();
+  const auto engine_msg = SceneEventConverter(kThreeBodies).impact(plain);
+  EXPECT_TRUE(engine_msg.predicted_velocities_after.empty());
+  EXPECT_TRUE(engine_msg.paper_energy_transfer.empty());
+  EXPECT_EQ(engine_msg.velocities_after.size(), 3u);
 }
 
 TEST(MsgConversion, PlotTopicsAreTheEventsSimulatedValues) {
-  collision_lab::CollisionEvent event = toCollisionEventMsg(sampleEvent());
+  collision_lab::CollisionEvent event = sampleMsg();
   event.header.stamp = ros::Time(1700000000, 5);
   event.run_id = "plotted";
   const auto v = toVelocitiesMsg(event);
@@ -452,16 +475,16 @@ TEST(MsgConversion, AReusedMessageCarriesItsNewEventAlone) {
 
   // A three-body event (every array filled, the model's too), then the large scene's
   // impact (no arrays): the same message as converted fresh.
-  collision_lab::CollisionEvent reused = toCollisionEventMsg(sampleEvent());
+  collision_lab::CollisionEvent reused = sampleMsg();
   reused_converter.impact(impact, reused);
   EXPECT_EQ(wireBytes(reused), wireBytes(fresh));
   EXPECT_TRUE(reused.predicted_velocities_after.empty());
   EXPECT_TRUE(reused.positions.empty());
 
-  collision_lab::Velocities velocities = toVelocitiesMsg(toCollisionEventMsg(sampleEvent()));
+  collision_lab::Velocities velocities = toVelocitiesMsg(sampleMsg());
   reused_converter.velocitiesMsg(reused, velocities);
   EXPECT_EQ(wireBytes(velocities), wireBytes(fresh_converter.velocitiesMsg(fresh)));
-  collision_lab::EnergyTransfer energy = toEnergyTransferMsg(toCollisionEventMsg(sampleEvent()), 2.0);
+  collision_lab::EnergyTransfer energy = toEnergyTransferMsg(sampleMsg(), 2.0);
   reused_converter.energyTransferMsg(reused, energy);
   EXPECT_EQ(wireBytes(energy), wireBytes(fresh_converter.energyTransferMsg(fresh)));
 
@@ -469,8 +492,8 @@ TEST(MsgConversion, AReusedMessageCarriesItsNewEventAlone) {
   collision_lab::CollisionEvent three_body = fresh;
   three_body.header.stamp = ros::Time(1700000000, 5);
   three_body.run_id = "plotted";
-  fillCollisionEventMsg(sampleEvent(), three_body);
-  collision_lab::CollisionEvent expected = toCollisionEventMsg(sampleEvent());
+  SceneEventConverter(kThreeBodies).impact(sampleEvent(), three_body);
+  collision_lab::CollisionEvent expected = sampleMsg();
   expected.header = three_body.header;
   expected.run_id = three_body.run_id;
   EXPECT_EQ(wireBytes(three_body), wireBytes(expected));
@@ -519,6 +542,17 @@ TEST(MsgConversion, RunSummaryPhysicsFields) {
   EXPECT_TRUE(std::isnan(msg.momentum_relative_drift));
   EXPECT_EQ(msg.compute_time, 0.5);
   EXPECT_EQ(msg.mode, collision_lab::InitialConditions::MODE_FULL);
+}
+
+// The spiral's opening angle is its prediction's (the core's), copied like every field
+// (failed before: the prediction had none and the conversion computed it for that model).
+TEST(MsgConversion, TheSpiralsOpeningAngleComesFromItsPrediction) {
+  const collision_lab::core::ScenePlan plan = collision_lab::core::planScene({{1, 1, 1}, {2, 1, 0}, {-1, 0, 0.5}, {0.5}});
+  ASSERT_FALSE(plan.error);
+  ASSERT_EQ(plan.model.kind, collision_lab::core::ModelKind::kThreeBodySpiral);
+  ASSERT_TRUE(plan.prediction && plan.prediction->alpha);
+  EXPECT_NEAR(*plan.prediction->alpha, M_PI / 3, 1e-15);  // equal masses: alpha = pi/3
+  EXPECT_EQ(toPredictionMsg(plan).alpha, *plan.prediction->alpha);
 }
 
 TEST(MsgConversion, ThreeEqualMassesTakeTheOnePathToThreeImpacts) {

@@ -171,24 +171,25 @@ TEST(LabNode, RoundTripMatchesCore) {
   received_prediction.run_id = prediction.run_id;
   EXPECT_EQ(bytes(received_prediction), bytes(prediction));
 
+  collision_lab_ros::SceneEventConverter converter(scene);
   for (std::size_t k = 0; k < expected.events.size(); ++k) {
-    const core::LabEvent& e = expected.events[k];
-    auto event = collision_lab_ros::toCollisionEventMsg(e);
+    const core::ImpactRecord& e = expected.events[k];
+    auto event = converter.impact(e);
     event.header = out.events[k].header, event.run_id = "round_trip";
     EXPECT_EQ(bytes(out.events[k]), bytes(event)) << "collision " << k + 1;
     // The plot topics: the simulated values of the same collision, at the same stamp.
     const collision_lab::Velocities& v = out.velocities[k];
     EXPECT_EQ(v.header.stamp, out.events[k].header.stamp) << "collision " << k + 1;
     EXPECT_EQ(v.run_id, "round_trip");
-    EXPECT_EQ(v.index, e.event.index);
-    EXPECT_EQ(v.time, e.event.time);
-    expectArrayEq({{v.v_a, v.v_b, v.v_c}}, e.event.velocities_after, "v after collision " + std::to_string(k + 1));
+    EXPECT_EQ(v.index, e.index);
+    EXPECT_EQ(v.time, e.time);
+    expectArrayEq({{v.v_a, v.v_b, v.v_c}}, e.model->velocities_after, "v after collision " + std::to_string(k + 1));
     const collision_lab::EnergyTransfer& t = out.energies[k];
     EXPECT_EQ(t.header.stamp, out.events[k].header.stamp) << "collision " << k + 1;
-    EXPECT_EQ(t.index, e.event.index);
-    EXPECT_EQ(t.time, e.event.time);
-    expectArrayEq({{t.delta_a, t.delta_b, t.delta_c}}, e.event.energy_transfer, "delta " + std::to_string(k + 1));
-    expectArrayEq({{t.kinetic_a, t.kinetic_b, t.kinetic_c}}, e.kinetic_energy_after, "kinetic " + std::to_string(k + 1));
+    EXPECT_EQ(t.index, e.index);
+    EXPECT_EQ(t.time, e.time);
+    expectArrayEq({{t.delta_a, t.delta_b, t.delta_c}}, e.model->energy_transfer, "delta " + std::to_string(k + 1));
+    expectArrayEq({{t.kinetic_a, t.kinetic_b, t.kinetic_c}}, e.model->kinetic_energy_after, "kinetic " + std::to_string(k + 1));
   }
 
   const auto& summary = out.summaries.front();

@@ -710,8 +710,9 @@ PiRun piRun(const std::string& run_id) {
   options.lab.mode = collision_lab::core::RunMode::kFull;
   options.lab.max_collisions = 10'000;
   collision_lab::core::SceneVisitors visitors;
-  visitors.three_body_event = [&](const collision_lab::core::LabEvent& e) {
-    run.events.push_back(collision_lab_ros::toCollisionEventMsg(e));
+  collision_lab_ros::SceneEventConverter converter(plan.scene);
+  visitors.impact = [&](const collision_lab::core::ImpactRecord& e) {
+    run.events.push_back(converter.impact(e));
     run.events.back().run_id = run_id;
   };
   collision_lab::core::runScene(plan, options, visitors);

@@ -1,34 +1,15 @@
-// The three-body run's impact record and the policies every front end shares: which
-// events a run keeps (EventPolicy) and how often its decisions left the working precision
-// (EscalationStats). The run itself is the exact event engine's (nbody/engine.h), through
-// runLab (lab_run.h).
+// The policies every front end shares: which events a run keeps (EventPolicy) and how
+// often its decisions left the working precision (EscalationStats). Every run's impact
+// record is the engine's ImpactRecord (nbody/engine.h), with a model's values in its one
+// optional block (impact_model_values.h).
 #pragma once
 
-#include <array>
 #include <cstdint>
-#include <functional>
 
 #include "collision_lab/core/scene.h"
 
 namespace collision_lab {
 namespace core {
-
-/// One elastic two-body impact. Every value is the double nearest to the exact one (and
-/// never -0): a time below the smallest double rounds to 0, while positions keep their
-/// digits. An impact after the largest double is never published: the run stops before it
-/// (OUT_OF_RANGE, truncated).
-struct ImpactEvent {
-  std::uint64_t index = 0;                    ///< 1-based collision number
-  Pair pair = Pair::AB;
-  double time = 0.0;                          ///< [s] since the start of the run
-  double position = 0.0;                      ///< contact point [m]
-  std::array<double, 3> positions{};          ///< A, B, C at the impact [m]
-  std::array<double, 3> velocities_before{};  ///< [m/s]
-  std::array<double, 3> velocities_after{};   ///< [m/s]
-  std::array<double, 3> energy_transfer{};    ///< kinetic energy gained by A, B, C [J]
-  double total_energy = 0.0;                  ///< kinetic energy of the finite masses after [J]
-  double total_momentum = 0.0;                ///< momentum of the finite masses after [kg m/s]
-};
 
 /// Which events a run keeps (RunOptions::events, lab_run.h). Independent of the visitor,
 /// which sees every event.
@@ -56,9 +37,6 @@ struct EventPolicy {
     return kind == Kind::kAll || (kind == Kind::kFirstN && impacts_before <= first_n);
   }
 };
-
-/// Called for every collision, in order. May be empty.
-using EventVisitor = std::function<void(const ImpactEvent&)>;
 
 /// How often the adaptive path had to leave the working precision.
 struct EscalationStats {

@@ -43,19 +43,9 @@ struct AnalyticPrediction {
 
 AnalyticPrediction predict(const ThreeBodyScene& scene);
 
-/// One collision with everything a lab compares it to.
-struct LabEvent {
-  ImpactEvent event;
-  std::array<double, 3> predicted_velocities_after{};  ///< closed form [m/s]
-  std::array<double, 3> paper_velocities_after{};      ///< eqs. (2.15)/(2.16) as printed [m/s]
-  std::array<double, 3> predicted_energy_transfer{};   ///< closed form, gained by A,B,C [J]
-  std::array<double, 3> paper_energy_transfer{};       ///< eqs. (4.4)-(4.7) as printed [J]
-  std::array<double, 3> kinetic_energy_after{};        ///< per particle [J]; 0 for a wall
-};
-
 struct RunOptions {
   std::uint64_t max_collisions = 10'000'000;
-  EventPolicy events = EventPolicy::all();  ///< which LabEvents RunResult keeps
+  EventPolicy events = EventPolicy::all();  ///< which impacts RunResult keeps
   RunMode mode = RunMode::kFull;
   /// When the predicted count exceeds max_collisions, answer at once from the closed form
   /// (simulated false, its count and final velocities) instead of simulating up to the cap.
@@ -94,20 +84,19 @@ struct LabRunSummary {
 struct RunResult {
   AnalyticPrediction prediction;
   LabRunSummary summary;
-  std::vector<LabEvent> events;  ///< as RunOptions::events says
+  /// As RunOptions::events says: the engine's records, each with its model block
+  /// (ImpactRecord::model: every body's state, the closed form's and the paper's values).
+  std::vector<ImpactRecord> events;
 };
 
-using LabEventVisitor = std::function<void(const LabEvent&)>;
-
-/// Runs a validated scene. The visitor sees every event in order (none in predict-only
-/// or summary-only mode). Precondition: validate(scene) passed.
-RunResult runLab(const ThreeBodyScene& scene, const RunOptions& options,
-                 const LabEventVisitor& visitor = {});
+/// Runs a validated scene. The visitor sees every impact in order, with its model block
+/// (none in predict-only or summary-only mode). Precondition: validate(scene) passed.
+RunResult runLab(const ThreeBodyScene& scene, const RunOptions& options, const ImpactVisitor& visitor = {});
 
 /// The same with the prediction already made (for callers that publish it first);
 /// `prediction` must be predict(scene).
 RunResult runLab(const ThreeBodyScene& scene, const RunOptions& options, const AnalyticPrediction& prediction,
-                 const LabEventVisitor& visitor = {});
+                 const ImpactVisitor& visitor = {});
 
 }  // namespace core
 }  // namespace collision_lab

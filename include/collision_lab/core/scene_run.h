@@ -42,22 +42,20 @@ struct SceneRunOptions {
   /// When lab.events asks for any event (in full mode), a closed-form scene is simulated
   /// too, and the simulation is checked against the prediction.
   RunOptions lab;
-  /// Keep the events that lab.events selects (RunResult::events of the three-body path,
-  /// SceneSimulation::impacts and collapses of the engine). False, for front ends that
-  /// stream: the visitors still see them all.
+  /// Keep the events that lab.events selects (SceneSimulation::impacts and collapses).
+  /// False, for front ends that stream: the visitors still see them all.
   bool keep_events = true;
   /// Simulate up to the cap even when the model predicts more impacts than it (or, for two
   /// walls, infinitely many). False: the over-cap rule (above) answers from the model.
   bool simulate_to_cap = false;
   /// When set (by a signal handler or another thread), the run stops within 1024 impacts,
-  /// marked truncated (the event engine's stop reason CANCELLED, the three-body summary's
-  /// cancelled flag).
+  /// marked truncated with the stop reason CANCELLED.
   const std::atomic<bool>* cancel = nullptr;
   std::uint64_t progress_interval = std::uint64_t{1} << 20;  ///< impacts between progress calls
 };
 
-/// The simulation of a scene, for every scene (the three-body model's extras are in
-/// SceneRunResult::three_body).
+/// The simulation of a scene, for every scene: with the plan's Prediction, everything a
+/// report or a message says of the run.
 struct SceneSimulation {
   bool simulated = false;          ///< false: answered by the closed form alone (or predict-only)
   /// The run's answer: simulated, or the model's count when not simulated (0 when the model
@@ -91,18 +89,19 @@ struct SceneSimulation {
   /// states the model predicts: every impact for the rotation model (three elastic bodies),
   /// the end of a finished run for any other closed form. NaN: not compared.
   double max_prediction_error = std::numeric_limits<double>::quiet_NaN();
+  /// How often the engine left its working precision; zero when not simulated. The run
+  /// takes one sign decision per impact and a final one (impact_count + 1 when simulated).
   Escalations escalations;
   /// The impacts that options.lab.events selects, in order, when options.keep_events (the
-  /// collapses between them are in `collapses`, each after impacts_before impacts).
+  /// collapses between them are in `collapses`, each after impacts_before impacts); each
+  /// with its model block where the model fills one (the rotation model's: three elastic
+  /// bodies).
   std::vector<ImpactRecord> impacts;
 };
 
 struct SceneRunResult {
   ModelChoice model;                       ///< which model answered, and why (one line): the plan's
   std::optional<Prediction> prediction;    ///< the plan's closed form (empty for event_engine)
-  /// The three-body model's extras, when it answered (three elastic bodies): its prediction,
-  /// the closed form and the paper's values at every impact, its own summary.
-  std::optional<RunResult> three_body;
   SceneSimulation simulation;              ///< the run's summary, for every scene
   double compute_time_s = 0.0;             ///< wall time of planning and simulation [s]
 };
@@ -124,8 +123,9 @@ struct ScenePlan {
 
 /// What runScene calls back. Each may be empty.
 struct SceneVisitors {
-  LabEventVisitor three_body_event;  ///< every event of the three-body path (full mode)
-  ImpactVisitor impact;              ///< every impact of the event engine (full mode)
+  /// Every impact (full mode), in order; a model that answers impact by impact (the
+  /// rotation model) fills its block (ImpactRecord::model).
+  ImpactVisitor impact;
   /// Every collapse the event engine resolves (full mode), in order with the impacts
   /// (CollapseVisitor: right after the record of impact impacts_before).
   CollapseVisitor collapse;

@@ -39,7 +39,8 @@ struct EventRecord {
   const double* energy_transfer = nullptr;
   const double* kinetic_energy_after = nullptr;
   double total_energy = 0.0, total_momentum = 0.0;
-  /// The model's values (three bodies answered by the rotation); null otherwise.
+  /// The model block's values (core::ImpactModelValues), where the impact has one; null
+  /// otherwise.
   const std::array<double, 3>* predicted_velocities_after = nullptr;
   const std::array<double, 3>* predicted_energy_transfer = nullptr;
   const std::array<double, 3>* paper_velocities_after = nullptr;
@@ -48,8 +49,10 @@ struct EventRecord {
 
 /// The bodies' state through an N-body run, from its impacts and collapses in order, for
 /// their records (core::BodyStateReplay): the per-body arrays of a record only for scenes
-/// of at most kFullStateMaxBodies bodies. A record refers to this object's arrays,
-/// valid until the next impact() or collapse().
+/// of at most kFullStateMaxBodies bodies. An impact with a model block (ImpactRecord::model)
+/// takes its per-body arrays, totals and model values from the block, as the run computed
+/// them. A record refers to this object's arrays or to the impact's block, valid until the
+/// next impact() or collapse() and while the impact lives.
 class SceneEventState {
  public:
   explicit SceneEventState(const core::Scene& scene);
@@ -60,6 +63,7 @@ class SceneEventState {
 
  private:
   void fill(EventRecord& record);
+  static void fillFromModel(EventRecord& record, const core::ImpactModelValues& values);
 
   core::Scene scene_;
   bool full_state_;

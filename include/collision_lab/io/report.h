@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "collision_lab/core/lab_run.h"
+#include "collision_lab/core/scene_run.h"
 #include "collision_lab/io/scenario_file.h"
 
 namespace collision_lab {
@@ -44,25 +45,18 @@ Json sceneJson(const NamedScene& scene);
 /// max_collisions, events, mode, and "precision": always "double", kept for readers of the
 /// format (every run is exact; --precision was removed).
 Json optionsJson(const core::RunOptions& options);
-/// One event in the one event record of every scene (docs/cli.md "Events"): the
-/// simulation's full state, the closed-form prediction and the paper's printed values.
-Json eventJson(const core::LabEvent& event);
-/// The summary of a run next to its predictions (see docs/cli_section.md for the keys).
-Json summaryJson(const core::RunResult& result);
+/// One impact with a model block in the one event record of every scene (docs/cli.md
+/// "Events"): the simulation's full state, the closed-form prediction and the paper's
+/// printed values. Precondition: impact.model.
+Json eventJson(const core::ImpactRecord& impact);
+/// The summary of a run next to its predictions (see docs/cli_section.md for the keys), for
+/// a run whose prediction carries the rotation model's values (core::hasRotationValues).
+/// "escalation.decisions": one sign decision per impact and a final one (0 when not
+/// simulated); "high_precision" counts the decisions taken at 100 digits or more, the
+/// exact ones ("exact_rational") among them.
+Json summaryJson(const core::SceneRunResult& result);
 /// {"error": {"reason", "code", "field", "message"}}.
 Json errorJson(const std::string& reason, int code, const std::string& field, const std::string& message);
-
-/// Writes the report of one run while it runs, so that millions of events need no memory:
-/// begin(), then event() for each event to show, then end().
-class RunReportWriter {
- public:
-  virtual ~RunReportWriter() = default;
-  virtual void begin(const NamedScene& scene, const core::RunOptions& options) = 0;
-  virtual void event(const core::LabEvent& event) = 0;
-  virtual void end(const core::RunResult& result) = 0;
-};
-
-std::unique_ptr<RunReportWriter> makeRunReportWriter(ReportFormat format, std::ostream& out);
 
 }  // namespace io
 }  // namespace collision_lab

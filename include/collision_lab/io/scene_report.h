@@ -2,13 +2,16 @@
 // that answered and why. ROS-free. Conventions as report.h: SI units, doubles that read
 // back to the same double, never -0, null for NaN and infinities (walls are named).
 //
-// Three-body scenes that the three-body path answers keep report.h's output, with the
-// model added (makeThreeBodyReportWriter). Large scenes: the table shows the first and last
-// kTableBodies bodies and says how many it leaves out; JSON and CSV carry every body.
+// One writer for every scene. A run whose prediction carries the rotation model's values
+// (core::hasRotationValues: three elastic bodies) keeps the three-body layout of its scene
+// and summary (report.h's keys), with the model added; its events are every scene's, with
+// the impact's model block. Large scenes: the table shows the first and last kTableBodies
+// bodies and says how many it leaves out; JSON and CSV carry every body.
 #pragma once
 
 #include <cstddef>
 #include <memory>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -24,12 +27,14 @@ class SceneEventState;
 /// Bodies shown at each end of the table's body lists.
 constexpr std::size_t kTableBodies = 5;
 
-/// Writes the report of one N-body run while it runs: begin(), then impact() and collapse()
-/// for each event to show, in the order they happen, then end(). Nothing is kept per event.
+/// Writes the report of one run while it runs: begin(), then impact() and collapse() for
+/// each event to show, in the order they happen, then end(). Nothing is kept per event.
 class SceneReportWriter {
  public:
   virtual ~SceneReportWriter() = default;
-  virtual void begin(const SceneEntry& entry, const core::RunOptions& options, const core::ModelChoice& model) = 0;
+  /// `prediction`: the plan's (core::ScenePlan), which decides the layout (above).
+  virtual void begin(const SceneEntry& entry, const core::RunOptions& options, const core::ModelChoice& model,
+                     const std::optional<core::Prediction>& prediction) = 0;
   virtual void impact(const core::ImpactRecord& impact) = 0;
   /// An inelastic collapse: an event of its own, not counted as a collision.
   virtual void collapse(const core::Collapse& collapse) = 0;
@@ -37,11 +42,6 @@ class SceneReportWriter {
 };
 
 std::unique_ptr<SceneReportWriter> makeSceneReportWriter(ReportFormat format, std::ostream& out);
-
-/// report.h's three-body writer, which also states the model: the JSON summary gets
-/// "model" and "model_reason", CSV two "# summary.model..." lines, the table a "model:" line.
-std::unique_ptr<RunReportWriter> makeThreeBodyReportWriter(ReportFormat format, std::ostream& out,
-                                                           const core::ModelChoice& model);
 
 /// name, description, bodies (N), masses, positions, velocities, restitution, walls (names).
 Json sceneEntryJson(const SceneEntry& entry);

@@ -71,15 +71,6 @@ collision_lab::Prediction toPredictionMsg(const collision_lab::core::ScenePlan& 
 /// The same into msg, which may hold an earlier run's: every field is set (header and
 /// run_id to their defaults), and msg's strings and arrays keep their storage.
 void fillPredictionMsg(const collision_lab::core::ScenePlan& plan, collision_lab::Prediction& msg);
-/// An event of the three-body path (N = 3, elastic: every array filled).
-collision_lab::CollisionEvent toCollisionEventMsg(const collision_lab::core::LabEvent& event);
-/// The same into msg, which may hold an earlier event: every field but header and run_id
-/// is set, and msg's arrays keep their storage (a publisher reusing one message allocates
-/// nothing per event).
-void fillCollisionEventMsg(const collision_lab::core::LabEvent& event, collision_lab::CollisionEvent& msg);
-/// Inverse of toCollisionEventMsg: the message carries every field of a LabEvent.
-collision_lab::core::LabEvent toLabEvent(const collision_lab::CollisionEvent& msg);
-
 /// The core notification a received or recorded CollisionEvent stands for, from its pair
 /// fields (present for every N): KIND_IMPACT an impact record, KIND_COLLAPSE a collapse
 /// notice (velocity: pair_velocities_after[0]). Applies it to replay; false, and the replay
@@ -104,10 +95,10 @@ void fillVelocitiesMsg(const collision_lab::CollisionEvent& event, collision_lab
 void fillEnergyTransferMsg(const collision_lab::CollisionEvent& event, double cumulative_energy_lost,
                            collision_lab::EnergyTransfer& msg);
 
-/// The CollisionEvent of each of the engine's notifications, in the order the engine gives
-/// them (impacts and collapses interleaved, engine.h): a copy of the one event record that
-/// the CLI's reports write too (io::SceneEventState, event_record.h), so both carry the same
-/// values. The per-body arrays (positions at the event's time, velocities before and after,
+/// The CollisionEvent of each of a run's notifications, in the order the run gives them
+/// (impacts and collapses interleaved, engine.h): a copy of the one event record that the
+/// CLI's reports write too (io::SceneEventState, event_record.h), so both carry the same
+/// values, an impact's model block (ImpactRecord::model) included. The per-body arrays (positions at the event's time, velocities before and after,
 /// energy transfer, kinetic energy) and the totals only for N <= FULL_STATE_MAX_BODIES
 /// (NaN totals above). Header and run_id are the caller's to fill.
 class SceneEventConverter {

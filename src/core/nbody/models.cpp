@@ -380,6 +380,7 @@ Prediction predictThreeBodySpiral(const Scene& scene) {
   const bool one_e = cycle.e == cycle.eBC();
   const std::optional<int> wall = cycle.wall_a ? std::optional<int>(0) : (cycle.wall_c ? std::optional<int>(2) : std::nullopt);
   const double* m = cycle.m;
+  prediction.alpha = alphaOf<double>({m[0], m[1], m[2]});
   if (!one_e) {  // r_c is a value of the one e
   } else if (wall) {  // r_c = tan^2(pi/4 - alpha/2) = (1 - sin alpha) / (1 + sin alpha)
     const double sine = std::sqrt(1 - cycle.cos2_alpha());

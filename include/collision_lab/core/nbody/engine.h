@@ -57,6 +57,7 @@
 #include <string>
 #include <vector>
 
+#include "collision_lab/core/impact_model_values.h"
 #include "collision_lab/core/nbody/scene.h"
 
 namespace collision_lab {
@@ -82,6 +83,9 @@ struct ImpactRecord {
   /// (the cluster rule) the whole clusters on both sides, each moving as one.
   std::size_t first_moved = 0;
   std::size_t last_moved = 0;
+  /// The answering model's values beside this impact (impact_model_values.h); empty for the
+  /// engine's own records.
+  std::optional<ImpactModelValues> model;
 };
 
 /// Why a run ended. Values are stable: append only.

@@ -78,7 +78,7 @@ struct Prediction {
   std::optional<double> impact_time;          ///< two_body: time of the impact [s]
   std::optional<double> impact_position;      ///< two_body: contact point [m]
   double energy_lost = 0.0;                   ///< kinetic energy turned into heat [J]
-  // three_body_spiral only:
+  // three_body_spiral only (and alpha, below, the opening angle of the three masses):
   std::optional<double> critical_restitution;  ///< r_c = tan^2(pi/4 - alpha/2) [1]; one e for both pairs only
   std::optional<double> spiral_angle;          ///< phi, cos(phi) = T / (2 sqrt(e_AB e_BC)), complex eigenvalues [rad]
   bool collapsed = false;                      ///< inelastic collapse (then infinite is true)
