@@ -136,35 +136,34 @@ std::vector<collision_lab::CollisionEvent> expectBagOnTimeline(const std::string
   return events;
 }
 
-// ---- Round trip: every output, equal to the core's runLab ----
+// ---- Round trip: every output, equal to the core's run of the same plan ----
 
 TEST(LabNode, RoundTripMatchesCore) {
   const auto input = makeInput("round_trip", {1, 2, 3}, {2, 0, -2}, {-1, 0.5, 1});
   const RunOutputs& out = roundTrip();
   ASSERT_TRUE(out.rejections.empty()) << out.rejections.front().message;
 
-  collision_lab::core::RunOptions options;
-  options.events = collision_lab::core::EventPolicy::all();
-  options.skip_simulation_over_cap = true;
   const core::Scene scene = collision_lab_ros::toScene(input);
-  const collision_lab::core::RunResult expected =
-      collision_lab::core::runLab(core::ThreeBodyScene{{1, 2, 3}, {2, 0, -2}, {-1, 0.5, 1}}, options);
-  ASSERT_GT(expected.events.size(), 0u);
+  const core::ScenePlan plan = core::planScene(scene);
+  ASSERT_FALSE(plan.error);
+  ASSERT_TRUE(plan.prediction && plan.prediction->impact_count && plan.prediction->max_possible_impact_count);
+  core::SceneRunOptions options;
+  options.lab.events = collision_lab::core::EventPolicy::all();
+  const core::SceneRunResult run = core::runScene(plan, options);
+  const core::SceneSimulation& expected = run.simulation;
+  ASSERT_GT(expected.impacts.size(), 0u);
 
   ASSERT_EQ(out.predictions.size(), 1u);
   ASSERT_EQ(out.summaries.size(), 1u);
-  ASSERT_EQ(out.events.size(), expected.events.size());
-  ASSERT_EQ(out.velocities.size(), expected.events.size());
-  ASSERT_EQ(out.energies.size(), expected.events.size());
+  ASSERT_EQ(out.events.size(), expected.impacts.size());
+  ASSERT_EQ(out.velocities.size(), expected.impacts.size());
+  ASSERT_EQ(out.energies.size(), expected.impacts.size());
 
-  // The rotation model's prediction, as every scene's: its plan's (the run above is that plan's).
-  const core::ScenePlan plan = core::planScene(scene);
-  ASSERT_FALSE(plan.error);
-  ASSERT_TRUE(plan.prediction && plan.prediction->impact_count);
-  EXPECT_EQ(*plan.prediction->impact_count, expected.prediction.collision_count);
+  // The rotation model's prediction, as every scene's: its plan's.
   auto prediction = collision_lab_ros::toPredictionMsg(plan);
-  EXPECT_EQ(prediction.max_possible_collision_count, expected.prediction.max_possible_collision_count);
-  EXPECT_EQ(prediction.psi, expected.prediction.psi);
+  EXPECT_EQ(prediction.collision_count, *plan.prediction->impact_count);
+  EXPECT_EQ(prediction.max_possible_collision_count, *plan.prediction->max_possible_impact_count);
+  EXPECT_EQ(prediction.psi, plan.prediction->psi.value());
   prediction.timeline_scale = 1.0;  // the node's: first contact after 4/3 s, an ordinary scene
   auto received_prediction = out.predictions.front();
   received_prediction.header = prediction.header;
@@ -172,8 +171,8 @@ TEST(LabNode, RoundTripMatchesCore) {
   EXPECT_EQ(bytes(received_prediction), bytes(prediction));
 
   collision_lab_ros::SceneEventConverter converter(scene);
-  for (std::size_t k = 0; k < expected.events.size(); ++k) {
-    const core::ImpactRecord& e = expected.events[k];
+  for (std::size_t k = 0; k < expected.impacts.size(); ++k) {
+    const core::ImpactRecord& e = expected.impacts[k];
     auto event = converter.impact(e);
     event.header = out.events[k].header, event.run_id = "round_trip";
     EXPECT_EQ(bytes(out.events[k]), bytes(event)) << "collision " << k + 1;
@@ -193,14 +192,14 @@ TEST(LabNode, RoundTripMatchesCore) {
   }
 
   const auto& summary = out.summaries.front();
-  EXPECT_EQ(summary.collision_count, expected.summary.collision_count);
-  EXPECT_EQ(summary.predicted_collision_count, expected.prediction.collision_count);
+  EXPECT_EQ(summary.collision_count, expected.impact_count);
+  EXPECT_EQ(summary.predicted_collision_count, *plan.prediction->impact_count);
   EXPECT_FALSE(summary.truncated);
   EXPECT_TRUE(summary.simulated);
-  expectArrayEq(summary.final_velocities, expected.summary.final_velocities, "final_velocities");
-  EXPECT_EQ(summary.max_prediction_error, expected.summary.max_prediction_error);
-  EXPECT_EQ(summary.energy_relative_drift, expected.summary.energy_relative_drift);
-  EXPECT_EQ(summary.published_events, expected.events.size());
+  EXPECT_EQ(summary.final_velocities, expected.final_velocities);
+  EXPECT_EQ(summary.max_prediction_error, expected.max_prediction_error);
+  EXPECT_EQ(summary.energy_relative_drift, expected.energy_relative_drift);
+  EXPECT_EQ(summary.published_events, expected.impacts.size());
   EXPECT_FALSE(summary.events_not_published);
   EXPECT_TRUE(summary.recording_ok) << summary.recording_error;
   EXPECT_EQ(summary.bag_path, g_bag_directory + "/round_trip.bag");
