@@ -8,7 +8,8 @@
 #
 # Prints a table and one `goal:` line per format (the disk file; goal: CSV <= 0.5 us per
 # impact and within 2x of dd, JSON <= 1 us, the CLI's whole run), a missed one followed by a
-# `why:` line with its parts. About 2 minutes on 2 cores (about 5 GB written).
+# `why:` line with its parts; then the lean record of long runs (--full-state-every 1000)
+# against the full one, bytes and time per impact. About 3 minutes on 2 cores.
 #
 # CPU time (user + sys, all threads) is shown too: the CLI formats on up to two worker
 # threads, so on a busy machine the wall clock can exceed what an idle one gives.
@@ -46,11 +47,13 @@ seconds() {
 
 median3() { printf '%s\n' "$@" | sort -g | sed -n 2p; }
 
-# Median "wall cpu" of 3 runs of a CLI binary ($1) with the given format and events to $2.
+# Median "wall cpu" of 3 runs of a CLI binary ($1) with the given format and events to $2
+# (further arguments: more options).
 cli_seconds() {
   local binary="$1" target="$2" format="$3" events="$4" walls=() cpus=() w c
+  shift 4
   for _ in 1 2 3; do
-    read -r w c < <(seconds "$target" "$binary" "${scene[@]}" --format "$format" --events "$events")
+    read -r w c < <(seconds "$target" "$binary" "${scene[@]}" --format "$format" --events "$events" "$@")
     walls+=("$w")
     cpus+=("$c")
   done
@@ -107,6 +110,25 @@ for format in csv json; do
   if [[ -n "${BASELINE_CLI:-}" ]]; then
     read -r wall cpu < <(cli_seconds "$BASELINE_CLI" /dev/null "$format" all)
     printf '%-9s %-10s %9s %10s %10s\n' "$format" "baseline" "" "$(per_impact "$wall")" "$(per_impact "$cpu")"
+  fi
+done
+# The lean record of long runs (issue 34): every body's state every $lean_every impacts only.
+lean_every=1000
+for format in csv json; do
+  full_bytes=$("$cli" "${scene[@]}" --format "$format" --events all | wc -c)
+  lean_bytes=$("$cli" "${scene[@]}" --format "$format" --events all --full-state-every "$lean_every" | wc -c)
+  read -r full_wall _ < <(cli_seconds "$cli" "$file" "$format" all)
+  read -r lean_wall lean_cpu < <(cli_seconds "$cli" "$file" "$format" all --full-state-every "$lean_every")
+  full_b=$(echo "scale=1; $full_bytes / $impacts" | bc)
+  lean_b=$(echo "scale=1; $lean_bytes / $impacts" | bc)
+  byte_ratio=$(printf '%.2f' "$(echo "scale=4; $lean_bytes / $full_bytes" | bc)")
+  time_ratio=$(printf '%.2f' "$(echo "scale=4; $lean_wall / $full_wall" | bc)")
+  printf '%-9s %-10s %9s %10s %10s   (--full-state-every %s)\n' "$format" "disk file" "$lean_b" \
+    "$(per_impact "$lean_wall")" "$(per_impact "$lean_cpu")" "$lean_every"
+  verdict=$([[ $(echo "$byte_ratio <= 0.5" | bc) == 1 ]] && echo met || echo missed)
+  goal_lines+=("goal: lean ${format^^} event record (--full-state-every $lean_every), B per impact = $lean_b against the full record = $full_b (${byte_ratio}x the bytes, ${time_ratio}x the time: $(per_impact "$lean_wall") against $(per_impact "$full_wall") us per impact; goal <= 0.5x the bytes): $verdict")
+  if [[ "$verdict" == missed ]]; then
+    goal_lines+=("why: lean ${format^^}: a lean event keeps every key of the schema, null where the full record has the bodies' arrays, totals and model block (readers find every key in every event); the pair's values, time, position and names remain")
   fi
 done
 printf '%s\n' "${goal_lines[@]}"

@@ -13,6 +13,7 @@ catkin_add_gtest(collision_lab_cli_test
   test/cli/bad_inputs_test.cpp
   test/cli/random_input_test.cpp
   test/cli/nbody_cli_test.cpp
+  test/cli/lean_events_test.cpp
   test/cli/collapse_cli_test.cpp
   test/cli/temperature_cli_test.cpp
   test/cli/three_body_report_test.cpp

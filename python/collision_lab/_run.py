@@ -58,7 +58,7 @@ def _number_list(values):
 def scene_arguments(masses, positions, velocities, restitution=1.0, *, ring=None,
                     restitution_model='constant', tc=None, elastic_below=None,
                     viscoelastic_speed=None, max_collisions=10_000_000, simulate_to_cap=False,
-                    events='all', mode='full', temperature_csv=None):
+                    events='all', mode='full', temperature_csv=None, full_state_every=1):
     """collision_lab_cli's arguments for these keyword arguments (see run())."""
     args = ['--masses', _number_list(masses), '--positions', _number_list(positions),
             '--velocities', _number_list(velocities),
@@ -76,6 +76,8 @@ def scene_arguments(masses, positions, velocities, restitution=1.0, *, ring=None
         args += ['--temperature-csv', str(temperature_csv)]
     if simulate_to_cap:
         args.append('--simulate-to-cap')
+    if int(full_state_every) != 1:
+        args += ['--full-state-every', str(int(full_state_every))]
     return args
 
 
@@ -163,7 +165,8 @@ def prediction_of(summary):
 
 def run(masses, positions, velocities, restitution=1.0, *, ring=None, restitution_model='constant',
         tc=None, elastic_below=None, viscoelastic_speed=None, max_collisions=10_000_000,
-        simulate_to_cap=False, events='all', mode='full', name='', temperature_csv=None):
+        simulate_to_cap=False, events='all', mode='full', name='', temperature_csv=None,
+        full_state_every=1):
     """Runs one scene in process (as collision_lab_cli --format json) and returns a Run.
 
     masses [kg] (inf: a wall, first or last), positions [m] strictly decreasing, velocities
@@ -173,6 +176,8 @@ def run(masses, positions, velocities, restitution=1.0, *, ring=None, restitutio
     max_collisions: the cap; simulate_to_cap: simulate up to it even when the model
     answers. events: 'all', 'none' or 'first:N'. mode: 'full', 'predict' or 'summary'.
     name: the scene's name. temperature_csv: a path to write T(t) [J] to, as the CLI's.
+    full_state_every: K > 1 gives the lean record of long runs: every body's state (the
+    per-body event arrays) at impact 1 and every K-th impact only, NaN in the others.
     The GIL is released while it runs; Ctrl-C stops it (KeyboardInterrupt).
     Raises SceneError for a scene or option the CLI rejects.
     """
@@ -180,7 +185,7 @@ def run(masses, positions, velocities, restitution=1.0, *, ring=None, restitutio
                            restitution_model=restitution_model, tc=tc, elastic_below=elastic_below,
                            viscoelastic_speed=viscoelastic_speed, max_collisions=max_collisions,
                            simulate_to_cap=simulate_to_cap, events=events, mode=mode,
-                           temperature_csv=temperature_csv)
+                           temperature_csv=temperature_csv, full_state_every=full_state_every)
     return Run(parse_report(_core.run_json(args, name)), masses, positions, velocities)
 
 

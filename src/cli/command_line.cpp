@@ -15,11 +15,11 @@ namespace {
 
 /// Options that take a value. A value may start with '-' (negative numbers, "-inf",
 /// "-.5"), which CLI11 would take for a flag; normalizeArguments() prevents that.
-const std::array<const char*, 18> kValueOptions = {
+const std::array<const char*, 19> kValueOptions = {
     "--masses", "--positions", "--velocities", "--bodies",   "--restitution", "--max-collisions",
     "--restitution-model", "--tc", "--elastic-below", "--viscoelastic-speed", "--ring",
     "--events", "--format",    "--precision",  "--mode",     "--scenario",    "--name",
-    "--temperature-csv"};
+    "--temperature-csv", "--full-state-every"};
 
 bool isValueOption(const std::string& arg) {
   return std::find(kValueOptions.begin(), kValueOptions.end(), arg) != kValueOptions.end();
@@ -97,7 +97,7 @@ struct RawOptions {
   std::string masses, positions, velocities, bodies, restitution;
   std::string restitution_model, tc, elastic_below, viscoelastic_speed, ring;
   std::string max_collisions, events, format = "table", precision, mode = "full";
-  std::string scenario, name, temperature_csv;
+  std::string scenario, name, temperature_csv, full_state_every;
   bool list = false;
   bool simulate_to_cap = false;
   bool masses_given = false, positions_given = false, velocities_given = false, bodies_given = false;
@@ -105,6 +105,7 @@ struct RawOptions {
   bool max_collisions_given = false, events_given = false, scenario_given = false, name_given = false;
   bool temperature_csv_given = false;
   bool precision_given = false;
+  bool full_state_every_given = false;
 };
 
 /// Format, mode and collision cap; --precision, removed, is refused.
@@ -246,6 +247,15 @@ void readEventPolicy(const RawOptions& raw, CliRequest& request) {
                            : "'" + text + "' is not all, none or first:N with N a non-negative integer");
   }
   request.options.events = *events;
+  if (raw.full_state_every_given) {
+    const io::ParsedCount every = io::parseCount(raw.full_state_every);
+    if (!every.problem.empty() || every.value == 0) {
+      throw makeCliError(CliReason::kInvalidOption, "full-state-every",
+                         "'" + raw.full_state_every + "' " +
+                             (every.problem.empty() ? std::string("is not a positive integer: K >= 1") : every.problem));
+    }
+    request.options.events.full_state_every = every.value;
+  }
 }
 
 /// --temperature-csv FILE: T(t) of one simulated scene.
@@ -315,6 +325,9 @@ void declareOptions(CLI::App& app, RawOptions& raw) {
                "once; two walls: 1000 impacts shown)");
   app.add_option(
       "--events", raw.events, "events to print: all|none|first:N (default all; none when running every scenario)");
+  app.add_option("--full-state-every", raw.full_state_every,
+                 "K: JSON and CSV events carry every body's state at impact 1 and every K-th impact, the others "
+                 "only their pair's (the lean record of long runs; default 1: every event)");
   app.add_option("--format", raw.format, "table|json|csv (default table)");
   // Removed (every run is exact); kept only to refuse it with its reason, hidden from --help.
   app.add_option("--precision", raw.precision)->group("");
@@ -339,6 +352,7 @@ void markGiven(const CLI::App& app, RawOptions& raw) {
   raw.name_given = app.count("--name") > 0;
   raw.temperature_csv_given = app.count("--temperature-csv") > 0;
   raw.precision_given = app.count("--precision") > 0;
+  raw.full_state_every_given = app.count("--full-state-every") > 0;
 }
 
 CliRequest parseCommandLine(const std::vector<std::string>& args, const std::string& default_scenario_path) {

@@ -192,12 +192,13 @@ class JsonWriter : public RunReportWriter {
   explicit JsonWriter(std::ostream& out) : out_(out), events_(out, report_text::writeEventJsonLine) {}
 
   void begin(const NamedScene& named, const core::RunOptions& options) override {
+    policy_ = options.events;
     out_ << "{\"scene\": " << jsonText(sceneJson(named)) << ",\n\"options\": " << jsonText(optionsJson(options))
          << ",\n\"units\": " << jsonText(unitsJson()) << ",\n\"events\": [";
   }
 
   void event(const core::ImpactRecord& impact) override {
-    events_.push(impact);
+    events_.push(report_text::shownImpact(impact, policy_));
     any_event_ = true;
   }
 
@@ -209,6 +210,7 @@ class JsonWriter : public RunReportWriter {
  private:
   std::ostream& out_;
   EventPipeline events_;
+  core::EventPolicy policy_;  ///< from begin(): which events carry the full state
   bool any_event_ = false;
 };
 
@@ -267,9 +269,10 @@ class CsvWriter : public RunReportWriter {
     }
     writeCsvComments(out_, "", optionsJson(options));
     out_ << report_text::kEventCsvHeader << "\n";
+    policy_ = options.events;
   }
 
-  void event(const core::ImpactRecord& impact) override { events_.push(impact); }
+  void event(const core::ImpactRecord& impact) override { events_.push(report_text::shownImpact(impact, policy_)); }
 
   void end(const core::SceneRunResult& result) override {
     events_.finish();
@@ -279,6 +282,7 @@ class CsvWriter : public RunReportWriter {
  private:
   std::ostream& out_;
   EventPipeline events_;
+  core::EventPolicy policy_;  ///< from begin(): which events carry the full state
 };
 
 }  // namespace
@@ -350,10 +354,12 @@ Json sceneJson(const NamedScene& named) {
 }
 
 Json optionsJson(const core::RunOptions& options) {
-  return Json{{"max_collisions", options.max_collisions},
-              {"events", eventPolicyText(options.events)},
-              {"mode", runModeText(options.mode)},
-              {"precision", "double"}};  // kept for readers of the format: every run is exact
+  Json json{{"max_collisions", options.max_collisions},
+            {"events", eventPolicyText(options.events)},
+            {"mode", runModeText(options.mode)},
+            {"precision", "double"}};  // kept for readers of the format: every run is exact
+  if (options.events.full_state_every > 1) json["full_state_every"] = options.events.full_state_every;
+  return json;
 }
 
 Json eventJson(const core::ImpactRecord& impact) {
@@ -368,8 +374,22 @@ Json eventJson(const core::ImpactRecord& impact) {
 namespace report_text {
 
 EventRecord eventRecord(const core::ImpactRecord& impact) {
-  const core::ImpactModelValues& m = *impact.model;
   const std::size_t p = impact.pair_index;
+  if (!impact.model) {  // the lean record (leanImpact): the pair's values only
+    EventRecord r;
+    r.index = impact.index;
+    r.pair_index = p;
+    r.time = impact.time;
+    r.position = impact.position;
+    r.first_moved = impact.first_moved;
+    r.last_moved = impact.last_moved;
+    r.pair_velocities_before = impact.velocities_before;
+    r.pair_velocities_after = impact.velocities_after;
+    r.pair_energy_transfer = impact.energy_gained;
+    r.energy_lost = impact.energy_lost;
+    return r;
+  }
+  const core::ImpactModelValues& m = *impact.model;
   EventRecord r;
   r.index = impact.index;
   r.pair_index = p;
@@ -569,6 +589,20 @@ void writeEventRecordCsv(TextSink& sink, const EventRecord& r) {
 }
 
 void writeEventJson(TextSink& sink, const core::ImpactRecord& impact) { writeEventRecordJson(sink, eventRecord(impact)); }
+
+core::ImpactRecord shownImpact(const core::ImpactRecord& impact, const core::EventPolicy& policy) {
+  if (!impact.model || policy.fullStateAt(impact.index)) return impact;
+  core::ImpactRecord lean = impact;
+  const core::ImpactModelValues& m = *impact.model;
+  const std::size_t p = impact.pair_index;
+  for (std::size_t side = 0; side < 2; ++side) {
+    lean.velocities_before[side] = m.velocities_before[p + side];
+    lean.velocities_after[side] = m.velocities_after[p + side];
+    lean.energy_gained[side] = m.energy_transfer[p + side];
+  }
+  lean.model.reset();
+  return lean;
+}
 
 void writeEventJsonLine(TextSink& sink, const core::ImpactRecord& impact, bool first) {
   sink.put(first ? "\n" : ",\n");

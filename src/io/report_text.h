@@ -61,10 +61,13 @@ inline std::string padRight(const std::string& text, std::size_t width) {
 /// A double for JSON: never a negative zero (NaN and infinities become null when dumped).
 inline Json number(double value) { return Json(value == 0 ? 0.0 : value); }
 
-/// The record of an impact with a model block (its full state and the model's values).
-/// `positions` etc. point into `impact`, which must outlive the record. Precondition:
-/// impact.model.
+/// The record of an impact with a model block (its full state and the model's values);
+/// without one (leanImpact), the pair's values only. `positions` etc. point into `impact`,
+/// which must outlive the record.
 EventRecord eventRecord(const core::ImpactRecord& impact);
+/// The impact as policy.fullStateAt(its index) says: itself, or its lean copy (the pair's
+/// values from the model block, the block dropped).
+core::ImpactRecord shownImpact(const core::ImpactRecord& impact, const core::EventPolicy& policy);
 /// The record as one compact JSON object.
 void writeEventRecordJson(TextSink& sink, const EventRecord& record);
 /// The record as one CSV row (with its line break), in the columns of kEventCsvHeader.

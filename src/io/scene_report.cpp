@@ -14,8 +14,8 @@
 namespace collision_lab {
 namespace io {
 
-SceneEventState::SceneEventState(const core::Scene& scene)
-    : scene_(scene), full_state_(scene.size() <= kFullStateMaxBodies), replay_(scene) {}
+SceneEventState::SceneEventState(const core::Scene& scene, const core::EventPolicy& policy)
+    : scene_(scene), full_state_(scene.size() <= kFullStateMaxBodies), policy_(policy), replay_(scene) {}
 
 void SceneEventState::fill(EventRecord& r) {
   r.full_state = full_state_;
@@ -58,8 +58,10 @@ EventRecord SceneEventState::impact(const core::ImpactRecord& impact) {
   replay_.apply(impact);
   if (impact.model) {
     fillFromModel(r, *impact.model);
+    if (!policy_.fullStateAt(impact.index)) lean(r);
     return r;
   }
+  if (!policy_.fullStateAt(impact.index)) return r;  // the lean record: the pair's values
   fill(r);
   if (full_state_ && !r.cluster_impact) {
     // Two single bodies: their entries are the engine's gains, as the pair's fields.
@@ -85,6 +87,12 @@ void SceneEventState::fillFromModel(EventRecord& r, const core::ImpactModelValue
   r.predicted_energy_transfer = &m.predicted_energy_transfer;
   r.paper_velocities_after = &m.paper_velocities_after;
   r.paper_energy_transfer = &m.paper_energy_transfer;
+}
+
+void SceneEventState::lean(EventRecord& r) {
+  r.full_state = false;
+  r.predicted_velocities_after = r.predicted_energy_transfer = nullptr;
+  r.paper_velocities_after = r.paper_energy_transfer = nullptr;
 }
 
 EventRecord SceneEventState::collapse(const core::Collapse& collapse) {
@@ -457,7 +465,7 @@ class SceneJsonWriter : public SceneLayout {
   explicit SceneJsonWriter(std::ostream& out) : out_(out), sink_(out) {}
 
   void begin(const SceneEntry& entry, const core::RunOptions& options, const core::ModelChoice&) override {
-    state_.emplace(entry.scene);
+    state_.emplace(entry.scene, options.events);
     out_ << "{\"scene\": ";
     writeSceneJson(out_, entry);
     out_ << ",\n\"options\": " << jsonText(optionsJson(options)) << ",\n\"units\": " << jsonText(unitsJson())
@@ -539,7 +547,7 @@ class SceneCsvWriter : public SceneLayout {
     writeCsvComment(out_, "model", core::modelKindName(model.kind));
     writeCsvComment(out_, "model_reason", model.reason);
     out_ << report_text::kEventCsvHeader << "\n";
-    state_.emplace(s);
+    state_.emplace(s, options.events);
   }
 
   void impact(const core::ImpactRecord& r) override { write(state_->impact(r)); }
@@ -583,6 +591,7 @@ class ThreeBodyModelWriter : public RunReportWriter {
   }
 
   void begin(const NamedScene& scene, const core::RunOptions& options) override {
+    policy_ = options.events;
     if (format_ != ReportFormat::kJson) return inner_->begin(scene, options);
     out_ << "{\"scene\": " << jsonText(sceneJson(scene)) << ",\n\"options\": " << jsonText(optionsJson(options))
          << ",\n\"units\": " << jsonText(unitsJson()) << ",\n\"events\": [";
@@ -590,7 +599,7 @@ class ThreeBodyModelWriter : public RunReportWriter {
 
   void event(const core::ImpactRecord& event) override {
     if (format_ != ReportFormat::kJson) return inner_->event(event);
-    events_->push(event);
+    events_->push(report_text::shownImpact(event, policy_));
     any_event_ = true;
   }
 
@@ -618,6 +627,7 @@ class ThreeBodyModelWriter : public RunReportWriter {
   core::ModelChoice model_;
   std::unique_ptr<RunReportWriter> inner_;  ///< table and CSV
   std::optional<EventPipeline> events_;     ///< JSON events
+  core::EventPolicy policy_;                ///< from begin(): which events carry the full state
   bool any_event_ = false;
 };
 
@@ -684,7 +694,7 @@ void writeSceneBatchJson(const std::vector<SceneBatchOutcome>& outcomes, std::os
     entry["events"] = Json::array();
     // The kept impacts, each collapse after the impact it follows (as the stream shows
     // them); every collapse before the last kept impact updates the bodies' state.
-    SceneEventJson records(outcome.entry.scene);
+    SceneEventJson records(outcome.entry.scene, outcome.options.events);
     std::size_t next_collapse = 0;
     const auto collapsesUpTo = [&](std::uint64_t impacts) {
       for (; next_collapse < r.simulation.collapses.size() &&
@@ -736,8 +746,8 @@ Json recordJson(const EventRecord& record) {
 
 }  // namespace
 
-SceneEventJson::SceneEventJson(const core::Scene& scene)
-    : state_(std::make_unique<SceneEventState>(scene)) {}
+SceneEventJson::SceneEventJson(const core::Scene& scene, const core::EventPolicy& policy)
+    : state_(std::make_unique<SceneEventState>(scene, policy)) {}
 SceneEventJson::~SceneEventJson() = default;
 
 Json SceneEventJson::impact(const core::ImpactRecord& impact) { return recordJson(state_->impact(impact)); }

@@ -17,6 +17,16 @@ struct EventPolicy {
   enum class Kind { kNone, kAll, kFirstN };
   Kind kind = Kind::kNone;
   std::uint64_t first_n = 0;
+  /// The lean record of long runs (the CLI's --full-state-every): of the events written,
+  /// impact 1 and every full_state_every-th impact carry every body's state (and the model
+  /// block); the others only their pair's. 1: every event carries it. How front ends write
+  /// events; the run itself is the same.
+  std::uint64_t full_state_every = 1;
+
+  /// Does the record of impact `index` (1-based) carry every body's state?
+  bool fullStateAt(std::uint64_t index) const {
+    return full_state_every <= 1 || index == 1 || index % full_state_every == 0;
+  }
 
   static EventPolicy none() { return {Kind::kNone, 0}; }
   static EventPolicy all() { return {Kind::kAll, 0}; }

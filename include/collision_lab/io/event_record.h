@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "collision_lab/core/events.h"
 #include "collision_lab/core/nbody/body_state_replay.h"
 #include "collision_lab/core/nbody/engine.h"
 #include "collision_lab/core/nbody/scene.h"
@@ -55,7 +56,9 @@ struct EventRecord {
 /// next impact() or collapse() and while the impact lives.
 class SceneEventState {
  public:
-  explicit SceneEventState(const core::Scene& scene);
+  /// `policy`: which impacts' records carry every body's state (EventPolicy::fullStateAt;
+  /// the others, the lean record, only their pair's). Collapses always carry it.
+  explicit SceneEventState(const core::Scene& scene, const core::EventPolicy& policy = {});
   EventRecord impact(const core::ImpactRecord& impact);
   EventRecord collapse(const core::Collapse& collapse);
   /// The replay behind the records: the state after the last impact() or collapse().
@@ -64,9 +67,11 @@ class SceneEventState {
  private:
   void fill(EventRecord& record);
   static void fillFromModel(EventRecord& record, const core::ImpactModelValues& values);
+  static void lean(EventRecord& record);
 
   core::Scene scene_;
   bool full_state_;
+  core::EventPolicy policy_;
   core::BodyStateReplay replay_;  ///< the one replay of the records (core/nbody/body_state_replay.h)
   std::vector<double> positions_, before_, gain_;  ///< the record's arrays (full state only)
 };

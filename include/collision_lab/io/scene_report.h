@@ -51,7 +51,8 @@ Json sceneEntryJson(const SceneEntry& entry);
 /// arrays (scenes of at most 64 bodies; null above).
 class SceneEventJson {
  public:
-  explicit SceneEventJson(const core::Scene& scene);
+  /// `policy`: which impacts carry every body's state (core::EventPolicy::fullStateAt).
+  explicit SceneEventJson(const core::Scene& scene, const core::EventPolicy& policy = {});
   ~SceneEventJson();
   Json impact(const core::ImpactRecord& impact);
   Json collapse(const core::Collapse& collapse);
