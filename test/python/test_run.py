@@ -134,3 +134,20 @@ def test_temperature_csv_as_the_cli(cli, tmp_path):
          '--max-collisions 300 --events none --temperature-csv %s' % theirs).split())
     assert ours.read_text() == theirs.read_text()
     assert ours.read_text().count('\n') > 10
+
+
+def test_lean_record_keeps_the_pairs_and_every_kth_state():
+    """full_state_every=10: the per-body arrays at impact 1 and every 10th (NaN between),
+    times and positions at every impact, as the full record has them (docs/cli.md)."""
+    scene = dict(masses=[1e4, 1, math.inf], positions=[2, 1, 0], velocities=[-1, 0, 0])
+    full = collision_lab.run(**scene)
+    lean = collision_lab.run(**scene, full_state_every=10)
+    assert lean.options['full_state_every'] == 10
+    assert lean.summary['collision_count'] == full.summary['collision_count'] == 314
+    index = lean.events['index']
+    kept = (index == 1) | (index % 10 == 0)
+    v_full, v_lean = full.events['velocities_after'], lean.events['velocities_after']
+    assert np.array_equal(v_lean[kept], v_full[kept])
+    assert np.isnan(v_lean[~kept]).all()
+    assert np.array_equal(lean.events['time'], full.events['time'])
+    assert np.array_equal(lean.events['position'], full.events['position'])
