@@ -95,15 +95,7 @@ std::uint64_t knownCountPass(const ThreeBodyScene& scene, std::uint64_t impacts,
   return run ? run->impact_count : 0;
 }
 
-/// Can this process run the FMA instance (the CPU has FMA)?
-bool cpuHasFma() {
-#if CL_HAS_FMA_PATH
-  __builtin_cpu_init();
-  return __builtin_cpu_supports("fma") != 0;
-#else
-  return false;
-#endif
-}
+using nbody_detail::cpuHasFma;
 
 /// "FMA" or "portable (...)": the arithmetic path this process's runs take.
 const char* pathName() {

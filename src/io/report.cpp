@@ -401,22 +401,9 @@ EventRecord eventRecord(const core::ImpactRecord& impact) {
   for (std::size_t side = 0; side < 2; ++side) {
     r.pair_velocities_before[side] = m.velocities_before[p + side];
     r.pair_velocities_after[side] = m.velocities_after[p + side];
-    r.pair_energy_transfer[side] = m.energy_transfer[p + side];
   }
   r.energy_lost = impact.energy_lost;
-  r.full_state = true;
-  r.bodies = 3;
-  r.positions = m.positions.data();
-  r.velocities_before = m.velocities_before.data();
-  r.velocities_after = m.velocities_after.data();
-  r.energy_transfer = m.energy_transfer.data();
-  r.kinetic_energy_after = m.kinetic_energy_after.data();
-  r.total_energy = m.total_energy;
-  r.total_momentum = m.total_momentum;
-  r.predicted_velocities_after = &m.predicted_velocities_after;
-  r.predicted_energy_transfer = &m.predicted_energy_transfer;
-  r.paper_velocities_after = &m.paper_velocities_after;
-  r.paper_energy_transfer = &m.paper_energy_transfer;
+  fillFromModelBlock(r, m);
   return r;
 }
 

@@ -57,7 +57,7 @@ EventRecord SceneEventState::impact(const core::ImpactRecord& impact) {
   r.energy_lost = impact.energy_lost;
   replay_.apply(impact);
   if (impact.model) {
-    fillFromModel(r, *impact.model);
+    fillFromModelBlock(r, *impact.model);
     if (!policy_.fullStateAt(impact.index)) lean(r);
     return r;
   }
@@ -71,7 +71,7 @@ EventRecord SceneEventState::impact(const core::ImpactRecord& impact) {
   return r;
 }
 
-void SceneEventState::fillFromModel(EventRecord& r, const core::ImpactModelValues& m) {
+void fillFromModelBlock(EventRecord& r, const core::ImpactModelValues& m) {
   const std::size_t p = r.pair_index;
   for (std::size_t side = 0; side < 2; ++side) r.pair_energy_transfer[side] = m.energy_transfer[p + side];
   r.full_state = true;

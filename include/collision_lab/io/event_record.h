@@ -48,6 +48,10 @@ struct EventRecord {
   const std::array<double, 3>* paper_energy_transfer = nullptr;
 };
 
+/// The record's full state, pair energy transfers and model values from an impact's model
+/// block (core::ImpactModelValues, as the run computed them); the record refers to `values`.
+void fillFromModelBlock(EventRecord& record, const core::ImpactModelValues& values);
+
 /// The bodies' state through an N-body run, from its impacts and collapses in order, for
 /// their records (core::BodyStateReplay): the per-body arrays of a record only for scenes
 /// of at most kFullStateMaxBodies bodies. An impact with a model block (ImpactRecord::model)
@@ -66,7 +70,6 @@ class SceneEventState {
 
  private:
   void fill(EventRecord& record);
-  static void fillFromModel(EventRecord& record, const core::ImpactModelValues& values);
   static void lean(EventRecord& record);
 
   core::Scene scene_;

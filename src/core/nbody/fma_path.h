@@ -24,6 +24,9 @@ namespace collision_lab {
 namespace core {
 namespace nbody_detail {
 
+/// Does the CPU have FMA (and this build an FMA path)?
+bool cpuHasFma();
+
 /// Does this process take the FMA path? The CPU has FMA and COLLISION_LAB_NO_FMA is unset,
 /// empty or "0". Decided once per process.
 bool fmaPathEnabled();

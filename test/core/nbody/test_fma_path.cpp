@@ -22,11 +22,6 @@ namespace {
 
 #if CL_HAS_FMA_PATH
 
-bool cpuHasFma() {
-  __builtin_cpu_init();
-  return __builtin_cpu_supports("fma") != 0;
-}
-
 /// hi and lo, bit for bit (a -0 is not a +0).
 template <class A, class B>
 bool sameBits(const A& a, const B& b) {
