@@ -2,7 +2,7 @@
 //
 // Prints ns per collision for the event engine run directly (runEngine, nothing visited),
 // for the lab run with every event visited but not stored and with every event kept
-// (EventPolicy::all()), and the full lab run (runLab in full mode with events none, as
+// (EventPolicy::all()), and the full lab run (planScene and runScene in full mode with events none, as
 // `collision_lab_cli --mode full --events none`: every impact's velocities against the
 // closed form, the drifts and the final state), next to
 // a lean double event loop compiled into this binary
@@ -11,7 +11,7 @@
 // lean loop measured in the same process. Also times the closed form:
 // AnalyticModel<double>::velocitiesAfter(n) for n up to 1e12, and predictedCollisionCount.
 // And three elastic bodies at an extreme mass ratio, (1e37, 1, inf) (a wall on one side),
-// capped at 10^7 impacts: runLab in summary and in full mode (events none) against the
+// capped at 10^7 impacts: the lab run in summary and in full mode (events none) against the
 // lean loop on the same impacts, with the engine's escalations to 100 digits.
 // Beside both runs, the floor of exactness in double-double: the engine's impact map
 // (impact_rule.h) on double-double velocities, pairs in turn, nothing else; a `why:` line
@@ -31,7 +31,7 @@
 #include <vector>
 
 #include "collision_lab/core/analytic.h"
-#include "collision_lab/core/lab_run.h"
+#include "collision_lab/core/scene_run.h"
 #include "collision_lab/core/nbody/impact_rule.h"
 #include "collision_lab/core/nbody/engine.h"
 #include "closed_form_timing.h"
@@ -58,7 +58,7 @@ struct Method {
 /// The floor of an exact run in double-double: the engine's impact map on double-double
 /// velocities for `impacts` impacts, pairs in turn from `first` (0: AB, 1: BC); no positions,
 /// bounds, decisions or outputs. Returns its final velocities.
-std::array<double, 3> doubleDoubleImpactMaps(const ThreeBodyScene& scene, std::uint64_t impacts, int first) {
+std::array<double, 3> doubleDoubleImpactMaps(const Scene& scene, std::uint64_t impacts, int first) {
   using nbody_detail::DD;
   const std::array<ImpactMap<DD>, 2> maps = {makeImpactMap<DD>(scene.masses[0], scene.masses[1], 1.0),
                                              makeImpactMap<DD>(scene.masses[1], scene.masses[2], 1.0)};
@@ -71,11 +71,7 @@ std::array<double, 3> doubleDoubleImpactMaps(const ThreeBodyScene& scene, std::u
 /// The count-only run's kernel alone: the known-count pass (nbody/elastic_triple.h, the
 /// engine's replica) on the portable or the FMA path, whichever this process would not
 /// choose too, so that both are measured in one process. Returns its impacts (0: declined).
-std::uint64_t knownCountPass(const ThreeBodyScene& scene, std::uint64_t impacts, int first, bool fma) {
-  Scene s;
-  s.masses.assign(scene.masses.begin(), scene.masses.end());
-  s.positions.assign(scene.positions.begin(), scene.positions.end());
-  s.velocities.assign(scene.velocities.begin(), scene.velocities.end());
+std::uint64_t knownCountPass(const Scene& scene, std::uint64_t impacts, int first, bool fma) {
   double sink = 0.0;
   auto visit = [&sink](std::uint64_t, const std::array<double, 3>& v) { sink += v[0]; };
   const double inf = std::numeric_limits<double>::infinity();
@@ -83,12 +79,12 @@ std::uint64_t knownCountPass(const ThreeBodyScene& scene, std::uint64_t impacts,
   std::optional<nbody_detail::ElasticTripleRun> run;
 #if CL_HAS_FMA_PATH
   if (fma) {
-    run = nbody_detail::runElasticTriplePassFma<ElasticTriplePass::kReplica>(s, impacts, first, impacts, inf, nullptr,
+    run = nbody_detail::runElasticTriplePassFma<ElasticTriplePass::kReplica>(scene, impacts, first, impacts, inf, nullptr,
                                                                              visit);
   }
 #endif
   if (!fma) {
-    run = nbody_detail::runElasticTriplePass<ElasticTriplePass::kReplica>(s, impacts, first, impacts, inf, nullptr,
+    run = nbody_detail::runElasticTriplePass<ElasticTriplePass::kReplica>(scene, impacts, first, impacts, inf, nullptr,
                                                                           visit);
   }
   doNotOptimize(sink);
@@ -103,8 +99,19 @@ const char* pathName() {
   return cpuHasFma() ? "portable (COLLISION_LAB_NO_FMA set)" : "portable (this CPU has no FMA)";
 }
 
-ThreeBodyScene heavyLightHeavy(double heavy) {
-  ThreeBodyScene scene;
+/// A lab run as the CLI takes it: planScene, then runScene up to the cap (simulated to it
+/// where the model predicts more), the visitor seeing every impact.
+SceneSimulation labRun(const Scene& scene, const RunOptions& lab, const ImpactVisitor& visitor = {}) {
+  SceneRunOptions options;
+  options.lab = lab;
+  options.simulate_to_cap = true;
+  SceneVisitors visitors;
+  visitors.impact = visitor;
+  return runScene(planScene(scene), options, visitors).simulation;
+}
+
+Scene heavyLightHeavy(double heavy) {
+  Scene scene = threeBodies();
   scene.masses = {heavy, 1.0, heavy};
   scene.positions = {1.0, 0.0, -1.0};
   scene.velocities = {-1.0, 0.0, 0.0};
@@ -116,7 +123,7 @@ struct SceneFigures {
   double lean_ns = 0.0;
   double count_only_ns = 0.0;
   double full_lab_run_ns = 0.0;
-  double summary_ns = 0.0;        // runLab in summary mode
+  double summary_ns = 0.0;        // the lab run in summary mode
   double dd_maps_ns = 0.0;        // doubleDoubleImpactMaps alone
   double pass_portable_ns = 0.0;  // knownCountPass, portable
   double pass_fma_ns = 0.0;       // knownCountPass, FMA (0: no FMA)
@@ -125,15 +132,11 @@ struct SceneFigures {
 /// `lab_only`: the lean loop and the lab runs that publish no event (full and summary mode)
 /// alone, for a quick before/after of the count-only path.
 SceneFigures benchScene(double heavy, int repeats, bool keep_all, bool lab_only = false) {
-  const ThreeBodyScene scene = heavyLightHeavy(heavy);
+  const Scene scene = heavyLightHeavy(heavy);
   const std::uint64_t predicted = predictedCollisionCount(scene);
   std::printf("\nScene: masses (%g, 1, %g), positions (1, 0, -1) m, v = (-1, 0, 0) m/s; "
               "predicted collisions %llu\n", heavy, heavy, static_cast<unsigned long long>(predicted));
   constexpr std::uint64_t kMaxCollisions = 1'000'000'000;
-  Scene engine_scene;
-  engine_scene.masses.assign(scene.masses.begin(), scene.masses.end());
-  engine_scene.positions.assign(scene.positions.begin(), scene.positions.end());
-  engine_scene.velocities.assign(scene.velocities.begin(), scene.velocities.end());
   EngineOptions engine_options;
   engine_options.max_impacts = kMaxCollisions;
   engine_options.progress_interval = 0;
@@ -158,30 +161,30 @@ SceneFigures benchScene(double heavy, int repeats, bool keep_all, bool lab_only 
   Escalations escalation;
   if (!lab_only) {
     methods.emplace_back("engine count-only (runEngine)", [&] {
-                         const EngineResult result = runEngine(engine_scene, engine_options);
+                         const EngineResult result = runEngine(scene, engine_options);
                          escalation = result.escalations;
                          doNotOptimize(result.final_velocities.data());
                          return result.impact_count;
                        });
     methods.emplace_back("core, every event visited", [&] {
                          std::uint64_t seen = 0;
-                         const auto result = runLab(scene, full_run, [&](const ImpactRecord&) { ++seen; });
+                         const auto result = labRun(scene, full_run, [&](const ImpactRecord&) { ++seen; });
                          doNotOptimize(seen);
-                         return result.summary.collision_count;
+                         return result.impact_count;
                        });
   }
   // As `collision_lab_cli --mode full --events none` runs it: no event handed out.
   methods.emplace_back("core, full lab run (mode full)", [&] {
-                       const auto result = runLab(scene, full_run);
-                       doNotOptimize(result.summary.max_prediction_error);
-                       return result.summary.collision_count;
+                       const auto result = labRun(scene, full_run);
+                       doNotOptimize(result.max_prediction_error);
+                       return result.impact_count;
                      });
   RunOptions summary_run = full_run;
   summary_run.mode = RunMode::kSummaryOnly;
   methods.emplace_back("core, lab run (mode summary)", [&] {
-                       const auto result = runLab(scene, summary_run);
-                       doNotOptimize(result.summary.final_velocities);
-                       return result.summary.collision_count;
+                       const auto result = labRun(scene, summary_run);
+                       doNotOptimize(result.final_velocities.data());
+                       return result.impact_count;
                      });
   const int first = firstPair(scene) == Pair::BC ? 1 : 0;
   if (!lab_only) {
@@ -200,9 +203,9 @@ SceneFigures benchScene(double heavy, int repeats, bool keep_all, bool lab_only 
   }
   if (keep_all && !lab_only) {
     methods.emplace_back("core, every event kept (events all)", [&] {
-                         const auto result = runLab(scene, all_events);
-                         doNotOptimize(result.events.data());
-                         return result.summary.collision_count;
+                         const auto result = labRun(scene, all_events);
+                         doNotOptimize(result.impacts.data());
+                         return result.impact_count;
                        });
   }
   for (int rep = 0; rep < repeats; ++rep) {
@@ -250,7 +253,7 @@ struct ExtremeFigures {
 };
 
 ExtremeFigures benchExtreme(std::uint64_t impacts, int repeats) {
-  ThreeBodyScene scene;
+  Scene scene = threeBodies();
   scene.masses = {1e37, 1.0, std::numeric_limits<double>::infinity()};  // C: a wall
   scene.positions = {2.0, 1.0, 0.0};
   scene.velocities = {-1.0, 0.0, 0.0};
@@ -271,15 +274,15 @@ ExtremeFigures benchExtreme(std::uint64_t impacts, int repeats) {
                        return run.collision_count;
                      });
   methods.emplace_back("core, lab run (mode summary)", [&] {
-                       const auto result = runLab(scene, summary_run);
-                       figures.escalated = result.summary.escalation.high_precision;
-                       doNotOptimize(result.summary.final_velocities);
-                       return result.summary.collision_count;
+                       const auto result = labRun(scene, summary_run);
+                       figures.escalated = result.escalations.high_precision + result.escalations.exact_rational;
+                       doNotOptimize(result.final_velocities.data());
+                       return result.impact_count;
                      });
   methods.emplace_back("core, full lab run (mode full)", [&] {
-                       const auto result = runLab(scene, full_run);
-                       doNotOptimize(result.summary.max_prediction_error);
-                       return result.summary.collision_count;
+                       const auto result = labRun(scene, full_run);
+                       doNotOptimize(result.max_prediction_error);
+                       return result.impact_count;
                      });
   const int first = firstPair(scene) == Pair::BC ? 1 : 0;
   methods.emplace_back("double-double impact maps alone", [&] {
@@ -315,7 +318,7 @@ double benchClosedForm(int repeats) {
   std::printf("  %-22s %16s %18s\n", "masses", "n", "median ns/query");
   double worst = 0.0;
   for (double heavy : {1e14, 1e30}) {
-    const ThreeBodyScene scene = heavyLightHeavy(heavy);
+    const Scene scene = heavyLightHeavy(heavy);
     for (double n_double : {1e3, 1e6, 1e9, 1e12}) {
       const auto n = static_cast<std::uint64_t>(n_double);
       const double ns = velocitiesAfterNs(scene, n, repeats);
@@ -327,7 +330,7 @@ double benchClosedForm(int repeats) {
   std::printf("\npredictedCollisionCount (exact count, includes building the model)\n");
   std::printf("  %-22s %20s %18s\n", "masses", "count", "median ns/call");
   for (double heavy : {1e12, 1e14, 1e16, 1e20, 1e30}) {
-    const ThreeBodyScene scene = heavyLightHeavy(heavy);
+    const Scene scene = heavyLightHeavy(heavy);
     const std::uint64_t count = predictedCollisionCount(scene);
     const double ns = predictedCountNs(scene, repeats);
     std::printf("  (%-6g, 1, %-6g)       %20llu %18.1f\n", heavy, heavy,

@@ -47,6 +47,14 @@ using namespace collision_lab::bench;
 
 namespace {
 
+/// How often a run's decisions left the working precision: every decision (one per impact
+/// and a final one), those taken at 100 digits or more, and the exact ones among them.
+struct EscalationStats {
+  std::uint64_t decisions = 0;
+  std::uint64_t high_precision = 0;
+  std::uint64_t exact_rational = 0;
+};
+
 constexpr std::uint64_t kExactReferenceLimit = 5'000;    // exact::simulate up to this count
 constexpr std::uint64_t kMultiprecisionLimit = 3'000'000;  // 50-digit runs up to this count
 constexpr std::uint64_t kSimulationLimit = 1'000'000'000;  // any simulation up to this count
@@ -54,15 +62,11 @@ constexpr std::uint64_t kIsolateAbove = 1'000'000;  // longer runs go to a child
 
 struct HardCase {
   std::string name;
-  ThreeBodyScene scene;
+  Scene scene = threeBodies();
 };
 
-ThreeBodyScene makeScene(std::array<double, 3> m, std::array<double, 3> x, std::array<double, 3> v) {
-  ThreeBodyScene s;
-  s.masses = m;
-  s.positions = x;
-  s.velocities = v;
-  return s;
+Scene makeScene(std::array<double, 3> m, std::array<double, 3> x, std::array<double, 3> v) {
+  return threeBodies(m, x, v);
 }
 
 std::vector<HardCase> hardCases(bool quick) {
@@ -94,7 +98,7 @@ struct Reference {
   std::string kind;
 };
 
-Reference makeReference(const ThreeBodyScene& scene) {
+Reference makeReference(const Scene& scene) {
   Reference ref;
   ref.first_pair = ExactTrajectory(scene, 0).firstPair();  // exact, stops before any collision
   const std::uint64_t predicted = predictedCollisionCount(scene);
@@ -130,11 +134,11 @@ struct Method {
   std::string name;
   bool multiprecision;
   bool adaptive;  ///< the core in double: the column the goals are about
-  std::function<Outcome(const ThreeBodyScene&)> run;
+  std::function<Outcome(const Scene&)> run;
 };
 
 template <class Scalar, ImpulseForm kForm = ImpulseForm::kMassFraction>
-Outcome naiveOutcome(const ThreeBodyScene& scene) {
+Outcome naiveOutcome(const Scene& scene) {
   const auto run = naiveEventLoop<Scalar, false, kForm>(scene, kSimulationLimit);
   Outcome out;
   out.ran = true;
@@ -145,20 +149,16 @@ Outcome naiveOutcome(const ThreeBodyScene& scene) {
 }
 
 /// The engine's run of three bodies, count-only (no event visited or kept).
-EngineResult engineRun(const ThreeBodyScene& scene, std::uint64_t keep_events = 0) {
-  Scene engine_scene;
-  engine_scene.masses.assign(scene.masses.begin(), scene.masses.end());
-  engine_scene.positions.assign(scene.positions.begin(), scene.positions.end());
-  engine_scene.velocities.assign(scene.velocities.begin(), scene.velocities.end());
+EngineResult engineRun(const Scene& scene, std::uint64_t keep_events = 0) {
   EngineOptions options;
   options.max_impacts = kSimulationLimit;
   options.keep_events = keep_events;
   options.progress_interval = 0;
-  return runEngine(engine_scene, options);
+  return runEngine(scene, options);
 }
 
 /// The core: the exact event engine (keeping its first record, for the first pair).
-Outcome coreOutcome(const ThreeBodyScene& scene) {
+Outcome coreOutcome(const Scene& scene) {
   const EngineResult result = engineRun(scene, 1);
   Outcome out;
   out.ran = true;
@@ -194,7 +194,7 @@ std::size_t adaptiveIndex(const std::vector<Method>& list) {
 /// Runs `method` once in a forked child and returns its outcome, or an outcome saying it
 /// did not finish within `limit` seconds (the child is then killed). Keeps a run whose
 /// cost cannot be predicted (escalation replays) from holding up the whole table.
-Outcome runIsolated(const Method& method, const ThreeBodyScene& scene, double limit) {
+Outcome runIsolated(const Method& method, const Scene& scene, double limit) {
   struct Wire {
     std::uint64_t count;
     int first_pair;  // -1: none
@@ -259,7 +259,7 @@ double medianSeconds(Work&& work, int repeats) {
   return median(samples) / batch;
 }
 
-std::string cell(const Outcome& out, const Reference& ref, const ThreeBodyScene& scene) {
+std::string cell(const Outcome& out, const Reference& ref, const Scene& scene) {
   if (!out.ran) return out.why_not;
   const long long err = static_cast<long long>(out.count) - static_cast<long long>(ref.count);
   std::string text = format("%+lld / %s", err, sci(relativeVelocityError(scene, out.velocities, ref.velocities)).c_str());
@@ -274,7 +274,7 @@ bool outcomeExact(const Outcome& out, const Reference& ref) {
 struct RandomFamily {
   std::string name;
   std::string how;
-  std::function<ThreeBodyScene(std::mt19937_64&)> draw;
+  std::function<Scene(std::mt19937_64&)> draw;
 };
 
 std::vector<RandomFamily> randomFamilies() {
@@ -282,7 +282,7 @@ std::vector<RandomFamily> randomFamilies() {
       {"random generic", "masses 10^U(-3,3), velocities U(-1,1), gaps U(0.1,1) m",
        [](std::mt19937_64& rng) {
          std::uniform_real_distribution<double> u(0.0, 1.0);
-         ThreeBodyScene s;
+         Scene s = threeBodies();
          for (auto& m : s.masses) m = std::pow(10.0, -3.0 + 6.0 * u(rng));
          for (auto& v : s.velocities) v = -1.0 + 2.0 * u(rng);
          s.positions[2] = 0.0;
@@ -294,7 +294,7 @@ std::vector<RandomFamily> randomFamilies() {
                                 "(ties and grazing contacts are common)",
        [](std::mt19937_64& rng) {
          std::uniform_int_distribution<int> mass(1, 9), vel(-4, 4);
-         ThreeBodyScene s;
+         Scene s = threeBodies();
          for (auto& m : s.masses) m = mass(rng);
          for (auto& v : s.velocities) v = vel(rng) / 4.0;
          s.positions = {2.0, 1.0, 0.0};
@@ -338,9 +338,9 @@ int main(int argc, char** argv) {
   std::vector<std::string> adaptive_failures;
   Stopwatch total;
   for (const auto& hard : hardCases(quick)) {
-    const ThreeBodyScene& scene = hard.scene;
+    const Scene& scene = hard.scene;
     std::fprintf(stderr, "[%5.0f s] %s\n", total.seconds(), hard.name.c_str());
-    errors << "| " << hard.name << " | " << triple(scene.masses) << " | " << triple(scene.velocities) << " | ";
+    errors << "| " << hard.name << " | " << tripleText(scene.masses) << " | " << tripleText(scene.velocities) << " | ";
     if (const auto invalid = validate(scene)) {
       errors << "- | rejected by validate: " << reasonName(invalid->reason) << " |";
       for (std::size_t i = 0; i < method_list.size(); ++i) errors << " - |";
@@ -398,9 +398,9 @@ int main(int argc, char** argv) {
   std::vector<double> escalation_costs;
   for (const auto& family : randomFamilies()) {
     std::mt19937_64 rng(seed);
-    std::vector<ThreeBodyScene> scenes;
+    std::vector<Scene> scenes;
     while (static_cast<int>(scenes.size()) < random_scenes) {
-      const ThreeBodyScene s = family.draw(rng);
+      const Scene s = family.draw(rng);
       if (!validate(s)) scenes.push_back(s);
     }
     std::fprintf(stderr, "[%5.0f s] %s: %d scenes\n", total.seconds(), family.name.c_str(), random_scenes);
@@ -481,17 +481,17 @@ int main(int argc, char** argv) {
   closed << "| masses [kg] | n | velocitiesAfter(n) [ns] |\n|---|---|---|\n";
   double worst_query = 0.0;
   for (double heavy : {1e12, 1e30}) {
-    const ThreeBodyScene s = makeScene({heavy, 1, heavy}, {1, 0, -1}, {-1, 0, 0});
+    const Scene s = makeScene({heavy, 1, heavy}, {1, 0, -1}, {-1, 0, 0});
     for (double n : {1e3, 1e6, 1e9, 1e12}) {
       const double ns = velocitiesAfterNs(s, static_cast<std::uint64_t>(n), repeats);
       worst_query = std::max(worst_query, ns);
-      closed << "| " << triple(s.masses) << " | " << format("%g", n) << " | " << format("%.1f", ns) << " |\n";
+      closed << "| " << tripleText(s.masses) << " | " << format("%g", n) << " | " << format("%.1f", ns) << " |\n";
     }
   }
   closed << "\n| masses [kg] | predictedCollisionCount | time per call [ns] |\n|---|---|---|\n";
   for (double heavy : {1e12, 1e16, 1e20, 1e30}) {
-    const ThreeBodyScene s = makeScene({heavy, 1, heavy}, {1, 0, -1}, {-1, 0, 0});
-    closed << "| " << triple(s.masses) << " | " << predictedCollisionCount(s) << " | "
+    const Scene s = makeScene({heavy, 1, heavy}, {1, 0, -1}, {-1, 0, 0});
+    closed << "| " << tripleText(s.masses) << " | " << predictedCollisionCount(s) << " | "
            << format("%.0f", predictedCountNs(s, repeats)) << " |\n";
   }
 

@@ -49,8 +49,8 @@ constexpr double kThreeBodyEndTime = 3.0;
 struct BenchScene {
   std::string name;
   std::string description;
-  Scene scene;                          ///< the N-body form, run by every method
-  std::optional<ThreeBodyScene> three;  ///< the three-body elastic form: closed_form
+  Scene scene;                          ///< run by every method
+  std::optional<Scene> three;           ///< the same scene where it is three elastic bodies: closed_form
   double end_time = kThreeBodyEndTime;  ///< every method is compared at this instant [s]
   bool in_quick = true;
   std::string preset;                     ///< the config/scenarios.yaml scene it follows, if any
@@ -58,13 +58,11 @@ struct BenchScene {
   std::uint64_t engine_cap = 10'000'000;  ///< runEngine's max_impacts (the preset's cap where it has one)
 };
 
-BenchScene threeBody(std::string name, std::string description, const ThreeBodyScene& three, bool in_quick) {
+BenchScene threeBody(std::string name, std::string description, const Scene& three, bool in_quick) {
   BenchScene s;
   s.name = std::move(name);
   s.description = std::move(description);
-  s.scene.masses.assign(three.masses.begin(), three.masses.end());
-  s.scene.positions.assign(three.positions.begin(), three.positions.end());
-  s.scene.velocities.assign(three.velocities.begin(), three.velocities.end());
+  s.scene = three;
   s.three = three;
   s.in_quick = in_quick;
   return s;

@@ -8,8 +8,8 @@
 // Input layout (fuzz/make_seeds.py writes the committed seeds in it):
 //   byte 0   options: bit 0 a visitor watches every event (bit 1 unused; bits 0-1 chose
 //            the working precision, since removed), bits 2-3 kept events (none, all,
-//            first 3, none), bit 4 encoding (0 raw, 1 compact), bit 5 runLab skips the
-//            simulation over the cap, bits 6-7 run mode
+//            first 3, none), bit 4 encoding (0 raw, 1 compact), bit 5 the second run answers over the
+//            cap from the closed form (no simulation to the cap), bits 6-7 run mode
 //   byte 1   max_collisions: kCaps[byte % kCaps.size()]
 //   then 9 values, masses A B C, positions A B C, velocities A B C, each either
 //     raw:     8 bytes, a little-endian IEEE double (any bit pattern, NaN and inf too), or
@@ -28,7 +28,8 @@
 #include "fuzz_input.h"
 #include "collision_lab/core/analytic.h"
 #include "collision_lab/core/exact.h"
-#include "collision_lab/core/lab_run.h"
+#include "collision_lab/core/scene_run.h"
+#include "collision_lab/core/nbody/models.h"
 #include "collision_lab/core/paper.h"
 #include "collision_lab/core/scene.h"
 
@@ -38,7 +39,7 @@ namespace {
 
 /// Collision caps: small enough that one iteration stays in milliseconds.
 constexpr std::array<std::uint64_t, 10> kCaps = {0, 1, 2, 3, 5, 10, 100, 1000, 10000, 100000};
-/// Caps for the slower paths (events kept or visited, runLab's per-event model).
+/// Caps for the slower paths (events kept or visited, the rotation model's values beside each impact).
 constexpr std::uint64_t kSlowPathCap = 2000;
 /// Runs short enough to cross-check against exact rationals (their cost grows about
 /// cubically: 40 collisions of a scene mixing 1e30 kg and 1e-139 m/s take 1.3 s).
@@ -86,8 +87,8 @@ struct VelocityScales {
   std::array<double, 3> floor{};
 };
 
-VelocityScales velocityScales(const cl::ThreeBodyScene& scene) {
-  const int wall = scene.wallIndex();
+VelocityScales velocityScales(const cl::Scene& scene) {
+  const int wall = wallIndex(scene);
   double mass_max = 0.0;
   for (int i = 0; i < 3; ++i) {
     if (i != wall) mass_max = std::max(mass_max, scene.masses[i]);
@@ -129,34 +130,39 @@ void checkEscaped(const std::array<double, 3>& v, const VelocityScales& scales, 
 /// A generous bound on the rounding of a run's velocities: 64 eps per impact.
 double engineTolerance(std::uint64_t count) { return 64 * std::numeric_limits<double>::epsilon() * double(count + 2); }
 
-void checkSimulation(const cl::ThreeBodyScene& scene, const cl::RunResult& run, const cl::AnalyticPrediction& prediction,
+/// The pair of impact `index` (1-based): the first pair, then alternating.
+cl::Pair pairOfImpact(const cl::Prediction& prediction, std::uint64_t index) {
+  const cl::Pair first = *prediction.first_pair_index == 0 ? cl::Pair::AB : cl::Pair::BC;
+  return index % 2 == 1 ? first : cl::otherPair(first);
+}
+
+void checkSimulation(const cl::Scene& scene, const cl::SceneSimulation& sim, const cl::Prediction& prediction,
                      std::uint64_t cap) {
-  const cl::LabRunSummary& sim = run.summary;
+  const std::uint64_t predicted = *prediction.impact_count;
+  const std::array<double, 3> final_velocities = cl::triple(sim.final_velocities);
   // The one honest early stop: the next impact comes after the largest double.
   const bool out_of_range = sim.stop == cl::StopReason::kOutOfRange;
   FUZZ_CHECK(sim.stop == cl::StopReason::kFinished || sim.stop == cl::StopReason::kCap || out_of_range,
              "a three-body run finishes, reaches the cap or stops out of range");
-  FUZZ_CHECK(sim.truncated == (prediction.collision_count > cap || out_of_range),
+  FUZZ_CHECK(sim.truncated == (predicted > cap || out_of_range),
              "truncated iff the predicted count exceeds the cap or the next impact is out of range");
   if (out_of_range) {
-    FUZZ_CHECK(sim.collision_count < std::min(prediction.collision_count, cap), "an out-of-range stop comes early");
+    FUZZ_CHECK(sim.impact_count < std::min(predicted, cap), "an out-of-range stop comes early");
   } else {
-    FUZZ_CHECK(sim.collision_count == std::min(prediction.collision_count, cap),
-               "simulated count == predictedCollisionCount (capped)");
+    FUZZ_CHECK(sim.impact_count == std::min(predicted, cap), "simulated count == predictedCollisionCount (capped)");
   }
-  FUZZ_CHECK(allFinite(sim.final_velocities), "finite final velocities");
+  FUZZ_CHECK(allFinite(final_velocities), "finite final velocities");
   FUZZ_CHECK(std::isfinite(sim.energy_relative_drift), "finite energy drift");
-  const int wall = scene.wallIndex();
-  if (wall >= 0) FUZZ_CHECK(sim.final_velocities[wall] == scene.velocities[wall], "a wall keeps its velocity");
-  if (!sim.truncated) checkEscaped(sim.final_velocities, velocityScales(scene), engineTolerance(sim.collision_count));
+  const int wall = wallIndex(scene);
+  if (wall >= 0) FUZZ_CHECK(final_velocities[wall] == scene.velocities[wall], "a wall keeps its velocity");
+  if (!sim.truncated) checkEscaped(final_velocities, velocityScales(scene), engineTolerance(sim.impact_count));
   std::uint64_t index = 0;
   double time = 0.0;
-  for (const cl::ImpactRecord& event : run.events) {
+  for (const cl::ImpactRecord& event : sim.impacts) {
     FUZZ_CHECK(event.index == ++index, "events numbered 1, 2, ...");
     FUZZ_CHECK(event.model.has_value(), "every event has its model block");
     FUZZ_CHECK(allFinite(event.model->velocities_after), "finite event velocities");
-    const cl::Pair pair = (index % 2 == 1) ? *prediction.first_pair : cl::otherPair(*prediction.first_pair);
-    FUZZ_CHECK(event.pair_index == static_cast<std::size_t>(cl::pairIndex(pair)),
+    FUZZ_CHECK(event.pair_index == static_cast<std::size_t>(cl::pairIndex(pairOfImpact(prediction, index))),
                "pairs alternate from the predicted first pair");
     FUZZ_CHECK(std::isfinite(event.time) && event.time >= time, "event times finite and non-decreasing");
     FUZZ_CHECK(allFinite(event.model->positions), "finite event positions");
@@ -164,9 +170,17 @@ void checkSimulation(const cl::ThreeBodyScene& scene, const cl::RunResult& run, 
   }
 }
 
-void checkModel(const cl::ThreeBodyScene& scene, const cl::AnalyticPrediction& prediction) {
+/// Plans and runs a valid scene as the front ends do.
+cl::SceneSimulation runPlanned(const cl::ScenePlan& plan, const cl::SceneRunOptions& options,
+                               const cl::ImpactVisitor& visitor = {}) {
+  cl::SceneVisitors visitors;
+  visitors.impact = visitor;
+  return cl::runScene(plan, options, visitors).simulation;
+}
+
+void checkModel(const cl::Scene& scene, const cl::Prediction& prediction) {
   // AnalyticModel<double> needs finite-mass ratios up to about 2^1000 (analytic.h); beyond,
-  // predict() and runLab() take 50 digits, checked through the prediction above.
+  // the rotation model takes 50 digits, checked through the prediction above.
   int smallest = std::numeric_limits<int>::max(), largest = std::numeric_limits<int>::min();
   for (int i = 0; i < 3; ++i) {
     if (scene.isWall(i)) continue;
@@ -180,7 +194,7 @@ void checkModel(const cl::ThreeBodyScene& scene, const cl::AnalyticPrediction& p
   const double psi = model.psi();
   FUZZ_CHECK(psi >= 0 && psi < 2 * M_PI + 1e-12, "psi in [0, 2 pi)");
   const VelocityScales scales = velocityScales(scene);
-  for (const std::uint64_t n : {std::uint64_t{0}, std::uint64_t{1}, prediction.collision_count}) {
+  for (const std::uint64_t n : {std::uint64_t{0}, std::uint64_t{1}, *prediction.impact_count}) {
     const Eigen::Vector3d after = model.velocitiesAfter(n);
     FUZZ_CHECK(allFinite(after), "finite closed-form velocities");
     const Eigen::Vector3d back = model.initialVelocitiesFrom(after, n);
@@ -197,21 +211,22 @@ void checkModel(const cl::ThreeBodyScene& scene, const cl::AnalyticPrediction& p
                  "initialVelocitiesFrom inverts velocitiesAfter");
     }
   }
-  const Eigen::Vector3d last = model.velocitiesAfter(prediction.collision_count);
+  const Eigen::Vector3d last = model.velocitiesAfter(*prediction.impact_count);
   checkEscaped({last(0), last(1), last(2)}, scales, 1e-9);
 }
 
-void exercisePaper(const cl::ThreeBodyScene& scene, std::uint64_t count) {
+void exercisePaper(const cl::Scene& scene, std::uint64_t count) {
   // Printed formulas may be NaN or wrong by design (physics.md, Errata); they must only
   // answer without crashing or undefined behaviour.
   (void)cl::paper::velocitiesAfter(scene, count);
   (void)cl::paper::velocitiesAfter(scene, count + 1);
   (void)cl::paper::phiBC(scene);
-  (void)cl::paper::omega(scene.masses);
+  (void)cl::paper::omega(cl::triple(scene.masses));
   (void)cl::paper::collisionCount(scene);
-  (void)cl::paper::energyTransfer(scene, 1, cl::Pair::AB, scene.velocities, scene.velocities);
-  (void)cl::paper::energyTransfer(scene, 2, cl::Pair::BC, scene.velocities, scene.velocities);
-  (void)cl::eigenCheck(scene.masses);
+  const std::array<double, 3> v = cl::triple(scene.velocities);
+  (void)cl::paper::energyTransfer(scene, 1, cl::Pair::AB, v, v);
+  (void)cl::paper::energyTransfer(scene, 2, cl::Pair::BC, v, v);
+  (void)cl::eigenCheck(cl::triple(scene.masses));
 }
 
 }  // namespace
@@ -224,7 +239,7 @@ int collisionLabCoreFuzzOne(const std::uint8_t* data, std::size_t size) {
   const std::uint64_t cap = kCaps[in.byte() % kCaps.size()];
   const bool compact = flags & 0x10;
   if (!in.has(compact ? 9 * 4 : 9 * 8)) return 0;
-  cl::ThreeBodyScene scene;
+  cl::Scene scene = cl::threeBodies();
   for (auto* values : {&scene.masses, &scene.positions, &scene.velocities}) {
     for (double& value : *values) value = compact ? in.compactDouble() : in.rawDouble();
   }
@@ -245,47 +260,59 @@ int collisionLabCoreFuzzOne(const std::uint8_t* data, std::size_t size) {
   const std::uint64_t known_issue_cap =
       skipKnownIssues() && mass_max / mass_min > kQuadraticMassRatio ? kQuadraticCap : kCaps.back();
 
-  const cl::AnalyticPrediction prediction = cl::predict(scene);
-  const std::uint64_t max_possible = cl::maxPossibleCollisionCount(scene.masses);
-  FUZZ_CHECK(prediction.max_possible_collision_count == max_possible, "predict reports maxPossibleCollisionCount");
-  FUZZ_CHECK(prediction.collision_count <= max_possible, "count <= ceil(pi / alpha)");
-  FUZZ_CHECK(prediction.first_pair == cl::firstPair(scene), "predict reports firstPair");
-  FUZZ_CHECK(prediction.first_pair.has_value() || prediction.collision_count == 0, "no first pair, no collisions");
-  FUZZ_CHECK(allFinite(prediction.final_velocities), "finite predicted final velocities");
+  const cl::ScenePlan plan = cl::planScene(scene);
+  FUZZ_CHECK(!plan.error, "planScene accepts what validate accepts");
+  // Three elastic bodies beyond the rotation model's range (and two walls) are the
+  // engine's alone, fuzzed by nbody_fuzzer.
+  if (!plan.prediction || !cl::hasRotationValues(*plan.prediction)) return 0;
+  const cl::Prediction& prediction = *plan.prediction;
+  FUZZ_CHECK(prediction.impact_count.has_value(), "the rotation model gives a count");
+  const std::uint64_t predicted = *prediction.impact_count;
+  const std::uint64_t max_possible = cl::maxPossibleCollisionCount(cl::triple(scene.masses));
+  FUZZ_CHECK(prediction.max_possible_impact_count == max_possible, "the prediction reports maxPossibleCollisionCount");
+  FUZZ_CHECK(predicted <= max_possible, "count <= ceil(pi / alpha)");
+  const std::optional<cl::Pair> first = cl::firstPair(scene);
+  FUZZ_CHECK(prediction.first_pair_index.has_value() == first.has_value() &&
+                 (!first || *prediction.first_pair_index == static_cast<std::size_t>(cl::pairIndex(*first))),
+             "the prediction reports firstPair");
+  FUZZ_CHECK(first.has_value() || predicted == 0, "no first pair, no collisions");
+  FUZZ_CHECK(prediction.final_velocities.size() == 3 && allFinite(cl::triple(prediction.final_velocities)),
+             "finite predicted final velocities");
   checkModel(scene, prediction);
-  exercisePaper(scene, prediction.collision_count);
+  exercisePaper(scene, predicted);
 
   const bool watched = flags & 0x1;
   const int events = (flags >> 2) & 0x3;
-  cl::RunOptions options;
-  options.events = events == 1 ? cl::EventPolicy::all() : events == 2 ? cl::EventPolicy::firstN(3) : cl::EventPolicy::none();
+  cl::SceneRunOptions options;
+  options.lab.events =
+      events == 1 ? cl::EventPolicy::all() : events == 2 ? cl::EventPolicy::firstN(3) : cl::EventPolicy::none();
   const bool slow_path = watched || events == 1;
-  options.max_collisions = std::min({cap, slow_path ? kSlowPathCap : cap, known_issue_cap});
+  options.lab.max_collisions = std::min({cap, slow_path ? kSlowPathCap : cap, known_issue_cap});
+  options.simulate_to_cap = true;
   std::uint64_t watched_events = 0;
   cl::ImpactVisitor watch;
   if (watched) watch = [&watched_events](const cl::ImpactRecord&) { ++watched_events; };
-  const cl::RunResult sim = cl::runLab(scene, options, watch);
-  checkSimulation(scene, sim, prediction, options.max_collisions);
-  if (watched) FUZZ_CHECK(watched_events == sim.summary.collision_count, "the visitor sees every impact");
+  const cl::SceneSimulation sim = runPlanned(plan, options, watch);
+  checkSimulation(scene, sim, prediction, options.lab.max_collisions);
+  if (watched) FUZZ_CHECK(watched_events == sim.impact_count, "the visitor sees every impact");
 
-  if (prediction.collision_count <= kExactCrossCheckLimit) {
+  if (predicted <= kExactCrossCheckLimit) {
     const cl::exact::Run truth = cl::exact::simulate(scene, kExactCrossCheckLimit + 1);
-    FUZZ_CHECK(!truth.truncated && truth.collision_count == prediction.collision_count,
-               "predictedCollisionCount == exact rational count");
+    FUZZ_CHECK(!truth.truncated && truth.collision_count == predicted, "predictedCollisionCount == exact rational count");
   }
 
-  cl::RunOptions run_options;
-  run_options.max_collisions = std::min({cap, kSlowPathCap, known_issue_cap});
-  run_options.mode = static_cast<cl::RunMode>((flags >> 6) % 3);
-  run_options.skip_simulation_over_cap = flags & 0x20;
-  run_options.events = cl::EventPolicy::firstN(3);
-  const cl::RunResult run = cl::runLab(scene, run_options);
-  FUZZ_CHECK(allFinite(run.summary.final_velocities), "finite lab-run final velocities");
-  // The over-cap rule: skipping the simulation over the cap answers from the closed form, complete.
-  const bool over_cap = prediction.collision_count > run_options.max_collisions;
-  const bool simulates = run_options.mode != cl::RunMode::kPredictOnly && !(over_cap && run_options.skip_simulation_over_cap);
-  FUZZ_CHECK(run.summary.simulated == simulates, "a lab run simulates unless predict-only or skipped over the cap");
-  FUZZ_CHECK(run.summary.truncated == (simulates && (over_cap || run.summary.stop == cl::StopReason::kOutOfRange)),
+  cl::SceneRunOptions run_options;
+  run_options.lab.max_collisions = std::min({cap, kSlowPathCap, known_issue_cap});
+  run_options.lab.mode = static_cast<cl::RunMode>((flags >> 6) % 3);
+  run_options.simulate_to_cap = !(flags & 0x20);
+  run_options.lab.events = cl::EventPolicy::firstN(3);
+  const cl::SceneSimulation run = runPlanned(plan, run_options);
+  FUZZ_CHECK(allFinite(cl::triple(run.final_velocities)), "finite lab-run final velocities");
+  // The over-cap rule: answering over the cap from the closed form is complete.
+  const bool over_cap = predicted > run_options.lab.max_collisions;
+  const bool simulates = run_options.lab.mode != cl::RunMode::kPredictOnly && !(over_cap && !run_options.simulate_to_cap);
+  FUZZ_CHECK(run.simulated == simulates, "a lab run simulates unless predict-only or answered over the cap");
+  FUZZ_CHECK(run.truncated == (simulates && (over_cap || run.stop == cl::StopReason::kOutOfRange)),
              "a lab run is truncated iff it simulates and the prediction exceeds the cap, or it stops out of range");
   return 0;
 }

@@ -10,7 +10,7 @@ namespace collision_lab {
 namespace bench {
 
 /// Median ns per AnalyticModel<double>::velocitiesAfter(n) query (model built once).
-inline double velocitiesAfterNs(const core::ThreeBodyScene& scene, std::uint64_t n, int repeats) {
+inline double velocitiesAfterNs(const core::Scene& scene, std::uint64_t n, int repeats) {
   const core::AnalyticModel<double> model(scene);
   constexpr int kBatch = 100'000;
   const auto samples = timeRepeats(repeats, [&] {
@@ -21,7 +21,7 @@ inline double velocitiesAfterNs(const core::ThreeBodyScene& scene, std::uint64_t
 }
 
 /// Median ns per predictedCollisionCount(scene) call (builds its model every call).
-inline double predictedCountNs(const core::ThreeBodyScene& scene, int repeats) {
+inline double predictedCountNs(const core::Scene& scene, int repeats) {
   constexpr int kBatch = 200;
   const auto samples = timeRepeats(repeats, [&] {
     for (int i = 0; i < kBatch; ++i) doNotOptimize(core::predictedCollisionCount(scene));

@@ -26,14 +26,6 @@ mpq_class massFraction(double m_i, double m_j) {
   return mpq_class(mi / (mi + mpq_class(m_j)));
 }
 
-core::Scene toScene(const core::ThreeBodyScene& three) {
-  core::Scene scene;
-  scene.masses.assign(three.masses.begin(), three.masses.end());
-  scene.positions.assign(three.positions.begin(), three.positions.end());
-  scene.velocities.assign(three.velocities.begin(), three.velocities.end());
-  return scene;
-}
-
 }  // namespace
 
 ExactTrajectory::ExactTrajectory(const core::Scene& scene, std::uint64_t max_collisions, double until)
@@ -50,9 +42,6 @@ ExactTrajectory::ExactTrajectory(const core::Scene& scene, std::uint64_t max_col
   }
   run(max_collisions, until);
 }
-
-ExactTrajectory::ExactTrajectory(const core::ThreeBodyScene& scene, std::uint64_t max_collisions)
-    : ExactTrajectory(toScene(scene), max_collisions, HUGE_VAL) {}
 
 void ExactTrajectory::run(std::uint64_t max_collisions, double until) {
   auto& s = *state_;

@@ -6,6 +6,8 @@
 // few thousand impacts of a few bodies.
 #pragma once
 
+#include <cmath>
+
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -24,9 +26,7 @@ class ExactTrajectory {
   /// (none after it; +inf: to the end), or to max_collisions. Disjoint pairs that meet at one instant are
   /// all resolved (in pair order); throws std::invalid_argument on a multiple collision
   /// (two impacts sharing a body at one instant), whose outcome is undefined.
-  ExactTrajectory(const core::Scene& scene, std::uint64_t max_collisions, double until);
-  /// The three-body scene, run to its end (elastic; walls as in the scene).
-  ExactTrajectory(const core::ThreeBodyScene& scene, std::uint64_t max_collisions);
+  ExactTrajectory(const core::Scene& scene, std::uint64_t max_collisions, double until = HUGE_VAL);
   ~ExactTrajectory();
   ExactTrajectory(ExactTrajectory&&) noexcept;
   ExactTrajectory& operator=(ExactTrajectory&&) noexcept;

@@ -46,7 +46,7 @@ enum class ImpulseForm {
 /// loop": times, positions, velocities, nothing stored); without it only velocities
 /// change after the first pair is chosen.
 template <class Scalar, bool kTrackPositions, ImpulseForm kForm = ImpulseForm::kMassFraction>
-NaiveRun<Scalar> naiveEventLoop(const core::ThreeBodyScene& scene, std::uint64_t max_collisions) {
+NaiveRun<Scalar> naiveEventLoop(const core::Scene& scene, std::uint64_t max_collisions) {
   NaiveRun<Scalar> run;
   const auto& m = scene.masses;
   // Per pair: fraction of the left body (A of AB, B of BC) and of the right body.

@@ -29,8 +29,8 @@ std::string sci(double value) {
   return format("%.3g", value);
 }
 
-std::string triple(const std::array<double, 3>& values) {
-  return format("(%g, %g, %g)", values[0], values[1], values[2]);
+std::string tripleText(const std::vector<double>& values) {
+  return format("(%g, %g, %g)", values.at(0), values.at(1), values.at(2));
 }
 
 double relativeVelocityError(const std::vector<double>& masses, const std::vector<double>& a,
@@ -45,7 +45,7 @@ double relativeVelocityError(const std::vector<double>& masses, const std::vecto
   return scale > 0.0 ? diff / scale : diff;
 }
 
-double relativeVelocityError(const core::ThreeBodyScene& scene, const std::array<double, 3>& a,
+double relativeVelocityError(const core::Scene& scene, const std::array<double, 3>& a,
                              const std::array<double, 3>& b) {
   const std::vector<double> m(scene.masses.begin(), scene.masses.end());
   return relativeVelocityError(m, {a.begin(), a.end()}, {b.begin(), b.end()});

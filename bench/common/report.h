@@ -17,11 +17,11 @@ std::string format(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
 std::string sci(double value);
 
 /// "(a, b, c)" with %g, "inf" for walls.
-std::string triple(const std::array<double, 3>& values);
+std::string tripleText(const std::vector<double>& values);
 
 /// max_i |a_i - b_i| / max_i |b_i| over the finite-mass bodies (walls are skipped);
 /// absolute when b is all zero.
-double relativeVelocityError(const core::ThreeBodyScene& scene, const std::array<double, 3>& a,
+double relativeVelocityError(const core::Scene& scene, const std::array<double, 3>& a,
                              const std::array<double, 3>& b);
 
 /// The same for N bodies: masses[i] = +inf marks a wall, which is skipped.

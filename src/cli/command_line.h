@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "collision_lab/core/lab_run.h"
+#include "collision_lab/core/scene_run.h"
 #include "collision_lab/io/report.h"
 
 namespace collision_lab {

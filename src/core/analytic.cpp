@@ -45,7 +45,7 @@ struct Quotient {
 };
 
 template <class T>
-Quotient<T> countQuotient(const ThreeBodyScene& scene, Pair first) {
+Quotient<T> countQuotient(const Scene& scene, Pair first) {
   using std::sqrt;
   const AnalyticModel<T> model(scene);
   const T alpha = model.alpha();
@@ -57,7 +57,7 @@ Quotient<T> countQuotient(const ThreeBodyScene& scene, Pair first) {
   // Rounding in w = S (v - V 1) is relative to the velocities, not to w itself, so a
   // nearly common velocity makes psi inaccurate: bound the angular error by |dw| / |w|,
   // both weighted by sqrt(m_i / m_max) as w is.
-  const int wall = scene.wallIndex();
+  const int wall = wallIndex(scene);
   T velocity_scale = 0;
   for (int i = 0; i < 3; ++i) velocity_scale = std::max(velocity_scale, absOf(T(scene.velocities[i])));
   T w_norm_sq = 0, w_error = 0;
@@ -101,7 +101,7 @@ std::array<std::complex<double>, 3> sortedByArgument(std::array<std::complex<dou
 }  // namespace
 
 template <class Scalar>
-AnalyticModel<Scalar>::AnalyticModel(const ThreeBodyScene& scene) : masses_(scene.masses), wall_(scene.wallIndex()) {
+AnalyticModel<Scalar>::AnalyticModel(const Scene& scene) : masses_(triple(scene.masses)), wall_(wallIndex(scene)) {
   using std::atan2;
   for (int i = 0; i < 2; ++i) {
     fractions_[i] = {fraction<Scalar>(masses_[i], masses_[i + 1]), fraction<Scalar>(masses_[i + 1], masses_[i])};
@@ -252,9 +252,7 @@ Angles anglesFor(const std::array<double, 3>& masses) {
 }
 
 EigenCheck eigenCheck(const std::array<double, 3>& masses) {
-  ThreeBodyScene scene;
-  scene.masses = masses;
-  scene.positions = {2, 1, 0};
+  const Scene scene = threeBodies(masses, {2, 1, 0});
   const AnalyticModel<double> model(scene);
   const Eigen::Matrix3d d = model.D();
   Eigen::EigenSolver<Eigen::Matrix3d> solver(d, false);
@@ -270,7 +268,7 @@ EigenCheck eigenCheck(const std::array<double, 3>& masses) {
   return check;
 }
 
-std::uint64_t predictedCollisionCount(const ThreeBodyScene& scene) {
+std::uint64_t predictedCollisionCount(const Scene& scene) {
   const std::optional<Pair> first = firstPair(scene);
   if (!first) return 0;
   if (auto count = countIfSeparated(countQuotient<double>(scene, *first))) return *count;
@@ -280,7 +278,7 @@ std::uint64_t predictedCollisionCount(const ThreeBodyScene& scene) {
     // Even 50 digits cannot place u_perp (a body far lighter than the rest carries all the
     // relative motion): 500 digits, else count exactly when the run is short.
     if (auto count = countIfSeparated(countQuotient<DeepPrecision>(scene, *first))) return *count;
-    if (maxPossibleCollisionCount(scene.masses) <= kExactCountLimit) {
+    if (maxPossibleCollisionCount(triple(scene.masses)) <= kExactCountLimit) {
       return exact::simulate(scene, kExactCountLimit).collision_count;
     }
   }

@@ -19,7 +19,7 @@ Rational massFraction(double m_i, double m_j) {
 
 }  // namespace
 
-RationalState initialVelocities(const ThreeBodyScene& scene) {
+RationalState initialVelocities(const Scene& scene) {
   return {Rational(scene.velocities[0]), Rational(scene.velocities[1]), Rational(scene.velocities[2])};
 }
 
@@ -36,7 +36,7 @@ Rational approachSpeed(Pair pair, const RationalState& v) {
   return v[i + 1] - v[i];
 }
 
-int compareFirstContactTimes(const ThreeBodyScene& scene) {
+int compareFirstContactTimes(const Scene& scene) {
   const auto& x = scene.positions;
   const auto& v = scene.velocities;
   // t_AB - t_BC has the sign of (x_A - x_B)(v_C - v_B) - (x_B - x_C)(v_B - v_A), both
@@ -53,17 +53,17 @@ int compareFirstContactTimes(const ThreeBodyScene& scene) {
   return exact_ab < exact_bc ? -1 : (exact_ab > exact_bc ? 1 : 0);
 }
 
-RationalState velocitiesAfter(const ThreeBodyScene& scene, Pair first, std::uint64_t n) {
+RationalState velocitiesAfter(const Scene& scene, Pair first, std::uint64_t n) {
   RationalState v = initialVelocities(scene);
   Pair pair = first;
   for (std::uint64_t i = 0; i < n; ++i) {
-    applyCollision(scene.masses, pair, v);
+    applyCollision(triple(scene.masses), pair, v);
     pair = otherPair(pair);
   }
   return v;
 }
 
-Run simulate(const ThreeBodyScene& scene, std::uint64_t max_collisions) {
+Run simulate(const Scene& scene, std::uint64_t max_collisions) {
   Run run;
   RationalState v = initialVelocities(scene);
   const bool ab = approachSpeed(Pair::AB, v) > 0;
@@ -82,7 +82,7 @@ Run simulate(const ThreeBodyScene& scene, std::uint64_t max_collisions) {
         run.truncated = true;
         break;
       }
-      applyCollision(scene.masses, pair, v);
+      applyCollision(triple(scene.masses), pair, v);
       run.pairs.push_back(pair);
       ++run.collision_count;
       pair = otherPair(pair);

@@ -44,14 +44,14 @@ Constants constantsOf(const std::array<double, 3>& masses) {
 
 }  // namespace
 
-std::array<double, 3> velocitiesAfter(const ThreeBodyScene& scene, std::uint64_t n) {
+std::array<double, 3> velocitiesAfter(const Scene& scene, std::uint64_t n) {
   const PrintedClosedForm printed(scene);
   const double kth = static_cast<double>(n / 2) * printed.theta();
   return printed.velocitiesAfter(n, std::cos(kth), std::sin(kth));
 }
 
-PrintedClosedForm::PrintedClosedForm(const ThreeBodyScene& scene) {
-  const auto& m = scene.masses;
+PrintedClosedForm::PrintedClosedForm(const Scene& scene) {
+  const std::array<double, 3> m = triple(scene.masses);
   const auto& v0 = scene.velocities;
   const Constants k = constantsOf(m);
   c_ = k.c;
@@ -76,10 +76,10 @@ std::array<double, 3> PrintedClosedForm::velocitiesAfter(std::uint64_t n, double
                     m_ab_ * y / (d_ * m_ab_) + vbar_});
 }
 
-double phiBC(const ThreeBodyScene& scene) {
+double phiBC(const Scene& scene) {
   // As printed, with s = (sqrt m_i) unscaled: a wall makes it inf / inf.
-  if (scene.wallIndex() >= 0) return kNaN;
-  const auto& m = scene.masses;
+  if (wallIndex(scene) >= 0) return kNaN;
+  const std::array<double, 3> m = triple(scene.masses);
   const auto& v = scene.velocities;
   // u after the first AB impact (eq. 1.1, 1.2), in u = (sqrt(m_i) v_i).
   const double m_ab = m[kA] + m[kB];
@@ -97,17 +97,17 @@ double omega(const std::array<double, 3>& m) {
   return std::acos(wedge.n_ab.dot(wedge.n_bc));
 }
 
-std::optional<std::int64_t> collisionCount(const ThreeBodyScene& scene) {
-  const double x = (omega(scene.masses) - phiBC(scene)) / constantsOf(scene.masses).theta;
+std::optional<std::int64_t> collisionCount(const Scene& scene) {
+  const double x = (omega(triple(scene.masses)) - phiBC(scene)) / constantsOf(triple(scene.masses)).theta;
   // Evaluated in double as printed; 1 + floor(x) + ceil(x) must fit the int64 it is reported in.
   if (!std::isfinite(x) || std::fabs(x) > 4e18) return std::nullopt;
   return 1 + static_cast<std::int64_t>(std::floor(x)) + static_cast<std::int64_t>(std::ceil(x));  // eq. (3.22)
 }
 
-std::array<double, 3> energyTransfer(const ThreeBodyScene& scene, std::uint64_t n, Pair pair,
+std::array<double, 3> energyTransfer(const Scene& scene, std::uint64_t n, Pair pair,
                                      const std::array<double, 3>& state_before,
                                      const std::array<double, 3>& state_two_before) {
-  const auto& m = scene.masses;
+  const std::array<double, 3> m = triple(scene.masses);
   const double vbar = (scene.velocities[kA] + scene.velocities[kB]) / 2;  // initial average
   if (pair == Pair::AB) {
     // Eqs. (4.4), (4.5): v_k from v_A2k = v_k + vbar_AB, P_AB2k the AB momentum before.

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "collision_lab/core/count_text.h"
+#include "rotation_run.h"
 
 namespace collision_lab {
 namespace core {
@@ -116,6 +117,8 @@ SceneSimulation simulateScene(const Scene& scene, const SceneRunOptions& options
   }
   const bool over_cap = prediction && prediction->impact_count && *prediction->impact_count > lab.max_collisions;
   if (over_cap && !options.simulate_to_cap) return overCap(*prediction, lab.max_collisions);
+  // A model that predicts every impact is simulated beside them, whatever the output.
+  if (prediction && hasRotationValues(*prediction)) return simulateRotationScene(scene, *prediction, options, visitors);
   const bool wants_events = lab.mode == RunMode::kFull && lab.events.kind != EventPolicy::Kind::kNone;
   // Nothing approaching: there is nothing to simulate, events or not.
   const bool nothing_happens = prediction && prediction->kind == ModelKind::kNoCollisions;
@@ -155,65 +158,6 @@ SceneSimulation simulateScene(const Scene& scene, const SceneRunOptions& options
   return simulation;
 }
 
-/// The three-body scene of a three-body scene. Precondition: scene.size() == 3.
-ThreeBodyScene toThreeBodyScene(const Scene& scene) {
-  ThreeBodyScene triple;
-  for (int i = 0; i < 3; ++i) {
-    triple.masses[i] = scene.masses[i];
-    triple.positions[i] = scene.positions[i];
-    triple.velocities[i] = scene.velocities[i];
-  }
-  return triple;
-}
-
-/// The rotation model's prediction in the three-body run's terms (lab_run.h), as
-/// predictThreeBodyRotation gave it.
-AnalyticPrediction rotationPrediction(const Prediction& prediction) {
-  AnalyticPrediction rotation;
-  rotation.collision_count = prediction.impact_count.value_or(0);
-  rotation.paper_collision_count = prediction.paper_impact_count;
-  rotation.max_possible_collision_count = prediction.max_possible_impact_count.value_or(0);
-  rotation.angles = {prediction.alpha.value_or(0.0), prediction.theta.value_or(0.0), prediction.omega.value_or(0.0)};
-  rotation.phi_bc = prediction.phi_bc.value_or(0.0);
-  rotation.psi = prediction.psi.value_or(0.0);
-  if (prediction.first_pair_index) rotation.first_pair = *prediction.first_pair_index == 0 ? Pair::AB : Pair::BC;
-  for (std::size_t i = 0; i < 3; ++i) rotation.final_velocities[i] = prediction.final_velocities.at(i);
-  return rotation;
-}
-
-/// The three-body run's summary as every scene's: the engine simulated it (lab_run.h); its
-/// kept impacts move into the simulation.
-SceneSimulation fromThreeBody(RunResult&& run) {
-  const LabRunSummary& summary = run.summary;
-  SceneSimulation simulation;
-  simulation.simulated = summary.simulated;
-  simulation.impact_count = summary.collision_count;
-  simulation.truncated = summary.truncated;
-  simulation.stop = summary.stop;  // the engine's reason
-  if (!summary.simulated) {
-    simulation.stop_message = "answered by the closed form of three_body_rotation: nothing simulated";
-  } else if (summary.truncated) {
-    simulation.stop_message = summary.truncation_reason;
-  } else {
-    simulation.stop_message = "no pair approaches any more after " + std::to_string(summary.collision_count) +
-                              " impacts: the run is complete";
-  }
-  simulation.final_velocities.assign(summary.final_velocities.begin(), summary.final_velocities.end());
-  simulation.energy_lost = 0.0;  // elastic
-  simulation.energy_relative_drift = summary.energy_relative_drift;
-  simulation.momentum_relative_drift = summary.momentum_relative_drift;
-  // The rotation model predicts every impact: its error is the largest over them all.
-  if (summary.simulated) simulation.max_prediction_error = summary.max_prediction_error;
-  if (summary.simulated && !summary.truncated) {
-    simulation.matches_prediction = summary.collision_count == run.prediction.collision_count;
-  }
-  // The engine's replays: the summary counts the exact ones among those at 100 digits or more.
-  simulation.escalations.high_precision = summary.escalation.high_precision - summary.escalation.exact_rational;
-  simulation.escalations.exact_rational = summary.escalation.exact_rational;
-  simulation.impacts = std::move(run.events);
-  return simulation;
-}
-
 }  // namespace
 
 ScenePlan planScene(Scene scene) {
@@ -234,20 +178,7 @@ SceneRunResult runScene(const ScenePlan& plan, const SceneRunOptions& options, c
   SceneRunResult result;
   result.model = plan.model;
   result.prediction = plan.prediction;
-  if (plan.prediction && hasRotationValues(*plan.prediction)) {
-    RunOptions lab = options.lab;
-    if (!options.keep_events) lab.events = EventPolicy::none();
-    lab.skip_simulation_over_cap = !options.simulate_to_cap;
-    lab.cancel = options.cancel;
-    if (visitors.progress) {
-      lab.progress = visitors.progress;
-      lab.progress_interval = options.progress_interval;
-    }
-    result.simulation =
-        fromThreeBody(runLab(toThreeBodyScene(plan.scene), lab, rotationPrediction(*plan.prediction), visitors.impact));
-  } else {
-    result.simulation = simulateScene(plan.scene, options, result.prediction, visitors);
-  }
+  result.simulation = simulateScene(plan.scene, options, result.prediction, visitors);
   result.compute_time_s =
       plan.plan_time_s + std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;

@@ -47,8 +47,6 @@ std::string paperCountText(const core::Prediction& prediction) {
   return prediction.paper_impact_count ? std::to_string(*prediction.paper_impact_count) : std::string("undefined");
 }
 
-std::array<double, 3> array3Of(const std::vector<double>& values) { return {values.at(0), values.at(1), values.at(2)}; }
-
 /// The run's summary in the terms of the three-body reports: its prediction (with the
 /// rotation model's values) and simulation.
 struct ThreeBodySummary {
@@ -82,15 +80,15 @@ class TableWriter : public RunReportWriter {
  public:
   explicit TableWriter(std::ostream& out) : out_(out) {}
 
-  void begin(const NamedScene& named, const core::RunOptions& options) override {
+  void begin(const SceneEntry& named, const core::RunOptions& options) override {
     out_ << "collision_lab: " << (named.name.empty() ? "scene from the command line" : named.name);
     if (!named.description.empty()) out_ << " - " << named.description;
     out_ << "\n\n" << padRight("", 16);
     for (const char* name : kParticleNames) out_ << padLeft(name, kNumberWidth + 3);
     out_ << "\n";
-    writeSceneRow("mass [kg]", named.scene.masses);
-    writeSceneRow("position [m]", named.scene.positions);
-    writeSceneRow("velocity [m/s]", named.scene.velocities);
+    writeSceneRow("mass [kg]", core::triple(named.scene.masses));
+    writeSceneRow("position [m]", core::triple(named.scene.positions));
+    writeSceneRow("velocity [m/s]", core::triple(named.scene.velocities));
     out_ << "\nrun: mode " << runModeText(options.mode) << ", precision double"
          << ", events " << eventPolicyText(options.events) << ", at most " << options.max_collisions
          << " collisions\n";
@@ -191,7 +189,7 @@ class JsonWriter : public RunReportWriter {
  public:
   explicit JsonWriter(std::ostream& out) : out_(out), events_(out, report_text::writeEventJsonLine) {}
 
-  void begin(const NamedScene& named, const core::RunOptions& options) override {
+  void begin(const SceneEntry& named, const core::RunOptions& options) override {
     policy_ = options.events;
     out_ << "{\"scene\": " << jsonText(sceneJson(named)) << ",\n\"options\": " << jsonText(optionsJson(options))
          << ",\n\"units\": " << jsonText(unitsJson()) << ",\n\"events\": [";
@@ -256,9 +254,9 @@ class CsvWriter : public RunReportWriter {
  public:
   explicit CsvWriter(std::ostream& out) : out_(out), events_(out, writeEventCsv) {}
 
-  void begin(const NamedScene& named, const core::RunOptions& options) override {
+  void begin(const SceneEntry& named, const core::RunOptions& options) override {
     out_ << "# scene," << named.name << "\n";
-    const std::pair<const char*, const std::array<double, 3>*> vectors[] = {
+    const std::pair<const char*, const std::vector<double>*> vectors[] = {
         {"masses_kg", &named.scene.masses},
         {"positions_m", &named.scene.positions},
         {"velocities_m_s", &named.scene.velocities}};
@@ -341,16 +339,16 @@ Json unitsJson() {
               {"prediction_error", "energy norm |S (v_sim - v_pred)| / |S v0|, S = diag(sqrt m) (dimensionless)"}};
 }
 
-Json sceneJson(const NamedScene& named) {
+Json sceneJson(const SceneEntry& named) {
   Json walls = Json::array();
-  const int wall = named.scene.wallIndex();
+  const int wall = core::wallIndex(named.scene);
   if (wall >= 0) walls.push_back(kParticleNames[wall]);
   return Json{{"name", named.name},
               {"description", named.description},
-              {"masses", array3(named.scene.masses)},
+              {"masses", array3(core::triple(named.scene.masses))},
               {"walls", std::move(walls)},
-              {"positions", array3(named.scene.positions)},
-              {"velocities", array3(named.scene.velocities)}};
+              {"positions", array3(core::triple(named.scene.positions))},
+              {"velocities", array3(core::triple(named.scene.velocities))}};
 }
 
 Json optionsJson(const core::RunOptions& options) {
@@ -607,12 +605,12 @@ Json summaryJson(const core::SceneRunResult& result) {
               {"cancelled", summary.cancelled()},
               {"truncation_reason", summary.truncationReason()},
               {"simulated", s.simulated},
-              {"final_velocities", array3(array3Of(s.final_velocities))},
+              {"final_velocities", array3(core::triple(s.final_velocities))},
               {"predicted_collision_count", summary.predictedCount()},
               {"paper_predicted_collision_count", p.paper_impact_count ? Json(*p.paper_impact_count) : Json(nullptr)},
               {"max_possible_collision_count", p.max_possible_impact_count.value_or(0)},
               {"predicted_first_pair", optionalPair(summary.firstPair())},
-              {"predicted_final_velocities", array3(array3Of(p.final_velocities))},
+              {"predicted_final_velocities", array3(core::triple(p.final_velocities))},
               {"theta", number(p.theta.value_or(0.0))},
               {"alpha", number(p.alpha.value_or(0.0))},
               {"omega", number(p.omega.value_or(0.0))},

@@ -32,7 +32,7 @@ namespace io {
 class RunReportWriter {
  public:
   virtual ~RunReportWriter() = default;
-  virtual void begin(const NamedScene& scene, const core::RunOptions& options) = 0;
+  virtual void begin(const SceneEntry& scene, const core::RunOptions& options) = 0;
   virtual void event(const core::ImpactRecord& event) = 0;
   virtual void end(const core::SceneRunResult& result) = 0;
 };

@@ -177,16 +177,6 @@ std::vector<SceneEntry> loadScenes(const std::string& path) {
   return scenes;
 }
 
-NamedScene toNamedScene(const SceneEntry& entry) {
-  NamedScene named{entry.name, entry.description, {}, entry.max_collisions};
-  for (int i = 0; i < 3; ++i) {
-    named.scene.masses[i] = entry.scene.masses[i];
-    named.scene.positions[i] = entry.scene.positions[i];
-    named.scene.velocities[i] = entry.scene.velocities[i];
-  }
-  return named;
-}
-
 namespace {
 template <class Entry>
 Entry findByName(const std::vector<Entry>& scenes, const std::string& name) {

@@ -590,7 +590,7 @@ class ThreeBodyModelWriter : public RunReportWriter {
     }
   }
 
-  void begin(const NamedScene& scene, const core::RunOptions& options) override {
+  void begin(const SceneEntry& scene, const core::RunOptions& options) override {
     policy_ = options.events;
     if (format_ != ReportFormat::kJson) return inner_->begin(scene, options);
     out_ << "{\"scene\": " << jsonText(sceneJson(scene)) << ",\n\"options\": " << jsonText(optionsJson(options))
@@ -689,7 +689,7 @@ void writeSceneBatchJson(const std::vector<SceneBatchOutcome>& outcomes, std::os
     // A run whose prediction carries the rotation model's values has the three-body
     // report's scene and summary.
     const bool rotation = r.prediction && core::hasRotationValues(*r.prediction);
-    entry["scene"] = rotation ? sceneJson(toNamedScene(outcome.entry)) : sceneEntryJson(outcome.entry);
+    entry["scene"] = rotation ? sceneJson(outcome.entry) : sceneEntryJson(outcome.entry);
     entry["options"] = optionsJson(outcome.options);
     entry["events"] = Json::array();
     // The kept impacts, each collapse after the impact it follows (as the stream shows
@@ -783,7 +783,7 @@ class SceneReport : public SceneReportWriter {
              const std::optional<core::Prediction>& prediction) override {
     if (prediction && core::hasRotationValues(*prediction)) {
       rotation_ = std::make_unique<ThreeBodyModelWriter>(format_, out_, model);
-      rotation_->begin(toNamedScene(entry), options);
+      rotation_->begin(entry, options);
     } else {
       scene_ = makeSceneLayout(format_, out_);
       scene_->begin(entry, options, model);

@@ -79,10 +79,6 @@ std::array<double, 3> toArray(const std::vector<double>& values) {
   return result;
 }
 
-std::vector<double> toVector(const std::array<double, 3>& values) {
-  return {values.begin(), values.end()};
-}
-
 static_assert(collision_lab::InitialConditions::RESTITUTION_CONSTANT ==
                       static_cast<std::uint8_t>(core::RestitutionModelKind::kConstant) &&
                   collision_lab::InitialConditions::RESTITUTION_TC == static_cast<std::uint8_t>(core::RestitutionModelKind::kTc) &&
@@ -114,18 +110,6 @@ collision_lab::InitialConditions toInitialConditions(const core::Scene& scene, c
   msg.elastic_below = scene.restitution_model.elastic_below;
   msg.viscoelastic_speed = scene.restitution_model.viscoelastic_speed;
   msg.ring = scene.ring;
-  msg.max_collisions = max_collisions;
-  return msg;
-}
-
-collision_lab::InitialConditions toInitialConditions(const collision_lab::core::ThreeBodyScene& scene,
-                                                     collision_lab::core::RunMode mode,
-                                                     std::uint64_t max_collisions) {
-  collision_lab::InitialConditions msg;
-  msg.mode = static_cast<std::uint8_t>(mode);
-  msg.masses = toVector(scene.masses);
-  msg.positions = toVector(scene.positions);
-  msg.velocities = toVector(scene.velocities);
   msg.max_collisions = max_collisions;
   return msg;
 }

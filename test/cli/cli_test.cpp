@@ -132,7 +132,7 @@ TEST(CliJson, AgreesWithExactArithmetic) {
   for (const Case& c : cases) {
     SCOPED_TRACE(c.masses + " / " + c.positions + " / " + c.velocities);
     const Json doc = runJson({"--masses", c.masses, "--positions", c.positions, "--velocities", c.velocities});
-    collision_lab::core::ThreeBodyScene scene;
+    collision_lab::core::Scene scene = collision_lab::core::threeBodies();
     for (int i = 0; i < 3; ++i) {
       scene.masses[i] = doc.at("scene").at("masses")[i].is_null() ? std::numeric_limits<double>::infinity()
                                                                   : doc.at("scene").at("masses")[i].get<double>();

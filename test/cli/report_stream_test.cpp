@@ -17,7 +17,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "collision_lab/core/lab_run.h"
+#include "collision_lab/core/scene_run.h"
 #include "collision_lab/core/nbody/models.h"
 #include "collision_lab/core/scene_run.h"
 #include "collision_lab/io/report.h"
@@ -72,25 +72,18 @@ std::vector<double> csvRowValues(const core::ImpactRecord& impact) {
 }
 
 struct LabRun {
-  io::NamedScene named;
-  core::Scene result_scene;
+  io::SceneEntry entry;
   core::RunOptions options;
   core::SceneRunResult result;
   const std::vector<core::ImpactRecord>& events() const { return result.simulation.impacts; }
 };
 
-LabRun runScene(const core::ThreeBodyScene& scene) {
-  LabRun run{{"stream", "", scene},
-             {{scene.masses.begin(), scene.masses.end()},
-              {scene.positions.begin(), scene.positions.end()},
-              {scene.velocities.begin(), scene.velocities.end()},
-              {}},
-             {},
-             {}};
+LabRun runScene(const core::Scene& scene) {
+  LabRun run{{"stream", "", scene, 0}, {}, {}};
   run.options.events = core::EventPolicy::all();
   core::SceneRunOptions options;
   options.lab = run.options;
-  run.result = core::runScene(core::planScene(run.result_scene), options);
+  run.result = core::runScene(core::planScene(run.entry.scene), options);
   return run;
 }
 
@@ -99,14 +92,13 @@ LabRun runScene(const core::ThreeBodyScene& scene) {
 std::string report(const LabRun& run, io::ReportFormat format, bool with_model) {
   std::ostringstream out;
   if (with_model) {
-    const io::SceneEntry entry{run.named.name, run.named.description, run.result_scene, 0};
     const auto writer = io::makeSceneReportWriter(format, out);
-    writer->begin(entry, run.options, run.result.model, run.result.prediction);
+    writer->begin(run.entry, run.options, run.result.model, run.result.prediction);
     for (const core::ImpactRecord& event : run.events()) writer->impact(event);
     writer->end(run.result);
   } else {
     const auto writer = io::makeRunReportWriter(format, out);
-    writer->begin(run.named, run.options);
+    writer->begin(run.entry, run.options);
     for (const core::ImpactRecord& event : run.events()) writer->event(event);
     writer->end(run.result);
   }

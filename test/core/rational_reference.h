@@ -46,7 +46,7 @@ inline Wide toWide(const Q& q) {
 }
 
 /// The textbook impact rule for the pair of left body i and right body i + 1.
-inline void applyImpact(const ThreeBodyScene& scene, int i, std::array<Q, 3>& v) {
+inline void applyImpact(const Scene& scene, int i, std::array<Q, 3>& v) {
   const double m_l = scene.masses[i], m_r = scene.masses[i + 1];
   const Q v_l = v[i], v_r = v[i + 1];
   if (std::isinf(m_l)) {
@@ -61,7 +61,7 @@ inline void applyImpact(const ThreeBodyScene& scene, int i, std::array<Q, 3>& v)
 }
 
 /// The run of `scene`, at most `max_impacts` impacts. Throws on a triple collision.
-inline Run simulate(const ThreeBodyScene& scene, std::size_t max_impacts) {
+inline Run simulate(const Scene& scene, std::size_t max_impacts) {
   std::array<Q, 3> x, v;
   for (int i = 0; i < 3; ++i) {
     x[i] = Q(scene.positions[i]);
@@ -97,7 +97,7 @@ inline Run simulate(const ThreeBodyScene& scene, std::size_t max_impacts) {
 /// only when both pairs approach, which the exact positions of the start settle; after an
 /// impact its pair separates, so at most one pair approaches: checked at every step (throws
 /// otherwise), not assumed.
-inline Run simulateVelocities(const ThreeBodyScene& scene, std::size_t max_impacts) {
+inline Run simulateVelocities(const Scene& scene, std::size_t max_impacts) {
   std::array<Q, 3> v;
   for (int i = 0; i < 3; ++i) v[i] = Q(scene.velocities[i]);
   Run run;

@@ -19,12 +19,12 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 /// A valid random scene: masses within 10^(+-decades), about one in six with a wall,
 /// positions in order, velocities in [-1, 1]. Deterministic for a given generator.
 /// Wider mass ranges mean longer runs and much larger exact rationals.
-inline ThreeBodyScene randomScene(std::mt19937_64& rng, double decades_each_way = 1.0) {
+inline Scene randomScene(std::mt19937_64& rng, double decades_each_way = 1.0) {
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   std::uniform_real_distribution<double> decades(-decades_each_way, decades_each_way);
   std::uniform_int_distribution<int> wall_choice(0, 11);
   while (true) {
-    ThreeBodyScene scene;
+    Scene scene = threeBodies();
     for (double& m : scene.masses) m = std::pow(10.0, decades(rng));
     const int wall = wall_choice(rng);
     if (wall == 0) scene.masses[kA] = kInf;
@@ -38,13 +38,13 @@ inline ThreeBodyScene randomScene(std::mt19937_64& rng, double decades_each_way 
 /// |S (v - exact)| / |S v0| with S = diag(sqrt(m)) in the wall's frame: the scale-free
 /// norm in which every impact is an isometry.
 /// `reference` holds exact velocities (e.g. from rational_reference.h).
-inline double energyNormError(const ThreeBodyScene& scene, const std::array<double, 3>& v,
+inline double energyNormError(const Scene& scene, const std::array<double, 3>& v,
                               const std::array<boost::multiprecision::cpp_rational, 3>& reference) {
   double mass_max = 0.0;
   for (int i = 0; i < 3; ++i) {
     if (!scene.isWall(i)) mass_max = std::max(mass_max, scene.masses[i]);
   }
-  const int wall = scene.wallIndex();
+  const int wall = wallIndex(scene);
   const double frame = wall >= 0 ? scene.velocities[wall] : 0.0;
   double error_sq = 0.0, norm_sq = 0.0;
   for (int i = 0; i < 3; ++i) {

@@ -8,7 +8,7 @@
 #include <random>
 
 #include "collision_lab/core/analytic.h"
-#include "collision_lab/core/lab_run.h"
+#include "collision_lab/core/scene_run.h"
 #include "rational_reference.h"
 #include "scenes.h"
 #include "simulated_run.h"
@@ -40,7 +40,7 @@ TEST(Matrices, EigenSolverAgreesWithClosedFormEigenvalues) {
     for (const auto& lambda : check.eigen_solver) EXPECT_NEAR(std::abs(lambda), 1.0, 1e-12);
   }
   // D = D_BC D_AB equals the paper's explicit matrix (1.8), which is correct.
-  const ThreeBodyScene scene{{1, 2, 3}, {2, 1, 0}, {-1, 0, 1}};
+  const Scene scene{{1, 2, 3}, {2, 1, 0}, {-1, 0, 1}};
   const AnalyticModel<double> model(scene);
   const double m_a = 1, m_b = 2, m_c = 3, m_ab = 3, m_bc = 5;
   Eigen::Matrix3d paper;
@@ -53,7 +53,7 @@ TEST(Matrices, EigenSolverAgreesWithClosedFormEigenvalues) {
 TEST(ClosedForm, MatchesExactStateAfterEveryCollision) {
   std::mt19937_64 rng(99);
   for (int i = 0; i < 200; ++i) {
-    const ThreeBodyScene scene = randomScene(rng);
+    const Scene scene = randomScene(rng);
     const reference::Run reference = reference::simulate(scene, 100000);
     ASSERT_FALSE(reference.truncated);
     const AnalyticModel<double> model(scene);
@@ -69,10 +69,10 @@ TEST(ClosedForm, MatchesExactStateAfterEveryCollision) {
 }
 
 TEST(ClosedForm, AgreesWithSimulationUpToAMillionCollisions) {
-  const ThreeBodyScene scene{{2e11, 1, 3e11}, {2, 1, 0}, {-1, 0.5, 0.2}};
+  const Scene scene{{2e11, 1, 3e11}, {2, 1, 0}, {-1, 0.5, 0.2}};
   double worst = 0.0;
   const AnalyticModel<long double> model(scene);
-  const LabRunSummary result = testing_support::simulateThreeBodies(scene, EventPolicy::none(), 10'000'000, [&](const testing_support::ThreeBodyImpact& e) {
+  const SceneSimulation result = testing_support::simulateThreeBodies(scene, EventPolicy::none(), 10'000'000, [&](const testing_support::ThreeBodyImpact& e) {
     if (e.index % 997 != 0) return;
     const auto predicted = model.velocitiesAfter(e.index);
     const std::array<reference::Q, 3> p{reference::Q(static_cast<double>(predicted(0))),
@@ -80,15 +80,15 @@ TEST(ClosedForm, AgreesWithSimulationUpToAMillionCollisions) {
                                         reference::Q(static_cast<double>(predicted(2)))};
     worst = std::max(worst, energyNormError(scene, e.velocities_after, p));
   }).summary;
-  EXPECT_GT(result.collision_count, 500000u);
-  EXPECT_LT(result.collision_count, 1500000u);
-  EXPECT_EQ(predictedCollisionCount(scene), result.collision_count);
+  EXPECT_GT(result.impact_count, 500000u);
+  EXPECT_LT(result.impact_count, 1500000u);
+  EXPECT_EQ(predictedCollisionCount(scene), result.impact_count);
   EXPECT_LE(worst, 1e-11);
 }
 
 TEST(Count, PiBilliardByClosedForm) {
   // m_A / m_B = 100^8 with a wall: the first nine digits of pi.
-  const ThreeBodyScene scene{{1e16, 1, kInf}, {2, 1, 0}, {-1, 0, 0}};
+  const Scene scene{{1e16, 1, kInf}, {2, 1, 0}, {-1, 0, 0}};
   EXPECT_EQ(predictedCollisionCount(scene), 314159265u);
   EXPECT_EQ(maxPossibleCollisionCount({1e2, 1, kInf}), 32u);
 }
@@ -105,12 +105,12 @@ TEST(Count, MaxPossibleIsExactForKaleidoscopicMasses) {
   EXPECT_EQ(maxPossibleCollisionCount({1e12, 1, 1e12}), 2221442u);
   // A heavy B: alpha -> pi/2, pi/alpha exceeds 2 by ~1e-60; 3 collisions are possible.
   EXPECT_EQ(maxPossibleCollisionCount({1, 1e60, 1}), 3u);
-  EXPECT_EQ(predictedCollisionCount(ThreeBodyScene{{1, 1e60, 1}, {1e80, 1, 0}, {-1e61, 0, 1}}), 3u);
+  EXPECT_EQ(predictedCollisionCount(Scene{{1, 1e60, 1}, {1e80, 1, 0}, {-1e61, 0, 1}}), 3u);
   // No start exceeds the bound.
   std::mt19937_64 rng(3);
   for (int i = 0; i < 300; ++i) {
-    const ThreeBodyScene scene = randomScene(rng);
-    EXPECT_LE(predictedCollisionCount(scene), maxPossibleCollisionCount(scene.masses));
+    const Scene scene = randomScene(rng);
+    EXPECT_LE(predictedCollisionCount(scene), maxPossibleCollisionCount(triple(scene.masses)));
   }
 }
 
@@ -119,7 +119,7 @@ TEST(Count, MaxPossibleIsExactForKaleidoscopicMasses) {
 /// r_BC = s x n_BC and r_AB = s x n_AB (oriented into the cone), psi the angle of u from r_BC
 /// towards r_AB, alpha the cone's opening angle, N = ceil(psi / alpha) - 1 (AB first).
 /// Preconditions: finite masses, only AB approaches (so AB is first).
-std::uint64_t countFromFirstPrinciples(const ThreeBodyScene& scene) {
+std::uint64_t countFromFirstPrinciples(const Scene& scene) {
   using Precise = boost::multiprecision::cpp_bin_float_100;
   using Vec = std::array<Precise, 3>;
   const auto dot = [](const Vec& a, const Vec& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; };
@@ -155,33 +155,33 @@ TEST(Count, ExactUpToMassRatio1e20) {
   for (double ratio : {1e12, 1e14, 1e16, 1e18, 1e20}) {
     // Both starts have only AB approaching, and q = psi / alpha far from an integer.
     for (const auto& v : {std::array<double, 3>{-1, 0, 0}, std::array<double, 3>{-1, 0.3, 0.2}}) {
-      const ThreeBodyScene scene{{ratio, 1, 0.5 * ratio}, {2, 1, 0}, v};
+      const Scene scene = threeBodies({ratio, 1, 0.5 * ratio}, {2, 1, 0}, v);
       EXPECT_EQ(predictedCollisionCount(scene), countFromFirstPrinciples(scene)) << ratio;
     }
   }
   // The reference itself against known counts: equal masses exchange velocities, so
   // (-1, 0.3, 0.2) gives 2 by hand (AB, then BC, then (0.3, 0.2, -1) separates), and
   // (1e12, 1, 1e12) from (-1, 0, 0) gives physics.md's 2,221,441.
-  EXPECT_EQ(countFromFirstPrinciples(ThreeBodyScene{{1, 1, 1}, {2, 1, 0}, {-1, 0.3, 0.2}}), 2u);
-  EXPECT_EQ(countFromFirstPrinciples(ThreeBodyScene{{1e12, 1, 1e12}, {2, 1, 0}, {-1, 0, 0}}), 2221441u);
-  const ThreeBodyScene simulated{{1e12, 1, 0.5e12}, {2, 1, 0}, {-1, 0, 0}};
-  EXPECT_EQ(predictedCollisionCount(simulated), testing_support::simulateThreeBodies(simulated).summary.collision_count);
+  EXPECT_EQ(countFromFirstPrinciples(Scene{{1, 1, 1}, {2, 1, 0}, {-1, 0.3, 0.2}}), 2u);
+  EXPECT_EQ(countFromFirstPrinciples(Scene{{1e12, 1, 1e12}, {2, 1, 0}, {-1, 0, 0}}), 2221441u);
+  const Scene simulated{{1e12, 1, 0.5e12}, {2, 1, 0}, {-1, 0, 0}};
+  EXPECT_EQ(predictedCollisionCount(simulated), testing_support::simulateThreeBodies(simulated).summary.impact_count);
 }
 
 TEST(Count, FloorExceptWhenPsiOverAlphaIsAnInteger) {
   // (3, 1, 0.5) from (-1, 0, 0): q = 3 exactly, the third contact grazes, N = 2.
-  const ThreeBodyScene grazing{{3, 1, 0.5}, {2, 1, 0}, {-1, 0, 0}};
+  const Scene grazing{{3, 1, 0.5}, {2, 1, 0}, {-1, 0, 0}};
   const AnalyticModel<double> model(grazing);
   EXPECT_NEAR(model.psi() / model.alpha(), 3.0, 1e-12);
   EXPECT_EQ(predictedCollisionCount(grazing), 2u);
   // Equal masses, (-1, 0, 1), AB first: 3 collisions (the paper's formula says even).
-  EXPECT_EQ(predictedCollisionCount(ThreeBodyScene{{1, 1, 1}, {3, 2, 0}, {-1, 0, 1}}), 3u);
+  EXPECT_EQ(predictedCollisionCount(Scene{{1, 1, 1}, {3, 2, 0}, {-1, 0, 1}}), 3u);
 }
 
 TEST(Inverse, RoundTripRecoversInitialVelocities) {
   std::mt19937_64 rng(11);
   for (int i = 0; i < 300; ++i) {
-    const ThreeBodyScene scene = randomScene(rng);
+    const Scene scene = randomScene(rng);
     const AnalyticModel<double> model(scene);
     const std::uint64_t count = predictedCollisionCount(scene);
     for (std::uint64_t n : {std::uint64_t{0}, std::uint64_t{1}, count / 2, count}) {
@@ -195,11 +195,11 @@ TEST(Inverse, RoundTripRecoversInitialVelocities) {
 
 TEST(EnergyTransfer, FiniteAtTheEdgesOfTheDoubleRange) {
   // Found by the fuzzer: intermediate products overflowed though the energies do not.
-  const ThreeBodyScene tiny_masses{{2.6895203214236869e-306, 1.7765824089018436e-307, 1.7765824089018436e-307},
+  const Scene tiny_masses{{2.6895203214236869e-306, 1.7765824089018436e-307, 1.7765824089018436e-307},
                           {1.7800590868057611e-307, 1.7765824089018436e-307, 0},
                           {5.1294921942786796e-305, -5.4861240687936887e+303, 1}};
-  const ThreeBodyScene huge_mass{{kInf, 1.7e308, 1.7e308}, {5, 1, 0}, {0, 0, 1e-10}};
-  for (const ThreeBodyScene& scene : {tiny_masses, huge_mass}) {
+  const Scene huge_mass{{kInf, 1.7e308, 1.7e308}, {5, 1, 0}, {0, 0, 1e-10}};
+  for (const Scene& scene : {tiny_masses, huge_mass}) {
     ASSERT_FALSE(validate(scene));
     const AnalyticModel<double> model(scene);
     for (std::uint64_t n = 1; n <= 3; ++n) {
@@ -211,7 +211,7 @@ TEST(EnergyTransfer, FiniteAtTheEdgesOfTheDoubleRange) {
 TEST(EnergyTransfer, ClosedFormMatchesSimulatedEvents) {
   std::mt19937_64 rng(5);
   for (int i = 0; i < 100; ++i) {
-    const ThreeBodyScene scene = randomScene(rng);
+    const Scene scene = randomScene(rng);
     const AnalyticModel<double> model(scene);
     double energy = 0.0;
     for (int j = 0; j < 3; ++j) {

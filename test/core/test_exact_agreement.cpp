@@ -1,4 +1,4 @@
-// The three-body run (runLab: the event engine) against exact rational arithmetic on the same doubles: the
+// The three-body run (planScene and runScene: the event engine) against exact rational arithmetic on the same doubles: the
 // independent reference of rational_reference.h, which shares no code with core::exact.
 // core::exact (the engine's own exact fallback) is tested against that reference too.
 #include <gtest/gtest.h>
@@ -11,7 +11,7 @@
 
 #include "collision_lab/core/analytic.h"
 #include "collision_lab/core/exact.h"
-#include "collision_lab/core/lab_run.h"
+#include "collision_lab/core/scene_run.h"
 #include "rational_reference.h"
 #include "scenes.h"
 #include "simulated_run.h"
@@ -35,7 +35,7 @@ struct Truth {
 };
 
 /// `with_positions` false: velocities only (reference::simulateVelocities), for long runs.
-Truth truth(const ThreeBodyScene& scene, bool with_positions = true) {
+Truth truth(const Scene& scene, bool with_positions = true) {
   const reference::Run run = with_positions ? reference::simulate(scene, 100000)
                                             : reference::simulateVelocities(scene, 100000);
   EXPECT_FALSE(run.truncated);
@@ -48,31 +48,31 @@ Truth truth(const ThreeBodyScene& scene, bool with_positions = true) {
 }
 
 struct Observed {
-  LabRunSummary result;
+  testing_support::SimulatedRun result;
   std::vector<Pair> pairs;
 };
 
 /// The run with every impact visited (the engine's decisions).
-Observed run(const ThreeBodyScene& scene, std::uint64_t max_collisions = 10'000'000) {
+Observed run(const Scene& scene, std::uint64_t max_collisions = 10'000'000) {
   Observed observed;
   observed.result = simulateThreeBodies(scene, EventPolicy::none(), max_collisions, [&](const testing_support::ThreeBodyImpact& e) {
                       observed.pairs.push_back(e.pair);
-                    }).summary;
+                    });
   return observed;
 }
 
 /// The count-only run: no event published.
-LabRunSummary countOnly(const ThreeBodyScene& scene) { return simulateThreeBodies(scene).summary; }
+testing_support::SimulatedRun countOnly(const Scene& scene) { return simulateThreeBodies(scene); }
 
-void expectMatchesExact(const ThreeBodyScene& scene, double tolerance = 1e-13, bool with_positions = true) {
+void expectMatchesExact(const Scene& scene, double tolerance = 1e-13, bool with_positions = true) {
   const Truth reference = truth(scene, with_positions);
   const Observed observed = run(scene);
-  EXPECT_EQ(observed.result.collision_count, reference.collision_count);
+  EXPECT_EQ(observed.result.summary.impact_count, reference.collision_count);
   EXPECT_EQ(observed.pairs, reference.pairs);
   EXPECT_EQ(observed.pairs.empty() ? std::nullopt : std::optional<Pair>(observed.pairs.front()), reference.first_pair);
   EXPECT_LE(energyNormError(scene, observed.result.final_velocities, reference.final_velocities), tolerance);
   // Count-only mode must agree too.
-  EXPECT_EQ(countOnly(scene).collision_count, reference.collision_count);
+  EXPECT_EQ(countOnly(scene).summary.impact_count, reference.collision_count);
   EXPECT_EQ(predictedCollisionCount(scene), reference.collision_count);
 }
 
@@ -80,13 +80,13 @@ TEST(ExactAgreement, ThousandSeededRandomScenes) {
   std::mt19937_64 rng(20261122);
   int with_collisions = 0, bc_first = 0, walls = 0;
   for (int i = 0; i < 1000; ++i) {
-    const ThreeBodyScene scene = randomScene(rng);
+    const Scene scene = randomScene(rng);
     SCOPED_TRACE(::testing::Message() << "scene " << i);
     expectMatchesExact(scene, 1e-12);
     const auto first = firstPair(scene);
     with_collisions += first.has_value();
     bc_first += first == Pair::BC;
-    walls += scene.wallIndex() >= 0;
+    walls += wallIndex(scene) >= 0;
   }
   // The sample really covers the branches.
   EXPECT_GT(with_collisions, 500);
@@ -99,7 +99,7 @@ TEST(ExactAgreement, ThousandSeededRandomScenes) {
 TEST(ExactAgreement, CoreExactEqualsTheIndependentReference) {
   std::mt19937_64 rng(20261126);
   for (int i = 0; i < 300; ++i) {
-    const ThreeBodyScene scene = randomScene(rng, i < 250 ? 1.0 : 2.5);
+    const Scene scene = randomScene(rng, i < 250 ? 1.0 : 2.5);
     SCOPED_TRACE(::testing::Message() << "scene " << i);
     const exact::Run run = exact::simulate(scene, 100000);
     const Truth reference = truth(scene);
@@ -119,7 +119,7 @@ TEST(ExactAgreement, CoreExactEqualsTheIndependentReference) {
 TEST(ExactAgreement, WideMassRatiosWithLongerRuns) {
   std::mt19937_64 rng(31);
   for (int i = 0; i < 25; ++i) {
-    const ThreeBodyScene scene = randomScene(rng, 2.5);
+    const Scene scene = randomScene(rng, 2.5);
     SCOPED_TRACE(::testing::Message() << "scene " << i);
     // Exact positions over these runs would take seconds; the velocities decide the pairs.
     expectMatchesExact(scene, 1e-12, false);
@@ -131,27 +131,23 @@ TEST(ExactAgreement, KaleidoscopicMassesGrazeAtTheEnd) {
   const std::vector<std::pair<std::array<double, 3>, std::uint64_t>> cases = {
       {{1, 1, 1}, 2}, {{2, 1, 3}, 3}, {{5, 1, 9}, 5}};
   for (const auto& [masses, expected] : cases) {
-    const ThreeBodyScene scene{masses, {2, 1, 0}, {-1, 0, 0}};
-    EXPECT_EQ(run(scene).result.collision_count, expected);
+    const Scene scene = threeBodies(masses, {2, 1, 0}, {-1, 0, 0});
+    EXPECT_EQ(run(scene).result.summary.impact_count, expected);
     EXPECT_EQ(predictedCollisionCount(scene), expected);
     expectMatchesExact(scene);
   }
 }
 
 TEST(ExactAgreement, GrazingEndsWithEqualVelocities) {
-  const ThreeBodyScene scene{{3, 1, 0.5}, {2, 1, 0}, {-1, 0, 0}};
+  const Scene scene{{3, 1, 0.5}, {2, 1, 0}, {-1, 0, 0}};
   const Observed observed = run(scene);
-  EXPECT_EQ(observed.result.collision_count, 2u);
+  EXPECT_EQ(observed.result.summary.impact_count, 2u);
   const auto& v = observed.result.final_velocities;
   EXPECT_EQ(v[kA], v[kB]);  // exactly
   // The summary comes from the known count, which needs no decision; the engine, which
   // publishes the events, decides the grazing contact in exact rationals.
-  EXPECT_EQ(observed.result.escalation.exact_rational, 0u);
-  Scene engine_scene;
-  engine_scene.masses.assign(scene.masses.begin(), scene.masses.end());
-  engine_scene.positions.assign(scene.positions.begin(), scene.positions.end());
-  engine_scene.velocities.assign(scene.velocities.begin(), scene.velocities.end());
-  const EngineResult engine = runEngine(engine_scene);
+  EXPECT_EQ(observed.result.summary.escalations.exact_rational, 0u);
+  const EngineResult engine = runEngine(scene);
   EXPECT_GE(engine.escalations.exact_rational, 1u);
   EXPECT_EQ(engine.final_velocities[kA], engine.final_velocities[kB]);  // it adopted the exact state
   expectMatchesExact(scene);
@@ -164,7 +160,7 @@ TEST(ExactAgreement, NearTripleCollisionsPickTheExactFirstPair) {
     double x_a = 1.0;
     for (int i = 0; i < std::abs(ulps); ++i) x_a = std::nextafter(x_a, ulps > 0 ? 2.0 : 0.0);
     for (const auto& masses : {std::array<double, 3>{1, 1, 1}, std::array<double, 3>{3, 1, 7}}) {
-      const ThreeBodyScene scene{masses, {x_a, 0.0, -1.0}, {-1.0, 0.0, 1.0}};
+      const Scene scene = threeBodies(masses, {x_a, 0.0, -1.0}, {-1.0, 0.0, 1.0});
       ASSERT_FALSE(validate(scene));
       const Pair expected = ulps > 0 ? Pair::BC : Pair::AB;
       EXPECT_EQ(firstPair(scene), expected) << ulps;
@@ -172,7 +168,7 @@ TEST(ExactAgreement, NearTripleCollisionsPickTheExactFirstPair) {
     }
   }
   // Products that round to equal in double but differ exactly.
-  const ThreeBodyScene rounded{{1, 2, 3}, {0.3, 0.2, 0.1}, {-0.1, 0.0, 0.1}};
+  const Scene rounded{{1, 2, 3}, {0.3, 0.2, 0.1}, {-0.1, 0.0, 0.1}};
   ASSERT_FALSE(validate(rounded));
   const reference::Run first = reference::simulate(rounded, 1);
   ASSERT_EQ(first.impacts.size(), 1u);
@@ -182,16 +178,16 @@ TEST(ExactAgreement, NearTripleCollisionsPickTheExactFirstPair) {
 
 TEST(ExactAgreement, ExtremeScalesDoNotOverflow) {
   for (double scale : {1e-150, 1e150}) {
-    const ThreeBodyScene masses_scaled{{2 * scale, scale, 3 * scale}, {2, 1, 0}, {-1, 0.25, 1}};
+    const Scene masses_scaled{{2 * scale, scale, 3 * scale}, {2, 1, 0}, {-1, 0.25, 1}};
     expectMatchesExact(masses_scaled);
-    const ThreeBodyScene speeds_scaled{{2, 1, 3}, {2 * scale, scale, 0}, {-scale, 0.25 * scale, scale}};
+    const Scene speeds_scaled{{2, 1, 3}, {2 * scale, scale, 0}, {-scale, 0.25 * scale, scale}};
     expectMatchesExact(speeds_scaled);
   }
 }
 
 TEST(ExactAgreement, SubnormalVelocityDifferences) {
   // Found by the fuzzer: rounding is not relative down here.
-  const ThreeBodyScene scene{{1, 2, 0.26542376078465163}, {3e-16, 2e-16, 1.5e-16}, {-5e-324, 0, 5e-324}};
+  const Scene scene{{1, 2, 0.26542376078465163}, {3e-16, 2e-16, 1.5e-16}, {-5e-324, 0, 5e-324}};
   ASSERT_FALSE(validate(scene));
   expectMatchesExact(scene);
 }
@@ -201,26 +197,26 @@ TEST(ExactAgreement, AFeatherweightCarriesAllTheRelativeMotion) {
   // relative motion, below the rounding of the centre-of-mass velocity in double (and,
   // at 1e-99, in 50 digits too).
   for (double light : {1e-30, 1e-90, 1e-99}) {
-    const ThreeBodyScene scene{{5, 1, light}, {2, 1, 0}, {-0.1, -0.1, 0}};
+    const Scene scene{{5, 1, light}, {2, 1, 0}, {-0.1, -0.1, 0}};
     ASSERT_FALSE(validate(scene));
     expectMatchesExact(scene);
   }
 }
 
 TEST(ExactAgreement, WallsMovingAndResting) {
-  expectMatchesExact(ThreeBodyScene{{kInf, 1, 3}, {2, 1, 0}, {0.25, 0, 1}});
-  expectMatchesExact(ThreeBodyScene{{3, 1, kInf}, {2, 1, 0}, {-1, 0.5, -0.125}});
+  expectMatchesExact(Scene{{kInf, 1, 3}, {2, 1, 0}, {0.25, 0, 1}});
+  expectMatchesExact(Scene{{3, 1, kInf}, {2, 1, 0}, {-1, 0.5, -0.125}});
 }
 
 TEST(Conservation, EnergyAndMomentumOverLongRuns) {
-  for (const ThreeBodyScene& scene : {ThreeBodyScene{{1e6, 1, 1e6}, {2, 1, 0}, {-1, 0, 0}}, ThreeBodyScene{{1e8, 3, 1e9}, {2, 1, 0}, {-1, 0.5, 0.25}}}) {
-    const LabRunSummary result = countOnly(scene);
-    EXPECT_GT(result.collision_count, 1000u);
-    EXPECT_LE(result.energy_relative_drift, 1e-12);
-    EXPECT_LE(result.momentum_relative_drift, 1e-12);
+  for (const Scene& scene : {Scene{{1e6, 1, 1e6}, {2, 1, 0}, {-1, 0, 0}}, Scene{{1e8, 3, 1e9}, {2, 1, 0}, {-1, 0.5, 0.25}}}) {
+    const testing_support::SimulatedRun result = countOnly(scene);
+    EXPECT_GT(result.summary.impact_count, 1000u);
+    EXPECT_LE(result.summary.energy_relative_drift, 1e-12);
+    EXPECT_LE(result.summary.momentum_relative_drift, 1e-12);
   }
   // Every event's running totals stay on the initial values.
-  const ThreeBodyScene scene{{1, 2, 3}, {2, 1, 0}, {-1, 0.3, 0.7}};
+  const Scene scene{{1, 2, 3}, {2, 1, 0}, {-1, 0.3, 0.7}};
   const double energy = 0.5 * (1 * 1 + 2 * 0.09 + 3 * 0.49);
   const double momentum = -1 + 2 * 0.3 + 3 * 0.7;
   const SimulatedRun result = simulateThreeBodies(scene, EventPolicy::all());
@@ -233,11 +229,11 @@ TEST(Conservation, EnergyAndMomentumOverLongRuns) {
 }
 
 TEST(Events, PoliciesCapsAndTimes) {
-  const ThreeBodyScene scene{{100, 1, kInf}, {3, 2, 0}, {-1, 0, 0}};
+  const Scene scene{{100, 1, kInf}, {3, 2, 0}, {-1, 0, 0}};
   std::uint64_t visited = 0;
   const SimulatedRun first5 =
       simulateThreeBodies(scene, EventPolicy::firstN(5), 10'000'000, [&](const testing_support::ThreeBodyImpact&) { ++visited; });
-  EXPECT_EQ(first5.summary.collision_count, 31u);
+  EXPECT_EQ(first5.summary.impact_count, 31u);
   EXPECT_EQ(visited, 31u);
   ASSERT_EQ(first5.events.size(), 5u);
   // First impact: A (x = 3, v = -1) reaches B (x = 2, at rest) at t = 1, x = 2.
@@ -250,7 +246,7 @@ TEST(Events, PoliciesCapsAndTimes) {
 
   const SimulatedRun capped = simulateThreeBodies(scene, EventPolicy::none(), 10);
   EXPECT_TRUE(capped.summary.truncated);
-  EXPECT_EQ(capped.summary.collision_count, 10u);
+  EXPECT_EQ(capped.summary.impact_count, 10u);
   EXPECT_TRUE(capped.events.empty());
   // Exactly the count is not truncation.
   EXPECT_FALSE(simulateThreeBodies(scene, EventPolicy::none(), 31).summary.truncated);
@@ -259,17 +255,17 @@ TEST(Events, PoliciesCapsAndTimes) {
 TEST(PiDigits, BySimulation) {
   const std::vector<std::pair<double, std::uint64_t>> digits = {{1e2, 31}, {1e4, 314}, {1e6, 3141}, {1e8, 31415}};
   for (const auto& [ratio, expected] : digits) {
-    const ThreeBodyScene scene{{ratio, 1, kInf}, {2, 1, 0}, {-1, 0, 0}};
-    EXPECT_EQ(countOnly(scene).collision_count, expected);
+    const Scene scene{{ratio, 1, kInf}, {2, 1, 0}, {-1, 0, 0}};
+    EXPECT_EQ(countOnly(scene).summary.impact_count, expected);
     EXPECT_EQ(predictedCollisionCount(scene), expected);
   }
-  const ThreeBodyScene small{{1e4, 1, kInf}, {2, 1, 0}, {-1, 0, 0}};
+  const Scene small{{1e4, 1, kInf}, {2, 1, 0}, {-1, 0, 0}};
   expectMatchesExact(small);
   // 3141 impacts with a light body 1000 times faster at its peak than at the end.
-  const ThreeBodyScene pi_1e6{{1e6, 1, kInf}, {2, 1, 0}, {-1, 0, 0}};
+  const Scene pi_1e6{{1e6, 1, kInf}, {2, 1, 0}, {-1, 0, 0}};
   const AnalyticModel<HighPrecision> closed_form(pi_1e6);  // 50 digits
   const auto exact = closed_form.velocitiesAfter(3141);
-  const LabRunSummary fast = countOnly(pi_1e6);
+  const testing_support::SimulatedRun fast = countOnly(pi_1e6);
   for (int i = 0; i < 3; ++i) EXPECT_NEAR(fast.final_velocities[i], static_cast<double>(exact(i)), 1e-12) << i;
 }
 
@@ -283,7 +279,7 @@ struct FiftyDigitRun {
   std::array<double, 3> final_velocities{};
 };
 
-FiftyDigitRun fiftyDigitLoop(const ThreeBodyScene& scene) {
+FiftyDigitRun fiftyDigitLoop(const Scene& scene) {
   using Fifty = boost::multiprecision::cpp_bin_float_50;
   std::array<Fifty, 3> m, v;
   for (int i = 0; i < 3; ++i) {
@@ -308,17 +304,17 @@ FiftyDigitRun fiftyDigitLoop(const ThreeBodyScene& scene) {
 }
 
 TEST(HeavyLightHeavy, MillionsOfCollisionsStayAccurate) {
-  const ThreeBodyScene scene{{1e12, 1, 1e12}, {2, 1, 0}, {-1, 0, 0}};
-  const LabRunSummary fast = countOnly(scene);
+  const Scene scene{{1e12, 1, 1e12}, {2, 1, 0}, {-1, 0, 0}};
+  const testing_support::SimulatedRun fast = countOnly(scene);
   const FiftyDigitRun reference = fiftyDigitLoop(scene);
   EXPECT_EQ(reference.count, 2221441u);  // physics.md, hard cases
-  EXPECT_EQ(fast.collision_count, reference.count);
+  EXPECT_EQ(fast.summary.impact_count, reference.count);
   std::array<reference::Q, 3> reference_state;
   for (int i = 0; i < 3; ++i) reference_state[i] = reference::Q(reference.final_velocities[i]);
   EXPECT_LE(energyNormError(scene, fast.final_velocities, reference_state), 1e-12);
   // Each component too, the light body's included, although it peaks at ~1e6 m/s.
   for (int i = 0; i < 3; ++i) EXPECT_NEAR(fast.final_velocities[i], reference.final_velocities[i], 1e-12) << i;
-  EXPECT_LE(fast.energy_relative_drift, 1e-12);
+  EXPECT_LE(fast.summary.energy_relative_drift, 1e-12);
 }
 
 }  // namespace

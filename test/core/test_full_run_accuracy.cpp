@@ -17,8 +17,10 @@
 #include <string>
 #include <vector>
 
-#include "collision_lab/core/lab_run.h"
+#include "collision_lab/core/analytic.h"
+#include "collision_lab/core/scene_run.h"
 #include "rational_reference.h"
+#include "simulated_run.h"
 
 namespace collision_lab {
 namespace core {
@@ -31,7 +33,7 @@ using Dec = boost::multiprecision::cpp_dec_float_50;
 /// v_2k+1 = D_AB v_2k, with theta = 2 atan(sqrt(m_B M / (m_A m_C))), w = S (v_0 - V 1).
 class FiftyDigitClosedForm {
  public:
-  explicit FiftyDigitClosedForm(const ThreeBodyScene& scene) {
+  explicit FiftyDigitClosedForm(const Scene& scene) {
     Dec mass_sum = 0, momentum = 0, s_norm_sq = 0;
     for (int i = 0; i < 3; ++i) {
       m_[i] = Dec(scene.masses[i]);
@@ -79,11 +81,11 @@ class FiftyDigitClosedForm {
   Dec centre_, theta_, start_norm_sq_;  // |S v_0|^2, in the lab frame as the lab's own measure
 };
 
-const ThreeBodyScene kHeavyLightHeavy{{1e14, 1, 1e14}, {2, 1, 0}, {-1, 0, 0}};
+const Scene kHeavyLightHeavy{{1e14, 1, 1e14}, {2, 1, 0}, {-1, 0, 0}};
 
 TEST(FullRunAccuracy, TheFiftyDigitReferenceIsTheExactRun) {
   // The reference must be right before it judges anything: exact rationals, impact by impact.
-  for (const ThreeBodyScene& scene : {kHeavyLightHeavy, ThreeBodyScene{{3, 1, 2}, {2, 1, 0}, {-1, 0.25, 0.5}}}) {
+  for (const Scene& scene : {kHeavyLightHeavy, Scene{{3, 1, 2}, {2, 1, 0}, {-1, 0.25, 0.5}}}) {
     const FiftyDigitClosedForm reference(scene);
     const reference::Run exact = reference::simulate(scene, 40);
     ASSERT_GE(exact.impacts.size(), 2u);
@@ -122,13 +124,13 @@ TEST(FullRunAccuracy, RecurrenceStaysWithin1e13OfTheClosedFormOver2e7Impacts) {
   RunOptions options;
   options.max_collisions = 30'000'000;
   options.events = EventPolicy::none();
-  const RunResult result = runLab(kHeavyLightHeavy, options, [&](const ImpactRecord& lab) {
+  const SceneSimulation result = testing_support::runPlanned(kHeavyLightHeavy, options, [&](const ImpactRecord& lab) {
     const auto sample = samples.find(lab.index);
     if (sample != samples.end()) sample->second = lab.model->predicted_velocities_after;
-  });
-  ASSERT_FALSE(result.summary.truncated);
-  ASSERT_EQ(result.summary.collision_count, expected_count);
-  ASSERT_EQ(result.prediction.collision_count, expected_count);
+  }).simulation;
+  ASSERT_FALSE(result.truncated);
+  ASSERT_EQ(result.impact_count, expected_count);
+  ASSERT_EQ(predictedCollisionCount(kHeavyLightHeavy), expected_count);
 
   const FiftyDigitClosedForm reference(kHeavyLightHeavy);
   double worst = 0.0;
@@ -146,7 +148,7 @@ TEST(FullRunAccuracy, RecurrenceStaysWithin1e13OfTheClosedFormOver2e7Impacts) {
   RecordProperty("worst_at_collision", std::to_string(worst_n));
   EXPECT_LE(worst, 1e-13) << "at collision " << worst_n;
   // The run itself, every impact against the predictions: the lab's own measure.
-  EXPECT_LE(result.summary.max_prediction_error, 1e-13);
+  EXPECT_LE(result.max_prediction_error, 1e-13);
 }
 
 }  // namespace

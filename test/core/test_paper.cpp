@@ -10,7 +10,7 @@
 #include "collision_lab/core/analytic.h"
 #include "collision_lab/core/exact.h"
 #include "collision_lab/core/paper.h"
-#include "collision_lab/core/lab_run.h"
+#include "collision_lab/core/scene_run.h"
 #include "scenes.h"
 #include "simulated_run.h"
 
@@ -50,7 +50,7 @@ TEST(PaperErrata, Eigenvectors24AreNotEigenvectors) {
 
 TEST(PaperErrata, ClosedFormVelocities215AreWrong) {
   // physics.md Erratum 2: masses (1,1,1), v0 = (-1, 0.3, 0.7), k = 1.
-  const ThreeBodyScene scene{{1, 1, 1}, {3, 2, 0}, {-1, 0.3, 0.7}};
+  const Scene scene{{1, 1, 1}, {3, 2, 0}, {-1, 0.3, 0.7}};
   const auto printed = paper::velocitiesAfter(scene, 2);
   EXPECT_NEAR(printed[0], -1.2125, 1e-12);
   EXPECT_NEAR(printed[1], 0.5125, 1e-12);
@@ -70,8 +70,8 @@ TEST(PaperErrata, ClosedFormVelocities215AreWrong) {
 
 TEST(PaperErrata, CollisionCount322IsEvenForNonIntegerArguments) {
   // Equal masses (-1, 0, 1) with AB first: 3 collisions; (3.22) cannot give an odd number.
-  const ThreeBodyScene scene{{1, 1, 1}, {3, 2, 0}, {-1, 0, 1}};
-  ASSERT_EQ(testing_support::simulateThreeBodies(scene).summary.collision_count, 3u);
+  const Scene scene{{1, 1, 1}, {3, 2, 0}, {-1, 0, 1}};
+  ASSERT_EQ(testing_support::simulateThreeBodies(scene).summary.impact_count, 3u);
   const auto printed = paper::collisionCount(scene);
   ASSERT_TRUE(printed.has_value());
   EXPECT_NE(*printed, 3);
@@ -79,8 +79,8 @@ TEST(PaperErrata, CollisionCount322IsEvenForNonIntegerArguments) {
   std::mt19937_64 rng(2025);
   int matches = 0, ab_first = 0;
   for (int i = 0; i < 500; ++i) {
-    const ThreeBodyScene s = testing_support::randomScene(rng);
-    if (s.wallIndex() >= 0 || firstPair(s) != Pair::AB) continue;
+    const Scene s = testing_support::randomScene(rng);
+    if (wallIndex(s) >= 0 || firstPair(s) != Pair::AB) continue;
     ++ab_first;
     const std::uint64_t truth = exact::simulate(s, 100000).collision_count;
     EXPECT_EQ(predictedCollisionCount(s), truth);
@@ -94,12 +94,12 @@ TEST(PaperErrata, CollisionCount322IsEvenForNonIntegerArguments) {
 TEST(PaperErrata, EnergyTransfer44UsesTheWrongAverage) {
   // (4.4) with v_k against the initial vbar_AB differs from the true change once
   // v_A + v_B has changed, i.e. from the second AB impact on (collision 3).
-  const ThreeBodyScene scene{{1, 2, 3}, {3, 2, 0}, {-1, 0.3, 0.7}};
+  const Scene scene{{1, 2, 3}, {3, 2, 0}, {-1, 0.3, 0.7}};
   const auto result = testing_support::simulateThreeBodies(scene, EventPolicy::all());
-  ASSERT_GE(result.summary.collision_count, 3u);
+  ASSERT_GE(result.summary.impact_count, 3u);
   const testing_support::ThreeBodyImpact& first = result.events[0];
   const auto printed_first =
-      paper::energyTransfer(scene, 1, first.pair, first.velocities_before, scene.velocities);
+      paper::energyTransfer(scene, 1, first.pair, first.velocities_before, triple(scene.velocities));
   EXPECT_NEAR(printed_first[0], first.energy_transfer[0], 1e-12);  // right at k = 0
   const testing_support::ThreeBodyImpact& third = result.events[2];
   ASSERT_EQ(third.pair, Pair::AB);

@@ -32,14 +32,14 @@ bool correctlyRounded(double value, const Q& exact) {
   return true;
 }
 
-Scene general(const ThreeBodyScene& scene) {
+Scene general(const Scene& scene) {
   return {{scene.masses.begin(), scene.masses.end()},
           {scene.positions.begin(), scene.positions.end()},
           {scene.velocities.begin(), scene.velocities.end()},
           {}};
 }
 
-std::string describe(const ThreeBodyScene& s) {
+std::string describe(const Scene& s) {
   std::string text;
   for (const auto* values : {&s.masses, &s.positions, &s.velocities}) {
     for (double x : *values) text += std::to_string(x) + " ";
@@ -49,8 +49,8 @@ std::string describe(const ThreeBodyScene& s) {
 }
 
 /// The scenes: the hard classes, the example, and seeded random ones.
-std::vector<ThreeBodyScene> scenes() {
-  std::vector<ThreeBodyScene> all = {
+std::vector<Scene> scenes() {
+  std::vector<Scene> all = {
       {{1, 1, 1}, {1, 0, -1}, {-1, 0, 0}},               // kaleidoscopic, 2 impacts
       {{2, 1, 3}, {1, 0, -1}, {-1, 0, 0}},               // kaleidoscopic, 3
       {{5, 1, 9}, {1, 0, -1}, {-1, 0, 0}},               // kaleidoscopic, 5
@@ -68,7 +68,7 @@ std::vector<ThreeBodyScene> scenes() {
 
 TEST(ThreeBodyRounding, FinalAndEventVelocitiesAreTheCorrectlyRoundedExactOnesAndTheEngines) {
   int scenes_checked = 0;
-  for (const ThreeBodyScene& scene : scenes()) {
+  for (const Scene& scene : scenes()) {
     const reference::Run truth = reference::simulateVelocities(scene, 100000);
     ASSERT_FALSE(truth.truncated) << describe(scene);
     SceneRunOptions options;
@@ -105,7 +105,7 @@ TEST(ThreeBodyRounding, FinalAndEventVelocitiesAreTheCorrectlyRoundedExactOnesAn
 // engine took 28 of 101 decisions at 100 digits before.
 TEST(ThreeBodyRounding, RunsWithoutEventsAreTheEnginesAndNeverEscalateAtExtremeMassRatios) {
   struct Case {
-    ThreeBodyScene scene;
+    Scene scene = threeBodies();
     std::uint64_t cap;
   };
   const std::vector<Case> cases = {

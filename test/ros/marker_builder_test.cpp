@@ -46,10 +46,7 @@ FeedOptions withMode(std::uint8_t mode) {
 }
 
 Fed feed(const Array3& masses, const Array3& positions, const Array3& velocities, const FeedOptions& o = {}) {
-  collision_lab::core::ThreeBodyScene scene;
-  scene.masses = masses;
-  scene.positions = positions;
-  scene.velocities = velocities;
+  const collision_lab::core::Scene scene = collision_lab::core::threeBodies(masses, positions, velocities);
   const collision_lab::core::RunMode run_mode = *toRunMode(o.mode);
   collision_lab::InitialConditions input = toInitialConditions(scene, run_mode, o.max_collisions);
   input.run_id = "markers";

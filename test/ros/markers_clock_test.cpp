@@ -54,7 +54,7 @@ class Player {
 
   /// Queues the whole run, each message stamped on the timeline from `start`.
   void load(const std::string& run_id, const ros::Time& start) {
-    collision_lab::core::ThreeBodyScene scene;
+    collision_lab::core::Scene scene = collision_lab::core::threeBodies();
     scene.masses = {1, 1, 1};
     scene.positions = {2, 1, -1};
     scene.velocities = {-1, 0, 1};

@@ -19,7 +19,7 @@ using namespace collision_lab_ros;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 TEST(MsgConversion, SceneRoundTripKeepsWallsAndValues) {
-  collision_lab::core::ThreeBodyScene scene;
+  collision_lab::core::Scene scene = collision_lab::core::threeBodies();
   scene.masses = {kInf, 2.5, 1e-300};
   scene.positions = {3, 1, -0.1};
   scene.velocities = {-0.5, 0, 1e150};

@@ -696,7 +696,7 @@ struct PiRun {
 };
 
 PiRun piRun(const std::string& run_id) {
-  collision_lab::core::ThreeBodyScene scene;
+  collision_lab::core::Scene scene = collision_lab::core::threeBodies();
   scene.masses = {1e4, 1.0, std::numeric_limits<double>::infinity()};
   scene.positions = {2.0, 1.0, 0.0};
   scene.velocities = {-1.0, 0.0, 0.0};

@@ -31,15 +31,15 @@ struct Angles {
 /// double, HighPrecision) or an escalation tier (ReplayPrecision, DeepPrecision), the
 /// scalars analytic.cpp instantiates (declared below). Precondition: validate(scene)
 /// passed. In double it needs finite-mass ratios up to about 2^1000, beyond which the
-/// light body's share of the mass-weighted velocities underflows; predict() and runLab()
-/// go to HighPrecision there.
+/// light body's share of the mass-weighted velocities underflows; the rotation model
+/// goes to HighPrecision there.
 template <class Scalar>
 class AnalyticModel {
  public:
   using Vec3 = Eigen::Matrix<Scalar, 3, 1>;
   using Mat3 = Eigen::Matrix<Scalar, 3, 3>;
 
-  explicit AnalyticModel(const ThreeBodyScene& scene);
+  explicit AnalyticModel(const Scene& scene);
 
   Scalar alpha() const { return alpha_; }
   Scalar theta() const { return 2 * alpha_; }
@@ -188,7 +188,7 @@ EigenCheck eigenCheck(const std::array<double, 3>& masses);
 /// contact with exactly zero approach speed (psi / alpha an exact integer) does not count.
 /// Exact for the given doubles: double, then 50 digits, then exact rationals where the
 /// integer test needs them. Never rounded through a double: counts pass 2^53.
-std::uint64_t predictedCollisionCount(const ThreeBodyScene& scene);
+std::uint64_t predictedCollisionCount(const Scene& scene);
 
 /// The most collisions any start can give for these masses, ceil(pi / alpha)
 /// (Galperin & Zemlyakov; OEIS A119661). Exact, including the kaleidoscopic masses where

@@ -1,5 +1,4 @@
-// The policies every front end shares: which events a run keeps (EventPolicy) and how
-// often its decisions left the working precision (EscalationStats). Every run's impact
+// The policy every front end shares: which events a run keeps (EventPolicy). Every run's impact
 // record is the engine's ImpactRecord (nbody/engine.h), with a model's values in its one
 // optional block (impact_model_values.h).
 #pragma once
@@ -11,7 +10,7 @@
 namespace collision_lab {
 namespace core {
 
-/// Which events a run keeps (RunOptions::events, lab_run.h). Independent of the visitor,
+/// Which events a run keeps (RunOptions::events, scene_run.h). Independent of the visitor,
 /// which sees every event.
 struct EventPolicy {
   enum class Kind { kNone, kAll, kFirstN };
@@ -46,13 +45,6 @@ struct EventPolicy {
   bool keepsAfter(std::uint64_t impacts_before) const {
     return kind == Kind::kAll || (kind == Kind::kFirstN && impacts_before <= first_n);
   }
-};
-
-/// How often the adaptive path had to leave the working precision.
-struct EscalationStats {
-  std::uint64_t decisions = 0;        ///< sign decisions taken
-  std::uint64_t high_precision = 0;   ///< decisions taken at 100 digits or more
-  std::uint64_t exact_rational = 0;   ///< of those, decided by an exact rational replay
 };
 
 }  // namespace core

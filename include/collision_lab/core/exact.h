@@ -21,7 +21,7 @@ using Rational = boost::multiprecision::cpp_rational;
 using RationalState = std::array<Rational, 3>;
 
 /// The input velocities as exact rationals.
-RationalState initialVelocities(const ThreeBodyScene& scene);
+RationalState initialVelocities(const Scene& scene);
 
 /// Applies one elastic impact of `pair` to `v`, exactly. Walls keep their velocity.
 void applyCollision(const std::array<double, 3>& masses, Pair pair, RationalState& v);
@@ -32,10 +32,10 @@ Rational approachSpeed(Pair pair, const RationalState& v);
 
 /// Exact comparison of the first contact times when both pairs approach:
 /// < 0 when AB is first, > 0 when BC is first, 0 for a triple collision.
-int compareFirstContactTimes(const ThreeBodyScene& scene);
+int compareFirstContactTimes(const Scene& scene);
 
 /// Exact velocities after n alternating collisions starting with `first`.
-RationalState velocitiesAfter(const ThreeBodyScene& scene, Pair first, std::uint64_t n);
+RationalState velocitiesAfter(const Scene& scene, Pair first, std::uint64_t n);
 
 struct Run {
   std::uint64_t collision_count = 0;
@@ -47,7 +47,7 @@ struct Run {
 
 /// The whole run, exactly (velocities only; positions decide only the first pair).
 /// Precondition: validate(scene) passed.
-Run simulate(const ThreeBodyScene& scene, std::uint64_t max_collisions);
+Run simulate(const Scene& scene, std::uint64_t max_collisions);
 
 }  // namespace exact
 }  // namespace core

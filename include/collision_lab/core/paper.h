@@ -16,13 +16,13 @@ namespace paper {
 
 /// Velocities after n collisions by eq. (2.15) (n = 2k) and (2.16) (n = 2k+1), with the
 /// paper's c, d, nu^2 and the *initial* average vbar_AB. Written for AB first.
-std::array<double, 3> velocitiesAfter(const ThreeBodyScene& scene, std::uint64_t n);
+std::array<double, 3> velocitiesAfter(const Scene& scene, std::uint64_t n);
 
 /// Eqs. (2.15)/(2.16) of one scene with the paper's constants computed once, for runs that
 /// evaluate them at every collision.
 class PrintedClosedForm {
  public:
-  explicit PrintedClosedForm(const ThreeBodyScene& scene);
+  explicit PrintedClosedForm(const Scene& scene);
 
   /// The paper's theta = arg(lambda_+), eq. (2.2), as its formulas use it [rad].
   double theta() const { return theta_; }
@@ -37,7 +37,7 @@ class PrintedClosedForm {
 };
 
 /// phi_BC of eq. (3.21): atan2(u1.n_BC, u1.l_BC) with u1 = u after the first AB impact [rad].
-double phiBC(const ThreeBodyScene& scene);
+double phiBC(const Scene& scene);
 
 /// Omega as printed: arccos(n_AB . n_BC) [rad].
 double omega(const std::array<double, 3>& masses);
@@ -45,7 +45,7 @@ double omega(const std::array<double, 3>& masses);
 /// n_max of eq. (3.22): 1 + floor((Omega - phi_BC)/theta) + ceil((Omega - phi_BC)/theta).
 /// Empty when the printed expression is not a finite number for this scene, or when it
 /// does not fit an int64.
-std::optional<std::int64_t> collisionCount(const ThreeBodyScene& scene);
+std::optional<std::int64_t> collisionCount(const Scene& scene);
 
 /// Energy gained by A, B, C [J] in collision n (1-based) by eqs. (4.4)-(4.7), with v_k
 /// read as the paper defines it (against the *initial* vbar_AB). The equations give the
@@ -54,7 +54,7 @@ std::optional<std::int64_t> collisionCount(const ThreeBodyScene& scene);
 /// impact BC that comes first (4.6 and 4.7 refer to the impact before).
 /// state_before: velocities just before collision n; state_two_before: just before
 /// collision n-1 (used by the BC formulas 4.6, 4.7, which refer to v_{k-1}).
-std::array<double, 3> energyTransfer(const ThreeBodyScene& scene, std::uint64_t n, Pair pair,
+std::array<double, 3> energyTransfer(const Scene& scene, std::uint64_t n, Pair pair,
                                      const std::array<double, 3>& state_before,
                                      const std::array<double, 3>& state_two_before);
 

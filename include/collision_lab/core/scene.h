@@ -1,4 +1,4 @@
-// The three-body scene (A, B, C) of the paper and its validation.
+// The three bodies (A, B, C) of the paper as the rotation model reads a Scene of three bodies.
 // ROS-free: this header is part of collision_lab_core.
 #pragma once
 
@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "collision_lab/core/nbody/scene.h"  // Reason, ValidationError, reasonName
 
@@ -25,29 +26,26 @@ inline int pairIndex(Pair p) { return static_cast<int>(p); }
 inline Pair otherPair(Pair p) { return p == Pair::AB ? Pair::BC : Pair::AB; }
 inline const char* pairName(Pair p) { return p == Pair::AB ? "AB" : "BC"; }
 
-/// Initial conditions in SI units. A mass of +inf makes A or C a wall that keeps its
-/// (constant) velocity forever.
-struct ThreeBodyScene {
-  std::array<double, 3> masses{};      ///< [kg], +inf = wall (A or C only)
-  std::array<double, 3> positions{};   ///< [m], strictly decreasing: x_A > x_B > x_C
-  std::array<double, 3> velocities{};  ///< [m/s]
+/// A scene of three bodies A, B, C with these values (zeros by default), elastic.
+Scene threeBodies(const std::array<double, 3>& masses = {}, const std::array<double, 3>& positions = {},
+                  const std::array<double, 3>& velocities = {});
 
-  bool isWall(int i) const;
-  /// Index of the wall (kA or kC), or -1 when all three masses are finite.
-  int wallIndex() const;
-};
+/// The three values of a three-body scene's field (masses, positions or velocities), as the
+/// rotation model reads them. Precondition: three values.
+std::array<double, 3> triple(const std::vector<double>& values);
+
+/// The wall of a three-body scene (kA or kC; A's when both are walls), or -1 when all three
+/// masses are finite. Precondition: scene.size() == 3.
+int wallIndex(const Scene& scene);
 
 /// The largest finite mass [kg]; walls (+inf) left out. The scale of mass-weighted
-/// velocities throughout the core.
+/// velocities throughout the rotation model.
 double largestFiniteMass(const std::array<double, 3>& masses);
 
-/// Checks a scene. Returns nothing when the scene is valid. Never throws for any input.
-/// The triple-collision test is exact for the given doubles.
-std::optional<ValidationError> validate(const ThreeBodyScene& scene);
-
-/// Which pair collides first, exactly for the given doubles; empty when neither pair
-/// approaches. Precondition: validate(scene) passed (so the times are not tied).
-std::optional<Pair> firstPair(const ThreeBodyScene& scene);
+/// Which pair of a three-body scene collides first, exactly for the given doubles; empty
+/// when neither pair approaches. Precondition: scene.size() == 3 and validate(scene) passed
+/// (so the times are not tied).
+std::optional<Pair> firstPair(const Scene& scene);
 
 }  // namespace core
 }  // namespace collision_lab

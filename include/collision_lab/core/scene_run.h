@@ -3,12 +3,12 @@
 // the model's prediction, once; runScene runs that plan and gives one result whose
 // simulation summary is filled for every scene. ROS-free.
 //
-// Three elastic bodies that the rotation model answers (chooseModel: three_body_rotation)
-// are handed to runLab, which simulates them with the same event engine and puts the
-// paper's rotation model beside every impact.
-// Every other scene is answered by its model (models.h): a closed form alone when no event
-// is asked for and the prediction is finite; otherwise the exact event engine, whose
-// summary is put beside the prediction.
+// Every scene is answered by its model (models.h): a closed form alone when no event is
+// asked for and the prediction is finite; otherwise the exact event engine, the one
+// simulator, whose summary is put beside the prediction. A model that predicts every
+// impact (the rotation model of three elastic bodies) puts its values beside each one, in
+// the record's model block; a run of it takes its summary from the known count (no
+// decision) wherever it can, with events or without.
 //
 // The over-cap rule, the same for every front end: when a model predicts more impacts than
 // the cap (max_collisions), the model answers at once (simulated false, its count and final
@@ -25,7 +25,7 @@
 #include <string>
 #include <vector>
 
-#include "collision_lab/core/lab_run.h"
+#include "collision_lab/core/events.h"
 #include "collision_lab/core/nbody/engine.h"
 #include "collision_lab/core/nbody/models.h"
 #include "collision_lab/core/nbody/scene.h"
@@ -36,6 +36,20 @@ namespace core {
 /// Impacts simulated of a run that never ends (two walls) unless simulate_to_cap: enough to
 /// show its pattern, few enough to show at once.
 constexpr std::uint64_t kInfiniteRunDisplayCap = 1000;
+
+/// What a run models. Values match the ROS message constants MODE_*.
+enum class RunMode : std::uint8_t {
+  kFull = 0,         ///< simulate, report every event
+  kPredictOnly = 1,  ///< closed form only, no simulation
+  kSummaryOnly = 2,  ///< simulate, report no per-impact output
+};
+
+/// The cap, the events kept and the mode: what every front end asks of a run.
+struct RunOptions {
+  std::uint64_t max_collisions = 10'000'000;  ///< the cap on impacts simulated
+  EventPolicy events = EventPolicy::all();    ///< which impacts the result keeps
+  RunMode mode = RunMode::kFull;
+};
 
 struct SceneRunOptions {
   /// Cap, event policy and mode; max_collisions caps the engine.

@@ -17,7 +17,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "collision_lab/core/lab_run.h"
+#include "collision_lab/core/scene_run.h"
 #include "collision_lab/core/scene_run.h"
 #include "collision_lab/io/scenario_file.h"
 
@@ -41,7 +41,7 @@ std::string jsonText(const Json& json);
 
 Json unitsJson();
 /// name, description, masses, positions, velocities, walls (["A"], ["C"] or []).
-Json sceneJson(const NamedScene& scene);
+Json sceneJson(const SceneEntry& scene);
 /// max_collisions, events, mode, and "precision": always "double", kept for readers of the
 /// format (every run is exact; --precision was removed).
 Json optionsJson(const core::RunOptions& options);

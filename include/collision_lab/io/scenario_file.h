@@ -26,14 +26,6 @@ struct SceneEntry {
   std::uint64_t max_collisions = 0;  ///< 0: the caller's default
 };
 
-/// A three-body entry, as the three-body path (and the ROS node) takes it.
-struct NamedScene {
-  std::string name;         ///< unique key, e.g. "pi_digits_3"
-  std::string description;  ///< one line for people
-  core::ThreeBodyScene scene;              ///< masses may be written inf / .inf in the file
-  std::uint64_t max_collisions = 0;  ///< 0: the caller's default
-};
-
 /// A malformed file or entry. what() names the file, the entry and the field.
 struct ScenarioFileError : std::runtime_error {
   using std::runtime_error::runtime_error;
@@ -43,8 +35,6 @@ struct ScenarioFileError : std::runtime_error {
 /// Does not validate the physics (core::planScene validates each scene).
 std::vector<SceneEntry> loadScenes(const std::string& path);
 
-/// The entry as a three-body scene. Precondition: the entry has three bodies.
-NamedScene toNamedScene(const SceneEntry& entry);
 
 /// The entry called `name`; throws ScenarioFileError listing the known names if absent.
 SceneEntry findScene(const std::vector<SceneEntry>& scenes, const std::string& name);

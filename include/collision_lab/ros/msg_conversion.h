@@ -20,7 +20,6 @@
 #include "collision_lab/Rejected.h"
 #include "collision_lab/RunSummary.h"
 #include "collision_lab/Velocities.h"
-#include "collision_lab/core/lab_run.h"
 #include "collision_lab/core/nbody/body_state_replay.h"
 #include "collision_lab/core/nbody/engine.h"
 #include "collision_lab/core/nbody/models.h"
@@ -44,16 +43,11 @@ const char* nodeReasonName(NodeReason reason);
 
 /// The first three values (bodies A, B, C); NaN for a body the list does not have.
 std::array<double, 3> toArray(const std::vector<double>& values);
-std::vector<double> toVector(const std::array<double, 3>& values);
 
 /// Any N, the lists (restitution included) exactly as given: core::planScene judges them.
 collision_lab::core::Scene toScene(const collision_lab::InitialConditions& msg);
 /// mode and max_collisions as given; header and run_id left for the caller.
 collision_lab::InitialConditions toInitialConditions(const collision_lab::core::Scene& scene,
-                                                     collision_lab::core::RunMode mode,
-                                                     std::uint64_t max_collisions);
-/// The same for three elastic bodies (restitution empty).
-collision_lab::InitialConditions toInitialConditions(const collision_lab::core::ThreeBodyScene& scene,
                                                      collision_lab::core::RunMode mode,
                                                      std::uint64_t max_collisions);
 

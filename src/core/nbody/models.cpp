@@ -4,7 +4,7 @@
 #include <cmath>
 #include <functional>
 
-#include "collision_lab/core/lab_run.h"
+#include "../rotation_run.h"
 #include "collision_lab/core/wedge.h"
 #include "spiral.h"
 
@@ -448,26 +448,7 @@ Prediction predictThreeBodySpiral(const Scene& scene) {
 
 Prediction predictThreeBodyRotation(const Scene& scene) {
   Prediction prediction = base(ModelKind::kThreeBodyRotation, scene);
-  ThreeBodyScene triple;
-  for (int i = 0; i < 3; ++i) {
-    triple.masses[i] = scene.masses[i];
-    triple.positions[i] = scene.positions[i];
-    triple.velocities[i] = scene.velocities[i];
-  }
-  const AnalyticPrediction rotation = predict(triple);
-  prediction.impact_count = rotation.collision_count;
-  prediction.final_velocities.assign(rotation.final_velocities.begin(), rotation.final_velocities.end());
-  prediction.energy_lost = 0.0;  // elastic
-  prediction.critical_restitution = criticalRestitution(rotation.angles.alpha);
-  prediction.spiral_angle = rotation.angles.theta;
-  prediction.paper_impact_count = rotation.paper_collision_count;
-  prediction.max_possible_impact_count = rotation.max_possible_collision_count;
-  prediction.alpha = rotation.angles.alpha;
-  prediction.theta = rotation.angles.theta;
-  prediction.omega = rotation.angles.omega;
-  prediction.phi_bc = rotation.phi_bc;
-  prediction.psi = rotation.psi;
-  if (rotation.first_pair) prediction.first_pair_index = static_cast<std::size_t>(pairIndex(*rotation.first_pair));
+  fillRotationPrediction(scene, prediction);
   return prediction;
 }
 

@@ -9,7 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "collision_lab/core/lab_run.h"
+#include "collision_lab/core/scene_run.h"
+#include "../simulated_run.h"
 #include "collision_lab/core/nbody/engine.h"
 #include "engine_checks.h"
 #include "reference.h"
@@ -111,18 +112,18 @@ TEST(WideRange, AThreeBodyChainAfter2To900SecondsKeepsItsCount) {
   EXPECT_EQ(run.impact_count, 31u);
   expectCloseToReference(scene, run, exact, "pi billiard");
 
-  const ThreeBodyScene triple{{100, 1, kWall}, {2e210, 1e210, 0}, {-1e-61, 0, 0}};
-  const RunResult lab = runLab(triple, RunOptions{});
-  EXPECT_EQ(lab.summary.collision_count, 31u);
-  EXPECT_FALSE(lab.summary.truncated) << lab.summary.truncation_reason;
-  ASSERT_EQ(lab.events.size(), 31u);
+  const Scene three{{100, 1, kWall}, {2e210, 1e210, 0}, {-1e-61, 0, 0}};
+  const SceneSimulation lab = testing_support::runPlanned(three, RunOptions{}).simulation;
+  EXPECT_EQ(lab.impact_count, 31u);
+  EXPECT_FALSE(lab.truncated) << lab.stop_message;
+  ASSERT_EQ(lab.impacts.size(), 31u);
   for (std::size_t k = 0; k < 31; ++k) {
     const double t = static_cast<double>(exact.events[k].time);
-    EXPECT_NEAR(lab.events[k].time, t, 0x1p-42 * t) << "impact " << k + 1;
+    EXPECT_NEAR(lab.impacts[k].time, t, 0x1p-42 * t) << "impact " << k + 1;
   }
   for (int i = 0; i < 2; ++i) {
     const double v = static_cast<double>(exact.velocities[i]);
-    EXPECT_NEAR(lab.summary.final_velocities[i], v, 0x1p-50 * std::fabs(v)) << "body " << i;
+    EXPECT_NEAR(lab.final_velocities[i], v, 0x1p-50 * std::fabs(v)) << "body " << i;
   }
 }
 

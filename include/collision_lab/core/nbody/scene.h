@@ -82,7 +82,7 @@ enum class Reason : std::uint8_t {
   kNonFiniteValue = 1,       ///< NaN or inf in a position or velocity, or NaN in a mass
   kNonPositiveMass = 2,      ///< mass <= 0
   kTwoWalls = 3,             ///< two walls with no finite body between them (N = 2)
-  kInfiniteMiddleMass = 4,   ///< validate(ThreeBodyScene) only; validate(Scene) reports 13 for every N
+  kInfiniteMiddleMass = 4,   ///< no longer reported (validate reports 13 for every N); the value stays published
   kPositionsNotOrdered = 5,  ///< not x_0 > x_1 > ... > x_{N-1}
   kPositionsCoincident = 6,  ///< two neighbouring positions are equal
   kTripleCollision = 7,      ///< two first contacts that share a body come at exactly the same instant

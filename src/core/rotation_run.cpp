@@ -1,4 +1,4 @@
-#include "collision_lab/core/lab_run.h"
+#include "rotation_run.h"
 
 #include <algorithm>
 #include <atomic>
@@ -9,9 +9,11 @@
 #include <string>
 
 #include "collision_lab/core/count_text.h"
+#include "collision_lab/core/analytic.h"
 #include "collision_lab/core/nbody/engine.h"
 #include "collision_lab/core/paper.h"
 #include "collision_lab/core/precision.h"
+#include "collision_lab/core/wedge.h"
 #include "float_ops.h"
 #include "impact_energy.h"
 #include "nbody/elastic_triple.h"
@@ -21,9 +23,6 @@ namespace collision_lab {
 namespace core {
 
 namespace {
-
-/// What a run that was not simulated reports for the quantities it did not measure.
-constexpr double kNotMeasured = std::numeric_limits<double>::quiet_NaN();
 
 /// In double, a zero always +0 (outputs must not show "-0").
 template <class Vector>
@@ -41,7 +40,7 @@ std::array<double, 3> toArray(const std::array<T, 3>& v) {
 /// mass-weighted velocities (S = diag(sqrt(m / m_max))) in double.
 class ClosedForm {
  public:
-  explicit ClosedForm(const ThreeBodyScene& scene) : masses_(scene.masses) {
+  explicit ClosedForm(const Scene& scene) : masses_(triple(scene.masses)) {
     int smallest = std::numeric_limits<int>::max(), largest = std::numeric_limits<int>::min();
     for (int i = 0; i < 3; ++i) {
       if (scene.isWall(i)) continue;
@@ -131,7 +130,7 @@ class ClosedFormInTurn {
 /// advanced by a RotationRecurrence.
 class PaperInTurn {
  public:
-  explicit PaperInTurn(const ThreeBodyScene& scene) : printed_(scene), rotation_(printed_.theta()) {}
+  explicit PaperInTurn(const Scene& scene) : printed_(scene), rotation_(printed_.theta()) {}
 
   std::array<double, 3> velocitiesAfter(std::uint64_t n) {
     rotation_.moveTo(n / 2);
@@ -148,8 +147,8 @@ class PaperInTurn {
 /// light body's rounding is weighed by the energy it carries.
 class EnergyNormError {
  public:
-  explicit EnergyNormError(const ThreeBodyScene& scene) : mass_max_(largestFiniteMass(scene.masses)) {
-    const int wall = scene.wallIndex();
+  explicit EnergyNormError(const Scene& scene) : mass_max_(largestFiniteMass(triple(scene.masses))) {
+    const int wall = wallIndex(scene);
     for (int i = 0; i < 3; ++i) weight_[i] = i == wall ? 0.0 : scene.masses[i] / mass_max_;
     const double frame = wall >= 0 ? scene.velocities[wall] : 0.0;
     double norm_sq = 0.0;
@@ -183,22 +182,11 @@ class EnergyNormError {
   double initial_norm_ = 1.0;
 };
 
-/// The summary of a run that was not simulated (predict-only, or over the cap): the closed
-/// form answers with its count and final state, complete, and nothing was measured.
-void describeNotSimulated(RunResult& result) {
-  LabRunSummary& summary = result.summary;
-  summary.collision_count = result.prediction.collision_count;
-  summary.final_velocities = result.prediction.final_velocities;
-  summary.max_prediction_error = kNotMeasured;
-  summary.energy_relative_drift = kNotMeasured;
-  summary.momentum_relative_drift = kNotMeasured;
-}
-
 /// Simulated impacts beside the closed form and the paper's printed formulas, in turn.
 class ModelBesideImpacts {
  public:
-  explicit ModelBesideImpacts(const ThreeBodyScene& scene, const ClosedForm& model)
-      : scene_(scene), wall_(scene.wallIndex()), closed_form_(model), paper_(scene), previous_before_(scene.velocities) {}
+  explicit ModelBesideImpacts(const Scene& scene, const ClosedForm& model)
+      : scene_(scene), wall_(wallIndex(scene)), closed_form_(model), paper_(scene), previous_before_(triple(scene.velocities)) {}
 
   /// Fills the model's values of the next impact, collision previous + 1, whose state
   /// (`values`' velocities) is filled. The paper's BC energy formulas refer to the
@@ -216,7 +204,7 @@ class ModelBesideImpacts {
   }
 
  private:
-  const ThreeBodyScene& scene_;
+  const Scene& scene_;
   int wall_;
   ClosedFormInTurn closed_form_;
   PaperInTurn paper_;
@@ -239,17 +227,9 @@ struct SimulationResult {
   std::array<double, 3> final_velocities{};  ///< [m/s]
   double energy_relative_drift = 0.0;        ///< |E_end - E_0| / E_0, in the wall's frame
   double momentum_relative_drift = 0.0;      ///< |p_end - p_0| / sum |m v|; NaN with a wall
-  EscalationStats escalation;
+  /// The engine's replays at 100 digits and in exact rationals (none on the known count).
+  Escalations escalations;
 };
-
-/// The scene of the engine for three bodies.
-Scene asScene(const ThreeBodyScene& triple) {
-  Scene scene;
-  scene.masses.assign(triple.masses.begin(), triple.masses.end());
-  scene.positions.assign(triple.positions.begin(), triple.positions.end());
-  scene.velocities.assign(triple.velocities.begin(), triple.velocities.end());
-  return scene;
-}
 
 /// The run of three elastic bodies whose count the closed form gives (`count`), without the
 /// engine's queue or any decision (nbody/elastic_triple.h), the summary of every run that
@@ -261,13 +241,13 @@ Scene asScene(const ThreeBodyScene& triple) {
 /// cannot be taken this way (then the engine runs it). `progress` (RunOptions) sees every
 /// progress_interval-th impact, with no time (NaN).
 template <class Restart, class Visit>
-std::optional<SimulationResult> simulateKnownCount(const ThreeBodyScene& scene, std::uint64_t count,
+std::optional<SimulationResult> simulateKnownCount(const Scene& scene, std::uint64_t count,
                                                    const SimulationOptions& options, const ProgressCallback& progress,
                                                    std::uint64_t progress_interval, Restart&& restart, Visit&& visit) {
   if (scene.isWall(0) && scene.isWall(2)) return std::nullopt;
   const std::optional<Pair> first = firstPair(scene);
   if (count > 0 && !first) return std::nullopt;
-  const nbody_detail::WorkingUnits units(asScene(scene));  // the engine's units (nbody/units.h)
+  const nbody_detail::WorkingUnits units(scene);  // the engine's units (nbody/units.h)
   for (int p = 0; p < 2; ++p) {  // a heavy body's coefficient must not underflow
     const double light = std::min(units.scene.masses[p], units.scene.masses[p + 1]);
     const double heavy = std::max(units.scene.masses[p], units.scene.masses[p + 1]);
@@ -302,7 +282,6 @@ std::optional<SimulationResult> simulateKnownCount(const ThreeBodyScene& scene, 
   for (int k = 0; k < 3; ++k) result.final_velocities[k] = velocity_si(run->final_velocities[k]);
   result.energy_relative_drift = drift.energy_relative_drift;
   result.momentum_relative_drift = drift.momentum_relative_drift;
-  result.escalation.decisions = run->impact_count + 1;
   return result;
 }
 
@@ -314,7 +293,7 @@ std::optional<SimulationResult> simulateKnownCount(const ThreeBodyScene& scene, 
 /// totals after it from the velocities; the visitor adds the model's values. Escalations: one decision per impact and the final one. A run the engine
 /// ended otherwise than finished, capped or cancelled (out of range: the next impact comes
 /// after the largest double) is truncated, with the engine's sentence in `stopped_otherwise`.
-SimulationResult simulateByEngine(const ThreeBodyScene& scene, const SimulationOptions& options,
+SimulationResult simulateByEngine(const Scene& scene, const SimulationOptions& options,
                                   const ProgressCallback& progress, std::uint64_t progress_interval,
                                   const std::function<void(ImpactRecord&)>& visitor, std::string& stopped_otherwise) {
   EngineOptions engine_options;
@@ -324,9 +303,9 @@ SimulationResult simulateByEngine(const ThreeBodyScene& scene, const SimulationO
   SimulationResult result;
   // Velocities, and where body k was (since_position) at since_time[k].
   const auto positive = [](long double x) { return x == 0 ? 0.0 : static_cast<double>(x); };  // never -0
-  std::array<double, 3> velocities{}, since_position = scene.positions, since_time{};
+  std::array<double, 3> velocities{}, since_position = triple(scene.positions), since_time{};
   for (int k = 0; k < 3; ++k) velocities[k] = positive(scene.velocities[k]);
-  const int wall = scene.wallIndex();
+  const int wall = wallIndex(scene);
   ImpactRecord event;
   ImpactVisitor on_impact;
   if (visitor) {
@@ -365,7 +344,7 @@ SimulationResult simulateByEngine(const ThreeBodyScene& scene, const SimulationO
       visitor(event);
     };
   }
-  EngineResult engine = runEngine(asScene(scene), engine_options, on_impact, progress);
+  EngineResult engine = runEngine(scene, engine_options, on_impact, progress);
   result.collision_count = engine.impact_count;
   result.truncated = engine.truncated || engine.stop != StopReason::kFinished;
   result.cancelled = engine.stop == StopReason::kCancelled;
@@ -376,34 +355,37 @@ SimulationResult simulateByEngine(const ThreeBodyScene& scene, const SimulationO
   for (int k = 0; k < 3; ++k) result.final_velocities[k] = engine.final_velocities[k];
   result.energy_relative_drift = engine.energy_relative_drift;
   result.momentum_relative_drift = engine.momentum_relative_drift;
-  result.escalation.decisions = engine.impact_count + 1;
-  // Taken at 100 digits or more (the exact ones among them, as EscalationStats counts).
-  result.escalation.high_precision = engine.escalations.high_precision + engine.escalations.exact_rational;
-  result.escalation.exact_rational = engine.escalations.exact_rational;
+  result.escalations.high_precision = engine.escalations.high_precision;
+  result.escalations.exact_rational = engine.escalations.exact_rational;
   return result;
 }
 
-/// Simulates, in full mode with every event put beside the prediction, and measures how
-/// far the simulation is from the closed form.
-void simulateBesidePrediction(const ThreeBodyScene& scene, const RunOptions& options, const ImpactVisitor& visitor,
-                              RunResult& result) {
-  LabRunSummary& summary = result.summary;
+/// Simulates (full or summary mode), with every event put beside the prediction in full
+/// mode, and measures how far the simulation is from the closed form.
+SceneSimulation simulateBesidePrediction(const Scene& scene, const Prediction& prediction,
+                                         const SceneRunOptions& options, const SceneVisitors& visitors) {
+  const RunOptions& lab = options.lab;
+  const std::uint64_t predicted_count = prediction.impact_count.value_or(0);
   const EnergyNormError relative_error(scene);
   const ClosedForm model(scene);
   SimulationOptions simulation_options;
-  simulation_options.max_collisions = options.max_collisions;
+  simulation_options.max_collisions = lab.max_collisions;
   simulation_options.cancel = options.cancel;
+  const EventPolicy events = options.keep_events ? lab.events : EventPolicy::none();
+  const ProgressCallback& progress = visitors.progress;
+  const std::uint64_t progress_interval = progress ? options.progress_interval : 0;
+  SceneSimulation simulation;
   std::function<void(ImpactRecord&)> enrich;
   ModelBesideImpacts beside(scene, model);
   double max_error_sq = 0.0;
-  if (options.mode == RunMode::kFull) {
+  if (lab.mode == RunMode::kFull) {
     enrich = [&](ImpactRecord& event) {
       ImpactModelValues& values = *event.model;
       beside.describe(event.index, event.pair_index == 0 ? Pair::AB : Pair::BC, values);
       max_error_sq =
           std::max(max_error_sq, relative_error.squared(values.velocities_after, values.predicted_velocities_after));
-      if (visitor) visitor(event);
-      if (options.events.keeps(event.index)) result.events.push_back(event);
+      if (visitors.impact) visitors.impact(event);
+      if (events.keeps(event.index)) simulation.impacts.push_back(event);
     };
   }
   std::string stopped_otherwise;
@@ -411,14 +393,14 @@ void simulateBesidePrediction(const ThreeBodyScene& scene, const RunOptions& opt
   // events only watch (the engine's run publishes them), so a run's summary, its escalations
   // included, is the same whatever it shows. The count, the final state, the drifts and (in
   // full mode) the largest prediction error need no decision.
-  const bool publishes = options.mode == RunMode::kFull && (visitor || options.events.kind != EventPolicy::Kind::kNone);
-  const ProgressCallback known_progress = publishes ? ProgressCallback{} : options.progress;  // else the engine's
+  const bool publishes = lab.mode == RunMode::kFull && (visitors.impact || events.kind != EventPolicy::Kind::kNone);
+  const ProgressCallback known_progress = publishes ? ProgressCallback{} : progress;  // else the engine's
   double known_error_sq = 0.0;
   std::optional<SimulationResult> known;
-  if (options.mode == RunMode::kFull) {
+  if (lab.mode == RunMode::kFull) {
     std::optional<ClosedFormInTurn> predicted;
     known = simulateKnownCount(
-        scene, result.prediction.collision_count, simulation_options, known_progress, options.progress_interval,
+        scene, predicted_count, simulation_options, known_progress, progress_interval,
         [&] {
           predicted.emplace(model);
           known_error_sq = 0.0;
@@ -427,13 +409,12 @@ void simulateBesidePrediction(const ThreeBodyScene& scene, const RunOptions& opt
           known_error_sq = std::max(known_error_sq, relative_error.squared(v, predicted->velocitiesAfter(n)));
         });
   } else {
-    known = simulateKnownCount(scene, result.prediction.collision_count, simulation_options, known_progress,
-                               options.progress_interval, [] {}, [](std::uint64_t, const std::array<double, 3>&) {});
+    known = simulateKnownCount(scene, predicted_count, simulation_options, known_progress, progress_interval, [] {},
+                               [](std::uint64_t, const std::array<double, 3>&) {});
   }
   std::optional<SimulationResult> by_engine;
   if (publishes || !known) {
-    by_engine = simulateByEngine(scene, simulation_options, options.progress, options.progress_interval, enrich,
-                                 stopped_otherwise);
+    by_engine = simulateByEngine(scene, simulation_options, progress, progress_interval, enrich, stopped_otherwise);
   }
   // The engine's run is the summary where the known count declined, or where the engine
   // published fewer impacts (cancelled while it published them).
@@ -443,68 +424,61 @@ void simulateBesidePrediction(const ThreeBodyScene& scene, const RunOptions& opt
     max_error_sq = known_error_sq;
     stopped_otherwise.clear();
   }
-  const SimulationResult& simulation = *by_engine;
-  summary.max_prediction_error = relative_error.fromSquared(max_error_sq);
-  summary.simulated = true;
-  summary.collision_count = simulation.collision_count;
-  summary.truncated = simulation.truncated;
-  summary.cancelled = simulation.cancelled;
-  summary.stop = simulation.stop;
-  if (simulation.cancelled) {
-    summary.truncation_reason = "cancelled after " + countText(simulation.collision_count) + " of " +
-                                countText(result.prediction.collision_count) + " predicted";
+  const SimulationResult& run = *by_engine;
+  simulation.simulated = true;
+  simulation.impact_count = run.collision_count;
+  simulation.truncated = run.truncated;
+  simulation.stop = run.stop;  // the engine's reason
+  if (run.cancelled) {
+    simulation.stop_message =
+        "cancelled after " + countText(run.collision_count) + " of " + countText(predicted_count) + " predicted";
   } else if (!stopped_otherwise.empty()) {
-    summary.truncation_reason = stopped_otherwise;
-  } else if (simulation.truncated) {
-    summary.truncation_reason = "stopped at max_collisions = " + countText(options.max_collisions) + " of " +
-                                countText(result.prediction.collision_count) + " predicted";
+    simulation.stop_message = stopped_otherwise;
+  } else if (run.truncated) {
+    simulation.stop_message = "stopped at max_collisions = " + countText(lab.max_collisions) + " of " +
+                              countText(predicted_count) + " predicted";
+  } else {
+    simulation.stop_message =
+        "no pair approaches any more after " + std::to_string(run.collision_count) + " impacts: the run is complete";
   }
-  summary.final_velocities = simulation.final_velocities;
-  summary.energy_relative_drift = simulation.energy_relative_drift;
-  summary.momentum_relative_drift = simulation.momentum_relative_drift;
-  summary.escalation = simulation.escalation;
-  const auto predicted_final = model.velocitiesAfter(simulation.collision_count);
-  summary.max_prediction_error =
-      std::max(summary.max_prediction_error, relative_error(simulation.final_velocities, predicted_final));
+  simulation.final_velocities.assign(run.final_velocities.begin(), run.final_velocities.end());
+  simulation.energy_lost = 0.0;  // elastic
+  simulation.energy_relative_drift = run.energy_relative_drift;
+  simulation.momentum_relative_drift = run.momentum_relative_drift;
+  // The rotation model predicts every impact: its error is the largest over them all.
+  simulation.max_prediction_error = std::max(relative_error.fromSquared(max_error_sq),
+                                             relative_error(run.final_velocities, model.velocitiesAfter(run.collision_count)));
+  if (!run.truncated) simulation.matches_prediction = run.collision_count == predicted_count;
+  simulation.escalations = run.escalations;
+  return simulation;
 }
 
 }  // namespace
 
-AnalyticPrediction predict(const ThreeBodyScene& scene) {
+void fillRotationPrediction(const Scene& scene, Prediction& prediction) {
   const ClosedForm model(scene);
-  AnalyticPrediction prediction;
-  prediction.collision_count = predictedCollisionCount(scene);
-  prediction.paper_collision_count = paper::collisionCount(scene);
-  prediction.max_possible_collision_count = maxPossibleCollisionCount(scene.masses);
-  prediction.angles = anglesFor(scene.masses);
+  const std::array<double, 3> masses = triple(scene.masses);
+  const std::uint64_t count = predictedCollisionCount(scene);
+  const Angles angles = anglesFor(masses);
+  prediction.impact_count = count;
+  const std::array<double, 3> final_velocities = model.velocitiesAfter(count);
+  prediction.final_velocities.assign(final_velocities.begin(), final_velocities.end());
+  prediction.energy_lost = 0.0;  // elastic
+  prediction.critical_restitution = criticalRestitution(angles.alpha);
+  prediction.spiral_angle = angles.theta;
+  prediction.paper_impact_count = paper::collisionCount(scene);
+  prediction.max_possible_impact_count = maxPossibleCollisionCount(masses);
+  prediction.alpha = angles.alpha;
+  prediction.theta = angles.theta;
+  prediction.omega = angles.omega;
   prediction.phi_bc = paper::phiBC(scene);
   prediction.psi = model.psi();
-  prediction.first_pair = firstPair(scene);
-  prediction.final_velocities = toArray(model.velocitiesAfter(prediction.collision_count));
-  return prediction;
+  if (const std::optional<Pair> first = firstPair(scene)) prediction.first_pair_index = static_cast<std::size_t>(pairIndex(*first));
 }
 
-RunResult runLab(const ThreeBodyScene& scene, const RunOptions& options, const ImpactVisitor& visitor) {
-  const auto started = std::chrono::steady_clock::now();
-  RunResult result = runLab(scene, options, predict(scene), visitor);
-  result.summary.compute_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  return result;
-}
-
-RunResult runLab(const ThreeBodyScene& scene, const RunOptions& options, const AnalyticPrediction& prediction,
-                 const ImpactVisitor& visitor) {
-  const auto started = std::chrono::steady_clock::now();
-  RunResult result;
-  result.prediction = prediction;
-  const bool over_cap = result.prediction.collision_count > options.max_collisions;
-  const bool skipped = options.mode != RunMode::kPredictOnly && over_cap && options.skip_simulation_over_cap;
-  if (options.mode == RunMode::kPredictOnly || skipped) {
-    describeNotSimulated(result);
-  } else {
-    simulateBesidePrediction(scene, options, visitor, result);
-  }
-  result.summary.compute_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  return result;
+SceneSimulation simulateRotationScene(const Scene& scene, const Prediction& prediction,
+                                      const SceneRunOptions& options, const SceneVisitors& visitors) {
+  return simulateBesidePrediction(scene, prediction, options, visitors);
 }
 
 }  // namespace core
