@@ -9,7 +9,7 @@
 // (times, positions, velocities, nothing stored) and a velocity-only loop. Methods run
 // round-robin, repeats are summarised by medians, and speeds are quoted as ratios to the
 // lean loop measured in the same process. Also times the closed form:
-// AnalyticModel<double>::velocitiesAfter(n) for n up to 1e12, and predictedCollisionCount.
+// AnalyticModel<double>::velocitiesAfter(n) for n up to 1e12, and predictedImpactCount.
 // And three elastic bodies at an extreme mass ratio, (1e37, 1, inf) (a wall on one side),
 // capped at 10^7 impacts: the lab run in summary and in full mode (events none) against the
 // lean loop on the same impacts, with the engine's escalations to 100 digits.
@@ -133,7 +133,7 @@ struct SceneFigures {
 /// alone, for a quick before/after of the count-only path.
 SceneFigures benchScene(double heavy, int repeats, bool keep_all, bool lab_only = false) {
   const Scene scene = heavyLightHeavy(heavy);
-  const std::uint64_t predicted = predictedCollisionCount(scene);
+  const std::uint64_t predicted = predictedImpactCount(scene);
   std::printf("\nScene: masses (%g, 1, %g), positions (1, 0, -1) m, v = (-1, 0, 0) m/s; "
               "predicted collisions %llu\n", heavy, heavy, static_cast<unsigned long long>(predicted));
   constexpr std::uint64_t kMaxCollisions = 1'000'000'000;
@@ -258,7 +258,7 @@ ExtremeFigures benchExtreme(std::uint64_t impacts, int repeats) {
   scene.positions = {2.0, 1.0, 0.0};
   scene.velocities = {-1.0, 0.0, 0.0};
   std::printf("\nScene: masses (1e37, 1, inf), positions (2, 1, 0) m, v = (-1, 0, 0) m/s; predicted collisions %llu, "
-              "capped at %llu\n", static_cast<unsigned long long>(predictedCollisionCount(scene)),
+              "capped at %llu\n", static_cast<unsigned long long>(predictedImpactCount(scene)),
               static_cast<unsigned long long>(impacts));
   RunOptions summary_run;
   summary_run.max_collisions = impacts;
@@ -327,11 +327,11 @@ double benchClosedForm(int repeats) {
                   static_cast<unsigned long long>(n), ns);
     }
   }
-  std::printf("\npredictedCollisionCount (exact count, includes building the model)\n");
+  std::printf("\npredictedImpactCount (exact count, includes building the model)\n");
   std::printf("  %-22s %20s %18s\n", "masses", "count", "median ns/call");
   for (double heavy : {1e12, 1e14, 1e16, 1e20, 1e30}) {
     const Scene scene = heavyLightHeavy(heavy);
-    const std::uint64_t count = predictedCollisionCount(scene);
+    const std::uint64_t count = predictedImpactCount(scene);
     const double ns = predictedCountNs(scene, repeats);
     std::printf("  (%-6g, 1, %-6g)       %20llu %18.1f\n", heavy, heavy,
                 static_cast<unsigned long long>(count), ns);

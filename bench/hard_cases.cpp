@@ -7,7 +7,7 @@
 // cost against the double-only loop. Also the closed-form query time.
 //
 // Reference: exact::simulate (rationals) when the count is at most a few thousand;
-// beyond that the exact count (predictedCollisionCount) and the closed form evaluated at
+// beyond that the exact count (predictedImpactCount) and the closed form evaluated at
 // 50 digits (AnalyticModel<HighPrecision>). First pairs: an exact rational comparison.
 //
 // Usage: collision_lab_hard_cases [--quick] [--md FILE]
@@ -101,13 +101,13 @@ struct Reference {
 Reference makeReference(const Scene& scene) {
   Reference ref;
   ref.first_pair = ExactTrajectory(scene, 0).firstPair();  // exact, stops before any collision
-  const std::uint64_t predicted = predictedCollisionCount(scene);
+  const std::uint64_t predicted = predictedImpactCount(scene);
   if (predicted <= kExactReferenceLimit) {
     const exact::Run run = exact::simulate(scene, 10 * kExactReferenceLimit);
-    ref.count = run.collision_count;
+    ref.count = run.impact_count;
     for (int i = 0; i < 3; ++i) ref.velocities[i] = static_cast<double>(run.final_velocities[i]);
     ref.kind = "exact rational";
-    if (predicted != run.collision_count) ref.kind += format(" (predictedCollisionCount says %llu!)",
+    if (predicted != run.impact_count) ref.kind += format(" (predictedImpactCount says %llu!)",
                                                               static_cast<unsigned long long>(predicted));
   } else {
     ref.count = predicted;
@@ -488,10 +488,10 @@ int main(int argc, char** argv) {
       closed << "| " << tripleText(s.masses) << " | " << format("%g", n) << " | " << format("%.1f", ns) << " |\n";
     }
   }
-  closed << "\n| masses [kg] | predictedCollisionCount | time per call [ns] |\n|---|---|---|\n";
+  closed << "\n| masses [kg] | predictedImpactCount | time per call [ns] |\n|---|---|---|\n";
   for (double heavy : {1e12, 1e16, 1e20, 1e30}) {
     const Scene s = makeScene({heavy, 1, heavy}, {1, 0, -1}, {-1, 0, 0});
-    closed << "| " << tripleText(s.masses) << " | " << predictedCollisionCount(s) << " | "
+    closed << "| " << tripleText(s.masses) << " | " << predictedImpactCount(s) << " | "
            << format("%.0f", predictedCountNs(s, repeats)) << " |\n";
   }
 

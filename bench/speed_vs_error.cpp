@@ -138,20 +138,20 @@ std::string crossCheckThreeBody(const BenchScene& s, Reference* ref) {
   std::vector<double> v(3);
   for (int i = 0; i < 3; ++i) v[i] = static_cast<double>(run.final_velocities[i]);
   const double diff = relativeVelocityError(s.scene.masses, ref->velocities, v);
-  const bool agree = run.collision_count == ref->collision_count &&
+  const bool agree = run.impact_count == ref->collision_count &&
                      run.first_pair == (ref->first_pair ? std::optional<Pair>(*ref->first_pair == 0 ? Pair::AB : Pair::BC)
                                                         : std::nullopt) &&
                      diff <= 4 * std::numeric_limits<double>::epsilon();
   ref->velocities = v;  // exact::simulate is the stated reference for velocities
   return agree ? "exact::simulate agrees (count, first pair, velocities to rounding)"
                : format("MISMATCH: exact::simulate count %llu, velocity difference %s",
-                        static_cast<unsigned long long>(run.collision_count), sci(diff).c_str());
+                        static_cast<unsigned long long>(run.impact_count), sci(diff).c_str());
 }
 
 Reference makeReference(const BenchScene& s) {
   Reference ref;
   const ExactTrajectory trajectory(s.scene, 10'000'000, s.end_time);
-  ref.collision_count = trajectory.collisionCount();
+  ref.collision_count = trajectory.impactCount();
   ref.first_pair = trajectory.firstPairIndex();
   ref.velocities = trajectory.finalVelocities();
   ref.positions_at_end = trajectory.positionsAt(s.end_time);
@@ -250,7 +250,7 @@ Row runClosedForm(const BenchScene& s, const Reference& ref, bool quick) {
   std::uint64_t count = 0;
   std::vector<double> v(3);
   auto work = [&] {
-    count = predictedCollisionCount(*s.three);
+    count = predictedImpactCount(*s.three);
     const AnalyticModel<double> model(*s.three);
     const auto after = model.velocitiesAfter(count);
     for (int i = 0; i < 3; ++i) v[i] = after[i];
@@ -542,7 +542,7 @@ std::string toMarkdown(const std::vector<Row>& rows, const std::vector<BenchScen
       << "- The three-body loop `simulate(scene, options, Precision)` (event_double, event_long_double, "
          "event_high) was removed with `--precision`: the event engine (nbody_engine below) simulates "
          "every scene.\n"
-      << "- **closed_form** (three-body scenes): `predictedCollisionCount(scene)`, then "
+      << "- **closed_form** (three-body scenes): `predictedImpactCount(scene)`, then "
          "`AnalyticModel<double>(scene).velocitiesAfter(count)`; the time includes both.\n"
       << "- **nbody_engine** (every scene): the exact N-body engine, `runEngine(scene, options, visitor)` "
          "(include/collision_lab/core/nbody/engine.h), max_impacts 10^7 (ball_walls_e09: 50, the preset's "

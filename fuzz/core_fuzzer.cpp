@@ -149,7 +149,7 @@ void checkSimulation(const cl::Scene& scene, const cl::SceneSimulation& sim, con
   if (out_of_range) {
     FUZZ_CHECK(sim.impact_count < std::min(predicted, cap), "an out-of-range stop comes early");
   } else {
-    FUZZ_CHECK(sim.impact_count == std::min(predicted, cap), "simulated count == predictedCollisionCount (capped)");
+    FUZZ_CHECK(sim.impact_count == std::min(predicted, cap), "simulated count == predictedImpactCount (capped)");
   }
   FUZZ_CHECK(allFinite(final_velocities), "finite final velocities");
   FUZZ_CHECK(std::isfinite(sim.energy_relative_drift), "finite energy drift");
@@ -222,7 +222,7 @@ void exercisePaper(const cl::Scene& scene, std::uint64_t count) {
   (void)cl::paper::velocitiesAfter(scene, count + 1);
   (void)cl::paper::phiBC(scene);
   (void)cl::paper::omega(cl::triple(scene.masses));
-  (void)cl::paper::collisionCount(scene);
+  (void)cl::paper::impactCount(scene);
   const std::array<double, 3> v = cl::triple(scene.velocities);
   (void)cl::paper::energyTransfer(scene, 1, cl::Pair::AB, v, v);
   (void)cl::paper::energyTransfer(scene, 2, cl::Pair::BC, v, v);
@@ -268,8 +268,8 @@ int collisionLabCoreFuzzOne(const std::uint8_t* data, std::size_t size) {
   const cl::Prediction& prediction = *plan.prediction;
   FUZZ_CHECK(prediction.impact_count.has_value(), "the rotation model gives a count");
   const std::uint64_t predicted = *prediction.impact_count;
-  const std::uint64_t max_possible = cl::maxPossibleCollisionCount(cl::triple(scene.masses));
-  FUZZ_CHECK(prediction.max_possible_impact_count == max_possible, "the prediction reports maxPossibleCollisionCount");
+  const std::uint64_t max_possible = cl::maxPossibleImpactCount(cl::triple(scene.masses));
+  FUZZ_CHECK(prediction.max_possible_impact_count == max_possible, "the prediction reports maxPossibleImpactCount");
   FUZZ_CHECK(predicted <= max_possible, "count <= ceil(pi / alpha)");
   const std::optional<cl::Pair> first = cl::firstPair(scene);
   FUZZ_CHECK(prediction.first_pair_index.has_value() == first.has_value() &&
@@ -298,7 +298,7 @@ int collisionLabCoreFuzzOne(const std::uint8_t* data, std::size_t size) {
 
   if (predicted <= kExactCrossCheckLimit) {
     const cl::exact::Run truth = cl::exact::simulate(scene, kExactCrossCheckLimit + 1);
-    FUZZ_CHECK(!truth.truncated && truth.collision_count == predicted, "predictedCollisionCount == exact rational count");
+    FUZZ_CHECK(!truth.truncated && truth.impact_count == predicted, "predictedImpactCount == exact rational count");
   }
 
   cl::SceneRunOptions run_options;

@@ -20,11 +20,11 @@ inline double velocitiesAfterNs(const core::Scene& scene, std::uint64_t n, int r
   return median(samples) * 1e9 / kBatch;
 }
 
-/// Median ns per predictedCollisionCount(scene) call (builds its model every call).
+/// Median ns per predictedImpactCount(scene) call (builds its model every call).
 inline double predictedCountNs(const core::Scene& scene, int repeats) {
   constexpr int kBatch = 200;
   const auto samples = timeRepeats(repeats, [&] {
-    for (int i = 0; i < kBatch; ++i) doNotOptimize(core::predictedCollisionCount(scene));
+    for (int i = 0; i < kBatch; ++i) doNotOptimize(core::predictedImpactCount(scene));
   });
   return median(samples) * 1e9 / kBatch;
 }

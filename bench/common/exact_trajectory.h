@@ -31,7 +31,7 @@ class ExactTrajectory {
   ExactTrajectory(ExactTrajectory&&) noexcept;
   ExactTrajectory& operator=(ExactTrajectory&&) noexcept;
 
-  std::uint64_t collisionCount() const { return collision_count_; }
+  std::uint64_t impactCount() const { return collision_count_; }
   /// Stopped by max_collisions with an impact still due.
   bool truncated() const { return truncated_; }
   /// No pair approaches after the last impact: the scene has ended (false when stopped by

@@ -268,7 +268,7 @@ EigenCheck eigenCheck(const std::array<double, 3>& masses) {
   return check;
 }
 
-std::uint64_t predictedCollisionCount(const Scene& scene) {
+std::uint64_t predictedImpactCount(const Scene& scene) {
   const std::optional<Pair> first = firstPair(scene);
   if (!first) return 0;
   if (auto count = countIfSeparated(countQuotient<double>(scene, *first))) return *count;
@@ -278,8 +278,8 @@ std::uint64_t predictedCollisionCount(const Scene& scene) {
     // Even 50 digits cannot place u_perp (a body far lighter than the rest carries all the
     // relative motion): 500 digits, else count exactly when the run is short.
     if (auto count = countIfSeparated(countQuotient<DeepPrecision>(scene, *first))) return *count;
-    if (maxPossibleCollisionCount(triple(scene.masses)) <= kExactCountLimit) {
-      return exact::simulate(scene, kExactCountLimit).collision_count;
+    if (maxPossibleImpactCount(triple(scene.masses)) <= kExactCountLimit) {
+      return exact::simulate(scene, kExactCountLimit).impact_count;
     }
   }
   // psi / alpha is an integer Q to 50 digits. If it is exactly Q, contact Q grazes with
@@ -297,7 +297,7 @@ std::uint64_t predictedCollisionCount(const Scene& scene) {
   return nearest - 1;  // an integer to 500 digits: a grazing last contact
 }
 
-std::optional<std::uint64_t> checkedMaxPossibleCollisionCount(const std::array<double, 3>& m) {
+std::optional<std::uint64_t> checkedMaxPossibleImpactCount(const std::array<double, 3>& m) {
   // pi / alpha is an integer only for alpha = pi/3, pi/4, pi/6, where
   // cos^2 alpha = m_A m_C / ((m_A + m_B)(m_B + m_C)) is the rational 1/4, 1/2, 3/4.
   // In double (no sum overflowing), cos^2 alpha in [0, 1] is within 1e-15 of the exact
@@ -337,8 +337,8 @@ std::optional<std::uint64_t> checkedMaxPossibleCollisionCount(const std::array<d
   return std::max<std::uint64_t>(3, static_cast<std::uint64_t>(count));
 }
 
-std::uint64_t maxPossibleCollisionCount(const std::array<double, 3>& m) {
-  return checkedMaxPossibleCollisionCount(m).value_or(std::numeric_limits<std::uint64_t>::max());
+std::uint64_t maxPossibleImpactCount(const std::array<double, 3>& m) {
+  return checkedMaxPossibleImpactCount(m).value_or(std::numeric_limits<std::uint64_t>::max());
 }
 
 }  // namespace core

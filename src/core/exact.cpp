@@ -23,7 +23,7 @@ RationalState initialVelocities(const Scene& scene) {
   return {Rational(scene.velocities[0]), Rational(scene.velocities[1]), Rational(scene.velocities[2])};
 }
 
-void applyCollision(const std::array<double, 3>& masses, Pair pair, RationalState& v) {
+void applyImpact(const std::array<double, 3>& masses, Pair pair, RationalState& v) {
   const int i = pairIndex(pair);  // the pair's bodies are i and i + 1
   const Rational approach = approachSpeed(pair, v);
   const Rational f_i = massFraction(masses[i], masses[i + 1]);
@@ -57,13 +57,13 @@ RationalState velocitiesAfter(const Scene& scene, Pair first, std::uint64_t n) {
   RationalState v = initialVelocities(scene);
   Pair pair = first;
   for (std::uint64_t i = 0; i < n; ++i) {
-    applyCollision(triple(scene.masses), pair, v);
+    applyImpact(triple(scene.masses), pair, v);
     pair = otherPair(pair);
   }
   return v;
 }
 
-Run simulate(const Scene& scene, std::uint64_t max_collisions) {
+Run simulate(const Scene& scene, std::uint64_t max_impacts) {
   Run run;
   RationalState v = initialVelocities(scene);
   const bool ab = approachSpeed(Pair::AB, v) > 0;
@@ -78,13 +78,13 @@ Run simulate(const Scene& scene, std::uint64_t max_collisions) {
   if (run.first_pair) {
     Pair pair = *run.first_pair;
     while (approachSpeed(pair, v) > 0) {
-      if (run.collision_count == max_collisions) {
+      if (run.impact_count == max_impacts) {
         run.truncated = true;
         break;
       }
-      applyCollision(triple(scene.masses), pair, v);
+      applyImpact(triple(scene.masses), pair, v);
       run.pairs.push_back(pair);
-      ++run.collision_count;
+      ++run.impact_count;
       pair = otherPair(pair);
     }
   }

@@ -97,7 +97,7 @@ double omega(const std::array<double, 3>& m) {
   return std::acos(wedge.n_ab.dot(wedge.n_bc));
 }
 
-std::optional<std::int64_t> collisionCount(const Scene& scene) {
+std::optional<std::int64_t> impactCount(const Scene& scene) {
   const double x = (omega(triple(scene.masses)) - phiBC(scene)) / constantsOf(triple(scene.masses)).theta;
   // Evaluated in double as printed; 1 + floor(x) + ceil(x) must fit the int64 it is reported in.
   if (!std::isfinite(x) || std::fabs(x) > 4e18) return std::nullopt;

@@ -70,7 +70,7 @@ class ClosedForm {
   std::optional<AnalyticModel<HighPrecision>> wide_;
 };
 
-/// A ClosedForm's velocities after collision n and the energies gained in it, for n = 1,
+/// A ClosedForm's velocities after impact n and the energies gained in it, for n = 1,
 /// 2, 3, ... in turn: in double by the ClosedFormSequence recurrence (a few ns each), at
 /// 50 digits directly.
 class ClosedFormInTurn {
@@ -82,7 +82,7 @@ class ClosedFormInTurn {
     }
   }
 
-  /// The velocities after collision n alone, as describe() gives them [m/s]; n = 1, 2, 3,
+  /// The velocities after impact n alone, as describe() gives them [m/s]; n = 1, 2, 3,
   /// ... in turn (not mixed with describe()).
   std::array<double, 3> velocitiesAfter(std::uint64_t n) {
     return sequence_ ? toArray(sequence_->velocitiesAfter(n)) : model_.velocitiesAfter(n);
@@ -103,7 +103,7 @@ class ClosedFormInTurn {
   }
 
  private:
-  /// The closed form's energy gains in collision n from the state before it, previous_:
+  /// The closed form's energy gains in impact n from the state before it, previous_:
   /// in double where the gain is safely inside its range, else in the model's wider type.
   std::array<double, 3> energyTransfer(std::uint64_t n) const {
     const AnalyticModel<double>& model = *model_.fast_;
@@ -122,11 +122,11 @@ class ClosedFormInTurn {
   const ClosedForm& model_;
   detail::ImpactEnergy<double> energy_{model_.masses()};
   std::optional<ClosedFormSequence> sequence_;
-  Eigen::Vector3d previous_;  // after collision last_
+  Eigen::Vector3d previous_;  // after impact last_
   std::uint64_t last_ = 0;
 };
 
-/// The paper's printed closed form at collisions n = 1, 2, 3, ... in turn, its angle
+/// The paper's printed closed form at impacts n = 1, 2, 3, ... in turn, its angle
 /// advanced by a RotationRecurrence.
 class PaperInTurn {
  public:
@@ -188,9 +188,9 @@ class ModelBesideImpacts {
   explicit ModelBesideImpacts(const Scene& scene, const ClosedForm& model)
       : scene_(scene), wall_(wallIndex(scene)), closed_form_(model), paper_(scene), previous_before_(triple(scene.velocities)) {}
 
-  /// Fills the model's values of the next impact, collision previous + 1, whose state
+  /// Fills the model's values of the next impact, impact previous + 1, whose state
   /// (`values`' velocities) is filled. The paper's BC energy formulas refer to the
-  /// velocities before the collision before it, which this keeps.
+  /// velocities before the impact before it, which this keeps.
   void describe(std::uint64_t index, Pair pair, ImpactModelValues& values) {
     closed_form_.describe(index, values);
     values.paper_velocities_after = paper_.velocitiesAfter(index);
@@ -214,13 +214,13 @@ class ModelBesideImpacts {
 /// The limits of one simulation of the three bodies.
 struct SimulationOptions {
   std::uint64_t max_collisions = 10'000'000;  ///< stops the run cleanly; marks it truncated
-  /// When set, the run stops within 1024 collisions, marked truncated and cancelled.
+  /// When set, the run stops within 1024 impacts, marked truncated and cancelled.
   const std::atomic<bool>* cancel = nullptr;
 };
 
 /// What one simulation of the three bodies measured.
 struct SimulationResult {
-  std::uint64_t collision_count = 0;
+  std::uint64_t impact_count = 0;
   bool truncated = false;                    ///< more impacts were due: the cap, a cancel or a stop
   bool cancelled = false;                    ///< stopped by SimulationOptions::cancel
   StopReason stop = StopReason::kFinished;   ///< the engine's reason
@@ -272,7 +272,7 @@ std::optional<SimulationResult> simulateKnownCount(const Scene& scene, std::uint
       });
   if (!run) return std::nullopt;
   SimulationResult result;
-  result.collision_count = run->impact_count;
+  result.impact_count = run->impact_count;
   result.truncated = run->capped || run->cancelled;
   result.cancelled = run->cancelled;
   result.stop = run->cancelled ? StopReason::kCancelled : run->capped ? StopReason::kCap : StopReason::kFinished;
@@ -345,7 +345,7 @@ SimulationResult simulateByEngine(const Scene& scene, const SimulationOptions& o
     };
   }
   EngineResult engine = runEngine(scene, engine_options, on_impact, progress);
-  result.collision_count = engine.impact_count;
+  result.impact_count = engine.impact_count;
   result.truncated = engine.truncated || engine.stop != StopReason::kFinished;
   result.cancelled = engine.stop == StopReason::kCancelled;
   result.stop = engine.stop;
@@ -418,7 +418,7 @@ SceneSimulation simulateBesidePrediction(const Scene& scene, const Prediction& p
   }
   // The engine's run is the summary where the known count declined, or where the engine
   // published fewer impacts (cancelled while it published them).
-  const bool from_known = known && (!by_engine || by_engine->collision_count == known->collision_count);
+  const bool from_known = known && (!by_engine || by_engine->impact_count == known->impact_count);
   if (from_known) {
     by_engine = known;
     max_error_sq = known_error_sq;
@@ -426,12 +426,12 @@ SceneSimulation simulateBesidePrediction(const Scene& scene, const Prediction& p
   }
   const SimulationResult& run = *by_engine;
   simulation.simulated = true;
-  simulation.impact_count = run.collision_count;
+  simulation.impact_count = run.impact_count;
   simulation.truncated = run.truncated;
   simulation.stop = run.stop;  // the engine's reason
   if (run.cancelled) {
     simulation.stop_message =
-        "cancelled after " + countText(run.collision_count) + " of " + countText(predicted_count) + " predicted";
+        "cancelled after " + countText(run.impact_count) + " of " + countText(predicted_count) + " predicted";
   } else if (!stopped_otherwise.empty()) {
     simulation.stop_message = stopped_otherwise;
   } else if (run.truncated) {
@@ -439,7 +439,7 @@ SceneSimulation simulateBesidePrediction(const Scene& scene, const Prediction& p
                               countText(predicted_count) + " predicted";
   } else {
     simulation.stop_message =
-        "no pair approaches any more after " + std::to_string(run.collision_count) + " impacts: the run is complete";
+        "no pair approaches any more after " + std::to_string(run.impact_count) + " impacts: the run is complete";
   }
   simulation.final_velocities.assign(run.final_velocities.begin(), run.final_velocities.end());
   simulation.energy_lost = 0.0;  // elastic
@@ -447,8 +447,8 @@ SceneSimulation simulateBesidePrediction(const Scene& scene, const Prediction& p
   simulation.momentum_relative_drift = run.momentum_relative_drift;
   // The rotation model predicts every impact: its error is the largest over them all.
   simulation.max_prediction_error = std::max(relative_error.fromSquared(max_error_sq),
-                                             relative_error(run.final_velocities, model.velocitiesAfter(run.collision_count)));
-  if (!run.truncated) simulation.matches_prediction = run.collision_count == predicted_count;
+                                             relative_error(run.final_velocities, model.velocitiesAfter(run.impact_count)));
+  if (!run.truncated) simulation.matches_prediction = run.impact_count == predicted_count;
   simulation.escalations = run.escalations;
   return simulation;
 }
@@ -458,7 +458,7 @@ SceneSimulation simulateBesidePrediction(const Scene& scene, const Prediction& p
 void fillRotationPrediction(const Scene& scene, Prediction& prediction) {
   const ClosedForm model(scene);
   const std::array<double, 3> masses = triple(scene.masses);
-  const std::uint64_t count = predictedCollisionCount(scene);
+  const std::uint64_t count = predictedImpactCount(scene);
   const Angles angles = anglesFor(masses);
   prediction.impact_count = count;
   const std::array<double, 3> final_velocities = model.velocitiesAfter(count);
@@ -466,8 +466,8 @@ void fillRotationPrediction(const Scene& scene, Prediction& prediction) {
   prediction.energy_lost = 0.0;  // elastic
   prediction.critical_restitution = criticalRestitution(angles.alpha);
   prediction.spiral_angle = angles.theta;
-  prediction.paper_impact_count = paper::collisionCount(scene);
-  prediction.max_possible_impact_count = maxPossibleCollisionCount(masses);
+  prediction.paper_impact_count = paper::impactCount(scene);
+  prediction.max_possible_impact_count = maxPossibleImpactCount(masses);
   prediction.alpha = angles.alpha;
   prediction.theta = angles.theta;
   prediction.omega = angles.omega;

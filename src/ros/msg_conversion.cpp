@@ -173,9 +173,6 @@ void fillPredictionMsg(const core::ScenePlan& plan, collision_lab::Prediction& m
   msg.collision_count = p.impact_count.value_or(0);
   msg.collision_count_defined = p.impact_count.has_value();
   msg.infinite_collisions = p.infinite;
-  if (p.kind == core::ModelKind::kTwoBody && p.impact_count == std::uint64_t{1}) {
-    msg.first_pair_index = collision_lab::Prediction::PAIR_AB;
-  }
   if (p.first_pair_index) msg.first_pair_index = static_cast<std::uint32_t>(*p.first_pair_index);
   msg.paper_collision_count_defined = p.paper_impact_count.has_value();
   msg.paper_collision_count = p.paper_impact_count.value_or(0);

@@ -141,8 +141,8 @@ TEST(CliJson, AgreesWithExactArithmetic) {
     }
     const collision_lab::core::exact::Run truth = collision_lab::core::exact::simulate(scene, 100000);
     ASSERT_FALSE(truth.truncated);
-    EXPECT_EQ(doc.at("summary").at("collision_count"), truth.collision_count);
-    EXPECT_EQ(doc.at("summary").at("predicted_collision_count"), truth.collision_count);
+    EXPECT_EQ(doc.at("summary").at("collision_count"), truth.impact_count);
+    EXPECT_EQ(doc.at("summary").at("predicted_collision_count"), truth.impact_count);
     const Json& events = doc.at("events");
     ASSERT_EQ(events.size(), truth.pairs.size());
     for (std::size_t i = 0; i < events.size(); ++i) {

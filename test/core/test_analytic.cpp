@@ -82,35 +82,35 @@ TEST(ClosedForm, AgreesWithSimulationUpToAMillionCollisions) {
   }).summary;
   EXPECT_GT(result.impact_count, 500000u);
   EXPECT_LT(result.impact_count, 1500000u);
-  EXPECT_EQ(predictedCollisionCount(scene), result.impact_count);
+  EXPECT_EQ(predictedImpactCount(scene), result.impact_count);
   EXPECT_LE(worst, 1e-11);
 }
 
 TEST(Count, PiBilliardByClosedForm) {
   // m_A / m_B = 100^8 with a wall: the first nine digits of pi.
   const Scene scene{{1e16, 1, kInf}, {2, 1, 0}, {-1, 0, 0}};
-  EXPECT_EQ(predictedCollisionCount(scene), 314159265u);
-  EXPECT_EQ(maxPossibleCollisionCount({1e2, 1, kInf}), 32u);
+  EXPECT_EQ(predictedImpactCount(scene), 314159265u);
+  EXPECT_EQ(maxPossibleImpactCount({1e2, 1, kInf}), 32u);
 }
 
 TEST(Count, MaxPossibleIsExactForKaleidoscopicMasses) {
-  EXPECT_EQ(maxPossibleCollisionCount({1, 1, 1}), 3u);
+  EXPECT_EQ(maxPossibleImpactCount({1, 1, 1}), 3u);
   // One unit in the last place off (1, 1, 1): cos^2 alpha just above 1/4, alpha just below
   // pi/3, so pi/alpha just above 3.
-  EXPECT_EQ(maxPossibleCollisionCount({1, 1, 1 + 0x1p-52}), 4u);
-  EXPECT_EQ(maxPossibleCollisionCount({kInf, 1, 1}), 4u);           // cos^2 = 1/2: pi/4
-  EXPECT_EQ(maxPossibleCollisionCount({5 * 0x1p1020, 0x1p1020, 9 * 0x1p1020}), 6u);  // (5, 1, 9) scaled: 3/4
-  EXPECT_EQ(maxPossibleCollisionCount({2, 1, 3}), 4u);
-  EXPECT_EQ(maxPossibleCollisionCount({5, 1, 9}), 6u);
-  EXPECT_EQ(maxPossibleCollisionCount({1e12, 1, 1e12}), 2221442u);
+  EXPECT_EQ(maxPossibleImpactCount({1, 1, 1 + 0x1p-52}), 4u);
+  EXPECT_EQ(maxPossibleImpactCount({kInf, 1, 1}), 4u);           // cos^2 = 1/2: pi/4
+  EXPECT_EQ(maxPossibleImpactCount({5 * 0x1p1020, 0x1p1020, 9 * 0x1p1020}), 6u);  // (5, 1, 9) scaled: 3/4
+  EXPECT_EQ(maxPossibleImpactCount({2, 1, 3}), 4u);
+  EXPECT_EQ(maxPossibleImpactCount({5, 1, 9}), 6u);
+  EXPECT_EQ(maxPossibleImpactCount({1e12, 1, 1e12}), 2221442u);
   // A heavy B: alpha -> pi/2, pi/alpha exceeds 2 by ~1e-60; 3 collisions are possible.
-  EXPECT_EQ(maxPossibleCollisionCount({1, 1e60, 1}), 3u);
-  EXPECT_EQ(predictedCollisionCount(Scene{{1, 1e60, 1}, {1e80, 1, 0}, {-1e61, 0, 1}}), 3u);
+  EXPECT_EQ(maxPossibleImpactCount({1, 1e60, 1}), 3u);
+  EXPECT_EQ(predictedImpactCount(Scene{{1, 1e60, 1}, {1e80, 1, 0}, {-1e61, 0, 1}}), 3u);
   // No start exceeds the bound.
   std::mt19937_64 rng(3);
   for (int i = 0; i < 300; ++i) {
     const Scene scene = randomScene(rng);
-    EXPECT_LE(predictedCollisionCount(scene), maxPossibleCollisionCount(triple(scene.masses)));
+    EXPECT_LE(predictedImpactCount(scene), maxPossibleImpactCount(triple(scene.masses)));
   }
 }
 
@@ -156,7 +156,7 @@ TEST(Count, ExactUpToMassRatio1e20) {
     // Both starts have only AB approaching, and q = psi / alpha far from an integer.
     for (const auto& v : {std::array<double, 3>{-1, 0, 0}, std::array<double, 3>{-1, 0.3, 0.2}}) {
       const Scene scene = threeBodies({ratio, 1, 0.5 * ratio}, {2, 1, 0}, v);
-      EXPECT_EQ(predictedCollisionCount(scene), countFromFirstPrinciples(scene)) << ratio;
+      EXPECT_EQ(predictedImpactCount(scene), countFromFirstPrinciples(scene)) << ratio;
     }
   }
   // The reference itself against known counts: equal masses exchange velocities, so
@@ -165,7 +165,7 @@ TEST(Count, ExactUpToMassRatio1e20) {
   EXPECT_EQ(countFromFirstPrinciples(Scene{{1, 1, 1}, {2, 1, 0}, {-1, 0.3, 0.2}}), 2u);
   EXPECT_EQ(countFromFirstPrinciples(Scene{{1e12, 1, 1e12}, {2, 1, 0}, {-1, 0, 0}}), 2221441u);
   const Scene simulated{{1e12, 1, 0.5e12}, {2, 1, 0}, {-1, 0, 0}};
-  EXPECT_EQ(predictedCollisionCount(simulated), testing_support::simulateThreeBodies(simulated).summary.impact_count);
+  EXPECT_EQ(predictedImpactCount(simulated), testing_support::simulateThreeBodies(simulated).summary.impact_count);
 }
 
 TEST(Count, FloorExceptWhenPsiOverAlphaIsAnInteger) {
@@ -173,9 +173,9 @@ TEST(Count, FloorExceptWhenPsiOverAlphaIsAnInteger) {
   const Scene grazing{{3, 1, 0.5}, {2, 1, 0}, {-1, 0, 0}};
   const AnalyticModel<double> model(grazing);
   EXPECT_NEAR(model.psi() / model.alpha(), 3.0, 1e-12);
-  EXPECT_EQ(predictedCollisionCount(grazing), 2u);
+  EXPECT_EQ(predictedImpactCount(grazing), 2u);
   // Equal masses, (-1, 0, 1), AB first: 3 collisions (the paper's formula says even).
-  EXPECT_EQ(predictedCollisionCount(Scene{{1, 1, 1}, {3, 2, 0}, {-1, 0, 1}}), 3u);
+  EXPECT_EQ(predictedImpactCount(Scene{{1, 1, 1}, {3, 2, 0}, {-1, 0, 1}}), 3u);
 }
 
 TEST(Inverse, RoundTripRecoversInitialVelocities) {
@@ -183,7 +183,7 @@ TEST(Inverse, RoundTripRecoversInitialVelocities) {
   for (int i = 0; i < 300; ++i) {
     const Scene scene = randomScene(rng);
     const AnalyticModel<double> model(scene);
-    const std::uint64_t count = predictedCollisionCount(scene);
+    const std::uint64_t count = predictedImpactCount(scene);
     for (std::uint64_t n : {std::uint64_t{0}, std::uint64_t{1}, count / 2, count}) {
       const Eigen::Vector3d back = model.initialVelocitiesFrom(model.velocitiesAfter(n), n);
       const std::array<reference::Q, 3> v0{reference::Q(scene.velocities[0]), reference::Q(scene.velocities[1]),

@@ -132,7 +132,7 @@ bool expectExactRun(const Scene& scene, const reference::Run& truth, bool spread
   std::array<Q, 3> last{Q(scene.velocities[0]), Q(scene.velocities[1]), Q(scene.velocities[2])};
   if (publishable > 0) last = truth.impacts[publishable - 1].velocities;
   EXPECT_TRUE(velocitiesClose(scene, observed.final_velocities, last));
-  EXPECT_EQ(predictedCollisionCount(scene), truth.impacts.size());
+  EXPECT_EQ(predictedImpactCount(scene), truth.impacts.size());
   return complete;
 }
 
@@ -291,11 +291,11 @@ TEST(DoubleRange, TheIndependentCountGeometryAgreesWithExactSimulation) {
 TEST(DoubleRange, CountsPast2To53AreExact) {
   // The issue's exact figures.
   const Scene pi_1e32{{1e32, 1, kInf}, {2, 1, 0}, {-1, 0, 0}};
-  EXPECT_EQ(predictedCollisionCount(pi_1e32), 31415926535897933u);
-  EXPECT_EQ(maxPossibleCollisionCount(triple(pi_1e32.masses)), 31415926535897934u);
+  EXPECT_EQ(predictedImpactCount(pi_1e32), 31415926535897933u);
+  EXPECT_EQ(maxPossibleImpactCount(triple(pi_1e32.masses)), 31415926535897934u);
   const Scene heavy_light_heavy{{1e36, 1, 1e36}, {2, 1, 0}, {-1, 0, 0}};
-  EXPECT_EQ(predictedCollisionCount(heavy_light_heavy), 2221441469079183170u);
-  EXPECT_EQ(maxPossibleCollisionCount(triple(heavy_light_heavy.masses)), 2221441469079183171u);
+  EXPECT_EQ(predictedImpactCount(heavy_light_heavy), 2221441469079183170u);
+  EXPECT_EQ(maxPossibleImpactCount(triple(heavy_light_heavy.masses)), 2221441469079183171u);
   const Prediction prediction = predict(heavy_light_heavy).value();
   EXPECT_EQ(prediction.impact_count, 2221441469079183170u);
   EXPECT_EQ(prediction.max_possible_impact_count, 2221441469079183171u);
@@ -310,8 +310,8 @@ TEST(DoubleRange, CountsPast2To53AreExact) {
         if (validate(scene)) continue;  // beyond 2^64 - 1: rejected, tested below
         const CountGeometry g = countGeometry(scene);
         const auto expected = static_cast<std::uint64_t>(ceil(g.quotient)) - 1;
-        EXPECT_EQ(predictedCollisionCount(scene), expected) << heavy << (wall ? ", wall" : "");
-        EXPECT_EQ(maxPossibleCollisionCount(triple(scene.masses)), static_cast<std::uint64_t>(ceil(g.pi_over_alpha)));
+        EXPECT_EQ(predictedImpactCount(scene), expected) << heavy << (wall ? ", wall" : "");
+        EXPECT_EQ(maxPossibleImpactCount(triple(scene.masses)), static_cast<std::uint64_t>(ceil(g.pi_over_alpha)));
         past_2_53 += expected > (std::uint64_t{1} << 53);
       }
     }
@@ -328,7 +328,7 @@ TEST(DoubleRange, ACountBeyond64BitsIsAClearError) {
   // Just inside: 8e36 with a wall has 8885765876316732682 collisions (issue 14), which fit.
   const Scene inside{{8e36, 1, kInf}, {2, 1, 0}, {-1, 0, 0}};
   ASSERT_FALSE(validate(inside));
-  EXPECT_EQ(predictedCollisionCount(inside), 8885765876316732682u);
+  EXPECT_EQ(predictedImpactCount(inside), 8885765876316732682u);
   EXPECT_EQ(static_cast<std::uint64_t>(ceil(countGeometry(inside).quotient)) - 1, 8885765876316732682u);
 }
 
@@ -420,7 +420,7 @@ TEST(DoubleRange, SeededScenesAcrossTheDoubleRange) {
     scene.positions = {top, top - gap_ab, top - gap_ab - gap_bc};
     for (double& v : scene.velocities) v = value();
     if (validate(scene)) continue;
-    const auto most = checkedMaxPossibleCollisionCount(triple(scene.masses));
+    const auto most = checkedMaxPossibleImpactCount(triple(scene.masses));
     if (!most || *most > 40) continue;  // short runs: the rational reference stays small
     SCOPED_TRACE(::testing::Message() << "attempt " << attempt);
     ++accepted;

@@ -130,7 +130,7 @@ TEST(FullRunAccuracy, RecurrenceStaysWithin1e13OfTheClosedFormOver2e7Impacts) {
   }).simulation;
   ASSERT_FALSE(result.truncated);
   ASSERT_EQ(result.impact_count, expected_count);
-  ASSERT_EQ(predictedCollisionCount(kHeavyLightHeavy), expected_count);
+  ASSERT_EQ(predictedImpactCount(kHeavyLightHeavy), expected_count);
 
   const FiftyDigitClosedForm reference(kHeavyLightHeavy);
   double worst = 0.0;

@@ -72,7 +72,7 @@ TEST(PaperErrata, CollisionCount322IsEvenForNonIntegerArguments) {
   // Equal masses (-1, 0, 1) with AB first: 3 collisions; (3.22) cannot give an odd number.
   const Scene scene{{1, 1, 1}, {3, 2, 0}, {-1, 0, 1}};
   ASSERT_EQ(testing_support::simulateThreeBodies(scene).summary.impact_count, 3u);
-  const auto printed = paper::collisionCount(scene);
+  const auto printed = paper::impactCount(scene);
   ASSERT_TRUE(printed.has_value());
   EXPECT_NE(*printed, 3);
   // On seeded random AB-first starts it rarely matches; the correct count always does.
@@ -82,9 +82,9 @@ TEST(PaperErrata, CollisionCount322IsEvenForNonIntegerArguments) {
     const Scene s = testing_support::randomScene(rng);
     if (wallIndex(s) >= 0 || firstPair(s) != Pair::AB) continue;
     ++ab_first;
-    const std::uint64_t truth = exact::simulate(s, 100000).collision_count;
-    EXPECT_EQ(predictedCollisionCount(s), truth);
-    const auto p = paper::collisionCount(s);
+    const std::uint64_t truth = exact::simulate(s, 100000).impact_count;
+    EXPECT_EQ(predictedImpactCount(s), truth);
+    const auto p = paper::impactCount(s);
     matches += p && *p == static_cast<std::int64_t>(truth);
   }
   EXPECT_GT(ab_first, 100);

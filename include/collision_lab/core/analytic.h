@@ -1,7 +1,7 @@
 // The paper's analytic model, done right (see shared/physics.md):
 // the maps D_AB, D_BC, D = D_BC D_AB; the rotation angle theta = 2 alpha; the wedge in
 // mass-weighted velocity space u = S v, S = diag(sqrt(m)); the O(1) closed-form state
-// after n collisions; the exact collision count; per-collision energy transfer; and the
+// after n impacts; the exact impact count; per-impact energy transfer; and the
 // inverse map. Walls (infinite A or C) are the m -> inf limits throughout.
 #pragma once
 
@@ -53,16 +53,16 @@ class AnalyticModel {
   /// Which pair hits first (exact); empty when nothing collides.
   std::optional<Pair> firstPair() const { return first_pair_; }
 
-  /// Velocities [m/s] after the first n collisions of this scene, in O(1) for any n.
-  /// Meaningful for n <= the collision count; beyond it this is the algebraic
+  /// Velocities [m/s] after the first n impacts of this scene, in O(1) for any n.
+  /// Meaningful for n <= the impact count; beyond it this is the algebraic
   /// continuation of the alternating maps, not the physics.
   Vec3 velocitiesAfter(std::uint64_t n) const;
 
   /// Inverse: the initial velocities [m/s], recovered from the velocities after n
-  /// collisions of a run whose first pair is this scene's.
+  /// impacts of a run whose first pair is this scene's.
   Vec3 initialVelocitiesFrom(const Vec3& after, std::uint64_t n) const;
 
-  /// Kinetic energy gained by A, B, C [J] in collision n (1-based), from the closed form.
+  /// Kinetic energy gained by A, B, C [J] in impact n (1-based), from the closed form.
   std::array<Scalar, 3> energyTransfer(std::uint64_t n) const;
 
   /// Angle of u_perp from the escape cone's ray r_BC towards r_AB, in [0, 2 pi) [rad].
@@ -76,7 +76,7 @@ class AnalyticModel {
   const Scalar& centreVelocity() const { return centre_velocity_(0); }
   const Vec3& sHat() const { return s_hat_; }
 
-  /// energyTransfer(n) from the velocities before collision n, velocitiesAfter(n - 1)
+  /// energyTransfer(n) from the velocities before impact n, velocitiesAfter(n - 1)
   /// [m/s], when the caller has them already.
   std::array<Scalar, 3> energyTransfer(std::uint64_t n, const Vec3& before) const;
 
@@ -147,18 +147,18 @@ class RotationRecurrence {
   double cos_ = 1.0, sin_ = 0.0;
 };
 
-/// The closed form's velocities after collisions n = 1, 2, 3, ... in turn, in double, at
+/// The closed form's velocities after impacts n = 1, 2, 3, ... in turn, in double, at
 /// a few nanoseconds each: v_n = V 1 + cos(k theta) a + sin(k theta) b with k = n / 2 and
 /// the vectors a = S^-1 w, b = S^-1 (s_hat x w) (mapped once more by the first pair's map
 /// for odd n), the rotation advanced by a RotationRecurrence. Within 1e-13 of the closed
 /// form at every n in the energy norm |S dv| / |S v_0| (test_full_run_accuracy.cpp checks
-/// it against 50 digits over 2.2e7 collisions). Any n may be asked; cheapest when each n
+/// it against 50 digits over 2.2e7 impacts). Any n may be asked; cheapest when each n
 /// is the previous one or the one after it.
 class ClosedFormSequence {
  public:
   explicit ClosedFormSequence(const AnalyticModel<double>& model);
 
-  /// Velocities after collision n [m/s], as AnalyticModel<double>::velocitiesAfter(n).
+  /// Velocities after impact n [m/s], as AnalyticModel<double>::velocitiesAfter(n).
   Eigen::Vector3d velocitiesAfter(std::uint64_t n) {
     rotation_.moveTo(n / 2);
     const int odd = static_cast<int>(n % 2);
@@ -183,21 +183,21 @@ struct EigenCheck {
 };
 EigenCheck eigenCheck(const std::array<double, 3>& masses);
 
-/// The exact number of collisions this scene will have: N = ceil(psi / alpha) - 1 for AB
+/// The exact number of impacts this scene will have: N = ceil(psi / alpha) - 1 for AB
 /// first (psi' = (alpha - psi) mod 2 pi for BC first); 0 when nothing collides. A last
 /// contact with exactly zero approach speed (psi / alpha an exact integer) does not count.
 /// Exact for the given doubles: double, then 50 digits, then exact rationals where the
 /// integer test needs them. Never rounded through a double: counts pass 2^53.
-std::uint64_t predictedCollisionCount(const Scene& scene);
+std::uint64_t predictedImpactCount(const Scene& scene);
 
-/// The most collisions any start can give for these masses, ceil(pi / alpha)
+/// The most impacts any start can give for these masses, ceil(pi / alpha)
 /// (Galperin & Zemlyakov; OEIS A119661). Exact, including the kaleidoscopic masses where
 /// pi / alpha is an integer. Empty when it exceeds 2^64 - 1, the largest count the lab
 /// reports (validate() rejects such masses).
-std::optional<std::uint64_t> checkedMaxPossibleCollisionCount(const std::array<double, 3>& masses);
+std::optional<std::uint64_t> checkedMaxPossibleImpactCount(const std::array<double, 3>& masses);
 
-/// checkedMaxPossibleCollisionCount for masses that validate() accepts.
-std::uint64_t maxPossibleCollisionCount(const std::array<double, 3>& masses);
+/// checkedMaxPossibleImpactCount for masses that validate() accepts.
+std::uint64_t maxPossibleImpactCount(const std::array<double, 3>& masses);
 
 }  // namespace core
 }  // namespace collision_lab

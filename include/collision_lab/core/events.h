@@ -31,7 +31,7 @@ struct EventPolicy {
   static EventPolicy all() { return {Kind::kAll, 0}; }
   static EventPolicy firstN(std::uint64_t n) { return {Kind::kFirstN, n}; }
 
-  /// Is the event of collision `index` (1-based) kept? The one place this is decided.
+  /// Is the event of impact `index` (1-based) kept? The one place this is decided.
   bool keeps(std::uint64_t index) const {
     switch (kind) {
       case Kind::kNone: return false;

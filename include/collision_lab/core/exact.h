@@ -1,7 +1,7 @@
 // Exact rational reference: the same physics in boost::multiprecision::cpp_rational,
 // exact for the input doubles. Used by the tests as ground truth and by the adaptive
 // engine as its last resort. Cost grows with the size of the rationals (roughly
-// quadratically in the collision count): meant for counts up to a few thousand.
+// quadratically in the impact count): meant for counts up to a few thousand.
 #pragma once
 
 #include <array>
@@ -24,7 +24,7 @@ using RationalState = std::array<Rational, 3>;
 RationalState initialVelocities(const Scene& scene);
 
 /// Applies one elastic impact of `pair` to `v`, exactly. Walls keep their velocity.
-void applyCollision(const std::array<double, 3>& masses, Pair pair, RationalState& v);
+void applyImpact(const std::array<double, 3>& masses, Pair pair, RationalState& v);
 
 /// Exact approach speed of `pair` in state `v` (> 0: approaching; 0: touching without
 /// impact; < 0: separating).
@@ -34,11 +34,11 @@ Rational approachSpeed(Pair pair, const RationalState& v);
 /// < 0 when AB is first, > 0 when BC is first, 0 for a triple collision.
 int compareFirstContactTimes(const Scene& scene);
 
-/// Exact velocities after n alternating collisions starting with `first`.
+/// Exact velocities after n alternating impacts starting with `first`.
 RationalState velocitiesAfter(const Scene& scene, Pair first, std::uint64_t n);
 
 struct Run {
-  std::uint64_t collision_count = 0;
+  std::uint64_t impact_count = 0;
   bool truncated = false;
   std::optional<Pair> first_pair;
   std::vector<Pair> pairs;
@@ -47,7 +47,7 @@ struct Run {
 
 /// The whole run, exactly (velocities only; positions decide only the first pair).
 /// Precondition: validate(scene) passed.
-Run simulate(const Scene& scene, std::uint64_t max_collisions);
+Run simulate(const Scene& scene, std::uint64_t max_impacts);
 
 }  // namespace exact
 }  // namespace core

@@ -14,12 +14,12 @@ namespace collision_lab {
 namespace core {
 namespace paper {
 
-/// Velocities after n collisions by eq. (2.15) (n = 2k) and (2.16) (n = 2k+1), with the
+/// Velocities after n impacts by eq. (2.15) (n = 2k) and (2.16) (n = 2k+1), with the
 /// paper's c, d, nu^2 and the *initial* average vbar_AB. Written for AB first.
 std::array<double, 3> velocitiesAfter(const Scene& scene, std::uint64_t n);
 
 /// Eqs. (2.15)/(2.16) of one scene with the paper's constants computed once, for runs that
-/// evaluate them at every collision.
+/// evaluate them at every impact.
 class PrintedClosedForm {
  public:
   explicit PrintedClosedForm(const Scene& scene);
@@ -45,15 +45,15 @@ double omega(const std::array<double, 3>& masses);
 /// n_max of eq. (3.22): 1 + floor((Omega - phi_BC)/theta) + ceil((Omega - phi_BC)/theta).
 /// Empty when the printed expression is not a finite number for this scene, or when it
 /// does not fit an int64.
-std::optional<std::int64_t> collisionCount(const Scene& scene);
+std::optional<std::int64_t> impactCount(const Scene& scene);
 
-/// Energy gained by A, B, C [J] in collision n (1-based) by eqs. (4.4)-(4.7), with v_k
+/// Energy gained by A, B, C [J] in impact n (1-based) by eqs. (4.4)-(4.7), with v_k
 /// read as the paper defines it (against the *initial* vbar_AB). The equations give the
 /// colliding pair's entries only; the third body, which the paper's impact does not touch,
 /// gains 0. A wall in the pair makes its printed entries NaN (inf / inf), as does an
 /// impact BC that comes first (4.6 and 4.7 refer to the impact before).
-/// state_before: velocities just before collision n; state_two_before: just before
-/// collision n-1 (used by the BC formulas 4.6, 4.7, which refer to v_{k-1}).
+/// state_before: velocities just before impact n; state_two_before: just before
+/// impact n-1 (used by the BC formulas 4.6, 4.7, which refer to v_{k-1}).
 std::array<double, 3> energyTransfer(const Scene& scene, std::uint64_t n, Pair pair,
                                      const std::array<double, 3>& state_before,
                                      const std::array<double, 3>& state_two_before);

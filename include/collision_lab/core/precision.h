@@ -25,12 +25,12 @@ using ReplayPrecision = boost::multiprecision::cpp_bin_float_100;
 /// beyond the exact replay's reach.
 using DeepPrecision = boost::multiprecision::number<boost::multiprecision::cpp_bin_float<500>>;
 
-/// Longest run (collisions) an exact rational replay is attempted for: its cost grows
+/// Longest run (impacts) an exact rational replay is attempted for: its cost grows
 /// about quadratically. Beyond it 500 digits decide, and a zero to 500 digits counts as
 /// zero.
 constexpr std::uint64_t kExactReplayLimit = 20000;
 
-/// Longest run (collisions) the predicted count is found by exact simulation for, when
+/// Longest run (impacts) the predicted count is found by exact simulation for, when
 /// not even 500 digits can place the start in the wedge (analytic.h).
 constexpr std::uint64_t kExactCountLimit = 2000;
 

@@ -1,5 +1,5 @@
 // Three elastic bodies whose impact count is known in advance (the three-body closed form,
-// predictedCollisionCount): the engine's working tier on velocities alone, with no
+// predictedImpactCount): the engine's working tier on velocities alone, with no
 // decision taken (internal; not installed).
 //
 // Why no decision is needed. With three bodies the pairs alternate: after an impact its

@@ -298,6 +298,7 @@ Prediction predictTwoBody(const Scene& scene) {
   }
   const Rational time = (Rational(x[0]) - x[1]) / (v1 - v0);
   prediction.impact_count = 1;
+  prediction.first_pair_index = 0;
   prediction.impact_time = static_cast<double>(time);
   prediction.impact_position = static_cast<double>(Rational(x[0]) + time * v0);
   prediction.final_velocities = {scene.isWall(0) ? v[0] : static_cast<double>((1 + re) * centre - re * v0),

@@ -240,12 +240,12 @@ std::string formatShort(const Rational& q) {
 
 /// The rotation model (three elastic bodies, the middle one finite, at most one wall)
 /// reports its counts as 64-bit integers, and no start of these masses can have more
-/// collisions than ceil(pi / alpha). Only a light B makes that many: the count grows like
+/// impacts than ceil(pi / alpha). Only a light B makes that many: the count grows like
 /// pi sqrt(m / m_B) with m the lighter of A and C.
 std::optional<ValidationError> checkCountFits(const Scene& scene) {
   if (scene.size() != 3 || !scene.isElastic() || scene.wallCount() == 2 || scene.isRing()) return std::nullopt;
   const std::array<double, 3> masses{scene.masses[0], scene.masses[1], scene.masses[2]};
-  if (checkedMaxPossibleCollisionCount(masses)) return std::nullopt;
+  if (checkedMaxPossibleImpactCount(masses)) return std::nullopt;
   const double most = M_PI / anglesFor(masses).alpha;
   return makeError(Reason::kOverflow, "masses",
                    "these masses allow up to ceil(pi / alpha) = " +

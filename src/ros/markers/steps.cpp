@@ -147,8 +147,10 @@ void addVelocityLegend(const Canvas& c, bool own_scale, const PaperShown& paper)
   std::string legend = paper.dots ? "steps: simulated   dots: closed form" : "steps: simulated";
   if (paper.any) legend += "   pink: paper's eqs. (2.15)/(2.16) where they differ";
   if (paper.off_scale) legend += " (clipped)";
-  const bool rotation = c.run.prediction && c.run.prediction->model == collision_lab::Prediction::MODEL_THREE_BODY_ROTATION;
-  if (!paper.any && rotation && (isWall(c.run.input(), 0) || isWall(c.run.input(), 2))) {
+  // A prediction with the paper's values (max_possible_collision_count, the rotation
+  // model's) beside a wall, where the printed formulas have no value.
+  const bool paper_predicted = c.run.prediction && c.run.prediction->max_possible_collision_count > 0;
+  if (!paper.any && paper_predicted && (isWall(c.run.input(), 0) || isWall(c.run.input(), 2))) {
     legend += "   paper's (2.15)/(2.16): undefined with a wall";
   }
   if (const auto period = periodOf(c.run)) {

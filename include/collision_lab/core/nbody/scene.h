@@ -112,7 +112,7 @@ struct ValidationError {
 /// input (short of running out of memory). The first contact (its multiple-collision test,
 /// its time and the positions then, which must be doubles) is decided exactly for the given
 /// doubles. Two walls with bodies between them are valid. Three elastic bodies (the rotation
-/// model) must allow at most 2^64 - 1 collisions and have no mass-ratio limit; other scenes,
+/// model) must allow at most 2^64 - 1 impacts and have no mass-ratio limit; other scenes,
 /// which the event engine may simulate, a finite-mass ratio of at most 1e100.
 std::optional<ValidationError> validate(const Scene& scene);
 
