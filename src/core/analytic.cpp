@@ -5,7 +5,6 @@
 #include <limits>
 #include <type_traits>
 
-#include <Eigen/Eigenvalues>
 #include <boost/math/constants/constants.hpp>
 #include <boost/multiprecision/cpp_bin_float.hpp>
 #include <boost/multiprecision/eigen.hpp>
@@ -92,12 +91,6 @@ std::optional<std::uint64_t> countIfSeparated(const Quotient<T>& quotient) {
   return count < 0 ? 0 : static_cast<std::uint64_t>(count);  // never through a double: counts pass 2^53
 }
 
-std::array<std::complex<double>, 3> sortedByArgument(std::array<std::complex<double>, 3> values) {
-  std::sort(values.begin(), values.end(),
-            [](const std::complex<double>& a, const std::complex<double>& b) { return std::arg(a) < std::arg(b); });
-  return values;
-}
-
 }  // namespace
 
 template <class Scalar>
@@ -176,18 +169,6 @@ typename AnalyticModel<Scalar>::Vec3 AnalyticModel<Scalar>::velocitiesAfter(std:
 }
 
 template <class Scalar>
-typename AnalyticModel<Scalar>::Vec3 AnalyticModel<Scalar>::initialVelocitiesFrom(const Vec3& after,
-                                                                                 std::uint64_t n) const {
-  if (!first_pair_ || n == 0) return after;
-  const Pair first = *first_pair_;
-  const Vec3 even = n % 2 == 0 ? after : applyPairMap(first, after);  // the maps are involutions
-  const Scalar centre = centre_velocity_(0);
-  Vec3 w_after;
-  for (int i = 0; i < 3; ++i) w_after(i) = i == wall_ ? Scalar(0) : sqrt_mass_scaled_(i) * (even(i) - centre);
-  return velocitiesOfRotated(w_after, Scalar(first == Pair::AB ? 1 : -1) * Scalar(n / 2) * theta());
-}
-
-template <class Scalar>
 std::array<Scalar, 3> AnalyticModel<Scalar>::energyTransfer(std::uint64_t n) const {
   if (!first_pair_ || n == 0) return {Scalar(0), Scalar(0), Scalar(0)};
   return energyTransfer(n, velocitiesAfter(n - 1));
@@ -249,23 +230,6 @@ Angles anglesFor(const std::array<double, 3>& masses) {
   angles.theta = 2 * angles.alpha;
   angles.omega = pi<double>() - angles.alpha;
   return angles;
-}
-
-EigenCheck eigenCheck(const std::array<double, 3>& masses) {
-  const Scene scene = threeBodies(masses, {2, 1, 0});
-  const AnalyticModel<double> model(scene);
-  const Eigen::Matrix3d d = model.D();
-  Eigen::EigenSolver<Eigen::Matrix3d> solver(d, false);
-  EigenCheck check;
-  for (int i = 0; i < 3; ++i) check.eigen_solver[i] = solver.eigenvalues()(i);
-  check.eigen_solver = sortedByArgument(check.eigen_solver);
-  const double theta = model.theta();
-  check.closed_form = sortedByArgument({std::complex<double>(1, 0), std::polar(1.0, theta), std::polar(1.0, -theta)});
-  for (int i = 0; i < 3; ++i) {
-    check.max_difference = std::max(check.max_difference, std::abs(check.eigen_solver[i] - check.closed_form[i]));
-  }
-  check.determinant = d.determinant();
-  return check;
 }
 
 std::uint64_t predictedImpactCount(const Scene& scene) {

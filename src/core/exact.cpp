@@ -17,11 +17,12 @@ Rational massFraction(double m_i, double m_j) {
   return mi / (mi + Rational(m_j));
 }
 
-}  // namespace
-
+/// The input velocities as exact rationals.
 RationalState initialVelocities(const Scene& scene) {
   return {Rational(scene.velocities[0]), Rational(scene.velocities[1]), Rational(scene.velocities[2])};
 }
+
+}  // namespace
 
 void applyImpact(const std::array<double, 3>& masses, Pair pair, RationalState& v) {
   const int i = pairIndex(pair);  // the pair's bodies are i and i + 1

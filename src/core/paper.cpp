@@ -44,12 +44,6 @@ Constants constantsOf(const std::array<double, 3>& masses) {
 
 }  // namespace
 
-std::array<double, 3> velocitiesAfter(const Scene& scene, std::uint64_t n) {
-  const PrintedClosedForm printed(scene);
-  const double kth = static_cast<double>(n / 2) * printed.theta();
-  return printed.velocitiesAfter(n, std::cos(kth), std::sin(kth));
-}
-
 PrintedClosedForm::PrintedClosedForm(const Scene& scene) {
   const std::array<double, 3> m = triple(scene.masses);
   const auto& v0 = scene.velocities;

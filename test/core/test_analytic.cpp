@@ -1,6 +1,10 @@
 // The closed-form model against the simulation and exact arithmetic (the independent
 // reference of rational_reference.h, no core::exact).
 #include <gtest/gtest.h>
+#include <complex>
+#include <algorithm>
+
+#include <Eigen/Eigenvalues>
 
 #include <boost/math/constants/constants.hpp>
 #include <boost/multiprecision/cpp_bin_float.hpp>
@@ -34,10 +38,24 @@ TEST(Angles, AtanFormIsWellConditioned) {
 TEST(Matrices, EigenSolverAgreesWithClosedFormEigenvalues) {
   for (const auto& masses : {std::array<double, 3>{1, 2, 3}, std::array<double, 3>{1e3, 1, 1e3},
                              std::array<double, 3>{0.5, 7, 2}, std::array<double, 3>{100, 1, kInf}}) {
-    const EigenCheck check = eigenCheck(masses);
-    EXPECT_LE(check.max_difference, 1e-12);
-    EXPECT_NEAR(check.determinant, 1.0, 1e-12);
-    for (const auto& lambda : check.eigen_solver) EXPECT_NEAR(std::abs(lambda), 1.0, 1e-12);
+    // Eigen's general solver on D against the closed form 1, exp(+-i theta), both sorted
+    // by argument.
+    const AnalyticModel<double> model(threeBodies(masses, {2, 1, 0}));
+    const Eigen::Matrix3d d = model.D();
+    const Eigen::EigenSolver<Eigen::Matrix3d> solver(d, false);
+    std::array<std::complex<double>, 3> found, closed_form{std::complex<double>(1, 0), std::polar(1.0, model.theta()),
+                                                             std::polar(1.0, -model.theta())};
+    for (int i = 0; i < 3; ++i) found[i] = solver.eigenvalues()(i);
+    const auto by_argument = [](const std::complex<double>& a, const std::complex<double>& b) {
+      return std::arg(a) < std::arg(b);
+    };
+    std::sort(found.begin(), found.end(), by_argument);
+    std::sort(closed_form.begin(), closed_form.end(), by_argument);
+    for (int i = 0; i < 3; ++i) {
+      EXPECT_LE(std::abs(found[i] - closed_form[i]), 1e-12);
+      EXPECT_NEAR(std::abs(found[i]), 1.0, 1e-12);
+    }
+    EXPECT_NEAR(d.determinant(), 1.0, 1e-12);
   }
   // D = D_BC D_AB equals the paper's explicit matrix (1.8), which is correct.
   const Scene scene{{1, 2, 3}, {2, 1, 0}, {-1, 0, 1}};
@@ -178,17 +196,37 @@ TEST(Count, FloorExceptWhenPsiOverAlphaIsAnInteger) {
   EXPECT_EQ(predictedImpactCount(Scene{{1, 1, 1}, {3, 2, 0}, {-1, 0, 1}}), 3u);
 }
 
-TEST(Inverse, RoundTripRecoversInitialVelocities) {
+TEST(ClosedForm, KeepsEnergyAndMomentumAtAnyImpactCount) {
+  // Every impact is an isometry in the energy norm and keeps the momentum (the wall's frame
+  // with a wall): so does the closed form at any n, far past the count as well (its
+  // algebraic continuation), whatever rounding the angle n theta carries.
   std::mt19937_64 rng(11);
   for (int i = 0; i < 300; ++i) {
     const Scene scene = randomScene(rng);
     const AnalyticModel<double> model(scene);
-    const std::uint64_t count = predictedImpactCount(scene);
-    for (std::uint64_t n : {std::uint64_t{0}, std::uint64_t{1}, count / 2, count}) {
-      const Eigen::Vector3d back = model.initialVelocitiesFrom(model.velocitiesAfter(n), n);
-      const std::array<reference::Q, 3> v0{reference::Q(scene.velocities[0]), reference::Q(scene.velocities[1]),
-                                           reference::Q(scene.velocities[2])};
-      EXPECT_LE(energyNormError(scene, {back(0), back(1), back(2)}, v0), 1e-12) << i << " n=" << n;
+    const int wall = wallIndex(scene);
+    const double frame = wall >= 0 ? scene.velocities[wall] : 0.0;
+    const auto energy = [&](const Eigen::Vector3d& v) {
+      double sum = 0.0;
+      for (int k = 0; k < 3; ++k) sum += k == wall ? 0.0 : scene.masses[k] * (v(k) - frame) * (v(k) - frame) / 2;
+      return sum;
+    };
+    const auto momentum = [&](const Eigen::Vector3d& v) {
+      double sum = 0.0, scale = 0.0;
+      for (int k = 0; k < 3; ++k) {
+        sum += scene.masses[k] * v(k);
+        scale += std::fabs(scene.masses[k] * v(k));
+      }
+      return std::make_pair(sum, scale);
+    };
+    const Eigen::Vector3d v0(scene.velocities[0], scene.velocities[1], scene.velocities[2]);
+    for (std::uint64_t n : {std::uint64_t{1}, predictedImpactCount(scene), std::uint64_t{1000001}, std::uint64_t{1} << 40}) {
+      const Eigen::Vector3d v = model.velocitiesAfter(n);
+      EXPECT_NEAR(energy(v), energy(v0), 1e-12 * energy(v0)) << i << " n=" << n;
+      if (wall < 0) {
+        const auto [p, scale] = momentum(v);
+        EXPECT_NEAR(p, momentum(v0).first, 1e-12 * std::max(scale, momentum(v0).second)) << i << " n=" << n;
+      }
     }
   }
 }

@@ -51,7 +51,8 @@ TEST(PaperErrata, Eigenvectors24AreNotEigenvectors) {
 TEST(PaperErrata, ClosedFormVelocities215AreWrong) {
   // physics.md Erratum 2: masses (1,1,1), v0 = (-1, 0.3, 0.7), k = 1.
   const Scene scene{{1, 1, 1}, {3, 2, 0}, {-1, 0.3, 0.7}};
-  const auto printed = paper::velocitiesAfter(scene, 2);
+  const paper::PrintedClosedForm printed_form(scene);
+  const auto printed = printed_form.velocitiesAfter(2, std::cos(printed_form.theta()), std::sin(printed_form.theta()));
   EXPECT_NEAR(printed[0], -1.2125, 1e-12);
   EXPECT_NEAR(printed[1], 0.5125, 1e-12);
   EXPECT_NEAR(printed[2], -0.475, 1e-12);

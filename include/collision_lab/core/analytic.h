@@ -1,13 +1,11 @@
 // The paper's analytic model, done right (see shared/physics.md):
 // the maps D_AB, D_BC, D = D_BC D_AB; the rotation angle theta = 2 alpha; the wedge in
 // mass-weighted velocity space u = S v, S = diag(sqrt(m)); the O(1) closed-form state
-// after n impacts; the exact impact count; per-impact energy transfer; and the
-// inverse map. Walls (infinite A or C) are the m -> inf limits throughout.
+// after n impacts; the exact impact count; and per-impact energy transfer. Walls (infinite A or C) are the m -> inf limits throughout.
 #pragma once
 
 #include <array>
 #include <cmath>
-#include <complex>
 #include <cstdint>
 #include <optional>
 
@@ -57,10 +55,6 @@ class AnalyticModel {
   /// Meaningful for n <= the impact count; beyond it this is the algebraic
   /// continuation of the alternating maps, not the physics.
   Vec3 velocitiesAfter(std::uint64_t n) const;
-
-  /// Inverse: the initial velocities [m/s], recovered from the velocities after n
-  /// impacts of a run whose first pair is this scene's.
-  Vec3 initialVelocitiesFrom(const Vec3& after, std::uint64_t n) const;
 
   /// Kinetic energy gained by A, B, C [J] in impact n (1-based), from the closed form.
   std::array<Scalar, 3> energyTransfer(std::uint64_t n) const;
@@ -173,15 +167,6 @@ class ClosedFormSequence {
 
 /// Angles in double, atan form (well conditioned for extreme mass ratios).
 Angles anglesFor(const std::array<double, 3>& masses);
-
-/// Eigenvalues of D: Eigen's general solver, and the closed form 1, exp(+-i theta).
-struct EigenCheck {
-  std::array<std::complex<double>, 3> eigen_solver;  ///< sorted by argument
-  std::array<std::complex<double>, 3> closed_form;   ///< 1, exp(i theta), exp(-i theta) sorted alike
-  double max_difference = 0.0;
-  double determinant = 0.0;
-};
-EigenCheck eigenCheck(const std::array<double, 3>& masses);
 
 /// The exact number of impacts this scene will have: N = ceil(psi / alpha) - 1 for AB
 /// first (psi' = (alpha - psi) mod 2 pi for BC first); 0 when nothing collides. A last

@@ -20,9 +20,6 @@ namespace exact {
 using Rational = boost::multiprecision::cpp_rational;
 using RationalState = std::array<Rational, 3>;
 
-/// The input velocities as exact rationals.
-RationalState initialVelocities(const Scene& scene);
-
 /// Applies one elastic impact of `pair` to `v`, exactly. Walls keep their velocity.
 void applyImpact(const std::array<double, 3>& masses, Pair pair, RationalState& v);
 

@@ -14,12 +14,9 @@ namespace collision_lab {
 namespace core {
 namespace paper {
 
-/// Velocities after n impacts by eq. (2.15) (n = 2k) and (2.16) (n = 2k+1), with the
-/// paper's c, d, nu^2 and the *initial* average vbar_AB. Written for AB first.
-std::array<double, 3> velocitiesAfter(const Scene& scene, std::uint64_t n);
-
-/// Eqs. (2.15)/(2.16) of one scene with the paper's constants computed once, for runs that
-/// evaluate them at every impact.
+/// Eqs. (2.15)/(2.16) of one scene, the velocities after n impacts (n = 2k and 2k + 1),
+/// with the paper's c, d, nu^2 and the *initial* average vbar_AB, computed once. Written for
+/// AB first.
 class PrintedClosedForm {
  public:
   explicit PrintedClosedForm(const Scene& scene);
@@ -27,7 +24,7 @@ class PrintedClosedForm {
   /// The paper's theta = arg(lambda_+), eq. (2.2), as its formulas use it [rad].
   double theta() const { return theta_; }
 
-  /// velocitiesAfter(scene, n) [m/s], given cos and sin of (n / 2) theta().
+  /// The velocities after impact n [m/s], given cos and sin of (n / 2) theta().
   std::array<double, 3> velocitiesAfter(std::uint64_t n, double cos_k_theta, double sin_k_theta) const;
 
  private:
