@@ -6,7 +6,7 @@
 // rationals), how often the engine escalated (EngineResult::escalations) and what that
 // cost against the double-only loop. Also the closed-form query time.
 //
-// Reference: exact::simulate (rationals) when the count is at most a few thousand;
+// Reference: exact::walkVelocityMaps (rationals) when the count is at most a few thousand;
 // beyond that the exact count (predictedImpactCount) and the closed form evaluated at
 // 50 digits (AnalyticModel<HighPrecision>). First pairs: an exact rational comparison.
 //
@@ -55,7 +55,7 @@ struct EscalationStats {
   std::uint64_t exact_rational = 0;
 };
 
-constexpr std::uint64_t kExactReferenceLimit = 5'000;    // exact::simulate up to this count
+constexpr std::uint64_t kExactReferenceLimit = 5'000;    // exact::walkVelocityMaps up to this count
 constexpr std::uint64_t kMultiprecisionLimit = 3'000'000;  // 50-digit runs up to this count
 constexpr std::uint64_t kSimulationLimit = 1'000'000'000;  // any simulation up to this count
 constexpr std::uint64_t kIsolateAbove = 1'000'000;  // longer runs go to a child process with a time limit
@@ -103,7 +103,7 @@ Reference makeReference(const Scene& scene) {
   ref.first_pair = ExactTrajectory(scene, 0).firstPair();  // exact, stops before any collision
   const std::uint64_t predicted = predictedImpactCount(scene);
   if (predicted <= kExactReferenceLimit) {
-    const exact::Run run = exact::simulate(scene, 10 * kExactReferenceLimit);
+    const exact::MapWalk run = exact::walkVelocityMaps(scene, 10 * kExactReferenceLimit);
     ref.count = run.impact_count;
     for (int i = 0; i < 3; ++i) ref.velocities[i] = static_cast<double>(run.final_velocities[i]);
     ref.kind = "exact rational";

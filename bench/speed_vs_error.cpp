@@ -8,7 +8,7 @@
 // models.h) where one does; fixed_step (a hand-written time-stepping loop) and every real
 // engine this build found (Bullet, ODE, Box2D, restitution set per pair), each swept over dt.
 // Reference: exact rationals (an independent GMP trajectory, bench/common; on the
-// three-body scenes also exact::simulate for counts and velocities).
+// three-body scenes also exact::walkVelocityMaps for counts and velocities).
 //
 // Usage: collision_lab_speed_vs_error [--quick] [--csv FILE] [--md FILE] [--plot FILE]
 //   The full run (no --quick) writes docs/speed_vs_error.{csv,md,png} unless told
@@ -132,9 +132,9 @@ struct Reference {
   std::string check;      ///< how the independent checks agreed
 };
 
-/// exact::simulate, on the three-body scenes: count, first pair and velocities.
+/// exact::walkVelocityMaps, on the three-body scenes: count, first pair and velocities.
 std::string crossCheckThreeBody(const BenchScene& s, Reference* ref) {
-  const exact::Run run = exact::simulate(*s.three, 10'000'000);
+  const exact::MapWalk run = exact::walkVelocityMaps(*s.three, 10'000'000);
   std::vector<double> v(3);
   for (int i = 0; i < 3; ++i) v[i] = static_cast<double>(run.final_velocities[i]);
   const double diff = relativeVelocityError(s.scene.masses, ref->velocities, v);
@@ -142,9 +142,9 @@ std::string crossCheckThreeBody(const BenchScene& s, Reference* ref) {
                      run.first_pair == (ref->first_pair ? std::optional<Pair>(*ref->first_pair == 0 ? Pair::AB : Pair::BC)
                                                         : std::nullopt) &&
                      diff <= 4 * std::numeric_limits<double>::epsilon();
-  ref->velocities = v;  // exact::simulate is the stated reference for velocities
-  return agree ? "exact::simulate agrees (count, first pair, velocities to rounding)"
-               : format("MISMATCH: exact::simulate count %llu, velocity difference %s",
+  ref->velocities = v;  // exact::walkVelocityMaps is the stated reference for velocities
+  return agree ? "exact::walkVelocityMaps agrees (count, first pair, velocities to rounding)"
+               : format("MISMATCH: exact::walkVelocityMaps count %llu, velocity difference %s",
                         static_cast<unsigned long long>(run.impact_count), sci(diff).c_str());
 }
 
@@ -535,7 +535,7 @@ std::string toMarkdown(const std::vector<Row>& rows, const std::vector<BenchScen
       << "Reference: an exact GMP rational trajectory (bench/common/exact_trajectory.cpp, N bodies, "
          "walls, each e the exact value of its double), written independently of the core; positions "
          "and velocities rounded to double. On the three-body scenes the count and velocities come from "
-         "`exact::simulate` (Boost cpp_rational), checked against it; on the others the count is checked "
+         "`exact::walkVelocityMaps` (Boost cpp_rational), checked against it; on the others the count is checked "
          "against physics.md or the preset where one is known.\n\n";
   out << scenesTable(scenes, refs);
   out << "## Methods and every setting\n\n"

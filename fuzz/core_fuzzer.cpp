@@ -290,7 +290,7 @@ int collisionLabCoreFuzzOne(const std::uint8_t* data, std::size_t size) {
   if (watched) FUZZ_CHECK(watched_events == sim.impact_count, "the visitor sees every impact");
 
   if (predicted <= kExactCrossCheckLimit) {
-    const cl::exact::Run truth = cl::exact::simulate(scene, kExactCrossCheckLimit + 1);
+    const cl::exact::MapWalk truth = cl::exact::walkVelocityMaps(scene, kExactCrossCheckLimit + 1);
     FUZZ_CHECK(!truth.truncated && truth.impact_count == predicted, "predictedImpactCount == exact rational count");
   }
 

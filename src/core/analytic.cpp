@@ -243,7 +243,7 @@ std::uint64_t predictedImpactCount(const Scene& scene) {
     // relative motion): 500 digits, else count exactly when the run is short.
     if (auto count = countIfSeparated(countQuotient<DeepPrecision>(scene, *first))) return *count;
     if (maxPossibleImpactCount(triple(scene.masses)) <= kExactCountLimit) {
-      return exact::simulate(scene, kExactCountLimit).impact_count;
+      return exact::walkVelocityMaps(scene, kExactCountLimit).impact_count;
     }
   }
   // psi / alpha is an integer Q to 50 digits. If it is exactly Q, contact Q grazes with

@@ -64,8 +64,8 @@ RationalState velocitiesAfter(const Scene& scene, Pair first, std::uint64_t n) {
   return v;
 }
 
-Run simulate(const Scene& scene, std::uint64_t max_impacts) {
-  Run run;
+MapWalk walkVelocityMaps(const Scene& scene, std::uint64_t max_impacts) {
+  MapWalk run;
   RationalState v = initialVelocities(scene);
   const bool ab = approachSpeed(Pair::AB, v) > 0;
   const bool bc = approachSpeed(Pair::BC, v) > 0;

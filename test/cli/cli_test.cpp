@@ -139,7 +139,7 @@ TEST(CliJson, AgreesWithExactArithmetic) {
       scene.positions[i] = doc.at("scene").at("positions")[i].get<double>();
       scene.velocities[i] = doc.at("scene").at("velocities")[i].get<double>();
     }
-    const collision_lab::core::exact::Run truth = collision_lab::core::exact::simulate(scene, 100000);
+    const collision_lab::core::exact::MapWalk truth = collision_lab::core::exact::walkVelocityMaps(scene, 100000);
     ASSERT_FALSE(truth.truncated);
     EXPECT_EQ(doc.at("summary").at("collision_count"), truth.impact_count);
     EXPECT_EQ(doc.at("summary").at("predicted_collision_count"), truth.impact_count);

@@ -101,7 +101,7 @@ TEST(ExactAgreement, CoreExactEqualsTheIndependentReference) {
   for (int i = 0; i < 300; ++i) {
     const Scene scene = randomScene(rng, i < 250 ? 1.0 : 2.5);
     SCOPED_TRACE(::testing::Message() << "scene " << i);
-    const exact::Run run = exact::simulate(scene, 100000);
+    const exact::MapWalk run = exact::walkVelocityMaps(scene, 100000);
     const Truth reference = truth(scene);
     ASSERT_FALSE(run.truncated);
     EXPECT_EQ(run.impact_count, reference.collision_count);

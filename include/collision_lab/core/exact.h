@@ -1,6 +1,6 @@
-// Exact rational reference: the same physics in boost::multiprecision::cpp_rational,
-// exact for the input doubles. Used by the tests as ground truth and by the adaptive
-// engine as its last resort. Cost grows with the size of the rationals (roughly
+// The three-body velocity maps in boost::multiprecision::cpp_rational, exact for the input
+// doubles: the rotation model's exact decisions (the first pair, a grazing last contact,
+// the count where 500 digits cannot place u_perp), and ground truth for the tests. Cost grows with the size of the rationals (roughly
 // quadratically in the impact count): meant for counts up to a few thousand.
 #pragma once
 
@@ -34,7 +34,9 @@ int compareFirstContactTimes(const Scene& scene);
 /// Exact velocities after n alternating impacts starting with `first`.
 RationalState velocitiesAfter(const Scene& scene, Pair first, std::uint64_t n);
 
-struct Run {
+/// The velocity maps walked from the start: D_AB and D_BC in turn from the first pair,
+/// while the next pair approaches (exactly).
+struct MapWalk {
   std::uint64_t impact_count = 0;
   bool truncated = false;
   std::optional<Pair> first_pair;
@@ -42,9 +44,12 @@ struct Run {
   RationalState final_velocities;
 };
 
-/// The whole run, exactly (velocities only; positions decide only the first pair).
+/// The impacts of three elastic bodies, exactly, by the velocity maps alone (positions decide
+/// only the first pair; no time is computed, so an impact after the largest double counts
+/// too): the rotation model's exact count where 500 digits cannot place u_perp, and the
+/// tests' reference. Not a simulation of the scene: the engine is the one simulator.
 /// Precondition: validate(scene) passed.
-Run simulate(const Scene& scene, std::uint64_t max_impacts);
+MapWalk walkVelocityMaps(const Scene& scene, std::uint64_t max_impacts);
 
 }  // namespace exact
 }  // namespace core
