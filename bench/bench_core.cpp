@@ -161,7 +161,7 @@ SceneFigures benchScene(double heavy, int repeats, bool keep_all, bool lab_only 
   Escalations escalation;
   if (!lab_only) {
     methods.emplace_back("engine count-only (runEngine)", [&] {
-                         const EngineResult result = runEngine(scene, engine_options);
+                         const SceneSimulation result = runEngine(scene, engine_options);
                          escalation = result.escalations;
                          doNotOptimize(result.final_velocities.data());
                          return result.impact_count;

@@ -23,7 +23,7 @@ namespace {
 using namespace collision_lab::core;
 
 struct Timed {
-  EngineResult run;
+  SceneSimulation run;
   double seconds = 0.0;
 };
 
@@ -90,7 +90,7 @@ int main(int argc, char** argv) {
         const Scene scene = testing_support::granularGas(n, e, seed);
         const auto start = std::chrono::steady_clock::now();
         const std::clock_t cpu_start = std::clock();
-        const EngineResult run = runEngine(scene);
+        const SceneSimulation run = runEngine(scene);
         const double cpu = static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         const double per_impact = run.impact_count ? 1e6 * seconds / static_cast<double>(run.impact_count) : 0.0;

@@ -289,12 +289,12 @@ void tcBoxAgainstElastic(const std::string& box_path, std::uint64_t impacts, int
   std::vector<double> tc_ns, elastic_ns;
   std::uint64_t tc_impacts = 0, elastic_impacts = 0, escalations = 0, replayed = 0, elastic_replayed = 0;
   for (int r = 0; r < repeats; ++r) {
-    collision_lab::core::EngineResult result;
+    collision_lab::core::SceneSimulation result;
     const Timed t = timeRun([&] {
       result = collision_lab::core::runEngine(tc, options);
       return result.impact_count;
     });
-    collision_lab::core::EngineResult elastic_result;
+    collision_lab::core::SceneSimulation elastic_result;
     const Timed e = timeRun([&] {
       elastic_result = collision_lab::core::runEngine(elastic, options);
       return elastic_result.impact_count;
@@ -371,7 +371,7 @@ int main(int argc, char** argv) {
       const Timed t = timeRun([&] { return tree.run(c.max_impacts); });
       collision_lab::core::EngineOptions options;
       options.max_impacts = c.max_impacts;
-      collision_lab::core::EngineResult result;
+      collision_lab::core::SceneSimulation result;
       const Timed e = timeRun([&] {
         result = collision_lab::core::runEngine(c.scene, options);
         return result.impact_count;

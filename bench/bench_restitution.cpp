@@ -78,7 +78,7 @@ int main(int argc, char** argv) {
     const long long count = p.impact_count ? static_cast<long long>(*p.impact_count) : -1;
     std::string engine_count = "", engine_time = "", engine_collapsed = "", engine_truncated = "";
     if (!p.collapsed ? count <= 2000 : std::fabs(e - rc) > 1e-4) {
-      EngineResult run;
+      SceneSimulation run;
       const double t = medianSeconds(repeats, [&] { run = runEngine(scene(e)); });
       engine_count = std::to_string(run.impact_count);
       engine_truncated = run.stop == StopReason::kCap ? "1" : "0";

@@ -3,7 +3,7 @@
 // naive fixed-precision loops (double-only, long-double-only, 50-digit-only: no error
 // bounds, no escalation; bench/common/naive_loop.h) and of the core (the exact event
 // engine, runEngine, in count-only mode: adaptive precision from double-double up to exact
-// rationals), how often the engine escalated (EngineResult::escalations) and what that
+// rationals), how often the engine escalated (SceneSimulation::escalations) and what that
 // cost against the double-only loop. Also the closed-form query time.
 //
 // Reference: exact::walkVelocityMaps (rationals) when the count is at most a few thousand;
@@ -149,7 +149,7 @@ Outcome naiveOutcome(const Scene& scene) {
 }
 
 /// The engine's run of three bodies, count-only (no event visited or kept).
-EngineResult engineRun(const Scene& scene, std::uint64_t keep_events = 0) {
+SceneSimulation engineRun(const Scene& scene, std::uint64_t keep_events = 0) {
   EngineOptions options;
   options.max_impacts = kSimulationLimit;
   options.keep_events = keep_events;
@@ -159,11 +159,11 @@ EngineResult engineRun(const Scene& scene, std::uint64_t keep_events = 0) {
 
 /// The core: the exact event engine (keeping its first record, for the first pair).
 Outcome coreOutcome(const Scene& scene) {
-  const EngineResult result = engineRun(scene, 1);
+  const SceneSimulation result = engineRun(scene, 1);
   Outcome out;
   out.ran = true;
   out.count = result.impact_count;
-  if (!result.events.empty()) out.first_pair = result.events.front().pair_index == 0 ? Pair::AB : Pair::BC;
+  if (!result.impacts.empty()) out.first_pair = result.impacts.front().pair_index == 0 ? Pair::AB : Pair::BC;
   for (int i = 0; i < 3; ++i) out.velocities[i] = result.final_velocities[i];
   // As the lab run counts them: a decision per impact and the final one; escalated ones
   // taken at 100 digits or more, of which exact.
@@ -448,7 +448,7 @@ int main(int argc, char** argv) {
     double sn = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
     std::vector<bool> did_escalate(scenes.size());
     for (std::size_t k = 0; k < scenes.size(); ++k) {
-      const EngineResult result = engineRun(scenes[k]);
+      const SceneSimulation result = engineRun(scenes[k]);
       did_escalate[k] = result.escalations.high_precision + result.escalations.exact_rational > 0;
       sum_core += t_core[k];
       sum_naive += t_naive[k];

@@ -265,7 +265,7 @@ Row runNbodyEngine(const BenchScene& s, const Reference& ref, bool quick) {
   options.max_impacts = s.engine_cap;
   // The state at end_time: the core's replay of the impacts up to it.
   BodyStateReplay state(s.scene);
-  EngineResult result;
+  SceneSimulation result;
   auto work = [&] {
     state = BodyStateReplay(s.scene);
     result = runEngine(s.scene, options, [&](const ImpactRecord& r) {

@@ -218,19 +218,6 @@ struct SimulationOptions {
   const std::atomic<bool>* cancel = nullptr;
 };
 
-/// What one simulation of the three bodies measured.
-struct SimulationResult {
-  std::uint64_t impact_count = 0;
-  bool truncated = false;                    ///< more impacts were due: the cap, a cancel or a stop
-  bool cancelled = false;                    ///< stopped by SimulationOptions::cancel
-  StopReason stop = StopReason::kFinished;   ///< the engine's reason
-  std::array<double, 3> final_velocities{};  ///< [m/s]
-  double energy_relative_drift = 0.0;        ///< |E_end - E_0| / E_0, in the wall's frame
-  double momentum_relative_drift = 0.0;      ///< |p_end - p_0| / sum |m v|; NaN with a wall
-  /// The engine's replays at 100 digits and in exact rationals (none on the known count).
-  Escalations escalations;
-};
-
 /// The run of three elastic bodies whose count the closed form gives (`count`), without the
 /// engine's queue or any decision (nbody/elastic_triple.h), the summary of every run that
 /// can be had so: its count, final velocities (the engine's bit for bit, or certified
@@ -241,7 +228,7 @@ struct SimulationResult {
 /// cannot be taken this way (then the engine runs it). `progress` (RunOptions) sees every
 /// progress_interval-th impact, with no time (NaN).
 template <class Restart, class Visit>
-std::optional<SimulationResult> simulateKnownCount(const Scene& scene, std::uint64_t count,
+std::optional<SceneSimulation> simulateKnownCount(const Scene& scene, std::uint64_t count,
                                                    const SimulationOptions& options, const ProgressCallback& progress,
                                                    std::uint64_t progress_interval, Restart&& restart, Visit&& visit) {
   if (scene.isWall(0) && scene.isWall(2)) return std::nullopt;
@@ -271,17 +258,14 @@ std::optional<SimulationResult> simulateKnownCount(const Scene& scene, std::uint
         if (every != 0 && n % every == 0) progress(EngineProgress{n, std::numeric_limits<double>::quiet_NaN()});
       });
   if (!run) return std::nullopt;
-  SimulationResult result;
+  SceneSimulation result;
+  result.simulated = true;
   result.impact_count = run->impact_count;
   result.truncated = run->capped || run->cancelled;
-  result.cancelled = run->cancelled;
   result.stop = run->cancelled ? StopReason::kCancelled : run->capped ? StopReason::kCap : StopReason::kFinished;
-  EngineResult drift;
-  drift.final_velocities.assign(run->final_velocities.begin(), run->final_velocities.end());
-  nbody_detail::fillEngineDrift(units.scene, drift);
-  for (int k = 0; k < 3; ++k) result.final_velocities[k] = velocity_si(run->final_velocities[k]);
-  result.energy_relative_drift = drift.energy_relative_drift;
-  result.momentum_relative_drift = drift.momentum_relative_drift;
+  result.final_velocities.assign(run->final_velocities.begin(), run->final_velocities.end());
+  nbody_detail::fillEngineDrift(units.scene, result);  // in working units, where the run's values are
+  for (double& v : result.final_velocities) v = velocity_si(v);
   return result;
 }
 
@@ -293,14 +277,13 @@ std::optional<SimulationResult> simulateKnownCount(const Scene& scene, std::uint
 /// totals after it from the velocities; the visitor adds the model's values. Escalations: one decision per impact and the final one. A run the engine
 /// ended otherwise than finished, capped or cancelled (out of range: the next impact comes
 /// after the largest double) is truncated, with the engine's sentence in `stopped_otherwise`.
-SimulationResult simulateByEngine(const Scene& scene, const SimulationOptions& options,
+SceneSimulation simulateByEngine(const Scene& scene, const SimulationOptions& options,
                                   const ProgressCallback& progress, std::uint64_t progress_interval,
                                   const std::function<void(ImpactRecord&)>& visitor, std::string& stopped_otherwise) {
   EngineOptions engine_options;
   engine_options.max_impacts = options.max_collisions;
   engine_options.progress_interval = progress ? progress_interval : 0;
   engine_options.cancel = options.cancel;
-  SimulationResult result;
   // Velocities, and where body k was (since_position) at since_time[k].
   const auto positive = [](long double x) { return x == 0 ? 0.0 : static_cast<double>(x); };  // never -0
   std::array<double, 3> velocities{}, since_position = triple(scene.positions), since_time{};
@@ -344,15 +327,16 @@ SimulationResult simulateByEngine(const Scene& scene, const SimulationOptions& o
       visitor(event);
     };
   }
-  EngineResult engine = runEngine(scene, engine_options, on_impact, progress);
+  const SceneSimulation engine = runEngine(scene, engine_options, on_impact, progress);
+  SceneSimulation result;  // what the summary takes from the engine's run
+  result.simulated = true;
   result.impact_count = engine.impact_count;
   result.truncated = engine.truncated || engine.stop != StopReason::kFinished;
-  result.cancelled = engine.stop == StopReason::kCancelled;
   result.stop = engine.stop;
-  if (engine.stop != StopReason::kFinished && engine.stop != StopReason::kCap && !result.cancelled) {
+  if (engine.stop != StopReason::kFinished && engine.stop != StopReason::kCap && engine.stop != StopReason::kCancelled) {
     stopped_otherwise = engine.stop_message;
   }
-  for (int k = 0; k < 3; ++k) result.final_velocities[k] = engine.final_velocities[k];
+  result.final_velocities = engine.final_velocities;
   result.energy_relative_drift = engine.energy_relative_drift;
   result.momentum_relative_drift = engine.momentum_relative_drift;
   result.escalations.high_precision = engine.escalations.high_precision;
@@ -396,7 +380,7 @@ SceneSimulation simulateBesidePrediction(const Scene& scene, const Prediction& p
   const bool publishes = lab.mode == RunMode::kFull && (visitors.impact || events.kind != EventPolicy::Kind::kNone);
   const ProgressCallback known_progress = publishes ? ProgressCallback{} : progress;  // else the engine's
   double known_error_sq = 0.0;
-  std::optional<SimulationResult> known;
+  std::optional<SceneSimulation> known;
   if (lab.mode == RunMode::kFull) {
     std::optional<ClosedFormInTurn> predicted;
     known = simulateKnownCount(
@@ -412,7 +396,7 @@ SceneSimulation simulateBesidePrediction(const Scene& scene, const Prediction& p
     known = simulateKnownCount(scene, predicted_count, simulation_options, known_progress, progress_interval, [] {},
                                [](std::uint64_t, const std::array<double, 3>&) {});
   }
-  std::optional<SimulationResult> by_engine;
+  std::optional<SceneSimulation> by_engine;
   if (publishes || !known) {
     by_engine = simulateByEngine(scene, simulation_options, progress, progress_interval, enrich, stopped_otherwise);
   }
@@ -424,12 +408,12 @@ SceneSimulation simulateBesidePrediction(const Scene& scene, const Prediction& p
     max_error_sq = known_error_sq;
     stopped_otherwise.clear();
   }
-  const SimulationResult& run = *by_engine;
+  const SceneSimulation& run = *by_engine;
   simulation.simulated = true;
   simulation.impact_count = run.impact_count;
   simulation.truncated = run.truncated;
   simulation.stop = run.stop;  // the engine's reason
-  if (run.cancelled) {
+  if (run.stop == StopReason::kCancelled) {
     simulation.stop_message =
         "cancelled after " + countText(run.impact_count) + " of " + countText(predicted_count) + " predicted";
   } else if (!stopped_otherwise.empty()) {
@@ -441,13 +425,13 @@ SceneSimulation simulateBesidePrediction(const Scene& scene, const Prediction& p
     simulation.stop_message =
         "no pair approaches any more after " + std::to_string(run.impact_count) + " impacts: the run is complete";
   }
-  simulation.final_velocities.assign(run.final_velocities.begin(), run.final_velocities.end());
+  simulation.final_velocities = run.final_velocities;
   simulation.energy_lost = 0.0;  // elastic
   simulation.energy_relative_drift = run.energy_relative_drift;
   simulation.momentum_relative_drift = run.momentum_relative_drift;
   // The rotation model predicts every impact: its error is the largest over them all.
   simulation.max_prediction_error = std::max(relative_error.fromSquared(max_error_sq),
-                                             relative_error(run.final_velocities, model.velocitiesAfter(run.impact_count)));
+                                             relative_error(triple(run.final_velocities), model.velocitiesAfter(run.impact_count)));
   if (!run.truncated) simulation.matches_prediction = run.impact_count == predicted_count;
   simulation.escalations = run.escalations;
   return simulation;

@@ -75,29 +75,6 @@ double energyNormError(const Scene& scene, const std::vector<double>& simulated,
   return std::sqrt(error_sq / initial_sq);
 }
 
-SceneSimulation fromEngine(EngineResult&& engine) {
-  SceneSimulation simulation;
-  simulation.simulated = true;
-  simulation.impact_count = engine.impact_count;
-  simulation.truncated = engine.truncated;
-  simulation.stop = engine.stop;
-  simulation.stop_message = std::move(engine.stop_message);
-  simulation.multiple_collision = engine.multiple_collision;
-  simulation.final_time = engine.final_time;
-  simulation.final_velocities = std::move(engine.final_velocities);
-  simulation.energy_lost = engine.energy_lost;
-  simulation.collapsed = engine.collapsed;
-  simulation.collapse_time = engine.collapse_time;
-  simulation.collapse_position = engine.collapse_position;
-  simulation.collapses = std::move(engine.collapses);
-  simulation.cluster_impacts = engine.cluster_impacts;
-  simulation.rule_elastic_impacts = engine.rule_elastic_impacts;
-  simulation.energy_relative_drift = engine.energy_relative_drift;
-  simulation.momentum_relative_drift = engine.momentum_relative_drift;
-  simulation.escalations = engine.escalations;
-  return simulation;
-}
-
 /// The over-cap rule: the model's count exceeds the cap, so the model answers alone.
 SceneSimulation overCap(const Prediction& prediction, std::uint64_t cap) {
   SceneSimulation simulation = fromPrediction(prediction);
@@ -148,8 +125,8 @@ SceneSimulation simulateScene(const Scene& scene, const SceneRunOptions& options
       if (lab.events.keeps(impact.index)) kept.push_back(impact);
     };
   }
-  SceneSimulation simulation = fromEngine(
-      runEngine(scene, engine_options, on_impact, visitors.progress, full ? visitors.collapse : CollapseVisitor{}));
+  SceneSimulation simulation =
+      runEngine(scene, engine_options, on_impact, visitors.progress, full ? visitors.collapse : CollapseVisitor{});
   simulation.impacts = std::move(kept);
   if (prediction && prediction->impact_count && simulation.stop == StopReason::kFinished) {
     simulation.max_prediction_error = energyNormError(scene, simulation.final_velocities, prediction->final_velocities);

@@ -78,7 +78,7 @@ TEST(SceneRun, ThreeBodiesFillTheSimulationSummaryLikeEveryScene) {
   ASSERT_FALSE(plan.error);
   const core::SceneRunResult result = core::runScene(plan, withEvents(core::EventPolicy::none()));
   ASSERT_EQ(result.model.kind, core::ModelKind::kThreeBodyRotation);
-  const core::EngineResult engine = core::runEngine(scene);
+  const core::SceneSimulation engine = core::runEngine(scene);
   EXPECT_TRUE(result.simulation.simulated);
   EXPECT_FALSE(result.simulation.truncated);
   EXPECT_EQ(result.simulation.stop, core::StopReason::kFinished);

@@ -147,7 +147,7 @@ TEST(ExactAgreement, GrazingEndsWithEqualVelocities) {
   // The summary comes from the known count, which needs no decision; the engine, which
   // publishes the events, decides the grazing contact in exact rationals.
   EXPECT_EQ(observed.result.summary.escalations.exact_rational, 0u);
-  const EngineResult engine = runEngine(scene);
+  const SceneSimulation engine = runEngine(scene);
   EXPECT_GE(engine.escalations.exact_rational, 1u);
   EXPECT_EQ(engine.final_velocities[kA], engine.final_velocities[kB]);  // it adopted the exact state
   expectMatchesExact(scene);

@@ -77,7 +77,7 @@ TEST(ThreeBodyRounding, FinalAndEventVelocitiesAreTheCorrectlyRoundedExactOnesAn
     ASSERT_TRUE(run.prediction && hasRotationValues(*run.prediction)) << describe(scene);
     const SceneSimulation& result = run.simulation;
     ASSERT_EQ(result.impact_count, truth.impacts.size()) << describe(scene);
-    const EngineResult engine = runEngine(general(scene));
+    const SceneSimulation engine = runEngine(general(scene));
     ASSERT_EQ(engine.impact_count, truth.impacts.size()) << describe(scene);
     for (int i = 0; i < 3; ++i) {
       EXPECT_TRUE(correctlyRounded(result.final_velocities[i], truth.final_velocities[i]))

@@ -63,7 +63,7 @@ CollisionEvent impactMessage(const collision_lab::core::ImpactRecord& r, const S
 
 struct NBodyRun {
   Scene scene;
-  collision_lab::core::EngineResult result;
+  collision_lab::core::SceneSimulation result;
   std::vector<CollisionEvent> events;  ///< impacts and collapses, in order
   RunRecord run;
 };

@@ -18,7 +18,7 @@ using collision_lab::core::Scene;
 using collision_lab_ros::RunRecord;
 
 struct GranularRun {
-  collision_lab::core::EngineResult result;
+  collision_lab::core::SceneSimulation result;
   RunRecord record;
 };
 

@@ -68,55 +68,10 @@ struct SceneRunOptions {
   std::uint64_t progress_interval = std::uint64_t{1} << 20;  ///< impacts between progress calls
 };
 
-/// The simulation of a scene, for every scene: with the plan's Prediction, everything a
-/// report or a message says of the run.
-struct SceneSimulation {
-  bool simulated = false;          ///< false: answered by the closed form alone (or predict-only)
-  /// The run's answer: simulated, or the model's count when not simulated (0 when the model
-  /// gives none: predict-only without a count formula).
-  std::uint64_t impact_count = 0;
-  bool truncated = false;          ///< the cap or a cancellation stopped it: more impacts were due
-  StopReason stop = StopReason::kFinished;
-  std::string stop_message;  ///< one sentence: why the run ended
-  std::optional<MultipleCollision> multiple_collision;
-  double final_time = 0.0;               ///< time of the last impact [s]
-  std::vector<double> final_velocities;  ///< [m/s]; the predicted ones when not simulated
-  double energy_lost = 0.0;              ///< total kinetic energy turned into heat [J]; NaN: not known
-  /// An inelastic collapse was resolved (simulated) or is predicted (closed form alone):
-  /// infinitely many impacts before collapse_time, then the bodies move as one cluster.
-  bool collapsed = false;
-  std::optional<double> collapse_time;      ///< of the first collapse [s]
-  std::optional<double> collapse_position;  ///< where its bodies meet [m]
-  std::vector<Collapse> collapses;          ///< every collapse the engine resolved, in order
-  /// Impacts in which a cluster (stuck by e = 0 or left by a collapse) was hit as one body
-  /// of its total mass (the cluster rule, nbody/engine.h).
-  std::uint64_t cluster_impacts = 0;
-  /// Impacts the scene's restitution model made elastic (EngineResult::rule_elastic_impacts).
-  std::uint64_t rule_elastic_impacts = 0;
-  double energy_relative_drift = 0.0;    ///< as EngineResult; NaN when not simulated
-  double momentum_relative_drift = 0.0;  ///< as EngineResult; NaN when not simulated or with a wall
-  /// Simulated to the end and predicted with a finite count: the engine's count equals it.
-  /// Empty otherwise.
-  std::optional<bool> matches_prediction;
-  /// [1] The largest |S (v_sim - v_pred)| / |S v_0| (S = diag(sqrt(m)) over the finite
-  /// bodies, v_0 in the first wall's frame: the relative error in the energy norm) over the
-  /// states the model predicts: every impact for the rotation model (three elastic bodies),
-  /// the end of a finished run for any other closed form. NaN: not compared.
-  double max_prediction_error = std::numeric_limits<double>::quiet_NaN();
-  /// How often the engine left its working precision; zero when not simulated. The run
-  /// takes one sign decision per impact and a final one (impact_count + 1 when simulated).
-  Escalations escalations;
-  /// The impacts that options.lab.events selects, in order, when options.keep_events (the
-  /// collapses between them are in `collapses`, each after impacts_before impacts); each
-  /// with its model block where the model fills one (the rotation model's: three elastic
-  /// bodies).
-  std::vector<ImpactRecord> impacts;
-};
-
 struct SceneRunResult {
   ModelChoice model;                       ///< which model answered, and why (one line): the plan's
   std::optional<Prediction> prediction;    ///< the plan's closed form (empty for event_engine)
-  SceneSimulation simulation;              ///< the run's summary, for every scene
+  SceneSimulation simulation;              ///< the run's simulation (nbody/engine.h), for every scene
   double compute_time_s = 0.0;             ///< wall time of planning and simulation [s]
 };
 

@@ -43,7 +43,7 @@ namespace nbody_detail {
 
 /// The engine's energy and momentum drifts of a run from its final_velocities (and
 /// energy_lost), as runEngine fills them (engine.cpp).
-void fillEngineDrift(const Scene& scene, EngineResult& result);
+void fillEngineDrift(const Scene& scene, SceneSimulation& result);
 
 /// How a run of runElasticTriple ended. Velocities in the scene's units [m/s].
 struct ElasticTripleRun {

@@ -123,7 +123,7 @@ class Driver {
   /// After the impact of `pair`: when two pairs have alternated for 8 impacts, asks the
   /// working tier whether their three clusters collapse, and resolves a collapse in every
   /// tier (each applies it when it reaches this impact count, replays included).
-  StepResult afterImpact(std::size_t pair, EngineResult& result) {
+  StepResult afterImpact(std::size_t pair, SceneSimulation& result) {
     alternating_ = pair != last_ && pair == before_last_ ? alternating_ + 1 : 2;
     before_last_ = last_;
     last_ = pair;
@@ -142,7 +142,7 @@ class Driver {
   /// When the exact tier has taken every one of the last kGroupStreak impacts (an
   /// accumulation) and they repeat a pattern of period 3 or more, asks it whether the group
   /// collapses (every 8th impact: each try costs a few exact matrix products).
-  StepResult groupCollapse(EngineResult& result) {
+  StepResult groupCollapse(SceneSimulation& result) {
     if (exact_streak_ < kGroupStreak || !exact_ || exact_->count() != fast_->count() || fast_->count() % 8 != 0) {
       return {};
     }
@@ -174,7 +174,7 @@ class Driver {
 
   /// Records a proved collapse and applies it in every tier (each when it reaches this count).
   template <class Found>
-  StepResult resolve(const Found& found, EngineResult& result) {
+  StepResult resolve(const Found& found, SceneSimulation& result) {
     collapses_.push_back({fast_->count(), found.first, found.last});
     result.collapses.push_back({found.first, found.last, found.time, found.position, fast_->count()});
     alternating_ = 0;
@@ -398,7 +398,7 @@ std::optional<double> energyFrame(const Scene& scene) {
   return 0.0;
 }
 
-void fillDrift(const Scene& scene, EngineResult& result) {
+void fillDrift(const Scene& scene, SceneSimulation& result) {
   long double e0 = 0, e1 = 0, p0 = 0, p1 = 0, magnitude = 0;
   const std::optional<double> frame = energyFrame(scene);
   for (std::size_t k = 0; k < scene.size(); ++k) {
@@ -443,7 +443,7 @@ std::string modelAdvice(const Scene& scene) {
   return "; a model of the physics there goes on: --restitution-model tc or --restitution-model viscoelastic";
 }
 
-std::string stopMessage(const Scene& scene, const EngineResult& result, bool exhausted, bool beyond_doubles,
+std::string stopMessage(const Scene& scene, const SceneSimulation& result, bool exhausted, bool beyond_doubles,
                         const ExactProgress& exact) {
   // "1 impact", "31,415 impacts".
   const std::string impacts = countText(result.impact_count) + (result.impact_count == 1 ? " impact" : " impacts");
@@ -522,7 +522,7 @@ std::string stopMessage(const Scene& scene, const EngineResult& result, bool exh
 }
 
 /// Maps a step that did not produce an impact to the way the run ends.
-void finish(const StepResult& r, EngineResult& result) {
+void finish(const StepResult& r, SceneSimulation& result) {
   switch (r.kind) {
     case StepKind::kImpact:
     case StepKind::kFinished: result.stop = StopReason::kFinished; break;
@@ -542,7 +542,7 @@ void finish(const StepResult& r, EngineResult& result) {
 
 }  // namespace
 
-void fillEngineDrift(const Scene& scene, EngineResult& result) { fillDrift(scene, result); }
+void fillEngineDrift(const Scene& scene, SceneSimulation& result) { fillDrift(scene, result); }
 
 }  // namespace nbody_detail
 
@@ -559,7 +559,7 @@ const char* stopReasonName(StopReason reason) {
   return "UNKNOWN";
 }
 
-EngineResult runEngine(const Scene& si_scene, const EngineOptions& options, const ImpactVisitor& visitor,
+SceneSimulation runEngine(const Scene& si_scene, const EngineOptions& options, const ImpactVisitor& visitor,
                        const ProgressCallback& progress, const CollapseVisitor& on_collapse) {
   using namespace nbody_detail;
   // The run takes place in working units (units.h); every value leaves it in SI.
@@ -583,7 +583,8 @@ EngineResult runEngine(const Scene& si_scene, const EngineOptions& options, cons
     c.velocity = si.velocity(c.velocity);
     return c;
   };
-  EngineResult result;
+  SceneSimulation result;
+  result.simulated = true;
   Driver driver(scene, options);
   StepResult r = driver.start();
   const bool wants_records = static_cast<bool>(visitor) || options.keep_events > 0;
@@ -613,7 +614,7 @@ EngineResult runEngine(const Scene& si_scene, const EngineOptions& options, cons
       record.index = count;
       if (!units.identity()) toSiRecord(record);
       if (visitor) visitor(record);
-      if (count <= options.keep_events) result.events.push_back(record);
+      if (count <= options.keep_events) result.impacts.push_back(record);
     }
     const std::size_t collapses = result.collapses.size();
     const StepResult collapse = driver.afterImpact(r.pair, result);

@@ -23,14 +23,14 @@ constexpr double kVelocityTolerance = 1e-12;
 /// A collapse the engine resolved: the reference, which cannot resolve it, steps through
 /// the same impacts up to it and then impacts forever (it stops at its cap), all before the
 /// collapse time.
-inline void expectCollapseMatchesReference(const EngineResult& run, const reference::Run& exact,
+inline void expectCollapseMatchesReference(const SceneSimulation& run, const reference::Run& exact,
                                            const std::string& label) {
   const Collapse& first = run.collapses.front();
   EXPECT_TRUE(exact.truncated) << label << ": " << run.stop_message;
   EXPECT_GE(exact.events.size(), first.impacts_before) << label;
   const std::size_t shared = std::min<std::size_t>(first.impacts_before, exact.events.size());
-  for (std::size_t k = 0; k < std::min(shared, run.events.size()); ++k) {
-    EXPECT_EQ(run.events[k].pair_index, exact.events[k].pair) << label << ", impact " << k + 1;
+  for (std::size_t k = 0; k < std::min(shared, run.impacts.size()); ++k) {
+    EXPECT_EQ(run.impacts[k].pair_index, exact.events[k].pair) << label << ", impact " << k + 1;
   }
   const double t = first.time;
   for (const auto& event : exact.events) {
@@ -41,12 +41,12 @@ inline void expectCollapseMatchesReference(const EngineResult& run, const refere
 
 /// Runs the engine with every event kept and checks it against the exact reference:
 /// count, how it ended, the pair sequence, the times and the final velocities.
-inline EngineResult expectMatchesReference(const Scene& scene, std::uint64_t cap, const std::string& label) {
+inline SceneSimulation expectMatchesReference(const Scene& scene, std::uint64_t cap, const std::string& label) {
   const reference::Run exact = reference::simulate(scene, cap);
   EngineOptions options;
   options.max_impacts = cap;
   options.keep_events = cap;
-  const EngineResult run = runEngine(scene, options);
+  const SceneSimulation run = runEngine(scene, options);
   if (run.collapsed) {
     expectCollapseMatchesReference(run, exact, label);
     return run;
@@ -59,12 +59,12 @@ inline EngineResult expectMatchesReference(const Scene& scene, std::uint64_t cap
     const double t = static_cast<double>(exact.multiple_time);
     EXPECT_NEAR(run.multiple_collision->time, t, kTimeTolerance * std::fabs(t)) << label;
   }
-  const std::size_t shared = std::min<std::size_t>(run.events.size(), exact.events.size());
+  const std::size_t shared = std::min<std::size_t>(run.impacts.size(), exact.events.size());
   for (std::size_t k = 0; k < shared; ++k) {
-    EXPECT_EQ(run.events[k].pair_index, exact.events[k].pair) << label << ", impact " << k + 1;
+    EXPECT_EQ(run.impacts[k].pair_index, exact.events[k].pair) << label << ", impact " << k + 1;
     const double t = static_cast<double>(exact.events[k].time);
-    EXPECT_NEAR(run.events[k].time, t, kTimeTolerance * std::fabs(t)) << label << ", impact " << k + 1;
-    if (run.events[k].pair_index != exact.events[k].pair) break;
+    EXPECT_NEAR(run.impacts[k].time, t, kTimeTolerance * std::fabs(t)) << label << ", impact " << k + 1;
+    if (run.impacts[k].pair_index != exact.events[k].pair) break;
   }
   if (run.impact_count == exact.events.size()) {
     EXPECT_LE(reference::energyNormError(scene, run.final_velocities, exact.velocities), kVelocityTolerance) << label;

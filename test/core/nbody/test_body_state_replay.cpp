@@ -98,7 +98,7 @@ TEST(BodyStateReplay, CollapseAndClusterImpactConserveMomentumAndAccountTheHeat)
   const Scene four{{1, 1, 1, 1}, {2, 1, 0, -30}, {-1, 0, 0, 1}, {0.06}};
   BodyStateReplay replay(four);
   std::size_t collapses = 0;
-  const EngineResult run = runEngine(
+  const SceneSimulation run = runEngine(
       four, {}, [&](const ImpactRecord& r) { ASSERT_TRUE(replay.apply(r)); },
       {}, [&](const Collapse& c) {
         ASSERT_TRUE(replay.apply(c));
@@ -138,7 +138,7 @@ TEST(BodyStateReplay, AgreesWithTheExactReferenceOnSeededScenes) {
         EXPECT_NEAR(replay.totalKineticEnergy() + replay.heat(), e0, 1e-12 * e0) << where;
       }
     };
-    const EngineResult run = runEngine(
+    const SceneSimulation run = runEngine(
         scene, options, [&](const ImpactRecord& r) { ASSERT_TRUE(replay.apply(r)) << where, conserved(); }, {},
         [&](const Collapse& c) { ASSERT_TRUE(replay.apply(c)) << where, conserved(); });
     collapses += run.collapses.size();

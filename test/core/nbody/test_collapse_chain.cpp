@@ -63,7 +63,7 @@ struct Stage {
 
 /// Checks every collapse of `run` (the engine's, on `s`) and its final velocities against
 /// the chain of reference stages, each run to `stage_impacts` impacts at most.
-void expectCollapseChain(const Scene& s, const EngineResult& run, std::uint64_t stage_impacts) {
+void expectCollapseChain(const Scene& s, const SceneSimulation& run, std::uint64_t stage_impacts) {
   Stage stage{s, {}, 0};
   for (std::size_t k = 0; k < s.size(); ++k) stage.units.push_back({k, k});
   for (std::size_t c = 0; c <= run.collapses.size(); ++c) {
@@ -141,7 +141,7 @@ Rational kinetic(const Scene& s, const std::vector<double>& velocities, double f
 void expectEndsAsOneCluster(const Scene& s, std::size_t collapses) {
   EngineOptions options;
   options.keep_events = 100000;
-  const EngineResult run = runEngine(s, options);
+  const SceneSimulation run = runEngine(s, options);
   ASSERT_EQ(run.stop, StopReason::kFinished) << run.stop_message;
   ASSERT_EQ(run.collapses.size(), collapses) << run.stop_message;
   EXPECT_EQ(run.collapses.back().first_body, 0u);
@@ -182,7 +182,7 @@ TEST(CollapseChain, EightUnequalMassesCollapseAgainstAWall) {
                             {0, -0.09375, 0.28125, 0.71875, 1.125, 1.4375, 1.4375, 1.46875}, 0.0625);
   EngineOptions options;
   options.keep_events = 100000;
-  const EngineResult run = runEngine(s, options);
+  const SceneSimulation run = runEngine(s, options);
   ASSERT_EQ(run.stop, StopReason::kFinished) << run.stop_message;
   ASSERT_EQ(run.collapses.size(), 3u) << run.stop_message;
   EXPECT_EQ(run.collapses[0].first_body, 1u);
@@ -206,14 +206,14 @@ TEST(CollapseChain, EightBodiesCrowdingWithoutAPatternStopHonestly) {
                             {-0.65625, -0.59375, -0.6875, -0.25, 0.21875, 0.40625, 0.4375, 0.8125}, 0.125);
   EngineOptions options;
   options.keep_events = 100000;
-  const EngineResult run = runEngine(s, options);
+  const SceneSimulation run = runEngine(s, options);
   ASSERT_EQ(run.stop, StopReason::kCap) << run.stop_message;
   EXPECT_TRUE(run.truncated);
   EXPECT_TRUE(run.collapses.empty());
   const reference::Run exact = reference::simulate(s, 800);
   ASSERT_TRUE(exact.truncated);
   ASSERT_LT(run.impact_count, exact.events.size());
-  for (std::size_t k = 0; k < run.impact_count; ++k) ASSERT_EQ(run.events[k].pair_index, exact.events[k].pair) << k;
+  for (std::size_t k = 0; k < run.impact_count; ++k) ASSERT_EQ(run.impacts[k].pair_index, exact.events[k].pair) << k;
   EXPECT_EQ(trailingPeriod(exact), 0u);
   std::size_t lo = s.size(), hi = 0;
   for (std::size_t k = exact.events.size() - 100; k < exact.events.size(); ++k) {

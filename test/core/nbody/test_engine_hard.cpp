@@ -21,9 +21,9 @@ using testing_support::kInf;
 
 constexpr std::uint64_t kCap = 10'000;
 
-std::vector<std::size_t> pairsOf(const EngineResult& run) {
+std::vector<std::size_t> pairsOf(const SceneSimulation& run) {
   std::vector<std::size_t> pairs;
-  for (const ImpactRecord& r : run.events) pairs.push_back(r.pair_index);
+  for (const ImpactRecord& r : run.impacts) pairs.push_back(r.pair_index);
   return pairs;
 }
 
@@ -32,15 +32,15 @@ TEST(NBodyEngineHard, CradleWithGaps) {
   // C at 1 m at 3 s, D at 0 m at 4 s, and E leaves at -1 m/s.
   const Scene s{{1, 1, 1, 1, 1}, {4, 3, 2, 1, 0}, {-1, 0, 0, 0, 0}, {}};
   ASSERT_FALSE(validate(s));
-  const EngineResult run = expectMatchesReference(s, kCap, "cradle");
+  const SceneSimulation run = expectMatchesReference(s, kCap, "cradle");
   ASSERT_EQ(run.impact_count, 4u);
   for (std::size_t k = 0; k < 4; ++k) {
-    EXPECT_EQ(run.events[k].pair_index, k);
-    EXPECT_EQ(run.events[k].time, k + 1.0);
-    EXPECT_EQ(run.events[k].position, 3.0 - k);
-    EXPECT_EQ(run.events[k].velocities_before[0], -1.0);
-    EXPECT_EQ(run.events[k].velocities_after[1], -1.0);
-    EXPECT_EQ(run.events[k].energy_gained[1], 0.5);
+    EXPECT_EQ(run.impacts[k].pair_index, k);
+    EXPECT_EQ(run.impacts[k].time, k + 1.0);
+    EXPECT_EQ(run.impacts[k].position, 3.0 - k);
+    EXPECT_EQ(run.impacts[k].velocities_before[0], -1.0);
+    EXPECT_EQ(run.impacts[k].velocities_after[1], -1.0);
+    EXPECT_EQ(run.impacts[k].energy_gained[1], 0.5);
   }
   EXPECT_EQ(run.final_velocities, (std::vector<double>{0, 0, 0, 0, -1}));
   EXPECT_EQ(run.final_positions, (std::vector<double>{3, 2, 1, 0, 0}));  // at t = 4 s
@@ -58,25 +58,25 @@ TEST(NBodyEngineHard, NearSimultaneousImpactsOneUlpApart) {
   Scene s{{1, 2, 3, 4}, {2, 1, 0, -5}, {-1, 0, 1, -1}, {}};
   s.positions[0] = std::nextafter(2.0, 3.0);  // A one ulp further: BC first
   ASSERT_FALSE(validate(s));
-  EngineResult run = expectMatchesReference(s, kCap, "BC first by one ulp");
-  ASSERT_GE(run.events.size(), 2u);
-  EXPECT_EQ(run.events[0].pair_index, 1u);
-  EXPECT_EQ(run.events[1].pair_index, 0u);
+  SceneSimulation run = expectMatchesReference(s, kCap, "BC first by one ulp");
+  ASSERT_GE(run.impacts.size(), 2u);
+  EXPECT_EQ(run.impacts[0].pair_index, 1u);
+  EXPECT_EQ(run.impacts[1].pair_index, 0u);
   s.positions[0] = std::nextafter(2.0, 1.0);  // one ulp nearer: AB first
   ASSERT_FALSE(validate(s));
   run = expectMatchesReference(s, kCap, "AB first by one ulp");
-  ASSERT_GE(run.events.size(), 1u);
-  EXPECT_EQ(run.events[0].pair_index, 0u);
+  ASSERT_GE(run.impacts.size(), 1u);
+  EXPECT_EQ(run.impacts[0].pair_index, 0u);
 }
 
 TEST(NBodyEngineHard, DisjointImpactsAtTheSameInstantBothHappen) {
   // AB and CD at t = 1 s exactly, BC at 1.5 s, AB and CD again at 2 s: A and D leave.
   const Scene s{{1, 1, 1, 1}, {3, 2, 1, 0}, {-1, 0, 0, 1}, {}};
   ASSERT_FALSE(validate(s));
-  const EngineResult run = expectMatchesReference(s, kCap, "two strikers, symmetric");
+  const SceneSimulation run = expectMatchesReference(s, kCap, "two strikers, symmetric");
   EXPECT_EQ(pairsOf(run), (std::vector<std::size_t>{0, 2, 1, 0, 2}));
   const std::vector<double> times{1, 1, 1.5, 2, 2};
-  for (std::size_t k = 0; k < run.events.size(); ++k) EXPECT_EQ(run.events[k].time, times[k]);
+  for (std::size_t k = 0; k < run.impacts.size(); ++k) EXPECT_EQ(run.impacts[k].time, times[k]);
   EXPECT_EQ(run.final_velocities, (std::vector<double>{1, 0, 0, -1}));
   EXPECT_GT(run.escalations.exact_rational, 0u);  // exactly equal times: the exact tier orders them
   // One ulp later for D: CD is strictly after AB, and the order is still exact.
@@ -94,10 +94,10 @@ TEST(NBodyEngineHard, GrazingContactsAreNoImpacts) {
       {{3, 1, 0.5}, 2}, {{1, 1, 1}, 2}, {{2, 1, 3}, 3}, {{5, 1, 9}, 5}};
   for (const auto& [masses, count] : cases) {
     const Scene s{masses, {2, 1, 0}, {-1, 0, 0}, {}};
-    const EngineResult run = expectMatchesReference(s, kCap, "grazing");
+    const SceneSimulation run = expectMatchesReference(s, kCap, "grazing");
     EXPECT_EQ(run.impact_count, count) << masses[0] << ", " << masses[1] << ", " << masses[2];
   }
-  const EngineResult run = runEngine(Scene{{3, 1, 0.5}, {2, 1, 0}, {-1, 0, 0}, {}});
+  const SceneSimulation run = runEngine(Scene{{3, 1, 0.5}, {2, 1, 0}, {-1, 0, 0}, {}});
   EXPECT_EQ(run.final_velocities[0], run.final_velocities[1]);
   EXPECT_GT(run.escalations.exact_rational, 0u);  // an exact zero after rounded impacts
 }
@@ -106,7 +106,7 @@ TEST(NBodyEngineHard, TwoStrikers) {
   // Two balls strike a row of three from the right, with gaps: 6 impacts, and two leave.
   const Scene s{{1, 1, 1, 1, 1}, {5.5, 4, 2, 1, 0}, {-1, -1, 0, 0, 0}, {}};
   ASSERT_FALSE(validate(s));
-  const EngineResult run = expectMatchesReference(s, kCap, "two strikers");
+  const SceneSimulation run = expectMatchesReference(s, kCap, "two strikers");
   EXPECT_EQ(run.impact_count, 6u);
   EXPECT_EQ(run.final_velocities, (std::vector<double>{0, 0, 0, -1, -1}));
   EXPECT_EQ(run.impact_count, *predictGhosts(s).impact_count);
@@ -116,7 +116,7 @@ TEST(NBodyEngineHard, LaterMultipleCollisionEndsTheRun) {
   // AB and DE at 1 s (disjoint, fine); then B and D reach C at 2 s from both sides.
   const Scene s{{1, 1, 1, 1, 1}, {4, 3, 2, 1, 0}, {-1, 0, 0, 0, 1}, {}};
   ASSERT_FALSE(validate(s));
-  const EngineResult run = expectMatchesReference(s, kCap, "later multiple collision");
+  const SceneSimulation run = expectMatchesReference(s, kCap, "later multiple collision");
   EXPECT_EQ(run.impact_count, 2u);
   EXPECT_EQ(run.stop, StopReason::kMultipleCollision);
   EXPECT_FALSE(run.truncated);
@@ -128,7 +128,7 @@ TEST(NBodyEngineHard, LaterMultipleCollisionEndsTheRun) {
   EXPECT_EQ(run.final_velocities, (std::vector<double>{0, -1, 0, 1, 0}));  // before it
   // The scene of the validation test: DE at 0.5 s, then A, B and C meet at 2 s.
   const Scene later{{1, 1, 1, 1, 1}, {20, 10, 0, -10, -10.5}, {-5, 0, 5, -1, 0}, {}};
-  const EngineResult second = expectMatchesReference(later, kCap, "A, B and C at 2 s");
+  const SceneSimulation second = expectMatchesReference(later, kCap, "A, B and C at 2 s");
   EXPECT_EQ(second.impact_count, 1u);
   ASSERT_TRUE(second.multiple_collision);
   EXPECT_EQ(second.multiple_collision->first_body, 0u);
@@ -143,7 +143,7 @@ TEST(NBodyEngineHard, MassRatiosOfAMillionInsideAChain) {
     if (trial % 2) std::swap(s.masses[1], s.masses[2]);
     if (trial % 3 == 0) s.restitution = {0.95};
     if (validate(s)) continue;
-    const EngineResult run = expectMatchesReference(s, 120, "1e6 chain " + std::to_string(trial));
+    const SceneSimulation run = expectMatchesReference(s, 120, "1e6 chain " + std::to_string(trial));
     if (s.isElastic() && !run.truncated) {
       EXPECT_LT(run.energy_relative_drift, 1e-14) << trial;
     }
@@ -158,13 +158,13 @@ TEST(NBodyEngineHard, WallsAtBothEnds) {
   EngineOptions options;
   options.max_impacts = 1001;
   options.keep_events = 1001;
-  const EngineResult run = runEngine(ball, options);
+  const SceneSimulation run = runEngine(ball, options);
   EXPECT_EQ(run.impact_count, 1001u);
   EXPECT_TRUE(run.truncated);
-  for (std::size_t k = 0; k < run.events.size(); ++k) {
-    EXPECT_EQ(run.events[k].pair_index, k % 2);
-    EXPECT_EQ(run.events[k].time, 1.0 + 2.0 * k);
-    EXPECT_EQ(run.events[k].position, k % 2 ? 0.0 : 2.0);
+  for (std::size_t k = 0; k < run.impacts.size(); ++k) {
+    EXPECT_EQ(run.impacts[k].pair_index, k % 2);
+    EXPECT_EQ(run.impacts[k].time, 1.0 + 2.0 * k);
+    EXPECT_EQ(run.impacts[k].position, k % 2 ? 0.0 : 2.0);
   }
   EXPECT_EQ(run.final_velocities[1], -1.0);
   EXPECT_EQ(run.energy_relative_drift, 0.0);
@@ -177,7 +177,7 @@ TEST(NBodyEngineHard, WallsAtBothEnds) {
 TEST(NBodyEngineHard, StickingWithZeroRestitution) {
   // A hits B at 1 s and they move on together at -0.5 m/s; their touching is no impact.
   const Scene away{{1, 1, 1}, {2, 1, 0}, {-1, 0, -2}, {0.0}};
-  const EngineResult run = expectMatchesReference(away, kCap, "stuck pair");
+  const SceneSimulation run = expectMatchesReference(away, kCap, "stuck pair");
   EXPECT_EQ(run.impact_count, 1u);
   EXPECT_EQ(run.final_velocities, (std::vector<double>{-0.5, -0.5, -2}));
   EXPECT_DOUBLE_EQ(run.energy_lost, 0.25);
@@ -185,7 +185,7 @@ TEST(NBodyEngineHard, StickingWithZeroRestitution) {
   // When the stuck pair reaches C at 3 s, C hits the cluster AB as one body of 2 kg (the
   // cluster rule), and all three stick: -1/3 m/s each, 1/4 + 1/12 J lost.
   const Scene onto{{1, 1, 1}, {2, 1, 0}, {-1, 0, 0}, {0.0}};
-  const EngineResult hit = expectMatchesReference(onto, kCap, "stuck pair hits C");
+  const SceneSimulation hit = expectMatchesReference(onto, kCap, "stuck pair hits C");
   EXPECT_EQ(hit.impact_count, 2u);
   EXPECT_EQ(hit.cluster_impacts, 1u);
   EXPECT_FALSE(hit.multiple_collision);
@@ -195,7 +195,7 @@ TEST(NBodyEngineHard, StickingWithZeroRestitution) {
   EXPECT_NE(hit.stop_message.find("1 impacts hit a cluster"), std::string::npos) << hit.stop_message;
   // A cluster with e = 0.5 towards C bounces: AB (2 kg, -0.5 m/s) on C (1 kg, 0) at 3 s.
   const Scene bounce{{1, 1, 1}, {2, 1, 0}, {-1, 0, 0}, {0.0, 0.5}};
-  const EngineResult bounced = expectMatchesReference(bounce, kCap, "cluster bounces off C");
+  const SceneSimulation bounced = expectMatchesReference(bounce, kCap, "cluster bounces off C");
   EXPECT_EQ(bounced.impact_count, 2u);
   EXPECT_EQ(bounced.cluster_impacts, 1u);
   // By hand: M = 3 kg, V = -1/3 m/s, v_AB - v_C = -0.5 m/s, so
@@ -211,7 +211,7 @@ TEST(NBodyEngineHard, ThreeEqualMassesWithRestitution) {
                                                      {0.1, 6},   {0.08, 10}, {0.075, 16}, {0.072, 63}};
   for (const auto& [e, count] : counts) {
     const Scene s{{1, 1, 1}, {2, 1, 0}, {-1, 0, 0}, {e}};
-    const EngineResult run = runEngine(s);
+    const SceneSimulation run = runEngine(s);
     EXPECT_EQ(run.impact_count, count) << "e = " << e;
     EXPECT_EQ(run.stop, StopReason::kFinished) << run.stop_message;
     if (e == 0.072) {
@@ -224,7 +224,7 @@ TEST(NBodyEngineHard, ThreeEqualMassesWithRestitution) {
   for (const double e : {0.06, 0.07}) {
     // The limit of the exact impact times (physics.md: 3.7313542986536 s, 4.2578666486407 s).
     const double time = reference::collapseTime(Scene{{1, 1, 1}, {2, 1, 0}, {-1, 0, 0}, {e}});
-    const EngineResult run = runEngine(Scene{{1, 1, 1}, {2, 1, 0}, {-1, 0, 0}, {e}});
+    const SceneSimulation run = runEngine(Scene{{1, 1, 1}, {2, 1, 0}, {-1, 0, 0}, {e}});
     EXPECT_EQ(run.stop, StopReason::kFinished) << run.stop_message;
     ASSERT_TRUE(run.collapsed) << run.stop_message;
     EXPECT_NEAR(*run.collapse_time, time, 1e-12) << "e = " << e;
@@ -246,8 +246,8 @@ TEST(NBodyEngineHard, RecordsConserveEnergyAndMatchTheReference) {
     EngineOptions options;
     options.max_impacts = 30;
     std::vector<ImpactRecord> seen;
-    const EngineResult run = runEngine(s, options, [&](const ImpactRecord& r) { seen.push_back(r); });
-    EXPECT_TRUE(run.events.empty());  // nothing kept unless asked
+    const SceneSimulation run = runEngine(s, options, [&](const ImpactRecord& r) { seen.push_back(r); });
+    EXPECT_TRUE(run.impacts.empty());  // nothing kept unless asked
     ASSERT_EQ(seen.size(), exact.events.size()) << trial;
     double scale = 0.0;
     for (std::size_t k = 0; k < s.size(); ++k) {
@@ -285,7 +285,7 @@ TEST(NBodyEngineContract, ProgressAndCancellation) {
   options.progress_interval = 1000;
   options.cancel = &cancel;
   std::vector<EngineProgress> reports;
-  const EngineResult run = runEngine(s, options, {}, [&](const EngineProgress& p) {
+  const SceneSimulation run = runEngine(s, options, {}, [&](const EngineProgress& p) {
     reports.push_back(p);
     if (reports.size() == 3) cancel = true;
   });
@@ -305,10 +305,10 @@ TEST(NBodyEngineContract, KeepsOnlyTheEventsAskedFor) {
   const Scene s = gas(200);
   EngineOptions options;
   options.keep_events = 10;
-  const EngineResult run = runEngine(s, options);
+  const SceneSimulation run = runEngine(s, options);
   EXPECT_GT(run.impact_count, 1000u);
-  ASSERT_EQ(run.events.size(), 10u);
-  EXPECT_EQ(run.events[9].index, 10u);
+  ASSERT_EQ(run.impacts.size(), 10u);
+  EXPECT_EQ(run.impacts[9].index, 10u);
   EXPECT_EQ(run.stop, StopReason::kFinished);
   EXPECT_LT(run.energy_relative_drift, 1e-14);
 }

@@ -20,7 +20,7 @@ TEST(NBodyEngineRandom, AgreesWithExactReference) {
   for (int trial = 0; trial < 700; ++trial) {
     const std::size_t n = 2 + trial % 7;
     const Scene scene = randomScene(rng, n);
-    const EngineResult run = expectMatchesReference(scene, 40, "scene " + std::to_string(trial));
+    const SceneSimulation run = expectMatchesReference(scene, 40, "scene " + std::to_string(trial));
     with_wall += scene.wallCount() == 1;
     with_two_walls += scene.wallCount() == 2;
     inelastic += !scene.isElastic();

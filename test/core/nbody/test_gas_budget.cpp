@@ -34,7 +34,7 @@ TEST(NBodyGasBudget, HundredBodyGasEndsWithAReasonAndBalancesEnergy) {
   for (const double e : {0.1, 0.3, 0.5}) {
     const Scene s = granularGas(100, e, kSeed);
     ASSERT_FALSE(validate(s));
-    const EngineResult run = runEngine(s);
+    const SceneSimulation run = runEngine(s);
     const std::string label = "e = " + std::to_string(e) + ": " + run.stop_message;
     // Either honest stop: the work budget of an exact replay, or the exactness cap of an
     // accumulation (the exact tier's own steps outgrew its bits).
@@ -68,7 +68,7 @@ TEST(NBodyGasBudget, CancelReachesTheExactReplay) {
   EngineOptions options;
   options.cancel = &cancel;
   options.progress_interval = 4000;
-  const EngineResult run = runEngine(s, options, {}, [&](const EngineProgress&) { cancel = true; });
+  const SceneSimulation run = runEngine(s, options, {}, [&](const EngineProgress&) { cancel = true; });
   EXPECT_EQ(run.stop, StopReason::kCancelled) << run.stop_message;
   EXPECT_TRUE(run.truncated);
   EXPECT_GT(run.impact_count, 4000u);
@@ -88,7 +88,7 @@ struct Published {
   }
 };
 
-EngineResult runRecorded(const Scene& s, const EngineOptions& options, Published& out) {
+SceneSimulation runRecorded(const Scene& s, const EngineOptions& options, Published& out) {
   return runEngine(s, options, [&out](const ImpactRecord& r) {
     out.pairs.push_back(r.pair_index);
     out.values.push_back(r.time);
@@ -110,8 +110,8 @@ TEST(NBodyGasBudget, TheForecastStopsWithTheSameImpactsForLessWork) {
     EngineOptions foresee = spend;
     foresee.forecast_exact_work = true;
     Published spent, foreseen;
-    const EngineResult a = runRecorded(s, spend, spent);
-    const EngineResult b = runRecorded(s, foresee, foreseen);
+    const SceneSimulation a = runRecorded(s, spend, spent);
+    const SceneSimulation b = runRecorded(s, foresee, foreseen);
     ASSERT_EQ(a.stop, StopReason::kPrecisionBudget) << a.stop_message;
     ASSERT_EQ(b.stop, StopReason::kPrecisionBudget) << b.stop_message;
     EXPECT_EQ(b.impact_count, a.impact_count);
@@ -128,7 +128,7 @@ TEST(NBodyGasBudget, TheForecastStopsWithTheSameImpactsForLessWork) {
     // at the cap foreseen, and its impacts are those the run without the forecast publishes.
     const Scene s = granularGas(100, 0.1, kSeed);
     Published foreseen, spent;
-    const EngineResult b = runRecorded(s, EngineOptions{}, foreseen);
+    const SceneSimulation b = runRecorded(s, EngineOptions{}, foreseen);
     ASSERT_EQ(b.stop, StopReason::kCap) << b.stop_message;
     EXPECT_TRUE(b.truncated);
     EXPECT_NE(b.stop_message.find("impacts at the exactness cap (truncated), foreseen after"), std::string::npos)
@@ -136,7 +136,7 @@ TEST(NBodyGasBudget, TheForecastStopsWithTheSameImpactsForLessWork) {
     EngineOptions spend;
     spend.forecast_exact_work = false;
     spend.max_impacts = b.impact_count;
-    const EngineResult a = runRecorded(s, spend, spent);
+    const SceneSimulation a = runRecorded(s, spend, spent);
     EXPECT_EQ(a.impact_count, b.impact_count);
     EXPECT_TRUE(foreseen == spent);
     EXPECT_EQ(b.final_velocities, a.final_velocities);

@@ -36,7 +36,7 @@ double kinetic(const Scene& scene, const std::vector<double>& v) {
   return sum;
 }
 
-std::vector<ImpactRecord> recorded(const Scene& scene, EngineResult& run, std::uint64_t cap = 10'000'000) {
+std::vector<ImpactRecord> recorded(const Scene& scene, SceneSimulation& run, std::uint64_t cap = 10'000'000) {
   std::vector<ImpactRecord> records;
   EngineOptions options;
   options.max_impacts = cap;
@@ -50,7 +50,7 @@ std::vector<ImpactRecord> recorded(const Scene& scene, EngineResult& run, std::u
 // made elastic; heat 0.1875 + 0.01171875 J of the 0.5 J.
 TEST(TcModel, TheImpactWithinTcIsElasticByHand) {
   const Scene scene = chain(0.0, tc(2.0));
-  EngineResult run;
+  SceneSimulation run;
   const std::vector<ImpactRecord> records = recorded(scene, run);
   ASSERT_EQ(run.stop, StopReason::kFinished) << run.stop_message;
   ASSERT_EQ(run.impact_count, 3u);
@@ -71,9 +71,9 @@ TEST(TcModel, TheImpactWithinTcIsElasticByHand) {
   EXPECT_NE(chooseModel(scene).reason.find("TC model"), std::string::npos) << chooseModel(scene).reason;
 
   // t_c = 1 s < 4/3 s: every impact dissipates, as with the constant e.
-  EngineResult constant;
+  SceneSimulation constant;
   recorded(chain(0.0, RestitutionModel{}), constant);
-  const EngineResult short_tc = runEngine(chain(0.0, tc(1.0)));
+  const SceneSimulation short_tc = runEngine(chain(0.0, tc(1.0)));
   EXPECT_EQ(short_tc.rule_elastic_impacts, 0u);
   EXPECT_EQ(short_tc.impact_count, constant.impact_count);
   EXPECT_EQ(short_tc.final_velocities, constant.final_velocities);
@@ -83,14 +83,14 @@ TEST(TcModel, TheImpactWithinTcIsElasticByHand) {
 // t_c = 1 s makes the second elastic, and the bounds of the double times cannot tell 1 from
 // 1 + 2^-50: the exact tier decides. Just below, it dissipates.
 TEST(TcModel, ExactlyTcApartIsElastic) {
-  const EngineResult at = runEngine(chain(0.25, tc(1.0)));
+  const SceneSimulation at = runEngine(chain(0.25, tc(1.0)));
   EXPECT_EQ(at.rule_elastic_impacts, 1u) << at.stop_message;
   EXPECT_EQ(at.impact_count, 3u);
   EXPECT_GT(at.escalations.exact_rational, 0u);  // decided in rationals
   EXPECT_DOUBLE_EQ(at.final_velocities[0], -0.0625);
   EXPECT_DOUBLE_EQ(at.final_velocities[1], -0.1875);
   EXPECT_DOUBLE_EQ(at.final_velocities[2], -0.75);
-  const EngineResult below = runEngine(chain(0.25, tc(std::nextafter(1.0, 0.0))));
+  const SceneSimulation below = runEngine(chain(0.25, tc(std::nextafter(1.0, 0.0))));
   EXPECT_EQ(below.rule_elastic_impacts, 0u);
 }
 
@@ -102,14 +102,14 @@ TEST(ThresholdModel, SlowImpactsAreElasticByHand) {
   model.kind = RestitutionModelKind::kThreshold;
   model.elastic_below = 0.8;
   const Scene scene = chain(0.0, model);
-  EngineResult run;
+  SceneSimulation run;
   const std::vector<ImpactRecord> records = recorded(scene, run);
   ASSERT_EQ(run.impact_count, 3u) << run.stop_message;
   EXPECT_EQ(run.rule_elastic_impacts, 2u);
   EXPECT_EQ(run.final_velocities, (std::vector<double>{0.0, -0.25, -0.75}));
   EXPECT_DOUBLE_EQ(run.energy_lost, 0.1875);
   model.elastic_below = 0.75;
-  EngineResult at;
+  SceneSimulation at;
   const std::vector<ImpactRecord> at_records = recorded(chain(0.0, model), at);
   ASSERT_GE(at_records.size(), 2u);
   EXPECT_DOUBLE_EQ(at_records[1].energy_lost, 0.75 * 0.5 * 0.75 * 0.75 / 2);  // (1 - e^2) mu A^2 / 2
@@ -136,7 +136,7 @@ TEST(ViscoelasticModel, EachImpactFollowsTheLaw) {
   }
   scene.restitution_model.kind = RestitutionModelKind::kViscoelastic;
   scene.restitution_model.viscoelastic_speed = 2.0;
-  EngineResult run;
+  SceneSimulation run;
   const std::vector<ImpactRecord> records = recorded(scene, run, 20000);
   ASSERT_EQ(records.size(), 20000u) << run.stop_message;
   double smallest = INFINITY, largest = 0;
@@ -175,7 +175,7 @@ TEST(Ring, SeamImpactByHand) {
   Scene scene{{1, 3}, {9, 1}, {1, -1}, {}};
   scene.ring = 10.0;
   ASSERT_FALSE(validate(scene));
-  EngineResult run;
+  SceneSimulation run;
   const std::vector<ImpactRecord> records = recorded(scene, run, 2);
   ASSERT_EQ(records.size(), 2u) << run.stop_message;
   EXPECT_EQ(records[0].pair_index, 1u);  // the seam pair: B (right), A (left)
@@ -205,7 +205,7 @@ TEST(Ring, ExactDecisionAfterASeamImpact) {
   ASSERT_FALSE(validate(scene));
   EngineOptions options;
   options.max_impacts = 20;
-  const EngineResult run = runEngine(scene, options);
+  const SceneSimulation run = runEngine(scene, options);
   EXPECT_TRUE(run.stop == StopReason::kCap || run.stop == StopReason::kFinished) << run.stop_message;
   EXPECT_GT(run.escalations.exact_rational, 0u);
   long double p0 = 0, p1 = 0, e0 = 0, e1 = 0;
@@ -238,7 +238,7 @@ TEST(Ring, ElasticGasConservesMomentumAndEnergy) {
   for (std::uint64_t seed : {1, 2, 3}) {
     const Scene scene = randomRing(seed, 30, false);
     ASSERT_FALSE(validate(scene));
-    EngineResult run;
+    SceneSimulation run;
     const std::vector<ImpactRecord> records = recorded(scene, run, 50000);
     ASSERT_EQ(run.impact_count, 50000u) << run.stop_message;
     EXPECT_LT(run.energy_relative_drift, 1e-12);
@@ -283,7 +283,7 @@ TEST(Ring, EqualMassesAreGhostsCountedByTheirCrossings) {
     EXPECT_TRUE(p->infinite);
     EngineOptions options;
     options.max_impacts = 2000;
-    const EngineResult run = runEngine(scene, options);
+    const SceneSimulation run = runEngine(scene, options);
     ASSERT_EQ(run.impact_count, 2000u) << run.stop_message;
     // The 2000th impact is at final_time (rounded): 2000 crossings just after it, 1999 just before.
     const auto crossingsBy = [&](long double t) {

@@ -28,7 +28,7 @@ using reference::Rational;
 void expectWholeGroupCollapses(const Scene& s, std::size_t period, std::uint64_t reference_impacts) {
   EngineOptions options;
   options.keep_events = 100000;
-  const EngineResult run = runEngine(s, options);
+  const SceneSimulation run = runEngine(s, options);
   ASSERT_EQ(run.stop, StopReason::kFinished) << run.stop_message;
   ASSERT_TRUE(run.collapsed) << run.stop_message;
   ASSERT_EQ(run.collapses.size(), 1u);
@@ -38,7 +38,7 @@ void expectWholeGroupCollapses(const Scene& s, std::size_t period, std::uint64_t
   const reference::Run exact = reference::simulate(s, std::max<std::uint64_t>(reference_impacts, run.impact_count));
   ASSERT_TRUE(exact.truncated);  // the impacts do not stop
   for (std::size_t k = 0; k < run.impact_count; ++k) {
-    ASSERT_EQ(run.events[k].pair_index, exact.events[k].pair) << "impact " << k + 1;
+    ASSERT_EQ(run.impacts[k].pair_index, exact.events[k].pair) << "impact " << k + 1;
   }
   // The pattern repeats at the reference's end too.
   const auto& ev = exact.events;
@@ -92,7 +92,7 @@ TEST(GroupCollapse, FiveUnequalMassesPeriodTwentyTwo) {
 TEST(GroupCollapse, TheClusterGoesOnAndIsHitAsOneBody) {
   Scene s = makeScene({1, 1, 1, 1, 1}, {3.3, 2.0, 1.3, 0.0, -10.0}, {-0.9, -0.2, 0.6, 0.5, 1.0}, 0.15);
   s.restitution = {0.15, 0.15, 0.15, 0.5};
-  const EngineResult run = runEngine(s);
+  const SceneSimulation run = runEngine(s);
   ASSERT_EQ(run.stop, StopReason::kFinished) << run.stop_message;
   ASSERT_EQ(run.collapses.size(), 1u) << run.stop_message;
   EXPECT_EQ(run.collapses[0].first_body, 0u);

@@ -42,7 +42,7 @@ struct Replay {
   }
 };
 
-EngineResult runStreamed(const Scene& scene, Replay& replay) {
+SceneSimulation runStreamed(const Scene& scene, Replay& replay) {
   EngineOptions options;
   // Low: beyond it, scenes with an accumulation the engine does not resolve (four or more
   // bodies) spend seconds in exact arithmetic before the exactness cap stops them.
@@ -58,7 +58,7 @@ TEST(ImpactStream, ClusterImpactMovesBothWholeClustersAndTheCollapseIsNotified) 
   Replay replay(four);
   std::vector<Collapse> notices;
   std::vector<ImpactRecord> records;
-  const EngineResult run = runEngine(four, {}, [&](const ImpactRecord& r) { records.push_back(r), replay.impact(r); },
+  const SceneSimulation run = runEngine(four, {}, [&](const ImpactRecord& r) { records.push_back(r), replay.impact(r); },
                                      {}, [&](const Collapse& c) { notices.push_back(c), replay.collapse(c); });
   ASSERT_EQ(notices.size(), 1u);
   EXPECT_EQ(notices[0].first_body, 0u);
@@ -92,7 +92,7 @@ TEST(ImpactStream, ReplayOfRecordsAndNoticesGivesTheFinalVelocitiesExactly) {
     for (std::size_t p = 0; p + 1 < scene.size(); ++p) scene.restitution.push_back(restitutions[pick(rng)]);
     if (validate(scene)) continue;
     Replay replay(scene);
-    const EngineResult run = runStreamed(scene, replay);
+    const SceneSimulation run = runStreamed(scene, replay);
     ++runs;
     ASSERT_EQ(replay.impacts, run.impact_count) << "scene " << scene_index;
     ASSERT_EQ(replay.collapses, run.collapses.size()) << "scene " << scene_index;
@@ -116,7 +116,7 @@ TEST(ImpactStream, AnUnresolvedAccumulationEndsAtTheExactnessCapInsteadOfRunning
   // every step needed ever larger rationals. (The squeeze of a ball against one wall by a
   // 10 kg body, the scene of this test before, is now resolved: test_wall_collapse.cpp.)
   const Scene closing{{testing_support::kInf, 1, testing_support::kInf}, {2, 1, 0}, {-0.5, 0.25, 0.5}, {0.5}};
-  const EngineResult run = runEngine(closing);
+  const SceneSimulation run = runEngine(closing);
   EXPECT_EQ(run.stop, StopReason::kCap);
   EXPECT_TRUE(run.truncated);
   EXPECT_FALSE(run.collapsed);

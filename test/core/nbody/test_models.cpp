@@ -137,7 +137,7 @@ TEST(NBodyModels, TwoWallsAreInfinite) {
   EXPECT_FALSE(p.impact_count);
   EngineOptions options;
   options.max_impacts = 1000;
-  const EngineResult run = runEngine(s, options);
+  const SceneSimulation run = runEngine(s, options);
   EXPECT_EQ(run.impact_count, 1000u);
   EXPECT_TRUE(run.truncated);
   EXPECT_EQ(run.stop, StopReason::kCap);
@@ -209,7 +209,7 @@ TEST(NBodyModels, GhostsAgreeWithEngineOnAThousandBodies) {
   ASSERT_FALSE(validate(s));
   ASSERT_EQ(chooseModel(s).kind, ModelKind::kGhosts);
   const Prediction p = *predict(s);
-  const EngineResult run = runEngine(s);
+  const SceneSimulation run = runEngine(s);
   EXPECT_EQ(run.stop, StopReason::kFinished) << run.stop_message;
   EXPECT_EQ(run.impact_count, *p.impact_count);
   EXPECT_GT(run.impact_count, 200'000u);

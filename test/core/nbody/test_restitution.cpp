@@ -24,7 +24,7 @@ TEST(Restitution, ReferencePointsOfTheSpiralModelAndTheEngine) {
     EXPECT_EQ(p.impact_count, count) << "e = " << e;
     EXPECT_FALSE(p.collapsed);
     ASSERT_TRUE(p.spiral_angle) << "e = " << e;
-    const EngineResult run = runEngine(equalMasses(e));
+    const SceneSimulation run = runEngine(equalMasses(e));
     EXPECT_EQ(run.impact_count, count) << "e = " << e;
     for (std::size_t k = 0; k < 3; ++k) EXPECT_NEAR(p.final_velocities[k], run.final_velocities[k], 1e-15);
     EXPECT_NEAR(p.energy_lost, run.energy_lost, 1e-15);
@@ -42,7 +42,7 @@ TEST(Restitution, ReferencePointsOfTheSpiralModelAndTheEngine) {
     // Centre of mass: 1 m at t = 0, moving at -1/3 m/s; all the energy about it is lost.
     EXPECT_NEAR(*p.collapse_position, 1.0 - *p.collapse_time / 3, 1e-13);
     EXPECT_NEAR(p.energy_lost, 1.0 / 3, 1e-15);
-    const EngineResult run = runEngine(equalMasses(e));
+    const SceneSimulation run = runEngine(equalMasses(e));
     ASSERT_TRUE(run.collapsed) << run.stop_message;
     EXPECT_NEAR(*run.collapse_time, *p.collapse_time, 1e-12 * *p.collapse_time);
     EXPECT_NEAR(*run.collapse_position, *p.collapse_position, 1e-12);
@@ -82,7 +82,7 @@ TEST(Restitution, CollapseTimesAreTheLimitOfTheExactImpactTimes) {
     const Scene s{c.m, {2, 1, 0}, {-1, 0, 0}, {c.e}};
     const Prediction p = *predict(s);
     ASSERT_TRUE(p.collapsed) << "e = " << c.e;
-    const EngineResult run = runEngine(s);
+    const SceneSimulation run = runEngine(s);
     ASSERT_TRUE(run.collapsed) << run.stop_message;
     EXPECT_NEAR(*run.collapse_time, *p.collapse_time, 1e-13 * *p.collapse_time);
     // The exact impact times (rationals, every impact) converge geometrically to the limit.
@@ -113,7 +113,7 @@ TEST(Restitution, AtRcExactlyTheDoubleEigenvalueAndTheDoublesNextToIt) {
       const reference::Run exact = reference::simulate(s, 100);
       ASSERT_FALSE(exact.truncated) << label;
       const Prediction p = *predict(s);
-      const EngineResult run = runEngine(s);
+      const SceneSimulation run = runEngine(s);
       ASSERT_TRUE(p.impact_count) << label << ": " << p.reason;
       EXPECT_EQ(*p.impact_count, exact.events.size()) << label;
       EXPECT_EQ(run.impact_count, exact.events.size()) << label;
@@ -130,7 +130,7 @@ TEST(Restitution, AtRcExactlyTheDoubleEigenvalueAndTheDoublesNextToIt) {
     const Scene s{{4, 1, 4}, {2, 1, 0}, {-1, 0, 0}, {e}};
     const Prediction p = *predict(s);
     ASSERT_TRUE(p.collapsed) << "e = " << e << ": " << p.reason;
-    const EngineResult run = runEngine(s);
+    const SceneSimulation run = runEngine(s);
     ASSERT_TRUE(run.collapsed) << run.stop_message;
     EXPECT_NEAR(*run.collapse_time, *p.collapse_time, 1e-13 * *p.collapse_time);
     // At the double eigenvalue the orbit is d0 + n N d0 times e^n, so one pair's impact times
@@ -171,14 +171,14 @@ TEST(Restitution, ZeroRestitutionSticksAndTheClusterIsHitAsOneBody) {
   EXPECT_EQ(p.impact_count, 2u);
   EXPECT_FALSE(p.collapsed);
   for (double v : p.final_velocities) EXPECT_DOUBLE_EQ(v, -1.0 / 3);
-  const EngineResult run = runEngine(equalMasses(0.0));
+  const SceneSimulation run = runEngine(equalMasses(0.0));
   EXPECT_EQ(run.impact_count, 2u);
   EXPECT_EQ(run.cluster_impacts, 1u);
   EXPECT_EQ(run.stop, StopReason::kFinished);
   // A collapse leaves a cluster that a fourth body then hits as one body of 3 kg: D at
   // -3 m, 1 m/s reaches the cluster (at -1/3 m/s) well after the collapse (t = 3.73 s).
   const Scene four{{1, 1, 1, 1}, {2, 1, 0, -30}, {-1, 0, 0, 1}, {0.06}};
-  const EngineResult hit = runEngine(four);
+  const SceneSimulation hit = runEngine(four);
   ASSERT_TRUE(hit.collapsed) << hit.stop_message;
   EXPECT_EQ(hit.cluster_impacts, 1u);
   // By hand, e = 0.06, cluster 3 kg at -1/3, D 1 kg at 1: V = 0, relative -4/3:
@@ -209,7 +209,7 @@ TEST(Restitution, HeavyLightHeavyCollapsesAtEveryMassRatio) {
       const double position = static_cast<double>(Rational((moment + momentum * Rational(time)) / mass));
       const double heat = static_cast<double>(Rational(energy - momentum * momentum / (2 * mass)));
       const double velocity = static_cast<double>(Rational(momentum / mass));
-      const EngineResult run = runEngine(s);
+      const SceneSimulation run = runEngine(s);
       ASSERT_TRUE(run.collapsed) << label << ": " << run.stop_message;
       EXPECT_EQ(run.stop, StopReason::kFinished) << label;
       EXPECT_NEAR(*run.collapse_time, time, 1e-13 * time) << label;

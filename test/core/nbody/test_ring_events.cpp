@@ -27,15 +27,15 @@ RingCheck expectRingMatchesReference(const Scene& scene, std::uint64_t cap, cons
   EngineOptions options;
   options.max_impacts = cap;
   options.keep_events = cap;
-  const EngineResult run = runEngine(scene, options);
+  const SceneSimulation run = runEngine(scene, options);
   EXPECT_NE(run.stop, StopReason::kInternalError) << label << ": " << run.stop_message;
-  const reference::RingRun exact = reference::simulateRing(scene, run.events.size());
-  EXPECT_EQ(exact.events.size(), run.events.size()) << label;
+  const reference::RingRun exact = reference::simulateRing(scene, run.impacts.size());
+  EXPECT_EQ(exact.events.size(), run.impacts.size()) << label;
   double speed = 0.0;  // the velocity scale [m/s]
   for (double v : scene.velocities) speed = std::max(speed, std::fabs(v));
   RingCheck check;
-  for (std::size_t k = 0; k < std::min(exact.events.size(), run.events.size()); ++k) {
-    const ImpactRecord& got = run.events[k];
+  for (std::size_t k = 0; k < std::min(exact.events.size(), run.impacts.size()); ++k) {
+    const ImpactRecord& got = run.impacts[k];
     const reference::RingEvent& want = exact.events[k];
     const std::string at = label + ", impact " + std::to_string(k + 1);
     EXPECT_EQ(got.pair_index, want.pair) << at;

@@ -36,21 +36,21 @@ TEST(SimultaneousImpacts, FourEqualMassesHandDerived) {
   EngineOptions options;
   options.max_impacts = 60;
   options.keep_events = 60;
-  const EngineResult run = runEngine(fourSymmetric(), options);
+  const SceneSimulation run = runEngine(fourSymmetric(), options);
   ASSERT_NE(run.stop, StopReason::kInternalError) << run.stop_message;
-  ASSERT_GE(run.events.size(), 6u) << run.stop_message;
+  ASSERT_GE(run.impacts.size(), 6u) << run.stop_message;
   const std::size_t pairs[] = {0, 2, 1, 0, 2, 1};
   const double times[] = {1, 1, t3, t4, t4, t6};
   for (std::size_t k = 0; k < 6; ++k) {
-    EXPECT_EQ(run.events[k].pair_index, pairs[k]) << "impact " << k + 1;
-    EXPECT_NEAR(run.events[k].time, times[k], 1e-14 * times[k]) << "impact " << k + 1;
+    EXPECT_EQ(run.impacts[k].pair_index, pairs[k]) << "impact " << k + 1;
+    EXPECT_NEAR(run.impacts[k].time, times[k], 1e-14 * times[k]) << "impact " << k + 1;
   }
-  EXPECT_NEAR(run.events[2].position, 1.5, 1e-15);
-  EXPECT_NEAR(run.events[5].position, 1.5, 1e-15);
-  EXPECT_NEAR(run.events[3].velocities_after[0], -0.21184375, 1e-15);
-  EXPECT_NEAR(run.events[3].velocities_after[1], -0.23690625, 1e-15);
-  EXPECT_NEAR(run.events[4].velocities_after[0], 0.23690625, 1e-15);
-  EXPECT_NEAR(run.events[4].velocities_after[1], 0.21184375, 1e-15);
+  EXPECT_NEAR(run.impacts[2].position, 1.5, 1e-15);
+  EXPECT_NEAR(run.impacts[5].position, 1.5, 1e-15);
+  EXPECT_NEAR(run.impacts[3].velocities_after[0], -0.21184375, 1e-15);
+  EXPECT_NEAR(run.impacts[3].velocities_after[1], -0.23690625, 1e-15);
+  EXPECT_NEAR(run.impacts[4].velocities_after[0], 0.23690625, 1e-15);
+  EXPECT_NEAR(run.impacts[4].velocities_after[1], 0.21184375, 1e-15);
   // The impacts go on towards a collapse of all four (not resolved for four bodies): the cap.
   EXPECT_EQ(run.stop, StopReason::kCap) << run.stop_message;
   EXPECT_EQ(run.impact_count, 60u);
@@ -75,7 +75,7 @@ TEST(SimultaneousImpacts, CollapseLeavesAnExactlyZeroApproach) {
   // e = 0.05: v_A' = 0.5 + 0.05 / 2, v_B' = 0.5 - 0.05 / 2. Heat: all 4 J of DEF, and AB's
   // (1 - e^2) (1/2) 1^2 / 2 = 0.249375 J.
   const Scene scene{{1, 1, 1, 1, 1, 1}, {8, 5, 4, 3, 1, 0}, {0, 1, 0, -2, 0, 2}, {0.05}};
-  const EngineResult run = expectMatchesReference(scene, 60, "DEF collapse");
+  const SceneSimulation run = expectMatchesReference(scene, 60, "DEF collapse");
   ASSERT_EQ(run.stop, StopReason::kFinished) << run.stop_message;
   ASSERT_EQ(run.collapses.size(), 1u);
   EXPECT_EQ(run.collapses[0].first_body, 3u);
@@ -83,8 +83,8 @@ TEST(SimultaneousImpacts, CollapseLeavesAnExactlyZeroApproach) {
   EXPECT_NEAR(run.collapses[0].position, 4.0 / 3, 1e-12);
   EXPECT_EQ(run.collapses[0].velocity, 0.0);
   EXPECT_EQ(run.impact_count, run.collapses[0].impacts_before + 1);
-  EXPECT_EQ(run.events.back().pair_index, 0u);
-  EXPECT_NEAR(run.events.back().time, 3.0, 1e-15);
+  EXPECT_EQ(run.impacts.back().pair_index, 0u);
+  EXPECT_NEAR(run.impacts.back().time, 3.0, 1e-15);
   const double expected[] = {0.525, 0.475, 0, 0, 0, 0};
   for (std::size_t k = 0; k < 6; ++k) EXPECT_NEAR(run.final_velocities[k], expected[k], 1e-15) << "body " << k;
   EXPECT_NEAR(run.energy_lost, 4.249375, 1e-14);
@@ -141,13 +141,13 @@ TEST(SimultaneousImpacts, SeededSweepAgreesWithReference) {
     const bool mirrored = (trial / 24) % 2 == 0;     // each (n, e) both ways
     const Scene scene = tieScene(rng, n, mirrored, e);
     const std::string label = "scene " + std::to_string(trial) + ", n = " + std::to_string(n) + ", e = " + std::to_string(e);
-    const EngineResult run = expectMatchesReference(scene, kCap, label);
+    const SceneSimulation run = expectMatchesReference(scene, kCap, label);
     const reference::Run exact = reference::simulate(scene, kCap);
     // Disjoint pairs at one instant go in pair order (engine.h).
-    const std::size_t shared = std::min(run.events.size(), exact.events.size());
+    const std::size_t shared = std::min(run.impacts.size(), exact.events.size());
     for (std::size_t k = 0; k + 1 < shared; ++k) {
       if (exact.events[k].time != exact.events[k + 1].time) continue;
-      EXPECT_LT(run.events[k].pair_index, run.events[k + 1].pair_index) << label << ", impact " << k + 1;
+      EXPECT_LT(run.impacts[k].pair_index, run.impacts[k + 1].pair_index) << label << ", impact " << k + 1;
     }
     simultaneous += hasSimultaneous(exact);
     both_tiers += run.escalations.high_precision > 0 && run.escalations.exact_rational > 0;

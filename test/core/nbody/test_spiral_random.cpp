@@ -164,7 +164,7 @@ TEST(SpiralModelRandom, EqualsTheSimulationOnAThousandScenes) {
     ++engine_checked;
     EngineOptions options;
     options.max_impacts = 1000;
-    const EngineResult run = runEngine(s, options);
+    const SceneSimulation run = runEngine(s, options);
     EXPECT_EQ(run.collapsed, p.collapsed) << label << ": " << run.stop_message;
     EXPECT_EQ(run.stop, StopReason::kFinished) << label << ": " << run.stop_message;
     if (p.collapsed && run.collapsed) {

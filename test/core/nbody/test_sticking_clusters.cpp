@@ -48,14 +48,14 @@ TEST(StickingClusters, SnowballOfEighteenBodiesByHand) {
   ASSERT_FALSE(validate(s));
   EngineOptions options;
   options.keep_events = kBodies;
-  EngineResult run;
+  SceneSimulation run;
   ASSERT_NO_THROW(run = runEngine(s, options));
   EXPECT_EQ(run.stop, StopReason::kFinished) << run.stop_message;
   EXPECT_FALSE(run.truncated);
   ASSERT_EQ(run.impact_count, kBodies - 1) << run.stop_message;
   EXPECT_EQ(run.cluster_impacts, kBodies - 2);
   for (std::size_t i = 0; i + 1 < kBodies; ++i) {
-    const ImpactRecord& r = run.events[i];
+    const ImpactRecord& r = run.impacts[i];
     const double t = 0.5 * static_cast<double>((i + 1) * (i + 2));
     EXPECT_EQ(r.pair_index, i);
     EXPECT_NEAR(r.time, t, 1e-12 * t) << "impact " << i;
@@ -84,7 +84,7 @@ TEST(StickingClusters, GranularGasesAgainstTheExactReference) {
     const Scene s = testing_support::granularGas(c.bodies, 0.0, c.seed);
     ASSERT_FALSE(validate(s));
     const std::string label = std::to_string(c.bodies) + " bodies, seed " + std::to_string(c.seed);
-    EngineResult run;
+    SceneSimulation run;
     // The exact reference: the same count, pairs, times and final velocities.
     ASSERT_NO_THROW(run = testing_support::expectMatchesReference(s, c.bodies, label)) << label;
     const reference::Run exact = reference::simulate(s, c.bodies);
@@ -103,11 +103,11 @@ TEST(StickingClusters, GranularGasesAgainstTheExactReference) {
         << label;
     const double heat = static_cast<double>(exact.energy_lost);
     EXPECT_NEAR(run.energy_lost, heat, 1e-12 * heat) << label;
-    for (const ImpactRecord& r : run.events) EXPECT_GT(r.energy_lost, 0.0) << label << ", impact " << r.index;
+    for (const ImpactRecord& r : run.impacts) EXPECT_GT(r.energy_lost, 0.0) << label << ", impact " << r.index;
     // e = 0: the two sides of every pair that met move on as one (same velocity, same
     // place); every other pair has come to rest relative to, or moves away from, its neighbour.
     std::vector<char> met(s.size() - 1, 0);
-    for (const ImpactRecord& r : run.events) met[r.pair_index] = 1;
+    for (const ImpactRecord& r : run.impacts) met[r.pair_index] = 1;
     for (std::size_t p = 0; p + 1 < s.size(); ++p) {
       const double v = run.final_velocities[p], w = run.final_velocities[p + 1];
       const double x = run.final_positions[p], y = run.final_positions[p + 1];

@@ -121,7 +121,7 @@ TEST(StickyModel, EngineAgreesAtHundredThousandBodies) {
   const Prediction p = *predict(scene);
   EngineOptions options;
   options.max_impacts = 10 * kBodies;
-  const EngineResult run = runEngine(scene, options);
+  const SceneSimulation run = runEngine(scene, options);
   ASSERT_EQ(run.stop, StopReason::kFinished) << run.stop_message;
   EXPECT_EQ(run.impact_count, *p.impact_count);
   EXPECT_GT(*p.impact_count, kBodies / 2);

@@ -36,7 +36,7 @@ TEST(Temperature, SamplesOfASmallRunByHand) {
   const Scene scene{{1, 1, 1}, {2, 1, 0}, {0, 0, 1}, {0.5}};
   std::vector<TemperatureSample> samples;
   TemperatureSampler sampler(scene, 1, [&](const TemperatureSample& s) { samples.push_back(s); });
-  const EngineResult run = runEngine(
+  const SceneSimulation run = runEngine(
       scene, {}, [&](const ImpactRecord& r) { sampler.onImpact(r); }, {},
       [&](const Collapse& c) { sampler.onCollapse(c); });
   sampler.finish();
@@ -61,7 +61,7 @@ TEST(Temperature, DecimatedReplayThroughACollapseEndsAtTheEnginesState) {
   const Scene scene{{1, 1, 1}, {2, 1, 0}, {-1, 0, 0}, {0.07}};
   std::vector<TemperatureSample> samples;
   TemperatureSampler sampler(scene, 2, [&](const TemperatureSample& s) { samples.push_back(s); });
-  const EngineResult run = runEngine(
+  const SceneSimulation run = runEngine(
       scene, {}, [&](const ImpactRecord& r) { sampler.onImpact(r); }, {},
       [&](const Collapse& c) { sampler.onCollapse(c); });
   sampler.finish();

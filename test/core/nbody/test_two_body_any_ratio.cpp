@@ -45,7 +45,7 @@ TEST(TwoBodyAnyRatio, AcceptedAndPredictedCorrectlyRounded) {
 
 TEST(TwoBodyAnyRatio, EngineSimulatesTheSameImpact) {
   for (const TwoBodyCase& c : extremeRatioScenes()) {
-    const EngineResult run = runEngine(c.scene, EngineOptions{});
+    const SceneSimulation run = runEngine(c.scene, EngineOptions{});
     ASSERT_EQ(run.stop, StopReason::kFinished) << c.name << ": " << run.stop_message;
     const reference::Run exact = reference::simulate(c.scene, 10);
     EXPECT_EQ(run.impact_count, 1u) << c.name;

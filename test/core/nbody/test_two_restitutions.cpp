@@ -94,7 +94,7 @@ TEST(TwoRestitutions, SeededScenesAgreeWithTheExactReferences) {
       ASSERT_TRUE(exact.truncated) << label;
       const double limit = reference::limitOfImpactTimes(exact);
       EXPECT_NEAR(*p->collapse_time, limit, 1e-10 * std::fabs(limit)) << label;
-      const EngineResult run = runEngine(s);
+      const SceneSimulation run = runEngine(s);
       ASSERT_TRUE(run.collapsed) << label << ": " << run.stop_message;
       EXPECT_NEAR(*run.collapse_time, limit, 1e-10 * std::fabs(limit)) << label;
       continue;

@@ -43,11 +43,11 @@ Scene seededOneWallScene(std::mt19937_64& rng, bool wall_right) {
 }
 
 /// The engine's first impacts follow the exact reference's pairs.
-void expectSamePairs(const EngineResult& run, const reference::Run& exact, std::size_t count, const std::string& label) {
-  ASSERT_LE(count, run.events.size()) << label;
+void expectSamePairs(const SceneSimulation& run, const reference::Run& exact, std::size_t count, const std::string& label) {
+  ASSERT_LE(count, run.impacts.size()) << label;
   ASSERT_LE(count, exact.events.size()) << label;
   for (std::size_t k = 0; k < count; ++k) {
-    ASSERT_EQ(run.events[k].pair_index, exact.events[k].pair) << label << ", impact " << k + 1;
+    ASSERT_EQ(run.impacts[k].pair_index, exact.events[k].pair) << label << ", impact " << k + 1;
   }
 }
 
@@ -56,7 +56,7 @@ void expectSamePairs(const EngineResult& run, const reference::Run& exact, std::
 void expectSqueeze(const Scene& s, double position, double wall_v, double heat) {
   EngineOptions options;
   options.keep_events = 100000;
-  const EngineResult run = runEngine(s, options);
+  const SceneSimulation run = runEngine(s, options);
   ASSERT_TRUE(run.collapsed) << run.stop_message;
   EXPECT_EQ(run.stop, StopReason::kFinished) << run.stop_message;
   ASSERT_EQ(run.collapses.size(), 1u);
@@ -91,7 +91,7 @@ TEST(WallCollapse, AMovingWallCarriesTheClusterAway) {
   // time; the bodies meet at the wall, 2 + 0.25 T m, and move on at 0.25 m/s; the heat is
   // the same 5 J (frame-independent).
   const Scene moving{{kWall, 1, 10}, {2, 1, 0}, {0.25, 0.25, 1.25}, {0.5}};
-  const EngineResult rest = runEngine(Scene{{kWall, 1, 10}, {2, 1, 0}, {0, 0, 1}, {0.5}});
+  const SceneSimulation rest = runEngine(Scene{{kWall, 1, 10}, {2, 1, 0}, {0, 0, 1}, {0.5}});
   ASSERT_TRUE(rest.collapsed) << rest.stop_message;
   expectSqueeze(moving, 2.0 + 0.25 * *rest.collapse_time, 0.25, 5.0);
 }
@@ -105,7 +105,7 @@ TEST(WallCollapse, AboveTheWallsCriticalRestitutionTheImpactsStop) {
     const Scene s{{kWall, 1, 10}, {2, 1, 0}, {0, 0, 1}, {e}};
     EngineOptions options;
     options.keep_events = 100000;
-    const EngineResult run = runEngine(s, options);
+    const SceneSimulation run = runEngine(s, options);
     const reference::Run exact = reference::simulate(s, 100000);
     const std::string label = "e = " + std::to_string(e);
     ASSERT_FALSE(exact.truncated) << label;
@@ -118,7 +118,7 @@ TEST(WallCollapse, AboveTheWallsCriticalRestitutionTheImpactsStop) {
   }
   // Just below r_c the ball is squeezed (the start, at rest against the wall, lies in the
   // approaching cone).
-  const EngineResult below = runEngine(Scene{{kWall, 1, 10}, {2, 1, 0}, {0, 0, 1}, {0.53}});
+  const SceneSimulation below = runEngine(Scene{{kWall, 1, 10}, {2, 1, 0}, {0, 0, 1}, {0.53}});
   EXPECT_TRUE(below.collapsed) << below.stop_message;
 }
 
@@ -135,7 +135,7 @@ TEST(WallCollapse, SeededScenesWithOneWallAgreeWithTheExactReference) {
     const std::string label = "scene " + std::to_string(trial) + ", e = " + std::to_string(s.restitution[0]);
     EngineOptions options;
     options.keep_events = kCap;
-    const EngineResult run = runEngine(s, options);
+    const SceneSimulation run = runEngine(s, options);
     ASSERT_NE(run.stop, StopReason::kInternalError) << label << ": " << run.stop_message;
     ASSERT_EQ(run.stop, StopReason::kFinished) << label << ": " << run.stop_message;
     // Past a collapse the reference's rationals grow by some bits per impact: 60 more suffice.
@@ -170,7 +170,7 @@ TEST(WallCollapse, TheSpiralModelTakesTheWallAsAnInfiniteMass) {
   EXPECT_NE(p.reason.find("wall"), std::string::npos);
   EXPECT_NEAR(*p.critical_restitution, (6 - std::sqrt(11.0)) / 5, 1e-15);
   ASSERT_TRUE(p.collapsed) << p.reason;
-  const EngineResult run = runEngine(squeeze);
+  const SceneSimulation run = runEngine(squeeze);
   ASSERT_TRUE(run.collapsed) << run.stop_message;
   EXPECT_NEAR(*p.collapse_time, *run.collapse_time, 1e-13 * *run.collapse_time);
   EXPECT_NEAR(*p.collapse_time, 2.276, 5e-4);  // physics.md
@@ -216,7 +216,7 @@ TEST(WallCollapse, SpiralModelWithAWallEqualsTheEngineOnSeededScenes) {
     near += kind != 0;
     const Prediction p = *predict(s);
     EXPECT_NEAR(*p.critical_restitution, rc, 1e-14) << label;
-    const EngineResult run = runEngine(s);
+    const SceneSimulation run = runEngine(s);
     ASSERT_EQ(run.stop, StopReason::kFinished) << label << ": " << run.stop_message;
     EXPECT_EQ(p.collapsed, run.collapsed) << label;
     if (run.collapsed && p.collapsed) {

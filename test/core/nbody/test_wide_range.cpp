@@ -23,15 +23,15 @@ constexpr double k2To900 = 0x1p900;
 
 /// Every event's time and position, and the final velocities, within 2^-42 of the exact
 /// values (the engine's published time precision; its velocities are closer still).
-void expectCloseToReference(const Scene& scene, const EngineResult& run, const reference::Run& exact,
+void expectCloseToReference(const Scene& scene, const SceneSimulation& run, const reference::Run& exact,
                             const std::string& label) {
-  ASSERT_EQ(run.events.size(), exact.events.size()) << label << ": " << run.stop_message;
+  ASSERT_EQ(run.impacts.size(), exact.events.size()) << label << ": " << run.stop_message;
   for (std::size_t k = 0; k < exact.events.size(); ++k) {
     const double t = static_cast<double>(exact.events[k].time);
     const double x = static_cast<double>(exact.events[k].position);
-    EXPECT_EQ(run.events[k].pair_index, exact.events[k].pair) << label << ", impact " << k + 1;
-    EXPECT_NEAR(run.events[k].time, t, 0x1p-42 * std::fabs(t)) << label << ", impact " << k + 1;
-    EXPECT_NEAR(run.events[k].position, x, 0x1p-42 * std::fabs(x) + 1e-300) << label << ", impact " << k + 1;
+    EXPECT_EQ(run.impacts[k].pair_index, exact.events[k].pair) << label << ", impact " << k + 1;
+    EXPECT_NEAR(run.impacts[k].time, t, 0x1p-42 * std::fabs(t)) << label << ", impact " << k + 1;
+    EXPECT_NEAR(run.impacts[k].position, x, 0x1p-42 * std::fabs(x) + 1e-300) << label << ", impact " << k + 1;
   }
   ASSERT_EQ(run.final_velocities.size(), exact.velocities.size());
   for (std::size_t i = 0; i < exact.velocities.size(); ++i) {
@@ -41,7 +41,7 @@ void expectCloseToReference(const Scene& scene, const EngineResult& run, const r
   EXPECT_LE(reference::energyNormError(scene, run.final_velocities, exact.velocities), 1e-15) << label;
 }
 
-EngineResult runKeepingEvents(const Scene& scene, std::uint64_t cap = 1000) {
+SceneSimulation runKeepingEvents(const Scene& scene, std::uint64_t cap = 1000) {
   EngineOptions options;
   options.max_impacts = cap;
   options.keep_events = cap;
@@ -57,7 +57,7 @@ TEST(WideRange, AFourBodyChainWithImpactsAfter2To900SecondsRunsToTheEnd) {
   ASSERT_FALSE(exact.truncated);
   ASSERT_EQ(exact.events.size(), 6u);
   ASSERT_GT(static_cast<double>(exact.events.back().time), k2To900);  // the premise
-  const EngineResult run = runKeepingEvents(scene);
+  const SceneSimulation run = runKeepingEvents(scene);
   EXPECT_EQ(run.stop, StopReason::kFinished) << run.stop_message;
   EXPECT_FALSE(run.truncated);
   EXPECT_EQ(run.impact_count, 6u);
@@ -75,7 +75,7 @@ TEST(WideRange, APairApproachingBeyondTheRangeDoesNotStopTheImpactsBeforeIt) {
   ASSERT_FALSE(validate(scene)) << validate(scene)->message;
   const reference::Run exact = reference::simulate(scene, 1000);
   ASSERT_FALSE(exact.truncated);
-  const EngineResult run = runKeepingEvents(scene);
+  const SceneSimulation run = runKeepingEvents(scene);
   EXPECT_EQ(run.stop, StopReason::kFinished) << run.stop_message;
   EXPECT_EQ(run.impact_count, exact.events.size());
   expectCloseToReference(scene, run, exact, "creeping pair");
@@ -86,15 +86,15 @@ TEST(WideRange, AnInelasticChainAfter2To900SecondsKeepsItsHeat) {
   const Scene scene = reference::makeScene({1, 2, 3, 4}, {1, 0, -1e210, -2e210}, {-1e-61, 0, 1e-61, 2e-61}, 0.5);
   const reference::Run exact = reference::simulate(scene, 1000);
   ASSERT_FALSE(exact.truncated);
-  const EngineResult run = runKeepingEvents(scene);
+  const SceneSimulation run = runKeepingEvents(scene);
   EXPECT_EQ(run.stop, StopReason::kFinished) << run.stop_message;
-  ASSERT_EQ(run.events.size(), exact.events.size()) << run.stop_message;
+  ASSERT_EQ(run.impacts.size(), exact.events.size()) << run.stop_message;
   expectCloseToReference(scene, run, exact, "inelastic chain");
   const double lost = static_cast<double>(exact.energy_lost);
   EXPECT_NEAR(run.energy_lost, lost, 1e-14 * lost);
   for (std::size_t k = 0; k < exact.events.size(); ++k) {
     const double heat = static_cast<double>(exact.events[k].lost);
-    EXPECT_NEAR(run.events[k].energy_lost, heat, 1e-14 * heat) << "impact " << k + 1;
+    EXPECT_NEAR(run.impacts[k].energy_lost, heat, 1e-14 * heat) << "impact " << k + 1;
   }
 }
 
@@ -107,7 +107,7 @@ TEST(WideRange, AThreeBodyChainAfter2To900SecondsKeepsItsCount) {
   const reference::Run exact = reference::simulate(scene, 1000);
   ASSERT_EQ(exact.events.size(), 31u);
   ASSERT_GT(static_cast<double>(exact.events.back().time), k2To900);
-  const EngineResult run = runKeepingEvents(scene);
+  const SceneSimulation run = runKeepingEvents(scene);
   EXPECT_EQ(run.stop, StopReason::kFinished) << run.stop_message;
   EXPECT_EQ(run.impact_count, 31u);
   expectCloseToReference(scene, run, exact, "pi billiard");
@@ -144,19 +144,19 @@ Scene rescaled(Scene scene, int length, int velocity) {
 /// change of units is exact and changes no rounding, for the restitution models too.
 void expectSameRunAtAnyScale(const Scene& scene, const std::string& label) {
   ASSERT_FALSE(validate(scene)) << label << ": " << validate(scene)->message;
-  const EngineResult near_one = runKeepingEvents(scene, 400);
+  const SceneSimulation near_one = runKeepingEvents(scene, 400);
   ASSERT_GT(near_one.impact_count, 3u) << label;
   const int length = 600, velocity = -300;  // times 2^900: past 2^900 from 1 s on
   const Scene far = rescaled(scene, length, velocity);
   ASSERT_FALSE(validate(far)) << label << ": " << validate(far)->message;
-  const EngineResult run = runKeepingEvents(far, 400);
+  const SceneSimulation run = runKeepingEvents(far, 400);
   EXPECT_EQ(run.stop, near_one.stop) << label << ": " << run.stop_message;
   EXPECT_EQ(run.truncated, near_one.truncated) << label;
   ASSERT_EQ(run.impact_count, near_one.impact_count) << label << ": " << run.stop_message;
   EXPECT_EQ(run.rule_elastic_impacts, near_one.rule_elastic_impacts) << label;
-  for (std::size_t k = 0; k < run.events.size(); ++k) {
-    const ImpactRecord& a = run.events[k];
-    const ImpactRecord& b = near_one.events[k];
+  for (std::size_t k = 0; k < run.impacts.size(); ++k) {
+    const ImpactRecord& a = run.impacts[k];
+    const ImpactRecord& b = near_one.impacts[k];
     ASSERT_EQ(a.pair_index, b.pair_index) << label << ", impact " << k + 1;
     EXPECT_EQ(a.time, std::ldexp(b.time, length - velocity)) << label << ", impact " << k + 1;
     EXPECT_EQ(a.position, std::ldexp(b.position, length)) << label << ", impact " << k + 1;
@@ -203,14 +203,14 @@ TEST(WideRange, AnImpactAfterTheLargestDoubleStopsTheRunTruncated) {
   const reference::Run exact = reference::simulate(scene, 10);
   ASSERT_GE(exact.events.size(), 4u);
   ASSERT_GT(exact.events[3].time, reference::Rational(std::numeric_limits<double>::max()));  // the premise
-  const EngineResult run = runKeepingEvents(scene);
+  const SceneSimulation run = runKeepingEvents(scene);
   EXPECT_EQ(run.stop, StopReason::kOutOfRange);
   EXPECT_TRUE(run.truncated);
-  ASSERT_EQ(run.events.size(), 3u) << run.stop_message;
+  ASSERT_EQ(run.impacts.size(), 3u) << run.stop_message;
   EXPECT_NE(run.stop_message.find("the largest double"), std::string::npos) << run.stop_message;
   for (std::size_t k = 0; k < 3; ++k) {
     const double t = static_cast<double>(exact.events[k].time);
-    EXPECT_NEAR(run.events[k].time, t, 0x1p-42 * t) << "impact " << k + 1;
+    EXPECT_NEAR(run.impacts[k].time, t, 0x1p-42 * t) << "impact " << k + 1;
   }
   EXPECT_EQ(run.final_velocities, (std::vector<double>{-1e-10, 0, 0, -1}));
 }
@@ -222,15 +222,15 @@ TEST(WideRange, AnImpactAfterTheLargestDoubleStopsTheRunTruncated) {
 TEST(WideRange, ASubnormalApproachSpeedWaitsUntilItsImpactIsNext) {
   const Scene scene = reference::makeScene({1, 1, 1}, {2, 1, 0}, {-1, -5e-324, 0}, 1.0);
   ASSERT_FALSE(validate(scene)) << validate(scene)->message;
-  const EngineResult run = runKeepingEvents(scene);
+  const SceneSimulation run = runKeepingEvents(scene);
   EXPECT_EQ(run.stop, StopReason::kOutOfRange);
   EXPECT_TRUE(run.truncated);
   ASSERT_EQ(run.impact_count, 2u);
   // Equal masses exchange velocities: AB at t = 1 (x = 1), BC at t = 2 (x = 0), exactly.
-  EXPECT_EQ(run.events[0].time, 1.0);
-  EXPECT_EQ(run.events[0].position, 1.0);
-  EXPECT_EQ(run.events[1].time, 2.0);
-  EXPECT_EQ(run.events[1].position, 0.0);
+  EXPECT_EQ(run.impacts[0].time, 1.0);
+  EXPECT_EQ(run.impacts[0].position, 1.0);
+  EXPECT_EQ(run.impacts[1].time, 2.0);
+  EXPECT_EQ(run.impacts[1].position, 0.0);
   EXPECT_EQ(run.final_velocities, (std::vector<double>{-5e-324, 0, -1}));
   EXPECT_NE(run.stop_message.find("the next impact comes after t = 1.7976931348623157e+308 s, the largest double"),
             std::string::npos)
@@ -249,7 +249,7 @@ TEST(WideRange, APairWhoseTimeBoundsStraddle2To900RunsToTheEnd) {
   ASSERT_FALSE(exact.truncated);
   ASSERT_EQ(exact.events.size(), 3u);
   EXPECT_GT(static_cast<double>(exact.events[2].time), k2To900);
-  const EngineResult run = runKeepingEvents(scene);
+  const SceneSimulation run = runKeepingEvents(scene);
   EXPECT_EQ(run.stop, StopReason::kFinished) << run.stop_message;
   expectCloseToReference(scene, run, exact, "straddling 2^900");
 }
@@ -262,7 +262,7 @@ TEST(WideRange, ASubnormalApproachSpeedThatNeverComesFirstStopsNothing) {
   const reference::Run exact = reference::simulate(scene, 1000);
   ASSERT_FALSE(exact.truncated);
   ASSERT_EQ(exact.events.size(), 2u);
-  const EngineResult run = runKeepingEvents(scene);
+  const SceneSimulation run = runKeepingEvents(scene);
   EXPECT_EQ(run.stop, StopReason::kFinished) << run.stop_message;
   expectCloseToReference(scene, run, exact, "subnormal approach");
 }

@@ -53,6 +53,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -173,27 +174,38 @@ struct Collapse {
   double velocity = 0.0;             ///< the cluster's velocity after it [m/s]
 };
 
-struct EngineResult {
+/// The simulation of a run: what runEngine measured and what runScene (scene_run.h) adds
+/// beside the model's prediction. The one result of every run, simulated or answered by a
+/// closed form alone.
+struct SceneSimulation {
+  bool simulated = false;  ///< false: answered by the closed form alone (or predict-only)
+  /// The run's answer: simulated, or the model's count when not simulated (0 when the model
+  /// gives none: predict-only without a count formula).
   std::uint64_t impact_count = 0;
   bool truncated = false;  ///< stopped with more impacts due: cap, cancelled, precision budget or out of range
   StopReason stop = StopReason::kFinished;
   std::string stop_message;  ///< one sentence: why the run ended
   std::optional<MultipleCollision> multiple_collision;
   double final_time = 0.0;               ///< time of the last impact [s] (0 without any)
-  std::vector<double> final_positions;   ///< at final_time [m]
-  std::vector<double> final_velocities;  ///< [m/s]
-  double energy_lost = 0.0;              ///< total kinetic energy lost to heat [J]
+  std::vector<double> final_positions;   ///< at final_time [m]; empty when not simulated
+  std::vector<double> final_velocities;  ///< [m/s]; the predicted ones when not simulated
+  double energy_lost = 0.0;              ///< total kinetic energy turned into heat [J]; NaN: not known
   /// |E_end + energy_lost - E_0| / E_0, kinetic energies in the walls' frame (the lab frame
-  /// without walls); NaN when two walls move at different velocities (not conserved).
+  /// without walls); NaN when two walls move at different velocities (not conserved), or
+  /// when not simulated.
   double energy_relative_drift = 0.0;
-  /// |p_end - p_0| / sum |m v_0| over the finite masses; NaN with a wall (not conserved).
+  /// |p_end - p_0| / sum |m v_0| over the finite masses; NaN with a wall (not conserved), or
+  /// when not simulated.
   double momentum_relative_drift = 0.0;
+  /// How often the engine left its working precision; zero when not simulated.
   Escalations escalations;
+  /// An inelastic collapse was resolved (simulated) or is predicted (closed form alone):
+  /// infinitely many impacts before collapse_time, then the bodies move as one cluster.
+  bool collapsed = false;
+  std::optional<double> collapse_time;      ///< of the first collapse [s]
+  std::optional<double> collapse_position;  ///< where its bodies meet [m]
   /// Collapses resolved, in order (their infinitely many impacts are not in impact_count).
   std::vector<Collapse> collapses;
-  bool collapsed = false;                   ///< collapses is not empty
-  std::optional<double> collapse_time;      ///< of the first collapse [s]
-  std::optional<double> collapse_position;  ///< of the first collapse [m]
   /// Impacts in which a cluster (stuck by e = 0 or left by a collapse) met its neighbour as
   /// ONE body of its total mass, with the restitution of the pair that touches (the cluster rule).
   std::uint64_t cluster_impacts = 0;
@@ -204,7 +216,19 @@ struct EngineResult {
   /// Impacts whose pair has e < 1 (or, viscoelastic, whose e(v) is 1) that the scene's
   /// restitution model made elastic (scene.h, RestitutionModel); 0 for the constant model.
   std::uint64_t rule_elastic_impacts = 0;
-  std::vector<ImpactRecord> events;  ///< the first options.keep_events impacts
+  /// runScene: simulated to the end and predicted with a finite count: the engine's count
+  /// equals it. Empty otherwise.
+  std::optional<bool> matches_prediction;
+  /// runScene: the largest |S (v_sim - v_pred)| / |S v_0| [1] (S = diag(sqrt(m)) over the
+  /// finite bodies, v_0 in the first wall's frame: the relative error in the energy norm)
+  /// over the states the model predicts: every impact for the rotation model (three elastic
+  /// bodies), the end of a finished run for any other closed form. NaN: not compared.
+  double max_prediction_error = std::numeric_limits<double>::quiet_NaN();
+  /// The impacts kept: runEngine's first options.keep_events; runScene's, those its
+  /// options.lab.events selects when options.keep_events (the collapses between them are in
+  /// `collapses`, each after impacts_before impacts), each with its model block where the
+  /// model fills one (the rotation model's: three elastic bodies).
+  std::vector<ImpactRecord> impacts;
 };
 
 /// Called for every impact, in order. May be empty.
@@ -224,7 +248,7 @@ using ProgressCallback = std::function<void(const EngineProgress&)>;
 /// final_velocities, so their replay gives final_velocities exactly; the one exception is a
 /// value within about 2^-100 (relative) of a rounding boundary of doubles when a more precise
 /// tier's state is adopted, which can move its rounding by one unit in the last place.
-EngineResult runEngine(const Scene& scene, const EngineOptions& options = {}, const ImpactVisitor& visitor = {},
+SceneSimulation runEngine(const Scene& scene, const EngineOptions& options = {}, const ImpactVisitor& visitor = {},
                        const ProgressCallback& progress = {}, const CollapseVisitor& on_collapse = {});
 
 }  // namespace core
