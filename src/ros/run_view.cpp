@@ -48,7 +48,10 @@ std::string titleOf(const RunRecord& run) {
   if (run.bodies() != 3) title += ",  " + withSeparators(run.bodies()) + " bodies";
   if (run.prediction) {
     const auto& p = *run.prediction;
-    if (p.model != Prediction::MODEL_THREE_BODY_ROTATION) title += " (" + p.model_name + ")";
+    // A prediction with the paper's values (the rotation model's) shows the paper's count
+    // instead of the model's name.
+    const bool paper_values = p.max_possible_collision_count > 0;
+    if (!paper_values) title += " (" + p.model_name + ")";
     if (p.collapsed) {
       title += ":  predicted collapse at t = " + numberText(p.collapse_time, 6) + " s";
     } else if (p.infinite_collisions) {
@@ -56,7 +59,7 @@ std::string titleOf(const RunRecord& run) {
     } else if (p.collision_count_defined) {
       title += ":  predicted " + collisionsText(p.collision_count);
     }
-    if (p.model == Prediction::MODEL_THREE_BODY_ROTATION) {
+    if (paper_values) {
       title += p.paper_collision_count_defined
                    ? "  (paper's eq. 3.22: " + withSeparators(p.paper_collision_count) + ")"
                    : "  (paper's eq. 3.22: undefined)";

@@ -59,12 +59,10 @@ Row row(const std::string& scene, const collision_lab::RunScene::Response& respo
   const std::string collisions = std::to_string(s.collision_count) + (s.collapsed ? "+c" : "") +
                                  (s.cancelled ? " (cancelled)" : s.truncated ? "*" : "") +
                                  (s.simulated ? "" : " (n/s)");
-  // Infinitely many: bodies between two walls (a ball or a box), a ring of ghosts, or the
-  // spiral's predicted collapse.
-  const bool infinite = s.infinite_collisions ||
-                        (s.model == collision_lab::Prediction::MODEL_THREE_BODY_SPIRAL && s.collapsed);
+  // Infinitely many: bodies between two walls (a ball or a box), a ring of ghosts, or a
+  // predicted collapse.
   const std::string predicted = s.predicted_collision_count_defined ? std::to_string(s.predicted_collision_count)
-                                : infinite                           ? "inf"
+                                : s.infinite_collisions              ? "inf"
                                                                      : "-";
   const std::string paper =
       s.paper_predicted_collision_count_defined ? std::to_string(s.paper_predicted_collision_count) : "-";
