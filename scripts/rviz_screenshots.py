@@ -89,7 +89,7 @@ def main():
 
     to_cap = "--simulate-to-cap" in sys.argv[1:]
     wanted = set(sys.argv[1:]) - {"--simulate-to-cap"}
-    shots = ["hint", "not_simulated", "pi", "walls", "box", "collapse", "cluster", "ring", "gas", "granular_gas",
+    shots = ["hint", "not_simulated", "pi", "pi_long", "walls", "box", "collapse", "cluster", "ring", "gas", "granular_gas",
              "rejected", "replay"]
     if to_cap:
         shots = ["box_to_cap"]
@@ -140,6 +140,8 @@ def main():
                   positions=[2, 1, 0], velocities=[-1, 0, 0], max_collisions=10)
         elif shot == "pi":
             preset("pi_digits_2", "collisions_31_pi_digits_2.png")
+        elif shot == "pi_long":
+            preset("pi_digits_5", "collisions_31415_pi_digits_5_end.png")
         elif shot == "walls":
             # Infinitely many predicted: cut at the node's cap of 1,000 impacts, one period drawn.
             preset("ball_between_walls", "nbody_ball_between_walls_end.png")

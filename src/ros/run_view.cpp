@@ -48,10 +48,10 @@ std::string titleOf(const RunRecord& run) {
   if (run.bodies() != 3) title += ",  " + withSeparators(run.bodies()) + " bodies";
   if (run.prediction) {
     const auto& p = *run.prediction;
-    // A prediction with the paper's values (the rotation model's) shows the paper's count
-    // instead of the model's name.
+    // Every prediction names its model; one with the paper's values (the rotation model's)
+    // shows the paper's count as well.
     const bool paper_values = p.max_possible_collision_count > 0;
-    if (!paper_values) title += " (" + p.model_name + ")";
+    title += " (" + p.model_name + ")";
     if (p.collapsed) {
       title += ":  predicted collapse at t = " + numberText(p.collapse_time, 6) + " s";
     } else if (p.infinite_collisions) {
