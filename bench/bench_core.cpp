@@ -348,11 +348,12 @@ void printCountOnlyGoals(const char* scene, const SceneFigures& f) {
               scene, f.summary_ns, f.lean_ns, ratio, ratio <= 1.5 ? "under it by" : "over it by",
               ratio <= 1.5 ? 1.5 / ratio : ratio / 1.5, pathName(), ratio <= 1.5 ? "met" : "missed");
   if (ratio > 1.5) {
-    std::printf("why: count-only: the run is the engine's known-count pass (double-double velocities and intercepts "
-                "by the engine's impact map, its rounding bounds, precision guard and range checks: the engine's bits "
-                "without its queue); that pass alone takes %.1f ns per impact portable (%.2fx the lean loop) and "
-                "%.1f ns with FMA (0: no FMA here); double-double additions, not products, are most of it: six "
-                "dependent double operations per addition, three additions per impact map, two maps per impact\n",
+    std::printf("why: count-only: the run is the engine's known-count pass (double-double velocities by the "
+                "engine's impact map, the intercepts in double with bounds on their distance from the engine's, its "
+                "rounding bounds, precision guard and range checks: the engine's bits without its queue); that pass "
+                "alone takes %.1f ns per impact portable (%.2fx the lean loop) and %.1f ns with FMA (0: no FMA here); "
+                "the double-double velocity map (three dependent additions of six double operations each) and the "
+                "bounds of both maps are most of it\n",
                 f.pass_portable_ns, f.pass_portable_ns / f.lean_ns, f.pass_fma_ns);
   }
   if (f.pass_fma_ns > 0) {
@@ -407,8 +408,8 @@ int main(int argc, char** argv) {
   // Where the time goes, for a missed goal: the floor that exactness in double-double sets.
   const auto why = [](const char* what, double lean_ns, double dd_ns, double summary_ns, double full_ns) {
     std::printf("why: %s: the lean loop %.1f ns per impact; the engine's double-double impact maps alone (velocities, "
-                "nothing else) %.1f ns = %.2fx; the lab run in summary mode (maps on velocities and intercepts, the "
-                "engine's error bounds and range checks) %.1f ns = %.2fx; full mode (each impact against the closed "
+                "nothing else) %.1f ns = %.2fx; the lab run in summary mode (the velocity map, the intercepts in "
+                "double with bounds, the engine's error bounds and range checks) %.1f ns = %.2fx; full mode (each impact against the closed "
                 "form) %.1f ns = %.2fx. (Double-double on the %s path.)\n",
                 what, lean_ns, dd_ns, dd_ns / lean_ns, summary_ns, summary_ns / lean_ns, full_ns, full_ns / lean_ns,
                 pathName());

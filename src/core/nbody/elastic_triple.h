@@ -9,8 +9,10 @@
 // only to order events and publish times; a run that publishes neither needs none of them.
 //
 // What it computes. The engine's working tier without its queue: the double-double
-// velocities and intercepts after every impact by the same impact map (applyImpactMap,
-// impact_rule.h), the same mass-weighted bounds (tier.h, rho) and the same range check. The
+// velocities after every impact by the same impact map (applyImpactMap, impact_rule.h), the
+// same mass-weighted bounds (tier.h, rho) and the same range check. The intercepts, which the
+// engine's checks read only through their sizes, are mapped in double, each with a bound on
+// its distance from the engine's, so that every check is bounded from the safe side. The
 // engine leaves that state only when its precision guard (tier.h, timeIsPrecise) hands an
 // impact to 100 digits and adopts that tier's state; every other escalation (which pair is
 // next, does a pair still approach) is followed in double-double, which keeps the state. So
@@ -103,18 +105,28 @@ CL_DD_INLINE std::optional<ElasticTripleRun> elasticTriplePass(const Scene& scen
     pair.s_l = sqrt_mass[pair.map.heavy_is_i ? p + 1 : p];
     pair.scale = (sqrt_mass[p] > 0 ? 1 / sqrt_mass[p] : 0.0) + (sqrt_mass[p + 1] > 0 ? 1 / sqrt_mass[p + 1] : 0.0);
   }
-  // tier.h, rho(): the engine's bound on one impact's mass-weighted rounding.
-  const auto rho = [](const PairTables& pair, const ImpactChange<W>& change, const W& q_i, const W& q_j) {
+  // tier.h, rho(): the engine's bound on one impact's mass-weighted rounding, from the sizes
+  // of the heavy and light values after it, its increment and its difference; increasing in
+  // each, so that upper bounds of them bound it.
+  const auto rho_of = [](const PairTables& pair, double q_h, double q_l, double inc, double d) {
     if (pair.map.exchange) return 0.0;
-    const double q_h = std::fabs((pair.map.heavy_is_i ? q_i : q_j).hi);
-    const double q_l = std::fabs((pair.map.heavy_is_i ? q_j : q_i).hi);
-    const double inc = std::fabs(change.heavy_increment.hi), d = std::fabs(change.difference.hi);
     return 2 * kEta * (pair.s_h * (q_h + 8 * inc) + pair.s_l * (q_l + q_h + 8 * inc + 2 * d)) +
            (pair.s_h + pair.s_l) * 0x1p-1000;
   };
+  const auto rho = [&rho_of](const PairTables& pair, const ImpactChange<W>& change, const W& q_i, const W& q_j) {
+    return rho_of(pair, std::fabs((pair.map.heavy_is_i ? q_i : q_j).hi), std::fabs((pair.map.heavy_is_i ? q_j : q_i).hi),
+                  std::fabs(change.heavy_increment.hi), std::fabs(change.difference.hi));
+  };
+  // kReplica reads the engine's double-double intercepts only through the sizes of their hi
+  // parts, in its guard, range and time checks: bounds of them from the safe side serve, from
+  // intercepts mapped in double, each within b_error[k] of the engine's (kU per operation
+  // covers a double's rounding and the engine's double-double rounding with it).
+  constexpr double kU = 0x1p-52;
+  const auto hi_above = [](double x, double err) { return (std::fabs(x) + err) * (1 + kU); };
+  const auto hi_below = [](double x, double err) { return std::max(0.0, (std::fabs(x) - err) * (1 - kU)); };
   std::array<W, 3> v = {W(scene.velocities[0]), W(scene.velocities[1]), W(scene.velocities[2])};
-  std::array<W, 3> b = {W(scene.positions[0]), W(scene.positions[1]), W(scene.positions[2])};  // kReplica
-  std::array<double, 3> b_double = {scene.positions[0], scene.positions[1], scene.positions[2]};  // kCertified
+  std::array<double, 3> b_double = {scene.positions[0], scene.positions[1], scene.positions[2]};
+  std::array<double, 3> b_error{};  // kReplica: |b_double[k] - the engine's intercept|; the inputs are exact
   std::array<double, 3> error{};  // E_k [m/s] (kCertified); the inputs are exact
   // The engine's mass-weighted bounds (tier.h; kReplica), from what its start adds when it
   // adopts a more precise tier's state (tier.h, adopt(): 2^-100 per conversion), so that
@@ -140,16 +152,42 @@ CL_DD_INLINE std::optional<ElasticTripleRun> elasticTriplePass(const Scene& scen
     const ImpactChange<W> dv = applyImpactMap(map, vi, vj);
     if constexpr (kReplica) {
       const double eu_before = eu, eb_before = eb;
-      const ImpactChange<W> db = applyImpactMap(map, b[p], b[p + 1]);
+      // The engine's intercept map (applyImpactMap on double-double), in double with bounds.
+      double& ei = b_error[p];
+      double& ej = b_error[p + 1];
+      const double d = b_double[p + 1] - b_double[p];
+      const double d_error = (ei + ej + kU * std::fabs(d)) * kSlack + kTinyError;
+      double increment = d, increment_error = d_error;
+      if (map.exchange) {
+        std::swap(b_double[p], b_double[p + 1]);
+        std::swap(ei, ej);
+      } else {
+        if (map.light_factor != 1.0 && map.light_factor != -1.0) return std::nullopt;  // elastic: never
+        double& bh = map.heavy_is_i ? b_double[p] : b_double[p + 1];
+        double& bl = map.heavy_is_i ? b_double[p + 1] : b_double[p];
+        double& eh = map.heavy_is_i ? ei : ej;
+        double& el = map.heavy_is_i ? ej : ei;
+        increment = map.heavy_gain.hi * d;  // the gain's hi: within kU of the engine's gain
+        increment_error = (pair.gain * d_error + 2 * kU * std::fabs(increment)) * kSlack + kTinyError;
+        bh += increment;
+        eh = (eh + increment_error + kU * std::fabs(bh)) * kSlack + kTinyError;
+        bl = map.light_factor == -1.0 ? bh - d : bh + d;
+        el = (eh + d_error + kU * std::fabs(bl)) * kSlack + kTinyError;
+      }
+      const double heavy_after = map.heavy_is_i ? b_double[p] : b_double[p + 1];
+      const double light_after = map.heavy_is_i ? b_double[p + 1] : b_double[p];
+      const double heavy_error = map.heavy_is_i ? ei : ej, light_error = map.heavy_is_i ? ej : ei;
       eu += rho(pair, dv, vi, vj);
-      eb += rho(pair, db, b[p], b[p + 1]);
+      eb += rho_of(pair, hi_above(heavy_after, heavy_error), hi_above(light_after, light_error),
+                   hi_above(increment, increment_error), hi_above(d, d_error)) * kSlack;
       if (!(eu_before * pair.scale <= kGuard * std::fabs(dv.difference.hi) &&
-            eb_before * pair.scale <= kGuard * std::fabs(db.difference.hi))) {
+            eb_before * pair.scale <= kGuard * hi_below(d, d_error))) {
         return std::nullopt;  // the engine may adopt a 100-digit state here
       }
-      const double magnitude = std::fabs(b[p].hi) + std::fabs(b[p + 1].hi) + std::fabs(vi.hi) + std::fabs(vj.hi);
+      const double magnitude = hi_above(b_double[p], ei) + hi_above(b_double[p + 1], ej) + std::fabs(vi.hi) +
+                               std::fabs(vj.hi);
       if (!(magnitude < kRange)) return std::nullopt;
-      if (!(std::fabs(db.difference.hi) < time_bound * std::fabs(dv.difference.hi))) return std::nullopt;
+      if (!(hi_above(d, d_error) < time_bound * std::fabs(dv.difference.hi))) return std::nullopt;
     } else {
       double& ei = error[p];
       double& ej = error[p + 1];

@@ -10,10 +10,14 @@
 #include <random>
 #include <vector>
 
+#include "collision_lab/core/analytic.h"
+#include "collision_lab/core/nbody/engine.h"
 #include "collision_lab/core/nbody/scene.h"
+#include "collision_lab/core/scene.h"
 #include "double_double.h"
 #include "elastic_triple.h"
 #include "fma_path.h"
+#include "units.h"
 
 namespace collision_lab {
 namespace core {
@@ -153,6 +157,73 @@ TEST(FmaPath, KnownCountPassesGiveThePortableBitsImpactByImpact) {
 TEST(FmaPath, NotBuiltOnThisTarget) { GTEST_SKIP() << "no FMA path on this target: only the portable path"; }
 
 #endif
+
+// The replica pass's contract (elastic_triple.h): where it answers, its final velocities are
+// the engine's, bit for bit; where the engine's precision guard may fire, it declines. Its
+// intercepts are doubles with bounds on their distance from the engine's: this checks that
+// those bounds keep it on the safe side, against runEngine itself, on seeded scenes from
+// equal masses to ratios of 1e12, walls, near-grazing ends, and the extreme (1e37, 1, wall),
+// where the guard fires.
+TEST(KnownCountPass, TheReplicaAnswersOnlyWithTheEnginesBits) {
+  std::mt19937_64 rng(20261128);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0), decades(-6.0, 6.0);
+  std::uniform_int_distribution<int> kind(0, 5);
+  const double inf = std::numeric_limits<double>::infinity();
+  std::vector<Scene> scenes = {Scene{{1e37, 1, inf}, {2, 1, 0}, {-1, 0, 0}},
+                               Scene{{3, 1, 0.5}, {2, 1, 0}, {-1, 0, 0}},
+                               Scene{{1e4, 1, inf}, {2, 1, 0}, {-1, 0, 0}}};
+  while (scenes.size() < 400) {
+    Scene s = threeBodies();
+    for (double& m : s.masses) m = std::pow(10.0, decades(rng));
+    if (kind(rng) == 0) s.masses[kind(rng) % 2 == 0 ? 0 : 2] = inf;
+    s.positions = {2.0 + unit(rng), 0.5 * unit(rng), -2.0 + unit(rng)};
+    for (double& v : s.velocities) v = kind(rng) == 1 ? 1e-9 * unit(rng) : unit(rng);
+    if (!validate(s)) scenes.push_back(s);
+  }
+  int answered = 0, declined = 0;
+  for (const Scene& si : scenes) {
+    const WorkingUnits units(si);
+    const Scene& scene = units.scene;  // the pass and the engine, both in the engine's units
+    const std::optional<Pair> first = firstPair(scene);
+    const std::uint64_t count = std::min<std::uint64_t>(predictedImpactCount(scene), 20000);
+    if (!first || (scene.isWall(0) && scene.isWall(2))) continue;
+    auto ignore = [](std::uint64_t, const std::array<double, 3>&) {};
+    const std::optional<ElasticTripleRun> replica = runElasticTriplePass<ElasticTriplePass::kReplica>(
+        scene, count, *first == Pair::BC ? 1 : 0, count, inf, nullptr, ignore);
+    if (!replica) {
+      ++declined;
+      continue;
+    }
+    ++answered;
+    EngineOptions options;
+    options.max_impacts = count;
+    const SceneSimulation engine = runEngine(scene, options);
+    SCOPED_TRACE(::testing::Message() << "masses " << si.masses[0] << ", " << si.masses[1] << ", " << si.masses[2]
+                                      << "; velocities " << si.velocities[0] << ", " << si.velocities[1] << ", "
+                                      << si.velocities[2]);
+    ASSERT_EQ(engine.impact_count, replica->impact_count);
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_EQ(std::memcmp(&engine.final_velocities[k], &replica->final_velocities[k], sizeof(double)), 0)
+          << "body " << k << ": engine " << engine.final_velocities[k] << ", replica " << replica->final_velocities[k];
+    }
+  }
+  RecordProperty("answered", answered);
+  RecordProperty("declined", declined);
+  EXPECT_GT(answered, 300);  // the check covers most scenes
+  EXPECT_GE(declined, 1);    // (1e37, 1, wall): the engine's guard fires there
+  // The guard on the intercepts, which the replica reads in double: A meets B 1e-6 m away
+  // while the heavy C (1e12 kg) waits at -1e6 m. The bound the replica keeps of the engine's
+  // intercept error, sqrt(m_C) |x_C| 2^-99 = 1.6e-18 from the start, is more than 2^-43 of
+  // the impact's intercept difference (1e-6): the engine's guard may fire, so the replica
+  // must decline (it does with the intercepts in double-double too).
+  const Scene near_heavy{{1, 1, 1e12}, {1e-6, 0, -1e6}, {-1, 0, 0}};
+  ASSERT_FALSE(validate(near_heavy));
+  const WorkingUnits units(near_heavy);
+  auto ignore = [](std::uint64_t, const std::array<double, 3>&) {};
+  const std::uint64_t count = predictedImpactCount(units.scene);
+  ASSERT_GE(count, 1u);
+  EXPECT_FALSE((runElasticTriplePass<ElasticTriplePass::kReplica>(units.scene, count, 0, count, inf, nullptr, ignore)));
+}
 
 }  // namespace
 }  // namespace nbody_detail
