@@ -344,10 +344,33 @@ SceneSimulation simulateByEngine(const Scene& scene, const SimulationOptions& op
   return result;
 }
 
+}  // namespace
+
+void fillRotationPrediction(const Scene& scene, Prediction& prediction) {
+  const ClosedForm model(scene);
+  const std::array<double, 3> masses = triple(scene.masses);
+  const std::uint64_t count = predictedImpactCount(scene);
+  const Angles angles = anglesFor(masses);
+  prediction.impact_count = count;
+  const std::array<double, 3> final_velocities = model.velocitiesAfter(count);
+  prediction.final_velocities.assign(final_velocities.begin(), final_velocities.end());
+  prediction.energy_lost = 0.0;  // elastic
+  prediction.critical_restitution = criticalRestitution(angles.alpha);
+  prediction.spiral_angle = angles.theta;
+  prediction.paper_impact_count = paper::impactCount(scene);
+  prediction.max_possible_impact_count = maxPossibleImpactCount(masses);
+  prediction.alpha = angles.alpha;
+  prediction.theta = angles.theta;
+  prediction.omega = angles.omega;
+  prediction.phi_bc = paper::phiBC(scene);
+  prediction.psi = model.psi();
+  if (const std::optional<Pair> first = firstPair(scene)) prediction.first_pair_index = static_cast<std::size_t>(pairIndex(*first));
+}
+
 /// Simulates (full or summary mode), with every event put beside the prediction in full
 /// mode, and measures how far the simulation is from the closed form.
-SceneSimulation simulateBesidePrediction(const Scene& scene, const Prediction& prediction,
-                                         const SceneRunOptions& options, const SceneVisitors& visitors) {
+SceneSimulation simulateRotationScene(const Scene& scene, const Prediction& prediction,
+                                      const SceneRunOptions& options, const SceneVisitors& visitors) {
   const RunOptions& lab = options.lab;
   const std::uint64_t predicted_count = prediction.impact_count.value_or(0);
   const EnergyNormError relative_error(scene);
@@ -435,34 +458,6 @@ SceneSimulation simulateBesidePrediction(const Scene& scene, const Prediction& p
   if (!run.truncated) simulation.matches_prediction = run.impact_count == predicted_count;
   simulation.escalations = run.escalations;
   return simulation;
-}
-
-}  // namespace
-
-void fillRotationPrediction(const Scene& scene, Prediction& prediction) {
-  const ClosedForm model(scene);
-  const std::array<double, 3> masses = triple(scene.masses);
-  const std::uint64_t count = predictedImpactCount(scene);
-  const Angles angles = anglesFor(masses);
-  prediction.impact_count = count;
-  const std::array<double, 3> final_velocities = model.velocitiesAfter(count);
-  prediction.final_velocities.assign(final_velocities.begin(), final_velocities.end());
-  prediction.energy_lost = 0.0;  // elastic
-  prediction.critical_restitution = criticalRestitution(angles.alpha);
-  prediction.spiral_angle = angles.theta;
-  prediction.paper_impact_count = paper::impactCount(scene);
-  prediction.max_possible_impact_count = maxPossibleImpactCount(masses);
-  prediction.alpha = angles.alpha;
-  prediction.theta = angles.theta;
-  prediction.omega = angles.omega;
-  prediction.phi_bc = paper::phiBC(scene);
-  prediction.psi = model.psi();
-  if (const std::optional<Pair> first = firstPair(scene)) prediction.first_pair_index = static_cast<std::size_t>(pairIndex(*first));
-}
-
-SceneSimulation simulateRotationScene(const Scene& scene, const Prediction& prediction,
-                                      const SceneRunOptions& options, const SceneVisitors& visitors) {
-  return simulateBesidePrediction(scene, prediction, options, visitors);
 }
 
 }  // namespace core

@@ -136,6 +136,21 @@ CL_DD_INLINE std::optional<ElasticTripleRun> elasticTriplePass(const Scene& scen
     eu += 2 * 0x1p-100 * sqrt_mass[k] * std::fabs(scene.velocities[k]);
     eb += 2 * 0x1p-100 * sqrt_mass[k] * std::fabs(scene.positions[k]);
   }
+  // Both passes map the intercepts in double as the engine maps them in double-double
+  // (applyImpactMap, e = 1: a swap, or heavy += g d and light = heavy -+ d); returns g d, or
+  // d for a swap.
+  const auto map_intercepts = [&b_double](const ImpactMap<W>& map, std::size_t p, double d) {
+    if (map.exchange) {
+      std::swap(b_double[p], b_double[p + 1]);
+      return d;
+    }
+    double& bh = map.heavy_is_i ? b_double[p] : b_double[p + 1];
+    double& bl = map.heavy_is_i ? b_double[p + 1] : b_double[p];
+    const double increment = map.heavy_gain.hi * d;
+    bh += increment;
+    bl = map.light_factor == -1.0 ? bh - d : bh + d;
+    return increment;
+  };
   ElasticTripleRun run;
   const std::uint64_t target = count < cap ? count : cap;
   std::size_t p = first_pair;
@@ -150,29 +165,25 @@ CL_DD_INLINE std::optional<ElasticTripleRun> elasticTriplePass(const Scene& scen
     W& vi = v[p];
     W& vj = v[p + 1];
     const ImpactChange<W> dv = applyImpactMap(map, vi, vj);
+    if (!map.exchange && map.light_factor != 1.0 && map.light_factor != -1.0) return std::nullopt;  // elastic: never
+    const double d = b_double[p + 1] - b_double[p];
     if constexpr (kReplica) {
       const double eu_before = eu, eb_before = eb;
-      // The engine's intercept map (applyImpactMap on double-double), in double with bounds.
+      // The engine's intercept map, in double with bounds on the distance from its values.
       double& ei = b_error[p];
       double& ej = b_error[p + 1];
-      const double d = b_double[p + 1] - b_double[p];
       const double d_error = (ei + ej + kU * std::fabs(d)) * kSlack + kTinyError;
-      double increment = d, increment_error = d_error;
+      const double increment = map_intercepts(map, p, d);  // the gain's hi: within kU of the engine's gain
+      double increment_error = d_error;
       if (map.exchange) {
-        std::swap(b_double[p], b_double[p + 1]);
         std::swap(ei, ej);
       } else {
-        if (map.light_factor != 1.0 && map.light_factor != -1.0) return std::nullopt;  // elastic: never
-        double& bh = map.heavy_is_i ? b_double[p] : b_double[p + 1];
-        double& bl = map.heavy_is_i ? b_double[p + 1] : b_double[p];
         double& eh = map.heavy_is_i ? ei : ej;
         double& el = map.heavy_is_i ? ej : ei;
-        increment = map.heavy_gain.hi * d;  // the gain's hi: within kU of the engine's gain
         increment_error = (pair.gain * d_error + 2 * kU * std::fabs(increment)) * kSlack + kTinyError;
-        bh += increment;
-        eh = (eh + increment_error + kU * std::fabs(bh)) * kSlack + kTinyError;
-        bl = map.light_factor == -1.0 ? bh - d : bh + d;
-        el = (eh + d_error + kU * std::fabs(bl)) * kSlack + kTinyError;
+        eh = (eh + increment_error + kU * std::fabs(map.heavy_is_i ? b_double[p] : b_double[p + 1])) * kSlack +
+             kTinyError;
+        el = (eh + d_error + kU * std::fabs(map.heavy_is_i ? b_double[p + 1] : b_double[p])) * kSlack + kTinyError;
       }
       const double heavy_after = map.heavy_is_i ? b_double[p] : b_double[p + 1];
       const double light_after = map.heavy_is_i ? b_double[p + 1] : b_double[p];
@@ -192,10 +203,9 @@ CL_DD_INLINE std::optional<ElasticTripleRun> elasticTriplePass(const Scene& scen
       double& ei = error[p];
       double& ej = error[p + 1];
       const double difference_error = (ei + ej + kEta * std::fabs(dv.difference.hi)) * kSlack + kTinyError;
-      if (!(std::fabs(b_double[p + 1] - b_double[p]) < time_bound * std::fabs(dv.difference.hi))) return std::nullopt;
+      if (!(std::fabs(d) < time_bound * std::fabs(dv.difference.hi))) return std::nullopt;
       if (map.exchange) {  // a swap rounds nothing
         std::swap(ei, ej);
-        std::swap(b_double[p], b_double[p + 1]);
       } else {
         double& eh = map.heavy_is_i ? ei : ej;
         double& el = map.heavy_is_i ? ej : ei;
@@ -207,12 +217,8 @@ CL_DD_INLINE std::optional<ElasticTripleRun> elasticTriplePass(const Scene& scen
           eh = (eh + increment_error + kEta * std::fabs(heavy.hi)) * kSlack + kTinyError;
         }
         el = (eh + difference_error + kEta * std::fabs(light.hi)) * kSlack + kTinyError;
-        const double d = b_double[p + 1] - b_double[p];
-        double& bh = map.heavy_is_i ? b_double[p] : b_double[p + 1];
-        double& bl = map.heavy_is_i ? b_double[p + 1] : b_double[p];
-        bh += map.heavy_gain.hi * d;
-        bl = map.heavy_is_i ? bh - d : bh + d;
       }
+      map_intercepts(map, p, d);
       const double magnitude =
           std::fabs(b_double[p]) + std::fabs(b_double[p + 1]) + std::fabs(vi.hi) + std::fabs(vj.hi);
       if (!(magnitude < kRange)) return std::nullopt;

@@ -106,14 +106,6 @@ PassTrace trace(const Scene& scene, std::uint64_t count, std::size_t first_pair)
   return t;
 }
 
-Scene triple(std::array<double, 3> m, std::array<double, 3> x, std::array<double, 3> v) {
-  Scene s;
-  s.masses.assign(m.begin(), m.end());
-  s.positions.assign(x.begin(), x.end());
-  s.velocities.assign(v.begin(), v.end());
-  return s;
-}
-
 // Counts by the closed form (ceil(pi / alpha) - 1 for a block against a wall and for the
 // symmetric heavy-light-heavy case); both passes run to the count and must agree.
 TEST(FmaPath, KnownCountPassesGiveThePortableBitsImpactByImpact) {
@@ -125,12 +117,12 @@ TEST(FmaPath, KnownCountPassesGiveThePortableBitsImpactByImpact) {
     std::size_t first_pair;
   };
   const std::vector<Case> cases = {
-      {triple({100, 1, inf}, {2, 1, 0}, {-1, 0, 0}), 31, 0},
-      {triple({1e4, 1, inf}, {2, 1, 0}, {-1, 0, 0}), 314, 0},
-      {triple({1e10, 1, inf}, {2, 1, 0}, {-1, 0, 0}), 314159, 0},
-      {triple({1e12, 1, 1e12}, {1, 0, -1}, {-1, 0, 0}), 2221441, 0},
-      {triple({1e37, 1, inf}, {2, 1, 0}, {-1, 0, 0}), 200000, 0},  // a prefix: capped
-      {triple({3.7, 1.3, 5.1}, {1, 0, -1}, {-1, 0.25, 1}), 0, 0},
+      {threeBodies({100, 1, inf}, {2, 1, 0}, {-1, 0, 0}), 31, 0},
+      {threeBodies({1e4, 1, inf}, {2, 1, 0}, {-1, 0, 0}), 314, 0},
+      {threeBodies({1e10, 1, inf}, {2, 1, 0}, {-1, 0, 0}), 314159, 0},
+      {threeBodies({1e12, 1, 1e12}, {1, 0, -1}, {-1, 0, 0}), 2221441, 0},
+      {threeBodies({1e37, 1, inf}, {2, 1, 0}, {-1, 0, 0}), 200000, 0},  // a prefix: capped
+      {threeBodies({3.7, 1.3, 5.1}, {1, 0, -1}, {-1, 0.25, 1}), 0, 0},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(::testing::Message() << "masses " << c.scene.masses[0] << ", " << c.scene.masses[1] << ", "
