@@ -73,7 +73,7 @@ class Driver {
     const StepResult r = stepOrEscalate<DD>(record);
     exact_streak_ = escalations_.exact_rational > exact ? exact_streak_ + 1 : 0;
     if (exact_streak_ == 0) {
-      streak_work_ = {};
+      streak_work_.clear();
     } else if (exact_ && exact_->count() == fast_->count()) {
       const double bits = exact_->exactBits();
       streak_work_.add(bits * bits);
@@ -237,7 +237,12 @@ class Driver {
     if constexpr (Arithmetic<S>::kExact) {
       if (cancel_ && cancel_->load(std::memory_order_relaxed)) return {StepKind::kCancelled, 0, t.lastTime()};
     }
-    StepResult r = t.step(record);
+    StepResult r;
+    if constexpr (std::is_same_v<S, DD>) {
+      r = t.stepInlined(record);
+    } else {
+      r = t.step(record);
+    }
     if constexpr (Arithmetic<S>::kExact) {
       if (r.kind == StepKind::kAmbiguous || r.kind == StepKind::kImprecise) r.kind = StepKind::kInconsistent;  // cannot happen
       return r;

@@ -127,9 +127,11 @@ class CL_NBODY_INTERNAL TournamentTree {
   /// The winner of node n's parent, given n's winner; stores and returns it. Which of two
   /// equal keys wins does not matter: the engine settles near-ties with precise times.
   Node climb(std::size_t n, const Node& winner) {
-    const Node candidates[2] = {winner, nodes_[n ^ 1]};
-    // The winner's address comes from the comparison: no branch to mispredict.
-    const Node parent = candidates[static_cast<std::size_t>(candidates[1].key < winner.key)];
+    const Node sibling = nodes_[n ^ 1];
+    // Selected in registers (a minimum and a conditional move): no branch to mispredict,
+    // and no round trip through memory on the path to the root.
+    const std::uint32_t sibling_wins = -static_cast<std::uint32_t>(sibling.key < winner.key);  // all ones or 0
+    const Node parent{least(winner.key, sibling.key), winner.leaf ^ ((winner.leaf ^ sibling.leaf) & sibling_wins)};
     nodes_[n >> 1] = parent;
     return parent;
   }
