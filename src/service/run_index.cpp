@@ -48,16 +48,27 @@ constexpr const char* kRunColumns =
     "run_id, student, requested_run_id, state, accepted_at, started_at, finished_at, scene_json, summary_json, "
     "stop_reason, collision_count, bag_path, csv_path";
 
-/// One prepared statement, reset and cleared when it goes out of scope. Every value is
-/// bound, never spliced into the SQL.
+using StatementCache = std::unordered_map<std::string, sqlite3_stmt*>;
+
+/// One use of a prepared statement, taken from the connection's cache (prepared on first
+/// use), reset and cleared when it goes out of scope. Every value is bound, never spliced
+/// into the SQL.
 class Statement {
  public:
-  Statement(sqlite3* db, const std::string& path, const std::string& sql) : db_(db), path_(path) {
-    if (sqlite3_prepare_v2(db, sql.c_str(), static_cast<int>(sql.size()), &stmt_, nullptr) != SQLITE_OK) {
+  Statement(StatementCache& cache, sqlite3* db, const std::string& path, const std::string& sql)
+      : db_(db), path_(path) {
+    sqlite3_stmt*& cached = cache[sql];
+    if (!cached && sqlite3_prepare_v3(db, sql.c_str(), static_cast<int>(sql.size()), SQLITE_PREPARE_PERSISTENT,
+                                      &cached, nullptr) != SQLITE_OK) {
+      cache.erase(sql);
       fail("preparing '" + sql + "'");
     }
+    stmt_ = cached;
   }
-  ~Statement() { sqlite3_finalize(stmt_); }
+  ~Statement() {
+    sqlite3_reset(stmt_);
+    sqlite3_clear_bindings(stmt_);
+  }
   Statement(const Statement&) = delete;
   Statement& operator=(const Statement&) = delete;
 
@@ -179,6 +190,7 @@ RunIndex::RunIndex(const std::string& path) : path_(path) {
         std::this_thread::sleep_for(std::chrono::milliseconds(20));
         continue;
       }
+      finalizeStatements();
       sqlite3_close(db_);
       db_ = nullptr;
       throw;
@@ -193,7 +205,7 @@ void RunIndex::initialize() {
   execute("PRAGMA synchronous=NORMAL");
   std::int64_t found = 0;
   {  // finalized before the writes below: a finalize resets the connection's error code
-    Statement version(db_, path_, "PRAGMA user_version");
+    Statement version(statements_, db_, path_, "PRAGMA user_version");
     version.step();
     found = version.integer(0);
   }
@@ -208,7 +220,15 @@ void RunIndex::initialize() {
   execute("COMMIT");
 }
 
-RunIndex::~RunIndex() { sqlite3_close(db_); }
+RunIndex::~RunIndex() {
+  finalizeStatements();
+  sqlite3_close(db_);
+}
+
+void RunIndex::finalizeStatements() {
+  for (auto& entry : statements_) sqlite3_finalize(entry.second);
+  statements_.clear();
+}
 
 std::string RunIndex::defaultPath(const std::string& bag_directory) {
   return (std::filesystem::path(bag_directory) / "runs.sqlite").string();
@@ -225,7 +245,7 @@ void RunIndex::execute(const std::string& sql) {
 
 void RunIndex::accepted(const IndexedRun& run) {
   std::lock_guard<std::mutex> lock(mutex_);
-  Statement s(db_, path_,
+  Statement s(statements_, db_, path_,
               std::string("INSERT OR REPLACE INTO runs (") + kRunColumns +
                   ") VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13)");
   s.bind(1, run.run_id).bind(2, run.student).bind(3, run.requested_run_id).bind(4, std::string(runStateName(run.state)));
@@ -235,10 +255,34 @@ void RunIndex::accepted(const IndexedRun& run) {
   s.run();
 }
 
+void RunIndex::writeTogether(const std::function<void()>& writes) {
+  bool begun = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    begun = sqlite3_exec(db_, "BEGIN IMMEDIATE", nullptr, nullptr, nullptr) == SQLITE_OK;
+  }
+  try {
+    writes();
+  } catch (...) {
+    if (begun) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      sqlite3_exec(db_, "COMMIT", nullptr, nullptr, nullptr);
+    }
+    throw;
+  }
+  if (!begun) return;
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (sqlite3_exec(db_, "COMMIT", nullptr, nullptr, nullptr) != SQLITE_OK) {
+    const std::string error = sqlite3_errmsg(db_);
+    sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
+    throw RunIndexError("run index " + path_ + ": committing a group of writes: " + error);
+  }
+}
+
 void RunIndex::started(const std::string& run_id, double at) {
   std::lock_guard<std::mutex> lock(mutex_);
   // Only a queued run starts: a late call never takes a run back from its end.
-  Statement s(db_, path_, "UPDATE runs SET state = 'running', started_at = ?2 WHERE run_id = ?1 AND state = 'queued'");
+  Statement s(statements_, db_, path_, "UPDATE runs SET state = 'running', started_at = ?2 WHERE run_id = ?1 AND state = 'queued'");
   s.bind(1, run_id).bind(2, at).run();
 }
 
@@ -257,7 +301,7 @@ void RunIndex::end(const std::string& run_id, RunState state, double at, const s
   std::lock_guard<std::mutex> lock(mutex_);
   // A run without a row (accepted before its node had the index) gets one, so that no
   // run's end is lost.
-  Statement s(db_, path_,
+  Statement s(statements_, db_, path_,
               "INSERT INTO runs (run_id, state, finished_at, summary_json, stop_reason, collision_count, bag_path) "
               "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7) ON CONFLICT(run_id) DO UPDATE SET state = excluded.state, "
               "finished_at = excluded.finished_at, summary_json = excluded.summary_json, "
@@ -270,25 +314,25 @@ void RunIndex::end(const std::string& run_id, RunState state, double at, const s
 
 void RunIndex::rejected(const IndexedRejection& rejection) {
   std::lock_guard<std::mutex> lock(mutex_);
-  Statement s(db_, path_,
+  Statement s(statements_, db_, path_,
               "INSERT INTO rejections (at, student, run_id, reason_name, field, message) VALUES (?1, ?2, ?3, ?4, ?5, ?6)");
   s.bind(1, rejection.at).bind(2, rejection.student).bind(3, rejection.run_id).bind(4, rejection.reason_name);
   s.bind(5, rejection.field).bind(6, rejection.message);
   s.run();
   // Bounded: a student's loop of bad sends cannot grow the file without end.
-  Statement trim(db_, path_, "DELETE FROM rejections WHERE id <= last_insert_rowid() - ?1");
+  Statement trim(statements_, db_, path_, "DELETE FROM rejections WHERE id <= last_insert_rowid() - ?1");
   trim.bind(1, static_cast<std::int64_t>(kRejectionsKept)).run();
 }
 
 void RunIndex::setCsvPath(const std::string& run_id, const std::string& csv_path) {
   std::lock_guard<std::mutex> lock(mutex_);
-  Statement s(db_, path_, "UPDATE runs SET csv_path = ?2 WHERE run_id = ?1");
+  Statement s(statements_, db_, path_, "UPDATE runs SET csv_path = ?2 WHERE run_id = ?1");
   s.bind(1, run_id).bind(2, csv_path).run();
 }
 
 std::optional<IndexedRun> RunIndex::find(const std::string& run_id) const {
   std::lock_guard<std::mutex> lock(mutex_);
-  Statement s(db_, path_, std::string("SELECT ") + kRunColumns + " FROM runs WHERE run_id = ?1");
+  Statement s(statements_, db_, path_, std::string("SELECT ") + kRunColumns + " FROM runs WHERE run_id = ?1");
   s.bind(1, run_id);
   if (!s.step()) return std::nullopt;
   return readRun(s);
@@ -296,7 +340,7 @@ std::optional<IndexedRun> RunIndex::find(const std::string& run_id) const {
 
 std::vector<IndexedRun> RunIndex::list(const std::optional<std::string>& student, std::size_t limit) const {
   std::lock_guard<std::mutex> lock(mutex_);
-  Statement s(db_, path_,
+  Statement s(statements_, db_, path_,
               std::string("SELECT ") + kRunColumns + " FROM runs" + (student ? " WHERE student = ?1" : "") +
                   " ORDER BY accepted_at, rowid" + limitClause(limit));
   if (student) s.bind(1, *student);
@@ -307,7 +351,7 @@ std::vector<IndexedRun> RunIndex::list(const std::optional<std::string>& student
 
 std::vector<IndexedRun> RunIndex::inState(RunState state) const {
   std::lock_guard<std::mutex> lock(mutex_);
-  Statement s(db_, path_,
+  Statement s(statements_, db_, path_,
               std::string("SELECT ") + kRunColumns + " FROM runs WHERE state = ?1 ORDER BY accepted_at, rowid");
   s.bind(1, std::string(runStateName(state)));
   std::vector<IndexedRun> runs;
@@ -317,7 +361,7 @@ std::vector<IndexedRun> RunIndex::inState(RunState state) const {
 
 std::vector<IndexedRejection> RunIndex::rejections(const std::optional<std::string>& student, std::size_t limit) const {
   std::lock_guard<std::mutex> lock(mutex_);
-  Statement s(db_, path_,
+  Statement s(statements_, db_, path_,
               std::string("SELECT id, at, student, run_id, reason_name, field, message FROM rejections") +
                   (student ? " WHERE student = ?1" : "") + " ORDER BY id DESC" + limitClause(limit));
   if (student) s.bind(1, *student);
@@ -338,7 +382,7 @@ std::vector<IndexedRejection> RunIndex::rejections(const std::optional<std::stri
 
 std::size_t RunIndex::runCount() const {
   std::lock_guard<std::mutex> lock(mutex_);
-  Statement s(db_, path_, "SELECT count(*) FROM runs");
+  Statement s(statements_, db_, path_, "SELECT count(*) FROM runs");
   s.step();
   return static_cast<std::size_t>(s.integer(0));
 }

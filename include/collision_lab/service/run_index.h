@@ -12,13 +12,16 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <mutex>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 struct sqlite3;
+struct sqlite3_stmt;
 
 namespace collision_lab::service {
 
@@ -84,6 +87,10 @@ class RunIndex {
                    std::uint64_t collision_count, const std::string& bag_path);
   /// A rejected input; only the newest kRejectionsKept are kept.
   void rejected(const IndexedRejection& rejection);
+  /// Calls `writes` (calls of the write methods above) inside one transaction: one commit
+  /// for all of them (group commit). When the transaction cannot begin, each write commits
+  /// on its own, as outside. Throws RunIndexError when the commit fails.
+  void writeTogether(const std::function<void()>& writes);
   static constexpr std::size_t kRejectionsKept = 100000;
   /// The events CSV made beside the run's bag (the web node, once, on the first download).
   void setCsvPath(const std::string& run_id, const std::string& csv_path);
@@ -109,9 +116,15 @@ class RunIndex {
   void end(const std::string& run_id, RunState state, double at, const std::string& summary_json,
            const std::string& stop_reason, std::uint64_t collision_count, const std::string& bag_path);
 
+  /// Finalizes the prepared statements (before the connection closes).
+  void finalizeStatements();
+
   const std::string path_;  ///< for the errors
   mutable std::mutex mutex_;
   sqlite3* db_ = nullptr;
+  /// Each SQL text prepared once, on first use, and reused (under mutex_): preparing cost
+  /// more than a row's write.
+  mutable std::unordered_map<std::string, sqlite3_stmt*> statements_;
 };
 
 }  // namespace collision_lab::service
