@@ -295,9 +295,62 @@ RunIndexRecorder::RunIndexRecorder(const std::string& bag_directory) : bag_direc
   } catch (const RunIndexError& e) {
     ROS_ERROR_STREAM("the run index is not written (runs are served and recorded in bags as ever): " << e.what());
   }
+  if (index_) writer_ = std::thread(&RunIndexRecorder::writerLoop, this);
 }
 
-RunIndexRecorder::~RunIndexRecorder() = default;
+RunIndexRecorder::~RunIndexRecorder() {
+  if (!writer_.joinable()) return;
+  {
+    std::lock_guard<std::mutex> lock(writes_mutex_);
+    writer_stops_ = true;
+  }
+  writes_queued_.notify_one();
+  writer_.join();  // every queued write committed
+}
+
+std::uint64_t RunIndexRecorder::enqueue(std::function<void()> write) {
+  std::lock_guard<std::mutex> lock(writes_mutex_);
+  pending_.push_back(std::move(write));
+  writes_queued_.notify_one();
+  return ++queued_;
+}
+
+void RunIndexRecorder::waitWritten(std::uint64_t ticket) const {
+  std::unique_lock<std::mutex> lock(writes_mutex_);
+  writes_committed_.wait(lock, [&] { return written_ >= ticket; });
+}
+
+void RunIndexRecorder::flush() const {
+  std::uint64_t ticket = 0;
+  {
+    std::lock_guard<std::mutex> lock(writes_mutex_);
+    ticket = queued_;
+  }
+  waitWritten(ticket);
+}
+
+void RunIndexRecorder::writerLoop() {
+  std::vector<std::function<void()>> group;
+  std::unique_lock<std::mutex> lock(writes_mutex_);
+  for (;;) {
+    writes_queued_.wait(lock, [this] { return !pending_.empty() || writer_stops_; });
+    if (pending_.empty()) return;
+    group.swap(pending_);
+    lock.unlock();
+    try {
+      index_->writeTogether([&group] {
+        for (const auto& write : group) write();  // each logs its own failure
+      });
+    } catch (const std::exception& e) {  // the node serves on; the writes are logged as lost
+      ROS_ERROR_STREAM("run index: " << group.size() << " writes were not committed: " << e.what());
+    }
+    const std::size_t done = group.size();
+    group.clear();
+    lock.lock();
+    written_ += done;
+    writes_committed_.notify_all();
+  }
+}
 
 void RunIndexRecorder::accepted(const std::string& run_id, const std::string& student, const std::string& requested_run_id,
                                 const collision_lab::InitialConditions& input) {
@@ -309,30 +362,39 @@ void RunIndexRecorder::accepted(const std::string& run_id, const std::string& st
   row.state = RunState::kQueued;
   row.accepted_at = wallNow();
   row.scene_json = inputJson(input);
-  try {
-    index_->accepted(row);
-  } catch (const RunIndexError& e) {
-    ROS_ERROR_STREAM("run " << run_id << ": not in the run index: " << e.what());
-  }
+  enqueue([this, row = std::move(row)] {
+    try {
+      index_->accepted(row);
+    } catch (const RunIndexError& e) {
+      ROS_ERROR_STREAM("run " << row.run_id << ": not in the run index: " << e.what());
+    }
+  });
 }
 
 void RunIndexRecorder::started(const std::string& run_id) {
   if (!index_) return;
-  try {
-    index_->started(run_id, wallNow());
-  } catch (const RunIndexError& e) {
-    ROS_ERROR_STREAM("run " << run_id << ": its start is not in the run index: " << e.what());
-  }
+  enqueue([this, run_id, at = wallNow()] {
+    try {
+      index_->started(run_id, at);
+    } catch (const RunIndexError& e) {
+      ROS_ERROR_STREAM("run " << run_id << ": its start is not in the run index: " << e.what());
+    }
+  });
 }
 
 void RunIndexRecorder::finished(const collision_lab::RunSummary& summary) {
   if (!index_) return;
-  try {
-    index_->finished(summary.run_id, wallNow(), summaryJson(summary), summary.stop_reason, summary.collision_count,
-                     summary.recording_ok ? summary.bag_path : std::string());
-  } catch (const RunIndexError& e) {
-    ROS_ERROR_STREAM("run " << summary.run_id << ": its end is not in the run index: " << e.what());
-  }
+  const std::uint64_t ticket =
+      enqueue([this, run_id = summary.run_id, at = wallNow(), json = summaryJson(summary),
+               stop_reason = summary.stop_reason, count = summary.collision_count,
+               bag = summary.recording_ok ? summary.bag_path : std::string()] {
+        try {
+          index_->finished(run_id, at, json, stop_reason, count, bag);
+        } catch (const RunIndexError& e) {
+          ROS_ERROR_STREAM("run " << run_id << ": its end is not in the run index: " << e.what());
+        }
+      });
+  waitWritten(ticket);
 }
 
 void RunIndexRecorder::rejected(const collision_lab::Rejected& rejected) {
@@ -344,16 +406,19 @@ void RunIndexRecorder::rejected(const collision_lab::Rejected& rejected) {
   row.reason_name = rejected.reason_name;
   row.field = rejected.field;
   row.message = rejected.message;
-  try {
-    index_->rejected(row);
-  } catch (const RunIndexError& e) {
-    ROS_ERROR_STREAM("a rejection is not in the run index: " << e.what());
-  }
+  enqueue([this, row = std::move(row)] {
+    try {
+      index_->rejected(row);
+    } catch (const RunIndexError& e) {
+      ROS_ERROR_STREAM("a rejection is not in the run index: " << e.what());
+    }
+  });
 }
 
 std::vector<collision_lab::ServedRun> RunIndexRecorder::list(const std::string& student) const {
   std::vector<collision_lab::ServedRun> served;
   if (!index_) return served;
+  flush();
   std::vector<IndexedRun> rows;
   try {
     rows = index_->list(student.empty() ? std::nullopt : std::optional<std::string>(student));

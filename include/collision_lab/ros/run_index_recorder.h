@@ -6,10 +6,14 @@
 // logged (ROS_ERROR), and the run goes on. Thread-safe (RunIndex is).
 #pragma once
 
+#include <condition_variable>
 #include <cstdint>
+#include <functional>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "collision_lab/InitialConditions.h"
@@ -68,7 +72,18 @@ class RunIndexRecorder {
 
   bool ok() const { return index_ != nullptr; }
   const std::string& bagDirectory() const { return bag_directory_; }
-  collision_lab::service::RunIndex* index() { return index_.get(); }
+  /// The index, with every write handed over so far committed.
+  collision_lab::service::RunIndex* index() {
+    flush();
+    return index_.get();
+  }
+  /// Waits until every write handed over so far is committed.
+  void flush() const;
+
+  // The writes go to a writer thread, in order, which commits whatever has queued up in
+  // one transaction (a group commit: under load one commit serves many runs). finished()
+  // returns once its write is committed, so that whoever sees the summary finds the run
+  // finished; list() and index() first wait for every write handed over.
 
   /// A run accepted and queued, before any worker can take it; input as served (its
   /// run_id assigned). requested_run_id: InitialConditions.run_id as sent.
@@ -98,8 +113,25 @@ class RunIndexRecorder {
   void endFromBag(const std::string& run_id, const std::string& bag_path, const BagContents& contents,
                   const std::string& note);
 
+  /// Hands `write` to the writer thread; returns its ticket (its place in the order of writes).
+  std::uint64_t enqueue(std::function<void()> write);
+  /// Waits until every write up to `ticket` is committed.
+  void waitWritten(std::uint64_t ticket) const;
+  /// The writer thread: takes every write queued so far and commits them together
+  /// (RunIndex::writeTogether), until the recorder is destroyed and nothing is left.
+  void writerLoop();
+
   std::string bag_directory_;
   std::unique_ptr<collision_lab::service::RunIndex> index_;
+  // The writer thread's queue: writes in order, committed in groups.
+  mutable std::mutex writes_mutex_;
+  mutable std::condition_variable writes_queued_;     ///< pending_ grew, or writer_stops_
+  mutable std::condition_variable writes_committed_;  ///< written_ grew
+  std::vector<std::function<void()>> pending_;
+  std::uint64_t queued_ = 0;   ///< writes ever queued
+  std::uint64_t written_ = 0;  ///< writes ever committed (or failed and logged)
+  bool writer_stops_ = false;
+  std::thread writer_;
 };
 
 }  // namespace collision_lab_ros
