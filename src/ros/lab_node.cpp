@@ -644,6 +644,7 @@ LabNode::LabNode(ros::NodeHandle nh, ros::NodeHandle private_nh, const RunObserv
   diagnostics_timer_ = nh_.createWallTimer(ros::WallDuration(kDiagnosticsPeriod),
                                            [this](const ros::WallTimerEvent&) { diagnostics_.force_update(); });
 
+  queue_publisher_ = std::thread(&LabNode::queuePublisherLoop, this);
   for (auto& worker : workers_) worker->thread = std::thread(&LabNode::workerLoop, this, std::ref(*worker));
   watchdog_ = std::thread(&LabNode::watchdogLoop, this);
   input_sub_ = nh_.subscribe(kInitialConditionsTopic, kInputQueueSize,
@@ -688,6 +689,12 @@ LabNode::~LabNode() {
   for (Scheduler::Entry& entry : waiting) dropWaiting(std::move(entry.job), "the node's shutdown");
   for (auto& worker : workers_) worker->thread.join();
   watchdog_.join();
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    queue_publisher_stops_ = true;
+  }
+  queue_wake_.notify_one();
+  queue_publisher_.join();  // the last queue state is out
   // Calls still in progress end once their run's bag is closed (the writers run on).
   input_sub_.shutdown();
   run_scene_srv_.shutdown();
@@ -876,7 +883,27 @@ void LabNode::stopRun(Worker& worker, StopCause cause, const std::string& by) {
 }
 
 void LabNode::publishQueue() {
-  collision_lab::RunQueue& msg = queue_msg_;
+  queue_changed_ = true;
+  queue_wake_.notify_one();
+}
+
+void LabNode::queuePublisherLoop() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  for (;;) {
+    queue_wake_.wait(lock, [this] { return queue_changed_ || queue_publisher_stops_; });
+    if (!queue_changed_) return;
+    queue_changed_ = false;
+    collision_lab::RunQueue msg = buildQueue();
+    lock.unlock();
+    run_queue_pub_.publish(msg);
+    lock.lock();
+    // At most kRunQueuePeriod apart: a burst of runs is one message, not one per change.
+    queue_wake_.wait_for(lock, std::chrono::duration<double>(kRunQueuePeriod), [this] { return queue_publisher_stops_; });
+  }
+}
+
+collision_lab::RunQueue LabNode::buildQueue() const {
+  collision_lab::RunQueue msg = queue_msg_;
   msg.header.stamp = stampNow();
   msg.runs.clear();
   collision_lab::QueuedRun run;
@@ -900,7 +927,7 @@ void LabNode::publishQueue() {
     run.body_count = static_cast<std::uint32_t>(entry->job.plan.scene.size());
     msg.runs.push_back(run);
   }
-  run_queue_pub_.publish(msg);
+  return msg;
 }
 
 std::string LabNode::newRunId(std::string& claim_error) {

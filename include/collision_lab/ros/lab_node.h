@@ -306,8 +306,15 @@ class LabNode {
   void watchdogLoop();
   /// Sets worker's cancel flag with cause (kept when one is set already). mutex_ held.
   static void stopRun(Worker& worker, StopCause cause, const std::string& by);
-  /// Publishes run_queue. mutex_ held.
+  /// The queue changed: run_queue is published with its state by the queue publisher's
+  /// thread, which coalesces changes that come faster than it publishes (the latched
+  /// message is always the newest state). mutex_ held.
   void publishQueue();
+  /// The queue publisher's thread: builds run_queue under mutex_, publishes it outside,
+  /// until the node stops (the last state published first).
+  void queuePublisherLoop();
+  /// run_queue's message of the queue's state now. mutex_ held.
+  collision_lab::RunQueue buildQueue() const;
 
   // ---- A worker's (each on its own Worker) ----
   /// Runs job, catching every exception (WORKER_ERROR).
@@ -392,11 +399,15 @@ class LabNode {
   RememberedRunIds used_run_ids_;
   bool stopping_ = false;
   bool view_busy_ = false;  ///< a running run feeds the marker view
-  collision_lab::RunQueue queue_msg_;
+  collision_lab::RunQueue queue_msg_;  ///< run_queue's constant fields (its workers)
   std::vector<std::unique_ptr<Worker>> workers_;
 
   std::condition_variable watchdog_wake_;  ///< with mutex_: stopping_
   std::thread watchdog_;
+  bool queue_changed_ = false;           ///< run_queue's state is not published yet
+  bool queue_publisher_stops_ = false;   ///< the queue publisher ends once the state is out
+  std::condition_variable queue_wake_;   ///< with mutex_: queue_changed_ or queue_publisher_stops_
+  std::thread queue_publisher_;
 
   ros::CallbackQueue service_queue_;
   ros::AsyncSpinner service_spinner_;

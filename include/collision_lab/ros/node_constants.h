@@ -47,6 +47,9 @@ constexpr bool kLatchRunQueue = true;
 /// run_queue lists every running run and at most this many waiting ones (the first to be
 /// served): a burst of thousands of inputs is not republished whole at every change.
 constexpr std::size_t kRunQueueListed = 500;
+/// run_queue's messages come at most this often [s]; the latched one is the newest state
+/// once the period has passed.
+constexpr double kRunQueuePeriod = 0.05;
 /// Bag only (the node does not publish it): the settings of the run (RunParameters),
 /// written first in each bag, latched on replay like the run's other one-shot messages.
 constexpr char kRunParametersTopic[] = "run_parameters";
