@@ -1241,6 +1241,10 @@ class CL_NBODY_INTERNAL Tier {
     __builtin_prefetch(&pairs_[next]);
     __builtin_prefetch(&bodies_[next]);
     __builtin_prefetch(&bodies_[left(next)]);
+    // Its impact reschedules the pairs on either side, which read the bodies beyond.
+    if (next > 0) __builtin_prefetch(&pairs_[next - 1]), __builtin_prefetch(&bodies_[next - 1]);
+    if (next + 1 < pairs_.size()) __builtin_prefetch(&pairs_[next + 1]);
+    if (next + 2 < bodies_.size()) __builtin_prefetch(&bodies_[next + 2]);
   }
 
   /// Pair m separates (e > 0) or moves on together (e = 0): no impact; its neighbours get
