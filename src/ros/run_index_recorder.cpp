@@ -308,15 +308,22 @@ RunIndexRecorder::~RunIndexRecorder() {
   writer_.join();  // every queued write committed
 }
 
-std::uint64_t RunIndexRecorder::enqueue(std::function<void()> write) {
+std::uint64_t RunIndexRecorder::enqueue(std::function<void()> write, bool urgent) {
   std::lock_guard<std::mutex> lock(writes_mutex_);
+  if (pending_.empty()) oldest_pending_ = std::chrono::steady_clock::now();
   pending_.push_back(std::move(write));
-  writes_queued_.notify_one();
+  if (urgent) {
+    ++urgent_;
+    writes_queued_.notify_one();
+  }
   return ++queued_;
 }
 
 void RunIndexRecorder::waitWritten(std::uint64_t ticket) const {
   std::unique_lock<std::mutex> lock(writes_mutex_);
+  if (written_ >= ticket) return;
+  ++urgent_;  // a writer waits: commit now
+  writes_queued_.notify_one();
   writes_committed_.wait(lock, [&] { return written_ >= ticket; });
 }
 
@@ -335,7 +342,11 @@ void RunIndexRecorder::writerLoop() {
   for (;;) {
     writes_queued_.wait(lock, [this] { return !pending_.empty() || writer_stops_; });
     if (pending_.empty()) return;
+    // Deferrable writes alone wait for an urgent one, or for kDeferredWritesDelay.
+    writes_queued_.wait_until(lock, oldest_pending_ + kDeferredWritesDelay,
+                              [this] { return urgent_ > 0 || writer_stops_; });
     group.swap(pending_);
+    urgent_ = 0;
     lock.unlock();
     try {
       index_->writeTogether([&group] {
@@ -362,24 +373,28 @@ void RunIndexRecorder::accepted(const std::string& run_id, const std::string& st
   row.state = RunState::kQueued;
   row.accepted_at = wallNow();
   row.scene_json = inputJson(input);
-  enqueue([this, row = std::move(row)] {
-    try {
-      index_->accepted(row);
-    } catch (const RunIndexError& e) {
-      ROS_ERROR_STREAM("run " << row.run_id << ": not in the run index: " << e.what());
-    }
-  });
+  enqueue(
+      [this, row = std::move(row)] {
+        try {
+          index_->accepted(row);
+        } catch (const RunIndexError& e) {
+          ROS_ERROR_STREAM("run " << row.run_id << ": not in the run index: " << e.what());
+        }
+      },
+      /*urgent=*/true);
 }
 
 void RunIndexRecorder::started(const std::string& run_id) {
   if (!index_) return;
-  enqueue([this, run_id, at = wallNow()] {
-    try {
-      index_->started(run_id, at);
-    } catch (const RunIndexError& e) {
-      ROS_ERROR_STREAM("run " << run_id << ": its start is not in the run index: " << e.what());
-    }
-  });
+  enqueue(
+      [this, run_id, at = wallNow()] {
+        try {
+          index_->started(run_id, at);
+        } catch (const RunIndexError& e) {
+          ROS_ERROR_STREAM("run " << run_id << ": its start is not in the run index: " << e.what());
+        }
+      },
+      /*urgent=*/false);
 }
 
 void RunIndexRecorder::finished(const collision_lab::RunSummary& summary) {
@@ -393,7 +408,8 @@ void RunIndexRecorder::finished(const collision_lab::RunSummary& summary) {
         } catch (const RunIndexError& e) {
           ROS_ERROR_STREAM("run " << run_id << ": its end is not in the run index: " << e.what());
         }
-      });
+      },
+      /*urgent=*/true);
   waitWritten(ticket);
 }
 
@@ -406,13 +422,15 @@ void RunIndexRecorder::rejected(const collision_lab::Rejected& rejected) {
   row.reason_name = rejected.reason_name;
   row.field = rejected.field;
   row.message = rejected.message;
-  enqueue([this, row = std::move(row)] {
-    try {
-      index_->rejected(row);
-    } catch (const RunIndexError& e) {
-      ROS_ERROR_STREAM("a rejection is not in the run index: " << e.what());
-    }
-  });
+  enqueue(
+      [this, row = std::move(row)] {
+        try {
+          index_->rejected(row);
+        } catch (const RunIndexError& e) {
+          ROS_ERROR_STREAM("a rejection is not in the run index: " << e.what());
+        }
+      },
+      /*urgent=*/true);
 }
 
 std::vector<collision_lab::ServedRun> RunIndexRecorder::list(const std::string& student) const {

@@ -6,6 +6,7 @@
 // logged (ROS_ERROR), and the run goes on. Thread-safe (RunIndex is).
 #pragma once
 
+#include <chrono>
 #include <condition_variable>
 #include <cstdint>
 #include <functional>
@@ -62,6 +63,9 @@ std::vector<RecoveredBag> recoverActiveBags(const std::string& directory);
 /// Whether a live process holds <run_id>.bag.active (its flock cannot be taken).
 bool activeBagOwned(const std::string& active_path);
 
+/// How long a deferrable write of the index (a run's start) may wait for a commit.
+constexpr std::chrono::milliseconds kDeferredWritesDelay{500};
+
 /// The lab node's writer of the index.
 class RunIndexRecorder {
  public:
@@ -81,9 +85,12 @@ class RunIndexRecorder {
   void flush() const;
 
   // The writes go to a writer thread, in order, which commits whatever has queued up in
-  // one transaction (a group commit: under load one commit serves many runs). finished()
-  // returns once its write is committed, so that whoever sees the summary finds the run
-  // finished; list() and index() first wait for every write handed over.
+  // one transaction (a group commit: under load one commit serves many runs). accepted(),
+  // finished() and rejected() are committed at once; started() (queued -> running, which
+  // recovery treats alike) waits for the next of them, at most kDeferredWritesDelay, so
+  // that a short run's start and end share a commit. finished() returns once its write is
+  // committed, so that whoever sees the summary finds the run finished; list() and index()
+  // first wait for every write handed over.
 
   /// A run accepted and queued, before any worker can take it; input as served (its
   /// run_id assigned). requested_run_id: InitialConditions.run_id as sent.
@@ -113,9 +120,11 @@ class RunIndexRecorder {
   void endFromBag(const std::string& run_id, const std::string& bag_path, const BagContents& contents,
                   const std::string& note);
 
-  /// Hands `write` to the writer thread; returns its ticket (its place in the order of writes).
-  std::uint64_t enqueue(std::function<void()> write);
-  /// Waits until every write up to `ticket` is committed.
+  /// Hands `write` to the writer thread; returns its ticket (its place in the order of
+  /// writes). An urgent write is committed at once (with whatever has queued up); a
+  /// deferrable one waits for the next urgent write, or kDeferredWritesDelay.
+  std::uint64_t enqueue(std::function<void()> write, bool urgent);
+  /// Waits until every write up to `ticket` is committed (they become urgent).
   void waitWritten(std::uint64_t ticket) const;
   /// The writer thread: takes every write queued so far and commits them together
   /// (RunIndex::writeTogether), until the recorder is destroyed and nothing is left.
@@ -128,6 +137,8 @@ class RunIndexRecorder {
   mutable std::condition_variable writes_queued_;     ///< pending_ grew, or writer_stops_
   mutable std::condition_variable writes_committed_;  ///< written_ grew
   std::vector<std::function<void()>> pending_;
+  std::chrono::steady_clock::time_point oldest_pending_;  ///< when pending_ last became non-empty
+  mutable std::uint64_t urgent_ = 0;  ///< urgent writes and waiters since the last commit
   std::uint64_t queued_ = 0;   ///< writes ever queued
   std::uint64_t written_ = 0;  ///< writes ever committed (or failed and logged)
   bool writer_stops_ = false;
