@@ -490,6 +490,7 @@ void RunIndexRecorder::endFromBag(const std::string& run_id, const std::string& 
 }
 
 std::size_t RunIndexRecorder::recover() {
+  flush();  // it reads the runs' states
   std::size_t ended = 0;
   for (const RecoveredBag& bag : recoverActiveBags(bag_directory_)) {
     if (!bag.error.empty()) {

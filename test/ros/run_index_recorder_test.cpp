@@ -230,6 +230,41 @@ TEST_F(RunIndexRecorderTest, ALiveNodesQueuedRunIsLeftAlone) {
   EXPECT_FALSE(fs::exists(bagPath(dir_, "waiting") + ".active"));
 }
 
+TEST_F(RunIndexRecorderTest, WritesAreCommittedInOrderAndAFinishedRunIsSeenAtOnce) {
+  RunIndexRecorder recorder(dir_);
+  RunIndex reader(RunIndex::defaultPath(dir_));  // another connection, as the web node's
+  constexpr int kRuns = 200;
+  for (int k = 0; k < kRuns; ++k) {
+    const std::string run_id = "r" + std::to_string(k);
+    recorder.accepted(run_id, "ana", "", input(run_id, "ana"));
+    recorder.started(run_id);
+    if (k % 2 != 0) continue;
+    collision_lab::RunSummary summary;
+    summary.run_id = run_id;
+    summary.student = "ana";
+    summary.stop_reason = "FINISHED";
+    summary.collision_count = 31;
+    recorder.finished(summary);
+    // finished() returns once its row is committed: whoever saw the summary finds it.
+    const auto row = reader.find(run_id);
+    ASSERT_TRUE(row.has_value()) << run_id;
+    EXPECT_EQ(row->state, RunState::kFinished) << run_id;
+    EXPECT_EQ(row->collision_count, 31u) << run_id;
+    EXPECT_GT(row->started_at, 0.0) << run_id;  // its start went in before its end
+  }
+  // list() first waits for every write handed over: the odd runs running (their start
+  // waited for a commit), the even ones finished, all in the order accepted.
+  const auto runs = recorder.list("ana");
+  ASSERT_EQ(runs.size(), static_cast<std::size_t>(kRuns));
+  for (int k = 0; k < kRuns; ++k) {
+    EXPECT_EQ(runs[k].accepted.run_id, "r" + std::to_string(k));
+    EXPECT_EQ(runs[k].finished, k % 2 == 0) << k;
+  }
+  const auto odd = reader.find("r1");
+  ASSERT_TRUE(odd.has_value());
+  EXPECT_EQ(odd->state, RunState::kRunning);
+}
+
 TEST_F(RunIndexRecorderTest, JsonOfInputAndSummary) {
   const std::string in = inputJson(input("r", "ana"));
   EXPECT_NE(in.find("\"masses\":[100.0,1.0,\"inf\"]"), std::string::npos) << in;
