@@ -12,6 +12,7 @@
 
 #include "collision_lab/core/count_text.h"
 #include "elastic_triple.h"
+#include "fma_path.h"
 #include "tier.h"
 #include "units.h"
 
@@ -37,8 +38,8 @@ namespace {
 
 template <class S>
 struct NextTier;
-template <>
-struct NextTier<DD> {
+template <bool kFma>
+struct NextTier<BasicDD<kFma>> {
   using type = Float100;
 };
 template <>
@@ -58,7 +59,9 @@ struct ExactProgress {
 
 /// Owns the tiers: the double-double one always, the others from their first use on. A
 /// higher tier keeps its state between escalations, so each replays every impact at most
-/// once over the whole run.
+/// once over the whole run. W: the working tier's double-double, DD or (on the FMA path,
+/// fma_path.h) DDFma, the same values either way.
+template <class W>
 class Driver {
  public:
   /// `cancel` (may be null) is read before every step of the exact tier, whose replays can be long.
@@ -66,11 +69,11 @@ class Driver {
       : tables_(scene), cancel_(options.cancel), budget_(options.exact_work_budget),
         forecast_(options.forecast_exact_work) {}
 
-  StepResult start() { return startOrEscalate<DD>(); }
+  StepResult start() { return startOrEscalate<W>(); }
   StepResult step(ImpactRecord* record) {
     const std::uint64_t exact = escalations_.exact_rational;
     const std::uint64_t escalated = exact + escalations_.high_precision;
-    const StepResult r = stepOrEscalate<DD>(record);
+    const StepResult r = stepOrEscalate<W>(record);
     exact_streak_ = escalations_.exact_rational > exact ? exact_streak_ + 1 : 0;
     if (exact_streak_ == 0) {
       streak_work_.clear();
@@ -110,7 +113,7 @@ class Driver {
   }
   static constexpr std::size_t kCrowdWindow = 32;
 
-  const Tier<DD>& fast() const { return *fast_; }
+  const Tier<W>& fast() const { return *fast_; }
 
   /// A lower bound [s] of the next impact's time after the working tier's last impact, from
   /// the exact tier brought to the same count (a pair it parks has its exact time, rounded
@@ -161,11 +164,11 @@ class Driver {
   /// The three-cluster collapse test (Tier::collapseCandidate) in double-double, or, where
   /// its bounds do not pin the approach speeds (extreme mass ratios), in the most precise
   /// tier that stands at the same impact (it took the last step; none: no answer yet).
-  std::optional<Tier<DD>::CollapseFound> collapseCandidate(std::size_t p, std::size_t q, bool q_next) const {
+  std::optional<typename Tier<W>::CollapseFound> collapseCandidate(std::size_t p, std::size_t q, bool q_next) const {
     if (fast_->pinsApproaches(p, q)) return fast_->collapseCandidate(p, q, q_next);
-    const auto convert = [](const auto& found) -> std::optional<Tier<DD>::CollapseFound> {
+    const auto convert = [](const auto& found) -> std::optional<typename Tier<W>::CollapseFound> {
       if (!found) return {};
-      return Tier<DD>::CollapseFound{found->first, found->last, found->time, found->position};
+      return typename Tier<W>::CollapseFound{found->first, found->last, found->time, found->position};
     };
     if (exact_ && exact_->count() == fast_->count()) return convert(exact_->collapseCandidate(p, q, q_next));
     if (high_ && high_->count() == fast_->count()) return convert(high_->collapseCandidate(p, q, q_next));
@@ -180,7 +183,7 @@ class Driver {
     alternating_ = 0;
     last_ = before_last_ = kNone;
     history_.clear();
-    const StepResult r = catchUp<DD>();
+    const StepResult r = catchUp<W>();
     result.collapses.back().velocity = fast_->velocity(found.first);
     return r;
   }
@@ -195,7 +198,7 @@ class Driver {
  private:
   template <class S>
   std::unique_ptr<Tier<S>>& tier() {
-    if constexpr (std::is_same_v<S, DD>) return fast_;
+    if constexpr (std::is_same_v<S, W>) return fast_;
     if constexpr (std::is_same_v<S, Float100>) return high_;
     if constexpr (std::is_same_v<S, Rational>) return exact_;
   }
@@ -240,6 +243,10 @@ class Driver {
     StepResult r;
     if constexpr (std::is_same_v<S, DD>) {
       r = t.stepInlined(record);
+#if CL_HAS_FMA_PATH
+    } else if constexpr (std::is_same_v<S, DDFma>) {
+      r = t.stepInlinedFma(record);
+#endif
     } else {
       r = t.step(record);
     }
@@ -248,10 +255,10 @@ class Driver {
       return r;
     } else {
       if (r.kind != StepKind::kAmbiguous && r.kind != StepKind::kImprecise) return r;
-      if constexpr (std::is_same_v<S, DD>) undecided_pair_ = r.pair;
+      if constexpr (std::is_same_v<S, W>) undecided_pair_ = r.pair;
       // A value exactly 0 in double-double is in practice an exact tie, which 100 digits
       // cannot settle either: go straight to the rationals.
-      if constexpr (std::is_same_v<S, DD>) {
+      if constexpr (std::is_same_v<S, W>) {
         if (r.at_zero) return escalate<S, Rational>(r, count, record);
       }
       return escalate<S, typename NextTier<S>::type>(r, count, record);
@@ -380,7 +387,7 @@ class Driver {
   const std::atomic<bool>* cancel_;
   double budget_;   ///< EngineOptions::exact_work_budget [bit^2]
   bool forecast_;   ///< EngineOptions::forecast_exact_work
-  std::unique_ptr<Tier<DD>> fast_;
+  std::unique_ptr<Tier<W>> fast_;
   std::unique_ptr<Tier<Float100>> high_;
   std::unique_ptr<Tier<Rational>> exact_;
   Escalations escalations_;
@@ -564,8 +571,12 @@ const char* stopReasonName(StopReason reason) {
   return "UNKNOWN";
 }
 
-SceneSimulation runEngine(const Scene& si_scene, const EngineOptions& options, const ImpactVisitor& visitor,
-                       const ProgressCallback& progress, const CollapseVisitor& on_collapse) {
+namespace {
+
+/// runEngine with the working tier W (nbody_detail::DD or DDFma).
+template <class W>
+SceneSimulation runEngineOn(const Scene& si_scene, const EngineOptions& options, const ImpactVisitor& visitor,
+                            const ProgressCallback& progress, const CollapseVisitor& on_collapse) {
   using namespace nbody_detail;
   // The run takes place in working units (units.h); every value leaves it in SI.
   const WorkingUnits units(si_scene);
@@ -590,7 +601,7 @@ SceneSimulation runEngine(const Scene& si_scene, const EngineOptions& options, c
   };
   SceneSimulation result;
   result.simulated = true;
-  Driver driver(scene, options);
+  Driver<W> driver(scene, options);
   StepResult r = driver.start();
   const bool wants_records = static_cast<bool>(visitor) || options.keep_events > 0;
   ImpactRecord record;
@@ -669,6 +680,31 @@ SceneSimulation runEngine(const Scene& si_scene, const EngineOptions& options, c
       stopMessage(si_scene, result, r.kind == StepKind::kExhausted, beyond_doubles, driver.exactProgress());
   return result;
 }
+
+}  // namespace
+
+SceneSimulation runEngine(const Scene& si_scene, const EngineOptions& options, const ImpactVisitor& visitor,
+                          const ProgressCallback& progress, const CollapseVisitor& on_collapse) {
+#if CL_HAS_FMA_PATH
+  if (nbody_detail::fmaPathEnabled()) {
+    return runEngineOn<nbody_detail::DDFma>(si_scene, options, visitor, progress, on_collapse);
+  }
+#endif
+  return runEngineOn<nbody_detail::DD>(si_scene, options, visitor, progress, on_collapse);
+}
+
+namespace nbody_detail {
+
+SceneSimulation runEngineOnPath(bool fma, const Scene& scene, const EngineOptions& options,
+                                const ImpactVisitor& visitor) {
+#if CL_HAS_FMA_PATH
+  if (fma) return runEngineOn<DDFma>(scene, options, visitor, {}, {});
+#endif
+  (void)fma;
+  return runEngineOn<DD>(scene, options, visitor, {}, {});
+}
+
+}  // namespace nbody_detail
 
 }  // namespace core
 }  // namespace collision_lab

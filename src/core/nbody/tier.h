@@ -223,6 +223,10 @@ class CL_NBODY_INTERNAL Tier {
   }
   /// step() with every call it makes inlined into one function: the working tier's hot loop.
   CL_FLATTEN StepResult stepInlined(ImpactRecord* record) { return step(record); }
+#if CL_HAS_FMA_PATH
+  /// stepInlined() compiled for FMA (fma_path.h); only the FMA path's tier (DDFma) calls it.
+  CL_FLATTEN CL_FMA_TARGET StepResult stepInlinedFma(ImpactRecord* record) { return step(record); }
+#endif
 
   /// Takes over the state of a more precise tier at the same impact count.
   template <class From>
@@ -329,7 +333,7 @@ class CL_NBODY_INTERNAL Tier {
     }
     using spiral_detail::Rational;
     const auto exact = [](const S& x) {  // the tier's value as a rational (to within its bound)
-      if constexpr (std::is_same_v<S, DD>) return Rational(x.hi) + Rational(x.lo);
+      if constexpr (kIsDoubleDouble<S>) return Rational(x.hi) + Rational(x.lo);
       else if constexpr (std::is_same_v<S, Rational>) return x;
       else return Rational(Float100(x));
     };
@@ -626,7 +630,7 @@ class CL_NBODY_INTERNAL Tier {
 
   /// x - y as a double, with a bound on its distance to the exact difference of x and y.
   static Approx approxDifference(const S& x, const S& y) {
-    if constexpr (std::is_same_v<S, DD>) {
+    if constexpr (kIsDoubleDouble<S>) {
       const double value = (x.hi - y.hi) + (x.lo - y.lo);
       return {value, 2.01 * kUnit * std::fabs(value) + 3 * kUnit * kUnit * (std::fabs(x.hi) + std::fabs(y.hi)) + kTiny};
     } else {

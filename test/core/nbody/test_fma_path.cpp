@@ -1,6 +1,6 @@
 // The FMA path (src/core/nbody/fma_path.h) computes the portable path's bits: every
-// double-double operation, and the known-count three-body passes impact by impact. Skipped on
-// a CPU without FMA (there only the portable path runs).
+// double-double operation, the known-count three-body passes and the engine's runs impact by
+// impact. Skipped on a CPU without FMA (there only the portable path runs).
 #include <gtest/gtest.h>
 
 #include <array>
@@ -142,6 +142,76 @@ TEST(FmaPath, KnownCountPassesGiveThePortableBitsImpactByImpact) {
     EXPECT_TRUE(replica.run || certified.run);
     EXPECT_EQ(replica.run ? replica.visits : certified.visits, c.count);
   }
+}
+
+/// Every double of a run, in order: each impact's record, then the final state.
+std::vector<double> runWords(bool fma, const Scene& scene, std::uint64_t cap, SceneSimulation& result) {
+  std::vector<double> words;
+  EngineOptions options;
+  options.max_impacts = cap;
+  result = runEngineOnPath(fma, scene, options, [&words](const ImpactRecord& r) {
+    words.insert(words.end(), {static_cast<double>(r.index), static_cast<double>(r.pair_index), r.time, r.position,
+                               r.velocities_before[0], r.velocities_before[1], r.velocities_after[0],
+                               r.velocities_after[1], r.energy_gained[0], r.energy_gained[1], r.energy_lost});
+  });
+  words.push_back(result.final_time);
+  words.insert(words.end(), result.final_positions.begin(), result.final_positions.end());
+  words.insert(words.end(), result.final_velocities.begin(), result.final_velocities.end());
+  words.push_back(result.energy_lost);
+  return words;
+}
+
+// The engine on the FMA path (its working tier compiled for FMA, on DDFma) publishes the
+// portable path's records bit for bit: elastic and inelastic gases (collapses and
+// escalations to 100 digits and rationals among them), the TC and viscoelastic models, a
+// ring, walls, and three bodies at mass ratios up to 1e12.
+TEST(FmaPath, EngineRunsGiveThePortableBitsImpactByImpact) {
+  if (!cpuHasFma()) GTEST_SKIP() << "this CPU has no FMA: only the portable path runs";
+  std::mt19937_64 rng(20261129);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0), mass(1.0, 2.0);
+  const double inf = std::numeric_limits<double>::infinity();
+  std::vector<Scene> scenes = {Scene{{1e12, 1, inf}, {2, 1, 0}, {-1, 0, 0}},
+                               Scene{{1e6, 1, 1e6}, {2, 1, 0}, {-1, 0, 0.5}},
+                               Scene{{3, 1, 0.5}, {2, 1, 0}, {-1, 0.25, 0.5}}};
+  for (int k = 0; k < 12; ++k) {
+    Scene gas;
+    const int n = 20 + 10 * k;
+    for (int b = 0; b < n; ++b) {
+      gas.masses.push_back(mass(rng));
+      gas.positions.push_back(static_cast<double>(n - b));
+      gas.velocities.push_back(unit(rng));
+    }
+    switch (k % 6) {
+      case 0: break;                                         // elastic
+      case 1: gas.restitution = {0.5}; break;                // collapses
+      case 2: gas.restitution = {0.9}; gas.restitution_model.kind = RestitutionModelKind::kTc;
+              gas.restitution_model.tc = 1e-3; break;
+      case 3: gas.restitution_model.kind = RestitutionModelKind::kViscoelastic;
+              gas.restitution_model.viscoelastic_speed = 1.0; break;
+      case 4: gas.restitution = {0.95}; gas.ring = n + 0.5; break;
+      case 5: gas.masses.front() = inf; gas.masses.back() = inf; gas.restitution = {0.8}; break;
+    }
+    scenes.push_back(gas);
+  }
+  std::uint64_t escalated = 0, impacts = 0;
+  for (const Scene& scene : scenes) {
+    ASSERT_FALSE(validate(scene)) << scene.size() << " bodies";
+    SceneSimulation portable, fma;
+    const std::vector<double> a = runWords(false, scene, 20000, portable), b = runWords(true, scene, 20000, fma);
+    SCOPED_TRACE(::testing::Message() << scene.size() << " bodies, " << portable.impact_count << " impacts");
+    ASSERT_EQ(a.size(), b.size());
+    EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(double)), 0);
+    EXPECT_EQ(portable.stop, fma.stop);
+    EXPECT_EQ(portable.impact_count, fma.impact_count);
+    EXPECT_EQ(portable.collapses.size(), fma.collapses.size());
+    EXPECT_EQ(portable.escalations.high_precision, fma.escalations.high_precision);
+    EXPECT_EQ(portable.escalations.exact_rational, fma.escalations.exact_rational);
+    escalated += portable.escalations.high_precision + portable.escalations.exact_rational;
+    impacts += portable.impact_count;
+  }
+  RecordProperty("impacts", static_cast<int>(impacts));
+  RecordProperty("escalations", static_cast<int>(escalated));
+  EXPECT_GT(escalated, 0u);  // the adoption of a more precise tier's state into DDFma is covered
 }
 
 #else
