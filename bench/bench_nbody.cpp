@@ -31,6 +31,7 @@
 #include <vector>
 
 #include "collision_lab/core/nbody/engine.h"
+#include "fma_path.h"         // the engine's two paths (src/core/nbody), compared on 1,000 bodies
 #include "tournament_tree.h"  // the engine's event queue (src/core/nbody), for the queue comparison
 
 namespace {
@@ -363,6 +364,9 @@ int main(int argc, char** argv) {
   cases.push_back({10'000, budget, gasScene(10'000, 2), {}, {}, {}});
   cases.push_back({100'000, budget, gasScene(100'000, 3), {}, {}, {}});
 
+  // The engine on the portable path beside the FMA path, on the first case (1,000 bodies).
+  const bool fma_path = collision_lab::core::nbody_detail::fmaPathEnabled();
+  std::vector<double> portable_ns;
   for (int r = 0; r < repeats; ++r) {
     for (Case& c : cases) {
       LeanLoop anchor(c.scene);
@@ -383,6 +387,12 @@ int main(int argc, char** argv) {
       c.tree_impacts = t.impacts;
       c.engine_impacts = e.impacts;
       c.escalations = result.escalations.refinements + result.escalations.high_precision + result.escalations.exact_rational;
+      if (fma_path && &c == &cases.front()) {
+        const Timed p = timeRun([&] {
+          return collision_lab::core::nbody_detail::runEngineOnPath(false, c.scene, options, {}).impact_count;
+        });
+        portable_ns.push_back(p.ns_per_impact);
+      }
     }
   }
 
@@ -432,6 +442,15 @@ int main(int argc, char** argv) {
                   c.n, tree, tree / anchor, anchor, engine, engine - tree,
                   static_cast<unsigned long long>(c.escalations));
     }
+  }
+  if (fma_path) {
+    const double with_fma = median(cases.front().engine_ns), portable = median(portable_ns);
+    std::printf("goal: FMA chosen at run time for the engine (this process: FMA path), %zu bodies, ns per impact with "
+                "FMA = %.1f against the portable engine = %.1f (%.2fx; the same bits, test "
+                "FmaPath.EngineRunsGiveThePortableBitsImpactByImpact): %s\n",
+                cases.front().n, with_fma, portable, with_fma / portable, with_fma <= portable ? "met" : "missed");
+  } else {
+    std::printf("FMA path for the engine: not taken in this process (no FMA, or COLLISION_LAB_NO_FMA set)\n");
   }
   // O(N): the memory added by 9 x 10^4 more bodies, per body, against the state a body needs at least
   // (mass, position, velocity, time: 32 B).
