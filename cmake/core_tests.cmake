@@ -45,10 +45,11 @@ catkin_add_gtest(collision_lab_nbody_tests
   test/core/nbody/test_two_body_any_ratio.cpp
   test/core/nbody/test_ring_events.cpp
   test/core/nbody/test_wide_range.cpp
-  test/core/nbody/test_fma_path.cpp)
+  test/core/nbody/test_fma_path.cpp
+  test/core/nbody/test_tier_arithmetic.cpp)
 if(TARGET collision_lab_nbody_tests)
   target_link_libraries(collision_lab_nbody_tests collision_lab_test_support GTest::gtest_main)
-  # test_fma_path.cpp compares the engine's internal double-double instances.
+  # test_fma_path.cpp and test_tier_arithmetic.cpp test the engine's internal arithmetic.
   target_include_directories(collision_lab_nbody_tests PRIVATE src/core/nbody)
 endif()
 
