@@ -16,9 +16,12 @@ catkin_add_gtest(collision_lab_core_tests
   test/core/test_lab_run.cpp
   test/core/test_full_run_accuracy.cpp
   test/core/test_wedge_cycle.cpp
-  test/core/test_three_body_rounding.cpp)
+  test/core/test_three_body_rounding.cpp
+  test/core/test_long_run_rounding.cpp)
 if(TARGET collision_lab_core_tests)
   target_link_libraries(collision_lab_core_tests collision_lab_test_support GTest::gtest_main)
+  # test_long_run_rounding.cpp tests the known-count pass (src/core/nbody/elastic_triple.h).
+  target_include_directories(collision_lab_core_tests PRIVATE src/core/nbody)
 endif()
 
 # N-body core (issue 10): scene, models, exact event engine, against the exact rational

@@ -220,8 +220,8 @@ struct SimulationOptions {
 
 /// The run of three elastic bodies whose count the closed form gives (`count`), without the
 /// engine's queue or any decision (nbody/elastic_triple.h), the summary of every run that
-/// can be had so: its count, final velocities (the engine's bit for bit, or certified
-/// correctly rounded) and drifts, as simulateByEngine gives them; no final time or
+/// can be had so: its count, final velocities (certified correctly rounded, or where no
+/// certificate can be had, an exact zero or tie, the engine's bit for bit) and drifts, as simulateByEngine gives them; no final time or
 /// positions. An impact that may come after the largest double [s] declines it. restart() is called before
 /// each pass over the impacts (at most two); after each impact n, visit(n, v) sees the
 /// velocities [m/s] that simulateByEngine's event would carry. Returns nothing when the run
@@ -277,9 +277,12 @@ std::optional<SceneSimulation> simulateKnownCount(const Scene& scene, std::uint6
 /// totals after it from the velocities; the visitor adds the model's values. Escalations: one decision per impact and the final one. A run the engine
 /// ended otherwise than finished, capped or cancelled (out of range: the next impact comes
 /// after the largest double) is truncated, with the engine's sentence in `stopped_otherwise`.
+/// `final_state`, when set (the known count's summary), is the state after its last impact:
+/// the record of that impact carries it, so that the last event and the summary agree.
 SceneSimulation simulateByEngine(const Scene& scene, const SimulationOptions& options,
                                   const ProgressCallback& progress, std::uint64_t progress_interval,
-                                  const std::function<void(ImpactRecord&)>& visitor, std::string& stopped_otherwise) {
+                                  const std::function<void(ImpactRecord&)>& visitor, std::string& stopped_otherwise,
+                                  const SceneSimulation* final_state = nullptr) {
   EngineOptions engine_options;
   engine_options.max_impacts = options.max_collisions;
   engine_options.progress_interval = progress ? progress_interval : 0;
@@ -303,9 +306,11 @@ SceneSimulation simulateByEngine(const Scene& scene, const SimulationOptions& op
             velocities[k] == 0 ? since_position[k] : since_position[k] + velocities[k] * elapsed;
         state.positions[k] = positive(position);
       }
+      const bool last = final_state && record.index == final_state->impact_count;
       for (int side = 0; side < 2; ++side) {
         const int body = i + side;
-        velocities[body] = record.velocities_after[side];
+        if (last) event.velocities_after[side] = final_state->final_velocities[body];
+        velocities[body] = event.velocities_after[side];
         state.positions[body] = record.position;
         since_position[body] = record.position;
         since_time[body] = record.time;
@@ -315,6 +320,7 @@ SceneSimulation simulateByEngine(const Scene& scene, const SimulationOptions& op
       const int side = scene.isWall(i) ? 1 : 0;
       state.energy_transfer[i + side] = record.energy_gained[side];
       state.energy_transfer[i + 1 - side] = positive(-static_cast<long double>(record.energy_gained[side]));
+      if (last) velocities = triple(final_state->final_velocities);
       state.velocities_after = velocities;
       long double energy = 0, momentum = 0;
       for (int k = 0; k < 3; ++k) {
@@ -421,7 +427,8 @@ SceneSimulation simulateRotationScene(const Scene& scene, const Prediction& pred
   }
   std::optional<SceneSimulation> by_engine;
   if (publishes || !known) {
-    by_engine = simulateByEngine(scene, simulation_options, progress, progress_interval, enrich, stopped_otherwise);
+    by_engine = simulateByEngine(scene, simulation_options, progress, progress_interval, enrich, stopped_otherwise,
+                                 known ? &*known : nullptr);
   }
   // The engine's run is the summary where the known count declined, or where the engine
   // published fewer impacts (cancelled while it published them).

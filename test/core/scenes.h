@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <string>
 
 #include <boost/multiprecision/cpp_int.hpp>
 
@@ -15,6 +16,16 @@ namespace core {
 namespace testing_support {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+
+/// The scene's masses, positions and velocities on one line, for failure messages.
+inline std::string describe(const Scene& s) {
+  std::string text;
+  for (const auto* values : {&s.masses, &s.positions, &s.velocities}) {
+    for (double x : *values) text += std::to_string(x) + " ";
+    text += "| ";
+  }
+  return text;
+}
 
 /// A valid random scene: masses within 10^(+-decades), about one in six with a wall,
 /// positions in order, velocities in [-1, 1]. Deterministic for a given generator.

@@ -19,6 +19,7 @@ namespace core {
 namespace {
 
 using reference::Q;
+using testing_support::describe;
 using testing_support::kInf;
 
 /// Is `value` the double nearest to `exact` (either one on an exact tie)? Exact: the
@@ -37,15 +38,6 @@ Scene general(const Scene& scene) {
           {scene.positions.begin(), scene.positions.end()},
           {scene.velocities.begin(), scene.velocities.end()},
           {}};
-}
-
-std::string describe(const Scene& s) {
-  std::string text;
-  for (const auto* values : {&s.masses, &s.positions, &s.velocities}) {
-    for (double x : *values) text += std::to_string(x) + " ";
-    text += "| ";
-  }
-  return text;
 }
 
 /// The scenes: the hard classes, the example, and seeded random ones.
