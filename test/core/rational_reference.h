@@ -123,6 +123,18 @@ inline Run simulateVelocities(const Scene& scene, std::size_t max_impacts) {
   return run;
 }
 
+/// Is `value` the double nearest to `exact` (either one on an exact tie)? Exact: the
+/// distances to `value` and to its two neighbours are compared as rationals.
+inline bool correctlyRounded(double value, const Q& exact) {
+  if (!std::isfinite(value)) return false;
+  const Q distance = abs(Q(value) - exact);
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  for (const double neighbour : {std::nextafter(value, kInf), std::nextafter(value, -kInf)}) {
+    if (std::isfinite(neighbour) && abs(Q(neighbour) - exact) < distance) return false;
+  }
+  return true;
+}
+
 /// Is the reported double `value` within `relative` of the exact `truth`? A truth beyond
 /// the double range must be reported as the infinity of its sign; a truth below it may
 /// round to zero or a subnormal (absolute tolerance: the smallest subnormal).

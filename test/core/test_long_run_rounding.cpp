@@ -26,19 +26,9 @@ namespace core {
 namespace {
 
 using nbody_detail::certifiedVelocitiesAfter;
-using reference::Q;
+using reference::correctlyRounded;
 using testing_support::describe;
 using testing_support::kInf;
-
-/// Is `value` strictly nearer to `exact` than both neighbouring doubles (exact rationals)?
-bool nearestDouble(double value, const Q& exact) {
-  if (!std::isfinite(value)) return false;
-  const Q distance = abs(Q(value) - exact);
-  for (const double neighbour : {std::nextafter(value, kInf), std::nextafter(value, -kInf)}) {
-    if (std::isfinite(neighbour) && !(distance < abs(Q(neighbour) - exact))) return false;
-  }
-  return true;
-}
 
 /// The double nearest to x, when x is not within 2^-200 of a tie (else empty).
 std::optional<double> nearestClearOfTies(const DeepPrecision& x) {
@@ -90,7 +80,7 @@ TEST(ImpactMapProduct, IsTheCorrectlyRoundedExactStateAfterEveryCountChecked) {
       if (!v) continue;
       ++certified;
       for (int k = 0; k < 3; ++k) {
-        EXPECT_TRUE(nearestDouble((*v)[k], truth.impacts[n - 1].velocities[k]))
+        EXPECT_TRUE(correctlyRounded((*v)[k], truth.impacts[n - 1].velocities[k]))
             << describe(scene) << " body " << k << " after " << n << ": " << (*v)[k];
       }
     }

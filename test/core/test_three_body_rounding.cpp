@@ -18,20 +18,9 @@ namespace collision_lab {
 namespace core {
 namespace {
 
-using reference::Q;
+using reference::correctlyRounded;
 using testing_support::describe;
 using testing_support::kInf;
-
-/// Is `value` the double nearest to `exact` (either one on an exact tie)? Exact: the
-/// distances to `value` and to its two neighbours are compared as rationals.
-bool correctlyRounded(double value, const Q& exact) {
-  if (!std::isfinite(value)) return false;
-  const Q distance = abs(Q(value) - exact);
-  for (const double neighbour : {std::nextafter(value, kInf), std::nextafter(value, -kInf)}) {
-    if (std::isfinite(neighbour) && abs(Q(neighbour) - exact) < distance) return false;
-  }
-  return true;
-}
 
 Scene general(const Scene& scene) {
   return {{scene.masses.begin(), scene.masses.end()},
