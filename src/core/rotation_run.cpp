@@ -221,8 +221,8 @@ struct SimulationOptions {
 /// The run of three elastic bodies whose count the closed form gives (`count`), without the
 /// engine's queue or any decision (nbody/elastic_triple.h), the summary of every run that
 /// can be had so: its count, final velocities (certified correctly rounded, or where no
-/// certificate can be had, an exact zero or tie, the engine's bit for bit) and drifts, as simulateByEngine gives them; no final time or
-/// positions. An impact that may come after the largest double [s] declines it. restart() is called before
+/// certificate can be had, an exact zero or tie, the engine's bit for bit) and drifts, as
+/// simulateByEngine gives them; no final time or positions. An impact that may come after the largest double [s] declines it. restart() is called before
 /// each pass over the impacts (at most two); after each impact n, visit(n, v) sees the
 /// velocities [m/s] that simulateByEngine's event would carry. Returns nothing when the run
 /// cannot be taken this way (then the engine runs it). `progress` (RunOptions) sees every
@@ -307,9 +307,9 @@ SceneSimulation simulateByEngine(const Scene& scene, const SimulationOptions& op
         state.positions[k] = positive(position);
       }
       const bool last = final_state && record.index == final_state->impact_count;
+      if (last) event.velocities_after = {final_state->final_velocities[i], final_state->final_velocities[i + 1]};
       for (int side = 0; side < 2; ++side) {
         const int body = i + side;
-        if (last) event.velocities_after[side] = final_state->final_velocities[body];
         velocities[body] = event.velocities_after[side];
         state.positions[body] = record.position;
         since_position[body] = record.position;
@@ -320,7 +320,7 @@ SceneSimulation simulateByEngine(const Scene& scene, const SimulationOptions& op
       const int side = scene.isWall(i) ? 1 : 0;
       state.energy_transfer[i + side] = record.energy_gained[side];
       state.energy_transfer[i + 1 - side] = positive(-static_cast<long double>(record.energy_gained[side]));
-      if (last) velocities = triple(final_state->final_velocities);
+      if (last) velocities = triple(final_state->final_velocities);  // the third body's too
       state.velocities_after = velocities;
       long double energy = 0, momentum = 0;
       for (int k = 0; k < 3; ++k) {
