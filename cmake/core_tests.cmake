@@ -17,7 +17,8 @@ catkin_add_gtest(collision_lab_core_tests
   test/core/test_full_run_accuracy.cpp
   test/core/test_wedge_cycle.cpp
   test/core/test_three_body_rounding.cpp
-  test/core/test_long_run_rounding.cpp)
+  test/core/test_long_run_rounding.cpp
+  test/core/test_published_rounding.cpp)
 if(TARGET collision_lab_core_tests)
   target_link_libraries(collision_lab_core_tests collision_lab_test_support GTest::gtest_main)
   # test_long_run_rounding.cpp tests the known-count pass (src/core/nbody/elastic_triple.h).
@@ -49,7 +50,8 @@ catkin_add_gtest(collision_lab_nbody_tests
   test/core/nbody/test_ring_events.cpp
   test/core/nbody/test_wide_range.cpp
   test/core/nbody/test_fma_path.cpp
-  test/core/nbody/test_tier_arithmetic.cpp)
+  test/core/nbody/test_tier_arithmetic.cpp
+  test/core/nbody/test_published_rounding_nbody.cpp)
 if(TARGET collision_lab_nbody_tests)
   target_link_libraries(collision_lab_nbody_tests collision_lab_test_support GTest::gtest_main)
   # test_fma_path.cpp and test_tier_arithmetic.cpp test the engine's internal arithmetic.

@@ -75,6 +75,18 @@ double energyNormError(const Scene& scene, const std::vector<double>& simulated,
   return std::sqrt(error_sq / initial_sq);
 }
 
+bool isUncertified(const Prediction& prediction, const std::string& key) {
+  return std::find(prediction.uncertified.begin(), prediction.uncertified.end(), key) != prediction.uncertified.end();
+}
+
+/// A collapse of every body, with the model's certified time, point and common velocity.
+Collapse certified(Collapse collapse, const Prediction& prediction) {
+  collapse.time = *prediction.collapse_time;
+  collapse.position = *prediction.collapse_position;
+  if (!prediction.final_velocities.empty()) collapse.velocity = prediction.final_velocities[1];  // not a wall's
+  return collapse;
+}
+
 /// The over-cap rule: the model's count exceeds the cap, so the model answers alone.
 SceneSimulation overCap(const Prediction& prediction, std::uint64_t cap) {
   SceneSimulation simulation = fromPrediction(prediction);
@@ -90,7 +102,9 @@ SceneSimulation simulateScene(const Scene& scene, const SceneRunOptions& options
                               const std::optional<Prediction>& prediction, const SceneVisitors& visitors) {
   const RunOptions& lab = options.lab;
   if (lab.mode == RunMode::kPredictOnly) {
-    return prediction && !prediction->infinite ? fromPrediction(*prediction) : notSimulated(prediction);
+    // A collapse is infinitely many impacts with a known end: its time, point and heat.
+    const bool answered = prediction && (!prediction->infinite || prediction->collapsed);
+    return answered ? fromPrediction(*prediction) : notSimulated(prediction);
   }
   const bool over_cap = prediction && prediction->impact_count && *prediction->impact_count > lab.max_collisions;
   if (over_cap && !options.simulate_to_cap) return overCap(*prediction, lab.max_collisions);
@@ -125,9 +139,50 @@ SceneSimulation simulateScene(const Scene& scene, const SceneRunOptions& options
       if (lab.events.keeps(impact.index)) kept.push_back(impact);
     };
   }
-  SceneSimulation simulation =
-      runEngine(scene, engine_options, on_impact, visitors.progress, full ? visitors.collapse : CollapseVisitor{});
+  // Two bodies: the engine decides the one impact; its values are the exact ones rounded once
+  // (the engine's double-double ones can be an ulp off), in the record and the summary alike.
+  std::optional<TwoBodyImpact> two_body;
+  if (prediction && prediction->kind == ModelKind::kTwoBody && prediction->impact_count == 1u) {
+    two_body = exactTwoBodyImpact(scene);
+    if (on_impact) {
+      on_impact = [inner = std::move(on_impact), &two_body](const ImpactRecord& impact) {
+        ImpactRecord exact = impact;
+        exact.time = two_body->time;
+        exact.position = two_body->position;
+        exact.velocities_after = two_body->velocities_after;
+        exact.energy_gained = two_body->energy_gained;
+        exact.energy_lost = two_body->energy_lost;
+        inner(exact);
+      };
+    }
+  }
+  // Three bodies that collapse: the engine finds the collapse; its time, point and velocity
+  // are the model's, certified from the start (the engine's come from its state at the time,
+  // and a heavy-light-heavy point cancels), in the record and the summary alike.
+  const bool whole_collapse = prediction && prediction->collapsed && prediction->collapse_time;
+  CollapseVisitor on_collapse = full ? visitors.collapse : CollapseVisitor{};
+  if (whole_collapse && on_collapse) {
+    on_collapse = [inner = std::move(on_collapse), &prediction, &scene](const Collapse& collapse) {
+      inner(collapse.first_body == 0 && collapse.last_body + 1 == scene.size() ? certified(collapse, *prediction) : collapse);
+    };
+  }
+  SceneSimulation simulation = runEngine(scene, engine_options, on_impact, visitors.progress, on_collapse);
   simulation.impacts = std::move(kept);
+  const bool agrees = prediction && prediction->impact_count && simulation.stop == StopReason::kFinished &&
+                      simulation.impact_count == *prediction->impact_count;
+  if (whole_collapse && simulation.collapsed && simulation.stop == StopReason::kFinished) {
+    for (Collapse& collapse : simulation.collapses) {
+      if (collapse.first_body == 0 && collapse.last_body + 1 == scene.size()) collapse = certified(collapse, *prediction);
+    }
+    simulation.collapse_time = prediction->collapse_time;
+    simulation.collapse_position = prediction->collapse_position;
+  }
+  if (agrees || (whole_collapse && simulation.collapsed && simulation.stop == StopReason::kFinished)) {
+    // The run reached the state the model gives exactly: its values name the same exact ones,
+    // which the model rounded once (the engine's double-double ones can be ulps off).
+    if (!isUncertified(*prediction, "predicted_final_velocities")) simulation.final_velocities = prediction->final_velocities;
+    if (!isUncertified(*prediction, "energy_lost")) simulation.energy_lost = prediction->energy_lost;
+  }
   if (prediction && prediction->impact_count && simulation.stop == StopReason::kFinished) {
     simulation.max_prediction_error = energyNormError(scene, simulation.final_velocities, prediction->final_velocities);
     simulation.matches_prediction = simulation.impact_count == *prediction->impact_count;

@@ -18,6 +18,7 @@
 #include <boost/multiprecision/cpp_int.hpp>
 
 #include "collision_lab/core/scene.h"
+#include "rounding_checks.h"
 
 namespace collision_lab {
 namespace core {
@@ -123,17 +124,7 @@ inline Run simulateVelocities(const Scene& scene, std::size_t max_impacts) {
   return run;
 }
 
-/// Is `value` the double nearest to `exact` (either one on an exact tie)? Exact: the
-/// distances to `value` and to its two neighbours are compared as rationals.
-inline bool correctlyRounded(double value, const Q& exact) {
-  if (!std::isfinite(value)) return false;
-  const Q distance = abs(Q(value) - exact);
-  constexpr double kInf = std::numeric_limits<double>::infinity();
-  for (const double neighbour : {std::nextafter(value, kInf), std::nextafter(value, -kInf)}) {
-    if (std::isfinite(neighbour) && abs(Q(neighbour) - exact) < distance) return false;
-  }
-  return true;
-}
+using testing_support::correctlyRounded;
 
 /// Is the reported double `value` within `relative` of the exact `truth`? A truth beyond
 /// the double range must be reported as the infinity of its sign; a truth below it may

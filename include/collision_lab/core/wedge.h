@@ -30,13 +30,6 @@ T alphaOf(const std::array<double, 3>& m) {
   return atan(sqrt(b_over_a * (1 + b_over_c) + b_over_c));
 }
 
-/// r_c = tan^2(pi/4 - alpha/2) [1]: below it three bodies with one restitution e can
-/// collapse (the AB+BC cycle's eigenvalues turn real; physics.md, "Restitution").
-inline double criticalRestitution(double alpha) {
-  const double root = std::tan(M_PI / 4 - alpha / 2);
-  return root * root;
-}
-
 /// a x b, written out (Eigen's cross needs its own scalar traits for every T).
 template <class T>
 Eigen::Matrix<T, 3, 1> cross(const Eigen::Matrix<T, 3, 1>& a, const Eigen::Matrix<T, 3, 1>& b) {

@@ -70,6 +70,9 @@ struct ElasticTripleRun {
 /// wall keeps its velocity. Empty when a body's is not certified (an exact zero or tie).
 std::optional<std::array<double, 3>> certifiedVelocitiesAfter(const Scene& scene, std::uint64_t impacts,
                                                               std::size_t first_pair);
+/// The same, body by body: each velocity that is certified (a wall's always).
+std::array<std::optional<double>, 3> certifiedVelocityComponentsAfter(const Scene& scene, std::uint64_t impacts,
+                                                                      std::size_t first_pair);
 
 /// Is `hi + lo` within `error` of x certainly rounded to hi (x strictly inside hi's rounding
 /// cell)? hi + lo is a normalized double-double.

@@ -68,9 +68,10 @@ double upperNorm(const Vec3& u) {
 
 }  // namespace
 
-std::optional<std::array<double, 3>> certifiedVelocitiesAfter(const Scene& scene, std::uint64_t impacts,
-                                                              std::size_t first_pair) {
-  if (impacts == 0 || (scene.isWall(0) && scene.isWall(2))) return std::nullopt;
+std::array<std::optional<double>, 3> certifiedVelocityComponentsAfter(const Scene& scene, std::uint64_t impacts,
+                                                                      std::size_t first_pair) {
+  std::array<std::optional<double>, 3> result;
+  if (impacts == 0 || (scene.isWall(0) && scene.isWall(2))) return result;
   const int wall = scene.isWall(0) ? 0 : scene.isWall(2) ? 2 : -1;
   const std::array<double, 3> masses = triple(scene.masses);
   const Wedge<Float100> wedge = wedgeOf<Float100>(masses);
@@ -94,7 +95,6 @@ std::optional<std::array<double, 3>> certifiedVelocitiesAfter(const Scene& scene
   // ||M~ u~ - M u|| <= e_M ||u|| + ||M~|| e_u, plus the rounding of the product.
   const double end_error =
       (all.error * exact_norm + (1 + all.error) * start_error + kProductError * (1 + all.error) * start_norm) * kUp;
-  std::array<double, 3> result{};
   for (int k = 0; k < 3; ++k) {
     if (k == wall) {
       result[k] = scene.velocities[k];
@@ -110,11 +110,18 @@ std::optional<std::array<double, 3>> certifiedVelocitiesAfter(const Scene& scene
     const double low = toDoubleNearest(Float100(v - margin));
     const double high = toDoubleNearest(Float100(v + margin));
     if (low != high || !(std::fabs(low) >= std::numeric_limits<double>::min()) || std::isinf(low)) {
-      return std::nullopt;  // not certified (or zero, subnormal, overflowing)
+      continue;  // not certified (or zero, subnormal, overflowing)
     }
     result[k] = low;
   }
   return result;
+}
+
+std::optional<std::array<double, 3>> certifiedVelocitiesAfter(const Scene& scene, std::uint64_t impacts,
+                                                              std::size_t first_pair) {
+  const std::array<std::optional<double>, 3> components = certifiedVelocityComponentsAfter(scene, impacts, first_pair);
+  if (!components[0] || !components[1] || !components[2]) return std::nullopt;
+  return std::array<double, 3>{*components[0], *components[1], *components[2]};
 }
 
 }  // namespace nbody_detail

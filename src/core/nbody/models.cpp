@@ -4,6 +4,7 @@
 #include <cmath>
 #include <functional>
 
+#include "../correct_rounding.h"
 #include "../rotation_run.h"
 #include "collision_lab/core/wedge.h"
 #include "spiral.h"
@@ -212,25 +213,34 @@ int firstPair(const Scene& scene, const Rational& a, const Rational& c) {
   return a > 0 ? 0 : (c > 0 ? 1 : -1);
 }
 
-/// Velocities [m/s] relative to the frame (the centre of mass, or the wall) from approach
-/// speeds (a, c) * 2^exponent.
-std::vector<double> relativeVelocities(const spiral_detail::Cycle& cy, double a, double c, long exponent) {
+/// Velocities [m/s] relative to the frame (the centre of mass, or the wall) from the approach
+/// speeds (a, c) = (v_B - v_A, v_C - v_B), exactly: the frame's body (a wall) at 0.
+std::array<Rational, 3> relativeVelocities(const spiral_detail::Cycle& cy, const Rational& a, const Rational& c) {
   const double* m = cy.m;
-  double w_a = -(m[1] * a + m[2] * (a + c)) / (m[0] + m[1] + m[2]);
-  if (cy.wall_a) w_a = 0.0;
-  if (cy.wall_c) w_a = -(a + c);
-  std::vector<double> w{w_a, w_a + a, w_a + a + c};
-  for (double& x : w) x = std::ldexp(x, static_cast<int>(std::max(-2000L, std::min(2000L, exponent))));
-  return w;
+  Rational w_a = cy.wall_a ? Rational(0)
+                 : cy.wall_c ? Rational(-(a + c))
+                             : Rational(-(Rational(m[1]) * a + Rational(m[2]) * (a + c)) /
+                                        (Rational(m[0]) + Rational(m[1]) + Rational(m[2])));
+  return {w_a, w_a + a, w_a + a + c};
 }
 
-/// Kinetic energy [J] of the finite bodies.
-double kineticEnergy(const spiral_detail::Cycle& cy, const std::vector<double>& v) {
-  double sum = 0.0;
+/// Kinetic energy [J] of the finite bodies at velocities w, exactly.
+Rational kineticEnergy(const spiral_detail::Cycle& cy, const std::array<Rational, 3>& w) {
+  Rational sum = 0;
   for (int k = 0; k < 3; ++k) {
-    if (!(k == 0 && cy.wall_a) && !(k == 2 && cy.wall_c)) sum += 0.5 * cy.m[k] * v[k] * v[k];
+    if (!(k == 0 && cy.wall_a) && !(k == 2 && cy.wall_c)) sum += Rational(cy.m[k]) * w[k] * w[k] / 2;
   }
   return sum;
+}
+
+/// Impacts up to which the spiral's end state is walked again in exact rationals (their size
+/// grows with every impact).
+constexpr std::uint64_t kExactSpiralStateLimit = 512;
+
+/// mantissa * 2^exponent, exactly.
+Rational scaledRational(double mantissa, long exponent) {
+  const boost::multiprecision::cpp_int power = boost::multiprecision::cpp_int(1) << static_cast<unsigned>(std::labs(exponent));
+  return exponent >= 0 ? Rational(mantissa) * power : Rational(mantissa) / power;
 }
 
 Rational weightedMean(const double m[3], const std::vector<double>& q) {
@@ -273,19 +283,15 @@ Prediction predictTwoWalls(const Scene& scene) {
   return prediction;
 }
 
-Prediction predictTwoBody(const Scene& scene) {
+TwoBodyImpact exactTwoBodyImpact(const Scene& scene) {
   using spiral_detail::Rational;
-  Prediction prediction = base(ModelKind::kTwoBody, scene);
   const auto& x = scene.positions;
   const auto& v = scene.velocities;
-  prediction.final_velocities = v;
-  prediction.impact_count = 0;
-  if (!(v[0] < v[1])) return prediction;
   // Everything exactly in rationals from the input doubles, each result rounded once, so any
   // mass ratio is exact. The centre-of-mass velocity V is a wall's velocity when one is a
   // wall; v' = (1 + e) V - e v; heat = mu (1 - e^2) (v_1 - v_0)^2 / 2, mu the reduced mass.
-  const double e = scene.restitutionOf(0);
-  const Rational v0 = v[0], v1 = v[1], re = e;
+  const Rational re = scene.restitutionOf(0);
+  const Rational v0 = v[0], v1 = v[1];
   Rational centre, reduced;
   if (scene.isWall(0) || scene.isWall(1)) {
     const std::size_t wall = scene.isWall(0) ? 0 : 1;
@@ -297,13 +303,39 @@ Prediction predictTwoBody(const Scene& scene) {
     reduced = m0 * m1 / (m0 + m1);
   }
   const Rational time = (Rational(x[0]) - x[1]) / (v1 - v0);
+  const Rational after[2] = {scene.isWall(0) ? v0 : Rational((1 + re) * centre - re * v0),
+                             scene.isWall(1) ? v1 : Rational((1 + re) * centre - re * v1)};
+  const Rational heat = reduced * (1 - re * re) * (v1 - v0) * (v1 - v0) / 2;
+  Rational gained[2];
+  for (int k = 0; k < 2; ++k) {
+    if (!scene.isWall(k)) gained[k] = Rational(scene.masses[k]) * (after[k] * after[k] - v[k] * Rational(v[k])) / 2;
+  }
+  for (int k = 0; k < 2; ++k) {
+    if (scene.isWall(k)) gained[k] = -(gained[1 - k] + heat);  // as the engine's record: the entries and the heat sum to 0
+  }
+  TwoBodyImpact impact;
+  impact.time = detail::nearestDouble(time);
+  impact.position = detail::nearestDouble(Rational(x[0]) + time * v0);
+  for (int k = 0; k < 2; ++k) {
+    impact.velocities_after[k] = scene.isWall(k) ? v[k] : detail::nearestDouble(after[k]);
+    impact.energy_gained[k] = detail::nearestDouble(gained[k]);
+  }
+  impact.energy_lost = detail::nearestDouble(heat);
+  return impact;
+}
+
+Prediction predictTwoBody(const Scene& scene) {
+  Prediction prediction = base(ModelKind::kTwoBody, scene);
+  prediction.final_velocities = scene.velocities;
+  prediction.impact_count = 0;
+  if (!(scene.velocities[0] < scene.velocities[1])) return prediction;
+  const TwoBodyImpact impact = exactTwoBodyImpact(scene);
   prediction.impact_count = 1;
   prediction.first_pair_index = 0;
-  prediction.impact_time = static_cast<double>(time);
-  prediction.impact_position = static_cast<double>(Rational(x[0]) + time * v0);
-  prediction.final_velocities = {scene.isWall(0) ? v[0] : static_cast<double>((1 + re) * centre - re * v0),
-                                 scene.isWall(1) ? v[1] : static_cast<double>((1 + re) * centre - re * v1)};
-  prediction.energy_lost = static_cast<double>(reduced * (1 - re * re) * (v1 - v0) * (v1 - v0) / 2);
+  prediction.impact_time = impact.time;
+  prediction.impact_position = impact.position;
+  prediction.final_velocities = {impact.velocities_after[0], impact.velocities_after[1]};
+  prediction.energy_lost = impact.energy_lost;
   return prediction;
 }
 
@@ -378,39 +410,37 @@ Prediction predictThreeBodySpiral(const Scene& scene) {
   Prediction prediction = base(ModelKind::kThreeBodySpiral, scene);
   Cycle cycle{{scene.masses[0], scene.masses[1], scene.masses[2]}, scene.restitutionOf(0), scene.restitutionOf(1)};
   cycle.wall_a = scene.isWall(0), cycle.wall_c = scene.isWall(2);
-  const bool one_e = cycle.e == cycle.eBC();
   const std::optional<int> wall = cycle.wall_a ? std::optional<int>(0) : (cycle.wall_c ? std::optional<int>(2) : std::nullopt);
   const double* m = cycle.m;
-  prediction.alpha = alphaOf<double>({m[0], m[1], m[2]});
-  if (!one_e) {  // r_c is a value of the one e
-  } else if (wall) {  // r_c = tan^2(pi/4 - alpha/2) = (1 - sin alpha) / (1 + sin alpha)
-    const double sine = std::sqrt(1 - cycle.cos2_alpha());
-    prediction.critical_restitution = (1 - sine) / (1 + sine);
-  } else {
-    const double alpha = std::atan(std::sqrt(m[1] * (m[0] + m[1] + m[2]) / (m[0] * m[2])));
-    const double root = std::tan(M_PI / 4 - alpha / 2);
-    prediction.critical_restitution = root * root;
-  }
+  const detail::RoundedAngles angles = detail::roundedAngles({m[0], m[1], m[2]});
+  prediction.alpha = angles.alpha;
+  if (cycle.e == cycle.eBC()) prediction.critical_restitution = angles.critical_restitution;  // a value of the one e
   if (cycle.complexEigenvalues()) {
-    prediction.spiral_angle = std::acos(cycle.trace() / (2 * (one_e ? cycle.e : std::sqrt(cycle.e * cycle.eBC()))));
+    prediction.spiral_angle =
+        detail::roundedSpiralAngle(cycle.exactTrace(), Rational(cycle.e) * Rational(cycle.eBC()));
   }
   const auto& v = scene.velocities;
   const Rational a0 = Rational(v[1]) - v[0], c0 = Rational(v[2]) - v[1];
   // The frame: the centre of mass, or the wall (which the bodies follow after a collapse).
-  const double centre = wall ? v[*wall] : static_cast<double>(weightedMean(m, v));
-  const double heat0 = kineticEnergy(cycle, relativeVelocities(cycle, static_cast<double>(a0), static_cast<double>(c0), 0));
+  const Rational centre = wall ? Rational(v[*wall]) : weightedMean(m, v);
+  const Rational heat0 = kineticEnergy(cycle, relativeVelocities(cycle, a0, c0));
+  // Every body at the frame's velocity, all the relative motion turned into heat.
+  const auto together = [&] {
+    prediction.final_velocities.assign(3, detail::nearestDouble(centre));
+    if (wall) prediction.final_velocities[*wall] = v[*wall];
+    prediction.energy_lost = detail::nearestDouble(heat0);
+  };
   const int first = firstPair(scene, a0, c0);
   Walk walked;
   if (first < 0) {
-    walked = {WalkEnd::kFinished, 0, static_cast<double>(a0), static_cast<double>(c0), 0};
+    walked = {WalkEnd::kFinished, 0, 0.0, 0.0, 0};
   } else if (cycle.e == 0.0) {  // the first pair sticks; a hit on that cluster makes all three one
     Rational a = a0, c = c0;
     Maps<Rational>(cycle).apply(first, a, c);
-    walked = {WalkEnd::kFinished, 1, static_cast<double>(a), static_cast<double>(c), 0};
+    walked = {WalkEnd::kFinished, 1, 0.0, 0.0, 0};
     if ((first == 0 ? c : a) > 0) {  // the third body hits the cluster and sticks: all three move at V
       prediction.impact_count = 2;
-      prediction.final_velocities.assign(3, centre);
-      prediction.energy_lost = heat0;
+      together();
       return prediction;
     }
   } else {
@@ -428,22 +458,43 @@ Prediction predictThreeBodySpiral(const Scene& scene) {
   }
   if (walked.end == WalkEnd::kCollapse) {
     prediction.collapsed = true;
-    prediction.final_velocities.assign(3, centre);
-    prediction.energy_lost = heat0;
     prediction.infinite = true;
+    together();
     const Rational dv[2] = {a0, c0};
     const Rational db[2] = {Rational(scene.positions[1]) - scene.positions[0],
                             Rational(scene.positions[2]) - scene.positions[1]};
-    const double t = collapseTime(cycle, first, dv, db);
-    prediction.collapse_time = t;
+    const Bounded time = collapseTimeBounded(cycle, first, dv, db);
+    // The meeting point start + V t from the exact start and V, in 100 digits: the two terms
+    // of a heavy-light-heavy collapse nearly cancel, and their difference is rounded once.
     const Rational start = wall ? Rational(scene.positions[*wall]) : weightedMean(m, scene.positions);
-    prediction.collapse_position = static_cast<double>(start + Rational(centre) * t);
+    const auto wide = [](const Rational& r) { return Float100(numerator(r)) / Float100(denominator(r)); };
+    const Float100 velocity = wide(centre), eps = ldexp(Float100(1), -320);
+    const Float100 point = wide(start) + velocity * time.value;
+    const Float100 point_error = abs(velocity) * time.error + 8 * eps * (abs(wide(start)) + abs(velocity * time.value));
+    const auto certified_time = detail::certifiedNearest(time.value, time.error);
+    const auto certified_point = detail::certifiedNearest(point, point_error);
+    prediction.collapse_time = certified_time.value_or(static_cast<double>(time.value));
+    prediction.collapse_position = certified_point.value_or(static_cast<double>(point));
+    if (!certified_time) prediction.uncertified.push_back("collapse_time");
+    if (!certified_point) prediction.uncertified.push_back("collapse_position");
     return prediction;
   }
   prediction.impact_count = walked.count;
-  const std::vector<double> w = relativeVelocities(cycle, walked.a, walked.c, walked.exponent);
-  for (double x : w) prediction.final_velocities.push_back(centre + x);
-  prediction.energy_lost = heat0 - kineticEnergy(cycle, w);
+  // The state after the count's impacts, exactly: the maps in rationals from the start (short
+  // walks, the spiral's usual case), else the walk's end state (to its rounding, flagged).
+  Rational a = a0, c = c0;
+  if (walked.count <= kExactSpiralStateLimit) {
+    for (std::uint64_t n = 0; n < walked.count; ++n) Maps<Rational>(cycle).apply((first + static_cast<int>(n)) % 2, a, c);
+  } else {
+    a = scaledRational(walked.a, walked.exponent), c = scaledRational(walked.c, walked.exponent);
+    prediction.uncertified.push_back("predicted_final_velocities");
+    prediction.uncertified.push_back("energy_lost");
+  }
+  const std::array<Rational, 3> w = relativeVelocities(cycle, a, c);
+  for (int k = 0; k < 3; ++k) {
+    prediction.final_velocities.push_back(wall && *wall == k ? v[k] : detail::nearestDouble(centre + w[k]));
+  }
+  prediction.energy_lost = detail::nearestDouble(heat0 - kineticEnergy(cycle, w));
   return prediction;
 }
 

@@ -80,8 +80,7 @@ struct Cycle {
     }
     return (1 + 2 * std::max(e, eBC()) / std::max(gap, 1e-300)) * std::sqrt(heaviest / lightest);
   }
-
- private:
+  /// T exactly.
   Rational exactTrace() const {
     return (1 + Rational(e)) * (1 + Rational(eBC())) * ratioA<Rational>() * ratioC<Rational>() - Rational(e) -
            Rational(eBC());
@@ -459,29 +458,56 @@ inline Walk walkExactly(const Cycle& cy, int first, const Rational& a0, const Ra
   return walk<Rational>(cy, first, a0, c0, kRationalLimit);
 }
 
+/// A value in 100 digits and a rigorous bound on its distance from the exact value.
+struct Bounded {
+  Float100 value;
+  Float100 error;
+};
+
 /// Collapse time [s] for the cycle starting with `first`, from the initial approach
 /// speeds dv and intercept differences db = (x_B - x_A, x_C - x_B): the impact times
 /// -db_p/dv_p tend to -(w1 . db)/(w1 . dv), w1 the left eigenvector of the dominant
-/// eigenvalue. Evaluated in 100 digits. Requires real eigenvalues (for the double one,
-/// M^n = l^n (I + n N) gives the same limit, w the left eigenvector).
-inline double collapseTime(const Cycle& cy, int first, const Rational dv[2], const Rational db[2]) {
+/// eigenvalue. The cycle's matrix exactly (rationals), the rest in 100 digits with every
+/// rounding bounded (first order, with a wide margin). Requires real eigenvalues (for the
+/// double one, M^n = l^n (I + n N) gives the same limit, w the left eigenvector). An infinite
+/// error where w1 . dv cannot be told from 0.
+inline Bounded collapseTimeBounded(const Cycle& cy, int first, const Rational dv[2], const Rational db[2]) {
   using F = Float100;
-  const Maps<F> mp(cy);
-  F m00 = 1, m10 = 0, m01 = 0, m11 = 1;
+  const F eps = ldexp(F(1), -320);  // one operation or conversion, relative, with margin
+  const Maps<Rational> mp(cy);
+  Rational m00 = 1, m10 = 0, m01 = 0, m11 = 1;
   mp.apply(first, m00, m10), mp.apply(1 - first, m00, m10);
   mp.apply(first, m01, m11), mp.apply(1 - first, m01, m11);
-  const F t = m00 + m11, det = m00 * m11 - m01 * m10;
-  const F disc = t * t - 4 * det;  // 0 for the double eigenvalue: no rounding below 0
-  const F l1 = (t + sqrt(disc > 0 ? disc : F(0))) / 2;
-  // Left eigenvector w with w M = l1 w: (m10, l1 - m00), or (l1 - m11, m01).
-  F w0, w1;
+  const Rational trace = m00 + m11, disc = trace * trace - 4 * (m00 * m11 - m01 * m10);
+  const auto f = [](const Rational& r) { return F(numerator(r)) / F(denominator(r)); };
+  // l1 = (T + sqrt(disc)) / 2 with T > 0: no cancellation.
+  const F l1 = (f(trace) + sqrt(f(disc > 0 ? disc : Rational(0)))) / 2;
+  const F l1_error = 8 * eps * abs(l1);
+  // Left eigenvector w with w M = l1 w: (m10, l1 - m00), or (l1 - m11, m01); l1 - m_ii may cancel.
+  F w0, w1, e0, e1;
   if (abs(m10) >= abs(m01)) {
-    w0 = m10, w1 = l1 - m00;
+    const F d = f(m00);
+    w0 = f(m10), e0 = 4 * eps * abs(w0);
+    w1 = l1 - d, e1 = l1_error + 4 * eps * (abs(l1) + abs(d));
   } else {
-    w0 = l1 - m11, w1 = m01;
+    const F d = f(m11);
+    w0 = l1 - d, e0 = l1_error + 4 * eps * (abs(l1) + abs(d));
+    w1 = f(m01), e1 = 4 * eps * abs(w1);
   }
-  auto f = [](const Rational& r) { return F(numerator(r)) / F(denominator(r)); };
-  return static_cast<double>(F(-(w0 * f(db[0]) + w1 * f(db[1])) / (w0 * f(dv[0]) + w1 * f(dv[1]))));
+  const F b0 = f(db[0]), b1 = f(db[1]), v0 = f(dv[0]), v1 = f(dv[1]);
+  const F num = -(w0 * b0 + w1 * b1), den = w0 * v0 + w1 * v1;
+  const F num_error = e0 * abs(b0) + e1 * abs(b1) + 8 * eps * (abs(w0 * b0) + abs(w1 * b1));
+  const F den_error = e0 * abs(v0) + e1 * abs(v1) + 8 * eps * (abs(w0 * v0) + abs(w1 * v1));
+  if (!(abs(den) > 2 * den_error)) return {num / den, std::numeric_limits<F>::infinity()};
+  const F time = num / den;
+  // |N~/D~ - N/D| <= (e_N + |N~/D~| e_D) / (|D~| - e_D), and the quotient's own rounding.
+  return {time, 2 * (num_error + abs(time) * den_error) / (abs(den) - den_error) + 4 * eps * abs(time)};
+}
+
+/// collapseTimeBounded's value rounded to double: the correctly rounded collapse time
+/// wherever its bound decides (almost always).
+inline double collapseTime(const Cycle& cy, int first, const Rational dv[2], const Rational db[2]) {
+  return static_cast<double>(collapseTimeBounded(cy, first, dv, db).value);
 }
 
 }  // namespace spiral_detail

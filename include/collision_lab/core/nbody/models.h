@@ -33,6 +33,7 @@
 // ROS-free; every function here never throws for a validated scene (short of memory).
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -96,6 +97,10 @@ struct Prediction {
   /// The pair p (bodies p and p + 1) that meets first, decided exactly; empty when no pair
   /// approaches or the model does not say.
   std::optional<std::size_t> first_pair_index;
+  /// Every value above is the correctly rounded exact value of what it names, except those
+  /// named here (by their summary key, e.g. "predicted_final_velocities"), which no
+  /// certificate within the model's work budget could decide; they are within a few ulps.
+  std::vector<std::string> uncertified;
 };
 
 /// Each requires the scene its model is chosen for (chooseModel) and validate() passed.
@@ -103,6 +108,19 @@ Prediction predictNoCollisions(const Scene& scene);
 /// two_walls_infinite or box_infinite: infinitely many impacts, nothing else predicted.
 Prediction predictTwoWalls(const Scene& scene);
 Prediction predictTwoBody(const Scene& scene);
+
+/// The one impact of two approaching bodies (a two_body scene whose pair approaches), from
+/// exact rationals, each value the correctly rounded exact one: when [s] and where [m] it
+/// happens, the velocities after it [m/s], the energy each body gains [J] (a wall's entry is
+/// minus the other's gain and the heat, as in the engine's ImpactRecord) and the heat [J].
+struct TwoBodyImpact {
+  double time = 0.0;
+  double position = 0.0;
+  std::array<double, 2> velocities_after{};
+  std::array<double, 2> energy_gained{};
+  double energy_lost = 0.0;
+};
+TwoBodyImpact exactTwoBodyImpact(const Scene& scene);
 Prediction predictGhosts(const Scene& scene);
 /// Every pair e = 0, no ring: the final groups are the blocks of the weighted isotonic
 /// regression of the initial velocities (pool-adjacent-violators, O(N)); each group moves at

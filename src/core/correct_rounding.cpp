@@ -1,0 +1,118 @@
+#include "correct_rounding.h"
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+
+#include <boost/math/constants/constants.hpp>
+
+namespace collision_lab {
+namespace core {
+namespace detail {
+
+namespace {
+
+bool evenMantissa(double x) {
+  std::uint64_t bits;
+  std::memcpy(&bits, &x, sizeof bits);
+  return (bits & 1) == 0;
+}
+
+/// x rounded to the nearest double, ties to even, subnormals included: Boost's conversion in
+/// the normal range, and below it the nearest multiple of 2^-1074 found in 333 bits (exact:
+/// a scaled subnormal has at most 1074 + 1 integer bits, far inside the significand).
+double roundToDouble(const Certifying& x) {
+  const Certifying magnitude = x < 0 ? Certifying(-x) : x;
+  if (x == 0 || !(magnitude < std::numeric_limits<double>::min())) return static_cast<double>(x);
+  const Certifying scaled = ldexp(magnitude, 1074);
+  Certifying whole = floor(scaled);
+  const Certifying fraction = scaled - whole;
+  const bool odd = fmod(whole, Certifying(2)) != 0;
+  if (fraction > 0.5 || (fraction == 0.5 && odd)) whole += 1;
+  const double rounded = std::ldexp(static_cast<double>(whole), -1074);
+  return x < 0 ? -rounded : rounded;
+}
+
+}  // namespace
+
+double nearestDouble(const ExactRational& exact) {
+  if (exact == 0) return 0.0;
+  double nearest = roundToDouble(Certifying(numerator(exact)) / Certifying(denominator(exact)));
+  if (std::isinf(nearest)) return nearest;
+  // The estimate is within an ulp: the exact distances to it and its neighbours decide.
+  ExactRational best = abs(ExactRational(nearest) - exact);
+  const double start = nearest;
+  for (const double neighbour : {std::nextafter(start, std::numeric_limits<double>::infinity()),
+                                 std::nextafter(start, -std::numeric_limits<double>::infinity())}) {
+    if (!std::isfinite(neighbour)) continue;
+    const ExactRational distance = abs(ExactRational(neighbour) - exact);
+    if (distance < best || (distance == best && evenMantissa(neighbour))) {
+      nearest = neighbour;
+      best = distance;
+    }
+  }
+  return nearest == 0 ? 0.0 : nearest;
+}
+
+std::optional<double> certifiedNearest(const Certifying& value, const Certifying& error) {
+  if (isnan(value) || isnan(error)) return std::nullopt;
+  const double low = roundToDouble(Certifying(value - error));
+  const double high = roundToDouble(Certifying(value + error));
+  if (low != high) return std::nullopt;
+  return low == 0 ? 0.0 : low;
+}
+
+std::optional<ExactRational> rationalSqrt(const ExactRational& q) {
+  using boost::multiprecision::cpp_int;
+  if (q < 0) return std::nullopt;
+  const cpp_int top = numerator(q), bottom = denominator(q);
+  const cpp_int top_root = sqrt(top), bottom_root = sqrt(bottom);
+  if (top_root * top_root != top || bottom_root * bottom_root != bottom) return std::nullopt;
+  return ExactRational(top_root, bottom_root);
+}
+
+RoundedAngles roundedAngles(const std::array<double, 3>& m) {
+  using F = Certifying;
+  // x = tan^2 alpha = m_B M / (m_A m_C) = (m_B/m_A)(1 + m_B/m_C) + m_B/m_C, exactly; a wall's
+  // ratio is 0.
+  const ExactRational b_over_a = std::isinf(m[0]) ? ExactRational(0) : ExactRational(m[1]) / ExactRational(m[0]);
+  const ExactRational b_over_c = std::isinf(m[2]) ? ExactRational(0) : ExactRational(m[1]) / ExactRational(m[2]);
+  const ExactRational x = b_over_a * (1 + b_over_c) + b_over_c;
+  const F x_f = F(numerator(x)) / F(denominator(x));
+  // Each value below is within a few roundings of 333 bits of the exact one, relatively (the
+  // square roots, atan and the quotients are well conditioned here): 2^-300 is a wide margin.
+  const F relative = ldexp(F(1), -300);
+  const F alpha = atan(sqrt(x_f));
+  const F omega = boost::math::constants::pi<F>() - alpha;
+  const F sine = sqrt(x_f / (1 + x_f));
+  const F r_c = 1 / ((1 + x_f) * (1 + sine) * (1 + sine));
+  RoundedAngles angles;
+  // alpha and omega are transcendental (alpha > 0), never a double nor a tie: the interval
+  // always decides, and the estimate's own rounding stands only as a last resort.
+  angles.alpha = certifiedNearest(alpha, alpha * relative).value_or(static_cast<double>(alpha));
+  angles.theta = 2 * angles.alpha;  // doubling is exact, so 2 round(alpha) = round(2 alpha)
+  angles.omega = certifiedNearest(omega, omega * relative).value_or(static_cast<double>(omega));
+  if (const auto rounded = certifiedNearest(r_c, r_c * relative)) {
+    angles.critical_restitution = *rounded;
+  } else if (const auto s = rationalSqrt(x / (1 + x))) {  // r_c rational, perhaps a double
+    angles.critical_restitution = nearestDouble(1 / ((1 + x) * (1 + *s) * (1 + *s)));
+  } else {
+    angles.critical_restitution = static_cast<double>(r_c);
+  }
+  return angles;
+}
+
+double roundedSpiralAngle(const ExactRational& trace, const ExactRational& determinant) {
+  using F = Certifying;
+  // phi = atan2(sqrt(1 - y^2), y), y = T / (2 sqrt(det)), with 1 - y^2 exact: no cancellation
+  // near the threshold, where acos would lose half the digits.
+  const ExactRational sine_squared = 1 - trace * trace / (4 * determinant);
+  const auto f = [](const ExactRational& q) { return F(numerator(q)) / F(denominator(q)); };
+  const F phi = atan2(sqrt(f(sine_squared)), f(trace) / (2 * sqrt(f(determinant))));
+  return certifiedNearest(phi, phi * ldexp(F(1), -300)).value_or(static_cast<double>(phi));
+}
+
+}  // namespace detail
+}  // namespace core
+}  // namespace collision_lab

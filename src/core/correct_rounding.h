@@ -1,0 +1,51 @@
+// Correct rounding of published values (physics.md, "How close the published values are"):
+// the double nearest the exact value of what a number names, ties to even. Two ways in:
+// an exact rational, rounded once; or a multiprecision value with a rigorous error bound,
+// rounded when both ends of its interval round to the same double (Ziv's test). A value
+// whose interval straddles a rounding boundary is not certified; the caller decides it
+// exactly (an exact zero, a wall's velocity, a rational) or says that it is not certified.
+// Private to the core.
+#pragma once
+
+#include <array>
+#include <optional>
+
+#include <boost/multiprecision/cpp_bin_float.hpp>
+#include <boost/multiprecision/cpp_int.hpp>
+
+namespace collision_lab {
+namespace core {
+namespace detail {
+
+using ExactRational = boost::multiprecision::cpp_rational;
+using Certifying = boost::multiprecision::cpp_bin_float_100;  // about 333 bits
+
+/// The double nearest `exact` (ties to even; +-inf beyond the double range; +0 for 0).
+double nearestDouble(const ExactRational& exact);
+
+/// The double nearest the exact value x when |x - value| <= error and every point of
+/// [value - error, value + error] rounds to that double; empty otherwise. A zero is +0.
+std::optional<double> certifiedNearest(const Certifying& value, const Certifying& error);
+
+/// sqrt(q) when it is rational (numerator and denominator perfect squares); else empty.
+std::optional<ExactRational> rationalSqrt(const ExactRational& q);
+
+/// The three-body angles of one set of masses (walls infinite), each the correctly rounded
+/// exact value [rad, 1]: alpha = atan(sqrt(m_B M / (m_A m_C))), theta = 2 alpha,
+/// omega = pi - alpha and r_c = tan^2(pi/4 - alpha/2) = 1 / ((1 + x)(1 + sin alpha)^2)
+/// with x = tan^2 alpha (no cancellation as alpha -> pi/2).
+struct RoundedAngles {
+  double alpha = 0.0;
+  double theta = 0.0;
+  double omega = 0.0;
+  double critical_restitution = 0.0;
+};
+RoundedAngles roundedAngles(const std::array<double, 3>& masses);
+
+/// phi in (0, pi) with cos(phi) = T / (2 sqrt(det)), correctly rounded [rad]: the spiral's
+/// turn per cycle, for an exact trace T and determinant det > 0 with T^2 < 4 det.
+double roundedSpiralAngle(const ExactRational& trace, const ExactRational& determinant);
+
+}  // namespace detail
+}  // namespace core
+}  // namespace collision_lab
