@@ -12,7 +12,8 @@
 // AnalyticModel<double>::velocitiesAfter(n) for n up to 1e12, and predictedImpactCount.
 // And three elastic bodies at an extreme mass ratio, (1e37, 1, inf) (a wall on one side),
 // capped at 10^7 impacts: the lab run in summary and in full mode (events none) against the
-// lean loop on the same impacts, with the engine's escalations to 100 digits.
+// lean loop on the same impacts, with the engine's escalations to 100 digits. And the cost of
+// the certified prediction per plan (planScene) beside the closed form in double.
 // Beside both runs, the floor of exactness in double-double: the engine's impact map
 // (impact_rule.h) on double-double velocities, pairs in turn, nothing else; a `why:` line
 // after each missed goal gives that breakdown.
@@ -369,6 +370,36 @@ void printCountOnlyGoals(const char* scene, const SceneFigures& f) {
 
 }  // namespace
 
+/// The cost of the certified prediction (issue 44), once per run: planScene (validation, the
+/// model, its prediction with the correctly rounded values) against the closed form in double
+/// that it replaced (the count, the final velocities and the angles, uncertified), the anchor
+/// measured in the same process. Prints microseconds per plan, medians.
+void benchCertifiedPlans(int repeats) {
+  const Scene scenes[] = {{{1, 1, 1}, {2, 1, -1}, {-1, 0, 1}},             // equal_masses, 3 impacts
+                          {{1e4, 1, std::numeric_limits<double>::infinity()}, {2, 1, 0}, {-1, 0, 0}},  // 314
+                          {{1e16, 1, 1e16}, {2, 1, 0}, {-1, 0, 0}}};     // 222,144,146 impacts
+  const char* names[] = {"equal_masses (3 impacts)", "(1e4, 1, inf) (314)", "(1e16, 1, 1e16) (2.2e8)"};
+  constexpr int kPlans = 200;
+  std::printf("
+certified predictions (issue 44), microseconds per plan, medians of %d x %d:\n", repeats, kPlans);
+  for (int k = 0; k < 3; ++k) {
+    double sink = 0.0;
+    const auto certified = timeRepeats(repeats, [&] {
+      for (int i = 0; i < kPlans; ++i) sink += planScene(scenes[k]).prediction->final_velocities[0];
+    });
+    const auto in_double = timeRepeats(repeats, [&] {
+      for (int i = 0; i < kPlans; ++i) {
+        const std::uint64_t count = predictedImpactCount(scenes[k]);
+        sink += AnalyticModel<double>(scenes[k]).velocitiesAfter(count)(0) + anglesFor(triple(scenes[k].masses)).alpha;
+      }
+    });
+    doNotOptimize(sink);
+    const double certified_us = median(certified) / kPlans * 1e6, double_us = median(in_double) / kPlans * 1e6;
+    std::printf("  %-26s planScene %.1f us, the closed form in double %.1f us (%.1fx)\n", names[k], certified_us,
+                double_us, certified_us / double_us);
+  }
+}
+
 int main(int argc, char** argv) {
   int repeats = 5;
   bool quick = false, count_only = false;
@@ -400,6 +431,7 @@ int main(int argc, char** argv) {
   const double full_ratio = large.full_lab_run_ns / large.lean_ns;
   const ExtremeFigures extreme = benchExtreme(quick ? 1'000'000 : 10'000'000, repeats);
   const double worst_query_ns = benchClosedForm(repeats);
+  benchCertifiedPlans(repeats);
 
   std::printf("\nGoals (measured, not asserted)\n");
   if (!quick) {

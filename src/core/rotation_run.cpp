@@ -37,12 +37,96 @@ std::array<double, 3> toArray(const std::array<T, 3>& v) {
   return toArray(Eigen::Matrix<T, 3, 1>(v[0], v[1], v[2]));
 }
 
+/// Impacts up to which the rotation model's state is walked in exact rationals and rounded
+/// once: the rationals grow with every impact, and beyond this the certified product of the
+/// impact maps (about 0.1 ms at any count) is the cheaper certificate.
+constexpr std::uint64_t kExactStateLimit = 64;
+
+/// The exact state after impacts n = 0, 1, 2, ... of a scene whose pairs alternate from its
+/// first pair, walked in rationals (exact.h), and each value rounded once: the model's
+/// per-impact values of a short run, correctly rounded.
+class ExactInTurn {
+ public:
+  explicit ExactInTurn(const Scene& scene)
+      : scene_(scene), first_(firstPair(scene).value_or(Pair::AB)), start_(exact::velocitiesAfter(scene, first_, 0)) {
+    restart();
+  }
+
+  /// The velocities after impact n [m/s], correctly rounded.
+  std::array<double, 3> velocitiesAfter(std::uint64_t n) {
+    moveTo(n);
+    return rounded(state_);
+  }
+
+  /// The state before and after impact n >= 1 and its energies and momentum, each correctly
+  /// rounded: the values of `state` that the exact walk knows (not the positions).
+  void fillState(std::uint64_t n, ImpactModelValues& state) {
+    state.energy_transfer = energyTransfer(n);
+    state.velocities_before = rounded(before_);
+    state.velocities_after = rounded(state_);
+    exact::Rational energy = 0, momentum = 0;
+    for (std::size_t k = 0; k < 3; ++k) {
+      state.kinetic_energy_after[k] = 0.0;
+      if (scene_.isWall(k)) continue;
+      const exact::Rational m(scene_.masses[k]);
+      const exact::Rational kinetic = m * state_[k] * state_[k] / 2;
+      state.kinetic_energy_after[k] = detail::nearestDouble(kinetic);
+      energy += kinetic;
+      momentum += m * state_[k];
+    }
+    state.total_energy = detail::nearestDouble(energy);
+    state.total_momentum = detail::nearestDouble(momentum);
+  }
+
+  /// The kinetic energy each body gains in impact n >= 1 [J], correctly rounded; a wall's entry
+  /// is minus the other body's (elastic: the pair's gains cancel), the third body's 0.
+  std::array<double, 3> energyTransfer(std::uint64_t n) {
+    moveTo(n);
+    const int i = pairIndex(n % 2 == 1 ? first_ : otherPair(first_));
+    std::array<double, 3> gained{0.0, 0.0, 0.0};
+    for (const int body : {i, i + 1}) {
+      if (scene_.isWall(static_cast<std::size_t>(body))) continue;
+      const exact::Rational m(scene_.masses[body]);
+      gained[body] = detail::nearestDouble(m * (state_[body] * state_[body] - before_[body] * before_[body]) / 2);
+    }
+    for (const int body : {i, i + 1}) {
+      if (scene_.isWall(static_cast<std::size_t>(body))) gained[body] = detail::toDouble(-gained[2 * i + 1 - body]);
+    }
+    return gained;
+  }
+
+ private:
+  static std::array<double, 3> rounded(const exact::RationalState& v) {
+    return {detail::nearestDouble(v[0]), detail::nearestDouble(v[1]), detail::nearestDouble(v[2])};
+  }
+  void restart() {
+    state_ = before_ = start_;
+    n_ = 0;
+  }
+  void moveTo(std::uint64_t n) {
+    if (n < n_) restart();
+    while (n_ < n) {
+      before_ = state_;
+      exact::applyImpact(triple(scene_.masses), n_ % 2 == 0 ? first_ : otherPair(first_), state_);
+      ++n_;
+    }
+  }
+
+  Scene scene_;
+  Pair first_;
+  exact::RationalState start_, state_, before_;  // before_: the state before impact n_
+  std::uint64_t n_ = 0;
+};
+
 /// The closed form in double; at 50 digits, whose exponent range has no end in sight,
 /// where a finite-mass ratio beyond 2^1000 would underflow the light body's share of the
 /// mass-weighted velocities (S = diag(sqrt(m / m_max))) in double.
 class ClosedForm {
  public:
-  explicit ClosedForm(const Scene& scene) : masses_(triple(scene.masses)) {
+  /// `count`: the scene's predicted impacts; a run of at most kExactStateLimit of them has
+  /// its per-impact values from exact rationals (ExactInTurn).
+  ClosedForm(const Scene& scene, std::uint64_t count)
+      : masses_(triple(scene.masses)), exact_(count <= kExactStateLimit ? std::optional<Scene>(scene) : std::nullopt) {
     int smallest = std::numeric_limits<int>::max(), largest = std::numeric_limits<int>::min();
     for (int i = 0; i < 3; ++i) {
       if (scene.isWall(i)) continue;
@@ -68,6 +152,7 @@ class ClosedForm {
  private:
   friend class ClosedFormInTurn;
   std::array<double, 3> masses_;
+  std::optional<Scene> exact_;
   std::optional<AnalyticModel<double>> fast_;
   std::optional<AnalyticModel<HighPrecision>> wide_;
 };
@@ -78,7 +163,9 @@ class ClosedForm {
 class ClosedFormInTurn {
  public:
   explicit ClosedFormInTurn(const ClosedForm& model) : model_(model) {
-    if (model.fast_) {
+    if (model.exact_) {
+      exact_.emplace(*model.exact_);
+    } else if (model.fast_) {
       sequence_.emplace(*model.fast_);
       previous_ = sequence_->velocitiesAfter(0);
     }
@@ -87,10 +174,24 @@ class ClosedFormInTurn {
   /// The velocities after impact n alone, as describe() gives them [m/s]; n = 1, 2, 3,
   /// ... in turn (not mixed with describe()).
   std::array<double, 3> velocitiesAfter(std::uint64_t n) {
+    if (exact_) return exact_->velocitiesAfter(n);
     return sequence_ ? toArray(sequence_->velocitiesAfter(n)) : model_.velocitiesAfter(n);
   }
 
+  /// A short run's exact state around impact n (ExactInTurn::fillState): false, and nothing
+  /// filled, for a longer run.
+  bool fillExactState(std::uint64_t n, ImpactModelValues& state) {
+    if (!exact_) return false;
+    exact_->fillState(n, state);
+    return true;
+  }
+
   void describe(std::uint64_t n, ImpactModelValues& values) {
+    if (exact_) {
+      values.predicted_velocities_after = exact_->velocitiesAfter(n);
+      values.predicted_energy_transfer = exact_->energyTransfer(n);
+      return;
+    }
     if (!sequence_) {
       values.predicted_velocities_after = model_.velocitiesAfter(n);
       values.predicted_energy_transfer = model_.energyTransfer(n);
@@ -122,6 +223,7 @@ class ClosedFormInTurn {
   }
 
   const ClosedForm& model_;
+  std::optional<ExactInTurn> exact_;  // a short run's exact states
   detail::ImpactEnergy<double> energy_{model_.masses()};
   std::optional<ClosedFormSequence> sequence_;
   Eigen::Vector3d previous_;  // after impact last_
@@ -193,16 +295,23 @@ class ModelBesideImpacts {
   /// Fills the model's values of the next impact, impact previous + 1, whose state
   /// (`values`' velocities) is filled. The paper's BC energy formulas refer to the
   /// velocities before the impact before it, which this keeps.
-  void describe(std::uint64_t index, Pair pair, ImpactModelValues& values) {
+  /// Returns true when the impact's state was filled from the exact walk (a short run): the
+  /// simulation's values name the same exact ones as the model's, rounded once (the engine's
+  /// and the long-double totals can be ulps off).
+  bool describe(std::uint64_t index, Pair pair, ImpactModelValues& values) {
+    const bool exact_state = closed_form_.fillExactState(index, values);
     closed_form_.describe(index, values);
     values.paper_velocities_after = paper_.velocitiesAfter(index);
     values.paper_energy_transfer =
         paper::energyTransfer(scene_, index, pair, values.velocities_before, previous_before_);
-    for (int i = 0; i < 3; ++i) {
-      const double v = values.velocities_after[i];
-      values.kinetic_energy_after[i] = i == wall_ ? 0.0 : scene_.masses[i] * v * v / 2;
+    if (!exact_state) {
+      for (int i = 0; i < 3; ++i) {
+        const double v = values.velocities_after[i];
+        values.kinetic_energy_after[i] = i == wall_ ? 0.0 : scene_.masses[i] * v * v / 2;
+      }
     }
     previous_before_ = values.velocities_before;
+    return exact_state;
   }
 
  private:
@@ -352,10 +461,6 @@ SceneSimulation simulateByEngine(const Scene& scene, const SimulationOptions& op
   return result;
 }
 
-/// Impacts up to which the rotation model's state is walked in exact rationals and rounded
-/// once: the rationals grow with every impact, and beyond this the certified product of the
-/// impact maps (about 0.1 ms at any count) is the cheaper certificate.
-constexpr std::uint64_t kExactStateLimit = 64;
 /// Impacts up to which a velocity that the product cannot certify (an exact zero or a tie) is
 /// decided by exact rationals instead.
 constexpr std::uint64_t kExactFallbackLimit = 2000;
@@ -392,9 +497,9 @@ std::array<double, 3> roundedVelocitiesAfter(const Scene& scene, std::uint64_t c
 }  // namespace
 
 void fillRotationPrediction(const Scene& scene, Prediction& prediction) {
-  const ClosedForm model(scene);
   const std::array<double, 3> masses = triple(scene.masses);
   const std::uint64_t count = predictedImpactCount(scene);
+  const ClosedForm model(scene, count);
   const detail::RoundedAngles angles = detail::roundedAngles(masses);
   prediction.impact_count = count;
   bool certified = true;
@@ -421,7 +526,7 @@ SceneSimulation simulateRotationScene(const Scene& scene, const Prediction& pred
   const RunOptions& lab = options.lab;
   const std::uint64_t predicted_count = prediction.impact_count.value_or(0);
   const EnergyNormError relative_error(scene);
-  const ClosedForm model(scene);
+  const ClosedForm model(scene, predicted_count);
   SimulationOptions simulation_options;
   simulation_options.max_collisions = lab.max_collisions;
   simulation_options.cancel = options.cancel;
@@ -435,7 +540,14 @@ SceneSimulation simulateRotationScene(const Scene& scene, const Prediction& pred
   if (lab.mode == RunMode::kFull) {
     enrich = [&](ImpactRecord& event) {
       ImpactModelValues& values = *event.model;
-      beside.describe(event.index, event.pair_index == 0 ? Pair::AB : Pair::BC, values);
+      if (beside.describe(event.index, event.pair_index == 0 ? Pair::AB : Pair::BC, values)) {
+        for (std::size_t side = 0; side < 2; ++side) {  // the pair's entries of the record too
+          const std::size_t body = event.pair_index + side;
+          event.velocities_before[side] = values.velocities_before[body];
+          event.velocities_after[side] = values.velocities_after[body];
+          event.energy_gained[side] = values.energy_transfer[body];
+        }
+      }
       max_error_sq =
           std::max(max_error_sq, relative_error.squared(values.velocities_after, values.predicted_velocities_after));
       if (visitors.impact) visitors.impact(event);
@@ -501,8 +613,12 @@ SceneSimulation simulateRotationScene(const Scene& scene, const Prediction& pred
   simulation.energy_relative_drift = run.energy_relative_drift;
   simulation.momentum_relative_drift = run.momentum_relative_drift;
   // The rotation model predicts every impact: its error is the largest over them all.
-  simulation.max_prediction_error = std::max(relative_error.fromSquared(max_error_sq),
-                                             relative_error(triple(run.final_velocities), model.velocitiesAfter(run.impact_count)));
+  // At the predicted count the prediction's own (correctly rounded) final velocities.
+  const std::array<double, 3> predicted_end = run.impact_count == predicted_count
+                                                  ? triple(prediction.final_velocities)
+                                                  : ClosedFormInTurn(model).velocitiesAfter(run.impact_count);
+  simulation.max_prediction_error =
+      std::max(relative_error.fromSquared(max_error_sq), relative_error(triple(run.final_velocities), predicted_end));
   if (!run.truncated) simulation.matches_prediction = run.impact_count == predicted_count;
   simulation.escalations = run.escalations;
   return simulation;

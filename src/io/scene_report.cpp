@@ -431,6 +431,7 @@ Json summaryScalars(const core::SceneRunResult& result) {
   json["rule_elastic_impacts"] = s.rule_elastic_impacts;
   json["critical_restitution"] = p && p->critical_restitution ? number(*p->critical_restitution) : Json(nullptr);
   json["spiral_angle"] = p && p->spiral_angle ? number(*p->spiral_angle) : Json(nullptr);
+  json["uncertified_values"] = p ? Json(p->uncertified) : Json::array();
   json["multiple_collision"] = nullptr;
   if (s.multiple_collision) {
     const std::size_t b = s.multiple_collision->first_body;
