@@ -380,8 +380,7 @@ void benchCertifiedPlans(int repeats) {
                           {{1e16, 1, 1e16}, {2, 1, 0}, {-1, 0, 0}}};     // 222,144,146 impacts
   const char* names[] = {"equal_masses (3 impacts)", "(1e4, 1, inf) (314)", "(1e16, 1, 1e16) (2.2e8)"};
   constexpr int kPlans = 200;
-  std::printf("
-certified predictions (issue 44), microseconds per plan, medians of %d x %d:\n", repeats, kPlans);
+  std::printf("\ncertified predictions (issue 44), microseconds per plan, medians of %d x %d:\n", repeats, kPlans);
   for (int k = 0; k < 3; ++k) {
     double sink = 0.0;
     const auto certified = timeRepeats(repeats, [&] {
