@@ -34,10 +34,28 @@ double roundToDouble(const Certifying& x) {
   return x < 0 ? -rounded : rounded;
 }
 
+/// The double nearest x when every value within `relative` |x| of it rounds to that double,
+/// in the normal range; else empty (Ziv's first, cheap step, in long double).
+std::optional<double> quickNearest(long double x, long double relative) {
+  const long double margin = (x < 0 ? -x : x) * relative;
+  const double low = static_cast<double>(x - margin), high = static_cast<double>(x + margin);
+  if (low != high || !std::isfinite(low) || !(std::fabs(low) >= std::numeric_limits<double>::min())) {
+    return std::nullopt;
+  }
+  return low;
+}
+
 }  // namespace
 
 double nearestDouble(const ExactRational& exact) {
   if (exact == 0) return 0.0;
+  // The quotient of the two integers, each within an ulp of long double, is within 3 ulps
+  // (2^-61 relative): decided here unless it lies next to a rounding boundary.
+  const long double top = static_cast<long double>(numerator(exact));
+  const long double bottom = static_cast<long double>(denominator(exact));
+  if (std::isfinite(top) && std::isfinite(bottom) && bottom != 0) {
+    if (const auto quick = quickNearest(top / bottom, 0x1p-59L)) return *quick;
+  }
   double nearest = roundToDouble(Certifying(numerator(exact)) / Certifying(denominator(exact)));
   if (std::isinf(nearest)) return nearest;
   // The estimate is within an ulp: the exact distances to it and its neighbours decide.
@@ -73,6 +91,24 @@ std::optional<ExactRational> rationalSqrt(const ExactRational& q) {
 }
 
 RoundedAngles roundedAngles(const std::array<double, 3>& m) {
+  // Ziv's first step in long double: x = tan^2 alpha within 4 roundings, sqrt correctly
+  // rounded, atanl within a few ulps (glibc), all well conditioned: 2^-58 relative is wide.
+  // Otherwise (about 1 in 30, or masses beyond long double's exactness) the 100-digit step.
+  {
+    const long double b_over_a = std::isinf(m[0]) ? 0.0L : static_cast<long double>(m[1]) / m[0];
+    const long double b_over_c = std::isinf(m[2]) ? 0.0L : static_cast<long double>(m[1]) / m[2];
+    const long double x = b_over_a * (1 + b_over_c) + b_over_c;
+    const long double alpha = std::atan(std::sqrt(x));
+    const long double sine = std::sqrt(x / (1 + x));
+    const long double r_c = 1 / ((1 + x) * (1 + sine) * (1 + sine));
+    constexpr long double kRelative = 0x1p-58L;
+    const auto quick_alpha = quickNearest(alpha, kRelative);
+    const auto quick_omega = quickNearest(3.14159265358979323846264338327950288L - alpha, kRelative);
+    const auto quick_r_c = quickNearest(r_c, kRelative);
+    if (std::isnormal(x) && quick_alpha && quick_omega && quick_r_c) {
+      return {*quick_alpha, 2 * *quick_alpha, *quick_omega, *quick_r_c};
+    }
+  }
   using F = Certifying;
   // x = tan^2 alpha = m_B M / (m_A m_C) = (m_B/m_A)(1 + m_B/m_C) + m_B/m_C, exactly; a wall's
   // ratio is 0.

@@ -41,6 +41,10 @@ std::array<double, 3> toArray(const std::array<T, 3>& v) {
 /// once: the rationals grow with every impact, and beyond this the certified product of the
 /// impact maps (about 0.1 ms at any count) is the cheaper certificate.
 constexpr std::uint64_t kExactStateLimit = 64;
+/// Impacts up to which every impact's values are walked in exact rationals (ExactInTurn):
+/// each costs tens of microseconds there (every rational operation reduces by a gcd), so
+/// only the shortest runs; longer ones keep the closed form in double per impact.
+constexpr std::uint64_t kExactEventLimit = 8;
 
 /// The exact state after impacts n = 0, 1, 2, ... of a scene whose pairs alternate from its
 /// first pair, walked in rationals (exact.h), and each value rounded once: the model's
@@ -123,10 +127,10 @@ class ExactInTurn {
 /// mass-weighted velocities (S = diag(sqrt(m / m_max))) in double.
 class ClosedForm {
  public:
-  /// `count`: the scene's predicted impacts; a run of at most kExactStateLimit of them has
+  /// `count`: the scene's predicted impacts; a run of at most kExactEventLimit of them has
   /// its per-impact values from exact rationals (ExactInTurn).
   ClosedForm(const Scene& scene, std::uint64_t count)
-      : masses_(triple(scene.masses)), exact_(count <= kExactStateLimit ? std::optional<Scene>(scene) : std::nullopt) {
+      : masses_(triple(scene.masses)), exact_(count <= kExactEventLimit ? std::optional<Scene>(scene) : std::nullopt) {
     int smallest = std::numeric_limits<int>::max(), largest = std::numeric_limits<int>::min();
     for (int i = 0; i < 3; ++i) {
       if (scene.isWall(i)) continue;
