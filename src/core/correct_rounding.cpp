@@ -47,10 +47,19 @@ std::optional<double> quickNearest(long double x, long double relative) {
 
 }  // namespace
 
-double nearestDouble(const ExactRational& exact) {
-  if (exact == 0) return 0.0;
+double nearestDouble(const boost::multiprecision::cpp_int& top, const boost::multiprecision::cpp_int& bottom) {
+  if (top == 0) return 0.0;
   // The quotient of the two integers, each within an ulp of long double, is within 3 ulps
   // (2^-61 relative): decided here unless it lies next to a rounding boundary.
+  const long double top_ld = static_cast<long double>(top), bottom_ld = static_cast<long double>(bottom);
+  if (std::isfinite(top_ld) && std::isfinite(bottom_ld) && bottom_ld != 0) {
+    if (const auto quick = quickNearest(top_ld / bottom_ld, 0x1p-59L)) return *quick;
+  }
+  return nearestDouble(ExactRational(top, bottom));
+}
+
+double nearestDouble(const ExactRational& exact) {
+  if (exact == 0) return 0.0;
   const long double top = static_cast<long double>(numerator(exact));
   const long double bottom = static_cast<long double>(denominator(exact));
   if (std::isfinite(top) && std::isfinite(bottom) && bottom != 0) {

@@ -22,6 +22,9 @@ using Certifying = boost::multiprecision::cpp_bin_float_100;  // about 333 bits
 
 /// The double nearest `exact` (ties to even; +-inf beyond the double range; +0 for 0).
 double nearestDouble(const ExactRational& exact);
+/// The double nearest top / bottom (bottom > 0), the same, without reducing the fraction
+/// unless the cheap step does not decide.
+double nearestDouble(const boost::multiprecision::cpp_int& top, const boost::multiprecision::cpp_int& bottom);
 
 /// The double nearest the exact value x when |x - value| <= error and every point of
 /// [value - error, value + error] rounds to that double; empty otherwise. A zero is +0.

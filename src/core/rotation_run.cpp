@@ -37,22 +37,64 @@ std::array<double, 3> toArray(const std::array<T, 3>& v) {
   return toArray(Eigen::Matrix<T, 3, 1>(v[0], v[1], v[2]));
 }
 
-/// Impacts up to which the rotation model's state is walked in exact rationals and rounded
-/// once: the rationals grow with every impact, and beyond this the certified product of the
-/// impact maps (about 0.1 ms at any count) is the cheaper certificate.
-constexpr std::uint64_t kExactStateLimit = 64;
-/// Impacts up to which every impact's values are walked in exact rationals (ExactInTurn):
-/// each costs tens of microseconds there (every rational operation reduces by a gcd), so
-/// only the shortest runs; longer ones keep the closed form in double per impact.
-constexpr std::uint64_t kExactEventLimit = 8;
+/// The exact walk's budget (ExactInTurn): the bits its common denominator may reach. Each
+/// impact adds the bits of its pair's Q (7 for masses 100 and 1, about 54 for random
+/// doubles, none against a wall), and its cost grows with them; beyond the budget the
+/// certified product of the impact maps (about 0.1 ms at any count) is the cheaper
+/// certificate of a final state.
+constexpr std::uint64_t kExactWalkBits = 16384;
+/// Impacts up to which every impact's values (not only the final state) come from the exact
+/// walk, within its budget; longer runs keep the closed form in double per impact.
+constexpr std::uint64_t kExactEventLimit = 64;
+
+/// Does the exact walk of `count` impacts of these masses stay within kExactWalkBits?
+bool exactWalkAffordable(const std::array<double, 3>& masses, std::uint64_t count) {
+  std::uint64_t bits_per_impact = 0;
+  for (int p = 0; p < 2; ++p) {
+    if (std::isinf(masses[p]) || std::isinf(masses[p + 1])) continue;
+    const exact::Rational sum = exact::Rational(masses[p]) + exact::Rational(masses[p + 1]);
+    const exact::Rational f = exact::Rational(masses[p]) / sum;
+    bits_per_impact = std::max<std::uint64_t>(bits_per_impact, msb(denominator(f)) + 1);
+  }
+  return bits_per_impact == 0 || count <= kExactWalkBits / bits_per_impact;
+}
 
 /// The exact state after impacts n = 0, 1, 2, ... of a scene whose pairs alternate from its
-/// first pair, walked in rationals (exact.h), and each value rounded once: the model's
-/// per-impact values of a short run, correctly rounded.
+/// first pair, each value rounded once: the model's (and the run's) per-impact values of a
+/// short run, correctly rounded. The velocities are integers over one common denominator D:
+/// an impact of the pair (i, j = i + 1), with f = m_i / (m_i + m_j) = P / Q, maps
+/// N_i -> Q N_i + 2 (Q - P)(N_j - N_i), N_j -> Q N_j - 2 P (N_j - N_i), the third body's
+/// N -> Q N, and D -> Q D: integer products only (rationals would reduce by a gcd at every
+/// operation), the numbers growing by the bits of Q per impact. A wall (f = 1 or 0, Q = 1)
+/// keeps its velocity.
 class ExactInTurn {
  public:
-  explicit ExactInTurn(const Scene& scene)
-      : scene_(scene), first_(firstPair(scene).value_or(Pair::AB)), start_(exact::velocitiesAfter(scene, first_, 0)) {
+  using Integer = boost::multiprecision::cpp_int;
+
+  explicit ExactInTurn(const Scene& scene) : scene_(scene), first_(firstPair(scene).value_or(Pair::AB)) {
+    for (int p = 0; p < 2; ++p) {
+      const double m_i = scene.masses[p], m_j = scene.masses[p + 1];
+      const exact::Rational f = std::isinf(m_i)   ? exact::Rational(1)
+                                : std::isinf(m_j) ? exact::Rational(0)
+                                                  : exact::Rational(m_i) / (exact::Rational(m_i) + exact::Rational(m_j));
+      fraction_[p] = {numerator(f), denominator(f)};
+    }
+    // Masses over one power of two, m_k = mass_[k] / mass_scale_ (0 for a wall: it has no
+    // kinetic energy or momentum of its own here).
+    for (std::size_t k = 0; k < 3; ++k) {
+      if (scene.isWall(k)) continue;
+      mass_scale_ = boost::multiprecision::lcm(mass_scale_, denominator(exact::Rational(scene.masses[k])));
+    }
+    for (std::size_t k = 0; k < 3; ++k) {
+      if (scene.isWall(k)) continue;
+      const exact::Rational m(scene.masses[k]);
+      mass_[k] = numerator(m) * (mass_scale_ / denominator(m));
+    }
+    for (std::size_t k = 0; k < 3; ++k) start_.scale = lcm(start_.scale, denominator(exact::Rational(scene.velocities[k])));
+    for (std::size_t k = 0; k < 3; ++k) {
+      const exact::Rational v(scene.velocities[k]);
+      start_.top[k] = numerator(v) * (start_.scale / denominator(v));
+    }
     restart();
   }
 
@@ -68,18 +110,19 @@ class ExactInTurn {
     state.energy_transfer = energyTransfer(n);
     state.velocities_before = rounded(before_);
     state.velocities_after = rounded(state_);
-    exact::Rational energy = 0, momentum = 0;
+    // K = sum m_k N_k^2 / (2 mass_scale D^2), P = sum m_k N_k / (mass_scale D).
+    Integer energy = 0, momentum = 0;
+    const Integer energy_scale = 2 * mass_scale_ * state_.scale * state_.scale;
     for (std::size_t k = 0; k < 3; ++k) {
       state.kinetic_energy_after[k] = 0.0;
       if (scene_.isWall(k)) continue;
-      const exact::Rational m(scene_.masses[k]);
-      const exact::Rational kinetic = m * state_[k] * state_[k] / 2;
-      state.kinetic_energy_after[k] = detail::nearestDouble(kinetic);
+      const Integer kinetic = mass_[k] * state_.top[k] * state_.top[k];
+      state.kinetic_energy_after[k] = detail::nearestDouble(kinetic, energy_scale);
       energy += kinetic;
-      momentum += m * state_[k];
+      momentum += mass_[k] * state_.top[k];
     }
-    state.total_energy = detail::nearestDouble(energy);
-    state.total_momentum = detail::nearestDouble(momentum);
+    state.total_energy = detail::nearestDouble(energy, energy_scale);
+    state.total_momentum = detail::nearestDouble(momentum, mass_scale_ * state_.scale);
   }
 
   /// The kinetic energy each body gains in impact n >= 1 [J], correctly rounded; a wall's entry
@@ -87,11 +130,14 @@ class ExactInTurn {
   std::array<double, 3> energyTransfer(std::uint64_t n) {
     moveTo(n);
     const int i = pairIndex(n % 2 == 1 ? first_ : otherPair(first_));
+    // Before, over the new denominator: N Q / (D Q).
+    const Integer& q = fraction_[i].second;
+    const Integer scale = 2 * mass_scale_ * state_.scale * state_.scale;
     std::array<double, 3> gained{0.0, 0.0, 0.0};
     for (const int body : {i, i + 1}) {
       if (scene_.isWall(static_cast<std::size_t>(body))) continue;
-      const exact::Rational m(scene_.masses[body]);
-      gained[body] = detail::nearestDouble(m * (state_[body] * state_[body] - before_[body] * before_[body]) / 2);
+      const Integer old_top = before_.top[body] * q;
+      gained[body] = detail::nearestDouble(mass_[body] * (state_.top[body] * state_.top[body] - old_top * old_top), scale);
     }
     for (const int body : {i, i + 1}) {
       if (scene_.isWall(static_cast<std::size_t>(body))) gained[body] = detail::toDouble(-gained[2 * i + 1 - body]);
@@ -100,8 +146,14 @@ class ExactInTurn {
   }
 
  private:
-  static std::array<double, 3> rounded(const exact::RationalState& v) {
-    return {detail::nearestDouble(v[0]), detail::nearestDouble(v[1]), detail::nearestDouble(v[2])};
+  struct State {
+    std::array<Integer, 3> top;
+    Integer scale = 1;  // the common denominator D
+  };
+
+  static std::array<double, 3> rounded(const State& v) {
+    return {detail::nearestDouble(v.top[0], v.scale), detail::nearestDouble(v.top[1], v.scale),
+            detail::nearestDouble(v.top[2], v.scale)};
   }
   void restart() {
     state_ = before_ = start_;
@@ -111,14 +163,23 @@ class ExactInTurn {
     if (n < n_) restart();
     while (n_ < n) {
       before_ = state_;
-      exact::applyImpact(triple(scene_.masses), n_ % 2 == 0 ? first_ : otherPair(first_), state_);
+      const int i = pairIndex(n_ % 2 == 0 ? first_ : otherPair(first_));
+      const auto& [p, q] = fraction_[i];
+      const Integer approach = state_.top[i + 1] - state_.top[i];
+      for (Integer& top : state_.top) top *= q;
+      state_.top[i] += 2 * (q - p) * approach;
+      state_.top[i + 1] -= 2 * p * approach;
+      state_.scale *= q;
       ++n_;
     }
   }
 
   Scene scene_;
   Pair first_;
-  exact::RationalState start_, state_, before_;  // before_: the state before impact n_
+  std::array<std::pair<Integer, Integer>, 2> fraction_;  // P, Q of f = m_i / (m_i + m_j), by pair
+  std::array<Integer, 3> mass_{};
+  Integer mass_scale_ = 1;
+  State start_, state_, before_;  // before_: the state before impact n_
   std::uint64_t n_ = 0;
 };
 
@@ -127,10 +188,12 @@ class ExactInTurn {
 /// mass-weighted velocities (S = diag(sqrt(m / m_max))) in double.
 class ClosedForm {
  public:
-  /// `count`: the scene's predicted impacts; a run of at most kExactEventLimit of them has
-  /// its per-impact values from exact rationals (ExactInTurn).
+  /// `count`: the scene's predicted impacts; a run of at most kExactEventLimit of them (within
+  /// the exact walk's budget) has its per-impact values from the exact walk (ExactInTurn).
   ClosedForm(const Scene& scene, std::uint64_t count)
-      : masses_(triple(scene.masses)), exact_(count <= kExactEventLimit ? std::optional<Scene>(scene) : std::nullopt) {
+      : masses_(triple(scene.masses)),
+        exact_(count <= kExactEventLimit && exactWalkAffordable(masses_, count) ? std::optional<Scene>(scene)
+                                                                                 : std::nullopt) {
     int smallest = std::numeric_limits<int>::max(), largest = std::numeric_limits<int>::min();
     for (int i = 0; i < 3; ++i) {
       if (scene.isWall(i)) continue;
@@ -465,14 +528,11 @@ SceneSimulation simulateByEngine(const Scene& scene, const SimulationOptions& op
   return result;
 }
 
-/// Impacts up to which a velocity that the product cannot certify (an exact zero or a tie) is
-/// decided by exact rationals instead.
-constexpr std::uint64_t kExactFallbackLimit = 2000;
-
-/// The exact velocities after `count` impacts of the scene [m/s], each correctly rounded: exact
-/// rationals for a short run, else the certified product of the impact maps (the paper's
-/// powers of D), a wall's velocity unchanged. A velocity that neither decides within the
-/// limits above keeps the closed form's double, and `certified` turns false.
+/// The exact velocities after `count` impacts of the scene [m/s], each correctly rounded: the
+/// exact walk within its budget, else the certified product of the impact maps (the paper's
+/// powers of D), a wall's velocity unchanged; a velocity that the product cannot certify (an
+/// exact zero or a tie) by the exact walk at up to 8 times its budget. A velocity that
+/// neither decides keeps the closed form's double, and `certified` turns false.
 std::array<double, 3> roundedVelocitiesAfter(const Scene& scene, std::uint64_t count, const ClosedForm& model,
                                              bool& certified) {
   const std::optional<Pair> first = firstPair(scene);
@@ -481,15 +541,13 @@ std::array<double, 3> roundedVelocitiesAfter(const Scene& scene, std::uint64_t c
     for (double& v : result) v = detail::toDouble(v);  // never -0
     return result;
   }
-  const auto exactly = [&] {
-    const exact::RationalState v = exact::velocitiesAfter(scene, *first, count);
-    return std::array<double, 3>{detail::nearestDouble(v[0]), detail::nearestDouble(v[1]), detail::nearestDouble(v[2])};
-  };
-  if (count <= kExactStateLimit) return exactly();
+  const auto exactly = [&] { return ExactInTurn(scene).velocitiesAfter(count); };
+  const std::array<double, 3> masses = triple(scene.masses);
+  if (exactWalkAffordable(masses, count)) return exactly();
   const std::array<std::optional<double>, 3> product =
       nbody_detail::certifiedVelocityComponentsAfter(scene, count, static_cast<std::size_t>(pairIndex(*first)));
   if (product[0] && product[1] && product[2]) return {*product[0], *product[1], *product[2]};
-  if (count <= kExactFallbackLimit) return exactly();
+  if (exactWalkAffordable(masses, count / 8)) return exactly();
   const std::array<double, 3> closed = model.velocitiesAfter(count);
   for (int k = 0; k < 3; ++k) {
     result[k] = product[k].value_or(closed[k]);
