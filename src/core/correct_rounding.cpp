@@ -37,6 +37,9 @@ double roundToDouble(const Certifying& x) {
 /// The double nearest x when every value within `relative` |x| of it rounds to that double,
 /// in the normal range; else empty (Ziv's first, cheap step, in long double).
 std::optional<double> quickNearest(long double x, long double relative) {
+  // The bounds of the callers assume x87's 64-bit significand; where long double is a double,
+  // the cheap step decides nothing and the exact or 100-digit step answers.
+  if constexpr (std::numeric_limits<long double>::digits < 64) return std::nullopt;
   const long double margin = (x < 0 ? -x : x) * relative;
   const double low = static_cast<double>(x - margin), high = static_cast<double>(x + margin);
   if (low != high || !std::isfinite(low) || !(std::fabs(low) >= std::numeric_limits<double>::min())) {

@@ -59,6 +59,20 @@ bool exactWalkAffordable(const std::array<double, 3>& masses, std::uint64_t coun
   return bits_per_impact == 0 || count <= kExactWalkBits / bits_per_impact;
 }
 
+/// The certified product's own range (as the known-count pass checks it): no finite mass
+/// ratio of a pair below 2^-900, where S = diag(sqrt(m / m_max)) would lose its bound.
+bool productInRange(const std::array<double, 3>& masses) {
+  for (int p = 0; p < 2; ++p) {
+    const double light = std::min(masses[p], masses[p + 1]), heavy = std::max(masses[p], masses[p + 1]);
+    if (!std::isinf(heavy) && !(light / heavy > 0x1p-900)) return false;
+  }
+  const double largest = largestFiniteMass(masses);
+  for (const double m : masses) {
+    if (!std::isinf(m) && !(m / largest > 0x1p-900)) return false;
+  }
+  return true;
+}
+
 /// The exact state after impacts n = 0, 1, 2, ... of a scene whose pairs alternate from its
 /// first pair, each value rounded once: the model's (and the run's) per-impact values of a
 /// short run, correctly rounded. The velocities are integers over one common denominator D:
@@ -192,8 +206,9 @@ class ClosedForm {
   /// the exact walk's budget) has its per-impact values from the exact walk (ExactInTurn).
   ClosedForm(const Scene& scene, std::uint64_t count)
       : masses_(triple(scene.masses)),
-        exact_(count <= kExactEventLimit && exactWalkAffordable(masses_, count) ? std::optional<Scene>(scene)
-                                                                                 : std::nullopt) {
+        // Energies are over the square of the walk's denominator: half the budget.
+        exact_(count <= kExactEventLimit && exactWalkAffordable(masses_, 2 * count) ? std::optional<Scene>(scene)
+                                                                                     : std::nullopt) {
     int smallest = std::numeric_limits<int>::max(), largest = std::numeric_limits<int>::min();
     for (int i = 0; i < 3; ++i) {
       if (scene.isWall(i)) continue;
@@ -544,10 +559,11 @@ std::array<double, 3> roundedVelocitiesAfter(const Scene& scene, std::uint64_t c
   const auto exactly = [&] { return ExactInTurn(scene).velocitiesAfter(count); };
   const std::array<double, 3> masses = triple(scene.masses);
   if (exactWalkAffordable(masses, count)) return exactly();
-  const std::array<std::optional<double>, 3> product =
-      nbody_detail::certifiedVelocityComponentsAfter(scene, count, static_cast<std::size_t>(pairIndex(*first)));
+  std::array<std::optional<double>, 3> product;
+  if (productInRange(masses)) {
+    product = nbody_detail::certifiedVelocityComponentsAfter(scene, count, static_cast<std::size_t>(pairIndex(*first)));
+  }
   if (product[0] && product[1] && product[2]) return {*product[0], *product[1], *product[2]};
-  if (exactWalkAffordable(masses, count / 8)) return exactly();
   const std::array<double, 3> closed = model.velocitiesAfter(count);
   for (int k = 0; k < 3; ++k) {
     result[k] = product[k].value_or(closed[k]);
