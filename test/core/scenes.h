@@ -3,6 +3,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <random>
 #include <string>
@@ -10,12 +11,23 @@
 #include <boost/multiprecision/cpp_int.hpp>
 
 #include "collision_lab/core/scene.h"
+#include "collision_lab/core/scene_run.h"
 
 namespace collision_lab {
 namespace core {
 namespace testing_support {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+
+/// planScene and runScene of a valid scene in `mode` (every event kept in full mode), up to
+/// `max_collisions` impacts.
+inline SceneRunResult runInMode(const Scene& scene, RunMode mode,
+                                std::uint64_t max_collisions = RunOptions{}.max_collisions) {
+  SceneRunOptions options;
+  options.lab.mode = mode;
+  options.lab.max_collisions = max_collisions;
+  return runScene(planScene(scene), options);
+}
 
 /// The scene's masses, positions and velocities on one line, for failure messages.
 inline std::string describe(const Scene& s) {

@@ -24,13 +24,6 @@ using testing_support::describe;
 using testing_support::kInf;
 using Q = reference::Q;
 
-SceneRunResult runWith(const Scene& scene, RunMode mode) {
-  SceneRunOptions options;
-  options.lab.mode = mode;
-  options.lab.max_collisions = 4'000'000'000;
-  return runScene(planScene(scene), options);
-}
-
 Prediction predictionOf(const Scene& scene) {
   const ScenePlan plan = planScene(scene);
   EXPECT_FALSE(plan.error) << describe(scene);
@@ -121,7 +114,7 @@ TEST(PublishedRounding, RotationFinalVelocitiesAreTheExactOnesRoundedExactZerosI
     const reference::Run run = reference::simulate(scene, 5000);
     ASSERT_FALSE(run.truncated) << describe(scene);
     for (const RunMode mode : {RunMode::kPredictOnly, RunMode::kSummaryOnly}) {
-      const SceneRunResult result = runWith(scene, mode);
+      const SceneRunResult result = testing_support::runInMode(scene, mode, 4'000'000'000);
       ASSERT_EQ(*result.prediction->impact_count, run.impacts.size()) << describe(scene);
       EXPECT_TRUE(result.prediction->uncertified.empty()) << describe(scene);
       for (int i = 0; i < 3; ++i) {

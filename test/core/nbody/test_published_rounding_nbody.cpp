@@ -23,13 +23,8 @@ using testing_support::closeToExact;
 using testing_support::correctlyRounded;
 using testing_support::describe;
 using testing_support::kInf;
+using testing_support::runInMode;
 using Q = reference::Rational;
-
-SceneRunResult runWith(const Scene& scene, RunMode mode) {
-  SceneRunOptions options;
-  options.lab.mode = mode;
-  return runScene(planScene(scene), options);
-}
 
 Q q(double x) { return Q(x); }
 
@@ -103,7 +98,7 @@ TEST(PublishedRounding, TheSpiralsValuesAreExactAndAWallKeepsItsVelocity) {
     const reference::Run run = reference::simulate(scene, 2000);
     ASSERT_FALSE(run.truncated) << describe(scene);
     for (const RunMode mode : {RunMode::kPredictOnly, RunMode::kSummaryOnly, RunMode::kFull}) {
-      const SceneRunResult result = runWith(scene, mode);
+      const SceneRunResult result = runInMode(scene, mode);
       ASSERT_EQ(result.prediction->kind, ModelKind::kThreeBodySpiral) << describe(scene);
       ASSERT_EQ(result.simulation.impact_count, run.events.size()) << describe(scene);
       EXPECT_TRUE(correctlyRounded(result.simulation.energy_lost, run.energy_lost)) << describe(scene);
@@ -133,7 +128,7 @@ TEST(PublishedRounding, ACollapseHasItsTimePointAndHeatInPredictModeAndTheHeavyL
     ASSERT_TRUE(run.truncated) << describe(scene);
     const Q& point = run.events.back().position;
     for (const RunMode mode : {RunMode::kPredictOnly, RunMode::kFull}) {
-      const SceneRunResult result = runWith(scene, mode);
+      const SceneRunResult result = runInMode(scene, mode);
       const SceneSimulation& s = result.simulation;
       ASSERT_TRUE(s.collapsed && s.collapse_time && s.collapse_position) << describe(scene);
       EXPECT_TRUE(closeToExact(*s.collapse_time, run.last_time, 1e-15)) << describe(scene) << " t " << *s.collapse_time;
