@@ -48,26 +48,27 @@ std::optional<double> quickNearest(long double x, long double relative) {
   return low;
 }
 
+/// top / bottom (bottom > 0) rounded, when the cheap step decides: each integer within an
+/// ulp of long double, the quotient within 3 ulps (2^-61 relative), so decided unless it lies
+/// next to a rounding boundary.
+std::optional<double> quickQuotient(const boost::multiprecision::cpp_int& top,
+                                    const boost::multiprecision::cpp_int& bottom) {
+  const long double top_ld = static_cast<long double>(top), bottom_ld = static_cast<long double>(bottom);
+  if (!std::isfinite(top_ld) || !std::isfinite(bottom_ld) || bottom_ld == 0) return std::nullopt;
+  return quickNearest(top_ld / bottom_ld, 0x1p-59L);
+}
+
 }  // namespace
 
 double nearestDouble(const boost::multiprecision::cpp_int& top, const boost::multiprecision::cpp_int& bottom) {
   if (top == 0) return 0.0;
-  // The quotient of the two integers, each within an ulp of long double, is within 3 ulps
-  // (2^-61 relative): decided here unless it lies next to a rounding boundary.
-  const long double top_ld = static_cast<long double>(top), bottom_ld = static_cast<long double>(bottom);
-  if (std::isfinite(top_ld) && std::isfinite(bottom_ld) && bottom_ld != 0) {
-    if (const auto quick = quickNearest(top_ld / bottom_ld, 0x1p-59L)) return *quick;
-  }
+  if (const auto quick = quickQuotient(top, bottom)) return *quick;
   return nearestDouble(ExactRational(top, bottom));
 }
 
 double nearestDouble(const ExactRational& exact) {
   if (exact == 0) return 0.0;
-  const long double top = static_cast<long double>(numerator(exact));
-  const long double bottom = static_cast<long double>(denominator(exact));
-  if (std::isfinite(top) && std::isfinite(bottom) && bottom != 0) {
-    if (const auto quick = quickNearest(top / bottom, 0x1p-59L)) return *quick;
-  }
+  if (const auto quick = quickQuotient(numerator(exact), denominator(exact))) return *quick;
   double nearest = roundToDouble(Certifying(numerator(exact)) / Certifying(denominator(exact)));
   if (std::isinf(nearest)) return nearest;
   // The estimate is within an ulp: the exact distances to it and its neighbours decide.
