@@ -532,6 +532,7 @@ SceneSimulation simulateByEngine(const Scene& scene, const SimulationOptions& op
   result.impact_count = engine.impact_count;
   result.truncated = engine.truncated || engine.stop != StopReason::kFinished;
   result.stop = engine.stop;
+  result.time_beyond_range = engine.time_beyond_range;
   if (engine.stop != StopReason::kFinished && engine.stop != StopReason::kCap && engine.stop != StopReason::kCancelled) {
     stopped_otherwise = engine.stop_message;
   }
@@ -664,6 +665,7 @@ SceneSimulation simulateRotationScene(const Scene& scene, const Prediction& pred
   // The engine's run is the summary where the known count declined, or where the engine
   // published fewer impacts (cancelled while it published them).
   const bool from_known = known && (!by_engine || by_engine->impact_count == known->impact_count);
+  simulation.time_beyond_range = by_engine && by_engine->time_beyond_range;  // the published events' times
   if (from_known) {
     by_engine = known;
     max_error_sq = known_error_sq;

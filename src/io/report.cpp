@@ -28,6 +28,7 @@ using report_text::humanText;
 using report_text::number;
 using report_text::padLeft;
 using report_text::padRight;
+using report_text::kTimeBeyondRangeNote;
 
 Json array3(const std::array<double, 3>& values) {
   return Json::array({number(values[0]), number(values[1]), number(values[2])});
@@ -142,6 +143,7 @@ class TableWriter : public RunReportWriter {
               "--simulate-to-cap simulates up to it)\n";
     }
     out_ << "truncated: " << (s.truncated ? "yes, " + summary.truncationReason() : std::string("no")) << "\n";
+    if (s.time_beyond_range) out_ << "time: " << kTimeBeyondRangeNote << "\n";
     out_ << "precision: " << summary.decisions() << " decisions, " << summary.highPrecision()
          << " taken at 100 digits or more, " << s.escalations.exact_rational << " by exact rationals; compute time "
          << humanText(summary.compute_time_s, 3) << " s\n";
@@ -604,6 +606,7 @@ Json summaryJson(const core::SceneRunResult& result) {
               {"truncated", s.truncated},
               {"cancelled", summary.cancelled()},
               {"truncation_reason", summary.truncationReason()},
+              {"time_beyond_range", s.time_beyond_range},
               {"simulated", s.simulated},
               {"final_velocities", array3(core::triple(s.final_velocities))},
               {"predicted_collision_count", summary.predictedCount()},

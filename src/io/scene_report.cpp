@@ -140,6 +140,7 @@ using report_text::humanText;
 using report_text::number;
 using report_text::padLeft;
 using report_text::padRight;
+using report_text::kTimeBeyondRangeNote;
 
 /// A JSON array of doubles, streamed without building a document (10^6 bodies).
 void writeJsonNumbers(std::ostream& out, const std::vector<double>& values) {
@@ -289,6 +290,7 @@ class SceneTableWriter : public SceneLayout {
          << ", predicted " << predictedCountText(p) << "\n";
     if (!p || (!p->impact_count && !p->infinite)) out_ << "count formula: " << kNoCountFormula << "\n";
     out_ << "truncated: " << (s.truncated ? "yes" : "no") << "; end of run: " << s.stop_message << "\n";
+    if (s.time_beyond_range) out_ << "time: " << kTimeBeyondRangeNote << "\n";
     if (!std::isnan(s.energy_lost)) out_ << "energy lost [J]: " << humanText(s.energy_lost, kDigits) << "\n";
     writeRestitution(s, p);
     if (s.simulated) writeChecks(s);
@@ -420,6 +422,7 @@ Json summaryScalars(const core::SceneRunResult& result) {
             {"matches_prediction", s.matches_prediction ? Json(*s.matches_prediction) : Json(nullptr)},
             {"max_prediction_error", number(s.max_prediction_error)},
             {"final_time", number(s.final_time)},
+            {"time_beyond_range", s.time_beyond_range},
             {"energy_lost", number(s.energy_lost)},
             {"energy_relative_drift", number(s.energy_relative_drift)},
             {"momentum_relative_drift", number(s.momentum_relative_drift)},

@@ -417,16 +417,14 @@ TEST(CliDoubleRange, ASubnormalSpeedOfTheOtherPairIsNoReasonToReject) {
   EXPECT_NEAR(v[0], 1.0 / 3, 1e-15);    // exact: 1/3
   EXPECT_NEAR(v[1], 2.0 / 15, 1e-15);   // 2/15
   EXPECT_NEAR(v[2], -8.0 / 15, 1e-15);  // -8/15 + 1e-324
-  // The third impact comes at 2.02e323 s, beyond a double: the run stops honestly after the
-  // second, truncated (it used to publish the third with a null time).
+  // The third impact comes at 2.02e323 s, beyond a double: counted, its time null (+inf).
   const Json three = runJson({"--masses", "1,1,1", "--positions", "2,1,0", "--velocities=-1,-5e-324,0"});
-  EXPECT_EQ(three.at("summary").at("collision_count"), 2);
+  EXPECT_EQ(three.at("summary").at("collision_count"), 3);
   EXPECT_EQ(three.at("summary").at("predicted_collision_count"), 3);
-  EXPECT_EQ(three.at("summary").at("truncated"), true);
-  EXPECT_NE(three.at("summary").at("truncation_reason").get<std::string>().find(
-                "the next impact comes after t = 1.7976931348623157e+308 s"),
-            std::string::npos);
-  EXPECT_EQ(three.at("events").size(), 2u);
+  EXPECT_EQ(three.at("summary").at("truncated"), false);
+  EXPECT_EQ(three.at("summary").at("time_beyond_range"), true);
+  ASSERT_EQ(three.at("events").size(), 3u);
+  EXPECT_TRUE(three.at("events")[2].at("time").is_null());
 }
 
 TEST(CliDoubleRange, CountsPast2To53AreJsonIntegers) {
@@ -467,8 +465,30 @@ TEST(CliDoubleRange, SubnormalApproachSpeed) {
   EXPECT_NEAR(third.at("position").get<double>() / -2.4128228820241767e-184, 1.0, 1e-9);
 }
 
+TEST(CliDoubleRange, AnImpactAfterTheLargestDoubleIsCountedWithANullTime) {
+  // The fourth impact comes after the largest double, within the engine's working range: it
+  // is counted with events and without, its time null (+inf) and the summary saying why.
+  const std::vector<std::string> scene = {"--masses", "3,2,10", "--positions", "2,1,0", "--velocities=-1,0,5e-324"};
+  std::vector<std::string> quiet_args = scene;
+  quiet_args.insert(quiet_args.end(), {"--events", "none"});
+  const Json all = runJson(scene);
+  const Json quiet = runJson(quiet_args);
+  EXPECT_EQ(all.at("summary").at("collision_count"), 4);
+  EXPECT_EQ(quiet.at("summary").at("collision_count"), 4);
+  EXPECT_EQ(all.at("summary").at("truncated"), false);
+  EXPECT_EQ(all.at("summary").at("time_beyond_range"), true);
+  ASSERT_EQ(all.at("events").size(), 4u);
+  EXPECT_TRUE(all.at("events")[3].at("time").is_null());
+  EXPECT_TRUE(all.at("events")[2].at("time").is_number());
+  EXPECT_EQ(all.at("summary").at("final_velocities"), quiet.at("summary").at("final_velocities"));
+  const CliOutput table = run(scene);
+  EXPECT_NE(table.out.find("the last impacts come after t = 1.8e+308 s, the largest double"), std::string::npos)
+      << table.out;
+}
+
 TEST(CliDoubleRange, ExtremeMassRatiosAreRun) {
-  // The second impact comes after the largest double: the run stops honestly after the first.
+  // The second impact comes after the largest double, beyond the engine's working range too:
+  // the run stops honestly after the first.
   const Json doc = runJson({"--masses", "1e-300,1,inf", "--positions", "2,1,0", "--velocities", "-1e-140,0,0"});
   EXPECT_EQ(doc.at("summary").at("collision_count"), 1);
   EXPECT_EQ(doc.at("summary").at("predicted_collision_count"), 2);

@@ -3,8 +3,9 @@
 // an independent 100-digit evaluation of the count's geometry, or from the issue's own
 // exact figures; the tolerances are the issue's: counts exact, velocities within 1e-12 in
 // the energy norm, times within 1e-9 relative, positions within 1e-9 of the length scale.
-// Every run is the event engine's (planScene, runScene); an impact after the largest double stops it
-// honestly at its last certified impact (OUT_OF_RANGE, truncated).
+// Every run is the event engine's (planScene, runScene); an impact after the largest double is
+// counted and published with time +inf (time_beyond_range), and the run goes on; only one
+// whose time lies beyond the engine's working range too stops it honestly (OUT_OF_RANGE, truncated).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -36,15 +37,20 @@ using Observed = testing_support::SimulatedRun;
 /// The run of `scene` with every event published (the engine's path; RunOptions' defaults).
 Observed run(const Scene& scene) { return testing_support::simulateThreeBodies(scene, EventPolicy::all()); }
 
-/// Does the run of `observed` stop honestly before an impact after the largest double?
-void expectStopAfterTheLargestDouble(const Observed& observed, std::size_t certified) {
+/// Does the run of `observed` stop honestly, after `certified` impacts, before one after the
+/// largest double that the engine's working range cannot hold either?
+void expectStopBeyondTheWorkingRange(const Observed& observed, std::size_t certified) {
   EXPECT_EQ(observed.summary.impact_count, certified);
   EXPECT_TRUE(observed.summary.truncated);
-  EXPECT_NE(observed.summary.stop, StopReason::kCancelled);
   EXPECT_EQ(observed.summary.stop, StopReason::kOutOfRange);
-  EXPECT_NE(observed.summary.stop_message.find("the next impact comes after t = 1.7976931348623157e+308 s, the largest double"),
+  EXPECT_NE(observed.summary.stop_message.find("the largest double, and beyond the engine's working range"),
             std::string::npos)
       << observed.summary.stop_message;
+}
+
+bool stoppedBeyondTheWorkingRange(const Observed& observed) {
+  return observed.summary.stop == StopReason::kOutOfRange &&
+         observed.summary.stop_message.find("beyond the engine's working range") != std::string::npos;
 }
 
 /// |S (v - exact)| / |S v0| with S = diag(sqrt(m / m_max)), in the wall's frame, allowing
@@ -88,28 +94,31 @@ bool stoppedForItsSpreadOfScales(const Observed& observed) {
 }
 
 /// The run of `scene` against the exact reference `truth`, impact by impact. An impact of
-/// `truth` after the largest double is not published: the run stops before it, truncated,
-/// with the velocities after the impact before it. With `spread_allowed`, the run may also
-/// stop honestly for its spread of scales: its published impacts are then checked. Returns
-/// whether the run published every publishable impact.
+/// `truth` after the largest double is published with time +inf, and the run goes on, unless
+/// its time lies beyond the engine's working range too: then the run stops before it,
+/// truncated. With `spread_allowed`, the run may also stop honestly for its spread of
+/// scales: its published impacts are then checked. Returns whether the run published every
+/// impact of `truth`, or stopped beyond the working range (false: stopped for its spread).
 bool expectExactRun(const Scene& scene, const reference::Run& truth, bool spread_allowed = false) {
   SCOPED_TRACE(describe(scene));
   EXPECT_FALSE(truth.truncated);
   const Observed observed = run(scene);
   const reference::Q largest(std::numeric_limits<double>::max());
-  std::size_t publishable = 0;
-  while (publishable < truth.impacts.size() && truth.impacts[publishable].time <= largest) ++publishable;
+  std::size_t publishable = truth.impacts.size();
   // (An impact after the largest double may be found as out of the tiers' range first.)
   const bool spread = spread_allowed && stoppedForItsSpreadOfScales(observed) &&
                       observed.summary.impact_count <= publishable;
-  const bool complete = !spread || observed.summary.impact_count == publishable;
   if (spread) {
     publishable = observed.summary.impact_count;
-  } else if (publishable < truth.impacts.size()) {
-    expectStopAfterTheLargestDouble(observed, publishable);
+  } else if (stoppedBeyondTheWorkingRange(observed) && observed.summary.impact_count < publishable) {
+    publishable = observed.summary.impact_count;
+    expectStopBeyondTheWorkingRange(observed, publishable);
+    EXPECT_GT(truth.impacts[publishable].time, largest) << "an impact in the range of doubles";
   } else {
     EXPECT_FALSE(observed.summary.truncated) << observed.summary.stop_message;
+    EXPECT_EQ(observed.summary.time_beyond_range, publishable > 0 && truth.impacts.back().time > largest);
   }
+  const bool complete = !spread;
   EXPECT_EQ(observed.summary.impact_count, publishable);
   if (observed.events.size() != publishable) {
     ADD_FAILURE() << observed.events.size() << " events, " << publishable << " expected";
@@ -122,11 +131,19 @@ bool expectExactRun(const Scene& scene, const reference::Run& truth, bool spread
     const reference::Impact& t = truth.impacts[k];
     SCOPED_TRACE(::testing::Message() << "impact " << k + 1);
     EXPECT_EQ(e.pair, t.pair);
-    EXPECT_TRUE(reference::closeRelative(e.time, t.time, 1e-9))
-        << e.time << " vs " << reference::toWide(t.time).str(17);
+    if (t.time > largest) {
+      EXPECT_EQ(e.time, kInf);
+    } else {
+      EXPECT_TRUE(reference::closeRelative(e.time, t.time, 1e-9))
+          << e.time << " vs " << reference::toWide(t.time).str(17);
+    }
     const Wide scale = std::max(extent, Wide(abs(reference::toWide(t.position))));
-    EXPECT_TRUE(reference::closeOnScale(e.position, t.position, scale, 1e-9))
-        << e.position << " vs " << reference::toWide(t.position).str(17);
+    if (abs(t.position) > largest) {  // after a time past the largest double, a place past it
+      EXPECT_EQ(e.position, t.position > 0 ? kInf : -kInf);
+    } else {
+      EXPECT_TRUE(reference::closeOnScale(e.position, t.position, scale, 1e-9))
+          << e.position << " vs " << reference::toWide(t.position).str(17);
+    }
     EXPECT_TRUE(velocitiesClose(scene, e.velocities_after, t.velocities));
   }
   std::array<Q, 3> last{Q(scene.velocities[0]), Q(scene.velocities[1]), Q(scene.velocities[2])};
@@ -157,23 +174,45 @@ TEST(DoubleRange, OtherPairApproachingAtASubnormalSpeedIsAccepted) {
   EXPECT_NEAR(v[kC], -8.0 / 15, 1e-15);
 }
 
-TEST(DoubleRange, AnImpactAfterTheLargestDoubleStopsTheRunHonestly) {
+TEST(DoubleRange, AnImpactAfterTheLargestDoubleIsCountedWithTimeInfinity) {
+  // C creeps towards B at 5e-324 m/s: after three impacts in 2.7 s, C (now slower than B)
+  // is caught by nothing but its own creep, and the fourth impact comes after the largest
+  // double, within the engine's working range. It is counted, with exact positions and
+  // velocities and time +inf, with events and without: the same answer.
+  const Scene scene{{3, 2, 10}, {2, 1, 0}, {-1, 0, 5e-324}};
+  ASSERT_FALSE(validate(scene)) << validate(scene)->message;
+  const reference::Run truth = reference::simulate(scene, 1000);
+  ASSERT_EQ(truth.impacts.size(), 4u);
+  ASSERT_LE(truth.impacts[2].time, Q(std::numeric_limits<double>::max()));  // the premise
+  ASSERT_GT(truth.impacts[3].time, Q(std::numeric_limits<double>::max()));
+  EXPECT_TRUE(expectExactRun(scene, truth));
+  const Observed observed = run(scene);
+  EXPECT_TRUE(observed.summary.time_beyond_range);
+  RunOptions count_only;
+  count_only.events = EventPolicy::none();
+  const SceneSimulation quiet = testing_support::runPlanned(scene, count_only).simulation;
+  EXPECT_EQ(quiet.impact_count, 4u);
+  EXPECT_FALSE(quiet.truncated) << quiet.stop_message;
+  EXPECT_EQ(quiet.final_velocities, std::vector<double>(observed.final_velocities.begin(), observed.final_velocities.end()));
+}
+
+TEST(DoubleRange, ACreepAfterTheLargestDoubleIsCounted) {
   // Equal masses swap velocities: the third impact comes when A, creeping at 5e-324 m/s,
   // has covered 1 m to B at rest at 0: at t = 2 + 1/5e-324 = 2.02e323 s, beyond any double.
-  // The run stops at its last certified impact, the second, truncated (OUT_OF_RANGE), as
-  // every engine run does; it used to publish the third with t = inf.
+  // It is counted, with time +inf; it used to stop the run after the second, truncated.
   const Scene scene{{1, 1, 1}, {2, 1, 0}, {-1, -5e-324, 0}};
   ASSERT_FALSE(validate(scene)) << validate(scene)->message;
   const reference::Run truth = reference::simulate(scene, 1000);
   ASSERT_EQ(truth.impacts.size(), 3u);
   ASSERT_GT(truth.impacts[2].time, Q(std::numeric_limits<double>::max()));
-  expectExactRun(scene, truth);
+  EXPECT_TRUE(expectExactRun(scene, truth));
   const Observed observed = run(scene);
-  expectStopAfterTheLargestDouble(observed, 2);
-  ASSERT_EQ(observed.events.size(), 2u);
+  ASSERT_EQ(observed.events.size(), 3u);
   EXPECT_EQ(observed.events[1].time, 2.0);
-  // After the second impact: A creeps at -5e-324 m/s, B at -1 m/s towards C, now at rest.
-  EXPECT_EQ(observed.final_velocities, (std::array<double, 3>{-5e-324, 0.0, -1.0}));
+  EXPECT_EQ(observed.events[2].time, kInf);
+  EXPECT_EQ(observed.events[2].position, 0.0);  // A reaches B where B stopped C, at 0
+  // After the third impact: A at rest, B creeps at -5e-324 m/s, C at -1 m/s.
+  EXPECT_EQ(observed.final_velocities, (std::array<double, 3>{0.0, -5e-324, -1.0}));
   EXPECT_EQ(predict(scene)->impact_count, 3u);  // the closed form counts it
 }
 
@@ -376,12 +415,13 @@ TEST(DoubleRange, SubnormalVelocitiesThroughLongRuns) {
 
 TEST(DoubleRange, ExtremeMassRatiosAreAcceptedAndExact) {
   // The scene: 2 collisions, the second after the largest double (B creeps at
-  // 2e-440 m/s towards the wall): the run stops after the first, truncated.
+  // 2e-440 m/s towards the wall, 1e300 s in working units, past their range): the run
+  // stops after the first, truncated.
   const Scene feather{{1e-300, 1, kInf}, {2, 1, 0}, {-1e-140, 0, 0}};
   ASSERT_FALSE(validate(feather)) << validate(feather)->message;
   expectExactRun(feather);
   const Observed observed = run(feather);
-  expectStopAfterTheLargestDouble(observed, 1);
+  expectStopBeyondTheWorkingRange(observed, 1);
   EXPECT_EQ(predict(feather)->impact_count, 2u);
   // A heavy B (it cannot be a wall), ratios past the double range (1e300 / 1e-310), and a
   // light B between bodies 1e200 apart in mass (31 impacts).

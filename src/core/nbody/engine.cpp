@@ -507,7 +507,8 @@ std::string stopMessage(const Scene& scene, const SceneSimulation& result, bool 
       if (beyond_doubles) {
         return "stopped after " + impacts + " (truncated): the next impact comes after t = " +
                formatValue(std::numeric_limits<double>::max()) +
-               " s, the largest double, so its time cannot be written; a longer unit of time brings it into range";
+               " s, the largest double, and beyond the engine's working range (2^900 in its units), so the "
+               "run cannot go on; a longer unit of time brings it into range";
       }
       return "stopped after " + impacts + " (truncated): the next one would take a time, position or velocity "
              "beyond 2^900 in the run's working units (the powers of two of m, m/s and kg that bring the scene's "
@@ -617,12 +618,6 @@ SceneSimulation runEngineOn(const Scene& si_scene, const EngineOptions& options,
       result.stop = StopReason::kCancelled;
       break;
     }
-    // An impact whose time [s] no double holds cannot be published: the run stops before it.
-    if (!(driver.fast().nextTimeLowerBound() <= time_limit)) {
-      result.stop = StopReason::kOutOfRange;
-      beyond_doubles = true;
-      break;
-    }
     r = driver.step(wants_records ? &record : nullptr);
     if (r.kind != StepKind::kImpact) break;
     ++count;
@@ -659,6 +654,8 @@ SceneSimulation runEngineOn(const Scene& si_scene, const EngineOptions& options,
   result.final_time = driver.fast().lastTime();
   result.collapsed = !result.collapses.empty();
   if (result.collapsed) result.final_time = std::max(result.final_time, result.collapses.back().time);
+  // An impact after the largest double [s] was counted and published with time +inf.
+  result.time_beyond_range = !(result.final_time <= time_limit);
   result.cluster_impacts = driver.fast().clusterImpacts();
   result.rule_elastic_impacts = driver.fast().ruleElastic();
   driver.fast().state(result.final_time, result.final_positions, result.final_velocities);

@@ -187,6 +187,10 @@ struct SceneSimulation {
   std::string stop_message;  ///< one sentence: why the run ended
   std::optional<MultipleCollision> multiple_collision;
   double final_time = 0.0;               ///< time of the last impact [s] (0 without any)
+  /// The run's last impacts came after the largest double [s]: counted, with exact
+  /// velocities, their times (and final_time) published as +inf, as is any position past
+  /// the largest double [m].
+  bool time_beyond_range = false;
   std::vector<double> final_positions;   ///< at final_time [m]; empty when not simulated
   std::vector<double> final_velocities;  ///< [m/s]; the predicted ones when not simulated
   double energy_lost = 0.0;              ///< total kinetic energy turned into heat [J]; NaN: not known
