@@ -397,6 +397,33 @@ void benchCertifiedPlans(int repeats) {
     std::printf("  %-26s planScene %.1f us, the closed form in double %.1f us (%.1fx)\n", names[k], certified_us,
                 double_us, certified_us / double_us);
   }
+  // Short runs publish every impact's values from the exact walk (the model's, the
+  // simulation's and the paper's): the whole run with every event kept, against the same
+  // run publishing none.
+  const Scene short_runs[] = {scenes[0], {{100, 1, std::numeric_limits<double>::infinity()}, {2, 1, 0}, {-1, 0, 0}},
+                              {{1, 2, 3}, {3, 2, 0}, {-1, 0.5, 1}}, scenes[1]};
+  const char* short_names[] = {"equal_masses (3 impacts)", "(100, 1, inf) (31)", "(1, 2, 3) (3, no wall)",
+                               "(1e4, 1, inf) (314)"};
+  constexpr int kRuns = 50;
+  std::printf("certified events (issue 44), microseconds per full run (plan included), medians of %d x %d:\n", repeats,
+              kRuns);
+  for (int k = 0; k < 4; ++k) {
+    double sink = 0.0;
+    const auto timed = [&](const EventPolicy& events) {
+      return timeRepeats(repeats, [&] {
+        for (int i = 0; i < kRuns; ++i) {
+          SceneRunOptions options;
+          options.lab.events = events;
+          sink += static_cast<double>(runScene(planScene(short_runs[k]), options).simulation.impact_count);
+        }
+      });
+    };
+    const double all_us = median(timed(EventPolicy::all())) / kRuns * 1e6;
+    const double none_us = median(timed(EventPolicy::none())) / kRuns * 1e6;
+    doNotOptimize(sink);
+    std::printf("  %-26s every event %.1f us, no event %.1f us (%.2fx)\n", short_names[k], all_us, none_us,
+                all_us / none_us);
+  }
 }
 
 int main(int argc, char** argv) {

@@ -34,8 +34,18 @@ double roundToDouble(const Certifying& x) {
   return x < 0 ? -rounded : rounded;
 }
 
-/// The double nearest x when every value within `relative` |x| of it rounds to that double,
-/// in the normal range; else empty (Ziv's first, cheap step, in long double).
+/// top / bottom (bottom > 0) rounded, when the cheap step decides: each integer within an
+/// ulp of long double, the quotient within 3 ulps (2^-61 relative), so decided unless it lies
+/// next to a rounding boundary.
+std::optional<double> quickQuotient(const boost::multiprecision::cpp_int& top,
+                                    const boost::multiprecision::cpp_int& bottom) {
+  const long double top_ld = static_cast<long double>(top), bottom_ld = static_cast<long double>(bottom);
+  if (!std::isfinite(top_ld) || !std::isfinite(bottom_ld) || bottom_ld == 0) return std::nullopt;
+  return quickNearest(top_ld / bottom_ld, 0x1p-59L);
+}
+
+}  // namespace
+
 std::optional<double> quickNearest(long double x, long double relative) {
   // The bounds of the callers assume x87's 64-bit significand; where long double is a double,
   // the cheap step decides nothing and the exact or 100-digit step answers.
@@ -48,17 +58,9 @@ std::optional<double> quickNearest(long double x, long double relative) {
   return low;
 }
 
-/// top / bottom (bottom > 0) rounded, when the cheap step decides: each integer within an
-/// ulp of long double, the quotient within 3 ulps (2^-61 relative), so decided unless it lies
-/// next to a rounding boundary.
-std::optional<double> quickQuotient(const boost::multiprecision::cpp_int& top,
-                                    const boost::multiprecision::cpp_int& bottom) {
-  const long double top_ld = static_cast<long double>(top), bottom_ld = static_cast<long double>(bottom);
-  if (!std::isfinite(top_ld) || !std::isfinite(bottom_ld) || bottom_ld == 0) return std::nullopt;
-  return quickNearest(top_ld / bottom_ld, 0x1p-59L);
+long double approximate(const ExactRational& q) {
+  return static_cast<long double>(numerator(q)) / static_cast<long double>(denominator(q));
 }
-
-}  // namespace
 
 double nearestDouble(const boost::multiprecision::cpp_int& top, const boost::multiprecision::cpp_int& bottom) {
   if (top == 0) return 0.0;

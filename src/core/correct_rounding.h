@@ -30,6 +30,15 @@ double nearestDouble(const boost::multiprecision::cpp_int& top, const boost::mul
 /// [value - error, value + error] rounds to that double; empty otherwise. A zero is +0.
 std::optional<double> certifiedNearest(const Certifying& value, const Certifying& error);
 
+/// The double nearest x when every value within `relative` |x| of x rounds to that double, in
+/// the normal range; else empty (Ziv's first, cheap step; empty where long double has fewer
+/// than 64 bits).
+std::optional<double> quickNearest(long double x, long double relative);
+
+/// q in long double, within 3 ulps of it (2^-61 relative) where long double has 64 bits; not
+/// finite where q's numerator or denominator leaves its range.
+long double approximate(const ExactRational& q);
+
 /// sqrt(q) when it is rational (numerator and denominator perfect squares); else empty.
 std::optional<ExactRational> rationalSqrt(const ExactRational& q);
 

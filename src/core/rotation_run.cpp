@@ -139,6 +139,12 @@ class ExactInTurn {
     state.total_momentum = detail::nearestDouble(momentum, mass_scale_ * state_.scale);
   }
 
+  /// The exact velocities before impact n >= 1 [m/s].
+  paper::ScaledState velocitiesBefore(std::uint64_t n) {
+    moveTo(n);
+    return {before_.top, before_.scale};
+  }
+
   /// The kinetic energy each body gains in impact n >= 1 [J], correctly rounded; a wall's entry
   /// is minus the other body's (elastic: the pair's gains cancel), the third body's 0.
   std::array<double, 3> energyTransfer(std::uint64_t n) {
@@ -268,6 +274,15 @@ class ClosedFormInTurn {
     return true;
   }
 
+  /// Does every impact's values come from the exact walk (a short run)?
+  bool exactEvents() const { return exact_.has_value(); }
+
+  /// A short run's exact velocities before impact n; empty for a longer run.
+  std::optional<paper::ScaledState> exactVelocitiesBefore(std::uint64_t n) {
+    if (!exact_) return std::nullopt;
+    return exact_->velocitiesBefore(n);
+  }
+
   void describe(std::uint64_t n, ImpactModelValues& values) {
     if (exact_) {
       values.predicted_velocities_after = exact_->velocitiesAfter(n);
@@ -312,13 +327,17 @@ class ClosedFormInTurn {
   std::uint64_t last_ = 0;
 };
 
-/// The paper's printed closed form at impacts n = 1, 2, 3, ... in turn, its angle
-/// advanced by a RotationRecurrence.
+/// The paper's printed closed form at impacts n = 1, 2, 3, ... in turn: its exact values,
+/// correctly rounded, for a short run (`exact`) without a wall; else in double, its angle
+/// advanced by a RotationRecurrence (with a wall every value is NaN, inf / inf as printed).
 class PaperInTurn {
  public:
-  explicit PaperInTurn(const Scene& scene) : printed_(scene), rotation_(printed_.theta()) {}
+  PaperInTurn(const Scene& scene, bool exact) : printed_(scene), rotation_(printed_.theta()) {
+    if (exact && wallIndex(scene) < 0) exact_.emplace(scene);
+  }
 
   std::array<double, 3> velocitiesAfter(std::uint64_t n) {
+    if (exact_) return exact_->velocitiesAfter(n);
     rotation_.moveTo(n / 2);
     return printed_.velocitiesAfter(n, rotation_.cos(), rotation_.sin());
   }
@@ -326,6 +345,7 @@ class PaperInTurn {
  private:
   paper::PrintedClosedForm printed_;
   RotationRecurrence rotation_;
+  std::optional<paper::ExactPrintedClosedForm> exact_;
 };
 
 /// Relative error in the energy norm: |S (a - b)| / |S v_0| with S = diag(sqrt(m)), in
@@ -372,7 +392,16 @@ class EnergyNormError {
 class ModelBesideImpacts {
  public:
   explicit ModelBesideImpacts(const Scene& scene, const ClosedForm& model)
-      : scene_(scene), wall_(wallIndex(scene)), closed_form_(model), paper_(scene), previous_before_(triple(scene.velocities)) {}
+      : scene_(scene),
+        wall_(wallIndex(scene)),
+        closed_form_(model),
+        paper_(scene, closed_form_.exactEvents()),
+        previous_before_(triple(scene.velocities)) {
+    if (closed_form_.exactEvents()) {
+      exact_energy_.emplace(scene);
+      previous_exact_before_ = closed_form_.exactVelocitiesBefore(1).value();  // the start
+    }
+  }
 
   /// Fills the model's values of the next impact, impact previous + 1, whose state
   /// (`values`' velocities) is filled. The paper's BC energy formulas refer to the
@@ -384,8 +413,14 @@ class ModelBesideImpacts {
     const bool exact_state = closed_form_.fillExactState(index, values);
     closed_form_.describe(index, values);
     values.paper_velocities_after = paper_.velocitiesAfter(index);
-    values.paper_energy_transfer =
-        paper::energyTransfer(scene_, index, pair, values.velocities_before, previous_before_);
+    if (exact_energy_) {
+      paper::ScaledState before = closed_form_.exactVelocitiesBefore(index).value();
+      values.paper_energy_transfer = exact_energy_->transfer(index, pair, before, previous_exact_before_);
+      previous_exact_before_ = std::move(before);
+    } else {
+      values.paper_energy_transfer =
+          paper::energyTransfer(scene_, index, pair, values.velocities_before, previous_before_);
+    }
     if (!exact_state) {
       for (int i = 0; i < 3; ++i) {
         const double v = values.velocities_after[i];
@@ -402,6 +437,8 @@ class ModelBesideImpacts {
   ClosedFormInTurn closed_form_;
   PaperInTurn paper_;
   std::array<double, 3> previous_before_;
+  std::optional<paper::ExactPrintedEnergy> exact_energy_;  // a short run's
+  paper::ScaledState previous_exact_before_;
 };
 
 /// The limits of one simulation of the three bodies.
@@ -588,12 +625,16 @@ void fillRotationPrediction(const Scene& scene, Prediction& prediction) {
   prediction.energy_lost = 0.0;  // elastic
   prediction.critical_restitution = angles.critical_restitution;
   prediction.spiral_angle = angles.theta;
-  prediction.paper_impact_count = paper::impactCount(scene);
+  bool paper_certified = true;
+  prediction.paper_impact_count = paper::impactCount(scene, &paper_certified);
+  if (!paper_certified) prediction.uncertified.push_back("paper_predicted_collision_count");
+  paper_certified = true;
   prediction.max_possible_impact_count = maxPossibleImpactCount(masses);
   prediction.alpha = angles.alpha;
   prediction.theta = angles.theta;
   prediction.omega = angles.omega;
-  prediction.phi_bc = paper::phiBC(scene);
+  prediction.phi_bc = paper::phiBC(scene, &paper_certified);
+  if (!paper_certified) prediction.uncertified.push_back("phi_bc");
   prediction.psi = model.psi();
   if (const std::optional<Pair> first = firstPair(scene)) prediction.first_pair_index = static_cast<std::size_t>(pairIndex(*first));
 }

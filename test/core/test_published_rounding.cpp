@@ -12,6 +12,7 @@
 #include "collision_lab/core/analytic.h"
 #include "collision_lab/core/precision.h"
 #include "collision_lab/core/scene_run.h"
+#include "collision_lab/core/wedge.h"
 #include "rational_reference.h"
 #include "scenes.h"
 
@@ -116,7 +117,8 @@ TEST(PublishedRounding, RotationFinalVelocitiesAreTheExactOnesRoundedExactZerosI
     for (const RunMode mode : {RunMode::kPredictOnly, RunMode::kSummaryOnly}) {
       const SceneRunResult result = testing_support::runInMode(scene, mode, 4'000'000'000);
       ASSERT_EQ(*result.prediction->impact_count, run.impacts.size()) << describe(scene);
-      EXPECT_TRUE(result.prediction->uncertified.empty()) << describe(scene);
+      EXPECT_TRUE(result.prediction->uncertified.empty())
+          << describe(scene) << ": " << result.prediction->uncertified.front();
       for (int i = 0; i < 3; ++i) {
         EXPECT_TRUE(correctlyRounded(result.prediction->final_velocities[i], run.final_velocities[i]))
             << describe(scene) << " body " << i << ": " << result.prediction->final_velocities[i];
@@ -192,6 +194,116 @@ TEST(PublishedRounding, RotationPredictionsOfLongRunsAgreeWithTheClosedFormAt500
                                                              << p.final_velocities[i];
     }
   }
+}
+
+/// The paper's eqs. (2.15)/(2.16) after impact n, transcribed again at 500 bits with cos and
+/// sin of (n/2) theta from the library's trigonometry (the core walks lambda_+^k in integers).
+std::array<DeepPrecision, 3> printedVelocitiesAt500Bits(const Scene& scene, std::uint64_t n) {
+  using D = DeepPrecision;
+  const D m_a(scene.masses[0]), m_b(scene.masses[1]), m_c(scene.masses[2]);
+  const D m_ab = m_a + m_b, m_bc = m_b + m_c, total = m_a + m_b + m_c;
+  const D root = sqrt(m_a * m_b * m_c * total);
+  const D c = 2 * m_a * m_c / (m_a * m_ab), d = root / (m_a * m_ab), nu_sq = c * c + d * d;
+  const D theta = atan2(2 * root / (m_ab * m_bc), (m_a * m_c - m_b * total) / (m_ab * m_bc));
+  const D angle = theta * D(n / 2);
+  const D vbar = (D(scene.velocities[0]) + D(scene.velocities[1])) / 2;
+  const D half_ba = (D(scene.velocities[1]) - D(scene.velocities[0])) / 2, v_c(scene.velocities[2]);
+  const D x = ((vbar - v_c) * nu_sq + c * half_ba) * sin(angle) - d * half_ba * cos(angle);
+  const D y = (-half_ba - c * (vbar - v_c)) * sin(angle) - d * (vbar - v_c) * cos(angle);
+  if (n % 2 == 0) return {x / d + vbar, -x / d + vbar, y / d + vbar};
+  return {(m_a - 3 * m_b) * x / (d * m_ab) + vbar, (m_b - 3 * m_a) * x / (d * m_ab) + vbar, y / d + vbar};
+}
+
+struct PrintedAngles {
+  DeepPrecision phi_bc;          ///< eq. (3.21)
+  DeepPrecision count_argument;  ///< (Omega - phi_BC) / theta of eq. (3.22)
+};
+
+/// phi_BC and the argument of eq. (3.22) from the wedge's vectors at 500 bits (no wall).
+PrintedAngles printedAnglesAt500Bits(const Scene& scene) {
+  using D = DeepPrecision;
+  const Wedge<D> wedge = wedgeOf<D>(triple(scene.masses));
+  const D m_a(scene.masses[0]), m_b(scene.masses[1]), m_c(scene.masses[2]);
+  const D v_a(scene.velocities[0]), v_b(scene.velocities[1]);
+  const D v_a1 = ((m_a - m_b) * v_a + 2 * m_b * v_b) / (m_a + m_b);
+  const D v_b1 = (2 * m_a * v_a + (m_b - m_a) * v_b) / (m_a + m_b);
+  const Eigen::Matrix<D, 3, 1> u1(sqrt(m_a) * v_a1, sqrt(m_b) * v_b1, sqrt(m_c) * scene.velocities[2]);
+  Eigen::Matrix<D, 3, 1> l_bc = cross<D>(wedge.s_hat, wedge.n_bc);
+  l_bc /= sqrt(l_bc.squaredNorm());
+  const D phi = atan2(D(u1.dot(wedge.n_bc)), D(u1.dot(l_bc)));
+  const D omega = acos(D(wedge.n_ab.dot(wedge.n_bc)));
+  return {phi, (omega - phi) / (2 * wedge.alpha)};  // theta = arg lambda_+ = 2 alpha
+}
+
+TEST(PublishedRounding, ThePapersPrintedFormulasArePublishedAsTheirExactValuesRounded) {
+  // The difference a class sees between the paper and the simulation is the formula's, not
+  // the arithmetic's: eqs. (2.15)/(2.16) against the transcription at 500 bits, eqs.
+  // (4.4)-(4.7) in rationals at the textbook loop's exact states, phi_BC (3.21) and the count
+  // (3.22) from the wedge's vectors at 500 bits.
+  std::vector<Scene> scenes = {{{1, 1, 1}, {3, 2, 0}, {-1, 0.3, 0.7}}, {{1, 2, 3}, {3, 2, 0}, {-1, 0.5, 1}},
+                               {{1, 1, 1}, {2, 1, -1}, {-1, 0, 1}}};
+  std::mt19937_64 rng(4404);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (int k = 0; k < 20; ++k) {
+    scenes.push_back({{1 + 30 * unit(rng), 1 + unit(rng), 1 + 30 * unit(rng)},
+                      {1 + unit(rng), 0, -1 - unit(rng)},
+                      {-unit(rng), 2 * unit(rng) - 1, unit(rng)}});
+  }
+  int values = 0;
+  for (const Scene& scene : scenes) {
+    const reference::Run run = reference::simulate(scene, 100);
+    if (run.impacts.size() > 64) continue;
+    const SceneRunResult result = runScene(planScene(scene), SceneRunOptions{});
+    ASSERT_EQ(result.simulation.impacts.size(), run.impacts.size()) << describe(scene);
+    const Q m_a(scene.masses[0]), m_b(scene.masses[1]), m_c(scene.masses[2]);
+    const Q vbar = (Q(scene.velocities[0]) + Q(scene.velocities[1])) / 2;
+    std::array<Q, 3> before{Q(scene.velocities[0]), Q(scene.velocities[1]), Q(scene.velocities[2])};
+    std::array<Q, 3> two_before = before;
+    for (std::size_t n = 0; n < run.impacts.size(); ++n) {
+      const ImpactModelValues& model = *result.simulation.impacts[n].model;
+      const auto printed = printedVelocitiesAt500Bits(scene, n + 1);
+      for (int i = 0; i < 3; ++i) {
+        EXPECT_TRUE(nearestTo(model.paper_velocities_after[i], printed[i]))
+            << describe(scene) << " impact " << n + 1 << " body " << i << ": " << model.paper_velocities_after[i];
+        ++values;
+      }
+      std::array<Q, 3> gained{0, 0, 0};
+      if (run.impacts[n].pair == Pair::AB) {  // (4.4), (4.5)
+        gained[0] = -4 * m_a * m_b * (before[0] - vbar) * (m_a * before[0] + m_b * before[1]) / ((m_a + m_b) * (m_a + m_b));
+        gained[1] = -gained[0];
+      } else if (n > 0) {  // (4.6), (4.7)
+        gained[2] = -4 * m_b * m_c / ((m_b + m_c) * (m_b + m_c)) * (two_before[0] - vbar + two_before[2] - vbar) / 2 *
+                    (m_b * before[1] + m_c * before[2]);
+        gained[1] = -gained[2];
+      }
+      for (int i = 0; i < 3; ++i) {
+        if (run.impacts[n].pair == Pair::BC && n == 0 && i > 0) continue;  // undefined as printed (NaN)
+        EXPECT_TRUE(correctlyRounded(model.paper_energy_transfer[i], gained[i]))
+            << describe(scene) << " impact " << n + 1 << " body " << i << ": " << model.paper_energy_transfer[i];
+      }
+      two_before = before;
+      before = run.impacts[n].velocities;
+    }
+    const Prediction& p = *result.prediction;
+    const PrintedAngles printed = printedAnglesAt500Bits(scene);
+    ASSERT_TRUE(p.phi_bc);
+    EXPECT_TRUE(nearestTo(*p.phi_bc, printed.phi_bc)) << describe(scene) << ": phi_BC " << *p.phi_bc;
+    const DeepPrecision& x = printed.count_argument;
+    ASSERT_TRUE(p.paper_impact_count);
+    EXPECT_EQ(*p.paper_impact_count, 1 + static_cast<std::int64_t>(floor(x)) + static_cast<std::int64_t>(ceil(x)))
+        << describe(scene);
+    EXPECT_TRUE(p.uncertified.empty()) << describe(scene);
+  }
+  EXPECT_GE(values, 150);
+  // A grazing start: (Omega - phi_BC) / theta is an integer j (to 500 bits here; the core
+  // decides it exactly), and eq. (3.22) gives 1 + 2 j.
+  const Scene grazing{{3, 1, 0.5}, {2, 1, 0}, {-1, 0, 0}};
+  const DeepPrecision x = printedAnglesAt500Bits(grazing).count_argument;
+  const DeepPrecision j = round(x);
+  ASSERT_LT(abs(x - j), 1e-140);
+  const Prediction p = predictionOf(grazing);
+  EXPECT_EQ(p.paper_impact_count, 1 + 2 * static_cast<std::int64_t>(j));
+  EXPECT_TRUE(p.uncertified.empty());
 }
 
 }  // namespace
