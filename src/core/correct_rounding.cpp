@@ -154,6 +154,32 @@ RoundedAngles roundedAngles(const std::array<double, 3>& m) {
   return angles;
 }
 
+long double cheapAtan2Sqrt(const ExactRational& y, const ExactRational& x, const ExactRational& scale) {
+  const long double x_size = std::sqrt(approximate(x * x * scale));
+  return std::atan2(approximate(y), x < 0 ? -x_size : x_size);
+}
+
+Certifying certifyingAtan2Sqrt(const ExactRational& y, const ExactRational& x, const ExactRational& scale) {
+  if (y == 0) return x < 0 ? boost::math::constants::pi<Certifying>() : Certifying(0);
+  const ExactRational x_sq = x * x * scale;
+  const Certifying x_size = sqrt(Certifying(numerator(x_sq)) / Certifying(denominator(x_sq)));
+  return atan2(Certifying(numerator(y)) / Certifying(denominator(y)), x < 0 ? Certifying(-x_size) : x_size);
+}
+
+Certifying atan2SqrtError() { return ldexp(Certifying(1), -298); }
+
+std::optional<double> roundedAtan2Sqrt(const ExactRational& y, const ExactRational& x, const ExactRational& scale,
+                                       bool from_zero) {
+  if (y == 0 && (x >= 0 || scale == 0)) return 0.0;  // exactly (atan2(0, 0) = 0)
+  // Shifted by 2 pi (a negative angle only, so in (pi, 2 pi)): the bounds hold relatively.
+  long double cheap = cheapAtan2Sqrt(y, x, scale);
+  if (from_zero && cheap < 0) cheap += 2 * 3.14159265358979323846264338327950288L;
+  if (const auto quick = quickNearest(cheap, 0x1p-57L)) return quick;
+  Certifying angle = certifyingAtan2Sqrt(y, x, scale);
+  if (from_zero && angle < 0) angle += 2 * boost::math::constants::pi<Certifying>();
+  return certifiedNearest(angle, atan2SqrtError());
+}
+
 double roundedSpiralAngle(const ExactRational& trace, const ExactRational& determinant) {
   using F = Certifying;
   // phi = atan2(sqrt(1 - y^2), y), y = T / (2 sqrt(det)), with 1 - y^2 exact: no cancellation

@@ -76,11 +76,6 @@ using Integer = boost::multiprecision::cpp_int;
 
 Certifying toCertifying(const Rational& q) { return Certifying(numerator(q)) / Certifying(denominator(q)); }
 
-/// A bound on the error of one of the angles below at 100 digits [rad]: a few roundings of
-/// 333 bits in its arguments (relative, to which atan2 is insensitive) and Boost's atan2
-/// within 2^-300 relative.
-Certifying angleError() { return ldexp(Certifying(1), -298); }
-
 /// The exact arguments of the printed angles of a scene without a wall. With u1 after the
 /// first AB impact, u1.n_BC and u1.l_BC of eq. (3.21) are, up to one positive factor,
 /// Y = v_B1 - v_C1 and X sqrt(m_A / (m_B m_C M)) with X = m_B v_B1 + m_C v_C1 - (m_B + m_C) v_A1;
@@ -95,35 +90,20 @@ struct PrintedAngleArguments {
     const Rational v_b1 = (2 * m_a * v_a + (m_b - m_a) * v_b) / m_ab;
     x = m_b * v_b1 + m_c * v_c - (m_b + m_c) * v_a1;
     y = v_b1 - v_c;
-    x_sq_scaled = x * x * m_a / (m_b * m_c * total);
+    x_scale = m_a / (m_b * m_c * total);
     const Rational q = m_a * m_c + m_b * total;
     omega_cos_sq = m_a * m_c / q;
     omega_sin_sq = m_b * total / q;
     theta_d = m_a * m_b * m_c * total;
     theta_a = m_a * m_c - m_b * total;
   }
-  Rational x, y, x_sq_scaled;          // X, Y and X^2 m_A / (m_B m_C M)
+  Rational x, y, x_scale;              // X, Y and m_A / (m_B m_C M): phi_BC = atan2(Y, X sqrt(x_scale))
   Rational omega_cos_sq, omega_sin_sq;
   Rational theta_d, theta_a;           // D and a
 };
 
 /// Long double with a 64-bit significand, where the cheap first step's bounds hold.
 constexpr bool kCheapStep = std::numeric_limits<long double>::digits >= 64;
-
-/// phi_BC in long double, within 2^-59 of it relatively: its arguments within 2^-61 each
-/// (atan2 moves by at most the relative error of its arguments times |sin 2 phi| / 2 <= |phi|),
-/// atan2l within 2 ulps. X = Y = 0 gives 0.
-long double cheapPhi(const PrintedAngleArguments& a) {
-  const long double x = std::sqrt(approximate(a.x_sq_scaled));
-  return std::atan2(approximate(a.y), a.x < 0 ? -x : x);
-}
-
-/// phi_BC at 100 digits, within 2^-298 (angleError); X = Y = 0 gives 0.
-Certifying certifyingPhi(const PrintedAngleArguments& a) {
-  if (a.y == 0) return a.x < 0 ? boost::math::constants::pi<Certifying>() : Certifying(0);
-  const Certifying x = sqrt(toCertifying(a.x_sq_scaled));
-  return atan2(toCertifying(a.y), a.x < 0 ? Certifying(-x) : x);
-}
 
 /// 1 + floor(x) + ceil(x) of eq. (3.22) when every value within `error` of x gives the same.
 std::optional<std::int64_t> decidedCount(const Certifying& x, const Certifying& error) {
@@ -258,12 +238,8 @@ std::array<double, 3> ExactPrintedClosedForm::velocitiesAfter(std::uint64_t n) {
 
 double phiBC(const Scene& scene, bool* certified) {
   if (wallIndex(scene) >= 0) return kNaN;  // as printed, s = (sqrt m_i) unscaled: inf / inf
-  const PrintedAngleArguments arguments(scene);
-  if (arguments.y == 0 && arguments.x >= 0) return 0.0;  // exactly (u1 = 0: atan2(0, 0))
-  if (kCheapStep) {
-    if (const auto quick = detail::quickNearest(cheapPhi(arguments), 0x1p-57L)) return *quick;
-  }
-  if (const auto rounded = detail::certifiedNearest(certifyingPhi(arguments), angleError())) return *rounded;
+  const PrintedAngleArguments a(scene);
+  if (const auto rounded = detail::roundedAtan2Sqrt(a.y, a.x, a.x_scale)) return *rounded;
   if (certified) *certified = false;
   return phiBCInDouble(scene);
 }
@@ -271,10 +247,10 @@ double phiBC(const Scene& scene, bool* certified) {
 std::optional<std::int64_t> impactCount(const Scene& scene, bool* certified) {
   if (wallIndex(scene) >= 0) return std::nullopt;  // phi_BC is inf / inf as printed
   const PrintedAngleArguments a(scene);
-  if (kCheapStep) {  // each angle within 2^-59 relatively (cheapPhi)
+  if (kCheapStep) {  // each angle within 2^-59 relatively (cheapAtan2Sqrt)
     const long double omega = std::atan2(std::sqrt(approximate(a.omega_sin_sq)), -std::sqrt(approximate(a.omega_cos_sq)));
     const long double theta = std::atan2(2 * std::sqrt(approximate(a.theta_d)), approximate(a.theta_a));
-    const long double phi = cheapPhi(a);
+    const long double phi = detail::cheapAtan2Sqrt(a.y, a.x, a.x_scale);
     const long double x = (omega - phi) / theta;
     const long double error = 0x1p-57L * ((omega + std::fabs(phi)) / theta + std::fabs(x));
     if (std::isfinite(x) && std::isfinite(error) && std::fabs(x) + error < 4e18L) {
@@ -283,8 +259,8 @@ std::optional<std::int64_t> impactCount(const Scene& scene, bool* certified) {
   }
   const Certifying omega = atan2(sqrt(toCertifying(a.omega_sin_sq)), -sqrt(toCertifying(a.omega_cos_sq)));
   const Certifying theta = atan2(2 * sqrt(toCertifying(a.theta_d)), toCertifying(a.theta_a));
-  const Certifying x = (omega - certifyingPhi(a)) / theta;
-  const Certifying error = 4 * angleError() / theta + abs(x) * 4 * angleError();
+  const Certifying x = (omega - detail::certifyingAtan2Sqrt(a.y, a.x, a.x_scale)) / theta;
+  const Certifying error = 4 * detail::atan2SqrtError() / theta + abs(x) * 4 * detail::atan2SqrtError();
   if (abs(x) + error > 4e18) return std::nullopt;  // as the double evaluation: beyond an int64
   if (const auto count = decidedCount(x, error)) return count;
   // Within the bound of an integer j (a grazing start): x = j exactly when the rotation by

@@ -610,6 +610,29 @@ std::array<double, 3> roundedVelocitiesAfter(const Scene& scene, std::uint64_t c
   return result;
 }
 
+/// psi (analytic.h: the angle of the start's u_perp from r_BC towards r_AB) correctly rounded
+/// [rad]: atan2(Y, X sqrt(scale)) with exact Y = v_B - v_C and, up to one positive factor,
+/// X and scale from the wedge's vectors: no wall X = (m_B + m_C) v_A - m_B v_B - m_C v_C,
+/// scale = m_A / (m_B m_C M); a wall A: X = -(m_B (v_B - v_A) + m_C (v_C - v_A)), scale =
+/// 1 / (m_B m_C); a wall C: X = v_A - v_C, scale = m_A / m_B; in [0, 2 pi). Empty where it
+/// is not certified.
+std::optional<double> roundedPsi(const Scene& scene) {
+  using R = detail::ExactRational;
+  if (scene.isWall(kA) && scene.isWall(kC)) return std::nullopt;
+  const R v_a(scene.velocities[kA]), v_b(scene.velocities[kB]), v_c(scene.velocities[kC]);
+  const R m_b(scene.masses[kB]);
+  const R y = v_b - v_c;
+  if (scene.isWall(kA)) {
+    const R m_c(scene.masses[kC]);
+    return detail::roundedAtan2Sqrt(y, -(m_b * (v_b - v_a) + m_c * (v_c - v_a)), 1 / (m_b * m_c), true);
+  }
+  const R m_a(scene.masses[kA]);
+  if (scene.isWall(kC)) return detail::roundedAtan2Sqrt(y, v_a - v_c, m_a / m_b, true);
+  const R m_c(scene.masses[kC]);
+  return detail::roundedAtan2Sqrt(y, (m_b + m_c) * v_a - m_b * v_b - m_c * v_c, m_a / (m_b * m_c * (m_a + m_b + m_c)),
+                                  true);
+}
+
 }  // namespace
 
 void fillRotationPrediction(const Scene& scene, Prediction& prediction) {
@@ -635,7 +658,12 @@ void fillRotationPrediction(const Scene& scene, Prediction& prediction) {
   prediction.omega = angles.omega;
   prediction.phi_bc = paper::phiBC(scene, &paper_certified);
   if (!paper_certified) prediction.uncertified.push_back("phi_bc");
-  prediction.psi = model.psi();
+  if (const std::optional<double> psi = roundedPsi(scene)) {
+    prediction.psi = *psi;
+  } else {
+    prediction.psi = model.psi();
+    prediction.uncertified.push_back("psi");
+  }
   if (const std::optional<Pair> first = firstPair(scene)) prediction.first_pair_index = static_cast<std::size_t>(pairIndex(*first));
 }
 

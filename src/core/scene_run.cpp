@@ -199,12 +199,18 @@ SceneSimulation simulateScene(const Scene& scene, const SceneRunOptions& options
     // which the model rounded once (the engine's double-double ones can be ulps off). Only
     // values within a few ulps of the engine's are taken: a larger difference is a fault,
     // and the engine's values then stand beside the model's for all to see.
+    const auto certify = [&simulation](const std::string& key) {
+      auto& keys = simulation.uncertified;
+      keys.erase(std::remove(keys.begin(), keys.end(), key), keys.end());
+    };
     if (!isUncertified(*prediction, "predicted_final_velocities") &&
         withinUlps(simulation.final_velocities, prediction->final_velocities)) {
       simulation.final_velocities = prediction->final_velocities;
+      certify("final_velocities");
     }
     if (!isUncertified(*prediction, "energy_lost") && withinUlps({simulation.energy_lost}, {prediction->energy_lost})) {
       simulation.energy_lost = prediction->energy_lost;
+      certify("energy_lost");
     }
   }
   return simulation;
@@ -223,6 +229,14 @@ ScenePlan planScene(Scene scene) {
   plan.scene = std::move(scene);
   plan.plan_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return plan;
+}
+
+std::vector<std::string> uncertifiedValues(const SceneRunResult& result) {
+  std::vector<std::string> keys = result.prediction ? result.prediction->uncertified : std::vector<std::string>{};
+  for (const std::string& key : result.simulation.uncertified) {
+    if (std::find(keys.begin(), keys.end(), key) == keys.end()) keys.push_back(key);
+  }
+  return keys;
 }
 
 SceneRunResult runScene(const ScenePlan& plan, const SceneRunOptions& options, const SceneVisitors& visitors) {

@@ -620,7 +620,7 @@ Json summaryJson(const core::SceneRunResult& result) {
               {"psi", number(p.psi.value_or(0.0))},
               {"paper_phi_bc", number(p.phi_bc.value_or(0.0))},
               {"max_prediction_error", number(s.max_prediction_error)},
-              {"uncertified_values", p.uncertified},
+              {"uncertified_values", core::uncertifiedValues(result)},
               {"energy_relative_drift", number(s.energy_relative_drift)},
               {"momentum_relative_drift", number(s.momentum_relative_drift)},
               {"compute_time_s", number(summary.compute_time_s)},

@@ -52,7 +52,7 @@ EventRecord SceneEventState::impact(const core::ImpactRecord& impact) {
   for (std::size_t side = 0; side < 2; ++side) {
     r.pair_velocities_before[side] = impact.velocities_before[side];
     r.pair_velocities_after[side] = impact.velocities_after[side];
-    r.pair_energy_transfer[side] = scene_.isWall(side == 0 ? p : left) ? 0.0 : impact.energy_gained[side];
+    r.pair_energy_transfer[side] = impact.energy_gained[side];  // a wall's: minus the other's gain and the heat
   }
   r.energy_lost = impact.energy_lost;
   replay_.apply(impact);
@@ -434,7 +434,7 @@ Json summaryScalars(const core::SceneRunResult& result) {
   json["rule_elastic_impacts"] = s.rule_elastic_impacts;
   json["critical_restitution"] = p && p->critical_restitution ? number(*p->critical_restitution) : Json(nullptr);
   json["spiral_angle"] = p && p->spiral_angle ? number(*p->spiral_angle) : Json(nullptr);
-  json["uncertified_values"] = p ? Json(p->uncertified) : Json::array();
+  json["uncertified_values"] = core::uncertifiedValues(result);
   json["multiple_collision"] = nullptr;
   if (s.multiple_collision) {
     const std::size_t b = s.multiple_collision->first_body;

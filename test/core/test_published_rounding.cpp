@@ -5,6 +5,7 @@
 // the spiral: nbody/test_published_rounding_nbody.cpp.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <vector>
@@ -212,6 +213,30 @@ std::array<DeepPrecision, 3> printedVelocitiesAt500Bits(const Scene& scene, std:
   const D y = (-half_ba - c * (vbar - v_c)) * sin(angle) - d * (vbar - v_c) * cos(angle);
   if (n % 2 == 0) return {x / d + vbar, -x / d + vbar, y / d + vbar};
   return {(m_a - 3 * m_b) * x / (d * m_ab) + vbar, (m_b - 3 * m_a) * x / (d * m_ab) + vbar, y / d + vbar};
+}
+
+TEST(PublishedRounding, PsiIsCorrectlyRounded) {
+  // psi against the rotation model at 500 bits (its wedge vectors, atan2), with and without
+  // a wall, the three-body presets among them.
+  std::vector<Scene> scenes = {{{1, 1, 1}, {2, 1, -1}, {-1, 0, 1}}, {{100, 1, kInf}, {2, 1, 0}, {-1, 0, 0}},
+                               {{kInf, 10, 1}, {3, 2, 0}, {-0.5, -1, 0}}, {{2, 1, 3}, {2, 1, 0}, {-1, 0, 0}}};
+  std::mt19937_64 rng(4406);
+  std::uniform_real_distribution<double> decade(-8.0, 8.0), unit(0.0, 1.0);
+  for (int k = 0; k < 60; ++k) {
+    Scene scene{{std::pow(10.0, decade(rng)), std::pow(10.0, decade(rng)), std::pow(10.0, decade(rng))},
+                {2, 1, 0},
+                {-unit(rng), 2 * unit(rng) - 1, unit(rng)}};
+    if (k % 4 == 1) scene.masses[0] = kInf, scene.velocities[0] = unit(rng) - 0.5;
+    if (k % 4 == 3) scene.masses[2] = kInf, scene.velocities[2] = unit(rng) - 0.5;
+    scenes.push_back(scene);
+  }
+  for (const Scene& scene : scenes) {
+    const Prediction p = predictionOf(scene);
+    ASSERT_TRUE(p.psi) << describe(scene);
+    const DeepPrecision psi = AnalyticModel<DeepPrecision>(scene).psi();
+    EXPECT_TRUE(nearestTo(*p.psi, psi)) << describe(scene) << ": psi " << *p.psi << " against " << psi.str(20);
+    EXPECT_TRUE(std::find(p.uncertified.begin(), p.uncertified.end(), "psi") == p.uncertified.end());
+  }
 }
 
 struct PrintedAngles {

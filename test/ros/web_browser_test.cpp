@@ -15,6 +15,7 @@
 #include <sstream>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -249,6 +250,32 @@ TEST_F(RunPageViewTest, PredictOnlyRunDrawsNoEmptyChart) {
   const std::string dom = finalPage({{"student", "view"}, {"preset", "pi_digits_2"}, {"mode", 1}});
   EXPECT_NE(dom.find("data-plots-hidden=\"velocity energy xt\""), std::string::npos) << dom.substr(0, 2000);
   EXPECT_NE(dom.find("answered: 31 collisions"), std::string::npos);
+}
+
+/// The cells of the summary table's row `label`: simulation, prediction, paper (as fmt drew them).
+std::vector<std::string> summaryCells(const std::string& dom, const std::string& label) {
+  std::smatch m;
+  const std::string escaped = std::regex_replace(label, std::regex(R"([\[\]])"), R"(\$&)");
+  if (!std::regex_search(dom, m, std::regex("<th>" + escaped + "</th><td>([^<]*)</td><td>([^<]*)</td><td>([^<]*)</td>"))) {
+    return {};
+  }
+  return {m[1].str(), m[2].str(), m[3].str()};
+}
+
+// The first preset a class opens: the model's B ends exactly at rest, as the simulation's
+// does (it showed -3.33×10⁻¹⁶ m/s, the closed form's rounding in double), and the largest
+// prediction error is 0.
+TEST_F(RunPageViewTest, EqualMassesShowsTheModelsBExactlyAtRest) {
+  const std::string dom = finalPage({{"student", "view"}, {"preset", "equal_masses"}});
+  const std::vector<std::string> b = summaryCells(dom, "final v B [m/s]");
+  ASSERT_EQ(b.size(), 3u) << dom.substr(0, 3000);
+  EXPECT_EQ(b[0], "0");  // simulated
+  EXPECT_EQ(b[1], "0");  // the model's
+  EXPECT_EQ(summaryCells(dom, "final v A [m/s]").at(1), "1");
+  EXPECT_EQ(summaryCells(dom, "final v C [m/s]").at(1), "-1");
+  const std::vector<std::string> error = summaryCells(dom, "max prediction error (ratio)");
+  ASSERT_EQ(error.size(), 3u);
+  EXPECT_EQ(error[0], "0");
 }
 
 TEST_F(RunPageViewTest, CollapseIsNamed) {

@@ -75,6 +75,10 @@ struct SceneRunResult {
   double compute_time_s = 0.0;             ///< wall time of planning and simulation [s]
 };
 
+/// The keys of the result's published values that are not certified correctly rounded: the
+/// prediction's and the simulation's, in that order, each once.
+std::vector<std::string> uncertifiedValues(const SceneRunResult& result);
+
 /// A scene's plan, computed once by planScene: its one validation, the model that answers
 /// it and that model's prediction. runScene and everything after it (the CLI's report, the
 /// node's publication, record and markers) take the plan: nothing validates, chooses a

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "collision_lab/core/count_text.h"
+#include "../correct_rounding.h"
 #include "elastic_triple.h"
 #include "fma_path.h"
 #include "tier.h"
@@ -35,6 +36,11 @@ SceneTables::SceneTables(const Scene& s) : scene(s), pairs(s.contactCount()), ri
 }
 
 namespace {
+
+/// Runs of up to this many impacts whose final velocities the working tier's bound does not
+/// certify replay at 100 digits to certify them (about 5 us per impact); longer ones name
+/// them uncertified.
+constexpr std::uint64_t kCertifyingReplay = 10'000;
 
 template <class S>
 struct NextTier;
@@ -123,6 +129,62 @@ class Driver {
     return exact_->nextTimeLowerBound();
   }
 
+  /// Every body's velocity after the working tier's last impact [working units], correctly
+  /// rounded where it can be certified: by the working tier's bound; where that does not
+  /// decide and `replay` allows, by the 100-digit tier brought to the same count (a replay of
+  /// the run, its bound 2^-300 or so), then by the exact tier (within its work budget). Empty
+  /// where none decides.
+  std::vector<std::optional<double>> certifiedVelocities(bool replay) {
+    const std::size_t n = tables_.scene.masses.size();
+    std::vector<std::optional<double>> velocities(n);
+    const auto missing = [&velocities] {
+      return std::any_of(velocities.begin(), velocities.end(), [](const auto& v) { return !v; });
+    };
+    for (std::size_t k = 0; k < n; ++k) velocities[k] = fast_->certifiedVelocity(k);
+    if (!missing() || !replay) return velocities;
+    const std::uint64_t count = fast_->count();
+    if (advanceTo<Float100>(count).kind == StepKind::kImpact) {
+      for (std::size_t k = 0; k < n; ++k) {
+        if (!velocities[k]) velocities[k] = high_->certifiedVelocity(k);
+      }
+    }
+    if (missing() && advanceTo<Rational>(count).kind == StepKind::kImpact) {  // an exact zero or tie
+      for (std::size_t k = 0; k < n; ++k) {
+        if (!velocities[k]) velocities[k] = detail::nearestDouble(exact_->velocityValue(k));
+      }
+    }
+    return velocities;
+  }
+
+  /// The heat of the run so far [working units], correctly rounded where it can be
+  /// certified: the kinetic energy lost, E_0 - E, in the walls' frame (where the walls do no
+  /// work: at most one wall velocity), from the working tier's velocities and bound, else
+  /// (with `replay`) the 100-digit tier's, else the exact tier's. Empty where none decides,
+  /// or with two walls moving apart.
+  std::optional<double> certifiedHeat(bool replay) {
+    const Scene& scene = tables_.scene;
+    std::optional<double> frame;
+    for (std::size_t k = 0; k < scene.size(); ++k) {
+      if (!scene.isWall(k)) continue;
+      if (frame && *frame != scene.velocities[k]) return std::nullopt;
+      frame = scene.velocities[k];
+    }
+    const double f = frame.value_or(0.0);
+    if (const auto heat = heatFrom(*fast_, f)) return heat;
+    if (!replay) return std::nullopt;
+    const std::uint64_t count = fast_->count();
+    if (advanceTo<Float100>(count).kind != StepKind::kImpact) return std::nullopt;
+    if (const auto heat = heatFrom(*high_, f)) return heat;
+    if (advanceTo<Rational>(count).kind != StepKind::kImpact) return std::nullopt;
+    Rational heat = 0;
+    for (std::size_t k = 0; k < scene.size(); ++k) {
+      if (scene.isWall(k)) continue;
+      const Rational v0 = Rational(scene.velocities[k]) - Rational(f), v = exact_->velocityValue(k) - Rational(f);
+      heat += Rational(scene.masses[k]) * (v0 * v0 - v * v) / 2;
+    }
+    return detail::nearestDouble(heat);
+  }
+
   /// After the impact of `pair`: when two pairs have alternated for 8 impacts, asks the
   /// working tier whether their three clusters collapse, and resolves a collapse in every
   /// tier (each applies it when it reaches this impact count, replays included).
@@ -142,6 +204,36 @@ class Driver {
   }
 
  private:
+  /// x at 100 digits, exactly (a double-double's two parts fit its significand).
+  template <class S>
+  static Float100 exactlyWide(const S& x) {
+    if constexpr (std::is_same_v<S, Float100>) {
+      return x;
+    } else {
+      return Float100(x.hi) + Float100(x.lo);
+    }
+  }
+
+  /// E_0 - E in the frame moving at `frame` [working units] from tier t's velocities and its
+  /// bound on them (t inexact), at 100 digits, when the bound certifies its rounding.
+  template <class S>
+  std::optional<double> heatFrom(const Tier<S>& t, double frame) const {
+    const Scene& scene = tables_.scene;
+    Float100 initial = 0, now = 0, error = 0;
+    for (std::size_t k = 0; k < scene.size(); ++k) {
+      if (scene.isWall(k)) continue;
+      const Float100 m(scene.masses[k]);
+      const Float100 v0 = Float100(scene.velocities[k]) - frame;
+      const Float100 v = exactlyWide(t.velocityValue(k)) - frame;
+      const Float100 e(t.velocityBound(k));
+      initial += m * v0 * v0 / 2;
+      now += m * v * v / 2;
+      error += m * (abs(v) * e + e * e / 2);
+    }
+    error += (initial + now) * ldexp(Float100(1), -300);
+    return detail::certifiedNearest(initial - now, error);
+  }
+
   /// When the exact tier has taken every one of the last kGroupStreak impacts (an
   /// accumulation) and they repeat a pattern of period 3 or more, asks it whether the group
   /// collapses (every 8th impact: each try costs a few exact matrix products).
@@ -660,6 +752,22 @@ SceneSimulation runEngineOn(const Scene& si_scene, const EngineOptions& options,
   result.rule_elastic_impacts = driver.fast().ruleElastic();
   driver.fast().state(result.final_time, result.final_positions, result.final_velocities);
   result.energy_lost = driver.fast().energyLost();
+  // The final velocities certified once per run (a replay only for runs of up to
+  // kCertifyingReplay impacts); a velocity none certifies keeps the working tier's value.
+  const std::vector<std::optional<double>> certified = driver.certifiedVelocities(count <= kCertifyingReplay);
+  bool all_certified = true;
+  for (std::size_t k = 0; k < certified.size(); ++k) {
+    if (certified[k]) result.final_velocities[k] = *certified[k];
+    all_certified = all_certified && certified[k].has_value();
+  }
+  if (!all_certified) result.uncertified.push_back("final_velocities");
+  if (result.energy_lost != 0.0) {  // an inelastic impact (elastic ones lose exactly 0)
+    if (const auto heat = driver.certifiedHeat(count <= kCertifyingReplay)) {
+      result.energy_lost = *heat;
+    } else {
+      result.uncertified.push_back("energy_lost");
+    }
+  }
   result.escalations = driver.escalations();
   fillDrift(scene, result);  // relative: the same in any units
   // Back to SI.

@@ -475,6 +475,34 @@ class CL_NBODY_INTERNAL Tier {
   /// Velocity of body k [m/s], rounded to double.
   double velocity(std::size_t k) const { return Ar::toDouble(bodies_[k].v); }
 
+  /// Velocity of body k [m/s] in this tier's number type (exact in the exact tier).
+  const S& velocityValue(std::size_t k) const { return bodies_[k].v; }
+
+  /// Velocity of body k [m/s] correctly rounded, when every value within this tier's bound of
+  /// it (eu_ / sqrt(m_k), widened by the rounding of forming the ends) rounds to the same
+  /// normal double; a wall's, which never changes, always. Empty otherwise, and in the exact
+  /// tier (whose caller rounds the exact value).
+  std::optional<double> certifiedVelocity(std::size_t k) const {
+    if (tables_.scene.isWall(k)) return velocity(k);
+    if constexpr (Ar::kExact) {
+      return std::nullopt;
+    } else {
+      const S& v = bodies_[k].v;
+      const double bound = velocityBound(k);
+      const double low = Ar::toDouble(S(v - S(bound))), high = Ar::toDouble(S(v + S(bound)));
+      if (low != high || !(std::fabs(low) >= std::numeric_limits<double>::min())) return std::nullopt;
+      return low;
+    }
+  }
+
+  /// A bound on |velocityValue(k) - the exact velocity of body k| [m/s] (finite k; 0 in the
+  /// exact tier), widened by the rounding of using it.
+  double velocityBound(std::size_t k) const {
+    if constexpr (Ar::kExact) return 0.0;
+    const double size = std::fabs(Ar::toDouble(bodies_[k].v));
+    return (eu_ / tables_.sqrt_mass[k] + 4 * Ar::kOpError * size) * kSlack + kTiny;
+  }
+
   /// Positions [m] at time t [s] and velocities [m/s], rounded to double.
   void state(double t, std::vector<double>& positions, std::vector<double>& velocities) const {
     positions.resize(bodies_.size());

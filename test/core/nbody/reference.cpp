@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 
 namespace collision_lab {
@@ -17,7 +18,46 @@ struct State {
   std::vector<Rational> x, v;
   std::vector<bool> stuck;  // per pair: stuck together by e = 0 (one cluster)
   Rational now;
+  std::vector<std::optional<Rational>> last_impact;  // per body, for the TC model [s]
 };
+
+/// The double nearest q (ties to even), found by exact comparison with its neighbours.
+double nearest(const Rational& q) {
+  double d = static_cast<double>(q);
+  for (int step = 0; step < 4; ++step) {
+    const double up = std::nextafter(d, INFINITY), down = std::nextafter(d, -INFINITY);
+    if (abs(Rational(up) - q) < abs(Rational(d) - q)) d = up;
+    else if (abs(Rational(down) - q) < abs(Rational(d) - q)) d = down;
+  }
+  for (const double other : {std::nextafter(d, INFINITY), std::nextafter(d, -INFINITY)}) {
+    std::uint64_t bits;
+    std::memcpy(&bits, &d, sizeof bits);
+    if (abs(Rational(other) - q) == abs(Rational(d) - q) && (bits & 1)) d = other;
+  }
+  return d;
+}
+
+/// The restitution of an impact of pair p at approach speed `approach` (> 0), by the scene's
+/// model (physics.md, "Restitution models"): the pair's e, or 1 where the model says elastic.
+Rational restitutionOf(const Scene& scene, const State& s, std::size_t p, const Rational& approach) {
+  const RestitutionModel& model = scene.restitution_model;
+  switch (model.kind) {
+    case RestitutionModelKind::kConstant: return s.e[p];
+    case RestitutionModelKind::kThreshold: return approach < Rational(model.elastic_below) ? Rational(1) : s.e[p];
+    case RestitutionModelKind::kTc:
+      for (const std::size_t k : {p, p + 1}) {  // a body that has not collided waited forever
+        if (!s.wall[k] && s.last_impact[k] && !(s.now - *s.last_impact[k] > Rational(model.tc))) return 1;
+      }
+      return s.e[p];
+    case RestitutionModelKind::kViscoelastic: {
+      // e(v) = 1 - C1 s + C2 s^2, s = (v / v*)^(1/5), in double at the speed rounded to the
+      // nearest double, clamped to [0, 1].
+      const double root = std::pow(nearest(approach) / model.viscoelastic_speed, 0.2);
+      return Rational(std::min(1.0, std::max(0.0, 1.0 - 1.15344 * root + 0.79826 * root * root)));
+    }
+  }
+  return s.e[p];
+}
 
 State initial(const Scene& scene) {
   State s;
@@ -34,6 +74,7 @@ State initial(const Scene& scene) {
     s.e.emplace_back(e);
   }
   s.stuck.assign(n - 1, false);
+  s.last_impact.assign(n, std::nullopt);
   return s;
 }
 
@@ -50,7 +91,7 @@ std::pair<std::size_t, std::size_t> clusterOf(const State& s, std::size_t body) 
 /// physics.md: v_i' = V - e m_j (v_i - v_j)/M, v_j' = V + e m_i (v_i - v_j)/M; against a
 /// wall i: v_j' = v_i - e (v_j - v_i). A stuck cluster (e = 0 earlier) takes part as one body
 /// of its total mass (a wall in it makes it a wall); e = 0 sticks the two sides.
-Rational collide(State& s, std::size_t p) {
+Rational collide(const Scene& scene, State& s, std::size_t p) {
   const auto [first, p_last] = clusterOf(s, p);
   const auto [p_first, last] = clusterOf(s, p + 1);
   (void)p_last, (void)p_first;
@@ -62,7 +103,7 @@ Rational collide(State& s, std::size_t p) {
   }
   const Rational v_i = s.v[p], v_j = s.v[p + 1];
   const Rational relative = v_i - v_j;
-  const Rational& e = s.e[p];
+  const Rational e = restitutionOf(scene, s, p, v_j - v_i);
   Rational lost = 0, after_i = v_i, after_j = v_j;
   if (wall_i) {
     lost = (1 - e * e) * mass_j * relative * relative / 2;
@@ -79,6 +120,7 @@ Rational collide(State& s, std::size_t p) {
   }
   for (std::size_t k = first; k <= last; ++k) s.v[k] = k <= p ? after_i : after_j;
   if (e == 0) s.stuck[p] = true;
+  s.last_impact[p] = s.last_impact[p + 1] = s.now;
   return lost;
 }
 
@@ -118,7 +160,7 @@ Run simulate(const Scene& scene, std::uint64_t max_impacts) {
     s.now += *soonest;
     const std::size_t p = tied.front();
     const State before = s;
-    const Rational lost = collide(s, p);
+    const Rational lost = collide(scene, s, p);
     // A neighbour that now approaches at zero gap hits in the same instant: the two impacts
     // form one multiple collision, which does not happen (the state stays as before it).
     const std::size_t outer_first = clusterOf(s, p).first, outer_last = clusterOf(s, p + 1).second;

@@ -1,7 +1,8 @@
 // Exact N-body reference for the tests: cpp_rational positions and velocities, advanced
 // event by event with a plain O(N) scan for the next contact. Written from physics.md
 // independently of the engine (no shared code, a different state: positions at the
-// current time instead of line intercepts, the centre-of-mass form of the impact rule).
+// current time instead of line intercepts, the centre-of-mass form of the impact rule), each
+// impact's e chosen by the scene's restitution model as physics.md states it.
 // Bodies stuck by e = 0 are hit as one body of their total mass (engine.h, the cluster
 // rule). An inelastic collapse is not resolved: the reference steps through its impacts
 // until the cap, and its impact times approach the collapse time.

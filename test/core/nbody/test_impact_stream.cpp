@@ -78,12 +78,12 @@ TEST(ImpactStream, ClusterImpactMovesBothWholeClustersAndTheCollapseIsNotified) 
   }
 }
 
-TEST(ImpactStream, ReplayOfRecordsAndNoticesGivesTheFinalVelocitiesExactly) {
+TEST(ImpactStream, ReplayOfRecordsAndNoticesGivesTheFinalVelocities) {
   std::mt19937_64 rng(1212);
   std::uniform_int_distribution<std::size_t> size(3, 5);
   std::uniform_int_distribution<int> pick(0, 4);
   const double restitutions[] = {0.0, 0.0, 0.05, 0.06, 0.5};
-  std::uint64_t collapses = 0, cluster_impacts = 0, runs = 0;
+  std::uint64_t collapses = 0, cluster_impacts = 0, runs = 0, corrected = 0;
   for (int scene_index = 0; scene_index < 300; ++scene_index) {
     testing_support::SceneMix mix;
     mix.mass_decades = scene_index % 2 == 0 ? 0.0 : 0.5;  // half equal masses: collapses are frequent
@@ -97,7 +97,16 @@ TEST(ImpactStream, ReplayOfRecordsAndNoticesGivesTheFinalVelocitiesExactly) {
     ASSERT_EQ(replay.impacts, run.impact_count) << "scene " << scene_index;
     ASSERT_EQ(replay.collapses, run.collapses.size()) << "scene " << scene_index;
     EXPECT_EQ(replay.cluster_impacts, run.cluster_impacts) << "scene " << scene_index;
-    EXPECT_EQ(replay.velocities, run.final_velocities) << "scene " << scene_index << ": " << run.stop_message;
+    // The stream carries the working tier's values; the summary's are certified (runEngine),
+    // the same but where the certificate corrected the working value's last bits.
+    ASSERT_EQ(replay.velocities.size(), run.final_velocities.size());
+    for (std::size_t k = 0; k < run.final_velocities.size(); ++k) {
+      const double published = run.final_velocities[k], streamed = replay.velocities[k];
+      if (published == streamed) continue;
+      ++corrected;
+      const double ulp = std::nextafter(std::fabs(published), INFINITY) - std::fabs(published);
+      EXPECT_LE(std::fabs(published - streamed), 4 * ulp) << "scene " << scene_index << " body " << k;
+    }
     collapses += replay.collapses;
     cluster_impacts += replay.cluster_impacts;
   }
@@ -105,8 +114,10 @@ TEST(ImpactStream, ReplayOfRecordsAndNoticesGivesTheFinalVelocitiesExactly) {
   EXPECT_GT(runs, 250u);
   EXPECT_GT(collapses, 10u);
   EXPECT_GT(cluster_impacts, 200u);
-  std::printf("replayed %lu runs: %lu collapses, %lu cluster impacts\n", static_cast<unsigned long>(runs),
-              static_cast<unsigned long>(collapses), static_cast<unsigned long>(cluster_impacts));
+  EXPECT_LE(corrected, 8u);  // 4 with seed 1212
+  std::printf("replayed %lu runs: %lu collapses, %lu cluster impacts, %lu final velocities corrected by the certificate\n",
+              static_cast<unsigned long>(runs), static_cast<unsigned long>(collapses),
+              static_cast<unsigned long>(cluster_impacts), static_cast<unsigned long>(corrected));
 }
 
 TEST(ImpactStream, AnUnresolvedAccumulationEndsAtTheExactnessCapInsteadOfRunningOn) {

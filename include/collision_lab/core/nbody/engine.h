@@ -201,6 +201,10 @@ struct SceneSimulation {
   /// |p_end - p_0| / sum |m v_0| over the finite masses; NaN with a wall (not conserved), or
   /// when not simulated.
   double momentum_relative_drift = 0.0;
+  /// The run's published values that are not certified correctly rounded, by their summary
+  /// keys (e.g. "final_velocities"); empty when every one is (physics.md, "How close the
+  /// published values are").
+  std::vector<std::string> uncertified;
   /// How often the engine left its working precision; zero when not simulated.
   Escalations escalations;
   /// An inelastic collapse was resolved (simulated) or is predicted (closed form alone):

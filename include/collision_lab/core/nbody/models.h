@@ -97,11 +97,10 @@ struct Prediction {
   /// The pair p (bodies p and p + 1) that meets first, decided exactly; empty when no pair
   /// approaches or the model does not say.
   std::optional<std::size_t> first_pair_index;
-  /// Every value above is the correctly rounded exact value of what it names, except psi and
-  /// the paper's printed values (phi_bc, paper_impact_count: evaluated in double as printed;
-  /// not yet certified) and those named here (by their summary key, e.g.
-  /// "predicted_final_velocities"), which no certificate within the model's work budget
-  /// could decide; they are within a few ulps.
+  /// Every value above is the correctly rounded exact value of what it names (the paper's
+  /// phi_bc and paper_impact_count the exact values of the formulas as printed), except those
+  /// named here (by their summary key, e.g. "predicted_final_velocities"), which no
+  /// certificate within the model's work budget could decide; they are within a few ulps.
   std::vector<std::string> uncertified;
 };
 
