@@ -273,7 +273,7 @@ collision_lab::RunSummary summaryFromRow(const collision_lab::service::IndexedRu
   s.recording_ok = !row.bag_path.empty();
   const json fields = json::parse(row.summary_json, nullptr, false);
   if (fields.is_object()) {
-    s.model_name = fields.value("model_name", s.model_name);
+    s.model_name = fields.value("model", s.model_name);  // the key collision_lab_ros::summaryJson writes
     s.model_reason = fields.value("model_reason", s.model_reason);
     s.truncated = fields.value("truncated", false);
     s.truncation_reason = fields.value("truncation_reason", s.truncation_reason);

@@ -27,6 +27,7 @@
 #include "collision_lab/ros/msg_conversion.h"
 #include "collision_lab/ros/run_view.h"
 #include "collision_lab/web/run_book.h"
+#include "collision_lab/ros/run_index_recorder.h"
 
 namespace {
 
@@ -264,7 +265,7 @@ IndexedRun rowOf(const ScriptedRun& run, RunState state) {
   if (state == RunState::kFinished) {
     row.stop_reason = run.summary.stop_reason;
     row.collision_count = run.summary.collision_count;
-    row.summary_json = json({{"model_name", run.summary.model_name}}).dump();
+    row.summary_json = collision_lab_ros::summaryJson(run.summary);  // as the lab node writes it
   }
   if (state == RunState::kInterrupted) row.stop_reason = "INTERRUPTED";
   row.bag_path = run.summary.bag_path;
@@ -525,7 +526,7 @@ TEST(RunBookMemory, RestartedWebNodeServesTheIndexsRuns) {
       if (k == 30) {
         index.interrupted(row.run_id, row.accepted_at + 1, "", 25, run.summary.bag_path);
       } else {
-        index.finished(row.run_id, row.accepted_at + 1, json({{"model_name", "scripted"}}).dump(), "NO_MORE_COLLISIONS",
+        index.finished(row.run_id, row.accepted_at + 1, collision_lab_ros::summaryJson(run.summary), "NO_MORE_COLLISIONS",
                        25, run.summary.bag_path);
       }
     }
@@ -535,6 +536,7 @@ TEST(RunBookMemory, RestartedWebNodeServesTheIndexsRuns) {
   ASSERT_EQ(list.size(), 30u);
   EXPECT_EQ(list[0].at("run_id"), "run1");
   EXPECT_EQ(list[0].at("state"), "finished");
+  EXPECT_EQ(list[0].at("model"), "scripted");  // read back from the index as the node wrote it
   EXPECT_EQ(list[29].at("state"), "interrupted");
   EXPECT_EQ(json::parse(book.list(std::string("s1"))).size(), 6u);
   EXPECT_EQ(book.residentRuns(), 0u);

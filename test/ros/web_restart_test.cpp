@@ -25,6 +25,7 @@
 #include "collision_lab/InitialConditions.h"
 #include "collision_lab/RunSummary.h"
 #include "collision_lab/service/run_index.h"
+#include "collision_lab/ros/run_index_recorder.h"
 
 namespace {
 
@@ -104,6 +105,7 @@ void writeDay(const std::filesystem::path& dir) {
     summary.collision_count = 1;
     summary.published_events = 1;
     summary.stop_reason = "NO_MORE_COLLISIONS";
+    summary.model_name = "two_body";
     summary.recording_ok = true;
     summary.bag_path = bag_path;
     const bool interrupted = k == kRuns;
@@ -127,8 +129,8 @@ void writeDay(const std::filesystem::path& dir) {
     if (interrupted) {
       index.interrupted(run_id, row.accepted_at + 0.2, "", 1, bag_path);
     } else {
-      index.finished(run_id, row.accepted_at + 0.2, json({{"model_name", "two bodies"}}).dump(), summary.stop_reason,
-                     1, bag_path);
+      index.finished(run_id, row.accepted_at + 0.2, collision_lab_ros::summaryJson(summary), summary.stop_reason, 1,
+                     bag_path);  // as the lab node writes it
     }
   }
 }
@@ -142,6 +144,7 @@ void expectEveryRunServed(const std::pair<std::string, int>& address) {
   const json runs = json::parse(list->body);
   ASSERT_EQ(runs.size(), static_cast<std::size_t>(kRuns)) << "every run of the day is listed";
   EXPECT_EQ(runs[0].at("run_id"), "s1.run1");
+  EXPECT_EQ(runs[0].at("model"), "two_body") << "the model, read back from the index";
   EXPECT_EQ(runs[kRuns - 1].at("state"), "interrupted");
   auto page = c.Get("/runs/s3.run3");
   ASSERT_TRUE(page);
