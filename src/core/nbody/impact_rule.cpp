@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "double_double.h"
+#include "viscoelastic.h"
 
 namespace collision_lab {
 namespace core {
@@ -17,11 +19,118 @@ double impactEnergyLost(double m_i, double m_j, double approach, double e) {
   return 0.5 * (1.0 - e) * (1.0 + e) * mu * approach * approach;
 }
 
+namespace nbody_detail {
+
+namespace {
+
+/// The double of a value known to lie in [low, high] (low <= 1 + a little): e = min(1, f);
+/// anything from 1 - 2^-54 up rounds to 1.
+template <class F>
+std::optional<double> roundedIn(const F& low, const F& high) {
+  if (low >= F(1) - F(0x1p-54)) return 1.0;
+  const double a = static_cast<double>(low), b = static_cast<double>(high < F(1) ? high : F(1));
+  if (a != b) return std::nullopt;
+  return a;
+}
+
+/// e near v (known within `error`) in the multiprecision type F, relative precision `unit`
+/// of its arithmetic (several roundings and pow included).
+template <class F>
+std::optional<double> viscoelasticIn(const F& v, const F& error, double v_star, const F& unit) {
+  const F c1 = F(115344) / 100000, c2 = F(79826) / 100000;
+  const F x = v / F(v_star);
+  const F s = pow(x, F(1) / 5);
+  const F f = 1 - c1 * s + c2 * s * s;
+  // |f'(v)| = |2 c2 s - c1| s / (5 v), bounded over [v - error, v + error] by s's bound
+  // there (s grows like v^(1/5): at most s (1 + error / v)) and v - error.
+  const F s_high = s * (1 + error / v);
+  const F slope = (c1 + 2 * c2 * s_high) * s_high / (5 * (v - error));
+  const F bound = slope * error + unit * (1 + c1 * s_high + c2 * s_high * s_high) * 16;
+  return roundedIn(F(f - bound), F(f + bound));
+}
+
+}  // namespace
+
+std::optional<double> viscoelasticOver(long double v, long double error, double v_star) {
+  if constexpr (std::numeric_limits<long double>::digits < 64) return std::nullopt;
+  constexpr long double c1 = 1.15344L, c2 = 0.79826L;  // each within 2^-64 of the decimal
+  const long double x = v / v_star;
+  if (!(x > 0x1p-1000L && x < 0x1p1000L)) return std::nullopt;
+  // s = x^(1/5): pow in double (within an ulp, 2^-52), then one Newton step for s^5 = x in
+  // long double, which leaves 2 (2^-52)^2 relatively and the step's roundings: within
+  // 2^-62. f's own few operations stay within 2^-61 of its terms. Over [v - error,
+  // v + error], |f'(v)| = |2 c2 s - c1| s / (5 v) is at most (c1 + 2 c2 s') s' / (5 (v - error)),
+  // s' = s (1 + error / v).
+  const long double guess = std::pow(static_cast<double>(x), 0.2);
+  const long double guess_4 = (guess * guess) * (guess * guess);
+  const long double s = guess - (guess_4 * guess - x) / (5 * guess_4);
+  const long double relative = 0x1p-62L;
+  const long double s_high = s * (1 + relative) * (1 + error / v);
+  const long double slope = (c1 + 2 * c2 * s_high) * s_high / (5 * (v - error));
+  const long double bound = slope * error + 0x1p-61L * (1 + c1 * s_high + c2 * s_high * s_high) +
+                            (c1 * s_high + 2 * c2 * s_high * s_high) * relative;
+  const long double f = 1 - c1 * s + c2 * s * s;
+  return roundedIn(f - bound, f + bound);
+}
+
+std::optional<double> viscoelasticDD(const DD& v, double error, double v_star) {
+  const DD x = v / DD(v_star);
+  if (!(x.hi > 0x1p-900 && x.hi < 0x1p900) || !(error < 0x1p-20 * v.hi)) return std::nullopt;
+  // s from pow in double (within 2^-52 relatively), then one Newton step for s^5 = x in
+  // double-double: 2 (2^-52)^2 relatively, plus a dozen double-double operations (2^-104
+  // each): within 2^-98.
+  DD s(std::pow(x.hi, 0.2));
+  const DD s_sq = s * s, s_4 = s_sq * s_sq;
+  s = s - (s_4 * s - x) / (s_4 * 5.0);
+  const DD c1 = DD(115344.0) / DD(100000.0), c2 = DD(79826.0) / DD(100000.0);  // within 2^-104
+  const DD f = DD(1.0) - c1 * s + c2 * (s * s);
+  const double size = s.hi * (1 + 0x1p-40);
+  // f's bound: s's error through f' = 2 c2 s - c1, f's own operations (2^-100 of its
+  // terms), and the speed's bound through f'(v) = f'(s) s / (5 v).
+  const double slope = (1.15345 + 2 * 0.79827 * size) * size;
+  const double bound =
+      (slope * 0x1p-98 + 0x1p-99 * (1 + 1.15345 * size + 0.79827 * size * size)) + slope * error / (5 * (v.hi - error));
+  const DD low = f - DD(bound * (1 + 0x1p-40)), high = f + DD(bound * (1 + 0x1p-40));
+  constexpr double kToOne = 1 - 0x1p-54;  // from here up, e rounds to 1
+  if (low.hi > kToOne || (low.hi == kToOne && low.lo >= 0)) return 1.0;
+  if (high.hi >= kToOne) return std::nullopt;
+  // A normalized double-double rounds to its hi unless its lo reaches half an ulp.
+  const double half_ulp = (std::nextafter(low.hi, 2.0) - low.hi) / 2;
+  if (low.hi != high.hi || !(low.lo > -half_ulp) || !(high.lo < half_ulp)) return std::nullopt;
+  return low.hi;
+}
+
+std::optional<double> viscoelasticNear(const Float100& v, const Float100& error, double v_star) {
+  // 128 bits first (a double-double tier's speed is known to about 2^-100): a few times
+  // cheaper than 100 digits.
+  using Narrow = boost::multiprecision::number<boost::multiprecision::cpp_bin_float<128, boost::multiprecision::digit_base_2>>;
+  const Narrow narrow_error = Narrow(error) * (1 + ldexp(Narrow(1), -120)) + Narrow(v) * ldexp(Narrow(1), -126);
+  if (const auto e = viscoelasticIn(Narrow(v), narrow_error, v_star, Narrow(ldexp(Narrow(1), -122)))) return e;
+  if (error > v * ldexp(Float100(1), -120)) return std::nullopt;  // more digits cannot narrow the speed's bound
+  return viscoelasticIn(v, error, v_star, Float100(ldexp(Float100(1), -325)));
+}
+
+double viscoelasticAt(const Rational& v, double v_star) {
+  const Float100 wide = Float100(numerator(v)) / Float100(denominator(v));  // within 2^-330
+  if (const auto e = viscoelasticNear(wide, wide * ldexp(Float100(1), -329), v_star)) return *e;
+  // Within the bound of a rounding boundary: 500 bits. e is irrational wherever v / v* is not
+  // a fifth power of a rational, so only a bound this close to it is left undecided.
+  using Deep = boost::multiprecision::number<boost::multiprecision::cpp_bin_float<500>>;
+  const Deep deep = Deep(numerator(v)) / Deep(denominator(v));
+  const Deep unit = ldexp(Deep(1), -1640);
+  if (const auto e = viscoelasticIn(deep, Deep(deep * unit * 2), v_star, unit)) return *e;
+  const Deep s = pow(deep / Deep(v_star), Deep(1) / 5);
+  const Deep f = 1 - Deep(115344) / 100000 * s + Deep(79826) / 100000 * s * s;
+  return f >= 1 ? 1.0 : static_cast<double>(f);
+}
+
+}  // namespace nbody_detail
+
 double viscoelasticRestitution(double speed, double v_star) {
-  constexpr double kC1 = 1.15344, kC2 = 0.79826;
-  const double s = std::pow(speed / v_star, 0.2);
-  const double e = 1.0 - kC1 * s + kC2 * s * s;
-  return std::min(1.0, std::max(0.0, e));
+  if (!(speed > 0)) return 1.0;  // s = 0
+  if (const auto e = nbody_detail::viscoelasticOver(speed, 0.0L, v_star)) return *e;
+  if (const auto e = nbody_detail::viscoelasticDD(nbody_detail::DD(speed), 0.0, v_star)) return *e;
+  return nbody_detail::viscoelasticAt(nbody_detail::Rational(speed), v_star);
 }
 
 ImpactOutcome impact(double m_i, double m_j, double v_i, double v_j, double e) {

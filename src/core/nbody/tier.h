@@ -40,6 +40,7 @@
 #include "collision_lab/core/nbody/impact_rule.h"
 #include "collision_lab/core/nbody/scene.h"
 #include "tournament_tree.h"
+#include "viscoelastic.h"
 
 namespace collision_lab {
 namespace core {
@@ -1069,9 +1070,9 @@ class CL_NBODY_INTERNAL Tier {
       case RestitutionModelKind::kThreshold: return decided(base == 1.0 ? Decision::kNo : slowerThan(m, model.elastic_below));
       case RestitutionModelKind::kViscoelastic: {
         Rule rule;
-        const std::optional<double> speed = roundedApproach(m, rule.at_zero);
-        if (!speed) return {StepKind::kAmbiguous, 0.0, false, rule.at_zero};
-        rule.e = viscoelasticRestitution(*speed, model.viscoelastic_speed);
+        const std::optional<double> e = viscoelasticE(m, model.viscoelastic_speed);
+        if (!e) return {StepKind::kAmbiguous, 0.0, false, false};
+        rule.e = *e;
         rule.made_elastic = rule.e == 1.0;
         return rule;
       }
@@ -1127,35 +1128,33 @@ class CL_NBODY_INTERNAL Tier {
     return positive(difference, error);
   }
 
-  /// Viscoelastic law: pair m's approach speed rounded to the nearest double (ties to even),
-  /// the same in every tier: an inexact tier answers only when its bound keeps the exact
-  /// speed strictly between the two rounding midpoints; at_zero: a speed at a midpoint (to
-  /// this tier's precision), for the exact tier.
-  std::optional<double> roundedApproach(std::size_t m, bool& at_zero) const {
+  /// Viscoelastic law: e of pair m's impact, the correctly rounded value of e(v) at the exact
+  /// approach speed v (viscoelastic.h), the same in every tier: an inexact tier answers only
+  /// when every speed within its bound of its own gives the same double.
+  std::optional<double> viscoelasticE(std::size_t m, double v_star) const {
     const S speed = bodies_[left(m)].v - bodies_[m].v;
-    double d = Ar::toDouble(speed);
-    const auto midpoint = [](double x, double y) { return S(S(x) + S(y)) / S(2); };
     if constexpr (Ar::kExact) {
-      for (int step = 0; step < 8; ++step) {  // the conversion is within a few ulps
-        if (speed > midpoint(d, std::nextafter(d, kInf))) d = std::nextafter(d, kInf);
-        else if (speed < midpoint(std::nextafter(d, -kInf), d)) d = std::nextafter(d, -kInf);
-        else break;
-      }
-      const double up = std::nextafter(d, kInf), down = std::nextafter(d, -kInf);
-      std::uint64_t bits = 0;
-      std::memcpy(&bits, &d, sizeof bits);
-      if (speed == midpoint(d, up) && (bits & 1)) d = up;
-      if (speed == midpoint(down, d) && (bits & 1)) d = down;
-      return d;
+      return viscoelasticAt(speed, v_star);
     } else {
-      const double error = (eu_ * pairScale(m) + 2.02 * Ar::kOpError * std::fabs(d)) * kSlack + kTiny;
-      const S above = S(midpoint(d, std::nextafter(d, kInf)) - speed);
-      const S below = S(speed - midpoint(std::nextafter(d, -kInf), d));
-      const Decision a = positive(above, error + 2 * Ar::kOpError * std::fabs(d));
-      const Decision b = positive(below, error + 2 * Ar::kOpError * std::fabs(d));
-      if (a == Decision::kYes && b == Decision::kYes) return d;
-      at_zero = a == Decision::kUnknownAtZero || b == Decision::kUnknownAtZero;
-      return std::nullopt;
+      const double d = Ar::toDouble(speed);
+      // The state's bound on the speed and the rounding of forming it.
+      const double error = (eu_ * pairScale(m) + 4.04 * Ar::kOpError * std::fabs(d)) * kSlack + kTiny;
+      if constexpr (std::is_same_v<S, Float100>) {
+        if (!(d - 2 * error > 0)) return std::nullopt;
+        return viscoelasticNear(speed, Float100(error), v_star);
+      } else {
+        // The double-double speed in long double (within 2^-63 of it), and the bound widened
+        // by that and by forming the ends.
+        const long double v = static_cast<long double>(speed.hi) + speed.lo;
+        const long double wider = (error + std::fabs(v) * 0x1p-62L) * (1 + 0x1p-60L);
+        if (!(v - wider > 0)) return std::nullopt;
+        if (const auto e = viscoelasticOver(v, wider, v_star)) return e;
+        // Next to a rounding boundary (a few impacts in 100): the same speed and bound in
+        // double-double, then at 128 bits, without a replay in the 100-digit tier.
+        if (!(d - 2 * error > 0)) return std::nullopt;
+        if (const auto e = viscoelasticDD(DD(speed.hi, speed.lo, 0), error, v_star)) return e;
+        return viscoelasticNear(Float100(speed.hi) + speed.lo, Float100(error), v_star);
+      }
     }
   }
 

@@ -2,8 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <stdexcept>
+
+#include <boost/multiprecision/cpp_bin_float.hpp>
 
 namespace collision_lab {
 namespace core {
@@ -21,22 +22,6 @@ struct State {
   std::vector<std::optional<Rational>> last_impact;  // per body, for the TC model [s]
 };
 
-/// The double nearest q (ties to even), found by exact comparison with its neighbours.
-double nearest(const Rational& q) {
-  double d = static_cast<double>(q);
-  for (int step = 0; step < 4; ++step) {
-    const double up = std::nextafter(d, INFINITY), down = std::nextafter(d, -INFINITY);
-    if (abs(Rational(up) - q) < abs(Rational(d) - q)) d = up;
-    else if (abs(Rational(down) - q) < abs(Rational(d) - q)) d = down;
-  }
-  for (const double other : {std::nextafter(d, INFINITY), std::nextafter(d, -INFINITY)}) {
-    std::uint64_t bits;
-    std::memcpy(&bits, &d, sizeof bits);
-    if (abs(Rational(other) - q) == abs(Rational(d) - q) && (bits & 1)) d = other;
-  }
-  return d;
-}
-
 /// The restitution of an impact of pair p at approach speed `approach` (> 0), by the scene's
 /// model (physics.md, "Restitution models"): the pair's e, or 1 where the model says elastic.
 Rational restitutionOf(const Scene& scene, const State& s, std::size_t p, const Rational& approach) {
@@ -50,10 +35,13 @@ Rational restitutionOf(const Scene& scene, const State& s, std::size_t p, const 
       }
       return s.e[p];
     case RestitutionModelKind::kViscoelastic: {
-      // e(v) = 1 - C1 s + C2 s^2, s = (v / v*)^(1/5), in double at the speed rounded to the
-      // nearest double, clamped to [0, 1].
-      const double root = std::pow(nearest(approach) / model.viscoelastic_speed, 0.2);
-      return Rational(std::min(1.0, std::max(0.0, 1.0 - 1.15344 * root + 0.79826 * root * root)));
+      // e(v) = 1 - C1 s + C2 s^2, s = (v / v*)^(1/5), at the exact speed (here to 600 bits),
+      // clamped to [0, 1], rounded to the nearest double.
+      using Deep = boost::multiprecision::number<boost::multiprecision::cpp_bin_float<600>>;
+      const Deep x = Deep(numerator(approach)) / Deep(denominator(approach)) / Deep(model.viscoelastic_speed);
+      const Deep root = pow(x, Deep(1) / 5);
+      const Deep e = 1 - Deep(115344) / 100000 * root + Deep(79826) / 100000 * root * root;
+      return Rational(e >= 1 ? 1.0 : static_cast<double>(e));
     }
   }
   return s.e[p];

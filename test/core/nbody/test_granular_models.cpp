@@ -6,6 +6,8 @@
 #include <cmath>
 #include <random>
 
+#include <boost/multiprecision/cpp_bin_float.hpp>
+
 #include "collision_lab/core/nbody/engine.h"
 #include "collision_lab/core/nbody/impact_rule.h"
 #include "collision_lab/core/nbody/models.h"
@@ -165,6 +167,32 @@ TEST(ViscoelasticModel, LawAtItsLandmarks) {
   EXPECT_DOUBLE_EQ(viscoelasticRestitution(3.0, 3.0), 1 - 1.15344 + 0.79826);
   // s = C1 / C2 (about 1.445) brings the truncated law back to 1; beyond, the clamp holds it there.
   EXPECT_EQ(viscoelasticRestitution(3.0 * std::pow(1.15344 / 0.79826, 5) * 1.01, 3.0), 1.0);
+}
+
+// e(v) is the correctly rounded value of the formula at the exact speed: against the
+// formula at 600 bits, over speeds from 1e-12 v* to 10 v* (the clamp included).
+TEST(ViscoelasticModel, LawIsCorrectlyRounded) {
+  using Deep = boost::multiprecision::number<boost::multiprecision::cpp_bin_float<600>>;
+  std::mt19937_64 rng(4407);
+  std::uniform_real_distribution<double> decade(-12.0, 1.0);
+  int below_one = 0;
+  for (int k = 0; k < 400; ++k) {
+    const double v_star = k % 2 == 0 ? 3.0 : 0.7;
+    const double speed = v_star * std::pow(10.0, decade(rng));
+    const Deep s = pow(Deep(speed) / Deep(v_star), Deep(1) / 5);
+    const Deep f = 1 - Deep(115344) / 100000 * s + Deep(79826) / 100000 * s * s;
+    const double e = viscoelasticRestitution(speed, v_star);
+    if (f >= 1) {
+      EXPECT_EQ(e, 1.0) << speed;
+      continue;
+    }
+    ++below_one;
+    const Deep distance = abs(Deep(e) - f);
+    for (const double neighbour : {std::nextafter(e, 2.0), std::nextafter(e, 0.0)}) {
+      EXPECT_GE(abs(Deep(neighbour) - f), distance) << "v = " << speed << ", v* = " << v_star << ": e = " << e;
+    }
+  }
+  EXPECT_GT(below_one, 300);
 }
 
 // The seam by hand: L = 10 m, body A (1 kg) at 9 m moving at +1 m/s, B (3 kg) at 1 m at -1

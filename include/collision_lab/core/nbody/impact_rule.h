@@ -101,9 +101,10 @@ ImpactChange<T> applyImpactMap(const ImpactMap<T>& map, T& q_i, T& q_j) {
 
 /// The viscoelastic law (Brilliantov, Spahn, Hertzsch and Poschel, PRE 53, 1996), truncated
 /// after the second order in s = (v / v*)^(1/5): e = 1 - C1 s + C2 s^2, C1 = 1.15344,
-/// C2 = 0.79826, clamped to [0, 1]. speed: the approach speed v >= 0 [m/s]; v_star > 0
-/// [m/s]. The truncation holds for s well below 1; it reaches its minimum 0.583 at s = 0.72
-/// and comes back to 1 at s = C1 / C2 (v = 6.3 v*), where the clamp keeps e = 1.
+/// C2 = 0.79826 (the decimals), clamped to [0, 1]: the correctly rounded value of that
+/// formula at the exact speed. speed: the approach speed v >= 0 [m/s]; v_star > 0 [m/s].
+/// The truncation holds for s well below 1; it reaches its minimum 0.583 at s = 0.72 and
+/// comes back to 1 at s = C1 / C2 (v = 6.3 v*), where the clamp keeps e = 1.
 double viscoelasticRestitution(double speed, double v_star);
 
 /// Outcome of one impact in double.
