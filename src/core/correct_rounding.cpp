@@ -166,8 +166,6 @@ Certifying certifyingAtan2Sqrt(const ExactRational& y, const ExactRational& x, c
   return atan2(Certifying(numerator(y)) / Certifying(denominator(y)), x < 0 ? Certifying(-x_size) : x_size);
 }
 
-Certifying atan2SqrtError() { return ldexp(Certifying(1), -298); }
-
 std::optional<double> roundedAtan2Sqrt(const ExactRational& y, const ExactRational& x, const ExactRational& scale,
                                        bool from_zero) {
   if (y == 0 && (x >= 0 || scale == 0)) return 0.0;  // exactly (atan2(0, 0) = 0)
@@ -177,7 +175,7 @@ std::optional<double> roundedAtan2Sqrt(const ExactRational& y, const ExactRation
   if (const auto quick = quickNearest(cheap, 0x1p-57L)) return quick;
   Certifying angle = certifyingAtan2Sqrt(y, x, scale);
   if (from_zero && angle < 0) angle += 2 * boost::math::constants::pi<Certifying>();
-  return certifiedNearest(angle, atan2SqrtError());
+  return certifiedNearest(angle, abs(angle) * ldexp(Certifying(1), -298));  // shifted: larger, so wider
 }
 
 double roundedSpiralAngle(const ExactRational& trace, const ExactRational& determinant) {

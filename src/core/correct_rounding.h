@@ -42,11 +42,10 @@ long double approximate(const ExactRational& q);
 /// The angle atan2(y, x sqrt(scale)) [rad] of exact rationals (scale >= 0): in long double
 /// within 2^-59 of it relatively (atan2 moves by at most the relative error of its
 /// arguments, each within 2^-61 here, times |sin 2 phi| / 2 <= |phi|; atan2l within 2 ulps),
-/// where long double has 64 bits; and at 100 digits within 2^-298. y = x = 0 gives 0.
+/// where long double has 64 bits; and at 100 digits within 2^-298 of it relatively. y = x =
+/// 0 gives 0.
 long double cheapAtan2Sqrt(const ExactRational& y, const ExactRational& x, const ExactRational& scale);
 Certifying certifyingAtan2Sqrt(const ExactRational& y, const ExactRational& x, const ExactRational& scale);
-/// The bound of certifyingAtan2Sqrt [rad].
-Certifying atan2SqrtError();
 /// atan2(y, x sqrt(scale)) correctly rounded [rad] (an exact 0 decided exactly), in (-pi, pi],
 /// or with `from_zero` in [0, 2 pi) (a negative angle plus 2 pi); empty where neither step
 /// certifies it.

@@ -2,8 +2,10 @@
 // double, long double and the multiprecision types alike. Private to the core.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstddef>
 
 namespace collision_lab {
 namespace core {
@@ -34,6 +36,19 @@ template <class T>
 double toDouble(const T& value) {
   const double rounded = static_cast<double>(value);
   return rounded == 0 ? 0.0 : rounded;
+}
+
+/// Is each of `a` within 4 ulps of its entry of `b` (a zero against a value below 2^-1000)?
+/// The test of a substitution: a certified value for one a few roundings away.
+template <class A, class B>
+bool withinUlps(const A& a, const B& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const double size = std::max(std::fabs(a[i]), std::fabs(b[i]));
+    const double ulp = std::nextafter(size, HUGE_VAL) - size;
+    if (!(std::fabs(a[i] - b[i]) <= 4 * std::max(ulp, 0x1p-1000))) return false;
+  }
+  return true;
 }
 
 /// Does every value survive scaling by 2^shift and back unchanged?

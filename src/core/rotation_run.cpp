@@ -494,6 +494,7 @@ std::optional<SceneSimulation> simulateKnownCount(const Scene& scene, std::uint6
   result.truncated = run->capped || run->cancelled;
   result.stop = run->cancelled ? StopReason::kCancelled : run->capped ? StopReason::kCap : StopReason::kFinished;
   result.final_velocities.assign(run->final_velocities.begin(), run->final_velocities.end());
+  if (!run->certified) result.uncertified.push_back("final_velocities");  // the engine's bits stand
   nbody_detail::fillEngineDrift(units.scene, result);  // in working units, where the run's values are
   for (double& v : result.final_velocities) v = velocity_si(v);
   return result;
@@ -534,7 +535,9 @@ SceneSimulation simulateByEngine(const Scene& scene, const SimulationOptions& op
         const long double elapsed = static_cast<long double>(record.time) - since_time[k];
         const long double position =
             velocities[k] == 0 ? since_position[k] : since_position[k] + velocities[k] * elapsed;
-        state.positions[k] = positive(position);
+        // At a time past the largest double a moving body's place is not known here (NaN).
+        state.positions[k] = std::isinf(record.time) && velocities[k] != 0 ? std::numeric_limits<double>::quiet_NaN()
+                                                                            : positive(position);
       }
       const bool last = final_state && record.index == final_state->impact_count;
       if (last) event.velocities_after = {final_state->final_velocities[i], final_state->final_velocities[i + 1]};
@@ -570,6 +573,7 @@ SceneSimulation simulateByEngine(const Scene& scene, const SimulationOptions& op
   result.truncated = engine.truncated || engine.stop != StopReason::kFinished;
   result.stop = engine.stop;
   result.time_beyond_range = engine.time_beyond_range;
+  result.uncertified = engine.uncertified;
   if (engine.stop != StopReason::kFinished && engine.stop != StopReason::kCap && engine.stop != StopReason::kCancelled) {
     stopped_otherwise = engine.stop_message;
   }
@@ -758,6 +762,17 @@ SceneSimulation simulateRotationScene(const Scene& scene, const Prediction& pred
         "no pair approaches any more after " + std::to_string(run.impact_count) + " impacts: the run is complete";
   }
   simulation.final_velocities = run.final_velocities;
+  simulation.uncertified = run.uncertified;
+  // At the model's count the model's certified velocities name the same exact values: an
+  // uncertified run value within a few ulps of them gives way to them.
+  if (!simulation.uncertified.empty() && run.impact_count == predicted_count &&
+      std::find(prediction.uncertified.begin(), prediction.uncertified.end(), "predicted_final_velocities") ==
+          prediction.uncertified.end()) {
+    if (detail::withinUlps(run.final_velocities, prediction.final_velocities)) {
+      simulation.final_velocities = prediction.final_velocities;
+      simulation.uncertified.clear();
+    }
+  }
   simulation.energy_lost = 0.0;  // elastic
   simulation.energy_relative_drift = run.energy_relative_drift;
   simulation.momentum_relative_drift = run.momentum_relative_drift;

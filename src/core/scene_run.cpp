@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "collision_lab/core/count_text.h"
+#include "float_ops.h"
 #include "rotation_run.h"
 
 namespace collision_lab {
@@ -77,17 +78,6 @@ double energyNormError(const Scene& scene, const std::vector<double>& simulated,
 
 bool isUncertified(const Prediction& prediction, const std::string& key) {
   return std::find(prediction.uncertified.begin(), prediction.uncertified.end(), key) != prediction.uncertified.end();
-}
-
-/// Is each of `a` within 4 ulps of its entry of `b` (a zero against a value below 2^-1000)?
-bool withinUlps(const std::vector<double>& a, const std::vector<double>& b) {
-  if (a.size() != b.size()) return false;
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    const double size = std::max(std::fabs(a[i]), std::fabs(b[i]));
-    const double ulp = std::nextafter(size, std::numeric_limits<double>::infinity()) - size;
-    if (!(std::fabs(a[i] - b[i]) <= 4 * std::max(ulp, 0x1p-1000))) return false;
-  }
-  return true;
 }
 
 /// A collapse of every body, with the model's certified time, point and common velocity.
@@ -204,11 +194,12 @@ SceneSimulation simulateScene(const Scene& scene, const SceneRunOptions& options
       keys.erase(std::remove(keys.begin(), keys.end(), key), keys.end());
     };
     if (!isUncertified(*prediction, "predicted_final_velocities") &&
-        withinUlps(simulation.final_velocities, prediction->final_velocities)) {
+        detail::withinUlps(simulation.final_velocities, prediction->final_velocities)) {
       simulation.final_velocities = prediction->final_velocities;
       certify("final_velocities");
     }
-    if (!isUncertified(*prediction, "energy_lost") && withinUlps({simulation.energy_lost}, {prediction->energy_lost})) {
+    const std::array<double, 1> heat{simulation.energy_lost}, predicted_heat{prediction->energy_lost};
+    if (!isUncertified(*prediction, "energy_lost") && detail::withinUlps(heat, predicted_heat)) {
       simulation.energy_lost = prediction->energy_lost;
       certify("energy_lost");
     }

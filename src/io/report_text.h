@@ -61,7 +61,8 @@ inline std::string padRight(const std::string& text, std::size_t width) {
 /// The note of a run with time_beyond_range (core::SceneSimulation), in every report.
 inline const char* const kTimeBeyondRangeNote =
     "the last impacts come after t = 1.8e+308 s, the largest double: counted, with exact velocities, their times "
-    "(and any position past 1.8e+308 m) shown as inf (null in JSON); a longer unit of time brings them into range";
+    "(and any position past 1.8e+308 m) shown as inf, and the places of moving bodies not in them as nan (both null "
+    "in JSON); a longer unit of time brings them into range";
 
 /// A double for JSON: never a negative zero (NaN and infinities become null when dumped).
 inline Json number(double value) { return Json(value == 0 ? 0.0 : value); }

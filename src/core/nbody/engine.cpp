@@ -42,6 +42,12 @@ namespace {
 /// them uncertified.
 constexpr std::uint64_t kCertifyingReplay = 10'000;
 
+/// q 2^e, exactly.
+Rational scaledByPowerOfTwo(const Rational& q, int e) {
+  const boost::multiprecision::cpp_int power = boost::multiprecision::cpp_int(1) << (e < 0 ? -e : e);
+  return e < 0 ? Rational(q / power) : Rational(q * power);
+}
+
 template <class S>
 struct NextTier;
 template <bool kFma>
@@ -154,6 +160,13 @@ class Driver {
       }
     }
     return velocities;
+  }
+
+  /// Body k's exact velocity after the working tier's last impact [working units], where the
+  /// exact tier can be brought there within its budget.
+  std::optional<Rational> exactVelocity(std::size_t k) {
+    if (advanceTo<Rational>(fast_->count()).kind != StepKind::kImpact) return std::nullopt;
+    return exact_->velocityValue(k);
   }
 
   /// The heat of the run so far [working units], correctly rounded where it can be
@@ -752,6 +765,8 @@ SceneSimulation runEngineOn(const Scene& si_scene, const EngineOptions& options,
   result.rule_elastic_impacts = driver.fast().ruleElastic();
   driver.fast().state(result.final_time, result.final_positions, result.final_velocities);
   result.energy_lost = driver.fast().energyLost();
+  result.escalations = driver.escalations();  // the run's decisions, before any certifying replay
+  std::vector<std::pair<std::size_t, double>> subnormal_velocities;  // [m/s], set after the SI conversion
   // The final velocities certified once per run (a replay only for runs of up to
   // kCertifyingReplay impacts); a velocity none certifies keeps the working tier's value.
   const std::vector<std::optional<double>> certified = driver.certifiedVelocities(count <= kCertifyingReplay);
@@ -768,12 +783,33 @@ SceneSimulation runEngineOn(const Scene& si_scene, const EngineOptions& options,
       result.uncertified.push_back("energy_lost");
     }
   }
-  result.escalations = driver.escalations();
+  // A value subnormal in SI rounds again when scaled there: a velocity's exact value is
+  // scaled exactly instead; such a heat is named uncertified.
+  const int velocity_shift = -units.velocity_shift;
+  for (std::size_t k = 0; k < result.final_velocities.size(); ++k) {
+    const double v = result.final_velocities[k];
+    if (v == 0 || scene.isWall(k) || !(std::fabs(std::ldexp(v, velocity_shift)) < std::numeric_limits<double>::min())) {
+      continue;
+    }
+    const std::optional<Rational> exact = count <= kCertifyingReplay ? driver.exactVelocity(k) : std::nullopt;
+    if (exact) {
+      subnormal_velocities.emplace_back(k, detail::nearestDouble(scaledByPowerOfTwo(*exact, velocity_shift)));
+    } else if (std::find(result.uncertified.begin(), result.uncertified.end(), "final_velocities") ==
+               result.uncertified.end()) {
+      result.uncertified.push_back("final_velocities");
+    }
+  }
+  if (result.energy_lost != 0.0 &&
+      std::fabs(std::ldexp(result.energy_lost, -units.energyShift())) < std::numeric_limits<double>::min() &&
+      std::find(result.uncertified.begin(), result.uncertified.end(), "energy_lost") == result.uncertified.end()) {
+    result.uncertified.push_back("energy_lost");
+  }
   fillDrift(scene, result);  // relative: the same in any units
   // Back to SI.
   result.final_time = si.time(result.final_time);
   for (double& x : result.final_positions) x = si.position(x);
   for (double& v : result.final_velocities) v = si.velocity(v);
+  for (const auto& [k, v] : subnormal_velocities) result.final_velocities[k] = v;
   result.energy_lost = si.energy(result.energy_lost);
   for (Collapse& c : result.collapses) c = toSiCollapse(c);
   if (result.collapsed) {

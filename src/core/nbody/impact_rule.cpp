@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "../correct_rounding.h"
 #include "double_double.h"
 #include "viscoelastic.h"
 
@@ -49,6 +50,21 @@ std::optional<double> viscoelasticIn(const F& v, const F& error, double v_star, 
   return roundedIn(F(f - bound), F(f + bound));
 }
 
+/// The integer r >= 0 with r^5 = n (n >= 0), if there is one.
+std::optional<boost::multiprecision::cpp_int> fifthRoot(const boost::multiprecision::cpp_int& n) {
+  using boost::multiprecision::cpp_int;
+  if (n < 2) return n;
+  // Newton's iteration from above: r <- (4 r + n / r^4) / 5 decreases to floor(n^(1/5)).
+  cpp_int r = cpp_int(1) << (msb(n) / 5 + 1);
+  for (;;) {
+    const cpp_int next = (4 * r + n / (r * r * r * r)) / 5;
+    if (next >= r) break;
+    r = next;
+  }
+  if (r * r * r * r * r != n) return std::nullopt;
+  return r;
+}
+
 }  // namespace
 
 std::optional<double> viscoelasticOver(long double v, long double error, double v_star) {
@@ -91,9 +107,13 @@ std::optional<double> viscoelasticDD(const DD& v, double error, double v_star) {
   const double bound =
       (slope * 0x1p-98 + 0x1p-99 * (1 + 1.15345 * size + 0.79827 * size * size)) + slope * error / (5 * (v.hi - error));
   const DD low = f - DD(bound * (1 + 0x1p-40)), high = f + DD(bound * (1 + 0x1p-40));
-  constexpr double kToOne = 1 - 0x1p-54;  // from here up, e rounds to 1
-  if (low.hi > kToOne || (low.hi == kToOne && low.lo >= 0)) return 1.0;
-  if (high.hi >= kToOne) return std::nullopt;
+  // From 1 - 2^-54 (the midpoint below 1, a tie that goes to 1) up, e rounds to 1; a
+  // normalized double-double there has hi = 1, or hi = 1 - 2^-53 with lo = 2^-54.
+  const auto reaches_one = [](const DD& x) {
+    return x.hi > 1 || (x.hi == 1 && x.lo >= -0x1p-54) || (x.hi == 1 - 0x1p-53 && x.lo >= 0x1p-54);
+  };
+  if (reaches_one(low)) return 1.0;
+  if (reaches_one(high)) return std::nullopt;
   // A normalized double-double rounds to its hi unless its lo reaches half an ulp.
   const double half_ulp = (std::nextafter(low.hi, 2.0) - low.hi) / 2;
   if (low.hi != high.hi || !(low.lo > -half_ulp) || !(high.lo < half_ulp)) return std::nullopt;
@@ -111,10 +131,19 @@ std::optional<double> viscoelasticNear(const Float100& v, const Float100& error,
 }
 
 double viscoelasticAt(const Rational& v, double v_star) {
+  // v / v* the fifth power of a rational: s is rational, and so is e, which may then be a
+  // double or a tie; decided exactly.
+  const Rational x = v / Rational(v_star);
+  const auto root = fifthRoot(numerator(x)), root_of_denominator = fifthRoot(denominator(x));
+  if (root && root_of_denominator) {
+    const Rational s(*root, *root_of_denominator);
+    const Rational f = 1 - Rational(115344, 100000) * s + Rational(79826, 100000) * s * s;
+    return f >= 1 ? 1.0 : core::detail::nearestDouble(f);
+  }
   const Float100 wide = Float100(numerator(v)) / Float100(denominator(v));  // within 2^-330
   if (const auto e = viscoelasticNear(wide, wide * ldexp(Float100(1), -329), v_star)) return *e;
-  // Within the bound of a rounding boundary: 500 bits. e is irrational wherever v / v* is not
-  // a fifth power of a rational, so only a bound this close to it is left undecided.
+  // Within the bound of a rounding boundary: 500 digits. e is irrational wherever v / v* is
+  // not a fifth power of a rational (above), so no tie is left, only a bound this close to one.
   using Deep = boost::multiprecision::number<boost::multiprecision::cpp_bin_float<500>>;
   const Deep deep = Deep(numerator(v)) / Deep(denominator(v));
   const Deep unit = ldexp(Deep(1), -1640);
