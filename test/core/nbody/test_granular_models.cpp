@@ -11,6 +11,7 @@
 #include "collision_lab/core/nbody/engine.h"
 #include "collision_lab/core/nbody/impact_rule.h"
 #include "collision_lab/core/nbody/models.h"
+#include "viscoelastic.h"
 
 namespace collision_lab {
 namespace core {
@@ -193,6 +194,14 @@ TEST(ViscoelasticModel, LawIsCorrectlyRounded) {
     }
   }
   EXPECT_GT(below_one, 300);
+}
+
+// An exact tie: at v* = 2^125 m/s and the exact speed 5^25 m/s, s = 3125 / 2^25 exactly and
+// e = 18012463483007805 / 2^54, the midpoint of k 2^-53 for k = 9006231741503902 (even) and
+// k + 1: it rounds to the even one. No interval can decide it; the exact step does.
+TEST(ViscoelasticModel, AnExactTieRoundsToEven) {
+  const nbody_detail::Rational speed(boost::multiprecision::pow(boost::multiprecision::cpp_int(5), 25));
+  EXPECT_EQ(nbody_detail::viscoelasticAt(speed, std::ldexp(1.0, 125)), std::ldexp(9006231741503902.0, -53));
 }
 
 // The seam by hand: L = 10 m, body A (1 kg) at 9 m moving at +1 m/s, B (3 kg) at 1 m at -1

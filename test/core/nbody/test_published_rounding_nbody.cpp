@@ -224,6 +224,27 @@ TEST(PublishedRounding, LongInelasticRunsPublishCertifiedFinalVelocitiesAndHeat)
   EXPECT_EQ(certified, static_cast<int>(scenes.size()));  // within the replay's reach, all are
 }
 
+// A velocity subnormal in SI: the engine works in units that bring the speeds near 1, and
+// scaling its rounded value back rounded again (B got 1e-323 m/s, a tie of 1.5 2^-1074 in
+// working units, where the exact 2 m_A v_A / (m_A + m_B) is just below it: 5e-324). The
+// threshold law (every impact slower than v_0 elastic) takes the scene to the engine.
+TEST(PublishedRounding, AVelocitySubnormalInSiIsRoundedOnce) {
+  const double m_a = 1 + 0x1p-52, m_b = 3 * m_a;
+  Scene scene{{m_a, m_b}, {2e-300, 1e-300}, {-3 * 0x1p-1074, 0.0}};
+  scene.restitution = {0.5};
+  scene.restitution_model.kind = RestitutionModelKind::kThreshold;
+  scene.restitution_model.elastic_below = 1e-300;
+  ASSERT_FALSE(validate(scene)) << validate(scene)->message;
+  const SceneRunResult result = runInMode(scene, RunMode::kSummaryOnly);
+  ASSERT_EQ(result.simulation.impact_count, 1u) << result.simulation.stop_message;
+  const Q a(m_a), b(m_b), v(scene.velocities[0]);
+  EXPECT_TRUE(correctlyRounded(result.simulation.final_velocities[1], 2 * a * v / (a + b)))
+      << result.simulation.final_velocities[1];
+  EXPECT_TRUE(correctlyRounded(result.simulation.final_velocities[0], (a - b) * v / (a + b)))
+      << result.simulation.final_velocities[0];
+  EXPECT_TRUE(uncertifiedValues(result).empty());
+}
+
 }  // namespace
 }  // namespace core
 }  // namespace collision_lab
