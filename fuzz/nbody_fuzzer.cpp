@@ -86,13 +86,17 @@ int collisionLabNbodyFuzzOne(const std::uint8_t* data, std::size_t size) {
   options.lab.events = events == 1 ? cl::EventPolicy::all() : events == 2 ? cl::EventPolicy::firstN(3) : cl::EventPolicy::none();
   options.simulate_to_cap = flags & 0x40;
   std::uint64_t impacts = 0;
+  bool beyond = false;  // an impact came after the largest double
   cl::SceneVisitors visitors;
   visitors.impact = [&](const cl::ImpactRecord& record) {
     FUZZ_CHECK(record.index == ++impacts, "impacts numbered 1, 2, ... in order");
     FUZZ_CHECK(record.pair_index < (ring ? n : n - 1), "an impact's pair exists");
     FUZZ_CHECK(record.first_moved < n && record.last_moved < n, "an impact moves bodies that exist");
     FUZZ_CHECK(ring || record.first_moved <= record.last_moved, "on a line, the moved bodies are in order");
-    FUZZ_CHECK(std::isfinite(record.time) && std::isfinite(record.position), "finite impact time and point");
+    // A time past the largest double is +inf (time_beyond_range), a point past it +-inf.
+    FUZZ_CHECK((std::isfinite(record.time) || record.time == HUGE_VAL) && !std::isnan(record.position),
+               "an impact time finite or past the largest double, a point");
+    beyond = beyond || std::isinf(record.time);
     FUZZ_CHECK(std::isfinite(record.velocities_after[0]) || std::isinf(scene.masses[record.pair_index]),
                "finite velocities after an impact");
     if (record.model) {
@@ -104,6 +108,7 @@ int collisionLabNbodyFuzzOne(const std::uint8_t* data, std::size_t size) {
   const cl::SceneRunResult result = cl::runScene(plan, options, visitors);
   const cl::SceneSimulation& sim = result.simulation;
   FUZZ_CHECK(!sim.stop_message.empty(), "every run says why it ended");
+  FUZZ_CHECK(!beyond || sim.time_beyond_range, "an impact past the largest double is said in the summary");
   FUZZ_CHECK(sim.stop != cl::StopReason::kInternalError, "the tiers never disagree");
   FUZZ_CHECK(sim.final_velocities.size() == n, "one final velocity per body");
   FUZZ_CHECK(!sim.simulated || sim.impact_count <= cap, "a simulation stops at the cap");

@@ -255,7 +255,7 @@ TEST_F(RunPageViewTest, PredictOnlyRunDrawsNoEmptyChart) {
 /// The cells of the summary table's row `label`: simulation, prediction, paper (as fmt drew them).
 std::vector<std::string> summaryCells(const std::string& dom, const std::string& label) {
   std::smatch m;
-  const std::string escaped = std::regex_replace(label, std::regex(R"([\[\]])"), R"(\$&)");
+  const std::string escaped = std::regex_replace(label, std::regex(R"([\[\]()])"), R"(\$&)");
   if (!std::regex_search(dom, m, std::regex("<th>" + escaped + "</th><td>([^<]*)</td><td>([^<]*)</td><td>([^<]*)</td>"))) {
     return {};
   }
