@@ -82,22 +82,24 @@ Certifying toCertifying(const Rational& q) { return Certifying(numerator(q)) / C
 /// Omega = arccos(n_AB . n_BC) has cos^2 = m_A m_C / q and sin^2 = m_B M / q (cos < 0), and
 /// theta = arg lambda_+ = atan2(2 sqrt(D), a) (eq. 2.2), q = m_A m_C + m_B M, a = m_A m_C - m_B M.
 struct PrintedAngleArguments {
-  explicit PrintedAngleArguments(const Scene& scene) {
-    const Rational m_a(scene.masses[kA]), m_b(scene.masses[kB]), m_c(scene.masses[kC]);
+  explicit PrintedAngleArguments(const Scene& scene)
+      : m_a(scene.masses[kA]), m_b(scene.masses[kB]), m_c(scene.masses[kC]), total(m_a + m_b + m_c) {
     const Rational v_a(scene.velocities[kA]), v_b(scene.velocities[kB]), v_c(scene.velocities[kC]);
-    const Rational m_ab = m_a + m_b, total = m_ab + m_c;
+    const Rational m_ab = m_a + m_b;
     const Rational v_a1 = ((m_a - m_b) * v_a + 2 * m_b * v_b) / m_ab;
     const Rational v_b1 = (2 * m_a * v_a + (m_b - m_a) * v_b) / m_ab;
     x = m_b * v_b1 + m_c * v_c - (m_b + m_c) * v_a1;
     y = v_b1 - v_c;
     x_scale = m_a / (m_b * m_c * total);
-    const Rational q = m_a * m_c + m_b * total;
+    q = m_a * m_c + m_b * total;
     omega_cos_sq = m_a * m_c / q;
     omega_sin_sq = m_b * total / q;
     theta_d = m_a * m_b * m_c * total;
     theta_a = m_a * m_c - m_b * total;
   }
+  Rational m_a, m_b, m_c, total;       // the masses [kg] and M
   Rational x, y, x_scale;              // X, Y and m_A / (m_B m_C M): phi_BC = atan2(Y, X sqrt(x_scale))
+  Rational q;
   Rational omega_cos_sq, omega_sin_sq;
   Rational theta_d, theta_a;           // D and a
 };
@@ -118,28 +120,21 @@ std::optional<std::int64_t> decidedCount(const Certifying& x, const Certifying& 
 /// q = m_A m_C + m_B M; lambda_+^j = c_j + i sqrt(D) s_j with rationals c_j, s_j. Equal unit
 /// vectors: the signs agree and the cosines' squares are equal. (Equal modulo 2 pi: the caller
 /// knows the two angles to be within far less than 2 pi.)
-bool isMultipleOfTheta(const Scene& scene, std::int64_t j) {
-  const Rational m_a(scene.masses[kA]), m_b(scene.masses[kB]), m_c(scene.masses[kC]);
-  const Rational v_a(scene.velocities[kA]), v_b(scene.velocities[kB]), v_c(scene.velocities[kC]);
-  const Rational m_ab = m_a + m_b, total = m_ab + m_c;
-  const Rational q = m_a * m_c + m_b * total, d = m_a * m_b * m_c * total;
-  const Rational v_a1 = ((m_a - m_b) * v_a + 2 * m_b * v_b) / m_ab;
-  const Rational v_b1 = (2 * m_a * v_a + (m_b - m_a) * v_b) / m_ab;
-  const Rational x = m_b * v_b1 + m_c * v_c - (m_b + m_c) * v_a1;
-  const Rational y = v_b1 - v_c;
+bool isMultipleOfTheta(const PrintedAngleArguments& a, std::int64_t j) {
+  const Rational &m_a = a.m_a, &m_b = a.m_b, &m_c = a.m_c, &total = a.total, &q = a.q, &x = a.x, &y = a.y;
   // lambda_+^|j| by squaring, (c, s) for c + i sqrt(D) s; a negative j conjugates.
   using Complex = std::pair<Rational, Rational>;
-  const auto times = [&d](const Complex& u, const Complex& w) {
-    return Complex{u.first * w.first - d * u.second * w.second, u.first * w.second + u.second * w.first};
+  const auto times = [&a](const Complex& u, const Complex& w) {
+    return Complex{u.first * w.first - a.theta_d * u.second * w.second, u.first * w.second + u.second * w.first};
   };
-  Complex power{1, 0}, base{(m_a * m_c - m_b * total) / q, Rational(2) / q};
+  Complex power{1, 0}, base{a.theta_a / q, Rational(2) / q};
   for (std::uint64_t e = static_cast<std::uint64_t>(j < 0 ? -j : j); e > 0; e >>= 1) {
     if (e & 1) power = times(power, base);
     base = times(base, base);
   }
   if (j < 0) power.second = -power.second;
   const Rational n = m_b * total * y - m_a * x, s = x + m_c * y;
-  const Rational rho_sq = x * x * m_a / (m_b * m_c * total) + y * y;
+  const Rational rho_sq = x * x * a.x_scale + y * y;
   const auto sign = [](const Rational& value) { return (value > 0) - (value < 0); };
   return sign(n) == sign(power.first) && sign(s) == sign(power.second) &&
          n * n == power.first * power.first * m_b * total * q * rho_sq;
@@ -269,7 +264,7 @@ std::optional<std::int64_t> impactCount(const Scene& scene, bool* certified) {
   // Within the bound of an integer j (a grazing start): x = j exactly when the rotation by
   // Omega - phi_BC is lambda_+^j, decided in rationals (a small j only).
   const Certifying nearest = round(x);
-  if (abs(nearest) <= 4096 && isMultipleOfTheta(scene, static_cast<std::int64_t>(nearest))) {
+  if (abs(nearest) <= 4096 && isMultipleOfTheta(a, static_cast<std::int64_t>(nearest))) {
     return 1 + 2 * static_cast<std::int64_t>(nearest);
   }
   if (certified) *certified = false;

@@ -679,6 +679,58 @@ const char* stopReasonName(StopReason reason) {
 
 namespace {
 
+/// Names `key` in result.uncertified, once.
+void nameUncertified(SceneSimulation& result, const char* key) {
+  auto& keys = result.uncertified;
+  if (std::find(keys.begin(), keys.end(), key) == keys.end()) keys.push_back(key);
+}
+
+/// Certifies the run's final velocities and heat once (physics.md, "How close the published
+/// values are"), in working units: a replay only for runs of up to kCertifyingReplay impacts;
+/// a value none certifies keeps the working tier's and is named uncertified. A value
+/// subnormal in SI rounds again when scaled there: such a velocity is returned, its exact
+/// value scaled exactly and rounded [m/s], for after the conversion; such a heat is named.
+template <class W>
+std::vector<std::pair<std::size_t, double>> certifyFinalValues(nbody_detail::Driver<W>& driver,
+                                                               const nbody_detail::WorkingUnits& units,
+                                                               SceneSimulation& result) {
+  using nbody_detail::Rational;
+  const Scene& scene = units.scene;
+  const bool replay = result.impact_count <= nbody_detail::kCertifyingReplay;
+  const std::vector<std::optional<double>> certified = driver.certifiedVelocities(replay);
+  for (std::size_t k = 0; k < certified.size(); ++k) {
+    if (certified[k]) {
+      result.final_velocities[k] = *certified[k];
+    } else {
+      nameUncertified(result, "final_velocities");
+    }
+  }
+  if (result.energy_lost != 0.0) {  // an inelastic impact (elastic ones lose exactly 0)
+    if (const auto heat = driver.certifiedHeat(replay)) {
+      result.energy_lost = *heat;
+    } else {
+      nameUncertified(result, "energy_lost");
+    }
+  }
+  const int to_si = -units.velocity_shift;
+  std::vector<std::pair<std::size_t, double>> subnormal;
+  for (std::size_t k = 0; k < result.final_velocities.size(); ++k) {
+    const double v = result.final_velocities[k];
+    if (v == 0 || scene.isWall(k) || !(std::fabs(std::ldexp(v, to_si)) < std::numeric_limits<double>::min())) continue;
+    const std::optional<Rational> exact = replay ? driver.exactVelocity(k) : std::nullopt;
+    if (exact) {
+      subnormal.emplace_back(k, detail::nearestDouble(nbody_detail::scaledByPowerOfTwo(*exact, to_si)));
+    } else {
+      nameUncertified(result, "final_velocities");
+    }
+  }
+  if (result.energy_lost != 0.0 &&
+      std::fabs(std::ldexp(result.energy_lost, -units.energyShift())) < std::numeric_limits<double>::min()) {
+    nameUncertified(result, "energy_lost");
+  }
+  return subnormal;
+}
+
 /// runEngine with the working tier W (nbody_detail::DD or DDFma).
 template <class W>
 SceneSimulation runEngineOn(const Scene& si_scene, const EngineOptions& options, const ImpactVisitor& visitor,
@@ -766,44 +818,8 @@ SceneSimulation runEngineOn(const Scene& si_scene, const EngineOptions& options,
   driver.fast().state(result.final_time, result.final_positions, result.final_velocities);
   result.energy_lost = driver.fast().energyLost();
   result.escalations = driver.escalations();  // the run's decisions, before any certifying replay
-  std::vector<std::pair<std::size_t, double>> subnormal_velocities;  // [m/s], set after the SI conversion
-  // The final velocities certified once per run (a replay only for runs of up to
-  // kCertifyingReplay impacts); a velocity none certifies keeps the working tier's value.
-  const std::vector<std::optional<double>> certified = driver.certifiedVelocities(count <= kCertifyingReplay);
-  bool all_certified = true;
-  for (std::size_t k = 0; k < certified.size(); ++k) {
-    if (certified[k]) result.final_velocities[k] = *certified[k];
-    all_certified = all_certified && certified[k].has_value();
-  }
-  if (!all_certified) result.uncertified.push_back("final_velocities");
-  if (result.energy_lost != 0.0) {  // an inelastic impact (elastic ones lose exactly 0)
-    if (const auto heat = driver.certifiedHeat(count <= kCertifyingReplay)) {
-      result.energy_lost = *heat;
-    } else {
-      result.uncertified.push_back("energy_lost");
-    }
-  }
-  // A value subnormal in SI rounds again when scaled there: a velocity's exact value is
-  // scaled exactly instead; such a heat is named uncertified.
-  const int velocity_shift = -units.velocity_shift;
-  for (std::size_t k = 0; k < result.final_velocities.size(); ++k) {
-    const double v = result.final_velocities[k];
-    if (v == 0 || scene.isWall(k) || !(std::fabs(std::ldexp(v, velocity_shift)) < std::numeric_limits<double>::min())) {
-      continue;
-    }
-    const std::optional<Rational> exact = count <= kCertifyingReplay ? driver.exactVelocity(k) : std::nullopt;
-    if (exact) {
-      subnormal_velocities.emplace_back(k, detail::nearestDouble(scaledByPowerOfTwo(*exact, velocity_shift)));
-    } else if (std::find(result.uncertified.begin(), result.uncertified.end(), "final_velocities") ==
-               result.uncertified.end()) {
-      result.uncertified.push_back("final_velocities");
-    }
-  }
-  if (result.energy_lost != 0.0 &&
-      std::fabs(std::ldexp(result.energy_lost, -units.energyShift())) < std::numeric_limits<double>::min() &&
-      std::find(result.uncertified.begin(), result.uncertified.end(), "energy_lost") == result.uncertified.end()) {
-    result.uncertified.push_back("energy_lost");
-  }
+  // Set after the SI conversion: velocities subnormal in SI, correctly rounded there [m/s].
+  const std::vector<std::pair<std::size_t, double>> subnormal_velocities = certifyFinalValues(driver, units, result);
   fillDrift(scene, result);  // relative: the same in any units
   // Back to SI.
   result.final_time = si.time(result.final_time);
