@@ -24,6 +24,9 @@ namespace nbody_detail {
 
 namespace {
 
+/// The law's constants C1 = 1.15344 and C2 = 0.79826, as the decimals n / 100000 they are.
+constexpr int kC1 = 115344, kC2 = 79826, kDecimals = 100000;
+
 /// The double of a value known to lie in [low, high] (low <= 1 + a little): e = min(1, f);
 /// anything from 1 - 2^-54 up rounds to 1.
 template <class F>
@@ -38,7 +41,7 @@ std::optional<double> roundedIn(const F& low, const F& high) {
 /// of its arithmetic (several roundings and pow included).
 template <class F>
 std::optional<double> viscoelasticIn(const F& v, const F& error, double v_star, const F& unit) {
-  const F c1 = F(115344) / 100000, c2 = F(79826) / 100000;
+  const F c1 = F(kC1) / kDecimals, c2 = F(kC2) / kDecimals;
   const F x = v / F(v_star);
   const F s = pow(x, F(1) / 5);
   const F f = 1 - c1 * s + c2 * s * s;
@@ -69,7 +72,7 @@ std::optional<boost::multiprecision::cpp_int> fifthRoot(const boost::multiprecis
 
 std::optional<double> viscoelasticOver(long double v, long double error, double v_star) {
   if constexpr (std::numeric_limits<long double>::digits < 64) return std::nullopt;
-  constexpr long double c1 = 1.15344L, c2 = 0.79826L;  // each within 2^-64 of the decimal
+  constexpr long double c1 = static_cast<long double>(kC1) / kDecimals, c2 = static_cast<long double>(kC2) / kDecimals;  // within 2^-64
   const long double x = v / v_star;
   if (!(x > 0x1p-1000L && x < 0x1p1000L)) return std::nullopt;
   // s = x^(1/5): pow in double (within an ulp, 2^-52), then one Newton step for s^5 = x in
@@ -98,7 +101,7 @@ std::optional<double> viscoelasticDD(const DD& v, double error, double v_star) {
   DD s(std::pow(x.hi, 0.2));
   const DD s_sq = s * s, s_4 = s_sq * s_sq;
   s = s - (s_4 * s - x) / (s_4 * 5.0);
-  const DD c1 = DD(115344.0) / DD(100000.0), c2 = DD(79826.0) / DD(100000.0);  // within 2^-104
+  const DD c1 = DD(kC1) / DD(kDecimals), c2 = DD(kC2) / DD(kDecimals);  // within 2^-104
   const DD f = DD(1.0) - c1 * s + c2 * (s * s);
   const double size = s.hi * (1 + 0x1p-40);
   // f's bound: s's error through f' = 2 c2 s - c1, f's own operations (2^-100 of its
@@ -137,7 +140,7 @@ double viscoelasticAt(const Rational& v, double v_star) {
   const auto root = fifthRoot(numerator(x)), root_of_denominator = fifthRoot(denominator(x));
   if (root && root_of_denominator) {
     const Rational s(*root, *root_of_denominator);
-    const Rational f = 1 - Rational(115344, 100000) * s + Rational(79826, 100000) * s * s;
+    const Rational f = 1 - Rational(kC1, kDecimals) * s + Rational(kC2, kDecimals) * s * s;
     return f >= 1 ? 1.0 : core::detail::nearestDouble(f);
   }
   const Float100 wide = Float100(numerator(v)) / Float100(denominator(v));  // within 2^-330
@@ -148,9 +151,7 @@ double viscoelasticAt(const Rational& v, double v_star) {
   const Deep deep = Deep(numerator(v)) / Deep(denominator(v));
   const Deep unit = ldexp(Deep(1), -1640);
   if (const auto e = viscoelasticIn(deep, Deep(deep * unit * 2), v_star, unit)) return *e;
-  const Deep s = pow(deep / Deep(v_star), Deep(1) / 5);
-  const Deep f = 1 - Deep(115344) / 100000 * s + Deep(79826) / 100000 * s * s;
-  return f >= 1 ? 1.0 : static_cast<double>(f);
+  return *viscoelasticIn(deep, Deep(0), v_star, Deep(0));  // the 500-digit value, rounded
 }
 
 }  // namespace nbody_detail
