@@ -525,12 +525,18 @@ SceneSimulation simulateByEngine(const Scene& scene, const SimulationOptions& op
   const int wall = wallIndex(scene);
   ImpactRecord event;
   ImpactVisitor on_impact;
+  std::array<bool, 3> velocity_uncertified{};  // set by an uncertified value
+  const auto any = [](const std::array<bool, 3>& flags) { return flags[0] || flags[1] || flags[2]; };
   if (visitor) {
     on_impact = [&](const ImpactRecord& record) {
       const int i = static_cast<int>(record.pair_index);
       event = record;
       ImpactModelValues& state = event.model.emplace();
       state.velocities_before = velocities;
+      // Positions and totals are computed here from rounded values.
+      event.uncertified |= kPositions | kKineticEnergyAfter | kTotalEnergy | kTotalMomentum;
+      if (any(velocity_uncertified)) event.uncertified |= kVelocitiesBefore;
+      if (record.uncertified & kPairEnergyTransfer) event.uncertified |= kEnergyTransfer;
       for (int k = 0; k < 3; ++k) {
         const long double elapsed = static_cast<long double>(record.time) - since_time[k];
         const long double position =
@@ -540,9 +546,15 @@ SceneSimulation simulateByEngine(const Scene& scene, const SimulationOptions& op
                                                                             : positive(position);
       }
       const bool last = final_state && record.index == final_state->impact_count;
-      if (last) event.velocities_after = {final_state->final_velocities[i], final_state->final_velocities[i + 1]};
+      const bool final_uncertified = last && std::find(final_state->uncertified.begin(), final_state->uncertified.end(),
+                                                       "final_velocities") != final_state->uncertified.end();
+      if (last) {
+        event.velocities_after = {final_state->final_velocities[i], final_state->final_velocities[i + 1]};
+        event.uncertified = (event.uncertified & ~kPairVelocitiesAfter) | (final_uncertified ? kPairVelocitiesAfter : 0u);
+      }
       for (int side = 0; side < 2; ++side) {
         const int body = i + side;
+        velocity_uncertified[body] = event.uncertified & kPairVelocitiesAfter;
         velocities[body] = event.velocities_after[side];
         state.positions[body] = record.position;
         since_position[body] = record.position;
@@ -553,7 +565,11 @@ SceneSimulation simulateByEngine(const Scene& scene, const SimulationOptions& op
       const int side = scene.isWall(i) ? 1 : 0;
       state.energy_transfer[i + side] = record.energy_gained[side];
       state.energy_transfer[i + 1 - side] = positive(-static_cast<long double>(record.energy_gained[side]));
-      if (last) velocities = triple(final_state->final_velocities);  // the third body's too
+      if (last) {
+        velocities = triple(final_state->final_velocities);  // the third body's too
+        velocity_uncertified = {final_uncertified, final_uncertified, final_uncertified};
+      }
+      if (any(velocity_uncertified)) event.uncertified |= kVelocitiesAfter;
       state.velocities_after = velocities;
       long double energy = 0, momentum = 0;
       for (int k = 0; k < 3; ++k) {
@@ -673,6 +689,59 @@ void fillRotationPrediction(const Scene& scene, Prediction& prediction) {
 
 /// Simulates (full or summary mode), with every event put beside the prediction in full
 /// mode, and measures how far the simulation is from the closed form.
+/// An impact's values that the exact walk gives a short run, each correctly rounded (the
+/// positions are still the run's; ExactInTurn::fillState, ModelBesideImpacts).
+constexpr std::uint32_t kExactWalkValues = (kPairValues & ~(kImpactTime | kImpactPosition | kImpactEnergyLost)) |
+                                           kVelocitiesBefore | kVelocitiesAfter | kEnergyTransfer |
+                                           kKineticEnergyAfter | kTotalEnergy | kTotalMomentum |
+                                           kPredictedVelocitiesAfter | kPredictedEnergyTransfer |
+                                           kPaperVelocitiesAfter | kPaperEnergyTransfer;
+
+/// The finite bodies' kinetic energy at the start in the lab frame [J] (the smallest
+/// normal double when none): the scale of an impact's energy transfers.
+double kineticEnergyScale(const Scene& scene) {
+  long double energy = 0;
+  for (std::size_t k = 0; k < scene.size(); ++k) {
+    if (!scene.isWall(k)) energy += static_cast<long double>(scene.masses[k]) * scene.velocities[k] * scene.velocities[k] / 2;
+  }
+  return std::max(static_cast<double>(energy), std::numeric_limits<double>::min());
+}
+
+/// Agreement of the closed form in double with the run's certified values, in the energy
+/// norm relative to the start (and energies relative to the start's): far above its
+/// rounding, far below any fault.
+constexpr double kClosedFormAgreement = 0x1p-40;
+
+/// A long run's impact (no exact walk): the closed form names the same exact state as the
+/// run. Where the run's values are certified and the closed form in double agrees with them
+/// to its own precision, they are the model's values, correctly rounded; otherwise the
+/// closed form's doubles stand, flagged. The paper's printed values are in double (flagged
+/// where they are numbers; NaN where undefined).
+void certifyPrediction(ImpactRecord& event, const EnergyNormError& relative_error, double energy_scale) {
+  ImpactModelValues& values = *event.model;
+  if (!(event.uncertified & kVelocitiesAfter) &&
+      relative_error(values.velocities_after, values.predicted_velocities_after) <= kClosedFormAgreement) {
+    values.predicted_velocities_after = values.velocities_after;
+  } else {
+    event.uncertified |= kPredictedVelocitiesAfter;
+  }
+  bool energies_agree = !(event.uncertified & kEnergyTransfer);
+  for (int k = 0; k < 3 && energies_agree; ++k) {
+    energies_agree = std::fabs(values.energy_transfer[k] - values.predicted_energy_transfer[k]) <=
+                     kClosedFormAgreement * energy_scale;
+  }
+  if (energies_agree) {
+    values.predicted_energy_transfer = values.energy_transfer;
+  } else {
+    event.uncertified |= kPredictedEnergyTransfer;
+  }
+  const auto numbers = [](const std::array<double, 3>& v) {
+    return !std::isnan(v[0]) || !std::isnan(v[1]) || !std::isnan(v[2]);
+  };
+  if (numbers(values.paper_velocities_after)) event.uncertified |= kPaperVelocitiesAfter;
+  if (numbers(values.paper_energy_transfer)) event.uncertified |= kPaperEnergyTransfer;
+}
+
 SceneSimulation simulateRotationScene(const Scene& scene, const Prediction& prediction,
                                       const SceneRunOptions& options, const SceneVisitors& visitors) {
   const RunOptions& lab = options.lab;
@@ -689,19 +758,28 @@ SceneSimulation simulateRotationScene(const Scene& scene, const Prediction& pred
   std::function<void(ImpactRecord&)> enrich;
   ModelBesideImpacts beside(scene, model);
   double max_error_sq = 0.0;
+  // The closed form and the run name the same exact state after every impact: a difference
+  // within the closed form's rounding (kClosedFormAgreement) is none; a larger one, a fault.
+  const auto disagreement = [&relative_error](const std::array<double, 3>& run, const std::array<double, 3>& model) {
+    const double error_sq = relative_error.squared(run, model);
+    return relative_error.fromSquared(error_sq) <= kClosedFormAgreement ? 0.0 : error_sq;
+  };
+  const double energy_scale = kineticEnergyScale(scene);
   if (lab.mode == RunMode::kFull) {
     enrich = [&](ImpactRecord& event) {
       ImpactModelValues& values = *event.model;
-      if (beside.describe(event.index, event.pair_index == 0 ? Pair::AB : Pair::BC, values)) {
+      const bool exact_walk = beside.describe(event.index, event.pair_index == 0 ? Pair::AB : Pair::BC, values);
+      if (exact_walk) {
         for (std::size_t side = 0; side < 2; ++side) {  // the pair's entries of the record too
           const std::size_t body = event.pair_index + side;
           event.velocities_before[side] = values.velocities_before[body];
           event.velocities_after[side] = values.velocities_after[body];
           event.energy_gained[side] = values.energy_transfer[body];
         }
+        event.uncertified &= ~kExactWalkValues;
       }
-      max_error_sq =
-          std::max(max_error_sq, relative_error.squared(values.velocities_after, values.predicted_velocities_after));
+      max_error_sq = std::max(max_error_sq, disagreement(values.velocities_after, values.predicted_velocities_after));
+      if (!exact_walk) certifyPrediction(event, relative_error, energy_scale);
       if (visitors.impact) visitors.impact(event);
       if (events.keeps(event.index)) simulation.impacts.push_back(event);
     };
@@ -724,7 +802,7 @@ SceneSimulation simulateRotationScene(const Scene& scene, const Prediction& pred
           known_error_sq = 0.0;
         },
         [&](std::uint64_t n, const std::array<double, 3>& v) {
-          known_error_sq = std::max(known_error_sq, relative_error.squared(v, predicted->velocitiesAfter(n)));
+          known_error_sq = std::max(known_error_sq, disagreement(v, predicted->velocitiesAfter(n)));
         });
   } else {
     known = simulateKnownCount(scene, predicted_count, simulation_options, known_progress, progress_interval, [] {},
@@ -782,7 +860,7 @@ SceneSimulation simulateRotationScene(const Scene& scene, const Prediction& pred
                                                   ? triple(prediction.final_velocities)
                                                   : ClosedFormInTurn(model).velocitiesAfter(run.impact_count);
   simulation.max_prediction_error =
-      std::max(relative_error.fromSquared(max_error_sq), relative_error(triple(run.final_velocities), predicted_end));
+      relative_error.fromSquared(std::max(max_error_sq, disagreement(triple(run.final_velocities), predicted_end)));
   if (!run.truncated) simulation.matches_prediction = run.impact_count == predicted_count;
   simulation.escalations = run.escalations;
   return simulation;

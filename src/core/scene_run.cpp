@@ -85,6 +85,11 @@ Collapse certified(Collapse collapse, const Prediction& prediction) {
   collapse.time = *prediction.collapse_time;
   collapse.position = *prediction.collapse_position;
   if (!prediction.final_velocities.empty()) collapse.velocity = prediction.final_velocities[1];  // not a wall's
+  if (!isUncertified(prediction, "collapse_time")) collapse.uncertified &= ~kImpactTime;
+  if (!isUncertified(prediction, "collapse_position")) collapse.uncertified &= ~kImpactPosition;
+  if (!prediction.final_velocities.empty() && !isUncertified(prediction, "predicted_final_velocities")) {
+    collapse.uncertified &= ~kPairVelocitiesAfter;
+  }
   return collapse;
 }
 
@@ -153,6 +158,7 @@ SceneSimulation simulateScene(const Scene& scene, const SceneRunOptions& options
         exact.velocities_after = two_body->velocities_after;
         exact.energy_gained = two_body->energy_gained;
         exact.energy_lost = two_body->energy_lost;
+        exact.uncertified = 0;  // the velocities before are the scene's
         inner(exact);
       };
     }
@@ -172,11 +178,20 @@ SceneSimulation simulateScene(const Scene& scene, const SceneRunOptions& options
   const bool agrees = prediction && prediction->impact_count && simulation.stop == StopReason::kFinished &&
                       simulation.impact_count == *prediction->impact_count;
   if (whole_collapse && simulation.collapsed && simulation.stop == StopReason::kFinished) {
+    const bool ends_at_collapse = simulation.final_time == simulation.collapses.back().time;
     for (Collapse& collapse : simulation.collapses) {
       if (collapse.first_body == 0 && collapse.last_body + 1 == scene.size()) collapse = certified(collapse, *prediction);
     }
     simulation.collapse_time = prediction->collapse_time;
     simulation.collapse_position = prediction->collapse_position;
+    const Collapse& last = simulation.collapses.back();
+    if (ends_at_collapse && last.first_body == 0 && last.last_body + 1 == scene.size()) {
+      simulation.final_time = last.time;  // the model's
+      if (!(last.uncertified & kImpactTime)) {
+        auto& keys = simulation.uncertified;
+        keys.erase(std::remove(keys.begin(), keys.end(), "final_time"), keys.end());
+      }
+    }
   }
   // The engine's own values against the model's, before the run publishes the model's:
   // the comparison checks the engine, not the substitution.

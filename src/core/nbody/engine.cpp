@@ -41,6 +41,9 @@ namespace {
 /// certify replay at 100 digits to certify them (about 5 us per impact); longer ones name
 /// them uncertified.
 constexpr std::uint64_t kCertifyingReplay = 10'000;
+/// The exact tier's work budget [bit^2, summed] for bringing it to one impact whose record
+/// only it can certify (an exact zero or tie): milliseconds, against the 1e11 of a decision.
+constexpr double kRecordExactWorkBudget = 1e8;
 
 /// q 2^e, exactly.
 Rational scaledByPowerOfTwo(const Rational& q, int e) {
@@ -96,7 +99,30 @@ class Driver {
     if (r.kind == StepKind::kImpact && escalations_.exact_rational + escalations_.high_precision > escalated) {
       crowd_[crowd_next_++ % crowd_.size()] = r.pair;
     }
+    if (r.kind == StepKind::kImpact && record && record->uncertified != 0 && fast_->count() <= kCertifyingReplay) {
+      certifyRecord(*record);
+    }
     return r;
+  }
+
+  /// The values of the impact just taken (the working tier's last) that its record does not
+  /// certify, from the same impact re-taken by the 100-digit tier, then the exact one (an exact
+  /// zero or tie), each brought there by replay: within a run's first kCertifyingReplay impacts,
+  /// and the exact tier only until its budget first stops it. What none certifies stays flagged.
+  /// These replays are not the run's decisions: the escalations and budget the run reports
+  /// stay as they were, the same with events or without.
+  void certifyRecord(ImpactRecord& record) {
+    const Escalations escalations = escalations_;
+    const ExactProgress budget_stop = budget_stop_;
+    rerecord<Float100>(record);
+    if (record.uncertified != 0 && !exact_records_failed_) {
+      const double budget = budget_;
+      budget_ = std::min(budget_, kRecordExactWorkBudget);
+      rerecord<Rational>(record);
+      budget_ = budget;
+    }
+    escalations_ = escalations;
+    budget_stop_ = budget_stop;
   }
 
   /// The bodies of the last kCrowdWindow impacts that needed more than double-double, and of
@@ -133,6 +159,30 @@ class Driver {
   double exactNextTimeLowerBound() {
     if (advanceTo<Rational>(fast_->count()).kind != StepKind::kImpact) return 0.0;
     return exact_->nextTimeLowerBound();
+  }
+
+  /// Re-takes the working tier's last impact in tier S and takes from its record the values
+  /// `record` does not certify and it does.
+  template <class S>
+  void rerecord(ImpactRecord& record) {
+    const std::uint64_t count = fast_->count();
+    auto& t = tier<S>();
+    if (t && t->count() >= count) return;  // it took this impact already (an escalation), or passed it
+    const StepResult at = advanceTo<S>(count - 1);
+    ImpactRecord again;
+    const StepResult r = at.kind == StepKind::kImpact ? stepOrEscalate<S>(&again) : at;
+    if (r.kind != StepKind::kImpact || again.pair_index != record.pair_index) {
+      if constexpr (Arithmetic<S>::kExact) exact_records_failed_ = true;
+      return;
+    }
+    const std::uint32_t taken = record.uncertified & ~again.uncertified;
+    if (taken & kImpactTime) record.time = again.time;
+    if (taken & kImpactPosition) record.position = again.position;
+    if (taken & kPairVelocitiesBefore) record.velocities_before = again.velocities_before;
+    if (taken & kPairVelocitiesAfter) record.velocities_after = again.velocities_after;
+    if (taken & kPairEnergyTransfer) record.energy_gained = again.energy_gained;
+    if (taken & kImpactEnergyLost) record.energy_lost = again.energy_lost;
+    record.uncertified &= ~taken;
   }
 
   /// Every body's velocity after the working tier's last impact [working units], correctly
@@ -381,7 +431,8 @@ class Driver {
     const bool followed =
         r.kind == StepKind::kAmbiguous && higher.kind == StepKind::kImpact && t.follow(*tier<H>(), higher.pair);
     if (!followed) t.adopt(*tier<H>());
-    if (record && higher.kind == StepKind::kImpact) {  // publish what this tier now holds
+    // Velocities after that tier H did not certify: what this tier now holds.
+    if (record && higher.kind == StepKind::kImpact && (record->uncertified & kPairVelocitiesAfter)) {
       record->velocities_after = {t.velocity(higher.pair), t.velocity(tables_.scene.leftOf(higher.pair))};
     }
     return higher;
@@ -496,6 +547,7 @@ class Driver {
   std::unique_ptr<Tier<Float100>> high_;
   std::unique_ptr<Tier<Rational>> exact_;
   Escalations escalations_;
+  bool exact_records_failed_ = false;  ///< the exact tier could not re-take an impact (its budget): no more tries
 };
 
 std::string formatValue(double value) {
@@ -677,6 +729,16 @@ const char* stopReasonName(StopReason reason) {
   return "UNKNOWN";
 }
 
+const char* impactValueName(int k) {
+  static const char* const kNames[kImpactValueCount] = {
+      "time",           "position",          "pair_velocities_before",     "pair_velocities_after",
+      "pair_energy_transfer", "energy_lost", "positions",                  "velocities_before",
+      "velocities_after",     "energy_transfer", "kinetic_energy_after",   "total_energy",
+      "total_momentum",       "predicted_velocities_after", "predicted_energy_transfer", "paper_velocities_after",
+      "paper_energy_transfer"};
+  return k >= 0 && k < kImpactValueCount ? kNames[k] : "";
+}
+
 namespace {
 
 /// Names `key` in result.uncertified, once.
@@ -743,13 +805,18 @@ SceneSimulation runEngineOn(const Scene& si_scene, const EngineOptions& options,
   // The largest working time [s * 2^timeShift] whose SI value a double holds (inf: any).
   constexpr double kLargest = std::numeric_limits<double>::max();
   const double time_limit = static_cast<double>(std::ldexp(static_cast<long double>(kLargest), units.timeShift()));
+  // A value subnormal in SI is rounded a second time there: no longer certified.
   const auto toSiRecord = [&si](ImpactRecord& record) {
-    record.time = si.time(record.time);
-    record.position = si.position(record.position);
-    for (double& v : record.velocities_before) v = si.velocity(v);
-    for (double& v : record.velocities_after) v = si.velocity(v);
-    for (double& e : record.energy_gained) e = si.energy(e);
-    record.energy_lost = si.energy(record.energy_lost);
+    const auto scaled = [&record](double x, ImpactValue bit) {
+      if (x != 0 && std::fabs(x) < std::numeric_limits<double>::min()) record.uncertified |= bit;
+      return x;
+    };
+    record.time = scaled(si.time(record.time), kImpactTime);
+    record.position = scaled(si.position(record.position), kImpactPosition);
+    for (double& v : record.velocities_before) v = scaled(si.velocity(v), kPairVelocitiesBefore);
+    for (double& v : record.velocities_after) v = scaled(si.velocity(v), kPairVelocitiesAfter);
+    for (double& e : record.energy_gained) e = scaled(si.energy(e), kPairEnergyTransfer);
+    record.energy_lost = scaled(si.energy(record.energy_lost), kImpactEnergyLost);
   };
   const auto toSiCollapse = [&si](Collapse c) {
     c.time = si.time(c.time);
@@ -809,8 +876,16 @@ SceneSimulation runEngineOn(const Scene& si_scene, const EngineOptions& options,
     result.crowding_bodies = driver.crowdingBodies();
   }
   result.final_time = driver.fast().lastTime();
+  if (const auto certified = driver.fast().certifiedLastTime()) {
+    result.final_time = *certified;
+  } else {
+    nameUncertified(result, "final_time");
+  }
   result.collapsed = !result.collapses.empty();
-  if (result.collapsed) result.final_time = std::max(result.final_time, result.collapses.back().time);
+  if (result.collapsed && !(result.collapses.back().time <= result.final_time)) {
+    result.final_time = result.collapses.back().time;  // the engine's, from its state at the time
+    nameUncertified(result, "final_time");
+  }
   // An impact after the largest double [s] was counted and published with time +inf.
   result.time_beyond_range = !(result.final_time <= time_limit);
   result.cluster_impacts = driver.fast().clusterImpacts();

@@ -32,6 +32,7 @@
 #include <optional>
 #include <vector>
 
+#include "../correct_rounding.h"
 #include "arithmetic.h"
 #include "fma_path.h"
 #include "group_collapse.h"
@@ -209,6 +210,18 @@ class CL_NBODY_INTERNAL Tier {
   double energyLost() const { return lost_ + lost_compensation_; }
   /// Time of the last impact [s], or of the one in progress (0 before the first).
   double lastTime() const { return Ar::sign(now_.A) > 0 ? Ar::toDouble(S(now_.G / now_.A)) : 0.0; }
+
+  /// The time of the last impact [s] correctly rounded, where this tier's bound decides it
+  /// (rounded once in the exact tier); 0 before the first; empty otherwise.
+  std::optional<double> certifiedLastTime() const {
+    if (!(Ar::sign(now_.A) > 0)) return 0.0;
+    const Precise t = preciseNow();
+    if (!t.ok) return std::nullopt;
+    ImpactRecord scratch;
+    const double value = publish(t.value, t.error, kImpactTime, scratch);
+    if (scratch.uncertified != 0) return std::nullopt;
+    return value;
+  }
 
   /// Finds and performs the next impact (or reports why not). `record` may be null.
   StepResult step(ImpactRecord* record) {
@@ -718,6 +731,10 @@ class CL_NBODY_INTERNAL Tier {
   /// a schedule out of step with the state, which the driver reports as an internal error).
   Precise preciseTime(std::size_t p) {
     ++refinements_;
+    return timeOf(p);
+  }
+  /// preciseTime(p) without counting a refinement.
+  Precise timeOf(std::size_t p) const {
     const S G = gapOf(p);
     const S A = bodies_[left(p)].v - bodies_[p].v;
     if constexpr (Ar::kExact) return Ar::sign(A) > 0 ? Precise{G / A, 0.0, true} : Precise{S(), kInf, false};
@@ -920,37 +937,127 @@ class CL_NBODY_INTERNAL Tier {
     return 2 * Ar::kOpError * (s_h * (q_h + 8 * inc) + s_l * (q_l + q_h + 8 * inc + 2 * d)) + (s_h + s_l) * kTiny;
   }
 
-  void recordBefore(std::size_t m, ImpactRecord& record) const {
-    const BodyState& i = bodies_[m];
-    const BodyState& j = bodies_[left(m)];
-    // The contact point is best extrapolated along the slower body's line.
-    const bool i_slow = std::fabs(Ar::toDouble(i.v)) <= std::fabs(Ar::toDouble(j.v));
-    const BodyState& slow = i_slow ? i : j;
-    const S time = gapOf(m) / (j.v - i.v);
-    record.pair_index = m;
-    record.first_moved = m;
-    record.last_moved = left(m);
-    record.time = Ar::toDouble(time);
-    record.position = wrap(Ar::toDouble(S(slow.b + S(slow.v * time))) - (i_slow ? 0.0 : offset(m)));
-    record.velocities_before = {Ar::toDouble(i.v), Ar::toDouble(j.v)};
+  /// x rounded to double and published as `bit` of the record: correctly rounded when every
+  /// value within `error` of it (a bound on |x - the exact value|; 0: x is exact) rounds to
+  /// the same normal double, and in the exact tier; else the bit is set (not certified).
+  static double publish(const S& x, double error, ImpactValue bit, ImpactRecord& record) {
+    if constexpr (Ar::kExact) {
+      return detail::nearestDouble(x);
+    } else {
+      const double value = Ar::toDouble(x);
+      if (error == 0.0) return value;  // a double-double's head, or toDoubleNearest: x rounded once
+      const double wide = (error + 2 * Ar::kOpError * std::fabs(value)) * kSlack + kTiny;
+      if constexpr (!std::is_same_v<S, Float100>) {
+        // The head's nearest rounding boundary lies at least |hi| 2^-54 away (half the gap
+        // below a power of two): the tail and the bound well inside it decide at once.
+        if (std::fabs(x.lo) + wide < std::fabs(value) * 0x1p-54 && std::fabs(value) >= 0x1p-960) return value;
+      }
+      const double low = Ar::toDouble(S(x - S(wide))), high = Ar::toDouble(S(x + S(wide)));
+      if (low != high || !(std::fabs(low) >= std::numeric_limits<double>::min())) record.uncertified |= bit;
+      return value;
+    }
   }
 
-  void recordAfter(std::size_t m, const S& before_i, const S& before_j, double lost, ImpactRecord& record) const {
+  /// Bound on |v - the exact velocity| of body k [m/s] for the state bound eu (0 for a wall).
+  double velocityError(std::size_t k, double eu) const { return eu * tables_.inv_sqrt_mass[k]; }  // a wall's is 0
+
+  void recordBefore(std::size_t m, ImpactRecord& record) const {
+    const std::size_t left_body = left(m);
+    const BodyState& i = bodies_[m];
+    const BodyState& j = bodies_[left_body];
+    // The contact point is best extrapolated along the slower body's line.
+    const bool i_slow = std::fabs(Ar::toDouble(i.v)) <= std::fabs(Ar::toDouble(j.v));
+    const std::size_t slow_body = i_slow ? m : left_body;
+    const BodyState& slow = bodies_[slow_body];
+    record.uncertified = 0;
+    const Precise time = timeOf(m);
+    record.pair_index = m;
+    record.first_moved = m;
+    record.last_moved = left_body;
+    if (!time.ok) {  // a pair that does not approach: cannot happen for the pair about to collide
+      record.uncertified |= kImpactTime | kImpactPosition;
+      record.time = Ar::toDouble(S(gapOf(m) / S(j.v - i.v)));
+    } else {
+      record.time = publish(time.value, time.error, kImpactTime, record);
+    }
+    // x = b + v t - L across the seam: the intercept's and velocity's bounds, the time's, and
+    // the rounding of the two operations and of the seam's subtraction.
+    const S at = S(slow.b + S(slow.v * time.value));
+    S position = i_slow ? at : S(at - S(offset(m)));
+    double position_error = 0.0;
+    if constexpr (!Ar::kExact) {
+      const double t = std::fabs(Ar::toDouble(time.value)), v = std::fabs(Ar::toDouble(slow.v));
+      position_error = velocityError(slow_body, eb_) + t * velocityError(slow_body, eu_) + v * time.error +
+                       2.02 * Ar::kOpError * (std::fabs(Ar::toDouble(slow.b)) + v * t + offset(m));
+    }
+    if (tables_.ring != 0.0) {  // into [0, L) in S: whole turns, the product of two doubles, exact
+      const double turns = std::floor(Ar::toDouble(position) / tables_.ring);
+      if (turns != 0.0) {
+        position = S(position - S(S(turns) * S(tables_.ring)));
+        position_error += 1.01 * Ar::kOpError * std::fabs(turns * tables_.ring);
+      }
+    }
+    const double x = publish(position, time.ok ? position_error : kInf, kImpactPosition, record);
+    record.position = wrap(x);
+    if (record.position != x) record.uncertified |= kImpactPosition;  // the ring's wrap rounds
+    record.velocities_before = {publish(i.v, velocityError(m, eu_), kPairVelocitiesBefore, record),
+                                publish(j.v, velocityError(left_body, eu_), kPairVelocitiesBefore, record)};
+  }
+
+  /// The record after the impact of pair m, sides of masses `mass` (kInf: a wall; a cluster's
+  /// total), known exactly or within `mass_error` [kg], restitution e: the velocities after,
+  /// the energies gained, and the heat (1 - e^2) mu A^2 / 2 at the approach speed A before
+  /// (now_.A), each in S with its bound. A wall's entry is minus the other's gain and the heat.
+  void recordAfter(std::size_t m, const S& before_i, const S& before_j, const std::array<S, 2>& mass,
+                   const std::array<bool, 2>& wall, bool mass_exact, double e, ImpactRecord& record) const {
     const std::size_t body[2] = {m, left(m)};
-    record.velocities_after = {Ar::toDouble(bodies_[body[0]].v), Ar::toDouble(bodies_[body[1]].v)};
-    record.energy_lost = lost;
     const S* before[2] = {&before_i, &before_j};
-    const Scene& scene = tables_.scene;
+    std::array<S, 2> gained{S(0), S(0)};
+    std::array<double, 2> gained_error{0.0, 0.0};
     for (int k = 0; k < 2; ++k) {
-      if (scene.isWall(body[k])) continue;
-      const double dv = Ar::toDouble(S(bodies_[body[k]].v - *before[k]));
-      const double sum = record.velocities_after[k] + record.velocities_before[k];
-      record.energy_gained[k] = 0.5 * scene.masses[body[k]] * dv * sum;
+      const S& after = bodies_[body[k]].v;
+      // Stuck (e = 0) to a wall: the wall's velocity, exactly.
+      const bool on_wall = e == 0.0 && wall[1 - k];
+      record.velocities_after[k] =
+          publish(after, on_wall ? 0.0 : velocityError(body[k], eu_), kPairVelocitiesAfter, record);
+      if (wall[k]) continue;
+      // Bounced elastically off a wall at rest: it gains exactly nothing.
+      if (e == 1.0 && wall[1 - k] && Ar::toDouble(bodies_[body[1 - k]].v) == 0.0) continue;
+      // m/2 (v' - v)(v' + v), each factor within the bounds of v' and v.
+      const S dv = after - *before[k], sum = after + *before[k];
+      gained[k] = S(S(mass[k] * dv) * sum) * S(0.5);
+      if constexpr (!Ar::kExact) {
+        const double ev = velocityError(body[k], eu_) + velocityError(body[k], now_.eu);
+        const double d = std::fabs(Ar::toDouble(dv)) * (1 + 2 * Ar::kOpError) + ev;
+        const double s = std::fabs(Ar::toDouble(sum)) * (1 + 2 * Ar::kOpError) + ev;
+        const double mk = std::fabs(Ar::toDouble(mass[k]));
+        gained_error[k] = 0.5 * mk * (d * s - (d - ev) * (s - ev)) + 6 * Ar::kOpError * mk * d * s;
+      }
     }
-    // A wall takes what the finite body gave up minus the heat.
+    S lost(0);
+    double lost_error = 0.0;
+    if (e != 1.0) {
+      const S mu = wall[0] ? mass[1] : wall[1] ? mass[0] : S(S(mass[0] * mass[1]) / S(mass[0] + mass[1]));
+      const S factor = S(S(S(1) - S(S(e) * S(e))) * mu) * S(0.5);
+      lost = S(factor * now_.A) * now_.A;
+      if constexpr (!Ar::kExact) {
+        const double a = std::fabs(Ar::toDouble(now_.A));
+        const double ea = now_.eu * pairs_[m].scale + now_.extra;
+        const double f = std::fabs(Ar::toDouble(factor)) * (1 + 8 * Ar::kOpError);
+        lost_error = f * (2 * a * ea + ea * ea) + 4 * Ar::kOpError * f * a * a;
+      }
+    }
+    record.energy_lost = publish(lost, lost_error, kImpactEnergyLost, record);
     for (int k = 0; k < 2; ++k) {
-      if (scene.isWall(body[k])) record.energy_gained[k] = -record.energy_gained[1 - k] - lost;
+      if (!wall[k]) continue;
+      if (Ar::toDouble(bodies_[body[k]].v) == 0.0) continue;  // a wall at rest does no work: exactly 0
+      gained[k] = S(-gained[1 - k]) - lost;
+      gained_error[k] = gained_error[1 - k] + lost_error + 2 * Ar::kOpError * std::fabs(Ar::toDouble(gained[k]));
     }
+    for (int k = 0; k < 2; ++k) {
+      record.energy_gained[k] = publish(gained[k], gained_error[k], kPairEnergyTransfer, record);
+    }
+    if (!mass_exact) record.uncertified |= kPairEnergyTransfer | kImpactEnergyLost;
   }
 
   /// Precision guard: an impact's time t = G / A is published to about 1e-12. When this
@@ -1196,22 +1303,28 @@ class CL_NBODY_INTERNAL Tier {
     const double lost = impactEnergyLost(mass_d[0], mass_d[1], Ar::toDouble(now_.A), e);
     if (lost != 0.0) addLoss(lost);
     if (record) {
-      record->velocities_after = {Ar::toDouble(i.v), Ar::toDouble(j.v)};
-      record->energy_lost = lost;
-      const S* before[2] = {&before_i, &before_j};
-      for (int k = 0; k < 2; ++k) {
-        const double dvk = Ar::toDouble(S(bodies_[m + k].v - *before[k]));
-        record->energy_gained[k] = 0.5 * mass_d[k] * dvk * (record->velocities_after[k] + record->velocities_before[k]);
-      }
-      for (int k = 0; k < 2; ++k) {
-        if (wall[k]) record->energy_gained[k] = -record->energy_gained[1 - k] - lost;
-      }
+      recordAfter(m, before_i, before_j, {mass[0], mass[1]}, {wall[0], wall[1]}, massSumsExact(lo, hi), e, *record);
     }
     ++cluster_impacts_;
     const double magnitude = std::fabs(Ar::toDouble(i.b)) + std::fabs(Ar::toDouble(j.b)) +
                              std::fabs(Ar::toDouble(i.v)) + std::fabs(Ar::toDouble(j.v));
     if (!(magnitude < kMaxMagnitude)) return {StepKind::kOutOfRange, m, lastTime()};
     return {StepKind::kImpact, m, 0.0};
+  }
+
+  /// Are the sums of the masses of bodies lo..hi exact in S? Always in the exact tier; at 100
+  /// digits (333 bits) when their exponents span less than 260 bits (a double's 53 and the
+  /// carries of up to 2^20 terms within the rest); never in double-double.
+  bool massSumsExact(std::size_t lo, std::size_t hi) const {
+    if constexpr (Ar::kExact) return true;
+    if constexpr (!std::is_same_v<S, Float100>) return false;
+    int smallest = std::numeric_limits<int>::max(), largest = std::numeric_limits<int>::min();
+    for (std::size_t k = lo; k <= hi; ++k) {
+      if (tables_.scene.isWall(k)) continue;
+      smallest = std::min(smallest, std::ilogb(tables_.scene.masses[k]));
+      largest = std::max(largest, std::ilogb(tables_.scene.masses[k]));
+    }
+    return hi - lo < (1u << 20) && largest - smallest < 260;
   }
 
   /// The impact of pair m on its two single bodies.
@@ -1257,7 +1370,11 @@ class CL_NBODY_INTERNAL Tier {
                  : impactEnergyLost(scene.masses[m], scene.masses[left_body], approach_speed, rule.e);
       addLoss(lost);
     }
-    if (record) recordAfter(m, before_i, before_j, lost, *record);
+    if (record) {
+      const auto mass_of = [&scene](std::size_t k) { return scene.isWall(k) ? S(0) : S(scene.masses[k]); };
+      recordAfter(m, before_i, before_j, {mass_of(m), mass_of(left_body)},
+                  {scene.isWall(m), scene.isWall(left_body)}, true, rule.e, *record);
+    }
     const double magnitude = std::fabs(Ar::toDouble(i.b)) + std::fabs(Ar::toDouble(j.b)) +
                              std::fabs(Ar::toDouble(i.v)) + std::fabs(Ar::toDouble(j.v));
     if (!(magnitude < kMaxMagnitude)) return {StepKind::kOutOfRange, m, lastTime()};

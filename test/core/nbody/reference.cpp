@@ -163,7 +163,7 @@ Run simulate(const Scene& scene, std::uint64_t max_impacts) {
       break;
     }
     run.energy_lost += lost;
-    run.events.push_back({p, s.now, s.x[p], lost});
+    run.events.push_back({p, s.now, s.x[p], lost, before.v[p], before.v[p + 1], s.v[p], s.v[p + 1]});
     run.last_time = s.now;
   }
   run.velocities = s.v;

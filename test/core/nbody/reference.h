@@ -40,6 +40,8 @@ struct Event {
   Rational time;      ///< [s]
   Rational position;  ///< contact point [m]
   Rational lost;      ///< kinetic energy lost [J]
+  Rational before_right, before_left;  ///< velocities of bodies pair and pair + 1 before [m/s]
+  Rational after_right, after_left;    ///< and after [m/s]
 };
 
 struct Run {

@@ -64,6 +64,43 @@
 namespace collision_lab {
 namespace core {
 
+/// The published values of an impact, as bits of ImpactRecord::uncertified: those set are
+/// not certified correctly rounded (physics.md, "How close the published values are"). Each
+/// bit's name (impactValueName) is the event's field in JSON, CSV and CollisionEvent.msg.
+enum ImpactValue : std::uint32_t {
+  kImpactTime = 1u << 0,
+  kImpactPosition = 1u << 1,
+  kPairVelocitiesBefore = 1u << 2,
+  kPairVelocitiesAfter = 1u << 3,
+  kPairEnergyTransfer = 1u << 4,
+  kImpactEnergyLost = 1u << 5,
+  // Every body's state (the full state of an event), and the model block.
+  kPositions = 1u << 6,
+  kVelocitiesBefore = 1u << 7,
+  kVelocitiesAfter = 1u << 8,
+  kEnergyTransfer = 1u << 9,
+  kKineticEnergyAfter = 1u << 10,
+  kTotalEnergy = 1u << 11,
+  kTotalMomentum = 1u << 12,
+  kPredictedVelocitiesAfter = 1u << 13,
+  kPredictedEnergyTransfer = 1u << 14,
+  kPaperVelocitiesAfter = 1u << 15,
+  kPaperEnergyTransfer = 1u << 16,
+};
+constexpr int kImpactValueCount = 17;
+/// The event field of bit 1 << k (k < kImpactValueCount), e.g. "pair_velocities_after".
+const char* impactValueName(int k);
+/// The pair's own values, which every event carries.
+constexpr std::uint32_t kPairValues = kImpactTime | kImpactPosition | kPairVelocitiesBefore | kPairVelocitiesAfter |
+                                      kPairEnergyTransfer | kImpactEnergyLost;
+/// The values of an event's full state that an N-body run's events derive from rounded
+/// values (io's SceneEventState, core::BodyStateReplay): never certified.
+constexpr std::uint32_t kReplayedStateValues = kPositions | kKineticEnergyAfter | kTotalEnergy | kTotalMomentum;
+/// A collapse event's values that are not certified: the limit's time, point and velocity
+/// come from the engine's state at the time, its energies from the replay.
+constexpr std::uint32_t kCollapseValues =
+    kImpactTime | kImpactPosition | kPairVelocitiesAfter | kPairEnergyTransfer | kImpactEnergyLost;
+
 /// One impact of pair p (bodies p and p+1; on a ring's seam pair N-1, bodies N-1 and 0,
 /// with first_moved = N-1 and last_moved = 0). Replaying the records (and the collapse notices,
 /// CollapseVisitor) in order from the initial velocities rebuilds the velocity of every body:
@@ -87,6 +124,8 @@ struct ImpactRecord {
   /// The answering model's values beside this impact (impact_model_values.h); empty for the
   /// engine's own records.
   std::optional<ImpactModelValues> model;
+  /// ImpactValue bits: the values above (and in `model`) not certified correctly rounded.
+  std::uint32_t uncertified = 0;
 };
 
 /// Why a run ended. Values are stable: append only.
@@ -172,6 +211,9 @@ struct Collapse {
   double position = 0.0;             ///< where the bodies meet [m]
   std::uint64_t impacts_before = 0;  ///< impacts performed (and counted) before it was resolved
   double velocity = 0.0;             ///< the cluster's velocity after it [m/s]
+  /// ImpactValue bits of its event's values not certified: all of kCollapseValues, unless a
+  /// model's certified values replaced the engine's (scene_run.cpp).
+  std::uint32_t uncertified = kCollapseValues;
 };
 
 /// The simulation of a run: what runEngine measured and what runScene (scene_run.h) adds
@@ -203,7 +245,7 @@ struct SceneSimulation {
   double momentum_relative_drift = 0.0;
   /// The run's published values that are not certified correctly rounded, by their summary
   /// keys (e.g. "final_velocities"); empty when every one is (physics.md, "How close the
-  /// published values are").
+  /// published values are"). An event's own are its record's (ImpactRecord::uncertified).
   std::vector<std::string> uncertified;
   /// How often the engine left its working precision; zero when not simulated.
   Escalations escalations;
