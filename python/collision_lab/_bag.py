@@ -36,7 +36,8 @@ def _event(msg):
              'pair_velocities_after': _values(msg.pair_velocities_after),
              'pair_energy_transfer': _values(msg.pair_energy_transfer),
              'energy_lost': _value(msg.energy_lost), 'total_energy': _value(msg.total_energy),
-             'total_momentum': _value(msg.total_momentum)}
+             'total_momentum': _value(msg.total_momentum),
+             'uncertified': list(getattr(msg, 'uncertified', []))}
     for key in ('positions', 'velocities_before', 'velocities_after', 'energy_transfer',
                 'kinetic_energy_after', 'predicted_velocities_after', 'paper_velocities_after',
                 'predicted_energy_transfer', 'paper_energy_transfer'):
@@ -77,6 +78,8 @@ def _summary(msg, prediction):
                'critical_restitution': _value(msg.critical_restitution),
                'spiral_angle': _value(msg.spiral_angle),
                'final_velocities': _values(msg.final_velocities),
+               'uncertified_values': list(getattr(msg, 'uncertified_values', [])),
+               'time_beyond_range': bool(getattr(msg, 'time_beyond_range', False)),
                # The bag's own: whose run, and where it was recorded.
                'run_id': msg.run_id, 'student': msg.student, 'bag_path': msg.bag_path}
     if prediction is not None:

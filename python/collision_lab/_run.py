@@ -112,6 +112,10 @@ def _events_arrays(events, bodies):
         rows = [e.get(key) for e in events]
         if any(row is not None for row in rows):
             arrays[key] = _float_rows(rows, bodies)
+    # Per event, the names of its values not certified correctly rounded (a tuple each).
+    uncertified = np.empty(len(events), dtype=object)
+    uncertified[:] = [tuple(e.get('uncertified', ())) for e in events]
+    arrays['uncertified'] = uncertified
     return arrays
 
 

@@ -387,6 +387,7 @@ EventRecord eventRecord(const core::ImpactRecord& impact) {
     r.pair_velocities_after = impact.velocities_after;
     r.pair_energy_transfer = impact.energy_gained;
     r.energy_lost = impact.energy_lost;
+    r.uncertified = impact.uncertified & core::kPairValues;
     return r;
   }
   const core::ImpactModelValues& m = *impact.model;
@@ -403,6 +404,7 @@ EventRecord eventRecord(const core::ImpactRecord& impact) {
     r.pair_velocities_after[side] = m.velocities_after[p + side];
   }
   r.energy_lost = impact.energy_lost;
+  r.uncertified = impact.uncertified;
   fillFromModelBlock(r, m);
   return r;
 }
@@ -422,6 +424,19 @@ void jsonValues(TextSink& sink, std::string_view key, const double* values, std:
 
 void jsonModel(TextSink& sink, std::string_view key, const std::array<double, 3>* values) {
   jsonValues(sink, key, values ? values->data() : nullptr, 3);
+}
+
+/// The JSON strings of the names of the record's uncertified values (core::impactValueName),
+/// separated by commas.
+void putUncertified(TextSink& sink, std::uint32_t bits) {
+  bool first = true;
+  for (int k = 0; k < core::kImpactValueCount; ++k) {
+    if (!(bits & (1u << k))) continue;
+    sink.put(first ? "\"" : ",\"");
+    sink.put(core::impactValueName(k));
+    sink.put('"');
+    first = false;
+  }
 }
 
 /// One CSV cell of n values separated by ';' (empty for none).
@@ -531,7 +546,9 @@ void writeEventRecordJson(TextSink& sink, const EventRecord& r) {
   jsonModel(sink, ",\"predicted_energy_transfer\":", r.predicted_energy_transfer);
   jsonModel(sink, ",\"paper_velocities_after\":", r.paper_velocities_after);
   jsonModel(sink, ",\"paper_energy_transfer\":", r.paper_energy_transfer);
-  sink.put('}');
+  sink.put(",\"uncertified\":[");
+  putUncertified(sink, r.uncertified);
+  sink.put("]}");
 }
 
 void writeEventRecordCsv(TextSink& sink, const EventRecord& r) {

@@ -15,11 +15,26 @@ namespace collision_lab {
 namespace io {
 
 SceneEventState::SceneEventState(const core::Scene& scene, const core::EventPolicy& policy)
-    : scene_(scene), full_state_(scene.size() <= kFullStateMaxBodies), policy_(policy), replay_(scene) {}
+    : scene_(scene), full_state_(scene.size() <= kFullStateMaxBodies), policy_(policy), replay_(scene),
+      velocity_uncertified_(scene.size(), 0) {}
 
-void SceneEventState::fill(EventRecord& r) {
+void SceneEventState::moved(std::size_t first, std::size_t last, bool uncertified) {
+  const auto mark = [&](std::size_t k) {
+    velocities_uncertified_ += static_cast<std::size_t>(uncertified) - velocity_uncertified_[k];
+    velocity_uncertified_[k] = uncertified;
+  };
+  if (first > last) return mark(first), mark(last);
+  for (std::size_t k = first; k <= last; ++k) mark(k);
+}
+
+void SceneEventState::fill(EventRecord& r, bool velocities_before_uncertified) {
   r.full_state = full_state_;
   if (!full_state_) return;
+  // Positions, kinetic energies and totals come from the replay's rounded values; the
+  // velocities are the records' (certified when every one that set them is).
+  r.uncertified |= core::kReplayedStateValues;
+  if (velocities_before_uncertified) r.uncertified |= core::kVelocitiesBefore;
+  if (velocities_uncertified_ > 0) r.uncertified |= core::kVelocitiesAfter;
   const std::size_t n = replay_.size();
   r.bodies = n;
   positions_ = replay_.positions(r.time);
@@ -55,18 +70,24 @@ EventRecord SceneEventState::impact(const core::ImpactRecord& impact) {
     r.pair_energy_transfer[side] = impact.energy_gained[side];  // a wall's: minus the other's gain and the heat
   }
   r.energy_lost = impact.energy_lost;
+  r.uncertified = impact.uncertified;
+  const bool before_uncertified = velocities_uncertified_ > 0;
   replay_.apply(impact);
+  moved(impact.first_moved, impact.last_moved, impact.uncertified & core::kPairVelocitiesAfter);
   if (impact.model) {
     fillFromModelBlock(r, *impact.model);
     if (!policy_.fullStateAt(impact.index)) lean(r);
     return r;
   }
   if (!policy_.fullStateAt(impact.index)) return r;  // the lean record: the pair's values
-  fill(r);
+  fill(r, before_uncertified);
   if (full_state_ && !r.cluster_impact) {
     // Two single bodies: their entries are the engine's gains, as the pair's fields.
     gain_[p] = r.pair_energy_transfer[0];
     gain_[left] = r.pair_energy_transfer[1];
+    if (r.uncertified & core::kPairEnergyTransfer) r.uncertified |= core::kEnergyTransfer;
+  } else if (full_state_) {
+    r.uncertified |= core::kEnergyTransfer;  // a cluster's gain shared out by the replay
   }
   return r;
 }
@@ -91,6 +112,7 @@ void fillFromModelBlock(EventRecord& r, const core::ImpactModelValues& m) {
 
 void SceneEventState::lean(EventRecord& r) {
   r.full_state = false;
+  r.uncertified &= core::kPairValues;
   r.predicted_velocities_after = r.predicted_energy_transfer = nullptr;
   r.paper_velocities_after = r.paper_energy_transfer = nullptr;
 }
@@ -106,14 +128,19 @@ EventRecord SceneEventState::collapse(const core::Collapse& collapse) {
   r.restitution = scene_.restitutionOf(first);
   r.first_moved = first;
   r.last_moved = collapse.last_body;
+  const bool before_uncertified = velocities_uncertified_ > 0;
   replay_.apply(collapse);
+  moved(first, collapse.last_body, collapse.uncertified & core::kPairVelocitiesAfter);
   for (std::size_t side = 0; side < 2; ++side) {
     r.pair_velocities_before[side] = replay_.velocityBefore(first + side);
     r.pair_velocities_after[side] = collapse.velocity;
     r.pair_energy_transfer[side] = replay_.energyGained(first + side);
   }
   r.energy_lost = replay_.lastHeat();
-  fill(r);
+  // The limit of infinitely many impacts, from the state at the time and the replay.
+  r.uncertified = collapse.uncertified | (before_uncertified ? core::kPairVelocitiesBefore : 0u);
+  fill(r, before_uncertified);
+  if (full_state_) r.uncertified |= core::kEnergyTransfer;
   return r;
 }
 

@@ -163,6 +163,14 @@ class Table {
       }
     });
   }
+  /// A list of names in one cell, separated by ';' (empty cell: none).
+  Table& names(const std::string& field, std::vector<std::string> M::*member) {
+    return add(field, field, [member](std::ostream& o, const M& m) {
+      std::string joined;
+      for (const std::string& name : m.*member) joined += (joined.empty() ? "" : ";") + name;
+      writeCell(o, joined);
+    });
+  }
   /// A field that is exported to a tidy table (file), not to this topic's CSV: listed by
   /// columns() so that every field has a column.
   Table& elsewhere(const std::string& file, const std::vector<std::pair<std::string, std::string>>& columns) {
@@ -255,6 +263,7 @@ Table<collision_lab::CollisionEvent> collisionEventTable() {
       .field("energy_lost", &M::energy_lost, "_J")
       .field("total_energy", &M::total_energy, "_J")
       .field("total_momentum", &M::total_momentum, "_kg_m_s")
+      .names("uncertified", &M::uncertified)
       .elsewhere(kBodiesFile, {{"x_m", "positions"},
                                {"v_before_m_s", "velocities_before"},
                                {"v_m_s", "velocities_after"},
@@ -338,6 +347,8 @@ Table<collision_lab::RunSummary> runSummaryTable() {
       .flag("timeline_saturated", &M::timeline_saturated)
       .field("requested_run_id", &M::requested_run_id)
       .field("student", &M::student)
+      .names("uncertified_values", &M::uncertified_values)
+      .flag("time_beyond_range", &M::time_beyond_range)
       .elsewhere(kFinalVelocitiesFile, {{"v_m_s", "final_velocities"}});
   return t;
 }

@@ -321,6 +321,10 @@ void SceneEventConverter::toMsg(const collision_lab::io::EventRecord& r, collisi
     msg.pair_energy_transfer[side] = r.pair_energy_transfer[side];
   }
   msg.energy_lost = r.energy_lost;
+  msg.uncertified.clear();
+  for (int k = 0; k < core::kImpactValueCount; ++k) {
+    if (r.uncertified & (1u << k)) msg.uncertified.emplace_back(core::impactValueName(k));
+  }
   // The model block's values where the impact has one; empty arrays otherwise.
   const auto copy = [](const std::array<double, 3>* values, std::vector<double>& to) {
     if (values) {
@@ -463,6 +467,8 @@ void fillRunSummaryMsg(const core::SceneRunResult& result, std::size_t body_coun
   msg.energy_relative_drift = s.energy_relative_drift;
   msg.momentum_relative_drift = s.momentum_relative_drift;
   msg.compute_time = result.compute_time_s;
+  msg.uncertified_values = core::uncertifiedValues(result);
+  msg.time_beyond_range = s.time_beyond_range;
 }
 
 collision_lab::Rejected toRejectedMsg(const collision_lab::core::ValidationError& error) {

@@ -230,6 +230,8 @@ std::string summaryJson(const collision_lab::RunSummary& s) {
               {"energy_relative_drift", finite(s.energy_relative_drift)},
               {"momentum_relative_drift", finite(s.momentum_relative_drift)},
               {"compute_time", finite(s.compute_time)},
+              {"uncertified_values", s.uncertified_values},
+              {"time_beyond_range", static_cast<bool>(s.time_beyond_range)},
               {"published_events", s.published_events},
               {"bag_path", s.bag_path},
               {"recorded", s.recording_ok && !s.bag_path.empty()},

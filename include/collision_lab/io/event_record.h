@@ -46,6 +46,9 @@ struct EventRecord {
   const std::array<double, 3>* predicted_energy_transfer = nullptr;
   const std::array<double, 3>* paper_velocities_after = nullptr;
   const std::array<double, 3>* paper_energy_transfer = nullptr;
+  /// core::ImpactValue bits: the record's values not certified correctly rounded (JSON and
+  /// CSV "uncertified": their names).
+  std::uint32_t uncertified = 0;
 };
 
 /// The record's full state, pair energy transfers and model values from an impact's model
@@ -69,13 +72,18 @@ class SceneEventState {
   const core::BodyStateReplay& replay() const { return replay_; }
 
  private:
-  void fill(EventRecord& record);
+  void fill(EventRecord& record, bool velocities_before_uncertified);
   static void lean(EventRecord& record);
 
   core::Scene scene_;
   bool full_state_;
   core::EventPolicy policy_;
   core::BodyStateReplay replay_;  ///< the one replay of the records (core/nbody/body_state_replay.h)
+  std::vector<char> velocity_uncertified_;  ///< per body: its velocity came from an uncertified value
+  std::size_t velocities_uncertified_ = 0;  ///< bodies whose velocity is
+  /// Marks bodies first..last (first > last: the two of a ring's seam) as moved to a
+  /// velocity certified or not.
+  void moved(std::size_t first, std::size_t last, bool uncertified);
   std::vector<double> positions_, before_, gain_;  ///< the record's arrays (full state only)
 };
 
