@@ -536,6 +536,9 @@ SceneSimulation simulateByEngine(const Scene& scene, const SimulationOptions& op
       // Positions and totals are computed here from rounded values.
       event.uncertified |= kPositions | kKineticEnergyAfter | kTotalEnergy | kTotalMomentum;
       if (any(velocity_uncertified)) event.uncertified |= kVelocitiesBefore;
+      // The pair's velocities before are the tracked ones (the record's own may be a higher tier's).
+      event.uncertified &= ~kPairVelocitiesBefore;
+      if (velocity_uncertified[i] || velocity_uncertified[i + 1]) event.uncertified |= kPairVelocitiesBefore;
       if (record.uncertified & kPairEnergyTransfer) event.uncertified |= kEnergyTransfer;
       for (int k = 0; k < 3; ++k) {
         const long double elapsed = static_cast<long double>(record.time) - since_time[k];

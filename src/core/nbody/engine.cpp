@@ -41,9 +41,6 @@ namespace {
 /// certify replay at 100 digits to certify them (about 5 us per impact); longer ones name
 /// them uncertified.
 constexpr std::uint64_t kCertifyingReplay = 10'000;
-/// The exact tier's work budget [bit^2, summed] for bringing it to one impact whose record
-/// only it can certify (an exact zero or tie): milliseconds, against the 1e11 of a decision.
-constexpr double kRecordExactWorkBudget = 1e8;
 
 /// q 2^e, exactly.
 Rational scaledByPowerOfTwo(const Rational& q, int e) {
@@ -99,30 +96,7 @@ class Driver {
     if (r.kind == StepKind::kImpact && escalations_.exact_rational + escalations_.high_precision > escalated) {
       crowd_[crowd_next_++ % crowd_.size()] = r.pair;
     }
-    if (r.kind == StepKind::kImpact && record && record->uncertified != 0 && fast_->count() <= kCertifyingReplay) {
-      certifyRecord(*record);
-    }
     return r;
-  }
-
-  /// The values of the impact just taken (the working tier's last) that its record does not
-  /// certify, from the same impact re-taken by the 100-digit tier, then the exact one (an exact
-  /// zero or tie), each brought there by replay: within a run's first kCertifyingReplay impacts,
-  /// and the exact tier only until its budget first stops it. What none certifies stays flagged.
-  /// These replays are not the run's decisions: the escalations and budget the run reports
-  /// stay as they were, the same with events or without.
-  void certifyRecord(ImpactRecord& record) {
-    const Escalations escalations = escalations_;
-    const ExactProgress budget_stop = budget_stop_;
-    rerecord<Float100>(record);
-    if (record.uncertified != 0 && !exact_records_failed_) {
-      const double budget = budget_;
-      budget_ = std::min(budget_, kRecordExactWorkBudget);
-      rerecord<Rational>(record);
-      budget_ = budget;
-    }
-    escalations_ = escalations;
-    budget_stop_ = budget_stop;
   }
 
   /// The bodies of the last kCrowdWindow impacts that needed more than double-double, and of
@@ -161,29 +135,6 @@ class Driver {
     return exact_->nextTimeLowerBound();
   }
 
-  /// Re-takes the working tier's last impact in tier S and takes from its record the values
-  /// `record` does not certify and it does.
-  template <class S>
-  void rerecord(ImpactRecord& record) {
-    const std::uint64_t count = fast_->count();
-    auto& t = tier<S>();
-    if (t && t->count() >= count) return;  // it took this impact already (an escalation), or passed it
-    const StepResult at = advanceTo<S>(count - 1);
-    ImpactRecord again;
-    const StepResult r = at.kind == StepKind::kImpact ? stepOrEscalate<S>(&again) : at;
-    if (r.kind != StepKind::kImpact || again.pair_index != record.pair_index) {
-      if constexpr (Arithmetic<S>::kExact) exact_records_failed_ = true;
-      return;
-    }
-    const std::uint32_t taken = record.uncertified & ~again.uncertified;
-    if (taken & kImpactTime) record.time = again.time;
-    if (taken & kImpactPosition) record.position = again.position;
-    if (taken & kPairVelocitiesBefore) record.velocities_before = again.velocities_before;
-    if (taken & kPairVelocitiesAfter) record.velocities_after = again.velocities_after;
-    if (taken & kPairEnergyTransfer) record.energy_gained = again.energy_gained;
-    if (taken & kImpactEnergyLost) record.energy_lost = again.energy_lost;
-    record.uncertified &= ~taken;
-  }
 
   /// Every body's velocity after the working tier's last impact [working units], correctly
   /// rounded where it can be certified: by the working tier's bound; where that does not
@@ -547,7 +498,6 @@ class Driver {
   std::unique_ptr<Tier<Float100>> high_;
   std::unique_ptr<Tier<Rational>> exact_;
   Escalations escalations_;
-  bool exact_records_failed_ = false;  ///< the exact tier could not re-take an impact (its budget): no more tries
 };
 
 std::string formatValue(double value) {
