@@ -46,8 +46,8 @@ struct EventRecord {
   const std::array<double, 3>* predicted_energy_transfer = nullptr;
   const std::array<double, 3>* paper_velocities_after = nullptr;
   const std::array<double, 3>* paper_energy_transfer = nullptr;
-  /// core::ImpactValue bits: the record's values not certified correctly rounded (JSON and
-  /// CSV "uncertified": their names).
+  /// core::ImpactValue bits: the record's values not certified correctly rounded (the JSON's
+  /// "uncertified": their names; the CSV has no such column).
   std::uint32_t uncertified = 0;
 };
 

@@ -1004,8 +1004,8 @@ class CL_NBODY_INTERNAL Tier {
                                 publish(j.v, velocityError(left_body, eu_), kPairVelocitiesBefore, record)};
   }
 
-  /// The record after the impact of pair m, sides of masses `mass` (kInf: a wall; a cluster's
-  /// total), known exactly or within `mass_error` [kg], restitution e: the velocities after,
+  /// The record after the impact of pair m, sides of masses `mass` (0 for a wall side, which
+  /// `wall` marks; a cluster's total), exact in S when `mass_exact`, restitution e: the velocities after,
   /// the energies gained, and the heat (1 - e^2) mu A^2 / 2 at the approach speed A before
   /// (now_.A), each in S with its bound. A wall's entry is minus the other's gain and the heat.
   void recordAfter(std::size_t m, const S& before_i, const S& before_j, const std::array<S, 2>& mass,

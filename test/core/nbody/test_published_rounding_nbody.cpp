@@ -166,6 +166,16 @@ Scene seededGas(std::mt19937_64& rng, std::size_t n, bool ring, double e) {
   return scene;
 }
 
+/// `scene` under a restitution model with its one parameter (t_c [s], v_0 or v* [m/s]).
+Scene underModel(Scene scene, RestitutionModelKind kind, double parameter) {
+  RestitutionModel& model = scene.restitution_model;
+  model.kind = kind;
+  if (kind == RestitutionModelKind::kTc) model.tc = parameter;
+  if (kind == RestitutionModelKind::kThreshold) model.elastic_below = parameter;
+  if (kind == RestitutionModelKind::kViscoelastic) model.viscoelastic_speed = parameter;
+  return scene;
+}
+
 TEST(PublishedRounding, LongInelasticRunsPublishCertifiedFinalVelocitiesAndHeat) {
   // Long inelastic runs drifted up to 1,672 ulps from the exact velocities. Every model:
   // constant e in a box and on a ring, TC, the threshold law and the viscoelastic e(v), each
@@ -175,18 +185,9 @@ TEST(PublishedRounding, LongInelasticRunsPublishCertifiedFinalVelocitiesAndHeat)
   std::vector<Scene> scenes;
   scenes.push_back(seededGas(rng, 6, false, 0.875));
   scenes.push_back(seededGas(rng, 6, true, 0.75));
-  Scene tc = seededGas(rng, 6, false, 0.75);
-  tc.restitution_model.kind = RestitutionModelKind::kTc;
-  tc.restitution_model.tc = 0.05;
-  scenes.push_back(tc);
-  Scene threshold = seededGas(rng, 6, false, 0.75);
-  threshold.restitution_model.kind = RestitutionModelKind::kThreshold;
-  threshold.restitution_model.elastic_below = 0.05;
-  scenes.push_back(threshold);
-  Scene viscoelastic = seededGas(rng, 6, false, 1.0);
-  viscoelastic.restitution_model.kind = RestitutionModelKind::kViscoelastic;
-  viscoelastic.restitution_model.viscoelastic_speed = 20.0;
-  scenes.push_back(viscoelastic);
+  scenes.push_back(underModel(seededGas(rng, 6, false, 0.75), RestitutionModelKind::kTc, 0.05));
+  scenes.push_back(underModel(seededGas(rng, 6, false, 0.75), RestitutionModelKind::kThreshold, 0.05));
+  scenes.push_back(underModel(seededGas(rng, 6, false, 1.0), RestitutionModelKind::kViscoelastic, 20.0));
   constexpr std::uint64_t kImpacts = 300;
   int certified = 0;
   for (const Scene& scene : scenes) {
@@ -292,14 +293,8 @@ TEST(PublishedRounding, EveryImpactsValuesAreTheExactOnesRoundedOrFlagged) {
   for (int k = 0; k < 6; ++k) scenes.push_back(testing_support::randomScene(rng, 3.0));
   scenes.push_back(seededGas(rng, 6, false, 0.875));
   scenes.push_back(seededGas(rng, 5, false, 0.0));  // e = 0: clusters
-  Scene tc = seededGas(rng, 6, false, 0.75);
-  tc.restitution_model.kind = RestitutionModelKind::kTc;
-  tc.restitution_model.tc = 0.05;
-  scenes.push_back(tc);
-  Scene viscoelastic = seededGas(rng, 6, false, 1.0);
-  viscoelastic.restitution_model.kind = RestitutionModelKind::kViscoelastic;
-  viscoelastic.restitution_model.viscoelastic_speed = 20.0;
-  scenes.push_back(viscoelastic);
+  scenes.push_back(underModel(seededGas(rng, 6, false, 0.75), RestitutionModelKind::kTc, 0.05));
+  scenes.push_back(underModel(seededGas(rng, 6, false, 1.0), RestitutionModelKind::kViscoelastic, 20.0));
   scenes.push_back(Scene{{1, 1, 1, 1}, {4, 3, 2, 0}, {-1, 0, 0, 1}, {1.0}});
   int flagged = 0, values = 0;
   for (const Scene& scene : scenes) {
