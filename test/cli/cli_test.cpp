@@ -488,13 +488,20 @@ TEST(CliDoubleRange, AnImpactAfterTheLargestDoubleIsCountedWithANullTime) {
 
 TEST(CliDoubleRange, ExtremeMassRatiosAreRun) {
   // The second impact comes after the largest double, beyond the engine's working range too:
-  // the run stops honestly after the first.
-  const Json doc = runJson({"--masses", "1e-300,1,inf", "--positions", "2,1,0", "--velocities", "-1e-140,0,0"});
-  EXPECT_EQ(doc.at("summary").at("collision_count"), 1);
-  EXPECT_EQ(doc.at("summary").at("predicted_collision_count"), 2);
-  EXPECT_EQ(doc.at("summary").at("truncated"), true);
-  EXPECT_NE(doc.at("summary").at("truncation_reason").get<std::string>().find("1.7976931348623157e+308 s, the largest double"),
-            std::string::npos);
+  // counted all the same (the exact tier takes it), its time null (+inf), events or not.
+  for (const char* events : {"all", "none"}) {
+    const Json doc = runJson({"--masses", "1e-300,1,inf", "--positions", "2,1,0", "--velocities", "-1e-140,0,0",
+                              "--events", events});
+    EXPECT_EQ(doc.at("summary").at("collision_count"), 2) << events;
+    EXPECT_EQ(doc.at("summary").at("predicted_collision_count"), 2);
+    EXPECT_EQ(doc.at("summary").at("truncated"), false);
+    EXPECT_EQ(doc.at("summary").at("time_beyond_range"), true);
+    if (std::string(events) == "all") {
+      ASSERT_EQ(doc.at("events").size(), 2u);
+      EXPECT_TRUE(doc.at("events")[1].at("time").is_null());
+      EXPECT_EQ(doc.at("events")[1].at("pair"), "BC");
+    }
+  }
 }
 
 // ---------------------------------------------------------------------------------------

@@ -127,6 +127,39 @@ class Driver {
 
   const Tier<W>& fast() const { return *fast_; }
 
+  /// The working tier stopped out of range, its next impact due past the largest double: the
+  /// run goes on in the exact tier alone (brought to the same impact by replay, within its
+  /// budget), whose numbers have no range. Every later step is the exact tier's.
+  StepResult stepBeyondRange(ImpactRecord* record) {
+    if (!beyond_range_) {
+      if (!exact_) {
+        const StepResult r = startOrEscalate<Rational>();
+        if (r.kind != StepKind::kImpact) return r;
+      }
+      exact_->allowAnyMagnitude();
+      const StepResult at = advanceTo<Rational>(fast_->count());
+      if (at.kind != StepKind::kImpact) return at;
+      beyond_range_ = true;
+    }
+    // Every step is exact: a streak, so that the tier's growing numbers stop the run as
+    // they would in step() (kExhausted).
+    const StepResult r = stepOrEscalate<Rational>(record);
+    ++exact_streak_;
+    const double bits = exact_->exactBits();
+    streak_work_.add(bits * bits);
+    return r;
+  }
+  bool beyondRange() const { return beyond_range_; }
+
+  /// f(tier) of the tier that leads the run: the working one, or the exact one beyond the
+  /// range (stepBeyondRange).
+  template <class F>
+  decltype(auto) leading(F&& f) const {
+    return beyond_range_ ? f(*exact_) : f(*fast_);
+  }
+  /// Impacts the run has taken.
+  std::uint64_t count() const { return leading([](const auto& t) { return t.count(); }); }
+
   /// A lower bound [s] of the next impact's time after the working tier's last impact, from
   /// the exact tier brought to the same count (a pair it parks has its exact time, rounded
   /// down, as key): what an out-of-range stop says. 0 when the exact replay cannot be had.
@@ -147,6 +180,10 @@ class Driver {
     const auto missing = [&velocities] {
       return std::any_of(velocities.begin(), velocities.end(), [](const auto& v) { return !v; });
     };
+    if (beyond_range_) {
+      for (std::size_t k = 0; k < n; ++k) velocities[k] = detail::nearestDouble(exact_->velocityValue(k));
+      return velocities;
+    }
     for (std::size_t k = 0; k < n; ++k) velocities[k] = fast_->certifiedVelocity(k);
     if (!missing() || !replay) return velocities;
     const std::uint64_t count = fast_->count();
@@ -166,7 +203,7 @@ class Driver {
   /// Body k's exact velocity after the working tier's last impact [working units], where the
   /// exact tier can be brought there within its budget.
   std::optional<Rational> exactVelocity(std::size_t k) {
-    if (advanceTo<Rational>(fast_->count()).kind != StepKind::kImpact) return std::nullopt;
+    if (!beyond_range_ && advanceTo<Rational>(fast_->count()).kind != StepKind::kImpact) return std::nullopt;
     return exact_->velocityValue(k);
   }
 
@@ -184,12 +221,14 @@ class Driver {
       frame = scene.velocities[k];
     }
     const double f = frame.value_or(0.0);
-    if (const auto heat = heatFrom(*fast_, f)) return heat;
-    if (!replay) return std::nullopt;
-    const std::uint64_t count = fast_->count();
-    if (advanceTo<Float100>(count).kind != StepKind::kImpact) return std::nullopt;
-    if (const auto heat = heatFrom(*high_, f)) return heat;
-    if (advanceTo<Rational>(count).kind != StepKind::kImpact) return std::nullopt;
+    if (!beyond_range_) {
+      if (const auto heat = heatFrom(*fast_, f)) return heat;
+      if (!replay) return std::nullopt;
+      const std::uint64_t count = fast_->count();
+      if (advanceTo<Float100>(count).kind != StepKind::kImpact) return std::nullopt;
+      if (const auto heat = heatFrom(*high_, f)) return heat;
+      if (advanceTo<Rational>(count).kind != StepKind::kImpact) return std::nullopt;
+    }
     Rational heat = 0;
     for (std::size_t k = 0; k < scene.size(); ++k) {
       if (scene.isWall(k)) continue;
@@ -498,6 +537,7 @@ class Driver {
   std::unique_ptr<Tier<Float100>> high_;
   std::unique_ptr<Tier<Rational>> exact_;
   Escalations escalations_;
+  bool beyond_range_ = false;          ///< stepBeyondRange(): the exact tier leads the run
 };
 
 std::string formatValue(double value) {
@@ -782,8 +822,13 @@ SceneSimulation runEngineOn(const Scene& si_scene, const EngineOptions& options,
   ImpactRecord record;
   std::uint64_t& count = result.impact_count;
   bool beyond_doubles = false;  // the next impact's time [s] is beyond the largest double
+  // Beyond the range the exact tier goes on alone only where the impacts are elastic (no
+  // collapse to detect) and few (no ring, no box: their impacts never end).
+  const bool may_go_beyond_range = scene.isElastic() &&
+                                   scene.restitution_model.kind != RestitutionModelKind::kViscoelastic &&
+                                   !scene.isRing() && !(scene.isWall(0) && scene.isWall(scene.size() - 1));
   while (r.kind == StepKind::kImpact) {
-    if (!driver.fast().pending()) break;
+    if (!driver.leading([](const auto& t) { return t.pending(); })) break;
     if (count == options.max_impacts) {
       result.stop = StopReason::kCap;
       break;
@@ -792,7 +837,18 @@ SceneSimulation runEngineOn(const Scene& si_scene, const EngineOptions& options,
       result.stop = StopReason::kCancelled;
       break;
     }
-    r = driver.step(wants_records ? &record : nullptr);
+    ImpactRecord* const into = wants_records ? &record : nullptr;
+    r = driver.beyondRange() ? driver.stepBeyondRange(into) : driver.step(into);
+    // Out of range with the next impact past the largest double: counted all the same, in
+    // the exact tier, its time +inf (time_beyond_range), where the scene may go there
+    // (above); where the exact tier cannot be brought there (its budget), the out-of-range
+    // stop stands.
+    if (r.kind == StepKind::kOutOfRange && may_go_beyond_range && !driver.beyondRange() &&
+        (!(r.time <= time_limit) || !(driver.exactNextTimeLowerBound() <= time_limit))) {
+      beyond_doubles = true;
+      const StepResult beyond = driver.stepBeyondRange(into);
+      if (driver.beyondRange()) r = beyond;
+    }
     if (r.kind != StepKind::kImpact) break;
     ++count;
     if (wants_records) {
@@ -801,6 +857,7 @@ SceneSimulation runEngineOn(const Scene& si_scene, const EngineOptions& options,
       if (visitor) visitor(record);
       if (count <= options.keep_events) result.impacts.push_back(record);
     }
+    if (driver.beyondRange()) continue;  // elastic: no collapse to look for
     const std::size_t collapses = result.collapses.size();
     const StepResult collapse = driver.afterImpact(r.pair, result);
     if (collapse.kind != StepKind::kImpact) {
@@ -825,8 +882,8 @@ SceneSimulation runEngineOn(const Scene& si_scene, const EngineOptions& options,
   if (result.stop == StopReason::kPrecisionBudget || r.kind == StepKind::kExhausted) {
     result.crowding_bodies = driver.crowdingBodies();
   }
-  result.final_time = driver.fast().lastTime();
-  if (const auto certified = driver.fast().certifiedLastTime()) {
+  result.final_time = driver.leading([](const auto& t) { return t.lastTime(); });
+  if (const auto certified = driver.leading([](const auto& t) { return t.certifiedLastTime(); })) {
     result.final_time = *certified;
   } else {
     nameUncertified(result, "final_time");
@@ -838,10 +895,12 @@ SceneSimulation runEngineOn(const Scene& si_scene, const EngineOptions& options,
   }
   // An impact after the largest double [s] was counted and published with time +inf.
   result.time_beyond_range = !(result.final_time <= time_limit);
-  result.cluster_impacts = driver.fast().clusterImpacts();
-  result.rule_elastic_impacts = driver.fast().ruleElastic();
-  driver.fast().state(result.final_time, result.final_positions, result.final_velocities);
-  result.energy_lost = driver.fast().energyLost();
+  driver.leading([&](const auto& t) {
+    result.cluster_impacts = t.clusterImpacts();
+    result.rule_elastic_impacts = t.ruleElastic();
+    t.state(result.final_time, result.final_positions, result.final_velocities);
+    result.energy_lost = t.energyLost();
+  });
   result.escalations = driver.escalations();  // the run's decisions, before any certifying replay
   // Set after the SI conversion: velocities subnormal in SI, correctly rounded there [m/s].
   const std::vector<std::pair<std::size_t, double>> subnormal_velocities = certifyFinalValues(driver, units, result);

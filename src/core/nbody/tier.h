@@ -200,6 +200,13 @@ class CL_NBODY_INTERNAL Tier {
   }
 
   bool pending() const { return tree_.minKey() < kInf; }
+  /// The exact tier only: from now on its numbers have no range. Impacts past the tiers'
+  /// range (kMaxMagnitude, whose times lie beyond the largest double) are ordered by their
+  /// exact times and performed, where the other tiers stop out of range.
+  void allowAnyMagnitude() {
+    static_assert(Ar::kExact, "only exact numbers have no range");
+    unbounded_ = true;
+  }
   /// A lower bound of the next impact's time [s] (inf: none is due).
   double nextTimeLowerBound() const { return tree_.minKey(); }
   std::uint64_t count() const { return count_; }
@@ -227,8 +234,8 @@ class CL_NBODY_INTERNAL Tier {
   StepResult step(ImpactRecord* record) {
     std::size_t next = tree_.minLeaf();
     if (!(tree_.minKey() < kInf)) return {StepKind::kFinished, 0, lastTime()};
-    if (parked(next)) return {StepKind::kOutOfRange, next, tree_.minKey()};  // may come at 2^900 or later
-    if (!(pairs_[next].upper < tree_.minKeyExcluding(next))) {
+    if (parked(next) && !unbounded_) return {StepKind::kOutOfRange, next, tree_.minKey()};  // may come at 2^900 or later
+    if (parked(next) || !(pairs_[next].upper < tree_.minKeyExcluding(next))) {
       const StepResult r = resolveNext(next);
       if (r.kind != StepKind::kImpact) return r;
       next = r.pair;
@@ -522,8 +529,13 @@ class CL_NBODY_INTERNAL Tier {
     positions.resize(bodies_.size());
     velocities.resize(bodies_.size());
     for (std::size_t k = 0; k < bodies_.size(); ++k) {
-      positions[k] = wrap(Ar::toDouble(S(bodies_[k].b + S(bodies_[k].v * S(t)))));
       velocities[k] = Ar::toDouble(bodies_[k].v);
+      if (!std::isfinite(t)) {  // past the largest double: a moving body is out of range too
+        const int direction = Ar::sign(bodies_[k].v);
+        positions[k] = direction == 0 ? wrap(Ar::toDouble(bodies_[k].b)) : direction * kInf;
+        continue;
+      }
+      positions[k] = wrap(Ar::toDouble(S(bodies_[k].b + S(bodies_[k].v * S(t)))));
     }
   }
 
@@ -869,8 +881,9 @@ class CL_NBODY_INTERNAL Tier {
   /// come strictly after the impact; exactly at it is a multiple collision.
   StepResult reschedule(std::size_t q, std::size_t m) {
     const StepResult r = schedule(q);
-    if (r.kind != StepKind::kImpact || !(tree_.key(q) <= now_.upper)) return r;
-    if (parked(q)) return {StepKind::kOutOfRange, q, lastTime()};  // cannot be ordered within the tiers' range
+    // Not due (inf), or certainly after (a parked impact's upper bound is inf: not that).
+    if (r.kind != StepKind::kImpact || !(tree_.key(q) <= now_.upper) || !(tree_.key(q) < kInf)) return r;
+    if (parked(q) && !unbounded_) return {StepKind::kOutOfRange, q, lastTime()};  // cannot be ordered within the tiers' range
     switch (compare(preciseNow(), preciseTime(q))) {
       case Order::kLess: return {};
       case Order::kEqual: return {StepKind::kMultipleCollision, std::min(q, m), lastTime()};
@@ -885,9 +898,11 @@ class CL_NBODY_INTERNAL Tier {
   /// of disjoint pairs go in pair order; of pairs sharing a body, they are a multiple collision.
   StepResult resolveNext(std::size_t root) {
     std::vector<std::size_t> candidates;
-    tree_.forEachAtMost(pairs_[root].upper, [&](std::size_t p) { candidates.push_back(p); });
+    tree_.forEachAtMost(pairs_[root].upper, [&](std::size_t p) {
+      if (tree_.key(p) < kInf) candidates.push_back(p);  // due (an unbounded root's reach: every due pair)
+    });
     for (std::size_t p : candidates) {
-      if (parked(p)) return {StepKind::kOutOfRange, p, lastTime()};  // may come first, beyond the tiers' range
+      if (parked(p) && !unbounded_) return {StepKind::kOutOfRange, p, lastTime()};  // may come first, beyond the tiers' range
     }
     std::vector<Precise> times;
     std::size_t best = 0;
@@ -1308,7 +1323,7 @@ class CL_NBODY_INTERNAL Tier {
     ++cluster_impacts_;
     const double magnitude = std::fabs(Ar::toDouble(i.b)) + std::fabs(Ar::toDouble(j.b)) +
                              std::fabs(Ar::toDouble(i.v)) + std::fabs(Ar::toDouble(j.v));
-    if (!(magnitude < kMaxMagnitude)) return {StepKind::kOutOfRange, m, lastTime()};
+    if (!(magnitude < kMaxMagnitude) && !unbounded_) return {StepKind::kOutOfRange, m, lastTime()};
     return {StepKind::kImpact, m, 0.0};
   }
 
@@ -1377,7 +1392,7 @@ class CL_NBODY_INTERNAL Tier {
     }
     const double magnitude = std::fabs(Ar::toDouble(i.b)) + std::fabs(Ar::toDouble(j.b)) +
                              std::fabs(Ar::toDouble(i.v)) + std::fabs(Ar::toDouble(j.v));
-    if (!(magnitude < kMaxMagnitude)) return {StepKind::kOutOfRange, m, lastTime()};
+    if (!(magnitude < kMaxMagnitude) && !unbounded_) return {StepKind::kOutOfRange, m, lastTime()};
     return {StepKind::kImpact, m, 0.0};
   }
 
@@ -1436,6 +1451,7 @@ class CL_NBODY_INTERNAL Tier {
   std::vector<Clock> clocks_;               ///< per body, TC only
   std::vector<S> last_exact_;               ///< per body, TC in the exact tier only: last impact time [s]
   std::size_t merged_ = 0;             ///< collapses applied (the driver's list, in order)
+  bool unbounded_ = false;     ///< allowAnyMagnitude() (the exact tier past the range)
   double eu_ = 0.0;            ///< bound on ||U_computed - U_exact|| [kg^0.5 m/s]
   double eb_ = 0.0;            ///< bound on ||B_computed - B_exact|| [kg^0.5 m]
   std::uint64_t count_ = 0;
