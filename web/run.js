@@ -187,6 +187,11 @@ function summaryRows(run) {
   if (s) {
     rows.push(['max prediction error (ratio)', s.max_prediction_error, null, null]);
     rows.push(['energy drift (ratio)', s.energy_relative_drift, null, null]);
+    // Every other value shown is the exact one correctly rounded (docs/physics.md).
+    if (s.uncertified_values && s.uncertified_values.length) {
+      rows.push(['not certified (may be off in the last digit)', s.uncertified_values.join(', '), null, null]);
+    }
+    if (s.time_beyond_range) rows.push(['time', 'an impact came after 1.8e308 s, the largest double: shown as inf', null, null]);
     rows.push(['stop reason', s.stop_reason + (view.truncated ? ': ' + view.truncated : ''), null, null]);
   }
   return rows;

@@ -105,6 +105,8 @@ json summaryJson(const collision_lab::RunSummary& s) {
           {"energy_relative_drift", exactNumber(s.energy_relative_drift)},
           {"published_events", s.published_events},
           {"compute_time", exactNumber(s.compute_time)},
+          {"uncertified_values", s.uncertified_values},
+          {"time_beyond_range", static_cast<bool>(s.time_beyond_range)},
           {"recorded", s.recording_ok && !s.bag_path.empty()}};
 }
 
@@ -280,6 +282,8 @@ collision_lab::RunSummary summaryFromRow(const collision_lab::service::IndexedRu
     s.simulated = fields.value("simulated", false);
     s.body_count = fields.value("body_count", s.body_count);
     s.published_events = fields.value("published_events", s.published_events);
+    s.uncertified_values = fields.value("uncertified_values", s.uncertified_values);
+    s.time_beyond_range = fields.value("time_beyond_range", false);
   }
   return s;
 }

@@ -232,6 +232,7 @@ ScriptedRun scriptedRun(const std::string& student, const std::string& run_id, d
   run.summary.published_events = collisions;
   run.summary.stop_reason = "NO_MORE_COLLISIONS";
   run.summary.model_name = "scripted";
+  run.summary.uncertified_values = {"final_time"};  // a value the run could not certify, named
   if (!dir.empty()) {
     run.summary.recording_ok = true;
     run.summary.bag_path = (dir / (run_id + ".bag")).string();
@@ -545,6 +546,8 @@ TEST(RunBookMemory, RestartedWebNodeServesTheIndexsRuns) {
   EXPECT_EQ(run.at("state"), "finished");
   EXPECT_EQ(run.at("collisions"), 25);
   EXPECT_EQ(run.at("student"), "s2");
+  EXPECT_EQ(run.at("summary").at("uncertified_values"), json::array({"final_time"}));
+  EXPECT_EQ(run.at("summary").at("time_beyond_range"), false);
   EXPECT_EQ(book.bagPath("run7"), (dir.path / "run7.bag").string());
   EXPECT_EQ(json::parse(served(book, "run30")).at("state"), "interrupted");
 }
