@@ -102,38 +102,62 @@ SceneSimulation overCap(const Prediction& prediction, std::uint64_t cap) {
   return simulation;
 }
 
-/// The engine's run of an N-body scene, compared with a finite prediction when it finished.
-/// With options.keep_events, the shown impacts are kept in simulation.impacts.
-SceneSimulation simulateScene(const Scene& scene, const SceneRunOptions& options,
-                              const std::optional<Prediction>& prediction, const SceneVisitors& visitors) {
+/// Who answers a run, and the engine's cap where the engine runs: the one decision of
+/// simulateScene and plannedImpacts.
+struct Route {
+  enum Kind {
+    kPredicted,     ///< the model's prediction alone
+    kNotSimulated,  ///< predict mode, and no model answers
+    kOverCap,       ///< the over-cap rule: the model answers alone
+    kRotation,      ///< the rotation model, every impact simulated beside it
+    kEngine,        ///< the event engine, to its end or engine_cap
+  } kind = kEngine;
+  std::uint64_t engine_cap = 0;  ///< kRotation and kEngine: impacts at most [1]
+};
+
+Route routeOf(const std::optional<Prediction>& prediction, const SceneRunOptions& options) {
   const RunOptions& lab = options.lab;
   if (lab.mode == RunMode::kPredictOnly) {
     // A collapse is infinitely many impacts with a known end: its time, point and heat.
     const bool answered = prediction && (!prediction->infinite || prediction->collapsed);
-    return answered ? fromPrediction(*prediction) : notSimulated(prediction);
+    return {answered ? Route::kPredicted : Route::kNotSimulated};
   }
   const bool over_cap = prediction && prediction->impact_count && *prediction->impact_count > lab.max_collisions;
-  if (over_cap && !options.simulate_to_cap) return overCap(*prediction, lab.max_collisions);
+  if (over_cap && !options.simulate_to_cap) return {Route::kOverCap};
   // A model that predicts every impact is simulated beside them, whatever the output.
-  if (prediction && hasRotationValues(*prediction)) return simulateRotationScene(scene, *prediction, options, visitors);
+  if (prediction && hasRotationValues(*prediction)) return {Route::kRotation, lab.max_collisions};
   const bool wants_events = lab.mode == RunMode::kFull && lab.events.kind != EventPolicy::Kind::kNone;
   // Nothing approaching: there is nothing to simulate, events or not.
   const bool nothing_happens = prediction && prediction->kind == ModelKind::kNoCollisions;
   // The sticky count assumes that no three bodies meet at once; only the engine can tell.
   const bool count_certain = prediction && prediction->kind != ModelKind::kSticky;
   if (prediction && !prediction->infinite && !over_cap && ((!wants_events && count_certain) || nothing_happens)) {
-    return fromPrediction(*prediction);
+    return {Route::kPredicted};
   }
-
-  EngineOptions engine_options;
-  engine_options.max_impacts = lab.max_collisions;
   // Impacts that never end are shown, not counted: a display's worth unless asked for more.
   const bool endless = prediction && (prediction->kind == ModelKind::kTwoWallsInfinite ||
                                       prediction->kind == ModelKind::kBoxInfinite ||
                                       (prediction->kind == ModelKind::kGhosts && prediction->infinite));  // a ring
-  if (endless && !options.simulate_to_cap) {
-    engine_options.max_impacts = std::min(lab.max_collisions, kInfiniteRunDisplayCap);
+  if (endless && !options.simulate_to_cap) return {Route::kEngine, std::min(lab.max_collisions, kInfiniteRunDisplayCap)};
+  return {Route::kEngine, lab.max_collisions};
+}
+
+/// The engine's run of an N-body scene, compared with a finite prediction when it finished.
+/// With options.keep_events, the shown impacts are kept in simulation.impacts.
+SceneSimulation simulateScene(const Scene& scene, const SceneRunOptions& options,
+                              const std::optional<Prediction>& prediction, const SceneVisitors& visitors) {
+  const RunOptions& lab = options.lab;
+  const Route route = routeOf(prediction, options);
+  switch (route.kind) {
+    case Route::kPredicted: return fromPrediction(*prediction);
+    case Route::kNotSimulated: return notSimulated(prediction);
+    case Route::kOverCap: return overCap(*prediction, lab.max_collisions);
+    case Route::kRotation: return simulateRotationScene(scene, *prediction, options, visitors);
+    case Route::kEngine: break;
   }
+
+  EngineOptions engine_options;
+  engine_options.max_impacts = route.engine_cap;
   engine_options.progress_interval = options.progress_interval;
   engine_options.cancel = options.cancel;
   const bool full = lab.mode == RunMode::kFull;
@@ -235,6 +259,17 @@ ScenePlan planScene(Scene scene) {
   plan.scene = std::move(scene);
   plan.plan_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return plan;
+}
+
+std::optional<std::uint64_t> plannedImpacts(const ScenePlan& plan, const SceneRunOptions& options) {
+  const Route route = routeOf(plan.prediction, options);
+  if (route.kind != Route::kRotation && route.kind != Route::kEngine) return 0;
+  const std::optional<Prediction>& prediction = plan.prediction;
+  if (prediction && prediction->impact_count && !prediction->infinite) {
+    return std::min(*prediction->impact_count, route.engine_cap);
+  }
+  if (prediction && prediction->infinite && !prediction->collapsed) return route.engine_cap;  // endless
+  return std::nullopt;
 }
 
 std::vector<std::string> uncertifiedValues(const SceneRunResult& result) {

@@ -397,6 +397,22 @@ std::vector<std::string> latchedRecordedTopics(const RunTopics& topics, const st
   return latched;
 }
 
+/// The core's options of a run in `mode`: what the lane chosen at intake (core::plannedImpacts)
+/// and the worker's run both follow. Events are streamed to the visitors, never kept; asking
+/// for them makes a closed-form scene simulated too (its events are published), as the CLI
+/// does when it shows events. Without simulate_to_cap the model answers over the cap.
+collision_lab::core::SceneRunOptions sceneRunOptions(collision_lab::core::RunMode mode, std::uint64_t max_collisions,
+                                                     bool simulate_to_cap) {
+  namespace core = collision_lab::core;
+  core::SceneRunOptions options;
+  options.lab.max_collisions = max_collisions;
+  options.lab.events = mode == core::RunMode::kFull ? core::EventPolicy::all() : core::EventPolicy::none();
+  options.lab.mode = mode;
+  options.simulate_to_cap = simulate_to_cap;
+  options.keep_events = false;
+  return options;
+}
+
 /// The settings a run is served with (run_id and stamp are the RunWriter's).
 collision_lab::RunParameters runParameters(const LabNodeParams& params, std::uint64_t max_collisions) {
   collision_lab::RunParameters msg;
@@ -795,9 +811,8 @@ void LabNode::intake(collision_lab::InitialConditions input, Reply reply) {
   }
   Job job;
   job.limits = limitsOf(input);
-  const bool predict_only = *toRunMode(input.mode) == core::RunMode::kPredictOnly;
-  const collision_lab::service::Lane lane =
-      collision_lab::service::chooseLane(*plan, predict_only, job.limits.max_collisions, params_.simulate_to_cap, params_.lanes);
+  const collision_lab::service::Lane lane = collision_lab::service::chooseLane(
+      *plan, sceneRunOptions(*toRunMode(input.mode), job.limits.max_collisions, params_.simulate_to_cap), params_.lanes);
   if (plan->prediction && plan->prediction->impact_count) job.predicted_collisions = *plan->prediction->impact_count;
   const std::string base = requestedRunId(input);
   {
@@ -1045,18 +1060,11 @@ void LabNode::run(Worker& worker, Job& job, RunWriter& out, RunProgress& progres
   run_index_->started(input.run_id);
   publishStart(worker, out, input, plan);  // the prediction goes out before the simulation starts
 
-  core::SceneRunOptions options;
-  options.lab.max_collisions = job.limits.max_collisions;
+  core::SceneRunOptions options = sceneRunOptions(mode, job.limits.max_collisions, params_.simulate_to_cap);
   collision_lab::RunParameters parameters = runParameters(params_, options.lab.max_collisions);
   parameters.max_run_seconds = job.limits.max_run_seconds;
   parameters.max_bag_bytes = job.limits.max_bag_bytes;
   out.record(std::move(parameters));
-  // Events are streamed to the visitors, never kept; asking for them makes a closed-form
-  // scene simulated too (its events are published), as the CLI does when it shows events.
-  options.lab.events = mode == core::RunMode::kFull ? core::EventPolicy::all() : core::EventPolicy::none();
-  options.lab.mode = mode;
-  options.simulate_to_cap = params_.simulate_to_cap;  // else the model answers over the cap (runScene)
-  options.keep_events = false;
   options.cancel = &worker.cancel;
   const bool fail = !params_.fail_runs_of_student.empty() && input.student == params_.fail_runs_of_student;
   const PublishLimits limits{params_.max_published_events, params_.progress_period, params_.progress_every_events};

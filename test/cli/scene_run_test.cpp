@@ -249,6 +249,59 @@ TEST(SceneRun, TwoWallsAreSimulatedForDisplayOnly) {
   EXPECT_EQ(core::runScene(core::planScene(scene), options).simulation.impact_count, 5000u);
 }
 
+// plannedImpacts (what the node's lanes follow) is the run's own decision: 0 where the model
+// answers alone, else the impacts the run simulates, or empty where the plan cannot count them
+// (then the run is simulated, to its end or the cap).
+TEST(SceneRun, PlannedImpactsAreTheImpactsTheRunSimulates) {
+  std::vector<core::Scene> scenes = {
+      core::Scene{{100, 1, INFINITY}, {2, 1, 0}, {-1, 0, 0}, {}},     // 31 impacts, the rotation model
+      core::Scene{{1e6, 1, INFINITY}, {2, 1, 0}, {-1, 0, 0}, {}},     // 3,141 impacts
+      cradle(),                                                      // equal masses: counted inversions
+      core::Scene{{INFINITY, 1, INFINITY}, {1, 0.5, 0}, {0, 1, 0}, {}},  // two walls: endless
+      core::Scene{{1, 1, 1}, {2, 1, 0}, {-1, 0, 0}, {0.05}},          // the spiral collapses
+      core::Scene{{2, 1}, {1, 0}, {-1, 1}, {0.5}},                    // two bodies
+      core::Scene{{1, 3, 2, 5}, {3, 2, 1, 0}, {-1, 0.5, 0, 1}, {0.9}},  // no closed form
+  };
+  int counted = 0, uncounted = 0, answered = 0;
+  for (const core::Scene& scene : scenes) {
+    const core::ScenePlan plan = core::planScene(scene);
+    ASSERT_FALSE(plan.error) << plan.error->message;
+    for (const core::RunMode mode : {core::RunMode::kFull, core::RunMode::kSummaryOnly, core::RunMode::kPredictOnly}) {
+      for (const bool events : {true, false}) {
+        for (const std::uint64_t cap : {std::uint64_t{20}, std::uint64_t{100'000}}) {
+          for (const bool to_cap : {false, true}) {
+            core::SceneRunOptions options = withEvents(events ? core::EventPolicy::all() : core::EventPolicy::none());
+            options.lab.mode = mode;
+            options.lab.max_collisions = cap;
+            options.simulate_to_cap = to_cap;
+            const std::optional<std::uint64_t> planned = core::plannedImpacts(plan, options);
+            const core::SceneSimulation run = core::runScene(plan, options).simulation;
+            const std::string what = "scene " + std::to_string(&scene - scenes.data()) + " mode " +
+                                     std::to_string(static_cast<int>(mode)) + " events " + std::to_string(events) +
+                                     " cap " + std::to_string(cap) + " to_cap " + std::to_string(to_cap);
+            if (!planned) {
+              ++uncounted;
+              EXPECT_TRUE(run.simulated) << what;
+              EXPECT_LE(run.impact_count, cap) << what;
+            } else if (*planned == 0) {
+              ++answered;
+              EXPECT_FALSE(run.simulated) << what;
+            } else {
+              ++counted;
+              EXPECT_TRUE(run.simulated) << what;
+              EXPECT_EQ(run.impact_count, *planned) << what;
+            }
+          }
+        }
+      }
+    }
+  }
+  // Every kind of answer was met.
+  EXPECT_GT(counted, 0);
+  EXPECT_GT(uncounted, 0);
+  EXPECT_GT(answered, 0);
+}
+
 // The engine's run keeps the events asked for, as the three-body path does (failed before:
 // none kept, so a batch lost them).
 TEST(SceneRun, TheEngineKeepsTheEventsAskedFor) {

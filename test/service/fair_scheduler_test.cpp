@@ -91,21 +91,46 @@ core::ScenePlan plan(std::vector<double> masses, std::vector<double> positions, 
   return core::planScene(scene);
 }
 
+core::SceneRunOptions runOptions(core::RunMode mode, std::uint64_t cap, bool simulate_to_cap) {
+  core::SceneRunOptions options;
+  options.lab.mode = mode;
+  options.lab.events = mode == core::RunMode::kFull ? core::EventPolicy::all() : core::EventPolicy::none();
+  options.lab.max_collisions = cap;
+  options.simulate_to_cap = simulate_to_cap;
+  return options;
+}
+
 TEST(ChooseLane, FromWhatThePlanKnows) {
   constexpr double kInf = std::numeric_limits<double>::infinity();
   const LaneLimits limits;  // 100,000 impacts, 100 bodies
+  const auto full = core::RunMode::kFull, predict = core::RunMode::kPredictOnly;
   const auto pi31 = plan({100, 1, kInf}, {2, 1, 0}, {-1, 0, 0});
   ASSERT_FALSE(pi31.error);
-  EXPECT_EQ(chooseLane(pi31, false, 0, false, limits), Lane::kShort);
+  EXPECT_EQ(chooseLane(pi31, runOptions(full, 10'000'000, false), limits), Lane::kShort);
   // 3.14e8 impacts: long when simulated to a large cap, short when predict-only or when the
   // model answers over a smaller cap.
   const auto pi_big = plan({1e16, 1, kInf}, {2, 1, 0}, {-1, 0, 0});
   ASSERT_FALSE(pi_big.error);
   const std::uint64_t all = std::numeric_limits<std::uint64_t>::max();
-  EXPECT_EQ(chooseLane(pi_big, false, all, false, limits), Lane::kLong);
-  EXPECT_EQ(chooseLane(pi_big, true, all, false, limits), Lane::kShort);
-  EXPECT_EQ(chooseLane(pi_big, false, 1000, false, limits), Lane::kShort);
-  EXPECT_EQ(chooseLane(pi_big, false, 1'000'000, true, limits), Lane::kLong);
+  EXPECT_EQ(chooseLane(pi_big, runOptions(full, all, false), limits), Lane::kLong);
+  EXPECT_EQ(chooseLane(pi_big, runOptions(predict, all, false), limits), Lane::kShort);
+  EXPECT_EQ(chooseLane(pi_big, runOptions(full, 1000, false), limits), Lane::kShort);
+  EXPECT_EQ(chooseLane(pi_big, runOptions(full, 1'000'000, true), limits), Lane::kLong);
+  // Endless impacts between two walls: a display's worth (short), or the cap when asked for.
+  const auto box = plan({kInf, 1, kInf}, {1, 0.5, 0}, {0, 1, 0});
+  ASSERT_FALSE(box.error);
+  EXPECT_EQ(chooseLane(box, runOptions(full, 10'000'000, false), limits), Lane::kShort);
+  EXPECT_EQ(chooseLane(box, runOptions(full, 10'000'000, true), limits), Lane::kLong);
+  // A collapse the plan cannot count, of three bodies: the engine stops at it.
+  core::Scene spiral;
+  spiral.masses = {1, 1, 1};
+  spiral.positions = {2, 1, 0};
+  spiral.velocities = {-1, 0, 0};
+  spiral.restitution = {0.05};
+  const auto collapse = core::planScene(spiral);
+  ASSERT_FALSE(collapse.error);
+  EXPECT_FALSE(core::plannedImpacts(collapse, runOptions(full, 10'000'000, true)));
+  EXPECT_EQ(chooseLane(collapse, runOptions(full, 10'000'000, true), limits), Lane::kShort);
 }
 
 }  // namespace

@@ -109,6 +109,14 @@ struct SceneVisitors {
 /// prediction. Never throws for any input (short of memory).
 ScenePlan planScene(Scene scene);
 
+/// The impacts runScene(plan, options) will simulate, as far as the plan knows before the
+/// run (the same decision runScene takes): 0 where the model answers alone (predict mode,
+/// over the cap, or a count it knows with no event asked for); the count, or the cap, where
+/// the engine runs to one of them (a display's worth of endless impacts); empty where the
+/// engine runs to an end the plan cannot count (a collapse, or a scene no model counts).
+/// Precondition: !plan.error.
+std::optional<std::uint64_t> plannedImpacts(const ScenePlan& plan, const SceneRunOptions& options);
+
 /// Runs a planned scene. Precondition: !plan.error. Never throws (short of memory); the
 /// visitors may throw, which ends the run.
 SceneRunResult runScene(const ScenePlan& plan, const SceneRunOptions& options, const SceneVisitors& visitors = {});

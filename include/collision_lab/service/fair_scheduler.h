@@ -33,35 +33,17 @@ struct LaneLimits {
   std::uint64_t short_max_bodies = 100;          ///< [1] bodies, walls included
 };
 
-/// The impacts a run will compute as far as its plan knows before it starts; empty when
-/// the plan does not know (no count). cap: the run's collision cap (0: none);
-/// simulate_to_cap: core::SceneRunOptions::simulate_to_cap.
-inline std::optional<std::uint64_t> plannedImpacts(const core::ScenePlan& plan, bool predict_only,
-                                                   std::uint64_t cap, bool simulate_to_cap) {
-  if (predict_only) return 0;
-  const bool capped = cap > 0;
-  std::optional<std::uint64_t> count;
-  if (plan.prediction && plan.prediction->impact_count) count = plan.prediction->impact_count;
-  if (plan.prediction && plan.prediction->infinite) {
-    // Over any cap: the model answers unless the run simulates to its cap.
-    if (!simulate_to_cap) return 0;
-    return capped ? std::optional<std::uint64_t>(cap) : std::nullopt;
-  }
-  if (!count) return std::nullopt;
-  if (capped && *count > cap) return simulate_to_cap ? cap : 0;  // the over-cap rule: the model answers
-  return count;
-}
-
-/// Short when the run's planned impacts are at most limits.short_max_collisions, or, when
-/// the plan knows no count, when it has at most short_max_bodies bodies and a cap of at
-/// most short_max_collisions; else long.
-inline Lane chooseLane(const core::ScenePlan& plan, bool predict_only, std::uint64_t cap, bool simulate_to_cap,
-                       const LaneLimits& limits) {
-  if (const auto impacts = plannedImpacts(plan, predict_only, cap, simulate_to_cap)) {
+/// Short when the run's planned impacts (core::plannedImpacts: the core's own decision) are
+/// at most limits.short_max_collisions. When the plan cannot count them, short when the
+/// scene has at most short_max_bodies bodies and either a cap of at most
+/// short_max_collisions or a predicted collapse (the engine stops at it); else long.
+inline Lane chooseLane(const core::ScenePlan& plan, const core::SceneRunOptions& options, const LaneLimits& limits) {
+  if (const auto impacts = core::plannedImpacts(plan, options)) {
     return *impacts <= limits.short_max_collisions ? Lane::kShort : Lane::kLong;
   }
-  const bool small_cap = cap > 0 && cap <= limits.short_max_collisions;
-  return plan.scene.size() <= limits.short_max_bodies && small_cap ? Lane::kShort : Lane::kLong;
+  const bool small_cap = options.lab.max_collisions <= limits.short_max_collisions;
+  const bool collapses = plan.prediction && plan.prediction->collapsed;
+  return plan.scene.size() <= limits.short_max_bodies && (small_cap || collapses) ? Lane::kShort : Lane::kLong;
 }
 
 template <class Job>
