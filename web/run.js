@@ -189,7 +189,7 @@ function summaryRows(run) {
     rows.push(['energy drift (ratio)', s.energy_relative_drift, null, null]);
     // Every other value shown is the exact one correctly rounded (docs/physics.md).
     if (s.uncertified_values && s.uncertified_values.length) {
-      rows.push(['not certified (may be off in the last digit)', s.uncertified_values.join(', '), null, null]);
+      rows.push(['not certified as correctly rounded', s.uncertified_values.map((k) => k.replace(/_/g, ' ')).join(', '), null, null]);
     }
     if (s.time_beyond_range) rows.push(['time', 'an impact came after 1.8e308 s, the largest double: shown as inf', null, null]);
     rows.push(['stop reason', s.stop_reason + (view.truncated ? ': ' + view.truncated : ''), null, null]);
