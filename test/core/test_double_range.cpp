@@ -21,8 +21,10 @@
 #include <boost/multiprecision/cpp_bin_float.hpp>
 
 #include "collision_lab/core/analytic.h"
+#include "collision_lab/core/nbody/engine.h"
 #include "collision_lab/core/scene_run.h"
 #include "rational_reference.h"
+#include "rounding_checks.h"
 #include "simulated_run.h"
 
 namespace collision_lab {
@@ -433,6 +435,17 @@ TEST(DoubleRange, ExtremeMassRatiosAreAcceptedAndExact) {
   const SceneSimulation quiet = testing_support::runPlanned(feather, count_only).simulation;
   EXPECT_EQ(quiet.impact_count, 2u);
   EXPECT_FALSE(quiet.truncated) << quiet.stop_message;
+  // The bodies at the second impact's exact time, each rounded once: A about 5e299 m out, B
+  // at the wall (a double time there is inf, and no time a double holds places them).
+  const reference::Run truth = reference::simulate(feather, 10);
+  ASSERT_EQ(truth.impacts.size(), 2u);
+  const SceneSimulation engine = runEngine(feather, EngineOptions{});
+  EXPECT_EQ(engine.impact_count, 2u);
+  ASSERT_EQ(engine.final_positions.size(), 3u);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_TRUE(testing_support::correctlyRounded(engine.final_positions[k], truth.impacts[1].positions[k]))
+        << k << ": " << engine.final_positions[k];
+  }
   // A heavy B (it cannot be a wall), ratios past the double range (1e300 / 1e-310), and a
   // light B between bodies 1e200 apart in mass (31 impacts).
   for (const Scene& scene : {Scene{{1e-300, 1e300, 1}, {3, 1, 0}, {-1, 0, 1}},

@@ -136,20 +136,30 @@ class Driver {
         const StepResult r = startOrEscalate<Rational>();
         if (r.kind != StepKind::kImpact) return r;
       }
-      exact_->allowAnyMagnitude();
+      // Every pair scheduled anew: a step the exact tier undid (restore) leaves its pairs'
+      // schedules behind.
+      const StepResult rescheduled = exact_->allowAnyMagnitude();
+      if (rescheduled.kind != StepKind::kImpact) return rescheduled;
       const StepResult at = advanceTo<Rational>(fast_->count());
       if (at.kind != StepKind::kImpact) return at;
       beyond_range_ = true;
     }
-    // Every step is exact: a streak, so that the tier's growing numbers stop the run as
-    // they would in step() (kExhausted).
+    // Every step is exact: counted as one, and a streak, so that the tier's growing numbers
+    // stop the run as they would in step() (kExhausted).
     const StepResult r = stepOrEscalate<Rational>(record);
+    ++escalations_.exact_rational;
+    ++escalations_.replayed_impacts;
     ++exact_streak_;
     const double bits = exact_->exactBits();
     streak_work_.add(bits * bits);
     return r;
   }
   bool beyondRange() const { return beyond_range_; }
+  /// Beyond the range: the bodies at the exact time of the last impact, each rounded once
+  /// [working units] (there, a double time is inf, or too coarse to place a body).
+  void exactStateAtLastImpact(std::vector<double>& positions, std::vector<double>& velocities) const {
+    exact_->stateAtLastImpact(positions, velocities);
+  }
 
   /// f(tier) of the tier that leads the run: the working one, or the exact one beyond the
   /// range (stepBeyondRange).
@@ -602,7 +612,15 @@ std::string modelAdvice(const Scene& scene) {
   return "; a model of the physics there goes on: --restitution-model tc or --restitution-model viscoelastic";
 }
 
-std::string stopMessage(const Scene& scene, const SceneSimulation& result, bool exhausted, bool beyond_doubles,
+/// How a run met an impact past the largest double and the tiers' range.
+enum class BeyondRange {
+  kNotMet,        ///< it did not
+  kGoneOn,        ///< the exact tier took the run on alone
+  kNotEligible,   ///< the scene may not go on there (inelastic, a ring or a box)
+  kReplayFailed,  ///< the exact replay to there exceeded its work budget
+};
+
+std::string stopMessage(const Scene& scene, const SceneSimulation& result, bool exhausted, BeyondRange beyond,
                         const ExactProgress& exact) {
   // "1 impact", "31,415 impacts".
   const std::string impacts = countText(result.impact_count) + (result.impact_count == 1 ? " impact" : " impacts");
@@ -624,6 +642,13 @@ std::string stopMessage(const Scene& scene, const SceneSimulation& result, bool 
       return text;
     }
     case StopReason::kCap:
+      if (exhausted && beyond == BeyondRange::kGoneOn) {
+        return "stopped after " + impacts + " at the exactness cap (truncated): past t = " +
+               formatValue(std::numeric_limits<double>::max()) +
+               " s, the largest double, the run went on in exact rationals alone, and " +
+               countText(kExactStreak) + " impacts in a row needed numbers of more than " +
+               std::to_string(kExactBits) + " bits";
+      }
       if (exhausted) {
         std::string foreseen;
         if (exact.predicted) {
@@ -651,11 +676,15 @@ std::string stopMessage(const Scene& scene, const SceneSimulation& result, bool 
              ": a multiple collision, whose outcome point masses do not define, so the run ends here";
     }
     case StopReason::kOutOfRange:
-      if (beyond_doubles) {
+      if (beyond != BeyondRange::kNotMet) {
+        const std::string why =
+            beyond == BeyondRange::kReplayFailed
+                ? "the exact replay to there, which goes on past it, would exceed its work budget"
+                : "past it only the exact tier goes on, and only in elastic scenes without a ring or a box";
         return "stopped after " + impacts + " (truncated): the next impact comes after t = " +
                formatValue(std::numeric_limits<double>::max()) +
-               " s, the largest double, and beyond the engine's working range (2^900 in its units), so the "
-               "run cannot go on; a longer unit of time brings it into range";
+               " s, the largest double, and beyond the engine's working range (2^900 in its units); " + why +
+               ", so the run cannot go on";
       }
       return "stopped after " + impacts + " (truncated): the next one would take a time, position or velocity "
              "beyond 2^900 in the run's working units (the powers of two of m, m/s and kg that bring the scene's "
@@ -847,7 +876,7 @@ SceneSimulation runEngineOn(const Scene& si_scene, const EngineOptions& options,
         (!(r.time <= time_limit) || !(driver.exactNextTimeLowerBound() <= time_limit))) {
       beyond_doubles = true;
       const StepResult beyond = driver.stepBeyondRange(into);
-      if (driver.beyondRange()) r = beyond;
+      if (driver.beyondRange() || beyond.kind == StepKind::kCancelled) r = beyond;
     }
     if (r.kind != StepKind::kImpact) break;
     ++count;
@@ -857,16 +886,17 @@ SceneSimulation runEngineOn(const Scene& si_scene, const EngineOptions& options,
       if (visitor) visitor(record);
       if (count <= options.keep_events) result.impacts.push_back(record);
     }
-    if (driver.beyondRange()) continue;  // elastic: no collapse to look for
-    const std::size_t collapses = result.collapses.size();
-    const StepResult collapse = driver.afterImpact(r.pair, result);
-    if (collapse.kind != StepKind::kImpact) {
-      r = collapse;
-      break;
+    if (!driver.beyondRange()) {  // beyond it every impact is elastic: no collapse to look for
+      const std::size_t collapses = result.collapses.size();
+      const StepResult collapse = driver.afterImpact(r.pair, result);
+      if (collapse.kind != StepKind::kImpact) {
+        r = collapse;
+        break;
+      }
+      if (on_collapse && result.collapses.size() > collapses) on_collapse(toSiCollapse(result.collapses.back()));
     }
-    if (on_collapse && result.collapses.size() > collapses) on_collapse(toSiCollapse(result.collapses.back()));
     if (progress && options.progress_interval > 0 && count % options.progress_interval == 0) {
-      progress(EngineProgress{count, si.time(driver.fast().lastTime())});
+      progress(EngineProgress{count, si.time(driver.leading([](const auto& t) { return t.lastTime(); }))});
     }
   }
   if (result.stop == StopReason::kFinished) finish(r, result);
@@ -898,7 +928,11 @@ SceneSimulation runEngineOn(const Scene& si_scene, const EngineOptions& options,
   driver.leading([&](const auto& t) {
     result.cluster_impacts = t.clusterImpacts();
     result.rule_elastic_impacts = t.ruleElastic();
-    t.state(result.final_time, result.final_positions, result.final_velocities);
+    if (driver.beyondRange()) {
+      driver.exactStateAtLastImpact(result.final_positions, result.final_velocities);
+    } else {
+      t.state(result.final_time, result.final_positions, result.final_velocities);
+    }
     result.energy_lost = t.energyLost();
   });
   result.escalations = driver.escalations();  // the run's decisions, before any certifying replay
@@ -917,8 +951,11 @@ SceneSimulation runEngineOn(const Scene& si_scene, const EngineOptions& options,
     result.collapse_position = result.collapses.front().position;
   }
   if (result.multiple_collision) result.multiple_collision->time = si.time(result.multiple_collision->time);
-  result.stop_message =
-      stopMessage(si_scene, result, r.kind == StepKind::kExhausted, beyond_doubles, driver.exactProgress());
+  const BeyondRange beyond = driver.beyondRange() ? BeyondRange::kGoneOn
+                             : !beyond_doubles      ? BeyondRange::kNotMet
+                             : may_go_beyond_range  ? BeyondRange::kReplayFailed
+                                                    : BeyondRange::kNotEligible;
+  result.stop_message = stopMessage(si_scene, result, r.kind == StepKind::kExhausted, beyond, driver.exactProgress());
   return result;
 }
 

@@ -203,9 +203,11 @@ class CL_NBODY_INTERNAL Tier {
   /// The exact tier only: from now on its numbers have no range. Impacts past the tiers'
   /// range (kMaxMagnitude, whose times lie beyond the largest double) are ordered by their
   /// exact times and performed, where the other tiers stop out of range.
-  void allowAnyMagnitude() {
+  /// Every pair is scheduled anew from the state (the same as start()).
+  StepResult allowAnyMagnitude() {
     static_assert(Ar::kExact, "only exact numbers have no range");
     unbounded_ = true;
+    return start();
   }
   /// A lower bound of the next impact's time [s] (inf: none is due).
   double nextTimeLowerBound() const { return tree_.minKey(); }
@@ -530,12 +532,19 @@ class CL_NBODY_INTERNAL Tier {
     velocities.resize(bodies_.size());
     for (std::size_t k = 0; k < bodies_.size(); ++k) {
       velocities[k] = Ar::toDouble(bodies_[k].v);
-      if (!std::isfinite(t)) {  // past the largest double: a moving body is out of range too
-        const int direction = Ar::sign(bodies_[k].v);
-        positions[k] = direction == 0 ? wrap(Ar::toDouble(bodies_[k].b)) : direction * kInf;
-        continue;
-      }
       positions[k] = wrap(Ar::toDouble(S(bodies_[k].b + S(bodies_[k].v * S(t)))));
+    }
+  }
+  /// The exact tier only: the state at the exact time of the last impact (0 before the
+  /// first), each value rounded once [working units] (no ring: its wrap is not applied).
+  void stateAtLastImpact(std::vector<double>& positions, std::vector<double>& velocities) const {
+    static_assert(Ar::kExact, "the exact time of the last impact is the exact tier's");
+    const S t = Ar::sign(now_.A) > 0 ? S(now_.G / now_.A) : S(0);
+    positions.resize(bodies_.size());
+    velocities.resize(bodies_.size());
+    for (std::size_t k = 0; k < bodies_.size(); ++k) {
+      velocities[k] = detail::nearestDouble(bodies_[k].v);
+      positions[k] = detail::nearestDouble(S(bodies_[k].b + bodies_[k].v * t));
     }
   }
 

@@ -87,7 +87,8 @@ class CL_NBODY_INTERNAL TournamentTree {
     return least(even, odd);
   }
 
-  /// Calls f(leaf) for every leaf whose key is <= threshold (a finite threshold).
+  /// Calls f(leaf) for every leaf whose key is <= threshold; an infinite threshold visits
+  /// every leaf, the padding ones too (key inf): the caller filters them.
   template <class F>
   void forEachAtMost(double threshold, F&& f) const {
     visit(1, threshold, f);
