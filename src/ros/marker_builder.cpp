@@ -180,8 +180,6 @@ RunRecord::RunRecord(const collision_lab::InitialConditions& input, const Record
     : input_(input),
       limits_(limits),
       replay_(input.masses, input.positions, input.velocities, input.ring),
-      first_collapse_time_(std::nan("")),
-      first_collapse_position_(std::nan("")),
       min_velocity_(kInf),
       max_velocity_(-kInf) {
   // An input of unequal lengths (the node rejects those) is cut to its shortest list.
@@ -385,10 +383,8 @@ void RunRecord::makeNewest(const collision_lab::CollisionEvent& event, bool foll
   newest_is_collapse_ = collapse;
   has_newest_ = true;
   newest_predicted_ = event.predicted_velocities_after;
-  if (collapse && collapses_++ == 0) {
-    first_collapse_time_ = event.time;
-    first_collapse_position_ = event.position;
-    first_collapse_bodies_ = {event.first_moved, event.last_moved};
+  if (collapse && collapses_++ < kNamedCollapses) {
+    named_collapses_.push_back({event.time, event.position, {event.first_moved, event.last_moved}});
   }
 }
 

@@ -208,25 +208,34 @@ RunView makeRunView(const RunRecord& run) {
     view.truncated = truncationSentence(run.summary->truncation_reason);
   }
 
-  // A collapse: the first collapse event received, else the summary's or the model's.
-  const bool collapsed_event = run.collapses() > 0;
-  const bool collapsed = collapsed_event || (run.summary && run.summary->collapsed) ||
-                         (run.prediction && run.prediction->collapsed);
-  if (collapsed) {
-    std::pair<std::size_t, std::size_t> bodies{0, run.bodies() ? run.bodies() - 1 : 0};
-    if (collapsed_event) {
-      view.collapse_time = run.firstCollapseTime();
-      view.collapse_position = run.firstCollapsePosition();
-      bodies = run.firstCollapseBodies();
-    } else if (run.summary && run.summary->collapsed) {
-      view.collapse_time = run.summary->collapse_time;
-      view.collapse_position = run.summary->collapse_position;
-    } else {
-      view.collapse_time = run.prediction->collapse_time;
-      view.collapse_position = run.prediction->collapse_position;
+  // The collapses: those received as events, else the summary's or the model's one.
+  std::vector<RunRecord::CollapseMark> marks = run.namedCollapses();
+  view.collapse_count = std::max<std::uint64_t>(run.collapses(), run.summary ? run.summary->collapse_count : 0);
+  if (marks.empty() && ((run.summary && run.summary->collapsed) || (run.prediction && run.prediction->collapsed))) {
+    RunRecord::CollapseMark whole;
+    whole.bodies = {0, run.bodies() ? run.bodies() - 1 : 0};
+    const bool simulated = run.summary && run.summary->collapsed;
+    whole.time = simulated ? run.summary->collapse_time : run.prediction->collapse_time;
+    whole.position = simulated ? run.summary->collapse_position : run.prediction->collapse_position;
+    marks.push_back(whole);
+  }
+  if (!marks.empty()) {
+    view.collapse_count = std::max<std::uint64_t>(view.collapse_count, marks.size());
+    view.collapse_time = marks.front().time;
+    view.collapse_position = marks.front().position;
+    for (std::size_t k = 0; k < marks.size(); ++k) {
+      const RunRecord::CollapseMark& mark = marks[k];
+      view.collapse += (k == 0 ? "collapse" : "; collapse " + std::to_string(k + 1)) + " at t = " +
+                       format("%.6g s", mark.time) + ", x = " + format("%.6g m", mark.position) + ", " +
+                       bodyRange(mark.bodies.first, mark.bodies.second);
     }
-    view.collapse = "collapse at t = " + format("%.6g s", view.collapse_time) + ", x = " +
-                    format("%.6g m", view.collapse_position) + ", " + bodyRange(bodies.first, bodies.second);
+    if (view.collapse_count > marks.size()) {
+      view.collapse += "; and " + withSeparators(view.collapse_count - marks.size()) + " more";
+    }
+    view.collapse_brief = view.collapse.substr(0, view.collapse.find(';'));
+    if (view.collapse_count > 1) {
+      view.collapse_brief += "; " + withSeparators(view.collapse_count - 1) + " more";
+    }
   }
 
   if (in.ring > 0) {
@@ -263,7 +272,9 @@ RunView makeRunView(const RunRecord& run) {
         view.counter += " (infinitely many predicted)";
       }
     }
-    if (!view.collapse.empty() && view.state != "running") view.counter += " + 1 collapse";
+    if (view.collapse_count > 0 && view.state != "running") {
+      view.counter += " + " + withSeparators(view.collapse_count) + (view.collapse_count == 1 ? " collapse" : " collapses");
+    }
     view.counter += ", " + view.state;
   }
 
@@ -371,6 +382,7 @@ nlohmann::json viewJson(const RunView& view) {
           {"not_simulated", view.not_simulated},
           {"truncated", view.truncated},
           {"collapse", view.collapse},
+          {"collapse_count", view.collapse_count},
           {"collapse_time", view.collapse.empty() ? nlohmann::json(nullptr) : nlohmann::json(view.collapse_time)},
           {"collapse_position",
            view.collapse.empty() || !std::isfinite(view.collapse_position) ? nlohmann::json(nullptr)

@@ -142,6 +142,43 @@ TEST(RunView, CollapseIsNamedWithTimePointAndBodies) {
   EXPECT_EQ(view.title.find("collapse(s)"), std::string::npos) << view.title;
 }
 
+// cluster_collapse_5: A..C collapse at t = 3.5 s after impact 8, then A..E at t = 10.43 s
+// after impact 16. Both are named, and the counter and the title count both (the counter
+// said "+ 1 collapse", and only the first was named).
+TEST(RunView, EveryCollapseIsNamedAndCounted) {
+  auto in = input({1, 1, 1, 1, 1}, {4, 3, 2, 1, 0}, {-1, 0, 0, 0, 0});
+  in.restitution = {0.05};
+  RunRecord run(in);
+  const auto collapseAfter = [](std::uint64_t index, std::uint32_t last, double t, double x, double v) {
+    CollisionEvent c;
+    c.kind = CollisionEvent::KIND_COLLAPSE;
+    c.index = index;
+    c.first_moved = 0;
+    c.last_moved = last;
+    c.time = t;
+    c.position = x;
+    c.pair_velocities_after = {v, v};
+    return c;
+  };
+  for (std::uint64_t k = 1; k <= 16; ++k) {
+    run.add(impact(k, static_cast<std::uint32_t>(k % 4), 0.5 * static_cast<double>(k), 1.0, -0.2, -0.2));
+    if (k == 8) run.add(collapseAfter(8, 2, 3.5, 1.8333333333333333, -1.0 / 3));
+  }
+  run.add(collapseAfter(16, 4, 10.433529702243725, -0.08670594044874491, -0.2));
+  auto s = simulatedSummary(16);
+  s.collapsed = true;
+  s.collapse_count = 2;
+  run.summary = s;
+  const auto view = makeRunView(run);
+  EXPECT_EQ(view.collapse_count, 2u);
+  EXPECT_EQ(view.collapse,
+            "collapse at t = 3.5 s, x = 1.83333 m, bodies A..C; collapse 2 at t = 10.4335 s, x = -0.0867059 m, "
+            "bodies A..E");
+  EXPECT_EQ(view.collapse_brief, "collapse at t = 3.5 s, x = 1.83333 m, bodies A..C; 1 more");
+  EXPECT_EQ(view.counter, "16 collisions + 2 collapses, finished");
+  EXPECT_NE(view.title.find("16 + 2 collapses"), std::string::npos) << view.title;
+}
+
 TEST(RunView, WorldlinesReachTheRunsEnd) {
   // Two carts meet at t = 0.5 s and part: the diagram goes on past the impact.
   RunRecord run(input({1, 1}, {1, 0}, {-1, 1}));

@@ -175,12 +175,17 @@ class RunRecord {
   bool sampled() const { return sampled_; }
   std::uint64_t sampledAfter() const { return sampled_after_; }
   std::uint64_t sampledCollisions() const { return sampled_collisions_; }
-  /// Collapses applied [1] and the first one's time [s] (NaN when none).
+  /// One collapse: its time [s], point [m] and bodies, first .. last [1].
+  struct CollapseMark {
+    double time = 0.0;
+    double position = 0.0;
+    std::pair<std::size_t, std::size_t> bodies{0, 0};
+  };
+  /// The first kNamedCollapses collapses are kept, in order; collapses() counts them all.
+  static constexpr std::size_t kNamedCollapses = 3;
+  /// Collapses applied [1].
   std::uint32_t collapses() const { return collapses_; }
-  double firstCollapseTime() const { return first_collapse_time_; }
-  /// The first collapse's point [m] (NaN when none) and bodies, first .. last [1].
-  double firstCollapsePosition() const { return first_collapse_position_; }
-  std::pair<std::size_t, std::size_t> firstCollapseBodies() const { return first_collapse_bodies_; }
+  const std::vector<CollapseMark>& namedCollapses() const { return named_collapses_; }
   /// Time of the newest collision added [s] (0 before the first).
   double newestTime() const { return newest_time_; }
   /// Bounds of every finite velocity any body has had so far, the start's included [m/s]:
@@ -261,9 +266,7 @@ class RunRecord {
   bool sampled_ = false;
   std::uint64_t sampled_after_ = 0, sampled_collisions_ = 0;
   std::uint32_t collapses_ = 0;
-  double first_collapse_time_;
-  double first_collapse_position_;
-  std::pair<std::size_t, std::size_t> first_collapse_bodies_{0, 0};
+  std::vector<CollapseMark> named_collapses_;
   std::vector<std::size_t> tracked_, plotted_;
   std::vector<int> track_slot_, plot_slot_;  ///< body -> its series, -1 for none
   std::vector<Envelope> velocity_, paper_velocity_, body_energy_, worldline_;

@@ -45,10 +45,14 @@ struct RunView {
   /// "" or one sentence: "stopped at the cap of 10 collisions."
   std::string truncated;
 
-  /// A collapse: named with its time, point and bodies ("" when none).
+  /// The collapses: each named with its time, point and bodies, in order (the first
+  /// RunRecord::kNamedCollapses; "" when none).
   std::string collapse;
-  double collapse_time = 0.0;      ///< [s]
-  double collapse_position = 0.0;  ///< [m]
+  /// The first collapse alone, and how many more: for one line (rviz's status line).
+  std::string collapse_brief;
+  double collapse_time = 0.0;      ///< the first's [s]
+  double collapse_position = 0.0;  ///< the first's [m]
+  std::uint64_t collapse_count = 0;  ///< [1]
 
   /// "ring of 1,000 m" ("" when not a ring), its circumference [m] (0 when none).
   std::string ring;
