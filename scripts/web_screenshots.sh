@@ -67,6 +67,12 @@ shoot_views() {
   wait_finished "$run"; shoot "/runs/$run" web_view_not_simulated.png 1250
   run=$(send eve collapse_equal); wait_finished "$run"; shoot "/runs/$run" web_view_collapse.png 1250
   run=$(send eve two_carts); wait_finished "$run"; shoot "/runs/$run" web_view_two_carts.png 1250
+  # The state after the last collision: each plot goes on one past it (the heat of an
+  # inelastic pair, equal_masses' A at +1 m/s), and a run without collisions.
+  run=$(send_body '{"student":"eve","masses":[2,1],"positions":[1,0],"velocities":[-1,1],"restitution":[0.5]}')
+  wait_finished "$run"; shoot "/runs/$run" web_view_two_body_inelastic.png 1250
+  run=$(send eve equal_masses); wait_finished "$run"; shoot "/runs/$run" web_view_equal_masses.png 1250
+  run=$(send eve no_collision); wait_finished "$run"; shoot "/runs/$run" web_view_no_collision.png 1250
   # A value the run could not certify is named in the summary table (cluster_collapse_5's final time).
   run=$(send eve cluster_collapse_5); wait_finished "$run"; shoot "/runs/$run" web_view_uncertified.png 1400
   run=$(send_body '{"student":"eve","preset":"granular_ring","max_collisions":5000}')

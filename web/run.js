@@ -125,21 +125,42 @@ function drawScene(scene) {
   document.body.dataset.sceneColours = colours.size;
 }
 
+// The collision-index axis ends one past the last collision, as rviz's does: each series
+// goes on there with its last value, so that the state after the last collision shows.
+function indexAxisEnd(run) {
+  let last = 0;
+  run.plots.velocity.forEach((s) => s.points.forEach((q) => { last = Math.max(last, q[0]); }));
+  run.plots.energy.forEach((q) => { last = Math.max(last, q[0]); });
+  return Math.max(1, Math.ceil(last) + 1);
+}
+
+function toEnd(points, end) {
+  const data = xy(points);
+  if (data.length > 0 && data[data.length - 1].x < end) data.push({x: end, y: data[data.length - 1].y});
+  return data;
+}
+
+function indexAxis(c, end) {
+  c.options.scales.x.min = 0;
+  c.options.scales.x.max = end;
+  c.options.scales.x.ticks = {precision: 0};  // collisions are counted: whole numbers
+}
+
 function velocityDatasets(run) {
   const p = run.plots;
   const sets = [];
   const name = bodyName;
   const colour = (s) => bodyColour(s.body);
-  p.velocity.forEach((s) => sets.push({label: 'v ' + name(s.body) + ' simulated', data: xy(s.points), borderColor: colour(s), stepped: false}));
-  p.predicted_velocity.forEach((s) => sets.push({label: 'v ' + name(s.body) + ' closed form', data: xy(s.points), borderColor: colour(s), borderDash: [6, 4]}));
-  p.paper_velocity.forEach((s) => sets.push({label: 'v ' + name(s.body) + ' paper (2.15)/(2.16)', data: xy(s.points), borderColor: colour(s), borderDash: [2, 3]}));
+  const end = indexAxisEnd(run);
+  p.velocity.forEach((s) => sets.push({label: 'v ' + name(s.body) + ' simulated', data: toEnd(s.points, end), borderColor: colour(s), stepped: false}));
+  p.predicted_velocity.forEach((s) => sets.push({label: 'v ' + name(s.body) + ' closed form', data: toEnd(s.points, end), borderColor: colour(s), borderDash: [6, 4]}));
+  p.paper_velocity.forEach((s) => sets.push({label: 'v ' + name(s.body) + ' paper (2.15)/(2.16)', data: toEnd(s.points, end), borderColor: colour(s), borderDash: [2, 3]}));
   // Other models give the final velocities only: drawn beside the end of the run.
   const fin = run.prediction && p.predicted_velocity.length === 0 ? run.prediction.final_velocities : [];
-  if (fin.length > 0) {
-    const end = Math.max(1, run.collisions);
+  if (fin.length > 0) {  // on the last segment, after the last collision
     p.velocity.forEach((s) => {
       const v = fin[s.body];
-      if (v !== null && v !== undefined) sets.push({label: 'v ' + name(s.body) + ' predicted final', data: [{x: end, y: v}, {x: end * 1.08 + 0.5, y: v}], borderColor: colour(s), borderDash: [6, 4], borderWidth: 3});
+      if (v !== null && v !== undefined) sets.push({label: 'v ' + name(s.body) + ' predicted final', data: [{x: end - 1, y: v}, {x: end, y: v}], borderColor: colour(s), borderDash: [6, 4], borderWidth: 3});
     });
   }
   return sets;
@@ -299,14 +320,20 @@ function render(run) {
   drawScene(run.scene);
   document.getElementById('model').textContent = run.prediction ? 'Model: ' + run.prediction.model + '. ' + run.prediction.model_reason : '';
   const notSimulated = showNotSimulated(run, view);
+  // No collision: no event to export (the events CSV would answer 404).
+  if (ended(run.state) && run.summary && run.summary.collision_count === 0) document.getElementById('dl_csv').hidden = true;
   const v = chart('velocity', 'collision index', 'velocity [m/s]');
+  const indexEnd = indexAxisEnd(run);
   v.data.datasets = velocityDatasets(run);
   v.options.plugins.legend.display = v.data.datasets.length <= 12;
+  indexAxis(v, indexEnd);
   v.update('none');
   const e = chart('energy', 'collision index', 'energy [J]');
-  e.data.datasets = [{label: 'kinetic energy', data: xy(run.plots.energy), borderColor: totalColours[0]},
-    {label: 'heat so far', data: xy(run.plots.heat), borderColor: totalColours[1]}];
+  e.data.datasets = [{label: 'kinetic energy', data: toEnd(run.plots.energy, indexEnd), borderColor: totalColours[0]},
+    {label: 'heat so far', data: toEnd(run.plots.heat, indexEnd), borderColor: totalColours[1]}];
+  indexAxis(e, indexEnd);
   e.update('none');
+  document.body.dataset.indexAxisEnd = String(indexEnd);
   const t = chart('xt', 'x [m]', 't [s]');
   t.data.datasets = xtDatasets(run);
   t.options.plugins.legend.display = (run.plots.worldlines || []).length <= 12;

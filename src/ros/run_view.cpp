@@ -338,11 +338,14 @@ std::vector<WorldlineSegments> worldlineSegments(const RunRecord& run, double en
       line.segments.back().emplace_back(t, x);
     };
     for (const auto& v : run.worldline(i).polyline()) add(v.x, wrap(v.y));
-    // Free flight from the newest state to the run's end (every seam crossing on the way).
-    if (!frames.empty() && i < frames.back().positions.size() && std::isfinite(end_time)) {
-      const Keyframe& newest = frames.back();
-      double t = newest.time, x = newest.positions[i];
-      const double v = newest.velocities[i];
+    // Free flight from the newest state (the initial one before any collision) to the run's
+    // end, every seam crossing on the way.
+    const bool started = !frames.empty();
+    const std::vector<double>& positions = started ? frames.back().positions : run.input().positions;
+    const std::vector<double>& velocities = started ? frames.back().velocities : run.input().velocities;
+    if (i < positions.size() && i < velocities.size() && std::isfinite(end_time)) {
+      double t = started ? frames.back().time : 0.0, x = positions[i];
+      const double v = velocities[i];
       if (line.segments.back().empty() || line.segments.back().back().first < t) add(t, wrap(x));
       if (ring > 0 && v != 0 && std::isfinite(v)) {
         x = wrap(x);

@@ -278,6 +278,37 @@ TEST_F(RunPageViewTest, EqualMassesShowsTheModelsBExactlyAtRest) {
   EXPECT_EQ(error[0], "0");
 }
 
+// The state after the last collision shows: the collision-index axis ends one past it, as
+// rviz's does (it ended at the last collision, whose heat was a line on the right border).
+// (Student "lesson": the page allows 10 runs per student a minute, and "view" sends many.)
+TEST_F(RunPageViewTest, TheStateAfterTheLastCollisionIsDrawn) {
+  const std::string dom = finalPage({{"student", "lesson"}, {"masses", {2, 1}}, {"positions", {1, 0}},
+                                     {"velocities", {-1, 1}}, {"restitution", {0.5}}});
+  EXPECT_EQ(bodyData(dom, "index-axis-end"), 2.0) << dom.substr(0, 2000);
+  EXPECT_EQ(summaryCells(dom, "heat [J]").at(0), "1");
+  EXPECT_EQ(bodyData(finalPage({{"student", "lesson"}, {"preset", "equal_masses"}}), "index-axis-end"), 4.0);
+}
+
+// No collision: the bodies still fly apart on every plot, and no events CSV link leads to a 404.
+TEST_F(RunPageViewTest, NoCollisionDrawsTheBodiesFlyingApart) {
+  const std::string dom = finalPage({{"student", "lesson"}, {"preset", "no_collision"}});
+  const auto pixels = plotPixels(dom);
+  for (const char* plot : {"velocity", "energy", "xt"}) {
+    ASSERT_TRUE(pixels.count(plot)) << dom.substr(0, 2000);
+    EXPECT_GT(pixels.at(plot), 0) << plot;
+  }
+  EXPECT_GT(bodyData(dom, "xt-end"), 0.0);
+  EXPECT_TRUE(std::regex_search(dom, std::regex("<a id=\"dl_csv\"[^>]*hidden"))) << dom.substr(0, 3000);
+}
+
+// cluster_collapse_5 collapses twice (A..C at t = 3.5 s, A..E at t = 10.43 s): both are
+// named, and the counter counts both.
+TEST_F(RunPageViewTest, EveryCollapseIsNamedAndCounted) {
+  const std::string dom = finalPage({{"student", "lesson"}, {"preset", "cluster_collapse_5"}});
+  EXPECT_NE(dom.find("16 collisions + 2 collapses"), std::string::npos) << dom.substr(0, 2000);
+  EXPECT_NE(dom.find("collapse 2 at t = 10.4335 s"), std::string::npos);
+}
+
 TEST_F(RunPageViewTest, CollapseIsNamed) {
   const std::string dom = finalPage({{"student", "view"}, {"preset", "collapse_equal"}});
   EXPECT_NE(dom.find("collapse at t = "), std::string::npos) << dom.substr(0, 2000);
