@@ -18,7 +18,8 @@ catkin_add_gtest(collision_lab_core_tests
   test/core/test_wedge_cycle.cpp
   test/core/test_three_body_rounding.cpp
   test/core/test_long_run_rounding.cpp
-  test/core/test_published_rounding.cpp)
+  test/core/test_published_rounding.cpp
+  test/core/test_totals.cpp)
 if(TARGET collision_lab_core_tests)
   target_link_libraries(collision_lab_core_tests collision_lab_test_support GTest::gtest_main)
   # test_long_run_rounding.cpp tests the known-count pass (src/core/nbody/elastic_triple.h).

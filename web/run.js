@@ -205,6 +205,17 @@ function summaryRows(run) {
         paperFinal.length === n ? paperFinal[i] : null]);
     }
   }
+  // Momentum and kinetic energy of the finite masses, at the start and at the end by each
+  // column (correctly rounded by the server): a collision keeps the momentum, an elastic one
+  // the energy too; a moving wall adds or takes both; the paper's printed formulas need not.
+  const totals = run.totals;
+  if (totals && totals.start) {
+    const end = (column, key) => (totals[column] ? totals[column][key] : null);
+    rows.push(['momentum at the start [kg m/s]', totals.start.momentum, null, null]);
+    rows.push(['momentum at the end [kg m/s]', notSimulated ? null : end('simulated', 'momentum'), end('predicted', 'momentum'), end('paper', 'momentum')]);
+    rows.push(['kinetic energy at the start [J]', totals.start.kinetic_energy, null, null]);
+    rows.push(['kinetic energy at the end [J]', notSimulated ? null : end('simulated', 'kinetic_energy'), end('predicted', 'kinetic_energy'), end('paper', 'kinetic_energy')]);
+  }
   if (s) {
     rows.push(['max prediction error (ratio)', s.max_prediction_error, null, null]);
     rows.push(['energy drift (ratio)', s.energy_relative_drift, null, null]);
@@ -278,7 +289,7 @@ function showNotSimulated(run, view) {
 function showFacts(view) {
   const facts = document.getElementById('view_facts');
   // The note repeats a cut's sentence when there is one: said once.
-  const items = view ? [view.title, view.not_simulated, view.note ? '' : view.truncated, view.collapse, view.ring, view.box, view.note] : [];
+  const items = view ? [view.title, view.not_simulated, view.note ? '' : view.truncated, view.collapse, view.ring, view.box, view.moving_wall, view.note] : [];
   facts.replaceChildren(...items.filter((text) => text).map((text) => el('li', text)));
   document.getElementById('velocity_legend').textContent = view ? 'Bodies shown: ' + view.velocity_legend + '.' : '';
   document.getElementById('xt_legend').textContent = view ? 'Bodies shown: ' + view.worldline_legend + '.' : '';

@@ -246,6 +246,11 @@ RunView makeRunView(const RunRecord& run) {
                 " m";
   }
   if (view.kind == "box") view.box = "box: walls at both ends";
+  for (std::size_t i = 0; i < in.masses.size() && i < in.velocities.size(); ++i) {
+    if (!std::isfinite(in.masses[i]) && in.velocities[i] != 0.0) {
+      view.moving_wall = "a moving wall does work on the bodies: their kinetic energy changes by it, heat aside";
+    }
+  }
 
   view.collisions_so_far = run.collisions();
   if (run.summary && run.summary->simulated && !run.summary->truncated) {
@@ -393,6 +398,7 @@ nlohmann::json viewJson(const RunView& view) {
           {"ring", view.ring},
           {"ring_circumference", view.ring_circumference},
           {"box", view.box},
+          {"moving_wall", view.moving_wall},
           {"collisions_so_far", view.collisions_so_far},
           {"expected_collisions", optional(view.expected)},
           {"state", view.state},

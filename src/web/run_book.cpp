@@ -15,6 +15,7 @@
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 
+#include "collision_lab/core/totals.h"
 #include "collision_lab/ros/bag_csv.h"
 #include "collision_lab/ros/bag_reading.h"
 #include "collision_lab/ros/run_view.h"
@@ -124,6 +125,33 @@ json worldlineSegmentsJson(const RunRecord& record, double end_time) {
     lines.push_back({{"body", line.body}, {"segments", segments}});
   }
   return lines;
+}
+
+json totalsJson(const collision_lab::core::Totals& t) {
+  return {{"momentum", exactNumber(t.momentum)}, {"kinetic_energy", exactNumber(t.kinetic_energy)}};
+}
+
+/// The finite masses' momentum [kg m/s] and kinetic energy [J] (core::totalsOf, correctly
+/// rounded): at the start, and at the end by the simulation, the model and the paper's
+/// printed formulas, each where its final velocities are known (else null).
+json totalsJson(const RunRecord& record, const collision_lab::RunSummary* summary) {
+  const auto& masses = record.input().masses;
+  const auto at = [&masses](const std::vector<double>& velocities) -> json {
+    if (velocities.size() != masses.size()) return nullptr;
+    for (std::size_t i = 0; i < masses.size(); ++i) {
+      if (std::isfinite(masses[i]) && !std::isfinite(velocities[i])) return nullptr;
+    }
+    return totalsJson(collision_lab::core::totalsOf(masses, velocities));
+  };
+  std::vector<double> paper;
+  for (std::size_t i = 0; i < masses.size() && !record.plottedBodies().empty(); ++i) {
+    if (record.paperVelocity(i).empty()) break;
+    paper.push_back(record.paperVelocity(i).last().y);
+  }
+  return {{"start", at(record.input().velocities)},
+          {"simulated", summary && summary->simulated ? at(summary->final_velocities) : json(nullptr)},
+          {"predicted", record.prediction ? at(record.prediction->final_velocities) : json(nullptr)},
+          {"paper", at(paper)}};
 }
 
 /// The plotted series: at most a few thousand points whatever the count.
@@ -852,6 +880,7 @@ std::optional<std::pair<std::string, std::uint64_t>> RunBook::json(const std::st
       out["plots"]["worldline_segments"] = worldlineSegmentsJson(*run.record, view.end_time);
     }
     if (run.summary) out["summary"] = summaryJson(*run.summary);
+    if (run.record && run.summary) out["totals"] = totalsJson(*run.record, &*run.summary);
     if (!run.bag_error.empty()) out["bag_error"] = run.bag_error;
     return std::make_pair(out.dump(), run.version);
   }

@@ -276,6 +276,23 @@ TEST_F(RunPageViewTest, EqualMassesShowsTheModelsBExactlyAtRest) {
   const std::vector<std::string> error = summaryCells(dom, "max prediction error (ratio)");
   ASSERT_EQ(error.size(), 3u);
   EXPECT_EQ(error[0], "0");
+  // The paper's printed final velocities carry momentum and energy the scene never had
+  // (1.375, 1.375, -0.25 m/s: 2.5 kg m/s against 0, 1.921875 J against 1 J).
+  EXPECT_EQ(summaryCells(dom, "momentum at the start [kg m/s]").at(0), "0");
+  EXPECT_EQ(summaryCells(dom, "momentum at the end [kg m/s]"), (std::vector<std::string>{"0", "0", "2.5"}));
+  EXPECT_EQ(summaryCells(dom, "kinetic energy at the start [J]").at(0), "1");
+  EXPECT_EQ(summaryCells(dom, "kinetic energy at the end [J]"), (std::vector<std::string>{"1", "1", "1.921875"}));
+}
+
+// A moving wall does work: the page says so, and its energy rows show the change.
+TEST_F(RunPageViewTest, AMovingWallsWorkIsNamed) {
+  const std::string dom = finalPage({{"student", "lesson"}, {"preset", "moving_wall"}});
+  EXPECT_NE(dom.find("a moving wall does work on the bodies"), std::string::npos) << dom.substr(0, 2000);
+  const auto start = summaryCells(dom, "kinetic energy at the start [J]");
+  const auto end = summaryCells(dom, "kinetic energy at the end [J]");
+  ASSERT_EQ(start.size(), 3u);
+  ASSERT_EQ(end.size(), 3u);
+  EXPECT_NE(start[0], end[0]);
 }
 
 // The state after the last collision shows: the collision-index axis ends one past it, as

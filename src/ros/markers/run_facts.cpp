@@ -64,7 +64,7 @@ std::string statusLine(const RunView& view, const SceneState& state, const Frame
   // count.
   if (view.not_simulated.empty()) s += "     collisions " + withSeparators(state.collisions);
   s += "     run: " + view.counter;
-  for (const std::string* fact : {&view.collapse_brief, &view.ring, &view.box}) {
+  for (const std::string* fact : {&view.collapse_brief, &view.ring, &view.box, &view.moving_wall}) {
     if (!fact->empty()) s += ";  " + *fact;
   }
   if (!clock.description.empty()) s += "     " + clock.description;
