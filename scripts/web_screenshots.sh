@@ -67,6 +67,7 @@ shoot_views() {
   run=$(send_body '{"student":"eve","masses":[100,1,"inf"],"positions":[2,1,0],"velocities":[-1,0,0],"max_collisions":10}')
   wait_finished "$run"; shoot "/runs/$run" web_view_not_simulated.png 1250
   run=$(send eve collapse_equal); wait_finished "$run"; shoot "/runs/$run" web_view_collapse.png 1250
+  run=$(send eve near_collapse); wait_finished "$run"; shoot "/runs/$run" web_view_near_collapse.png 1250
   run=$(send eve two_carts); wait_finished "$run"; shoot "/runs/$run" web_view_two_carts.png 1250
   # The state after the last collision: each plot goes on one past it (the heat of an
   # inelastic pair, equal_masses' A at +1 m/s), and a run without collisions.

@@ -289,7 +289,7 @@ function showNotSimulated(run, view) {
 function showFacts(view) {
   const facts = document.getElementById('view_facts');
   // The note repeats a cut's sentence when there is one: said once.
-  const items = view ? [view.title, view.not_simulated, view.note ? '' : view.truncated, view.collapse, view.ring, view.box, view.moving_wall, view.note] : [];
+  const items = view ? [view.title, view.not_simulated, view.note ? '' : view.truncated, view.collapse, view.spiral, view.ring, view.box, view.moving_wall, view.note] : [];
   facts.replaceChildren(...items.filter((text) => text).map((text) => el('li', text)));
   document.getElementById('velocity_legend').textContent = view ? 'Bodies shown: ' + view.velocity_legend + '.' : '';
   document.getElementById('xt_legend').textContent = view ? 'Bodies shown: ' + view.worldline_legend + '.' : '';

@@ -87,6 +87,28 @@ std::string truncationSentence(const std::string& reason) {
   return s + ".";
 }
 
+/// Collapse or not, for three bodies with e < 1: the restitution against the critical one
+/// (Prediction.critical_restitution), so that a collapse and a near miss, whose final
+/// velocities can round to the same doubles, are told apart.
+std::string spiralFact(const RunRecord& run, const RunView& view) {
+  if (!run.prediction || run.prediction->model_name != "three_body_spiral") return "";
+  const double critical = run.prediction->critical_restitution;
+  const auto& e = run.input().restitution;
+  if (!std::isfinite(critical) || e.empty()) return "";
+  const double least = *std::min_element(e.begin(), e.end());
+  const std::string compared = "e = " + numberText(least, 6) + " is " +
+                               (least <= critical ? "at most" : "above") + " the critical restitution r_c = " +
+                               numberText(critical, 6);
+  if (least <= critical) {
+    return "collapse: " + compared + ": infinitely many collisions in a finite time, then the three move as one";
+  }
+  std::string fact = "no collapse: " + compared;
+  if (view.predicted_collisions) fact += ": after " + collisionsText(*view.predicted_collisions) + " the bodies move apart";
+  const auto& v = run.prediction->final_velocities;
+  if (v.size() == 3 && v[0] == v[1] && v[1] == v[2]) fact += ", more slowly than the digits shown can tell";
+  return fact;
+}
+
 std::string noteOf(const RunRecord& run, const RunView& view) {
   std::string note;
   if (run.missedCollisions() > 0) {
@@ -246,6 +268,7 @@ RunView makeRunView(const RunRecord& run) {
                 " m";
   }
   if (view.kind == "box") view.box = "box: walls at both ends";
+  view.spiral = spiralFact(run, view);
   for (std::size_t i = 0; i < in.masses.size() && i < in.velocities.size(); ++i) {
     if (!std::isfinite(in.masses[i]) && in.velocities[i] != 0.0) {
       view.moving_wall = "a moving wall does work on the bodies: their kinetic energy changes by it, heat aside";
@@ -399,6 +422,7 @@ nlohmann::json viewJson(const RunView& view) {
           {"ring_circumference", view.ring_circumference},
           {"box", view.box},
           {"moving_wall", view.moving_wall},
+          {"spiral", view.spiral},
           {"collisions_so_far", view.collisions_so_far},
           {"expected_collisions", optional(view.expected)},
           {"state", view.state},

@@ -179,6 +179,33 @@ TEST(RunView, EveryCollapseIsNamedAndCounted) {
   EXPECT_NE(view.title.find("16 + 2 collapses"), std::string::npos) << view.title;
 }
 
+// Three equal masses at e = 0.05 collapse; at 0.072 they do not, but their final velocities
+// round to the same doubles (-1/3 m/s): the restitution against the critical one tells them
+// apart (issue 45: both pages looked alike).
+TEST(RunView, CollapseAndNearMissAreToldApart) {
+  const auto viewAt = [](double e, bool collapsed, std::uint64_t count) {
+    auto in = input({1, 1, 1}, {2, 1, 0}, {-1, 0, 0});
+    in.restitution = {e};
+    RunRecord run(in);
+    collision_lab::Prediction p;
+    p.model_name = "three_body_spiral";
+    p.critical_restitution = 0.07179676972449082;
+    p.collapsed = collapsed;
+    p.collision_count_defined = !collapsed;
+    p.collision_count = count;
+    p.final_velocities = {-1.0 / 3, -1.0 / 3, -1.0 / 3};
+    run.prediction = p;
+    return makeRunView(run);
+  };
+  EXPECT_EQ(viewAt(0.05, true, 0).spiral,
+            "collapse: e = 0.05 is at most the critical restitution r_c = 0.0717968: infinitely many collisions in a "
+            "finite time, then the three move as one");
+  EXPECT_EQ(viewAt(0.072, false, 63).spiral,
+            "no collapse: e = 0.072 is above the critical restitution r_c = 0.0717968: after 63 collisions the bodies "
+            "move apart, more slowly than the digits shown can tell");
+  EXPECT_EQ(makeRunView(RunRecord(input({1, 2, 3}, {2, 1, 0}, {-1, 0, 0}))).spiral, "");
+}
+
 TEST(RunView, WorldlinesReachTheRunsEnd) {
   // Two carts meet at t = 0.5 s and part: the diagram goes on past the impact.
   RunRecord run(input({1, 1}, {1, 0}, {-1, 1}));

@@ -57,6 +57,9 @@ struct RunView {
   /// "ring of 1,000 m" ("" when not a ring), its circumference [m] (0 when none).
   std::string ring;
   double ring_circumference = 0.0;
+  /// Three bodies with e < 1 (the spiral model): collapse or not, against the critical
+  /// restitution, in words ("" otherwise).
+  std::string spiral;
   /// "a moving wall does work ..." when a wall moves ("" otherwise).
   std::string moving_wall;
   /// "box: walls at both ends" ("" when not a box).
