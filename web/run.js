@@ -250,7 +250,8 @@ function drawTemperature(view) {
   c.options.scales.x.ticks = {autoSkip: false, maxRotation: 0, callback: (value) => logTickLabel(value, spanX)};
   c.options.scales.y.ticks = {autoSkip: false, callback: (value) => logTickLabel(value, spanY)};
   c.update('none');
-  document.getElementById('temperature_legend').textContent = view.temperature_legend;
+  document.getElementById('temperature_legend').textContent =
+    view.temperature_legend + (view.temperature_fit_note ? '. ' + view.temperature_fit_note : '');
   document.body.dataset.temperaturePoints = String(points.length);
   // For tests: the labels drawn on each axis, '|'-separated.
   const labels = (axis) => c.scales[axis].ticks.map((t) => t.label).filter((l) => l !== '').join('|');

@@ -196,7 +196,9 @@ RunRecord::RunRecord(const collision_lab::InitialConditions& input, const Record
   body_energy_.assign(plotted_.size(), empty);
   worldline_.assign(tracked_.size(), empty);
   energy_ = momentum_ = energy_lost_ = none_ = empty;
-  temperature_ = {};
+  temperature_ = temperature_fit_ = {};
+  temperature_newest_.reset();
+  temperature_stride_ = collision_lab::core::temperatureStride(n);
   for (std::size_t i = 0; i < n; ++i) widenVelocityRange(input_.velocities[i]);
   for (std::size_t k = 0; k < plotted_.size(); ++k) {
     const std::size_t i = plotted_[k];
@@ -216,6 +218,7 @@ RunRecord::RunRecord(const collision_lab::InitialConditions& input, const Record
     if (std::isfinite(m)) finite_mass_ += m, ++finite_bodies_;
   }
   temperature_.add({0, 0.0, temperatureNow()});
+  temperature_fit_.add({0, 0.0, temperatureNow()});
 }
 
 bool RunRecord::isWall(std::size_t i) const { return i < bodies() && replay_.isWall(i); }
@@ -311,7 +314,24 @@ void RunRecord::stepSeries(const collision_lab::CollisionEvent& event) {
   energy_.step(k, replay_.totalKineticEnergy());
   momentum_.step(k, replay_.momentum());
   energy_lost_.step(k, replay_.heat());
-  temperature_.add({event.index, event.time, temperatureNow()});
+  const collision_lab::core::TemperatureSample sample{event.index, event.time, temperatureNow()};
+  temperature_.add(sample);
+  // For the fit, offered as the CLI's sampler offers them (core::TemperatureSampler): every
+  // k-th impact and each collapse; the newest otherwise waits (temperatureForFit()). The same
+  // samples, so the same Haff fit as the CLI's --temperature-csv.
+  if (event.kind == collision_lab::CollisionEvent::KIND_COLLAPSE || event.index % temperature_stride_ == 0) {
+    temperature_fit_.add(sample);
+    temperature_newest_.reset();
+  } else {
+    temperature_newest_ = sample;
+  }
+}
+
+std::vector<collision_lab::core::TemperatureSample> RunRecord::temperatureForFit() const {
+  if (!temperature_newest_) return temperature_fit_.samples();
+  collision_lab::core::LogTimeSamples with_newest = temperature_fit_;
+  with_newest.add(*temperature_newest_);  // the CLI's sampler sends the last impact at the end
+  return with_newest.samples();
 }
 
 double RunRecord::temperatureNow() const {
@@ -425,7 +445,7 @@ std::size_t RunRecord::memoryBytes() const {
   bytes += envelopes(velocity_) + envelopes(paper_velocity_) + envelopes(body_energy_) + envelopes(worldline_) +
            envelopes(tracked_velocity_);
   bytes += energy_.memoryBytes() + momentum_.memoryBytes() + energy_lost_.memoryBytes() + none_.memoryBytes() +
-           temperature_.samples().capacity() * sizeof(collision_lab::core::TemperatureSample);
+           (temperature_.samples().capacity() + temperature_fit_.samples().capacity()) * sizeof(collision_lab::core::TemperatureSample);
   if (prediction) {
     bytes += prediction->run_id.capacity() + prediction->model_name.capacity() + prediction->model_reason.capacity() +
              doubles(prediction->final_velocities);

@@ -318,16 +318,27 @@ RunView makeRunView(const RunRecord& run) {
   if (view.gas) {
     const auto samples = run.temperature();
     for (const auto& sample : samples) view.temperature.emplace_back(sample.time, sample.temperature);
-    const auto fit = collision_lab::core::fitHaff(samples);
+    const auto fit = collision_lab::core::fitHaff(run.temperatureForFit());  // the CLI's fit
     view.haff_ok = fit.ok && std::isfinite(fit.tau);
     view.haff_t0 = fit.t0;
     view.haff_tau = fit.tau;
     // What T is, in a student's words, is the page's caption; this says what the lines are.
     // No subscript digits: rviz's font has code points below 1000 only (tau and the square do).
+    // How well it fits (the rms of ln T's misfit: 0.1 is about 10%), and whether the run
+    // saw a time as long as tau (else tau is an extrapolation of the early cooling).
+    const double seen = samples.empty() ? 0.0 : samples.back().time;
     view.temperature_legend =
         view.haff_ok ? "Haff's law T = T0 / (1 + t/τ)² fitted: T0 = " + numberText(fit.t0) + " J, τ = " +
                            numberText(fit.tau) + " s"
                      : std::string("Haff's law: no fit (no cooling seen)");
+    if (view.haff_ok) {
+      view.temperature_fit_note = "How well it fits: the rms misfit of ln T is " + numberText(fit.rms_log_error, 2) +
+                                  " (0.1: about 10%)" +
+                                  (seen < fit.tau ? "; the run spans " + numberText(seen) +
+                                                        " s, less than τ: τ extrapolates its early cooling"
+                                                  : "") +
+                                  ". Haff's law holds for a homogeneous gas cooling with a constant e.";
+    }
     // T held from the last collision to the run's end: no collision changes it in the free
     // flight after it (the fit above is to the collisions' values only).
     if (!view.temperature.empty() && std::isfinite(view.end_time) && view.end_time > view.temperature.back().first) {
@@ -441,6 +452,7 @@ nlohmann::json viewJson(const RunView& view) {
              for (const auto& [t, T] : view.temperature) points.push_back({t, T});
              return points;
            }()},
+          {"temperature_fit_note", view.temperature_fit_note},
           {"haff", view.haff_ok ? nlohmann::json{{"t0", view.haff_t0}, {"tau", view.haff_tau}} : nlohmann::json(nullptr)},
           {"temperature_legend", view.temperature_legend},
           {"end_time", std::isfinite(view.end_time) ? nlohmann::json(view.end_time) : nlohmann::json(nullptr)}};

@@ -361,6 +361,7 @@ TEST_F(RunPageViewTest, BoxOfManyBodiesHasItsLegend) {
   EXPECT_GT(bodyData(dom, "scene-colours"), 100.0);
   // A gas (e = 0.9): T(t) on log-log axes with Haff's law fitted.
   EXPECT_NE(dom.find("Haff's law T = T0 / (1 + t/τ)² fitted: T0 = "), std::string::npos);
+  EXPECT_NE(dom.find("How well it fits: the rms misfit of ln T is "), std::string::npos);
   EXPECT_GT(bodyData(dom, "temperature-points"), 10.0);
   EXPECT_GT(bodyData(dom, "haff-tau"), 0.0);
   // T said in a student's words, not as "T = sum m (v - V)^2 / N".

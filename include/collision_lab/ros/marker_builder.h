@@ -220,9 +220,13 @@ class RunRecord {
   /// Granular temperature T = (1/N) sum m (v - V)^2 of the finite masses [J] against time
   /// [s] (core::granularTemperature, from the running energy and momentum) after each
   /// collision: the gas's T(t), thinned evenly in log t (core::LogTimeSamples: the start,
-  /// 50 per decade of time and the newest), so that a log-log plot and Haff's fit see the
-  /// early cooling of a run that lasts 1e7 s.
+  /// 50 per decade of time and the newest), so that a log-log plot sees the early cooling of
+  /// a run that lasts 1e7 s.
   std::vector<collision_lab::core::TemperatureSample> temperature() const { return temperature_.samples(); }
+  /// The same T sampled as the CLI's --temperature-csv samples it (the start, every
+  /// core::temperatureStride(N)-th impact, each collapse and the newest), thinned alike:
+  /// Haff's fit to these is the CLI's.
+  std::vector<collision_lab::core::TemperatureSample> temperatureForFit() const;
   /// Total kinetic energy of the finite masses at the start [J].
   double startEnergy() const { return start_energy_; }
   /// Bytes the record holds, itself included: its input, the replay's state, the kept
@@ -272,7 +276,9 @@ class RunRecord {
   std::vector<Envelope> velocity_, paper_velocity_, body_energy_, worldline_;
   std::vector<Envelope> tracked_velocity_;  ///< empty unless no body is plotted
   Envelope energy_, momentum_, energy_lost_, none_;
-  collision_lab::core::LogTimeSamples temperature_;
+  collision_lab::core::LogTimeSamples temperature_, temperature_fit_;
+  std::optional<collision_lab::core::TemperatureSample> temperature_newest_;  ///< not offered to temperature_ yet
+  std::uint64_t temperature_stride_ = 1;
   double finite_mass_ = 0.0;         ///< [kg]
   std::size_t finite_bodies_ = 0;    ///< [1]
   double temperatureNow() const;

@@ -96,6 +96,8 @@ struct RunView {
   double haff_t0 = 0.0;   ///< [J]
   double haff_tau = 0.0;  ///< [s]
   std::string temperature_legend;
+  /// How well Haff's law fits and over what window, for the page ("" without a fit).
+  std::string temperature_fit_note;
 
   /// The x-t diagram's end time [s]: the run's end (endTime), every worldline reaches it.
   double end_time = 0.0;
