@@ -87,6 +87,16 @@ function sceneFromForm() {
   if (e !== '') scene.restitution = e.split(/[ ,;]+/).filter((t) => t !== '').map(numberOrText);
   const cap = document.getElementById('max_collisions').value.trim();
   if (cap !== '') scene.max_collisions = Number(cap);
+  // The restitution model and its one parameter, under the key the lab reads for it.
+  const model = document.getElementById('restitution_model').value;
+  const parameter = document.getElementById('model_parameter').value.trim();
+  if (model !== '') {
+    scene.restitution_model = model;
+    const key = {tc: 'tc', threshold: 'elastic_below', viscoelastic: 'viscoelastic_speed'}[model];
+    if (parameter !== '') scene[key] = numberOrText(parameter);
+  }
+  const ring = document.getElementById('ring').value.trim();
+  if (ring !== '') scene.ring = numberOrText(ring);
   return scene;
 }
 

@@ -11,7 +11,9 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <random>
+#include <set>
 #include <regex>
 #include <sstream>
 #include <stdexcept>
@@ -221,6 +223,46 @@ std::vector<double> parseList(const json& body, const std::string& name, bool re
   if (!list.is_array()) throw FieldError{name, name + " must be a list of numbers"};
   for (std::size_t i = 0; i < list.size(); ++i) out.push_back(parseNumber(list[i], name + "[" + std::to_string(i) + "]"));
   return out;
+}
+
+/// The keys POST /api/runs takes; any other is refused by name (it used to be dropped, and
+/// a ring ran on a plain line).
+const std::set<std::string>& knownSceneKeys() {
+  static const std::set<std::string> keys = {
+      "student", "code", "run_id", "mode", "preset", "masses", "positions", "velocities", "restitution",
+      "restitution_model", "tc", "elastic_below", "viscoelastic_speed", "ring", "max_collisions",
+      "max_run_seconds", "max_bag_bytes"};
+  return keys;
+}
+
+/// The keys that describe a scene: a preset brings its own.
+const std::set<std::string>& sceneKeys() {
+  static const std::set<std::string> keys = {"masses", "positions", "velocities", "restitution", "restitution_model",
+                                             "tc", "elastic_below", "viscoelastic_speed", "ring"};
+  return keys;
+}
+
+/// The restitution model and its parameters of body (the CLI's names), into input.
+void parseRestitutionModel(const json& body, collision_lab::InitialConditions& input) {
+  if (body.contains("restitution_model")) {
+    const json& name = body["restitution_model"];
+    static const std::map<std::string, std::uint8_t> models = {
+        {"constant", collision_lab::InitialConditions::RESTITUTION_CONSTANT},
+        {"tc", collision_lab::InitialConditions::RESTITUTION_TC},
+        {"viscoelastic", collision_lab::InitialConditions::RESTITUTION_VISCOELASTIC},
+        {"threshold", collision_lab::InitialConditions::RESTITUTION_THRESHOLD}};
+    if (!name.is_string() || !models.count(name.get<std::string>())) {
+      throw FieldError{"restitution_model", "restitution_model must be \"constant\", \"tc\", \"viscoelastic\" or \"threshold\""};
+    }
+    input.restitution_model = models.at(name.get<std::string>());
+  }
+  const auto number = [&body](const char* key, double& into) {
+    if (body.contains(key)) into = parseNumber(body[key], key);
+  };
+  number("tc", input.tc);  // [s]
+  number("elastic_below", input.elastic_below);  // [m/s]
+  number("viscoelastic_speed", input.viscoelastic_speed);  // [m/s]
+  number("ring", input.ring);  // [m]
 }
 
 json rejectionJson(const collision_lab::Rejected& r) {
@@ -665,6 +707,17 @@ void WebServer::postRun(const HttpRequest& request, const HttpReply& reply) {
   }
   collision_lab::InitialConditions input;
   try {
+    for (const auto& item : body.items()) {
+      if (!knownSceneKeys().count(item.key())) {
+        throw FieldError{printableExcerpt(item.key(), 40), "unknown key \"" + printableExcerpt(item.key(), 40) +
+                                         "\": a scene is sent as masses, positions, velocities, restitution, "
+                                         "restitution_model, tc, elastic_below, viscoelastic_speed and ring, or as a "
+                                         "preset; with max_collisions, max_run_seconds, max_bag_bytes, mode, run_id"};
+      }
+      if (body.contains("preset") && sceneKeys().count(item.key())) {
+        throw FieldError{item.key(), item.key() + " cannot change a preset: send the whole scene instead"};
+      }
+    }
     if (body.contains("preset")) {
       if (!body["preset"].is_string()) throw FieldError{"preset", "preset must be a preset's name"};
       collision_lab::io::SceneEntry entry;
@@ -679,6 +732,7 @@ void WebServer::postRun(const HttpRequest& request, const HttpReply& reply) {
       input.positions = parseList(body, "positions", true);
       input.velocities = parseList(body, "velocities", true);
       input.restitution = parseList(body, "restitution", false);
+      parseRestitutionModel(body, input);
     }
     if (body.contains("max_collisions")) {
       const json& cap = body["max_collisions"];

@@ -215,6 +215,41 @@ TEST_F(WebTest, RejectionCarriesReasonAndField) {
   EXPECT_EQ(json::parse(res->body)["field"], "velocities[1]");
 }
 
+// The API takes every scene the CLI takes (a ring, a restitution model), and refuses what it
+// does not know by name (a ring used to be dropped, and the scene ran on a plain line).
+TEST_F(WebTest, RingsAndModelsAreTakenAndUnknownKeysRefused) {
+  json ring = {{"student", "ring"}, {"masses", {1, 2}}, {"positions", {5, 0}}, {"velocities", {-1, 0}},
+               {"ring", 10}, {"restitution", {0.9}}, {"restitution_model", "tc"}, {"tc", 0.001},
+               {"max_collisions", 5}};
+  auto res = post(ring);
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 202) << res->body;
+  const json run = finishedRun(json::parse(res->body)["run_id"]);
+  EXPECT_EQ(run.at("scene").at("ring"), 10.0);
+  EXPECT_EQ(run.at("scene").at("restitution_model"), "tc");
+  EXPECT_EQ(run.at("summary").at("collision_count"), 5);  // a ring never ends: the cap
+
+  json unknown = piScene("ring");
+  unknown["rings"] = 10;
+  res = post(unknown);
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 400);
+  EXPECT_EQ(json::parse(res->body).at("field"), "rings");
+  EXPECT_NE(json::parse(res->body).at("error").get<std::string>().find("unknown key \"rings\""), std::string::npos);
+
+  json model = piScene("ring");
+  model["restitution_model"] = "sticky";
+  res = post(model);
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 400);
+  EXPECT_EQ(json::parse(res->body).at("field"), "restitution_model");
+
+  res = post({{"student", "ring"}, {"preset", "pi_digits_2"}, {"ring", 10}});
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 400);
+  EXPECT_EQ(json::parse(res->body).at("field"), "ring");
+}
+
 TEST_F(WebTest, TheTeacherSeesEachStudentsRejectedInputs) {
   json bad = piScene("jo");
   bad["positions"] = {0, 1, 2};  // not strictly decreasing
