@@ -9,6 +9,7 @@ pybind11_add_module(collision_lab_python_core MODULE
   src/python/core_module.cpp
   src/python/scene_driver.cpp)
 target_link_libraries(collision_lab_python_core PRIVATE collision_lab_cli_runner)
+target_compile_definitions(collision_lab_python_core PRIVATE COLLISION_LAB_VERSION="${collision_lab_VERSION}")
 set_target_properties(collision_lab_python_core PROPERTIES
   OUTPUT_NAME _core
   LIBRARY_OUTPUT_DIRECTORY ${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_PYTHON_DESTINATION}

@@ -68,6 +68,13 @@ function loadPreset(p) {
     document.getElementById('restitution').value = (s.restitution || []).join(', ');
     document.getElementById('max_collisions').value = s.max_collisions || '';
   }
+  // The model and ring are the preset's (or none): nothing typed before stays behind.
+  const s = p.scene || {};
+  const model = s.restitution_model || '';
+  document.getElementById('restitution_model').value = model;
+  const parameter = {tc: s.tc, threshold: s.elastic_below, viscoelastic: s.viscoelastic_speed}[model];
+  document.getElementById('model_parameter').value = parameter === undefined ? '' : parameter;
+  document.getElementById('ring').value = s.ring || '';
 }
 
 function numberOrText(text) {

@@ -206,8 +206,9 @@ function summaryRows(run) {
     }
   }
   // Momentum and kinetic energy of the finite masses, at the start and at the end by each
-  // column (correctly rounded by the server): a collision keeps the momentum, an elastic one
-  // the energy too; a moving wall adds or takes both; the paper's printed formulas need not.
+  // column (correctly rounded by the server): a collision between bodies keeps the momentum,
+  // an elastic one the energy too; a wall takes or gives momentum, a moving one energy too;
+  // the paper's printed formulas need not keep either.
   const totals = run.totals;
   if (totals && totals.start) {
     const end = (column, key) => (totals[column] ? totals[column][key] : null);

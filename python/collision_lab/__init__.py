@@ -11,8 +11,17 @@ from pkgutil import extend_path
 # inherits the sys.path that the devel __init__ extends, as a Dask worker does) gets both.
 __path__ = extend_path(__path__, __name__)
 
+from ._core import version as __version__
 from ._run import Run, SceneError, body_name, predict, run
 from ._sweep import sweep
 from ._bag import read_bag
 
-__all__ = ['Run', 'SceneError', 'body_name', 'predict', 'read_bag', 'run', 'sweep']
+__all__ = ['Run', 'SceneError', 'body_name', 'plot', 'predict', 'read_bag', 'run', 'sweep']
+
+
+def __getattr__(name):
+    """collision_lab.plot, imported on first use (it loads matplotlib)."""
+    if name == 'plot':
+        import importlib
+        return importlib.import_module('.plot', __name__)
+    raise AttributeError('module %r has no attribute %r' % (__name__, name))

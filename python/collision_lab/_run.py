@@ -36,6 +36,7 @@ class SceneError(ValueError):
     """
 
     def __init__(self, reason, code, field, message):
+        field = field.lstrip('-').replace('-', '_')  # run()'s keyword, not the CLI's option
         super().__init__('invalid %s (%s): %s' % (field, reason, message))
         self.reason = reason
         self.code = code
@@ -46,6 +47,46 @@ class SceneError(ValueError):
 def body_name(index):
     """The core's name of body `index` (0-based): A..Z, then #26, #27, ..."""
     return chr(ord('A') + index) if index < 26 else '#%d' % index
+
+
+def _body_values(name, values):
+    """values as one number per body: a flat list or 1-D array of numbers (not of bools)."""
+    array = np.asarray(values)
+    if array.ndim == 0:
+        array = array.reshape(1)
+    if array.ndim != 1:
+        raise ValueError('%s must be a list of numbers, one per body, not an array of shape %s'
+                         % (name, array.shape))
+    # np.asarray([True, 1]) is [1, 1]: a bool among numbers is found in the list itself.
+    listed = values if isinstance(values, (list, tuple)) else ()
+    if array.dtype == bool or any(isinstance(v, (bool, np.bool_)) for v in listed):
+        raise TypeError('%s must be numbers, not True or False' % name)
+    if array.size == 0 and name != 'restitution':
+        raise ValueError('%s is empty: give one number per body' % name)
+    return array
+
+
+# The CLI's reasons and codes of the option errors that run() words in Python (docs/cli.md).
+_USAGE = ('USAGE', 100)
+_INVALID_OPTION = ('INVALID_OPTION', 104)
+
+
+def _check_options(restitution, restitution_model, tc, elastic_below, viscoelastic_speed,
+                   max_collisions):
+    """The options' mistakes in run()'s words (its keywords, not the command line's options)."""
+    if isinstance(max_collisions, (bool, np.bool_)) or not isinstance(max_collisions, (int, np.integer)):
+        raise TypeError('max_collisions must be a whole number, not %r' % (max_collisions,))
+    if max_collisions < 0:
+        raise SceneError(*_INVALID_OPTION, 'max_collisions',
+                         'max_collisions must be >= 0, not %d' % max_collisions)
+    if np.ndim(restitution) != 0 and np.size(restitution) == 0:
+        raise SceneError(*_USAGE, 'restitution', 'restitution is empty: give one e for every pair, '
+                         'one per pair, or leave it out (elastic)')
+    for key, value, model in (('tc', tc, 'tc'), ('elastic_below', elastic_below, 'threshold'),
+                              ('viscoelastic_speed', viscoelastic_speed, 'viscoelastic')):
+        if value is not None and restitution_model != model:
+            raise SceneError(*_USAGE, key, "%s= belongs to restitution_model='%s' (it is %r)"
+                             % (key, model, restitution_model))
 
 
 def _number_list(values):
@@ -60,6 +101,13 @@ def scene_arguments(masses, positions, velocities, restitution=1.0, *, ring=None
                     viscoelastic_speed=None, max_collisions=10_000_000, simulate_to_cap=False,
                     events='all', mode='full', temperature_csv=None, full_state_every=1):
     """collision_lab_cli's arguments for these keyword arguments (see run())."""
+    masses, positions, velocities = (_body_values(name, values) for name, values in
+                                     (('masses', masses), ('positions', positions),
+                                      ('velocities', velocities)))
+    if np.ndim(restitution) != 0:
+        _body_values('restitution', restitution)
+    _check_options(restitution, restitution_model, tc, elastic_below, viscoelastic_speed,
+                   max_collisions)
     args = ['--masses', _number_list(masses), '--positions', _number_list(positions),
             '--velocities', _number_list(velocities),
             '--max-collisions', str(int(max_collisions)), '--events', str(events), '--mode', str(mode)]

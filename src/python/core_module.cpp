@@ -101,6 +101,7 @@ std::vector<std::string> runManyJson(const std::vector<SceneArgs>& scenes, unsig
 
 PYBIND11_MODULE(_core, m) {
   m.doc() = "collision_lab's C++ core, run in process: the CLI's JSON report of a scene.";
+  m.attr("version") = COLLISION_LAB_VERSION;  // package.xml's, as the node's RunParameters
   m.def("run_json", &collision_lab::python::runJson, py::arg("args"), py::arg("name"),
         "The CLI's JSON report (or JSON error) of one scene given as collision_lab_cli's arguments. "
         "Runs without the GIL; Ctrl-C cancels the run and raises KeyboardInterrupt.");

@@ -199,6 +199,7 @@ RunRecord::RunRecord(const collision_lab::InitialConditions& input, const Record
   temperature_ = temperature_fit_ = {};
   temperature_newest_.reset();
   temperature_stride_ = collision_lab::core::temperatureStride(n);
+  temperature_fit_bucket_ = 0;
   for (std::size_t i = 0; i < n; ++i) widenVelocityRange(input_.velocities[i]);
   for (std::size_t k = 0; k < plotted_.size(); ++k) {
     const std::size_t i = plotted_[k];
@@ -318,9 +319,12 @@ void RunRecord::stepSeries(const collision_lab::CollisionEvent& event) {
   temperature_.add(sample);
   // For the fit, offered as the CLI's sampler offers them (core::TemperatureSampler): every
   // k-th impact and each collapse; the newest otherwise waits (temperatureForFit()). The same
-  // samples, so the same Haff fit as the CLI's --temperature-csv.
-  if (event.kind == collision_lab::CollisionEvent::KIND_COLLAPSE || event.index % temperature_stride_ == 0) {
+  // samples, so the same Haff fit as the CLI's --temperature-csv. Past the published events
+  // (sampled states, addSample) the first state past each multiple of k stands for it.
+  const std::uint64_t bucket = event.index / temperature_stride_;
+  if (event.kind == collision_lab::CollisionEvent::KIND_COLLAPSE || bucket > temperature_fit_bucket_) {
     temperature_fit_.add(sample);
+    temperature_fit_bucket_ = std::max(temperature_fit_bucket_, bucket);
     temperature_newest_.reset();
   } else {
     temperature_newest_ = sample;

@@ -99,11 +99,14 @@ std::string spiralFact(const RunRecord& run, const RunView& view) {
   const std::string compared = "e = " + numberText(least, 6) + " is " +
                                (least <= critical ? "at most" : "above") + " the critical restitution r_c = " +
                                numberText(critical, 6);
-  if (least <= critical) {
+  // The model's answer decides; e against r_c says why (e = 0 sticks, and a start that
+  // separates ends the walk, below r_c too).
+  if (run.prediction->collapsed) {
     return "collapse: " + compared + ": infinitely many collisions in a finite time, then the three move as one";
   }
-  std::string fact = "no collapse: " + compared;
-  if (view.predicted_collisions) fact += ": after " + collisionsText(*view.predicted_collisions) + " the bodies move apart";
+  if (!view.predicted_collisions) return "";
+  std::string fact = "no collapse: after " + collisionsText(*view.predicted_collisions) + " the bodies move apart";
+  if (least > critical) fact += " (" + compared + ")";
   const auto& v = run.prediction->final_velocities;
   if (v.size() == 3 && v[0] == v[1] && v[1] == v[2]) fact += ", more slowly than the digits shown can tell";
   return fact;
@@ -271,7 +274,8 @@ RunView makeRunView(const RunRecord& run) {
   view.spiral = spiralFact(run, view);
   for (std::size_t i = 0; i < in.masses.size() && i < in.velocities.size(); ++i) {
     if (!std::isfinite(in.masses[i]) && in.velocities[i] != 0.0) {
-      view.moving_wall = "a moving wall does work on the bodies: their kinetic energy changes by it, heat aside";
+      view.moving_wall =
+          "a wall moves: a body that hits it gains or loses kinetic energy, the work the wall does, heat aside";
     }
   }
 

@@ -892,7 +892,13 @@ std::optional<std::pair<std::string, std::uint64_t>> RunBook::json(const std::st
       out["plots"]["worldline_segments"] = worldlineSegmentsJson(*run.record, view.end_time);
     }
     if (run.summary) out["summary"] = summaryJson(*run.summary);
-    if (run.record && run.summary) out["totals"] = totalsJson(*run.record, &*run.summary);
+    if (run.record && run.summary) {
+      if (run.totals_version != run.version) {
+        run.totals_json = totalsJson(*run.record, &*run.summary).dump();
+        run.totals_version = run.version;
+      }
+      out["totals"] = json::parse(run.totals_json);
+    }
     if (!run.bag_error.empty()) out["bag_error"] = run.bag_error;
     return std::make_pair(out.dump(), run.version);
   }

@@ -603,6 +603,22 @@ void WebServer::route(const HttpRequest& request, const Access& access, const Ht
                            {"velocities", s.velocities},
                            {"restitution", s.restitution},
                            {"max_collisions", entry.max_collisions}};
+          // The model and ring as POST /api/runs takes them (none for the defaults).
+          const auto& model = s.restitution_model;
+          if (model.kind != collision_lab::core::RestitutionModelKind::kConstant) {
+            item["scene"]["restitution_model"] = collision_lab::core::restitutionModelName(model.kind);
+            switch (model.kind) {
+              case collision_lab::core::RestitutionModelKind::kTc: item["scene"]["tc"] = model.tc; break;
+              case collision_lab::core::RestitutionModelKind::kThreshold:
+                item["scene"]["elastic_below"] = model.elastic_below;
+                break;
+              case collision_lab::core::RestitutionModelKind::kViscoelastic:
+                item["scene"]["viscoelastic_speed"] = model.viscoelastic_speed;
+                break;
+              default: break;
+            }
+          }
+          if (s.isRing()) item["scene"]["ring"] = s.ring;
         }
         out.push_back(item);
       }
@@ -710,9 +726,10 @@ void WebServer::postRun(const HttpRequest& request, const HttpReply& reply) {
     for (const auto& item : body.items()) {
       if (!knownSceneKeys().count(item.key())) {
         throw FieldError{printableExcerpt(item.key(), 40), "unknown key \"" + printableExcerpt(item.key(), 40) +
-                                         "\": a scene is sent as masses, positions, velocities, restitution, "
-                                         "restitution_model, tc, elastic_below, viscoelastic_speed and ring, or as a "
-                                         "preset; with max_collisions, max_run_seconds, max_bag_bytes, mode, run_id"};
+                                         "\": a send has student (and code), a scene as masses, positions, "
+                                         "velocities, restitution, restitution_model, tc, elastic_below, "
+                                         "viscoelastic_speed and ring, or as a preset; and max_collisions, "
+                                         "max_run_seconds, max_bag_bytes, mode, run_id"};
       }
       if (body.contains("preset") && sceneKeys().count(item.key())) {
         throw FieldError{item.key(), item.key() + " cannot change a preset: send the whole scene instead"};

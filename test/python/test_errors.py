@@ -18,8 +18,6 @@ BAD = [
      '--masses 1,1 --positions 1,0 --velocities 0,0 --restitution 1.5', None, None),
     (dict(masses=[1, 1], positions=[1, 0], velocities=[0, 0], events='sometimes'),
      '--masses 1,1 --positions 1,0 --velocities 0,0 --events sometimes', 'INVALID_OPTION', 'events'),
-    (dict(masses=[1, 1], positions=[1, 0], velocities=[0, 0], tc=1e-3),
-     '--masses 1,1 --positions 1,0 --velocities 0,0 --tc 0.001', 'USAGE', 'tc'),
 ]
 
 
@@ -41,3 +39,37 @@ def test_predict_raises_scene_error_too():
     with pytest.raises(collision_lab.SceneError) as raised:
         collision_lab.predict([1, 0, 1], [2, 1, 0], [0, 0, 0])
     assert raised.value.field == 'masses[1]'
+
+
+# Options in run()'s words: its keywords, not the CLI's options (the reasons and codes are the
+# CLI's), and TypeError / ValueError where Python would raise them.
+OPTIONS = [
+    (dict(tc=1e-3), '--tc 0.001', 'tc', "tc= belongs to restitution_model='tc'"),
+    (dict(max_collisions=-1), '--max-collisions -1', 'max_collisions', 'max_collisions must be >= 0'),
+    (dict(restitution=[]), '--restitution 0.5,0.5,0.5', 'restitution', 'restitution is empty'),
+]
+
+
+@pytest.mark.parametrize('kwargs,cli_args,field,words', OPTIONS)
+def test_options_are_named_as_run_names_them(cli, kwargs, cli_args, field, words):
+    scene = dict(masses=[1, 1], positions=[1, 0], velocities=[0, 0])
+    expected = cli(('--masses 1,1 --positions 1,0 --velocities 0,0 ' + cli_args).split())['error']
+    with pytest.raises(collision_lab.SceneError) as raised:
+        collision_lab.run(**scene, **kwargs)
+    assert raised.value.field == field
+    assert words in raised.value.message
+    assert '--' not in raised.value.message
+    if field != 'restitution':  # the CLI cannot be given an empty list
+        assert (raised.value.reason, raised.value.code) == (expected['reason'], expected['code'])
+
+
+def test_python_errors_for_python_mistakes():
+    inf = float('inf')
+    with pytest.raises(TypeError, match='max_collisions must be a whole number'):
+        collision_lab.run([100, 1, inf], [2, 1, 0], [-1, 0, 0], max_collisions=2.5)
+    with pytest.raises(TypeError, match='not True or False'):
+        collision_lab.run([True, 1, inf], [2, 1, 0], [-1, 0, 0])
+    with pytest.raises(ValueError, match=r'shape \(3, 1\)'):
+        collision_lab.run([[100], [1], [inf]], [2, 1, 0], [-1, 0, 0])
+    with pytest.raises(ValueError, match='masses is empty'):
+        collision_lab.run([], [], [])

@@ -201,8 +201,11 @@ TEST(RunView, CollapseAndNearMissAreToldApart) {
             "collapse: e = 0.05 is at most the critical restitution r_c = 0.0717968: infinitely many collisions in a "
             "finite time, then the three move as one");
   EXPECT_EQ(viewAt(0.072, false, 63).spiral,
-            "no collapse: e = 0.072 is above the critical restitution r_c = 0.0717968: after 63 collisions the bodies "
-            "move apart, more slowly than the digits shown can tell");
+            "no collapse: after 63 collisions the bodies move apart (e = 0.072 is above the critical restitution "
+            "r_c = 0.0717968), more slowly than the digits shown can tell");
+  // Below r_c and no collapse all the same (e = 0 sticks: 2 collisions): the model decides.
+  EXPECT_EQ(viewAt(0.0, false, 2).spiral,
+            "no collapse: after 2 collisions the bodies move apart, more slowly than the digits shown can tell");
   EXPECT_EQ(makeRunView(RunRecord(input({1, 2, 3}, {2, 1, 0}, {-1, 0, 0}))).spiral, "");
 }
 

@@ -279,6 +279,7 @@ class RunRecord {
   collision_lab::core::LogTimeSamples temperature_, temperature_fit_;
   std::optional<collision_lab::core::TemperatureSample> temperature_newest_;  ///< not offered to temperature_ yet
   std::uint64_t temperature_stride_ = 1;
+  std::uint64_t temperature_fit_bucket_ = 0;  ///< index / stride of the last impact offered to temperature_fit_
   double finite_mass_ = 0.0;         ///< [kg]
   std::size_t finite_bodies_ = 0;    ///< [1]
   double temperatureNow() const;

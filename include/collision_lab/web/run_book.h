@@ -70,6 +70,10 @@ struct WebRun {
   bool started = false;
   std::string bag_error;  ///< why the rebuild from the bag failed (the live record stays)
   std::uint64_t version = 0;  ///< bumped on every change (event streams wait on it)
+  /// The run JSON's totals (exact sums: computed once per version, not per request), and
+  /// the version they are of.
+  mutable std::string totals_json;
+  mutable std::uint64_t totals_version = ~std::uint64_t{0};
   double accepted_stamp = 0.0;  ///< [s] since the epoch
   std::uint64_t sequence = 0;   ///< arrival order in the book [1]
   std::uint64_t last_used = 0;  ///< the book's use clock at the last read or change [1]
