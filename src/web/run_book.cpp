@@ -65,22 +65,13 @@ json points(const Envelope& envelope) {
   return out;
 }
 
-/// The CLI's name of an InitialConditions restitution model ("constant" for any unknown one).
-std::string restitutionModelName(std::uint8_t model) {
-  switch (model) {
-    case collision_lab::InitialConditions::RESTITUTION_TC: return "tc";
-    case collision_lab::InitialConditions::RESTITUTION_VISCOELASTIC: return "viscoelastic";
-    case collision_lab::InitialConditions::RESTITUTION_THRESHOLD: return "threshold";
-    default: return "constant";
-  }
-}
-
 json sceneJson(const collision_lab::InitialConditions& in) {
   return {{"masses", masses(in.masses)},
           {"positions", numbers(in.positions)},
           {"velocities", numbers(in.velocities)},
           {"restitution", numbers(in.restitution)},
-          {"restitution_model", restitutionModelName(in.restitution_model)},
+          {"restitution_model", collision_lab::core::restitutionModelName(
+                                    static_cast<collision_lab::core::RestitutionModelKind>(in.restitution_model))},
           {"ring", number(in.ring)},
           {"max_collisions", in.max_collisions},
           {"mode", in.mode}};

@@ -246,15 +246,18 @@ const std::set<std::string>& sceneKeys() {
 void parseRestitutionModel(const json& body, collision_lab::InitialConditions& input) {
   if (body.contains("restitution_model")) {
     const json& name = body["restitution_model"];
-    static const std::map<std::string, std::uint8_t> models = {
-        {"constant", collision_lab::InitialConditions::RESTITUTION_CONSTANT},
-        {"tc", collision_lab::InitialConditions::RESTITUTION_TC},
-        {"viscoelastic", collision_lab::InitialConditions::RESTITUTION_VISCOELASTIC},
-        {"threshold", collision_lab::InitialConditions::RESTITUTION_THRESHOLD}};
-    if (!name.is_string() || !models.count(name.get<std::string>())) {
+    namespace core = collision_lab::core;
+    bool known = false;
+    for (const auto kind : {core::RestitutionModelKind::kConstant, core::RestitutionModelKind::kTc,
+                            core::RestitutionModelKind::kViscoelastic, core::RestitutionModelKind::kThreshold}) {
+      if (name.is_string() && name.get<std::string>() == core::restitutionModelName(kind)) {
+        input.restitution_model = static_cast<std::uint8_t>(kind);  // the message's value is the core's
+        known = true;
+      }
+    }
+    if (!known) {
       throw FieldError{"restitution_model", "restitution_model must be \"constant\", \"tc\", \"viscoelastic\" or \"threshold\""};
     }
-    input.restitution_model = models.at(name.get<std::string>());
   }
   const auto number = [&body](const char* key, double& into) {
     if (body.contains(key)) into = parseNumber(body[key], key);
