@@ -956,7 +956,7 @@ std::string LabNode::newRunId(std::string& claim_error) {
 bool LabNode::servedBefore(const std::string& run_id) {
   if (!run_index_->ok()) return false;
   try {
-    return run_index_->index()->find(run_id).has_value();
+    return run_index_->committed()->find(run_id).has_value();  // this node's own runs are in used_run_ids_
   } catch (const collision_lab::service::RunIndexError& e) {
     ROS_WARN_STREAM("the run index cannot tell whether run_id '" << run_id << "' was served: " << e.what());
     return false;

@@ -7,11 +7,13 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <iterator>
 #include <utility>
 
 #include <nlohmann/json.hpp>
@@ -293,7 +295,7 @@ RunIndexRecorder::RunIndexRecorder(const std::string& bag_directory) : bag_direc
   std::error_code ec;
   fs::create_directories(bag_directory, ec);
   try {
-    index_ = std::make_unique<RunIndex>(RunIndex::defaultPath(bag_directory));
+    index_ = std::make_unique<RunIndex>(RunIndex::defaultPath(bag_directory), kIndexWriterBusyTimeoutMs);
   } catch (const RunIndexError& e) {
     ROS_ERROR_STREAM("the run index is not written (runs are served and recorded in bags as ever): " << e.what());
   }
@@ -321,46 +323,73 @@ std::uint64_t RunIndexRecorder::enqueue(std::function<void()> write, bool urgent
   return ++queued_;
 }
 
-void RunIndexRecorder::waitWritten(std::uint64_t ticket) const {
+bool RunIndexRecorder::waitWritten(std::uint64_t ticket, std::chrono::milliseconds max_wait) const {
   std::unique_lock<std::mutex> lock(writes_mutex_);
-  if (written_ >= ticket) return;
+  if (written_ >= ticket) return true;
   ++urgent_;  // a writer waits: commit now
   writes_queued_.notify_one();
-  writes_committed_.wait(lock, [&] { return written_ >= ticket; });
+  const auto done = [&] { return written_ >= ticket; };
+  if (max_wait == std::chrono::milliseconds::max()) {
+    writes_committed_.wait(lock, done);
+    return true;
+  }
+  return writes_committed_.wait_for(lock, max_wait, done);
 }
 
-void RunIndexRecorder::flush() const {
+bool RunIndexRecorder::flush(std::chrono::milliseconds max_wait) const {
   std::uint64_t ticket = 0;
   {
     std::lock_guard<std::mutex> lock(writes_mutex_);
     ticket = queued_;
   }
-  waitWritten(ticket);
+  return waitWritten(ticket, max_wait);
+}
+
+bool RunIndexRecorder::commit(const std::vector<std::function<void()>>& group) {
+  try {
+    if (index_->writeTogether([&group] {
+          for (const auto& write : group) write();  // each logs its own failure
+        })) {
+      return true;
+    }
+    ROS_WARN_STREAM_THROTTLE(10, "run index: locked by another program; " << group.size()
+                                                                           << " writes wait and are tried again");
+  } catch (const std::exception& e) {
+    ROS_ERROR_STREAM_THROTTLE(10, "run index: " << group.size() << " writes wait and are tried again: " << e.what());
+  }
+  return false;
 }
 
 void RunIndexRecorder::writerLoop() {
   std::vector<std::function<void()>> group;
+  std::chrono::milliseconds pause{0};  // before the next try of a refused group; 0 after a commit
   std::unique_lock<std::mutex> lock(writes_mutex_);
   for (;;) {
     writes_queued_.wait(lock, [this] { return !pending_.empty() || writer_stops_; });
     if (pending_.empty()) return;
-    // Deferrable writes alone wait for an urgent one, or for kDeferredWritesDelay.
-    writes_queued_.wait_until(lock, oldest_pending_ + kDeferredWritesDelay,
-                              [this] { return urgent_ > 0 || writer_stops_; });
+    if (pause.count() > 0) {
+      writes_queued_.wait_for(lock, pause, [this] { return writer_stops_; });
+    } else {  // deferrable writes alone wait for an urgent one, or for kDeferredWritesDelay
+      writes_queued_.wait_until(lock, oldest_pending_ + kDeferredWritesDelay,
+                                [this] { return urgent_ > 0 || writer_stops_; });
+    }
     group.swap(pending_);
     urgent_ = 0;
+    const bool last_try = writer_stops_;
     lock.unlock();
-    try {
-      index_->writeTogether([&group] {
-        for (const auto& write : group) write();  // each logs its own failure
-      });
-    } catch (const std::exception& e) {  // the node serves on; the writes are logged as lost
-      ROS_ERROR_STREAM("run index: " << group.size() << " writes were not committed: " << e.what());
-    }
-    const std::size_t done = group.size();
-    group.clear();
+    const bool committed = commit(group);
     lock.lock();
-    written_ += done;
+    if (!committed && !last_try) {  // kept, in order, ahead of what came meanwhile
+      group.insert(group.end(), std::make_move_iterator(pending_.begin()), std::make_move_iterator(pending_.end()));
+      pending_.swap(group);
+      group.clear();
+      pause = std::clamp(2 * pause, std::chrono::milliseconds(250), kIndexRetryMaxPause);
+      continue;
+    }
+    if (!committed) ROS_ERROR_STREAM("run index: " << group.size() << " writes are lost: the node stops and the index refuses them");
+    pause = std::chrono::milliseconds(0);
+    written_ += group.size();
+    group.clear();
     writes_committed_.notify_all();
   }
 }
@@ -412,7 +441,9 @@ void RunIndexRecorder::finished(const collision_lab::RunSummary& summary) {
         }
       },
       /*urgent=*/true);
-  waitWritten(ticket);
+  if (!waitWritten(ticket, kIndexCommitWait)) {
+    ROS_WARN_STREAM("run " << summary.run_id << ": its end waits to be written into the run index");
+  }
 }
 
 void RunIndexRecorder::rejected(const collision_lab::Rejected& rejected) {
@@ -438,7 +469,7 @@ void RunIndexRecorder::rejected(const collision_lab::Rejected& rejected) {
 std::vector<collision_lab::ServedRun> RunIndexRecorder::list(const std::string& student) const {
   std::vector<collision_lab::ServedRun> served;
   if (!index_) return served;
-  flush();
+  if (!flush(kIndexCommitWait)) ROS_WARN("~list_runs: the newest runs wait to be written into the run index");
   std::vector<IndexedRun> rows;
   try {
     rows = index_->list(student.empty() ? std::nullopt : std::optional<std::string>(student));

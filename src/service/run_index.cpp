@@ -13,8 +13,6 @@ namespace {
 
 /// The schema this code writes (PRAGMA user_version). A file of a newer version is refused.
 constexpr int kSchemaVersion = 1;
-/// [ms] a statement waits for another connection's write lock before SQLITE_BUSY.
-constexpr int kBusyTimeoutMs = 10000;
 
 constexpr const char* kSchema = R"sql(
 CREATE TABLE IF NOT EXISTS runs (
@@ -164,7 +162,7 @@ std::optional<RunState> runStateFromName(const std::string& name) {
   return std::nullopt;
 }
 
-RunIndex::RunIndex(const std::string& path) : path_(path) {
+RunIndex::RunIndex(const std::string& path, int busy_timeout_ms) : path_(path) {
   const int rc = sqlite3_open_v2(path.c_str(), &db_,
                                  SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_FULLMUTEX, nullptr);
   if (rc != SQLITE_OK) {
@@ -173,12 +171,12 @@ RunIndex::RunIndex(const std::string& path) : path_(path) {
     db_ = nullptr;
     throw RunIndexError("run index " + path + ": cannot open: " + error);
   }
-  sqlite3_busy_timeout(db_, kBusyTimeoutMs);
+  sqlite3_busy_timeout(db_, busy_timeout_ms);
   // Nodes starting together (labs sharing a folder) meet here: switching to WAL and
   // creating the tables may answer SQLITE_BUSY at once, without the busy handler (e.g.
   // while another connection recovers the WAL), so the set-up is tried again until the
-  // busy timeout has passed.
-  const auto give_up = std::chrono::steady_clock::now() + std::chrono::milliseconds(kBusyTimeoutMs);
+  // default busy timeout has passed.
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::milliseconds(kDefaultBusyTimeoutMs);
   for (;;) {
     try {
       initialize();
@@ -255,28 +253,25 @@ void RunIndex::accepted(const IndexedRun& run) {
   s.run();
 }
 
-void RunIndex::writeTogether(const std::function<void()>& writes) {
-  bool begun = false;
+bool RunIndex::writeTogether(const std::function<void()>& writes) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    begun = sqlite3_exec(db_, "BEGIN IMMEDIATE", nullptr, nullptr, nullptr) == SQLITE_OK;
+    if (sqlite3_exec(db_, "BEGIN IMMEDIATE", nullptr, nullptr, nullptr) != SQLITE_OK) return false;
   }
   try {
     writes();
   } catch (...) {
-    if (begun) {
-      std::lock_guard<std::mutex> lock(mutex_);
-      sqlite3_exec(db_, "COMMIT", nullptr, nullptr, nullptr);
-    }
+    std::lock_guard<std::mutex> lock(mutex_);
+    sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
     throw;
   }
-  if (!begun) return;
   std::lock_guard<std::mutex> lock(mutex_);
   if (sqlite3_exec(db_, "COMMIT", nullptr, nullptr, nullptr) != SQLITE_OK) {
     const std::string error = sqlite3_errmsg(db_);
     sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
     throw RunIndexError("run index " + path_ + ": committing a group of writes: " + error);
   }
+  return true;
 }
 
 void RunIndex::started(const std::string& run_id, double at) {

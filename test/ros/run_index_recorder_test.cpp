@@ -1,15 +1,19 @@
 // The lab node's side of the run index, no master: the bag claim's lock (claimBag) held
 // while a bag is written and dropped when it closes; recovery of the .active bag of a
 // writer killed mid-run (reindexed, renamed, counted, indexed as interrupted), never of a
-// live owner's; stale rows ended; ~list_runs' rows from the index.
+// live owner's; stale rows ended; ~list_runs' rows from the index; a write-locked index
+// holds up nothing and loses no row.
+#include <sqlite3.h>
 #include <sys/file.h>
 #include <sys/wait.h>
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <string>
+#include <thread>
 
 #include <gtest/gtest.h>
 #include <ros/time.h>
@@ -279,3 +283,41 @@ TEST_F(RunIndexRecorderTest, JsonOfInputAndSummary) {
 }
 
 }  // namespace
+
+TEST_F(RunIndexRecorderTest, AWriteLockedIndexHoldsUpNothingAndLosesNoRow) {
+  RunIndexRecorder recorder(dir_);
+  ASSERT_TRUE(recorder.ok());
+  // Another program holds the write lock, far longer than the writer's busy timeout.
+  sqlite3* locker = nullptr;
+  ASSERT_EQ(sqlite3_open(RunIndex::defaultPath(dir_).c_str(), &locker), SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(locker, "BEGIN EXCLUSIVE", nullptr, nullptr, nullptr), SQLITE_OK);
+
+  recorder.accepted("locked", "ana", "", input("locked", "ana"));
+  recorder.started("locked");
+  collision_lab::RunSummary summary;
+  summary.run_id = "locked";
+  summary.student = "ana";
+  summary.stop_reason = "FINISHED";
+  summary.collision_count = 31;
+  recorder.finished(summary);  // returns: the run's end does not wait for the lock
+  collision_lab::Rejected rejected;
+  rejected.student = "ben";
+  rejected.reason_name = "INVALID_MASS";
+  rejected.message = "masses must be > 0";
+  recorder.rejected(rejected);
+  // Readers are not held up, and see nothing uncommitted.
+  EXPECT_FALSE(recorder.committed()->find("locked"));
+  EXPECT_FALSE(recorder.flush(std::chrono::milliseconds(10 * kIndexWriterBusyTimeoutMs)));
+
+  ASSERT_EQ(sqlite3_exec(locker, "COMMIT", nullptr, nullptr, nullptr), SQLITE_OK);
+  sqlite3_close(locker);
+  ASSERT_TRUE(recorder.flush(std::chrono::minutes(1)));  // the kept writes, tried again, commit
+  const auto row = recorder.committed()->find("locked");
+  ASSERT_TRUE(row);
+  EXPECT_EQ(row->state, RunState::kFinished);
+  EXPECT_EQ(row->collision_count, 31u);
+  EXPECT_EQ(row->student, "ana");
+  const auto rejections = recorder.committed()->rejections(std::string("ben"));
+  ASSERT_EQ(rejections.size(), 1u);
+  EXPECT_EQ(rejections[0].reason_name, "INVALID_MASS");
+}

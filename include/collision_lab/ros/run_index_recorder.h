@@ -65,6 +65,13 @@ bool activeBagOwned(const std::string& active_path);
 
 /// How long a deferrable write of the index (a run's start) may wait for a commit.
 constexpr std::chrono::milliseconds kDeferredWritesDelay{500};
+/// How long the lab's writes wait for another connection's write lock before they are
+/// put back and tried again later [ms]: short, so that a locked index holds up nothing.
+constexpr int kIndexWriterBusyTimeoutMs = 200;
+/// The longest pause between two tries of writes that a locked or failing index refused.
+constexpr std::chrono::milliseconds kIndexRetryMaxPause{5000};
+/// How long a run's end (finished()) and ~list_runs wait for the index's commit.
+constexpr std::chrono::milliseconds kIndexCommitWait{2000};
 
 /// The lab node's writer of the index.
 class RunIndexRecorder {
@@ -81,16 +88,21 @@ class RunIndexRecorder {
     flush();
     return index_.get();
   }
-  /// Waits until every write handed over so far is committed.
-  void flush() const;
+  /// The index as committed so far, at once (writes still queued are not in it yet).
+  const collision_lab::service::RunIndex* committed() const { return index_.get(); }
+  /// Waits until every write handed over so far is committed, at most max_wait; false
+  /// when they are not committed yet.
+  bool flush(std::chrono::milliseconds max_wait = std::chrono::milliseconds::max()) const;
 
   // The writes go to a writer thread, in order, which commits whatever has queued up in
   // one transaction (a group commit: under load one commit serves many runs). accepted(),
   // finished() and rejected() are committed at once; started() (queued -> running, which
   // recovery treats alike) waits for the next of them, at most kDeferredWritesDelay, so
   // that a short run's start and end share a commit. finished() returns once its write is
-  // committed, so that whoever sees the summary finds the run finished; list() and index()
-  // first wait for every write handed over.
+  // committed, so that whoever sees the summary finds the run finished; list() first waits
+  // for every write handed over. Both wait at most kIndexCommitWait: writes that a locked
+  // or failing index refuses are kept, in order, and tried again (pauses doubling up to
+  // kIndexRetryMaxPause) until they commit; none is dropped while the node runs.
 
   /// A run accepted and queued, before any worker can take it; input as served (its
   /// run_id assigned). requested_run_id: InitialConditions.run_id as sent.
@@ -124,11 +136,17 @@ class RunIndexRecorder {
   /// writes). An urgent write is committed at once (with whatever has queued up); a
   /// deferrable one waits for the next urgent write, or kDeferredWritesDelay.
   std::uint64_t enqueue(std::function<void()> write, bool urgent);
-  /// Waits until every write up to `ticket` is committed (they become urgent).
-  void waitWritten(std::uint64_t ticket) const;
+  /// Waits until every write up to `ticket` is committed (they become urgent), at most
+  /// max_wait; false when they are not committed yet.
+  bool waitWritten(std::uint64_t ticket,
+                   std::chrono::milliseconds max_wait = std::chrono::milliseconds::max()) const;
   /// The writer thread: takes every write queued so far and commits them together
   /// (RunIndex::writeTogether), until the recorder is destroyed and nothing is left.
+  /// Refused groups go back to the front of the queue and are tried again after a pause;
+  /// at the recorder's end they get one last try.
   void writerLoop();
+  /// One try at committing group; false when the index refused it (logged).
+  bool commit(const std::vector<std::function<void()>>& group);
 
   std::string bag_directory_;
   std::unique_ptr<collision_lab::service::RunIndex> index_;
@@ -140,7 +158,7 @@ class RunIndexRecorder {
   std::chrono::steady_clock::time_point oldest_pending_;  ///< when pending_ last became non-empty
   mutable std::uint64_t urgent_ = 0;  ///< urgent writes and waiters since the last commit
   std::uint64_t queued_ = 0;   ///< writes ever queued
-  std::uint64_t written_ = 0;  ///< writes ever committed (or failed and logged)
+  std::uint64_t written_ = 0;  ///< writes ever committed (or, at the end, given up and logged)
   bool writer_stops_ = false;
   std::thread writer_;
 };

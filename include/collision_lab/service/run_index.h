@@ -6,7 +6,8 @@
 // JSON text made by the layer above.
 //
 // Thread-safe: one connection per RunIndex, guarded by a mutex. Several processes may open
-// the same file (WAL: one writer, many readers; a busy timeout absorbs short waits).
+// the same file (WAL: one writer, many readers; a busy timeout absorbs short waits, and
+// readers never wait for a writer).
 // Every method throws RunIndexError when SQLite fails; the callers log it and go on (the
 // index is a record, never a reason to lose a run).
 #pragma once
@@ -63,8 +64,12 @@ struct IndexedRejection {
 
 class RunIndex {
  public:
+  /// [ms] how long a statement waits for another connection's write lock by default.
+  static constexpr int kDefaultBusyTimeoutMs = 10000;
   /// Opens (creating when missing) the database at path, in WAL mode, with its tables.
-  explicit RunIndex(const std::string& path);
+  /// busy_timeout_ms: how long a write waits for another connection's write lock before
+  /// it fails (opening the file waits up to kDefaultBusyTimeoutMs whatever it is).
+  explicit RunIndex(const std::string& path, int busy_timeout_ms = kDefaultBusyTimeoutMs);
   ~RunIndex();
   RunIndex(const RunIndex&) = delete;
   RunIndex& operator=(const RunIndex&) = delete;
@@ -88,9 +93,11 @@ class RunIndex {
   /// A rejected input; only the newest kRejectionsKept are kept.
   void rejected(const IndexedRejection& rejection);
   /// Calls `writes` (calls of the write methods above) inside one transaction: one commit
-  /// for all of them (group commit). When the transaction cannot begin, each write commits
-  /// on its own, as outside. Throws RunIndexError when the commit fails.
-  void writeTogether(const std::function<void()>& writes);
+  /// for all of them (group commit). Returns false, having called nothing, when the
+  /// transaction cannot begin (another connection held the write lock past the busy
+  /// timeout): the caller tries again later. Throws RunIndexError when the commit fails
+  /// (nothing of the group is then written).
+  bool writeTogether(const std::function<void()>& writes);
   static constexpr std::size_t kRejectionsKept = 100000;
   /// The events CSV made beside the run's bag (the web node, once, on the first download).
   void setCsvPath(const std::string& run_id, const std::string& csv_path);
