@@ -5,6 +5,12 @@ if(TARGET run_index_test)
   target_link_libraries(run_index_test collision_lab_service GTest::gtest_main)
 endif()
 
+# An address's bounded share of the class's runs (no master).
+catkin_add_gtest(address_share_test test/service/address_share_test.cpp)
+if(TARGET address_share_test)
+  target_link_libraries(address_share_test collision_lab_service GTest::gtest_main)
+endif()
+
 # The lab node's side (no master): the bag claim's lock, recovery of a killed writer's
 # .active bag (reindexed with `rosbag reindex`), stale rows ended, ~list_runs' rows.
 catkin_add_gtest(run_index_recorder_test test/ros/run_index_recorder_test.cpp)

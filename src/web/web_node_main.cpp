@@ -55,6 +55,7 @@ WebConfig loadConfig(const ros::NodeHandle& pnh) {
   c.max_bodies = sizeParam(pnh, "max_bodies", c.max_bodies);
   c.runs_per_minute = sizeParam(pnh, "runs_per_minute", c.runs_per_minute);
   c.runs_per_minute_per_address = sizeParam(pnh, "runs_per_minute_per_address", c.runs_per_minute_per_address);
+  c.unfinished_runs_per_address = sizeParam(pnh, "unfinished_runs_per_address", c.unfinished_runs_per_address);
   c.max_streams = sizeParam(pnh, "max_streams", c.max_streams);
   c.code_attempts = sizeParam(pnh, "code_attempts", c.code_attempts);
   pnh.param("code_lockout", c.code_lockout, c.code_lockout);

@@ -68,6 +68,9 @@ constexpr char kTeacherCookie[] = "collision_lab_teacher";
 constexpr int kCookieSeconds = 12 * 3600;
 /// Longest run_id the lab node takes [characters].
 constexpr std::size_t kMaxRunIdLength = 128;
+/// An address's place held by a run whose end this node never saw is given back after this.
+constexpr auto kForgetUnfinishedAfter = std::chrono::hours(1);
+constexpr int kUnfinishedRetryAfter = 5;  ///< [s] Retry-After of a 429 for unfinished runs
 
 std::string readFile(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -316,6 +319,7 @@ WebServer::WebServer(RunBook& book, WebConfig config, Publish publish, Cancel ca
       log_(std::move(log)),
       class_cookie_(randomToken()),
       teacher_cookie_(randomToken()),
+      shares_(config_.unfinished_runs_per_address, kForgetUnfinishedAfter),
       blocking_(std::make_unique<BlockingPool>()) {
   for (const char* page : {"index.html", "run.html", "teacher.html", "login.html", "app.js", "run.js", "login.js", "style.css"}) {
     files_[std::string("/static/") + page] = readFile(config_.web_root + "/" + page);
@@ -813,6 +817,16 @@ void WebServer::postRun(const HttpRequest& request, const HttpReply& reply) {
     res.set(http::field::retry_after, std::to_string(wait));
     return reply.send(std::move(res));
   }
+  // One address holds a bounded share of the lab, whatever names it types.
+  if (!shares_.reserve(request.client, [this](const std::string& run_id) { return book_.finished(run_id); })) {
+    log("limited " + request.client + " (" + student + "): unfinished runs per address");
+    Response res = refuse(429, "at most " + std::to_string(shares_.perAddress()) +
+                                   " runs from one address may be queued or running at once; try again when one "
+                                   "has finished (or stop one)");
+    res.set(http::field::retry_after, std::to_string(kUnfinishedRetryAfter));
+    return reply.send(std::move(res));
+  }
+  const std::string client = request.client;
   // Each input gets a run_id of its own to ask for, so that its answer is found: the
   // student's next run number.
   const bool numbered = input.run_id.empty();
@@ -826,7 +840,8 @@ void WebServer::postRun(const HttpRequest& request, const HttpReply& reply) {
   // student's next send, unless a later send of theirs took a higher one meanwhile. Should
   // the lab node run an unanswered one after all, it serves the next send as the next free
   // number: nothing is overwritten.
-  const auto give_back_number = [this, student, requested] {
+  const auto give_back_number = [this, student, requested, client] {
+    shares_.answered(client, std::nullopt);
     if (const auto number = runNumber(student + "." + requested, student)) {
       std::lock_guard<std::mutex> lock(mutex_);
       std::uint64_t& highest = runs_numbered_[student];
@@ -840,7 +855,7 @@ void WebServer::postRun(const HttpRequest& request, const HttpReply& reply) {
     std::lock_guard<std::mutex> lock(mutex_);
     pending_.emplace(student, requested);
   }
-  book_.expect(student, requested, [this, request, reply, timer, token, student, requested, numbered,
+  book_.expect(student, requested, [this, request, reply, timer, token, student, requested, numbered, client,
                                     give_back_number](const Submission& answer) {
     {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -862,6 +877,7 @@ void WebServer::postRun(const HttpRequest& request, const HttpReply& reply) {
       highest = std::max(highest, *number);
     }
     remember(*answer.run_id, token);
+    shares_.answered(client, *answer.run_id);
     reply.send(jsonAnswer(request, 202,
                           {{"run_id", *answer.run_id},
                            {"url", "/runs/" + *answer.run_id},

@@ -16,6 +16,7 @@
 #include <iterator>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -361,6 +362,48 @@ TEST_F(WebAccessTest, RunsPerAddressAreLimitedWhateverTheName) {
   EXPECT_EQ(statuses, expected);
 }
 
+/// POST /api/runs of scene from `source`: the status and the JSON body (null when none).
+std::pair<int, json> postFrom(const std::string& source, const json& scene) {
+  const std::string body = scene.dump();
+  const std::string raw = rawRequest(
+      source, std::string("POST /api/runs HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\nX-Class-Code: ") +
+                  kCode + "\r\nConnection: close\r\nContent-Length: " + std::to_string(body.size()) + "\r\n\r\n" + body);
+  const auto start = raw.find("\r\n\r\n");
+  return {statusOf(raw), start == std::string::npos ? json() : json::parse(raw.substr(start + 4), nullptr, false)};
+}
+
+TEST_F(WebAccessTest, OneAddressUnderManyNamesHoldsABoundedShare) {
+  constexpr int kShare = 6;  // unfinished_runs_per_address: its default
+  std::vector<json> held;
+  for (int i = 0; i < kShare; ++i) {  // runs that compute until stopped, a new name each
+    const auto [status, answer] = postFrom("127.0.6.1", endlessScene("flood" + std::to_string(i)));
+    ASSERT_EQ(status, 202) << answer.dump();
+    held.push_back(answer);
+  }
+  const auto [status, answer] = postFrom("127.0.6.1", endlessScene("flood" + std::to_string(kShare)));
+  EXPECT_EQ(status, 429) << answer.dump();
+  EXPECT_NE(answer.value("error", std::string()).find("queued or running at once"), std::string::npos) << answer.dump();
+  // A classmate at another address is served while the flood's runs hold their places.
+  const auto [classmate_status, classmate] = postFrom("127.0.6.2", piScene("classmate"));
+  ASSERT_EQ(classmate_status, 202) << classmate.dump();
+  EXPECT_EQ(finishedRun(classmate.at("run_id")).at("summary").at("collision_count"), 31);
+  // Once the flood's runs end, its places come back.
+  auto c = client();
+  for (const json& run : held) {
+    const std::string run_id = run.at("run_id");
+    EXPECT_TRUE(waitUntil(
+        [&] {
+          auto r = c.Post(("/api/runs/" + run_id + "/stop").c_str(), {{"X-Stop-Token", run.at("stop_token").get<std::string>()}},
+                          "", "application/json");
+          return r && r->status == 200 && json::parse(r->body)["ok"] == true;
+        },
+        "the stop of " + run_id));
+    finishedRun(run_id);
+  }
+  const auto [again_status, again] = postFrom("127.0.6.1", piScene("flood0"));
+  EXPECT_EQ(again_status, 202) << again.dump();
+}
+
 TEST_F(WebAccessTest, OwnerAndTeacherStopARunAClassmateCannot) {
   auto c = client();
   auto res = c.Post("/api/runs", endlessScene("una").dump(), "application/json");
@@ -561,7 +604,9 @@ TEST_F(WebAccessTest, PostDuringALongRunIsAnsweredAtOnce) {
   res = c.Post("/api/runs", piScene("zoe").dump(), "application/json");
   ASSERT_TRUE(res);
   EXPECT_EQ(res->status, 202) << "answered while the long run computes: " << res->body;
-  if (res->status == 202) EXPECT_EQ(finishedRun(json::parse(res->body).at("run_id")).at("summary").at("collision_count"), 31);
+  if (res->status == 202) {
+    EXPECT_EQ(finishedRun(json::parse(res->body).at("run_id")).at("summary").at("collision_count"), 31);
+  }
   auto stop = c.Post(("/api/runs/" + endless.at("run_id").get<std::string>() + "/stop").c_str(),
                      {{"X-Stop-Token", endless.at("stop_token").get<std::string>()}}, "", "application/json");
   ASSERT_TRUE(stop);

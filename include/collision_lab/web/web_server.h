@@ -33,6 +33,7 @@
 
 #include "collision_lab/InitialConditions.h"
 #include "collision_lab/RunQueue.h"
+#include "collision_lab/service/address_share.h"
 #include "collision_lab/web/run_book.h"
 
 namespace collision_lab_web {
@@ -54,6 +55,9 @@ struct WebConfig {
   std::size_t max_bodies = 10000;        ///< the lab node's ~max_bodies [1]
   std::size_t runs_per_minute = 10;      ///< per student [1]; more: 429
   std::size_t runs_per_minute_per_address = 30;  ///< per client address [1]; more: 429
+  /// Runs of one client address sent and not yet finished (queued or running), whatever the
+  /// names [1]; more: 429 until one ends. 0: no cap.
+  std::size_t unfinished_runs_per_address = 6;
   std::size_t max_streams = 64;          ///< concurrent event streams [1]; more: 503
   std::size_t code_attempts = 5;         ///< wrong codes per address per minute [1] before the lockout
   double code_lockout = 60.0;            ///< [s] an address is locked out after too many wrong codes
@@ -140,6 +144,7 @@ class WebServer {
   std::set<std::string> hosts_;               ///< names the lab serves (Host without port)
   std::string class_cookie_, teacher_cookie_;  ///< random per start: a login's proof
   std::atomic<std::size_t> streams_{0};
+  collision_lab::service::AddressShare shares_;  ///< unfinished_runs_per_address
   mutable std::mutex mutex_;  ///< guards everything below
   std::map<std::string, std::deque<std::chrono::steady_clock::time_point>> sends_;
   std::map<std::string, std::deque<std::chrono::steady_clock::time_point>> wrong_codes_;
