@@ -181,6 +181,17 @@ std::string legendOf(std::size_t shown, std::size_t all) {
   return withSeparators(shown) + " of " + withSeparators(all) + " bodies, evenly spaced, the outermost two included";
 }
 
+/// The cap that stopped a run the model answered over its cap: the input's max_collisions,
+/// or the lab's ~max_collisions when the input asked for none (0) or for more than the
+/// prediction (the lab's ceiling, lower, applied).
+std::string appliedCapText(std::uint64_t asked, const std::optional<std::uint64_t>& predicted) {
+  if (asked == 0) return "this lab's cap (its ~max_collisions)";
+  if (predicted && *predicted <= asked) {
+    return "this lab's cap (its ~max_collisions, below the " + withSeparators(asked) + " asked for)";
+  }
+  return "the cap of " + withSeparators(asked);
+}
+
 }  // namespace
 
 std::string collisionsText(std::uint64_t n) {
@@ -224,7 +235,7 @@ RunView makeRunView(const RunRecord& run) {
     } else if (run.summary && !run.summary->truncation_reason.empty()) {
       why = run.summary->truncation_reason;
     } else {
-      why = "more collisions predicted than the cap of " + withSeparators(in.max_collisions) +
+      why = "more collisions predicted than " + appliedCapText(in.max_collisions, view.predicted_collisions) +
             ", the model answered";
     }
     while (!why.empty() && why.back() == '.') why.pop_back();

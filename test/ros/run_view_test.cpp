@@ -93,6 +93,7 @@ TEST(RunView, NotSimulatedRunClaimsNoSimulatedCount) {
   const auto view = makeRunView(run);
   EXPECT_EQ(view.state, "not simulated");
   EXPECT_EQ(view.not_simulated.rfind("not simulated: ", 0), 0u) << view.not_simulated;
+  EXPECT_NE(view.not_simulated.find("than the cap of 10,"), std::string::npos) << view.not_simulated;
   EXPECT_FALSE(view.simulated);
   EXPECT_FALSE(view.simulated_collisions.has_value());
   ASSERT_TRUE(view.predicted_collisions.has_value());
@@ -104,6 +105,19 @@ TEST(RunView, NotSimulatedRunClaimsNoSimulatedCount) {
   EXPECT_EQ(view.note.find("plots"), std::string::npos) << view.note;
   EXPECT_NE(view.note.find("no collision simulated"), std::string::npos) << view.note;
   EXPECT_NE(view.note.find("the final velocities shown are the closed form's"), std::string::npos) << view.note;
+
+  // The cap named is the one that applied: the lab's when the input asked for none, or for
+  // more than the prediction (its ceiling lowered it). (Failed before: "the cap of 0", "the
+  // cap of 18,446,744,073,709,551,615".)
+  for (const std::uint64_t asked : {std::uint64_t{0}, std::numeric_limits<std::uint64_t>::max()}) {
+    in.max_collisions = asked;
+    RunRecord lab_capped(in);
+    lab_capped.prediction = p;
+    lab_capped.summary = s;
+    const std::string text = makeRunView(lab_capped).not_simulated;
+    EXPECT_NE(text.find("than this lab's cap (its ~max_collisions"), std::string::npos) << text;
+    EXPECT_EQ(text.find("cap of"), std::string::npos) << text;
+  }
 }
 
 TEST(RunView, TruncatedRunSaysSoInOneSentence) {
@@ -248,7 +262,9 @@ TEST(RunView, RingIsNamedAndItsWorldlinesAreCutAtTheSeam) {
       for (std::size_t k = 0; k < segment.size(); ++k) {
         EXPECT_GE(segment[k].second, 0.0);
         EXPECT_LE(segment[k].second, 1000.0);
-        if (k > 0) EXPECT_LE(std::abs(segment[k].second - segment[k - 1].second), 500.0) << "spans the seam";
+        if (k > 0) {
+          EXPECT_LE(std::abs(segment[k].second - segment[k - 1].second), 500.0) << "spans the seam";
+        }
       }
     }
   }
