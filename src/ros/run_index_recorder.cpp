@@ -295,7 +295,7 @@ RunIndexRecorder::RunIndexRecorder(const std::string& bag_directory) : bag_direc
   std::error_code ec;
   fs::create_directories(bag_directory, ec);
   try {
-    index_ = std::make_unique<RunIndex>(RunIndex::defaultPath(bag_directory), kIndexWriterBusyTimeoutMs);
+    index_ = std::make_unique<RunIndex>(RunIndex::defaultPath(bag_directory));
   } catch (const RunIndexError& e) {
     ROS_ERROR_STREAM("the run index is not written (runs are served and recorded in bags as ever): " << e.what());
   }
@@ -323,9 +323,10 @@ std::uint64_t RunIndexRecorder::enqueue(std::function<void()> write, bool urgent
   return ++queued_;
 }
 
-bool RunIndexRecorder::waitWritten(std::uint64_t ticket, std::chrono::milliseconds max_wait) const {
+bool RunIndexRecorder::waitWritten(std::uint64_t ticket, std::chrono::milliseconds max_wait, bool unless_locked) const {
   std::unique_lock<std::mutex> lock(writes_mutex_);
   if (written_ >= ticket) return true;
+  if (unless_locked && locked_out_) return false;
   ++urgent_;  // a writer waits: commit now
   writes_queued_.notify_one();
   const auto done = [&] { return written_ >= ticket; };
@@ -336,28 +337,31 @@ bool RunIndexRecorder::waitWritten(std::uint64_t ticket, std::chrono::millisecon
   return writes_committed_.wait_for(lock, max_wait, done);
 }
 
-bool RunIndexRecorder::flush(std::chrono::milliseconds max_wait) const {
+bool RunIndexRecorder::flush(std::chrono::milliseconds max_wait, bool unless_locked) const {
   std::uint64_t ticket = 0;
   {
     std::lock_guard<std::mutex> lock(writes_mutex_);
     ticket = queued_;
   }
-  return waitWritten(ticket, max_wait);
+  return waitWritten(ticket, max_wait, unless_locked);
 }
 
 bool RunIndexRecorder::commit(const std::vector<std::function<void()>>& group) {
   try {
-    if (index_->writeTogether([&group] {
-          for (const auto& write : group) write();  // each logs its own failure
-        })) {
+    if (index_->writeTogether(
+            [&group] {
+              for (const auto& write : group) write();  // each logs its own failure
+            },
+            kIndexWriterLockWait)) {
       return true;
     }
     ROS_WARN_STREAM_THROTTLE(10, "run index: locked by another program; " << group.size()
                                                                            << " writes wait and are tried again");
-  } catch (const std::exception& e) {
-    ROS_ERROR_STREAM_THROTTLE(10, "run index: " << group.size() << " writes wait and are tried again: " << e.what());
+    return false;
+  } catch (const std::exception& e) {  // the node serves on; the writes are logged as lost
+    ROS_ERROR_STREAM("run index: " << group.size() << " writes were not committed: " << e.what());
+    return true;
   }
-  return false;
 }
 
 void RunIndexRecorder::writerLoop() {
@@ -379,6 +383,7 @@ void RunIndexRecorder::writerLoop() {
     lock.unlock();
     const bool committed = commit(group);
     lock.lock();
+    locked_out_ = !committed;
     if (!committed && !last_try) {  // kept, in order, ahead of what came meanwhile
       group.insert(group.end(), std::make_move_iterator(pending_.begin()), std::make_move_iterator(pending_.end()));
       pending_.swap(group);
@@ -386,7 +391,7 @@ void RunIndexRecorder::writerLoop() {
       pause = std::clamp(2 * pause, std::chrono::milliseconds(250), kIndexRetryMaxPause);
       continue;
     }
-    if (!committed) ROS_ERROR_STREAM("run index: " << group.size() << " writes are lost: the node stops and the index refuses them");
+    if (!committed) ROS_ERROR_STREAM("run index: " << group.size() << " writes are lost: the node stops and the index is locked");
     pause = std::chrono::milliseconds(0);
     written_ += group.size();
     group.clear();
@@ -441,7 +446,7 @@ void RunIndexRecorder::finished(const collision_lab::RunSummary& summary) {
         }
       },
       /*urgent=*/true);
-  if (!waitWritten(ticket, kIndexCommitWait)) {
+  if (!waitWritten(ticket, kIndexCommitWait, /*unless_locked=*/true)) {
     ROS_WARN_STREAM("run " << summary.run_id << ": its end waits to be written into the run index");
   }
 }
@@ -469,7 +474,7 @@ void RunIndexRecorder::rejected(const collision_lab::Rejected& rejected) {
 std::vector<collision_lab::ServedRun> RunIndexRecorder::list(const std::string& student) const {
   std::vector<collision_lab::ServedRun> served;
   if (!index_) return served;
-  if (!flush(kIndexCommitWait)) ROS_WARN("~list_runs: the newest runs wait to be written into the run index");
+  if (!flush(kIndexCommitWait, /*unless_locked=*/true)) ROS_WARN("~list_runs: the newest runs wait to be written into the run index");
   std::vector<IndexedRun> rows;
   try {
     rows = index_->list(student.empty() ? std::nullopt : std::optional<std::string>(student));

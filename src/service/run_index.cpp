@@ -162,7 +162,7 @@ std::optional<RunState> runStateFromName(const std::string& name) {
   return std::nullopt;
 }
 
-RunIndex::RunIndex(const std::string& path, int busy_timeout_ms) : path_(path) {
+RunIndex::RunIndex(const std::string& path, int busy_timeout_ms) : path_(path), busy_timeout_ms_(busy_timeout_ms) {
   const int rc = sqlite3_open_v2(path.c_str(), &db_,
                                  SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_FULLMUTEX, nullptr);
   if (rc != SQLITE_OK) {
@@ -253,10 +253,14 @@ void RunIndex::accepted(const IndexedRun& run) {
   s.run();
 }
 
-bool RunIndex::writeTogether(const std::function<void()>& writes) {
+bool RunIndex::writeTogether(const std::function<void()>& writes, std::chrono::milliseconds lock_wait) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (sqlite3_exec(db_, "BEGIN IMMEDIATE", nullptr, nullptr, nullptr) != SQLITE_OK) return false;
+    sqlite3_busy_timeout(db_, static_cast<int>(lock_wait.count()));
+    const int rc = sqlite3_exec(db_, "BEGIN IMMEDIATE", nullptr, nullptr, nullptr);
+    sqlite3_busy_timeout(db_, busy_timeout_ms_);
+    if ((rc & 0xff) == SQLITE_BUSY || (rc & 0xff) == SQLITE_LOCKED) return false;
+    if (rc != SQLITE_OK) throw RunIndexError("run index " + path_ + ": beginning a group of writes: " + sqlite3_errmsg(db_));
   }
   try {
     writes();

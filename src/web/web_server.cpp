@@ -800,6 +800,15 @@ void WebServer::postRun(const HttpRequest& request, const HttpReply& reply) {
     refusedSend(text, r.reason_name, r.message, r.field);
     return reply.send(jsonAnswer(request, 422, rejectionJson(r)));
   }
+  // One address holds a bounded share of the lab, whatever names it types.
+  if (!shares_.reserve(request.client, [this](const std::string& run_id) { return book_.finished(run_id); })) {
+    log("limited " + request.client + " (" + student + "): unfinished runs per address");
+    Response res = refuse(429, "at most " + std::to_string(shares_.perAddress()) +
+                                   " runs from one address may be queued or running at once; try again when one "
+                                   "has finished (or stop one)");
+    res.set(http::field::retry_after, std::to_string(kUnfinishedRetryAfter));
+    return reply.send(std::move(res));
+  }
   // Per address and per name: another name does not escape the limit, and sending as a
   // classmate from elsewhere only spends the classmate's runs as well as one's own.
   long wait = admit("address " + request.client, config_.runs_per_minute_per_address);
@@ -811,19 +820,11 @@ void WebServer::postRun(const HttpRequest& request, const HttpReply& reply) {
     limit = config_.runs_per_minute;
   }
   if (wait) {
+    shares_.answered(request.client, std::nullopt);
     log("limited " + request.client + " (" + student + "): " + which);
     Response res = refuse(429, "at most " + std::to_string(limit) + " " + which + " per minute; try again in " +
                                    std::to_string(wait) + " s");
     res.set(http::field::retry_after, std::to_string(wait));
-    return reply.send(std::move(res));
-  }
-  // One address holds a bounded share of the lab, whatever names it types.
-  if (!shares_.reserve(request.client, [this](const std::string& run_id) { return book_.finished(run_id); })) {
-    log("limited " + request.client + " (" + student + "): unfinished runs per address");
-    Response res = refuse(429, "at most " + std::to_string(shares_.perAddress()) +
-                                   " runs from one address may be queued or running at once; try again when one "
-                                   "has finished (or stop one)");
-    res.set(http::field::retry_after, std::to_string(kUnfinishedRetryAfter));
     return reply.send(std::move(res));
   }
   const std::string client = request.client;
@@ -851,9 +852,15 @@ void WebServer::postRun(const HttpRequest& request, const HttpReply& reply) {
   const std::string token = randomToken();
   auto timer = std::make_shared<boost::asio::steady_timer>(
       reply.executor(), std::chrono::milliseconds(static_cast<long long>(config_.answer_timeout * 1000)));
+  bool already_sent = false;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    pending_.emplace(student, requested);
+    already_sent = !pending_.emplace(student, requested).second;
+  }
+  if (already_sent) {  // the same send twice at once (a double click): one answer each
+    shares_.answered(client, std::nullopt);
+    return reply.send(refuse(409, "run_id '" + requested + "' of " + student +
+                                      " is being sent already; wait for its answer", "run_id"));
   }
   book_.expect(student, requested, [this, request, reply, timer, token, student, requested, numbered, client,
                                     give_back_number](const Submission& answer) {

@@ -307,7 +307,7 @@ TEST_F(RunIndexRecorderTest, AWriteLockedIndexHoldsUpNothingAndLosesNoRow) {
   recorder.rejected(rejected);
   // Readers are not held up, and see nothing uncommitted.
   EXPECT_FALSE(recorder.committed()->find("locked"));
-  EXPECT_FALSE(recorder.flush(std::chrono::milliseconds(10 * kIndexWriterBusyTimeoutMs)));
+  EXPECT_FALSE(recorder.flush(10 * kIndexWriterLockWait));
 
   ASSERT_EQ(sqlite3_exec(locker, "COMMIT", nullptr, nullptr, nullptr), SQLITE_OK);
   sqlite3_close(locker);

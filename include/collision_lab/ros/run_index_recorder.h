@@ -66,8 +66,8 @@ bool activeBagOwned(const std::string& active_path);
 /// How long a deferrable write of the index (a run's start) may wait for a commit.
 constexpr std::chrono::milliseconds kDeferredWritesDelay{500};
 /// How long the lab's writes wait for another connection's write lock before they are
-/// put back and tried again later [ms]: short, so that a locked index holds up nothing.
-constexpr int kIndexWriterBusyTimeoutMs = 200;
+/// put back and tried again later: short, so that a locked index holds up nothing.
+constexpr std::chrono::milliseconds kIndexWriterLockWait{200};
 /// The longest pause between two tries of writes that a locked or failing index refused.
 constexpr std::chrono::milliseconds kIndexRetryMaxPause{5000};
 /// How long a run's end (finished()) and ~list_runs wait for the index's commit.
@@ -90,9 +90,9 @@ class RunIndexRecorder {
   }
   /// The index as committed so far, at once (writes still queued are not in it yet).
   const collision_lab::service::RunIndex* committed() const { return index_.get(); }
-  /// Waits until every write handed over so far is committed, at most max_wait; false
-  /// when they are not committed yet.
-  bool flush(std::chrono::milliseconds max_wait = std::chrono::milliseconds::max()) const;
+  /// Waits until every write handed over so far is committed, at most max_wait (and not
+  /// at all, unless_locked, while the index is locked); false when they are not committed yet.
+  bool flush(std::chrono::milliseconds max_wait = std::chrono::milliseconds::max(), bool unless_locked = false) const;
 
   // The writes go to a writer thread, in order, which commits whatever has queued up in
   // one transaction (a group commit: under load one commit serves many runs). accepted(),
@@ -100,9 +100,11 @@ class RunIndexRecorder {
   // recovery treats alike) waits for the next of them, at most kDeferredWritesDelay, so
   // that a short run's start and end share a commit. finished() returns once its write is
   // committed, so that whoever sees the summary finds the run finished; list() first waits
-  // for every write handed over. Both wait at most kIndexCommitWait: writes that a locked
-  // or failing index refuses are kept, in order, and tried again (pauses doubling up to
-  // kIndexRetryMaxPause) until they commit; none is dropped while the node runs.
+  // for every write handed over. Both wait at most kIndexCommitWait, and not at all while
+  // the index is locked: writes that a locked index refuses (another program holds its
+  // write lock) are kept, in order, and tried again (pauses doubling up to
+  // kIndexRetryMaxPause) until they commit; none is dropped while the node runs. Writes
+  // that fail otherwise (a full disk, a broken file) are logged and dropped.
 
   /// A run accepted and queued, before any worker can take it; input as served (its
   /// run_id assigned). requested_run_id: InitialConditions.run_id as sent.
@@ -137,15 +139,17 @@ class RunIndexRecorder {
   /// deferrable one waits for the next urgent write, or kDeferredWritesDelay.
   std::uint64_t enqueue(std::function<void()> write, bool urgent);
   /// Waits until every write up to `ticket` is committed (they become urgent), at most
-  /// max_wait; false when they are not committed yet.
-  bool waitWritten(std::uint64_t ticket,
-                   std::chrono::milliseconds max_wait = std::chrono::milliseconds::max()) const;
+  /// max_wait (and not at all, unless_locked, while the index is locked); false when they
+  /// are not committed yet.
+  bool waitWritten(std::uint64_t ticket, std::chrono::milliseconds max_wait = std::chrono::milliseconds::max(),
+                   bool unless_locked = false) const;
   /// The writer thread: takes every write queued so far and commits them together
   /// (RunIndex::writeTogether), until the recorder is destroyed and nothing is left.
   /// Refused groups go back to the front of the queue and are tried again after a pause;
   /// at the recorder's end they get one last try.
   void writerLoop();
-  /// One try at committing group; false when the index refused it (logged).
+  /// One try at committing group; false when the index was locked (logged). A group that
+  /// fails otherwise is logged and counts as done.
   bool commit(const std::vector<std::function<void()>>& group);
 
   std::string bag_directory_;
@@ -160,6 +164,7 @@ class RunIndexRecorder {
   std::uint64_t queued_ = 0;   ///< writes ever queued
   std::uint64_t written_ = 0;  ///< writes ever committed (or, at the end, given up and logged)
   bool writer_stops_ = false;
+  bool locked_out_ = false;  ///< the last try found the index locked: waiters do not wait
   std::thread writer_;
 };
 

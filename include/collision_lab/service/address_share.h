@@ -12,6 +12,7 @@
 #include <map>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -31,20 +32,28 @@ class AddressShare {
   std::size_t perAddress() const { return per_address_; }
 
   /// Takes a place for a send from address; false when its places are all taken by
-  /// unfinished runs (asked of `finished`, which may be called under this object's lock).
+  /// unfinished runs (asked of `finished`, outside this object's lock: it may read a file).
   bool reserve(const std::string& address, const Finished& finished, Clock::time_point now = Clock::now()) {
     if (per_address_ == 0) return true;
-    std::lock_guard<std::mutex> lock(mutex_);
-    const auto ended = [&](const Place& p) {
-      return now - p.since >= forget_after_ || (!p.run_id.empty() && finished(p.run_id));
-    };
-    if (by_address_.size() > kSweepAbove) {  // bounded: addresses whose runs all ended are dropped
-      for (auto it = by_address_.begin(); it != by_address_.end();) {
-        it = std::all_of(it->second.begin(), it->second.end(), ended) ? by_address_.erase(it) : std::next(it);
+    std::vector<std::string> runs;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      forgetLocked(now);
+      const auto it = by_address_.find(address);
+      if (it != by_address_.end()) {
+        for (const Place& p : it->second) {
+          if (!p.run_id.empty()) runs.push_back(p.run_id);
+        }
       }
     }
+    std::set<std::string> ended;
+    for (const std::string& run_id : runs) {
+      if (finished(run_id)) ended.insert(run_id);
+    }
+    std::lock_guard<std::mutex> lock(mutex_);
     std::vector<Place>& places = by_address_[address];
-    places.erase(std::remove_if(places.begin(), places.end(), ended), places.end());
+    places.erase(std::remove_if(places.begin(), places.end(), [&](const Place& p) { return ended.count(p.run_id) > 0; }),
+                 places.end());
     if (places.size() >= per_address_) return false;
     places.push_back(Place{std::string(), now});
     return true;
@@ -80,11 +89,20 @@ class AddressShare {
     std::string run_id;  ///< empty: sent, the lab's answer awaited
     Clock::time_point since;
   };
-  static constexpr std::size_t kSweepAbove = 1024;  ///< addresses kept before a sweep
+  /// Drops places older than forget_after_, and addresses left with none.
+  void forgetLocked(Clock::time_point now) {
+    for (auto it = by_address_.begin(); it != by_address_.end();) {
+      std::vector<Place>& places = it->second;
+      places.erase(std::remove_if(places.begin(), places.end(),
+                                  [&](const Place& p) { return now - p.since >= forget_after_; }),
+                   places.end());
+      it = places.empty() ? by_address_.erase(it) : std::next(it);
+    }
+  }
   const std::size_t per_address_;
   const Clock::duration forget_after_;
   mutable std::mutex mutex_;
-  std::map<std::string, std::vector<Place>> by_address_;  ///< no empty vector kept past answered()
+  std::map<std::string, std::vector<Place>> by_address_;  ///< addresses with places
 };
 
 }  // namespace collision_lab::service

@@ -12,6 +12,7 @@
 // index is a record, never a reason to lose a run).
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <mutex>
@@ -93,11 +94,11 @@ class RunIndex {
   /// A rejected input; only the newest kRejectionsKept are kept.
   void rejected(const IndexedRejection& rejection);
   /// Calls `writes` (calls of the write methods above) inside one transaction: one commit
-  /// for all of them (group commit). Returns false, having called nothing, when the
-  /// transaction cannot begin (another connection held the write lock past the busy
-  /// timeout): the caller tries again later. Throws RunIndexError when the commit fails
-  /// (nothing of the group is then written).
-  bool writeTogether(const std::function<void()>& writes);
+  /// for all of them (group commit). Waits at most lock_wait for the write lock; returns
+  /// false, having called nothing, when another connection held it longer (SQLITE_BUSY):
+  /// the caller tries again later. Throws RunIndexError when the transaction cannot begin
+  /// for another reason, or its commit fails (nothing of the group is then written).
+  bool writeTogether(const std::function<void()>& writes, std::chrono::milliseconds lock_wait);
   static constexpr std::size_t kRejectionsKept = 100000;
   /// The events CSV made beside the run's bag (the web node, once, on the first download).
   void setCsvPath(const std::string& run_id, const std::string& csv_path);
@@ -127,6 +128,7 @@ class RunIndex {
   void finalizeStatements();
 
   const std::string path_;  ///< for the errors
+  const int busy_timeout_ms_;
   mutable std::mutex mutex_;
   sqlite3* db_ = nullptr;
   /// Each SQL text prepared once, on first use, and reused (under mutex_): preparing cost
