@@ -58,6 +58,8 @@ WebConfig loadConfig(const ros::NodeHandle& pnh) {
   c.unfinished_runs_per_address = sizeParam(pnh, "unfinished_runs_per_address", c.unfinished_runs_per_address);
   c.max_streams = sizeParam(pnh, "max_streams", c.max_streams);
   c.code_attempts = sizeParam(pnh, "code_attempts", c.code_attempts);
+  c.code_attempts_total = sizeParam(pnh, "code_attempts_total", c.code_attempts_total);
+  c.max_streams_per_address = sizeParam(pnh, "max_streams_per_address", c.max_streams_per_address);
   pnh.param("code_lockout", c.code_lockout, c.code_lockout);
   pnh.param("answer_timeout", c.answer_timeout, c.answer_timeout);
   c.io_threads = sizeParam(pnh, "io_threads", c.io_threads);

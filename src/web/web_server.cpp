@@ -432,7 +432,12 @@ long WebServer::wrongCode(const std::string& client) {
   auto& wrong = wrong_codes_[client];
   while (!wrong.empty() && now - wrong.front() >= std::chrono::minutes(1)) wrong.pop_front();
   wrong.push_back(now);
-  if (wrong.size() < config_.code_attempts) return 0;
+  while (!wrong_codes_total_.empty() && now - wrong_codes_total_.front() >= std::chrono::minutes(1)) {
+    wrong_codes_total_.pop_front();
+  }
+  const bool budget_spent = wrong_codes_total_.size() >= config_.code_attempts_total;
+  if (!budget_spent) wrong_codes_total_.push_back(now);  // bounded by the budget
+  if (wrong.size() < config_.code_attempts && !budget_spent) return 0;
   wrong.clear();
   wrong_codes_.erase(client);
   const auto lockout = std::chrono::milliseconds(static_cast<long long>(config_.code_lockout * 1000));
@@ -1061,12 +1066,22 @@ void WebServer::sendBag(const HttpRequest& request, const std::string& run_id, c
 // most every kStreamInterval; an event `final` ends the stream. A timer per stream, no thread.
 void WebServer::stream(const HttpRequest& request, const std::string& run_id, const HttpReply& reply) {
   if (!book_.has(run_id)) return reply.send(errorAnswer(request, 404, "no such run"));
-  if (streams_.fetch_add(1) >= config_.max_streams) {
-    --streams_;
-    return reply.send(errorAnswer(request, 503, "too many live streams at once; the page reloads the run instead"));
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::size_t& mine = streams_by_address_[request.client];
+    if (mine >= config_.max_streams_per_address || streams_ >= config_.max_streams) {
+      if (mine == 0) streams_by_address_.erase(request.client);
+      return reply.send(errorAnswer(request, 503, "too many live streams at once; the page reloads the run instead"));
+    }
+    ++mine;
+    ++streams_;
   }
   // The slot is freed when the stream's poll is released (stream ended or client gone).
-  std::shared_ptr<void> slot(nullptr, [this](void*) { --streams_; });
+  std::shared_ptr<void> slot(nullptr, [this, client = request.client](void*) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    --streams_;
+    if (--streams_by_address_[client] == 0) streams_by_address_.erase(client);
+  });
   http::response<http::empty_body> header(http::status::ok, request.message.version());
   header.set(http::field::content_type, "text/event-stream");
   header.set(http::field::cache_control, "no-cache");

@@ -614,6 +614,64 @@ TEST_F(WebAccessTest, PostDuringALongRunIsAnsweredAtOnce) {
   finishedRun(endless.at("run_id"));
 }
 
+/// Opens GET path from `source` and reads the answer's header; the connection stays open
+/// (appended to fds). Returns the status and the header (and whatever came with it).
+std::pair<int, std::string> openFrom(const std::string& source, const std::string& path, std::vector<int>& fds) {
+  const int fd = connectFrom(source);
+  if (fd < 0) return {0, {}};
+  fds.push_back(fd);
+  sendAll(fd, "GET " + path + " HTTP/1.1\r\nHost: 127.0.0.1\r\nX-Class-Code: " + kCode + "\r\n\r\n");
+  std::string got;
+  char buffer[4096];
+  pollfd p{fd, POLLIN, 0};
+  while (got.find("\r\n\r\n") == std::string::npos && poll(&p, 1, 30000) > 0) {
+    const ssize_t n = recv(fd, buffer, sizeof buffer, 0);
+    if (n <= 0) break;
+    got.append(buffer, static_cast<std::size_t>(n));
+  }
+  return {statusOf(got), got};
+}
+
+TEST_F(WebAccessTest, LiveStreamsAreCappedPerAddress) {
+  constexpr int kPerAddressStreams = 3;  // max_streams_per_address in the .test
+  auto c = client();
+  const auto [sent, run] = postFrom("127.0.8.3", endlessScene("sam"));  // an address with runs to spare
+  ASSERT_EQ(sent, 202) << run.dump();
+  const std::string path = "/api/runs/" + run.at("run_id").get<std::string>() + "/stream";
+  std::vector<int> fds;
+  for (int k = 0; k < kPerAddressStreams; ++k) EXPECT_EQ(openFrom("127.0.8.1", path, fds).first, 200);
+  const auto [status, answer] = openFrom("127.0.8.1", path, fds);
+  EXPECT_EQ(status, 503) << answer;
+  EXPECT_NE(answer.find("too many live streams"), std::string::npos) << answer;
+  EXPECT_EQ(openFrom("127.0.8.2", path, fds).first, 200);  // a classmate's stream
+  for (const int fd : fds) close(fd);
+  EXPECT_TRUE(waitUntil(
+      [&] {
+        auto r = c.Post((("/api/runs/" + run.at("run_id").get<std::string>()) + "/stop").c_str(),
+                        {{"X-Stop-Token", run.at("stop_token").get<std::string>()}}, "", "application/json");
+        return r && r->status == 200 && json::parse(r->body)["ok"] == true;
+      },
+      "the stop to be taken"));
+  finishedRun(run.at("run_id"));
+}
+
+// Last: it spends the class's budget of wrong codes for a minute.
+TEST_F(WebAccessTest, WrongCodesFromManyAddressesSpendOneBudget) {
+  constexpr int kTotal = 30;  // code_attempts_total in the .test; code_attempts is 5 per address
+  int refused = 0, locked = 0;
+  for (int k = 0; k < kTotal + 5; ++k) {  // one wrong code from each of 35 addresses
+    const int status = statusOf(rawRequest("127.0.9." + std::to_string(k + 1), loginRequest("guess" + std::to_string(k))));
+    refused += status == 403;
+    locked += status == 429;
+  }
+  // Once the budget is spent, a single wrong code locks its address out. (Failed before:
+  // 35 answers of 403, no lockout: each address had 5 guesses of its own.)
+  EXPECT_LE(refused, kTotal);
+  EXPECT_GE(locked, 5);
+  // The right code still opens the class, from an address that guessed nothing.
+  EXPECT_EQ(statusOf(rawRequest("127.0.9.200", loginRequest(kCode))), 200);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {

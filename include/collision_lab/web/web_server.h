@@ -59,7 +59,11 @@ struct WebConfig {
   /// names [1]; more: 429 until one ends. 0: no cap.
   std::size_t unfinished_runs_per_address = 6;
   std::size_t max_streams = 64;          ///< concurrent event streams [1]; more: 503
+  std::size_t max_streams_per_address = 8;  ///< concurrent event streams of one client address [1]; more: 503
   std::size_t code_attempts = 5;         ///< wrong codes per address per minute [1] before the lockout
+  /// Wrong codes per minute from all addresses together [1]: once spent, a single wrong code
+  /// locks its address out (guessing from many addresses is slowed as from one).
+  std::size_t code_attempts_total = 50;
   double code_lockout = 60.0;            ///< [s] an address is locked out after too many wrong codes
   /// How long POST /api/runs waits for the lab node's AcceptedRun or Rejected [s]; then 503.
   double answer_timeout = 10.0;
@@ -148,6 +152,8 @@ class WebServer {
   mutable std::mutex mutex_;  ///< guards everything below
   std::map<std::string, std::deque<std::chrono::steady_clock::time_point>> sends_;
   std::map<std::string, std::deque<std::chrono::steady_clock::time_point>> wrong_codes_;
+  std::deque<std::chrono::steady_clock::time_point> wrong_codes_total_;  ///< of the last minute, every address
+  std::map<std::string, std::size_t> streams_by_address_;  ///< live streams per client address (no zero kept)
   std::map<std::string, std::chrono::steady_clock::time_point> locked_until_;
   std::map<std::string, std::string> stop_tokens_;  ///< run_id -> its owner's secret
   std::deque<std::string> token_order_;             ///< run_ids of stop_tokens_, oldest first
