@@ -231,7 +231,7 @@ function studentSection(name, runs, rejections) {
       const td = el('td');
       td.appendChild(el('a', r.run_id, {href: '/runs/' + encodeURIComponent(r.run_id)}));
       tr.appendChild(td);
-      tr.appendChild(el('td', r.state + (r.truncated ? ' (truncated)' : '')));
+      tr.appendChild(el('td', r.state + (r.truncated ? ' (truncated)' : '') + (r.recorded === false ? ' (not recorded)' : '')));
       tr.appendChild(el('td', r.bodies === undefined ? '' : countText(r.bodies)));
       tr.appendChild(el('td', r.collisions === undefined ? '' : countText(r.collisions)));
       tr.appendChild(el('td', r.model || ''));

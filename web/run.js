@@ -225,6 +225,9 @@ function summaryRows(run) {
       rows.push(['not certified as correctly rounded', s.uncertified_values.map((k) => k.replace(/_/g, ' ')).join(', '), null, null]);
     }
     if (s.time_beyond_range) rows.push(['time', 'an impact came after 1.8e308 s, the largest double: shown as inf', null, null]);
+    if (s.recorded === false) {
+      rows.push(['recorded', 'no: this run has no bag to download or replay' + (s.recording_error ? ' (' + s.recording_error + ')' : ''), null, null]);
+    }
     rows.push(['stop reason', s.stop_reason + (view.truncated ? ': ' + view.truncated : ''), null, null]);
   }
   return rows;

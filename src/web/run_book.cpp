@@ -111,7 +111,8 @@ json summaryJson(const collision_lab::RunSummary& s) {
           {"compute_time", exactNumber(s.compute_time)},
           {"uncertified_values", s.uncertified_values},
           {"time_beyond_range", static_cast<bool>(s.time_beyond_range)},
-          {"recorded", s.recording_ok && !s.bag_path.empty()}};
+          {"recorded", s.recording_ok && !s.bag_path.empty()},
+          {"recording_error", s.recording_error}};
 }
 
 /// The x-t diagram's lines to the run's end, cut at a ring's seam (RunView's
@@ -825,6 +826,7 @@ nlohmann::json listItem(const WebRun& run) {
   if (run.summary) {
     item["model"] = run.summary->model_name;
     item["truncated"] = static_cast<bool>(run.summary->truncated);
+    item["recorded"] = run.summary->recording_ok && !run.summary->bag_path.empty();
   }
   return item;
 }
@@ -837,7 +839,8 @@ nlohmann::json listItem(const std::string& run_id, const EvictedRun& stub) {
           {"collisions", stub.collision_count},
           {"bodies", stub.bodies},
           {"model", stub.model_name},
-          {"truncated", stub.truncated}};
+          {"truncated", stub.truncated},
+          {"recorded", !stub.bag_path.empty()}};
 }
 
 /// A run the web node does not hold, as its index row says.
@@ -853,6 +856,7 @@ nlohmann::json listItem(const collision_lab::service::IndexedRun& row) {
     const collision_lab::RunSummary summary = summaryFromRow(row);
     item["model"] = summary.model_name;
     item["truncated"] = static_cast<bool>(summary.truncated);
+    item["recorded"] = !row.bag_path.empty();
   }
   return item;
 }

@@ -51,6 +51,7 @@ TEST(RunBook, SummaryBeforeServedInputWaitsForTheScene) {
   summary.run_id = "ana.run1";
   summary.student = "ana";
   summary.recording_ok = false;
+  summary.recording_error = "no space left on device";
   book.onSummary(summary);
   EXPECT_NE(runJson(book, "ana.run1").at("state"), "finished") << "finished without its scene";
 
@@ -65,6 +66,12 @@ TEST(RunBook, SummaryBeforeServedInputWaitsForTheScene) {
   EXPECT_EQ(run.at("state"), "finished");
   EXPECT_EQ(run.at("scene").at("positions"), json({1.0, 0.0}));
   EXPECT_TRUE(run.contains("plots"));
+  // Not recorded, and said so: on its page and in the list.
+  EXPECT_EQ(run.at("summary").at("recorded"), false);
+  EXPECT_EQ(run.at("summary").at("recording_error"), "no space left on device");
+  const json listed = json::parse(book.list(std::nullopt));
+  ASSERT_EQ(listed.size(), 1u);
+  EXPECT_EQ(listed[0].at("recorded"), false);
 }
 
 TEST(RunBook, RunJoinedMidwayEndsWithItsSummary) {
