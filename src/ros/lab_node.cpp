@@ -493,7 +493,7 @@ LabNodeParams LabNodeParams::load(const ros::NodeHandle& private_nh) {
                                 ": at least one worker takes long runs");
   }
   params.lanes.short_max_collisions = getUint64(private_nh, "short_max_collisions", kDefaultShortMaxCollisions);
-  params.lanes.short_max_bodies = getUint64(private_nh, "short_max_bodies", kDefaultShortMaxBodies);
+  private_nh.param("short_max_seconds", params.lanes.short_max_seconds, kDefaultShortMaxSeconds);
   private_nh.param("max_run_seconds", params.max_run_seconds, kDefaultMaxRunSeconds);
   if (!std::isfinite(params.max_run_seconds) || params.max_run_seconds < 0) {
     std::ostringstream error;

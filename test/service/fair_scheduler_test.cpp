@@ -1,6 +1,7 @@
 // The lab node's run queue (fair_scheduler.h): round robin across students per lane,
 // queue positions, removal, lanes chosen from the plan. No master needed.
 #include <limits>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -102,7 +103,7 @@ core::SceneRunOptions runOptions(core::RunMode mode, std::uint64_t cap, bool sim
 
 TEST(ChooseLane, FromWhatThePlanKnows) {
   constexpr double kInf = std::numeric_limits<double>::infinity();
-  const LaneLimits limits;  // 100,000 impacts, 100 bodies
+  const LaneLimits limits;  // 100,000 impacts
   const auto full = core::RunMode::kFull, predict = core::RunMode::kPredictOnly;
   const auto pi31 = plan({100, 1, kInf}, {2, 1, 0}, {-1, 0, 0});
   ASSERT_FALSE(pi31.error);
@@ -131,6 +132,41 @@ TEST(ChooseLane, FromWhatThePlanKnows) {
   ASSERT_FALSE(collapse.error);
   EXPECT_FALSE(core::plannedImpacts(collapse, runOptions(full, 10'000'000, true)));
   EXPECT_EQ(chooseLane(collapse, runOptions(full, 10'000'000, true), limits), Lane::kShort);
+}
+
+// Where the plan counts nothing, the lane follows the measured cost, not the body count.
+// (Failed before: 100 bodies with a cap of 100,000 were short whatever they cost, 101
+// bodies that end in a few impacts were long.)
+TEST(ChooseLane, ByMeasuredCostWhereThePlanCountsNothing) {
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> mass(1.0, 3.0), speed(-1.0, 1.0);
+  std::vector<double> masses, positions, velocities;
+  for (int i = 0; i < 100; ++i) {
+    masses.push_back(mass(random));
+    positions.push_back(100.0 - i);
+    velocities.push_back(speed(random));
+  }
+  const auto gas = plan(masses, positions, velocities);
+  ASSERT_FALSE(gas.error);
+  const auto full = runOptions(core::RunMode::kFull, 100'000, false);
+  ASSERT_FALSE(core::plannedImpacts(gas, full));
+  LaneLimits limits;
+  ASSERT_GT(core::runScene(gas, full).simulation.impact_count, limits.probe_impacts);  // more than the probe
+  limits.short_max_seconds = 0.0;  // no estimate is short enough
+  EXPECT_EQ(chooseLane(gas, full, limits), Lane::kLong);
+  limits.short_max_seconds = 1e9;  // any estimate is
+  EXPECT_EQ(chooseLane(gas, full, limits), Lane::kShort);
+
+  // 101 bodies whose run ends within the probe: short, however little time is allowed.
+  std::vector<double> apart_masses(101, 1.0), apart_positions, apart_velocities(101, 0.0);
+  for (int i = 0; i < 101; ++i) apart_positions.push_back(101.0 - i);
+  apart_masses[3] = 2.0;  // no model counts unequal masses
+  apart_velocities[1] = 1.0;  // one impact: the rightmost body takes the velocity and leaves
+  const auto apart = plan(apart_masses, apart_positions, apart_velocities);
+  ASSERT_FALSE(apart.error);
+  ASSERT_FALSE(core::plannedImpacts(apart, full));
+  limits.short_max_seconds = 0.0;
+  EXPECT_EQ(chooseLane(apart, full, limits), Lane::kShort);
 }
 
 }  // namespace

@@ -107,7 +107,7 @@ struct LabNodeParams {
   /// short_lane_workers [1] take only short runs (~short_lane_workers, default 1).
   std::uint64_t workers = 2;
   std::uint64_t short_lane_workers = 1;
-  /// What makes a run short (~short_max_collisions, ~short_max_bodies).
+  /// What makes a run short (~short_max_collisions, ~short_max_seconds).
   collision_lab::service::LaneLimits lanes;
   /// Service ceilings an input may lower, never raise: wall time per run [s]
   /// (~max_run_seconds; <= 0: none) and recorded bytes per bag [bytes] (~max_bag_bytes; 0: none).
@@ -121,7 +121,7 @@ struct LabNodeParams {
   /// ~progress_period, ~progress_every_events,
   /// ~publish_markers, ~log_runs, ~max_bodies, ~min_free_space_mb, ~scenario_file (default: the package's
   /// config/scenarios.yaml), ~workers, ~short_lane_workers, ~short_max_collisions,
-  /// ~short_max_bodies, ~max_run_seconds, ~max_bag_bytes and ~fail_runs_of_student, with
+  /// ~short_max_seconds, ~max_run_seconds, ~max_bag_bytes and ~fail_runs_of_student, with
   /// the defaults of node_constants.h. Throws
   /// std::invalid_argument, naming the parameter, its value and the accepted range, when a
   /// count (~max_collisions, ~max_published_events, ~max_bodies, ~workers, ...) is not a

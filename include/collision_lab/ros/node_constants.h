@@ -98,10 +98,10 @@ constexpr std::uint64_t kMinDefaultWorkers = 2;
 constexpr std::uint64_t kDefaultShortLaneWorkers = 1;
 constexpr std::uint64_t kMaxWorkers = 256;
 /// A run is short when its plan says it computes at most this many impacts [1], or, when
-/// the plan knows no count, when it has at most kDefaultShortMaxBodies bodies [1] and a
-/// cap of at most kDefaultShortMaxCollisions.
+/// the plan knows no count, when its cap's impacts take at most kDefaultShortMaxSeconds [s]
+/// at the rate of its first impacts (service::chooseLane).
 constexpr std::uint64_t kDefaultShortMaxCollisions = 100'000;
-constexpr std::uint64_t kDefaultShortMaxBodies = 100;
+constexpr double kDefaultShortMaxSeconds = 1.0;
 /// Service ceilings an input may lower: wall time per run [s] and recorded bytes per bag
 /// [bytes] (the serialized size of the messages recorded).
 constexpr double kDefaultMaxRunSeconds = 300.0;

@@ -27,23 +27,33 @@ enum class Lane { kShort, kLong };
 
 inline const char* laneName(Lane lane) { return lane == Lane::kShort ? "short" : "long"; }
 
-/// What makes a run short (the node's ~short_max_collisions, ~short_max_bodies).
+/// What makes a run short (the node's ~short_max_collisions, ~short_max_seconds).
 struct LaneLimits {
-  std::uint64_t short_max_collisions = 100'000;  ///< [1] impacts
-  std::uint64_t short_max_bodies = 100;          ///< [1] bodies, walls included
+  std::uint64_t short_max_collisions = 100'000;  ///< [1] impacts, where the plan counts them
+  double short_max_seconds = 1.0;                ///< [s] estimated compute, where it does not
+  std::uint64_t probe_impacts = 1000;            ///< [1] impacts the estimate times
 };
 
 /// Short when the run's planned impacts (core::plannedImpacts: the core's own decision) are
-/// at most limits.short_max_collisions. When the plan cannot count them, short when the
-/// scene has at most short_max_bodies bodies and either a cap of at most
-/// short_max_collisions or a predicted collapse (the engine stops at it); else long.
+/// at most limits.short_max_collisions. When the plan cannot count them, by the run's cost:
+/// the engine's first limits.probe_impacts impacts are run and timed (core::runScene,
+/// summary only, nothing published); short when the run ends within them, or when its
+/// cap's impacts at the measured rate take at most limits.short_max_seconds; else long.
+/// The probe costs at most probe_impacts impacts of the intake's time.
 inline Lane chooseLane(const core::ScenePlan& plan, const core::SceneRunOptions& options, const LaneLimits& limits) {
   if (const auto impacts = core::plannedImpacts(plan, options)) {
     return *impacts <= limits.short_max_collisions ? Lane::kShort : Lane::kLong;
   }
-  const bool small_cap = options.lab.max_collisions <= limits.short_max_collisions;
-  const bool collapses = plan.prediction && plan.prediction->collapsed;
-  return plan.scene.size() <= limits.short_max_bodies && (small_cap || collapses) ? Lane::kShort : Lane::kLong;
+  core::SceneRunOptions probe = options;
+  probe.lab.max_collisions = std::min(options.lab.max_collisions, limits.probe_impacts);
+  probe.lab.mode = core::RunMode::kSummaryOnly;
+  probe.keep_events = false;
+  probe.cancel = nullptr;
+  const core::SceneRunResult timed = core::runScene(plan, probe);
+  if (!timed.simulation.truncated) return Lane::kShort;  // it ended within the probe
+  const double rate = static_cast<double>(timed.simulation.impact_count) / std::max(timed.compute_time_s, 1e-9);
+  const double estimate = static_cast<double>(options.lab.max_collisions) / rate;  // [s]
+  return estimate <= limits.short_max_seconds ? Lane::kShort : Lane::kLong;
 }
 
 template <class Job>
