@@ -670,14 +670,23 @@ TEST(Services, ConcurrentCallsAndTopicInputsAreAllServedOnce) {
   constexpr int kCalls = 6, kTopicInputs = 3;
   std::atomic<int> done{0};
   std::vector<collision_lab::RunScene> calls(kCalls);
+  // One persistent client per thread, alive until every call has returned: no service
+  // connection of this test closes while another one opens. roscpp's PollSet hands a stale
+  // POLLRDHUP of a just-closed socket to a new socket that reuses its fd number (its
+  // just_deleted_ guard skips only ERR/HUP/NVAL) and closes it, so a non-persistent call
+  // per thread (ros::service::call) now and then returned false although its run was served.
+  ros::NodeHandle nh;
+  std::vector<ros::ServiceClient> clients;
+  for (int i = 0; i < kCalls; ++i) clients.push_back(nh.serviceClient<collision_lab::RunScene>(kRunScene, true));
   std::vector<std::thread> threads;
-  for (auto& call : calls) {
+  for (int i = 0; i < kCalls; ++i) {
+    auto& call = calls[i];
     call.request.run_id = "class";
     call.request.masses = {{1, 2, 3}};
     call.request.positions = {{2, 0, -2}};
     call.request.velocities = {{-1, 0.5, 1}};
-    threads.emplace_back([&call, &done] {
-      if (!ros::service::call(kRunScene, call)) call.response.message = "call failed";
+    threads.emplace_back([&call, &client = clients[i], &done] {
+      if (!client.call(call)) call.response.message = "call failed";
       ++done;
     });
   }
