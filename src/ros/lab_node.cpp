@@ -636,7 +636,7 @@ LabNode::LabNode(ros::NodeHandle nh, ros::NodeHandle private_nh, const RunObserv
   run_id_prefix_ = std::string("run_") + utcStamp("%Y%m%d_%H%M%S") + "_";
   // Before any input is served: the runs of dead nodes are ended (docs/ros.md, "The run index").
   run_index_ = std::make_unique<RunIndexRecorder>(params_.bag_directory);
-  run_index_->recover();
+  run_index_->recover([this](const RunIndexRecorder::QueuedRun& run) { return intake(run.input, Reply(), run.requested_run_id); });
   const std::string parameters_topic = nh_.resolveName(kRunParametersTopic);
   const RunBagWriter::Topics bag_topics{nh_.resolveName(kInitialConditionsTopic), topics_.predictions.getTopic(),
                                         topics_.events.getTopic(), topics_.summaries.getTopic(), parameters_topic,
@@ -799,29 +799,38 @@ LabNode::RunLimits LabNode::limitsOf(const collision_lab::InitialConditions& inp
   return limits;
 }
 
-void LabNode::intake(collision_lab::InitialConditions input, Reply reply) {
+bool LabNode::intake(collision_lab::InitialConditions input, Reply reply, const std::optional<std::string>& served_again) {
   namespace core = collision_lab::core;
-  const std::string requested = input.run_id;
+  const std::string requested = served_again ? *served_again : input.run_id;
   std::optional<core::ScenePlan> plan;
   if (auto rejection = checkInput(input, params_.max_bodies, plan)) {
     rejection->student = input.student;
     ServeOutcome outcome = reject(std::move(*rejection), requested);
     if (reply) reply->set_value(std::move(outcome));
-    return;
+    return false;
   }
   Job job;
   job.limits = limitsOf(input);
   const collision_lab::service::Lane lane = collision_lab::service::chooseLane(
       *plan, sceneRunOptions(*toRunMode(input.mode), job.limits.max_collisions, params_.simulate_to_cap), params_.lanes);
   if (plan->prediction && plan->prediction->impact_count) job.predicted_collisions = *plan->prediction->impact_count;
-  const std::string base = requestedRunId(input);
+  // The run_id the input asks for: <student>.<run_id> (a run served again: as it first asked).
+  collision_lab::InitialConditions asked;
+  asked.student = input.student;
+  asked.run_id = requested;
+  const std::string base = requestedRunId(asked);
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (stopping_) return;  // reply's promise breaks: the call answers "shutting down"
+    if (stopping_) return false;  // reply's promise breaks: the call answers "shutting down"
     // Claimed here, before the run_id goes out on any message: the run_id a run reports
     // names a bag file this node created.
-    input.run_id = base.empty() ? newRunId(job.claim_error) : claimRunId(base, job.claim_error);
-    if (!base.empty() && input.run_id != base) {
+    if (served_again) {
+      if (!claim(input.run_id, job.claim_error)) return false;
+      ROS_INFO_STREAM("run " << input.run_id << ": queued when its lab node died; served again");
+    } else {
+      input.run_id = base.empty() ? newRunId(job.claim_error) : claimRunId(base, job.claim_error);
+    }
+    if (!served_again && !base.empty() && input.run_id != base) {
       ROS_WARN_STREAM("run_id '" << base << "' is taken (its bag exists, or this node served "
                       "it before); serving the run as '" << input.run_id << "'");
     }
@@ -838,6 +847,7 @@ void LabNode::intake(collision_lab::InitialConditions input, Reply reply) {
     publishQueue();
   }
   wake_.notify_all();
+  return true;
 }
 
 void LabNode::workerLoop(Worker& worker) {

@@ -14,6 +14,8 @@
 #include <cstring>
 #include <filesystem>
 #include <iterator>
+#include <limits>
+#include <stdexcept>
 #include <utility>
 
 #include <nlohmann/json.hpp>
@@ -204,6 +206,50 @@ std::string inputJson(const collision_lab::InitialConditions& in) {
               {"max_run_seconds", finite(in.max_run_seconds)},
               {"max_bag_bytes", in.max_bag_bytes}}
       .dump();
+}
+
+collision_lab::InitialConditions inputFromJson(const std::string& text) {
+  const json j = json::parse(text, nullptr, false);
+  if (!j.is_object()) throw std::invalid_argument("its stored input is not a JSON object");
+  const auto numbers = [&](const char* key, bool walls) {
+    std::vector<double> values;
+    if (!j.contains(key) || !j[key].is_array()) throw std::invalid_argument(std::string("its stored input has no ") + key);
+    for (const json& v : j[key]) {
+      if (walls && v == "inf") {
+        values.push_back(std::numeric_limits<double>::infinity());
+      } else if (v.is_number()) {
+        values.push_back(v.get<double>());
+      } else {
+        throw std::invalid_argument(std::string("its stored ") + key + " hold a value that is not a number");
+      }
+    }
+    return values;
+  };
+  const auto number = [&](const char* key) {
+    if (!j.contains(key) || !j[key].is_number()) throw std::invalid_argument(std::string("its stored input has no ") + key);
+    return j[key].get<double>();
+  };
+  const auto whole = [&](const char* key) {
+    if (!j.contains(key) || !j[key].is_number_unsigned()) throw std::invalid_argument(std::string("its stored input has no ") + key);
+    return j[key].get<std::uint64_t>();
+  };
+  collision_lab::InitialConditions in;
+  in.run_id = j.value("run_id", "");
+  in.student = j.value("student", "");
+  in.mode = static_cast<std::uint8_t>(whole("mode"));
+  in.masses = numbers("masses", true);
+  in.positions = numbers("positions", false);
+  in.velocities = numbers("velocities", false);
+  in.restitution = numbers("restitution", false);
+  in.restitution_model = static_cast<std::uint8_t>(whole("restitution_model"));
+  in.tc = number("tc");
+  in.elastic_below = number("elastic_below");
+  in.viscoelastic_speed = number("viscoelastic_speed");
+  in.ring = number("ring");
+  in.max_collisions = whole("max_collisions");
+  in.max_run_seconds = number("max_run_seconds");
+  in.max_bag_bytes = whole("max_bag_bytes");
+  return in;
 }
 
 std::string summaryJson(const collision_lab::RunSummary& s) {
@@ -527,7 +573,7 @@ void RunIndexRecorder::endFromBag(const std::string& run_id, const std::string& 
                   << (bag_path.empty() ? std::string("holds nothing") : bag_path + " holds " + std::to_string(contents.events) + " events"));
 }
 
-std::size_t RunIndexRecorder::recover() {
+std::size_t RunIndexRecorder::recover(const ServeAgain& serve_again) {
   flush();  // it reads the runs' states
   std::size_t ended = 0;
   for (const RecoveredBag& bag : recoverActiveBags(bag_directory_)) {
@@ -536,6 +582,11 @@ std::size_t RunIndexRecorder::recover() {
     }
     if (!index_) continue;
     try {
+      // An empty claim of a run still queued: it never started; ended or served again below.
+      if (bag.bag_path.empty() && bag.error.empty()) {
+        const auto row = index_->find(bag.run_id);
+        if (row && row->state == RunState::kQueued) continue;
+      }
       endFromBag(bag.run_id, bag.bag_path, bag.contents, "its node died; bag recovered from .active");
       ++ended;
     } catch (const std::exception& e) {
@@ -555,6 +606,13 @@ std::size_t RunIndexRecorder::recover() {
   for (const IndexedRun& run : open_runs) {
     const std::string final_path = bagPath(bag_directory_, run.run_id);
     if (activeBagOwned(final_path + ".active")) continue;  // a live node's run
+    if (serve_again && run.state == RunState::kQueued && !fs::exists(final_path)) {
+      try {
+        if (serve_again(QueuedRun{inputFromJson(run.scene_json), run.requested_run_id})) continue;
+      } catch (const std::invalid_argument& e) {
+        ROS_WARN_STREAM("run " << run.run_id << ": queued when its node died, and not served again: " << e.what());
+      }
+    }
     try {
       BagContents contents;
       std::string bag_path;

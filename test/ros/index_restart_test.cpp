@@ -1,7 +1,8 @@
 // A lab node killed (SIGKILL) and respawned by roslaunch (index_restart_test.test): its
 // ~list_runs, read from the run index, still lists every run served before the crash, and
 // its start-up recovery does not touch the .bag.active of a live node sharing the folder
-// (lab_b, mid-run), whose run then ends normally with its bag complete.
+// (lab_b, mid-run), whose run then ends normally with its bag complete; the run it was
+// computing is interrupted, and the one waiting in its queue is served again.
 #include <signal.h>
 
 #include <filesystem>
@@ -86,6 +87,20 @@ TEST(IndexRestart, AKilledNodeRespawnsListingEveryRunAndLeavesALiveNodesBagAlone
     return run != lab_b.runs().end() && run->second.events.size() >= 1000 && fs::exists(live_active);
   }, "1,000 impacts of lab_b's long run and its .bag.active");
 
+  // On lab_a, a long run computing and one waiting behind it (its one worker that takes
+  // long runs is busy): the waiting one is served again after the crash.
+  for (const std::string& student : {std::string("gus"), std::string("fay")}) {
+    auto input = makeInput("long_a", {1e14, 1, 1e14}, {2, 1, 0}, {-1, 0, 0});
+    input.student = student;
+    input.max_collisions = 1000000000;
+    lab_a.publish(input);
+  }
+  waitUntil([&] {
+    const auto running = lab_a.runs().find("gus.long_a");
+    const auto* queued = findRun(listRuns("lab_a"), "fay.long_a");
+    return running != lab_a.runs().end() && !running->second.events.empty() && queued && !queued->finished;
+  }, "lab_a computing gus's long run with fay's queued");
+
   const int old_pid = nodePid("/lab_a/collision_lab_node");
   ASSERT_GT(old_pid, 0);
   ASSERT_EQ(::kill(old_pid, SIGKILL), 0);
@@ -115,6 +130,27 @@ TEST(IndexRestart, AKilledNodeRespawnsListingEveryRunAndLeavesALiveNodesBagAlone
   ASSERT_TRUE(callService("/lab_a/collision_lab_node/list_runs", ana));
   ASSERT_EQ(ana.response.runs.size(), 1u);
   EXPECT_EQ(ana.response.runs[0].accepted.run_id, "ana.pi");
+
+  // gus's run, computing at the crash, is interrupted; fay's, queued, is served again under
+  // its run_id. (Failed before: both "interrupted, 0 events".)
+  const auto* crashed = findRun(runs, "gus.long_a");
+  ASSERT_NE(crashed, nullptr);
+  EXPECT_TRUE(crashed->finished);
+  EXPECT_EQ(crashed->stop_reason, "INTERRUPTED");
+  waitUntil([&] {
+    const auto again = lab_a.runs().find("fay.long_a");
+    return again != lab_a.runs().end() && !again->second.events.empty();
+  }, "fay's run, served again, to compute");
+  collision_lab::Cancel stop_fay;
+  stop_fay.request.run_id = "fay.long_a";
+  EXPECT_TRUE(waitUntil([&] { return callService("/lab_a/collision_lab_node/cancel", stop_fay) && stop_fay.response.ok; },
+                        "fay's run, served again, to be stopped"));
+  const auto& fay = lab_a.waitFor("fay.long_a");
+  ASSERT_EQ(fay.summaries.size(), 1u);
+  EXPECT_EQ(fay.summaries[0].stop_reason, "CANCELLED");
+  EXPECT_GT(fay.summaries[0].collision_count, 0u);
+  EXPECT_TRUE(fay.summaries[0].recording_ok) << fay.summaries[0].recording_error;
+  EXPECT_TRUE(fs::exists(bags + "/fay.long_a.bag"));
 
   // lab_b's run is in the shared index, still running, and its bag was not taken.
   const auto* live = findRun(runs, "long_b");

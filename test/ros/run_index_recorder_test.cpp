@@ -282,8 +282,6 @@ TEST_F(RunIndexRecorderTest, JsonOfInputAndSummary) {
   EXPECT_NE(sum.find("\"energy_lost\":null"), std::string::npos) << sum;
 }
 
-}  // namespace
-
 TEST_F(RunIndexRecorderTest, AWriteLockedIndexHoldsUpNothingAndLosesNoRow) {
   RunIndexRecorder recorder(dir_);
   ASSERT_TRUE(recorder.ok());
@@ -321,3 +319,46 @@ TEST_F(RunIndexRecorderTest, AWriteLockedIndexHoldsUpNothingAndLosesNoRow) {
   ASSERT_EQ(rejections.size(), 1u);
   EXPECT_EQ(rejections[0].reason_name, "INVALID_MASS");
 }
+
+TEST_F(RunIndexRecorderTest, AQueuedRunOfADeadNodeIsOfferedToBeServedAgain) {
+  auto served = input("fay.long", "fay");
+  served.restitution = {0.5, 1.0};
+  served.restitution_model = collision_lab::InitialConditions::RESTITUTION_THRESHOLD;
+  served.elastic_below = 0.25;
+  served.max_collisions = 1000;
+  served.max_run_seconds = 2.5;
+  {
+    RunIndexRecorder dead(dir_);
+    dead.accepted("fay.long", "fay", "long", served);
+    std::string error;
+    ASSERT_EQ(claimBag(dir_, "fay.long", error), BagClaim::kClaimed) << error;
+    releaseBagClaim(bagPath(dir_, "fay.long") + ".active");  // its node died: the claim is left empty
+  }
+  RunIndexRecorder recorder(dir_);
+  std::vector<RunIndexRecorder::QueuedRun> offered;
+  EXPECT_EQ(recorder.recover([&](const RunIndexRecorder::QueuedRun& run) {
+              offered.push_back(run);
+              return true;
+            }),
+            0u);
+  ASSERT_EQ(offered.size(), 1u);
+  const collision_lab::InitialConditions& again = offered[0].input;
+  EXPECT_EQ(offered[0].requested_run_id, "long");
+  EXPECT_EQ(again.run_id, "fay.long");
+  EXPECT_EQ(again.student, "fay");
+  EXPECT_EQ(again.masses, served.masses);  // the wall's inf included
+  EXPECT_EQ(again.positions, served.positions);
+  EXPECT_EQ(again.velocities, served.velocities);
+  EXPECT_EQ(again.restitution, served.restitution);
+  EXPECT_EQ(again.restitution_model, served.restitution_model);
+  EXPECT_EQ(again.elastic_below, served.elastic_below);
+  EXPECT_EQ(again.max_collisions, served.max_collisions);
+  EXPECT_EQ(again.max_run_seconds, served.max_run_seconds);
+  EXPECT_EQ(recorder.index()->find("fay.long")->state, RunState::kQueued);  // taken: left queued
+  // Not taken: ended as interrupted, as before.
+  EXPECT_EQ(recorder.recover([](const RunIndexRecorder::QueuedRun&) { return false; }), 1u);
+  EXPECT_EQ(recorder.index()->find("fay.long")->state, RunState::kInterrupted);
+  EXPECT_THROW(inputFromJson("{\"masses\": [1, null]}"), std::invalid_argument);
+}
+
+}  // namespace

@@ -299,8 +299,12 @@ class LabNode {
   /// Takes input in and waits for its outcome; empty when the node stops before serving it.
   std::optional<ServeOutcome> serveAndWait(const collision_lab::InitialConditions& input);
   /// Intake: checks input, then rejects it (reply answered) or claims its run_id, queues
-  /// it and announces it. On the receiving thread.
-  void intake(collision_lab::InitialConditions input, Reply reply);
+  /// it and announces it. On the receiving thread. served_again: the input is a queued run
+  /// of a dead node (RunIndexRecorder::recover), served under its own run_id (input.run_id)
+  /// and the run_id it asked for (*served_again); false when that run_id cannot be claimed,
+  /// or the input is rejected now.
+  bool intake(collision_lab::InitialConditions input, Reply reply,
+              const std::optional<std::string>& served_again = std::nullopt);
   RunLimits limitsOf(const collision_lab::InitialConditions& input) const;
   void workerLoop(Worker& worker);
   void watchdogLoop();

@@ -29,6 +29,10 @@ namespace collision_lab_ros {
 /// positions, velocities, restitution (null for a non-finite value), max_collisions, mode,
 /// student, run_id.
 std::string inputJson(const collision_lab::InitialConditions& input);
+/// The served input back from inputJson's text (a run to serve again). Throws
+/// std::invalid_argument when the text is not such JSON (a non-finite value it stored as
+/// null cannot come back either: it was not a served input's).
+collision_lab::InitialConditions inputFromJson(const std::string& text);
 /// The index's JSON of a summary (IndexedRun::summary_json): the fields the class pages
 /// show, under RunSummary's field names.
 std::string summaryJson(const collision_lab::RunSummary& summary);
@@ -121,13 +125,23 @@ class RunIndexRecorder {
   /// (and logged) when the index cannot be read.
   std::vector<collision_lab::ServedRun> list(const std::string& student) const;
 
+  /// A run that was queued, never started, when its node died: to be served again.
+  struct QueuedRun {
+    collision_lab::InitialConditions input;  ///< as served: its run_id, student and scene
+    std::string requested_run_id;            ///< as the input asked for it
+  };
+  /// Serves a queued run of a dead node again; true when it is taken (queued anew).
+  using ServeAgain = std::function<bool(const QueuedRun&)>;
+
   /// At the node's start, before it serves: recovers the .active bags of dead owners
   /// (recoverActiveBags) and records their runs as interrupted (stop reason INTERRUPTED,
   /// the events the bag holds; finished from its summary when the bag has one), then ends
-  /// every run the index still has queued or running with no live owner: completed as
+  /// every run the index still has running, or queued, with no live owner: completed as
   /// finished from its final bag's summary, else interrupted with the events its bag holds
-  /// (none without a bag). Nothing stays "running". Returns the runs it ended.
-  std::size_t recover();
+  /// (none without a bag). A queued run with no bag whose stored input reads back is first
+  /// offered to serve_again (oldest first), and left queued when it takes it. Nothing stays
+  /// "running". Returns the runs it ended.
+  std::size_t recover(const ServeAgain& serve_again = {});
 
  private:
   /// Ends run_id from what its bag holds (finished with a summary, else interrupted).
