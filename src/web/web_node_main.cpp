@@ -43,6 +43,8 @@ std::size_t sizeParam(const ros::NodeHandle& pnh, const std::string& name, std::
   return static_cast<std::size_t>(std::max(1, value));
 }
 
+std::string defaultBagDirectory();
+
 WebConfig loadConfig(const ros::NodeHandle& pnh) {
   WebConfig c;
   const std::string package = ros::package::getPath("collision_lab");
@@ -55,7 +57,9 @@ WebConfig loadConfig(const ros::NodeHandle& pnh) {
   c.max_bodies = sizeParam(pnh, "max_bodies", c.max_bodies);
   c.runs_per_minute = sizeParam(pnh, "runs_per_minute", c.runs_per_minute);
   c.runs_per_minute_per_address = sizeParam(pnh, "runs_per_minute_per_address", c.runs_per_minute_per_address);
-  c.unfinished_runs_per_address = sizeParam(pnh, "unfinished_runs_per_address", c.unfinished_runs_per_address);
+  int unfinished = static_cast<int>(c.unfinished_runs_per_address);
+  pnh.param("unfinished_runs_per_address", unfinished, unfinished);
+  c.unfinished_runs_per_address = static_cast<std::size_t>(std::max(0, unfinished));  // 0: no cap
   c.max_streams = sizeParam(pnh, "max_streams", c.max_streams);
   c.code_attempts = sizeParam(pnh, "code_attempts", c.code_attempts);
   c.code_attempts_total = sizeParam(pnh, "code_attempts_total", c.code_attempts_total);
@@ -71,6 +75,8 @@ WebConfig loadConfig(const ros::NodeHandle& pnh) {
   pnh.param("web_root", c.web_root, package + "/web");
   pnh.param("chartjs_path", c.chartjs_path, std::string("/usr/share/javascript/chart.js/chart.min.js"));
   pnh.param("scenario_file", c.scenario_file, package + "/" + kDefaultScenarioFile);
+  pnh.param("bag_directory", c.state_directory, defaultBagDirectory());
+  c.state_directory = expandUser(c.state_directory);
   return c;
 }
 

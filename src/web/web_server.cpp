@@ -89,24 +89,8 @@ std::optional<std::uint64_t> runNumber(const std::string& run_id, const std::str
   return std::stoull(digits);
 }
 
-std::string randomToken() {
-  std::random_device device;
-  std::string out;
-  const char* hex = "0123456789abcdef";
-  for (int i = 0; i < 8; ++i) {
-    const std::uint32_t word = device();
-    for (int b = 0; b < 8; ++b) out += hex[(word >> (4 * b)) & 0xf];
-  }
-  return out;
-}
 
 /// Equal without telling by its time how much of a secret matched.
-bool sameSecret(const std::string& a, const std::string& b) {
-  if (a.size() != b.size()) return false;
-  unsigned char diff = 0;
-  for (std::size_t i = 0; i < a.size(); ++i) diff |= static_cast<unsigned char>(a[i] ^ b[i]);
-  return diff == 0;
-}
 
 std::string lower(std::string text) {
   std::transform(text.begin(), text.end(), text.begin(), [](unsigned char c) { return std::tolower(c); });
@@ -317,8 +301,8 @@ WebServer::WebServer(RunBook& book, WebConfig config, Publish publish, Cancel ca
       publish_(std::move(publish)),
       cancel_(std::move(cancel)),
       log_(std::move(log)),
-      class_cookie_(randomToken()),
-      teacher_cookie_(randomToken()),
+      secrets_(config_.state_directory, config_.code, config_.teacher_code, config_.stop_tokens,
+               [this](const std::string& line) { this->log(line); }),
       shares_(config_.unfinished_runs_per_address, kForgetUnfinishedAfter),
       blocking_(std::make_unique<BlockingPool>()) {
   for (const char* page : {"index.html", "run.html", "teacher.html", "login.html", "app.js", "run.js", "login.js", "style.css"}) {
@@ -463,22 +447,6 @@ bool WebServer::originAllowed(const std::string& origin, const std::string& host
   return port_of(authority) == (host.empty() ? std::to_string(port_) : port_of(host));
 }
 
-void WebServer::remember(const std::string& run_id, const std::string& token) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  if (stop_tokens_.emplace(run_id, token).second) token_order_.push_back(run_id);
-  while (token_order_.size() > config_.stop_tokens) {
-    stop_tokens_.erase(token_order_.front());
-    token_order_.pop_front();
-  }
-}
-
-std::optional<std::string> WebServer::stopToken(const std::string& run_id) const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  auto it = stop_tokens_.find(run_id);
-  if (it == stop_tokens_.end()) return std::nullopt;
-  return it->second;
-}
-
 void WebServer::handle(HttpRequest request, HttpReply reply) {
   const auto& m = request.message;
   const std::string target(m.target());
@@ -542,8 +510,8 @@ void WebServer::handle(HttpRequest request, HttpReply reply) {
       access.teacher = access.teacher || is_teacher;
     }
   }
-  access.student = access.student || sameSecret(cookie(request, kClassCookie), class_cookie_);
-  if (sameSecret(cookie(request, kTeacherCookie), teacher_cookie_)) access.student = access.teacher = true;
+  access.student = access.student || sameSecret(cookie(request, kClassCookie), secrets_.classCookie());
+  if (sameSecret(cookie(request, kTeacherCookie), secrets_.teacherCookie())) access.student = access.teacher = true;
 
   const bool open_route = path == "/login" || path == "/api/login" || path == "/static/style.css" || path == "/static/login.js";
   if (!access.student && !open_route) {
@@ -707,8 +675,8 @@ void WebServer::login(const HttpRequest& request, const HttpReply& reply) {
   }
   Response res = jsonAnswer(request, 200, {{"role", teacher ? "teacher" : "student"}});
   const std::string attributes = "; Path=/; Max-Age=" + std::to_string(kCookieSeconds) + "; HttpOnly; SameSite=Strict";
-  res.insert(http::field::set_cookie, std::string(kClassCookie) + "=" + class_cookie_ + attributes);
-  if (teacher) res.insert(http::field::set_cookie, std::string(kTeacherCookie) + "=" + teacher_cookie_ + attributes);
+  res.insert(http::field::set_cookie, std::string(kClassCookie) + "=" + secrets_.classCookie() + attributes);
+  if (teacher) res.insert(http::field::set_cookie, std::string(kTeacherCookie) + "=" + secrets_.teacherCookie() + attributes);
   reply.send(std::move(res));
 }
 
@@ -854,7 +822,7 @@ void WebServer::postRun(const HttpRequest& request, const HttpReply& reply) {
       if (highest == *number) --highest;
     }
   };
-  const std::string token = randomToken();
+  const std::string token = WebSecrets::randomToken();
   auto timer = std::make_shared<boost::asio::steady_timer>(
       reply.executor(), std::chrono::milliseconds(static_cast<long long>(config_.answer_timeout * 1000)));
   bool already_sent = false;
@@ -888,7 +856,7 @@ void WebServer::postRun(const HttpRequest& request, const HttpReply& reply) {
       std::uint64_t& highest = runs_numbered_[student];
       highest = std::max(highest, *number);
     }
-    remember(*answer.run_id, token);
+    secrets_.rememberStopToken(*answer.run_id, token);
     shares_.answered(client, *answer.run_id);
     reply.send(jsonAnswer(request, 202,
                           {{"run_id", *answer.run_id},
@@ -964,15 +932,14 @@ std::string WebServer::rejectionsJson(const std::optional<std::string>& student)
 
 void WebServer::stopRun(const HttpRequest& request, const std::string& run_id, const Access& access,
                         const HttpReply& reply) {
-  const auto owner_token = stopToken(run_id);
-  if (!owner_token && !book_.has(run_id)) return reply.send(errorAnswer(request, 404, "no such run"));
+  if (!secrets_.hasStopToken(run_id) && !book_.has(run_id)) return reply.send(errorAnswer(request, 404, "no such run"));
   std::string token(request.message["X-Stop-Token"]);
   if (token.empty() && !request.message.body().empty()) {
     const json body = json::parse(request.message.body(), nullptr, false);
     if (body.is_object() && body.contains("stop_token") && body["stop_token"].is_string()) token = body["stop_token"];
   }
   std::string requested_by;
-  if (owner_token && !token.empty() && sameSecret(token, *owner_token)) {
+  if (!token.empty() && secrets_.stopTokenMatches(run_id, token)) {
     requested_by = "its student";
   } else if (access.teacher && !config_.teacher_code.empty()) {
     requested_by = "the teacher";

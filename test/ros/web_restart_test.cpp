@@ -9,6 +9,8 @@
 #include <chrono>
 #include <filesystem>
 #include <functional>
+#include <iterator>
+#include <fstream>
 #include <string>
 #include <thread>
 
@@ -44,10 +46,10 @@ void waitUntil(const std::function<bool()>& condition, const std::string& what) 
 }
 
 /// The web node's process id (its XML-RPC getPid); 0 when it is not registered.
-int webPid() {
+int webPid(const std::string& node = kWebNode) {
   XmlRpc::XmlRpcValue args, result, payload;
   args[0] = ros::this_node::getName();
-  args[1] = kWebNode;
+  args[1] = node;
   if (!ros::master::execute("lookupNode", args, result, payload, false)) return 0;
   std::string host;
   uint32_t port = 0;
@@ -60,16 +62,16 @@ int webPid() {
 }
 
 /// The web node's address once it answers: {host, port}.
-std::pair<std::string, int> webAddress() {
+std::pair<std::string, int> webAddress(const std::string& url_param = kUrlParam) {
   std::pair<std::string, int> address;
   waitUntil(
       [&] {
         std::string url;
-        if (!ros::param::get(kUrlParam, url)) return false;
+        if (!ros::param::get(url_param, url)) return false;
         const auto colon = url.rfind(':');
         address = {url.substr(7, colon - 7), std::stoi(url.substr(colon + 1))};
         httplib::Client c(address.first, address.second);
-        auto res = c.Get("/api/runs");
+        auto res = c.Get("/login");
         return res && res->status == 200;
       },
       "the web node to answer");
@@ -178,6 +180,74 @@ TEST(WebRestart, RespawnedWebNodeListsAndServesEveryRun) {
   expectEveryRunServed(webAddress());
 }
 
+
+// A class with codes (the "coded" web node, its own folder; the test answers as its lab
+// node): a login cookie and a run's stop token from before a kill -9 still work after it.
+// (Failed before: the cookie was 403 and the stop 404 after the restart.)
+TEST(WebRestart, LoginsAndStopTokensOutliveARestart) {
+  constexpr char kCodedNode[] = "/coded/collision_lab_web";
+  constexpr char kCodedUrl[] = "/coded/collision_lab_web/url";
+  ros::NodeHandle nh("/coded");
+  ros::AsyncSpinner spinner(1);
+  spinner.start();
+  auto accepted = nh.advertise<collision_lab::AcceptedRun>("accepted_runs", 10);
+  auto lab = nh.subscribe<collision_lab::InitialConditions>(
+      "initial_conditions", 10, [&](const collision_lab::InitialConditions::ConstPtr& in) {
+        collision_lab::AcceptedRun run;
+        run.header.stamp = ros::Time::now();
+        run.run_id = in->student + "." + in->run_id;
+        run.requested_run_id = in->run_id;
+        run.student = in->student;
+        run.lane = "short";
+        accepted.publish(run);
+      });
+  auto address = webAddress(kCodedUrl);
+  waitUntil([&] { return accepted.getNumSubscribers() > 0 && lab.getNumPublishers() > 0; }, "the coded web node");
+
+  httplib::Client c(address.first, address.second);
+  auto login = c.Post("/api/login", json{{"code", "sesame"}}.dump(), "application/json");
+  ASSERT_TRUE(login);
+  ASSERT_EQ(login->status, 200);
+  const std::string set_cookie = login->get_header_value("Set-Cookie");
+  const std::string cookie = set_cookie.substr(0, set_cookie.find(';'));
+  ASSERT_EQ(cookie.rfind("collision_lab_class=", 0), 0u) << set_cookie;
+  const httplib::Headers with_cookie{{"Cookie", cookie}};
+  auto sent = c.Post("/api/runs", with_cookie,
+                     json{{"student", "ana"}, {"masses", {100, 1, "inf"}}, {"positions", {2, 1, 0}}, {"velocities", {-1, 0, 0}}}.dump(),
+                     "application/json");
+  ASSERT_TRUE(sent);
+  ASSERT_EQ(sent->status, 202) << sent->body;
+  const json run = json::parse(sent->body);
+  const std::string stop = "/api/runs/" + run.at("run_id").get<std::string>() + "/stop";
+
+  int pid = 0;
+  waitUntil([&] { return (pid = webPid(kCodedNode)) > 0; }, "the coded web node's pid");
+  ros::param::del(kCodedUrl);
+  ASSERT_EQ(kill(pid, SIGKILL), 0);
+  waitUntil([&] { const int again = webPid(kCodedNode); return again > 0 && again != pid; }, "the coded web node to respawn");
+  address = webAddress(kCodedUrl);
+  httplib::Client after(address.first, address.second);
+  auto listed = after.Get("/api/runs", with_cookie);
+  ASSERT_TRUE(listed);
+  EXPECT_EQ(listed->status, 200) << "the login cookie of before the restart";
+  auto wrong = after.Post(stop.c_str(), {{"Cookie", cookie}, {"X-Stop-Token", std::string(64, '0')}}, "", "application/json");
+  ASSERT_TRUE(wrong);
+  EXPECT_EQ(wrong->status, 403);
+  // The owner's token is taken: the stop goes on to the lab node's ~cancel, which this test
+  // does not serve (503), instead of 404 (no such run) or 403.
+  auto owner = after.Post(stop.c_str(), {{"Cookie", cookie}, {"X-Stop-Token", run.at("stop_token").get<std::string>()}}, "",
+                          "application/json");
+  ASSERT_TRUE(owner);
+  EXPECT_EQ(owner->status, 503) << owner->body;
+  // Only hashes of the tokens are on disk.
+  ros::NodeHandle pnh("~");
+  std::string dir;
+  ASSERT_TRUE(pnh.getParam("coded_directory", dir));
+  std::ifstream tokens(dir + "/web_stop_tokens");
+  const std::string stored((std::istreambuf_iterator<char>(tokens)), std::istreambuf_iterator<char>());
+  EXPECT_NE(stored.find(run.at("run_id").get<std::string>()), std::string::npos) << stored;
+  EXPECT_EQ(stored.find(run.at("stop_token").get<std::string>()), std::string::npos) << stored;
+}
 
 /// A three-body run's messages and bag: `recorded` of its `collisions` events in the bag,
 /// with the summary when all are.

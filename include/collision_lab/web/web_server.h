@@ -35,6 +35,7 @@
 #include "collision_lab/RunQueue.h"
 #include "collision_lab/service/address_share.h"
 #include "collision_lab/web/run_book.h"
+#include "collision_lab/web/web_secrets.h"
 
 namespace collision_lab_web {
 
@@ -74,6 +75,9 @@ struct WebConfig {
   std::size_t max_connections_per_address = 32;  ///< [1] open connections per client address
   std::size_t max_connections = 1024;    ///< [1] open connections in total
   std::size_t stop_tokens = 4096;        ///< [1] runs whose stop_token is remembered (newest)
+  /// Where the cookie secrets and the stop tokens' hashes are kept across restarts (the web
+  /// node's ~bag_directory; WebSecrets); empty: this start only.
+  std::string state_directory;
   std::string web_root;       ///< folder of the pages (the package's web/)
   std::string chartjs_path;   ///< Debian's chart.min.js
   std::string scenario_file;  ///< the presets (config/scenarios.yaml)
@@ -127,8 +131,6 @@ class WebServer {
   long wrongCode(const std::string& client);
   bool hostAllowed(const std::string& host) const;
   bool originAllowed(const std::string& origin, const std::string& host) const;
-  void remember(const std::string& run_id, const std::string& token);
-  std::optional<std::string> stopToken(const std::string& run_id) const;
   void log(const std::string& line) const;
   /// Notes a send to POST /api/runs that this node refused itself (400, 413, 415, 422, 429),
   /// with the student and run_id its body named, when it could be read.
@@ -146,7 +148,7 @@ class WebServer {
   int port_ = 0;
   std::map<std::string, std::string> files_;  ///< URL path -> content
   std::set<std::string> hosts_;               ///< names the lab serves (Host without port)
-  std::string class_cookie_, teacher_cookie_;  ///< random per start: a login's proof
+  WebSecrets secrets_;  ///< the cookies' secrets and the stop tokens, kept across restarts
   std::atomic<std::size_t> streams_{0};
   collision_lab::service::AddressShare shares_;  ///< unfinished_runs_per_address
   mutable std::mutex mutex_;  ///< guards everything below
@@ -155,8 +157,6 @@ class WebServer {
   std::deque<std::chrono::steady_clock::time_point> wrong_codes_total_;  ///< of the last minute, every address
   std::map<std::string, std::size_t> streams_by_address_;  ///< live streams per client address (no zero kept)
   std::map<std::string, std::chrono::steady_clock::time_point> locked_until_;
-  std::map<std::string, std::string> stop_tokens_;  ///< run_id -> its owner's secret
-  std::deque<std::string> token_order_;             ///< run_ids of stop_tokens_, oldest first
   std::set<std::pair<std::string, std::string>> pending_;  ///< (student, requested) POSTs awaiting an answer
   /// student -> the highest n of the runs "<student>.run<n>" asked for or served [1]. The lab
   /// node serves a taken "run<n>" as the next free number, so numbers stay per student and
