@@ -221,6 +221,19 @@ function studentSection(name, runs, rejections) {
   const section = el('section', null, {'data-student': name});
   section.appendChild(el('h2', name + ' (' + counted(runs.length, 'run', 'runs') + ', ' +
                          counted(rejections.length, 'rejected input', 'rejected inputs') + ')'));
+  const unfinished = runs.filter((r) => r.state === 'queued' || r.state === 'running').length;
+  if (unfinished > 1) {
+    const all = el('button', 'Stop all ' + unfinished + ' of ' + name + "'s runs", {type: 'button', 'data-stop-student': name});
+    all.onclick = async () => {
+      all.disabled = true;
+      const res = await fetch('/api/students/' + encodeURIComponent(name) + '/stop',
+        {method: 'POST', headers: {'Content-Type': 'application/json'}, body: '{}'});
+      const answer = await res.json();
+      all.textContent = res.status === 200 ? counted(answer.stopped.length, 'run', 'runs') + ' stopped'
+                                           : 'HTTP ' + res.status + ': ' + answer.error;
+    };
+    section.appendChild(all);
+  }
   if (runs.length) {
     const table = el('table', null, {'data-runs': name});
     const head = el('tr');

@@ -634,6 +634,8 @@ void WebServer::route(const HttpRequest& request, const Access& access, const Ht
     if (body.empty()) body = json{{"workers", 0}, {"short_lane_workers", 0}, {"stamp", 0.0}, {"runs", json::array()}}.dump();
     return reply.send(answer(request, http::status::ok, std::move(body), "application/json"));
   }
+  static const std::regex student_stop("/api/students/([A-Za-z0-9_-]{1,64})/stop");
+  if (post && std::regex_match(path, match, student_stop)) return stopStudent(request, match[1], access, reply);
   static const std::regex run_api("/api/runs/" + kRunId + "(/events\\.csv|/bag|/stream|/stop)?");
   if (std::regex_match(path, match, run_api)) {
     const std::string run_id = match[1], what = match[2];
@@ -956,6 +958,37 @@ void WebServer::stopRun(const HttpRequest& request, const std::string& run_id, c
     }
     if (!answer) return reply.send(errorAnswer(request, 503, "the lab node's cancel service did not answer"));
     reply.send(jsonAnswer(request, 200, {{"ok", answer->ok}, {"message", answer->message}, {"requested_by", requested_by}}));
+  });
+}
+
+void WebServer::stopStudent(const HttpRequest& request, const std::string& student, const Access& access,
+                            const HttpReply& reply) {
+  if (!access.teacher || config_.teacher_code.empty()) {
+    return reply.send(errorAnswer(request, 403, "only the teacher may stop all of a student's runs", "code"));
+  }
+  if (!cancel_) return reply.send(errorAnswer(request, 503, "this server cannot reach the lab node's cancel service"));
+  std::vector<std::string> unfinished;
+  const json runs = json::parse(book_.list(student), nullptr, false);
+  for (const json& run : runs.is_array() ? runs : json::array()) {
+    const std::string state = run.value("state", "");
+    if (state == "queued" || state == "running") unfinished.push_back(run.value("run_id", ""));
+  }
+  boost::asio::post(blocking_->pool, [this, request, reply, student, unfinished] {
+    json stopped = json::array(), not_stopped = json::array();
+    for (const std::string& run_id : unfinished) {
+      std::optional<CancelAnswer> answer;
+      try {
+        answer = cancel_(run_id, "the teacher");
+      } catch (const std::exception&) {
+      }
+      if (answer && answer->ok) {
+        stopped.push_back(run_id);
+      } else {
+        not_stopped.push_back({{"run_id", run_id}, {"message", answer ? answer->message : "the lab node did not answer"}});
+      }
+    }
+    log("the teacher stopped " + std::to_string(stopped.size()) + " runs of " + student);
+    reply.send(jsonAnswer(request, 200, {{"student", student}, {"stopped", stopped}, {"not_stopped", not_stopped}}));
   });
 }
 

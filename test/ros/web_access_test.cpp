@@ -452,6 +452,42 @@ TEST_F(WebAccessTest, OwnerAndTeacherStopARunAClassmateCannot) {
   EXPECT_EQ(run.at("summary").at("stop_reason"), "CANCELLED");
 }
 
+TEST_F(WebAccessTest, TheTeacherStopsAllOfOneStudentsRunsAtOnce) {
+  std::vector<std::string> wils;
+  for (int k = 0; k < 3; ++k) {  // computing, and waiting behind it
+    const auto [status, run] = postFrom("127.0.10.1", endlessScene("wil"));
+    ASSERT_EQ(status, 202) << run.dump();
+    wils.push_back(run.at("run_id"));
+  }
+  const auto [xia_status, xia] = postFrom("127.0.10.2", endlessScene("xia"));
+  ASSERT_EQ(xia_status, 202) << xia.dump();
+  auto student = client();
+  auto refused = student.Post("/api/students/wil/stop", "{}", "application/json");
+  ASSERT_TRUE(refused);
+  EXPECT_EQ(refused->status, 403);
+  auto teacher = client({{"X-Teacher-Code", kTeacherCode}});
+  auto res = teacher.Post("/api/students/wil/stop", "{}", "application/json");
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 200) << res->body;
+  const json answer = json::parse(res->body);
+  std::vector<std::string> stopped = answer.at("stopped");
+  std::sort(stopped.begin(), stopped.end());
+  std::sort(wils.begin(), wils.end());
+  EXPECT_EQ(stopped, wils) << res->body;
+  for (const std::string& run_id : wils) EXPECT_EQ(finishedRun(run_id).at("summary").at("stop_reason"), "CANCELLED");
+  // A classmate's run goes on.
+  auto still = client().Get(("/api/runs/" + xia.at("run_id").get<std::string>()).c_str());
+  ASSERT_TRUE(still);
+  EXPECT_NE(json::parse(still->body).at("state"), "finished");
+  EXPECT_TRUE(waitUntil(
+      [&] {
+        auto r = teacher.Post(("/api/runs/" + xia.at("run_id").get<std::string>() + "/stop").c_str(), "", "application/json");
+        return r && r->status == 200 && json::parse(r->body)["ok"] == true;
+      },
+      "xia's run to be stopped"));
+  finishedRun(xia.at("run_id"));
+}
+
 TEST_F(WebAccessTest, QueueIsTheLabNodes) {
   ros::NodeHandle nh;
   ros::Publisher pub = nh.advertise<collision_lab::RunQueue>("/collision_lab/run_queue", 1, true);

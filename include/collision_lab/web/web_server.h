@@ -119,6 +119,8 @@ class WebServer {
   void route(const HttpRequest& request, const Access& access, const HttpReply& reply);
   void postRun(const HttpRequest& request, const HttpReply& reply);
   void stopRun(const HttpRequest& request, const std::string& run_id, const Access& access, const HttpReply& reply);
+  /// POST /api/students/<student>/stop (the teacher): every queued or running run of student.
+  void stopStudent(const HttpRequest& request, const std::string& student, const Access& access, const HttpReply& reply);
   void login(const HttpRequest& request, const HttpReply& reply);
   void sendEventsCsv(const HttpRequest& request, const std::string& run_id, const HttpReply& reply);
   void sendBag(const HttpRequest& request, const std::string& run_id, const HttpReply& reply);
