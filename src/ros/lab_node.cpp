@@ -804,6 +804,10 @@ bool LabNode::intake(collision_lab::InitialConditions input, Reply reply, const 
   const std::string requested = served_again ? *served_again : input.run_id;
   std::optional<core::ScenePlan> plan;
   if (auto rejection = checkInput(input, params_.max_bodies, plan)) {
+    if (served_again) {  // accepted once: not rejected now, ended as interrupted by recovery
+      ROS_WARN_STREAM("run " << input.run_id << ": queued when its lab node died, not served again: " << rejection->message);
+      return false;
+    }
     rejection->student = input.student;
     ServeOutcome outcome = reject(std::move(*rejection), requested);
     if (reply) reply->set_value(std::move(outcome));
@@ -838,12 +842,14 @@ bool LabNode::intake(collision_lab::InitialConditions input, Reply reply, const 
     job.requested_run_id = input.run_id != base ? requested : std::string();
     const std::string run_id = input.run_id;
     const std::string student = input.student;
-    run_index_->accepted(run_id, student, requested, input);
+    // A run served again keeps its row as it was (queued, its time of acceptance), and is
+    // not announced again: an AcceptedRun would answer whoever now asks for that run_id.
+    if (!served_again) run_index_->accepted(run_id, student, requested, input);
     job.input = std::move(input);
     job.plan = std::move(*plan);
     job.reply = std::move(reply);
     const std::size_t position = scheduler_.push(Scheduler::Entry{run_id, student, lane, std::move(job)});
-    announce(run_id, student, requested, position, lane);
+    if (!served_again) announce(run_id, student, requested, position, lane);
     publishQueue();
   }
   wake_.notify_all();

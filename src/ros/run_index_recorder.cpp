@@ -225,7 +225,10 @@ collision_lab::InitialConditions inputFromJson(const std::string& text) {
     }
     return values;
   };
+  // A value stored as null was not finite; these fields are ignored unless their model (or
+  // limit) is in use, where the node accepts only finite ones: null reads back as 0 (unset).
   const auto number = [&](const char* key) {
+    if (j.contains(key) && j[key].is_null()) return 0.0;
     if (!j.contains(key) || !j[key].is_number()) throw std::invalid_argument(std::string("its stored input has no ") + key);
     return j[key].get<double>();
   };
@@ -609,9 +612,10 @@ std::size_t RunIndexRecorder::recover(const ServeAgain& serve_again) {
     if (serve_again && run.state == RunState::kQueued && !fs::exists(final_path)) {
       try {
         if (serve_again(QueuedRun{inputFromJson(run.scene_json), run.requested_run_id})) continue;
-      } catch (const std::invalid_argument& e) {
+      } catch (const std::exception& e) {
         ROS_WARN_STREAM("run " << run.run_id << ": queued when its node died, and not served again: " << e.what());
       }
+      if (activeBagOwned(final_path + ".active")) continue;  // another live node claimed it meanwhile
     }
     try {
       BagContents contents;

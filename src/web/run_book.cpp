@@ -316,6 +316,7 @@ collision_lab::RunSummary summaryFromRow(const collision_lab::service::IndexedRu
     s.published_events = fields.value("published_events", s.published_events);
     s.uncertified_values = fields.value("uncertified_values", s.uncertified_values);
     s.time_beyond_range = fields.value("time_beyond_range", false);
+    s.recording_error = fields.value("recording_error", s.recording_error);
   }
   return s;
 }

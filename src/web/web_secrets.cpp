@@ -6,9 +6,12 @@
 
 #include <boost/uuid/detail/sha1.hpp>
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <type_traits>
 
 namespace collision_lab_web {
 
@@ -19,14 +22,36 @@ namespace fs = std::filesystem;
 constexpr char kCookiesFile[] = "web_cookies";
 constexpr char kTokensFile[] = "web_stop_tokens";
 
-/// Opens path for writing, created with mode 0600 (truncated, or appended to).
-std::FILE* openPrivate(const fs::path& path, bool append) {
-  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC | (append ? O_APPEND : O_TRUNC), 0600);
+/// Opens path to append to, created with mode 0600 (never through a symbolic link).
+std::FILE* openToAppend(const fs::path& path) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC | O_NOFOLLOW, 0600);
   if (fd < 0) return nullptr;
   ::fchmod(fd, 0600);
-  std::FILE* file = ::fdopen(fd, append ? "a" : "w");
+  std::FILE* file = ::fdopen(fd, "a");
   if (!file) ::close(fd);
   return file;
+}
+
+/// Replaces path by `text` whole: written to a new 0600 file beside it, then renamed over
+/// it, so that a crash or a full disk leaves the old file. False when it could not.
+bool replaceFile(const fs::path& path, const std::string& text) {
+  std::string temporary = path.string() + ".XXXXXX";
+  const int fd = ::mkstemp(temporary.data());
+  if (fd < 0) return false;
+  std::FILE* file = ::fdopen(fd, "w");
+  if (!file) {
+    ::close(fd);
+    ::unlink(temporary.c_str());
+    return false;
+  }
+  const bool written = std::fwrite(text.data(), 1, text.size(), file) == text.size() && std::fflush(file) == 0 &&
+                       ::fsync(fd) == 0;
+  const bool closed = std::fclose(file) == 0;
+  if (!written || !closed || std::rename(temporary.c_str(), path.c_str()) != 0) {
+    ::unlink(temporary.c_str());
+    return false;
+  }
+  return true;
 }
 
 /// The secret kept for `code` in lines "<role> <secret> <fingerprint>", or a new one (and
@@ -63,6 +88,9 @@ std::string WebSecrets::randomToken() {
 }
 
 std::string WebSecrets::sha1Hex(const std::string& text) {
+  // Boost 1.74's digest: five 32-bit words (newer Boosts give 20 bytes).
+  static_assert(std::is_same_v<std::remove_extent_t<boost::uuids::detail::sha1::digest_type>, unsigned int> &&
+                std::extent_v<boost::uuids::detail::sha1::digest_type> == 5);
   boost::uuids::detail::sha1 sha;
   sha.process_bytes(text.data(), text.size());
   boost::uuids::detail::sha1::digest_type digest;
@@ -92,14 +120,9 @@ WebSecrets::WebSecrets(const std::string& directory, const std::string& class_co
   bool changed = false;
   class_cookie_ = secretFor(stored, "class", class_code, changed);
   teacher_cookie_ = secretFor(stored, "teacher", teacher_code, changed);
-  if (changed) {
-    std::FILE* out = openPrivate(cookies, false);
-    if (!out || std::fprintf(out, "class %s %s\nteacher %s %s\n", class_cookie_.c_str(),
-                             sha1Hex(class_cookie_ + class_code).c_str(), teacher_cookie_.c_str(),
-                             sha1Hex(teacher_cookie_ + teacher_code).c_str()) < 0) {
-      warn("cannot write " + cookies.string() + ": logins end when this node restarts");
-    }
-    if (out) std::fclose(out);
+  if (changed && !replaceFile(cookies, "class " + class_cookie_ + " " + sha1Hex(class_cookie_ + class_code) + "\nteacher " +
+                                           teacher_cookie_ + " " + sha1Hex(teacher_cookie_ + teacher_code) + "\n")) {
+    warn("cannot write " + cookies.string() + ": logins end when this node restarts");
   }
 
   const fs::path tokens = fs::path(directory) / kTokensFile;
@@ -109,12 +132,9 @@ WebSecrets::WebSecrets(const std::string& directory, const std::string& class_co
     while (in >> run_id >> hash) keepLocked(run_id, hash);
   }
   // Rewritten with the kept ones only (bounded), then appended to.
-  std::FILE* rewritten = openPrivate(tokens, false);
-  if (rewritten) {
-    for (const std::string& run_id : order_) std::fprintf(rewritten, "%s %s\n", run_id.c_str(), token_hashes_[run_id].c_str());
-    std::fclose(rewritten);
-  }
-  tokens_file_ = openPrivate(tokens, true);
+  std::string kept_lines;
+  for (const std::string& run_id : order_) kept_lines += run_id + " " + token_hashes_[run_id] + "\n";
+  if (replaceFile(tokens, kept_lines)) tokens_file_ = openToAppend(tokens);
   if (!tokens_file_) warn("cannot write " + tokens.string() + ": stop tokens end when this node restarts");
 }
 
@@ -134,9 +154,9 @@ void WebSecrets::rememberStopToken(const std::string& run_id, const std::string&
   const std::string hash = sha1Hex(token);
   std::lock_guard<std::mutex> lock(mutex_);
   keepLocked(run_id, hash);
-  if (tokens_file_) {
-    std::fprintf(tokens_file_, "%s %s\n", run_id.c_str(), hash.c_str());
-    std::fflush(tokens_file_);
+  if (tokens_file_ && (std::fprintf(tokens_file_, "%s %s\n", run_id.c_str(), hash.c_str()) < 0 || std::fflush(tokens_file_) != 0)) {
+    std::fclose(tokens_file_);  // this start's tokens still work; the next start's do not
+    tokens_file_ = nullptr;
   }
 }
 

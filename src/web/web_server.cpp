@@ -1066,16 +1066,18 @@ void WebServer::sendBag(const HttpRequest& request, const std::string& run_id, c
 // most every kStreamInterval; an event `final` ends the stream. A timer per stream, no thread.
 void WebServer::stream(const HttpRequest& request, const std::string& run_id, const HttpReply& reply) {
   if (!book_.has(run_id)) return reply.send(errorAnswer(request, 404, "no such run"));
+  bool full = false;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     std::size_t& mine = streams_by_address_[request.client];
-    if (mine >= config_.max_streams_per_address || streams_ >= config_.max_streams) {
-      if (mine == 0) streams_by_address_.erase(request.client);
-      return reply.send(errorAnswer(request, 503, "too many live streams at once; the page reloads the run instead"));
+    full = mine >= config_.max_streams_per_address || streams_ >= config_.max_streams;
+    if (full && mine == 0) streams_by_address_.erase(request.client);
+    if (!full) {
+      ++mine;
+      ++streams_;
     }
-    ++mine;
-    ++streams_;
   }
+  if (full) return reply.send(errorAnswer(request, 503, "too many live streams at once; the page reloads the run instead"));
   // The slot is freed when the stream's poll is released (stream ended or client gone).
   std::shared_ptr<void> slot(nullptr, [this, client = request.client](void*) {
     std::lock_guard<std::mutex> lock(mutex_);

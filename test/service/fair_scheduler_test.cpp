@@ -156,6 +156,9 @@ TEST(ChooseLane, ByMeasuredCostWhereThePlanCountsNothing) {
   EXPECT_EQ(chooseLane(gas, full, limits), Lane::kLong);
   limits.short_max_seconds = 1e9;  // any estimate is
   EXPECT_EQ(chooseLane(gas, full, limits), Lane::kShort);
+  // A cap above short_max_collisions is long, whatever the estimate: the run publishes and
+  // records up to its cap.
+  EXPECT_EQ(chooseLane(gas, runOptions(core::RunMode::kFull, 100'001, false), limits), Lane::kLong);
 
   // 101 bodies whose run ends within the probe: short, however little time is allowed.
   std::vector<double> apart_masses(101, 1.0), apart_positions, apart_velocities(101, 0.0);

@@ -29,9 +29,10 @@ namespace collision_lab_ros {
 /// positions, velocities, restitution (null for a non-finite value), max_collisions, mode,
 /// student, run_id.
 std::string inputJson(const collision_lab::InitialConditions& input);
-/// The served input back from inputJson's text (a run to serve again). Throws
-/// std::invalid_argument when the text is not such JSON (a non-finite value it stored as
-/// null cannot come back either: it was not a served input's).
+/// The served input back from inputJson's text (a run to serve again). A scalar stored as
+/// null (not finite: tc, elastic_below, viscoelastic_speed, ring, max_run_seconds, which
+/// the node ignores unless in use) reads back as 0. Throws std::invalid_argument when the
+/// text is not such JSON, or a per-body value is null.
 collision_lab::InitialConditions inputFromJson(const std::string& text);
 /// The index's JSON of a summary (IndexedRun::summary_json): the fields the class pages
 /// show, under RunSummary's field names.

@@ -31,15 +31,17 @@ inline const char* laneName(Lane lane) { return lane == Lane::kShort ? "short" :
 struct LaneLimits {
   std::uint64_t short_max_collisions = 100'000;  ///< [1] impacts, where the plan counts them
   double short_max_seconds = 1.0;                ///< [s] estimated compute, where it does not
-  std::uint64_t probe_impacts = 1000;            ///< [1] impacts the estimate times
+  std::uint64_t probe_impacts = 256;             ///< [1] impacts the estimate times
 };
 
 /// Short when the run's planned impacts (core::plannedImpacts: the core's own decision) are
 /// at most limits.short_max_collisions. When the plan cannot count them, by the run's cost:
 /// the engine's first limits.probe_impacts impacts are run and timed (core::runScene,
-/// summary only, nothing published); short when the run ends within them, or when its
-/// cap's impacts at the measured rate take at most limits.short_max_seconds; else long.
-/// The probe costs at most probe_impacts impacts of the intake's time.
+/// summary only, nothing published; the plan's own time left out); short when the run ends
+/// within them, or when its cap is at most short_max_collisions (what it publishes and
+/// records is bounded as a counted run's) and the cap's impacts at the measured rate take
+/// at most limits.short_max_seconds; else long. The probe costs at most probe_impacts
+/// impacts of the intake's time.
 inline Lane chooseLane(const core::ScenePlan& plan, const core::SceneRunOptions& options, const LaneLimits& limits) {
   if (const auto impacts = core::plannedImpacts(plan, options)) {
     return *impacts <= limits.short_max_collisions ? Lane::kShort : Lane::kLong;
@@ -51,9 +53,10 @@ inline Lane chooseLane(const core::ScenePlan& plan, const core::SceneRunOptions&
   probe.cancel = nullptr;
   const core::SceneRunResult timed = core::runScene(plan, probe);
   if (!timed.simulation.truncated) return Lane::kShort;  // it ended within the probe
-  const double rate = static_cast<double>(timed.simulation.impact_count) / std::max(timed.compute_time_s, 1e-9);
-  const double estimate = static_cast<double>(options.lab.max_collisions) / rate;  // [s]
-  return estimate <= limits.short_max_seconds ? Lane::kShort : Lane::kLong;
+  if (options.lab.max_collisions > limits.short_max_collisions) return Lane::kLong;
+  const double seconds = std::max(timed.compute_time_s - plan.plan_time_s, 1e-9);
+  const double rate = static_cast<double>(timed.simulation.impact_count) / seconds;  // [1/s]
+  return static_cast<double>(options.lab.max_collisions) <= rate * limits.short_max_seconds ? Lane::kShort : Lane::kLong;
 }
 
 template <class Job>

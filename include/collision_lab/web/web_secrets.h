@@ -6,8 +6,10 @@
 //                    gets a new secret, and the old cookies stop working;
 //   web_stop_tokens  "<run_id> <SHA-1 of its token>" per line, appended as runs are
 //                    accepted, the newest `kept` read back (and rewritten) at the start.
-// Only hashes of the tokens are stored. Without a folder nothing is kept (secrets of this
-// start only). Thread-safe.
+// Only hashes of the tokens are stored; files are replaced whole (a new file renamed over
+// the old) and never opened through a symbolic link. One web node per folder: two would
+// replace each other's files. Without a folder nothing is kept (secrets of this start
+// only). Thread-safe.
 #pragma once
 
 #include <cstdio>

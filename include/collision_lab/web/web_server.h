@@ -63,7 +63,8 @@ struct WebConfig {
   std::size_t max_streams_per_address = 8;  ///< concurrent event streams of one client address [1]; more: 503
   std::size_t code_attempts = 5;         ///< wrong codes per address per minute [1] before the lockout
   /// Wrong codes per minute from all addresses together [1]: once spent, a single wrong code
-  /// locks its address out (guessing from many addresses is slowed as from one).
+  /// locks its address out for code_lockout, so each address guesses once per lockout
+  /// instead of code_attempts times a minute.
   std::size_t code_attempts_total = 50;
   double code_lockout = 60.0;            ///< [s] an address is locked out after too many wrong codes
   /// How long POST /api/runs waits for the lab node's AcceptedRun or Rejected [s]; then 503.
