@@ -17,6 +17,8 @@ Phases:
    attacker: slow connections that send a header byte every 4 s, chunked bodies larger than
    the limit, wrong class codes. Then both nodes' VmRSS again: memory per run is the growth
    divided by the runs of this phase.
+4. one bad student: one address sends --flood gas_1000 runs under as many names at once while
+   ten classmates send pi runs; their time to final (goal: p99 <= 2 s, 0 lost).
 
 It prints one block of figures and a `goal:` line per goal (bench/goals_table.py): small
 scenes' time to final p99 <= 2 s, 0 runs lost, memory per run < 1 KB (1,000 B) for each node.
@@ -586,6 +588,8 @@ def main():
     ap.add_argument("--runs", type=int, default=60, help="small runs per student in the measured phase")
     ap.add_argument("--gases", type=int, default=6, help="gas_1000 runs in the measured phase")
     ap.add_argument("--huge", type=int, default=4, help="runs asking for 2^64-1 impacts in the measured phase")
+    ap.add_argument("--flood", type=int, default=30,
+                    help="gas_1000 runs one address sends under as many names in the 'one bad student' phase (0: none)")
     ap.add_argument("--stop-after", type=float, default=3.0, help="every second huge run is stopped by its owner after this [s]")
     ap.add_argument("--slow", type=int, default=80, help="slow connections of the attacker")
     ap.add_argument("--slow-addresses", type=int, default=8, help="loopback addresses they come from (127.0.1.x)")
@@ -763,7 +767,46 @@ def measure(args, lab, base):
               f"{'unknown' if figure is None else f'{figure:.0f} B'} against {what} = "
               f"{'unknown' if size is None else f'{size} B'} (goal < {GOAL_BYTES_PER_RUN} B): "
               f"{met(figure is not None and figure < GOAL_BYTES_PER_RUN)}")
+    bad_student_phase(client, stats, args)
     return 0
+
+
+def bad_student_phase(client, stats, args):
+    """One address sends args.flood gas_1000 runs under as many names at once (each a long run);
+    meanwhile ten classmates at their own addresses send pi runs one after another. Reports the
+    classmates' time to final and what the flood got; then the flood's runs are stopped."""
+    if args.flood <= 0:
+        return
+    flood_source = "127.0.0.250"
+    answers, tokens = collections.Counter(), []
+
+    def flood_one(k):
+        status, _, answer = client.request("POST", "/api/runs", flood_source,
+                                           dict(GAS, student=f"alias{k:02d}"), timeout=args.post_timeout)
+        answers[str(status)] += 1
+        if status == 202:
+            reply = json.loads(answer)
+            tokens.append((reply["run_id"], reply["stop_token"]))
+
+    flooders = [threading.Thread(target=flood_one, args=(k,), daemon=True) for k in range(args.flood)]
+    for t in flooders:
+        t.start()
+    for t in flooders:
+        t.join(60)
+    mates = [Student(f"mate{k}", f"127.0.2.{10 + k}", client, stats, args) for k in range(10)]
+    run_phase(mates, [[("pi", PI, 31, None)] * 3 for _ in mates], "bad student", args.max_seconds)
+    times = [r["to_final_s"] if r["to_final_s"] is not None else float("inf")
+             for r in stats.runs if r["phase"] == "bad student"]
+    for run_id, token in tokens:
+        client.request("POST", f"/api/runs/{run_id}/stop", flood_source, body={},
+                       headers={"X-Stop-Token": token}, timeout=30)
+    p50, p99 = pct(times, 0.5), pct(times, 0.99)
+    lost = sum(1 for x in times if x == float("inf"))
+    print(f"one bad student: {args.flood} gas_1000 runs from one address under {args.flood} names at once: "
+          f"answers {dict(answers)}; meanwhile {len(times)} classmates' pi runs, time to final p50 {p50:.3f} s, "
+          f"p99 {p99:.3f} s, {lost} never final")
+    print(f"goal: one bad student, classmates' small scenes p99 = {p99:.3f} s (goal <= {GOAL_P99_S:.0f} s, 0 lost): "
+          f"{'met' if times and p99 <= GOAL_P99_S and lost == 0 else 'missed'}")
 
 
 if __name__ == "__main__":

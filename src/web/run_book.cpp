@@ -771,6 +771,11 @@ bool RunBook::has(const std::string& run_id) const {
   }
 }
 
+bool RunBook::resident(const std::string& run_id) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return runs_.count(run_id) > 0;
+}
+
 bool RunBook::finished(const std::string& run_id) const {
   {
     std::lock_guard<std::mutex> lock(mutex_);

@@ -40,8 +40,12 @@ namespace fs = std::filesystem;
 
 /// Threads for what may block (the lab node's ~cancel, a bag's CSV conversion), so that
 /// the I/O threads never do.
+/// Work kept off the I/O threads: `pool` for cancel calls and CSV conversions, `readers`
+/// for the run list (the index) and runs read back from their bags. Each bounds how many
+/// run at once; the I/O threads serve pages and sends meanwhile.
 struct BlockingPool {
   boost::asio::thread_pool pool{2};
+  boost::asio::thread_pool readers{2};
 };
 
 struct WebServer::Access {
@@ -618,7 +622,9 @@ void WebServer::route(const HttpRequest& request, const Access& access, const Ht
   if (post && path == "/api/runs") return postRun(request, reply);
   if (get && path == "/api/runs") {
     std::optional<std::string> student = queryParam(query, "student");
-    return reply.send(answer(request, http::status::ok, book_.list(student), "application/json"));
+    return boost::asio::post(blocking_->readers, [this, request, reply, student] {
+      reply.send(answer(request, http::status::ok, book_.list(student), "application/json"));
+    });
   }
   if (get && path == "/api/rejections") {
     if (!access.teacher) return reply.send(errorAnswer(request, 403, "only the teacher sees the rejected inputs", "code"));
@@ -641,9 +647,13 @@ void WebServer::route(const HttpRequest& request, const Access& access, const Ht
     const std::string run_id = match[1], what = match[2];
     if (post && what == "/stop") return stopRun(request, run_id, access, reply);
     if (get && what.empty()) {
-      const auto run = book_.json(run_id);
-      if (!run) return reply.send(errorAnswer(request, 404, "no such run"));
-      return reply.send(answer(request, http::status::ok, run->first, "application/json"));
+      const auto send = [this, request, reply, run_id] {
+        const auto run = book_.json(run_id);
+        if (!run) return reply.send(errorAnswer(request, 404, "no such run"));
+        reply.send(answer(request, http::status::ok, run->first, "application/json"));
+      };
+      if (book_.resident(run_id)) return send();
+      return boost::asio::post(blocking_->readers, send);  // read back from its bag
     }
     if (get && what == "/events.csv") return sendEventsCsv(request, run_id, reply);
     if (get && what == "/bag") return sendBag(request, run_id, reply);

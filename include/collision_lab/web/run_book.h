@@ -149,6 +149,8 @@ class RunBook {
 
   /// Known in memory, as an evicted stub or to the RunSource.
   bool has(const std::string& run_id) const;
+  /// Held in memory now: json(run_id) answers without reading a bag or the index.
+  bool resident(const std::string& run_id) const;
   /// The run as JSON text (docs/web.md), with its version; nullopt for an unknown run_id.
   /// A run not in memory is loaded first (from its bag when finished or interrupted; its
   /// state as the index says otherwise); concurrent loads of one run read its bag once.
