@@ -12,11 +12,11 @@ from pkgutil import extend_path
 __path__ = extend_path(__path__, __name__)
 
 from ._core import version as __version__
-from ._run import Run, SceneError, body_name, predict, run
+from ._run import CapWarning, Run, SceneError, body_name, predict, run
 from ._sweep import sweep
 from ._bag import read_bag
 
-__all__ = ['Run', 'SceneError', 'body_name', 'plot', 'predict', 'read_bag', 'run', 'sweep']
+__all__ = ['CapWarning', 'Run', 'SceneError', 'body_name', 'plot', 'predict', 'read_bag', 'run', 'sweep']
 
 
 def __getattr__(name):

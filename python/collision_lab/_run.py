@@ -6,6 +6,7 @@ and value for value.
 """
 import json
 import math
+import warnings
 
 import numpy as np
 
@@ -209,6 +210,26 @@ class Run:
             len(self.masses), self.model, self.summary.get('collision_count'))
 
 
+class CapWarning(UserWarning):
+    """The cap (max_collisions) left a run unsimulated or cut it short."""
+
+
+def _warn_about_cap(result, max_collisions, simulate_to_cap, mode):
+    """Says, as a CapWarning, when the cap decided what was simulated."""
+    s = result.summary
+    predicted = s.get('predicted_collision_count')
+    if mode != 'predict' and not s.get('simulated') and predicted is not None and predicted > max_collisions:
+        warnings.warn('the model predicts %s collisions, more than max_collisions=%s: nothing was simulated, the '
+                      'model answered (no events). Raise max_collisions, or pass simulate_to_cap=True to simulate '
+                      'the first %s.' % (format(predicted, ','), format(max_collisions, ','),
+                                         format(max_collisions, ',')), CapWarning, stacklevel=3)
+    elif s.get('truncated') and s.get('collision_count') == max_collisions:
+        warnings.warn('the run stopped at max_collisions=%s (truncated)%s; raise max_collisions to simulate more.'
+                      % (format(max_collisions, ','),
+                         '' if predicted is None else ' of the %s the model predicts' % format(predicted, ',')),
+                      CapWarning, stacklevel=3)
+
+
 def prediction_of(summary):
     """The summary's fields that are the model's answer (predicted_*, model, ...)."""
     return {key: value for key, value in summary.items()
@@ -231,14 +252,17 @@ def run(masses, positions, velocities, restitution=1.0, *, ring=None, restitutio
     full_state_every: K > 1 gives the lean record of long runs: every body's state (the
     per-body event arrays) at impact 1 and every K-th impact only, NaN in the others.
     The GIL is released while it runs; Ctrl-C stops it (KeyboardInterrupt).
-    Raises SceneError for a scene or option the CLI rejects.
+    Raises SceneError for a scene or option the CLI rejects. Warns (CapWarning) when the
+    cap left the run unsimulated (the model answered) or cut it short.
     """
     args = scene_arguments(masses, positions, velocities, restitution, ring=ring,
                            restitution_model=restitution_model, tc=tc, elastic_below=elastic_below,
                            viscoelastic_speed=viscoelastic_speed, max_collisions=max_collisions,
                            simulate_to_cap=simulate_to_cap, events=events, mode=mode,
                            temperature_csv=temperature_csv, full_state_every=full_state_every)
-    return Run(parse_report(_core.run_json(args, name)), masses, positions, velocities)
+    result = Run(parse_report(_core.run_json(args, name)), masses, positions, velocities)
+    _warn_about_cap(result, max_collisions, simulate_to_cap, mode)
+    return result
 
 
 def predict(masses, positions, velocities, restitution=1.0, **options):

@@ -120,6 +120,10 @@ def title_of(run, view):
 
 def _require_events(run, view):
     if len(run.events.get('time', ())) == 0 and run.summary.get('collision_count', 0) > 0:
+        if not run.summary.get('simulated'):
+            raise ValueError('plot.%s needs simulated events: the model answered this run\'s %s without simulating '
+                             'them (more than max_collisions, or mode=\'predict\'); raise max_collisions or pass '
+                             'simulate_to_cap=True' % (view, _count_text(run.summary['collision_count'])))
         raise ValueError('plot.%s needs the run\'s events: run it with events=\'all\' (this run has %s and none '
                          'recorded)' % (view, _count_text(run.summary['collision_count'])))
 

@@ -151,3 +151,23 @@ def test_lean_record_keeps_the_pairs_and_every_kth_state():
     assert np.isnan(v_lean[~kept]).all()
     assert np.array_equal(lean.events['time'], full.events['time'])
     assert np.array_equal(lean.events['position'], full.events['position'])
+
+
+def test_the_cap_is_said_when_it_decides():
+    """A run the cap leaves unsimulated, or cuts short, warns naming max_collisions and
+    simulate_to_cap; a run within the cap does not. (Failed before: 314,159,265 collisions,
+    0 events, silently.)"""
+    with pytest.warns(collision_lab.CapWarning, match=r'314,159,265 collisions, more than max_collisions=10,000,000'):
+        over = collision_lab.run([1e16, 1, INF], [2, 1, 0], [-1, 0, 0])
+    assert not over.summary['simulated'] and over.summary['collision_count'] == 314159265
+    with pytest.warns(collision_lab.CapWarning, match=r'stopped at max_collisions=50 \(truncated\) of the 314'):
+        cut = collision_lab.run([1e4, 1, INF], [2, 1, 0], [-1, 0, 0], max_collisions=50, simulate_to_cap=True)
+    assert cut.summary['collision_count'] == 50 and len(cut.events['time']) == 50
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter('error')
+        assert collision_lab.run([100, 1, INF], [2, 1, 0], [-1, 0, 0]).summary['collision_count'] == 31
+        collision_lab.run([1e16, 1, INF], [2, 1, 0], [-1, 0, 0], mode='predict')
+    from collision_lab import plot
+    with pytest.raises(ValueError, match='simulate_to_cap=True'):
+        plot.steps(over)
