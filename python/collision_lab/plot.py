@@ -474,6 +474,20 @@ def read_temperature_csv(path):
                     'samples': int(fit['samples'])} if 't0_J' in fit else None)
 
 
+MIN_GAS_BODIES = 10  # [1] finite bodies for Haff's law of a cooling gas to be fitted
+
+
+def _is_cooling_gas(run):
+    """(True, '') for a gas that cools: at least MIN_GAS_BODIES finite bodies and energy lost;
+    else (False, why), in words."""
+    bodies = int(np.isfinite(run.masses).sum())
+    if bodies < MIN_GAS_BODIES:
+        return False, '%d bodies are not a gas (Haff\'s law needs many; at least %d here)' % (bodies, MIN_GAS_BODIES)
+    if not (run.summary.get('energy_lost') or 0) > 0:
+        return False, 'no energy was lost: an elastic gas does not cool'
+    return True, ''
+
+
 def temperature(run, ax=None, csv=None):
     """Granular temperature T(t) [J] on log-log axes with Haff's law T0 / (1 + t/tau)^2 fitted
     (dashed), as the CLI's --temperature-csv computes it. csv: the path of that file (from
@@ -488,6 +502,10 @@ def temperature(run, ax=None, csv=None):
         _, t, T = temperature_samples(run)
         thinned = thin_log_time(t)
         fit = fit_haff(t[thinned], T[thinned])
+    gas, why_not = _is_cooling_gas(run)
+    if not gas:
+        fit = None
+        ax.plot([], [], ls='none', label="no Haff fit: %s" % why_not)
     after = t > 0
     ax.loglog(t[after], T[after], color='C0', lw=1.4, drawstyle='steps-post',
               label='T(t) simulated (held between samples)')

@@ -109,6 +109,20 @@ def test_temperature_and_haff_fit_equal_the_clis(tmp_path, cli_path):
     assert any("Haff's law fitted" in text.get_text() for text in ax.get_legend().get_texts())
 
 
+def test_no_haff_fit_for_what_is_not_a_cooling_gas():
+    """The elastic pi billiard (3 bodies) and an elastic gas get no fit, and the legend says
+    why. (Failed before: Haff's law was fitted to the pi billiard.)"""
+    pi = cl.run([100, 1, math.inf], [2, 1, 0], [-1, 0, 0])
+    texts = [t.get_text() for t in plot.temperature(pi).get_legend().get_texts()]
+    assert not any("Haff's law fitted" in t for t in texts)
+    assert any('2 bodies are not a gas' in t for t in texts), texts
+    rng = np.random.default_rng(3)
+    elastic = cl.run(rng.uniform(1, 2, 12), np.arange(12)[::-1] * 1.0, rng.uniform(-1, 1, 12), ring=12.0,
+                     max_collisions=300, simulate_to_cap=True)
+    texts = [t.get_text() for t in plot.temperature(elastic).get_legend().get_texts()]
+    assert any('an elastic gas does not cool' in t for t in texts), texts
+
+
 def test_plots_need_events():
     run = cl.run([100, 1, math.inf], [2, 1, 0], [-1, 0, 0], events='none')
     with pytest.raises(ValueError, match="events='all'"):
