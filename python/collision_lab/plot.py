@@ -200,7 +200,7 @@ def steps(run, ax=None, bodies=None):
                             label='predicted final' if labelled and j == 0 else None)
     lines += (predicted is not None) + (paper is not None)
     _mark_collapses(ax, run)
-    ax.set_xlabel('impact number [1] (0: the start)')
+    ax.set_xlabel('impact number (0: the start)')
     ax.set_ylabel('velocity after the impact [m/s]')
     ax.set_title(title_of(run, 'velocities after each impact'), fontsize=10)
     if last <= 40:
@@ -358,7 +358,7 @@ def energy(run, ax=None, transfer=False):
         ax.set_ylabel('energy [J]')
         view = 'energies after each impact'
     _mark_collapses(ax, run)
-    ax.set_xlabel('impact number [1] (0: the start)')
+    ax.set_xlabel('impact number (0: the start)')
     ax.set_title(title_of(run, view), fontsize=10)
     ax.grid(alpha=0.3)
     _legend(ax, lines)
