@@ -209,6 +209,45 @@ class Run:
         return '<collision_lab.Run %d bodies, model %s, %s collisions>' % (
             len(self.masses), self.model, self.summary.get('collision_count'))
 
+    def _repr_html_(self):
+        """A notebook's view: the bodies (up to 12), the model and why, and the summary's
+        counts and checks, with units."""
+        from html import escape
+        s = self.summary
+
+        def value(x):
+            if x is None:
+                return '&ndash;'
+            if isinstance(x, bool):
+                return 'yes' if x else 'no'
+            if isinstance(x, int):
+                return format(x, ',')
+            if isinstance(x, float):
+                return '%.10g' % x
+            return escape(str(x))
+
+        shown = min(len(self.masses), 12)
+        bodies = ''.join('<tr><td>%s</td><td>%s</td><td>%s</td><td>%s</td></tr>' % (
+            escape(self.names[i]), 'wall' if math.isinf(self.masses[i]) else value(float(self.masses[i])),
+            value(float(self.initial_positions[i])), value(float(self.initial_velocities[i]))) for i in range(shown))
+        more = '' if shown == len(self.masses) else '<tr><td colspan="4">... %s bodies in all</td></tr>' % format(
+            len(self.masses), ',')
+        rows = [('collisions', s.get('collision_count'), ''),
+                ('simulated', s.get('simulated'), ''),
+                ('predicted collisions', s.get('predicted_collision_count'), ''),
+                ("the paper's formula", s.get('paper_predicted_collision_count'), ''),
+                ('truncated', s.get('truncated'), escape(s.get('truncation_reason') or '')),
+                ('max prediction error', s.get('max_prediction_error'), 'ratio'),
+                ('energy drift', s.get('energy_relative_drift'), 'ratio'),
+                ('momentum drift', s.get('momentum_relative_drift'), 'ratio'),
+                ('compute time', s.get('compute_time_s'), 's')]
+        summary = ''.join('<tr><th style="text-align:left">%s</th><td>%s</td><td>%s</td></tr>' % (name, value(x), unit)
+                          for name, x, unit in rows if x is not None)
+        return ('<div><b>collision_lab run</b>: %d bodies, model <code>%s</code> (%s)'
+                '<table><tr><th>body</th><th>mass [kg]</th><th>x [m]</th><th>v [m/s]</th></tr>%s%s</table>'
+                '<table>%s</table></div>' % (len(self.masses), escape(self.model), escape(self.model_reason),
+                                             bodies, more, summary))
+
 
 class CapWarning(UserWarning):
     """The cap (max_collisions) left a run unsimulated or cut it short."""

@@ -171,3 +171,13 @@ def test_the_cap_is_said_when_it_decides():
     from collision_lab import plot
     with pytest.raises(ValueError, match='simulate_to_cap=True'):
         plot.steps(over)
+
+
+def test_a_run_shows_itself_in_a_notebook():
+    """Run._repr_html_: the bodies with units, the model and why, the counts."""
+    html = collision_lab.run([100, 1, INF], [2, 1, 0], [-1, 0, 0])._repr_html_()
+    assert 'three_body_rotation' in html and 'mass [kg]' in html and 'v [m/s]' in html
+    assert '<td>wall</td>' in html
+    assert '<th style="text-align:left">collisions</th><td>31</td>' in html
+    big = collision_lab.run(np.ones(20), np.arange(20)[::-1] * 1.0, np.zeros(20))._repr_html_()
+    assert '20 bodies in all' in big and big.count('<tr><td>') == 12
