@@ -38,8 +38,6 @@ namespace collision_lab_web {
 using nlohmann::json;
 namespace fs = std::filesystem;
 
-/// Threads for what may block (the lab node's ~cancel, a bag's CSV conversion), so that
-/// the I/O threads never do.
 /// Work kept off the I/O threads: `pool` for cancel calls and CSV conversions, `readers`
 /// for the run list (the index) and runs read back from their bags. Each bounds how many
 /// run at once; the I/O threads serve pages and sends meanwhile.
@@ -92,9 +90,6 @@ std::optional<std::uint64_t> runNumber(const std::string& run_id, const std::str
   if (digits.size() > 18 || digits.find_first_not_of("0123456789") != std::string::npos) return std::nullopt;
   return std::stoull(digits);
 }
-
-
-/// Equal without telling by its time how much of a secret matched.
 
 std::string lower(std::string text) {
   std::transform(text.begin(), text.end(), text.begin(), [](unsigned char c) { return std::tolower(c); });
