@@ -16,7 +16,7 @@ catkin_add_gtest(ros_tools_unit_test
   test/ros/run_timeline_test.cpp
   test/ros/bag_csv_test.cpp)
 if(TARGET ros_tools_unit_test)
-  target_link_libraries(ros_tools_unit_test collision_lab_tools GTest::gtest_main)
+  target_link_libraries(ros_tools_unit_test collision_lab_tools collision_lab_test_support GTest::gtest_main)
   add_dependencies(ros_tools_unit_test bag_to_csv)
   target_compile_definitions(ros_tools_unit_test PRIVATE
     COLLISION_LAB_BAG_TO_CSV="$<TARGET_FILE:bag_to_csv>")

@@ -22,6 +22,8 @@ const letterName = (i) => (i < 26 ? String.fromCharCode(65 + i) : '#' + i);
 const bodyName = (i) => (viewBodies.has(i) ? viewBodies.get(i).name : letterName(i));
 const bodyColour = (i) => viewColours[i] || (viewBodies.has(i) ? viewBodies.get(i).colour : '#aaaaaa');
 const plural = (n, word) => fmt(n) + ' ' + word + (n === 1 ? '' : 's');
+// The server's kClassTableMaxBodies: wider runs have no positions and velocities CSV.
+const CLASS_TABLE_MAX_BODIES = 64;
 const charts = {};
 let firstPlotMs = null;
 
@@ -238,6 +240,7 @@ function summaryRows(run) {
 // <body> gets data-temperature-points and data-haff-tau [s].
 function drawTemperature(view) {
   document.getElementById('temperature_box').hidden = false;
+  document.querySelector('button[data-plot="temperature"]').hidden = false;
   const points = view.temperature.filter((q) => q[0] > 0 && q[1] > 0).map((q) => ({x: q[0], y: q[1]}));
   const c = chart('temperature', 't [s]', 'T [J]');
   c.options.scales.x.type = 'logarithmic';
@@ -271,8 +274,9 @@ function showNotSimulated(run, view) {
   box.hidden = !hide;
   ['velocity', 'energy', 'xt'].forEach((id) => { document.getElementById(id + '_box').hidden = hide; });
   // Nor downloads of what does not exist: the plots' PNGs and the events CSV (a 404).
-  document.querySelectorAll('button[data-plot]').forEach((b) => { b.hidden = hide; });
+  document.querySelectorAll('button[data-plot]').forEach((b) => { if (b.dataset.plot !== 'temperature') b.hidden = hide; });
   document.getElementById('dl_csv').hidden = hide;
+  document.getElementById('dl_table').hidden = hide || run.scene.masses.length > CLASS_TABLE_MAX_BODIES;
   if (!hide) return false;
   const p = run.prediction;
   let answer = 'The model (' + (p ? p.model : 'none') + ') answered: ';
@@ -382,11 +386,13 @@ function render(run) {
   if (ended(run.state)) {
     document.body.dataset.final = 'true';
     document.getElementById('stop').hidden = true;
+    if (location.hash === '#check-png') checkSlideImages();
   }
 }
 
 function setupDownloads() {
   document.getElementById('dl_csv').href = api + '/events.csv';
+  document.getElementById('dl_table').href = api + '/table.csv';
   const json = document.getElementById('dl_json');
   json.href = api;
   json.download = runId + '_summary.json';
@@ -396,12 +402,70 @@ function setupDownloads() {
       const c = charts[b.dataset.plot];
       if (!c) return;
       const a = document.createElement('a');
-      a.href = c.toBase64Image('image/png', 1);
+      a.href = slideImage(c, b.dataset.plot);
       a.download = runId + '_' + b.dataset.plot + '.png';
       a.click();
     };
   });
 }
+
+// Paints the canvas white under the plot: a PNG that reads on a dark slide too.
+const opaqueBackground = {
+  id: 'opaqueBackground',
+  beforeDraw(c) {
+    const g = c.ctx;
+    g.save();
+    g.globalCompositeOperation = 'destination-over';
+    g.fillStyle = '#ffffff';
+    g.fillRect(0, 0, c.width, c.height);
+    g.restore();
+  },
+};
+
+// A plot as a slide: PNG_WIDTH pixels wide, opaque, titled with what it shows and the run
+// (the axes carry the units), drawn at twice the page's scale so its text stays legible.
+const PNG_WIDTH = 1600;
+function slideCanvas(c, id) {
+  const scale = 2;
+  const canvas = document.createElement('canvas');
+  canvas.width = PNG_WIDTH / scale;
+  canvas.height = Math.round(PNG_WIDTH * 9 / 16 / scale);
+  canvas.style.width = canvas.width + 'px';
+  canvas.style.height = canvas.height + 'px';
+  const heading = document.querySelector('#' + id + '_box h2');
+  const title = (heading ? heading.textContent : id) + ': run ' + runId;
+  const options = c.config.options;
+  const copy = new Chart(canvas, {
+    type: c.config.type,
+    data: {datasets: c.data.datasets.map((d) => Object.assign({}, d, {data: d.data.slice()}))},
+    options: Object.assign({}, options, {
+      responsive: false, animation: false, devicePixelRatio: scale,
+      plugins: Object.assign({}, options.plugins, {title: {display: true, text: title, font: {size: 15}}}),
+    }),
+    plugins: [opaqueBackground],
+  });
+  const slide = document.createElement('canvas');  // the chart clears its own canvas when destroyed
+  slide.width = canvas.width;
+  slide.height = canvas.height;
+  slide.getContext('2d').drawImage(canvas, 0, 0);
+  copy.destroy();
+  return slide;
+}
+const slideImage = (c, id) => slideCanvas(c, id).toDataURL('image/png');
+
+// For tests (the page opened at #check-png): <body> gets data-png, "<plot>:<width>x<height>:
+// opaque|transparent" for each plot's slide.
+function checkSlideImages() {
+  document.body.dataset.png = Object.keys(charts).map((id) => {
+    const slide = slideCanvas(charts[id], id);
+    const corner = slide.getContext('2d').getImageData(0, 0, 1, 1).data;
+    return id + ':' + slide.width + 'x' + slide.height + ':' + (corner[3] === 255 ? 'opaque' : 'transparent');
+  }).join(' ');
+}
+
+// Printed, the plots are redrawn at the paper's width (one column) instead of shrunk.
+window.addEventListener('beforeprint', () => Object.values(charts).forEach((c) => c.resize()));
+window.addEventListener('afterprint', () => Object.values(charts).forEach((c) => c.resize()));
 
 async function poll() {
   const run = await (await fetch(api)).json();

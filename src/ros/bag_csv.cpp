@@ -17,6 +17,7 @@
 #include <boost/array.hpp>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
+#include <rosbag/query.h>
 
 #include "collision_lab/CollisionEvent.h"
 #include "collision_lab/EnergyTransfer.h"
@@ -28,6 +29,7 @@
 #include "collision_lab/Velocities.h"
 #include "collision_lab/core/nbody/body_state_replay.h"
 #include "collision_lab/core/nbody/scene.h"
+#include "collision_lab/core/totals.h"
 #include "collision_lab/io/number_text.h"
 #include "collision_lab/ros/bag_reading.h"
 #include "collision_lab/ros/msg_conversion.h"
@@ -758,6 +760,88 @@ CsvExport bagToCsv(const std::string& bag_path, const std::string& out_dir) {
   if (auto f = tidy.final_velocities.close(topicsOf<Prediction, RunSummary>(topics))) result.files.push_back(*f);
   result.warnings = tidy.bodies.warnings;
   return result;
+}
+
+namespace {
+
+void writeClassTableRow(std::ostream& out, double time, std::uint64_t impacts, const char* event,
+                        const std::string& pair, const std::vector<double>& x, const core::BodyStateReplay& state) {
+  writeCell(out, time);
+  out << ',' << impacts << ',' << event << ',' << pair;
+  for (double value : x) {
+    out << ',';
+    writeCell(out, value);
+  }
+  for (double value : state.velocities()) {
+    out << ',';
+    writeCell(out, value);
+  }
+  const core::Totals totals = core::totalsOf(state.masses(), state.velocities());
+  out << ',';
+  writeCell(out, totals.momentum);
+  out << ',';
+  writeCell(out, totals.kinetic_energy);
+  out << '\n';
+}
+
+}  // namespace
+
+ClassTable bagToClassTable(const std::string& bag_path, const std::string& csv_path, std::size_t max_bodies) {
+  using collision_lab::CollisionEvent, collision_lab::InitialConditions, collision_lab::RunSummary;
+  ReadableBag bag;
+  try {
+    bag = openBagForReading(bag_path);
+  } catch (const std::exception& e) {
+    throw BagCsvError("cannot read bag " + bag_path + ": " + e.what());
+  }
+  // The start first, whatever its stamp; then the events in the bag's order.
+  rosbag::View starts(*bag, rosbag::TypeQuery(ros::message_traits::datatype<InitialConditions>()));
+  std::optional<core::BodyStateReplay> state;
+  for (const rosbag::MessageInstance& m : starts) {
+    if (const auto initial = m.instantiate<InitialConditions>()) {
+      state.emplace(initial->masses, initial->positions, initial->velocities, initial->ring);
+      break;
+    }
+  }
+  if (!state) throw BagCsvError(bag_path + " has no InitialConditions: not a run of collision_lab_node");
+  ClassTable table;
+  table.bodies = state->size();
+  if (table.bodies > max_bodies) {
+    table.too_many_bodies = true;
+    return table;
+  }
+  std::ofstream out(csv_path);
+  if (!out) throw BagCsvError("cannot write " + csv_path);
+  out << "t_s,collision,event,pair";
+  for (std::size_t i = 0; i < table.bodies; ++i) out << ",x_" << core::bodyName(i) << "_m";
+  for (std::size_t i = 0; i < table.bodies; ++i) out << ",v_" << core::bodyName(i) << "_m_s";
+  out << ",p_total_kg_m_s,kinetic_total_J\n";
+  writeClassTableRow(out, 0.0, 0, "start", "", state->positions(0.0), *state);
+  ++table.rows;
+  std::uint64_t impacts = 0, summary_impacts = 0;
+  rosbag::View rest(*bag, rosbag::TypeQuery(std::vector<std::string>{
+                              ros::message_traits::datatype<CollisionEvent>(), ros::message_traits::datatype<RunSummary>()}));
+  for (const rosbag::MessageInstance& m : rest) {
+    if (const auto event = m.instantiate<CollisionEvent>()) {
+      if (!replayEvent(*state, *event)) continue;
+      const bool collapse = event->kind == CollisionEvent::KIND_COLLAPSE;
+      if (!collapse) impacts = event->index;
+      const std::string pair = collapse ? core::bodyName(event->first_moved) + ".." + core::bodyName(event->last_moved)
+                                        : core::pairName(event->pair_index);
+      const bool every_body = event->positions.size() == state->size();
+      writeClassTableRow(out, event->time, impacts, collapse ? "collapse" : "impact", pair,
+                         every_body ? std::vector<double>(event->positions.begin(), event->positions.end())
+                                    : state->positions(event->time),
+                         *state);
+      ++table.rows;
+    } else if (const auto summary = m.instantiate<RunSummary>()) {
+      summary_impacts = summary->collision_count;
+    }
+  }
+  out.close();
+  if (!out) throw BagCsvError("writing " + csv_path + " failed");
+  table.events_missing = summary_impacts > impacts;
+  return table;
 }
 
 }  // namespace collision_lab_ros

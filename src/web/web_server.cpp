@@ -64,6 +64,8 @@ constexpr auto kStreamInterval = std::chrono::milliseconds(300);
 constexpr auto kStreamKeepAlive = std::chrono::seconds(10);
 /// Presets of more bodies than this come without their lists (the form sends their name).
 constexpr std::size_t kPresetSceneMaxBodies = 100;
+/// The class table's widest run: two columns per body, a row per event.
+constexpr std::size_t kClassTableMaxBodies = 64;
 constexpr char kClassCookie[] = "collision_lab_class";
 constexpr char kTeacherCookie[] = "collision_lab_teacher";
 /// [s] a login lasts: a school day.
@@ -637,7 +639,7 @@ void WebServer::route(const HttpRequest& request, const Access& access, const Ht
   }
   static const std::regex student_stop("/api/students/([A-Za-z0-9_-]{1,64})/stop");
   if (post && std::regex_match(path, match, student_stop)) return stopStudent(request, match[1], access, reply);
-  static const std::regex run_api("/api/runs/" + kRunId + "(/events\\.csv|/bag|/stream|/stop)?");
+  static const std::regex run_api("/api/runs/" + kRunId + "(/events\\.csv|/table\\.csv|/bag|/stream|/stop)?");
   if (std::regex_match(path, match, run_api)) {
     const std::string run_id = match[1], what = match[2];
     if (post && what == "/stop") return stopRun(request, run_id, access, reply);
@@ -651,6 +653,7 @@ void WebServer::route(const HttpRequest& request, const Access& access, const Ht
       return boost::asio::post(blocking_->readers, send);  // read back from its bag
     }
     if (get && what == "/events.csv") return sendEventsCsv(request, run_id, reply);
+    if (get && what == "/table.csv") return sendClassTable(request, run_id, reply);
     if (get && what == "/bag") return sendBag(request, run_id, reply);
     if (get && what == "/stream") return stream(request, run_id, reply);
   }
@@ -1015,29 +1018,24 @@ std::optional<http::response<http::file_body>> fileAnswer(const HttpRequest& req
 
 }  // namespace
 
-void WebServer::sendEventsCsv(const HttpRequest& request, const std::string& run_id, const HttpReply& reply) {
+void WebServer::sendMadeFromBag(const HttpRequest& request, const std::string& run_id, const std::string& name,
+                                MakeFromBag make, const HttpReply& reply) {
   if (!book_.has(run_id)) return reply.send(errorAnswer(request, 404, "no such run"));
   if (!book_.finished(run_id)) return reply.send(errorAnswer(request, 409, "the run is not finished yet"));
   const std::string bag = book_.bagPath(run_id);
   if (bag.empty()) return reply.send(errorAnswer(request, 404, "the run was not recorded"));
-  const std::string name = run_id + "_events.csv";
-  const fs::path csv = fs::path(bag).parent_path() / name;
-  if (auto res = fileAnswer(request, csv.string(), "text/csv", name)) return reply.sendFile(std::move(*res));
-  // Converted once, beside the bag, off the I/O threads; a conversion finished by another
-  // request meanwhile is simply replaced by an identical one.
-  boost::asio::post(blocking_->pool, [this, request, reply, bag, csv, name] {
-    std::string folder = (csv.parent_path() / ("." + name + ".XXXXXX")).string();
+  const std::string file_name = run_id + "_" + name;
+  const fs::path made = fs::path(bag).parent_path() / file_name;
+  if (auto res = fileAnswer(request, made.string(), "text/csv", file_name)) return reply.sendFile(std::move(*res));
+  // Made once, beside the bag, off the I/O threads; a file made by another request
+  // meanwhile is simply replaced by an identical one.
+  boost::asio::post(blocking_->pool, [this, request, reply, bag, made, file_name, make = std::move(make)] {
+    std::string folder = (made.parent_path() / ("." + file_name + ".XXXXXX")).string();
     if (!mkdtemp(folder.data())) return reply.send(errorAnswer(request, 500, "cannot write beside the bag"));
-    bool has_events = false;
-    std::string error;
+    std::string error, why_not;
     try {
-      const auto exported = collision_lab_ros::bagToCsv(bag, folder);
-      for (const auto& file : exported.files) {
-        if (fs::path(file.path).filename() == "collision_events.csv") {
-          fs::rename(file.path, csv);
-          has_events = true;
-        }
-      }
+      const std::string path = make(bag, folder, why_not);
+      if (!path.empty()) fs::rename(path, made);
     } catch (const std::exception& e) {
       error = e.what();
     }
@@ -1045,13 +1043,37 @@ void WebServer::sendEventsCsv(const HttpRequest& request, const std::string& run
     std::error_code ignored;
     fs::remove_all(folder, ignored);
     if (!error.empty()) return reply.send(errorAnswer(request, 500, error));
-    if (!has_events) {
-      return reply.send(errorAnswer(request, 404, "the run has no collision events to export: it was not simulated, or had no impact"));
-    }
-    auto res = fileAnswer(request, csv.string(), "text/csv", name);
+    if (!why_not.empty()) return reply.send(errorAnswer(request, 404, why_not));
+    auto res = fileAnswer(request, made.string(), "text/csv", file_name);
     if (!res) return reply.send(errorAnswer(request, 500, "the converted CSV is gone"));
     reply.sendFile(std::move(*res));
   });
+}
+
+void WebServer::sendEventsCsv(const HttpRequest& request, const std::string& run_id, const HttpReply& reply) {
+  sendMadeFromBag(request, run_id, "events.csv", [](const std::string& bag, const std::string& folder, std::string& why) {
+    for (const auto& file : collision_lab_ros::bagToCsv(bag, folder).files) {
+      if (fs::path(file.path).filename() == "collision_events.csv") return file.path;
+    }
+    why = "the run has no collision events to export: it was not simulated, or had no impact";
+    return std::string();
+  }, reply);
+}
+
+// The class table: the state at the start and after each event, a column per body.
+void WebServer::sendClassTable(const HttpRequest& request, const std::string& run_id, const HttpReply& reply) {
+  sendMadeFromBag(request, run_id, "table.csv", [](const std::string& bag, const std::string& folder, std::string& why) {
+    const std::string path = folder + "/table.csv";
+    const auto table = collision_lab_ros::bagToClassTable(bag, path, kClassTableMaxBodies);
+    if (table.too_many_bodies) {
+      why = "the class table has a column per body and is made for at most " + std::to_string(kClassTableMaxBodies) +
+            " bodies; this run has " + std::to_string(table.bodies) + " (its events CSV has every impact)";
+    } else if (table.events_missing) {
+      why = "the run was recorded without all its events (it was not simulated, or ran in summary mode), so the table "
+            "cannot show it";
+    }
+    return why.empty() ? path : std::string();
+  }, reply);
 }
 
 // The bag: only the file its RunSummary names, and only when that file is <run_id>.bag.

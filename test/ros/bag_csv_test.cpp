@@ -26,11 +26,15 @@
 #include "collision_lab/RunParameters.h"
 #include "collision_lab/RunSummary.h"
 #include "collision_lab/Velocities.h"
+#include "collision_lab/core/scene_run.h"
 #include "collision_lab/ros/bag_csv.h"
+#include "collision_lab/ros/msg_conversion.h"
+#include "../core/rational_reference.h"
 
 namespace {
 
 namespace fs = std::filesystem;
+using collision_lab_ros::bagToClassTable;
 using collision_lab_ros::bagToCsv;
 using collision_lab_ros::csvColumns;
 constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -603,3 +607,119 @@ TEST_F(BagCsvTest, AnUnreadableBagIsAClearError) {
 }
 
 }  // namespace
+
+namespace class_table {
+
+namespace core = collision_lab::core;
+using core::reference::Q;
+
+/// A bag of the engine's run of `scene`, as the node records it: InitialConditions, every
+/// event, RunSummary.
+void recordRun(const std::string& bag_path, const core::Scene& scene) {
+  rosbag::Bag bag(bag_path, rosbag::bagmode::Write);
+  const ros::Time start(1'700'000'000, 0);
+  collision_lab::InitialConditions input =
+      collision_lab_ros::toInitialConditions(scene, core::RunMode::kFull, 1000);
+  input.run_id = "table";
+  bag.write("/collision_lab/initial_conditions", start, input);
+  const core::ScenePlan plan = core::planScene(scene);
+  core::SceneRunOptions options;
+  options.lab.max_collisions = 1000;
+  options.lab.events = core::EventPolicy::none();
+  core::SceneVisitors visitors;
+  collision_lab_ros::SceneEventConverter converter(plan.scene);
+  ros::Time stamp = start;
+  visitors.impact = [&](const core::ImpactRecord& e) {
+    auto msg = converter.impact(e);
+    msg.run_id = "table";
+    stamp += ros::Duration(0, 1000);
+    bag.write("/collision_lab/collision_events", stamp, msg);
+  };
+  auto summary = collision_lab_ros::toRunSummaryMsg(core::runScene(plan, options, visitors), scene.size(),
+                                                    core::RunMode::kFull);
+  summary.run_id = "table";
+  bag.write("/collision_lab/run_summaries", stamp + ros::Duration(0, 1000), summary);
+}
+
+/// The exact momentum and kinetic energy of the finite masses at the given doubles.
+std::pair<Q, Q> exactTotals(const std::vector<double>& masses, const std::vector<double>& velocities) {
+  Q momentum = 0, energy = 0;
+  for (std::size_t i = 0; i < masses.size(); ++i) {
+    if (std::isinf(masses[i])) continue;
+    momentum += Q(masses[i]) * Q(velocities[i]);
+    energy += Q(masses[i]) * Q(velocities[i]) * Q(velocities[i]) / 2;
+  }
+  return {momentum, energy};
+}
+
+}  // namespace class_table
+
+// The class table of the pi billiard (100 kg and 1 kg against a wall, 31 impacts), row by
+// row against test/core's exact rational run, which shares no code with the engine: the
+// start, then every impact's time, pair, positions and velocities; the totals are the
+// exact sums of the row's own doubles, rounded once.
+TEST_F(BagCsvTest, ClassTableIsTheExactRunAtTheStartAndAfterEveryImpact) {
+  using namespace class_table;
+  const core::Scene scene = core::threeBodies({100, 1, kInf}, {2, 1, 0}, {-1, 0, 0});
+  recordRun(bag_path_, scene);
+  const auto table = bagToClassTable(bag_path_, dir_ + "/table.csv", 64);
+  const auto exact = core::reference::simulate(scene, 1000);
+  ASSERT_EQ(exact.impacts.size(), 31u);
+  EXPECT_EQ(table.bodies, 3u);
+  EXPECT_EQ(table.rows, 32u);
+  EXPECT_FALSE(table.events_missing);
+  EXPECT_FALSE(table.too_many_bodies);
+
+  const Table csv = readCsv(dir_ + "/table.csv");
+  ASSERT_EQ(csv.size(), 33u);
+  EXPECT_EQ(csv[0], split("t_s,collision,event,pair,x_A_m,x_B_m,x_C_m,v_A_m_s,v_B_m_s,v_C_m_s,p_total_kg_m_s,"
+                          "kinetic_total_J"));
+  EXPECT_EQ(csv[1], split("0,0,start,,2,1,0,-1,0,0,-100,50"));
+  for (std::size_t k = 1; k <= 31; ++k) {
+    const auto& impact = exact.impacts[k - 1];
+    SCOPED_TRACE("impact " + std::to_string(k));
+    EXPECT_EQ(cell(csv, k + 1, "collision"), std::to_string(k));
+    EXPECT_EQ(cell(csv, k + 1, "event"), "impact");
+    EXPECT_EQ(cell(csv, k + 1, "pair"), core::pairName(impact.pair));
+    EXPECT_TRUE(core::testing_support::correctlyRounded(number(csv, k + 1, "t_s"), impact.time));
+    std::vector<double> v;
+    for (int i = 0; i < 3; ++i) {
+      const std::string name = std::string(1, static_cast<char>('A' + i));
+      const double x = number(csv, k + 1, "x_" + name + "_m");
+      v.push_back(number(csv, k + 1, "v_" + name + "_m_s"));
+      EXPECT_TRUE(core::testing_support::correctlyRounded(v.back(), impact.velocities[i])) << name;
+      EXPECT_TRUE(core::reference::closeOnScale(x, impact.positions[i], 2, 1e-15)) << name << " at " << x;
+    }
+    const auto [momentum, energy] = exactTotals({100, 1, kInf}, v);
+    EXPECT_TRUE(core::testing_support::correctlyRounded(number(csv, k + 1, "p_total_kg_m_s"), momentum));
+    EXPECT_TRUE(core::testing_support::correctlyRounded(number(csv, k + 1, "kinetic_total_J"), energy));
+    EXPECT_NEAR(number(csv, k + 1, "kinetic_total_J"), 50.0, 1e-12);  // elastic, the wall at rest
+  }
+}
+
+// A table with a column per body is refused past max_bodies (nothing written); a bag whose
+// summary counts impacts it has no events for says so.
+TEST_F(BagCsvTest, ClassTableRefusesTooManyBodiesAndSaysWhenEventsAreMissing) {
+  using namespace class_table;
+  {
+    rosbag::Bag bag(bag_path_, rosbag::bagmode::Write);
+    collision_lab::InitialConditions input;
+    input.run_id = "wide";
+    input.masses.assign(5, 1.0);
+    input.positions = {4, 3, 2, 1, 0};
+    input.velocities = {-1, 0, 0, 0, 0};
+    bag.write("/collision_lab/initial_conditions", ros::Time(1, 0), input);
+    collision_lab::RunSummary summary;
+    summary.run_id = "wide";
+    summary.collision_count = 4;
+    bag.write("/collision_lab/run_summaries", ros::Time(1, 0), summary);
+  }
+  const auto refused = bagToClassTable(bag_path_, dir_ + "/wide.csv", 4);
+  EXPECT_TRUE(refused.too_many_bodies);
+  EXPECT_EQ(refused.bodies, 5u);
+  EXPECT_FALSE(fs::exists(dir_ + "/wide.csv"));
+  const auto start_only = bagToClassTable(bag_path_, dir_ + "/start.csv", 64);
+  EXPECT_TRUE(start_only.events_missing);
+  EXPECT_EQ(start_only.rows, 1u);
+  EXPECT_THROW(bagToClassTable(dir_ + "/missing.bag", dir_ + "/x.csv", 64), collision_lab_ros::BagCsvError);
+}

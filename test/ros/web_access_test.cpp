@@ -560,6 +560,21 @@ TEST_F(WebAccessTest, EventsCsvIsConvertedOnceBesideTheBagAndStreamed) {
   ASSERT_TRUE(csv);
   EXPECT_EQ(csv->status, 404);
   EXPECT_NE(json::parse(csv->body).at("error").get<std::string>().find("no collision events"), std::string::npos);
+
+  // The class table: a column per body, the start and one row per impact; without an
+  // impact, the start alone (the bodies move apart: still a table to plot).
+  auto table = c.Get(("/api/runs/" + run_id + "/table.csv").c_str());
+  ASSERT_TRUE(table);
+  ASSERT_EQ(table->status, 200) << table->body;
+  EXPECT_EQ(table->body.substr(0, table->body.find('\n')),
+            "t_s,collision,event,pair,x_A_m,x_B_m,x_C_m,v_A_m_s,v_B_m_s,v_C_m_s,p_total_kg_m_s,kinetic_total_J");
+  EXPECT_EQ(std::count(table->body.begin(), table->body.end(), '\n'), 1 + 1 + 31);
+  EXPECT_TRUE(std::ifstream(bag_directory + "/" + run_id + "_table.csv").good());
+  table = c.Get(("/api/runs/" + apart + "/table.csv").c_str());
+  ASSERT_TRUE(table);
+  ASSERT_EQ(table->status, 200) << table->body;
+  EXPECT_EQ(std::count(table->body.begin(), table->body.end(), '\n'), 2) << table->body;
+  EXPECT_NE(table->body.find("\n0,0,start,,1,0,1,-1,"), std::string::npos) << table->body;
 }
 
 TEST_F(WebAccessTest, HugeHeadersAre431AndIdleConnectionsAreClosed) {

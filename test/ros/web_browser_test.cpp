@@ -118,6 +118,11 @@ TEST_F(WebBrowserTest, RunPageDrawsItsPlots) {
     ASSERT_TRUE(pixels.count(plot)) << "no plot " << plot << " reported";
     EXPECT_GT(pixels.at(plot), 0) << plot;
   }
+  // Each plot's PNG is a slide: 1600 px wide, opaque.
+  const std::string checked = chromium("--dump-dom", page + "#check-png");
+  EXPECT_NE(checked.find("data-png=\"velocity:1600x900:opaque energy:1600x900:opaque xt:1600x900:opaque\""),
+            std::string::npos)
+      << checked.substr(0, 600);
 
   const std::string shot = dir_ + "/run.png";
   chromium("--screenshot=" + shot, page);

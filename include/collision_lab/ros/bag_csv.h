@@ -57,6 +57,30 @@ struct CsvExport {
 /// when the bag has their topics. Creates out_dir. Throws BagCsvError.
 CsvExport bagToCsv(const std::string& bag_path, const std::string& out_dir);
 
+/// A run's class table (bagToClassTable).
+struct ClassTable {
+  std::size_t bodies = 0;  ///< columns x_ and v_ per body
+  std::size_t rows = 0;    ///< the start and one per event
+  /// The run's RunSummary counts impacts the bag has no event for (recorded without events,
+  /// or cut): the table is not the whole run.
+  bool events_missing = false;
+  /// More than max_bodies bodies: nothing written (rows 0).
+  bool too_many_bodies = false;
+};
+
+/// The class table of the run recorded in the bag (one run per bag, as collision_lab_node
+/// writes them), written to csv_path: one row for the state at t = 0, then one after each
+/// event, in full precision (io::writeCsvNumber). Columns: t_s (simulated time from 0),
+/// collision (the impacts so far), event (start, impact, collapse), pair (the pair's name;
+/// a collapse names its first and last body, "A..E"), x_<name>_m for every body (at that
+/// time), v_<name>_m_s (just after), then the finite masses' p_total_kg_m_s and
+/// kinetic_total_J (core::totalsOf: each the exact sum rounded once). Body names are
+/// core::bodyName's (A is the rightmost). Positions are the event's when it carries every
+/// body, else the core's replay of the run. A run of more than max_bodies bodies (a column
+/// per body) writes nothing. Throws BagCsvError when the bag cannot be read, has no
+/// InitialConditions, or csv_path cannot be written.
+ClassTable bagToClassTable(const std::string& bag_path, const std::string& csv_path, std::size_t max_bodies);
+
 /// The CSV columns of a collision_lab message type, each with the message field it comes
 /// from ("header" for stamp_s) and its file ("" for the topic's own, else "bodies.csv" or
 /// "final_velocities.csv"); for tests that check every field is exported.

@@ -123,7 +123,14 @@ class WebServer {
   /// POST /api/students/<student>/stop (the teacher): every queued or running run of student.
   void stopStudent(const HttpRequest& request, const std::string& student, const Access& access, const HttpReply& reply);
   void login(const HttpRequest& request, const HttpReply& reply);
+  /// A file made once from a finished run's bag, kept beside the bag as <run_id>_<name> and
+  /// sent. make(bag, folder) writes it into a temporary folder and returns its path there,
+  /// or the empty string and, in why, the 404 text when the run has no such file.
+  using MakeFromBag = std::function<std::string(const std::string& bag, const std::string& folder, std::string& why)>;
+  void sendMadeFromBag(const HttpRequest& request, const std::string& run_id, const std::string& name,
+                       MakeFromBag make, const HttpReply& reply);
   void sendEventsCsv(const HttpRequest& request, const std::string& run_id, const HttpReply& reply);
+  void sendClassTable(const HttpRequest& request, const std::string& run_id, const HttpReply& reply);
   void sendBag(const HttpRequest& request, const std::string& run_id, const HttpReply& reply);
   void stream(const HttpRequest& request, const std::string& run_id, const HttpReply& reply);
   /// Seconds until `key` may send again under `limit` per minute; 0 (and counted) when now.
