@@ -194,7 +194,7 @@ function queueTable(queue) {
     tr.appendChild(td);
     tr.appendChild(el('td', r.student));
     tr.appendChild(el('td', r.lane));
-    tr.appendChild(el('td', r.running ? 'running' : 'waiting'));
+    tr.appendChild(el('td', (r.running ? 'running' : 'waiting') + (stopReplies.has(r.run_id) ? ', stopping' : '')));
     tr.appendChild(stopCell(r.run_id));
     table.appendChild(tr);
   }
@@ -202,12 +202,37 @@ function queueTable(queue) {
   return section;
 }
 
+/// The lab node's answer to each Stop sent from this page, by run_id: kept across the
+/// page's refreshes, which redraw every table.
+const stopReplies = new Map();
+
 function stopCell(runId) {
   const td = el('td');
+  if (stopReplies.has(runId)) {
+    td.appendChild(el('span', stopReplies.get(runId), {'data-stop-reply': runId}));
+    return td;
+  }
   const button = el('button', 'Stop', {type: 'button', 'data-stop': runId});
-  button.onclick = async () => { button.disabled = true; button.textContent = await stopRun(runId, null); };
+  button.onclick = async () => {
+    button.disabled = true;
+    stopReplies.set(runId, await stopRun(runId, null));
+    td.replaceChildren(el('span', stopReplies.get(runId), {'data-stop-reply': runId}));
+  };
   td.appendChild(button);
   return td;
+}
+
+/// A run's state as the teacher reads it: how it ended (not simulated, cancelled and by
+/// whom, collapsed, cut short, not recorded), or "stopping" once a Stop was answered.
+function stateText(r) {
+  if (r.state === 'queued' || r.state === 'running') return stopReplies.has(r.run_id) ? r.state + ', stopping' : r.state;
+  const parts = [r.state];
+  if (r.simulated === false) parts.push('not simulated: the model\'s count');
+  if (r.cancelled) parts.push(r.cancel_reason || 'cancelled');
+  else if (r.truncated) parts.push('truncated');
+  if (r.collapsed) parts.push('collapsed');
+  if (r.recorded === false) parts.push('not recorded');
+  return parts.join(', ');
 }
 
 /// A count as people read it: "31,415".
@@ -244,7 +269,7 @@ function studentSection(name, runs, rejections) {
       const td = el('td');
       td.appendChild(el('a', r.run_id, {href: '/runs/' + encodeURIComponent(r.run_id)}));
       tr.appendChild(td);
-      tr.appendChild(el('td', r.state + (r.truncated ? ' (truncated)' : '') + (r.recorded === false ? ' (not recorded)' : '')));
+      tr.appendChild(el('td', stateText(r), {'data-state': r.state}));
       tr.appendChild(el('td', r.bodies === undefined ? '' : countText(r.bodies)));
       tr.appendChild(el('td', r.collisions === undefined ? '' : countText(r.collisions)));
       tr.appendChild(el('td', r.model || ''));

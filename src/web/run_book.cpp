@@ -312,6 +312,8 @@ collision_lab::RunSummary summaryFromRow(const collision_lab::service::IndexedRu
     s.truncated = fields.value("truncated", false);
     s.truncation_reason = fields.value("truncation_reason", s.truncation_reason);
     s.simulated = fields.value("simulated", false);
+    s.cancelled = fields.value("cancelled", false);
+    s.collapsed = fields.value("collapsed", false);
     s.body_count = fields.value("body_count", s.body_count);
     s.published_events = fields.value("published_events", s.published_events);
     s.uncertified_values = fields.value("uncertified_values", s.uncertified_values);
@@ -330,6 +332,10 @@ collision_lab::RunSummary summaryOfStub(const std::string& run_id, const Evicted
   s.model_name = stub.model_name;
   s.collision_count = stub.collision_count;
   s.truncated = stub.truncated;
+  s.simulated = stub.simulated;
+  s.cancelled = stub.cancelled;
+  s.collapsed = stub.collapsed;
+  s.truncation_reason = stub.truncation_reason;
   s.stop_reason = stub.interrupted ? "INTERRUPTED" : "";
   s.bag_path = stub.bag_path;
   s.recording_ok = true;
@@ -593,6 +599,10 @@ void RunBook::enforceBudgetLocked(const std::string& keep) {
       stub.bodies = run.record ? static_cast<std::uint32_t>(run.record->bodies()) : 0;
       stub.interrupted = run.interrupted;
       stub.truncated = run.summary->truncated;
+      stub.simulated = run.summary->simulated;
+      stub.cancelled = run.summary->cancelled;
+      stub.collapsed = run.summary->collapsed;
+      if (stub.cancelled) stub.truncation_reason = run.summary->truncation_reason;
       stub.sequence = run.sequence;
       evicted_.emplace(run_id, std::move(stub));
     }
@@ -821,6 +831,18 @@ const char* stateOf(const WebRun& run) {
   return run.record || run.started ? "running" : "queued";
 }
 
+/// How an ended run ended, for the teacher's list: its model, whether it was simulated,
+/// cut short (cancelled: by whom, in cancel_reason), collapsed, and recorded.
+void addEnding(nlohmann::json& item, const collision_lab::RunSummary& summary, bool recorded) {
+  item["model"] = summary.model_name;
+  item["truncated"] = static_cast<bool>(summary.truncated);
+  item["recorded"] = recorded;
+  item["simulated"] = static_cast<bool>(summary.simulated);
+  item["collapsed"] = static_cast<bool>(summary.collapsed);
+  item["cancelled"] = static_cast<bool>(summary.cancelled);
+  if (summary.cancelled) item["cancel_reason"] = summary.truncation_reason;
+}
+
 nlohmann::json listItem(const WebRun& run) {
   nlohmann::json item = {{"run_id", run.run_id},
                          {"student", run.student},
@@ -829,24 +851,19 @@ nlohmann::json listItem(const WebRun& run) {
                          {"collisions", run.summary ? run.summary->collision_count
                                                     : (run.record ? run.record->collisions() : 0)}};
   if (run.record) item["bodies"] = run.record->bodies();
-  if (run.summary) {
-    item["model"] = run.summary->model_name;
-    item["truncated"] = static_cast<bool>(run.summary->truncated);
-    item["recorded"] = run.summary->recording_ok && !run.summary->bag_path.empty();
-  }
+  if (run.summary) addEnding(item, *run.summary, run.summary->recording_ok && !run.summary->bag_path.empty());
   return item;
 }
 
 nlohmann::json listItem(const std::string& run_id, const EvictedRun& stub) {
-  return {{"run_id", run_id},
-          {"student", stub.student},
-          {"state", stub.interrupted ? "interrupted" : "finished"},
-          {"accepted_stamp", stub.accepted_stamp},
-          {"collisions", stub.collision_count},
-          {"bodies", stub.bodies},
-          {"model", stub.model_name},
-          {"truncated", stub.truncated},
-          {"recorded", !stub.bag_path.empty()}};
+  nlohmann::json item = {{"run_id", run_id},
+                         {"student", stub.student},
+                         {"state", stub.interrupted ? "interrupted" : "finished"},
+                         {"accepted_stamp", stub.accepted_stamp},
+                         {"collisions", stub.collision_count},
+                         {"bodies", stub.bodies}};
+  addEnding(item, summaryOfStub(run_id, stub), !stub.bag_path.empty());
+  return item;
 }
 
 /// A run the web node does not hold, as its index row says.
@@ -858,12 +875,7 @@ nlohmann::json listItem(const collision_lab::service::IndexedRun& row) {
                          {"collisions", row.collision_count}};
   const nlohmann::json scene = nlohmann::json::parse(row.scene_json, nullptr, false);
   if (scene.is_object() && scene.contains("masses") && scene["masses"].is_array()) item["bodies"] = scene["masses"].size();
-  if (ended(row.state)) {
-    const collision_lab::RunSummary summary = summaryFromRow(row);
-    item["model"] = summary.model_name;
-    item["truncated"] = static_cast<bool>(summary.truncated);
-    item["recorded"] = !row.bag_path.empty();
-  }
+  if (ended(row.state)) addEnding(item, summaryFromRow(row), !row.bag_path.empty());
   return item;
 }
 }  // namespace

@@ -450,6 +450,17 @@ TEST_F(WebAccessTest, OwnerAndTeacherStopARunAClassmateCannot) {
       "the teacher's stop to be taken"));
   run = finishedRun(other);
   EXPECT_EQ(run.at("summary").at("stop_reason"), "CANCELLED");
+
+  // The teacher's list says who stopped each run.
+  const auto listed = [&](const std::string& student) {
+    auto r = teacher.Get(("/api/runs?student=" + student).c_str());
+    return r && r->status == 200 ? json::parse(r->body).at(0) : json();
+  };
+  const json una = listed("una"), vic = listed("vic");
+  EXPECT_EQ(una.value("cancelled", false), true) << una.dump();
+  EXPECT_NE(una.value("cancel_reason", "").find("by its student"), std::string::npos) << una.dump();
+  EXPECT_NE(vic.value("cancel_reason", "").find("by the teacher"), std::string::npos) << vic.dump();
+  EXPECT_EQ(vic.value("simulated", false), true) << vic.dump();
 }
 
 TEST_F(WebAccessTest, TheTeacherStopsAllOfOneStudentsRunsAtOnce) {

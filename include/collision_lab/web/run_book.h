@@ -91,6 +91,10 @@ struct EvictedRun {
   std::uint32_t bodies = 0;           ///< [1]
   bool interrupted = false;
   bool truncated = false;
+  bool simulated = true;
+  bool cancelled = false;
+  bool collapsed = false;
+  std::string truncation_reason;  ///< kept for a cancelled run only: who stopped it
 };
 
 struct RunBookOptions {
