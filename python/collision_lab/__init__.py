@@ -2,7 +2,9 @@
 
 run() and predict() run one scene as collision_lab_cli does (its JSON report, as dicts and
 numpy arrays); sweep() runs many, on every core or on a Dask cluster; read_bag() opens a
-run the ROS node recorded. collision_lab.msg holds the package's ROS messages.
+run the ROS node recorded. A Run's summary has the same keys (SUMMARY_KEYS) from all three,
+for every model, and its scene (SCENE_KEYS) goes back into run(**scene).
+collision_lab.msg holds the package's ROS messages.
 """
 from pkgutil import extend_path
 
@@ -12,11 +14,12 @@ from pkgutil import extend_path
 __path__ = extend_path(__path__, __name__)
 
 from ._core import version as __version__
-from ._run import CapWarning, Run, SceneError, body_name, predict, run
+from ._run import SCENE_KEYS, SUMMARY_KEYS, CapWarning, Run, SceneError, body_name, predict, run
 from ._sweep import sweep
 from ._bag import read_bag
 
-__all__ = ['CapWarning', 'Run', 'SceneError', 'body_name', 'plot', 'predict', 'read_bag', 'run', 'sweep']
+__all__ = ['CapWarning', 'Run', 'SCENE_KEYS', 'SUMMARY_KEYS', 'SceneError', 'body_name', 'plot', 'predict', 'read_bag',
+           'run', 'sweep']
 
 
 def __getattr__(name):

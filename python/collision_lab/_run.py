@@ -1,8 +1,9 @@
 """One scene run in process: collision_lab.run, predict, SceneError and the Run object.
 
 The C++ part (collision_lab._core) is collision_lab_cli's own parser, core run and JSON
-report writer: a Run's summary, scene, options and events are the CLI's JSON, key for key
-and value for value.
+report writer: a Run's report, options and events are the CLI's JSON, key for key and value
+for value; its summary is the CLI's completed to one set of keys for every model
+(SUMMARY_KEYS), and its scene is run()'s keyword arguments (SCENE_KEYS).
 """
 import json
 import math
@@ -16,6 +17,28 @@ from . import _core
 _PREDICTION_KEYS = ('model', 'model_reason', 'count_formula', 'max_possible_collision_count',
                     'critical_restitution', 'spiral_angle', 'theta', 'alpha', 'omega', 'psi',
                     'paper_phi_bc')
+# The keys of every Run's summary, whatever the model (run(), sweep()'s columns; read_bag()
+# adds run_id, student and bag_path). The CLI writes two summaries: the three-body report's
+# (three elastic bodies: the rotation model's angles, cancelled, truncation_reason) and the
+# scene report's (stop_reason, collapses, heat, ...). A key that a run's report lacks is
+# filled where the model decides it (below, complete_summary), else None.
+SUMMARY_KEYS = ('model', 'model_reason', 'collision_count', 'simulated', 'truncated', 'cancelled',
+                'truncation_reason', 'stop_reason', 'stop_message', 'predicted_collision_count',
+                'predicted_infinite', 'count_formula', 'matches_prediction', 'max_prediction_error',
+                'final_time', 'time_beyond_range', 'energy_lost', 'energy_relative_drift',
+                'momentum_relative_drift', 'compute_time_s', 'collapsed', 'collapse_time',
+                'collapse_position', 'cluster_impacts', 'rule_elastic_impacts', 'critical_restitution',
+                'spiral_angle', 'uncertified_values', 'multiple_collision', 'escalation',
+                'final_velocities', 'predicted_final_velocities', 'paper_predicted_collision_count',
+                'max_possible_collision_count', 'predicted_first_pair', 'theta', 'alpha', 'omega', 'psi',
+                'paper_phi_bc')
+# summary['escalation']: the three-body report's keys and the scene report's, None where not given.
+ESCALATION_KEYS = ('decisions', 'refinements', 'high_precision', 'exact_rational', 'replayed_impacts')
+# Run.scene's keys: run()'s keyword arguments but temperature_csv (a file the run writes), so
+# that run(**r.scene) runs r's scene again with r's options.
+SCENE_KEYS = ('name', 'masses', 'positions', 'velocities', 'restitution', 'ring', 'restitution_model',
+              'tc', 'elastic_below', 'viscoelastic_speed', 'max_collisions', 'simulate_to_cap', 'mode',
+              'events', 'full_state_every')
 # Per-event values with one number per body ([m], [m/s], [J]).
 _BODY_ARRAYS = ('positions', 'velocities_before', 'velocities_after', 'energy_transfer',
                 'kinetic_energy_after')
@@ -65,6 +88,56 @@ def _body_values(name, values):
     if array.size == 0 and name != 'restitution':
         raise ValueError('%s is empty: give one number per body' % name)
     return array
+
+
+def _plain(value):
+    """A number as a Python float, numbers as a list of them (None stays None)."""
+    if value is None:
+        return None
+    if np.ndim(value) == 0:
+        return float(value)
+    return np.asarray(value, dtype=float).reshape(-1).tolist()
+
+
+def scene_of(masses, positions, velocities, restitution=1.0, *, ring=None, restitution_model='constant',
+             tc=None, elastic_below=None, viscoelastic_speed=None, max_collisions=10_000_000,
+             simulate_to_cap=False, events='all', mode='full', name='', full_state_every=1):
+    """Run.scene of run()'s (checked) arguments: every key of SCENE_KEYS, numbers as Python
+    floats (the doubles the engine was given), so that run(**scene) runs the same scene."""
+    return {'name': str(name), 'masses': _plain(masses), 'positions': _plain(positions),
+            'velocities': _plain(velocities), 'restitution': _plain(restitution), 'ring': _plain(ring),
+            'restitution_model': str(restitution_model), 'tc': _plain(tc), 'elastic_below': _plain(elastic_below),
+            'viscoelastic_speed': _plain(viscoelastic_speed), 'max_collisions': int(max_collisions),
+            'simulate_to_cap': bool(simulate_to_cap), 'mode': str(mode), 'events': str(events),
+            'full_state_every': int(full_state_every)}
+
+
+def complete_summary(summary):
+    """The CLI's summary with every key of SUMMARY_KEYS, in that order (any other key after).
+
+    The three-body report (three elastic bodies, or three that never collide) lacks the
+    scene report's keys where the model decides them: elastic impacts neither collapse, stick
+    nor lose heat (collapsed False, collapse_time and collapse_position None, cluster_impacts
+    and rule_elastic_impacts 0, energy_lost 0.0), and the model counts every impact
+    (predicted_infinite False). The scene report lacks cancelled (stop_reason 'CANCELLED') and
+    truncation_reason (stop_message when truncated, else ''), as RunSummary has them. Every
+    other key a report lacks is None, and escalation has every key of ESCALATION_KEYS.
+    """
+    if not summary:
+        return {}
+    given = dict(summary)
+    if 'collapsed' not in given:  # the three-body report
+        given.update(collapsed=False, collapse_time=None, collapse_position=None, cluster_impacts=0,
+                     rule_elastic_impacts=0, energy_lost=0.0)
+        given['predicted_infinite'] = False if given.get('predicted_collision_count') is not None else None
+    if 'cancelled' not in given:  # the scene report
+        given['cancelled'] = given.get('stop_reason') == 'CANCELLED'
+        given['truncation_reason'] = (given.get('stop_message') or '') if given.get('truncated') else ''
+    escalation = dict(given.get('escalation') or {})
+    given['escalation'] = dict({key: escalation.pop(key, None) for key in ESCALATION_KEYS}, **escalation)
+    completed = {key: given.pop(key, None) for key in SUMMARY_KEYS}
+    completed.update(given)
+    return completed
 
 
 # The CLI's reasons and codes of the option errors that run() words in Python (docs/cli.md).
@@ -171,27 +244,32 @@ def _events_arrays(events, bodies):
 class Run:
     """One scene's run: the CLI's JSON report, with the events as numpy arrays.
 
-    summary, scene, options, units: the report's objects as dicts (null -> None).
-    model, model_reason: the model that answered, and why. prediction: the model's answer
-    (the summary's predicted_* and model fields; equal to predict()). events: dict of numpy
-    arrays, one entry per event in order (see docs/python.md for the keys and units).
-    names: the bodies' names; masses [kg] (inf: a wall), initial_positions [m],
-    initial_velocities [m/s]: numpy arrays.
+    scene: run()'s keyword arguments for this run (SCENE_KEYS): run(**r.scene) runs it again
+    (the same count and final velocities, bit for bit). summary: the CLI's summary under
+    every key of SUMMARY_KEYS, for every model (complete_summary). options, units: the
+    report's objects as dicts (null -> None); report: the whole JSON document (its 'scene'
+    has the CLI's description, bodies and walls). model, model_reason: the model that
+    answered, and why. prediction: the model's answer (the summary's predicted_* and model
+    fields; equal to predict()). events: dict of numpy arrays, one entry per event in order
+    (see docs/python.md for the keys and units). names: the bodies' names; walls: the names
+    of the walls; masses [kg] (inf: a wall), initial_positions [m], initial_velocities
+    [m/s]: numpy arrays.
     """
 
-    def __init__(self, report, masses, positions, velocities):
+    def __init__(self, report, scene, summary=None):
         self.report = report
-        self.summary = report['summary']
-        self.scene = report['scene']
+        self.scene = scene
+        self.summary = complete_summary(report.get('summary', {})) if summary is None else summary
         self.options = report['options']
         self.units = report['units']
-        self.model = self.summary.get('model', '')
-        self.model_reason = self.summary.get('model_reason', '')
+        self.model = self.summary.get('model') or ''
+        self.model_reason = self.summary.get('model_reason') or ''
         self.prediction = prediction_of(self.summary)
-        self.masses = np.asarray(masses, dtype=float)
-        self.initial_positions = np.asarray(positions, dtype=float)
-        self.initial_velocities = np.asarray(velocities, dtype=float)
+        self.masses = np.asarray(scene['masses'], dtype=float)
+        self.initial_positions = np.asarray(scene['positions'], dtype=float)
+        self.initial_velocities = np.asarray(scene['velocities'], dtype=float)
         self.names = [body_name(i) for i in range(len(self.masses))]
+        self.walls = [name for name, mass in zip(self.names, self.masses) if math.isinf(mass)]
         self.events = _events_arrays(report.get('events', []), len(self.masses))
 
     def to_pandas(self):
@@ -293,13 +371,18 @@ def run(masses, positions, velocities, restitution=1.0, *, ring=None, restitutio
     The GIL is released while it runs; Ctrl-C stops it (KeyboardInterrupt).
     Raises SceneError for a scene or option the CLI rejects. Warns (CapWarning) when the
     cap left the run unsimulated (the model answered) or cut it short.
+    The Run's scene holds these arguments (but temperature_csv): run(**r.scene) runs r again.
     """
     args = scene_arguments(masses, positions, velocities, restitution, ring=ring,
                            restitution_model=restitution_model, tc=tc, elastic_below=elastic_below,
                            viscoelastic_speed=viscoelastic_speed, max_collisions=max_collisions,
                            simulate_to_cap=simulate_to_cap, events=events, mode=mode,
                            temperature_csv=temperature_csv, full_state_every=full_state_every)
-    result = Run(parse_report(_core.run_json(args, name)), masses, positions, velocities)
+    scene = scene_of(masses, positions, velocities, restitution, ring=ring, restitution_model=restitution_model,
+                     tc=tc, elastic_below=elastic_below, viscoelastic_speed=viscoelastic_speed,
+                     max_collisions=max_collisions, simulate_to_cap=simulate_to_cap, events=events, mode=mode,
+                     name=name, full_state_every=full_state_every)
+    result = Run(parse_report(_core.run_json(args, name)), scene)
     _warn_about_cap(result, max_collisions, simulate_to_cap, mode)
     return result
 

@@ -6,7 +6,7 @@ import math
 import os
 
 from . import _core
-from ._run import scene_arguments
+from ._run import ESCALATION_KEYS, SUMMARY_KEYS, complete_summary, scene_arguments
 
 # A scene dict's keys besides the run() keyword arguments.
 _SCENE_KEYS = ('masses', 'positions', 'velocities', 'restitution', 'name')
@@ -45,15 +45,20 @@ def scene_job(scene, options):
 
 
 RUN_OPTIONS = ('ring', 'restitution_model', 'tc', 'elastic_below', 'viscoelastic_speed',
-               'max_collisions', 'simulate_to_cap', 'events', 'mode')
+               'max_collisions', 'simulate_to_cap', 'events', 'mode', 'full_state_every')
 
 
 def summary_row(text):
-    """One table row of a report: the summary, its dict values flattened to 'key.subkey'
-    columns (lists kept as lists), then the error columns."""
+    """One table row of a report: the summary (complete_summary: every key of SUMMARY_KEYS,
+    None for a rejected scene), its dict values flattened to 'key.subkey' columns (lists kept
+    as lists), then the error columns."""
     report = json.loads(text)
+    if 'error' in report:
+        summary = dict({key: None for key in SUMMARY_KEYS}, escalation=dict.fromkeys(ESCALATION_KEYS))
+    else:
+        summary = complete_summary(report['summary'])
     row = {}
-    for key, value in report.get('summary', {}).items():
+    for key, value in summary.items():
         if isinstance(value, dict):
             row.update(('%s.%s' % (key, sub), v) for sub, v in value.items())
         else:
@@ -88,10 +93,12 @@ def sweep(scenes=None, *, grid=None, base=None, client=None, workers=None, chunk
     Cartesian product, with base: a function(params) -> scene dict, or a dict of defaults.
     options: run() options for every scene (a scene's own keys win); events default 'none'
     (the summaries are the point: the CLI's --events none summary).
-    Columns: the grid's parameters, then the summary's keys (dicts flattened to
-    'escalation.decisions', ...; lists such as final_velocities kept as lists), then
-    error_reason, error_field, error_message (None unless the scene was rejected: its row
-    then has the CLI's JSON error and no summary).
+    Columns: the grid's parameters, then the summary's keys, the same for every model as in
+    run() (collision_lab.SUMMARY_KEYS; dicts flattened to 'escalation.decisions', ...; lists
+    such as final_velocities kept as lists), then error_reason, error_field, error_message
+    (None unless the scene was rejected: its row then has the CLI's JSON error and no
+    summary). A collapse is a collapse: collapsed is True or False for every scene that ran
+    (collision_count is then the impacts before it), collapse_time [s] None unless collapsed.
     Locally on `workers` C++ threads (default os.cpu_count()). client: a
     dask.distributed.Client; the scenes go in chunks of chunk_size (default: about four
     per worker thread) to the cluster, which runs the same C++ function: the table equals

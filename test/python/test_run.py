@@ -70,8 +70,14 @@ def test_run_equals_cli_json(cli, model, kwargs, cli_args):
     run = collision_lab.run(**kwargs)
     assert run.model == expected['summary']['model'] == model
     assert without_wall_time(run.report) == without_wall_time(expected)
-    assert run.summary.keys() == expected['summary'].keys()
-    assert run.scene == expected['scene'] and run.options == expected['options'] and run.units == expected['units']
+    # The summary: the CLI's keys and values, completed to the keys of every model (test_round_trip.py).
+    for key, value in expected['summary'].items():
+        if key == 'escalation':
+            assert value.items() <= run.summary[key].items()
+        elif key != 'compute_time_s':
+            assert run.summary[key] == value, key
+    assert run.report['scene'] == expected['scene']
+    assert run.options == expected['options'] and run.units == expected['units']
     assert run.model_reason == expected['summary']['model_reason']
     events = expected['events']
     assert list(run.events['kind']) == [e['kind'] for e in events]
