@@ -34,6 +34,14 @@ SUMMARY_KEYS = ('model', 'model_reason', 'collision_count', 'simulated', 'trunca
                 'paper_phi_bc')
 # summary['escalation']: the three-body report's keys and the scene report's, None where not given.
 ESCALATION_KEYS = ('decisions', 'refinements', 'high_precision', 'exact_rational', 'replayed_impacts')
+# The units of the summary's values that have one (sweep() columns: 'multiple_collision.time').
+SUMMARY_UNITS = {'final_time': 's', 'energy_lost': 'J', 'compute_time_s': 's', 'collapse_time': 's',
+                 'collapse_position': 'm', 'final_velocities': 'm/s', 'predicted_final_velocities': 'm/s',
+                 'spiral_angle': 'rad', 'theta': 'rad', 'alpha': 'rad', 'omega': 'rad', 'psi': 'rad',
+                 'paper_phi_bc': 'rad', 'multiple_collision.time': 's'}
+# The units of Run.to_pandas()'s columns that have one (v_<body> m/s and x_<body> m besides).
+EVENT_UNITS = {'time': 's', 'position': 'm', 'energy_lost': 'J', 'total_energy': 'J',
+               'total_momentum': 'kg m/s'}
 # Run.scene's keys: run()'s keyword arguments but temperature_csv (a file the run writes), so
 # that run(**r.scene) runs r's scene again with r's options.
 SCENE_KEYS = ('name', 'masses', 'positions', 'velocities', 'restitution', 'ring', 'restitution_model',
@@ -274,14 +282,20 @@ class Run:
 
     def to_pandas(self):
         """One row per event: the scalar fields, then v_A, v_B, ... (velocities after [m/s])
-        and x_A, x_B, ... (positions at the event [m])."""
+        and x_A, x_B, ... (positions at the event [m]). table.attrs['units']: column -> unit
+        of every column that has one."""
         import pandas as pd
         columns = {key: self.events[key] for key in ('kind', 'pair') + tuple(k for k, _ in _SCALARS)}
         for i, name in enumerate(self.names):
             columns['v_' + name] = self.events['velocities_after'][:, i]
         for i, name in enumerate(self.names):
             columns['x_' + name] = self.events['positions'][:, i]
-        return pd.DataFrame(columns)
+        table = pd.DataFrame(columns)
+        units = dict(EVENT_UNITS)
+        units.update(('v_' + name, 'm/s') for name in self.names)
+        units.update(('x_' + name, 'm') for name in self.names)
+        table.attrs['units'] = units
+        return table
 
     def __repr__(self):
         return '<collision_lab.Run %d bodies, model %s, %s collisions>' % (

@@ -6,7 +6,7 @@ import math
 import os
 
 from . import _core
-from ._run import ESCALATION_KEYS, SUMMARY_KEYS, complete_summary, scene_arguments
+from ._run import ESCALATION_KEYS, SUMMARY_KEYS, SUMMARY_UNITS, complete_summary, scene_arguments
 
 # A scene dict's keys besides the run() keyword arguments.
 _SCENE_KEYS = ('masses', 'positions', 'velocities', 'restitution', 'name')
@@ -77,11 +77,15 @@ def run_chunk(jobs, workers=1):
 
 def sweep_table(rows, parameter_names):
     """The DataFrame of rows (dicts: the parameters, then summary_row's columns): the
-    parameters, the summary columns in the order they first appear, the error columns."""
+    parameters, the summary columns in the order they first appear, the error columns.
+    table.attrs['units']: column -> unit of every summary column that has one."""
     import pandas as pd
     table = pd.DataFrame(rows)
     rest = [c for c in table.columns if c not in parameter_names and c not in ERROR_COLUMNS]
-    return table[list(parameter_names) + rest + list(ERROR_COLUMNS)]
+    table = table[list(parameter_names) + rest + list(ERROR_COLUMNS)]
+    table.attrs['units'] = {column: SUMMARY_UNITS[column] for column in table.columns
+                            if column in SUMMARY_UNITS and column not in parameter_names}
+    return table
 
 
 def sweep(scenes=None, *, grid=None, base=None, client=None, workers=None, chunk_size=None, **options):
@@ -99,6 +103,7 @@ def sweep(scenes=None, *, grid=None, base=None, client=None, workers=None, chunk
     (None unless the scene was rejected: its row then has the CLI's JSON error and no
     summary). A collapse is a collapse: collapsed is True or False for every scene that ran
     (collision_count is then the impacts before it), collapse_time [s] None unless collapsed.
+    table.attrs['units']: column -> unit ('s', 'm', 'm/s', 'J', 'rad') of the summary's.
     Locally on `workers` C++ threads (default os.cpu_count()). client: a
     dask.distributed.Client; the scenes go in chunks of chunk_size (default: about four
     per worker thread) to the cluster, which runs the same C++ function: the table equals

@@ -459,10 +459,12 @@ def fit_haff(t, T):
 
 def read_temperature_csv(path):
     """The CLI's --temperature-csv file (run(..., temperature_csv=path) writes it): (a pandas
-    DataFrame impacts [1], time_s [s], temperature_J [J]; the fit dict t0_J, tau_s,
-    rms_ln_error, samples, or None when the file says there is none)."""
+    DataFrame impacts [1], time_s [s], temperature_J [J], with table.attrs['units'] {'time_s':
+    's', 'temperature_J': 'J'}; the fit dict t0_J, tau_s, rms_ln_error, samples, or None
+    when the file says there is none)."""
     import pandas as pd
     table = pd.read_csv(path, comment='#')
+    table.attrs['units'] = {'time_s': 's', 'temperature_J': 'J'}
     fit = {}
     with open(path) as f:
         for line in f:

@@ -118,6 +118,14 @@ def test_a_bags_scene_runs_the_recorded_run_again(bags, name, node, given, model
     np.testing.assert_array_equal(again.events['velocities_after'], bag.events['velocities_after'])
 
 
+def test_a_bags_events_table_is_a_runs_with_its_units(bags):
+    bag, run = bags['engine'], collision_lab.run(**bags['engine'].scene)
+    table = bag.to_pandas()
+    assert list(table.columns) == list(run.to_pandas().columns)
+    assert table.attrs['units'] == run.to_pandas().attrs['units']
+    assert table.attrs['units']['v_E'] == 'm/s' and table.attrs['units']['total_momentum'] == 'kg m/s'
+
+
 def test_simulate_to_cap_is_read_from_what_the_run_did(bags):
     """The bag does not record the node's ~simulate_to_cap; read_bag takes it from the
     summary. Without it the to_cap bags would not run again as recorded."""
