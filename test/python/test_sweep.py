@@ -140,3 +140,47 @@ def test_merge_refuses_a_missing_shard(tmp_path, sweep_tool):
     done = subprocess.run([tool, 'sweep.yaml', '--merge', 'a.jsonl', '-o', 'm.jsonl'], cwd=tmp_path,
                           capture_output=True, text=True)
     assert done.returncode != 0 and '4 of 8 scenes missing' in done.stderr
+
+
+def three_equal_masses(e):
+    return dict(masses=[1, 1, 1], positions=[2, 1, 0], velocities=[-1, 0, 0], restitution=e)
+
+
+def test_a_collapse_is_a_collapse_in_the_table():
+    """Three equal masses collapse below r_c = 7 - 4 sqrt 3 = 0.072 (docs/physics.md): at
+    e = 0.05 after 8 impacts, at t = 3.5 s; at e = 0.5 they spiral apart, and elastic (the
+    three-body report, which has no collapse keys) they never collapse. Every row says
+    which, as a bool, with the collapse time."""
+    table = collision_lab.sweep(grid={'e': [0.05, 0.5, 1.0]}, base=lambda p: three_equal_masses(p['e']))
+    assert table['collapsed'].dtype == bool
+    assert table['collapsed'].tolist() == [True, False, False]
+    assert table['collapse_time'][0] == 3.5 and table['collapse_time'][1:].isna().all()
+    assert table['collision_count'].tolist()[0::2] == [8, 2]  # equal elastic masses: 2 exchanges
+    # The same as a run with every event: the collapse is its last event.
+    for i, e in enumerate([0.05, 0.5, 1.0]):
+        run = collision_lab.run(**three_equal_masses(e))
+        assert bool(table['collapsed'][i]) is run.summary['collapsed'] is ('collapse' in run.events['kind'])
+    # A rejected scene has no run: its row says nothing (None), the others still say.
+    mixed = collision_lab.sweep([three_equal_masses(0.05), BAD_SCENE, three_equal_masses(1.0)])
+    assert mixed['collapsed'].tolist() == [True, None, False]
+
+
+def test_the_docs_sweep_pivot_shows_collapses_as_collapses():
+    """docs/python.md's sweep example, run as written: its pivot says '8 + collapse' where
+    the pi billiard's blocks collapse (issue 47: 86 of 122 inelastic rows were shown as '8'),
+    and the collapse counts its comment gives."""
+    import re
+    docs = open(os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', 'docs', 'python.md')).read()
+    section = docs[docs.index('## Sweeps: `collision_lab.sweep`'):]
+    code = re.search(r'```python\n(.*?)```', section, re.S).group(1)
+    names = {}
+    exec(code, names)
+    table, counts, collapses = names['table'], names['counts'], names['collapses']
+    assert counts.loc[1e6, 1.0] == '3141'  # the pi billiard's digits: elastic, no collapse
+    assert collapses[1.0] == 0 and collapses[0.5] + collapses[0.9] == table['collapsed'].sum() > 0
+    for _, row in table.iterrows():
+        assert counts.loc[row['heavy'], row['e']].endswith(' + collapse') is bool(row['collapsed'])
+        if row['collapsed']:
+            assert counts.loc[row['heavy'], row['e']] == '%d + collapse' % row['collision_count']
+    said = dict(re.findall(r'([01]\.\d): (\d+)', code.split('collapses =')[1]))
+    assert {float(e): int(n) for e, n in said.items()} == collapses.to_dict()
