@@ -168,6 +168,166 @@ function velocityDatasets(run) {
   return sets;
 }
 
+// ---- Phase space (the paper's picture; the clacks' circle) ----
+// Velocities scaled by sqrt(m), u_i = sqrt(m_i) v_i: the kinetic energy is |u|^2 / 2, so an
+// elastic run stays on a circle and each impact reflects the point across a line through
+// its centre. Three finite masses: u projected on the plane of constant momentum; two finite
+// masses and a wall at rest: (u of the right one, u of the left one) as they are. Drawn for
+// runs whose velocity series are exact (every impact kept: at most PHASE_MAX_COLLISIONS).
+const PHASE_MAX_COLLISIONS = 400;
+
+// The phase picture of a run, or {why} when it has none: two axes (unit vectors in u space),
+// the states (start, then after each impact) as 2D points, and the lines v_i = v_j of each
+// pair (a wall at rest: v = 0) with the side where that pair no longer approaches.
+function phasePicture(run) {
+  const masses = run.scene.masses.map((m) => (m === 'inf' ? Infinity : m));
+  const n = masses.length;
+  const finite = masses.map((m, i) => i).filter((i) => Number.isFinite(masses[i]));
+  if (n !== 3 && !(n === 2 && finite.length === 2)) return {why: 'drawn for three bodies (walls included)'};
+  if (finite.length < 2) return {why: 'drawn when at least two bodies have finite mass'};
+  if (n === 2) return {why: 'two bodies alone have one velocity that changes, their relative one: no plane to draw'};
+  const walls = [0, 2].filter((i) => !Number.isFinite(masses[i]));
+  if (walls.some((i) => run.scene.velocities[i] !== 0)) return {why: 'drawn for walls at rest'};
+  const count = run.view ? run.view.simulated_collisions : null;
+  if (count === null || count === undefined) return {why: 'the run was not simulated'};
+  if (count > PHASE_MAX_COLLISIONS) return {why: 'drawn for runs of at most ' + PHASE_MAX_COLLISIONS + ' collisions; this one has ' + fmt(count)};
+  const root = masses.map((m) => (Number.isFinite(m) ? Math.sqrt(m) : 0));
+  let axes;
+  if (finite.length === 3) {
+    // e1 along an AB impact's change of u, e2 completes the plane orthogonal to sqrt(m).
+    const norm = (a) => { const l = Math.hypot(...a); return a.map((c) => c / l); };
+    const e1 = norm([root[1], -root[0], 0]);
+    const nHat = norm(root);
+    const e2 = [nHat[1] * e1[2] - nHat[2] * e1[1], nHat[2] * e1[0] - nHat[0] * e1[2], nHat[0] * e1[1] - nHat[1] * e1[0]];
+    axes = {e1, e2, x: 'along an A-B impact', y: 'across it, at constant momentum'};
+  } else {
+    const [i, j] = finite;
+    axes = {e1: [0, 1, 2].map((k) => (k === i ? 1 : 0)), e2: [0, 1, 2].map((k) => (k === j ? 1 : 0)),
+      x: '\u221Am\u00B7v of ' + bodyName(i), y: '\u221Am\u00B7v of ' + bodyName(j)};
+  }
+  const project = (v) => {
+    const u = v.map((vi, k) => root[k] * (Number.isFinite(vi) ? vi : 0));
+    return [u.reduce((a, c, k) => a + c * axes.e1[k], 0), u.reduce((a, c, k) => a + c * axes.e2[k], 0)];
+  };
+  // The state after impact k: each body's series at its last vertex at index <= k.
+  const series = new Map(run.plots.velocity.map((s) => [s.body, s.points]));
+  const valueAt = (body, k) => {
+    const pts = series.get(body);
+    if (!pts) return run.scene.velocities[body];
+    let v = pts.length ? pts[0][1] : run.scene.velocities[body];
+    for (const q of pts) { if (q[0] <= k) v = q[1]; else break; }
+    return v;
+  };
+  const states = [];
+  for (let k = 0; k <= count; ++k) states.push(project([0, 1, 2].map((b) => valueAt(b, k))));
+  // Pair (i, i + 1) stops approaching when v_i >= v_{i+1}: a . u >= 0 with a_i = 1/sqrt(m_i),
+  // a_{i+1} = -1/sqrt(m_{i+1}) (a wall's term dropped: v_wall = 0).
+  const lines = [0, 1].map((i) => {
+    const a = [0, 0, 0];
+    if (root[i]) a[i] = 1 / root[i];
+    if (root[i + 1]) a[i + 1] = -1 / root[i + 1];
+    const normal = [a.reduce((s2, c, k) => s2 + c * axes.e1[k], 0), a.reduce((s2, c, k) => s2 + c * axes.e2[k], 0)];
+    return {pair: bodyName(i) + bodyName(i + 1), normal};
+  });
+  return {states, lines, axes};
+}
+
+// Draws the picture into canvas g of w x h pixels: the circle of the start's energy in the
+// plane, the wedge where no pair approaches (shaded), the reflection lines, then the path.
+function drawPhase(g, w, h, picture, title) {
+  g.fillStyle = '#ffffff';
+  g.fillRect(0, 0, w, h);
+  const top = title ? 40 : 8;
+  const r0 = Math.hypot(...picture.states[0]);
+  const reach = Math.max(r0, ...picture.states.map((p) => Math.hypot(...p))) || 1;
+  const size = Math.min(w, h - top) / 2 - 24;
+  const cx = w / 2, cy = top + (h - top) / 2;
+  const scale = size / (1.08 * reach);
+  const X = (p) => cx + p[0] * scale, Y = (p) => cy - p[1] * scale;
+  if (title) {
+    g.fillStyle = '#222';
+    g.font = 'bold ' + Math.round(w / 60) + 'px sans-serif';
+    g.textAlign = 'center';
+    g.fillText(title, w / 2, 26);
+    g.textAlign = 'left';
+  }
+  // The wedge: points with both pairs apart, sampled on rays.
+  const apart = (p) => picture.lines.every((l) => l.normal[0] * p[0] + l.normal[1] * p[1] >= 0);
+  g.fillStyle = 'rgba(60, 160, 90, 0.16)';
+  g.beginPath();
+  let open = false;
+  for (let k = 0; k <= 720; ++k) {
+    const phi = (k / 720) * 2 * Math.PI;
+    const p = [Math.cos(phi) * 1.08 * reach, Math.sin(phi) * 1.08 * reach];
+    if (apart(p)) {
+      if (!open) { g.moveTo(cx, cy); open = true; }
+      g.lineTo(X(p), Y(p));
+    } else if (open) {
+      g.lineTo(cx, cy); open = false;
+    }
+  }
+  if (open) g.lineTo(cx, cy);
+  g.fill();
+  g.strokeStyle = '#999';
+  g.setLineDash([5, 4]);
+  g.beginPath(); g.arc(cx, cy, r0 * scale, 0, 2 * Math.PI); g.stroke();
+  g.setLineDash([]);
+  g.font = Math.max(13, Math.round(w / 60)) + 'px sans-serif';
+  picture.lines.forEach((l) => {
+    const d = [-l.normal[1], l.normal[0]];
+    const len = Math.hypot(...d) || 1;
+    const e = [d[0] / len * 1.08 * reach, d[1] / len * 1.08 * reach];
+    g.strokeStyle = '#777';
+    g.beginPath(); g.moveTo(X([-e[0], -e[1]]), Y([-e[0], -e[1]])); g.lineTo(X(e), Y(e)); g.stroke();
+    g.fillStyle = '#555';
+    g.fillText(l.pair + ' meet', X(e) + 4, Y(e));
+  });
+  g.strokeStyle = '#1f5fbf';
+  g.lineWidth = Math.max(1, w / 500);
+  g.beginPath();
+  picture.states.forEach((p, k) => (k ? g.lineTo(X(p), Y(p)) : g.moveTo(X(p), Y(p))));
+  g.stroke();
+  g.lineWidth = 1;
+  const dot = (p, colour) => { g.fillStyle = colour; g.beginPath(); g.arc(X(p), Y(p), Math.max(3, w / 150), 0, 2 * Math.PI); g.fill(); };
+  dot(picture.states[0], '#333');
+  dot(picture.states[picture.states.length - 1], '#c0392b');
+}
+
+function showPhase(run) {
+  const box = document.getElementById('phase_box');
+  const picture = phasePicture(run);
+  document.body.dataset.phase = picture.why ? 'none' : String(picture.states.length - 1);
+  document.querySelector('button[data-plot="phase"]').hidden = Boolean(picture.why);
+  if (picture.why) {
+    box.hidden = true;
+    return;
+  }
+  box.hidden = false;
+  // For tests: how far the states stray from the start's circle (0 when elastic), and
+  // whether the last state lies in the wedge where no pair approaches.
+  const r0 = Math.hypot(...picture.states[0]);
+  document.body.dataset.phaseSpread = String(Math.max(...picture.states.map((p) => Math.abs(Math.hypot(...p) - r0))) / r0);
+  const last = picture.states[picture.states.length - 1];
+  document.body.dataset.phaseEndsApart = String(picture.lines.every((l) => l.normal[0] * last[0] + l.normal[1] * last[1] >= -1e-12 * r0));
+  const canvas = document.getElementById('phase');
+  drawPhase(canvas.getContext('2d'), canvas.width, canvas.height, picture, '');
+  phaseImage = () => {
+    const slide = document.createElement('canvas');
+    slide.width = PNG_WIDTH;
+    slide.height = PNG_WIDTH * 3 / 4;
+    drawPhase(slide.getContext('2d'), slide.width, slide.height, picture,
+      'Phase space (\u221Am\u00B7v, energy = distance\u00B2 / 2): run ' + runId);
+    return slide;
+  };
+  document.getElementById('phase_legend').textContent =
+    'Each point is the three velocities scaled by \u221Am (axes: ' + picture.axes.x + '; ' + picture.axes.y +
+    ' [\u221Akg\u00B7m/s]). The kinetic energy is half the squared distance from the centre: an elastic ' +
+    'collision keeps the point on the dashed circle and reflects it across the line of the pair that meets. ' +
+    'Black: the start; red: after the last collision, inside the shaded wedge, where no body catches another, ' +
+    'so the run ends there. ' + plural(picture.states.length - 1, 'collision') + ' drawn.';
+}
+let phaseImage = null;
+
 // The x-t lines: every tracked body to the run's end, one dataset per segment (a ring's
 // lines are cut at its seam); the legend names each body once.
 function xtDatasets(run) {
@@ -274,7 +434,7 @@ function showNotSimulated(run, view) {
   box.hidden = !hide;
   ['velocity', 'energy', 'xt'].forEach((id) => { document.getElementById(id + '_box').hidden = hide; });
   // Nor downloads of what does not exist: the plots' PNGs and the events CSV (a 404).
-  document.querySelectorAll('button[data-plot]').forEach((b) => { if (b.dataset.plot !== 'temperature') b.hidden = hide; });
+  document.querySelectorAll('button[data-plot]').forEach((b) => { if (b.dataset.plot !== 'temperature' && b.dataset.plot !== 'phase') b.hidden = hide; });
   document.getElementById('dl_csv').hidden = hide;
   document.getElementById('dl_table').hidden = hide || run.scene.masses.length > CLASS_TABLE_MAX_BODIES;
   if (!hide) return false;
@@ -369,6 +529,7 @@ function render(run) {
   }
   t.update('none');
   if (view && view.gas) drawTemperature(view);
+  if (ended(run.state)) showPhase(run);
   const tbody = document.querySelector('#summary tbody');
   tbody.replaceChildren(...summaryRows(run).map((row) => {
     const tr = el('tr');
@@ -400,9 +561,9 @@ function setupDownloads() {
   document.querySelectorAll('button[data-plot]').forEach((b) => {
     b.onclick = () => {
       const c = charts[b.dataset.plot];
-      if (!c) return;
+      if (!c && !(b.dataset.plot === 'phase' && phaseImage)) return;
       const a = document.createElement('a');
-      a.href = slideImage(c, b.dataset.plot);
+      a.href = c ? slideImage(c, b.dataset.plot) : phaseImage().toDataURL('image/png');
       a.download = runId + '_' + b.dataset.plot + '.png';
       a.click();
     };

@@ -118,6 +118,14 @@ TEST_F(WebBrowserTest, RunPageDrawsItsPlots) {
     ASSERT_TRUE(pixels.count(plot)) << "no plot " << plot << " reported";
     EXPECT_GT(pixels.at(plot), 0) << plot;
   }
+  // The phase-space picture: the start and a point after each of the 31 impacts.
+  // Elastic: every state on the start's circle (to the 6 digits of the plotted series); the
+  // last one in the wedge where no pair approaches.
+  EXPECT_NE(dom.find("data-phase=\"31\""), std::string::npos) << dom.substr(0, 600);
+  EXPECT_NE(dom.find("data-phase-ends-apart=\"true\""), std::string::npos) << dom.substr(0, 600);
+  std::smatch spread;
+  ASSERT_TRUE(std::regex_search(dom, spread, std::regex("data-phase-spread=\"([^\"]*)\""))) << dom.substr(0, 600);
+  EXPECT_LT(std::stod(spread[1]), 1e-5);
   // Each plot's PNG is a slide: 1600 px wide, opaque.
   const std::string checked = chromium("--dump-dom", page + "#check-png");
   EXPECT_NE(checked.find("data-png=\"velocity:1600x900:opaque energy:1600x900:opaque xt:1600x900:opaque\""),
@@ -312,6 +320,19 @@ TEST_F(RunPageViewTest, TheStateAfterTheLastCollisionIsDrawn) {
 }
 
 // No collision: the bodies still fly apart on every plot, and no events CSV link leads to a 404.
+// Inelastic (e = 0.5 between equal masses): the point spirals inside the start's circle.
+TEST_F(RunPageViewTest, InelasticRunsSpiralInPhaseSpace) {
+  const std::string dom = finalPage({{"student", "phase"}, {"masses", {1, 1, 1}}, {"positions", {2, 1, -1}},
+                                     {"velocities", {-1, 0, 1}}, {"restitution", {0.5}}});
+  EXPECT_NE(dom.find("data-phase-ends-apart=\"true\""), std::string::npos) << dom.substr(0, 600);
+  EXPECT_GT(bodyData(dom, "phase-spread"), 0.1);
+}
+
+TEST_F(RunPageViewTest, ManyBodiesHaveNoPhaseSpacePicture) {
+  const std::string dom = finalPage({{"student", "phase"}, {"preset", "cradle_5"}});
+  EXPECT_NE(dom.find("data-phase=\"none\""), std::string::npos) << dom.substr(0, 600);
+}
+
 TEST_F(RunPageViewTest, NoCollisionDrawsTheBodiesFlyingApart) {
   const std::string dom = finalPage({{"student", "lesson"}, {"preset", "no_collision"}});
   const auto pixels = plotPixels(dom);
