@@ -395,6 +395,57 @@ function summaryRows(run) {
   return rows;
 }
 
+// The paper beside the correct formulas (docs/physics.md, Errata), shown when the paper's
+// printed values were computed (three elastic bodies, the rotation model): for each
+// printed formula, what it gives here, whether that keeps momentum and energy, and the
+// correct formula. Totals are the server's, each correctly rounded; "kept" allows the
+// rounding of the velocities (relative 1e-12).
+function paperRows(run) {
+  const totals = run.totals, p = run.prediction, s = run.summary;
+  if (!totals || !totals.paper || !totals.start) return [];
+  const wall = run.scene.masses.some((m) => m === 'inf');
+  const kept = (key, unit) => {
+    const a = totals.start[key], b = totals.paper[key];
+    const scale = Math.max(Math.abs(a), Math.abs(b), 1e-300);
+    if (Math.abs(a - b) <= 1e-12 * scale) return 'yes';
+    return 'no: ' + fmt(b, 6) + ' ' + unit + ' after, ' + fmt(a, 6) + ' before';
+  };
+  const rows = [];
+  rows.push(['(2.15), (2.16): the velocities after 2k and 2k+1 collisions',
+    'v\u2082\u2096 = V\u00B71 + S\u207B\u00B9(cos k\u03B8 w \u2212 sin k\u03B8 (\u015D\u00D7w)), v\u2082\u2096\u208A\u2081 = D_AB v\u2082\u2096',
+    wall ? 'a wall takes momentum: not a test here' : kept('momentum', 'kg m/s'),
+    kept('kinetic_energy', 'J'),
+    'The printed eigenvectors (2.4) are wrong in general, so P, P\u207B\u00B9, D\u1D4F and these closed forms are too: ' +
+    'their first rows keep v_A + v_B, which no collision does.']);
+  if (p && p.paper_collision_count !== null && p.paper_collision_count !== undefined) {
+    const simulatedCount = run.view ? run.view.simulated_collisions : null;
+    rows.push(['(3.22): the number of collisions n = 1 + \u230Ax\u230B + \u2308x\u2309',
+      'N = \u2308\u03C8/\u03B1\u2309 \u2212 1 (\u03C8 the start\u2019s angle in the plane, \u03B1 the wedge\u2019s opening)',
+      'counts: ' + fmt(p.paper_collision_count) + ' printed, ' + fmt(p.collision_count) + ' correct' +
+        (simulatedCount !== null && simulatedCount !== undefined ? ', ' + fmt(simulatedCount) + ' simulated' : ''),
+      '',
+      'For any x that is not a whole number, 1 + \u230Ax\u230B + \u2308x\u2309 is even, yet three bodies often collide an odd number of times.']);
+  }
+  rows.push(['(4.4)-(4.7): the energy each collision hands on',
+    'v_k = (v_A \u2212 v_B)/2, half the relative velocity now',
+    '', '',
+    'The printed formulas take v\u0304_AB as the average of the start, which assumes v_A + v_B never changes; ' +
+    'read with the current relative velocity they hold.']);
+  return rows;
+}
+
+function showPaper(run) {
+  const rows = paperRows(run);
+  const box = document.getElementById('paper_box');
+  box.hidden = rows.length === 0;
+  if (!rows.length) return;
+  document.querySelector('#paper tbody').replaceChildren(...rows.map((row) => {
+    const tr = el('tr');
+    row.forEach((cell, k) => tr.appendChild(el(k === 0 ? 'th' : 'td', cell)));
+    return tr;
+  }));
+}
+
 // A gas: T(t) on log-log axes with Haff's law T0/(1 + t/tau)^2 fitted (the view's numbers,
 // rviz's too). Points at t = 0 or T = 0 cannot be drawn on log axes: left out. For tests,
 // <body> gets data-temperature-points and data-haff-tau [s].
@@ -530,6 +581,7 @@ function render(run) {
   t.update('none');
   if (view && view.gas) drawTemperature(view);
   if (ended(run.state)) showPhase(run);
+  showPaper(run);
   const tbody = document.querySelector('#summary tbody');
   tbody.replaceChildren(...summaryRows(run).map((row) => {
     const tr = el('tr');

@@ -295,6 +295,12 @@ TEST_F(RunPageViewTest, EqualMassesShowsTheModelsBExactlyAtRest) {
   EXPECT_EQ(summaryCells(dom, "momentum at the end [kg m/s]"), (std::vector<std::string>{"0", "0", "2.5"}));
   EXPECT_EQ(summaryCells(dom, "kinetic energy at the start [J]").at(0), "1");
   EXPECT_EQ(summaryCells(dom, "kinetic energy at the end [J]"), (std::vector<std::string>{"1", "1", "1.921875"}));
+  // The paper's column explained: (2.15)/(2.16) keep neither, beside the correct formula;
+  // (3.22)'s count beside the correct one and the simulated one.
+  EXPECT_NE(dom.find("<div id=\"paper_box\">"), std::string::npos);
+  EXPECT_NE(dom.find("<td>no: 2.5 kg m/s after, 0 before</td><td>no: 1.92188 J after, 1 before</td>"), std::string::npos)
+      << dom.substr(dom.find("paper_box"), 2000);
+  EXPECT_NE(dom.find(", 3 correct, 3 simulated</td>"), std::string::npos);
 }
 
 // A moving wall does work: the page says so, and its energy rows show the change.
