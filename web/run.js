@@ -40,7 +40,8 @@ function fmt(x, digits) {
   const text = Number(x.toPrecision(digits || 6)).toString();
   // No e-notation that wraps: "1.2e-7" becomes "1.2×10⁻⁷" (one word, no break).
   const m = /^(-?[\d.]+)e([+-]\d+)$/.exec(text);
-  if (!m) return text;
+  // Thousands separators in the whole part, as rviz writes them: "929,465.012".
+  if (!m) return text.replace(/^(-?)(\d{4,})/, (all, sign, whole) => sign + Number(whole).toLocaleString('en-US'));
   return m[1] + '×10' + superscript(Number(m[2]));
 }
 
@@ -362,9 +363,11 @@ function summaryRows(run) {
   const n = run.scene.masses.length;
   if (n <= 10) {
     const paperFinal = run.plots.paper_final_velocities || [];
+    // A run stopped part-way has no final velocities of its own: its row says where it stopped.
+    const stoppedAt = view.truncated && simulated ? ' (simulated: at the stop, after collision ' + fmt(count) + ')' : '';
     for (let i = 0; i < n; ++i) {
-      rows.push(['final v ' + bodyName(i) + ' [m/s]', s && !notSimulated ? s.final_velocities[i] : null, p ? p.final_velocities[i] : null,
-        paperFinal.length === n ? paperFinal[i] : null]);
+      rows.push([(stoppedAt ? 'v ' : 'final v ') + bodyName(i) + ' [m/s]' + stoppedAt, s && !notSimulated ? s.final_velocities[i] : null,
+        p ? p.final_velocities[i] : null, paperFinal.length === n ? paperFinal[i] : null]);
     }
   }
   // Momentum and kinetic energy of the finite masses, at the start and at the end by each

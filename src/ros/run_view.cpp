@@ -192,6 +192,22 @@ std::string appliedCapText(std::uint64_t asked, const std::optional<std::uint64_
   return "the cap of " + withSeparators(asked);
 }
 
+/// What a class can do about a run the model answered instead of the engine: "" for a
+/// predict-only run, which asked for the model.
+std::string howToSimulate(const collision_lab::InitialConditions& in, const RunView& view) {
+  if (in.mode == collision_lab::InitialConditions::MODE_PREDICT_ONLY) return "";
+  if (view.infinitely_many_predicted) {
+    return ". Infinitely many collisions cannot all be simulated; the lab simulates the first ones, up to the cap, "
+           "when its ~simulate_to_cap is on: ask the teacher";
+  }
+  if (!view.predicted_collisions) return "";
+  const std::string count = withSeparators(*view.predicted_collisions);
+  if (in.max_collisions != 0 && *view.predicted_collisions > in.max_collisions) {
+    return ". To simulate it, set \"Stop after\" (max_collisions) to at least " + count;
+  }
+  return ". To simulate it, the lab's ~max_collisions must allow " + count + " collisions: ask the teacher";
+}
+
 }  // namespace
 
 std::string collisionsText(std::uint64_t n) {
@@ -239,7 +255,7 @@ RunView makeRunView(const RunRecord& run) {
             ", the model answered";
     }
     while (!why.empty() && why.back() == '.') why.pop_back();
-    view.not_simulated = "not simulated: " + why;
+    view.not_simulated = "not simulated: " + why + howToSimulate(in, view);
   } else if (run.summary && run.summary->truncated) {
     view.truncated = truncationSentence(run.summary->truncation_reason);
   }

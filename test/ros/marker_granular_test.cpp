@@ -112,8 +112,14 @@ TEST(MarkerGranular, GasShowsTOnLogLogAxesWithHaffsLaw) {
   const auto animated = buildAnimatedMarkers(r.record, FrameClock{1e30, "test"}, "f");
   const auto* now = find(animated, ids::ns::kTemperatureNow, ids::kTemperatureNowText);
   ASSERT_TRUE(now);
+  // Three digits, the exponent written as the page writes it (×10^n).
+  char digits[32];
+  std::snprintf(digits, sizeof digits, "%.3e", t_end);
+  const std::string mantissa = std::to_string(std::stod(digits) / std::pow(10.0, std::floor(std::log10(t_end))));
+  const int exponent = static_cast<int>(std::floor(std::log10(t_end)));
   char expected[64];
-  std::snprintf(expected, sizeof expected, "now: T = %.3g J", t_end);
+  std::snprintf(expected, sizeof expected, "now: T = %.3g×10^%d J", std::stod(mantissa), exponent);
+  ASSERT_TRUE(exponent < -4) << "a gas this cold has an exponent to write: T = " << t_end;
   EXPECT_EQ(now->text.rfind(expected, 0), 0u) << now->text << " vs " << expected;
   EXPECT_TRUE(find(animated, ids::ns::kTemperatureNow, ids::kTemperatureNowDot));
   // The left column's texts stay on screen and clear of the middle column.
@@ -228,10 +234,9 @@ TEST(MarkerGranular, DriftsAreSigned) {
   const auto* energy = find(fixed, ids::ns::kConserved, ids::kConservedEnergy + ids::kFrameLabel);
   const auto* momentum = find(fixed, ids::ns::kConserved, ids::kConservedMomentum + ids::kFrameLabel);
   ASSERT_TRUE(energy && momentum);
-  EXPECT_NE(energy->text.find("drift +8.4e-17"), std::string::npos) << energy->text;
-  char expected[32];
-  std::snprintf(expected, sizeof expected, "drift -%.2g", 3.95e-19);
-  EXPECT_NE(momentum->text.find(expected), std::string::npos) << momentum->text;
+  // In the page's number style: ×10^n, not e-notation.
+  EXPECT_NE(energy->text.find("drift +8.4×10^-17"), std::string::npos) << energy->text;
+  EXPECT_NE(momentum->text.find("drift -4×10^-19"), std::string::npos) << momentum->text;
   // Both labels bold: drawn again a pixel lower, so that the minus signs show.
   for (const int base : {ids::kConservedEnergy, ids::kConservedMomentum}) {
     const auto* label = find(fixed, ids::ns::kConserved, base + ids::kFrameLabel);

@@ -296,6 +296,9 @@ TEST(MarkerView, NotSimulatedRunSaysTheModelsAnswerAsTheViewDoes) {
   const auto status = textOf(buildAnimatedMarkers(run, FrameClock{0.0, ""}, "f"), ids::ns::kLabels, ids::kStatus);
   EXPECT_NE(status.find("run: not simulated: "), std::string::npos) << status;
   EXPECT_NE(status.find("predicted 31 collisions"), std::string::npos) << status;
+  // And says how to simulate it.
+  EXPECT_NE(makeRunView(run).not_simulated.find("set \"Stop after\" (max_collisions) to at least 31"), std::string::npos)
+      << makeRunView(run).not_simulated;
 }
 
 // A gas between two walls stopped at the cap: truncated, a box, a gas with T(t).

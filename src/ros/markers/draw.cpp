@@ -2,9 +2,11 @@
 #include "collision_lab/ros/markers/draw.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
+#include <string>
 
 #include "collision_lab/core/nbody/scene.h"
 
@@ -46,10 +48,42 @@ geometry_msgs::Point point(double x, double y, double z) {
   return p;
 }
 
+namespace {
+
+/// A printf number in the page's style: an exponent as "×10^n" ("4.68×10^11", not
+/// "4.68e+11") and thousands separators in the whole part ("169,548").
+std::string numberStyle(const std::string& text) {
+  const std::size_t e = text.find_first_of("eE");
+  if (e != std::string::npos && e > 0 && std::isdigit(static_cast<unsigned char>(text[e - 1]))) {
+    return text.substr(0, e) + "×10^" + std::to_string(std::stoi(text.substr(e + 1)));
+  }
+  const std::size_t start = text.find_first_of("0123456789");
+  if (start == std::string::npos) return text;
+  std::size_t end = start;
+  while (end < text.size() && std::isdigit(static_cast<unsigned char>(text[end]))) ++end;
+  std::string out = text.substr(0, start);
+  for (std::size_t k = start; k < end; ++k) {
+    if (k > start && (end - k) % 3 == 0) out += ',';
+    out += text[k];
+  }
+  return out + text.substr(end);
+}
+
+}  // namespace
+
 std::string format(const char* fmt, double value) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, fmt, value);
-  return buffer;
+  // The one conversion of fmt is printed alone and styled; the text around it is kept.
+  const std::string spec_and_text = fmt;
+  const std::size_t percent = spec_and_text.find('%');
+  const std::size_t conversion = spec_and_text.find_first_of("gGeEf", percent);
+  if (percent == std::string::npos || conversion == std::string::npos) {
+    char buffer[64];
+    std::snprintf(buffer, sizeof buffer, fmt, value);
+    return buffer;
+  }
+  char number[64];
+  std::snprintf(number, sizeof number, spec_and_text.substr(percent, conversion + 1 - percent).c_str(), value);
+  return spec_and_text.substr(0, percent) + numberStyle(number) + spec_and_text.substr(conversion + 1);
 }
 
 std::string withSign(const char* fmt, double value) {

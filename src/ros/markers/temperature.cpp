@@ -50,7 +50,7 @@ LogAxes logAxes(const Samples& samples) {
 /// superscript digits but ² and ³).
 std::string decade(double exponent) {
   const std::string text = format("%g", std::pow(10.0, exponent));
-  if (text.find('e') != std::string::npos) return format("10^%.0f", exponent);
+  if (text.find("×10^") != std::string::npos) return format("10^%.0f", exponent);
   return exponent >= 3 ? withSeparators(static_cast<std::uint64_t>(std::pow(10.0, exponent) + 0.5)) : text;
 }
 

@@ -37,6 +37,8 @@ std_msgs::ColorRGBA velocityColor(double v, double v_max);
 /// "A", "B", ... (core::bodyName).
 std::string bodyName(std::size_t i);
 geometry_msgs::Point point(double x, double y, double z = 0.0);
+/// value printed by fmt (one printf conversion: %g, %e or %f, with text around it) in one
+/// number style with the page: "4.68×10^11", "169,548".
 std::string format(const char* fmt, double value);
 /// value with its sign always written: "+1.12", "-1.12", "0". rviz's font has no proper
 /// minus (U+2212 and the dashes are not drawn) and draws '-' a few pixels wide; beside the
