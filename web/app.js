@@ -144,6 +144,61 @@ async function sendScene() {
   }
 }
 
+/// "My runs": the runs sent from this browser (each kept with its stop token in
+/// localStorage), newest first, with their state from GET /api/runs and a Stop for the
+/// unfinished ones. Refreshes every 5 s while one is unfinished.
+async function myRuns() {
+  const mine = Object.keys(localStorage).filter((k) => k.startsWith('collision_lab_stop_'))
+    .map((k) => k.slice('collision_lab_stop_'.length));
+  const box = document.getElementById('my_runs');
+  document.body.dataset.myRuns = String(mine.length);
+  if (!mine.length) {
+    box.replaceChildren(el('p', 'None yet: the runs you send from this browser are listed here.', {class: 'muted'}));
+    return;
+  }
+  const students = [...new Set(mine.map((id) => id.slice(0, id.lastIndexOf('.'))).filter((s) => s))];
+  const listed = new Map();
+  for (const student of students) {
+    try {
+      const runs = await (await fetch('/api/runs?student=' + encodeURIComponent(student))).json();
+      for (const r of runs) listed.set(r.run_id, r);
+    } catch (err) {
+      // The list stays as far as it was read; the next refresh tries again.
+    }
+  }
+  const table = el('table', null, {'data-my-runs': ''});
+  const head = el('tr');
+  for (const h of ['run', 'state', 'collisions', 'model', 'sent', '']) head.appendChild(el('th', h));
+  table.appendChild(head);
+  const rows = mine.map((id) => listed.get(id) || {run_id: id, state: 'not listed (older than the lab\'s list)'});
+  rows.sort((a, b) => (b.accepted_stamp || 0) - (a.accepted_stamp || 0));
+  let unfinished = false;
+  for (const r of rows) {
+    const tr = el('tr');
+    const td = el('td');
+    td.appendChild(el('a', r.run_id, {href: '/runs/' + encodeURIComponent(r.run_id)}));
+    tr.appendChild(td);
+    tr.appendChild(el('td', listed.has(r.run_id) ? stateText(r) : r.state));
+    tr.appendChild(el('td', r.collisions === undefined ? '' : countText(r.collisions)));
+    tr.appendChild(el('td', r.model || ''));
+    tr.appendChild(el('td', r.accepted_stamp ? new Date(r.accepted_stamp * 1000).toLocaleTimeString() : ''));
+    const stop = el('td');
+    if (r.state === 'queued' || r.state === 'running') {
+      unfinished = true;
+      const button = el('button', 'Stop', {type: 'button'});
+      button.onclick = async () => {
+        button.disabled = true;
+        button.textContent = await stopRun(r.run_id, localStorage.getItem('collision_lab_stop_' + r.run_id));
+      };
+      stop.appendChild(button);
+    }
+    tr.appendChild(stop);
+    table.appendChild(tr);
+  }
+  box.replaceChildren(table);
+  if (unfinished) setTimeout(myRuns, 5000);
+}
+
 async function startPage() {
   document.getElementById('student').value = localStorage.getItem('collision_lab_student') || '';
   document.getElementById('add').onclick = () => { loadedPreset = null; document.getElementById('preset_note').textContent = ''; bodyRow('1', '', '0'); };
@@ -166,6 +221,7 @@ async function startPage() {
   }
   const pi = presets.find((p) => p.name === 'pi_digits_2');  // 31 impacts: the first two digits of pi
   loadPreset(pi || presets[0]);
+  await myRuns();
   document.body.dataset.ready = 'true';
 }
 

@@ -186,6 +186,8 @@ TEST_F(WebBrowserTest, FormSendsASceneAndSeesTheResult) {
   EXPECT_NE(result.find("run_id=formbot."), std::string::npos) << result;
   EXPECT_NE(result.find("collisions|31|31|"), std::string::npos) << result;
   EXPECT_EQ(result.find("plots=velocity:0"), std::string::npos) << result;
+  // Back on the class page, "My runs" lists the run this browser sent, finished.
+  EXPECT_NE(result.find("my_runs=formbot.run1|finished|31"), std::string::npos) << result;
   // The form names bodies in the colours the views will draw: rviz's palette by index for 3
   // bodies (A red, B green, C blue: three different colours), none for 11, which the views
   // colour by start velocity.
@@ -332,6 +334,17 @@ TEST_F(RunPageViewTest, InelasticRunsSpiralInPhaseSpace) {
                                      {"velocities", {-1, 0, 1}}, {"restitution", {0.5}}});
   EXPECT_NE(dom.find("data-phase-ends-apart=\"true\""), std::string::npos) << dom.substr(0, 600);
   EXPECT_GT(bodyData(dom, "phase-spread"), 0.1);
+}
+
+// A run stopped at its cap shows where it stopped, not "final" velocities; a run the model
+// answered over its cap says how to simulate it.
+TEST_F(RunPageViewTest, AStoppedRunSaysWhereItStoppedAndACappedOneHowToSimulateIt) {
+  std::string dom = finalPage({{"student", "cap"}, {"preset", "ball_between_walls"}, {"max_collisions", 100}});
+  EXPECT_EQ(summaryCells(dom, "v B [m/s] (simulated: at the stop, after collision 100)").size(), 3u) << dom.substr(0, 3000);
+  EXPECT_TRUE(summaryCells(dom, "final v B [m/s]").empty());
+  dom = finalPage({{"student", "cap"}, {"masses", {1e6, 1, "inf"}}, {"positions", {2, 1, 0}},
+                   {"velocities", {-1, 0, 0}}, {"max_collisions", 100}});
+  EXPECT_NE(dom.find("set \"Stop after\" (max_collisions) to at least 3,141"), std::string::npos) << dom.substr(0, 3000);
 }
 
 TEST_F(RunPageViewTest, ManyBodiesHaveNoPhaseSpacePicture) {
