@@ -27,9 +27,10 @@ const CLASS_TABLE_MAX_BODIES = 64;
 const charts = {};
 let firstPlotMs = null;
 
-function el(tag, text) {
+function el(tag, text, attrs) {
   const node = document.createElement(tag);
   if (text !== undefined && text !== null) node.textContent = String(text);
+  for (const [k, v] of Object.entries(attrs || {})) node.setAttribute(k, v);
   return node;
 }
 
@@ -320,6 +321,23 @@ function showPhase(run) {
       'Phase space (\u221Am\u00B7v, energy = distance\u00B2 / 2): run ' + runId);
     return slide;
   };
+  const details = el('details', null, {class: 'plot_table'});
+  details.appendChild(el('summary', 'The numbers of this plot, as a table'));
+  details.addEventListener('toggle', () => {
+    if (!details.open) return;
+    const table = el('table');
+    const head = el('tr');
+    for (const h of ['after collision', picture.axes.x + ' [\u221Akg\u00B7m/s]', picture.axes.y + ' [\u221Akg\u00B7m/s]']) head.appendChild(el('th', h));
+    table.appendChild(head);
+    picture.states.forEach((p, k) => {
+      const tr = el('tr');
+      [k === 0 ? 'start' : fmt(k), fmt(p[0], 9), fmt(p[1], 9)].forEach((cell) => tr.appendChild(el('td', cell)));
+      table.appendChild(tr);
+    });
+    details.replaceChildren(details.firstChild, table);
+  });
+  box.querySelectorAll('details.plot_table').forEach((old) => old.remove());
+  box.appendChild(details);
   document.getElementById('phase_legend').textContent =
     'Each point is the three velocities scaled by \u221Am (axes: ' + picture.axes.x + '; ' + picture.axes.y +
     ' [\u221Akg\u00B7m/s]). The kinetic energy is half the squared distance from the centre: an elastic ' +
@@ -602,7 +620,10 @@ function render(run) {
   if (ended(run.state)) {
     document.body.dataset.final = 'true';
     document.getElementById('stop').hidden = true;
+    addPlotTables();
     if (location.hash === '#check-png') checkSlideImages();
+    // For tests and screenshots: every plot's table open.
+    if (location.hash === '#open-tables') document.querySelectorAll('details.plot_table').forEach((d) => { d.open = true; });
   }
 }
 
@@ -668,6 +689,49 @@ function slideCanvas(c, id) {
   return slide;
 }
 const slideImage = (c, id) => slideCanvas(c, id).toDataURL('image/png');
+
+// ---- Text alternatives: each plot as a table ----
+// Under each plot, a "the numbers" disclosure holds the plotted points as a table (series,
+// x, y with the axes' titles and units), built when opened; the CSV downloads have every
+// value in full precision.
+const TABLE_MAX_ROWS = 2000;
+function plotTable(c) {
+  const xTitle = c.options.scales.x.title.text, yTitle = c.options.scales.y.title.text;
+  const table = el('table');
+  const head = el('tr');
+  for (const h of ['series', xTitle, yTitle]) head.appendChild(el('th', h));
+  table.appendChild(head);
+  let rows = 0, total = 0, series = '';
+  c.data.datasets.forEach((d) => {
+    series = d.label || series;  // a body's later segments carry no label of their own
+    d.data.forEach((q) => {
+      ++total;
+      if (rows >= TABLE_MAX_ROWS) return;
+      const tr = el('tr');
+      tr.appendChild(el('td', series));
+      tr.appendChild(el('td', fmt(q.x, 9)));
+      tr.appendChild(el('td', fmt(q.y, 9)));
+      table.appendChild(tr);
+      ++rows;
+    });
+  });
+  const note = el('p', total > rows ? 'The first ' + fmt(rows) + ' of ' + fmt(total) + ' plotted points; the CSV downloads hold every value.'
+                                    : fmt(total) + ' plotted points.', {class: 'muted'});
+  return [note, table];
+}
+
+function addPlotTables() {
+  Object.keys(charts).forEach((id) => {
+    const box = document.getElementById(id + '_box');
+    if (!box || box.querySelector('details.plot_table')) return;
+    const details = el('details', null, {class: 'plot_table'});
+    details.appendChild(el('summary', 'The numbers of this plot, as a table'));
+    details.addEventListener('toggle', () => {
+      if (details.open) details.replaceChildren(details.firstChild, ...plotTable(charts[id]));
+    });
+    box.appendChild(details);
+  });
+}
 
 // For tests (the page opened at #check-png): <body> gets data-png, "<plot>:<width>x<height>:
 // opaque|transparent" for each plot's slide.

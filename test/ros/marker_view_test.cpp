@@ -425,3 +425,32 @@ TEST(MarkerView, ManyBodiesAreDrawnInTheViewsColours) {
 }
 
 }  // namespace
+
+namespace {
+
+// WCAG 2 relative luminance of an sRGB colour given as bytes.
+double relativeLuminance(int r, int g, int b) {
+  const auto linear = [](int byte) {
+    const double c = byte / 255.0;
+    return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+  };
+  return 0.2126 * linear(r) + 0.7152 * linear(g) + 0.0722 * linear(b);
+}
+
+double contrast(double a, double b) { return (std::max(a, b) + 0.05) / (std::min(a, b) + 0.05); }
+
+}  // namespace
+
+// Every body colour, as the page draws it (RunView's "#rrggbb") and rviz too, keeps 3:1
+// against the page's white and rviz's background (rviz/collision_lab.rviz: 30; 32; 40).
+TEST(MarkerView, BodyColoursKeepAContrastOf3To1OnBothBackgrounds) {
+  const double white = relativeLuminance(255, 255, 255), rviz = relativeLuminance(30, 32, 40);
+  for (std::size_t i = 0; i < layout::kPaletteSize; ++i) {
+    const std::string hex = collision_lab_ros::bodyColourHex(i);
+    ASSERT_EQ(hex.size(), 7u) << hex;
+    const double l = relativeLuminance(std::stoi(hex.substr(1, 2), nullptr, 16), std::stoi(hex.substr(3, 2), nullptr, 16),
+                                       std::stoi(hex.substr(5, 2), nullptr, 16));
+    EXPECT_GE(contrast(l, white), 3.0) << "body " << i << " " << hex;
+    EXPECT_GE(contrast(l, rviz), 3.0) << "body " << i << " " << hex;
+  }
+}

@@ -126,6 +126,13 @@ TEST_F(WebBrowserTest, RunPageDrawsItsPlots) {
   std::smatch spread;
   ASSERT_TRUE(std::regex_search(dom, spread, std::regex("data-phase-spread=\"([^\"]*)\""))) << dom.substr(0, 600);
   EXPECT_LT(std::stod(spread[1]), 1e-5);
+  // Each plot has its numbers as a table (its text alternative): the velocity plot's first
+  // row is A at the start, -1 m/s.
+  EXPECT_NE(dom.find("class=\"plot_table\""), std::string::npos);
+  const std::string tables = chromium("--dump-dom", page + "#open-tables");
+  EXPECT_NE(tables.find("<tr><td>v A simulated</td><td>0</td><td>-1</td></tr>"), std::string::npos)
+      << tables.substr(tables.find("velocity_box"), 1500);
+  EXPECT_NE(tables.find("<th>after collision</th>"), std::string::npos) << "the phase-space table";
   // Each plot's PNG is a slide: 1600 px wide, opaque.
   const std::string checked = chromium("--dump-dom", page + "#check-png");
   EXPECT_NE(checked.find("data-png=\"velocity:1600x900:opaque energy:1600x900:opaque xt:1600x900:opaque\""),

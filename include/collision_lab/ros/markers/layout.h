@@ -50,9 +50,11 @@ constexpr double kDotZ = 0.05;  ///< dots over lines
 // ---- colours ----
 /// Bodies' colours: A, B, C as always, then more for up to kMaxPlottedBodies bodies.
 constexpr std::size_t kPaletteSize = 10;
+/// Each keeps a contrast of at least 3:1 (WCAG, relative luminance 0.23 to 0.28) on the
+/// page's white and on rviz's dark grey background alike.
 constexpr Rgba kParticleRgb[kPaletteSize] = {
-    {0.95, 0.25, 0.25}, {0.25, 0.8, 0.3}, {0.3, 0.55, 1.0}, {1.0, 0.75, 0.2}, {0.75, 0.45, 1.0},
-    {0.2, 0.85, 0.85},  {1.0, 0.5, 0.75}, {0.65, 0.8, 0.25}, {1.0, 0.55, 0.3}, {0.6, 0.6, 0.95}};
+    {0.95, 0.25, 0.25}, {0.19, 0.63, 0.23}, {0.3, 0.55, 1.0},   {0.7, 0.52, 0.13},  {0.7, 0.42, 0.93},
+    {0.13, 0.61, 0.61}, {0.82, 0.41, 0.62}, {0.47, 0.59, 0.17}, {0.82, 0.45, 0.24}, {0.52, 0.52, 0.82}};
 /// The diverging colour map of velocity: its ends, and purple at rest, seen on rviz's dark
 /// background and on the page's white one alike (white at rest vanished on the page).
 constexpr Rgba kSlowBlue{0.2, 0.4, 1.0};
