@@ -592,7 +592,7 @@ function render(run) {
   t.options.plugins.legend.labels.filter = (item) => item.text !== '';
   if (view && view.end_time !== null) {
     t.options.scales.y.min = 0;
-    t.options.scales.y.max = view.end_time;
+    t.options.scales.y.max = roundUp(view.end_time);
     document.body.dataset.viewEnd = String(view.end_time);
   }
   if (view && view.ring_circumference > 0) {
@@ -621,6 +621,7 @@ function render(run) {
     document.body.dataset.final = 'true';
     document.getElementById('stop').hidden = true;
     addPlotTables();
+    setupXtWindow(run);
     if (location.hash === '#check-png') checkSlideImages();
     // For tests and screenshots: every plot's table open.
     if (location.hash === '#open-tables') document.querySelectorAll('details.plot_table').forEach((d) => { d.open = true; });
@@ -689,6 +690,86 @@ function slideCanvas(c, id) {
   return slide;
 }
 const slideImage = (c, id) => slideCanvas(c, id).toDataURL('image/png');
+
+// ---- A time window of the x-t diagram ----
+// A long run's whole-run lines keep its early impacts as a few columns; a window is read
+// again from every event in the bag (GET .../worldlines), for the bodies the view tracks.
+// Axis ends are round numbers (1, 2 or 5 x 10^n).
+function roundUp(x) {
+  if (!(x > 0)) return x;
+  const p = Math.pow(10, Math.floor(Math.log10(x)));
+  for (const m of [1, 2, 2.5, 5, 10]) if (m * p >= x * (1 - 1e-12)) return m * p;
+  return 10 * p;
+}
+
+let wholeRunXt = null;  // the whole run's datasets and axis, to go back to
+function setupXtWindow(run) {
+  const box = document.getElementById('xt_window');
+  const view = run.view || {};
+  const recorded = run.summary && run.summary.recorded === true;
+  box.hidden = !(ended(run.state) && recorded && !(view.ring_circumference > 0) && view.end_time > 0);
+  if (box.hidden) return;
+  const c = charts.xt;
+  wholeRunXt = {datasets: c.data.datasets, min: c.options.scales.y.min, max: c.options.scales.y.max};
+  const bodies = (run.plots.worldline_segments || run.plots.worldlines).map((l) => l.body);
+  const note = document.getElementById('xt_window_note');
+  // log: a logarithmic time axis over the whole run, x held to the scene's extent (the start's
+  // positions and as much again on each side), where the collisions happen.
+  const show = async (from, to, log) => {
+    document.getElementById('xt_from').value = from;
+    document.getElementById('xt_to').value = to;
+    note.textContent = 'Reading every event from ' + fmt(from) + ' s to ' + fmt(to) + ' s...';
+    const res = await fetch(api + '/worldlines?from=' + from + '&to=' + to + '&bodies=' + bodies.join(','));
+    const answer = await res.json();
+    if (res.status !== 200) { note.textContent = 'HTTP ' + res.status + ': ' + answer.error; return; }
+    c.data.datasets = answer.lines.map((l) => ({label: bodyName(l.body), data: l.points.map((q) => ({x: q[1], y: q[0]})),
+      borderColor: bodyColour(l.body)}));
+    if (log) {
+      let first = answer.to;
+      answer.lines.forEach((l) => l.points.forEach((q) => { if (q[0] > 0) first = Math.min(first, q[0]); }));
+      const x = run.scene.positions, lo = Math.min(...x), hi = Math.max(...x), pad = Math.max(hi - lo, 1);
+      const step = roundUp((hi - lo + 2 * pad) / 6);  // round axis ends
+      c.options.scales.y.type = 'logarithmic';
+      c.options.scales.y.min = Math.pow(10, Math.floor(Math.log10(first)));
+      const span = Math.log10(answer.to / c.options.scales.y.min);
+      c.options.scales.y.ticks = {autoSkip: false, callback: (value) => logTickLabel(value, span)};
+      c.options.scales.x.min = Math.floor((lo - pad) / step) * step;
+      c.options.scales.x.max = Math.ceil((hi + pad) / step) * step;
+    } else {
+      c.options.scales.y.type = 'linear';
+      c.options.scales.y.ticks = {};
+      c.options.scales.y.min = answer.from;
+      delete c.options.scales.x.min;
+      delete c.options.scales.x.max;
+    }
+    c.options.scales.y.max = answer.to;
+    c.update('none');
+    note.textContent = 'Shown: t from ' + fmt(answer.from) + ' s to ' + fmt(answer.to) + ' s, ' +
+      (answer.exact ? 'every event.' : 'drawn per column (over 2,048 points per body).');
+    document.body.dataset.xtWindow = answer.from + '-' + answer.to + ':' + answer.lines.length;
+  };
+  document.getElementById('xt_show').onclick = () => {
+    const from = Number(document.getElementById('xt_from').value), to = Number(document.getElementById('xt_to').value);
+    if (!(from >= 0 && to > from)) { note.textContent = 'Give 0 <= from < to, in seconds.'; return; }
+    show(from, to);
+  };
+  document.getElementById('xt_early').onclick = () => show(0, roundUp(view.end_time / 100));
+  document.getElementById('xt_log').onclick = () => show(0, roundUp(view.end_time), true);
+  document.getElementById('xt_whole').onclick = () => {
+    c.data.datasets = wholeRunXt.datasets;
+    c.options.scales.y.type = 'linear';
+    c.options.scales.y.ticks = {};
+    delete c.options.scales.x.min;
+    delete c.options.scales.x.max;
+    c.options.scales.y.min = wholeRunXt.min;
+    c.options.scales.y.max = wholeRunXt.max;
+    c.update('none');
+    note.textContent = '';
+  };
+  // For tests: the page opened at #xt-early shows the first 1% at once.
+  if (location.hash === '#xt-early') show(0, roundUp(view.end_time / 100));
+  if (location.hash === '#xt-log') show(0, roundUp(view.end_time), true);
+}
 
 // ---- Text alternatives: each plot as a table ----
 // Under each plot, a "the numbers" disclosure holds the plotted points as a table (series,

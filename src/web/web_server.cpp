@@ -1,4 +1,5 @@
 #include "collision_lab/web/web_server.h"
+#include "collision_lab/web/window_worldlines.h"
 
 #include <arpa/inet.h>
 #include <ifaddrs.h>
@@ -66,6 +67,9 @@ constexpr auto kStreamKeepAlive = std::chrono::seconds(10);
 constexpr std::size_t kPresetSceneMaxBodies = 100;
 /// The class table's widest run: two columns per body, a row per event.
 constexpr std::size_t kClassTableMaxBodies = 64;
+/// A time window's x-t diagram: at most this many bodies, and vertices per body.
+constexpr std::size_t kWindowMaxBodies = 64;
+constexpr std::size_t kWindowVertices = 2048;
 constexpr char kClassCookie[] = "collision_lab_class";
 constexpr char kTeacherCookie[] = "collision_lab_teacher";
 /// [s] a login lasts: a school day.
@@ -639,7 +643,7 @@ void WebServer::route(const HttpRequest& request, const Access& access, const Ht
   }
   static const std::regex student_stop("/api/students/([A-Za-z0-9_-]{1,64})/stop");
   if (post && std::regex_match(path, match, student_stop)) return stopStudent(request, match[1], access, reply);
-  static const std::regex run_api("/api/runs/" + kRunId + "(/events\\.csv|/table\\.csv|/bag|/stream|/stop)?");
+  static const std::regex run_api("/api/runs/" + kRunId + "(/events\\.csv|/table\\.csv|/worldlines|/bag|/stream|/stop)?");
   if (std::regex_match(path, match, run_api)) {
     const std::string run_id = match[1], what = match[2];
     if (post && what == "/stop") return stopRun(request, run_id, access, reply);
@@ -654,6 +658,7 @@ void WebServer::route(const HttpRequest& request, const Access& access, const Ht
     }
     if (get && what == "/events.csv") return sendEventsCsv(request, run_id, reply);
     if (get && what == "/table.csv") return sendClassTable(request, run_id, reply);
+    if (get && what == "/worldlines") return sendWindow(request, run_id, query, reply);
     if (get && what == "/bag") return sendBag(request, run_id, reply);
     if (get && what == "/stream") return stream(request, run_id, reply);
   }
@@ -1074,6 +1079,56 @@ void WebServer::sendClassTable(const HttpRequest& request, const std::string& ru
     }
     return why.empty() ? path : std::string();
   }, reply);
+}
+
+// GET /api/runs/<run_id>/worldlines?from=T0&to=T1&bodies=0,1,2: the x-t diagram of a time
+// window, from every event in the bag (windowWorldlines), read on the reader pool.
+void WebServer::sendWindow(const HttpRequest& request, const std::string& run_id, const std::string& query,
+                           const HttpReply& reply) {
+  if (!book_.has(run_id)) return reply.send(errorAnswer(request, 404, "no such run"));
+  if (!book_.finished(run_id)) return reply.send(errorAnswer(request, 409, "the run is not finished yet"));
+  const std::string bag = book_.bagPath(run_id);
+  if (bag.empty()) return reply.send(errorAnswer(request, 404, "the run was not recorded"));
+  const auto number = [&](const char* name) {
+    const auto text = queryParam(query, name);
+    char* end = nullptr;
+    const double value = text ? std::strtod(text->c_str(), &end) : std::nan("");
+    return text && end && *end == '\0' && std::isfinite(value) ? value : std::nan("");
+  };
+  const double from = number("from"), to = number("to");
+  if (!(from >= 0.0 && from < to)) {
+    return reply.send(errorAnswer(request, 400, "give from and to [s] with 0 <= from < to", "from"));
+  }
+  std::vector<std::size_t> bodies;
+  const std::string list = queryParam(query, "bodies").value_or("");
+  for (std::size_t at = 0; at < list.size() && bodies.size() < kWindowMaxBodies;) {
+    const std::size_t end = std::min(list.find(',', at), list.size());
+    const std::string item = list.substr(at, end - at);
+    if (item.empty() || item.find_first_not_of("0123456789") != std::string::npos || item.size() > 9) {
+      return reply.send(errorAnswer(request, 400, "bodies: body indices separated by commas", "bodies"));
+    }
+    bodies.push_back(std::stoul(item));
+    at = end + 1;
+  }
+  boost::asio::post(blocking_->readers, [this, request, reply, bag, from, to, bodies] {
+    json lines = json::array();
+    bool exact = true;
+    try {
+      const auto window = windowWorldlines(bag, from, to, bodies, kWindowVertices);
+      exact = window.exact;
+      for (const auto& line : window.lines) {
+        json points = json::array();
+        for (const auto& [t, x] : line.points) points.push_back({t, x});
+        lines.push_back({{"body", line.body}, {"points", std::move(points)}});
+      }
+    } catch (const std::invalid_argument& e) {
+      return reply.send(errorAnswer(request, 400, e.what()));
+    } catch (const std::exception& e) {
+      return reply.send(errorAnswer(request, 500, e.what()));
+    }
+    collision_lab_ros::releaseMemoryAfterBag(bag);
+    reply.send(jsonAnswer(request, 200, {{"from", from}, {"to", to}, {"exact", exact}, {"lines", std::move(lines)}}));
+  });
 }
 
 // The bag: only the file its RunSummary names, and only when that file is <run_id>.bag.

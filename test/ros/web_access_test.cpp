@@ -588,6 +588,32 @@ TEST_F(WebAccessTest, EventsCsvIsConvertedOnceBesideTheBagAndStreamed) {
   EXPECT_NE(table->body.find("\n0,0,start,,1,0,1,-1,"), std::string::npos) << table->body;
 }
 
+// A time window of the x-t diagram, from every event in the bag: the ball between walls 1 m
+// apart (at 0.5 m, 1 m/s) meets the right wall at t = 0.5 s, the left at 1.5 s, the right at
+// 2.5 s; at 3 s it is back at 0.5 m.
+TEST_F(WebAccessTest, ATimeWindowOfTheXtDiagramHasEveryEventInIt) {
+  auto c = client();
+  auto res = c.Post("/api/runs", json{{"student", "win"}, {"preset", "ball_between_walls"}}.dump(), "application/json");
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 202) << res->body;
+  const std::string run_id = json::parse(res->body).at("run_id");
+  finishedRun(run_id);
+  auto window = c.Get(("/api/runs/" + run_id + "/worldlines?from=0&to=3&bodies=1").c_str());
+  ASSERT_TRUE(window);
+  ASSERT_EQ(window->status, 200) << window->body;
+  const json w = json::parse(window->body);
+  EXPECT_EQ(w.at("exact"), true);
+  ASSERT_EQ(w.at("lines").size(), 1u);
+  EXPECT_EQ(w.at("lines")[0].at("body"), 1);
+  EXPECT_EQ(w.at("lines")[0].at("points"), json::parse("[[0,0.5],[0.5,1],[1.5,0],[2.5,1],[3,0.5]]")) << w.dump();
+  // Bad windows are refused with the field.
+  for (const char* query : {"from=3&to=1", "from=-1&to=2", "to=2", "from=0&to=1&bodies=a"}) {
+    auto bad = c.Get(("/api/runs/" + run_id + "/worldlines?" + query).c_str());
+    ASSERT_TRUE(bad);
+    EXPECT_EQ(bad->status, 400) << query << ": " << bad->body;
+  }
+}
+
 TEST_F(WebAccessTest, HugeHeadersAre431AndIdleConnectionsAreClosed) {
   const std::string huge = rawRequest("127.0.6.1", "GET / HTTP/1.1\r\nHost: 127.0.0.1\r\nX-Padding: " +
                                                        std::string(32 << 10, 'x') + "\r\n\r\n");

@@ -354,6 +354,20 @@ TEST_F(RunPageViewTest, AStoppedRunSaysWhereItStoppedAndACappedOneHowToSimulateI
   EXPECT_NE(dom.find("set \"Stop after\" (max_collisions) to at least 3,141"), std::string::npos) << dom.substr(0, 3000);
 }
 
+// A long run read in a window: the first 1% of ball_between_walls (999.5 s), every event.
+TEST_F(RunPageViewTest, ALongRunIsReadInATimeWindow) {
+  const std::string dom = finalPage({{"student", "window"}, {"preset", "ball_between_walls"}});
+  const std::string run_id = dom.substr(dom.find("data-run-id=\"") + 13, dom.find('"', dom.find("data-run-id=\"") + 13) - dom.find("data-run-id=\"") - 13);
+  const std::string windowed = chromium("--dump-dom", "http://" + host_ + ":" + std::to_string(port_) + "/runs/" + run_id + "#xt-early");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(windowed, m, std::regex("data-xt-window=\"0-([0-9.]+):([0-9]+)\""))) << windowed.substr(0, 800);
+  const double to = std::stod(m[1]);
+  EXPECT_GE(to, 999.5 / 100);
+  EXPECT_LE(to, 2 * 1049.5 / 100);  // a round number above 1% of the run's end
+  EXPECT_GE(std::stoi(m[2]), 1);
+  EXPECT_NE(windowed.find("every event."), std::string::npos);
+}
+
 TEST_F(RunPageViewTest, ManyBodiesHaveNoPhaseSpacePicture) {
   const std::string dom = finalPage({{"student", "phase"}, {"preset", "cradle_5"}});
   EXPECT_NE(dom.find("data-phase=\"none\""), std::string::npos) << dom.substr(0, 600);

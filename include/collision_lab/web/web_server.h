@@ -131,6 +131,8 @@ class WebServer {
                        MakeFromBag make, const HttpReply& reply);
   void sendEventsCsv(const HttpRequest& request, const std::string& run_id, const HttpReply& reply);
   void sendClassTable(const HttpRequest& request, const std::string& run_id, const HttpReply& reply);
+  void sendWindow(const HttpRequest& request, const std::string& run_id, const std::string& query,
+                  const HttpReply& reply);
   void sendBag(const HttpRequest& request, const std::string& run_id, const HttpReply& reply);
   void stream(const HttpRequest& request, const std::string& run_id, const HttpReply& reply);
   /// Seconds until `key` may send again under `limit` per minute; 0 (and counted) when now.
