@@ -504,7 +504,7 @@ function showNotSimulated(run, view) {
   const box = document.getElementById('not_simulated_box');
   const hide = Boolean(view && view.not_simulated);
   box.hidden = !hide;
-  ['velocity', 'energy', 'xt'].forEach((id) => { document.getElementById(id + '_box').hidden = hide; });
+  ['velocity', 'energy', 'xt', 'momentum', 'bars'].forEach((id) => { document.getElementById(id + '_box').hidden = hide; });
   // Nor downloads of what does not exist: the plots' PNGs and the events CSV (a 404).
   document.querySelectorAll('button[data-plot]').forEach((b) => { if (b.dataset.plot !== 'temperature' && b.dataset.plot !== 'phase') b.hidden = hide; });
   document.getElementById('dl_csv').hidden = hide;
@@ -586,6 +586,7 @@ function render(run) {
   indexAxis(e, indexEnd);
   e.update('none');
   document.body.dataset.indexAxisEnd = String(indexEnd);
+  if (!notSimulated) drawMomentumAndEnergy(run, indexEnd);
   const t = chart('xt', 'x [m]', 't [s]');
   t.data.datasets = xtDatasets(run);
   t.options.plugins.legend.display = (run.plots.worldlines || []).length <= 12;
@@ -675,7 +676,7 @@ function slideCanvas(c, id) {
   const options = c.config.options;
   const copy = new Chart(canvas, {
     type: c.config.type,
-    data: {datasets: c.data.datasets.map((d) => Object.assign({}, d, {data: d.data.slice()}))},
+    data: {labels: c.data.labels, datasets: c.data.datasets.map((d) => Object.assign({}, d, {data: d.data.slice()}))},
     options: Object.assign({}, options, {
       responsive: false, animation: false, devicePixelRatio: scale,
       plugins: Object.assign({}, options.plugins, {title: {display: true, text: title, font: {size: 15}}}),
@@ -690,6 +691,78 @@ function slideCanvas(c, id) {
   return slide;
 }
 const slideImage = (c, id) => slideCanvas(c, id).toDataURL('image/png');
+
+// ---- Momentum, the centre of mass, energy before and after ----
+// The finite masses' momentum against the collision index (a wall's impacts are its steps),
+// each body's kinetic energy and the heat at the start and at the end as bars, and what is
+// conserved, in words. Every number is the server's (run.totals: each the exact value
+// correctly rounded).
+function drawMomentumAndEnergy(run, indexEnd) {
+  const totals = run.totals;
+  const m = chart('momentum', 'collision index', 'momentum [kg m/s]');
+  m.data.datasets = [{label: 'total momentum of the finite masses', data: toEnd(run.plots.momentum || [], indexEnd), borderColor: totalColours[0]}];
+  indexAxis(m, indexEnd);
+  m.update('none');
+  const s = run.summary;
+  const end = totals && totals.simulated;
+  const perBody = totals && totals.start && totals.start.kinetic_per_body;
+  const walls = run.scene.masses.map((mass, i) => (mass === 'inf' ? i : -1)).filter((i) => i >= 0);
+  const bodies = perBody ? run.scene.masses.map((mass, i) => i).filter((i) => !walls.includes(i)) : [];
+  const labels = perBody ? bodies.map((i) => bodyName(i)) : ['all bodies'];
+  labels.push('heat');
+  const startValues = perBody ? bodies.map((i) => perBody[i]) : [totals && totals.start ? totals.start.kinetic_energy : null];
+  startValues.push(0);
+  const endValues = end ? (perBody && end.kinetic_per_body ? bodies.map((i) => end.kinetic_per_body[i]) : [end.kinetic_energy]) : [];
+  if (end) endValues.push(s ? s.energy_lost : null);
+  if (!charts.energy_bars) {
+    charts.energy_bars = new Chart(document.getElementById('energy_bars'), {
+      type: 'bar',
+      data: {labels: [], datasets: []},
+      options: {animation: false, responsive: true, maintainAspectRatio: false, plugins: {legend: {labels: {boxWidth: 12}}},
+        scales: {x: {title: {display: true, text: 'kinetic energy of each body, and the heat'}}, y: {title: {display: true, text: 'energy [J]'}}}},
+    });
+  }
+  const bars = charts.energy_bars;
+  bars.data.labels = labels;
+  bars.data.datasets = [{label: 'at the start', data: startValues, backgroundColor: '#6b7c93'},
+    {label: 'at the end', data: endValues, backgroundColor: totalColours[1]}];
+  bars.update('none');
+  document.getElementById('conservation').replaceChildren(...conservationText(run).map((t) => el('li', t)));
+}
+
+// What is conserved and what is not, and why, from the server's totals.
+function conservationText(run) {
+  const t = run.totals, s = run.summary;
+  if (!t || !t.start || !t.simulated) return [];
+  const walls = run.scene.masses.filter((mass) => mass === 'inf').length;
+  const movingWall = run.scene.masses.some((mass, i) => mass === 'inf' && run.scene.velocities[i] !== 0);
+  const p0 = t.start.momentum, p1 = t.simulated.momentum;
+  const e0 = t.start.kinetic_energy, e1 = t.simulated.kinetic_energy;
+  const heat = s ? s.energy_lost : 0;
+  const out = [];
+  if (walls) {
+    out.push('Momentum: ' + fmt(p0) + ' kg m/s at the start, ' + fmt(p1) + ' kg m/s at the end. A wall is an infinite mass: ' +
+      'it takes and gives momentum at each of its impacts, so the bodies\u2019 total is not conserved (the steps in the plot).');
+  } else {
+    out.push('Momentum: ' + fmt(p0) + ' kg m/s at the start and ' + fmt(p1) + ' kg m/s at the end' +
+      (p0 === p1 ? ': conserved, as in every collision between bodies, elastic or not (equal and opposite impulses).'
+                 : ': it should be conserved; the difference is the rounding of the velocities shown.'));
+  }
+  const v0 = t.start.centre_of_mass_velocity, v1 = t.simulated.centre_of_mass_velocity;
+  out.push('Centre of mass: at ' + fmt(t.centre_of_mass_start) + ' m at the start, moving at ' + fmt(v0) + ' m/s; at the end at ' +
+    fmt(v1) + ' m/s' + (walls ? ' (the walls changed it).' : ' (the same: no outside force acts).'));
+  if (movingWall) {
+    out.push('Energy: ' + fmt(e0) + ' J at the start, ' + fmt(e1) + ' J at the end, ' + fmt(heat) + ' J of heat. ' +
+      'A moving wall does work on the bodies it pushes, so their energy is not conserved.');
+  } else if (heat > 0) {
+    out.push('Energy: ' + fmt(e0) + ' J at the start, ' + fmt(e1) + ' J at the end: ' + fmt(heat) +
+      ' J turned into heat in the collisions with e < 1. Kinetic energy plus heat is conserved.');
+  } else {
+    out.push('Energy: ' + fmt(e0) + ' J at the start and ' + fmt(e1) + ' J at the end: conserved, since every collision is elastic' +
+      (walls ? ' and a wall at rest does no work.' : '.'));
+  }
+  return out;
+}
 
 // ---- A time window of the x-t diagram ----
 // A long run's whole-run lines keep its early impacts as a few columns; a window is read
@@ -785,13 +858,14 @@ function plotTable(c) {
   let rows = 0, total = 0, series = '';
   c.data.datasets.forEach((d) => {
     series = d.label || series;  // a body's later segments carry no label of their own
-    d.data.forEach((q) => {
+    d.data.forEach((q, k) => {
       ++total;
       if (rows >= TABLE_MAX_ROWS) return;
       const tr = el('tr');
       tr.appendChild(el('td', series));
-      tr.appendChild(el('td', fmt(q.x, 9)));
-      tr.appendChild(el('td', fmt(q.y, 9)));
+      // A bar chart's values are plain numbers under its labels.
+      tr.appendChild(el('td', q !== null && typeof q === 'object' ? fmt(q.x, 9) : c.data.labels[k]));
+      tr.appendChild(el('td', fmt(q !== null && typeof q === 'object' ? q.y : q, 9)));
       table.appendChild(tr);
       ++rows;
     });

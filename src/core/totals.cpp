@@ -20,5 +20,27 @@ Totals totalsOf(const std::vector<double>& masses, const std::vector<double>& ve
   return {detail::nearestDouble(momentum), detail::nearestDouble(twice_energy / 2)};
 }
 
+CentreOfMass centreOfMass(const std::vector<double>& masses, const std::vector<double>& positions,
+                          const std::vector<double>& velocities) {
+  detail::ExactRational mass = 0, moment = 0, momentum = 0;
+  for (std::size_t i = 0; i < masses.size() && i < positions.size() && i < velocities.size(); ++i) {
+    if (!std::isfinite(masses[i])) continue;
+    const detail::ExactRational m(masses[i]);
+    mass += m;
+    moment += m * detail::ExactRational(positions[i]);
+    momentum += m * detail::ExactRational(velocities[i]);
+  }
+  if (mass == 0) return {0.0, std::nan(""), std::nan("")};
+  return {detail::nearestDouble(mass), detail::nearestDouble(moment / mass), detail::nearestDouble(momentum / mass)};
+}
+
+std::vector<double> kineticEnergies(const std::vector<double>& masses, const std::vector<double>& velocities) {
+  std::vector<double> out;
+  for (std::size_t i = 0; i < masses.size() && i < velocities.size(); ++i) {
+    out.push_back(std::isfinite(masses[i]) ? totalsOf({masses[i]}, {velocities[i]}).kinetic_energy : 0.0);
+  }
+  return out;
+}
+
 }  // namespace core
 }  // namespace collision_lab

@@ -135,9 +135,14 @@ json totalsJson(const collision_lab::core::Totals& t) {
   return {{"momentum", exactNumber(t.momentum)}, {"kinetic_energy", exactNumber(t.kinetic_energy)}};
 }
 
-/// The finite masses' momentum [kg m/s] and kinetic energy [J] (core::totalsOf, correctly
-/// rounded): at the start, and at the end by the simulation, the model and the paper's
-/// printed formulas, each where its final velocities are known (else null).
+/// Runs of at most this many bodies get each body's kinetic energy in their totals.
+constexpr std::size_t kPerBodyTotalsMaxBodies = 64;
+
+/// The finite masses' momentum [kg m/s], kinetic energy [J], centre-of-mass velocity [m/s]
+/// and (kPerBodyTotalsMaxBodies) each body's kinetic energy [J], every one the exact value
+/// correctly rounded (core/totals.h): at the start, and at the end by the simulation, the
+/// model and the paper's printed formulas, each where its final velocities are known (else
+/// null); with the total finite mass [kg] and the centre of mass at the start [m].
 json totalsJson(const RunRecord& record, const collision_lab::RunSummary* summary) {
   const auto& masses = record.input().masses;
   const auto at = [&masses](const std::vector<double>& velocities) -> json {
@@ -145,14 +150,25 @@ json totalsJson(const RunRecord& record, const collision_lab::RunSummary* summar
     for (std::size_t i = 0; i < masses.size(); ++i) {
       if (std::isfinite(masses[i]) && !std::isfinite(velocities[i])) return nullptr;
     }
-    return totalsJson(collision_lab::core::totalsOf(masses, velocities));
+    json totals = totalsJson(collision_lab::core::totalsOf(masses, velocities));
+    const std::vector<double> origin(masses.size(), 0.0);
+    totals["centre_of_mass_velocity"] = exactNumber(collision_lab::core::centreOfMass(masses, origin, velocities).velocity);
+    if (masses.size() <= kPerBodyTotalsMaxBodies) {
+      json each = json::array();
+      for (double k : collision_lab::core::kineticEnergies(masses, velocities)) each.push_back(exactNumber(k));
+      totals["kinetic_per_body"] = std::move(each);
+    }
+    return totals;
   };
   std::vector<double> paper;
   for (std::size_t i = 0; i < masses.size() && !record.plottedBodies().empty(); ++i) {
     if (record.paperVelocity(i).empty()) break;
     paper.push_back(record.paperVelocity(i).last().y);
   }
-  return {{"start", at(record.input().velocities)},
+  const auto centre = collision_lab::core::centreOfMass(masses, record.input().positions, record.input().velocities);
+  return {{"finite_mass", exactNumber(centre.mass)},
+          {"centre_of_mass_start", exactNumber(centre.position)},
+          {"start", at(record.input().velocities)},
           {"simulated", summary && summary->simulated ? at(summary->final_velocities) : json(nullptr)},
           {"predicted", record.prediction ? at(record.prediction->final_velocities) : json(nullptr)},
           {"paper", at(paper)}};
@@ -185,6 +201,7 @@ json plotsJson(const RunRecord& record, const std::vector<Envelope>& predicted) 
   plots["paper_final_velocities"] = paper_final;
   plots["predicted_velocity"] = closed_form;
   plots["energy"] = points(record.energy());
+  plots["momentum"] = points(record.momentum());
   plots["heat"] = points(record.energyLost());
   plots["worldlines"] = worldlines;
   return plots;

@@ -135,9 +135,10 @@ TEST_F(WebBrowserTest, RunPageDrawsItsPlots) {
   EXPECT_NE(tables.find("<th>after collision</th>"), std::string::npos) << "the phase-space table";
   // Each plot's PNG is a slide: 1600 px wide, opaque.
   const std::string checked = chromium("--dump-dom", page + "#check-png");
-  EXPECT_NE(checked.find("data-png=\"velocity:1600x900:opaque energy:1600x900:opaque xt:1600x900:opaque\""),
-            std::string::npos)
-      << checked.substr(0, 600);
+  for (const char* plot : {"velocity", "energy", "momentum", "energy_bars", "xt"}) {
+    EXPECT_TRUE(std::regex_search(checked, std::regex(std::string("data-png=\"[^\"]*\\b") + plot + ":1600x900:opaque")))
+        << plot << ": " << checked.substr(0, 600);
+  }
 
   const std::string shot = dir_ + "/run.png";
   chromium("--screenshot=" + shot, page);
@@ -366,6 +367,23 @@ TEST_F(RunPageViewTest, ALongRunIsReadInATimeWindow) {
   EXPECT_LE(to, 2 * 1049.5 / 100);  // a round number above 1% of the run's end
   EXPECT_GE(std::stoi(m[2]), 1);
   EXPECT_NE(windowed.find("every event."), std::string::npos);
+}
+
+// What is conserved, in words, from the server's exact totals: equal masses keep momentum
+// (0) and energy (1 J); an inelastic pair keeps momentum and turns energy into heat.
+TEST_F(RunPageViewTest, ConservationIsSaidInWords) {
+  std::string dom = finalPage({{"student", "keep"}, {"preset", "equal_masses"}});
+  EXPECT_NE(dom.find("<li>Momentum: 0 kg m/s at the start and 0 kg m/s at the end: conserved"), std::string::npos)
+      << dom.substr(dom.find("conservation"), 1500);
+  EXPECT_NE(dom.find("<li>Energy: 1 J at the start and 1 J at the end: conserved, since every collision is elastic.</li>"),
+            std::string::npos);
+  EXPECT_NE(dom.find("moving at 0 m/s; at the end at 0 m/s (the same: no outside force acts).</li>"), std::string::npos);
+  // Two 1 kg carts at e = 0.5 (preset two_carts_inelastic: 2 m/s against 0): momentum 2,
+  // heat (1 - e^2) mu v^2 / 2 = 0.75 * 0.5 * 4 / 2 = 0.75 J of the 2 J.
+  dom = finalPage({{"student", "keep"}, {"masses", {1, 1}}, {"positions", {1, 0}}, {"velocities", {0, 2}}, {"restitution", {0.5}}});
+  EXPECT_NE(dom.find("<li>Momentum: 2 kg m/s at the start and 2 kg m/s at the end: conserved"), std::string::npos)
+      << dom.substr(dom.find("conservation"), 1500);
+  EXPECT_NE(dom.find("<li>Energy: 2 J at the start, 1.25 J at the end: 0.75 J turned into heat"), std::string::npos);
 }
 
 TEST_F(RunPageViewTest, ManyBodiesHaveNoPhaseSpacePicture) {

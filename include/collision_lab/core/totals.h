@@ -20,5 +20,21 @@ struct Totals {
 /// finite.
 Totals totalsOf(const std::vector<double>& masses, const std::vector<double>& velocities);
 
+struct CentreOfMass {
+  double mass = 0.0;      ///< sum m_i over the finite masses [kg]
+  double position = 0.0;  ///< sum m_i x_i / sum m_i [m]
+  double velocity = 0.0;  ///< sum m_i v_i / sum m_i [m/s]
+};
+
+/// The centre of mass of the finite masses (walls left out) at the given positions [m] and
+/// velocities [m/s]: each value the exact one of the given doubles correctly rounded; NaN
+/// position and velocity when no mass is finite. Precondition as totalsOf.
+CentreOfMass centreOfMass(const std::vector<double>& masses, const std::vector<double>& positions,
+                          const std::vector<double>& velocities);
+
+/// Each body's kinetic energy m_i v_i^2 / 2 [J], the exact value correctly rounded; 0 for a
+/// wall. Precondition as totalsOf.
+std::vector<double> kineticEnergies(const std::vector<double>& masses, const std::vector<double>& velocities);
+
 }  // namespace core
 }  // namespace collision_lab
