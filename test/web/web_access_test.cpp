@@ -27,7 +27,7 @@
 
 #include "collision_lab/InitialConditions.h"
 #include "collision_lab/RunQueue.h"
-#include "run_collector.h"
+#include "../ros/run_collector.h"
 // Last: it includes <resolv.h>, whose macro _res breaks Eigen's headers included after it.
 #include <httplib.h>
 

@@ -22,7 +22,7 @@
 #include <ros/ros.h>
 
 #include "collision_lab/ros/run_view.h"
-#include "run_collector.h"
+#include "../ros/run_collector.h"
 // Last: it includes <resolv.h>, whose macro _res breaks Eigen's headers included after it.
 #include <httplib.h>
 
@@ -158,7 +158,7 @@ TEST_F(WebBrowserTest, RunPageDrawsItsPlots) {
 TEST_F(WebBrowserTest, FormSendsASceneAndSeesTheResult) {
   // The driver page must share the class page's origin to reach into its frame: a proxy on
   // a port of its own serves the driver and forwards everything else to the web node.
-  std::ifstream in(std::string(COLLISION_LAB_SOURCE_DIR) + "/test/ros/web_form_driver.html");
+  std::ifstream in(std::string(COLLISION_LAB_SOURCE_DIR) + "/test/web/web_form_driver.html");
   std::stringstream driver;
   driver << in.rdbuf();
   httplib::Server proxy;

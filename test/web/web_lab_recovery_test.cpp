@@ -21,7 +21,7 @@
 #include <ros/ros.h>
 #include <xmlrpcpp/XmlRpcClient.h>
 
-#include "run_collector.h"
+#include "../ros/run_collector.h"
 // Last: it includes <resolv.h>, whose macro _res breaks Eigen's headers included after it.
 #include <httplib.h>
 

@@ -14,7 +14,7 @@
 #include "collision_lab/AcceptedRun.h"
 #include "collision_lab/InitialConditions.h"
 #include "collision_lab/web/run_book.h"
-#include "run_collector.h"
+#include "../ros/run_collector.h"
 // Last: it includes <resolv.h>, whose macro _res breaks Eigen's headers included after it.
 #include <httplib.h>
 

@@ -19,7 +19,7 @@
 
 #include "collision_lab/RunProgress.h"
 #include "collision_lab/RunSummary.h"
-#include "run_collector.h"
+#include "../ros/run_collector.h"
 // Last: it includes <resolv.h>, whose macro _res breaks Eigen's headers included after it.
 #include <httplib.h>
 
