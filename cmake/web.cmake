@@ -13,6 +13,10 @@ add_library(collision_lab_web_lib
   src/web/index_run_source.cpp
   src/web/web_secrets.cpp
   src/web/web_server.cpp
+  src/web/web_access.cpp
+  src/web/web_post.cpp
+  src/web/web_exports.cpp
+  src/web/web_stream.cpp
   src/web/window_worldlines.cpp)
 target_include_directories(collision_lab_web_lib PUBLIC include)
 target_link_libraries(collision_lab_web_lib PUBLIC collision_lab_ros collision_lab_views collision_lab_tools collision_lab_service Threads::Threads)

@@ -27,9 +27,13 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <regex>
 #include <set>
 #include <string>
 #include <vector>
+
+#include <boost/beast/http/verb.hpp>
+#include <nlohmann/json_fwd.hpp>
 
 #include "collision_lab/InitialConditions.h"
 #include "collision_lab/RunQueue.h"
@@ -117,8 +121,30 @@ class WebServer {
 
  private:
   void handle(HttpRequest request, HttpReply reply);
+  /// The route table: {method, path pattern, handler}; the first route whose method and
+  /// pattern match a request answers it, and a request no route takes is 404.
+  struct RouteCall;
+  struct Route {
+    Route(boost::beast::http::verb method, const std::string& pattern, std::function<void(const RouteCall&)> handle)
+        : method(method), path(pattern), handle(std::move(handle)) {}
+    boost::beast::http::verb method;
+    std::regex path;
+    std::function<void(const RouteCall&)> handle;
+  };
+  std::vector<Route> makeRoutes();
   void route(const HttpRequest& request, const Access& access, const HttpReply& reply);
+  void sendStatic(const HttpRequest& request, const HttpReply& reply);
+  void sendRunPage(const HttpRequest& request, const std::string& run_id, const HttpReply& reply);
+  void sendPresets(const HttpRequest& request, const HttpReply& reply);
+  void sendQueue(const HttpRequest& request, const HttpReply& reply);
+  void sendRun(const HttpRequest& request, const std::string& run_id, const HttpReply& reply);
   void postRun(const HttpRequest& request, const HttpReply& reply);
+  struct Refuse;  ///< answers a refused send (web_post.cpp)
+  collision_lab::InitialConditions sceneOfSend(const nlohmann::json& body) const;
+  bool admitSend(const HttpRequest& request, const collision_lab::InitialConditions& input, const std::string& student,
+                 const Refuse& refuse, const HttpReply& reply);
+  void sendToLab(const HttpRequest& request, const HttpReply& reply, collision_lab::InitialConditions input,
+                 const Refuse& refuse);
   void stopRun(const HttpRequest& request, const std::string& run_id, const Access& access, const HttpReply& reply);
   /// POST /api/students/<student>/stop (the teacher): every queued or running run of student.
   void stopStudent(const HttpRequest& request, const std::string& student, const Access& access, const HttpReply& reply);
@@ -189,6 +215,7 @@ class WebServer {
   std::string queue_json_;
   std::unique_ptr<BlockingPool> blocking_;  ///< cancel calls and CSV conversions
   std::unique_ptr<HttpServer> server_;
+  std::vector<Route> routes_;  ///< after everything its handlers use
 };
 
 }  // namespace collision_lab_web
