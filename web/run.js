@@ -948,6 +948,8 @@ async function main() {
   const source = new EventSource(api + '/stream');
   source.addEventListener('run', (e) => render(JSON.parse(e.data)));
   source.addEventListener('final', (e) => { render(JSON.parse(e.data)); source.close(); });
+  // The web server is restarting: go on by polling, which its next start answers.
+  source.addEventListener('restart', () => { source.close(); setTimeout(poll, 1000); });
   // 503 (too many live streams) or a dropped connection: reload the run every second.
   source.onerror = () => { if (document.body.dataset.final !== 'true') { source.close(); poll(); } };
 }

@@ -18,6 +18,7 @@
 #include <regex>
 #include <sstream>
 #include <stdexcept>
+#include <thread>
 
 #include <boost/asio/post.hpp>
 #include <boost/asio/steady_timer.hpp>
@@ -39,6 +40,8 @@ namespace collision_lab_web {
 
 namespace {
 
+/// At stop, open streams are given this long to send their `restart` event.
+constexpr auto kStreamsEndWithin = std::chrono::seconds(1);
 /// Presets of more bodies than this come without their lists (the form sends their name).
 constexpr std::size_t kPresetSceneMaxBodies = 100;
 /// An address's place held by a run whose end this node never saw is given back after this.
@@ -166,6 +169,10 @@ void WebServer::stop() {
     pending.swap(pending_);
   }
   for (const auto& [student, requested] : pending) book_.forget(student, requested);
+  // Open streams end with an event `restart` at their next poll, before the server closes.
+  stopping_ = true;
+  const auto deadline = std::chrono::steady_clock::now() + kStreamsEndWithin;
+  while (streams_ > 0 && std::chrono::steady_clock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(20));
   if (blocking_) blocking_->pool.join();
   if (server_) server_->stop();
 }

@@ -17,7 +17,9 @@ constexpr auto kStreamKeepAlive = std::chrono::seconds(10);
 }  // namespace
 
 // Server-Sent Events: the run as JSON (as GET /api/runs/<run_id>) whenever it changed, at
-// most every kStreamInterval; an event `final` ends the stream. A timer per stream, no thread.
+// most every kStreamInterval; an event `final` ends the stream, and an event `restart` when
+// this server stops (stop(): the page goes on by polling, and the respawned server serves
+// it). A timer per stream, no thread.
 void WebServer::stream(const HttpRequest& request, const std::string& run_id, const HttpReply& reply) {
   if (!book_.has(run_id)) return reply.send(errorAnswer(request, 404, "no such run"));
   bool full = false;
@@ -46,6 +48,7 @@ void WebServer::stream(const HttpRequest& request, const std::string& run_id, co
   reply.stream(
       std::move(header),
       [this, run_id, slot, seen, last]() -> StreamStep {
+        if (stopping_) return {"event: restart\ndata: {\"reason\": \"the web server is restarting\"}\n\n", true};
         const auto now = std::chrono::steady_clock::now();
         const auto version = book_.waitForChange(run_id, *seen, std::chrono::milliseconds(0)).first;
         if (version == *seen) {

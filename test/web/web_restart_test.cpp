@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <functional>
 #include <iterator>
+#include <mutex>
 #include <fstream>
 #include <string>
 #include <thread>
@@ -220,8 +221,36 @@ TEST(WebRestart, LoginsAndStopTokensOutliveARestart) {
   const json run = json::parse(sent->body);
   const std::string stop = "/api/runs/" + run.at("run_id").get<std::string>() + "/stop";
 
+  // A graceful stop (SIGINT, as roslaunch stops a node) ends an open stream with an event
+  // `restart`, which the page answers by polling; the stream does not just break off.
+  std::mutex streamed_mutex;
+  std::string streamed;
+  const auto seen = [&](const std::string& text) {
+    std::lock_guard<std::mutex> lock(streamed_mutex);
+    return streamed.find(text) != std::string::npos;
+  };
+  std::thread reader([&] {
+    httplib::Client s(address.first, address.second);
+    s.set_read_timeout(30, 0);
+    s.Get(("/api/runs/" + run.at("run_id").get<std::string>() + "/stream").c_str(), with_cookie,
+          [&](const char* data, std::size_t n) {
+            std::lock_guard<std::mutex> lock(streamed_mutex);
+            streamed.append(data, n);
+            return true;
+          });
+  });
+  waitUntil([&] { return seen("event: run"); }, "the stream's first event");
   int pid = 0;
   waitUntil([&] { return (pid = webPid(kCodedNode)) > 0; }, "the coded web node's pid");
+  ros::param::del(kCodedUrl);
+  ASSERT_EQ(kill(pid, SIGINT), 0);
+  reader.join();
+  EXPECT_TRUE(seen("event: restart\ndata: ")) << streamed.substr(streamed.size() > 300 ? streamed.size() - 300 : 0);
+  waitUntil([&] { const int again = webPid(kCodedNode); return again > 0 && again != pid; }, "the coded web node to respawn");
+  address = webAddress(kCodedUrl);
+
+  // Then a kill -9.
+  waitUntil([&] { return (pid = webPid(kCodedNode)) > 0; }, "the respawned coded web node's pid");
   ros::param::del(kCodedUrl);
   ASSERT_EQ(kill(pid, SIGKILL), 0);
   waitUntil([&] { const int again = webPid(kCodedNode); return again > 0 && again != pid; }, "the coded web node to respawn");
@@ -247,6 +276,7 @@ TEST(WebRestart, LoginsAndStopTokensOutliveARestart) {
   const std::string stored((std::istreambuf_iterator<char>(tokens)), std::istreambuf_iterator<char>());
   EXPECT_NE(stored.find(run.at("run_id").get<std::string>()), std::string::npos) << stored;
   EXPECT_EQ(stored.find(run.at("stop_token").get<std::string>()), std::string::npos) << stored;
+
 }
 
 /// A three-body run's messages and bag: `recorded` of its `collisions` events in the bag,

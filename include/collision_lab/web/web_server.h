@@ -188,6 +188,7 @@ class WebServer {
   std::set<std::string> hosts_;               ///< names the lab serves (Host without port)
   WebSecrets secrets_;  ///< the cookies' secrets and the stop tokens, kept across restarts
   std::atomic<std::size_t> streams_{0};
+  std::atomic<bool> stopping_{false};  ///< stop() began: streams end with `restart`
   collision_lab::service::AddressShare shares_;  ///< unfinished_runs_per_address
   mutable std::mutex mutex_;  ///< guards everything below
   std::map<std::string, std::deque<std::chrono::steady_clock::time_point>> sends_;
