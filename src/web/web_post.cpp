@@ -240,13 +240,14 @@ bool WebServer::admitSend(const HttpRequest& request, const collision_lab::Initi
     reply.send(std::move(res));
     return false;
   }
-  // Per address and per name: another name does not escape the limit, and sending as a
-  // classmate from elsewhere only spends the classmate's runs as well as one's own.
+  // Per address, and per name at that address: another name does not escape the address's
+  // limit, and sending as a classmate from another address spends none of the classmate's
+  // own runs.
   long wait = admit("address " + request.client, config_.runs_per_minute_per_address);
   std::string which = "runs per address";
   std::size_t limit = config_.runs_per_minute_per_address;
   if (!wait) {
-    wait = admit("student " + student, config_.runs_per_minute);
+    wait = admit("student " + student + " at " + request.client, config_.runs_per_minute);
     which = "runs per student";
     limit = config_.runs_per_minute;
   }

@@ -372,6 +372,22 @@ std::pair<int, json> postFrom(const std::string& source, const json& scene) {
   return {statusOf(raw), start == std::string::npos ? json() : json::parse(raw.substr(start + 4), nullptr, false)};
 }
 
+// Someone else sending as "zoe" from another machine spends none of zoe's own runs a
+// minute (runs_per_minute = 10, counted per name at each address). (Failed before: zoe's
+// next send was 429 for a minute.)
+TEST_F(WebAccessTest, SendingAsAClassmateFromElsewhereSpendsNoneOfTheirRuns) {
+  std::vector<int> impostor;
+  for (int i = 0; i < 11; ++i) {
+    const auto [status, body] = postFrom("127.0.9.1", piScene("zoe"));
+    impostor.push_back(status);
+    if (status == 202) finishedRun(body.at("run_id"));  // no unfinished run holds the address's share
+  }
+  std::vector<int> expected(10, 202);
+  expected.push_back(429);
+  EXPECT_EQ(impostor, expected) << "the impostor's address spends its own 10 runs of zoe";
+  EXPECT_EQ(postFrom("127.0.9.2", piScene("zoe")).first, 202) << "zoe, at her own machine";
+}
+
 TEST_F(WebAccessTest, OneAddressUnderManyNamesHoldsABoundedShare) {
   constexpr int kShare = 6;  // unfinished_runs_per_address: its default
   std::vector<json> held;
