@@ -2,7 +2,7 @@
 
 run() and predict() run one scene as collision_lab_cli does (its JSON report, as dicts and
 numpy arrays); sweep() runs many, on every core or on a Dask cluster; read_bag() opens a
-run the ROS node recorded. A Run's summary has the same keys (SUMMARY_KEYS) from all three,
+run the ROS node recorded; preset() a named scene of config/scenarios.yaml. A Run's summary has the same keys (SUMMARY_KEYS) from all three,
 for every model, and its scene (SCENE_KEYS) goes back into run(**scene).
 collision_lab.msg holds the package's ROS messages.
 """
@@ -17,9 +17,10 @@ from ._core import version as __version__
 from ._run import SCENE_KEYS, SUMMARY_KEYS, CapWarning, Run, SceneError, body_name, predict, run
 from ._sweep import sweep
 from ._bag import read_bag
+from ._presets import data_path, preset, presets
 
-__all__ = ['CapWarning', 'Run', 'SCENE_KEYS', 'SUMMARY_KEYS', 'SceneError', 'body_name', 'plot', 'predict', 'read_bag',
-           'run', 'sweep']
+__all__ = ['CapWarning', 'Run', 'SCENE_KEYS', 'SUMMARY_KEYS', 'SceneError', 'body_name', 'data_path', 'plot', 'predict',
+           'preset', 'presets', 'read_bag', 'run', 'sweep']
 
 
 def __getattr__(name):

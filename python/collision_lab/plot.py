@@ -1,24 +1,31 @@
 """collision_lab.plot: the views of a run that the class page and rviz draw, with matplotlib.
 
-steps(run)        velocities after each impact against the impact number, beside the model's
-                  predicted values (the closed form after every impact for three elastic
-                  bodies and the paper's printed eqs. (2.15)/(2.16); else the predicted final
-                  velocities);
+steps(run)        velocities after each impact against the impact number (solid steps),
+                  beside the model's predicted values: for three elastic bodies the closed
+                  form after every impact (open circles) and the paper's printed eqs.
+                  (2.15)/(2.16) (crosses); else the predicted final velocities (a thick
+                  dashed stub past the last impact);
 xt(run)           worldlines: position x [m] across, time t [s] up (as the page draws them),
-                  every line to the run's end; on a ring cut at the seam;
+                  every line to the run's end; on a ring cut at the seam; a collapse as a star;
 energy(run)       per-body kinetic energy (or energy transfer per impact), the total and the
                   heat so far;
 temperature(run)  granular temperature T(t) on log-log axes with Haff's law fitted, as the
                   CLI's --temperature-csv computes it (from the run's events, or from that
-                  CSV file).
+                  CSV file); or fitted over a window of time only, with the exponent free
+                  beside it and the kinetic theory's tau (haff_tau).
 
-Each takes `ax=None` (a new figure) and returns the matplotlib Axes. Colours are the views'
-(docs/web.md, "Bodies: names and colours"): up to 10 bodies the palette by index (A red,
-B green, C blue, ...); beyond, the start velocity on the map blue (moving left) -> purple
-(at rest) -> red (moving right), scaled by the largest start speed; walls grey. Works with any
-backend (Agg included): pyplot is imported only to make a figure when no `ax` is given.
+Each takes `ax=None` (a new figure) and returns the matplotlib Axes. Made to be projected:
+legends sit outside the axes, right of them, so they never cover data (a new figure makes
+room for them; with your own `ax`, use a constrained layout or savefig's
+bbox_inches='tight'); log axes read 1, 10, 100 or 10^5, never 2x10^0 (log_ticks). Colours are
+the views' (docs/web.md, "Bodies: names and colours"): up to 10 bodies the palette by index
+(A red, B green, C blue, ...); beyond, the start velocity on the map blue (moving left) ->
+purple (at rest) -> red (moving right), scaled by the largest start speed; walls grey. Works
+with any backend (Agg included): pyplot is imported only to make a figure when no `ax` is
+given.
 """
 import math
+import textwrap
 
 import numpy as np
 
@@ -41,7 +48,7 @@ MAX_RING_PIECES = 10000
 SAMPLES_PER_DECADE = 50
 
 
-def _new_axes(ax, size=(7.0, 4.2)):
+def _new_axes(ax, size=(9.0, 4.2)):
     if ax is not None:
         return ax
     import matplotlib.pyplot as plt
@@ -146,9 +153,63 @@ def _mark_collapses(ax, run):
                     xytext=(-4, -4), textcoords='offset points', ha='right', va='top', fontsize=8, color='0.3')
 
 
+# Legend labels are wrapped at this many characters (the legend sits right of the axes).
+LEGEND_WRAP = 36
+
+
+def legend_outside(ax, ncol=1, **options):
+    """The Axes' legend right of it, outside the data area (top-aligned), labels wrapped at
+    LEGEND_WRAP characters: a legend that never covers data. Returns the Legend (None when
+    nothing is labelled)."""
+    handles, labels = ax.get_legend_handles_labels()
+    if not handles:
+        return None
+    labels = [textwrap.fill(label, LEGEND_WRAP) for label in labels]
+    options.setdefault('fontsize', 8)
+    return ax.legend(handles, labels, loc='upper left', bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0, ncol=ncol,
+                     **options)
+
+
 def _legend(ax, n_lines):
     if 0 < n_lines <= 14:
-        ax.legend(fontsize=8, loc='best', ncol=2 if n_lines > 7 else 1)
+        legend_outside(ax, ncol=2 if n_lines > 7 else 1)
+
+
+def log_label(value, pos=None):
+    """A log axis's tick label: a plain number from 1e-4 to 1e4 ('0.01', '1', '10', '2',
+    '0.5'), a power of ten beyond as 10^n (mathtext); never 'a x 10^n'."""
+    if not (value > 0 and math.isfinite(value)):
+        return ''
+    exponent = round(math.log10(value))
+    if abs(value / 10.0 ** exponent - 1) < 1e-9:  # a power of ten
+        return '%g' % 10.0 ** exponent if -4 <= exponent <= 4 else r'$10^{%d}$' % exponent
+    return '%g' % value
+
+
+def log_ticks(ax, axis='both'):
+    """Readable log axes (axis 'x', 'y' or 'both'; linear axes are left alone): major ticks at
+    the powers of ten, or at 1, 2 and 5 times them where the axis spans less than a decade
+    (decided whenever the ticks are drawn, so later limits are followed), labelled by
+    log_label; minor ticks unlabelled. Returns the Axes."""
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+
+    class ReadableLogLocator(LogLocator):
+        def tick_values(self, vmin, vmax):
+            if vmin > vmax:
+                vmin, vmax = vmax, vmin
+            narrow = vmin > 0 and math.isfinite(vmax / vmin) and vmax / vmin < 10
+            self.set_params(subs=(1.0, 2.0, 5.0) if narrow else (1.0,))
+            return super().tick_values(vmin, vmax)
+
+    for name in ('x', 'y') if axis == 'both' else (axis,):
+        scaled = getattr(ax, 'get_%sscale' % name)()
+        if scaled != 'log':
+            continue
+        target = ax.xaxis if name == 'x' else ax.yaxis
+        target.set_major_locator(ReadableLogLocator(base=10.0, numticks=12))
+        target.set_major_formatter(FuncFormatter(log_label))
+        target.set_minor_formatter(NullFormatter())
+    return ax
 
 
 def _given(values):
@@ -157,11 +218,14 @@ def _given(values):
 
 
 def steps(run, ax=None, bodies=None):
-    """Velocities after each impact [m/s] against the impact number, as steps, with the
-    model's prediction: the closed form after every impact (dashed) and the paper's printed
-    eqs. (2.15)/(2.16) (dotted) where the model gives them, else the predicted final
-    velocities (a thick dashed stub past the last impact). bodies: indices to draw
-    (default: all up to 10 bodies, else 24 evenly spaced). Returns the Axes."""
+    """Velocities after each impact [m/s] against the impact number: each body's simulated
+    velocity as solid steps in its colour, held one impact past the last; where the model
+    gives them (three elastic bodies), the closed form after every impact as open circles and
+    the paper's printed eqs. (2.15)/(2.16) as crosses, in the body's colour; else the
+    predicted final velocities as a thick dashed stub past the last impact. A collapse is a
+    dotted vertical line. Up to 10 bodies each has a legend entry (outside the axes, right).
+    bodies: indices to draw (default: all up to 10 bodies, else 24 evenly spaced). Returns
+    the Axes."""
     _require_events(run, 'steps')
     ax = _new_axes(ax)
     colours = body_colours(run)
@@ -269,12 +333,14 @@ def ring_segments(t, x, ring, max_pieces=MAX_RING_PIECES):
 
 
 def xt(run, ax=None, bodies=None):
-    """Worldlines: position x [m] across, time t [s] up, every line (walls and bodies that
-    never collide included) to the run's end; on a ring x in [0, L) with each line cut at
-    the seam. bodies: indices (default: all up to 24 bodies, else 24 evenly spaced, the
+    """Worldlines: position x [m] across, time t [s] up, one solid line per body in its
+    colour, every line (walls and bodies that never collide included) to the run's end
+    (1.25 x the last event's time); on a ring x in [0, L) with each line cut at the seam; a
+    collapse as a black star. Up to 10 bodies each line has a legend entry (outside the axes,
+    right). bodies: indices (default: all up to 24 bodies, else 24 evenly spaced, the
     outermost two included). Returns the Axes."""
     _require_events(run, 'xt')
-    ax = _new_axes(ax, size=(6.0, 5.0))
+    ax = _new_axes(ax, size=(7.5, 5.0))
     colours = body_colours(run)
     n = len(colours)
     if bodies is None:
@@ -303,16 +369,18 @@ def xt(run, ax=None, bodies=None):
     ax.set_title(title_of(run, 'worldlines (%s)' % shown), fontsize=10)
     ax.grid(alpha=0.3)
     if labelled:
-        ax.legend(fontsize=8, loc='best')
+        legend_outside(ax)
     return ax
 
 
 def energy(run, ax=None, transfer=False):
     """Energies [J] against the impact number. transfer=False: each body's kinetic energy
-    after each impact (up to 10 bodies), the total kinetic energy and the heat so far
-    (the energy lost by inelastic impacts, summed). transfer=True: the energy each body
-    gained at each impact (dots), beside the closed form's and the paper's printed
-    transfer where the model gives them. Returns the Axes."""
+    after each impact as steps in its colour (up to 10 bodies), the total kinetic energy
+    (thick black steps) and the heat so far (the energy lost by inelastic impacts, summed;
+    grey dashed steps). transfer=True: the energy each body gained at each impact (filled
+    dots), beside the closed form's (open squares) and the paper's printed eqs. (4.4)-(4.7)
+    (crosses) where the model gives them, and a grey line at 0. Legend outside the axes,
+    right. Returns the Axes."""
     _require_events(run, 'energy')
     ax = _new_axes(ax)
     colours = body_colours(run)
@@ -457,6 +525,124 @@ def fit_haff(t, T):
     return {'t0': math.exp(log_t0), 'tau': tau, 'rms_ln_error': math.sqrt(cost / t.size), 'samples': int(t.size)}
 
 
+def _golden_min(cost, a, b):
+    """The minimum of a unimodal cost(u) on [a, b] by golden sections, to 1e-13 relative."""
+    phi = (math.sqrt(5.0) - 1) / 2
+    c, d = b - phi * (b - a), a + phi * (b - a)
+    fc, fd = cost(c), cost(d)
+    while b - a > 1e-13 * max(1.0, abs(a)):
+        if fc < fd:
+            b, d, fd = d, c, fc
+            c = b - phi * (b - a)
+            fc = cost(c)
+        else:
+            a, c, fc = c, d, fd
+            d = a + phi * (b - a)
+            fd = cost(d)
+    return (a + b) / 2
+
+
+def _free_exponent_fit(t, log_T, u):
+    """(cost, ln T0, beta) of ln T = ln T0 - beta ln(1 + t/tau), tau = e^u, by linear least
+    squares in (ln T0, beta)."""
+    x = np.log1p(t / math.exp(u))
+    xc = x - x.mean()
+    sxx = float(xc @ xc)
+    if not sxx > 0:
+        return math.inf, float(log_T.mean()), 0.0
+    beta = -float(xc @ (log_T - log_T.mean())) / sxx
+    log_t0 = float(log_T.mean() + beta * x.mean())
+    r = log_T - (log_t0 - beta * x)
+    return float(r @ r), log_t0, beta
+
+
+def fit_haff_exponent(t, T):
+    """T(t) = t0 / (1 + t/tau)^beta with the exponent beta free beside t0 and tau (Haff's law
+    has beta = 2), by least squares on ln T: for each tau a linear fit of ln t0 and beta, tau
+    on the grid of fit_haff (0.05 decades over [1e-6, 1e6] x the last time), then golden
+    sections. Returns dict(t0 [J], tau [s], beta [1], rms_ln_error [1], samples [1]) or None
+    with fewer than three usable samples (finite t >= 0, T > 0). Over a window much shorter
+    than tau only beta/tau is decided (the law is then exp(-beta t/tau)); the exponent is
+    the late-time slope d ln T / d ln t only for t >> tau."""
+    t = np.asarray(t, dtype=float)
+    T = np.asarray(T, dtype=float)
+    use = np.isfinite(t) & (t >= 0) & np.isfinite(T) & (T > 0)
+    t, log_T = t[use], np.log(T[use])
+    if t.size < 3 or not t.max() > 0:
+        return None
+    steps_ = 12 * 20
+    lo = math.log(t.max()) - 6 * math.log(10.0)
+    du = 12 * math.log(10.0) / steps_
+    costs = [_free_exponent_fit(t, log_T, lo + k * du)[0] for k in range(steps_ + 1)]
+    best = int(np.argmin(costs))
+    u = _golden_min(lambda w: _free_exponent_fit(t, log_T, w)[0], lo + max(best - 1, 0) * du,
+                    lo + min(best + 1, steps_) * du)
+    cost, log_t0, beta = _free_exponent_fit(t, log_T, u)
+    return {'t0': math.exp(log_t0), 'tau': math.exp(u), 'beta': beta, 'rms_ln_error': math.sqrt(cost / t.size),
+            'samples': int(t.size)}
+
+
+def cooling_exponent(t, T, decades=0.2):
+    """The local cooling exponent -d ln T / d ln t [1] (2 for t^-2): the slope of a straight
+    line fitted to (ln t, ln T) over the samples within decades/2 of each of the samples thinned
+    as the CLI thins them (t > 0 only). Haff's law T0 / (1 + t/tau)^2 has the exponent
+    2 t / (t + tau): 2 only for t >> tau. Returns (t [s], exponent [1]) where at least three
+    samples fall in the window."""
+    t = np.asarray(t, dtype=float)
+    T = np.asarray(T, dtype=float)
+    use = np.isfinite(t) & (t > 0) & np.isfinite(T) & (T > 0)
+    t, T = t[use], T[use]
+    kept = thin_log_time(t)
+    log_t, log_T = np.log(t[kept]), np.log(T[kept])
+    half = 0.5 * decades * math.log(10.0)
+    centres, exponents = [], []
+    for c in log_t:
+        near = np.abs(log_t - c) <= half
+        if near.sum() >= 3:
+            centres.append(math.exp(c))
+            exponents.append(-np.polyfit(log_t[near], log_T[near], 1)[0])
+    return np.array(centres), np.array(exponents)
+
+
+# Pairs averaged exactly up to this many bodies; beyond, this many random pairs (seeded).
+HAFF_TAU_ALL_PAIRS_UP_TO = 3000
+HAFF_TAU_SAMPLED_PAIRS = 2_000_000
+
+
+def haff_tau(masses, velocities, restitution, length):
+    """Haff's tau [s] from kinetic theory, for point masses on a line of length L [m] (a ring
+    or a box; number density n = N / L) with one restitution r: the initial cooling rate of
+    the Boltzmann equation with molecular chaos (colliding pairs uncorrelated), set equal to
+    Haff's dT/dt(0) = -2 T0 / tau. A pair meets at the rate n |v_i - v_j| / 2 per body and
+    loses (1 - r^2) mu_ij (v_i - v_j)^2 / 2 (mu_ij the reduced mass), and T = (1/N) sum m (v -
+    V)^2 is twice the energy per body, so
+        tau = 4 T0 / ((1 - r^2) n <mu_ij |v_i - v_j|^3>),
+    the average over pairs of bodies (all pairs up to HAFF_TAU_ALL_PAIRS_UP_TO bodies, else
+    HAFF_TAU_SAMPLED_PAIRS random pairs, seeded). For equal masses m with Gaussian velocities
+    it is tau = sqrt(pi m / T0) / ((1 - r^2) n) = 2 / ((1 - r^2) nu0), nu0 = 2 n sqrt(T0 /
+    (pi m)) the collisions per body and second (Haff, J. Fluid Mech. 134, 401 (1983); the
+    same Boltzmann estimate as in Brilliantov and Poschel, Kinetic Theory of Granular Gases,
+    Oxford 2004, here in one dimension). Walls and infinite masses are left out."""
+    m = np.asarray(masses, dtype=float)
+    v = np.asarray(velocities, dtype=float)
+    finite = np.isfinite(m)
+    m, v = m[finite], v[finite]
+    n_bodies = m.size
+    if n_bodies < 2 or not 0 <= restitution < 1 or not length > 0:
+        raise ValueError('haff_tau needs at least two finite bodies, 0 <= restitution < 1 and length > 0')
+    T0 = float(granular_temperature(m, v)[0])
+    if n_bodies <= HAFF_TAU_ALL_PAIRS_UP_TO:
+        i, j = np.triu_indices(n_bodies, 1)
+    else:
+        rng = np.random.default_rng(0)
+        i = rng.integers(0, n_bodies, HAFF_TAU_SAMPLED_PAIRS)
+        j = rng.integers(0, n_bodies - 1, HAFF_TAU_SAMPLED_PAIRS)
+        j = j + (j >= i)
+    mu = m[i] * m[j] / (m[i] + m[j])
+    moment = float(np.mean(mu * np.abs(v[i] - v[j]) ** 3))
+    return 4 * T0 / ((1 - restitution ** 2) * (n_bodies / length) * moment)
+
+
 def read_temperature_csv(path):
     """The CLI's --temperature-csv file (run(..., temperature_csv=path) writes it): (a pandas
     DataFrame impacts [1], time_s [s], temperature_J [J], with table.attrs['units'] {'time_s':
@@ -490,13 +676,22 @@ def _is_cooling_gas(run):
     return True, ''
 
 
-def temperature(run, ax=None, csv=None):
-    """Granular temperature T(t) [J] on log-log axes with Haff's law T0 / (1 + t/tau)^2 fitted
-    (dashed), as the CLI's --temperature-csv computes it. csv: the path of that file (from
-    run(..., events='none', temperature_csv=path): no events needed); else T is computed from
-    the run's events, sampled and fitted as the CLI does. The start (t = 0) cannot sit on a
-    log axis: its T0 is a horizontal tick at the left edge. Returns the Axes."""
-    ax = _new_axes(ax)
+def temperature(run, ax=None, csv=None, window=None, free_exponent=False, tau_kinetic=None):
+    """Granular temperature T(t) [J] on log-log axes (solid steps, held between samples) with
+    Haff's law T0 / (1 + t/tau)^2. The start (t = 0) cannot sit on a log axis: its measured
+    T(0) is a left-pointing triangle at the first sampled time. csv: the path of the CLI's
+    --temperature-csv file (from run(..., events='none', temperature_csv=path): no events
+    needed); else T is computed from the run's events, sampled as the CLI does.
+    window=None: Haff's law fitted to the whole run as the CLI fits it (red dashed).
+    window=(t_start, t_end) [s]: fitted to those samples only (thinned as the CLI thins),
+    the window shaded grey, the law drawn over the whole run (red dashed); free_exponent=True
+    adds T0 / (1 + t/tau)^beta with beta free fitted to the same samples (purple dotted,
+    fit_haff_exponent). tau_kinetic [s] (e.g. haff_tau(...)): Haff's law with the measured
+    T(0) and this tau, no fitted parameter (green solid), a dotted vertical line at t = tau,
+    and the run's length in units of tau. A run that is not a cooling gas (under 10 bodies,
+    or no energy lost) gets no law, and the legend says why. Legend outside the axes, right;
+    log ticks by log_ticks. Returns the Axes."""
+    ax = _new_axes(ax, size=(10.0, 4.6))
     if csv is not None:
         table, fit = read_temperature_csv(csv)
         t, T = table['time_s'].to_numpy(), table['temperature_J'].to_numpy()
@@ -505,23 +700,49 @@ def temperature(run, ax=None, csv=None):
         thinned = thin_log_time(t)
         fit = fit_haff(t[thinned], T[thinned])
     gas, why_not = _is_cooling_gas(run)
+    after = t > 0
+    t_first = t[after].min() if after.any() else 1.0
+    tt = np.geomspace(t_first, t.max(), 300) if after.any() else np.array([1.0])
     if not gas:
         fit = None
         ax.plot([], [], ls='none', label="no Haff fit: %s" % why_not)
-    after = t > 0
-    ax.loglog(t[after], T[after], color='C0', lw=1.4, drawstyle='steps-post',
+    if gas and window is not None:
+        t_start, t_end = window
+        inside = (t >= t_start) & (t <= t_end)
+        kept = np.flatnonzero(inside)[thin_log_time(t[inside])]
+        fit = fit_haff(t[kept], T[kept])
+        ax.axvspan(max(t_start, t_first), t_end, color='0.85', alpha=0.6, lw=0, zorder=0,
+                   label='fit window: t = %g to %g s (%d samples)' % (t_start, t_end, len(kept)))
+        free = fit_haff_exponent(t[kept], T[kept]) if free_exponent else None
+    else:
+        free = None
+    ax.loglog(t[after], T[after], color='C0', lw=1.6, drawstyle='steps-post',
               label='T(t) simulated (held between samples)')
-    ax.plot([t[after].min() if after.any() else 1.0], [T[0]], marker='<', color='C0', ms=8, ls='none',
-            label='T at the start: %.4g J' % T[0])
+    ax.plot([t_first], [T[0]], marker='<', color='C0', ms=9, ls='none', label='T(0) measured: %.4g J' % T[0])
     if fit is not None and math.isfinite(fit['tau']):
-        tt = np.geomspace(t[after].min(), t.max(), 200)
+        where = 'whole run' if window is None else 'window'
         ax.loglog(tt, fit['t0'] / (1 + tt / fit['tau']) ** 2, color='C3', ls='--', lw=1.6,
-                  label="Haff's law fitted: T0 = %.3g J, tau = %.3g s (rms in ln T: %.2g)"
-                  % (fit['t0'], fit['tau'], fit['rms_ln_error']))
+                  label="Haff's law fitted (%s): T0 = %.3g J, tau = %.3g s, rms in ln T %.2g"
+                  % (where, fit['t0'], fit['tau'], fit['rms_ln_error']))
+    if free is not None:
+        with np.errstate(over='ignore', under='ignore'):
+            free_T = free['t0'] / (1 + tt / free['tau']) ** free['beta']
+        ax.loglog(tt, free_T, color='C4', ls=':', lw=2.0,
+                  label='exponent free (window): beta = %.2f, T0 = %.3g J, tau = %.3g s'
+                  % (free['beta'], free['t0'], free['tau']))
+    if gas and tau_kinetic is not None:
+        ax.loglog(tt, T[0] / (1 + tt / tau_kinetic) ** 2, color='C2', lw=1.4,
+                  label="Haff's law, kinetic theory: T(0) measured, tau = %.3g s (no fit)" % tau_kinetic)
+        ax.axvline(tau_kinetic, color='C2', ls=':', lw=1)
+        ax.annotate('t = tau', (tau_kinetic, 0.02), xycoords=('data', 'axes fraction'), xytext=(3, 0),
+                    textcoords='offset points', fontsize=8, color='C2')
+        ax.plot([], [], ls='none', label='the run: %.3g s = %.3g tau' % (t.max(), t.max() / tau_kinetic))
+    if gas:
         ax.set_ylim(T[T > 0].min() / 2, T.max() * 2)
     ax.set_xlabel('time t [s]')
     ax.set_ylabel('granular temperature T [J]')
     ax.set_title(title_of(run, 'granular temperature T = (1/N) sum m_i (v_i - V)^2'), fontsize=10)
     ax.grid(alpha=0.3, which='both')
-    ax.legend(fontsize=8, loc='lower left')
+    log_ticks(ax)
+    legend_outside(ax)
     return ax
