@@ -156,7 +156,8 @@ async function myRuns() {
     box.replaceChildren(el('p', 'None yet: the runs you send from this browser are listed here.', {class: 'muted'}));
     return;
   }
-  const students = [...new Set(mine.map((id) => id.slice(0, id.lastIndexOf('.'))).filter((s) => s))];
+  // A run_id is "<student>.<the id asked for>", and a student's name has no '.'.
+  const students = [...new Set(mine.map((id) => id.slice(0, id.indexOf('.'))).filter((s) => s))];
   const listed = new Map();
   for (const student of students) {
     try {
@@ -228,11 +229,21 @@ async function startPage() {
 /// Asks the lab node to stop a run: with the run's stop_token (the student's own run) or, on
 /// the teacher page, with the teacher's login. Returns the server's answer as one line.
 async function stopRun(runId, stopToken) {
+  return (await stopAnswer(runId, stopToken)).text;
+}
+
+/// The same as {ok, text}: ok when the lab node took the stop.
+async function stopAnswer(runId, stopToken) {
   const body = stopToken ? {stop_token: stopToken} : {};
-  const res = await fetch('/api/runs/' + encodeURIComponent(runId) + '/stop',
-    {method: 'POST', headers: {'Content-Type': 'application/json'}, body: JSON.stringify(body)});
-  const answer = await res.json();
-  return res.status === 200 ? answer.message : 'HTTP ' + res.status + ': ' + answer.error;
+  try {
+    const res = await fetch('/api/runs/' + encodeURIComponent(runId) + '/stop',
+      {method: 'POST', headers: {'Content-Type': 'application/json'}, body: JSON.stringify(body)});
+    const answer = await res.json();
+    if (res.status === 200) return {ok: answer.ok === true, text: answer.message};
+    return {ok: false, text: 'HTTP ' + res.status + ': ' + answer.error};
+  } catch (err) {
+    return {ok: false, text: 'the lab did not answer: ' + err};
+  }
 }
 
 function queueTable(queue) {
@@ -271,8 +282,15 @@ function stopCell(runId) {
   const button = el('button', 'Stop', {type: 'button', 'data-stop': runId});
   button.onclick = async () => {
     button.disabled = true;
-    stopReplies.set(runId, await stopRun(runId, null));
-    td.replaceChildren(el('span', stopReplies.get(runId), {'data-stop-reply': runId}));
+    const answer = await stopAnswer(runId, null);
+    if (!answer.ok) {  // not taken: the button stays, with the reason beside it
+      button.disabled = false;
+      button.title = answer.text;
+      td.appendChild(el('span', ' ' + answer.text));
+      return;
+    }
+    stopReplies.set(runId, answer.text);
+    td.replaceChildren(el('span', answer.text, {'data-stop-reply': runId}));
   };
   td.appendChild(button);
   return td;
@@ -283,8 +301,8 @@ function stopCell(runId) {
 function stateText(r) {
   if (r.state === 'queued' || r.state === 'running') return stopReplies.has(r.run_id) ? r.state + ', stopping' : r.state;
   const parts = [r.state];
-  if (r.simulated === false) parts.push('not simulated: the model\'s count');
   if (r.cancelled) parts.push(r.cancel_reason || 'cancelled');
+  else if (r.simulated === false) parts.push('not simulated: the model\'s count');
   else if (r.truncated) parts.push('truncated');
   if (r.collapsed) parts.push('collapsed');
   if (r.recorded === false) parts.push('not recorded');

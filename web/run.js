@@ -185,6 +185,7 @@ function phasePicture(run) {
   const masses = run.scene.masses.map((m) => (m === 'inf' ? Infinity : m));
   const n = masses.length;
   const finite = masses.map((m, i) => i).filter((i) => Number.isFinite(masses[i]));
+  if (run.scene.ring > 0) return {why: 'not drawn for a ring, whose third pair (the seam) the plane leaves out'};
   if (n !== 3 && !(n === 2 && finite.length === 2)) return {why: 'drawn for three bodies (walls included)'};
   if (finite.length < 2) return {why: 'drawn when at least two bodies have finite mass'};
   if (n === 2) return {why: 'two bodies alone have one velocity that changes, their relative one: no plane to draw'};
@@ -749,8 +750,11 @@ function conservationText(run) {
                  : ': it should be conserved; the difference is the rounding of the velocities shown.'));
   }
   const v0 = t.start.centre_of_mass_velocity, v1 = t.simulated.centre_of_mass_velocity;
+  let why;
+  if (walls) why = v0 === v1 ? ' (the walls gave back what they took).' : ' (the walls changed it).';
+  else why = v0 === v1 ? ' (the same: no outside force acts).' : ' (no outside force acts: the difference is the rounding of the velocities).';
   out.push('Centre of mass: at ' + fmt(t.centre_of_mass_start) + ' m at the start, moving at ' + fmt(v0) + ' m/s; at the end at ' +
-    fmt(v1) + ' m/s' + (walls ? ' (the walls changed it).' : ' (the same: no outside force acts).'));
+    fmt(v1) + ' m/s' + why);
   if (movingWall) {
     out.push('Energy: ' + fmt(e0) + ' J at the start, ' + fmt(e1) + ' J at the end, ' + fmt(heat) + ' J of heat. ' +
       'A moving wall does work on the bodies it pushes, so their energy is not conserved.');
@@ -792,8 +796,18 @@ function setupXtWindow(run) {
     document.getElementById('xt_from').value = from;
     document.getElementById('xt_to').value = to;
     note.textContent = 'Reading every event from ' + fmt(from) + ' s to ' + fmt(to) + ' s...';
-    const res = await fetch(api + '/worldlines?from=' + from + '&to=' + to + '&bodies=' + bodies.join(','));
-    const answer = await res.json();
+    const buttons = [...box.querySelectorAll('button')];
+    buttons.forEach((b) => { b.disabled = true; });  // one window at a time
+    let res, answer;
+    try {
+      res = await fetch(api + '/worldlines?from=' + from + '&to=' + to + '&bodies=' + bodies.join(','));
+      answer = await res.json();
+    } catch (err) {
+      note.textContent = 'The lab did not answer: ' + err;
+      return;
+    } finally {
+      buttons.forEach((b) => { b.disabled = false; });
+    }
     if (res.status !== 200) { note.textContent = 'HTTP ' + res.status + ': ' + answer.error; return; }
     c.data.datasets = answer.lines.map((l) => ({label: bodyName(l.body), data: l.points.map((q) => ({x: q[1], y: q[0]})),
       borderColor: bodyColour(l.body)}));

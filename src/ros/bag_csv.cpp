@@ -810,6 +810,16 @@ ClassTable bagToClassTable(const std::string& bag_path, const std::string& csv_p
     table.too_many_bodies = true;
     return table;
   }
+  // A run recorded without all its events is known before anything is written: its summary
+  // counts more impacts than the bag has events.
+  std::uint64_t summary_impacts = 0;
+  for (const rosbag::MessageInstance& m : rosbag::View(*bag, rosbag::TypeQuery(ros::message_traits::datatype<RunSummary>()))) {
+    if (const auto summary = m.instantiate<RunSummary>()) summary_impacts = summary->collision_count;
+  }
+  if (summary_impacts > rosbag::View(*bag, rosbag::TypeQuery(ros::message_traits::datatype<CollisionEvent>())).size()) {
+    table.events_missing = true;
+    return table;
+  }
   std::ofstream out(csv_path);
   if (!out) throw BagCsvError("cannot write " + csv_path);
   out << "t_s,collision,event,pair";
@@ -818,10 +828,8 @@ ClassTable bagToClassTable(const std::string& bag_path, const std::string& csv_p
   out << ",p_total_kg_m_s,kinetic_total_J\n";
   writeClassTableRow(out, 0.0, 0, "start", "", state->positions(0.0), *state);
   ++table.rows;
-  std::uint64_t impacts = 0, summary_impacts = 0;
-  rosbag::View rest(*bag, rosbag::TypeQuery(std::vector<std::string>{
-                              ros::message_traits::datatype<CollisionEvent>(), ros::message_traits::datatype<RunSummary>()}));
-  for (const rosbag::MessageInstance& m : rest) {
+  std::uint64_t impacts = 0;
+  for (const rosbag::MessageInstance& m : rosbag::View(*bag, rosbag::TypeQuery(ros::message_traits::datatype<CollisionEvent>()))) {
     if (const auto event = m.instantiate<CollisionEvent>()) {
       if (!replayEvent(*state, *event)) continue;
       const bool collapse = event->kind == CollisionEvent::KIND_COLLAPSE;
@@ -834,8 +842,6 @@ ClassTable bagToClassTable(const std::string& bag_path, const std::string& csv_p
                                     : state->positions(event->time),
                          *state);
       ++table.rows;
-    } else if (const auto summary = m.instantiate<RunSummary>()) {
-      summary_impacts = summary->collision_count;
     }
   }
   out.close();

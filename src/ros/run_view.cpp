@@ -192,10 +192,9 @@ std::string appliedCapText(std::uint64_t asked, const std::optional<std::uint64_
   return "the cap of " + withSeparators(asked);
 }
 
-/// What a class can do about a run the model answered instead of the engine: "" for a
-/// predict-only run, which asked for the model.
+/// What a class can do about a run the model answered instead of the engine because of its
+/// cap.
 std::string howToSimulate(const collision_lab::InitialConditions& in, const RunView& view) {
-  if (in.mode == collision_lab::InitialConditions::MODE_PREDICT_ONLY) return "";
   if (view.infinitely_many_predicted) {
     return ". Infinitely many collisions cannot all be simulated; the lab simulates the first ones, up to the cap, "
            "when its ~simulate_to_cap is on: ask the teacher";
@@ -252,10 +251,10 @@ RunView makeRunView(const RunRecord& run) {
       why = run.summary->truncation_reason;
     } else {
       why = "more collisions predicted than " + appliedCapText(in.max_collisions, view.predicted_collisions) +
-            ", the model answered";
+            ", the model answered" + howToSimulate(in, view);
     }
     while (!why.empty() && why.back() == '.') why.pop_back();
-    view.not_simulated = "not simulated: " + why + howToSimulate(in, view);
+    view.not_simulated = "not simulated: " + why;
   } else if (run.summary && run.summary->truncated) {
     view.truncated = truncationSentence(run.summary->truncation_reason);
   }

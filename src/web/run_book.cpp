@@ -964,7 +964,7 @@ std::string RunBook::rejections(const std::optional<std::string>& student) const
   return out.dump();
 }
 
-std::string RunBook::list(const std::optional<std::string>& student) const {
+std::string RunBook::list(const std::optional<std::string>& student, const ListPage& page) const {
   std::vector<collision_lab::service::IndexedRun> rows;
   if (source_) {
     try {
@@ -973,35 +973,47 @@ std::string RunBook::list(const std::optional<std::string>& student) const {
       rows.clear();  // the runs in memory are listed still
     }
   }
-  // The rows' items are made before locking (their scene and summary JSON is parsed).
-  std::vector<std::pair<double, nlohmann::json>> items;  // accepted stamp, item
-  items.reserve(rows.size());
-  for (const auto& row : rows) items.emplace_back(row.accepted_at, listItem(row));
-  std::lock_guard<std::mutex> lock(mutex_);
-  std::set<std::string> listed;
-  for (std::size_t k = 0; k < rows.size(); ++k) {
-    auto it = runs_.find(rows[k].run_id);
-    if (it != runs_.end()) items[k].second = listItem(it->second);  // the live state
-    listed.insert(rows[k].run_id);
-  }
-  // The runs in memory the source does not list (yet), in their order of arrival.
-  for (const auto& [sequence, run_id] : order_) {
-    if (listed.count(run_id)) continue;
-    auto it = runs_.find(run_id);
-    if (it != runs_.end()) {
-      if (student && it->second.student != *student) continue;
-      items.emplace_back(it->second.accepted_stamp, listItem(it->second));
-    } else if (auto stub = evicted_.find(run_id); stub != evicted_.end()) {
-      if (student && stub->second.student != *student) continue;
-      items.emplace_back(stub->second.accepted_stamp, listItem(run_id, stub->second));
+  // An entry is its accepted stamp and either its item (a run in memory: its live state)
+  // or the index row it is made from; only the page's rows are parsed, outside the lock.
+  struct Entry {
+    double stamp;
+    std::optional<nlohmann::json> item;
+    std::size_t row;
+  };
+  std::vector<Entry> entries;
+  entries.reserve(rows.size());
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::set<std::string> listed;
+    for (std::size_t k = 0; k < rows.size(); ++k) {
+      auto it = runs_.find(rows[k].run_id);
+      entries.push_back({rows[k].accepted_at,
+                         it != runs_.end() ? std::optional<nlohmann::json>(listItem(it->second)) : std::nullopt, k});
+      listed.insert(rows[k].run_id);
+    }
+    // The runs in memory the source does not list (yet), in their order of arrival.
+    for (const auto& [sequence, run_id] : order_) {
+      if (listed.count(run_id)) continue;
+      auto it = runs_.find(run_id);
+      if (it != runs_.end()) {
+        if (student && it->second.student != *student) continue;
+        entries.push_back({it->second.accepted_stamp, listItem(it->second), 0});
+      } else if (auto stub = evicted_.find(run_id); stub != evicted_.end()) {
+        if (student && stub->second.student != *student) continue;
+        entries.push_back({stub->second.accepted_stamp, listItem(run_id, stub->second), 0});
+      }
     }
   }
   if (!rows.empty()) {
-    std::stable_sort(items.begin(), items.end(),
-                     [](const auto& a, const auto& b) { return a.first < b.first; });
+    std::stable_sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) { return a.stamp < b.stamp; });
   }
+  if (page.total) *page.total = entries.size();
+  const std::size_t first = std::min(page.offset, entries.size());
+  const std::size_t last = first + std::min(page.limit, entries.size() - first);
   nlohmann::json out = nlohmann::json::array();
-  for (auto& [stamp, item] : items) out.push_back(std::move(item));
+  for (std::size_t k = first; k < last; ++k) {
+    out.push_back(entries[k].item ? std::move(*entries[k].item) : listItem(rows[entries[k].row]));
+  }
   return out.dump();
 }
 

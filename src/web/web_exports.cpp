@@ -42,6 +42,22 @@ std::optional<http::response<http::file_body>> fileAnswer(const HttpRequest& req
 
 }  // namespace
 
+bool WebServer::startExport(const HttpRequest& request, const HttpReply& reply) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (exporting_.insert(request.client).second) return true;
+  }
+  Response res = errorAnswer(request, 429, "one file made from a bag at a time from your address: wait for the last one");
+  res.set(http::field::retry_after, "2");
+  reply.send(std::move(res));
+  return false;
+}
+
+void WebServer::endExport(const std::string& client) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  exporting_.erase(client);
+}
+
 void WebServer::sendMadeFromBag(const HttpRequest& request, const std::string& run_id, const std::string& name,
                                 MakeFromBag make, const HttpReply& reply) {
   if (!book_.has(run_id)) return reply.send(errorAnswer(request, 404, "no such run"));
@@ -53,9 +69,12 @@ void WebServer::sendMadeFromBag(const HttpRequest& request, const std::string& r
   if (auto res = fileAnswer(request, made.string(), "text/csv", file_name)) return reply.sendFile(std::move(*res));
   // Made once, beside the bag, off the I/O threads; a file made by another request
   // meanwhile is simply replaced by an identical one.
-  boost::asio::post(blocking_->pool, [this, request, reply, bag, made, file_name, make = std::move(make)] {
+  if (!startExport(request, reply)) return;
+  boost::asio::post(blocking_->exports, [this, request, reply, bag, made, file_name, make = std::move(make)] {
+    // The address may make its next file once this answer is on its way.
+    std::shared_ptr<void> done(nullptr, [this, client = request.client](void*) { endExport(client); });
     std::string folder = (made.parent_path() / ("." + file_name + ".XXXXXX")).string();
-    if (!mkdtemp(folder.data())) return reply.send(errorAnswer(request, 500, "cannot write beside the bag"));
+    if (!mkdtemp(folder.data())) return done.reset(), reply.send(errorAnswer(request, 500, "cannot write beside the bag"));
     std::string error, why_not;
     try {
       const std::string path = make(bag, folder, why_not);
@@ -66,10 +85,11 @@ void WebServer::sendMadeFromBag(const HttpRequest& request, const std::string& r
     collision_lab_ros::releaseMemoryAfterBag(bag);
     std::error_code ignored;
     fs::remove_all(folder, ignored);
-    if (!error.empty()) return reply.send(errorAnswer(request, 500, error));
-    if (!why_not.empty()) return reply.send(errorAnswer(request, 404, why_not));
+    if (!error.empty()) return done.reset(), reply.send(errorAnswer(request, 500, error));
+    if (!why_not.empty()) return done.reset(), reply.send(errorAnswer(request, 404, why_not));
     auto res = fileAnswer(request, made.string(), "text/csv", file_name);
-    if (!res) return reply.send(errorAnswer(request, 500, "the converted CSV is gone"));
+    if (!res) return done.reset(), reply.send(errorAnswer(request, 500, "the converted CSV is gone"));
+    done.reset();
     reply.sendFile(std::move(*res));
   });
 }
@@ -129,7 +149,11 @@ void WebServer::sendWindow(const HttpRequest& request, const std::string& run_id
     bodies.push_back(std::stoul(item));
     at = end + 1;
   }
-  boost::asio::post(blocking_->readers, [this, request, reply, bag, from, to, bodies] {
+  if (bodies.empty()) return reply.send(errorAnswer(request, 400, "bodies: which bodies to draw, e.g. 0,1,2", "bodies"));
+  if (!startExport(request, reply)) return;
+  boost::asio::post(blocking_->exports, [this, request, reply, bag, from, to, bodies] {
+    // The address may make its next file once this answer is on its way.
+    std::shared_ptr<void> done(nullptr, [this, client = request.client](void*) { endExport(client); });
     json lines = json::array();
     bool exact = true;
     try {
@@ -141,11 +165,12 @@ void WebServer::sendWindow(const HttpRequest& request, const std::string& run_id
         lines.push_back({{"body", line.body}, {"points", std::move(points)}});
       }
     } catch (const std::invalid_argument& e) {
-      return reply.send(errorAnswer(request, 400, e.what()));
+      return done.reset(), reply.send(errorAnswer(request, 400, e.what()));
     } catch (const std::exception& e) {
-      return reply.send(errorAnswer(request, 500, e.what()));
+      return done.reset(), reply.send(errorAnswer(request, 500, e.what()));
     }
     collision_lab_ros::releaseMemoryAfterBag(bag);
+    done.reset();
     reply.send(jsonAnswer(request, 200, {{"from", from}, {"to", to}, {"exact", exact}, {"lines", std::move(lines)}}));
   });
 }

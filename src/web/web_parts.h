@@ -25,12 +25,14 @@ inline constexpr char kTeacherCookie[] = "collision_lab_teacher";
 /// [s] a login lasts: a school day.
 inline constexpr int kCookieSeconds = 12 * 3600;
 
-/// Work kept off the I/O threads: `pool` for cancel calls and CSV conversions, `readers`
-/// for the run list (the index) and runs read back from their bags. Each bounds how many
-/// run at once; the I/O threads serve pages and sends meanwhile.
+/// Work kept off the I/O threads: `pool` for cancel calls, `readers` for the run list (the
+/// index) and runs read back from their bags, `exports` for files made from bags (CSVs, x-t
+/// windows), so that a long conversion holds up neither a Stop nor the run list. Each
+/// bounds how many run at once; the I/O threads serve pages and sends meanwhile.
 struct BlockingPool {
   boost::asio::thread_pool pool{2};
   boost::asio::thread_pool readers{2};
+  boost::asio::thread_pool exports{1};
 };
 
 struct WebServer::Access {

@@ -173,7 +173,11 @@ void WebServer::stop() {
   stopping_ = true;
   const auto deadline = std::chrono::steady_clock::now() + kStreamsEndWithin;
   while (streams_ > 0 && std::chrono::steady_clock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  if (blocking_) blocking_->pool.join();
+  if (blocking_) {
+    blocking_->pool.join();
+    blocking_->readers.join();
+    blocking_->exports.join();
+  }
   if (server_) server_->stop();
 }
 
@@ -320,13 +324,7 @@ std::vector<WebServer::Route> WebServer::makeRoutes() {
          c.reply.send(jsonAnswer(c.request, 200, json{{"palette", palette}}));
        }},
       {V::post, "/api/runs", [this](const RouteCall& c) { postRun(c.request, c.reply); }},
-      {V::get, "/api/runs",
-       [this](const RouteCall& c) {
-         boost::asio::post(blocking_->readers,
-                           [this, request = c.request, reply = c.reply, student = queryParam(c.query, "student")] {
-                             reply.send(answer(request, http::status::ok, book_.list(student), "application/json"));
-                           });
-       }},
+      {V::get, "/api/runs", [this](const RouteCall& c) { sendRunList(c.request, c.query, c.reply); }},
       {V::get, "/api/rejections",
        [this](const RouteCall& c) {
          if (!c.access.teacher) {
@@ -404,6 +402,27 @@ void WebServer::sendPresets(const HttpRequest& request, const HttpReply& reply) 
     return reply.send(errorAnswer(request, 500, e.what()));
   }
   reply.send(jsonAnswer(request, 200, out));
+}
+
+// GET /api/runs[?student=NAME][&offset=K][&limit=N]: the runs, oldest first, or a page of
+// them; X-Total-Count gives the whole list's length. Read on a reader thread.
+void WebServer::sendRunList(const HttpRequest& request, const std::string& query, const HttpReply& reply) {
+  RunBook::ListPage page;
+  for (const auto& [name, value] : {std::pair<const char*, std::size_t*>{"offset", &page.offset}, {"limit", &page.limit}}) {
+    const auto text = queryParam(query, name);
+    if (!text) continue;
+    if (text->empty() || text->size() > 9 || text->find_first_not_of("0123456789") != std::string::npos) {
+      return reply.send(errorAnswer(request, 400, std::string(name) + " must be a whole number", name));
+    }
+    *value = std::stoul(*text);
+  }
+  boost::asio::post(blocking_->readers, [this, request, reply, page, student = queryParam(query, "student")]() mutable {
+    std::size_t total = 0;
+    page.total = &total;
+    Response res = answer(request, http::status::ok, book_.list(student, page), "application/json");
+    res.set("X-Total-Count", std::to_string(total));
+    reply.send(std::move(res));
+  });
 }
 
 void WebServer::sendQueue(const HttpRequest& request, const HttpReply& reply) {

@@ -39,8 +39,10 @@ WindowWorldlines windowWorldlines(const std::string& bag_path, double from, doub
   std::vector<std::size_t> line_of(state->size(), shown.size());
   for (std::size_t k = 0; k < shown.size(); ++k) line_of[shown[k]] = k;
   std::vector<collision_lab_ros::Envelope> lines(shown.size(), collision_lab_ros::Envelope(max_vertices));
+  // The lines' x is the time since `from`, so that the columns of a long line divide the
+  // window, not the run from t = 0.
   const auto addAll = [&](double t) {
-    for (std::size_t k = 0; k < shown.size(); ++k) lines[k].add(t, state->position(shown[k], t));
+    for (std::size_t k = 0; k < shown.size(); ++k) lines[k].add(t - from, state->position(shown[k], t));
   };
   bool started = false;
   rosbag::View events(*bag, rosbag::TypeQuery(ros::message_traits::datatype<CollisionEvent>()));
@@ -56,7 +58,7 @@ WindowWorldlines windowWorldlines(const std::string& bag_path, double from, doub
     for (std::size_t k = 0; k < state->movedCount(); ++k) {
       const std::size_t body = state->firstMoved() + k;
       if (body < line_of.size() && line_of[body] < shown.size()) {
-        lines[line_of[body]].add(event->time, state->position(body, event->time));
+        lines[line_of[body]].add(event->time - from, state->position(body, event->time));
       }
     }
   }
@@ -68,7 +70,7 @@ WindowWorldlines windowWorldlines(const std::string& bag_path, double from, doub
     out.exact = out.exact && lines[k].exact();
     WindowLine line;
     line.body = shown[k];
-    for (const auto& v : lines[k].polyline()) line.points.emplace_back(v.x, v.y);
+    for (const auto& v : lines[k].polyline()) line.points.emplace_back(from + v.x, v.y);
     out.lines.push_back(std::move(line));
   }
   return out;

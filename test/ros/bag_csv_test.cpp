@@ -697,8 +697,8 @@ TEST_F(BagCsvTest, ClassTableIsTheExactRunAtTheStartAndAfterEveryImpact) {
   }
 }
 
-// A table with a column per body is refused past max_bodies (nothing written); a bag whose
-// summary counts impacts it has no events for says so.
+// A table with a column per body is refused past max_bodies, and a bag whose summary counts
+// impacts it has no events for says so; neither writes anything.
 TEST_F(BagCsvTest, ClassTableRefusesTooManyBodiesAndSaysWhenEventsAreMissing) {
   using namespace class_table;
   {
@@ -720,6 +720,7 @@ TEST_F(BagCsvTest, ClassTableRefusesTooManyBodiesAndSaysWhenEventsAreMissing) {
   EXPECT_FALSE(fs::exists(dir_ + "/wide.csv"));
   const auto start_only = bagToClassTable(bag_path_, dir_ + "/start.csv", 64);
   EXPECT_TRUE(start_only.events_missing);
-  EXPECT_EQ(start_only.rows, 1u);
+  EXPECT_EQ(start_only.rows, 0u);
+  EXPECT_FALSE(fs::exists(dir_ + "/start.csv")) << "refused before anything is written";
   EXPECT_THROW(bagToClassTable(dir_ + "/missing.bag", dir_ + "/x.csv", 64), collision_lab_ros::BagCsvError);
 }

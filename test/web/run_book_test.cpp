@@ -386,6 +386,14 @@ TEST(RunBookMemory, ListComesFromTheIndexWithLiveState) {
   const json bo = json::parse(book.list(std::string("bo")));
   ASSERT_EQ(bo.size(), 2u);
   EXPECT_EQ(book.residentRuns(), 2u) << "listing reads no old run back";
+  // A page of the list: the same items, and the whole list's length.
+  std::size_t total = 0;
+  const json page = json::parse(book.list(std::nullopt, {1, 1, &total}));
+  EXPECT_EQ(total, 3u);
+  ASSERT_EQ(page.size(), 1u);
+  EXPECT_EQ(page[0], all[1]);
+  EXPECT_EQ(json::parse(book.list(std::nullopt, {2, 10, nullptr})), json::array({all[2]}));
+  EXPECT_EQ(json::parse(book.list(std::nullopt, {5, 10, nullptr})), json::array());
 }
 
 TEST(RunBookMemory, MissedSummaryIsCompletedFromTheIndexAndTheBag) {

@@ -62,7 +62,8 @@ struct ClassTable {
   std::size_t bodies = 0;  ///< columns x_ and v_ per body
   std::size_t rows = 0;    ///< the start and one per event
   /// The run's RunSummary counts impacts the bag has no event for (recorded without events,
-  /// or cut): the table is not the whole run.
+  /// or cut): the table is not the whole run; nothing is written when the bag holds fewer
+  /// events than that count.
   bool events_missing = false;
   /// More than max_bodies bodies: nothing written (rows 0).
   bool too_many_bodies = false;

@@ -164,9 +164,18 @@ class RunBook {
   /// interrupted run is finished too).
   std::pair<std::uint64_t, bool> waitForChange(const std::string& run_id, std::uint64_t seen,
                                                std::chrono::milliseconds timeout) const;
-  /// Every run (student empty: everyone's), oldest first, as a JSON array text. With a
-  /// RunSource: every run it lists, with the live state of the runs in memory.
-  std::string list(const std::optional<std::string>& student) const;
+  /// A page of a list: entries offset .. offset + limit - 1; total (when given) gets the
+  /// length of the whole list.
+  struct ListPage {
+    std::size_t offset = 0;
+    std::size_t limit = static_cast<std::size_t>(-1);
+    std::size_t* total = nullptr;
+  };
+  /// Every run (student empty: everyone's), oldest first, as a JSON array text, or the page
+  /// of it asked for. With a RunSource: every run it lists, with the live state of the runs
+  /// in memory; only the page's index rows are read back into items.
+  std::string list(const std::optional<std::string>& student, const ListPage& page) const;
+  std::string list(const std::optional<std::string>& student) const { return list(student, ListPage{}); }
   /// The lab node's rejected inputs (student empty: everyone's), newest first, at most
   /// kRejectionsListed, as a JSON array text of {at [s since the epoch], student, run_id,
   /// reason_name, field, message}. Empty without a RunSource (the index keeps them).

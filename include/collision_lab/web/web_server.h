@@ -137,6 +137,7 @@ class WebServer {
   void sendRunPage(const HttpRequest& request, const std::string& run_id, const HttpReply& reply);
   void sendPresets(const HttpRequest& request, const HttpReply& reply);
   void sendQueue(const HttpRequest& request, const HttpReply& reply);
+  void sendRunList(const HttpRequest& request, const std::string& query, const HttpReply& reply);
   void sendRun(const HttpRequest& request, const std::string& run_id, const HttpReply& reply);
   void postRun(const HttpRequest& request, const HttpReply& reply);
   struct Refuse;  ///< answers a refused send (web_post.cpp)
@@ -155,6 +156,10 @@ class WebServer {
   using MakeFromBag = std::function<std::string(const std::string& bag, const std::string& folder, std::string& why)>;
   void sendMadeFromBag(const HttpRequest& request, const std::string& run_id, const std::string& name,
                        MakeFromBag make, const HttpReply& reply);
+  /// One file made from a bag at a time per address: true and the address noted, or false
+  /// and answered 429. endExport releases it.
+  bool startExport(const HttpRequest& request, const HttpReply& reply);
+  void endExport(const std::string& client);
   void sendEventsCsv(const HttpRequest& request, const std::string& run_id, const HttpReply& reply);
   void sendClassTable(const HttpRequest& request, const std::string& run_id, const HttpReply& reply);
   void sendWindow(const HttpRequest& request, const std::string& run_id, const std::string& query,
@@ -196,6 +201,7 @@ class WebServer {
   std::deque<std::chrono::steady_clock::time_point> wrong_codes_total_;  ///< of the last minute, every address
   std::map<std::string, std::size_t> streams_by_address_;  ///< live streams per client address (no zero kept)
   std::map<std::string, std::chrono::steady_clock::time_point> locked_until_;
+  std::set<std::string> exporting_;  ///< addresses with a file being made from a bag
   std::set<std::pair<std::string, std::string>> pending_;  ///< (student, requested) POSTs awaiting an answer
   /// student -> the highest n of the runs "<student>.run<n>" asked for or served [1]. The lab
   /// node serves a taken "run<n>" as the next free number, so numbers stay per student and
