@@ -14,12 +14,12 @@ from pkgutil import extend_path
 __path__ = extend_path(__path__, __name__)
 
 from ._core import version as __version__
-from ._run import SCENE_KEYS, SUMMARY_KEYS, CapWarning, Run, SceneError, body_name, predict, run
+from ._run import SCENE_KEYS, SUMMARY_KEYS, CapWarning, Run, RunInterrupted, SceneError, body_name, predict, run
 from ._sweep import sweep
 from ._bag import read_bag
 from ._presets import data_path, preset, presets
 
-__all__ = ['CapWarning', 'Run', 'SCENE_KEYS', 'SUMMARY_KEYS', 'SceneError', 'body_name', 'data_path', 'plot', 'predict',
+__all__ = ['CapWarning', 'Run', 'RunInterrupted', 'SCENE_KEYS', 'SUMMARY_KEYS', 'SceneError', 'body_name', 'data_path', 'plot', 'predict',
            'preset', 'presets', 'read_bag', 'run', 'sweep']
 
 

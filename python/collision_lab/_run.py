@@ -345,6 +345,17 @@ class CapWarning(UserWarning):
     """The cap (max_collisions) left a run unsimulated or cut it short."""
 
 
+class RunInterrupted(KeyboardInterrupt):
+    """Ctrl-C stopped run(): `run` is the Run as far as it was simulated (its summary says
+    cancelled, its events are the impacts before the stop). A KeyboardInterrupt, so that
+    code that stops on Ctrl-C still does."""
+
+    def __init__(self, run):
+        super().__init__('the run was stopped (Ctrl-C) after %d impacts; .run holds what it simulated'
+                         % run.summary.get('collision_count', 0))
+        self.run = run
+
+
 def _warn_about_cap(result, max_collisions, simulate_to_cap, mode):
     """Says, as a CapWarning, when the cap decided what was simulated."""
     s = result.summary
@@ -382,7 +393,8 @@ def run(masses, positions, velocities, restitution=1.0, *, ring=None, restitutio
     name: the scene's name. temperature_csv: a path to write T(t) [J] to, as the CLI's.
     full_state_every: K > 1 gives the lean record of long runs: every body's state (the
     per-body event arrays) at impact 1 and every K-th impact only, NaN in the others.
-    The GIL is released while it runs; Ctrl-C stops it (KeyboardInterrupt).
+    The GIL is released while it runs; Ctrl-C stops it and raises RunInterrupted (a
+    KeyboardInterrupt) whose .run is the run as far as it went.
     Raises SceneError for a scene or option the CLI rejects. Warns (CapWarning) when the
     cap left the run unsimulated (the model answered) or cut it short.
     The Run's scene holds these arguments (but temperature_csv): run(**r.scene) runs r again.
@@ -396,7 +408,10 @@ def run(masses, positions, velocities, restitution=1.0, *, ring=None, restitutio
                      tc=tc, elastic_below=elastic_below, viscoelastic_speed=viscoelastic_speed,
                      max_collisions=max_collisions, simulate_to_cap=simulate_to_cap, events=events, mode=mode,
                      name=name, full_state_every=full_state_every)
-    result = Run(parse_report(_core.run_json(args, name)), scene)
+    text, interrupted = _core.run_json(args, name)
+    result = Run(parse_report(text), scene)
+    if interrupted:
+        raise RunInterrupted(result) from None
     _warn_about_cap(result, max_collisions, simulate_to_cap, mode)
     return result
 

@@ -27,10 +27,11 @@ using SceneArgs = std::pair<std::vector<std::string>, std::string>;
 
 /// Runs `work` on its own thread while the calling thread, without the GIL, checks for
 /// Python signals every 50 ms. A signal handler that raises (SIGINT: KeyboardInterrupt)
-/// sets `cancel`; once `work` has returned, that exception is raised here. Exceptions of
-/// `work` are rethrown (pybind11 turns them into Python's).
+/// sets `cancel`; once `work` has returned, true says so and that exception is pending (the
+/// caller raises it, or another). Exceptions of `work` are rethrown (pybind11 turns them
+/// into Python's).
 template <class Work>
-void runWatchingSignals(std::atomic<bool>& cancel, Work work) {
+bool runWatchingSignals(std::atomic<bool>& cancel, Work work) {
   std::exception_ptr failure;
   std::promise<void> done;
   std::future<void> finished = done.get_future();
@@ -55,15 +56,20 @@ void runWatchingSignals(std::atomic<bool>& cancel, Work work) {
     }
     worker.join();
   }
-  if (interrupted) throw py::error_already_set();
+  if (interrupted) return true;
   if (failure) std::rethrow_exception(failure);
+  return false;
 }
 
-std::string runJson(const std::vector<std::string>& args, const std::string& name) {
+/// The report of one scene and whether Ctrl-C stopped it: then the report is of the run as
+/// far as it went (its summary cancelled), and the KeyboardInterrupt is cleared for the
+/// caller to raise with it.
+std::pair<std::string, bool> runJson(const std::vector<std::string>& args, const std::string& name) {
   std::atomic<bool> cancel{false};
   std::string json;
-  runWatchingSignals(cancel, [&] { json = runSceneJson(args, name, &cancel); });
-  return json;
+  const bool interrupted = runWatchingSignals(cancel, [&] { json = runSceneJson(args, name, &cancel); });
+  if (interrupted) PyErr_Clear();
+  return {json, interrupted};
 }
 
 /// Every scene on `workers` threads (each takes the next scene not yet taken); the reports
@@ -71,7 +77,7 @@ std::string runJson(const std::vector<std::string>& args, const std::string& nam
 std::vector<std::string> runManyJson(const std::vector<SceneArgs>& scenes, unsigned workers) {
   std::atomic<bool> cancel{false};
   std::vector<std::string> reports(scenes.size());
-  runWatchingSignals(cancel, [&] {
+  const bool interrupted = runWatchingSignals(cancel, [&] {
     std::atomic<std::size_t> next{0};
     std::vector<std::exception_ptr> failures(std::max(1u, workers));
     const auto drain = [&](std::exception_ptr& failure) {
@@ -92,6 +98,7 @@ std::vector<std::string> runManyJson(const std::vector<SceneArgs>& scenes, unsig
       if (failure) std::rethrow_exception(failure);
     }
   });
+  if (interrupted) throw py::error_already_set();
   return reports;
 }
 
@@ -103,8 +110,9 @@ PYBIND11_MODULE(_core, m) {
   m.doc() = "collision_lab's C++ core, run in process: the CLI's JSON report of a scene.";
   m.attr("version") = COLLISION_LAB_VERSION;  // package.xml's, as the node's RunParameters
   m.def("run_json", &collision_lab::python::runJson, py::arg("args"), py::arg("name"),
-        "The CLI's JSON report (or JSON error) of one scene given as collision_lab_cli's arguments. "
-        "Runs without the GIL; Ctrl-C cancels the run and raises KeyboardInterrupt.");
+        "(report, interrupted): the CLI's JSON report (or JSON error) of one scene given as "
+        "collision_lab_cli's arguments, and whether Ctrl-C cancelled it (the report is then of the run "
+        "as far as it went). Runs without the GIL.");
   m.def("run_many_json", &collision_lab::python::runManyJson, py::arg("scenes"), py::arg("workers"),
         "run_json of every (args, name) pair on `workers` C++ threads, without the GIL; the reports in order.");
 }

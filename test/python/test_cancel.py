@@ -1,5 +1,6 @@
-"""Ctrl-C during a run: the engine's cancel flag stops it and KeyboardInterrupt is raised;
-the GIL is free while a run goes on. The run would take hours uncancelled (3.1e10 impacts),
+"""Ctrl-C during a run: the engine's cancel flag stops it and RunInterrupted (a
+KeyboardInterrupt) is raised with the run as far as it went; the GIL is free while a run goes
+on. The run would take hours uncancelled (3.1e10 impacts),
 so returning at all is the check."""
 import _thread
 import os
@@ -22,9 +23,9 @@ def ctrl_c_raises():
     signal.signal(signal.SIGINT, previous)
 
 
-def long_run():
+def long_run(events='none'):
     # m_A/m_B = 1e20: 31,415,926,535 impacts, simulated one by one up to the cap.
-    collision_lab.run([1e20, 1, INF], [2, 1, 0], [-1, 0, 0], simulate_to_cap=True, events='none',
+    collision_lab.run([1e20, 1, INF], [2, 1, 0], [-1, 0, 0], simulate_to_cap=True, events=events,
                       max_collisions=10 ** 12)
 
 
@@ -40,6 +41,27 @@ def test_ctrl_c_cancels_a_long_run(interrupt):
         timer.cancel()
     # The module still works afterwards.
     assert collision_lab.run([100, 1, INF], [2, 1, 0], [-1, 0, 0]).summary['collision_count'] == 31
+
+
+def test_a_stopped_run_gives_what_it_simulated():
+    # Two balls (1 and 2 kg) between walls 3 m apart bounce forever: the engine walks the
+    # impacts one by one until Ctrl-C.
+    timer = threading.Timer(0.5, _thread.interrupt_main)
+    timer.start()
+    try:
+        with pytest.raises(collision_lab.RunInterrupted) as stopped:
+            collision_lab.run([INF, 1, 2, INF], [3, 2, 1, 0], [0, 1, -1, 0], simulate_to_cap=True,
+                              events='first:1000', max_collisions=10 ** 12)
+    finally:
+        timer.cancel()
+    run = stopped.value.run
+    s = run.summary
+    assert s['cancelled'] is True and s['truncated'] is True
+    assert s['collision_count'] > 1000  # half a second of a run with no end
+    assert len(run.events['index']) == 1000  # the first 1,000 impacts, as asked
+    # Elastic, walls at rest: the energy at the stop is the start's, 1/2 + 1 = 1.5 J.
+    v = s['final_velocities']
+    assert abs((1 * v[1] ** 2 + 2 * v[2] ** 2) / 2 - 1.5) <= 1e-12
 
 
 def test_ctrl_c_cancels_a_sweep():
