@@ -238,6 +238,9 @@ def _events_arrays(events, bodies):
                        else np.array([np.nan if v is None else v for v in values], dtype=float))
     for key in _BODY_ARRAYS:
         arrays[key] = _float_rows([e[key] for e in events], bodies)
+    # What every event carries, whatever its record: the colliding pair's velocities [m/s].
+    for key in ('pair_velocities_before', 'pair_velocities_after'):
+        arrays[key] = _float_rows([e.get(key) for e in events], 2)
     for key in _MODEL_ARRAYS:
         rows = [e.get(key) for e in events]
         if any(row is not None for row in rows):
@@ -279,6 +282,57 @@ class Run:
         self.names = [body_name(i) for i in range(len(self.masses))]
         self.walls = [name for name, mass in zip(self.names, self.masses) if math.isinf(mass)]
         self.events = _events_arrays(report.get('events', []), len(self.masses))
+
+    def state_at(self, k=None, *, t=None):
+        """The bodies' state (positions [m], velocities [m/s]), each an array of one value per
+        body: after event k (1-based; 0: the start) of the recorded events, or at time t [s]
+        (a float, or an array like solve_ivp's t_eval: then arrays of shape (len(t), bodies)).
+        Rebuilt from the events' pair fields, which every record carries, so it needs no
+        dense events x bodies array; between events each body flies freely (on a ring,
+        wrapped into [0, L)). Times past the last recorded event fly on from it."""
+        if (k is None) == (t is None):
+            raise TypeError('give either k (an event number) or t (a time in seconds)')
+        e = self.events
+        count = len(e['time'])
+        if k is not None:
+            if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 0 <= k <= count:
+                raise ValueError('k must be a whole number from 0 to %d (the recorded events), not %r' % (count, k))
+            x, v, since = self._replay(int(k))
+            at = e['time'][k - 1] if k > 0 else 0.0
+            return self._flown(x, v, since, at), v
+        times = np.atleast_1d(np.asarray(t, dtype=float))
+        if np.any(~np.isfinite(times)) or np.any(times < 0):
+            raise ValueError('t must be finite times >= 0 [s]')
+        positions = np.empty((len(times), len(self.masses)))
+        velocities = np.empty_like(positions)
+        for row, time in enumerate(times):
+            x, v, since = self._replay(int(np.searchsorted(e['time'], time, side='right')))
+            positions[row], velocities[row] = self._flown(x, v, since, time), v
+        return (positions[0], velocities[0]) if np.ndim(t) == 0 else (positions, velocities)
+
+    def _replay(self, k):
+        """Each body's last point [m], its time [s] and its velocity [m/s] after event k."""
+        e = self.events
+        x = self.initial_positions.copy()
+        v = self.initial_velocities.copy()
+        since = np.zeros(len(x))
+        n = len(x)
+        for j in range(k):
+            first, pair, last = int(e['first_moved'][j]), int(e['pair_index'][j]), int(e['last_moved'][j])
+            after = e['pair_velocities_after'][j]
+            collapse = e['kind'][j] == 'collapse'
+            span = (last - first) % n + 1  # a ring's seam wraps
+            for step in range(span):
+                body = (first + step) % n
+                right_side = collapse or (step <= (pair - first) % n)
+                x[body], since[body] = e['position'][j], e['time'][j]
+                v[body] = after[0] if right_side else after[1]
+        return x, v, since
+
+    def _flown(self, x, v, since, time):
+        flown = x + v * (time - since)
+        ring = self.scene.get('ring')
+        return np.mod(flown, ring) if ring else flown
 
     def to_pandas(self):
         """One row per event: the scalar fields, then v_A, v_B, ... (velocities after [m/s])

@@ -1,0 +1,60 @@
+"""Run.state_at: the bodies' state after an event or at any time, rebuilt from the pair
+fields every record carries (no dense events x bodies array needed)."""
+import numpy as np
+import pytest
+
+import collision_lab
+
+INF = float('inf')
+
+
+def pi_run(**options):
+    return collision_lab.run([100, 1, INF], [2, 1, 0], [-1, 0, 0], **options)
+
+
+def test_a_lean_record_gives_every_state_of_the_full_one():
+    # full_state_every=10: only impacts 1, 10, 20, 30 carry every body; state_at rebuilds
+    # the others, and they equal the full record's: velocities bit for bit, positions to
+    # rounding (the full record's are the engine's, these are flown from the contacts).
+    full, lean = pi_run(), pi_run(full_state_every=10)
+    assert np.isnan(lean.events['velocities_after'][1]).all()
+    for k in range(1, 32):
+        x, v = lean.state_at(k)
+        assert np.array_equal(v, full.events['velocities_after'][k - 1]), k
+        assert np.allclose(x, full.events['positions'][k - 1], rtol=0, atol=4e-15), k
+
+
+def test_states_at_times_by_hand():
+    # A (100 kg, -1 m/s from 2 m) meets B (at rest at 1 m) at t = 1 s, x = 1 m; before
+    # that only A moves: at t = 0.5 s it is at 1.5 m.
+    run = pi_run()
+    x, v = run.state_at(t=0.5)
+    assert list(x) == [1.5, 1, 0] and list(v) == [-1, 0, 0]
+    xs, vs = run.state_at(t=[0, 0.5, 1.0])
+    assert xs.shape == (3, 3) and list(xs[2]) == [1, 1, 0]
+    assert list(vs[2]) == list(run.events['velocities_after'][0])  # just after the impact
+    assert list(run.state_at(0)[0]) == [2, 1, 0]
+    # After the last impact every body flies freely: the final velocities.
+    assert list(run.state_at(t=1e6)[1]) == list(run.summary['final_velocities'])
+
+
+def test_a_ring_wraps_its_positions():
+    # Two bodies on a ring of 4 m: B (at 1 m, +1 m/s) meets A (at 3 m, at rest) across
+    # nothing: they approach on the short side; every state stays in [0, 4).
+    with pytest.warns(collision_lab.CapWarning):  # endless: it stops at its cap
+        run = collision_lab.run([1, 1], [3, 1], [0, 1], ring=4, max_collisions=50, simulate_to_cap=True)
+    assert 'AB' in set(run.events['pair']) and len(set(run.events['pair'])) == 2  # the seam pair too
+    xs, _ = run.state_at(t=np.linspace(0, 40, 81))
+    assert np.all((xs >= 0) & (xs < 4))
+
+
+def test_bad_arguments_are_refused():
+    run = pi_run()
+    with pytest.raises(TypeError):
+        run.state_at()
+    with pytest.raises(TypeError):
+        run.state_at(1, t=1.0)
+    with pytest.raises(ValueError):
+        run.state_at(32)
+    with pytest.raises(ValueError):
+        run.state_at(t=-1)
