@@ -485,44 +485,16 @@ def _haff_cost(t, log_T, u):
     return float(((r - log_t0) ** 2).sum()), log_t0
 
 
-def fit_haff(t, T):
-    """Haff's law T(t) = t0 / (1 + t/tau)^2 fitted by least squares on ln T, as core::fitHaff:
-    a grid of 0.05 decades in tau over [1e-6, 1e6] x the last time, then golden sections.
-    Returns dict(t0 [J], tau [s] (inf: no cooling seen), rms_ln_error [1], samples [1]) or
-    None with fewer than two usable samples (finite t >= 0, T > 0) or none after t = 0."""
+def _usable_samples(t, T, least):
+    """(t [s], ln T) of the samples a fit uses (finite t >= 0, T > 0), or None with fewer than
+    `least` of them or none after t = 0."""
     t = np.asarray(t, dtype=float)
     T = np.asarray(T, dtype=float)
     use = np.isfinite(t) & (t >= 0) & np.isfinite(T) & (T > 0)
     t, log_T = t[use], np.log(T[use])
-    if t.size < 2 or not t.max() > 0:
+    if t.size < least or not t.max() > 0:
         return None
-    steps_ = 12 * 20
-    lo = math.log(t.max()) - 6 * math.log(10.0)
-    du = 12 * math.log(10.0) / steps_
-    costs = [_haff_cost(t, log_T, lo + k * du)[0] for k in range(steps_ + 1)]
-    best = int(np.argmin(costs))
-    if best == steps_:
-        log_t0 = log_T.mean()
-        cost = float(((log_T - log_t0) ** 2).sum())
-        tau = math.inf
-    else:
-        phi = (math.sqrt(5.0) - 1) / 2
-        a, b = lo + max(best - 1, 0) * du, lo + min(best + 1, steps_) * du
-        c, d = b - phi * (b - a), a + phi * (b - a)
-        fc, fd = _haff_cost(t, log_T, c)[0], _haff_cost(t, log_T, d)[0]
-        while b - a > 1e-13 * max(1.0, abs(a)):
-            if fc < fd:
-                b, d, fd = d, c, fc
-                c = b - phi * (b - a)
-                fc = _haff_cost(t, log_T, c)[0]
-            else:
-                a, c, fc = c, d, fd
-                d = a + phi * (b - a)
-                fd = _haff_cost(t, log_T, d)[0]
-        u = (a + b) / 2
-        cost, log_t0 = _haff_cost(t, log_T, u)
-        tau = math.exp(u)
-    return {'t0': math.exp(log_t0), 'tau': tau, 'rms_ln_error': math.sqrt(cost / t.size), 'samples': int(t.size)}
+    return t, log_T
 
 
 def _golden_min(cost, a, b):
@@ -540,6 +512,39 @@ def _golden_min(cost, a, b):
             d = a + phi * (b - a)
             fd = cost(d)
     return (a + b) / 2
+
+
+_GRID_STEPS = 12 * 20  # fit_haff's grid of ln tau: 0.05 decades over 12
+
+
+def _best_log_tau(cost, t):
+    """(grid index, ln tau) minimising cost(ln tau): the best of a grid of 0.05 decades over
+    [1e-6, 1e6] x the last time, refined by golden sections between its neighbours; the index
+    is the grid's last (GRID_STEPS) when the cost falls all the way (no cooling seen)."""
+    lo = math.log(t.max()) - 6 * math.log(10.0)
+    du = 12 * math.log(10.0) / _GRID_STEPS
+    best = int(np.argmin([cost(lo + k * du) for k in range(_GRID_STEPS + 1)]))
+    return best, _golden_min(cost, lo + max(best - 1, 0) * du, lo + min(best + 1, _GRID_STEPS) * du)
+
+
+def fit_haff(t, T):
+    """Haff's law T(t) = t0 / (1 + t/tau)^2 fitted by least squares on ln T, as core::fitHaff:
+    a grid of 0.05 decades in tau over [1e-6, 1e6] x the last time, then golden sections.
+    Returns dict(t0 [J], tau [s] (inf: no cooling seen), rms_ln_error [1], samples [1]) or
+    None with fewer than two usable samples (finite t >= 0, T > 0) or none after t = 0."""
+    samples = _usable_samples(t, T, 2)
+    if samples is None:
+        return None
+    t, log_T = samples
+    best, u = _best_log_tau(lambda w: _haff_cost(t, log_T, w)[0], t)
+    if best == _GRID_STEPS:
+        log_t0 = log_T.mean()
+        cost = float(((log_T - log_t0) ** 2).sum())
+        tau = math.inf
+    else:
+        cost, log_t0 = _haff_cost(t, log_T, u)
+        tau = math.exp(u)
+    return {'t0': math.exp(log_t0), 'tau': tau, 'rms_ln_error': math.sqrt(cost / t.size), 'samples': int(t.size)}
 
 
 def _free_exponent_fit(t, log_T, u):
@@ -564,19 +569,11 @@ def fit_haff_exponent(t, T):
     with fewer than three usable samples (finite t >= 0, T > 0). Over a window much shorter
     than tau only beta/tau is decided (the law is then exp(-beta t/tau)); the exponent is
     the late-time slope d ln T / d ln t only for t >> tau."""
-    t = np.asarray(t, dtype=float)
-    T = np.asarray(T, dtype=float)
-    use = np.isfinite(t) & (t >= 0) & np.isfinite(T) & (T > 0)
-    t, log_T = t[use], np.log(T[use])
-    if t.size < 3 or not t.max() > 0:
+    samples = _usable_samples(t, T, 3)
+    if samples is None:
         return None
-    steps_ = 12 * 20
-    lo = math.log(t.max()) - 6 * math.log(10.0)
-    du = 12 * math.log(10.0) / steps_
-    costs = [_free_exponent_fit(t, log_T, lo + k * du)[0] for k in range(steps_ + 1)]
-    best = int(np.argmin(costs))
-    u = _golden_min(lambda w: _free_exponent_fit(t, log_T, w)[0], lo + max(best - 1, 0) * du,
-                    lo + min(best + 1, steps_) * du)
+    t, log_T = samples
+    _, u = _best_log_tau(lambda w: _free_exponent_fit(t, log_T, w)[0], t)
     cost, log_t0, beta = _free_exponent_fit(t, log_T, u)
     return {'t0': math.exp(log_t0), 'tau': math.exp(u), 'beta': beta, 'rms_ln_error': math.sqrt(cost / t.size),
             'samples': int(t.size)}

@@ -77,6 +77,16 @@ bool WebServer::originAllowed(const std::string& origin, const std::string& host
   return port_of(authority) == (host.empty() ? std::to_string(port_) : port_of(host));
 }
 
+void WebServer::refuseWrongCode(const HttpRequest& request, const std::string& where, const HttpReply& reply) {
+  log("wrong code " + where + "from " + request.client);
+  if (const long wait = wrongCode(request.client)) {
+    Response res = errorAnswer(request, 429, "too many wrong codes from your address; try again in " + std::to_string(wait) + " s", "code");
+    res.set(http::field::retry_after, std::to_string(wait));
+    return reply.send(std::move(res));
+  }
+  reply.send(errorAnswer(request, 403, "wrong code", "code"));
+}
+
 void WebServer::login(const HttpRequest& request, const HttpReply& reply) {
   const json body = json::parse(request.message.body(), nullptr, false);
   if (!body.is_object() || !body.contains("code") || !body["code"].is_string() ||
@@ -91,15 +101,7 @@ void WebServer::login(const HttpRequest& request, const HttpReply& reply) {
   const std::string code = body["code"];
   const bool teacher = !config_.teacher_code.empty() && sameSecret(code, config_.teacher_code);
   const bool student = teacher || (!config_.code.empty() && sameSecret(code, config_.code));
-  if (!student) {
-    log("wrong code at login from " + request.client);
-    if (const long wait = wrongCode(request.client)) {
-      Response res = errorAnswer(request, 429, "too many wrong codes from your address; try again in " + std::to_string(wait) + " s", "code");
-      res.set(http::field::retry_after, std::to_string(wait));
-      return reply.send(std::move(res));
-    }
-    return reply.send(errorAnswer(request, 403, "wrong code", "code"));
-  }
+  if (!student) return refuseWrongCode(request, "at login ", reply);
   Response res = jsonAnswer(request, 200, {{"role", teacher ? "teacher" : "student"}});
   const std::string attributes = "; Path=/; Max-Age=" + std::to_string(kCookieSeconds) + "; HttpOnly; SameSite=Strict";
   res.insert(http::field::set_cookie, std::string(kClassCookie) + "=" + secrets_.classCookie() + attributes);

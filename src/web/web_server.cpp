@@ -259,13 +259,7 @@ void WebServer::handle(HttpRequest request, HttpReply reply) {
       const bool is_class = !config_.code.empty() && sameSecret(code, config_.code);
       const bool is_teacher = !config_.teacher_code.empty() && sameSecret(code, config_.teacher_code);
       if (!is_class && !is_teacher && (!config_.code.empty() || !config_.teacher_code.empty())) {
-        log("wrong code from " + request.client);
-        if (const long wait = wrongCode(request.client)) {
-          Response res = errorAnswer(request, 429, "too many wrong codes from your address; try again in " + std::to_string(wait) + " s", "code");
-          res.set(http::field::retry_after, std::to_string(wait));
-          return reply.send(std::move(res));
-        }
-        return reply.send(errorAnswer(request, 403, "wrong code", "code"));
+        return refuseWrongCode(request, "", reply);
       }
       access.student = access.student || is_class || is_teacher;
       access.teacher = access.teacher || is_teacher;

@@ -150,6 +150,9 @@ class WebServer {
   /// POST /api/students/<student>/stop (the teacher): every queued or running run of student.
   void stopStudent(const HttpRequest& request, const std::string& student, const Access& access, const HttpReply& reply);
   void login(const HttpRequest& request, const HttpReply& reply);
+  /// A wrong class or teacher code (`where`: "at login " or ""): logged and counted, then
+  /// 403, or 429 with Retry-After once the address is locked out.
+  void refuseWrongCode(const HttpRequest& request, const std::string& where, const HttpReply& reply);
   /// A file made once from a finished run's bag, kept beside the bag as <run_id>_<name> and
   /// sent. make(bag, folder) writes it into a temporary folder and returns its path there,
   /// or the empty string and, in why, the 404 text when the run has no such file.
