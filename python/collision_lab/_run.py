@@ -221,7 +221,11 @@ def parse_report(text):
 
 
 def _float_rows(rows, bodies):
-    """events x bodies floats; NaN where the JSON has null (a whole null row: all NaN)."""
+    """events x bodies floats; NaN where the JSON has null (a whole null row: all NaN). When
+    every row is null (more than 64 bodies: the record has no per-body arrays), a read-only
+    view of one NaN, which holds no events x bodies memory: Run.state_at rebuilds states."""
+    if all(row is None for row in rows):
+        return np.broadcast_to(np.float64(np.nan), (len(rows), bodies))
     out = np.full((len(rows), bodies), np.nan)
     for i, row in enumerate(rows):
         if row is not None:

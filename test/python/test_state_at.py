@@ -58,3 +58,19 @@ def test_bad_arguments_are_refused():
         run.state_at(32)
     with pytest.raises(ValueError):
         run.state_at(t=-1)
+
+
+def test_more_than_64_bodies_hold_no_dense_per_body_arrays():
+    # 200 equal masses, every other one moving left: the record carries the pair fields only,
+    # and the per-body arrays are one NaN seen through a view (no events x bodies memory);
+    # state_at gives every body's velocity. Equal masses only exchange velocities: the end's
+    # are the start's, rearranged, and state_at's are the summary's.
+    n = 200
+    v0 = np.where(np.arange(n) % 2 == 0, -1.0, 1.0)
+    run = collision_lab.run([1.0] * n, [float(x) for x in range(n, 0, -1)], v0)
+    per_body = run.events['velocities_after']
+    assert per_body.shape == (len(run.events['time']), n) and per_body.strides == (0, 0)
+    assert np.isnan(per_body).all()
+    _, v = run.state_at(len(run.events['time']))
+    assert sorted(v) == sorted(v0)
+    assert list(v) == list(run.summary['final_velocities'])
