@@ -8,21 +8,22 @@
 
 namespace collision_lab_web {
 
-long WebServer::admit(const std::string& key, std::size_t limit) {
+long WebServer::admit(const std::string& key, std::size_t limit, std::chrono::seconds window) {
   using Clock = std::chrono::steady_clock;
   const auto now = Clock::now();
   std::lock_guard<std::mutex> lock(mutex_);
-  auto& sent = sends_[key];
-  while (!sent.empty() && now - sent.front() >= std::chrono::minutes(1)) sent.pop_front();
+  auto& sends = window > std::chrono::minutes(1) ? hourly_sends_ : sends_;
+  auto& sent = sends[key];
+  while (!sent.empty() && now - sent.front() >= window) sent.pop_front();
   if (sent.size() >= limit) {
-    const auto wait = std::chrono::minutes(1) - (now - sent.front());
+    const auto wait = window - (now - sent.front());
     return std::max<long>(1, std::chrono::ceil<std::chrono::seconds>(wait).count());
   }
   sent.push_back(now);
-  // Bounded: keys idle for a minute are dropped once the map grows.
-  if (sends_.size() > 4096) {
-    for (auto it = sends_.begin(); it != sends_.end();) {
-      it = (it->second.empty() || now - it->second.back() >= std::chrono::minutes(1)) ? sends_.erase(it) : std::next(it);
+  // Bounded: keys idle for a whole window are dropped once the map grows.
+  if (sends.size() > 4096) {
+    for (auto it = sends.begin(); it != sends.end();) {
+      it = (it->second.empty() || now - it->second.back() >= window) ? sends.erase(it) : std::next(it);
     }
   }
   return 0;

@@ -57,6 +57,7 @@ WebConfig loadConfig(const ros::NodeHandle& pnh) {
   c.max_bodies = sizeParam(pnh, "max_bodies", c.max_bodies);
   c.runs_per_minute = sizeParam(pnh, "runs_per_minute", c.runs_per_minute);
   c.runs_per_minute_per_address = sizeParam(pnh, "runs_per_minute_per_address", c.runs_per_minute_per_address);
+  c.runs_per_hour = sizeParam(pnh, "runs_per_hour", c.runs_per_hour);
   int unfinished = static_cast<int>(c.unfinished_runs_per_address);
   pnh.param("unfinished_runs_per_address", unfinished, unfinished);
   c.unfinished_runs_per_address = static_cast<std::size_t>(std::max(0, unfinished));  // 0: no cap

@@ -246,15 +246,21 @@ bool WebServer::admitSend(const HttpRequest& request, const collision_lab::Initi
   long wait = admit("address " + request.client, config_.runs_per_minute_per_address);
   std::string which = "runs per address";
   std::size_t limit = config_.runs_per_minute_per_address;
+  std::string per = "minute";
   if (!wait) {
     wait = admit("student " + student + " at " + request.client, config_.runs_per_minute);
     which = "runs per student";
     limit = config_.runs_per_minute;
   }
+  if (!wait) {
+    wait = admit("student " + student + " at " + request.client, config_.runs_per_hour, std::chrono::hours(1));
+    per = "hour: this lesson's ceiling";
+    limit = config_.runs_per_hour;
+  }
   if (wait) {
     shares_.answered(request.client, std::nullopt);
-    log("limited " + request.client + " (" + student + "): " + which);
-    Response res = refuse(429, "at most " + std::to_string(limit) + " " + which + " per minute; try again in " +
+    log("limited " + request.client + " (" + student + "): " + which + (per == "minute" ? "" : " per hour"));
+    Response res = refuse(429, "at most " + std::to_string(limit) + " " + which + " per " + per + "; try again in " +
                                    std::to_string(wait) + " s");
     res.set(http::field::retry_after, std::to_string(wait));
     reply.send(std::move(res));

@@ -60,6 +60,9 @@ struct WebConfig {
   std::size_t max_bodies = 10000;        ///< the lab node's ~max_bodies [1]
   std::size_t runs_per_minute = 10;      ///< per student [1]; more: 429
   std::size_t runs_per_minute_per_address = 30;  ///< per client address [1]; more: 429
+  /// per student name at an address per hour [1]; more: 429 (a lesson's ceiling: a script
+  /// sending all afternoon stops here)
+  std::size_t runs_per_hour = 200;
   /// Runs of one client address sent and not yet finished (queued or running), whatever the
   /// names [1]; more: 429 until one ends. 0: no cap.
   std::size_t unfinished_runs_per_address = 6;
@@ -169,8 +172,8 @@ class WebServer {
                   const HttpReply& reply);
   void sendBag(const HttpRequest& request, const std::string& run_id, const HttpReply& reply);
   void stream(const HttpRequest& request, const std::string& run_id, const HttpReply& reply);
-  /// Seconds until `key` may send again under `limit` per minute; 0 (and counted) when now.
-  long admit(const std::string& key, std::size_t limit);
+  /// Seconds until `key` may send again under `limit` per `window`; 0 (and counted) when now.
+  long admit(const std::string& key, std::size_t limit, std::chrono::seconds window = std::chrono::minutes(1));
   /// Seconds the address is still locked out for wrong codes; 0 when it is not.
   long lockedOut(const std::string& client);
   /// Counts a wrong code from `client`: seconds of lockout when it is now locked out, else 0.
@@ -200,6 +203,7 @@ class WebServer {
   collision_lab::service::AddressShare shares_;  ///< unfinished_runs_per_address
   mutable std::mutex mutex_;  ///< guards everything below
   std::map<std::string, std::deque<std::chrono::steady_clock::time_point>> sends_;
+  std::map<std::string, std::deque<std::chrono::steady_clock::time_point>> hourly_sends_;  ///< windows over a minute
   std::map<std::string, std::deque<std::chrono::steady_clock::time_point>> wrong_codes_;
   std::deque<std::chrono::steady_clock::time_point> wrong_codes_total_;  ///< of the last minute, every address
   std::map<std::string, std::size_t> streams_by_address_;  ///< live streams per client address (no zero kept)
