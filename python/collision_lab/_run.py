@@ -293,7 +293,9 @@ class Run:
         (a float, or an array like solve_ivp's t_eval: then arrays of shape (len(t), bodies)).
         Rebuilt from the events' pair fields, which every record carries, so it needs no
         dense events x bodies array; between events each body flies freely (on a ring,
-        wrapped into [0, L)). Times past the last recorded event fly on from it."""
+        wrapped into [0, L)). After the last recorded event the bodies fly on only when the
+        record is the whole run (every impact recorded, the run finished); otherwise a time
+        past it is refused (ValueError): events='first:N' or 'none', a cap, a stop."""
         if (k is None) == (t is None):
             raise TypeError('give either k (an event number) or t (a time in seconds)')
         e = self.events
@@ -301,27 +303,58 @@ class Run:
         if k is not None:
             if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 0 <= k <= count:
                 raise ValueError('k must be a whole number from 0 to %d (the recorded events), not %r' % (count, k))
-            x, v, since = self._replay(int(k))
+            x, v, since = self._replay_to(int(k))
             at = e['time'][k - 1] if k > 0 else 0.0
             return self._flown(x, v, since, at), v
         times = np.atleast_1d(np.asarray(t, dtype=float))
         if np.any(~np.isfinite(times)) or np.any(times < 0):
             raise ValueError('t must be finite times >= 0 [s]')
+        last = e['time'][-1] if count else 0.0
+        if not self._whole_run() and np.any(times > last):
+            raise ValueError('the record ends at t = %r s (%d events of a run of %s impacts, %s): no state after it'
+                             % (float(last), count, self.summary.get('collision_count'),
+                                self.summary.get('truncation_reason') or self.summary.get('stop_reason')
+                                or 'events not all recorded'))
         positions = np.empty((len(times), len(self.masses)))
         velocities = np.empty_like(positions)
-        for row, time in enumerate(times):
-            x, v, since = self._replay(int(np.searchsorted(e['time'], time, side='right')))
-            positions[row], velocities[row] = self._flown(x, v, since, time), v
+        # One replay, forward through the times in order.
+        order = np.argsort(times, kind='stable')
+        replay = self._replay()
+        x, v, since = next(replay)
+        done = 0
+        for row in order:
+            wanted = int(np.searchsorted(e['time'], times[row], side='right'))
+            while done < wanted:
+                x, v, since = next(replay)
+                done += 1
+            positions[row], velocities[row] = self._flown(x, v, since, times[row]), v
         return (positions[0], velocities[0]) if np.ndim(t) == 0 else (positions, velocities)
 
-    def _replay(self, k):
+    def _whole_run(self):
+        """Is every impact of the run recorded, and the run over (no cap, stop or model)?"""
+        s = self.summary
+        impacts = int(np.sum(self.events['kind'] == 'impact'))
+        return (bool(s.get('simulated')) and not s.get('truncated') and not s.get('cancelled')
+                and impacts == s.get('collision_count'))
+
+    def _replay_to(self, k):
         """Each body's last point [m], its time [s] and its velocity [m/s] after event k."""
+        replay = self._replay()
+        state = next(replay)
+        for _ in range(k):
+            state = next(replay)
+        return state
+
+    def _replay(self):
+        """Yields (last point [m], its time [s], velocity [m/s]) of every body at the start,
+        then after each event in turn (the arrays are updated in place)."""
         e = self.events
         x = self.initial_positions.copy()
         v = self.initial_velocities.copy()
         since = np.zeros(len(x))
         n = len(x)
-        for j in range(k):
+        yield x, v, since
+        for j in range(len(e['time'])):
             first, pair, last = int(e['first_moved'][j]), int(e['pair_index'][j]), int(e['last_moved'][j])
             after = e['pair_velocities_after'][j]
             collapse = e['kind'][j] == 'collapse'
@@ -331,7 +364,7 @@ class Run:
                 right_side = collapse or (step <= (pair - first) % n)
                 x[body], since[body] = e['position'][j], e['time'][j]
                 v[body] = after[0] if right_side else after[1]
-        return x, v, since
+            yield x, v, since
 
     def _flown(self, x, v, since, time):
         flown = x + v * (time - since)
@@ -412,6 +445,9 @@ class RunInterrupted(KeyboardInterrupt):
         super().__init__('the run was stopped (Ctrl-C) after %d impacts; .run holds what it simulated'
                          % run.summary.get('collision_count', 0))
         self.run = run
+
+    def __reduce__(self):  # across processes (a pool's workers stopped by Ctrl-C too)
+        return RunInterrupted, (self.run,)
 
 
 def _warn_about_cap(result, max_collisions, simulate_to_cap, mode):

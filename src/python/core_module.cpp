@@ -63,11 +63,24 @@ bool runWatchingSignals(std::atomic<bool>& cancel, Work work) {
 
 /// The report of one scene and whether Ctrl-C stopped it: then the report is of the run as
 /// far as it went (its summary cancelled), and the KeyboardInterrupt is cleared for the
-/// caller to raise with it.
+/// caller to raise with it. Any other pending exception is raised as it is.
 std::pair<std::string, bool> runJson(const std::vector<std::string>& args, const std::string& name) {
   std::atomic<bool> cancel{false};
   std::string json;
-  const bool interrupted = runWatchingSignals(cancel, [&] { json = runSceneJson(args, name, &cancel); });
+  std::exception_ptr failure;
+  const bool interrupted = runWatchingSignals(cancel, [&] {
+    try {
+      json = runSceneJson(args, name, &cancel);
+    } catch (...) {
+      failure = std::current_exception();
+    }
+  });
+  // Only Ctrl-C with a report to show becomes RunInterrupted: another handler's exception
+  // (a timeout, sys.exit) and a run that failed keep theirs.
+  if (interrupted && (failure || json.empty() || !PyErr_ExceptionMatches(PyExc_KeyboardInterrupt))) {
+    throw py::error_already_set();
+  }
+  if (failure) std::rethrow_exception(failure);
   if (interrupted) PyErr_Clear();
   return {json, interrupted};
 }

@@ -8,7 +8,7 @@
 
 namespace collision_lab_web {
 
-long WebServer::admit(const std::string& key, std::size_t limit, std::chrono::seconds window) {
+long WebServer::admit(const std::string& key, std::size_t limit, std::chrono::seconds window, bool count) {
   using Clock = std::chrono::steady_clock;
   const auto now = Clock::now();
   std::lock_guard<std::mutex> lock(mutex_);
@@ -19,6 +19,7 @@ long WebServer::admit(const std::string& key, std::size_t limit, std::chrono::se
     const auto wait = window - (now - sent.front());
     return std::max<long>(1, std::chrono::ceil<std::chrono::seconds>(wait).count());
   }
+  if (!count) return 0;
   sent.push_back(now);
   // Bounded: keys idle for a whole window are dropped once the map grows.
   if (sends.size() > 4096) {

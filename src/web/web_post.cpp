@@ -242,20 +242,24 @@ bool WebServer::admitSend(const HttpRequest& request, const collision_lab::Initi
   }
   // Per address, and per name at that address: another name does not escape the address's
   // limit, and sending as a classmate from another address spends none of the classmate's
-  // own runs.
-  long wait = admit("address " + request.client, config_.runs_per_minute_per_address);
-  std::string which = "runs per address";
-  std::size_t limit = config_.runs_per_minute_per_address;
-  std::string per = "minute";
-  if (!wait) {
-    wait = admit("student " + student + " at " + request.client, config_.runs_per_minute);
-    which = "runs per student";
-    limit = config_.runs_per_minute;
-  }
-  if (!wait) {
-    wait = admit("student " + student + " at " + request.client, config_.runs_per_hour, std::chrono::hours(1));
-    per = "hour: this lesson's ceiling";
-    limit = config_.runs_per_hour;
+  // own runs. Each window is looked at first and counted only when all three admit the send,
+  // so that a student at the hour's ceiling spends none of the address's minute.
+  using std::chrono::hours;
+  using std::chrono::minutes;
+  const std::string address = "address " + request.client, name = "student " + student + " at " + request.client;
+  long wait = 0;
+  std::string which, per = "minute";
+  std::size_t limit = 0;
+  if ((wait = admit(address, config_.runs_per_minute_per_address, minutes(1), false))) {
+    which = "runs per address", limit = config_.runs_per_minute_per_address;
+  } else if ((wait = admit(name, config_.runs_per_minute, minutes(1), false))) {
+    which = "runs per student", limit = config_.runs_per_minute;
+  } else if ((wait = admit(name, config_.runs_per_hour, hours(1), false))) {
+    which = "runs per student", per = "hour: this lesson's ceiling", limit = config_.runs_per_hour;
+  } else {
+    admit(address, config_.runs_per_minute_per_address);
+    admit(name, config_.runs_per_minute);
+    admit(name, config_.runs_per_hour, hours(1));
   }
   if (wait) {
     shares_.answered(request.client, std::nullopt);

@@ -64,6 +64,36 @@ def test_a_stopped_run_gives_what_it_simulated():
     assert abs((1 * v[1] ** 2 + 2 * v[2] ** 2) / 2 - 1.5) <= 1e-12
 
 
+def test_a_stopped_run_crosses_processes():
+    # RunInterrupted pickles (a pool's worker stopped by Ctrl-C hands it to the parent).
+    import pickle
+    timer = threading.Timer(0.3, _thread.interrupt_main)
+    timer.start()
+    try:
+        with pytest.raises(collision_lab.RunInterrupted) as stopped:
+            long_run()
+    finally:
+        timer.cancel()
+    again = pickle.loads(pickle.dumps(stopped.value))
+    assert isinstance(again, collision_lab.RunInterrupted)
+    assert again.run.summary['cancelled'] is True
+
+
+def test_another_signal_handlers_exception_is_kept():
+    # A SIGALRM handler that raises TimeoutError (a test timeout) stops the run too, and its
+    # exception, not RunInterrupted, reaches the caller.
+    def timeout(signum, frame):
+        raise TimeoutError('too slow')
+    previous = signal.signal(signal.SIGALRM, timeout)
+    signal.setitimer(signal.ITIMER_REAL, 0.3)
+    try:
+        with pytest.raises(TimeoutError):
+            long_run()
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
+
+
 def test_ctrl_c_cancels_a_sweep():
     timer = threading.Timer(0.5, _thread.interrupt_main)
     timer.start()

@@ -74,3 +74,25 @@ def test_more_than_64_bodies_hold_no_dense_per_body_arrays():
     _, v = run.state_at(len(run.events['time']))
     assert sorted(v) == sorted(v0)
     assert list(v) == list(run.summary['final_velocities'])
+
+
+def test_no_state_past_an_incomplete_record():
+    # events='first:5' records 5 of the 31 impacts: after the fifth nothing is known, and
+    # flying on would put B behind the wall.
+    run = pi_run(events='first:5')
+    last = run.events['time'][-1]
+    run.state_at(t=last)  # up to the record's end: known
+    with pytest.raises(ValueError, match='record ends'):
+        run.state_at(t=last + 1)
+    # The whole run recorded: after its last impact every body flies freely.
+    complete = pi_run()
+    assert list(complete.state_at(t=complete.events['time'][-1] + 1)[1]) == list(complete.summary['final_velocities'])
+
+
+def test_times_in_any_order_are_the_states_at_each():
+    run = pi_run()
+    times = np.array([3.0, 0.5, 4.5, 1.0, 0.0])
+    xs, vs = run.state_at(t=times)
+    for row, time in enumerate(times):
+        x, v = run.state_at(t=float(time))
+        assert list(xs[row]) == list(x) and list(vs[row]) == list(v), time

@@ -172,8 +172,10 @@ class WebServer {
                   const HttpReply& reply);
   void sendBag(const HttpRequest& request, const std::string& run_id, const HttpReply& reply);
   void stream(const HttpRequest& request, const std::string& run_id, const HttpReply& reply);
-  /// Seconds until `key` may send again under `limit` per `window`; 0 (and counted) when now.
-  long admit(const std::string& key, std::size_t limit, std::chrono::seconds window = std::chrono::minutes(1));
+  /// Seconds until `key` may send again under `limit` per `window`; 0 when now, and then
+  /// the send is counted unless `count` is false (a look before the other limits agree).
+  long admit(const std::string& key, std::size_t limit, std::chrono::seconds window = std::chrono::minutes(1),
+             bool count = true);
   /// Seconds the address is still locked out for wrong codes; 0 when it is not.
   long lockedOut(const std::string& client);
   /// Counts a wrong code from `client`: seconds of lockout when it is now locked out, else 0.
