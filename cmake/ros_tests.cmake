@@ -24,7 +24,7 @@ endif()
 
 find_package(rostest REQUIRED)
 foreach(name node_test nbody_node_test burst_test demo_test crash_test markers_test markers_clock_test class_test
-    shared_folder_test service_test memory_test)
+    shared_folder_test service_test memory_test disk_test)
   add_rostest_gtest(${name} test/ros/${name}.test test/ros/${name}.cpp)
   target_link_libraries(${name} collision_lab_ros ${catkin_LIBRARIES})
   # The rostests start these nodes.

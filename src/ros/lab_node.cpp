@@ -1,13 +1,12 @@
 #include "collision_lab/ros/lab_node.h"
 
-#include <sys/statvfs.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <ctime>
 #include <functional>
+#include <iomanip>
 #include <new>
 #include <optional>
 #include <sstream>
@@ -28,15 +27,23 @@ namespace collision_lab_ros {
 
 /// Stamps the messages of one run on its timeline, publishes them and hands what is
 /// recorded over to the bag writer, in batches of at most kRecordBatchEvents events.
-/// Counts the serialized bytes it records: past max_bag_bytes (0: no limit) it calls
-/// on_bag_limit once (the run is then stopped; what the run still computes is recorded).
+/// Counts the serialized bytes it records: past max_bag_bytes (0: no limit), or when the
+/// bag directory's free space is under its floor (looked at every kFreeSpaceProbeBytes), it
+/// calls on_limit once (the run is then stopped; what the run still computes is recorded).
 class RunWriter {
  public:
+  enum class Limit { kBagBytes, kFreeSpace };
+  /// What recording may take: bytes per bag (0: no limit) and the free space it leaves.
+  struct RecordLimits {
+    std::uint64_t max_bag_bytes = 0;
+    std::string bag_directory;
+    double min_free_space_mb = 0.0;  ///< [MB] 0: none
+  };
   /// bags may be null (not recording). claim_error: RunBagBatch::claim_error.
   RunWriter(std::string run_id, RunTimeline timeline, RunBagWriter* bags, std::string claim_error,
-            std::uint64_t max_bag_bytes = 0, std::function<void()> on_bag_limit = {})
-      : run_id_(std::move(run_id)), timeline_(timeline), bags_(bags), max_bag_bytes_(max_bag_bytes),
-        on_bag_limit_(std::move(on_bag_limit)) {
+            RecordLimits limits, std::function<void(Limit)> on_limit)
+      : run_id_(std::move(run_id)), timeline_(timeline), bags_(bags), limits_(std::move(limits)),
+        on_limit_(std::move(on_limit)) {
     batch_.run_id = run_id_;
     batch_.opens = true;
     batch_.claim_error = std::move(claim_error);
@@ -107,11 +114,24 @@ class RunWriter {
  private:
   template <class Message>
   void count(const Message& msg) {
-    recorded_bytes_ += ros::serialization::serializationLength(msg);
-    if (max_bag_bytes_ > 0 && recorded_bytes_ > max_bag_bytes_ && !over_limit_) {
-      over_limit_ = true;
-      if (on_bag_limit_) on_bag_limit_();
+    const std::uint32_t bytes = ros::serialization::serializationLength(msg);
+    recorded_bytes_ += bytes;
+    batch_.bytes += bytes;
+    if (over_limit_) return;
+    if (limits_.max_bag_bytes > 0 && recorded_bytes_ > limits_.max_bag_bytes) {
+      reach(Limit::kBagBytes);
+    } else if (limits_.min_free_space_mb > 0 && recorded_bytes_ >= next_space_probe_) {
+      next_space_probe_ = recorded_bytes_ + kFreeSpaceProbeBytes;
+      // What the bag writers still hold will take space too.
+      const auto free_mb = freeMegabytes(limits_.bag_directory);
+      if (free_mb && *free_mb - 1e-6 * static_cast<double>(RunBagWriter::bytesWaiting()) < limits_.min_free_space_mb) {
+        reach(Limit::kFreeSpace);
+      }
     }
+  }
+  void reach(Limit limit) {
+    over_limit_ = true;
+    if (on_limit_) on_limit_(limit);
   }
   template <class F>
   void timed(F&& f) {
@@ -130,9 +150,10 @@ class RunWriter {
   RunBagWriter* bags_;
   RunBagBatch batch_;
   std::chrono::duration<double> recording_time_{0.0};
-  std::uint64_t max_bag_bytes_;
-  std::function<void()> on_bag_limit_;
+  RecordLimits limits_;
+  std::function<void(Limit)> on_limit_;
   std::uint64_t recorded_bytes_ = 0;
+  std::uint64_t next_space_probe_ = kFreeSpaceProbeBytes;
   bool over_limit_ = false;
   bool finished_ = false;
 };
@@ -799,6 +820,22 @@ LabNode::RunLimits LabNode::limitsOf(const collision_lab::InitialConditions& inp
   return limits;
 }
 
+std::optional<collision_lab::Rejected> LabNode::checkFreeSpace() const {
+  if (!params_.record || params_.min_free_space_mb <= 0) return std::nullopt;
+  const auto free_mb = freeMegabytes(params_.bag_directory);
+  if (!free_mb || *free_mb >= params_.min_free_space_mb) return std::nullopt;
+  collision_lab::Rejected rejection;
+  rejection.reason = collision_lab::Rejected::DISK_SPACE;
+  rejection.reason_name = "DISK_SPACE";
+  rejection.field = "bag_directory";
+  std::ostringstream message;
+  message << "the lab's bag folder " << params_.bag_directory << " has " << std::fixed << std::setprecision(1)
+          << *free_mb << " MB free, under the node's floor ~min_free_space_mb = " << params_.min_free_space_mb
+          << " MB: no run starts until space is freed (ask the teacher), so that no bag is cut short";
+  rejection.message = message.str();
+  return rejection;
+}
+
 bool LabNode::intake(collision_lab::InitialConditions input, Reply reply, const std::optional<std::string>& served_again) {
   namespace core = collision_lab::core;
   const std::string requested = served_again ? *served_again : input.run_id;
@@ -808,6 +845,12 @@ bool LabNode::intake(collision_lab::InitialConditions input, Reply reply, const 
       ROS_WARN_STREAM("run " << input.run_id << ": queued when its lab node died, not served again: " << rejection->message);
       return false;
     }
+    rejection->student = input.student;
+    ServeOutcome outcome = reject(std::move(*rejection), requested);
+    if (reply) reply->set_value(std::move(outcome));
+    return false;
+  }
+  if (auto rejection = checkFreeSpace(); rejection && !served_again) {
     rejection->student = input.student;
     ServeOutcome outcome = reject(std::move(*rejection), requested);
     if (reply) reply->set_value(std::move(outcome));
@@ -1041,9 +1084,12 @@ ServeOutcome LabNode::reject(collision_lab::Rejected msg, const std::string& run
 void LabNode::serve(Worker& worker, Job& job) {
   const ros::Time start = stampNow();
   RunWriter out(job.input.run_id, RunTimeline(start, chooseTimelineScale(firstContactTime(job.plan.scene))),
-                worker.bags.get(), job.claim_error, job.limits.max_bag_bytes, [this, &worker] {
+                worker.bags.get(), job.claim_error,
+                RunWriter::RecordLimits{job.limits.max_bag_bytes, params_.bag_directory, params_.min_free_space_mb},
+                [this, &worker](RunWriter::Limit limit) {
                   std::lock_guard<std::mutex> lock(mutex_);
-                  stopRun(worker, StopCause::kBagLimit, std::string());
+                  stopRun(worker, limit == RunWriter::Limit::kBagBytes ? StopCause::kBagLimit : StopCause::kDiskSpace,
+                          std::string());
                 });
   job.input.header.stamp = start;
   RunProgress progress;
@@ -1116,6 +1162,11 @@ void LabNode::applyStopCause(Worker& worker, const Job& job, collision_lab::RunS
     why << "stopped when its recorded messages passed the bag limit of " << limits.max_bag_bytes << " bytes ("
         << (limits.bag_from_input ? "the input's max_bag_bytes" : "the node's ~max_bag_bytes") << ") after "
         << summary.collision_count << " collisions, at its last certified impact";
+  } else if (stopped && cause == StopCause::kDiskSpace) {
+    summary.stop_reason = "SERVICE_DISK_SPACE";
+    why << "stopped when the bag folder's free space fell under the node's ~min_free_space_mb = "
+        << params_.min_free_space_mb << " MB after " << summary.collision_count
+        << " collisions, at its last certified impact; its bag holds the run to there";
   } else if (stopped && cause == StopCause::kCancel) {
     std::string by;
     {
@@ -1169,7 +1220,7 @@ void LabNode::failRun(Worker& worker, Job& job, RunWriter& out, const RunProgres
 void LabNode::dropWaiting(Job job, const std::string& by) {
   const ros::Time start = stampNow();
   RunWriter out(job.input.run_id, RunTimeline(start, chooseTimelineScale(firstContactTime(job.plan.scene))),
-                dropped_bags_.get(), job.claim_error);
+                dropped_bags_.get(), job.claim_error, RunWriter::RecordLimits{}, {});
   job.input.header.stamp = start;
   out.record(job.input);
   collision_lab::RunParameters parameters = runParameters(params_, job.limits.max_collisions);
@@ -1311,15 +1362,20 @@ void LabNode::addRecordingStatus(diagnostic_updater::DiagnosticStatusWrapper& st
   if (!recording_error.empty()) {
     status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "recording failed: " + recording_error);
   }
-  struct statvfs space {};
-  if (statvfs(params_.bag_directory.c_str(), &space) != 0) {
+  const auto free_mb = freeMegabytes(params_.bag_directory);
+  if (!free_mb) {
     status.add("free space in bag directory [MB]", "unknown (directory not readable)");
     return;
   }
-  const double free_mb = static_cast<double>(space.f_bavail) * space.f_frsize / 1e6;
-  status.add("free space in bag directory [MB]", std::to_string(free_mb));
-  if (free_mb < params_.min_free_space_mb && status.level == diagnostic_msgs::DiagnosticStatus::OK) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "low free space for bags: " + std::to_string(free_mb) + " MB");
+  status.add("free space in bag directory [MB]", std::to_string(*free_mb));
+  status.add("free space floor [MB]", std::to_string(params_.min_free_space_mb));
+  const std::string free_text = std::to_string(*free_mb) + " MB free for bags";
+  if (*free_mb < params_.min_free_space_mb) {
+    status.mergeSummary(diagnostic_msgs::DiagnosticStatus::ERROR,
+                        free_text + ", under the floor: runs are refused (DISK_SPACE)");
+  } else if (*free_mb < kFreeSpaceWarnFactor * params_.min_free_space_mb &&
+             status.level == diagnostic_msgs::DiagnosticStatus::OK) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "low free space: " + free_text);
   }
 }
 

@@ -174,6 +174,18 @@ RecoveredBag recoverOne(const std::string& directory, const std::string& active,
   return recovered;
 }
 
+/// Runs one write of a group. A failure is logged as `lost` and the group goes on, except a
+/// full disk: rethrown, so that the whole group is kept and tried again.
+template <class Write>
+void writeOrLog(Write&& write, const std::string& lost) {
+  try {
+    write();
+  } catch (const RunIndexError& e) {
+    if (e.diskFull()) throw;
+    ROS_ERROR_STREAM(lost << ": " << e.what());
+  }
+}
+
 std::string interruptedJson(const std::string& bag_path, const BagContents& contents, const std::string& note) {
   return json{{"stop_reason", "INTERRUPTED"},
               {"truncated", true},
@@ -399,7 +411,7 @@ bool RunIndexRecorder::commit(const std::vector<std::function<void()>>& group) {
   try {
     if (index_->writeTogether(
             [&group] {
-              for (const auto& write : group) write();  // each logs its own failure
+              for (const auto& write : group) write();  // each logs its own failure (writeOrLog)
             },
             kIndexWriterLockWait)) {
       return true;
@@ -407,7 +419,14 @@ bool RunIndexRecorder::commit(const std::vector<std::function<void()>>& group) {
     ROS_WARN_STREAM_THROTTLE(10, "run index: locked by another program; " << group.size()
                                                                            << " writes wait and are tried again");
     return false;
-  } catch (const std::exception& e) {  // the node serves on; the writes are logged as lost
+  } catch (const std::exception& e) {
+    const auto* index_error = dynamic_cast<const RunIndexError*>(&e);
+    if (index_error && index_error->diskFull()) {  // kept, like a locked index's, until space is freed
+      ROS_ERROR_STREAM_THROTTLE(10, "run index: the disk is full; " << group.size()
+                                                                    << " writes wait and are tried again: " << e.what());
+      return false;
+    }
+    // The node serves on; the writes are logged as lost.
     ROS_ERROR_STREAM("run index: " << group.size() << " writes were not committed: " << e.what());
     return true;
   }
@@ -440,7 +459,7 @@ void RunIndexRecorder::writerLoop() {
       pause = std::clamp(2 * pause, std::chrono::milliseconds(250), kIndexRetryMaxPause);
       continue;
     }
-    if (!committed) ROS_ERROR_STREAM("run index: " << group.size() << " writes are lost: the node stops and the index is locked");
+    if (!committed) ROS_ERROR_STREAM("run index: " << group.size() << " writes are lost: the node stops and the index is locked or its disk full");
     pause = std::chrono::milliseconds(0);
     written_ += group.size();
     group.clear();
@@ -460,11 +479,7 @@ void RunIndexRecorder::accepted(const std::string& run_id, const std::string& st
   row.scene_json = inputJson(input);
   enqueue(
       [this, row = std::move(row)] {
-        try {
-          index_->accepted(row);
-        } catch (const RunIndexError& e) {
-          ROS_ERROR_STREAM("run " << row.run_id << ": not in the run index: " << e.what());
-        }
+        writeOrLog([&] { index_->accepted(row); }, "run " + row.run_id + ": not in the run index");
       },
       /*urgent=*/true);
 }
@@ -473,11 +488,7 @@ void RunIndexRecorder::started(const std::string& run_id) {
   if (!index_) return;
   enqueue(
       [this, run_id, at = wallNow()] {
-        try {
-          index_->started(run_id, at);
-        } catch (const RunIndexError& e) {
-          ROS_ERROR_STREAM("run " << run_id << ": its start is not in the run index: " << e.what());
-        }
+        writeOrLog([&] { index_->started(run_id, at); }, "run " + run_id + ": its start is not in the run index");
       },
       /*urgent=*/false);
 }
@@ -488,11 +499,8 @@ void RunIndexRecorder::finished(const collision_lab::RunSummary& summary) {
       enqueue([this, run_id = summary.run_id, at = wallNow(), json = summaryJson(summary),
                stop_reason = summary.stop_reason, count = summary.collision_count,
                bag = summary.recording_ok ? summary.bag_path : std::string()] {
-        try {
-          index_->finished(run_id, at, json, stop_reason, count, bag);
-        } catch (const RunIndexError& e) {
-          ROS_ERROR_STREAM("run " << run_id << ": its end is not in the run index: " << e.what());
-        }
+        writeOrLog([&] { index_->finished(run_id, at, json, stop_reason, count, bag); },
+                   "run " + run_id + ": its end is not in the run index");
       },
       /*urgent=*/true);
   if (!waitWritten(ticket, kIndexCommitWait, /*unless_locked=*/true)) {
@@ -511,11 +519,7 @@ void RunIndexRecorder::rejected(const collision_lab::Rejected& rejected) {
   row.message = rejected.message;
   enqueue(
       [this, row = std::move(row)] {
-        try {
-          index_->rejected(row);
-        } catch (const RunIndexError& e) {
-          ROS_ERROR_STREAM("a rejection is not in the run index: " << e.what());
-        }
+        writeOrLog([&] { index_->rejected(row); }, "a rejection is not in the run index");
       },
       /*urgent=*/true);
 }
@@ -552,9 +556,16 @@ std::vector<collision_lab::ServedRun> RunIndexRecorder::list(const std::string& 
   return served;
 }
 
-void RunIndexRecorder::endFromBag(const std::string& run_id, const std::string& bag_path, const BagContents& contents,
+bool RunIndexRecorder::endFromBag(const std::string& run_id, const std::string& bag_path, const BagContents& contents,
                                   const std::string& note) {
-  if (!index_->find(run_id) && contents.input) {
+  const auto row = index_->find(run_id);
+  if (row && row->state == RunState::kFinished) {
+    // Its end is known (e.g. its bag failed on a full disk, and the summary went to the index).
+    ROS_WARN_STREAM("run " << run_id << ": its bag was left unfinished, and the index has the run as finished: its summary is kept ("
+                    << (bag_path.empty() ? std::string("no bag") : "its bag " + bag_path) << ")");
+    return false;
+  }
+  if (!row && contents.input) {
     // A run the index never saw (its node had no index): its row from the bag's input.
     IndexedRun row;
     row.run_id = run_id;
@@ -569,11 +580,12 @@ void RunIndexRecorder::endFromBag(const std::string& run_id, const std::string& 
     summary.recording_ok = !bag_path.empty();
     index_->finished(run_id, wallNow(), summaryJson(summary), summary.stop_reason, summary.collision_count, bag_path);
     ROS_INFO_STREAM("run " << run_id << ": completed from its bag's summary (" << note << ")");
-    return;
+    return true;
   }
   index_->interrupted(run_id, wallNow(), interruptedJson(bag_path, contents, note), contents.events, bag_path);
   ROS_WARN_STREAM("run " << run_id << ": interrupted (" << note << "); its bag "
                   << (bag_path.empty() ? std::string("holds nothing") : bag_path + " holds " + std::to_string(contents.events) + " events"));
+  return true;
 }
 
 std::size_t RunIndexRecorder::recover(const ServeAgain& serve_again) {
@@ -590,8 +602,7 @@ std::size_t RunIndexRecorder::recover(const ServeAgain& serve_again) {
         const auto row = index_->find(bag.run_id);
         if (row && row->state == RunState::kQueued) continue;
       }
-      endFromBag(bag.run_id, bag.bag_path, bag.contents, "its node died; bag recovered from .active");
-      ++ended;
+      if (endFromBag(bag.run_id, bag.bag_path, bag.contents, "its node died; bag recovered from .active")) ++ended;
     } catch (const std::exception& e) {
       ROS_ERROR_STREAM("run " << bag.run_id << ": not recorded as interrupted: " << e.what());
     }
@@ -624,8 +635,7 @@ std::size_t RunIndexRecorder::recover(const ServeAgain& serve_again) {
         contents = readBagContents(final_path);
         bag_path = final_path;
       }
-      endFromBag(run.run_id, bag_path, contents, "its node died before the run finished");
-      ++ended;
+      if (endFromBag(run.run_id, bag_path, contents, "its node died before the run finished")) ++ended;
     } catch (const std::exception& e) {
       ROS_ERROR_STREAM("run " << run.run_id << ": not recovered: " << e.what());
     }

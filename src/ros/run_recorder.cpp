@@ -4,6 +4,7 @@
 
 #include <fcntl.h>
 #include <sys/file.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -121,6 +122,12 @@ std::string expandUser(const std::string& path) {
   return std::string(home ? home : "") + path.substr(1);
 }
 
+std::optional<double> freeMegabytes(const std::string& directory) {
+  struct statvfs space {};
+  if (::statvfs(directory.c_str(), &space) != 0) return std::nullopt;
+  return static_cast<double>(space.f_bavail) * static_cast<double>(space.f_frsize) / 1e6;
+}
+
 RunRecorder::RunRecorder(const std::string& directory, const std::string& run_id)
     : path_(bagPath(directory, run_id)), active_path_(path_ + kActiveSuffix) {
   try {
@@ -163,8 +170,9 @@ void RunRecorder::open() {
     bag_->setCompression(rosbag::compression::LZ4);
     bag_->open(active_path_, rosbag::bagmode::Write);
   } catch (const std::exception& e) {
-    bag_ = nullptr;
     fail("cannot open bag " + active_path_ + ": " + e.what());
+    closeIntoNull();  // a bag whose first writes failed is open
+    bag_ = nullptr;
     releaseBagClaim(active_path_);
   }
 }
@@ -172,7 +180,14 @@ void RunRecorder::open() {
 RunRecorder::~RunRecorder() {
   close();
   const auto lifecycle = lockBagLifecycle();
+  keepIfClosable(owned_);
   owned_.reset();
+}
+
+void keepIfClosable(std::unique_ptr<rosbag::Bag>& bag) {
+  if (!bag || !bag->isOpen()) return;
+  ROS_ERROR("a bag that could not be closed is left open (its file is /dev/null now) and a new one used");
+  (void)bag.release();
 }
 
 bool RunRecorder::close() {
@@ -185,6 +200,7 @@ bool RunRecorder::close() {
     bag_->close();
   } catch (const std::exception& e) {
     fail(std::string("closing the bag failed: ") + e.what());
+    closeIntoNull();
   }
   bag_ = nullptr;
   if (ok()) {
@@ -219,11 +235,19 @@ RunBagWriter::~RunBagWriter() {
   thread_.join();
   recorder_.reset();
   const auto lifecycle = lockBagLifecycle();
+  keepIfClosable(bag_);
   bag_.reset();
 }
 
+namespace {
+std::atomic<std::uint64_t> bytes_waiting_for_bags{0};
+}  // namespace
+
+std::uint64_t RunBagWriter::bytesWaiting() { return bytes_waiting_for_bags.load(std::memory_order_relaxed); }
+
 void RunBagWriter::push(RunBagBatch batch) {
   const std::size_t n = batch.messages();
+  bytes_waiting_for_bags += batch.bytes;
   {
     std::unique_lock<std::mutex> lock(mutex_);
     // A batch larger than the bound still goes in, alone.
@@ -251,6 +275,7 @@ void RunBagWriter::loop() {
     } catch (...) {
       recover(batch, "an exception of unknown type");
     }
+    bytes_waiting_for_bags -= batch.bytes;
     {
       std::lock_guard<std::mutex> lock(mutex_);
       queued_messages_ -= batch.messages();
@@ -268,13 +293,16 @@ boost::shared_ptr<ros::M_string> RunBagWriter::headerFor(const std::string& topi
 void RunBagWriter::write(RunBagBatch& batch) {
   if (batch.opens) {
     recorder_.reset();  // closes a run left open by a failure before its bag is replaced
+    {
+      const auto lifecycle = lockBagLifecycle();
+      keepIfClosable(bag_);
+    }
     // A reopened rosbag::Bag keeps some memory of every bag it wrote (6 KB for 40 small
     // messages, about 38 KB per run of the node): a new one every kBagReuses bags keeps
     // the writer's memory flat.
     if (!bag_ || ++bag_reuses_ == kBagReuses) {
       const auto lifecycle = lockBagLifecycle();
-      bag_.reset();
-      bag_.emplace();
+      bag_ = std::make_unique<rosbag::Bag>();
       bag_reuses_ = 0;
     }
     recorder_.emplace(directory_, batch.run_id, *bag_, batch.claim_error);
@@ -323,6 +351,42 @@ void RunBagWriter::recover(RunBagBatch& batch, const std::string& what) {
     ROS_ERROR_STREAM("run " << batch.run_id << ": the bag writer failed again, reporting it: " << e.what());
   } catch (...) {
     ROS_ERROR_STREAM("run " << batch.run_id << ": the bag writer failed again, reporting it");
+  }
+}
+
+void RunRecorder::closeIntoNull() {
+  if (!bag_ || !bag_->isOpen()) return;
+  int claim_fd = -1;
+  {
+    std::lock_guard<std::mutex> lock(claims_mutex);
+    const auto it = heldClaims().find(active_path_);
+    if (it != heldClaims().end()) claim_fd = it->second;
+  }
+  std::error_code ec;
+  const std::string target = fs::absolute(active_path_, ec).string();
+  int bag_fd = -1;
+  for (const auto& entry : fs::directory_iterator("/proc/self/fd", ec)) {
+    const int fd = std::atoi(entry.path().filename().c_str());
+    const std::string link = fs::read_symlink(entry.path(), ec).string();
+    // A deleted file's link reads "<path> (deleted)".
+    if (fd != claim_fd && !ec && link.compare(0, target.size(), target) == 0 &&
+        (link.size() == target.size() || link.compare(target.size(), std::string::npos, " (deleted)") == 0)) {
+      bag_fd = fd;
+      break;
+    }
+  }
+  const int null_fd = bag_fd < 0 ? -1 : ::open("/dev/null", O_WRONLY | O_CLOEXEC);
+  if (null_fd < 0 || ::dup2(null_fd, bag_fd) < 0) {
+    ROS_ERROR_STREAM("the failed bag " << active_path_ << " stays open: its descriptor was not found or not replaced");
+    if (null_fd >= 0) ::close(null_fd);
+    return;
+  }
+  ::close(null_fd);
+  try {
+    const auto lifecycle = lockBagLifecycle();
+    bag_->close();
+  } catch (const std::exception& e) {
+    ROS_ERROR_STREAM("the failed bag " << active_path_ << " did not close into /dev/null: " << e.what());
   }
 }
 

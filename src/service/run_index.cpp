@@ -105,7 +105,7 @@ class Statement {
     if (rc != SQLITE_OK) fail("binding a value");
   }
   [[noreturn]] void fail(const std::string& what) const {
-    throw RunIndexError("run index " + path_ + ": " + what + ": " + sqlite3_errmsg(db_));
+    throw RunIndexError("run index " + path_ + ": " + what + ": " + sqlite3_errmsg(db_), sqlite3_errcode(db_));
   }
 
   sqlite3* db_;
@@ -228,16 +228,19 @@ void RunIndex::finalizeStatements() {
   statements_.clear();
 }
 
+bool RunIndexError::diskFull() const { return (sqlite_code_ & 0xff) == SQLITE_FULL; }
+
 std::string RunIndex::defaultPath(const std::string& bag_directory) {
   return (std::filesystem::path(bag_directory) / "runs.sqlite").string();
 }
 
 void RunIndex::execute(const std::string& sql) {
   char* message = nullptr;
-  if (sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, &message) != SQLITE_OK) {
+  const int rc = sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, &message);
+  if (rc != SQLITE_OK) {
     const std::string error = message ? message : sqlite3_errmsg(db_);
     sqlite3_free(message);
-    throw RunIndexError("run index " + path_ + ": executing '" + sql.substr(0, 60) + "': " + error);
+    throw RunIndexError("run index " + path_ + ": executing '" + sql.substr(0, 60) + "': " + error, rc);
   }
 }
 
@@ -260,7 +263,9 @@ bool RunIndex::writeTogether(const std::function<void()>& writes, std::chrono::m
     const int rc = sqlite3_exec(db_, "BEGIN IMMEDIATE", nullptr, nullptr, nullptr);
     sqlite3_busy_timeout(db_, busy_timeout_ms_);
     if ((rc & 0xff) == SQLITE_BUSY || (rc & 0xff) == SQLITE_LOCKED) return false;
-    if (rc != SQLITE_OK) throw RunIndexError("run index " + path_ + ": beginning a group of writes: " + sqlite3_errmsg(db_));
+    if (rc != SQLITE_OK) {
+      throw RunIndexError("run index " + path_ + ": beginning a group of writes: " + sqlite3_errmsg(db_), rc);
+    }
   }
   try {
     writes();
@@ -270,10 +275,11 @@ bool RunIndex::writeTogether(const std::function<void()>& writes, std::chrono::m
     throw;
   }
   std::lock_guard<std::mutex> lock(mutex_);
-  if (sqlite3_exec(db_, "COMMIT", nullptr, nullptr, nullptr) != SQLITE_OK) {
+  const int rc = sqlite3_exec(db_, "COMMIT", nullptr, nullptr, nullptr);
+  if (rc != SQLITE_OK) {
     const std::string error = sqlite3_errmsg(db_);
     sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
-    throw RunIndexError("run index " + path_ + ": committing a group of writes: " + error);
+    throw RunIndexError("run index " + path_ + ": committing a group of writes: " + error, rc);
   }
   return true;
 }

@@ -2,7 +2,8 @@
 // while a bag is written and dropped when it closes; recovery of the .active bag of a
 // writer killed mid-run (reindexed, renamed, counted, indexed as interrupted), never of a
 // live owner's; stale rows ended; ~list_runs' rows from the index; a write-locked index
-// holds up nothing and loses no row.
+// holds up nothing and loses no row; a full disk holds the index's writes until space is
+// freed, and a finished run whose bag was left .active stays finished.
 #include <sqlite3.h>
 #include <sys/file.h>
 #include <sys/wait.h>
@@ -12,6 +13,7 @@
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <thread>
 
@@ -58,6 +60,25 @@ collision_lab::CollisionEvent event(const std::string& run_id, std::uint64_t k) 
   e.time = 0.5 * static_cast<double>(k + 1);
   e.header.stamp = ros::Time(1000) + ros::Duration(e.time);
   return e;
+}
+
+/// Mounts a tmpfs of `megabytes` on dir; false where this process may not (not root).
+bool mountTmpfs(const std::string& dir, int megabytes) {
+  const std::string command =
+      "mount -t tmpfs -o size=" + std::to_string(megabytes) + "m tmpfs '" + dir + "' 2>/dev/null";
+  return std::system(command.c_str()) == 0;
+}
+
+/// Writes path until its file system has no byte left.
+void fillDisk(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  ASSERT_GE(fd, 0);
+  const std::string chunk(1 << 20, 'x');
+  for (std::size_t size : {chunk.size(), std::size_t{4096}, std::size_t{1}}) {
+    while (::write(fd, chunk.data(), size) > 0) {
+    }
+  }
+  ::close(fd);
 }
 
 class RunIndexRecorderTest : public ::testing::Test {
@@ -359,6 +380,67 @@ TEST_F(RunIndexRecorderTest, AQueuedRunOfADeadNodeIsOfferedToBeServedAgain) {
   EXPECT_EQ(recorder.recover([](const RunIndexRecorder::QueuedRun&) { return false; }), 1u);
   EXPECT_EQ(recorder.index()->find("fay.long")->state, RunState::kInterrupted);
   EXPECT_THROW(inputFromJson("{\"masses\": [1, null]}"), std::invalid_argument);
+}
+
+TEST_F(RunIndexRecorderTest, AFinishedRunWhoseBagWasLeftActiveStaysFinished) {
+  // A bag that failed on a full disk keeps its .active name, while the run's summary
+  // reaches the index: the next start recovers the bag and keeps the run finished.
+  RunIndexRecorder recorder(dir_);
+  recorder.accepted("full", "ana", "", input("full", "ana"));
+  recorder.started("full");
+  killedWriter("full", 100);
+  collision_lab::RunSummary summary;
+  summary.run_id = "full";
+  summary.student = "ana";
+  summary.stop_reason = "FINISHED";
+  summary.collision_count = 245308;
+  summary.bag_path = bagPath(dir_, "full");
+  summary.recording_ok = false;
+  summary.recording_error = "writing /collision_events failed: Problem writing data to disk";
+  recorder.finished(summary);
+  ASSERT_TRUE(recorder.flush(std::chrono::minutes(1)));
+
+  EXPECT_EQ(recorder.recover(), 0u);
+  const auto row = recorder.index()->find("full");
+  ASSERT_TRUE(row);
+  EXPECT_EQ(row->state, RunState::kFinished);
+  EXPECT_EQ(row->stop_reason, "FINISHED");
+  EXPECT_EQ(row->collision_count, 245308u);
+  EXPECT_NE(row->summary_json.find("\"recorded\":false"), std::string::npos) << row->summary_json;
+  EXPECT_NE(row->summary_json.find("Problem writing data to disk"), std::string::npos) << row->summary_json;
+}
+
+TEST_F(RunIndexRecorderTest, AFullDiskHoldsTheIndexWritesUntilSpaceIsFreed) {
+  const std::string small = dir_ + "/small";
+  fs::create_directories(small);
+  if (!mountTmpfs(small, 2)) GTEST_SKIP() << "no tmpfs can be mounted here (it takes root)";
+  struct Unmount {
+    std::string dir;
+    ~Unmount() { std::system(("umount -l '" + dir + "'").c_str()); }
+  } unmount{small};
+  RunIndexRecorder recorder(small);
+  ASSERT_TRUE(recorder.ok());
+  recorder.accepted("early", "ana", "", input("early", "ana"));
+  ASSERT_TRUE(recorder.flush(std::chrono::minutes(1)));
+  fillDisk(small + "/filler");
+
+  recorder.accepted("late", "ben", "", input("late", "ben"));
+  collision_lab::RunSummary summary;
+  summary.run_id = "late";
+  summary.student = "ben";
+  summary.stop_reason = "FINISHED";
+  summary.collision_count = 31;
+  recorder.finished(summary);  // returns: the run's end does not wait for space
+  EXPECT_FALSE(recorder.flush(std::chrono::seconds(2)));
+  EXPECT_FALSE(recorder.committed()->find("late"));
+
+  fs::remove(small + "/filler");
+  ASSERT_TRUE(recorder.flush(std::chrono::minutes(1)));  // the kept writes, tried again, commit
+  const auto row = recorder.committed()->find("late");
+  ASSERT_TRUE(row);
+  EXPECT_EQ(row->state, RunState::kFinished);
+  EXPECT_EQ(row->collision_count, 31u);
+  EXPECT_EQ(row->student, "ben");
 }
 
 }  // namespace

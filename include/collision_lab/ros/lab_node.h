@@ -33,7 +33,8 @@
 //   bag closed on that thread, through the node's own bag writer) or stops a running one:
 //   stopRun() sets its worker's cancel flag, which the core polls, with a cause. The
 //   watchdog thread does the same with the cause kTimeLimit at a run's deadline, and a
-//   run's RunWriter with kBagLimit when its recorded bytes pass its limit.
+//   run's RunWriter with kBagLimit when its recorded bytes pass its limit, or kDiskSpace
+//   when the bag directory's free space falls under ~min_free_space_mb.
 // - Each worker catches every exception around its run: the run ends WORKER_ERROR, its
 //   summary published and its bag closed, and the worker serves the next run.
 // - With recording on, the worker hands each run's recorded messages over to its bag
@@ -101,7 +102,7 @@ struct LabNodeParams {
   bool publish_markers = true;
   bool log_runs = true;            ///< one INFO line per served run (else DEBUG)
   std::uint64_t max_bodies = 0;    ///< larger scenes are rejected (TOO_MANY_BODIES)
-  double min_free_space_mb = 0.0;  ///< [MB] diagnostics warn below it
+  double min_free_space_mb = 0.0;  ///< [MB] the bag directory's floor (kDefaultMinFreeSpaceMb); 0: none
   std::string scenario_file;       ///< the presets of ~run_preset
   /// Worker threads [1] (~workers; default max(2, hardware threads)), of which
   /// short_lane_workers [1] take only short runs (~short_lane_workers, default 1).
@@ -244,7 +245,7 @@ class LabNode {
   /// Where a service call waits for its outcome; null for topic inputs.
   using Reply = std::shared_ptr<std::promise<ServeOutcome>>;
   /// Why a run's cancel flag was set; the first cause wins.
-  enum class StopCause : int { kNone, kCancel, kTimeLimit, kBagLimit, kShutdown };
+  enum class StopCause : int { kNone, kCancel, kTimeLimit, kBagLimit, kDiskSpace, kShutdown };
   /// A run's limits: the node's ceilings, lowered by the input's own.
   struct RunLimits {
     std::uint64_t max_collisions = 0;  ///< [1]; 0: none
@@ -310,6 +311,8 @@ class LabNode {
   void watchdogLoop();
   /// Sets worker's cancel flag with cause (kept when one is set already). mutex_ held.
   static void stopRun(Worker& worker, StopCause cause, const std::string& by);
+  /// DISK_SPACE when recording and the bag directory's free space is under ~min_free_space_mb.
+  std::optional<collision_lab::Rejected> checkFreeSpace() const;
   /// The queue changed: run_queue is published with its state by the queue publisher's
   /// thread, which coalesces changes that come faster than it publishes (the latched
   /// message is always the newest state). mutex_ held.

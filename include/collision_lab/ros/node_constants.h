@@ -77,8 +77,13 @@ constexpr char kDefaultScenarioFile[] = "config/scenarios.yaml";
 /// aggregator listens there).
 constexpr char kDiagnosticsTopic[] = "/diagnostics";
 constexpr double kDiagnosticsPeriod = 1.0;  ///< [s]
-/// Below this much free space in bag_directory the diagnostics warn.
-constexpr double kDefaultMinFreeSpaceMb = 500.0;  ///< [MB]
+/// The free-space floor of bag_directory [MB]: below it inputs are refused (DISK_SPACE)
+/// and a recording run is stopped (SERVICE_DISK_SPACE); /diagnostics warns below
+/// kFreeSpaceWarnFactor times it.
+constexpr double kDefaultMinFreeSpaceMb = 100.0;
+constexpr double kFreeSpaceWarnFactor = 5.0;
+/// [bytes] a recording run writes between two looks at the free space.
+constexpr std::uint64_t kFreeSpaceProbeBytes = 1u << 20;
 
 /// Inputs arrive in bursts from scripts; the subscriber callback only queues them (the
 /// worker's queue is unbounded), so this covers bursts of up to 10,000 inputs between two

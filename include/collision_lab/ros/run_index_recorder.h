@@ -136,7 +136,8 @@ class RunIndexRecorder {
 
   /// At the node's start, before it serves: recovers the .active bags of dead owners
   /// (recoverActiveBags) and records their runs as interrupted (stop reason INTERRUPTED,
-  /// the events the bag holds; finished from its summary when the bag has one), then ends
+  /// the events the bag holds; finished from its summary when the bag has one; a run the
+  /// index has as finished keeps its row, e.g. one whose bag failed on a full disk), then ends
   /// every run the index still has running, or queued, with no live owner: completed as
   /// finished from its final bag's summary, else interrupted with the events its bag holds
   /// (none without a bag). A queued run with no bag whose stored input reads back is first
@@ -145,8 +146,9 @@ class RunIndexRecorder {
   std::size_t recover(const ServeAgain& serve_again = {});
 
  private:
-  /// Ends run_id from what its bag holds (finished with a summary, else interrupted).
-  void endFromBag(const std::string& run_id, const std::string& bag_path, const BagContents& contents,
+  /// Ends run_id from what its bag holds (finished with a summary, else interrupted); false,
+  /// and the row kept, when the index has it as finished already.
+  bool endFromBag(const std::string& run_id, const std::string& bag_path, const BagContents& contents,
                   const std::string& note);
 
   /// Hands `write` to the writer thread; returns its ticket (its place in the order of

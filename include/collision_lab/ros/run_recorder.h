@@ -95,6 +95,15 @@ boost::shared_ptr<ros::M_string> connectionHeader(const std::string& topic, cons
 /// Expands a leading "~" to $HOME.
 std::string expandUser(const std::string& path);
 
+/// [MB] free to an unprivileged writer in the file system of directory; nullopt when it
+/// cannot be read.
+std::optional<double> freeMegabytes(const std::string& directory);
+
+/// Releases bag unless it is closed: a rosbag::Bag that failed to close (RunRecorder's
+/// closeIntoNull) would throw from its destructor and end the process, so it is leaked,
+/// its file pointed at /dev/null. Logs each leak.
+void keepIfClosable(std::unique_ptr<rosbag::Bag>& bag);
+
 class RunRecorder {
  public:
   /// Claims the run's bag (claimBag; a run_id that is taken fails, nothing is
@@ -137,6 +146,11 @@ class RunRecorder {
 
  private:
   void open();
+  /// Closes a bag whose writes failed (e.g. a full disk): rosbag's close() throws before
+  /// it closes such a file, and ~Bag would throw again and end the process. The file's
+  /// descriptor is pointed at /dev/null and the bag closed into it: what was written stays
+  /// in the .active file for recovery, and deleting that file frees its space.
+  void closeIntoNull();
 
   std::string path_;
   std::string active_path_;
@@ -162,6 +176,8 @@ struct RunBagBatch {
   /// gets the summary with the recording fields as they stand after closing.
   std::optional<collision_lab::RunSummary> summary;
   std::function<void(collision_lab::RunSummary&)> on_closed;
+  /// [bytes] serialized size of its messages (as the caller counts them), 0 if not counted.
+  std::uint64_t bytes = 0;
 
   std::size_t messages() const { return parameters.has_value() + input.has_value() + prediction.has_value() + events.size() + summary.has_value(); }
 };
@@ -193,6 +209,9 @@ class RunBagWriter {
   RunBagWriter& operator=(const RunBagWriter&) = delete;
 
   void push(RunBagBatch batch);
+  /// [bytes] handed over to every RunBagWriter of this process and not yet written: the
+  /// disk space they will take (at most: bags are compressed).
+  static std::uint64_t bytesWaiting();
 
  private:
   void loop();
@@ -208,8 +227,9 @@ class RunBagWriter {
   const std::size_t max_queued_;
   /// The connection headers of the latched topics (null: not latched), built once.
   const boost::shared_ptr<ros::M_string> parameters_header_, input_header_, prediction_header_, summary_header_;
-  /// The writer thread's, reopened for every run and replaced every kBagReuses runs.
-  std::optional<rosbag::Bag> bag_;
+  /// The writer thread's, reopened for every run and replaced every kBagReuses runs, or
+  /// after a bag that could not be closed (keepIfClosable).
+  std::unique_ptr<rosbag::Bag> bag_;
   std::size_t bag_reuses_ = 0;
   static constexpr std::size_t kBagReuses = 100;
   std::optional<RunRecorder> recorder_;  ///< the writer thread's: the run being written

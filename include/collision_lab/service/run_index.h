@@ -29,7 +29,14 @@ namespace collision_lab::service {
 
 class RunIndexError : public std::runtime_error {
  public:
-  using std::runtime_error::runtime_error;
+  /// sqlite_code: SQLite's result code of the failure (0: not SQLite's).
+  explicit RunIndexError(const std::string& what, int sqlite_code = 0)
+      : std::runtime_error(what), sqlite_code_(sqlite_code) {}
+  /// True when the disk was full (SQLITE_FULL): the same write may succeed once space is freed.
+  bool diskFull() const;
+
+ private:
+  int sqlite_code_;
 };
 
 /// A run's state in the index. A run moves queued -> running -> finished, or to
