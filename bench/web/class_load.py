@@ -19,6 +19,16 @@ Phases:
    divided by the runs of this phase.
 4. one bad student: one address sends --flood gas_1000 runs under as many names at once while
    ten classmates send pi runs; their time to final (goal: p99 <= 2 s, 0 lost).
+5. bad disk (a started lab run as root: its bag folder is then a tmpfs of --disk-mb): a filler
+   file leaves the lab's free-space floor plus --disk-headroom MB, one address sends gas_1000
+   runs and ten classmates send pi runs; then the filler leaves 5 MB under the floor, and at
+   last it goes; the classmates send again each time.
+   Each classmate's send is answered: final, or refused with DISK_SPACE; its time to that
+   answer (goal: p99 <= 2 s), runs lost (accepted, never final: goal 0), and the phase's runs
+   as the index lists them (none interrupted).
+
+--class-defaults runs the lab with a class's defaults (no raised rate limits, no lowered time
+ceiling, the model answering over the cap), to measure memory per run as a class meets it.
 
 It prints one block of figures and a `goal:` line per goal (bench/goals_table.py): small
 scenes' time to final p99 <= 2 s, 0 runs lost, memory per run < 1 KB (1,000 B) for each node.
@@ -31,6 +41,7 @@ X-Stop-Token, GET /api/queue (skipped when absent), header X-Class-Code on every
 Usage (Debian's python3; the workspace's devel/setup.bash sourced):
   python3 bench/web/class_load.py [--students 30] [--warmup-runs 10] [--runs 60] [--gases 6] [--huge 4]
           [--slow 80] [--chunked 4] [--wrong-codes 300] [--web-param NAME=VALUE ...] [--lab-param NAME=VALUE ...]
+          [--class-defaults] [--disk-mb 4096] [--disk-headroom 40]
   python3 bench/web/class_load.py --url http://127.0.0.1:8080 --code CODE [--ns /collision_lab]
 """
 import argparse
@@ -419,6 +430,10 @@ class Lab:
         self.tmp = tempfile.mkdtemp(prefix="class_load_")
         self.bags = os.path.join(self.tmp, "bags")
         os.makedirs(self.bags)
+        # A disk of its own that the bad-disk phase may fill: a tmpfs (root only).
+        self.small_disk = args.disk_mb > 0 and os.geteuid() == 0 and subprocess.run(
+            ["mount", "-t", "tmpfs", "-o", f"size={args.disk_mb}m", "tmpfs", self.bags],
+            capture_output=True).returncode == 0
         self.code = args.code or f"class{random.randrange(10 ** 6):06d}"
         self.log = open(os.path.join(self.tmp, "launch.log"), "w")
         for attempt in range(3):  # another program may take the port first
@@ -437,8 +452,8 @@ class Lab:
         launch_args = {line.split()[0].rstrip(":") for line in listed.splitlines() if line.startswith("  ")}
         cmd = ["roslaunch", "collision_lab", "lab.launch", "web:=true", "rviz:=false", f"web_port:={self.web_port}",
                f"web_code:={self.code}", f"bag_directory:={self.bags}"]
-        web = dict(WEB_SETTINGS, **dict(p.split("=", 1) for p in args.web_param))
-        lab = dict(LAB_SETTINGS, **dict(p.split("=", 1) for p in args.lab_param))
+        web = dict({} if args.class_defaults else WEB_SETTINGS, **dict(p.split("=", 1) for p in args.web_param))
+        lab = dict({} if args.class_defaults else LAB_SETTINGS, **dict(p.split("=", 1) for p in args.lab_param))
         for node, values, arg_prefix in (("collision_lab_web", web, "web_"), ("collision_lab_node", lab, "")):
             for name, value in values.items():
                 value = parse_value(str(value))
@@ -481,6 +496,14 @@ class Lab:
             time.sleep(0.5)
         return False
 
+    def param(self, name, default):
+        """The lab's parameter <ns>/<name>, else default."""
+        try:
+            code, _, value = self.master().getParam("/class_load", f"{self.args.ns}/{name}")
+            return value if code == 1 else default
+        except (OSError, xmlrpc.client.Error):
+            return default
+
     def pid(self, node):
         try:
             code, _, uri = self.master().lookupNode("/class_load", f"{self.args.ns}/{node}")
@@ -513,6 +536,8 @@ class Lab:
                 except subprocess.TimeoutExpired:
                     os.killpg(proc.pid, signal.SIGKILL)
                     proc.wait(10)
+        if getattr(self, "small_disk", False):
+            subprocess.run(["umount", "-l", self.bags], capture_output=True)
         if self.tmp and not self.args.keep:
             shutil.rmtree(self.tmp, ignore_errors=True)
 
@@ -606,6 +631,12 @@ def main():
     ap.add_argument("--web-param", action="append", default=[], help="NAME=VALUE for the web node (started lab only)")
     ap.add_argument("--lab-param", action="append", default=[], help="NAME=VALUE for the lab node (started lab only)")
     ap.add_argument("--keep", action="store_true", help="keep the bag folder and the launch log")
+    ap.add_argument("--class-defaults", action="store_true",
+                    help="the lab as a class gets it: none of the benchmark's raised limits (WEB_SETTINGS, LAB_SETTINGS)")
+    ap.add_argument("--disk-mb", type=int, default=4096,
+                    help="[MB] the bag folder's tmpfs (root only; 0: none, and no bad-disk phase)")
+    ap.add_argument("--disk-headroom", type=float, default=40.0,
+                    help="[MB] free above the lab's floor that the bad-disk phase leaves")
     args = ap.parse_args()
 
     lab = Lab(args)
@@ -768,6 +799,7 @@ def measure(args, lab, base):
               f"{'unknown' if size is None else f'{size} B'} (goal < {GOAL_BYTES_PER_RUN} B): "
               f"{met(figure is not None and figure < GOAL_BYTES_PER_RUN)}")
     bad_student_phase(client, stats, args)
+    bad_disk_phase(client, stats, args, lab)
     return 0
 
 
@@ -807,6 +839,104 @@ def bad_student_phase(client, stats, args):
           f"p99 {p99:.3f} s, {lost} never final")
     print(f"goal: one bad student, classmates' small scenes p99 = {p99:.3f} s (goal <= {GOAL_P99_S:.0f} s, 0 lost): "
           f"{'met' if times and p99 <= GOAL_P99_S and lost == 0 else 'missed'}")
+
+
+def classmate_send(client, args, name, source, answers):
+    """One pi run of a classmate: appends (answer, seconds to it, run_id) to answers, the answer being
+    "final", "refused <reason_name>", "lost" (accepted, never final) or "HTTP <status>"."""
+    sent = time.monotonic()
+    status, _, answer = client.request("POST", "/api/runs", source, dict(PI, student=name), timeout=args.post_timeout)
+    try:
+        reply = json.loads(answer) if status in (202, 422) else {}
+    except ValueError:
+        reply = {}
+    if status == 422:
+        reason = (reply.get("rejected") or {}).get("reason_name")
+        answers.append((f"refused {reason}", time.monotonic() - sent, None))
+        return
+    if status != 202:
+        answers.append((f"HTTP {status}", time.monotonic() - sent, None))
+        return
+    run_id = reply["run_id"]
+    student = Student(name, source, client, Stats(), args)
+    final, at = student.follow(run_id, sent + args.final_timeout)
+    state = final.get("state") if final else None
+    answers.append(("final" if state in FINAL_STATES else "lost", (at or time.monotonic()) - sent, run_id))
+
+
+def bad_disk_phase(client, stats, args, lab):
+    """The disk of the bag folder filled to the lab's floor plus args.disk_headroom MB; one address sends
+    gas_1000 runs (bags of about 25 MB) while ten classmates send pi runs; then the disk is filled to 5 MB
+    under the floor and the classmates send again, and again once the filler is deleted. Reports the
+    classmates' time to an answer (final, or refused) and the phase's runs' states."""
+    if not getattr(lab, "small_disk", False):
+        print("bad disk: skipped (it needs a lab started here as root, whose bag folder is then a tmpfs; --disk-mb)")
+        return
+    floor = float(lab.param("collision_lab_node/min_free_space_mb", 100.0))
+    space = os.statvfs(lab.bags)
+    free_mb = space.f_bavail * space.f_frsize / 1e6
+    filler = os.path.join(lab.bags, "filler")
+    fill_mb = max(0.0, free_mb - floor - args.disk_headroom)
+    with open(filler, "wb") as f:
+        os.posix_fallocate(f.fileno(), 0, int(fill_mb * 1e6))
+    flood_source, flood_answers, flood_runs = "127.0.0.251", collections.Counter(), []
+
+    def flood_one(k):
+        status, _, answer = client.request("POST", "/api/runs", flood_source, dict(GAS, student=f"disk{k:02d}"),
+                                           timeout=args.post_timeout)
+        flood_answers[str(status)] += 1
+        if status == 202:
+            flood_runs.append(json.loads(answer)["run_id"])
+
+    answers = {"headroom": [], "under": [], "freed": []}
+
+    def classmates(part):
+        def one(k):
+            for _ in range(3):
+                classmate_send(client, args, f"dmate{k}", f"127.0.3.{10 + k}", answers[part])
+        threads = [threading.Thread(target=one, args=(k,), daemon=True) for k in range(10)]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join(args.final_timeout + 60)
+
+    flooders = [threading.Thread(target=flood_one, args=(k,), daemon=True) for k in range(4)]
+    for t in flooders:
+        t.start()
+    classmates("headroom")
+    for t in flooders:
+        t.join(60)
+    settle(client)
+    space = os.statvfs(lab.bags)
+    with open(filler, "ab") as f:  # now 5 MB under the floor
+        os.posix_fallocate(f.fileno(), os.path.getsize(filler),
+                           max(1, int(space.f_bavail * space.f_frsize - (floor - 5.0) * 1e6)))
+    classmates("under")
+    os.remove(filler)
+    classmates("freed")
+    settle(client)
+    states = collections.Counter()
+    for run_id in flood_runs + [r for part in answers.values() for _, _, r in part if r]:
+        status, _, body = client.request("GET", f"/api/runs/{run_id}", "127.0.0.9", timeout=30)
+        try:
+            run = json.loads(body) if status == 200 else {}
+        except ValueError:
+            run = {}
+        summary = run.get("summary") or {}
+        states[f"{run.get('state', f'HTTP {status}')} {summary.get('stop_reason', '')}".strip()] += 1
+    every = [t for part in answers.values() for _, t, _ in part]
+    lost = sum(1 for part in answers.values() for a, _, _ in part if a == "lost" or a.startswith("HTTP 5"))
+    p99 = pct(every, 0.99)
+    for part, what in (("headroom", f"{args.disk_headroom:.0f} MB above the floor of {floor:.0f} MB, gas runs filling it"),
+                       ("under", "5 MB under the floor"), ("freed", "after the filler was deleted")):
+        got = collections.Counter(a for a, _, _ in answers[part])
+        times = [t for _, t, _ in answers[part]]
+        print(f"bad disk, {what}: classmates' {len(times)} pi sends answered {dict(got)}, time to the answer "
+              f"p50 {pct(times, 0.5):.3f} s, p99 {pct(times, 0.99):.3f} s")
+    print(f"bad disk: 4 gas_1000 runs from one address: answers {dict(flood_answers)}; the phase's runs now: "
+          f"{dict(states)}")
+    print(f"goal: bad disk, classmates' small scenes p99 time to their answer = {p99:.3f} s "
+          f"(goal <= {GOAL_P99_S:.0f} s, 0 lost: {lost} lost): {'met' if every and p99 <= GOAL_P99_S and lost == 0 else 'missed'}")
 
 
 if __name__ == "__main__":
