@@ -11,6 +11,12 @@ if(TARGET address_share_test)
   target_link_libraries(address_share_test collision_lab_service GTest::gtest_main)
 endif()
 
+# A student's share of the lab's disk (no master).
+catkin_add_gtest(student_quota_test test/service/student_quota_test.cpp)
+if(TARGET student_quota_test)
+  target_link_libraries(student_quota_test collision_lab_service GTest::gtest_main)
+endif()
+
 # The lab node's side (no master): the bag claim's lock, recovery of a killed writer's
 # .active bag (reindexed with `rosbag reindex`), stale rows ended, ~list_runs' rows.
 catkin_add_gtest(run_index_recorder_test test/ros/run_index_recorder_test.cpp)

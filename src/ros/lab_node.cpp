@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <ctime>
 #include <functional>
 #include <iomanip>
@@ -32,12 +33,14 @@ namespace collision_lab_ros {
 /// calls on_limit once (the run is then stopped; what the run still computes is recorded).
 class RunWriter {
  public:
-  enum class Limit { kBagBytes, kFreeSpace };
+  enum class Limit { kBagBytes, kFreeSpace, kStudentQuota };
   /// What recording may take: bytes per bag (0: no limit) and the free space it leaves.
   struct RecordLimits {
     std::uint64_t max_bag_bytes = 0;
     std::string bag_directory;
     double min_free_space_mb = 0.0;  ///< [MB] 0: none
+    collision_lab::service::StudentQuota* quota = nullptr;  ///< null: none
+    std::string student;             ///< whose quota the run's bytes count in
   };
   /// bags may be null (not recording). claim_error: RunBagBatch::claim_error.
   RunWriter(std::string run_id, RunTimeline timeline, RunBagWriter* bags, std::string claim_error,
@@ -57,6 +60,8 @@ class RunWriter {
   void markFinished() { finished_ = true; }
   /// [bytes] serialized size of the messages recorded so far.
   std::uint64_t recordedBytes() const { return recorded_bytes_; }
+  /// [bytes] of them counted in the student's quota (RecordLimits::quota).
+  std::uint64_t quotaBytes() const { return quota_bytes_; }
   /// [s] of this (the node's) thread spent handing messages over to the bag writer.
   double recordingSeconds() const { return recording_time_.count(); }
 
@@ -118,15 +123,17 @@ class RunWriter {
     recorded_bytes_ += bytes;
     batch_.bytes += bytes;
     if (over_limit_) return;
-    if (limits_.max_bag_bytes > 0 && recorded_bytes_ > limits_.max_bag_bytes) {
-      reach(Limit::kBagBytes);
-    } else if (limits_.min_free_space_mb > 0 && recorded_bytes_ >= next_space_probe_) {
-      next_space_probe_ = recorded_bytes_ + kFreeSpaceProbeBytes;
-      // What the bag writers still hold will take space too.
-      const auto free_mb = freeMegabytes(limits_.bag_directory);
-      if (free_mb && *free_mb - 1e-6 * static_cast<double>(RunBagWriter::bytesWaiting()) < limits_.min_free_space_mb) {
-        reach(Limit::kFreeSpace);
-      }
+    if (limits_.max_bag_bytes > 0 && recorded_bytes_ > limits_.max_bag_bytes) return reach(Limit::kBagBytes);
+    if (recorded_bytes_ < next_probe_) return;
+    next_probe_ = recorded_bytes_ + kFreeSpaceProbeBytes;
+    const bool over_quota = limits_.quota && limits_.quota->recorded(limits_.student, recorded_bytes_ - quota_bytes_);
+    quota_bytes_ = recorded_bytes_;
+    if (over_quota) return reach(Limit::kStudentQuota);
+    if (limits_.min_free_space_mb <= 0) return;
+    // What the bag writers still hold will take space too.
+    const auto free_mb = freeMegabytes(limits_.bag_directory);
+    if (free_mb && *free_mb - 1e-6 * static_cast<double>(RunBagWriter::bytesWaiting()) < limits_.min_free_space_mb) {
+      reach(Limit::kFreeSpace);
     }
   }
   void reach(Limit limit) {
@@ -153,7 +160,8 @@ class RunWriter {
   RecordLimits limits_;
   std::function<void(Limit)> on_limit_;
   std::uint64_t recorded_bytes_ = 0;
-  std::uint64_t next_space_probe_ = kFreeSpaceProbeBytes;
+  std::uint64_t next_probe_ = kFreeSpaceProbeBytes;
+  std::uint64_t quota_bytes_ = 0;
   bool over_limit_ = false;
   bool finished_ = false;
 };
@@ -498,6 +506,7 @@ LabNodeParams LabNodeParams::load(const ros::NodeHandle& private_nh) {
   private_nh.param("log_runs", params.log_runs, true);
   params.max_bodies = getUint64(private_nh, "max_bodies", kDefaultMaxBodies);
   private_nh.param("min_free_space_mb", params.min_free_space_mb, kDefaultMinFreeSpaceMb);
+  private_nh.param("max_student_bag_mb", params.max_student_bag_mb, 0.0);
   private_nh.param("scenario_file", params.scenario_file,
                    ros::package::getPath("collision_lab") + "/" + kDefaultScenarioFile);
   params.scenario_file = expandUser(params.scenario_file);
@@ -657,6 +666,9 @@ LabNode::LabNode(ros::NodeHandle nh, ros::NodeHandle private_nh, const RunObserv
   run_id_prefix_ = std::string("run_") + utcStamp("%Y%m%d_%H%M%S") + "_";
   // Before any input is served: the runs of dead nodes are ended (docs/ros.md, "The run index").
   run_index_ = std::make_unique<RunIndexRecorder>(params_.bag_directory);
+  student_quota_ = std::make_unique<collision_lab::service::StudentQuota>(
+      static_cast<std::uint64_t>(std::max(0.0, params_.max_student_bag_mb) * 1e6),
+      [this](const std::string& student) { return studentBagBytes(student); });
   run_index_->recover([this](const RunIndexRecorder::QueuedRun& run) { return intake(run.input, Reply(), run.requested_run_id); });
   const std::string parameters_topic = nh_.resolveName(kRunParametersTopic);
   const RunBagWriter::Topics bag_topics{nh_.resolveName(kInitialConditionsTopic), topics_.predictions.getTopic(),
@@ -836,6 +848,37 @@ std::optional<collision_lab::Rejected> LabNode::checkFreeSpace() const {
   return rejection;
 }
 
+std::optional<collision_lab::Rejected> LabNode::checkStudentQuota(const std::string& student) {
+  if (!params_.record || !student_quota_ || !student_quota_->applies(student)) return std::nullopt;
+  const std::uint64_t used = student_quota_->admissionUse(student);
+  if (used < student_quota_->maxBytes()) return std::nullopt;
+  collision_lab::Rejected rejection;
+  rejection.reason = collision_lab::Rejected::STUDENT_QUOTA;
+  rejection.reason_name = "STUDENT_QUOTA";
+  rejection.field = "student";
+  std::ostringstream message;
+  message << "student '" << student << "' has " << std::fixed << std::setprecision(1) << 1e-6 * static_cast<double>(used)
+          << " MB of bags in this lab, the node's ~max_student_bag_mb = " << params_.max_student_bag_mb
+          << " MB or more: no run of theirs starts until the teacher deletes some of their bags";
+  rejection.message = message.str();
+  return rejection;
+}
+
+std::uint64_t LabNode::studentBagBytes(const std::string& student) const {
+  if (!run_index_->ok()) return 0;
+  std::uint64_t bytes = 0;
+  try {
+    for (const auto& row : run_index_->committed()->list(student)) {
+      std::error_code ec;
+      const auto size = row.bag_path.empty() ? 0 : std::filesystem::file_size(row.bag_path, ec);
+      if (!ec) bytes += size;
+    }
+  } catch (const collision_lab::service::RunIndexError& e) {
+    ROS_WARN_STREAM("student '" << student << "': their bags are not counted: " << e.what());
+  }
+  return bytes;
+}
+
 bool LabNode::intake(collision_lab::InitialConditions input, Reply reply, const std::optional<std::string>& served_again) {
   namespace core = collision_lab::core;
   const std::string requested = served_again ? *served_again : input.run_id;
@@ -850,9 +893,11 @@ bool LabNode::intake(collision_lab::InitialConditions input, Reply reply, const 
     if (reply) reply->set_value(std::move(outcome));
     return false;
   }
-  if (auto rejection = checkFreeSpace(); rejection && !served_again) {
-    rejection->student = input.student;
-    ServeOutcome outcome = reject(std::move(*rejection), requested);
+  std::optional<collision_lab::Rejected> refused;
+  if (!served_again && !(refused = checkFreeSpace())) refused = checkStudentQuota(input.student);
+  if (refused) {
+    refused->student = input.student;
+    ServeOutcome outcome = reject(std::move(*refused), requested);
     if (reply) reply->set_value(std::move(outcome));
     return false;
   }
@@ -1085,11 +1130,14 @@ void LabNode::serve(Worker& worker, Job& job) {
   const ros::Time start = stampNow();
   RunWriter out(job.input.run_id, RunTimeline(start, chooseTimelineScale(firstContactTime(job.plan.scene))),
                 worker.bags.get(), job.claim_error,
-                RunWriter::RecordLimits{job.limits.max_bag_bytes, params_.bag_directory, params_.min_free_space_mb},
+                RunWriter::RecordLimits{job.limits.max_bag_bytes, params_.bag_directory, params_.min_free_space_mb,
+                                        student_quota_.get(), job.input.student},
                 [this, &worker](RunWriter::Limit limit) {
+                  const StopCause cause = limit == RunWriter::Limit::kBagBytes    ? StopCause::kBagLimit
+                                          : limit == RunWriter::Limit::kFreeSpace ? StopCause::kDiskSpace
+                                                                                  : StopCause::kStudentQuota;
                   std::lock_guard<std::mutex> lock(mutex_);
-                  stopRun(worker, limit == RunWriter::Limit::kBagBytes ? StopCause::kBagLimit : StopCause::kDiskSpace,
-                          std::string());
+                  stopRun(worker, cause, std::string());
                 });
   job.input.header.stamp = start;
   RunProgress progress;
@@ -1166,6 +1214,11 @@ void LabNode::applyStopCause(Worker& worker, const Job& job, collision_lab::RunS
     summary.stop_reason = "SERVICE_DISK_SPACE";
     why << "stopped when the bag folder's free space fell under the node's ~min_free_space_mb = "
         << params_.min_free_space_mb << " MB after " << summary.collision_count
+        << " collisions, at its last certified impact; its bag holds the run to there";
+  } else if (stopped && cause == StopCause::kStudentQuota) {
+    summary.stop_reason = "SERVICE_STUDENT_QUOTA";
+    why << "stopped when student '" << job.input.student << "''s bags passed the node's ~max_student_bag_mb = "
+        << params_.max_student_bag_mb << " MB after " << summary.collision_count
         << " collisions, at its last certified impact; its bag holds the run to there";
   } else if (stopped && cause == StopCause::kCancel) {
     std::string by;
@@ -1309,7 +1362,12 @@ void LabNode::publishEnd(RunWriter& out, collision_lab::RunSummary& summary, dou
     finishRun(summary, reply, draws);
     return;
   }
-  out.finish(summary, [this, reply, draws](collision_lab::RunSummary& closed) { finishRun(closed, reply, draws); });
+  out.finish(summary, [this, reply, draws, counted = out.quotaBytes()](collision_lab::RunSummary& closed) {
+    std::error_code ec;
+    const auto bag_bytes = std::filesystem::file_size(closed.recording_ok ? closed.bag_path : closed.bag_path + ".active", ec);
+    student_quota_->ended(closed.student, counted, ec ? 0 : bag_bytes);
+    finishRun(closed, reply, draws);
+  });
   recording_times_.add(out.recordingSeconds());
 }
 

@@ -3,7 +3,10 @@
 // tmpfs; skipped where none may be mounted) a recording run stops at the floor with its bag
 // complete (SERVICE_DISK_SPACE). With no floor, a disk that fills under a run keeps the
 // run's summary in the index once space is freed, deleting its failed bag frees the space
-// (the node holds no descriptor of it), and the next run is recorded.
+// (the node holds no descriptor of it), and the next run is recorded. A student whose bags
+// pass ~max_student_bag_mb has their recording run stopped (SERVICE_STUDENT_QUOTA, its bag
+// complete) and their next input refused (STUDENT_QUOTA), while a classmate is served; once
+// their bags are deleted, they are served again.
 #include <sys/statvfs.h>
 
 #include <cstdlib>
@@ -152,6 +155,49 @@ TEST(Disk, AFullDiskKeepsTheSummaryAndADeletedBagFreesItsSpace) {
   EXPECT_TRUE(next.response.summary.recording_ok) << next.response.summary.recording_error;
   collision_lab::RunSummary recorded;
   EXPECT_EQ(eventsIn(next.response.summary.bag_path, recorded), 31u);
+}
+
+TEST(Disk, AStudentOverTheirQuotaOfBagsStartsNoRunAndAClassmateDoes) {
+  // gas_1000 records about 25 MB of messages: each run of ben's stops at the quota of 1 MB
+  // (counted as recorded while it runs, as it stands on disk after), until ben's bags on disk
+  // reach 1 MB and the next run is refused.
+  std::vector<std::string> bens_bags;
+  collision_lab::RunPreset call;
+  for (int k = 0; k < 10; ++k) {
+    call = gas("quota" + std::to_string(k));
+    ASSERT_TRUE(callService("/quota/collision_lab_node/run_preset", call));
+    if (!call.response.ok) break;
+    const collision_lab::RunSummary& s = call.response.summary;
+    EXPECT_EQ(s.stop_reason, "SERVICE_STUDENT_QUOTA") << s.truncation_reason;
+    EXPECT_NE(s.truncation_reason.find("student 'ben''s bags passed the node's ~max_student_bag_mb = 1 MB"),
+              std::string::npos)
+        << s.truncation_reason;
+    collision_lab::RunSummary recorded;
+    EXPECT_EQ(eventsIn(s.bag_path, recorded), s.collision_count);
+    bens_bags.push_back(s.bag_path);
+  }
+  ASSERT_FALSE(call.response.ok) << "ben was never refused";
+  const collision_lab::Rejected& r = call.response.rejected;
+  EXPECT_EQ(r.reason, collision_lab::Rejected::STUDENT_QUOTA);
+  EXPECT_EQ(r.reason_name, "STUDENT_QUOTA");
+  EXPECT_EQ(r.field, "student");
+  EXPECT_NE(r.message.find("student 'ben' has"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("~max_student_bag_mb = 1.0 MB or more"), std::string::npos) << r.message;
+  std::uint64_t on_disk = 0;
+  for (const std::string& bag : bens_bags) on_disk += fs::file_size(bag);
+  EXPECT_GE(on_disk, 1000000u);
+
+  auto classmate = piScene("classmate");
+  classmate.request.student = "cy";
+  ASSERT_TRUE(callService("/quota/collision_lab_node/run_scene", classmate));
+  EXPECT_TRUE(classmate.response.ok) << classmate.response.rejected.message;
+  EXPECT_EQ(classmate.response.summary.collision_count, 31u);
+
+  for (const std::string& bag : bens_bags) fs::remove(bag);
+  auto again = piScene("again");
+  again.request.student = "ben";
+  ASSERT_TRUE(callService("/quota/collision_lab_node/run_scene", again));
+  EXPECT_TRUE(again.response.ok) << again.response.rejected.message;
 }
 
 }  // namespace

@@ -33,8 +33,9 @@
 //   bag closed on that thread, through the node's own bag writer) or stops a running one:
 //   stopRun() sets its worker's cancel flag, which the core polls, with a cause. The
 //   watchdog thread does the same with the cause kTimeLimit at a run's deadline, and a
-//   run's RunWriter with kBagLimit when its recorded bytes pass its limit, or kDiskSpace
-//   when the bag directory's free space falls under ~min_free_space_mb.
+//   run's RunWriter with kBagLimit when its recorded bytes pass its limit, kDiskSpace
+//   when the bag directory's free space falls under ~min_free_space_mb, or kStudentQuota
+//   when its student's bags pass ~max_student_bag_mb.
 // - Each worker catches every exception around its run: the run ends WORKER_ERROR, its
 //   summary published and its bag closed, and the worker serves the next run.
 // - With recording on, the worker hands each run's recorded messages over to its bag
@@ -82,6 +83,7 @@
 #include "collision_lab/RunQueue.h"
 #include "collision_lab/ros/msg_conversion.h"
 #include "collision_lab/ros/run_observer.h"
+#include "collision_lab/service/student_quota.h"
 #include "collision_lab/service/fair_scheduler.h"
 
 namespace collision_lab_ros {
@@ -103,6 +105,7 @@ struct LabNodeParams {
   bool log_runs = true;            ///< one INFO line per served run (else DEBUG)
   std::uint64_t max_bodies = 0;    ///< larger scenes are rejected (TOO_MANY_BODIES)
   double min_free_space_mb = 0.0;  ///< [MB] the bag directory's floor (kDefaultMinFreeSpaceMb); 0: none
+  double max_student_bag_mb = 0.0; ///< [MB] a named student's bags at most (StudentQuota); 0: none
   std::string scenario_file;       ///< the presets of ~run_preset
   /// Worker threads [1] (~workers; default max(2, hardware threads)), of which
   /// short_lane_workers [1] take only short runs (~short_lane_workers, default 1).
@@ -245,7 +248,7 @@ class LabNode {
   /// Where a service call waits for its outcome; null for topic inputs.
   using Reply = std::shared_ptr<std::promise<ServeOutcome>>;
   /// Why a run's cancel flag was set; the first cause wins.
-  enum class StopCause : int { kNone, kCancel, kTimeLimit, kBagLimit, kDiskSpace, kShutdown };
+  enum class StopCause : int { kNone, kCancel, kTimeLimit, kBagLimit, kDiskSpace, kStudentQuota, kShutdown };
   /// A run's limits: the node's ceilings, lowered by the input's own.
   struct RunLimits {
     std::uint64_t max_collisions = 0;  ///< [1]; 0: none
@@ -313,6 +316,10 @@ class LabNode {
   static void stopRun(Worker& worker, StopCause cause, const std::string& by);
   /// DISK_SPACE when recording and the bag directory's free space is under ~min_free_space_mb.
   std::optional<collision_lab::Rejected> checkFreeSpace() const;
+  /// STUDENT_QUOTA when recording and the student's bags take ~max_student_bag_mb or more.
+  std::optional<collision_lab::Rejected> checkStudentQuota(const std::string& student);
+  /// [bytes] of the student's bags on disk, as the run index lists them.
+  std::uint64_t studentBagBytes(const std::string& student) const;
   /// The queue changed: run_queue is published with its state by the queue publisher's
   /// thread, which coalesces changes that come faster than it publishes (the latched
   /// message is always the newest state). mutex_ held.
@@ -380,6 +387,8 @@ class LabNode {
   ServedRuns served_runs_;
   /// Writes the run index (<bag_directory>/runs.sqlite) and answers ~list_runs from it.
   std::unique_ptr<RunIndexRecorder> run_index_;
+  /// Each named student's bytes of bags (~max_student_bag_mb); made before recovery serves runs.
+  std::unique_ptr<collision_lab::service::StudentQuota> student_quota_;
   /// Publishes /diagnostics; the wall timer forces an update every kDiagnosticsPeriod (the
   /// updater's own rate follows ROS time, which stands still on a replay before its clock).
   diagnostic_updater::Updater diagnostics_;
