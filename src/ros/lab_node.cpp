@@ -52,6 +52,14 @@ class RunWriter {
     batch_.claim_error = std::move(claim_error);
   }
 
+  RunWriter(const RunWriter&) = delete;
+  RunWriter& operator=(const RunWriter&) = delete;
+  /// A run that never handed its summary over (its end failed) gives its counted bytes back
+  /// to its student's quota; a finished one does so when its bag is closed (publishEnd).
+  ~RunWriter() {
+    if (!handed_over_ && limits_.quota) limits_.quota->ended(limits_.student, quota_bytes_, 0);
+  }
+
   const RunTimeline& timeline() const { return timeline_; }
   bool recording() const { return bags_ != nullptr; }
   /// True once the run's summary was handed over (finish()) or, not recording, is being
@@ -114,6 +122,7 @@ class RunWriter {
       batch_.on_closed = std::move(on_closed);
       handOver();
     });
+    handed_over_ = true;
   }
 
  private:
@@ -160,8 +169,9 @@ class RunWriter {
   RecordLimits limits_;
   std::function<void(Limit)> on_limit_;
   std::uint64_t recorded_bytes_ = 0;
-  std::uint64_t next_probe_ = kFreeSpaceProbeBytes;
+  std::uint64_t next_probe_ = 0;  ///< the first message looks: a run may start under the floor or over its quota
   std::uint64_t quota_bytes_ = 0;
+  bool handed_over_ = false;  ///< finish() handed the summary, and the quota's bytes, to the bag writer
   bool over_limit_ = false;
   bool finished_ = false;
 };

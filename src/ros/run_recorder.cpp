@@ -4,6 +4,7 @@
 
 #include <fcntl.h>
 #include <sys/file.h>
+#include <sys/stat.h>
 #include <sys/statvfs.h>
 #include <unistd.h>
 
@@ -247,13 +248,14 @@ std::uint64_t RunBagWriter::bytesWaiting() { return bytes_waiting_for_bags.load(
 
 void RunBagWriter::push(RunBagBatch batch) {
   const std::size_t n = batch.messages();
-  bytes_waiting_for_bags += batch.bytes;
   {
     std::unique_lock<std::mutex> lock(mutex_);
     // A batch larger than the bound still goes in, alone.
     changed_.wait(lock, [&] { return queued_messages_ == 0 || queued_messages_ + n <= max_queued_; });
-    queued_messages_ += n;
+    const std::uint64_t bytes = batch.bytes;
     queue_.push_back(std::move(batch));
+    queued_messages_ += n;
+    bytes_waiting_for_bags += bytes;  // once queued: the writer subtracts them after writing
   }
   changed_.notify_all();
 }
@@ -362,15 +364,19 @@ void RunRecorder::closeIntoNull() {
     const auto it = heldClaims().find(active_path_);
     if (it != heldClaims().end()) claim_fd = it->second;
   }
-  std::error_code ec;
-  const std::string target = fs::absolute(active_path_, ec).string();
+  // The bag's own descriptor is the other one open on the claimed file (same inode, even
+  // where the folder is reached through a symlink or the file was deleted).
+  struct stat claimed {};
+  if (claim_fd < 0 || ::fstat(claim_fd, &claimed) != 0) {
+    ROS_ERROR_STREAM("the failed bag " << active_path_ << " stays open: its claim is not held");
+    return;
+  }
   int bag_fd = -1;
+  std::error_code ec;
   for (const auto& entry : fs::directory_iterator("/proc/self/fd", ec)) {
     const int fd = std::atoi(entry.path().filename().c_str());
-    const std::string link = fs::read_symlink(entry.path(), ec).string();
-    // A deleted file's link reads "<path> (deleted)".
-    if (fd != claim_fd && !ec && link.compare(0, target.size(), target) == 0 &&
-        (link.size() == target.size() || link.compare(target.size(), std::string::npos, " (deleted)") == 0)) {
+    struct stat file {};
+    if (fd != claim_fd && ::fstat(fd, &file) == 0 && file.st_dev == claimed.st_dev && file.st_ino == claimed.st_ino) {
       bag_fd = fd;
       break;
     }

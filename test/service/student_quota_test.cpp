@@ -28,22 +28,30 @@ TEST(StudentQuota, BagsOnDiskAndRunningRunsCountUntilTheQuota) {
   EXPECT_TRUE(quota.recorded("ana", 100));  // 1,000: over
   EXPECT_FALSE(quota.recorded("ben", 100));  // a classmate has a share of their own
 
-  // The run ends: its 400 recorded (serialized) bytes give way to its bag's 150 on disk.
+  // The run ends: its 400 recorded (serialized) bytes give way to its bag's 150 on disk,
+  // without a count on disk (ana is under the quota).
   quota.ended("ana", 400, 150);
-  on_disk["ana"] = 750;
   EXPECT_EQ(quota.admissionUse("ana"), 750u);
+  EXPECT_EQ(counts, 1);
 }
 
 TEST(StudentQuota, AStudentOverTheQuotaIsCountedAgainSoDeletedBagsComeBack) {
+  using namespace std::chrono_literals;
   std::uint64_t ana_on_disk = 1200;
   int counts = 0;
-  StudentQuota quota(1000, [&](const std::string&) {
-    ++counts;
-    return ana_on_disk;
-  });
-  EXPECT_GE(quota.admissionUse("ana"), quota.maxBytes());
+  StudentQuota quota(
+      1000,
+      [&](const std::string&) {
+        ++counts;
+        return ana_on_disk;
+      },
+      1s);
+  const auto t0 = StudentQuota::Clock::now();
+  EXPECT_GE(quota.admissionUse("ana", t0), quota.maxBytes());
   ana_on_disk = 200;  // the teacher deleted some of ana's bags
-  EXPECT_EQ(quota.admissionUse("ana"), 200u);
+  EXPECT_EQ(quota.admissionUse("ana", t0 + 500ms), 1200u);  // a burst of sends reads no files
+  EXPECT_EQ(counts, 1);
+  EXPECT_EQ(quota.admissionUse("ana", t0 + 1s), 200u);
   EXPECT_EQ(counts, 2);
 }
 

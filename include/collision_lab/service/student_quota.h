@@ -5,6 +5,7 @@
 // Anonymous runs (no student name) are the lab's own and have no quota.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -18,23 +19,26 @@ class StudentQuota {
   /// [bytes] of a student's bags on disk, counted afresh (e.g. from the run index).
   using CountOnDisk = std::function<std::uint64_t(const std::string& student)>;
 
-  /// max_bytes: per student [bytes], 0 for no quota.
-  StudentQuota(std::uint64_t max_bytes, CountOnDisk count_on_disk)
-      : max_bytes_(max_bytes), count_on_disk_(std::move(count_on_disk)) {}
+  using Clock = std::chrono::steady_clock;
+
+  /// max_bytes: per student [bytes], 0 for no quota. A student over it is counted on disk
+  /// again at most once per recount_after (a burst of their inputs reads no more files).
+  StudentQuota(std::uint64_t max_bytes, CountOnDisk count_on_disk, Clock::duration recount_after = std::chrono::seconds(1))
+      : max_bytes_(max_bytes), count_on_disk_(std::move(count_on_disk)), recount_after_(recount_after) {}
 
   std::uint64_t maxBytes() const { return max_bytes_; }
   bool applies(const std::string& student) const { return max_bytes_ > 0 && !student.empty(); }
 
   /// [bytes] the student uses, for a new run's admission: their bags on disk, counted afresh
-  /// at their first run and whenever they seem over (bags may have been deleted), plus what
+  /// at their first run and when they seem over (bags may have been deleted), plus what
   /// their running runs have recorded.
-  std::uint64_t admissionUse(const std::string& student) {
+  std::uint64_t admissionUse(const std::string& student, Clock::time_point now = Clock::now()) {
     if (!applies(student)) return 0;
     bool count = false;
     {
       std::lock_guard<std::mutex> lock(mutex_);
       const Use& use = uses_[student];
-      count = !use.counted || use.on_disk + use.recording >= max_bytes_;
+      count = !use.counted || (use.on_disk + use.recording >= max_bytes_ && now - use.counted_at >= recount_after_);
     }
     if (count) {
       const std::uint64_t on_disk = count_on_disk_ ? count_on_disk_(student) : 0;  // outside the lock: it reads files
@@ -42,6 +46,7 @@ class StudentQuota {
       Use& use = uses_[student];
       use.on_disk = on_disk;
       use.counted = true;
+      use.counted_at = now;
     }
     std::lock_guard<std::mutex> lock(mutex_);
     const Use& use = uses_[student];
@@ -72,10 +77,12 @@ class StudentQuota {
     std::uint64_t on_disk = 0;    ///< [bytes] of ended runs' bags
     std::uint64_t recording = 0;  ///< [bytes] recorded by running runs (serialized: at least their share of the disk)
     bool counted = false;         ///< on_disk was counted from disk once
+    Clock::time_point counted_at;
   };
 
   const std::uint64_t max_bytes_;
   const CountOnDisk count_on_disk_;
+  const Clock::duration recount_after_;
   std::mutex mutex_;
   std::map<std::string, Use> uses_;
 };
