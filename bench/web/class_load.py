@@ -668,7 +668,8 @@ def measure(args, lab, base):
           f"{args.gases} gas_1000 and {args.huge} runs asking 2^64-1 impacts; attacker: {args.slow} slow connections, "
           f"{args.chunked} chunked bodies of {args.chunked_bytes} B, {args.wrong_codes} wrong codes")
     print(f"lab: {base}, class code set, pids web {pids['collision_lab_web']} lab {pids['collision_lab_node']}; "
-          + ("; ".join(lab.settings) if lab.settings else "attached, settings as found"))
+          + ("; ".join(lab.settings) if lab.settings else "attached, settings as found" if args.url
+             else "the class's defaults (nothing raised)"))
 
     anchor = Student("anchor", "127.0.0.9", client, stats, args)
     for _ in range(5):
