@@ -86,10 +86,9 @@ step "recording a long run against rosbag record" \
   roslaunch -p "$port" "$repo/bench/node/recording_vs_rosbag.launch" bag_directory:="$bags/recording"
 # A class of thirty (lab.launch web:=true, started by the script on free ports with a class code
 # and a bag folder of its own): small scenes' time to final, runs lost, memory per run. A long
-# class phase and a small run budget in the web node, so that memory per run is read in the
-# steady state (docs/benchmarks.md).
-class_load=(--web-param memory_budget_bytes=4194304 --runs 180 --max-seconds 900)
-[[ -n "$quick" ]] && class_load=(--web-param memory_budget_bytes=4194304 --warmup-runs 3 --runs 15 --gases 2 --huge 2 --slow 40 --wrong-codes 100)
+# class phase, so that memory per run is read in the steady state (docs/benchmarks.md).
+class_load=(--runs 180 --max-seconds 900)
+[[ -n "$quick" ]] && class_load=(--warmup-runs 3 --runs 15 --gases 2 --huge 2 --slow 40 --wrong-codes 100)
 step "a class of thirty with big jobs and an attacker (issue 30)" \
   python3 "$repo/bench/web/class_load.py" "${class_load[@]}"
 

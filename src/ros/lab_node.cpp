@@ -15,6 +15,8 @@
 #include <thread>
 #include <utility>
 
+#include <malloc.h>
+
 #include <ros/package.h>
 
 #include "collision_lab/io/scenario_file.h"
@@ -983,11 +985,19 @@ void LabNode::workerLoop(Worker& worker) {
       publishQueue();
     }
     serve(worker, entry->job);
-    std::lock_guard<std::mutex> lock(mutex_);
-    worker.current = CurrentRun();
-    if (worker.draws) view_busy_ = false;
-    worker.draws = false;
-    publishQueue();
+    bool idle = false;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      worker.current = CurrentRun();
+      if (worker.draws) view_busy_ = false;
+      worker.draws = false;
+      publishQueue();
+      idle = scheduler_.size() == 0 &&
+             std::all_of(workers_.begin(), workers_.end(), [](const auto& w) { return w->current.run_id.empty(); });
+    }
+    // An idle lab gives the memory its runs freed back to the system (glibc keeps it
+    // otherwise), so that its resident memory is what it holds, not its busiest moment.
+    if (idle) malloc_trim(0);
   }
 }
 

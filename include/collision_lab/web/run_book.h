@@ -101,8 +101,11 @@ struct RunBookOptions {
   std::size_t envelope_vertices = 1024;  ///< points per plotted series at most (RecordLimits) [1]
   /// The runs held in memory stay within this (web node ~memory_budget_bytes) [bytes]. A
   /// run without a bag is never evicted (it could not be read back); a run alone larger
-  /// than the budget is kept while it is the newest.
-  std::size_t memory_budget_bytes = std::size_t{64} << 20;
+  /// than the budget is kept while it is the newest. The default holds about 200 small
+  /// runs (a class's last few each, every run in progress), so that a class reaches it
+  /// early and the node's memory stays flat after; older runs come back from their bags
+  /// in milliseconds.
+  std::size_t memory_budget_bytes = std::size_t{4} << 20;
   /// The reconciliation against the RunSource runs this often on a thread of its own; 0:
   /// only when reconcile() is called [ms].
   std::chrono::milliseconds reconcile_period{2000};
