@@ -302,6 +302,17 @@ std::string summaryJson(const collision_lab::RunSummary& s) {
       .dump();
 }
 
+collision_lab::service::RunEnding endingOf(const collision_lab::RunSummary& summary) {
+  collision_lab::service::RunEnding ending;
+  ending.model_name = summary.model_name;
+  ending.simulated = summary.simulated;
+  ending.truncated = summary.truncated;
+  ending.collapsed = summary.collapsed;
+  ending.cancelled = summary.cancelled;
+  if (summary.cancelled) ending.cancel_reason = summary.truncation_reason;
+  return ending;
+}
+
 BagContents readBagContents(const std::string& path) {
   BagContents contents;
   const ReadableBag bag = openBagForReading(path);
@@ -476,6 +487,7 @@ void RunIndexRecorder::accepted(const std::string& run_id, const std::string& st
   row.requested_run_id = requested_run_id;
   row.state = RunState::kQueued;
   row.accepted_at = wallNow();
+  row.body_count = static_cast<std::uint32_t>(input.masses.size());
   row.scene_json = inputJson(input);
   enqueue(
       [this, row = std::move(row)] {
@@ -498,8 +510,8 @@ void RunIndexRecorder::finished(const collision_lab::RunSummary& summary) {
   const std::uint64_t ticket =
       enqueue([this, run_id = summary.run_id, at = wallNow(), json = summaryJson(summary),
                stop_reason = summary.stop_reason, count = summary.collision_count,
-               bag = summary.recording_ok ? summary.bag_path : std::string()] {
-        writeOrLog([&] { index_->finished(run_id, at, json, stop_reason, count, bag); },
+               bag = summary.recording_ok ? summary.bag_path : std::string(), ending = endingOf(summary)] {
+        writeOrLog([&] { index_->finished(run_id, at, json, stop_reason, count, bag, ending); },
                    "run " + run_id + ": its end is not in the run index");
       },
       /*urgent=*/true);
@@ -546,11 +558,8 @@ std::vector<collision_lab::ServedRun> RunIndexRecorder::list(const std::string& 
     run.collision_count = row.collision_count;
     run.stop_reason = row.stop_reason;
     run.bag_path = row.bag_path;
-    const json summary = json::parse(row.summary_json, nullptr, false);
-    if (summary.is_object()) {
-      run.truncated = summary.value("truncated", false);
-      run.recording_ok = summary.value("recorded", false);
-    }
+    run.truncated = row.ending.truncated;
+    run.recording_ok = !row.bag_path.empty();
     served.push_back(std::move(run));
   }
   return served;
@@ -571,6 +580,7 @@ bool RunIndexRecorder::endFromBag(const std::string& run_id, const std::string& 
     row.run_id = run_id;
     row.student = contents.input->student;
     row.accepted_at = contents.input->header.stamp.toSec();
+    row.body_count = static_cast<std::uint32_t>(contents.input->masses.size());
     row.scene_json = inputJson(*contents.input);
     index_->accepted(row);
   }
@@ -578,7 +588,8 @@ bool RunIndexRecorder::endFromBag(const std::string& run_id, const std::string& 
     collision_lab::RunSummary summary = *contents.summary;
     summary.bag_path = bag_path;
     summary.recording_ok = !bag_path.empty();
-    index_->finished(run_id, wallNow(), summaryJson(summary), summary.stop_reason, summary.collision_count, bag_path);
+    index_->finished(run_id, wallNow(), summaryJson(summary), summary.stop_reason, summary.collision_count, bag_path,
+                     endingOf(summary));
     ROS_INFO_STREAM("run " << run_id << ": completed from its bag's summary (" << note << ")");
     return true;
   }

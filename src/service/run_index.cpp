@@ -12,25 +12,39 @@ namespace collision_lab::service {
 namespace {
 
 /// The schema this code writes (PRAGMA user_version). A file of a newer version is refused.
-constexpr int kSchemaVersion = 1;
+constexpr int kSchemaVersion = 2;
 
-constexpr const char* kSchema = R"sql(
-CREATE TABLE IF NOT EXISTS runs (
+/// The runs table of version 2, its columns.
+constexpr const char* kRunsTable = R"sql((
   run_id TEXT PRIMARY KEY NOT NULL,
   student TEXT NOT NULL DEFAULT '',
   requested_run_id TEXT NOT NULL DEFAULT '',
   state TEXT NOT NULL,                      -- queued, running, finished, interrupted
   accepted_at REAL NOT NULL DEFAULT 0,      -- [s] since the epoch
   started_at REAL NOT NULL DEFAULT 0,       -- [s] since the epoch; 0 until running
-  finished_at REAL NOT NULL DEFAULT 0,      -- [s] since the epoch; 0 until finished or interrupted
-  scene_json TEXT NOT NULL DEFAULT '',      -- the served InitialConditions as JSON
-  summary_json TEXT NOT NULL DEFAULT '',    -- the RunSummary as JSON once finished
+  finished_at REAL NOT NULL DEFAULT 0,      -- [s] since the epoch; 0 until ended
   stop_reason TEXT NOT NULL DEFAULT '',
   collision_count INTEGER NOT NULL DEFAULT 0,  -- [1], a uint64 stored as its int64 bits
   bag_path TEXT NOT NULL DEFAULT '',
-  csv_path TEXT NOT NULL DEFAULT '');
+  csv_path TEXT NOT NULL DEFAULT '',
+  body_count INTEGER NOT NULL DEFAULT 0,    -- [1] the served input's bodies; 0: unknown
+  model_name TEXT NOT NULL DEFAULT '',      -- RunEnding: how the run ended, once ended
+  simulated INTEGER NOT NULL DEFAULT 0,
+  truncated INTEGER NOT NULL DEFAULT 0,
+  collapsed INTEGER NOT NULL DEFAULT 0,
+  cancelled INTEGER NOT NULL DEFAULT 0,
+  cancel_reason TEXT NOT NULL DEFAULT ''))sql";
+
+/// Version 2. A run's JSON texts are a table apart, so that listing runs (their columns)
+/// never reads them: a 10,000-body scene's text is 600 KB.
+std::string schemaSql() {
+  return std::string("CREATE TABLE IF NOT EXISTS runs ") + kRunsTable + ";" + R"sql(
 CREATE INDEX IF NOT EXISTS runs_by_student ON runs(student, accepted_at);
 CREATE INDEX IF NOT EXISTS runs_by_state ON runs(state);
+CREATE TABLE IF NOT EXISTS run_texts (
+  run_id TEXT PRIMARY KEY NOT NULL,
+  scene_json TEXT NOT NULL DEFAULT '',      -- the served InitialConditions as JSON
+  summary_json TEXT NOT NULL DEFAULT '');   -- the RunSummary as JSON once ended
 CREATE TABLE IF NOT EXISTS rejections (
   id INTEGER PRIMARY KEY AUTOINCREMENT,
   at REAL NOT NULL,                         -- [s] since the epoch
@@ -41,10 +55,49 @@ CREATE TABLE IF NOT EXISTS rejections (
   message TEXT NOT NULL DEFAULT '');
 CREATE INDEX IF NOT EXISTS rejections_by_student ON rejections(student, id);
 )sql";
+}
 
-constexpr const char* kRunColumns =
-    "run_id, student, requested_run_id, state, accepted_at, started_at, finished_at, scene_json, summary_json, "
-    "stop_reason, collision_count, bag_path, csv_path";
+/// Version 1 (one runs table with the texts, no ending columns) to 2: the rows keep their
+/// order, the texts move to run_texts, and the body count and ending are filled in from the
+/// texts as version 1 wrote them (collision_lab_ros::inputJson and summaryJson's keys).
+std::string migrationFrom1Sql() {
+  return std::string("ALTER TABLE runs RENAME TO runs_v1; DROP INDEX IF EXISTS runs_by_student; "
+                     "DROP INDEX IF EXISTS runs_by_state; CREATE TABLE runs ") + kRunsTable + ";" + R"sql(
+CREATE INDEX runs_by_student ON runs(student, accepted_at);
+CREATE INDEX runs_by_state ON runs(state);
+CREATE TABLE run_texts (
+  run_id TEXT PRIMARY KEY NOT NULL,
+  scene_json TEXT NOT NULL DEFAULT '',
+  summary_json TEXT NOT NULL DEFAULT '');
+INSERT INTO runs (run_id, student, requested_run_id, state, accepted_at, started_at, finished_at, stop_reason,
+                  collision_count, bag_path, csv_path, body_count, model_name, simulated, truncated, collapsed,
+                  cancelled, cancel_reason)
+  SELECT run_id, student, requested_run_id, state, accepted_at, started_at, finished_at, stop_reason,
+         collision_count, bag_path, csv_path,
+         CASE WHEN json_valid(scene_json) THEN coalesce(json_array_length(scene_json, '$.masses'), 0) ELSE 0 END,
+         CASE WHEN json_valid(summary_json) THEN coalesce(json_extract(summary_json, '$.model'), '') ELSE '' END,
+         CASE WHEN json_valid(summary_json) THEN coalesce(json_extract(summary_json, '$.simulated'), 0) ELSE 0 END,
+         CASE WHEN json_valid(summary_json) THEN coalesce(json_extract(summary_json, '$.truncated'), 0)
+              ELSE state = 'interrupted' END,
+         CASE WHEN json_valid(summary_json) THEN coalesce(json_extract(summary_json, '$.collapsed'), 0) ELSE 0 END,
+         CASE WHEN json_valid(summary_json) THEN coalesce(json_extract(summary_json, '$.cancelled'), 0) ELSE 0 END,
+         CASE WHEN json_valid(summary_json) AND coalesce(json_extract(summary_json, '$.cancelled'), 0)
+              THEN coalesce(json_extract(summary_json, '$.truncation_reason'), '') ELSE '' END
+  FROM runs_v1 ORDER BY rowid;
+INSERT INTO run_texts (run_id, scene_json, summary_json) SELECT run_id, scene_json, summary_json FROM runs_v1 ORDER BY rowid;
+DROP TABLE runs_v1;
+)sql";
+}
+
+/// A row's columns (the list), then with its texts (find, inState: runs r LEFT JOIN run_texts t).
+constexpr const char* kRunHeadColumns =
+    "run_id, student, requested_run_id, state, accepted_at, started_at, finished_at, stop_reason, collision_count, "
+    "bag_path, csv_path, body_count, model_name, simulated, truncated, collapsed, cancelled, cancel_reason";
+constexpr const char* kRunWithTexts =
+    "SELECT r.run_id, student, requested_run_id, state, accepted_at, started_at, finished_at, stop_reason, "
+    "collision_count, bag_path, csv_path, body_count, model_name, simulated, truncated, collapsed, cancelled, "
+    "cancel_reason, t.scene_json, t.summary_json FROM runs r LEFT JOIN run_texts t ON t.run_id = r.run_id";
+constexpr int kRunHeadColumnCount = 18;
 
 using StatementCache = std::unordered_map<std::string, sqlite3_stmt*>;
 
@@ -115,8 +168,10 @@ class Statement {
 
 std::int64_t asStored(std::uint64_t count) { return static_cast<std::int64_t>(count); }
 std::uint64_t asCount(std::int64_t stored) { return static_cast<std::uint64_t>(stored); }
+std::int64_t flag(bool value) { return value ? 1 : 0; }
 
-IndexedRun readRun(const Statement& s) {
+/// A row of kRunHeadColumns, or of kRunWithTexts when with_json.
+IndexedRun readRun(const Statement& s, bool with_json) {
   IndexedRun run;
   run.run_id = s.text(0);
   run.student = s.text(1);
@@ -126,12 +181,21 @@ IndexedRun readRun(const Statement& s) {
   run.accepted_at = s.real(4);
   run.started_at = s.real(5);
   run.finished_at = s.real(6);
-  run.scene_json = s.text(7);
-  run.summary_json = s.text(8);
-  run.stop_reason = s.text(9);
-  run.collision_count = asCount(s.integer(10));
-  run.bag_path = s.text(11);
-  run.csv_path = s.text(12);
+  run.stop_reason = s.text(7);
+  run.collision_count = asCount(s.integer(8));
+  run.bag_path = s.text(9);
+  run.csv_path = s.text(10);
+  run.body_count = static_cast<std::uint32_t>(s.integer(11));
+  run.ending.model_name = s.text(12);
+  run.ending.simulated = s.integer(13) != 0;
+  run.ending.truncated = s.integer(14) != 0;
+  run.ending.collapsed = s.integer(15) != 0;
+  run.ending.cancelled = s.integer(16) != 0;
+  run.ending.cancel_reason = s.text(17);
+  if (with_json) {
+    run.scene_json = s.text(kRunHeadColumnCount);
+    run.summary_json = s.text(kRunHeadColumnCount + 1);
+  }
   return run;
 }
 
@@ -213,8 +277,15 @@ void RunIndex::initialize() {
                         " is newer than this program's " + std::to_string(kSchemaVersion));
   }
   execute("BEGIN IMMEDIATE");
-  execute(kSchema);
-  execute("PRAGMA user_version=" + std::to_string(kSchemaVersion));
+  {  // again under the write lock: another process may have set the file up meanwhile
+    Statement version(statements_, db_, path_, "PRAGMA user_version");
+    version.step();
+    found = version.integer(0);
+  }
+  if (found < kSchemaVersion) {
+    execute(found == 1 ? migrationFrom1Sql() : schemaSql());
+    execute("PRAGMA user_version=" + std::to_string(kSchemaVersion));
+  }
   execute("COMMIT");
 }
 
@@ -247,13 +318,26 @@ void RunIndex::execute(const std::string& sql) {
 void RunIndex::accepted(const IndexedRun& run) {
   std::lock_guard<std::mutex> lock(mutex_);
   Statement s(statements_, db_, path_,
-              std::string("INSERT OR REPLACE INTO runs (") + kRunColumns +
-                  ") VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13)");
+              std::string("INSERT OR REPLACE INTO runs (") + kRunHeadColumns +
+                  ") VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14, ?15, ?16, ?17, ?18)");
   s.bind(1, run.run_id).bind(2, run.student).bind(3, run.requested_run_id).bind(4, std::string(runStateName(run.state)));
-  s.bind(5, run.accepted_at).bind(6, run.started_at).bind(7, run.finished_at).bind(8, run.scene_json);
-  s.bind(9, run.summary_json).bind(10, run.stop_reason).bind(11, asStored(run.collision_count));
-  s.bind(12, run.bag_path).bind(13, run.csv_path);
-  s.run();
+  s.bind(5, run.accepted_at).bind(6, run.started_at).bind(7, run.finished_at).bind(8, run.stop_reason);
+  s.bind(9, asStored(run.collision_count)).bind(10, run.bag_path).bind(11, run.csv_path);
+  s.bind(12, static_cast<std::int64_t>(run.body_count)).bind(13, run.ending.model_name);
+  s.bind(14, flag(run.ending.simulated)).bind(15, flag(run.ending.truncated)).bind(16, flag(run.ending.collapsed));
+  s.bind(17, flag(run.ending.cancelled)).bind(18, run.ending.cancel_reason);
+  Statement texts(statements_, db_, path_,
+                  "INSERT OR REPLACE INTO run_texts (run_id, scene_json, summary_json) VALUES (?1, ?2, ?3)");
+  texts.bind(1, run.run_id).bind(2, run.scene_json).bind(3, run.summary_json);
+  execute("SAVEPOINT accepted");  // the row and its texts together
+  try {
+    s.run();
+    texts.run();
+  } catch (...) {
+    sqlite3_exec(db_, "ROLLBACK TO accepted; RELEASE accepted", nullptr, nullptr, nullptr);
+    throw;
+  }
+  execute("RELEASE accepted");
 }
 
 bool RunIndex::writeTogether(const std::function<void()>& writes, std::chrono::milliseconds lock_wait) {
@@ -292,29 +376,50 @@ void RunIndex::started(const std::string& run_id, double at) {
 }
 
 void RunIndex::finished(const std::string& run_id, double at, const std::string& summary_json,
-                        const std::string& stop_reason, std::uint64_t collision_count, const std::string& bag_path) {
-  end(run_id, RunState::kFinished, at, summary_json, stop_reason, collision_count, bag_path);
+                        const std::string& stop_reason, std::uint64_t collision_count, const std::string& bag_path,
+                        const RunEnding& ending) {
+  end(run_id, RunState::kFinished, at, summary_json, stop_reason, collision_count, bag_path, ending);
 }
 
 void RunIndex::interrupted(const std::string& run_id, double at, const std::string& summary_json,
                            std::uint64_t collision_count, const std::string& bag_path) {
-  end(run_id, RunState::kInterrupted, at, summary_json, "INTERRUPTED", collision_count, bag_path);
+  RunEnding ending;
+  ending.truncated = true;
+  end(run_id, RunState::kInterrupted, at, summary_json, "INTERRUPTED", collision_count, bag_path, ending);
 }
 
 void RunIndex::end(const std::string& run_id, RunState state, double at, const std::string& summary_json,
-                   const std::string& stop_reason, std::uint64_t collision_count, const std::string& bag_path) {
+                   const std::string& stop_reason, std::uint64_t collision_count, const std::string& bag_path,
+                   const RunEnding& ending) {
   std::lock_guard<std::mutex> lock(mutex_);
   // A run without a row (accepted before its node had the index) gets one, so that no
   // run's end is lost.
   Statement s(statements_, db_, path_,
-              "INSERT INTO runs (run_id, state, finished_at, summary_json, stop_reason, collision_count, bag_path) "
-              "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7) ON CONFLICT(run_id) DO UPDATE SET state = excluded.state, "
-              "finished_at = excluded.finished_at, summary_json = excluded.summary_json, "
+              "INSERT INTO runs (run_id, state, finished_at, stop_reason, collision_count, bag_path, "
+              "model_name, simulated, truncated, collapsed, cancelled, cancel_reason) "
+              "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12) ON CONFLICT(run_id) DO UPDATE SET "
+              "state = excluded.state, finished_at = excluded.finished_at, "
               "stop_reason = excluded.stop_reason, collision_count = excluded.collision_count, "
-              "bag_path = excluded.bag_path");
-  s.bind(1, run_id).bind(2, std::string(runStateName(state))).bind(3, at).bind(4, summary_json);
-  s.bind(5, stop_reason).bind(6, asStored(collision_count)).bind(7, bag_path);
-  s.run();
+              "bag_path = excluded.bag_path, model_name = excluded.model_name, simulated = excluded.simulated, "
+              "truncated = excluded.truncated, collapsed = excluded.collapsed, cancelled = excluded.cancelled, "
+              "cancel_reason = excluded.cancel_reason");
+  s.bind(1, run_id).bind(2, std::string(runStateName(state))).bind(3, at).bind(4, stop_reason);
+  s.bind(5, asStored(collision_count)).bind(6, bag_path).bind(7, ending.model_name);
+  s.bind(8, flag(ending.simulated)).bind(9, flag(ending.truncated)).bind(10, flag(ending.collapsed));
+  s.bind(11, flag(ending.cancelled)).bind(12, ending.cancelled ? ending.cancel_reason : std::string());
+  Statement texts(statements_, db_, path_,
+                  "INSERT INTO run_texts (run_id, summary_json) VALUES (?1, ?2) "
+                  "ON CONFLICT(run_id) DO UPDATE SET summary_json = excluded.summary_json");
+  texts.bind(1, run_id).bind(2, summary_json);
+  execute("SAVEPOINT ended");  // the row and its texts together
+  try {
+    s.run();
+    texts.run();
+  } catch (...) {
+    sqlite3_exec(db_, "ROLLBACK TO ended; RELEASE ended", nullptr, nullptr, nullptr);
+    throw;
+  }
+  execute("RELEASE ended");
 }
 
 void RunIndex::rejected(const IndexedRejection& rejection) {
@@ -337,30 +442,30 @@ void RunIndex::setCsvPath(const std::string& run_id, const std::string& csv_path
 
 std::optional<IndexedRun> RunIndex::find(const std::string& run_id) const {
   std::lock_guard<std::mutex> lock(mutex_);
-  Statement s(statements_, db_, path_, std::string("SELECT ") + kRunColumns + " FROM runs WHERE run_id = ?1");
+  Statement s(statements_, db_, path_, std::string(kRunWithTexts) + " WHERE r.run_id = ?1");
   s.bind(1, run_id);
   if (!s.step()) return std::nullopt;
-  return readRun(s);
+  return readRun(s, /*with_json=*/true);
 }
 
 std::vector<IndexedRun> RunIndex::list(const std::optional<std::string>& student, std::size_t limit) const {
   std::lock_guard<std::mutex> lock(mutex_);
   Statement s(statements_, db_, path_,
-              std::string("SELECT ") + kRunColumns + " FROM runs" + (student ? " WHERE student = ?1" : "") +
+              std::string("SELECT ") + kRunHeadColumns + " FROM runs" + (student ? " WHERE student = ?1" : "") +
                   " ORDER BY accepted_at, rowid" + limitClause(limit));
   if (student) s.bind(1, *student);
   std::vector<IndexedRun> runs;
-  while (s.step()) runs.push_back(readRun(s));
+  while (s.step()) runs.push_back(readRun(s, /*with_json=*/false));
   return runs;
 }
 
 std::vector<IndexedRun> RunIndex::inState(RunState state) const {
   std::lock_guard<std::mutex> lock(mutex_);
   Statement s(statements_, db_, path_,
-              std::string("SELECT ") + kRunColumns + " FROM runs WHERE state = ?1 ORDER BY accepted_at, rowid");
+              std::string(kRunWithTexts) + " WHERE state = ?1 ORDER BY accepted_at, r.rowid");
   s.bind(1, std::string(runStateName(state)));
   std::vector<IndexedRun> runs;
-  while (s.step()) runs.push_back(readRun(s));
+  while (s.step()) runs.push_back(readRun(s, /*with_json=*/true));
   return runs;
 }
 

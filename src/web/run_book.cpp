@@ -18,6 +18,7 @@
 #include "collision_lab/core/totals.h"
 #include "collision_lab/ros/bag_csv.h"
 #include "collision_lab/ros/bag_reading.h"
+#include "collision_lab/ros/run_index_recorder.h"
 #include "collision_lab/ros/run_view.h"
 
 namespace collision_lab_web {
@@ -346,13 +347,13 @@ collision_lab::RunSummary summaryOfStub(const std::string& run_id, const Evicted
   s.run_id = run_id;
   s.student = stub.student;
   s.requested_run_id = stub.requested_run_id;
-  s.model_name = stub.model_name;
+  s.model_name = stub.ending.model_name;
   s.collision_count = stub.collision_count;
-  s.truncated = stub.truncated;
-  s.simulated = stub.simulated;
-  s.cancelled = stub.cancelled;
-  s.collapsed = stub.collapsed;
-  s.truncation_reason = stub.truncation_reason;
+  s.truncated = stub.ending.truncated;
+  s.simulated = stub.ending.simulated;
+  s.cancelled = stub.ending.cancelled;
+  s.collapsed = stub.ending.collapsed;
+  s.truncation_reason = stub.ending.cancel_reason;
   s.stop_reason = stub.interrupted ? "INTERRUPTED" : "";
   s.bag_path = stub.bag_path;
   s.recording_ok = true;
@@ -610,16 +611,11 @@ void RunBook::enforceBudgetLocked(const std::string& keep) {
       stub.student = run.student;
       stub.requested_run_id = run.requested_run_id;
       stub.accepted_stamp = run.accepted_stamp;
-      stub.model_name = run.summary->model_name;
       stub.bag_path = run.summary->bag_path;
       stub.collision_count = run.summary->collision_count;
       stub.bodies = run.record ? static_cast<std::uint32_t>(run.record->bodies()) : 0;
       stub.interrupted = run.interrupted;
-      stub.truncated = run.summary->truncated;
-      stub.simulated = run.summary->simulated;
-      stub.cancelled = run.summary->cancelled;
-      stub.collapsed = run.summary->collapsed;
-      if (stub.cancelled) stub.truncation_reason = run.summary->truncation_reason;
+      stub.ending = collision_lab_ros::endingOf(*run.summary);
       stub.sequence = run.sequence;
       evicted_.emplace(run_id, std::move(stub));
     }
@@ -850,14 +846,14 @@ const char* stateOf(const WebRun& run) {
 
 /// How an ended run ended, for the teacher's list: its model, whether it was simulated,
 /// cut short (cancelled: by whom, in cancel_reason), collapsed, and recorded.
-void addEnding(nlohmann::json& item, const collision_lab::RunSummary& summary, bool recorded) {
-  item["model"] = summary.model_name;
-  item["truncated"] = static_cast<bool>(summary.truncated);
+void addEnding(nlohmann::json& item, const collision_lab::service::RunEnding& ending, bool recorded) {
+  item["model"] = ending.model_name;
+  item["truncated"] = ending.truncated;
   item["recorded"] = recorded;
-  item["simulated"] = static_cast<bool>(summary.simulated);
-  item["collapsed"] = static_cast<bool>(summary.collapsed);
-  item["cancelled"] = static_cast<bool>(summary.cancelled);
-  if (summary.cancelled) item["cancel_reason"] = summary.truncation_reason;
+  item["simulated"] = ending.simulated;
+  item["collapsed"] = ending.collapsed;
+  item["cancelled"] = ending.cancelled;
+  if (ending.cancelled) item["cancel_reason"] = ending.cancel_reason;
 }
 
 nlohmann::json listItem(const WebRun& run) {
@@ -868,7 +864,9 @@ nlohmann::json listItem(const WebRun& run) {
                          {"collisions", run.summary ? run.summary->collision_count
                                                     : (run.record ? run.record->collisions() : 0)}};
   if (run.record) item["bodies"] = run.record->bodies();
-  if (run.summary) addEnding(item, *run.summary, run.summary->recording_ok && !run.summary->bag_path.empty());
+  if (run.summary) {
+    addEnding(item, collision_lab_ros::endingOf(*run.summary), run.summary->recording_ok && !run.summary->bag_path.empty());
+  }
   return item;
 }
 
@@ -879,20 +877,19 @@ nlohmann::json listItem(const std::string& run_id, const EvictedRun& stub) {
                          {"accepted_stamp", stub.accepted_stamp},
                          {"collisions", stub.collision_count},
                          {"bodies", stub.bodies}};
-  addEnding(item, summaryOfStub(run_id, stub), !stub.bag_path.empty());
+  addEnding(item, stub.ending, !stub.bag_path.empty());
   return item;
 }
 
-/// A run the web node does not hold, as its index row says.
+/// A run the web node does not hold, as its index row's columns say.
 nlohmann::json listItem(const collision_lab::service::IndexedRun& row) {
   nlohmann::json item = {{"run_id", row.run_id},
                          {"student", row.student},
                          {"state", stateName(row.state)},
                          {"accepted_stamp", row.accepted_at},
                          {"collisions", row.collision_count}};
-  const nlohmann::json scene = nlohmann::json::parse(row.scene_json, nullptr, false);
-  if (scene.is_object() && scene.contains("masses") && scene["masses"].is_array()) item["bodies"] = scene["masses"].size();
-  if (ended(row.state)) addEnding(item, summaryFromRow(row), !row.bag_path.empty());
+  if (row.body_count > 0) item["bodies"] = row.body_count;
+  if (ended(row.state)) addEnding(item, row.ending, !row.bag_path.empty());
   return item;
 }
 }  // namespace

@@ -13,6 +13,8 @@
 
 #include <gtest/gtest.h>
 
+#include <sqlite3.h>
+
 #include "collision_lab/service/run_index.h"
 
 namespace fs = std::filesystem;
@@ -41,7 +43,15 @@ class RunIndexTest : public ::testing::Test {
     run.requested_run_id = "asked";
     run.accepted_at = at;
     run.scene_json = R"({"masses":[100,1,"inf"]})";
+    run.body_count = 3;
     return run;
+  }
+  /// The ending of the pi billiard's run as its summary gives it.
+  static collision_lab::service::RunEnding pi() {
+    collision_lab::service::RunEnding ending;
+    ending.model_name = "three_body_rotation";
+    ending.simulated = true;
+    return ending;
   }
 
   std::string dir_, path_;
@@ -60,7 +70,7 @@ TEST_F(RunIndexTest, KeepsEveryRunAcrossReopening) {
     RunIndex index(path_);
     index.accepted(queued("r1", "ana", 1.0));
     index.started("r1", 2.0);
-    index.finished("r1", 3.0, R"({"collision_count":31})", "FINISHED", 31, dir_ + "/r1.bag");
+    index.finished("r1", 3.0, R"({"collision_count":31})", "FINISHED", 31, dir_ + "/r1.bag", pi());
     index.accepted(queued("r2", "ben", 4.0));
   }
   RunIndex reopened(path_);
@@ -78,6 +88,10 @@ TEST_F(RunIndexTest, KeepsEveryRunAcrossReopening) {
   EXPECT_EQ(r1->stop_reason, "FINISHED");
   EXPECT_EQ(r1->collision_count, 31u);
   EXPECT_EQ(r1->bag_path, dir_ + "/r1.bag");
+  EXPECT_EQ(r1->body_count, 3u);
+  EXPECT_EQ(r1->ending.model_name, "three_body_rotation");
+  EXPECT_TRUE(r1->ending.simulated);
+  EXPECT_FALSE(r1->ending.truncated);
   EXPECT_EQ(reopened.find("r2")->state, RunState::kQueued);
   EXPECT_FALSE(reopened.find("r3"));
 }
@@ -97,6 +111,8 @@ TEST_F(RunIndexTest, RecordsEveryStateChange) {
   EXPECT_EQ(r1->collision_count, 7u);
   EXPECT_EQ(r1->finished_at, 5.0);
   EXPECT_EQ(r1->summary_json, R"({"events_in_bag":7})");
+  EXPECT_TRUE(r1->ending.truncated);
+  EXPECT_FALSE(r1->ending.simulated);
   // A late start never takes a run back from its end.
   index.started("r1", 6.0);
   EXPECT_EQ(index.find("r1")->state, RunState::kInterrupted);
@@ -107,6 +123,83 @@ TEST_F(RunIndexTest, RecordsEveryStateChange) {
 
   EXPECT_EQ(index.inState(RunState::kInterrupted).size(), 1u);
   EXPECT_TRUE(index.inState(RunState::kRunning).empty());
+}
+
+TEST_F(RunIndexTest, TheListIsReadFromColumnsWithoutTheJsonTexts) {
+  RunIndex index(path_);
+  index.accepted(queued("r1", "ana", 1.0));
+  collision_lab::service::RunEnding stopped;
+  stopped.model_name = "engine";
+  stopped.simulated = stopped.truncated = stopped.cancelled = true;
+  stopped.cancel_reason = "cancelled by the teacher after 12 collisions";
+  index.finished("r1", 2.0, R"({"model":"not read by the list"})", "CANCELLED", 12, dir_ + "/r1.bag", stopped);
+  const auto listed = index.list();
+  ASSERT_EQ(listed.size(), 1u);
+  const IndexedRun& r1 = listed[0];
+  EXPECT_TRUE(r1.scene_json.empty());
+  EXPECT_TRUE(r1.summary_json.empty());
+  EXPECT_EQ(r1.body_count, 3u);
+  EXPECT_EQ(r1.ending.model_name, "engine");
+  EXPECT_TRUE(r1.ending.simulated && r1.ending.truncated && r1.ending.cancelled);
+  EXPECT_FALSE(r1.ending.collapsed);
+  EXPECT_EQ(r1.ending.cancel_reason, "cancelled by the teacher after 12 collisions");
+  EXPECT_EQ(index.find("r1")->summary_json, R"({"model":"not read by the list"})");
+}
+
+TEST_F(RunIndexTest, AVersionOneFileGetsItsColumnsFromItsJson) {
+  // A run index as version 1 wrote it (main of 2026-12-02): the ending only in the JSON.
+  {
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open(path_.c_str(), &db), SQLITE_OK);
+    const char* v1 = R"sql(
+CREATE TABLE runs (run_id TEXT PRIMARY KEY NOT NULL, student TEXT NOT NULL DEFAULT '',
+  requested_run_id TEXT NOT NULL DEFAULT '', state TEXT NOT NULL, accepted_at REAL NOT NULL DEFAULT 0,
+  started_at REAL NOT NULL DEFAULT 0, finished_at REAL NOT NULL DEFAULT 0, scene_json TEXT NOT NULL DEFAULT '',
+  summary_json TEXT NOT NULL DEFAULT '', stop_reason TEXT NOT NULL DEFAULT '',
+  collision_count INTEGER NOT NULL DEFAULT 0, bag_path TEXT NOT NULL DEFAULT '', csv_path TEXT NOT NULL DEFAULT '');
+CREATE TABLE rejections (id INTEGER PRIMARY KEY AUTOINCREMENT, at REAL NOT NULL, student TEXT NOT NULL DEFAULT '',
+  run_id TEXT NOT NULL DEFAULT '', reason_name TEXT NOT NULL DEFAULT '', field TEXT NOT NULL DEFAULT '',
+  message TEXT NOT NULL DEFAULT '');
+INSERT INTO runs (run_id, student, state, scene_json, summary_json, stop_reason, collision_count) VALUES
+  ('ana.pi', 'ana', 'finished', '{"masses":[100,1,"inf"]}',
+   '{"model":"three_body_rotation","simulated":true,"truncated":false,"collapsed":false,"cancelled":false}',
+   'NO_MORE_COLLISIONS', 31),
+  ('ben.gas', 'ben', 'finished', '{"masses":[1,1,1,1,1]}',
+   '{"model":"engine","simulated":true,"truncated":true,"cancelled":true,"collapsed":false,"truncation_reason":"cancelled by ben"}',
+   'CANCELLED', 9),
+  ('cy.lost', 'cy', 'interrupted', 'not json', '', 'INTERRUPTED', 0);
+PRAGMA user_version=1;
+)sql";
+    ASSERT_EQ(sqlite3_exec(db, v1, nullptr, nullptr, nullptr), SQLITE_OK) << sqlite3_errmsg(db);
+    sqlite3_close(db);
+  }
+  RunIndex index(path_);
+  const auto pi = index.find("ana.pi");
+  ASSERT_TRUE(pi);
+  EXPECT_EQ(pi->body_count, 3u);
+  EXPECT_EQ(pi->ending.model_name, "three_body_rotation");
+  EXPECT_EQ(pi->scene_json, R"({"masses":[100,1,"inf"]})");
+  EXPECT_TRUE(pi->ending.simulated);
+  EXPECT_FALSE(pi->ending.truncated || pi->ending.cancelled || pi->ending.collapsed);
+  EXPECT_TRUE(pi->ending.cancel_reason.empty());
+  const auto gas = index.find("ben.gas");
+  EXPECT_EQ(gas->body_count, 5u);
+  EXPECT_TRUE(gas->ending.truncated && gas->ending.cancelled);
+  EXPECT_EQ(gas->ending.cancel_reason, "cancelled by ben");
+  EXPECT_EQ(gas->summary_json.substr(0, 16), R"({"model":"engine)");
+  const auto lost = index.find("cy.lost");
+  EXPECT_EQ(lost->body_count, 0u);  // unknown: its scene text is no JSON
+  EXPECT_EQ(lost->scene_json, "not json");  // the texts kept as they were
+  EXPECT_EQ(lost->ending.model_name, "");
+  EXPECT_TRUE(lost->ending.truncated);  // interrupted
+  std::vector<std::string> order;
+  for (const auto& run : index.list()) order.push_back(run.run_id);
+  EXPECT_EQ(order, (std::vector<std::string>{"ana.pi", "ben.gas", "cy.lost"}));
+  // Written by this version from now on, and opened again without a second migration.
+  index.accepted(queued("dan.new", "dan", 4.0));
+  RunIndex again(path_);
+  EXPECT_EQ(again.runCount(), 4u);
+  EXPECT_EQ(again.find("dan.new")->body_count, 3u);
 }
 
 TEST_F(RunIndexTest, AnEndWithoutARowCreatesIt) {
@@ -122,7 +215,7 @@ TEST_F(RunIndexTest, KeepsCountsUpToTwoToTheSixtyFour) {
   RunIndex index(path_);
   index.accepted(queued("big", "", 1.0));
   const std::uint64_t max = ~std::uint64_t{0};
-  index.finished("big", 2.0, "{}", "CAP", max, "");
+  index.finished("big", 2.0, "{}", "CAP", max, "", {});
   EXPECT_EQ(index.find("big")->collision_count, max);
 }
 
@@ -195,7 +288,7 @@ TEST_F(RunIndexTest, AReaderSeesAWritersRowsAtOnce) {
   EXPECT_EQ(reader.find("r1")->state, RunState::kQueued);
   writer.started("r1", 2.0);
   EXPECT_EQ(reader.find("r1")->state, RunState::kRunning);
-  writer.finished("r1", 3.0, "{}", "FINISHED", 31, "");
+  writer.finished("r1", 3.0, "{}", "FINISHED", 31, "", {});
   EXPECT_EQ(reader.find("r1")->state, RunState::kFinished);
 }
 
@@ -209,7 +302,7 @@ TEST_F(RunIndexTest, TwoWritersOnOneFileLoseNothing) {
         const std::string id = prefix + std::to_string(k);
         index.accepted(queued(id, prefix, k));
         index.started(id, k);
-        index.finished(id, k, "{}", "FINISHED", k, "");
+        index.finished(id, k, "{}", "FINISHED", k, "", {});
       }
     };
     std::thread a([&] { write(first, "a"); });

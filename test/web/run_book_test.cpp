@@ -270,12 +270,17 @@ IndexedRun rowOf(const ScriptedRun& run, RunState state) {
   row.state = state;
   row.accepted_at = run.accepted.header.stamp.toSec();
   row.scene_json = json({{"masses", run.input.masses}}).dump();
-  if (state == RunState::kFinished) {
+  row.body_count = static_cast<std::uint32_t>(run.input.masses.size());
+  if (state == RunState::kFinished) {  // as the lab node writes it
     row.stop_reason = run.summary.stop_reason;
     row.collision_count = run.summary.collision_count;
-    row.summary_json = collision_lab_ros::summaryJson(run.summary);  // as the lab node writes it
+    row.summary_json = collision_lab_ros::summaryJson(run.summary);
+    row.ending = collision_lab_ros::endingOf(run.summary);
   }
-  if (state == RunState::kInterrupted) row.stop_reason = "INTERRUPTED";
+  if (state == RunState::kInterrupted) {
+    row.stop_reason = "INTERRUPTED";
+    row.ending.truncated = true;
+  }
   row.bag_path = run.summary.bag_path;
   return row;
 }
@@ -543,7 +548,7 @@ TEST(RunBookMemory, RestartedWebNodeServesTheIndexsRuns) {
         index.interrupted(row.run_id, row.accepted_at + 1, "", 25, run.summary.bag_path);
       } else {
         index.finished(row.run_id, row.accepted_at + 1, collision_lab_ros::summaryJson(run.summary), "NO_MORE_COLLISIONS",
-                       25, run.summary.bag_path);
+                       25, run.summary.bag_path, collision_lab_ros::endingOf(run.summary));
       }
     }
   }

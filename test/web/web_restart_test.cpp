@@ -126,6 +126,7 @@ void writeDay(const std::filesystem::path& dir) {
     row.state = collision_lab::service::RunState::kQueued;
     row.accepted_at = 1.0e9 + k;
     row.scene_json = json({{"masses", input.masses}}).dump();
+    row.body_count = static_cast<std::uint32_t>(input.masses.size());
     row.bag_path = bag_path;
     index.accepted(row);
     index.started(run_id, row.accepted_at + 0.1);
@@ -133,7 +134,7 @@ void writeDay(const std::filesystem::path& dir) {
       index.interrupted(run_id, row.accepted_at + 0.2, "", 1, bag_path);
     } else {
       index.finished(run_id, row.accepted_at + 0.2, collision_lab_ros::summaryJson(summary), summary.stop_reason, 1,
-                     bag_path);  // as the lab node writes it
+                     bag_path, collision_lab_ros::endingOf(summary));  // as the lab node writes it
     }
   }
 }
@@ -385,7 +386,7 @@ TEST(WebMissedEvents, RunsWhoseEndWasMissedEndFromTheIndex) {
   EXPECT_EQ(json::parse(httplib::Client(address.first, address.second).Get("/api/runs/late.finished")->body).at("state"),
             "running");
   // The rest of the events and the summaries are never delivered; the lab node's index says how they ended.
-  index.finished("late.finished", ros::Time::now().toSec(), "", "NO_MORE_COLLISIONS", 10, finished.bag_path);
+  index.finished("late.finished", ros::Time::now().toSec(), "", "NO_MORE_COLLISIONS", 10, finished.bag_path, {});
   index.interrupted("late.interrupted", ros::Time::now().toSec(), "", 6, interrupted.bag_path);
   const json done = settledRun(address, "late.finished");
   EXPECT_EQ(done.at("state"), "finished");

@@ -37,6 +37,8 @@ collision_lab::InitialConditions inputFromJson(const std::string& text);
 /// The index's JSON of a summary (IndexedRun::summary_json): the fields the class pages
 /// show, under RunSummary's field names.
 std::string summaryJson(const collision_lab::RunSummary& summary);
+/// How the summary's run ended, as the index's columns (IndexedRun::ending).
+collision_lab::service::RunEnding endingOf(const collision_lab::RunSummary& summary);
 
 /// What a bag holds, read with rosbag::View.
 struct BagContents {

@@ -46,6 +46,16 @@ enum class RunState { kQueued, kRunning, kFinished, kInterrupted };
 const char* runStateName(RunState state);  ///< "queued", "running", "finished", "interrupted"
 std::optional<RunState> runStateFromName(const std::string& name);
 
+/// How an ended run ended, as the run list shows it (columns, so that a list reads no JSON).
+struct RunEnding {
+  std::string model_name;  ///< the model that answered (RunSummary.model_name); empty when interrupted
+  bool simulated = false;  ///< impact by impact (not the model's count alone)
+  bool truncated = false;  ///< cut short (a cap, a limit, a Stop, the node's death)
+  bool collapsed = false;  ///< inelastic collapse
+  bool cancelled = false;  ///< stopped by a Stop
+  std::string cancel_reason;  ///< who stopped it and when, when cancelled
+};
+
 /// One row of the index.
 struct IndexedRun {
   std::string run_id;            ///< as served (unique)
@@ -61,6 +71,8 @@ struct IndexedRun {
   std::uint64_t collision_count = 0;  ///< [1] RunSummary.collision_count once finished
   std::string bag_path;      ///< the run's final bag (<run_id>.bag) once finished or recovered; empty until then, or when not recorded
   std::string csv_path;      ///< the events CSV made beside the bag once asked for; empty until then
+  std::uint32_t body_count = 0;  ///< [1] bodies of the served input (walls included); 0: unknown
+  RunEnding ending;              ///< once finished or interrupted
 };
 
 /// One rejected input.
@@ -93,8 +105,10 @@ class RunIndex {
   void started(const std::string& run_id, double at);
   /// The run's summary is out and its bag closed.
   void finished(const std::string& run_id, double at, const std::string& summary_json,
-                const std::string& stop_reason, std::uint64_t collision_count, const std::string& bag_path);
+                const std::string& stop_reason, std::uint64_t collision_count, const std::string& bag_path,
+                const RunEnding& ending);
   /// The run will never finish (its node died); summary_json may describe what its bag holds.
+  /// Its ending: truncated, not simulated.
   /// finished() and interrupted() create the run's row when it has none.
   void interrupted(const std::string& run_id, double at, const std::string& summary_json,
                    std::uint64_t collision_count, const std::string& bag_path);
@@ -113,7 +127,8 @@ class RunIndex {
   // ---- Readers ----
   std::optional<IndexedRun> find(const std::string& run_id) const;
   /// Oldest accepted first; only student's when student is given (empty string: anonymous).
-  /// limit 0: all.
+  /// limit 0: all. The rows come without their JSON texts (scene_json and summary_json
+  /// empty): find() gives them.
   std::vector<IndexedRun> list(const std::optional<std::string>& student = std::nullopt, std::size_t limit = 0) const;
   /// Runs in a state, oldest first (a lab node's start: queued and running ones are interrupted).
   std::vector<IndexedRun> inState(RunState state) const;
@@ -129,7 +144,8 @@ class RunIndex {
   void execute(const std::string& sql);
   /// finished() and interrupted(): the run's end, its row created when missing.
   void end(const std::string& run_id, RunState state, double at, const std::string& summary_json,
-           const std::string& stop_reason, std::uint64_t collision_count, const std::string& bag_path);
+           const std::string& stop_reason, std::uint64_t collision_count, const std::string& bag_path,
+           const RunEnding& ending);
 
   /// Finalizes the prepared statements (before the connection closes).
   void finalizeStatements();

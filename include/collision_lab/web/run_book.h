@@ -84,17 +84,13 @@ struct WebRun {
 /// What an evicted run leaves when the RunSource does not know it (or there is none):
 /// enough for the list and to read it back from its bag (whose summary it shows again).
 struct EvictedRun {
-  std::string student, requested_run_id, model_name, bag_path;
+  std::string student, requested_run_id, bag_path;
   double accepted_stamp = 0.0;        ///< [s] since the epoch
   std::uint64_t collision_count = 0;  ///< [1]
   std::uint64_t sequence = 0;         ///< its place in the list [1]
   std::uint32_t bodies = 0;           ///< [1]
   bool interrupted = false;
-  bool truncated = false;
-  bool simulated = true;
-  bool cancelled = false;
-  bool collapsed = false;
-  std::string truncation_reason;  ///< kept for a cancelled run only: who stopped it
+  collision_lab::service::RunEnding ending;
 };
 
 struct RunBookOptions {
