@@ -676,12 +676,10 @@ LabNode::LabNode(ros::NodeHandle nh, ros::NodeHandle private_nh, const RunObserv
   if (params_.publish_markers && make_observer) marker_view_ = make_observer(nh_, private_nh);
 
   run_id_prefix_ = std::string("run_") + utcStamp("%Y%m%d_%H%M%S") + "_";
-  // Before any input is served: the runs of dead nodes are ended (docs/ros.md, "The run index").
   run_index_ = std::make_unique<RunIndexRecorder>(params_.bag_directory);
   student_quota_ = std::make_unique<collision_lab::service::StudentQuota>(
       static_cast<std::uint64_t>(std::max(0.0, params_.max_student_bag_mb) * 1e6),
       [this](const std::string& student) { return studentBagBytes(student); });
-  run_index_->recover([this](const RunIndexRecorder::QueuedRun& run) { return intake(run.input, Reply(), run.requested_run_id); });
   const std::string parameters_topic = nh_.resolveName(kRunParametersTopic);
   const RunBagWriter::Topics bag_topics{nh_.resolveName(kInitialConditionsTopic), topics_.predictions.getTopic(),
                                         topics_.events.getTopic(), topics_.summaries.getTopic(), parameters_topic,
@@ -723,6 +721,18 @@ LabNode::LabNode(ros::NodeHandle nh, ros::NodeHandle private_nh, const RunObserv
   cancel_srv_ = cancel_nh.advertiseService(kCancelService, &LabNode::onCancel, this);
   list_runs_srv_ = cancel_nh.advertiseService(kListRunsService, &LabNode::onListRuns, this);
   cancel_spinner_.start();
+  // The runs of dead nodes are ended, or served again, while the node serves (docs/ros.md,
+  // "The run index"): reindexing a big bag takes seconds.
+  recovery_ = std::thread([this] {
+    const auto start = std::chrono::steady_clock::now();
+    const std::size_t ended =
+        run_index_->recover([this](const RunIndexRecorder::QueuedRun& run) { return intake(run.input, Reply(), run.requested_run_id); });
+    if (ended > 0) {
+      ROS_INFO_STREAM("recovery: " << ended << " runs of dead nodes ended in "
+                      << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()
+                      << " s, while the node served");
+    }
+  });
   ROS_INFO_STREAM("collision_lab_node: recording " << (params_.record ? "on" : "off")
                   << ", bags in " << params_.bag_directory << ", max_collisions "
                   << params_.max_collisions << ", max_published_events "
@@ -733,6 +743,7 @@ LabNode::LabNode(ros::NodeHandle nh, ros::NodeHandle private_nh, const RunObserv
 }
 
 LabNode::~LabNode() {
+  recovery_.join();  // its runs served again are then in the queue, and dropped below
   // Cancel first: shutting a service down waits for its calls in progress, and a call
   // waits for its run.
   std::vector<Scheduler::Entry> waiting;

@@ -341,7 +341,7 @@ bool activeBagOwned(const std::string& active_path) {
   return !FileLock(active_path).held();
 }
 
-std::vector<RecoveredBag> recoverActiveBags(const std::string& directory) {
+std::vector<RecoveredBag> recoverActiveBags(const std::string& directory, ActiveBags which) {
   std::vector<RecoveredBag> recovered;
   std::error_code ec;
   std::vector<std::string> actives, stale_claims;
@@ -357,6 +357,7 @@ std::vector<RecoveredBag> recoverActiveBags(const std::string& directory) {
   for (const std::string& active : actives) {
     FileLock lock(active);
     if (!lock.held() || !lock.stillAt(active)) continue;  // a live owner's, or another recoverer's
+    if (which == ActiveBags::kEmptyClaims && lock.size() != 0) continue;
     const std::string name = fs::path(active).filename().string();
     recovered.push_back(recoverOne(directory, active, name.substr(0, name.size() - std::strlen(kActiveSuffix)), lock));
   }
@@ -567,42 +568,60 @@ std::vector<collision_lab::ServedRun> RunIndexRecorder::list(const std::string& 
 
 bool RunIndexRecorder::endFromBag(const std::string& run_id, const std::string& bag_path, const BagContents& contents,
                                   const std::string& note) {
-  const auto row = index_->find(run_id);
-  if (row && row->state == RunState::kFinished) {
-    // Its end is known (e.g. its bag failed on a full disk, and the summary went to the index).
-    ROS_WARN_STREAM("run " << run_id << ": its bag was left unfinished, and the index has the run as finished: its summary is kept ("
-                    << (bag_path.empty() ? std::string("no bag") : "its bag " + bag_path) << ")");
-    return false;
+  // Made here, on the recovering thread: the writer thread only calls the index.
+  std::optional<IndexedRun> unseen;
+  if (contents.input) {  // the row of a run the index never saw (its node had no index)
+    unseen.emplace();
+    unseen->run_id = run_id;
+    unseen->student = contents.input->student;
+    unseen->accepted_at = contents.input->header.stamp.toSec();
+    unseen->body_count = static_cast<std::uint32_t>(contents.input->masses.size());
+    unseen->scene_json = inputJson(*contents.input);
   }
-  if (!row && contents.input) {
-    // A run the index never saw (its node had no index): its row from the bag's input.
-    IndexedRun row;
-    row.run_id = run_id;
-    row.student = contents.input->student;
-    row.accepted_at = contents.input->header.stamp.toSec();
-    row.body_count = static_cast<std::uint32_t>(contents.input->masses.size());
-    row.scene_json = inputJson(*contents.input);
-    index_->accepted(row);
+  std::optional<collision_lab::RunSummary> summary = contents.summary;
+  std::string text;
+  if (summary) {
+    summary->bag_path = bag_path;
+    summary->recording_ok = !bag_path.empty();
+    text = summaryJson(*summary);
+  } else {
+    text = interruptedJson(bag_path, contents, note);
   }
-  if (contents.summary) {
-    collision_lab::RunSummary summary = *contents.summary;
-    summary.bag_path = bag_path;
-    summary.recording_ok = !bag_path.empty();
-    index_->finished(run_id, wallNow(), summaryJson(summary), summary.stop_reason, summary.collision_count, bag_path,
-                     endingOf(summary));
-    ROS_INFO_STREAM("run " << run_id << ": completed from its bag's summary (" << note << ")");
-    return true;
-  }
-  index_->interrupted(run_id, wallNow(), interruptedJson(bag_path, contents, note), contents.events, bag_path);
-  ROS_WARN_STREAM("run " << run_id << ": interrupted (" << note << "); its bag "
-                  << (bag_path.empty() ? std::string("holds nothing") : bag_path + " holds " + std::to_string(contents.events) + " events"));
-  return true;
+  // Through the writer thread, as every write: never inside another group's transaction.
+  auto ended = std::make_shared<bool>(false);
+  const std::uint64_t ticket = enqueue(
+      [this, ended, run_id, bag_path, unseen, summary, text, note, events = contents.events] {
+        writeOrLog(
+            [&] {
+              const auto row = index_->find(run_id);
+              if (row && row->state == RunState::kFinished) {
+                // Its end is known (e.g. its bag failed on a full disk, and the summary went to the index).
+                ROS_WARN_STREAM("run " << run_id << ": its bag was left unfinished, and the index has the run as finished: its summary is kept ("
+                                << (bag_path.empty() ? std::string("no bag") : "its bag " + bag_path) << ")");
+                *ended = false;
+                return;
+              }
+              if (!row && unseen) index_->accepted(*unseen);
+              if (summary) {
+                index_->finished(run_id, wallNow(), text, summary->stop_reason, summary->collision_count, bag_path,
+                                 endingOf(*summary));
+                ROS_INFO_STREAM("run " << run_id << ": completed from its bag's summary (" << note << ")");
+              } else {
+                index_->interrupted(run_id, wallNow(), text, events, bag_path);
+                ROS_WARN_STREAM("run " << run_id << ": interrupted (" << note << "); its bag "
+                                << (bag_path.empty() ? std::string("holds nothing") : bag_path + " holds " + std::to_string(events) + " events"));
+              }
+              *ended = true;
+            },
+            "run " + run_id + ": its end is not in the run index");
+      },
+      /*urgent=*/true);
+  waitWritten(ticket);
+  return *ended;
 }
 
-std::size_t RunIndexRecorder::recover(const ServeAgain& serve_again) {
-  flush();  // it reads the runs' states
-  std::size_t ended = 0;
-  for (const RecoveredBag& bag : recoverActiveBags(bag_directory_)) {
+void RunIndexRecorder::takeRecoveredBags(const std::vector<RecoveredBag>& bags, std::size_t& ended) {
+  for (const RecoveredBag& bag : bags) {
     if (!bag.error.empty()) {
       ROS_ERROR_STREAM("run " << bag.run_id << ": its bag left .active by a dead node was not recovered: " << bag.error);
     }
@@ -618,26 +637,33 @@ std::size_t RunIndexRecorder::recover(const ServeAgain& serve_again) {
       ROS_ERROR_STREAM("run " << bag.run_id << ": not recorded as interrupted: " << e.what());
     }
   }
-  if (!index_) return ended;
+}
+
+void RunIndexRecorder::endOpenRuns(const ServeAgain& serve_again, bool queued_only,
+                                   std::map<std::string, bool>& offered, std::size_t& ended) {
   std::vector<IndexedRun> open_runs;
   try {
-    open_runs = index_->inState(RunState::kRunning);
+    if (!queued_only) open_runs = index_->inState(RunState::kRunning);
     const auto queued = index_->inState(RunState::kQueued);
     open_runs.insert(open_runs.end(), queued.begin(), queued.end());
   } catch (const RunIndexError& e) {
     ROS_ERROR_STREAM("recovery: the run index cannot be read: " << e.what());
-    return ended;
+    return;
   }
   for (const IndexedRun& run : open_runs) {
     const std::string final_path = bagPath(bag_directory_, run.run_id);
-    if (activeBagOwned(final_path + ".active")) continue;  // a live node's run
-    if (serve_again && run.state == RunState::kQueued && !fs::exists(final_path)) {
+    const std::string active_path = final_path + ".active";
+    if (activeBagOwned(active_path)) continue;  // a live node's run
+    if (queued_only && fs::exists(active_path)) continue;  // a dead node's bag: read in the second pass
+    const auto before = offered.find(run.run_id);
+    if (before != offered.end() && before->second) continue;  // served again
+    if (serve_again && run.state == RunState::kQueued && !fs::exists(final_path) && before == offered.end()) {
       try {
-        if (serve_again(QueuedRun{inputFromJson(run.scene_json), run.requested_run_id})) continue;
+        if ((offered[run.run_id] = serve_again(QueuedRun{inputFromJson(run.scene_json), run.requested_run_id}))) continue;
       } catch (const std::exception& e) {
         ROS_WARN_STREAM("run " << run.run_id << ": queued when its node died, and not served again: " << e.what());
       }
-      if (activeBagOwned(final_path + ".active")) continue;  // another live node claimed it meanwhile
+      if (activeBagOwned(active_path)) continue;  // another live node claimed it meanwhile
     }
     try {
       BagContents contents;
@@ -651,6 +677,19 @@ std::size_t RunIndexRecorder::recover(const ServeAgain& serve_again) {
       ROS_ERROR_STREAM("run " << run.run_id << ": not recovered: " << e.what());
     }
   }
+}
+
+std::size_t RunIndexRecorder::recover(const ServeAgain& serve_again) {
+  flush();  // it reads the runs' states
+  std::size_t ended = 0;
+  std::map<std::string, bool> offered;  // queued runs offered to serve_again (once each): taken
+  // First what needs no bag read: the dead nodes' empty claims, then their queued runs,
+  // served again at once.
+  takeRecoveredBags(recoverActiveBags(bag_directory_, ActiveBags::kEmptyClaims), ended);
+  if (index_) endOpenRuns(serve_again, /*queued_only=*/true, offered, ended);
+  // Then their bags, reindexed (seconds for a big one), and every run still open.
+  takeRecoveredBags(recoverActiveBags(bag_directory_, ActiveBags::kAll), ended);
+  if (index_) endOpenRuns(serve_again, /*queued_only=*/false, offered, ended);
   return ended;
 }
 

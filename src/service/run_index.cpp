@@ -14,6 +14,9 @@ namespace {
 /// The schema this code writes (PRAGMA user_version). A file of a newer version is refused.
 constexpr int kSchemaVersion = 2;
 
+/// [KiB] of pages each connection keeps in memory.
+constexpr int kPageCacheKiB = 256;
+
 /// The runs table of version 2, its columns.
 constexpr const char* kRunsTable = R"sql((
   run_id TEXT PRIMARY KEY NOT NULL,
@@ -265,6 +268,9 @@ void RunIndex::initialize() {
   // WAL's own durability: a commit survives the process (a crash of the node); only a
   // power cut may lose the last commits.
   execute("PRAGMA synchronous=NORMAL");
+  // A small page cache: the file's pages stay in the system's cache anyway, and a node's
+  // memory then stays flat as a class's index grows (SQLite's default is 2 MB per connection).
+  execute("PRAGMA cache_size=-" + std::to_string(kPageCacheKiB));
   std::int64_t found = 0;
   {  // finalized before the writes below: a finalize resets the connection's error code
     Statement version(statements_, db_, path_, "PRAGMA user_version");

@@ -130,22 +130,26 @@ TEST(Crash, KillNineKeepsFinishedBagsAndNeverOverwrites) {
   }
   fs::remove_all(copy_pattern);
 
-  // A restarted node recovers the interrupted bag at start, serves both run_ids again under
+  // A restarted node recovers the interrupted bag, serves both run_ids again under
   // the next free suffix, and touches neither the finished bag nor the recovered one.
   {
     const pid_t node = startNode(dir);
     ASSERT_GT(node, 0);
     RunCollector client(kNamespace);
     client.waitForConnection();
-    ASSERT_FALSE(fs::exists(dir + "/long_run.bag.active"));  // recovered before the node serves
-    ASSERT_TRUE(fs::exists(dir + "/long_run.bag"));
-    EXPECT_EQ(messageCount(dir + "/long_run.bag"), 3 + events_in_bag);  // parameters, input, prediction, events
     // ~list_runs (the run index) lists both runs of the killed node: the finished one, and
-    // the interrupted one with the events its bag holds.
+    // the interrupted one with the events its bag holds, once recovered (in the background,
+    // while the node serves).
     const std::string list_service = std::string("/") + kNamespace + "/collision_lab_node/list_runs";
     ASSERT_TRUE(ros::service::waitForService(list_service, ros::Duration(collision_lab_test::kWaitTimeout)));
     collision_lab::ListRuns list;
-    ASSERT_TRUE(ros::service::call(list_service, list));
+    waitUntil([&] {
+      return ros::service::call(list_service, list) && list.response.runs.size() == 2u &&
+             list.response.runs[1].finished;
+    }, "the node to recover the interrupted run");
+    ASSERT_FALSE(fs::exists(dir + "/long_run.bag.active"));
+    ASSERT_TRUE(fs::exists(dir + "/long_run.bag"));
+    EXPECT_EQ(messageCount(dir + "/long_run.bag"), 3 + events_in_bag);  // parameters, input, prediction, events
     ASSERT_EQ(list.response.runs.size(), 2u);
     EXPECT_EQ(list.response.runs[0].accepted.run_id, "finished");
     EXPECT_EQ(list.response.runs[0].stop_reason, "FINISHED");

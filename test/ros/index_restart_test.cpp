@@ -2,10 +2,14 @@
 // ~list_runs, read from the run index, still lists every run served before the crash, and
 // its start-up recovery does not touch the .bag.active of a live node sharing the folder
 // (lab_b, mid-run), whose run then ends normally with its bag complete; the run it was
-// computing is interrupted, and the one waiting in its queue is served again.
+// computing is interrupted, and the one waiting in its queue is served again. The respawned
+// node serves while it reindexes a dead node's big bag (no window without an answer).
 #include <signal.h>
 
+#include <chrono>
+#include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <set>
 #include <string>
 
@@ -15,8 +19,12 @@
 #include <ros/ros.h>
 #include <xmlrpcpp/XmlRpcClient.h>
 
+#include <rosbag/bag.h>
+#include <std_msgs/UInt64.h>
+
 #include "collision_lab/Cancel.h"
 #include "collision_lab/ListRuns.h"
+#include "collision_lab/RunScene.h"
 #include "run_collector.h"
 
 namespace {
@@ -51,6 +59,18 @@ std::vector<collision_lab::ServedRun> listRuns(const std::string& lab) {
   collision_lab::ListRuns list;
   EXPECT_TRUE(callService("/" + lab + "/collision_lab_node/list_runs", list));
   return list.response.runs;
+}
+
+/// A bag as a node killed mid-run leaves it: its chunks written, never closed, so never
+/// indexed (rosbag reindex reads it message by message). The Bag is not destroyed: its
+/// destructor would close it.
+void leaveUnfinishedBag(const std::string& path, std::uint64_t messages) {
+  auto* bag = new rosbag::Bag(path, rosbag::bagmode::Write);
+  std_msgs::UInt64 count;
+  for (std::uint64_t k = 0; k < messages; ++k) {
+    count.data = k;
+    bag->write("/dead_lab/count", ros::Time(1.0 + 1e-6 * static_cast<double>(k)), count);
+  }
 }
 
 const collision_lab::ServedRun* findRun(const std::vector<collision_lab::ServedRun>& runs, const std::string& run_id) {
@@ -101,6 +121,10 @@ TEST(IndexRestart, AKilledNodeRespawnsListingEveryRunAndLeavesALiveNodesBagAlone
     return running != lab_a.runs().end() && !running->second.events.empty() && queued && !queued->finished;
   }, "lab_a computing gus's long run with fay's queued");
 
+  // A big bag of another dead node in the folder: the respawned lab_a reindexes it.
+  const std::string dead_active = bags + "/dead_run.bag.active";
+  leaveUnfinishedBag(dead_active, 50000);
+
   const int old_pid = nodePid("/lab_a/collision_lab_node");
   ASSERT_GT(old_pid, 0);
   ASSERT_EQ(::kill(old_pid, SIGKILL), 0);
@@ -109,8 +133,36 @@ TEST(IndexRestart, AKilledNodeRespawnsListingEveryRunAndLeavesALiveNodesBagAlone
     const int pid = nodePid("/lab_a/collision_lab_node");
     return pid > 0 && pid != old_pid;
   }, "roslaunch to respawn /lab_a/collision_lab_node");
+  // It serves while it reindexes the dead bag. (Failed before: its services came up only
+  // once every dead bag was reindexed.)
+  const std::string run_scene = "/lab_a/collision_lab_node/run_scene";
+  ASSERT_TRUE(ros::service::waitForService(run_scene, ros::Duration(collision_lab_test::kWaitTimeout)));
+  collision_lab::RunScene pi;
+  pi.request.run_id = "after_crash";
+  pi.request.student = "hal";
+  pi.request.masses = {100, 1, std::numeric_limits<double>::infinity()};
+  pi.request.positions = {2, 1, 0};
+  pi.request.velocities = {-1, 0, 0};
+  const auto asked = std::chrono::steady_clock::now();
+  ASSERT_TRUE(callService(run_scene, pi));
+  const double answered_after = std::chrono::duration<double>(std::chrono::steady_clock::now() - asked).count();
+  const bool still_reindexing = fs::exists(dead_active);
+  EXPECT_TRUE(pi.response.ok) << pi.response.message;
+  EXPECT_EQ(pi.response.summary.collision_count, 31u);
+  EXPECT_TRUE(still_reindexing) << "lab_a served its first run only once the dead bag was reindexed";
   ASSERT_TRUE(ros::service::waitForService("/lab_a/collision_lab_node/list_runs",
                                            ros::Duration(collision_lab_test::kWaitTimeout)));
+  waitUntil([&] {
+    const auto listed = listRuns("lab_a");
+    const auto* dead = findRun(listed, "dead_run");
+    const auto* crashed = findRun(listed, "gus.long_a");
+    return dead && dead->finished && crashed && crashed->finished;
+  }, "the dead bags to be reindexed, and their runs ended, in the background");
+  const double recovered_after = std::chrono::duration<double>(std::chrono::steady_clock::now() - asked).count();
+  EXPECT_FALSE(fs::exists(dead_active));
+  EXPECT_TRUE(fs::exists(bags + "/dead_run.bag"));
+  std::printf("the respawned lab answered a pi run in %.3f s; it ended the dead runs %.1f s after it was asked\n",
+              answered_after, recovered_after);
 
   // The respawned node lists every earlier run, finished, with its bag.
   const auto runs = listRuns("lab_a");
@@ -132,11 +184,14 @@ TEST(IndexRestart, AKilledNodeRespawnsListingEveryRunAndLeavesALiveNodesBagAlone
   EXPECT_EQ(ana.response.runs[0].accepted.run_id, "ana.pi");
 
   // gus's run, computing at the crash, is interrupted; fay's, queued, is served again under
-  // its run_id. (Failed before: both "interrupted, 0 events".)
-  const auto* crashed = findRun(runs, "gus.long_a");
-  ASSERT_NE(crashed, nullptr);
-  EXPECT_TRUE(crashed->finished);
-  EXPECT_EQ(crashed->stop_reason, "INTERRUPTED");
+  // its run_id. (Failed before: both "interrupted, 0 events".) The dead bag's run, unknown
+  // to the index, is interrupted too.
+  for (const std::string run_id : {"gus.long_a", "dead_run"}) {
+    const auto* crashed = findRun(runs, run_id);
+    ASSERT_NE(crashed, nullptr) << run_id;
+    EXPECT_TRUE(crashed->finished) << run_id;
+    EXPECT_EQ(crashed->stop_reason, "INTERRUPTED") << run_id;
+  }
   waitUntil([&] {
     const auto again = lab_a.runs().find("fay.long_a");
     return again != lab_a.runs().end() && !again->second.events.empty();
@@ -145,7 +200,13 @@ TEST(IndexRestart, AKilledNodeRespawnsListingEveryRunAndLeavesALiveNodesBagAlone
   stop_fay.request.run_id = "fay.long_a";
   EXPECT_TRUE(waitUntil([&] { return callService("/lab_a/collision_lab_node/cancel", stop_fay) && stop_fay.response.ok; },
                         "fay's run, served again, to be stopped"));
-  const auto& fay = lab_a.waitFor("fay.long_a");
+  // Its summary (its first messages may have gone out before this test's subscribers met
+  // the respawned node: it starts at once).
+  waitUntil([&] {
+    const auto again = lab_a.runs().find("fay.long_a");
+    return again != lab_a.runs().end() && !again->second.summaries.empty();
+  }, "fay's run, stopped, to end");
+  const auto& fay = lab_a.runs().at("fay.long_a");
   ASSERT_EQ(fay.summaries.size(), 1u);
   EXPECT_EQ(fay.summaries[0].stop_reason, "CANCELLED");
   EXPECT_GT(fay.summaries[0].collision_count, 0u);

@@ -420,6 +420,7 @@ class LabNode {
 
   std::condition_variable watchdog_wake_;  ///< with mutex_: stopping_
   std::thread watchdog_;
+  std::thread recovery_;  ///< RunIndexRecorder::recover, at the start
   bool queue_changed_ = false;           ///< run_queue's state is not published yet
   bool queue_publisher_stops_ = false;   ///< the queue publisher ends once the state is out
   std::condition_variable queue_wake_;   ///< with mutex_: queue_changed_ or queue_publisher_stops_

@@ -12,6 +12,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <map>
 #include <optional>
 #include <string>
 #include <thread>
@@ -65,7 +66,10 @@ struct RecoveredBag {
 /// private folder of directory, renamed to <run_id>.bag (never replacing a file) and read;
 /// the .active file is then removed. An empty .active file (a claim whose bag was never
 /// opened) is removed. Claim files of claimers that died before renaming them are removed.
-std::vector<RecoveredBag> recoverActiveBags(const std::string& directory);
+/// kEmptyClaims: only the empty .active files (and the stale claim files), which cost no
+/// reading.
+enum class ActiveBags { kEmptyClaims, kAll };
+std::vector<RecoveredBag> recoverActiveBags(const std::string& directory, ActiveBags which = ActiveBags::kAll);
 
 /// Whether a live process holds <run_id>.bag.active (its flock cannot be taken).
 bool activeBagOwned(const std::string& active_path);
@@ -136,15 +140,17 @@ class RunIndexRecorder {
   /// Serves a queued run of a dead node again; true when it is taken (queued anew).
   using ServeAgain = std::function<bool(const QueuedRun&)>;
 
-  /// At the node's start, before it serves: recovers the .active bags of dead owners
+  /// At the node's start, on a thread of its own while the node serves: recovers the .active bags of dead owners
   /// (recoverActiveBags) and records their runs as interrupted (stop reason INTERRUPTED,
   /// the events the bag holds; finished from its summary when the bag has one; a run the
   /// index has as finished keeps its row, e.g. one whose bag failed on a full disk), then ends
   /// every run the index still has running, or queued, with no live owner: completed as
   /// finished from its final bag's summary, else interrupted with the events its bag holds
   /// (none without a bag). A queued run with no bag whose stored input reads back is first
-  /// offered to serve_again (oldest first), and left queued when it takes it. Nothing stays
-  /// "running". Returns the runs it ended.
+  /// offered to serve_again (oldest first), and left queued when it takes it. What needs no
+  /// bag read comes first (empty claims, then the queued runs), so that a big bag's
+  /// reindexing (seconds) holds up no queued run. Nothing stays "running". Its index writes
+  /// go through the writer thread, as every write. Returns the runs it ended.
   std::size_t recover(const ServeAgain& serve_again = {});
 
  private:
@@ -152,6 +158,13 @@ class RunIndexRecorder {
   /// and the row kept, when the index has it as finished already.
   bool endFromBag(const std::string& run_id, const std::string& bag_path, const BagContents& contents,
                   const std::string& note);
+  /// recover(): ends the runs of recovered bags (ended counts them).
+  void takeRecoveredBags(const std::vector<RecoveredBag>& bags, std::size_t& ended);
+  /// recover(): the open runs (queued_only: only the queued ones whose .active is gone)
+  /// with no live owner, each served again (when queued, not offered before; offered says
+  /// whether serve_again took it) or ended (not when taken).
+  void endOpenRuns(const ServeAgain& serve_again, bool queued_only, std::map<std::string, bool>& offered,
+                   std::size_t& ended);
 
   /// Hands `write` to the writer thread; returns its ticket (its place in the order of
   /// writes). An urgent write is committed at once (with whatever has queued up); a
