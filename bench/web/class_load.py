@@ -589,11 +589,12 @@ def queue_length(client):
 
 
 def settle(client, seconds=60):
-    """Waits until the lab's queue is empty (when it has one), then 2 s more."""
+    """Waits until the lab's queue is empty (when it has one), then 6 s more: the web node
+    gives the memory it freed back to the system every 5 s, the lab node when idle."""
     end = time.monotonic() + seconds
     while time.monotonic() < end and (queue_length(client) or 0) > 0:
         time.sleep(0.5)
-    time.sleep(2.0)
+    time.sleep(6.0)
 
 
 def mb(x):

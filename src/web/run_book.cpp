@@ -232,22 +232,21 @@ RunBook::RunBook(std::size_t envelope_vertices)
 
 RunBook::RunBook(const RunBookOptions& options, std::shared_ptr<const RunSource> source)
     : options_(options), source_(std::move(source)) {
+  for (std::size_t k = 0; k < std::max<std::size_t>(1, options_.rebuild_threads); ++k) {
+    rebuilders_.emplace_back(&RunBook::rebuildLoop, this);
+  }
   if (source_ && options_.reconcile_period.count() > 0) reconciler_ = std::thread(&RunBook::reconcileLoop, this);
 }
 
 RunBook::~RunBook() {
-  std::map<std::uint64_t, std::thread> rebuilds;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     stopping_ = true;
   }
   stop_.notify_all();
+  rebuild_wanted_.notify_all();
   if (reconciler_.joinable()) reconciler_.join();
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    rebuilds.swap(rebuilds_);
-  }
-  for (auto& [id, thread] : rebuilds) thread.join();
+  for (std::thread& rebuilder : rebuilders_) rebuilder.join();
 }
 
 namespace {
@@ -528,21 +527,21 @@ void RunBook::finishLocked(WebRun& run, const collision_lab::RunSummary& summary
 
 void RunBook::startRebuildLocked(WebRun& run, const std::string& bag_path) {
   run.rebuilding = true;
-  for (std::uint64_t done : rebuilds_done_) {
-    auto it = rebuilds_.find(done);
-    if (it == rebuilds_.end()) continue;
-    it->second.join();  // it has ended: it listed itself as its last step
-    rebuilds_.erase(it);
-  }
-  rebuilds_done_.clear();
-  const std::uint64_t id = next_rebuild_++;
-  rebuilds_.emplace(id, std::thread(&RunBook::rebuildFromBag, this, id, run.run_id, bag_path));
+  rebuild_queue_.emplace_back(run.run_id, bag_path);
+  rebuild_wanted_.notify_one();
 }
 
-void RunBook::rebuildFromBag(std::uint64_t rebuild, const std::string& run_id, const std::string& bag_path) {
-  completeFromBag(run_id, bag_path, std::nullopt);
-  std::lock_guard<std::mutex> lock(mutex_);
-  rebuilds_done_.push_back(rebuild);
+void RunBook::rebuildLoop() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  for (;;) {
+    rebuild_wanted_.wait(lock, [this] { return stopping_ || !rebuild_queue_.empty(); });
+    if (stopping_) return;
+    const auto [run_id, bag_path] = rebuild_queue_.front();
+    rebuild_queue_.pop_front();
+    lock.unlock();
+    completeFromBag(run_id, bag_path, std::nullopt);
+    lock.lock();
+  }
 }
 
 void RunBook::completeFromBag(const std::string& run_id, const std::string& bag_path,

@@ -3,6 +3,7 @@
 // topics, so a browser's run is recorded, published and drawn like any other.
 #include <arpa/inet.h>
 #include <ifaddrs.h>
+#include <malloc.h>
 #include <netinet/in.h>
 
 #include <algorithm>
@@ -32,6 +33,9 @@
 #include "collision_lab/web/web_server.h"
 
 namespace {
+
+/// [s] between two returns of freed memory to the system.
+constexpr double kFreedMemoryPeriod = 5.0;
 
 using namespace collision_lab_ros;  // topic names and queue sizes
 using collision_lab_web::WebConfig;
@@ -199,6 +203,11 @@ int main(int argc, char** argv) {
     ROS_INFO_STREAM("Class page: " << urls << (config.bind == "127.0.0.1" ? " (this machine only; web_bind:=0.0.0.0 opens it to the lab's network)" : " (give this address to the class)")
                                    << (config.code.empty() ? "" : "; every page needs the class code")
                                    << (config.teacher_code.empty() ? "" : "; the teacher page needs the teacher code"));
+    // The memory the node's threads freed (requests answered, runs evicted or read back)
+    // goes back to the system every few seconds: glibc keeps it in each thread's arena
+    // otherwise, and the node's resident memory would be its busiest moment's.
+    ros::WallTimer give_back = nh.createWallTimer(ros::WallDuration(kFreedMemoryPeriod),
+                                                  [](const ros::WallTimerEvent&) { malloc_trim(0); });
     ros::AsyncSpinner spinner(1);
     spinner.start();
     ros::waitForShutdown();

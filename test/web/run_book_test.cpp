@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <iostream>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <map>
 #include <mutex>
@@ -297,6 +298,45 @@ collision_lab_web::RunBookOptions smallBudget(std::size_t bytes) {
 std::string served(const collision_lab_web::RunBook& book, const std::string& run_id) {
   auto text = book.json(run_id);
   return text ? text->first : std::string();
+}
+
+/// Threads of this process now [1].
+std::size_t threadCount() {
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  while (std::getline(status, line)) {
+    if (line.rfind("Threads:", 0) == 0) return std::stoul(line.substr(8));
+  }
+  return 0;
+}
+
+// Thirty gases ending at once used to start thirty threads, each reading a bag: a few
+// rebuild threads take them in turn, and every run is still completed from its bag.
+TEST(RunBookMemory, RunsEndingTogetherAreRebuiltByAFewThreads) {
+  TempDir dir;
+  collision_lab_web::RunBook book(smallBudget(std::size_t{64} << 20), nullptr);
+  std::vector<ScriptedRun> runs;
+  for (int k = 0; k < 20; ++k) {
+    runs.push_back(scriptedRun("s" + std::to_string(k), "run" + std::to_string(k), 1.0e9 + k, 3, 2000, dir.path));
+    // The topics stopped at 10 events (~max_published_events): the rest is in the bag.
+    runs.back().summary.published_events = 10;
+    runs.back().summary.events_not_published = true;
+  }
+  const std::size_t threads_before = threadCount();
+  std::size_t threads_most = threads_before;
+  for (const ScriptedRun& run : runs) {
+    feed(book, run, 10);
+    threads_most = std::max(threads_most, threadCount());
+  }
+  EXPECT_LE(threads_most, threads_before) << "a thread per rebuild";
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  for (const ScriptedRun& run : runs) {
+    while (!book.finished(run.input.run_id) && std::chrono::steady_clock::now() < give_up) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    ASSERT_TRUE(book.finished(run.input.run_id)) << run.input.run_id;
+    EXPECT_EQ(json::parse(served(book, run.input.run_id)).at("collisions"), 2000) << run.input.run_id;
+  }
 }
 
 TEST(RunBookMemory, EvictedRunIsServedAgainFromItsBagWithTheSameContent) {

@@ -94,6 +94,9 @@ struct EvictedRun {
 };
 
 struct RunBookOptions {
+  /// Threads that rebuild runs from their bags (the runs whose events were not all
+  /// published): at most this many bags are read at once for them [1].
+  std::size_t rebuild_threads = 2;
   std::size_t envelope_vertices = 1024;  ///< points per plotted series at most (RecordLimits) [1]
   /// The runs held in memory stay within this (web node ~memory_budget_bytes) [bytes]. A
   /// run without a bag is never evicted (it could not be read back); a run alone larger
@@ -204,8 +207,11 @@ class RunBook {
   WebRun& runLocked(const std::string& run_id);
   void finishLocked(WebRun& run, const collision_lab::RunSummary& summary);
   void maybeFinishLocked(WebRun& run);
+  /// Queues the run's rebuild from its bag for the rebuild threads.
   void startRebuildLocked(WebRun& run, const std::string& bag_path);
-  void rebuildFromBag(std::uint64_t rebuild, const std::string& run_id, const std::string& bag_path);
+  /// A rebuild thread: takes the queued rebuilds one by one until the book stops (the
+  /// queued ones left are dropped then; each ends its current one).
+  void rebuildLoop();
   /// Reads the bag and completes the run (its pending summary, else the bag's, else the
   /// completion's fallback).
   void completeFromBag(const std::string& run_id, const std::string& bag_path, const std::optional<Completion>& how);
@@ -234,10 +240,11 @@ class RunBook {
   std::set<std::string> loading_;  ///< runs being read back (one load each)
   /// Inputs published and not yet answered: key student + '\n' + requested run_id.
   std::map<std::string, AnswerCallback> waiting_;
-  /// Rebuilds from bags in progress, and those done (joined at the next rebuild).
-  std::map<std::uint64_t, std::thread> rebuilds_;
-  std::vector<std::uint64_t> rebuilds_done_;
-  std::uint64_t next_rebuild_ = 0;
+  /// Rebuilds from bags waiting for a rebuild thread (run_id, bag path), oldest first. A
+  /// few threads read bags, however many runs end at once: memory and threads are bounded.
+  std::deque<std::pair<std::string, std::string>> rebuild_queue_;
+  std::condition_variable rebuild_wanted_;  ///< rebuild_queue_ grew, or stopping_
+  std::vector<std::thread> rebuilders_;
   bool stopping_ = false;
   std::condition_variable stop_;
   std::thread reconciler_;
