@@ -149,6 +149,15 @@ class Statement {
     while (step()) {
     }
   }
+  /// Runs a savepoint's SQL (SAVEPOINT, RELEASE) on the statement's connection.
+  void savepoint(const char* sql) const {
+    if (sqlite3_exec(db_, sql, nullptr, nullptr, nullptr) != SQLITE_OK) fail(std::string("executing '") + sql + "'");
+  }
+  /// Undoes the writes since the savepoint `name` and ends it; errors are ignored (the
+  /// failure being handled is the one reported).
+  void rollBackTo(const std::string& name) const {
+    sqlite3_exec(db_, ("ROLLBACK TO " + name + "; RELEASE " + name).c_str(), nullptr, nullptr, nullptr);
+  }
   std::string text(int column) const {
     const auto* p = reinterpret_cast<const char*>(sqlite3_column_text(stmt_, column));
     return p ? std::string(p, static_cast<std::size_t>(sqlite3_column_bytes(stmt_, column))) : std::string();
@@ -168,6 +177,20 @@ class Statement {
   const std::string& path_;
   sqlite3_stmt* stmt_ = nullptr;
 };
+
+/// Runs a run's row and its texts' statements as one (a savepoint: inside a group's
+/// transaction, or a transaction of its own); neither is written when one fails.
+void runTogether(Statement& row, Statement& texts) {
+  row.savepoint("SAVEPOINT run_row");
+  try {
+    row.run();
+    texts.run();
+  } catch (...) {
+    row.rollBackTo("run_row");
+    throw;
+  }
+  row.savepoint("RELEASE run_row");
+}
 
 std::int64_t asStored(std::uint64_t count) { return static_cast<std::int64_t>(count); }
 std::uint64_t asCount(std::int64_t stored) { return static_cast<std::uint64_t>(stored); }
@@ -335,15 +358,7 @@ void RunIndex::accepted(const IndexedRun& run) {
   Statement texts(statements_, db_, path_,
                   "INSERT OR REPLACE INTO run_texts (run_id, scene_json, summary_json) VALUES (?1, ?2, ?3)");
   texts.bind(1, run.run_id).bind(2, run.scene_json).bind(3, run.summary_json);
-  execute("SAVEPOINT accepted");  // the row and its texts together
-  try {
-    s.run();
-    texts.run();
-  } catch (...) {
-    sqlite3_exec(db_, "ROLLBACK TO accepted; RELEASE accepted", nullptr, nullptr, nullptr);
-    throw;
-  }
-  execute("RELEASE accepted");
+  runTogether(s, texts);
 }
 
 bool RunIndex::writeTogether(const std::function<void()>& writes, std::chrono::milliseconds lock_wait) {
@@ -417,15 +432,7 @@ void RunIndex::end(const std::string& run_id, RunState state, double at, const s
                   "INSERT INTO run_texts (run_id, summary_json) VALUES (?1, ?2) "
                   "ON CONFLICT(run_id) DO UPDATE SET summary_json = excluded.summary_json");
   texts.bind(1, run_id).bind(2, summary_json);
-  execute("SAVEPOINT ended");  // the row and its texts together
-  try {
-    s.run();
-    texts.run();
-  } catch (...) {
-    sqlite3_exec(db_, "ROLLBACK TO ended; RELEASE ended", nullptr, nullptr, nullptr);
-    throw;
-  }
-  execute("RELEASE ended");
+  runTogether(s, texts);
 }
 
 void RunIndex::rejected(const IndexedRejection& rejection) {
