@@ -743,7 +743,8 @@ LabNode::LabNode(ros::NodeHandle nh, ros::NodeHandle private_nh, const RunObserv
 }
 
 LabNode::~LabNode() {
-  recovery_.join();  // its runs served again are then in the queue, and dropped below
+  run_index_->stopRecovery();
+  recovery_.join();  // the runs it served again are in the queue, and dropped below
   // Cancel first: shutting a service down waits for its calls in progress, and a call
   // waits for its run.
   std::vector<Scheduler::Entry> waiting;
@@ -1112,8 +1113,9 @@ std::string LabNode::claimRunId(const std::string& requested, std::string& claim
     while (servedBefore(numbered()) || !claim(numbered(), claim_error)) ++n;
     return numbered();
   }
+  // A run_id the index has (any node's run, a dead node's queued one among them) is taken.
   std::string run_id = requested;
-  for (std::uint64_t n = 2; !claim(run_id, claim_error); ++n) {
+  for (std::uint64_t n = 2; servedBefore(run_id) || !claim(run_id, claim_error); ++n) {
     run_id = requested + "." + std::to_string(n);
   }
   return run_id;

@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -348,7 +349,10 @@ std::vector<RecoveredBag> recoverActiveBags(const std::string& directory, Active
   for (const auto& entry : fs::directory_iterator(directory, ec)) {
     const std::string name = entry.path().filename().string();
     if (endsWith(name, kActiveSuffix)) actives.push_back(entry.path().string());
-    else if (name.find(std::string(kActiveSuffix) + kClaimInfix) != std::string::npos) stale_claims.push_back(entry.path().string());
+    else if (name.find(std::string(kActiveSuffix) + kClaimInfix) != std::string::npos &&
+             name.find(std::string(kClaimInfix) + std::to_string(::getpid()) + ".") == std::string::npos) {
+      stale_claims.push_back(entry.path().string());  // another process's (this one's may be in the making)
+    }
   }
   for (const std::string& claim : stale_claims) {
     FileLock lock(claim);
@@ -364,7 +368,8 @@ std::vector<RecoveredBag> recoverActiveBags(const std::string& directory, Active
   return recovered;
 }
 
-RunIndexRecorder::RunIndexRecorder(const std::string& bag_directory) : bag_directory_(bag_directory) {
+RunIndexRecorder::RunIndexRecorder(const std::string& bag_directory)
+    : bag_directory_(bag_directory), started_at_(wallNow()) {
   std::error_code ec;
   fs::create_directories(bag_directory, ec);
   try {
@@ -588,7 +593,7 @@ bool RunIndexRecorder::endFromBag(const std::string& run_id, const std::string& 
     text = interruptedJson(bag_path, contents, note);
   }
   // Through the writer thread, as every write: never inside another group's transaction.
-  auto ended = std::make_shared<bool>(false);
+  auto ended = std::make_shared<std::atomic<bool>>(false);
   const std::uint64_t ticket = enqueue(
       [this, ended, run_id, bag_path, unseen, summary, text, note, events = contents.events] {
         writeOrLog(
@@ -616,12 +621,14 @@ bool RunIndexRecorder::endFromBag(const std::string& run_id, const std::string& 
             "run " + run_id + ": its end is not in the run index");
       },
       /*urgent=*/true);
-  waitWritten(ticket);
+  while (!waitWritten(ticket, kRecoveryWaitSlice) && !recovery_stops_) {
+  }
   return *ended;
 }
 
 void RunIndexRecorder::takeRecoveredBags(const std::vector<RecoveredBag>& bags, std::size_t& ended) {
   for (const RecoveredBag& bag : bags) {
+    if (recovery_stops_) return;
     if (!bag.error.empty()) {
       ROS_ERROR_STREAM("run " << bag.run_id << ": its bag left .active by a dead node was not recovered: " << bag.error);
     }
@@ -651,6 +658,9 @@ void RunIndexRecorder::endOpenRuns(const ServeAgain& serve_again, bool queued_on
     return;
   }
   for (const IndexedRun& run : open_runs) {
+    if (recovery_stops_) return;
+    // This process's own runs (accepted since it started) are never a dead node's.
+    if (run.accepted_at >= started_at_) continue;
     const std::string final_path = bagPath(bag_directory_, run.run_id);
     const std::string active_path = final_path + ".active";
     if (activeBagOwned(active_path)) continue;  // a live node's run
@@ -679,17 +689,20 @@ void RunIndexRecorder::endOpenRuns(const ServeAgain& serve_again, bool queued_on
   }
 }
 
+void RunIndexRecorder::stopRecovery() { recovery_stops_ = true; }
+
 std::size_t RunIndexRecorder::recover(const ServeAgain& serve_again) {
-  flush();  // it reads the runs' states
+  while (!flush(kRecoveryWaitSlice) && !recovery_stops_) {  // it reads the runs' states
+  }
   std::size_t ended = 0;
   std::map<std::string, bool> offered;  // queued runs offered to serve_again (once each): taken
   // First what needs no bag read: the dead nodes' empty claims, then their queued runs,
   // served again at once.
   takeRecoveredBags(recoverActiveBags(bag_directory_, ActiveBags::kEmptyClaims), ended);
-  if (index_) endOpenRuns(serve_again, /*queued_only=*/true, offered, ended);
+  if (index_ && !recovery_stops_) endOpenRuns(serve_again, /*queued_only=*/true, offered, ended);
   // Then their bags, reindexed (seconds for a big one), and every run still open.
-  takeRecoveredBags(recoverActiveBags(bag_directory_, ActiveBags::kAll), ended);
-  if (index_) endOpenRuns(serve_again, /*queued_only=*/false, offered, ended);
+  if (!recovery_stops_) takeRecoveredBags(recoverActiveBags(bag_directory_, ActiveBags::kAll), ended);
+  if (index_ && !recovery_stops_) endOpenRuns(serve_again, /*queued_only=*/false, offered, ended);
   return ended;
 }
 

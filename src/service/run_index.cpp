@@ -80,11 +80,12 @@ INSERT INTO runs (run_id, student, requested_run_id, state, accepted_at, started
          CASE WHEN json_valid(scene_json) THEN coalesce(json_array_length(scene_json, '$.masses'), 0) ELSE 0 END,
          CASE WHEN json_valid(summary_json) THEN coalesce(json_extract(summary_json, '$.model'), '') ELSE '' END,
          CASE WHEN json_valid(summary_json) THEN coalesce(json_extract(summary_json, '$.simulated'), 0) ELSE 0 END,
-         CASE WHEN json_valid(summary_json) THEN coalesce(json_extract(summary_json, '$.truncated'), 0)
-              ELSE state = 'interrupted' END,
+         CASE WHEN state = 'interrupted' THEN 1
+              WHEN json_valid(summary_json) THEN coalesce(json_extract(summary_json, '$.truncated'), 0) ELSE 0 END,
          CASE WHEN json_valid(summary_json) THEN coalesce(json_extract(summary_json, '$.collapsed'), 0) ELSE 0 END,
          CASE WHEN json_valid(summary_json) THEN coalesce(json_extract(summary_json, '$.cancelled'), 0) ELSE 0 END,
-         CASE WHEN json_valid(summary_json) AND coalesce(json_extract(summary_json, '$.cancelled'), 0)
+         CASE WHEN NOT json_valid(summary_json) THEN ''
+              WHEN coalesce(json_extract(summary_json, '$.cancelled'), 0)
               THEN coalesce(json_extract(summary_json, '$.truncation_reason'), '') ELSE '' END
   FROM runs_v1 ORDER BY rowid;
 INSERT INTO run_texts (run_id, scene_json, summary_json) SELECT run_id, scene_json, summary_json FROM runs_v1 ORDER BY rowid;

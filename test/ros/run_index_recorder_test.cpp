@@ -13,6 +13,7 @@
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
+#include <memory>
 #include <fstream>
 #include <string>
 #include <thread>
@@ -183,17 +184,19 @@ TEST_F(RunIndexRecorderTest, AKilledWritersBagIsReindexedRenamedAndCounted) {
 }
 
 TEST_F(RunIndexRecorderTest, RecoveryIndexesTheRunAsInterruptedWithItsEvents) {
-  RunIndexRecorder recorder(dir_);
-  ASSERT_TRUE(recorder.ok());
-  recorder.accepted("dead", "ana", "", input("dead", "ana"));
-  recorder.started("dead");
+  // The rows of a node that died (its recorder's writes committed), then the node that
+  // starts after it.
+  auto died = std::make_unique<RunIndexRecorder>(dir_);
+  ASSERT_TRUE(died->ok());
+  died->accepted("dead", "ana", "", input("dead", "ana"));
+  died->started("dead");
   killedWriter("dead", 30000);
   // Another dead run the index never saw: its row comes from the bag's input.
   killedWriter("unknown", 30000);
   // Queued rows of dead nodes: one without a bag, one whose final bag has its summary.
-  recorder.accepted("queued", "ana", "", input("queued", "ana"));
-  recorder.accepted("done", "ben", "", input("done", "ben"));
-  recorder.started("done");
+  died->accepted("queued", "ana", "", input("queued", "ana"));
+  died->accepted("done", "ben", "", input("done", "ben"));
+  died->started("done");
   {
     RunRecorder done(dir_, "done");
     collision_lab::RunSummary summary;
@@ -205,6 +208,8 @@ TEST_F(RunIndexRecorderTest, RecoveryIndexesTheRunAsInterruptedWithItsEvents) {
     ASSERT_TRUE(done.close());
   }
 
+  died.reset();
+  RunIndexRecorder recorder(dir_);
   EXPECT_EQ(recorder.recover(), 4u);
   RunIndex& index = *recorder.index();
   const auto dead = index.find("dead");
@@ -242,8 +247,8 @@ TEST_F(RunIndexRecorderTest, RecoveryIndexesTheRunAsInterruptedWithItsEvents) {
 }
 
 TEST_F(RunIndexRecorderTest, ALiveNodesQueuedRunIsLeftAlone) {
+  RunIndexRecorder(dir_).accepted("waiting", "", "", input("waiting", ""));  // another node's
   RunIndexRecorder recorder(dir_);
-  recorder.accepted("waiting", "", "", input("waiting", ""));
   std::string error;
   ASSERT_EQ(claimBag(dir_, "waiting", error), BagClaim::kClaimed) << error;  // its live owner
   EXPECT_EQ(recorder.recover(), 0u);
@@ -380,6 +385,20 @@ TEST_F(RunIndexRecorderTest, AQueuedRunOfADeadNodeIsOfferedToBeServedAgain) {
   EXPECT_EQ(recorder.recover([](const RunIndexRecorder::QueuedRun&) { return false; }), 1u);
   EXPECT_EQ(recorder.index()->find("fay.long")->state, RunState::kInterrupted);
   EXPECT_THROW(inputFromJson("{\"masses\": [1, null]}"), std::invalid_argument);
+}
+
+// A run this process accepted is its own, never a dead node's: recovery leaves it as it is,
+// with or without a bag claim (a node that does not record has none).
+TEST_F(RunIndexRecorderTest, RecoveryLeavesThisProcesssOwnRunsAlone) {
+  RunIndexRecorder recorder(dir_);
+  recorder.accepted("mine", "ana", "", input("mine", "ana"));
+  recorder.started("mine");
+  recorder.accepted("mine_queued", "ana", "", input("mine_queued", "ana"));
+  int offered = 0;
+  EXPECT_EQ(recorder.recover([&](const RunIndexRecorder::QueuedRun&) { return ++offered > 0; }), 0u);
+  EXPECT_EQ(offered, 0);
+  EXPECT_EQ(recorder.index()->find("mine")->state, RunState::kRunning);
+  EXPECT_EQ(recorder.index()->find("mine_queued")->state, RunState::kQueued);
 }
 
 TEST_F(RunIndexRecorderTest, AFinishedRunWhoseBagWasLeftActiveStaysFinished) {

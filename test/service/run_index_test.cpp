@@ -157,9 +157,12 @@ CREATE TABLE runs (run_id TEXT PRIMARY KEY NOT NULL, student TEXT NOT NULL DEFAU
   started_at REAL NOT NULL DEFAULT 0, finished_at REAL NOT NULL DEFAULT 0, scene_json TEXT NOT NULL DEFAULT '',
   summary_json TEXT NOT NULL DEFAULT '', stop_reason TEXT NOT NULL DEFAULT '',
   collision_count INTEGER NOT NULL DEFAULT 0, bag_path TEXT NOT NULL DEFAULT '', csv_path TEXT NOT NULL DEFAULT '');
+CREATE INDEX runs_by_student ON runs(student, accepted_at);
+CREATE INDEX runs_by_state ON runs(state);
 CREATE TABLE rejections (id INTEGER PRIMARY KEY AUTOINCREMENT, at REAL NOT NULL, student TEXT NOT NULL DEFAULT '',
   run_id TEXT NOT NULL DEFAULT '', reason_name TEXT NOT NULL DEFAULT '', field TEXT NOT NULL DEFAULT '',
   message TEXT NOT NULL DEFAULT '');
+CREATE INDEX rejections_by_student ON rejections(student, id);
 INSERT INTO runs (run_id, student, state, scene_json, summary_json, stop_reason, collision_count) VALUES
   ('ana.pi', 'ana', 'finished', '{"masses":[100,1,"inf"]}',
    '{"model":"three_body_rotation","simulated":true,"truncated":false,"collapsed":false,"cancelled":false}',
@@ -167,7 +170,9 @@ INSERT INTO runs (run_id, student, state, scene_json, summary_json, stop_reason,
   ('ben.gas', 'ben', 'finished', '{"masses":[1,1,1,1,1]}',
    '{"model":"engine","simulated":true,"truncated":true,"cancelled":true,"collapsed":false,"truncation_reason":"cancelled by ben"}',
    'CANCELLED', 9),
-  ('cy.lost', 'cy', 'interrupted', 'not json', '', 'INTERRUPTED', 0);
+  ('cy.lost', 'cy', 'interrupted', 'not json', '', 'INTERRUPTED', 0),
+  ('dan.cut', 'dan', 'interrupted', '{"masses":[1,1]}', '{"events_in_bag":4}', 'INTERRUPTED', 4);
+PRAGMA journal_mode=WAL;
 PRAGMA user_version=1;
 )sql";
     ASSERT_EQ(sqlite3_exec(db, v1, nullptr, nullptr, nullptr), SQLITE_OK) << sqlite3_errmsg(db);
@@ -192,13 +197,15 @@ PRAGMA user_version=1;
   EXPECT_EQ(lost->scene_json, "not json");  // the texts kept as they were
   EXPECT_EQ(lost->ending.model_name, "");
   EXPECT_TRUE(lost->ending.truncated);  // interrupted
+  EXPECT_TRUE(index.find("dan.cut")->ending.truncated);  // interrupted, whatever its text says
   std::vector<std::string> order;
   for (const auto& run : index.list()) order.push_back(run.run_id);
-  EXPECT_EQ(order, (std::vector<std::string>{"ana.pi", "ben.gas", "cy.lost"}));
+  EXPECT_EQ(order, (std::vector<std::string>{"ana.pi", "ben.gas", "cy.lost", "dan.cut"}));
+  EXPECT_EQ(index.list(std::string("ben")).size(), 1u);  // by student: its index made again
   // Written by this version from now on, and opened again without a second migration.
   index.accepted(queued("dan.new", "dan", 4.0));
   RunIndex again(path_);
-  EXPECT_EQ(again.runCount(), 4u);
+  EXPECT_EQ(again.runCount(), 5u);
   EXPECT_EQ(again.find("dan.new")->body_count, 3u);
 }
 

@@ -6,6 +6,7 @@
 // logged (ROS_ERROR), and the run goes on. Thread-safe (RunIndex is).
 #pragma once
 
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
@@ -83,6 +84,8 @@ constexpr std::chrono::milliseconds kIndexWriterLockWait{200};
 constexpr std::chrono::milliseconds kIndexRetryMaxPause{5000};
 /// How long a run's end (finished()) and ~list_runs wait for the index's commit.
 constexpr std::chrono::milliseconds kIndexCommitWait{2000};
+/// Recovery waits for the index in slices of this, so that stopRecovery() ends it.
+constexpr std::chrono::milliseconds kRecoveryWaitSlice{100};
 
 /// The lab node's writer of the index.
 class RunIndexRecorder {
@@ -151,7 +154,11 @@ class RunIndexRecorder {
   /// bag read comes first (empty claims, then the queued runs), so that a big bag's
   /// reindexing (seconds) holds up no queued run. Nothing stays "running". Its index writes
   /// go through the writer thread, as every write. Returns the runs it ended.
+  /// Runs accepted since this recorder was made are this process's and never ended here.
+  /// stopRecovery() ends it early (between two bags or runs; a reindex in progress ends
+  /// first), and its waits for the index give up then.
   std::size_t recover(const ServeAgain& serve_again = {});
+  void stopRecovery();
 
  private:
   /// Ends run_id from what its bag holds (finished with a summary, else interrupted); false,
@@ -185,6 +192,8 @@ class RunIndexRecorder {
   bool commit(const std::vector<std::function<void()>>& group);
 
   std::string bag_directory_;
+  const double started_at_;  ///< [s] since the epoch, wall time: this process's runs are newer
+  std::atomic<bool> recovery_stops_{false};
   std::unique_ptr<collision_lab::service::RunIndex> index_;
   // The writer thread's queue: writes in order, committed in groups.
   mutable std::mutex writes_mutex_;
