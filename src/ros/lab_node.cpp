@@ -1089,14 +1089,28 @@ std::string LabNode::newRunId(std::string& claim_error) {
   return run_id;
 }
 
-bool LabNode::servedBefore(const std::string& run_id) {
-  if (!run_index_->ok()) return false;
+namespace {
+/// run_id's state in the run index; none when the index does not list it or cannot be read.
+std::optional<collision_lab::service::RunState> indexedState(const RunIndexRecorder& run_index,
+                                                             const std::string& run_id) {
+  if (!run_index.ok()) return std::nullopt;
   try {
-    return run_index_->committed()->find(run_id).has_value();  // this node's own runs are in used_run_ids_
+    const auto run = run_index.committed()->find(run_id);  // this node's own runs are in used_run_ids_
+    if (!run) return std::nullopt;
+    return run->state;
   } catch (const collision_lab::service::RunIndexError& e) {
     ROS_WARN_STREAM("the run index cannot tell whether run_id '" << run_id << "' was served: " << e.what());
-    return false;
+    return std::nullopt;
   }
+}
+}  // namespace
+
+bool LabNode::servedBefore(const std::string& run_id) { return indexedState(*run_index_, run_id).has_value(); }
+
+bool LabNode::heldByUnendedRun(const std::string& run_id) {
+  using collision_lab::service::RunState;
+  const auto state = indexedState(*run_index_, run_id);
+  return state == RunState::kQueued || state == RunState::kRunning;
 }
 
 bool LabNode::claim(const std::string& run_id, std::string& claim_error) {
@@ -1113,9 +1127,10 @@ std::string LabNode::claimRunId(const std::string& requested, std::string& claim
     while (servedBefore(numbered()) || !claim(numbered(), claim_error)) ++n;
     return numbered();
   }
-  // A run_id the index has (any node's run, a dead node's queued one among them) is taken.
+  // A run the index has that has not ended (a dead node's queued run, served again by
+  // recovery under its id) holds its run_id; an ended one, without a bag, does not.
   std::string run_id = requested;
-  for (std::uint64_t n = 2; servedBefore(run_id) || !claim(run_id, claim_error); ++n) {
+  for (std::uint64_t n = 2; heldByUnendedRun(run_id) || !claim(run_id, claim_error); ++n) {
     run_id = requested + "." + std::to_string(n);
   }
   return run_id;

@@ -237,6 +237,47 @@ TEST(IndexRestart, AKilledNodeRespawnsListingEveryRunAndLeavesALiveNodesBagAlone
   EXPECT_EQ(ended->collision_count, long_out.summaries[0].collision_count);
 }
 
+/// The run_id lab_c served scene `run_id` under (pi, 31 impacts), through ~run_scene.
+std::string servedRunId(const std::string& run_id) {
+  collision_lab::RunScene pi;
+  pi.request.run_id = run_id;
+  pi.request.masses = {100, 1, std::numeric_limits<double>::infinity()};
+  pi.request.positions = {2, 1, 0};
+  pi.request.velocities = {-1, 0, 0};
+  EXPECT_TRUE(callService("/lab_c/collision_lab_node/run_scene", pi));
+  EXPECT_TRUE(pi.response.ok) << pi.response.message;
+  EXPECT_EQ(pi.response.summary.collision_count, 31u);
+  return pi.response.summary.run_id;
+}
+
+// A lab that records no bags (lab_c) shares the index: a run_id of an ended run there
+// holds nothing once its node is gone, so a class running the same scene after a restart
+// gets the run_id it typed. (Failed before: "again.3", as long as the index lists
+// "again" and "again.2".)
+TEST(IndexRestart, ARunIdOfAnEndedRunWithoutABagIsServedAsTypedAfterARestart) {
+  const std::string run_scene = "/lab_c/collision_lab_node/run_scene";
+  ASSERT_TRUE(ros::service::waitForService(run_scene, ros::Duration(collision_lab_test::kWaitTimeout)));
+  EXPECT_EQ(servedRunId("again"), "again");
+  EXPECT_EQ(servedRunId("again"), "again.2");  // the same process served "again"
+
+  const int old_pid = nodePid("/lab_c/collision_lab_node");
+  ASSERT_GT(old_pid, 0);
+  ASSERT_EQ(::kill(old_pid, SIGKILL), 0);
+  waitUntil([&] {
+    const int pid = nodePid("/lab_c/collision_lab_node");
+    return pid > 0 && pid != old_pid;
+  }, "roslaunch to respawn /lab_c/collision_lab_node");
+  ASSERT_TRUE(ros::service::waitForService(run_scene, ros::Duration(collision_lab_test::kWaitTimeout)));
+  EXPECT_EQ(servedRunId("again"), "again");
+
+  const auto runs = listRuns("lab_c");
+  const auto* again = findRun(runs, "again");
+  ASSERT_NE(again, nullptr);
+  EXPECT_TRUE(again->finished);
+  EXPECT_EQ(again->bag_path, "");
+  EXPECT_NE(findRun(runs, "again.2"), nullptr);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
