@@ -17,6 +17,13 @@ if(TARGET student_quota_test)
   target_link_libraries(student_quota_test collision_lab_service GTest::gtest_main)
 endif()
 
+# Whether the lab takes a run: the bag folder's floor and the student's quota, on a
+# disk the test sets (no master, no root).
+catkin_add_gtest(admission_test test/service/admission_test.cpp)
+if(TARGET admission_test)
+  target_link_libraries(admission_test collision_lab_service GTest::gtest_main)
+endif()
+
 # The lab node's side (no master): the bag claim's lock, recovery of a killed writer's
 # .active bag (reindexed with `rosbag reindex`), stale rows ended, ~list_runs' rows.
 catkin_add_gtest(run_index_recorder_test test/ros/run_index_recorder_test.cpp)

@@ -39,8 +39,7 @@ class RunWriter {
   /// What recording may take: bytes per bag (0: no limit) and the free space it leaves.
   struct RecordLimits {
     std::uint64_t max_bag_bytes = 0;
-    std::string bag_directory;
-    double min_free_space_mb = 0.0;  ///< [MB] 0: none
+    const collision_lab::service::Admission* admission = nullptr;  ///< the free-space floor; null: none
     collision_lab::service::StudentQuota* quota = nullptr;  ///< null: none
     std::string student;             ///< whose quota the run's bytes count in
   };
@@ -140,12 +139,8 @@ class RunWriter {
     const bool over_quota = limits_.quota && limits_.quota->recorded(limits_.student, recorded_bytes_ - quota_bytes_);
     quota_bytes_ = recorded_bytes_;
     if (over_quota) return reach(Limit::kStudentQuota);
-    if (limits_.min_free_space_mb <= 0) return;
     // What the bag writers still hold will take space too.
-    const auto free_mb = freeMegabytes(limits_.bag_directory);
-    if (free_mb && *free_mb - 1e-6 * static_cast<double>(RunBagWriter::bytesWaiting()) < limits_.min_free_space_mb) {
-      reach(Limit::kFreeSpace);
-    }
+    if (limits_.admission && limits_.admission->underFloor(RunBagWriter::bytesWaiting())) reach(Limit::kFreeSpace);
   }
   void reach(Limit limit) {
     over_limit_ = true;
@@ -680,6 +675,10 @@ LabNode::LabNode(ros::NodeHandle nh, ros::NodeHandle private_nh, const RunObserv
   student_quota_ = std::make_unique<collision_lab::service::StudentQuota>(
       static_cast<std::uint64_t>(std::max(0.0, params_.max_student_bag_mb) * 1e6),
       [this](const std::string& student) { return studentBagBytes(student); });
+  admission_ = std::make_unique<collision_lab::service::Admission>(
+      collision_lab::service::Admission::Options{params_.record, params_.bag_directory, params_.min_free_space_mb,
+                                                 params_.max_student_bag_mb},
+      student_quota_.get());
   const std::string parameters_topic = nh_.resolveName(kRunParametersTopic);
   const RunBagWriter::Topics bag_topics{nh_.resolveName(kInitialConditionsTopic), topics_.predictions.getTopic(),
                                         topics_.events.getTopic(), topics_.summaries.getTopic(), parameters_topic,
@@ -856,37 +855,19 @@ LabNode::RunLimits LabNode::limitsOf(const collision_lab::InitialConditions& inp
   return limits;
 }
 
-std::optional<collision_lab::Rejected> LabNode::checkFreeSpace() const {
-  if (!params_.record || params_.min_free_space_mb <= 0) return std::nullopt;
-  const auto free_mb = freeMegabytes(params_.bag_directory);
-  if (!free_mb || *free_mb >= params_.min_free_space_mb) return std::nullopt;
+namespace {
+/// A refusal of the admission (the floor, a quota) as the node's Rejected.
+collision_lab::Rejected rejectionOf(const collision_lab::service::Refusal& refusal) {
+  using Reason = collision_lab::service::Refusal::Reason;
   collision_lab::Rejected rejection;
-  rejection.reason = collision_lab::Rejected::DISK_SPACE;
-  rejection.reason_name = "DISK_SPACE";
-  rejection.field = "bag_directory";
-  std::ostringstream message;
-  message << "the lab's bag folder " << params_.bag_directory << " has " << std::fixed << std::setprecision(1)
-          << *free_mb << " MB free, under the node's floor ~min_free_space_mb = " << params_.min_free_space_mb
-          << " MB: no run starts until space is freed (ask the teacher), so that no bag is cut short";
-  rejection.message = message.str();
+  const bool disk = refusal.reason == Reason::kDiskSpace;
+  rejection.reason = disk ? collision_lab::Rejected::DISK_SPACE : collision_lab::Rejected::STUDENT_QUOTA;
+  rejection.reason_name = disk ? "DISK_SPACE" : "STUDENT_QUOTA";
+  rejection.field = refusal.field;
+  rejection.message = refusal.message;
   return rejection;
 }
-
-std::optional<collision_lab::Rejected> LabNode::checkStudentQuota(const std::string& student) {
-  if (!params_.record || !student_quota_ || !student_quota_->applies(student)) return std::nullopt;
-  const std::uint64_t used = student_quota_->admissionUse(student);
-  if (used < student_quota_->maxBytes()) return std::nullopt;
-  collision_lab::Rejected rejection;
-  rejection.reason = collision_lab::Rejected::STUDENT_QUOTA;
-  rejection.reason_name = "STUDENT_QUOTA";
-  rejection.field = "student";
-  std::ostringstream message;
-  message << "student '" << student << "' has " << std::fixed << std::setprecision(1) << 1e-6 * static_cast<double>(used)
-          << " MB of bags in this lab, the node's ~max_student_bag_mb = " << params_.max_student_bag_mb
-          << " MB or more: no run of theirs starts until the teacher deletes some of their bags";
-  rejection.message = message.str();
-  return rejection;
-}
+}  // namespace
 
 std::uint64_t LabNode::studentBagBytes(const std::string& student) const {
   if (!run_index_->ok()) return 0;
@@ -917,11 +898,11 @@ bool LabNode::intake(collision_lab::InitialConditions input, Reply reply, const 
     if (reply) reply->set_value(std::move(outcome));
     return false;
   }
-  std::optional<collision_lab::Rejected> refused;
-  if (!served_again && !(refused = checkFreeSpace())) refused = checkStudentQuota(input.student);
-  if (refused) {
-    refused->student = input.student;
-    ServeOutcome outcome = reject(std::move(*refused), requested);
+  const auto refusal = served_again ? std::nullopt : admission_->check(input.student);
+  if (refusal) {
+    collision_lab::Rejected refused = rejectionOf(*refusal);
+    refused.student = input.student;
+    ServeOutcome outcome = reject(std::move(refused), requested);
     if (reply) reply->set_value(std::move(outcome));
     return false;
   }
@@ -1178,8 +1159,8 @@ void LabNode::serve(Worker& worker, Job& job) {
   const ros::Time start = stampNow();
   RunWriter out(job.input.run_id, RunTimeline(start, chooseTimelineScale(firstContactTime(job.plan.scene))),
                 worker.bags.get(), job.claim_error,
-                RunWriter::RecordLimits{job.limits.max_bag_bytes, params_.bag_directory, params_.min_free_space_mb,
-                                        student_quota_.get(), job.input.student},
+                RunWriter::RecordLimits{job.limits.max_bag_bytes, admission_.get(), student_quota_.get(),
+                                        job.input.student},
                 [this, &worker](RunWriter::Limit limit) {
                   const StopCause cause = limit == RunWriter::Limit::kBagBytes    ? StopCause::kBagLimit
                                           : limit == RunWriter::Limit::kFreeSpace ? StopCause::kDiskSpace
@@ -1468,7 +1449,7 @@ void LabNode::addRecordingStatus(diagnostic_updater::DiagnosticStatusWrapper& st
   if (!recording_error.empty()) {
     status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "recording failed: " + recording_error);
   }
-  const auto free_mb = freeMegabytes(params_.bag_directory);
+  const auto free_mb = admission_->freeSpaceMb();
   if (!free_mb) {
     status.add("free space in bag directory [MB]", "unknown (directory not readable)");
     return;

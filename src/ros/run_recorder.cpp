@@ -5,7 +5,6 @@
 #include <fcntl.h>
 #include <sys/file.h>
 #include <sys/stat.h>
-#include <sys/statvfs.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -121,12 +120,6 @@ std::string expandUser(const std::string& path) {
   if (path.empty() || path[0] != '~') return path;
   const char* home = std::getenv("HOME");
   return std::string(home ? home : "") + path.substr(1);
-}
-
-std::optional<double> freeMegabytes(const std::string& directory) {
-  struct statvfs space {};
-  if (::statvfs(directory.c_str(), &space) != 0) return std::nullopt;
-  return static_cast<double>(space.f_bavail) * static_cast<double>(space.f_frsize) / 1e6;
 }
 
 RunRecorder::RunRecorder(const std::string& directory, const std::string& run_id)

@@ -83,6 +83,7 @@
 #include "collision_lab/RunQueue.h"
 #include "collision_lab/ros/msg_conversion.h"
 #include "collision_lab/ros/run_observer.h"
+#include "collision_lab/service/admission.h"
 #include "collision_lab/service/student_quota.h"
 #include "collision_lab/service/fair_scheduler.h"
 
@@ -314,10 +315,6 @@ class LabNode {
   void watchdogLoop();
   /// Sets worker's cancel flag with cause (kept when one is set already). mutex_ held.
   static void stopRun(Worker& worker, StopCause cause, const std::string& by);
-  /// DISK_SPACE when recording and the bag directory's free space is under ~min_free_space_mb.
-  std::optional<collision_lab::Rejected> checkFreeSpace() const;
-  /// STUDENT_QUOTA when recording and the student's bags take ~max_student_bag_mb or more.
-  std::optional<collision_lab::Rejected> checkStudentQuota(const std::string& student);
   /// [bytes] of the student's bags on disk, as the run index lists them.
   std::uint64_t studentBagBytes(const std::string& student) const;
   /// The queue changed: run_queue is published with its state by the queue publisher's
@@ -392,6 +389,9 @@ class LabNode {
   std::unique_ptr<RunIndexRecorder> run_index_;
   /// Each named student's bytes of bags (~max_student_bag_mb); made before recovery serves runs.
   std::unique_ptr<collision_lab::service::StudentQuota> student_quota_;
+  /// Whether a new run is taken now, whether a recording run goes on: the bag folder's
+  /// floor (~min_free_space_mb) and student_quota_ (DISK_SPACE, STUDENT_QUOTA).
+  std::unique_ptr<collision_lab::service::Admission> admission_;
   /// Publishes /diagnostics; the wall timer forces an update every kDiagnosticsPeriod (the
   /// updater's own rate follows ROS time, which stands still on a replay before its clock).
   diagnostic_updater::Updater diagnostics_;

@@ -95,10 +95,6 @@ boost::shared_ptr<ros::M_string> connectionHeader(const std::string& topic, cons
 /// Expands a leading "~" to $HOME.
 std::string expandUser(const std::string& path);
 
-/// [MB] free to an unprivileged writer in the file system of directory; nullopt when it
-/// cannot be read.
-std::optional<double> freeMegabytes(const std::string& directory);
-
 /// Releases bag unless it is closed: a rosbag::Bag that failed to close (RunRecorder's
 /// closeIntoNull) would throw from its destructor and end the process, so it is leaked,
 /// its file pointed at /dev/null. Logs each leak.
