@@ -13,7 +13,13 @@ add_library(collision_lab_ros
   src/ros/run_recorder.cpp
   src/ros/run_timeline.cpp
   src/ros/run_index_recorder.cpp
-  src/ros/lab_node.cpp)
+  src/ros/lab_node.cpp
+  src/ros/lab_node_diagnostics.cpp
+  src/ros/lab_node_inputs.cpp
+  src/ros/lab_node_params.cpp
+  src/ros/node_text.cpp
+  src/ros/run_ids.cpp
+  src/ros/served_runs.cpp)
 target_include_directories(collision_lab_ros PUBLIC include)
 # collision_lab_io: the node reads the presets of ~run_preset.
 # collision_lab_service: the run index the node writes and ~list_runs reads.

@@ -3,176 +3,23 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
 #include <filesystem>
-#include <ctime>
-#include <functional>
-#include <iomanip>
-#include <new>
 #include <optional>
 #include <sstream>
-#include <stdexcept>
 #include <thread>
 #include <utility>
 
 #include <malloc.h>
 
-#include <ros/package.h>
-
-#include "collision_lab/io/scenario_file.h"
 #include "collision_lab/ros/msg_conversion.h"
 #include "collision_lab/ros/node_constants.h"
 #include "collision_lab/ros/run_index_recorder.h"
 #include "collision_lab/ros/run_recorder.h"
 #include "collision_lab/ros/run_timeline.h"
+#include "node_text.h"
+#include "run_writer.h"
 
 namespace collision_lab_ros {
-
-/// Stamps the messages of one run on its timeline, publishes them and hands what is
-/// recorded over to the bag writer, in batches of at most kRecordBatchEvents events.
-/// Counts the serialized bytes it records: past max_bag_bytes (0: no limit), or when the
-/// bag directory's free space is under its floor (looked at every kFreeSpaceProbeBytes), it
-/// calls on_limit once (the run is then stopped; what the run still computes is recorded).
-class RunWriter {
- public:
-  enum class Limit { kBagBytes, kFreeSpace, kStudentQuota };
-  /// What recording may take: bytes per bag (0: no limit) and the free space it leaves.
-  struct RecordLimits {
-    std::uint64_t max_bag_bytes = 0;
-    const collision_lab::service::Admission* admission = nullptr;  ///< the free-space floor; null: none
-    collision_lab::service::StudentQuota* quota = nullptr;  ///< null: none
-    std::string student;             ///< whose quota the run's bytes count in
-  };
-  /// bags may be null (not recording). claim_error: RunBagBatch::claim_error.
-  RunWriter(std::string run_id, RunTimeline timeline, RunBagWriter* bags, std::string claim_error,
-            RecordLimits limits, std::function<void(Limit)> on_limit)
-      : run_id_(std::move(run_id)), timeline_(timeline), bags_(bags), limits_(std::move(limits)),
-        on_limit_(std::move(on_limit)) {
-    batch_.run_id = run_id_;
-    batch_.opens = true;
-    batch_.claim_error = std::move(claim_error);
-  }
-
-  RunWriter(const RunWriter&) = delete;
-  RunWriter& operator=(const RunWriter&) = delete;
-  /// A run that never handed its summary over (its end failed) gives its counted bytes back
-  /// to its student's quota; a finished one does so when its bag is closed (publishEnd).
-  ~RunWriter() {
-    if (!handed_over_ && limits_.quota) limits_.quota->ended(limits_.student, quota_bytes_, 0);
-  }
-
-  const RunTimeline& timeline() const { return timeline_; }
-  bool recording() const { return bags_ != nullptr; }
-  /// True once the run's summary was handed over (finish()) or, not recording, is being
-  /// published (markFinished()).
-  bool finished() const { return finished_; }
-  void markFinished() { finished_ = true; }
-  /// [bytes] serialized size of the messages recorded so far.
-  std::uint64_t recordedBytes() const { return recorded_bytes_; }
-  /// [bytes] of them counted in the student's quota (RecordLimits::quota).
-  std::uint64_t quotaBytes() const { return quota_bytes_; }
-  /// [s] of this (the node's) thread spent handing messages over to the bag writer.
-  double recordingSeconds() const { return recording_time_.count(); }
-
-  /// Sets run_id and header.stamp: the timeline's stamp of simulated time t [s].
-  template <class Message>
-  void stamp(Message& msg, double t) {
-    msg.run_id = run_id_;
-    msg.header.stamp = timeline_.stamp(t);
-  }
-  /// Stamps at t and publishes.
-  template <class Message>
-  void publish(const ros::Publisher& pub, Message& msg, double t) {
-    stamp(msg, t);
-    pub.publish(msg);
-  }
-
-  /// Records the run's parameters, stamped at the run's start.
-  void record(collision_lab::RunParameters parameters) {
-    if (!bags_) return;
-    stamp(parameters, 0.0);
-    count(parameters);
-    timed([&] { batch_.parameters = std::move(parameters); });
-  }
-  /// Record (at their header.stamp): the input, the prediction, each event.
-  void record(const collision_lab::InitialConditions& input) {
-    if (!bags_) return;
-    count(input);
-    timed([&] { batch_.input = input; });
-  }
-  void record(const collision_lab::Prediction& prediction) {
-    if (!bags_) return;
-    count(prediction);
-    timed([&] { batch_.prediction = prediction; });
-  }
-  void record(collision_lab::CollisionEvent&& event) {
-    if (!bags_) return;
-    count(event);
-    timed([&] {
-      batch_.events.push_back(std::move(event));
-      if (batch_.events.size() >= kRecordBatchEvents) handOver();
-    });
-  }
-  /// Records the summary last and closes the bag on the writer's thread, which then
-  /// calls on_closed with the summary's final recording fields.
-  void finish(const collision_lab::RunSummary& summary,
-              std::function<void(collision_lab::RunSummary&)> on_closed) {
-    finished_ = true;
-    timed([&] {
-      batch_.summary = summary;
-      batch_.on_closed = std::move(on_closed);
-      handOver();
-    });
-    handed_over_ = true;
-  }
-
- private:
-  template <class Message>
-  void count(const Message& msg) {
-    const std::uint32_t bytes = ros::serialization::serializationLength(msg);
-    recorded_bytes_ += bytes;
-    batch_.bytes += bytes;
-    if (over_limit_) return;
-    if (limits_.max_bag_bytes > 0 && recorded_bytes_ > limits_.max_bag_bytes) return reach(Limit::kBagBytes);
-    if (recorded_bytes_ < next_probe_) return;
-    next_probe_ = recorded_bytes_ + kFreeSpaceProbeBytes;
-    const bool over_quota = limits_.quota && limits_.quota->recorded(limits_.student, recorded_bytes_ - quota_bytes_);
-    quota_bytes_ = recorded_bytes_;
-    if (over_quota) return reach(Limit::kStudentQuota);
-    // What the bag writers still hold will take space too.
-    if (limits_.admission && limits_.admission->underFloor(RunBagWriter::bytesWaiting())) reach(Limit::kFreeSpace);
-  }
-  void reach(Limit limit) {
-    over_limit_ = true;
-    if (on_limit_) on_limit_(limit);
-  }
-  template <class F>
-  void timed(F&& f) {
-    const auto start = std::chrono::steady_clock::now();
-    f();
-    recording_time_ += std::chrono::steady_clock::now() - start;
-  }
-  void handOver() {
-    bags_->push(std::move(batch_));
-    batch_ = RunBagBatch();
-    batch_.run_id = run_id_;
-  }
-
-  std::string run_id_;
-  RunTimeline timeline_;
-  RunBagWriter* bags_;
-  RunBagBatch batch_;
-  std::chrono::duration<double> recording_time_{0.0};
-  RecordLimits limits_;
-  std::function<void(Limit)> on_limit_;
-  std::uint64_t recorded_bytes_ = 0;
-  std::uint64_t next_probe_ = 0;  ///< the first message looks: a run may start under the floor or over its quota
-  std::uint64_t quota_bytes_ = 0;
-  bool handed_over_ = false;  ///< finish() handed the summary, and the quota's bytes, to the bag writer
-  bool over_limit_ = false;
-  bool finished_ = false;
-};
-
 namespace {
 
 /// Message stamps double as bag times, which must be >= ros::TIME_MIN: under
@@ -183,138 +30,6 @@ ros::Time stampNow() {
   const ros::WallTime wall = ros::WallTime::now();
   return ros::Time(wall.sec, wall.nsec);
 }
-
-/// Now, in UTC, as format. Thread-safe (the service threads call it concurrently):
-/// gmtime_r, not std::gmtime's shared buffer.
-std::string utcStamp(const char* format) {
-  char buffer[32];
-  const std::time_t now = std::time(nullptr);
-  std::tm utc{};
-  gmtime_r(&now, &utc);
-  std::strftime(buffer, sizeof buffer, format, &utc);
-  return buffer;
-}
-
-/// What of a run's collisions goes out on the topics (LabNodeParams).
-struct PublishLimits {
-  std::uint64_t max_published = 0;          ///< [1] collisions published one by one
-  double progress_period = 0.0;             ///< [s] of wall time between two RunProgress
-  std::uint64_t progress_every_events = 0;  ///< [1] test hook: instead of the period, when > 0
-};
-
-/// Fills the state of every body after event from replay (for scenes above
-/// CollisionEvent.FULL_STATE_MAX_BODIES, whose events carry none): positions at the event's
-/// time, velocities and kinetic energies after it, the totals. Keeps event's storage.
-void fillFullState(const collision_lab::core::BodyStateReplay& replay, collision_lab::CollisionEvent& event) {
-  event.positions.resize(replay.size());
-  for (std::size_t i = 0; i < replay.size(); ++i) event.positions[i] = replay.position(i, event.time);
-  event.velocities_after = replay.velocities();
-  event.kinetic_energy_after = replay.kineticEnergies();
-  event.total_energy = replay.totalKineticEnergy();
-  event.total_momentum = replay.momentum();
-}
-
-/// The per-collision messages of one run. Every CollisionEvent is recorded and drawn;
-/// the first max_published also go out on collision_events and, as their plot
-/// projections (live only, never recorded: docs/messages.md), on velocities and
-/// energy_transfers. Past them, a RunProgress (live only) goes out at the first collision
-/// not published and then at most every progress_period of wall time: a clock check per
-/// collision, no allocation once its message has grown to the scene's size. Each is
-/// refilled in the node's one message of its kind (buffers), whose storage is reused from
-/// event to event and run to run.
-class EventStream {
- public:
-  /// fail_at_first_event: the test hook ~fail_runs_of_student (throws std::bad_alloc).
-  EventStream(const RunTopics& topics, RunWriter& out, RunObserver* markers, const PublishLimits& limits,
-              const collision_lab::core::Scene& scene, EventMessages& buffers, RunProgress& progress,
-              bool fail_at_first_event)
-      : topics_(topics), out_(out), markers_(markers), limits_(limits), scene_(scene),
-        msg_(buffers), progress_(progress), fail_(fail_at_first_event) {}
-
-  /// An impact, with its model block where it has one.
-  void operator()(const collision_lab::core::ImpactRecord& impact) {
-    converter().impact(impact, msg_.event);
-    sendWithPlots();
-  }
-  /// A collapse the event engine resolved.
-  void operator()(const collision_lab::core::Collapse& collapse) {
-    converter().collapse(collapse, msg_.event);
-    sendWithPlots();
-  }
-
-  /// True when ~max_published_events cut the published stream.
-  bool cut() const { return cut_; }
-
- private:
-  /// The converter, made at the run's first event.
-  SceneEventConverter& converter() {
-    if (!converter_) converter_.emplace(scene_);
-    return *converter_;
-  }
-  void sendWithPlots() {
-    if (send(msg_.event)) {
-      converter_->velocitiesMsg(msg_.event, msg_.velocities);
-      topics_.velocities.publish(msg_.velocities);
-      converter_->energyTransferMsg(msg_.event, msg_.energy);
-      topics_.energies.publish(msg_.energy);
-    }
-    out_.record(std::move(msg_.event));
-  }
-  /// Stamps and draws msg, and publishes it unless the cap is reached (then, when due, the
-  /// run's progress); true when published. The caller records it.
-  bool send(collision_lab::CollisionEvent& msg) {
-    if (fail_) throw std::bad_alloc();
-    ++progress_.collisions;
-    progress_.last_time = msg.time;
-    out_.stamp(msg, msg.time);
-    if (markers_) markers_->onCollisionEvent(msg);
-    if (progress_.published == limits_.max_published) {
-      if (progressDue()) publishProgress(msg);
-      cut_ = true;
-      return false;
-    }
-    topics_.events.publish(msg);
-    ++progress_.published;
-    return true;
-  }
-  /// At the first collision not published; then after progress_every_events more, or
-  /// without that hook once progress_period has passed since the last RunProgress.
-  bool progressDue() {
-    if (!cut_) return true;
-    if (limits_.progress_every_events > 0) return ++unpublished_since_progress_ >= limits_.progress_every_events;
-    return std::chrono::steady_clock::now() >= next_progress_;
-  }
-  void publishProgress(const collision_lab::CollisionEvent& msg) {
-    unpublished_since_progress_ = 0;
-    next_progress_ = std::chrono::steady_clock::now() +
-                     std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                         std::chrono::duration<double>(limits_.progress_period));
-    collision_lab::RunProgress& p = msg_.progress;
-    p.header = msg.header;
-    p.run_id = msg.run_id;
-    p.collisions = msg.index;
-    p.time = msg.time;
-    p.published = progress_.published;
-    p.latest_event = msg;
-    // The replay has the heat and, above FULL_STATE_MAX_BODIES, the state the event leaves out.
-    p.energy_lost = converter_->replay().heat();
-    if (p.latest_event.positions.empty()) fillFullState(converter_->replay(), p.latest_event);
-    topics_.progress.publish(p);
-  }
-
-  const RunTopics& topics_;
-  RunWriter& out_;
-  RunObserver* markers_;
-  PublishLimits limits_;
-  const collision_lab::core::Scene& scene_;
-  std::optional<SceneEventConverter> converter_;
-  EventMessages& msg_;
-  RunProgress& progress_;
-  bool fail_;
-  bool cut_ = false;
-  std::uint64_t unpublished_since_progress_ = 0;  ///< [1] since the last RunProgress
-  std::chrono::steady_clock::time_point next_progress_;
-};
 
 /// The reason to refuse input before simulating it (student, run_id, mode, size, then the
 /// scene), if any. The scene's plan (core::planScene: its one validation, model and
@@ -354,21 +69,6 @@ std::optional<collision_lab::Rejected> checkInput(const collision_lab::InitialCo
   return std::nullopt;
 }
 
-/// "predicted 31", or why there is no count ("no count predicted by event_engine"), and the
-/// collapse when there is one.
-std::string predictedText(const collision_lab::RunSummary& summary) {
-  std::ostringstream text;
-  if (summary.predicted_collision_count_defined) {
-    text << "predicted " << summary.predicted_collision_count;
-  } else if (summary.infinite_collisions) {
-    text << "predicted: infinitely many collisions (" << summary.model_name << ")";
-  } else {
-    text << "no count predicted by " << summary.model_name;
-  }
-  if (summary.collapsed) text << ", collapsed at t = " << summary.collapse_time << " s";
-  return text.str();
-}
-
 /// At INFO for a lab, at DEBUG with ~log_runs false: at thousands of runs per second an
 /// INFO line per run (console, log file and /rosout, another process) costs more than the
 /// run itself. Every result is on run_summaries either way, and failures and warnings are
@@ -380,48 +80,6 @@ void logRun(const collision_lab::RunSummary& summary, bool at_info) {
                         << (summary.truncated ? " (truncated)" : "") << ", " << predictedText(summary) << ", "
                         << summary.compute_time << " s"
                         << (summary.bag_path.empty() ? std::string() : ", bag " + summary.bag_path));
-}
-
-/// Fills a RunScene or RunPreset response (their fields are the same).
-template <class Response>
-void fillResponse(const std::optional<ServeOutcome>& outcome, Response& response) {
-  if (!outcome) {
-    response.ok = false;
-    response.message = "collision_lab_node is shutting down; the input was not served";
-    return;
-  }
-  response.ok = outcome->summary.has_value();
-  if (!response.ok) {
-    const collision_lab::Rejected& r = outcome->rejected;
-    response.rejected = r;
-    response.message = "rejected run '" + r.run_id + "': " + r.reason_name + " in " + r.field +
-                       ": " + r.message;
-    return;
-  }
-  const collision_lab::RunSummary& s = *outcome->summary;
-  response.summary = s;
-  std::ostringstream line;
-  line << "run " << s.run_id << ": " << s.collision_count << " collisions, " << predictedText(s);
-  if (s.truncated) line << " (truncated: " << s.truncation_reason << ")";
-  if (!s.requested_run_id.empty()) line << "; run_id '" << s.requested_run_id << "' was taken";
-  if (s.bag_path.empty()) {
-    line << "; not recorded";
-  } else if (s.recording_ok) {
-    line << "; bag " << s.bag_path;
-  } else {
-    line << "; recording FAILED: " << s.recording_error;
-  }
-  response.message = line.str();
-}
-
-/// $ROS_HOME/collision_lab/runs followed by the node's namespace, so that labs in other
-/// namespaces never share a folder by default: /collision_lab -> .../runs/collision_lab,
-/// /lab2 -> .../runs/lab2, /a/b -> .../runs/a/b, / -> .../runs.
-std::string defaultBagDirectory() {
-  const char* ros_home = std::getenv("ROS_HOME");
-  const std::string base = ros_home && *ros_home ? ros_home : expandUser("~/.ros");
-  const std::string& ns = ros::this_node::getNamespace();
-  return base + "/" + kDefaultBagSubdirectory + (ns == "/" ? std::string() : ns);
 }
 
 /// The recorded topics the node latches (node_constants.h): written with latching=1.
@@ -460,191 +118,7 @@ collision_lab::RunParameters runParameters(const LabNodeParams& params, std::uin
   return msg;
 }
 
-/// The count parameter `name`, or fallback when it is not set. Throws std::invalid_argument
-/// when it is set to anything but a whole number in countParameter's range.
-std::uint64_t getUint64(const ros::NodeHandle& nh, const std::string& name,
-                        std::uint64_t fallback) {
-  // XmlRpc integers are 32-bit; large values come as doubles. Read as they are: the typed
-  // getParam rounds a double to int (2.5 -> 3, 1e30 -> undefined).
-  XmlRpc::XmlRpcValue param;
-  if (!nh.getParam(name, param)) return fallback;
-  double value = 0.0;
-  if (param.getType() == XmlRpc::XmlRpcValue::TypeInt) {
-    value = static_cast<int>(param);
-  } else if (param.getType() == XmlRpc::XmlRpcValue::TypeDouble) {
-    value = static_cast<double>(param);
-  } else {
-    throw std::invalid_argument("~" + name + " is not a number; " + kCountParameterRange);
-  }
-  const CountParameter count = countParameter(name, value);
-  if (!count.error.empty()) throw std::invalid_argument(count.error);
-  return count.value;
-}
-
 }  // namespace
-
-CountParameter countParameter(const std::string& name, double value) {
-  // 2^64, exactly: every double below it converts to std::uint64_t without overflow.
-  constexpr double kTwoTo64 = 18446744073709551616.0;
-  if (value >= 0 && value < kTwoTo64 && value == std::floor(value)) return {static_cast<std::uint64_t>(value), {}};
-  std::ostringstream error;
-  error << "~" << name << " = " << value << " is out of range; " << kCountParameterRange;
-  return {0, error.str()};
-}
-
-LabNodeParams LabNodeParams::load(const ros::NodeHandle& private_nh) {
-  LabNodeParams params;
-  private_nh.param("record", params.record, true);
-  private_nh.param("bag_directory", params.bag_directory, defaultBagDirectory());
-  params.bag_directory = expandUser(params.bag_directory);
-  params.max_collisions = getUint64(private_nh, "max_collisions", kDefaultMaxCollisions);
-  private_nh.param("simulate_to_cap", params.simulate_to_cap, false);
-  params.max_published_events =
-      getUint64(private_nh, "max_published_events", kDefaultMaxPublishedEvents);
-  private_nh.param("progress_period", params.progress_period, kDefaultProgressPeriod);
-  if (!std::isfinite(params.progress_period) || params.progress_period <= 0) {
-    std::ostringstream error;
-    error << "~progress_period = " << params.progress_period << " is out of range; expected a finite number of "
-          << "seconds > 0";
-    throw std::invalid_argument(error.str());
-  }
-  params.progress_every_events = getUint64(private_nh, "progress_every_events", 0);
-  private_nh.param("publish_markers", params.publish_markers, true);
-  private_nh.param("log_runs", params.log_runs, true);
-  params.max_bodies = getUint64(private_nh, "max_bodies", kDefaultMaxBodies);
-  private_nh.param("min_free_space_mb", params.min_free_space_mb, kDefaultMinFreeSpaceMb);
-  private_nh.param("max_student_bag_mb", params.max_student_bag_mb, 0.0);
-  private_nh.param("scenario_file", params.scenario_file,
-                   ros::package::getPath("collision_lab") + "/" + kDefaultScenarioFile);
-  params.scenario_file = expandUser(params.scenario_file);
-  const std::uint64_t hardware_threads = std::thread::hardware_concurrency();
-  params.workers = getUint64(private_nh, "workers", std::max(kMinDefaultWorkers, hardware_threads));
-  params.short_lane_workers = getUint64(private_nh, "short_lane_workers", kDefaultShortLaneWorkers);
-  if (params.workers == 0 || params.workers > kMaxWorkers) {
-    throw std::invalid_argument("~workers = " + std::to_string(params.workers) + " is out of range; expected 1 to " +
-                                std::to_string(kMaxWorkers));
-  }
-  if (params.short_lane_workers >= params.workers) {
-    throw std::invalid_argument("~short_lane_workers = " + std::to_string(params.short_lane_workers) +
-                                " must be below ~workers = " + std::to_string(params.workers) +
-                                ": at least one worker takes long runs");
-  }
-  params.lanes.short_max_collisions = getUint64(private_nh, "short_max_collisions", kDefaultShortMaxCollisions);
-  private_nh.param("short_max_seconds", params.lanes.short_max_seconds, kDefaultShortMaxSeconds);
-  private_nh.param("max_run_seconds", params.max_run_seconds, kDefaultMaxRunSeconds);
-  if (!std::isfinite(params.max_run_seconds) || params.max_run_seconds < 0) {
-    std::ostringstream error;
-    error << "~max_run_seconds = " << params.max_run_seconds << " is out of range; expected a finite number of "
-          << "seconds >= 0 (0: no time limit)";
-    throw std::invalid_argument(error.str());
-  }
-  params.max_bag_bytes = getUint64(private_nh, "max_bag_bytes", kDefaultMaxBagBytes);
-  private_nh.param("fail_runs_of_student", params.fail_runs_of_student, std::string());
-  return params;
-}
-
-void RecentDurations::add(double seconds) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  if (samples_.size() < kRecordingTimeWindow) {
-    samples_.push_back(seconds);
-  } else {
-    samples_[next_] = seconds;
-    next_ = (next_ + 1) % kRecordingTimeWindow;
-  }
-}
-
-double RecentDurations::quantile(double q) const {
-  std::vector<double> sorted;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    sorted = samples_;
-  }
-  if (sorted.empty()) return 0.0;
-  const auto k = static_cast<std::size_t>(q * static_cast<double>(sorted.size() - 1) + 0.5);
-  std::nth_element(sorted.begin(), sorted.begin() + k, sorted.end());
-  return sorted[k];
-}
-
-std::size_t RecentDurations::size() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return samples_.size();
-}
-
-std::string runIdProblem(const std::string& run_id) {
-  if (run_id.size() > 200) return "is longer than 200 characters";
-  if (run_id.empty() || run_id[0] == '.') return "must not be empty or start with '.'";
-  for (char c : run_id) {
-    const bool safe = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') ||
-                      (c >= '0' && c <= '9') || c == '_' || c == '-' || c == '.';
-    if (!safe) return "may contain only letters, digits, '_', '-' and '.'";
-  }
-  return {};
-}
-
-std::string studentProblem(const std::string& student) {
-  if (student.size() > kMaxStudentLength) {
-    return "is longer than " + std::to_string(kMaxStudentLength) + " characters";
-  }
-  for (char c : student) {
-    const bool safe = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
-    if (!safe) return "may contain only letters, digits, '_' and '-' ('.' separates it from the run_id)";
-  }
-  return {};
-}
-
-std::optional<std::pair<std::string, std::uint64_t>> numberedRunId(const std::string& run_id) {
-  const std::size_t digits = run_id.find_last_not_of("0123456789") + 1;
-  if (digits == run_id.size() || run_id.size() - digits > 18) return std::nullopt;
-  if (digits < 3 || run_id.compare(digits - 3, 3, "run") != 0) return std::nullopt;
-  if (digits > 3 && run_id[digits - 4] != '.') return std::nullopt;
-  return std::make_pair(run_id.substr(0, digits), std::stoull(run_id.substr(digits)));
-}
-
-std::string requestedRunId(const collision_lab::InitialConditions& input) {
-  if (input.student.empty()) return input.run_id;
-  return input.run_id.empty() ? input.student : input.student + "." + input.run_id;
-}
-
-void ServedRuns::accepted(const collision_lab::AcceptedRun& run) {
-  collision_lab::ServedRun served;
-  served.accepted = run;
-  std::lock_guard<std::mutex> lock(mutex_);
-  if (runs_.size() == kServedRunsKept) runs_.pop_front();
-  runs_.push_back(std::move(served));
-}
-
-void ServedRuns::finished(const collision_lab::RunSummary& summary) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  // Summaries come in the order of the runs, so the run is one of the newest.
-  const auto it = std::find_if(runs_.rbegin(), runs_.rend(), [&](const collision_lab::ServedRun& run) {
-    return run.accepted.run_id == summary.run_id;
-  });
-  if (it == runs_.rend()) return;  // no longer kept
-  it->finished = true;
-  it->collision_count = summary.collision_count;
-  it->truncated = summary.truncated;
-  it->stop_reason = summary.stop_reason;
-  it->bag_path = summary.bag_path;
-  it->recording_ok = summary.recording_ok;
-}
-
-std::vector<collision_lab::ServedRun> ServedRuns::list(const std::string& student) const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  std::vector<collision_lab::ServedRun> listed;
-  for (const auto& run : runs_) {
-    if (student.empty() || run.accepted.student == student) listed.push_back(run);
-  }
-  return listed;
-}
-
-void RememberedRunIds::add(const std::string& run_id) {
-  if (!ids_.insert(run_id).second) return;
-  order_.push_back(run_id);
-  if (order_.size() > kRunIdsRemembered) {
-    ids_.erase(order_.front());
-    order_.pop_front();
-  }
-}
 
 LabNode::LabNode(ros::NodeHandle nh, ros::NodeHandle private_nh, const RunObserverFactory& make_observer)
     : nh_(nh),
@@ -777,57 +251,6 @@ LabNode::~LabNode() {
   list_runs_srv_.shutdown();
   cancel_spinner_.stop();
   service_spinner_.stop();
-}
-
-void LabNode::onInitialConditions(const collision_lab::InitialConditions::ConstPtr& msg) { intake(*msg, nullptr); }
-
-std::optional<ServeOutcome> LabNode::serveAndWait(const collision_lab::InitialConditions& input) {
-  auto reply = std::make_shared<std::promise<ServeOutcome>>();
-  std::future<ServeOutcome> outcome = reply->get_future();
-  intake(input, std::move(reply));
-  try {
-    return outcome.get();
-  } catch (const std::future_error&) {
-    return std::nullopt;  // dropped: the node is shutting down
-  }
-}
-
-bool LabNode::onRunScene(collision_lab::RunScene::Request& request,
-                         collision_lab::RunScene::Response& response) {
-  collision_lab::InitialConditions input;
-  input.run_id = request.run_id;
-  input.student = request.student;
-  input.mode = request.mode;
-  input.masses = request.masses;
-  input.positions = request.positions;
-  input.velocities = request.velocities;
-  input.restitution = request.restitution;
-  input.max_collisions = request.max_collisions;
-  input.max_run_seconds = request.max_run_seconds;
-  input.max_bag_bytes = request.max_bag_bytes;
-  fillResponse(serveAndWait(input), response);
-  return true;
-}
-
-bool LabNode::onRunPreset(collision_lab::RunPreset::Request& request,
-                          collision_lab::RunPreset::Response& response) {
-  collision_lab::io::SceneEntry preset;
-  try {
-    // Read on every call, so that an edited file counts at once.
-    preset = collision_lab::io::findScene(collision_lab::io::loadScenes(params_.scenario_file), request.name);
-  } catch (const collision_lab::io::ScenarioFileError& e) {
-    response.ok = false;
-    response.message = e.what();
-    return true;
-  }
-  collision_lab::InitialConditions input =
-      toInitialConditions(preset.scene, collision_lab::core::RunMode::kFull, preset.max_collisions);
-  input.mode = request.mode;
-  input.student = request.student;
-  input.run_id =
-      request.run_id.empty() ? preset.name + "_" + utcStamp("%Y%m%dT%H%M%SZ") : request.run_id;
-  fillResponse(serveAndWait(input), response);
-  return true;
 }
 
 LabNode::RunLimits LabNode::limitsOf(const collision_lab::InitialConditions& input) const {
@@ -1136,12 +559,6 @@ void LabNode::announce(const std::string& run_id, const std::string& student, co
                                  << ", " << accepted.lane << " lane, " << queue_position << " runs ahead");
 }
 
-bool LabNode::onListRuns(collision_lab::ListRuns::Request& request, collision_lab::ListRuns::Response& response) {
-  // The index lists every run of bag_directory, across restarts; without it, this process's.
-  response.runs = run_index_->ok() ? run_index_->list(request.student) : served_runs_.list(request.student);
-  return true;
-}
-
 ServeOutcome LabNode::reject(collision_lab::Rejected msg, const std::string& run_id) {
   msg.header.stamp = stampNow();
   msg.run_id = run_id;
@@ -1327,41 +744,6 @@ void LabNode::dropWaiting(Job job, const std::string& by) {
   publishEnd(out, summary, 0.0, std::move(job.reply), false);
 }
 
-bool LabNode::onCancel(collision_lab::Cancel::Request& request, collision_lab::Cancel::Response& response) {
-  // Whoever asks is logged and goes into a summary: bounded, like every name.
-  const std::string by = request.requested_by.empty() ? std::string("~cancel") : request.requested_by.substr(0, kMaxStudentLength);
-  std::optional<Scheduler::Entry> waiting;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (!request.run_id.empty()) waiting = scheduler_.remove(request.run_id);
-    if (waiting) {
-      publishQueue();
-      response.ok = true;
-      response.message = "run '" + request.run_id + "' was waiting; cancelled before it started";
-    } else {
-      std::vector<std::string> stopped;
-      for (auto& worker : workers_) {
-        const std::string& run_id = worker->current.run_id;
-        if (run_id.empty() || (!request.run_id.empty() && request.run_id != run_id)) continue;
-        stopRun(*worker, StopCause::kCancel, by);
-        stopped.push_back(run_id);
-      }
-      response.ok = !stopped.empty();
-      if (stopped.empty()) {
-        response.message = request.run_id.empty() ? "no run in progress"
-                                                   : "no run '" + request.run_id + "' is waiting or in progress; nothing stopped";
-      } else {
-        response.message = "run";
-        for (std::size_t i = 0; i < stopped.size(); ++i) response.message += (i ? ", '" : " '") + stopped[i] + "'";
-        response.message += " asked to stop";
-      }
-    }
-  }
-  if (waiting) dropWaiting(std::move(waiting->job), by);
-  ROS_INFO_STREAM("~cancel (by " << by << "): " << response.message);
-  return true;
-}
-
 void LabNode::publishStart(Worker& worker, RunWriter& out, const collision_lab::InitialConditions& input,
                            const collision_lab::core::ScenePlan& plan) {
   out.record(input);
@@ -1415,55 +797,6 @@ void LabNode::finishRun(const collision_lab::RunSummary& summary, const Reply& r
   if (draws && marker_view_) marker_view_->onRunSummary(summary);
   logRun(summary, params_.log_runs);
   if (reply) reply->set_value(ServeOutcome{summary, {}});
-}
-
-void LabNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
-  status.summary(diagnostic_msgs::DiagnosticStatus::OK, "serving");
-  status.add("runs accepted", std::to_string(runs_accepted_.load()));
-  status.add("runs rejected", std::to_string(runs_rejected_.load()));
-  status.add("last run compute time [s]", std::to_string(last_compute_time_.load()));
-  std::size_t waiting = 0, running = 0;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    waiting = scheduler_.size();
-    for (const auto& worker : workers_) running += worker->current.run_id.empty() ? 0 : 1;
-  }
-  status.add("workers", std::to_string(workers_.size()));
-  status.add("runs running", std::to_string(running));
-  status.add("runs waiting", std::to_string(waiting));
-  status.add("recording", params_.record ? "on" : "off");
-  status.add("bag directory", params_.bag_directory);
-  if (params_.record) addRecordingStatus(status);
-}
-
-void LabNode::addRecordingStatus(diagnostic_updater::DiagnosticStatusWrapper& status) {
-  std::string recording_error;
-  {
-    std::lock_guard<std::mutex> lock(recording_mutex_);
-    recording_error = last_recording_error_;
-  }
-  status.add("last recording error", recording_error);
-  status.add("recording hand-over per run, runs sampled", std::to_string(recording_times_.size()));
-  status.add("recording hand-over per run, median [us]", std::to_string(1e6 * recording_times_.quantile(0.5)));
-  status.add("recording hand-over per run, p99 [us]", std::to_string(1e6 * recording_times_.quantile(0.99)));
-  if (!recording_error.empty()) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "recording failed: " + recording_error);
-  }
-  const auto free_mb = admission_->freeSpaceMb();
-  if (!free_mb) {
-    status.add("free space in bag directory [MB]", "unknown (directory not readable)");
-    return;
-  }
-  status.add("free space in bag directory [MB]", std::to_string(*free_mb));
-  status.add("free space floor [MB]", std::to_string(params_.min_free_space_mb));
-  const std::string free_text = std::to_string(*free_mb) + " MB free for bags";
-  if (*free_mb < params_.min_free_space_mb) {
-    status.mergeSummary(diagnostic_msgs::DiagnosticStatus::ERROR,
-                        free_text + ", under the floor: runs are refused (DISK_SPACE)");
-  } else if (*free_mb < kFreeSpaceWarnFactor * params_.min_free_space_mb &&
-             status.level == diagnostic_msgs::DiagnosticStatus::OK) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "low free space: " + free_text);
-  }
 }
 
 }  // namespace collision_lab_ros

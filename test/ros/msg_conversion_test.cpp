@@ -460,7 +460,7 @@ std::vector<std::uint8_t> wireBytes(const Message& msg) {
   return bytes;
 }
 
-// The node refills one message of each kind for every event (lab_node.cpp's EventStream):
+// The node refills one message of each kind for every event (src/ros/run_writer.h's EventStream):
 // a message that carried another event, of the other path or another size, must go out
 // as a fresh conversion of the new one, with nothing left over.
 TEST(MsgConversion, AReusedMessageCarriesItsNewEventAlone) {

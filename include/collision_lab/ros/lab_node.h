@@ -56,14 +56,12 @@
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
-#include <deque>
 #include <future>
 #include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
 #include <thread>
-#include <unordered_set>
 #include <vector>
 
 #include <diagnostic_updater/diagnostic_updater.h>
@@ -81,108 +79,23 @@
 #include "collision_lab/RunSummary.h"
 #include "collision_lab/core/scene_run.h"
 #include "collision_lab/RunQueue.h"
+#include "collision_lab/ros/lab_node_params.h"
 #include "collision_lab/ros/msg_conversion.h"
+#include "collision_lab/ros/run_ids.h"
 #include "collision_lab/ros/run_observer.h"
+#include "collision_lab/ros/served_runs.h"
 #include "collision_lab/service/admission.h"
-#include "collision_lab/service/student_quota.h"
 #include "collision_lab/service/fair_scheduler.h"
+#include "collision_lab/service/student_quota.h"
 
 namespace collision_lab_ros {
-
-struct LabNodeParams {
-  bool record = true;
-  std::string bag_directory;  ///< "~" expanded
-  std::uint64_t max_collisions = 0;
-  /// Simulate up to the cap even when the model predicts more impacts (else the model
-  /// answers at once: core::SceneRunOptions::simulate_to_cap).
-  bool simulate_to_cap = false;
-  std::uint64_t max_published_events = 0;
-  /// Past max_published_events, a RunProgress goes out on run_progress at most this often
-  /// [s] of wall time (~progress_period), and, when progress_every_events > 0 (a test hook,
-  /// ~progress_every_events), every that many unpublished collisions [1] instead.
-  double progress_period = 0.0;
-  std::uint64_t progress_every_events = 0;
-  bool publish_markers = true;
-  bool log_runs = true;            ///< one INFO line per served run (else DEBUG)
-  std::uint64_t max_bodies = 0;    ///< larger scenes are rejected (TOO_MANY_BODIES)
-  double min_free_space_mb = 0.0;  ///< [MB] the bag directory's floor (kDefaultMinFreeSpaceMb); 0: none
-  double max_student_bag_mb = 0.0; ///< [MB] a named student's bags at most (StudentQuota); 0: none
-  std::string scenario_file;       ///< the presets of ~run_preset
-  /// Worker threads [1] (~workers; default max(2, hardware threads)), of which
-  /// short_lane_workers [1] take only short runs (~short_lane_workers, default 1).
-  std::uint64_t workers = 2;
-  std::uint64_t short_lane_workers = 1;
-  /// What makes a run short (~short_max_collisions, ~short_max_seconds).
-  collision_lab::service::LaneLimits lanes;
-  /// Service ceilings an input may lower, never raise: wall time per run [s]
-  /// (~max_run_seconds; <= 0: none) and recorded bytes per bag [bytes] (~max_bag_bytes; 0: none).
-  double max_run_seconds = 0.0;
-  std::uint64_t max_bag_bytes = 0;
-  /// Test hook (~fail_runs_of_student): a run of this student throws std::bad_alloc from
-  /// its first collision, as a worker that runs out of memory. Empty: none.
-  std::string fail_runs_of_student;
-
-  /// Reads ~record, ~bag_directory, ~max_collisions, ~simulate_to_cap, ~max_published_events,
-  /// ~progress_period, ~progress_every_events,
-  /// ~publish_markers, ~log_runs, ~max_bodies, ~min_free_space_mb, ~scenario_file (default: the package's
-  /// config/scenarios.yaml), ~workers, ~short_lane_workers, ~short_max_collisions,
-  /// ~short_max_seconds, ~max_run_seconds, ~max_bag_bytes and ~fail_runs_of_student, with
-  /// the defaults of node_constants.h. Throws
-  /// std::invalid_argument, naming the parameter, its value and the accepted range, when a
-  /// count (~max_collisions, ~max_published_events, ~max_bodies, ~workers, ...) is not a
-  /// whole number in [0, 2^64 - 1], when ~workers is 0 or ~short_lane_workers is not below
-  /// ~workers.
-  static LabNodeParams load(const ros::NodeHandle& private_nh);
-};
-
-/// The accepted range of a count parameter, as the errors state it.
-constexpr char kCountParameterRange[] = "expected a whole number from 0 to 18446744073709551615 (2^64 - 1)";
-
-/// A count parameter's value read as a double (the parameter server gives large integers
-/// as doubles): value when it is a whole number in [0, 2^64 - 1]; otherwise error says so,
-/// naming ~name, the value and the range (NaN, infinities, negative, fractional and too
-/// large values, whose conversion to std::uint64_t would be undefined behaviour).
-struct CountParameter {
-  std::uint64_t value = 0;
-  std::string error;  ///< empty when value holds
-};
-CountParameter countParameter(const std::string& name, double value);
-
-/// Empty when run_id is safe as a bag file name; otherwise why not.
-std::string runIdProblem(const std::string& run_id);
-/// Empty when student is a valid InitialConditions.student (empty is: anonymous);
-/// otherwise why not.
-std::string studentProblem(const std::string& student);
-/// The run_id an input asks for: <student>.<run_id>, <student> when it names no run_id,
-/// or run_id when it names no student (empty: the node assigns one). A taken one is then
-/// served as <that>.N, except a numbered run (numberedRunId): that one as the next free number.
-std::string requestedRunId(const collision_lab::InitialConditions& input);
-/// A numbered run, "run<n>" or "<prefix>.run<n>" (the web node numbers each student's runs
-/// so): its name up to the number ("ben.run") and n; nullopt for any other run_id.
-std::optional<std::pair<std::string, std::uint64_t>> numberedRunId(const std::string& run_id);
-
-/// The runs a node accepted, the newest kServedRunsKept of them: ~list_runs's answer when
-/// the run index cannot be opened.
-/// Thread-safe: the worker adds each run as it accepts it, and whichever thread publishes
-/// a run's summary completes it.
-class ServedRuns {
- public:
-  void accepted(const collision_lab::AcceptedRun& run);
-  void finished(const collision_lab::RunSummary& summary);
-  /// Oldest first; those of student, or every run when student is empty.
-  std::vector<collision_lab::ServedRun> list(const std::string& student) const;
-
- private:
-  mutable std::mutex mutex_;
-  std::deque<collision_lab::ServedRun> runs_;
-};
 
 /// The publishers of a run's outputs, in the order a run uses them.
 struct RunTopics {
   ros::Publisher predictions, events, velocities, energies, summaries, progress;
 };
 
-/// The per-collision messages the worker refills for every collision (lab_node.cpp's
+/// The per-collision messages the worker refills for every collision (run_writer.h's
 /// EventStream), kept by the node so that their storage is reused from run to run.
 struct EventMessages {
   collision_lab::CollisionEvent event;
@@ -191,7 +104,7 @@ struct EventMessages {
   collision_lab::RunProgress progress;
 };
 
-/// What a run has computed so far, kept outside its EventStream (lab_node.cpp) so that a
+/// What a run has computed so far, kept outside its EventStream (run_writer.h) so that a
 /// run that throws can still report it.
 struct RunProgress {
   std::uint64_t collisions = 0;  ///< [1] events seen
@@ -199,42 +112,15 @@ struct RunProgress {
   double last_time = 0.0;        ///< simulated time of the last collision [s]
 };
 
-/// Stamps, publishes and records the messages of one run (lab_node.cpp).
+/// Stamps, publishes and records the messages of one run (src/ros/run_writer.h).
 class RunWriter;
 class RunBagWriter;
 class RunIndexRecorder;
-
-/// The newest kRecordingTimeWindow samples of a duration [s], thread-safe.
-class RecentDurations {
- public:
-  void add(double seconds);
-  /// The q-quantile (q in [0, 1]) of the kept samples [s]; 0 when there are none.
-  double quantile(double q) const;
-  std::size_t size() const;
-
- private:
-  mutable std::mutex mutex_;
-  std::vector<double> samples_;
-  std::size_t next_ = 0;
-};
 
 /// The answer to one input: its summary when served, else its rejection.
 struct ServeOutcome {
   std::optional<collision_lab::RunSummary> summary;
   collision_lab::Rejected rejected;
-};
-
-/// A bounded memory of run_ids given out (the newest kRunIdsRemembered), so that a
-/// long-running node stays flat in memory; with recording on, the bag folder remembers
-/// every run_id anyway (claimBag).
-class RememberedRunIds {
- public:
-  bool contains(const std::string& run_id) const { return ids_.count(run_id) > 0; }
-  void add(const std::string& run_id);
-
- private:
-  std::unordered_set<std::string> ids_;
-  std::deque<std::string> order_;  ///< oldest first
 };
 
 class LabNode {
