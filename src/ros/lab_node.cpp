@@ -494,14 +494,12 @@ std::string LabNode::newRunId(std::string& claim_error) {
 }
 
 namespace {
-/// run_id's state in the run index; none when the index does not list it or cannot be read.
-std::optional<collision_lab::service::RunState> indexedState(const RunIndexRecorder& run_index,
+/// run_id's row in the run index; none when the index does not list it or cannot be read.
+std::optional<collision_lab::service::IndexedRun> indexedRun(const RunIndexRecorder& run_index,
                                                              const std::string& run_id) {
   if (!run_index.ok()) return std::nullopt;
   try {
-    const auto run = run_index.committed()->find(run_id);  // this node's own runs are in used_run_ids_
-    if (!run) return std::nullopt;
-    return run->state;
+    return run_index.committed()->find(run_id);  // this node's own runs are in used_run_ids_
   } catch (const collision_lab::service::RunIndexError& e) {
     ROS_WARN_STREAM("the run index cannot tell whether run_id '" << run_id << "' was served: " << e.what());
     return std::nullopt;
@@ -509,12 +507,15 @@ std::optional<collision_lab::service::RunState> indexedState(const RunIndexRecor
 }
 }  // namespace
 
-bool LabNode::servedBefore(const std::string& run_id) { return indexedState(*run_index_, run_id).has_value(); }
+bool LabNode::servedBefore(const std::string& run_id) { return indexedRun(*run_index_, run_id).has_value(); }
 
-bool LabNode::heldByUnendedRun(const std::string& run_id) {
+bool LabNode::heldInIndex(const std::string& run_id) {
   using collision_lab::service::RunState;
-  const auto state = indexedState(*run_index_, run_id);
-  return state == RunState::kQueued || state == RunState::kRunning;
+  const auto run = indexedRun(*run_index_, run_id);
+  if (!run) return false;
+  if (run->state == RunState::kQueued || run->state == RunState::kRunning) return true;
+  std::error_code ec;
+  return !run->bag_path.empty() && std::filesystem::exists(run->bag_path, ec);
 }
 
 bool LabNode::claim(const std::string& run_id, std::string& claim_error) {
@@ -531,10 +532,8 @@ std::string LabNode::claimRunId(const std::string& requested, std::string& claim
     while (servedBefore(numbered()) || !claim(numbered(), claim_error)) ++n;
     return numbered();
   }
-  // A run the index has that has not ended (a dead node's queued run, served again by
-  // recovery under its id) holds its run_id; an ended one, without a bag, does not.
   std::string run_id = requested;
-  for (std::uint64_t n = 2; heldByUnendedRun(run_id) || !claim(run_id, claim_error); ++n) {
+  for (std::uint64_t n = 2; heldInIndex(run_id) || !claim(run_id, claim_error); ++n) {
     run_id = requested + "." + std::to_string(n);
   }
   return run_id;

@@ -237,14 +237,14 @@ TEST(IndexRestart, AKilledNodeRespawnsListingEveryRunAndLeavesALiveNodesBagAlone
   EXPECT_EQ(ended->collision_count, long_out.summaries[0].collision_count);
 }
 
-/// The run_id lab_c served scene `run_id` under (pi, 31 impacts), through ~run_scene.
-std::string servedRunId(const std::string& run_id) {
+/// The run_id `lab` served scene `run_id` under (pi, 31 impacts), through ~run_scene.
+std::string servedRunId(const std::string& run_id, const std::string& lab = "lab_c") {
   collision_lab::RunScene pi;
   pi.request.run_id = run_id;
   pi.request.masses = {100, 1, std::numeric_limits<double>::infinity()};
   pi.request.positions = {2, 1, 0};
   pi.request.velocities = {-1, 0, 0};
-  EXPECT_TRUE(callService("/lab_c/collision_lab_node/run_scene", pi));
+  EXPECT_TRUE(callService("/" + lab + "/collision_lab_node/run_scene", pi));
   EXPECT_TRUE(pi.response.ok) << pi.response.message;
   EXPECT_EQ(pi.response.summary.collision_count, 31u);
   return pi.response.summary.run_id;
@@ -252,11 +252,20 @@ std::string servedRunId(const std::string& run_id) {
 
 // A lab that records no bags (lab_c) shares the index: a run_id of an ended run there
 // holds nothing once its node is gone, so a class running the same scene after a restart
-// gets the run_id it typed. (Failed before: "again.3", as long as the index lists
-// "again" and "again.2".)
-TEST(IndexRestart, ARunIdOfAnEndedRunWithoutABagIsServedAsTypedAfterARestart) {
+// gets the run_id it typed (failed with "any run_id the index lists is taken": "again.3");
+// a run_id whose bag another lab recorded is taken there too, and that lab's run stays
+// listed with its bag (failed with "only an unended run holds its run_id": lab_c served
+// "kept" and its row replaced lab_b's).
+TEST(IndexRestart, ALabWithoutBagsServesAnEndedRunsIdAsTypedAndNeverARecordedOne) {
+  ros::NodeHandle private_nh("~");
+  std::string bags;
+  ASSERT_TRUE(private_nh.getParam("bag_directory", bags));
   const std::string run_scene = "/lab_c/collision_lab_node/run_scene";
   ASSERT_TRUE(ros::service::waitForService(run_scene, ros::Duration(collision_lab_test::kWaitTimeout)));
+  ASSERT_TRUE(ros::service::waitForService("/lab_b/collision_lab_node/run_scene",
+                                           ros::Duration(collision_lab_test::kWaitTimeout)));
+  ASSERT_EQ(servedRunId("kept", "lab_b"), "kept");  // recorded by lab_b
+  EXPECT_EQ(servedRunId("kept"), "kept.2");
   EXPECT_EQ(servedRunId("again"), "again");
   EXPECT_EQ(servedRunId("again"), "again.2");  // the same process served "again"
 
@@ -276,6 +285,12 @@ TEST(IndexRestart, ARunIdOfAnEndedRunWithoutABagIsServedAsTypedAfterARestart) {
   EXPECT_TRUE(again->finished);
   EXPECT_EQ(again->bag_path, "");
   EXPECT_NE(findRun(runs, "again.2"), nullptr);
+  EXPECT_EQ(servedRunId("kept"), "kept.2");  // kept.2 was lab_c's own, ended, without a bag: free again
+  const auto after = listRuns("lab_c");
+  const auto* kept = findRun(after, "kept");
+  ASSERT_NE(kept, nullptr);
+  EXPECT_EQ(kept->bag_path, bags + "/kept.bag");
+  EXPECT_TRUE(fs::exists(bags + "/kept.bag"));
 }
 
 }  // namespace

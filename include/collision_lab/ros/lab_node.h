@@ -242,15 +242,18 @@ class LabNode {
                 std::size_t queue_position, collision_lab::service::Lane lane);
   /// <prefix><counter>, the first one claim() takes. mutex_ held (as the two below).
   std::string newRunId(std::string& claim_error);
-  /// requested, or the first requested.N (N = 2, 3, ...) that claim() takes and no unended
-  /// run of the index holds (heldByUnendedRun). A student's
+  /// requested, or the first requested.N (N = 2, 3, ...) that claim() takes and no run of
+  /// the index holds (heldInIndex). A student's
   /// n-th run (<student>.run<n>, numbered by the web node from 1 after each restart) goes
   /// on to the first number the run index does not know either (servedBefore).
   std::string claimRunId(const std::string& requested, std::string& claim_error);
   /// True when the run index lists run_id: served by this node or an earlier one.
   bool servedBefore(const std::string& run_id);
-  /// True when the run index lists run_id as queued or running (not ended).
-  bool heldByUnendedRun(const std::string& run_id);
+  /// True when a run of the run index holds run_id: it has not ended (a dead node's queued
+  /// run, which recovery serves again under its id, or a live node's), or its bag is on
+  /// disk (recorded by any node: a lab that records no bags must not take it over). An
+  /// ended run without a bag holds nothing: the index then keeps the newest run under it.
+  bool heldInIndex(const std::string& run_id);
   /// Takes run_id for this node's next run. False when this node served it recently
   /// (RememberedRunIds) or, recording, when claimBag finds its bag taken (by any process
   /// sharing bag_directory). True when taken: recording, its .bag.active file is this
