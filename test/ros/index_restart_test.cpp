@@ -55,6 +55,18 @@ int nodePid(const std::string& node) {
   return static_cast<int>(response[2]);
 }
 
+/// Kills node with SIGKILL and waits until roslaunch has respawned it (respawn_delay 1 s)
+/// and the new process has registered.
+void killAndAwaitRespawn(const std::string& node) {
+  const int old_pid = nodePid(node);
+  ASSERT_GT(old_pid, 0);
+  ASSERT_EQ(::kill(old_pid, SIGKILL), 0);
+  waitUntil([&] {
+    const int pid = nodePid(node);
+    return pid > 0 && pid != old_pid;
+  }, "roslaunch to respawn " + node);
+}
+
 std::vector<collision_lab::ServedRun> listRuns(const std::string& lab) {
   collision_lab::ListRuns list;
   EXPECT_TRUE(callService("/" + lab + "/collision_lab_node/list_runs", list));
@@ -125,14 +137,7 @@ TEST(IndexRestart, AKilledNodeRespawnsListingEveryRunAndLeavesALiveNodesBagAlone
   const std::string dead_active = bags + "/dead_run.bag.active";
   leaveUnfinishedBag(dead_active, 50000);
 
-  const int old_pid = nodePid("/lab_a/collision_lab_node");
-  ASSERT_GT(old_pid, 0);
-  ASSERT_EQ(::kill(old_pid, SIGKILL), 0);
-  // roslaunch respawns it (respawn_delay 1 s); the new process registers again.
-  waitUntil([&] {
-    const int pid = nodePid("/lab_a/collision_lab_node");
-    return pid > 0 && pid != old_pid;
-  }, "roslaunch to respawn /lab_a/collision_lab_node");
+  ASSERT_NO_FATAL_FAILURE(killAndAwaitRespawn("/lab_a/collision_lab_node"));
   // It serves while it reindexes the dead bag. (Failed before: its services came up only
   // once every dead bag was reindexed.)
   const std::string run_scene = "/lab_a/collision_lab_node/run_scene";
@@ -269,13 +274,7 @@ TEST(IndexRestart, ALabWithoutBagsServesAnEndedRunsIdAsTypedAndNeverARecordedOne
   EXPECT_EQ(servedRunId("again"), "again");
   EXPECT_EQ(servedRunId("again"), "again.2");  // the same process served "again"
 
-  const int old_pid = nodePid("/lab_c/collision_lab_node");
-  ASSERT_GT(old_pid, 0);
-  ASSERT_EQ(::kill(old_pid, SIGKILL), 0);
-  waitUntil([&] {
-    const int pid = nodePid("/lab_c/collision_lab_node");
-    return pid > 0 && pid != old_pid;
-  }, "roslaunch to respawn /lab_c/collision_lab_node");
+  ASSERT_NO_FATAL_FAILURE(killAndAwaitRespawn("/lab_c/collision_lab_node"));
   ASSERT_TRUE(ros::service::waitForService(run_scene, ros::Duration(collision_lab_test::kWaitTimeout)));
   EXPECT_EQ(servedRunId("again"), "again");
 
