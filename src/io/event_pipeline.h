@@ -113,7 +113,10 @@ class EventPipeline {
         std::unique_lock<std::mutex> lock(mutex_);
         changed_.wait(lock, [&] { return written_ == block->sequence; });
       }
-      // The only writer now: earlier blocks are out, later ones wait.
+      // The only writer now: earlier blocks are out, later ones wait. A block formatted
+      // while an earlier one failed is dropped, not left in the sink (whose destructor
+      // would write it after the failed block's gap).
+      if (format && failed()) sink.discard();
       if (format && !failed()) guarded(sink, [&] { sink.flush(); });
       {
         std::lock_guard<std::mutex> lock(mutex_);
