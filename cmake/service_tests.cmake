@@ -11,6 +11,12 @@ if(TARGET address_share_test)
   target_link_libraries(address_share_test collision_lab_service GTest::gtest_main)
 endif()
 
+# The envelope of an input, as the lab node and the web check it (no master).
+catkin_add_gtest(envelope_test test/service/envelope_test.cpp)
+if(TARGET envelope_test)
+  target_link_libraries(envelope_test collision_lab_service GTest::gtest_main)
+endif()
+
 # A student's share of the lab's disk (no master).
 catkin_add_gtest(student_quota_test test/service/student_quota_test.cpp)
 if(TARGET student_quota_test)

@@ -31,38 +31,16 @@ ros::Time stampNow() {
   return ros::Time(wall.sec, wall.nsec);
 }
 
-/// The reason to refuse input before simulating it (student, run_id, mode, size, then the
-/// scene), if any. The scene's plan (core::planScene: its one validation, model and
-/// prediction) goes to `plan` when the checks before it pass.
+/// The reason to refuse input before simulating it (its envelope, service::checkEnvelope,
+/// then the scene), if any. The scene's plan (core::planScene: its one validation, model and
+/// prediction) goes to `plan` when the envelope holds.
 std::optional<collision_lab::Rejected> checkInput(const collision_lab::InitialConditions& input,
                                                   std::size_t max_bodies,
                                                   std::optional<collision_lab::core::ScenePlan>& plan) {
-  if (const std::string problem = studentProblem(input.student); !problem.empty()) {
-    return toRejectedMsg(NodeReason::kInvalidStudent, "student", "student '" + input.student + "' " + problem);
-  }
-  if (!input.run_id.empty()) {
-    if (const std::string problem = runIdProblem(input.run_id); !problem.empty()) {
-      return toRejectedMsg(NodeReason::kInvalidRunId, "run_id",
-                           "run_id '" + input.run_id + "' " + problem);
-    }
-  }
-  if (const std::string served = requestedRunId(input); !input.student.empty() && !served.empty()) {
-    if (const std::string problem = runIdProblem(served); !problem.empty()) {
-      return toRejectedMsg(NodeReason::kInvalidRunId, "run_id",
-                           "run_id '" + served + "' (<student>.<run_id>) " + problem);
-    }
-  }
-  if (!toRunMode(input.mode)) {
-    return toRejectedMsg(NodeReason::kInvalidMode, "mode",
-                         "mode " + std::to_string(input.mode) + " is not one of MODE_FULL (0), "
-                         "MODE_PREDICT_ONLY (1), MODE_SUMMARY_ONLY (2)");
-  }
-  const std::size_t n = std::max({input.masses.size(), input.positions.size(), input.velocities.size()});
-  if (n > max_bodies) {
-    return toRejectedMsg(NodeReason::kTooManyBodies, "masses",
-                         std::to_string(n) + " bodies are more than this node's ~max_bodies = " +
-                             std::to_string(max_bodies) + "; send a smaller scene, or start the node with a "
-                             "larger ~max_bodies");
+  const std::size_t bodies = std::max({input.masses.size(), input.positions.size(), input.velocities.size()});
+  if (const auto refusal = collision_lab::service::checkEnvelope({input.student, input.run_id, input.mode, bodies},
+                                                                 max_bodies)) {
+    return toRejectedMsg(*refusal);
   }
   plan = collision_lab::core::planScene(toScene(input));
   if (const auto& error = plan->error) return toRejectedMsg(*error);

@@ -490,4 +490,18 @@ collision_lab::Rejected toRejectedMsg(NodeReason reason, const std::string& fiel
   return msg;
 }
 
+collision_lab::Rejected toRejectedMsg(const collision_lab::service::EnvelopeRefusal& refusal) {
+  using Reason = collision_lab::service::EnvelopeRefusal::Reason;
+  const NodeReason reason = [&] {
+    switch (refusal.reason) {
+      case Reason::kInvalidStudent: return NodeReason::kInvalidStudent;
+      case Reason::kInvalidRunId: return NodeReason::kInvalidRunId;
+      case Reason::kInvalidMode: return NodeReason::kInvalidMode;
+      case Reason::kTooManyBodies: break;
+    }
+    return NodeReason::kTooManyBodies;
+  }();
+  return toRejectedMsg(reason, refusal.field, refusal.message);
+}
+
 }  // namespace collision_lab_ros

@@ -15,6 +15,7 @@
 #include "collision_lab/io/scenario_file.h"
 #include "collision_lab/ros/msg_conversion.h"
 #include "collision_lab/ros/node_constants.h"
+#include "collision_lab/service/envelope.h"
 
 namespace collision_lab_web {
 
@@ -133,10 +134,10 @@ void WebServer::postRun(const HttpRequest& request, const HttpReply& reply) {
     return reply.send(refuse(400, "student is required: your name", "student"));
   }
   const std::string student = body["student"];
-  if (student.size() > collision_lab_ros::kMaxStudentLength) {
+  if (student.size() > collision_lab::service::kMaxStudentLength) {
     log("refused a scene from " + request.client + ": a name of " + std::to_string(student.size()) + " bytes");
     return reply.send(refuse(400,
-                             "student is longer than " + std::to_string(collision_lab_ros::kMaxStudentLength) +
+                             "student is longer than " + std::to_string(collision_lab::service::kMaxStudentLength) +
                                  " characters",
                              "student"));
   }
@@ -214,18 +215,16 @@ collision_lab::InitialConditions WebServer::sceneOfSend(const json& body) const 
   return input;
 }
 
-// The envelope and the limits of a send, past its fields: bodies (422), the address's share
-// of unfinished runs and the runs per minute (429). False when refused (answered here).
+// The envelope of a send (service::checkEnvelope, as the lab checks it: 422 with the lab's
+// Rejected), then the limits: the address's share of unfinished runs and the runs per
+// minute (429). False when refused (answered here).
 bool WebServer::admitSend(const HttpRequest& request, const collision_lab::InitialConditions& input,
                           const std::string& student, const Refuse& refuse, const HttpReply& reply) {
   const std::string& text = request.message.body();
-  if (input.masses.size() > config_.max_bodies) {
-    collision_lab::Rejected r;
-    r.reason = collision_lab::Rejected::TOO_MANY_BODIES;
-    r.reason_name = "TOO_MANY_BODIES";
-    r.field = "masses";
-    r.message = std::to_string(input.masses.size()) + " bodies are more than this lab's max_bodies = " +
-                std::to_string(config_.max_bodies);
+  const std::size_t bodies = std::max({input.masses.size(), input.positions.size(), input.velocities.size()});
+  if (const auto refusal =
+          collision_lab::service::checkEnvelope({student, input.run_id, input.mode, bodies}, config_.max_bodies)) {
+    const collision_lab::Rejected r = collision_lab_ros::toRejectedMsg(*refusal);
     refusedSend(text, r.reason_name, r.message, r.field);
     reply.send(jsonAnswer(request, 422, rejectionJson(r)));
     return false;

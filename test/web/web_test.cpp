@@ -5,6 +5,7 @@
 #include <atomic>
 #include <string>
 #include <thread>
+#include <tuple>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -385,6 +386,38 @@ TEST_F(WebTest, TooManyBodiesIs422) {
   const json body = json::parse(res->body);
   EXPECT_EQ(body.at("rejected").at("reason_name"), "TOO_MANY_BODIES");
   EXPECT_EQ(body.at("rejected").at("field"), "masses");
+}
+
+TEST_F(WebTest, TheEnvelopeIsCheckedHereInTheLabsWords) {
+  // The web checks a send's envelope with the lab's own function (service::checkEnvelope):
+  // the lab's reason and words, answered by the web node without a round trip (failed
+  // before: an invalid student or mode was listed as the lab node's, and a scene with more
+  // positions than max_bodies but few masses went to the lab).
+  json dotted = piScene("dot.ted");
+  json mode = piScene("lou");
+  mode["mode"] = 3;
+  json long_positions = piScene("lou");
+  for (int i = 0; i < 21; ++i) long_positions["positions"].push_back(100 + i);  // max_bodies = 20
+  const std::tuple<json, const char*, const char*, const char*> cases[] = {
+      {dotted, "INVALID_STUDENT", "student",
+       "student 'dot.ted' may contain only letters, digits, '_' and '-' ('.' separates it from the run_id)"},
+      {mode, "INVALID_MODE", "mode", "mode 3 is not one of MODE_FULL (0), MODE_PREDICT_ONLY (1), MODE_SUMMARY_ONLY (2)"},
+      {long_positions, "TOO_MANY_BODIES", "masses",
+       "24 bodies are more than this node's ~max_bodies = 20; send a smaller scene, or start the node with a larger "
+       "~max_bodies"}};
+  for (const auto& [scene, reason, field, message] : cases) {
+    auto res = post(scene);
+    ASSERT_TRUE(res);
+    ASSERT_EQ(res->status, 422) << res->body;
+    const json rejected = json::parse(res->body).at("rejected");
+    EXPECT_EQ(rejected.at("reason_name"), reason);
+    EXPECT_EQ(rejected.at("field"), field);
+    EXPECT_EQ(rejected.at("message"), message);
+    const json listed = json::parse(client().Get(("/api/rejections?student=" + scene["student"].get<std::string>()).c_str())->body);
+    ASSERT_FALSE(listed.empty());
+    EXPECT_EQ(listed[0].at("reason_name"), reason);
+    EXPECT_EQ(listed[0].at("by"), "web node") << listed.dump();
+  }
 }
 
 TEST_F(WebTest, RunsPerStudentPerMinuteIs429ForThatStudentOnly) {

@@ -27,6 +27,7 @@
 #include "collision_lab/core/scene.h"
 #include "collision_lab/core/scene_run.h"
 #include "collision_lab/io/event_record.h"
+#include "collision_lab/service/envelope.h"
 
 namespace collision_lab_ros {
 
@@ -143,5 +144,7 @@ void fillRunSummaryMsg(const collision_lab::core::SceneRunResult& result, std::s
 collision_lab::Rejected toRejectedMsg(const collision_lab::core::ValidationError& error);
 collision_lab::Rejected toRejectedMsg(NodeReason reason, const std::string& field,
                                       const std::string& message);
+/// An input outside the envelope (service::checkEnvelope), under its node reason.
+collision_lab::Rejected toRejectedMsg(const collision_lab::service::EnvelopeRefusal& refusal);
 
 }  // namespace collision_lab_ros

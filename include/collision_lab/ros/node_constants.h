@@ -5,6 +5,8 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "collision_lab/service/envelope.h"
+
 namespace collision_lab_ros {
 
 constexpr char kInitialConditionsTopic[] = "initial_conditions";
@@ -67,7 +69,7 @@ constexpr char kListRunsService[] = "list_runs";
 /// class's last runs, and the node's memory flat after its first few hundred runs.
 constexpr std::size_t kServedRunsKept = 200;
 /// InitialConditions.student: at most this many characters.
-constexpr std::size_t kMaxStudentLength = 64;
+constexpr std::size_t kMaxStudentLength = collision_lab::service::kMaxStudentLength;
 /// Service calls served at once; each blocks its thread until its run is over (the runs
 /// themselves are served by the workers). Further calls wait in roscpp.
 constexpr std::uint32_t kServiceThreads = 4;

@@ -1,5 +1,5 @@
-// Run ids: which are safe as bag names, the one an input asks for, a student's numbered
-// runs, and a bounded memory of those given out.
+// Run ids: the one an input asks for, a student's numbered runs, and a bounded memory of
+// those given out (which are safe as bag names: service/envelope.h).
 #pragma once
 
 #include <cstdint>
@@ -13,14 +13,8 @@
 
 namespace collision_lab_ros {
 
-/// Empty when run_id is safe as a bag file name; otherwise why not.
-std::string runIdProblem(const std::string& run_id);
-/// Empty when student is a valid InitialConditions.student (empty is: anonymous);
-/// otherwise why not.
-std::string studentProblem(const std::string& student);
-/// The run_id an input asks for: <student>.<run_id>, <student> when it names no run_id,
-/// or run_id when it names no student (empty: the node assigns one). A taken one is then
-/// served as <that>.N, except a numbered run (numberedRunId): that one as the next free number.
+/// The run_id an input asks for (service::requestedRunId). A taken one is then served as
+/// <that>.N, except a numbered run (numberedRunId): that one as the next free number.
 std::string requestedRunId(const collision_lab::InitialConditions& input);
 /// A numbered run, "run<n>" or "<prefix>.run<n>" (the web node numbers each student's runs
 /// so): its name up to the number ("ben.run") and n; nullopt for any other run_id.
