@@ -153,12 +153,16 @@ TEST(MarkersClock, ReplayGoesOnToTheRunsEndThoughTheClockStopsShortOfTheLastColl
   ASSERT_TRUE(spinUntil([&] { return player.connected(); }, kTimeout)) << "collision_lab_markers never subscribed";
   const ros::Time start = kStart + ros::Duration(1000.0);  // after the other test's clock
   player.load("stopped_clock_run", start);
-  // Played at a pace a wall clock can follow: up to t = 1.75 s, a second of wall time, then
-  // the rest at once.
+  // Played at a pace a wall clock can follow: up to t = 1.75 s, ten frames of wall time,
+  // then the rest at once.
   player.play(start + ros::Duration(kScale * 1.75));
   ASSERT_TRUE(spinUntil([&] { return timeShown(watcher.status) == "t = 1.75"; }, kTimeout))
       << "last shown: " << watcher.status;
-  ros::WallDuration(1.0).sleep();
+  // The clock stands at t = 1.75 s while frames go on (ten of them: wall time passes, as
+  // rosbag play takes it between two messages).
+  const std::uint64_t standing_at = watcher.frames;
+  ASSERT_TRUE(spinUntil([&] { return watcher.frames >= standing_at + 10; }, kTimeout)) << "frames stopped coming";
+  EXPECT_EQ(timeShown(watcher.status), "t = 1.75");
   player.play(std::nullopt, ros::Duration(0.005));
   ASSERT_TRUE(spinUntil([&] { return timeShown(watcher.status) == "t = 2.5"; }, kTimeout))
       << "last shown: " << watcher.status;

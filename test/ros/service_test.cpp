@@ -3,6 +3,7 @@
 // its own stop reason, the bag complete), the queue is fair across students, short runs
 // have a lane of their own, ~cancel drops a waiting run and stops a running one, and a
 // worker's exception ends only its run.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <limits>
@@ -230,23 +231,51 @@ FairWatch& fair() {
   return watch;
 }
 
+/// A run of the fair node's long lane that no machine ends by itself: the pi billiard at
+/// 10^20 (3.1 x 10^10 impacts), with a time budget of an hour. ~cancel ends it.
+collision_lab::InitialConditions endlessInput(const std::string& run_id, const std::string& student) {
+  collision_lab::InitialConditions input = piInput(run_id, student, 1e20);
+  input.max_run_seconds = 3600;
+  return input;
+}
+
+/// Stops run_id (running or waiting) with ~cancel and waits for its summary.
+void stopAndAwait(FairWatch& w, const std::string& run_id) {
+  collision_lab::Cancel cancel;
+  cancel.request.run_id = run_id;
+  cancel.request.requested_by = "service_test";
+  ASSERT_TRUE(callService("/fair/collision_lab_node/cancel", cancel));
+  EXPECT_TRUE(cancel.response.ok) << run_id << ": " << cancel.response.message;
+  w.runs().waitFor(run_id);
+}
+
 TEST(Service, AStudentsTenthRunWaitsBehindAClassmatesFirst) {
   FairWatch& w = fair();
-  // Ten long runs of ana (0.3 s each, by their own time budget), then one of ben.
+  // Ten runs of ana, then one of ben, each running until it is stopped: the order in which
+  // they start is the scheduler's alone, however fast the machine (no time budget decides).
+  const std::size_t before = w.started.size();
+  std::vector<std::string> ids;
   for (int i = 1; i <= 10; ++i) {
-    auto input = piInput("r" + std::to_string(i), "ana", 1e16);
-    input.max_run_seconds = 0.3;
-    w.runs().publish(input);
+    w.runs().publish(endlessInput("r" + std::to_string(i), "ana"));
+    ids.push_back("ana.r" + std::to_string(i));
   }
-  auto ben = piInput("r1", "ben", 1e16);
-  ben.max_run_seconds = 0.3;
-  w.runs().publish(ben);
-  w.runs().waitFor("ben.r1");
-  for (int i = 1; i <= 10; ++i) w.runs().waitFor("ana.r" + std::to_string(i));
-  const long ben_start = w.startIndex("ben.r1");
+  w.runs().publish(endlessInput("r1", "ben"));
+  ids.push_back("ben.r1");
+  ASSERT_TRUE(waitUntil(
+      [&] { return std::all_of(ids.begin(), ids.end(), [&](const std::string& id) { return w.acceptance(id); }); },
+      "all eleven runs to be accepted"));
+  // The fair node's one long-lane worker runs them one at a time: each is stopped once it
+  // has started, and the next starts.
+  for (std::size_t k = 0; k < ids.size(); ++k) {
+    ASSERT_TRUE(waitUntil([&] { return w.started.size() > before + k; }, "the next run to start"));
+    const std::string run_id = w.started[before + k];  // a copy: waiting spins callbacks that grow started
+    stopAndAwait(w, run_id);
+  }
+  const auto startOf = [&](const std::string& id) { return w.startIndex(id) - static_cast<long>(before); };
+  const long ben_start = startOf("ben.r1");
   ASSERT_GE(ben_start, 0);
   // ben's run starts right after ana's second (ana.r1 was running when the rest arrived).
-  EXPECT_LT(ben_start, w.startIndex("ana.r3"));
+  EXPECT_LT(ben_start, startOf("ana.r3"));
   EXPECT_LE(ben_start, 2);
   const auto* accepted = w.acceptance("ben.r1");
   ASSERT_NE(accepted, nullptr);
@@ -269,12 +298,8 @@ TEST(Service, AStudentsTenthRunWaitsBehindAClassmatesFirst) {
 
 TEST(Service, AShortRunNeverWaitsBehindLongOnes) {
   FairWatch& w = fair();
-  // Three long runs of 1.5 s each occupy the long lane for 4.5 s.
-  for (int i = 1; i <= 3; ++i) {
-    auto input = piInput("long" + std::to_string(i), "carl", 1e16);
-    input.max_run_seconds = 1.5;
-    w.runs().publish(input);
-  }
+  // Three long runs occupy the long lane until they are stopped.
+  for (int i = 1; i <= 3; ++i) w.runs().publish(endlessInput("long" + std::to_string(i), "carl"));
   ASSERT_TRUE(waitUntil([&] { return w.startIndex("carl.long1") >= 0; }, "carl.long1 to start"));
   const auto sent = std::chrono::steady_clock::now();
   w.runs().publish(piInput("quick", "dora", 100, collision_lab::InitialConditions::MODE_FULL));
@@ -288,7 +313,7 @@ TEST(Service, AShortRunNeverWaitsBehindLongOnes) {
   ASSERT_NE(accepted, nullptr);
   EXPECT_EQ(accepted->lane, "short");
   std::printf("short run with the long lane busy: summary %.3f s after it was sent\n", seconds);
-  for (int i = 1; i <= 3; ++i) w.runs().waitFor("carl.long" + std::to_string(i));
+  for (int i = 1; i <= 3; ++i) stopAndAwait(w, "carl.long" + std::to_string(i));
 }
 
 TEST(Service, CancelDropsAWaitingRunAndStopsARunningOne) {
