@@ -893,11 +893,9 @@ nlohmann::json listItem(const collision_lab::service::IndexedRun& row) {
 }
 }  // namespace
 
-std::optional<std::pair<std::string, std::uint64_t>> RunBook::json(const std::string& run_id) const {
-  // Reading a run back is a cache fill: the book's content does not change.
-  auto* self = const_cast<RunBook*>(this);
+std::optional<std::pair<std::string, std::uint64_t>> RunBook::json(const std::string& run_id) {
   for (int attempt = 0; attempt < 2; ++attempt) {
-    if (!self->load(run_id)) return std::nullopt;
+    if (!load(run_id)) return std::nullopt;
     std::lock_guard<std::mutex> lock(mutex_);
     auto it = runs_.find(run_id);
     if (it == runs_.end()) continue;  // evicted between the load and now: load it again
@@ -932,8 +930,8 @@ std::optional<std::pair<std::string, std::uint64_t>> RunBook::json(const std::st
 }
 
 std::pair<std::uint64_t, bool> RunBook::waitForChange(const std::string& run_id, std::uint64_t seen,
-                                                      std::chrono::milliseconds timeout) const {
-  const_cast<RunBook*>(this)->load(run_id);  // a stream of a run not in memory: read it back
+                                                      std::chrono::milliseconds timeout) {
+  load(run_id);  // a stream of a run not in memory: read it back
   std::unique_lock<std::mutex> lock(mutex_);
   auto current = [&]() -> std::pair<std::uint64_t, bool> {
     auto it = runs_.find(run_id);

@@ -34,7 +34,7 @@ namespace {
 
 using nlohmann::json;
 
-json runJson(const collision_lab_web::RunBook& book, const std::string& run_id) {
+json runJson(collision_lab_web::RunBook& book, const std::string& run_id) {
   auto text = book.json(run_id);
   return text ? json::parse(text->first) : json();
 }
@@ -295,7 +295,7 @@ collision_lab_web::RunBookOptions smallBudget(std::size_t bytes) {
 }
 
 /// A run's JSON without its version: what the page shows.
-std::string served(const collision_lab_web::RunBook& book, const std::string& run_id) {
+std::string served(collision_lab_web::RunBook& book, const std::string& run_id) {
   auto text = book.json(run_id);
   return text ? text->first : std::string();
 }

@@ -158,14 +158,15 @@ class RunBook {
   /// Held in memory now: json(run_id) answers without reading a bag or the index.
   bool resident(const std::string& run_id) const;
   /// The run as JSON text (docs/web.md), with its version; nullopt for an unknown run_id.
-  /// A run not in memory is loaded first (from its bag when finished or interrupted; its
-  /// state as the index says otherwise); concurrent loads of one run read its bag once.
-  std::optional<std::pair<std::string, std::uint64_t>> json(const std::string& run_id) const;
+  /// A run not in memory is loaded into the book first (from its bag when finished or
+  /// interrupted; its state as the index says otherwise); concurrent loads of one run read
+  /// its bag once.
+  std::optional<std::pair<std::string, std::uint64_t>> json(const std::string& run_id);
   /// Waits until the run's version differs from `seen` or `timeout` passes; returns the
   /// current version (0 for a run not in memory) and whether the run is finished (an
-  /// interrupted run is finished too).
+  /// interrupted run is finished too). A run not in memory is loaded first, as by json().
   std::pair<std::uint64_t, bool> waitForChange(const std::string& run_id, std::uint64_t seen,
-                                               std::chrono::milliseconds timeout) const;
+                                               std::chrono::milliseconds timeout);
   /// A page of a list: entries offset .. offset + limit - 1; total (when given) gets the
   /// length of the whole list.
   struct ListPage {
