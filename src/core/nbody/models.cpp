@@ -561,6 +561,20 @@ std::optional<Prediction> predict(const Scene& scene) {
   return std::nullopt;
 }
 
+std::optional<WallPeriod> wallToWallPeriod(const Scene& scene) {
+  if (scene.size() != 3 || scene.isRing() || !scene.isWall(0) || !scene.isWall(2) || scene.isWall(1) ||
+      !scene.isElastic()) {
+    return std::nullopt;
+  }
+  const auto& v = scene.velocities;
+  if (v[0] != 0 || v[2] != 0 || v[1] == 0 || !std::isfinite(v[1])) return std::nullopt;
+  using spiral_detail::Rational;
+  const Rational span = Rational(scene.positions[0]) - scene.positions[2];
+  const double time = detail::nearestDouble(2 * span / abs(Rational(v[1])));
+  if (!(time > 0) || !std::isfinite(time)) return std::nullopt;
+  return WallPeriod{time, 2};
+}
+
 std::uint64_t ringCrossingsBy(const Scene& scene, double t) {
   const double length = scene.ring;
   std::uint64_t crossings = 0;

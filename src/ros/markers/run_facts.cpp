@@ -2,7 +2,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include "collision_lab/core/nbody/models.h"
 #include "collision_lab/ros/markers/draw.h"
+#include "collision_lab/ros/msg_conversion.h"
 #include "collision_lab/ros/run_view.h"
 
 namespace collision_lab_ros::markers {
@@ -22,13 +24,10 @@ std::uint64_t Period::inPeriod(double t, std::uint64_t collisions) const {
 }
 
 std::optional<Period> periodOf(const RunRecord& run) {
-  const auto& in = run.input();
-  const bool elastic = std::all_of(in.restitution.begin(), in.restitution.end(), [](double e) { return e == 1.0; });
-  if (run.bodies() != 3 || !run.isWall(0) || !run.isWall(2) || run.isWall(1) || !elastic) return std::nullopt;
-  if (in.velocities[0] != 0 || in.velocities[2] != 0 || in.velocities[1] == 0) return std::nullopt;
-  const double period = 2 * (in.positions[0] - in.positions[2]) / std::abs(in.velocities[1]);
-  if (!(period > 0) || !(endTime(run) > layout::kPeriodsToFold * period)) return std::nullopt;
-  return Period{period, 2};
+  if (run.bodies() != 3) return std::nullopt;  // before copying a large scene, frame after frame
+  const auto period = collision_lab::core::wallToWallPeriod(toScene(run.input()));
+  if (!period || !(endTime(run) > layout::kPeriodsToFold * period->time)) return std::nullopt;
+  return Period{period->time, period->impacts};
 }
 
 std::string periodsSoFar(const Period& period, double t) {

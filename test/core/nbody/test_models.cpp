@@ -144,6 +144,43 @@ TEST(NBodyModels, TwoWallsAreInfinite) {
   EXPECT_NE(run.stop_message.find("two walls"), std::string::npos) << run.stop_message;
 }
 
+TEST(NBodyModels, ABallBetweenStillWallsRepeatsEveryPeriodExactlyRounded) {
+  // x_A - x_C is not a double here, so 2 (x_A - x_C) / |v_B| in doubles is 1 ulp off
+  // (10.824665500268292); the period is the exact value rounded once.
+  const double xa = 2.550690257394217, xc = -5.045649129080591, vb = -1.4035240878873405;
+  const Scene s = scene({kInf, 1, kInf}, {xa, 0.5, xc}, {0, vb, 0});
+  const auto period = wallToWallPeriod(s);
+  ASSERT_TRUE(period);
+  using Rational = boost::multiprecision::cpp_rational;
+  const Rational exact = 2 * (Rational(xa) - Rational(xc)) / -Rational(vb);
+  EXPECT_EQ(period->time, exact.convert_to<double>());
+  EXPECT_NE(period->time, 2 * (xa - xc) / -vb) << "the doubles' quotient rounds three times";
+  EXPECT_EQ(period->impacts, 2u);
+  // The engine agrees: impact n + 2 comes one period after impact n, and B moves as at the
+  // start after each second impact.
+  EngineOptions options;
+  options.max_impacts = 9;
+  std::vector<ImpactRecord> impacts;
+  runEngine(s, options, [&](const ImpactRecord& r) { impacts.push_back(r); });
+  ASSERT_EQ(impacts.size(), 9u);
+  for (std::size_t n = 0; n + 2 < impacts.size(); ++n) {
+    EXPECT_NEAR(impacts[n + 2].time - impacts[n].time, period->time, 1e-12 * impacts[n + 2].time);
+  }
+  for (std::size_t n = 1; n < impacts.size(); n += 2) {
+    const ImpactRecord& r = impacts[n];
+    EXPECT_EQ(r.velocities_after[r.pair_index == 0 ? 1 : 0], vb) << "B after impact " << n;  // B is pair AB's left body
+  }
+}
+
+TEST(NBodyModels, OnlyABallBetweenStillElasticWallsHasAPeriod) {
+  EXPECT_TRUE(wallToWallPeriod(scene({kInf, 1, kInf}, {2, 1, 0}, {0, 1, 0})));
+  EXPECT_FALSE(wallToWallPeriod(scene({kInf, 1, kInf}, {2, 1, 0}, {0.5, 1, 0})));  // a moving wall
+  EXPECT_FALSE(wallToWallPeriod(scene({kInf, 1, kInf}, {2, 1, 0}, {0, 1, 0}, {0.9})));  // inelastic
+  EXPECT_FALSE(wallToWallPeriod(scene({kInf, 1, kInf}, {2, 1, 0}, {0, 0, 0})));  // at rest
+  EXPECT_FALSE(wallToWallPeriod(scene({kInf, 1, 1, kInf}, {3, 2, 1, 0}, {0, 1, 0, 0})));  // two balls
+  EXPECT_FALSE(wallToWallPeriod(scene({1, 1, kInf}, {2, 1, 0}, {0, 1, 0})));  // one wall
+}
+
 /// Number of pairs i < j with v_i < v_j, by a Fenwick tree over the ranks of the values:
 /// independent of the merge sort in the model.
 std::uint64_t fenwickInversions(const std::vector<double>& v) {

@@ -147,6 +147,16 @@ Prediction predictThreeBodyRotation(const Scene& scene);
 /// hasRotationValues tells a prediction that carries them.
 std::optional<Prediction> predict(const Scene& scene);
 
+/// The period of a ball between two walls at rest (three bodies, A and C walls standing
+/// still, B moving, every pair elastic): B is back where it started, moving as it started,
+/// every `time` = 2 (x_A - x_C) / |v_B| [s], exact and rounded once, after `impacts` = 2
+/// impacts (one on each wall). Empty for any other scene, and where the time overflows.
+struct WallPeriod {
+  double time = 0.0;          ///< [s]
+  std::uint64_t impacts = 2;  ///< per period [1]
+};
+std::optional<WallPeriod> wallToWallPeriod(const Scene& scene);
+
 /// Equal masses on a ring (elastic): the number of crossings of the ghosts (each moving at
 /// its initial velocity round the ring of circumference scene.ring) in (0, t] [s], i.e. the
 /// impacts by time t; a crossing exactly at t counts. In double (the crossing times are

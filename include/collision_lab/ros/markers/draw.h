@@ -129,7 +129,7 @@ void addIndexAxisLabels(const Canvas& c, const std::string& ns, int base, const 
 /// A periodic motion, drawn over one period (x-t diagram and index plots): a ball between two
 /// walls at rest, all impacts elastic, once the run lasts layout::kPeriodsToFold periods.
 struct Period {
-  double time;            ///< T = 2 (x_A - x_C) / |v_B| [s]
+  double time;            ///< T = 2 (x_A - x_C) / |v_B| [s] (core::wallToWallPeriod)
   std::uint64_t impacts;  ///< per period, one on each wall [1]
   /// Whole periods before time t [s].
   std::uint64_t before(double t) const { return static_cast<std::uint64_t>(t / time); }
