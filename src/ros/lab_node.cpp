@@ -563,7 +563,7 @@ void LabNode::serve(Worker& worker, Job& job) {
                   stopRun(worker, cause, std::string());
                 });
   job.input.header.stamp = start;
-  RunProgress progress;
+  RunSoFar progress;
   std::string what;
   try {
     run(worker, job, out, progress);
@@ -585,7 +585,7 @@ void LabNode::serve(Worker& worker, Job& job) {
   }
 }
 
-void LabNode::run(Worker& worker, Job& job, RunWriter& out, RunProgress& progress) {
+void LabNode::run(Worker& worker, Job& job, RunWriter& out, RunSoFar& progress) {
   namespace core = collision_lab::core;
   collision_lab::InitialConditions& input = job.input;
   const core::ScenePlan& plan = job.plan;
@@ -676,7 +676,7 @@ void unsimulatedSummary(const collision_lab::core::ScenePlan& plan, const collis
 
 }  // namespace
 
-void LabNode::failRun(Worker& worker, Job& job, RunWriter& out, const RunProgress& progress, const std::string& what) {
+void LabNode::failRun(Worker& worker, Job& job, RunWriter& out, const RunSoFar& progress, const std::string& what) {
   ROS_ERROR_STREAM("run " << job.input.run_id << ": the worker failed after " << progress.collisions
                    << " collisions: " << what << "; the run ends WORKER_ERROR and the node goes on");
   collision_lab::RunSummary& summary = worker.summary_msg;

@@ -198,7 +198,7 @@ class EventStream {
  public:
   /// fail_at_first_event: the test hook ~fail_runs_of_student (throws std::bad_alloc).
   EventStream(const RunTopics& topics, RunWriter& out, RunObserver* markers, const PublishLimits& limits,
-              const collision_lab::core::Scene& scene, EventMessages& buffers, RunProgress& progress,
+              const collision_lab::core::Scene& scene, EventMessages& buffers, RunSoFar& progress,
               bool fail_at_first_event)
       : topics_(topics), out_(out), markers_(markers), limits_(limits), scene_(scene),
         msg_(buffers), progress_(progress), fail_(fail_at_first_event) {}
@@ -281,7 +281,7 @@ class EventStream {
   const collision_lab::core::Scene& scene_;
   std::optional<SceneEventConverter> converter_;
   EventMessages& msg_;
-  RunProgress& progress_;
+  RunSoFar& progress_;
   bool fail_;
   bool cut_ = false;
   std::uint64_t unpublished_since_progress_ = 0;  ///< [1] since the last RunProgress

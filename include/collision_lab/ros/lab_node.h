@@ -106,7 +106,7 @@ struct EventMessages {
 
 /// What a run has computed so far, kept outside its EventStream (run_writer.h) so that a
 /// run that throws can still report it.
-struct RunProgress {
+struct RunSoFar {
   std::uint64_t collisions = 0;  ///< [1] events seen
   std::uint64_t published = 0;   ///< [1] events published
   double last_time = 0.0;        ///< simulated time of the last collision [s]
@@ -217,9 +217,9 @@ class LabNode {
   /// Runs job, catching every exception (WORKER_ERROR).
   void serve(Worker& worker, Job& job);
   /// Publishes, records and draws one accepted run.
-  void run(Worker& worker, Job& job, RunWriter& out, RunProgress& progress);
+  void run(Worker& worker, Job& job, RunWriter& out, RunSoFar& progress);
   /// Ends a run that threw `what` before its summary was handed over: WORKER_ERROR.
-  void failRun(Worker& worker, Job& job, RunWriter& out, const RunProgress& progress, const std::string& what);
+  void failRun(Worker& worker, Job& job, RunWriter& out, const RunSoFar& progress, const std::string& what);
   /// The stop reason of a service limit or of ~cancel, put into summary.
   void applyStopCause(Worker& worker, const Job& job, collision_lab::RunSummary& summary);
   /// Ends a run that never started (cancelled while waiting, or at shutdown): a CANCELLED,
