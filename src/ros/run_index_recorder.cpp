@@ -17,7 +17,9 @@
 #include <iterator>
 #include <limits>
 #include <stdexcept>
+#include <type_traits>
 #include <utility>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 #include <ros/console.h>
@@ -268,39 +270,90 @@ collision_lab::InitialConditions inputFromJson(const std::string& text) {
   return in;
 }
 
-std::string summaryJson(const collision_lab::RunSummary& s) {
-  return json{{"run_id", s.run_id},
-              {"student", s.student},
-              {"requested_run_id", s.requested_run_id},
-              {"mode", s.mode},
-              {"model", s.model_name},
-              {"model_reason", s.model_reason},
-              {"body_count", s.body_count},
-              {"collision_count", s.collision_count},
-              {"simulated", static_cast<bool>(s.simulated)},
-              {"truncated", static_cast<bool>(s.truncated)},
-              {"truncation_reason", s.truncation_reason},
-              {"cancelled", static_cast<bool>(s.cancelled)},
-              {"stop_reason", s.stop_reason},
-              {"predicted_collision_count",
-               s.predicted_collision_count_defined ? json(s.predicted_collision_count) : json(nullptr)},
-              {"paper_collision_count",
-               s.paper_predicted_collision_count_defined ? json(s.paper_predicted_collision_count) : json(nullptr)},
-              {"infinite_collisions", static_cast<bool>(s.infinite_collisions)},
-              {"final_velocities", finiteArray(s.final_velocities)},
-              {"energy_lost", finite(s.energy_lost)},
-              {"collapsed", static_cast<bool>(s.collapsed)},
-              {"max_prediction_error", finite(s.max_prediction_error)},
-              {"energy_relative_drift", finite(s.energy_relative_drift)},
-              {"momentum_relative_drift", finite(s.momentum_relative_drift)},
-              {"compute_time", finite(s.compute_time)},
-              {"uncertified_values", s.uncertified_values},
-              {"time_beyond_range", static_cast<bool>(s.time_beyond_range)},
-              {"published_events", s.published_events},
-              {"bag_path", s.bag_path},
-              {"recorded", s.recording_ok && !s.bag_path.empty()},
-              {"recording_error", s.recording_error}}
-      .dump();
+json summaryFields(const collision_lab::RunSummary& s) {
+  return {{"run_id", s.run_id},
+          {"student", s.student},
+          {"requested_run_id", s.requested_run_id},
+          {"mode", s.mode},
+          {"model", s.model_name},
+          {"model_reason", s.model_reason},
+          {"body_count", s.body_count},
+          {"collision_count", s.collision_count},
+          {"simulated", static_cast<bool>(s.simulated)},
+          {"truncated", static_cast<bool>(s.truncated)},
+          {"truncation_reason", s.truncation_reason},
+          {"cancelled", static_cast<bool>(s.cancelled)},
+          {"stop_reason", s.stop_reason},
+          {"predicted_collision_count",
+           s.predicted_collision_count_defined ? json(s.predicted_collision_count) : json(nullptr)},
+          {"paper_collision_count",
+           s.paper_predicted_collision_count_defined ? json(s.paper_predicted_collision_count) : json(nullptr)},
+          {"infinite_collisions", static_cast<bool>(s.infinite_collisions)},
+          {"final_velocities", finiteArray(s.final_velocities)},
+          {"energy_lost", finite(s.energy_lost)},
+          {"collapsed", static_cast<bool>(s.collapsed)},
+          {"max_prediction_error", finite(s.max_prediction_error)},
+          {"energy_relative_drift", finite(s.energy_relative_drift)},
+          {"momentum_relative_drift", finite(s.momentum_relative_drift)},
+          {"compute_time", finite(s.compute_time)},
+          {"uncertified_values", s.uncertified_values},
+          {"time_beyond_range", static_cast<bool>(s.time_beyond_range)},
+          {"published_events", s.published_events},
+          {"bag_path", s.bag_path},
+          {"recorded", s.recording_ok && !s.bag_path.empty()},
+          {"recording_error", s.recording_error}};
+}
+
+std::string summaryJson(const collision_lab::RunSummary& s) { return summaryFields(s).dump(); }
+
+collision_lab::RunSummary summaryFromFields(const json& fields) {
+  collision_lab::RunSummary s;
+  const auto text = [&](const char* key, std::string& into) { into = fields.value(key, into); };
+  const auto flag = [&](const char* key, std::uint8_t& into) { into = fields.value(key, static_cast<bool>(into)); };
+  const auto number = [&](const json& value) {
+    return value.is_null() ? std::numeric_limits<double>::quiet_NaN() : value.get<double>();
+  };
+  const auto real = [&](const char* key, double& into) {
+    if (fields.contains(key)) into = number(fields.at(key));
+  };
+  const auto count = [&](const char* key, auto& into, std::uint8_t* defined = nullptr) {
+    if (!fields.contains(key)) return;
+    const json& value = fields.at(key);
+    if (defined) *defined = !value.is_null();
+    if (!value.is_null()) into = value.get<std::remove_reference_t<decltype(into)>>();
+  };
+  text("run_id", s.run_id);
+  text("student", s.student);
+  text("requested_run_id", s.requested_run_id);
+  count("mode", s.mode);
+  text("model", s.model_name);
+  text("model_reason", s.model_reason);
+  count("body_count", s.body_count);
+  count("collision_count", s.collision_count);
+  flag("simulated", s.simulated);
+  flag("truncated", s.truncated);
+  text("truncation_reason", s.truncation_reason);
+  flag("cancelled", s.cancelled);
+  text("stop_reason", s.stop_reason);
+  count("predicted_collision_count", s.predicted_collision_count, &s.predicted_collision_count_defined);
+  count("paper_collision_count", s.paper_predicted_collision_count, &s.paper_predicted_collision_count_defined);
+  flag("infinite_collisions", s.infinite_collisions);
+  if (fields.contains("final_velocities")) {
+    for (const json& v : fields.at("final_velocities")) s.final_velocities.push_back(number(v));
+  }
+  real("energy_lost", s.energy_lost);
+  flag("collapsed", s.collapsed);
+  real("max_prediction_error", s.max_prediction_error);
+  real("energy_relative_drift", s.energy_relative_drift);
+  real("momentum_relative_drift", s.momentum_relative_drift);
+  real("compute_time", s.compute_time);
+  if (fields.contains("uncertified_values")) s.uncertified_values = fields.at("uncertified_values").get<std::vector<std::string>>();
+  flag("time_beyond_range", s.time_beyond_range);
+  count("published_events", s.published_events);
+  text("bag_path", s.bag_path);
+  flag("recorded", s.recording_ok);
+  text("recording_error", s.recording_error);
+  return s;
 }
 
 collision_lab::service::RunEnding endingOf(const collision_lab::RunSummary& summary) {

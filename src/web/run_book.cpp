@@ -89,31 +89,12 @@ json predictionJson(const collision_lab::Prediction& p) {
           {"collapsed", static_cast<bool>(p.collapsed)}};
 }
 
+/// The one summary JSON (collision_lab_ros::summaryFields), less bag_path: a path on the
+/// lab machine (the page links the run's files instead).
 json summaryJson(const collision_lab::RunSummary& s) {
-  return {{"collision_count", s.collision_count},
-          {"model", s.model_name},
-          {"model_reason", s.model_reason},
-          {"body_count", s.body_count},
-          {"simulated", static_cast<bool>(s.simulated)},
-          {"truncated", static_cast<bool>(s.truncated)},
-          {"truncation_reason", s.truncation_reason},
-          {"stop_reason", s.stop_reason},
-          {"predicted_collision_count",
-           s.predicted_collision_count_defined ? json(s.predicted_collision_count) : json(nullptr)},
-          {"paper_collision_count",
-           s.paper_predicted_collision_count_defined ? json(s.paper_predicted_collision_count) : json(nullptr)},
-          {"infinite_collisions", static_cast<bool>(s.infinite_collisions)},
-          {"final_velocities", numbers(s.final_velocities)},
-          {"energy_lost", exactNumber(s.energy_lost)},
-          {"collapsed", static_cast<bool>(s.collapsed)},
-          {"max_prediction_error", exactNumber(s.max_prediction_error)},
-          {"energy_relative_drift", exactNumber(s.energy_relative_drift)},
-          {"published_events", s.published_events},
-          {"compute_time", exactNumber(s.compute_time)},
-          {"uncertified_values", s.uncertified_values},
-          {"time_beyond_range", static_cast<bool>(s.time_beyond_range)},
-          {"recorded", s.recording_ok && !s.bag_path.empty()},
-          {"recording_error", s.recording_error}};
+  json out = collision_lab_ros::summaryFields(s);
+  out.erase("bag_path");
+  return out;
 }
 
 /// The x-t diagram's lines to the run's end, cut at a ring's seam (RunView's
@@ -314,6 +295,14 @@ bool ended(collision_lab::service::RunState state) {
 /// stop reason, count and bag, and what its summary_json holds of RunSummary's fields.
 collision_lab::RunSummary summaryFromRow(const collision_lab::service::IndexedRun& row) {
   collision_lab::RunSummary s;
+  const json fields = json::parse(row.summary_json, nullptr, false);
+  if (fields.is_object()) {
+    try {
+      s = collision_lab_ros::summaryFromFields(fields);
+    } catch (const json::exception&) {
+      s = collision_lab::RunSummary();  // a row some other writer wrote: its columns only
+    }
+  }
   s.run_id = row.run_id;
   s.student = row.student;
   s.requested_run_id = row.requested_run_id;
@@ -322,21 +311,6 @@ collision_lab::RunSummary summaryFromRow(const collision_lab::service::IndexedRu
   s.collision_count = row.collision_count;
   s.bag_path = row.bag_path;
   s.recording_ok = !row.bag_path.empty();
-  const json fields = json::parse(row.summary_json, nullptr, false);
-  if (fields.is_object()) {
-    s.model_name = fields.value("model", s.model_name);  // the key collision_lab_ros::summaryJson writes
-    s.model_reason = fields.value("model_reason", s.model_reason);
-    s.truncated = fields.value("truncated", false);
-    s.truncation_reason = fields.value("truncation_reason", s.truncation_reason);
-    s.simulated = fields.value("simulated", false);
-    s.cancelled = fields.value("cancelled", false);
-    s.collapsed = fields.value("collapsed", false);
-    s.body_count = fields.value("body_count", s.body_count);
-    s.published_events = fields.value("published_events", s.published_events);
-    s.uncertified_values = fields.value("uncertified_values", s.uncertified_values);
-    s.time_beyond_range = fields.value("time_beyond_range", false);
-    s.recording_error = fields.value("recording_error", s.recording_error);
-  }
   return s;
 }
 

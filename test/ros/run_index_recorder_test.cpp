@@ -11,10 +11,12 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <memory>
 #include <fstream>
+#include <limits>
 #include <string>
 #include <thread>
 
@@ -115,6 +117,85 @@ class RunIndexRecorderTest : public ::testing::Test {
 
   std::string dir_;
 };
+
+TEST(SummaryJson, EveryFieldItWritesReadsBack) {
+  // The one summary JSON, which the index stores and the web serves and reads back: each
+  // field summaryFields writes comes back as it was (a value that is not finite as NaN).
+  collision_lab::RunSummary s;
+  s.run_id = "ana.pi";
+  s.student = "ana";
+  s.requested_run_id = "pi";
+  s.mode = collision_lab::InitialConditions::MODE_SUMMARY_ONLY;
+  s.model_name = "three_body_rotation";
+  s.model_reason = "three elastic bodies";
+  s.body_count = 3;
+  s.collision_count = 31;
+  s.simulated = true;
+  s.truncated = true;
+  s.truncation_reason = "stopped by the teacher";
+  s.cancelled = true;
+  s.stop_reason = "CANCELLED";
+  s.predicted_collision_count = 31;
+  s.predicted_collision_count_defined = true;
+  s.paper_predicted_collision_count = -2;
+  s.paper_predicted_collision_count_defined = true;
+  s.infinite_collisions = true;
+  s.final_velocities = {0.1, -0.7, std::numeric_limits<double>::infinity()};
+  s.energy_lost = 1.0 / 3.0;
+  s.collapsed = true;
+  s.max_prediction_error = std::numeric_limits<double>::quiet_NaN();
+  s.energy_relative_drift = 1e-300;
+  s.momentum_relative_drift = -2.5e-17;
+  s.compute_time = 0.125;
+  s.uncertified_values = {"final_velocities"};
+  s.time_beyond_range = true;
+  s.published_events = 29;
+  s.bag_path = "/bags/ana.pi.bag";
+  s.recording_ok = true;
+  s.recording_error = "none";
+  const collision_lab::RunSummary r = summaryFromFields(nlohmann::json::parse(summaryJson(s)));
+  EXPECT_EQ(r.run_id, s.run_id);
+  EXPECT_EQ(r.student, s.student);
+  EXPECT_EQ(r.requested_run_id, s.requested_run_id);
+  EXPECT_EQ(r.mode, s.mode);
+  EXPECT_EQ(r.model_name, s.model_name);
+  EXPECT_EQ(r.model_reason, s.model_reason);
+  EXPECT_EQ(r.body_count, s.body_count);
+  EXPECT_EQ(r.collision_count, s.collision_count);
+  EXPECT_EQ(r.simulated, s.simulated);
+  EXPECT_EQ(r.truncated, s.truncated);
+  EXPECT_EQ(r.truncation_reason, s.truncation_reason);
+  EXPECT_EQ(r.cancelled, s.cancelled);
+  EXPECT_EQ(r.stop_reason, s.stop_reason);
+  EXPECT_EQ(r.predicted_collision_count, 31u);
+  EXPECT_TRUE(r.predicted_collision_count_defined);
+  EXPECT_EQ(r.paper_predicted_collision_count, -2);
+  EXPECT_TRUE(r.paper_predicted_collision_count_defined);
+  EXPECT_EQ(r.infinite_collisions, s.infinite_collisions);
+  ASSERT_EQ(r.final_velocities.size(), 3u);
+  EXPECT_EQ(r.final_velocities[0], 0.1);
+  EXPECT_EQ(r.final_velocities[1], -0.7);
+  EXPECT_TRUE(std::isnan(r.final_velocities[2])) << "JSON has no inf: null, read as NaN";
+  EXPECT_EQ(r.energy_lost, s.energy_lost);
+  EXPECT_EQ(r.collapsed, s.collapsed);
+  EXPECT_TRUE(std::isnan(r.max_prediction_error));
+  EXPECT_EQ(r.energy_relative_drift, s.energy_relative_drift);
+  EXPECT_EQ(r.momentum_relative_drift, s.momentum_relative_drift);
+  EXPECT_EQ(r.compute_time, s.compute_time);
+  EXPECT_EQ(r.uncertified_values, s.uncertified_values);
+  EXPECT_EQ(r.time_beyond_range, s.time_beyond_range);
+  EXPECT_EQ(r.published_events, s.published_events);
+  EXPECT_EQ(r.bag_path, s.bag_path);
+  EXPECT_EQ(r.recording_ok, s.recording_ok);
+  EXPECT_EQ(r.recording_error, s.recording_error);
+
+  // Counts not defined are null, and read back as not defined.
+  collision_lab::RunSummary open;
+  const collision_lab::RunSummary o = summaryFromFields(summaryFields(open));
+  EXPECT_FALSE(o.predicted_collision_count_defined);
+  EXPECT_FALSE(o.paper_predicted_collision_count_defined);
+  EXPECT_FALSE(o.recording_ok) << "recorded needs a bag";
+}
 
 TEST_F(RunIndexRecorderTest, AClaimIsLockedUntilItsBagIsClosed) {
   std::string error;

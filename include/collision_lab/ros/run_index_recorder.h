@@ -19,6 +19,8 @@
 #include <thread>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "collision_lab/InitialConditions.h"
 #include "collision_lab/Rejected.h"
 #include "collision_lab/RunSummary.h"
@@ -36,9 +38,18 @@ std::string inputJson(const collision_lab::InitialConditions& input);
 /// the node ignores unless in use) reads back as 0. Throws std::invalid_argument when the
 /// text is not such JSON, or a per-body value is null.
 collision_lab::InitialConditions inputFromJson(const std::string& text);
-/// The index's JSON of a summary (IndexedRun::summary_json): the fields the class pages
-/// show, under RunSummary's field names.
+/// The one JSON of a RunSummary, which the run index stores (IndexedRun::summary_json) and
+/// the web serves: the fields the class pages show, under RunSummary's field names but
+/// "model" (model_name), "paper_collision_count" (paper_predicted_collision_count; null
+/// when not defined, as predicted_collision_count), "recorded" (recording_ok with a bag);
+/// a value that is not finite is null.
+nlohmann::json summaryFields(const collision_lab::RunSummary& summary);
+/// summaryFields as text.
 std::string summaryJson(const collision_lab::RunSummary& summary);
+/// The summary back from summaryFields: each field it holds (a null number as NaN), the
+/// others at their defaults; a key it lacks keeps its default too. Throws
+/// nlohmann::json::exception on a value of the wrong type.
+collision_lab::RunSummary summaryFromFields(const nlohmann::json& fields);
 /// How the summary's run ended, as the index's columns (IndexedRun::ending).
 collision_lab::service::RunEnding endingOf(const collision_lab::RunSummary& summary);
 
