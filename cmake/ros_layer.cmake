@@ -1,6 +1,8 @@
-# Thin ROS layer in three libraries, as grid_map does, over the ROS-free core:
+# Thin ROS layer in four libraries, as grid_map does, over the ROS-free core:
 #   collision_lab_ros    the node: message <-> core conversion, the lab node, per-run bags
-#   collision_lab_views  the rviz markers (links the node library for the conversions and
+#   collision_lab_view_model  a run kept for drawing and its view description, which rviz
+#                        and the web page share (no marker types)
+#   collision_lab_views  the rviz markers over the view model (links the node library for
 #                        RunObserver, the node's hook for an in-process view)
 #   collision_lab_tools  bag_to_csv and the scenario publisher
 # Each executable links the library it runs.
@@ -30,10 +32,17 @@ add_dependencies(collision_lab_ros ${PROJECT_NAME}_generate_messages_cpp ${catki
 # catkin_package() read it.
 target_compile_definitions(collision_lab_ros PRIVATE COLLISION_LAB_VERSION="${collision_lab_VERSION}")
 
+# The view model rviz and the web page share: a run kept for drawing (run_record), its view
+# description (run_view) and style (view_style); no marker types.
+add_library(collision_lab_view_model
+  src/ros/run_record.cpp
+  src/ros/run_view.cpp
+  src/ros/view_style.cpp)
+target_link_libraries(collision_lab_view_model PUBLIC collision_lab_ros)
+
 add_library(collision_lab_views
   src/ros/marker_builder.cpp
   src/ros/marker_view.cpp
-  src/ros/run_view.cpp  # the view description rviz and the web page share
   # the rviz views, one file each, and what they share (include/.../ros/markers/)
   src/ros/markers/draw.cpp
   src/ros/markers/run_facts.cpp
@@ -48,7 +57,7 @@ add_library(collision_lab_views
   src/ros/markers/temperature.cpp
   src/ros/markers/clusters.cpp
   src/ros/markers/rviz_limits.cpp)
-target_link_libraries(collision_lab_views PUBLIC collision_lab_ros)
+target_link_libraries(collision_lab_views PUBLIC collision_lab_view_model)
 
 add_library(collision_lab_tools
   src/ros/bag_csv.cpp
@@ -71,7 +80,7 @@ target_link_libraries(bag_to_csv PRIVATE collision_lab_tools)
 set_target_properties(${collision_lab_ROS_EXECUTABLES} PROPERTIES
   RUNTIME_OUTPUT_DIRECTORY ${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_BIN_DESTINATION})
 
-install(TARGETS collision_lab_ros collision_lab_views collision_lab_tools
+install(TARGETS collision_lab_ros collision_lab_view_model collision_lab_views collision_lab_tools
   ARCHIVE DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
   LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION})
 install(TARGETS ${collision_lab_ROS_EXECUTABLES}

@@ -15,7 +15,8 @@ add_dependencies(web_browser_test collision_lab_node collision_lab_web)
 target_compile_definitions(web_browser_test PRIVATE COLLISION_LAB_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
 # RunBook with the lab's topics out of order (no master).
 catkin_add_gtest(run_book_test test/web/run_book_test.cpp)
-target_link_libraries(run_book_test collision_lab_web_lib ${catkin_LIBRARIES} GTest::gtest_main)
+# collision_lab_views: the test compares the page's view with rviz's markers.
+target_link_libraries(run_book_test collision_lab_web_lib collision_lab_views ${catkin_LIBRARIES} GTest::gtest_main)
 # The web node killed and respawned: every run of the run index still listed and served;
 # runs whose end it missed end from the index.
 add_rostest_gtest(web_restart_test test/web/web_restart_test.test test/web/web_restart_test.cpp)

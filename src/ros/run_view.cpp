@@ -6,7 +6,7 @@
 
 #include "collision_lab/core/nbody/scene.h"
 #include "collision_lab/core/nbody/temperature.h"
-#include "collision_lab/ros/markers/draw.h"
+#include "collision_lab/ros/view_style.h"
 #include "collision_lab/ros/markers/layout.h"
 
 namespace collision_lab_ros {
@@ -161,7 +161,7 @@ void decideColours(const RunRecord& run, RunView& view) {
     if (run.isWall(i)) {
       view.body_colours.push_back(hexOf(layout::kGrey.r, layout::kGrey.g, layout::kGrey.b));
     } else if (view.colour_by_start_velocity) {
-      const auto c = markers::velocityColor(run.input().velocities[i], view.colour_scale);
+      const auto c = markers::velocityRgb(run.input().velocities[i], view.colour_scale);
       view.body_colours.push_back(hexOf(c.r, c.g, c.b));
     } else {
       view.body_colours.push_back(bodyColourHex(i));

@@ -12,7 +12,7 @@
 #include "collision_lab/InitialConditions.h"
 #include "collision_lab/core/nbody/body_state_replay.h"
 #include "collision_lab/ros/bag_reading.h"
-#include "collision_lab/ros/marker_builder.h"
+#include "collision_lab/ros/run_record.h"
 #include "collision_lab/ros/msg_conversion.h"
 
 namespace collision_lab_web {

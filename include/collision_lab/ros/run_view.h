@@ -14,7 +14,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "collision_lab/ros/marker_builder.h"
+#include "collision_lab/ros/run_record.h"
 
 namespace collision_lab_ros {
 

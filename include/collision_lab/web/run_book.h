@@ -3,7 +3,7 @@
 // accepted_runs and rejected. Every run the node serves is here, whoever sent it (a
 // browser, rostopic pub, a service call), keyed by its served run_id.
 //
-// Big runs stay light: each run keeps a marker view's RunRecord (marker_builder.h) without
+// Big runs stay light: each run keeps a view model's RunRecord (run_record.h) without
 // the rviz keyframes, whose series are min/max envelopes per column, so the JSON of a run
 // has at most a few thousand points whatever its count. Events beyond the node's
 // ~max_published_events are not published; when a summary says so, the run is rebuilt from
@@ -42,7 +42,7 @@
 #include "collision_lab/Rejected.h"
 #include "collision_lab/RunProgress.h"
 #include "collision_lab/RunSummary.h"
-#include "collision_lab/ros/marker_builder.h"
+#include "collision_lab/ros/run_record.h"
 #include "collision_lab/web/run_source.h"
 
 namespace collision_lab_web {

@@ -18,6 +18,7 @@
 #include "collision_lab/ros/markers/ids.h"
 #include "collision_lab/ros/markers/layout.h"
 #include "collision_lab/ros/run_view.h"
+#include "collision_lab/ros/view_style.h"
 
 namespace collision_lab_ros::markers {
 
@@ -31,21 +32,15 @@ std_msgs::ColorRGBA color(const Rgba& c);
 /// Body i's colour as the view decided it (RunView::body_colours: the same bytes the page
 /// draws), lightened towards white by `lighten` (0..1) for texts.
 std_msgs::ColorRGBA bodyColor(const RunView& view, std::size_t i, double lighten = 0.0);
-/// Velocity v [m/s] on a diverging map: blue at -v_max, purple at 0, red at +v_max
-/// (clipped beyond).
+/// velocityRgb as a marker colour.
 std_msgs::ColorRGBA velocityColor(double v, double v_max);
 /// "A", "B", ... (core::bodyName).
 std::string bodyName(std::size_t i);
 geometry_msgs::Point point(double x, double y, double z = 0.0);
-/// value printed by fmt (one printf conversion: %g, %e or %f, with text around it) in one
-/// number style with the page: "4.68×10^11", "169,548".
-std::string format(const char* fmt, double value);
 /// value with its sign always written: "+1.12", "-1.12", "0". rviz's font has no proper
 /// minus (U+2212 and the dashes are not drawn) and draws '-' a few pixels wide; beside the
 /// '+' of the positive values it still reads as a sign.
 std::string withSign(const char* fmt, double value);
-/// 31415 -> "31,415".
-std::string withSeparators(std::uint64_t n);
 /// A position [m] on an axis, one style for every view: four significant digits, no exponent
 /// from 1,000 on ("1,060", "-61.06", "0.6058"); a '+' before a positive value when signed_
 /// (beside negative ones).
@@ -62,9 +57,6 @@ std::string wrapped(const std::string& s, double size, double width);
 /// Bodies A, B, C (0, 1, 2) of a per-body array; NaN for a body it does not have.
 std::array<double, 3> toArray3(const std::vector<double>& a);
 bool isWall(const collision_lab::InitialConditions& input, std::size_t i);
-/// Largest |v| [m/s] of the finite bodies at the start (1 when all are at rest): the
-/// scale of the colour by velocity (RunView::colour_scale).
-double velocityScale(const RunRecord& run);
 /// Which view takes the wedge's place (markers/ids.h: ns kWedge or kVelocities).
 enum class SideView { kWedge, kVelocityProfile, kHistogram };
 SideView sideView(const RunRecord& run);
