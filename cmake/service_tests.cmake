@@ -17,6 +17,12 @@ if(TARGET envelope_test)
   target_link_libraries(envelope_test collision_lab_service GTest::gtest_main)
 endif()
 
+# A run's budget: the lab's limits lowered by the input's, and the service's stop reasons (no master).
+catkin_add_gtest(run_budget_test test/service/run_budget_test.cpp)
+if(TARGET run_budget_test)
+  target_link_libraries(run_budget_test collision_lab_service GTest::gtest_main)
+endif()
+
 # A student's share of the lab's disk (no master).
 catkin_add_gtest(student_quota_test test/service/student_quota_test.cpp)
 if(TARGET student_quota_test)

@@ -231,31 +231,6 @@ LabNode::~LabNode() {
   service_spinner_.stop();
 }
 
-LabNode::RunLimits LabNode::limitsOf(const collision_lab::InitialConditions& input) const {
-  RunLimits limits;
-  const std::uint64_t ceiling = params_.max_collisions;  // 0: none
-  if (input.max_collisions == 0) {
-    limits.max_collisions = ceiling;
-  } else if (ceiling == 0 || input.max_collisions <= ceiling) {
-    limits.max_collisions = input.max_collisions;
-  } else {
-    limits.max_collisions = ceiling;
-    limits.collision_ceiling = true;
-  }
-  limits.max_run_seconds = params_.max_run_seconds;
-  if (std::isfinite(input.max_run_seconds) && input.max_run_seconds > 0 &&
-      (limits.max_run_seconds == 0 || input.max_run_seconds < limits.max_run_seconds)) {
-    limits.max_run_seconds = input.max_run_seconds;
-    limits.time_from_input = true;
-  }
-  limits.max_bag_bytes = params_.max_bag_bytes;
-  if (input.max_bag_bytes > 0 && (limits.max_bag_bytes == 0 || input.max_bag_bytes < limits.max_bag_bytes)) {
-    limits.max_bag_bytes = input.max_bag_bytes;
-    limits.bag_from_input = true;
-  }
-  return limits;
-}
-
 namespace {
 /// A refusal of the admission (the floor, a quota) as the node's Rejected.
 collision_lab::Rejected rejectionOf(const collision_lab::service::Refusal& refusal) {
@@ -308,7 +283,9 @@ bool LabNode::intake(collision_lab::InitialConditions input, Reply reply, const 
     return false;
   }
   Job job;
-  job.limits = limitsOf(input);
+  job.limits = collision_lab::service::limitsOf(
+      {params_.max_collisions, params_.max_run_seconds, params_.max_bag_bytes},
+      {input.max_collisions, input.max_run_seconds, input.max_bag_bytes});
   const collision_lab::service::Lane lane = collision_lab::service::chooseLane(
       *plan, sceneRunOptions(*toRunMode(input.mode), job.limits.max_collisions, params_.simulate_to_cap), params_.lanes);
   if (plan->prediction && plan->prediction->impact_count) job.predicted_collisions = *plan->prediction->impact_count;
@@ -619,47 +596,24 @@ void LabNode::run(Worker& worker, Job& job, RunWriter& out, RunSoFar& progress) 
 }
 
 void LabNode::applyStopCause(Worker& worker, const Job& job, collision_lab::RunSummary& summary) {
-  const auto cause = static_cast<StopCause>(worker.cause.load());
-  const RunLimits& limits = job.limits;
-  const bool stopped = summary.stop_reason == "CANCELLED";
-  std::ostringstream why;
-  if (stopped && cause == StopCause::kTimeLimit) {
-    summary.stop_reason = "SERVICE_TIME_LIMIT";
-    why << "stopped by the time limit of " << limits.max_run_seconds << " s ("
-        << (limits.time_from_input ? "the input's max_run_seconds" : "the node's ~max_run_seconds") << ") after "
-        << summary.collision_count << " collisions, at its last certified impact";
-  } else if (stopped && cause == StopCause::kBagLimit) {
-    summary.stop_reason = "SERVICE_BAG_LIMIT";
-    why << "stopped when its recorded messages passed the bag limit of " << limits.max_bag_bytes << " bytes ("
-        << (limits.bag_from_input ? "the input's max_bag_bytes" : "the node's ~max_bag_bytes") << ") after "
-        << summary.collision_count << " collisions, at its last certified impact";
-  } else if (stopped && cause == StopCause::kDiskSpace) {
-    summary.stop_reason = "SERVICE_DISK_SPACE";
-    why << "stopped when the bag folder's free space fell under the node's ~min_free_space_mb = "
-        << params_.min_free_space_mb << " MB after " << summary.collision_count
-        << " collisions, at its last certified impact; its bag holds the run to there";
-  } else if (stopped && cause == StopCause::kStudentQuota) {
-    summary.stop_reason = "SERVICE_STUDENT_QUOTA";
-    why << "stopped when student '" << job.input.student << "''s bags passed the node's ~max_student_bag_mb = "
-        << params_.max_student_bag_mb << " MB after " << summary.collision_count
-        << " collisions, at its last certified impact; its bag holds the run to there";
-  } else if (stopped && cause == StopCause::kCancel) {
-    std::string by;
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      by = worker.current.stopped_by;
-    }
-    why << summary.truncation_reason << " (cancelled by " << by << ")";
-  } else if (summary.stop_reason == "CAP" && limits.collision_ceiling) {
-    summary.stop_reason = "SERVICE_COLLISION_LIMIT";
-    why << "stopped at the node's ~max_collisions = " << limits.max_collisions << ", which lowered the input's "
-        << "max_collisions = " << job.input.max_collisions;
-  } else {
-    return;
+  collision_lab::service::StopContext context;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    context.stopped_by = worker.current.stopped_by;
   }
-  summary.cancelled = cause == StopCause::kCancel;
+  context.student = job.input.student;
+  context.asked_max_collisions = job.input.max_collisions;
+  context.min_free_space_mb = params_.min_free_space_mb;
+  context.max_student_bag_mb = params_.max_student_bag_mb;
+  const auto stop =
+      collision_lab::service::serviceStop(static_cast<StopCause>(worker.cause.load()), job.limits,
+                                          {summary.stop_reason, summary.truncation_reason, summary.collision_count},
+                                          context);
+  if (!stop) return;
+  summary.stop_reason = stop->stop_reason;
+  summary.cancelled = stop->cancelled;
   summary.truncated = true;
-  summary.truncation_reason = why.str();
+  summary.truncation_reason = stop->truncation_reason;
 }
 
 namespace {

@@ -86,6 +86,7 @@
 #include "collision_lab/ros/served_runs.h"
 #include "collision_lab/service/admission.h"
 #include "collision_lab/service/fair_scheduler.h"
+#include "collision_lab/service/run_budget.h"
 #include "collision_lab/service/student_quota.h"
 
 namespace collision_lab_ros {
@@ -134,17 +135,8 @@ class LabNode {
  private:
   /// Where a service call waits for its outcome; null for topic inputs.
   using Reply = std::shared_ptr<std::promise<ServeOutcome>>;
-  /// Why a run's cancel flag was set; the first cause wins.
-  enum class StopCause : int { kNone, kCancel, kTimeLimit, kBagLimit, kDiskSpace, kStudentQuota, kShutdown };
-  /// A run's limits: the node's ceilings, lowered by the input's own.
-  struct RunLimits {
-    std::uint64_t max_collisions = 0;  ///< [1]; 0: none
-    bool collision_ceiling = false;    ///< the node's ~max_collisions lowered the input's cap
-    double max_run_seconds = 0.0;      ///< [s]; 0: none
-    bool time_from_input = false;      ///< the input's max_run_seconds is the binding one
-    std::uint64_t max_bag_bytes = 0;   ///< [bytes]; 0: none
-    bool bag_from_input = false;       ///< the input's max_bag_bytes is the binding one
-  };
+  using StopCause = collision_lab::service::StopCause;
+  using RunLimits = collision_lab::service::RunLimits;
   /// An accepted run, from intake to its worker.
   struct Job {
     collision_lab::InitialConditions input;  ///< run_id assigned
@@ -196,7 +188,6 @@ class LabNode {
   /// or the input is rejected now.
   bool intake(collision_lab::InitialConditions input, Reply reply,
               const std::optional<std::string>& served_again = std::nullopt);
-  RunLimits limitsOf(const collision_lab::InitialConditions& input) const;
   void workerLoop(Worker& worker);
   void watchdogLoop();
   /// Sets worker's cancel flag with cause (kept when one is set already). mutex_ held.
@@ -220,7 +211,7 @@ class LabNode {
   void run(Worker& worker, Job& job, RunWriter& out, RunSoFar& progress);
   /// Ends a run that threw `what` before its summary was handed over: WORKER_ERROR.
   void failRun(Worker& worker, Job& job, RunWriter& out, const RunSoFar& progress, const std::string& what);
-  /// The stop reason of a service limit or of ~cancel, put into summary.
+  /// The stop reason of a service limit or of ~cancel (service::serviceStop), put into summary.
   void applyStopCause(Worker& worker, const Job& job, collision_lab::RunSummary& summary);
   /// Ends a run that never started (cancelled while waiting, or at shutdown): a CANCELLED,
   /// not simulated summary, its bag written with its input and closed. Any thread.
