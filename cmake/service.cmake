@@ -6,6 +6,7 @@ add_library(collision_lab_service
   src/service/admission.cpp
   src/service/envelope.cpp
   src/service/run_budget.cpp
+  src/service/run_ids.cpp
   src/service/run_index.cpp)
 target_include_directories(collision_lab_service PUBLIC include)
 target_link_libraries(collision_lab_service PUBLIC SQLite::SQLite3)

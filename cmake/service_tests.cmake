@@ -23,6 +23,12 @@ if(TARGET run_budget_test)
   target_link_libraries(run_budget_test collision_lab_service GTest::gtest_main)
 endif()
 
+# The run_id a run is served under, against a ledger the test keeps (no master).
+catkin_add_gtest(run_ids_test test/service/run_ids_test.cpp)
+if(TARGET run_ids_test)
+  target_link_libraries(run_ids_test collision_lab_service GTest::gtest_main)
+endif()
+
 # A student's share of the lab's disk (no master).
 catkin_add_gtest(student_quota_test test/service/student_quota_test.cpp)
 if(TARGET student_quota_test)

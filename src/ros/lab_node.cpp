@@ -47,6 +47,18 @@ std::optional<collision_lab::Rejected> checkInput(const collision_lab::InitialCo
   return std::nullopt;
 }
 
+/// run_id's row in the run index; none when the index does not list it or cannot be read.
+std::optional<collision_lab::service::IndexedRun> indexedRun(const RunIndexRecorder& run_index,
+                                                             const std::string& run_id) {
+  if (!run_index.ok()) return std::nullopt;
+  try {
+    return run_index.committed()->find(run_id);  // this node's own runs are in run_ids_ too
+  } catch (const collision_lab::service::RunIndexError& e) {
+    ROS_WARN_STREAM("the run index cannot tell whether run_id '" << run_id << "' was served: " << e.what());
+    return std::nullopt;
+  }
+}
+
 /// At INFO for a lab, at DEBUG with ~log_runs false: at thousands of runs per second an
 /// INFO line per run (console, log file and /rosout, another process) costs more than the
 /// run itself. Every result is on run_summaries either way, and failures and warnings are
@@ -122,8 +134,15 @@ LabNode::LabNode(ros::NodeHandle nh, ros::NodeHandle private_nh, const RunObserv
   run_queue_pub_ = nh_.advertise<collision_lab::RunQueue>(kRunQueueTopic, kMarkerQueueSize, kLatchRunQueue);
   if (params_.publish_markers && make_observer) marker_view_ = make_observer(nh_, private_nh);
 
-  run_id_prefix_ = std::string("run_") + utcStamp("%Y%m%d_%H%M%S") + "_";
   run_index_ = std::make_unique<RunIndexRecorder>(params_.bag_directory);
+  collision_lab::service::RunIdClaims::Ledger ledger;
+  ledger.served_before = [this](const std::string& run_id) { return indexedRun(*run_index_, run_id).has_value(); };
+  ledger.held = [this](const std::string& run_id) { return heldInIndex(run_id); };
+  ledger.take_bag = [this](const std::string& run_id, std::string& error) {
+    return !params_.record || claimBag(params_.bag_directory, run_id, error) != BagClaim::kTaken;
+  };
+  run_ids_ = std::make_unique<collision_lab::service::RunIdClaims>(
+      std::string("run_") + utcStamp("%Y%m%d_%H%M%S") + "_", kRunIdsRemembered, std::move(ledger));
   student_quota_ = std::make_unique<collision_lab::service::StudentQuota>(
       static_cast<std::uint64_t>(std::max(0.0, params_.max_student_bag_mb) * 1e6),
       [this](const std::string& student) { return studentBagBytes(student); });
@@ -300,10 +319,10 @@ bool LabNode::intake(collision_lab::InitialConditions input, Reply reply, const 
     // Claimed here, before the run_id goes out on any message: the run_id a run reports
     // names a bag file this node created.
     if (served_again) {
-      if (!claim(input.run_id, job.claim_error)) return false;
+      if (!run_ids_->claim(input.run_id, job.claim_error)) return false;
       ROS_INFO_STREAM("run " << input.run_id << ": queued when its lab node died; served again");
     } else {
-      input.run_id = base.empty() ? newRunId(job.claim_error) : claimRunId(base, job.claim_error);
+      input.run_id = base.empty() ? run_ids_->fresh(job.claim_error) : run_ids_->claimAsked(base, job.claim_error);
     }
     if (!served_again && !base.empty() && input.run_id != base) {
       ROS_WARN_STREAM("run_id '" << base << "' is taken (its bag exists, or this node served "
@@ -440,30 +459,6 @@ collision_lab::RunQueue LabNode::buildQueue() const {
   return msg;
 }
 
-std::string LabNode::newRunId(std::string& claim_error) {
-  std::string run_id;
-  do {
-    run_id = run_id_prefix_ + std::to_string(++run_counter_);
-  } while (!claim(run_id, claim_error));
-  return run_id;
-}
-
-namespace {
-/// run_id's row in the run index; none when the index does not list it or cannot be read.
-std::optional<collision_lab::service::IndexedRun> indexedRun(const RunIndexRecorder& run_index,
-                                                             const std::string& run_id) {
-  if (!run_index.ok()) return std::nullopt;
-  try {
-    return run_index.committed()->find(run_id);  // this node's own runs are in used_run_ids_
-  } catch (const collision_lab::service::RunIndexError& e) {
-    ROS_WARN_STREAM("the run index cannot tell whether run_id '" << run_id << "' was served: " << e.what());
-    return std::nullopt;
-  }
-}
-}  // namespace
-
-bool LabNode::servedBefore(const std::string& run_id) { return indexedRun(*run_index_, run_id).has_value(); }
-
 bool LabNode::heldInIndex(const std::string& run_id) {
   using collision_lab::service::RunState;
   const auto run = indexedRun(*run_index_, run_id);
@@ -471,27 +466,6 @@ bool LabNode::heldInIndex(const std::string& run_id) {
   if (run->state == RunState::kQueued || run->state == RunState::kRunning) return true;
   std::error_code ec;
   return !run->bag_path.empty() && std::filesystem::exists(run->bag_path, ec);
-}
-
-bool LabNode::claim(const std::string& run_id, std::string& claim_error) {
-  if (used_run_ids_.contains(run_id)) return false;
-  if (params_.record && claimBag(params_.bag_directory, run_id, claim_error) == BagClaim::kTaken) return false;
-  used_run_ids_.add(run_id);
-  return true;
-}
-
-std::string LabNode::claimRunId(const std::string& requested, std::string& claim_error) {
-  if (const auto series = numberedRunId(requested)) {  // a student's n-th run: the next free number
-    std::uint64_t n = series->second;
-    const auto numbered = [&] { return series->first + std::to_string(n); };
-    while (servedBefore(numbered()) || !claim(numbered(), claim_error)) ++n;
-    return numbered();
-  }
-  std::string run_id = requested;
-  for (std::uint64_t n = 2; heldInIndex(run_id) || !claim(run_id, claim_error); ++n) {
-    run_id = requested + "." + std::to_string(n);
-  }
-  return run_id;
 }
 
 void LabNode::announce(const std::string& run_id, const std::string& student, const std::string& requested,

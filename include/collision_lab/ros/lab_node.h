@@ -87,6 +87,7 @@
 #include "collision_lab/service/admission.h"
 #include "collision_lab/service/fair_scheduler.h"
 #include "collision_lab/service/run_budget.h"
+#include "collision_lab/service/run_ids.h"
 #include "collision_lab/service/student_quota.h"
 
 namespace collision_lab_ros {
@@ -231,26 +232,11 @@ class LabNode {
   /// (`accepted_runs`, the log) and records the run for ~list_runs. mutex_ held.
   void announce(const std::string& run_id, const std::string& student, const std::string& requested,
                 std::size_t queue_position, collision_lab::service::Lane lane);
-  /// <prefix><counter>, the first one claim() takes. mutex_ held (as the two below).
-  std::string newRunId(std::string& claim_error);
-  /// requested, or the first requested.N (N = 2, 3, ...) that claim() takes and no run of
-  /// the index holds (heldInIndex). A student's
-  /// n-th run (<student>.run<n>, numbered by the web node from 1 after each restart) goes
-  /// on to the first number the run index does not know either (servedBefore).
-  std::string claimRunId(const std::string& requested, std::string& claim_error);
-  /// True when the run index lists run_id: served by this node or an earlier one.
-  bool servedBefore(const std::string& run_id);
   /// True when a run of the run index holds run_id: it has not ended (a dead node's queued
   /// run, which recovery serves again under its id, or a live node's), or its bag is on
   /// disk (recorded by any node: a lab that records no bags must not take it over). An
   /// ended run without a bag holds nothing: the index then keeps the newest run under it.
   bool heldInIndex(const std::string& run_id);
-  /// Takes run_id for this node's next run. False when this node served it recently
-  /// (RememberedRunIds) or, recording, when claimBag finds its bag taken (by any process
-  /// sharing bag_directory). True when taken: recording, its .bag.active file is this
-  /// node's (claimBag), or, when claimBag failed for another reason, claim_error says why
-  /// (the run is served unrecorded, recording_ok false).
-  bool claim(const std::string& run_id, std::string& claim_error);
 
   /// The status "<node>: lab runs" of /diagnostics: runs accepted and rejected, the queue,
   /// the last run's compute time, the recording state and the free space in bag_directory.
@@ -277,7 +263,6 @@ class LabNode {
   diagnostic_updater::Updater diagnostics_;
   ros::WallTimer diagnostics_timer_;
   std::unique_ptr<RunObserver> marker_view_;
-  std::string run_id_prefix_;
   std::vector<std::string> recorded_latched_topics_;
 
   // Counters, read by the diagnostics timer.
@@ -294,8 +279,9 @@ class LabNode {
   std::mutex mutex_;
   std::condition_variable wake_;  ///< a run waits, or stopping_
   Scheduler scheduler_;
-  std::uint64_t run_counter_ = 0;
-  RememberedRunIds used_run_ids_;
+  /// The run_ids this node serves under: remembered, and held in the index and the bag
+  /// folder (its Ledger); recording, a claimed run_id's .bag.active file is this node's.
+  std::unique_ptr<collision_lab::service::RunIdClaims> run_ids_;
   bool stopping_ = false;
   bool view_busy_ = false;  ///< a running run feeds the marker view
   collision_lab::RunQueue queue_msg_;  ///< run_queue's constant fields (its workers)
