@@ -2,10 +2,8 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cmath>
 #include <filesystem>
 #include <optional>
-#include <sstream>
 #include <thread>
 #include <utility>
 
@@ -309,10 +307,7 @@ bool LabNode::intake(collision_lab::InitialConditions input, Reply reply, const 
       *plan, sceneRunOptions(*toRunMode(input.mode), job.limits.max_collisions, params_.simulate_to_cap), params_.lanes);
   if (plan->prediction && plan->prediction->impact_count) job.predicted_collisions = *plan->prediction->impact_count;
   // The run_id the input asks for: <student>.<run_id> (a run served again: as it first asked).
-  collision_lab::InitialConditions asked;
-  asked.student = input.student;
-  asked.run_id = requested;
-  const std::string base = requestedRunId(asked);
+  const std::string base = collision_lab::service::requestedRunId(input.student, requested);
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (stopping_) return false;  // reply's promise breaks: the call answers "shutting down"
@@ -570,8 +565,9 @@ void LabNode::run(Worker& worker, Job& job, RunWriter& out, RunSoFar& progress) 
 }
 
 void LabNode::applyStopCause(Worker& worker, const Job& job, collision_lab::RunSummary& summary) {
+  const auto cause = static_cast<StopCause>(worker.cause.load());
   collision_lab::service::StopContext context;
-  {
+  if (cause == StopCause::kCancel) {  // the node's mutex only for a cancelled run
     std::lock_guard<std::mutex> lock(mutex_);
     context.stopped_by = worker.current.stopped_by;
   }
@@ -580,7 +576,7 @@ void LabNode::applyStopCause(Worker& worker, const Job& job, collision_lab::RunS
   context.min_free_space_mb = params_.min_free_space_mb;
   context.max_student_bag_mb = params_.max_student_bag_mb;
   const auto stop =
-      collision_lab::service::serviceStop(static_cast<StopCause>(worker.cause.load()), job.limits,
+      collision_lab::service::serviceStop(cause, job.limits,
                                           {summary.stop_reason, summary.truncation_reason, summary.collision_count},
                                           context);
   if (!stop) return;

@@ -161,8 +161,9 @@ void decideColours(const RunRecord& run, RunView& view) {
     if (run.isWall(i)) {
       view.body_colours.push_back(hexOf(layout::kGrey.r, layout::kGrey.g, layout::kGrey.b));
     } else if (view.colour_by_start_velocity) {
+      // Each channel as rviz gets it (a float of std_msgs/ColorRGBA), so that both draw one colour.
       const auto c = markers::velocityRgb(run.input().velocities[i], view.colour_scale);
-      view.body_colours.push_back(hexOf(c.r, c.g, c.b));
+      view.body_colours.push_back(hexOf(static_cast<float>(c.r), static_cast<float>(c.g), static_cast<float>(c.b)));
     } else {
       view.body_colours.push_back(bodyColourHex(i));
     }

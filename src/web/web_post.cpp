@@ -14,7 +14,6 @@
 #include "collision_lab/Rejected.h"
 #include "collision_lab/io/scenario_file.h"
 #include "collision_lab/ros/msg_conversion.h"
-#include "collision_lab/ros/node_constants.h"
 #include "collision_lab/service/envelope.h"
 
 namespace collision_lab_web {

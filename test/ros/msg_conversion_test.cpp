@@ -617,17 +617,6 @@ TEST(MsgConversion, EachEnvelopeRefusalHasItsNodeCode) {
   }
 }
 
-TEST(Student, TheRunIdAnInputAsksFor) {
-  collision_lab::InitialConditions input;
-  EXPECT_EQ(requestedRunId(input), "");
-  input.run_id = "pi_by_hand";
-  EXPECT_EQ(requestedRunId(input), "pi_by_hand");
-  input.student = "ana";
-  EXPECT_EQ(requestedRunId(input), "ana.pi_by_hand");
-  input.run_id.clear();
-  EXPECT_EQ(requestedRunId(input), "ana");
-}
-
 collision_lab::AcceptedRun accepted(const std::string& run_id, const std::string& student) {
   collision_lab::AcceptedRun run;
   run.run_id = run_id;

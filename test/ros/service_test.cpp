@@ -249,12 +249,27 @@ void stopAndAwait(FairWatch& w, const std::string& run_id) {
   w.runs().waitFor(run_id);
 }
 
+/// Stops every run it names when it goes out of scope (a test that failed part-way, too), so
+/// that no endless run is left on the fair node's one long-lane worker for the tests after.
+struct StopsAtExit {
+  std::vector<std::string> run_ids;
+  ~StopsAtExit() {
+    for (const std::string& run_id : run_ids) {
+      collision_lab::Cancel cancel;
+      cancel.request.run_id = run_id;
+      cancel.request.requested_by = "service_test's clean-up";
+      callService("/fair/collision_lab_node/cancel", cancel);  // not ok for a run already ended
+    }
+  }
+};
+
 TEST(Service, AStudentsTenthRunWaitsBehindAClassmatesFirst) {
   FairWatch& w = fair();
   // Ten runs of ana, then one of ben, each running until it is stopped: the order in which
   // they start is the scheduler's alone, however fast the machine (no time budget decides).
   const std::size_t before = w.started.size();
-  std::vector<std::string> ids;
+  StopsAtExit stops;
+  std::vector<std::string>& ids = stops.run_ids;
   for (int i = 1; i <= 10; ++i) {
     w.runs().publish(endlessInput("r" + std::to_string(i), "ana"));
     ids.push_back("ana.r" + std::to_string(i));
@@ -299,6 +314,7 @@ TEST(Service, AStudentsTenthRunWaitsBehindAClassmatesFirst) {
 TEST(Service, AShortRunNeverWaitsBehindLongOnes) {
   FairWatch& w = fair();
   // Three long runs occupy the long lane until they are stopped.
+  const StopsAtExit stops{{"carl.long1", "carl.long2", "carl.long3"}};
   for (int i = 1; i <= 3; ++i) w.runs().publish(endlessInput("long" + std::to_string(i), "carl"));
   ASSERT_TRUE(waitUntil([&] { return w.startIndex("carl.long1") >= 0; }, "carl.long1 to start"));
   const auto sent = std::chrono::steady_clock::now();

@@ -81,7 +81,6 @@
 #include "collision_lab/RunQueue.h"
 #include "collision_lab/ros/lab_node_params.h"
 #include "collision_lab/ros/msg_conversion.h"
-#include "collision_lab/ros/run_ids.h"
 #include "collision_lab/ros/run_observer.h"
 #include "collision_lab/ros/served_runs.h"
 #include "collision_lab/service/admission.h"
