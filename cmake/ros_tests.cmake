@@ -52,8 +52,3 @@ foreach(launch_file ${collision_lab_LAUNCH_FILES})
     DEPENDENCIES collision_lab_node collision_lab_markers scenario_publisher)
 endforeach()
 
-# The lab node's fair run queue (ROS-free, no master).
-catkin_add_gtest(fair_scheduler_test test/service/fair_scheduler_test.cpp)
-if(TARGET fair_scheduler_test)
-  target_link_libraries(fair_scheduler_test collision_lab_core GTest::gtest_main)
-endif()

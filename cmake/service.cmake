@@ -2,6 +2,7 @@
 # SQLite (Debian's libsqlite3-dev), written by the lab node and read by the web node and
 # ~list_runs.
 find_package(SQLite3 REQUIRED)
+find_package(Threads REQUIRED)
 add_library(collision_lab_service
   src/service/admission.cpp
   src/service/envelope.cpp
