@@ -19,7 +19,8 @@ add_library(collision_lab_ros
   src/ros/lab_node_diagnostics.cpp
   src/ros/lab_node_inputs.cpp
   src/ros/lab_node_params.cpp
-  src/ros/node_text.cpp
+  src/ros/lab_node_shared.cpp
+  src/ros/lab_node_runs.cpp
   src/ros/served_runs.cpp)
 target_include_directories(collision_lab_ros PUBLIC include)
 # collision_lab_io: the node reads the presets of ~run_preset.

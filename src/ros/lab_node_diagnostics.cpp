@@ -13,11 +13,11 @@ void LabNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   status.add("last run compute time [s]", std::to_string(last_compute_time_.load()));
   std::size_t waiting = 0, running = 0;
   {
-    std::lock_guard<std::mutex> lock(mutex_);
-    waiting = scheduler_.size();
-    for (const auto& worker : workers_) running += worker->current.run_id.empty() ? 0 : 1;
+    const auto lock = pool_->lock();
+    waiting = pool_->waiting();
+    running = pool_->running();
   }
-  status.add("workers", std::to_string(workers_.size()));
+  status.add("workers", std::to_string(params_.workers));
   status.add("runs running", std::to_string(running));
   status.add("runs waiting", std::to_string(waiting));
   status.add("recording", params_.record ? "on" : "off");

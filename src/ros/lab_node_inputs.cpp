@@ -8,7 +8,7 @@
 #include "collision_lab/ros/msg_conversion.h"
 #include "collision_lab/ros/node_constants.h"
 #include "collision_lab/ros/run_index_recorder.h"
-#include "node_text.h"
+#include "lab_node_shared.h"
 
 namespace collision_lab_ros {
 namespace {
@@ -107,22 +107,15 @@ bool LabNode::onListRuns(collision_lab::ListRuns::Request& request, collision_la
 bool LabNode::onCancel(collision_lab::Cancel::Request& request, collision_lab::Cancel::Response& response) {
   // Whoever asks is logged and goes into a summary: bounded, like every name.
   const std::string by = request.requested_by.empty() ? std::string("~cancel") : request.requested_by.substr(0, kMaxStudentLength);
-  std::optional<Scheduler::Entry> waiting;
+  std::optional<Pool::Entry> waiting;
   {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (!request.run_id.empty()) waiting = scheduler_.remove(request.run_id);
+    const auto lock = pool_->lock();
+    if (!request.run_id.empty()) waiting = pool_->remove(request.run_id);
     if (waiting) {
-      publishQueue();
       response.ok = true;
       response.message = "run '" + request.run_id + "' was waiting; cancelled before it started";
     } else {
-      std::vector<std::string> stopped;
-      for (auto& worker : workers_) {
-        const std::string& run_id = worker->current.run_id;
-        if (run_id.empty() || (!request.run_id.empty() && request.run_id != run_id)) continue;
-        stopRun(*worker, StopCause::kCancel, by);
-        stopped.push_back(run_id);
-      }
+      const std::vector<std::string> stopped = pool_->stopRunning(request.run_id, StopCause::kCancel, by);
       response.ok = !stopped.empty();
       if (stopped.empty()) {
         response.message = request.run_id.empty() ? "no run in progress"

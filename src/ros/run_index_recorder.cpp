@@ -595,6 +595,40 @@ void RunIndexRecorder::rejected(const collision_lab::Rejected& rejected) {
       /*urgent=*/true);
 }
 
+std::optional<collision_lab::service::IndexedRun> RunIndexRecorder::find(const std::string& run_id) const {
+  if (!ok()) return std::nullopt;
+  try {
+    return index_->find(run_id);
+  } catch (const collision_lab::service::RunIndexError& e) {
+    ROS_WARN_STREAM("the run index cannot tell whether run_id '" << run_id << "' was served: " << e.what());
+    return std::nullopt;
+  }
+}
+
+bool RunIndexRecorder::holds(const std::string& run_id) const {
+  using collision_lab::service::RunState;
+  const auto run = find(run_id);
+  if (!run) return false;
+  if (run->state == RunState::kQueued || run->state == RunState::kRunning) return true;
+  std::error_code ec;
+  return !run->bag_path.empty() && std::filesystem::exists(run->bag_path, ec);
+}
+
+std::uint64_t RunIndexRecorder::studentBagBytes(const std::string& student) const {
+  if (!ok()) return 0;
+  std::uint64_t bytes = 0;
+  try {
+    for (const auto& row : index_->list(student)) {
+      std::error_code ec;
+      const auto size = row.bag_path.empty() ? 0 : std::filesystem::file_size(row.bag_path, ec);
+      if (!ec) bytes += size;
+    }
+  } catch (const collision_lab::service::RunIndexError& e) {
+    ROS_WARN_STREAM("student '" << student << "': their bags are not counted: " << e.what());
+  }
+  return bytes;
+}
+
 std::vector<collision_lab::ServedRun> RunIndexRecorder::list(const std::string& student) const {
   std::vector<collision_lab::ServedRun> served;
   if (!index_) return served;

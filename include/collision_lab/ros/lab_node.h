@@ -7,32 +7,31 @@
 // run index (<bag_directory>/runs.sqlite: every node process's), which the node writes
 // (RunIndexRecorder). At start the node ends the runs of dead nodes in it (recover()).
 //
-// Threading contract:
+// Threading contract (the workers' own: service/worker_pool.h):
 // - Intake at arrival: the thread that receives an input (the topic callback on the global
 //   queue, spun by main, or a service thread) checks it (checkInput, planScene), claims its
-//   run_id and bag, puts it in the FairScheduler and publishes its AcceptedRun (with its
-//   queue_position and lane) at once, all under mutex_, so AcceptedRuns and run_queue
-//   go out in the order of the queue. A rejection is answered on that thread too.
-// - ~workers worker threads (Worker) take the runs from the scheduler, of which the first
-//   ~short_lane_workers take only short runs. Each worker has its own message buffers,
-//   cancel flag and bag writer thread (RunBagWriter: a run's batches stay contiguous), so
+//   run_id and bag, pushes it to the pool and publishes its AcceptedRun (with its
+//   queue_position and lane) at once, all under the pool's lock, so AcceptedRuns go out in
+//   the order of the queue. A rejection is answered on that thread too.
+// - ~workers workers (service::WorkerPool) serve the runs, of which the first
+//   ~short_lane_workers take only short runs. Each worker has its own message buffers and
+//   bag writer thread (WorkerSlot; RunBagWriter: a run's batches stay contiguous), so
 //   runs of different workers interleave on the topics (every message names its run_id);
 //   a run's own messages keep the order predictions, (collision_events, velocities,
 //   energy_transfers) per collision, run_summaries. ros::Publisher is thread-safe.
-// - mutex_ guards the scheduler, the run_id claims, stopping_, every worker's current run
-//   (Worker::current) and the marker view's owner, and is held while run_queue is
-//   published. The marker view (a RunObserver) draws one run at a time: a run draws when
-//   it starts while no other run is drawn and the view follows it; other runs are not
-//   drawn live. Its summary and rejections reach it from other threads (it is
-//   thread-safe).
+// - The pool's lock guards its queue and running runs, the run_id claims and the marker
+//   view's owner. The marker view (a RunObserver) draws one run at a time: a run draws
+//   when it starts while no other run is drawn and the view follows it; other runs are
+//   not drawn live. Its summary and rejections reach it from other threads (it is
+//   thread-safe). run_queue is published on the pool's notice thread.
 // - The services run on their own callback queue, spun by kServiceThreads threads. A call
 //   takes its input in like the topic does and blocks only its own service thread until
 //   the worker hands back the outcome (a promise). Further concurrent calls wait in roscpp.
 // - ~cancel and ~list_runs run on a callback queue and thread of their own. ~cancel takes
 //   a waiting run out of the scheduler (it is answered with a CANCELLED summary and its
 //   bag closed on that thread, through the node's own bag writer) or stops a running one:
-//   stopRun() sets its worker's cancel flag, which the core polls, with a cause. The
-//   watchdog thread does the same with the cause kTimeLimit at a run's deadline, and a
+//   the pool sets its worker's cancel flag, which the core polls, with a cause. The
+//   pool's watchdog does the same with the cause kTimeLimit at a run's deadline, and a
 //   run's RunWriter with kBagLimit when its recorded bytes pass its limit, kDiskSpace
 //   when the bag directory's free space falls under ~min_free_space_mb, or kStudentQuota
 //   when its student's bags pass ~max_student_bag_mb.
@@ -53,8 +52,6 @@
 #pragma once
 
 #include <atomic>
-#include <chrono>
-#include <condition_variable>
 #include <cstdint>
 #include <future>
 #include <memory>
@@ -84,10 +81,10 @@
 #include "collision_lab/ros/run_observer.h"
 #include "collision_lab/ros/served_runs.h"
 #include "collision_lab/service/admission.h"
-#include "collision_lab/service/fair_scheduler.h"
 #include "collision_lab/service/run_budget.h"
 #include "collision_lab/service/run_ids.h"
 #include "collision_lab/service/student_quota.h"
+#include "collision_lab/service/worker_pool.h"
 
 namespace collision_lab_ros {
 
@@ -147,30 +144,17 @@ class LabNode {
     std::uint64_t predicted_collisions = 0;  ///< the model's count; 0: none
     Reply reply;
   };
-  using Scheduler = collision_lab::service::FairScheduler<Job>;
-  /// The run a worker computes (guarded by mutex_).
-  struct CurrentRun {
-    std::string run_id;  ///< empty: idle
-    std::string student;
-    collision_lab::service::Lane lane = collision_lab::service::Lane::kLong;
-    std::uint64_t predicted_collisions = 0;
-    std::uint32_t body_count = 0;
-    std::optional<std::chrono::steady_clock::time_point> deadline;  ///< of ~max_run_seconds
-    std::string stopped_by;  ///< who asked it to stop (~cancel's requested_by)
-  };
-  struct Worker {
-    bool short_only = false;  ///< a short-lane worker
+  /// A worker's own state: its bag writer and its messages, refilled for every run (their
+  /// storage is reused).
+  struct WorkerSlot {
     std::unique_ptr<RunBagWriter> bags;  ///< null when not recording
-    // The worker's messages of a run, refilled for every run: their storage is reused.
     collision_lab::Prediction prediction_msg;
     EventMessages event_messages;
     collision_lab::RunSummary summary_msg;
-    std::atomic<bool> cancel{false};
-    std::atomic<int> cause{static_cast<int>(StopCause::kNone)};
-    CurrentRun current;
-    bool draws = false;  ///< the current run feeds the marker view
-    std::thread thread;
+    bool draws = false;  ///< the current run feeds the marker view (the pool's lock)
   };
+  using Pool = collision_lab::service::WorkerPool<Job, WorkerSlot>;
+  using Worker = Pool::Worker;
 
   void onInitialConditions(const collision_lab::InitialConditions::ConstPtr& msg);
   bool onRunScene(collision_lab::RunScene::Request& request,
@@ -188,21 +172,8 @@ class LabNode {
   /// or the input is rejected now.
   bool intake(collision_lab::InitialConditions input, Reply reply,
               const std::optional<std::string>& served_again = std::nullopt);
-  void workerLoop(Worker& worker);
-  void watchdogLoop();
-  /// Sets worker's cancel flag with cause (kept when one is set already). mutex_ held.
-  static void stopRun(Worker& worker, StopCause cause, const std::string& by);
-  /// [bytes] of the student's bags on disk, as the run index lists them.
-  std::uint64_t studentBagBytes(const std::string& student) const;
-  /// The queue changed: run_queue is published with its state by the queue publisher's
-  /// thread, which coalesces changes that come faster than it publishes (the latched
-  /// message is always the newest state). mutex_ held.
-  void publishQueue();
-  /// The queue publisher's thread: builds run_queue under mutex_, publishes it outside,
-  /// until the node stops (the last state published first).
-  void queuePublisherLoop();
-  /// run_queue's message of the queue's state now. mutex_ held.
-  collision_lab::RunQueue buildQueue() const;
+  /// Publishes run_queue (latched) with the queue's state (the pool's notice thread).
+  void publishQueue(const std::vector<collision_lab::service::QueuedRunState>& runs);
 
   // ---- A worker's (each on its own Worker) ----
   /// Runs job, catching every exception (WORKER_ERROR).
@@ -228,14 +199,9 @@ class LabNode {
   void finishRun(const collision_lab::RunSummary& summary, const Reply& reply, bool draws);
   ServeOutcome reject(collision_lab::Rejected msg, const std::string& run_id);
   /// Tells the sender which run_id input got, its place in the queue and lane
-  /// (`accepted_runs`, the log) and records the run for ~list_runs. mutex_ held.
+  /// (`accepted_runs`, the log) and records the run for ~list_runs. The pool's lock held.
   void announce(const std::string& run_id, const std::string& student, const std::string& requested,
                 std::size_t queue_position, collision_lab::service::Lane lane);
-  /// True when a run of the run index holds run_id: it has not ended (a dead node's queued
-  /// run, which recovery serves again under its id, or a live node's), or its bag is on
-  /// disk (recorded by any node: a lab that records no bags must not take it over). An
-  /// ended run without a bag holds nothing: the index then keeps the newest run under it.
-  bool heldInIndex(const std::string& run_id);
 
   /// The status "<node>: lab runs" of /diagnostics: runs accepted and rejected, the queue,
   /// the last run's compute time, the recording state and the free space in bag_directory.
@@ -274,25 +240,15 @@ class LabNode {
   /// Writes the bags of runs that never started (dropWaiting); null when not recording.
   std::unique_ptr<RunBagWriter> dropped_bags_;
 
-  // Guarded by mutex_.
-  std::mutex mutex_;
-  std::condition_variable wake_;  ///< a run waits, or stopping_
-  Scheduler scheduler_;
+  /// The scheduler, the workers, the watchdog and the queue's notices. Its lock guards
+  /// run_ids_ and view_busy_ too.
+  std::unique_ptr<Pool> pool_;
   /// The run_ids this node serves under: remembered, and held in the index and the bag
   /// folder (its Ledger); recording, a claimed run_id's .bag.active file is this node's.
   std::unique_ptr<collision_lab::service::RunIdClaims> run_ids_;
-  bool stopping_ = false;
   bool view_busy_ = false;  ///< a running run feeds the marker view
   collision_lab::RunQueue queue_msg_;  ///< run_queue's constant fields (its workers)
-  std::vector<std::unique_ptr<Worker>> workers_;
-
-  std::condition_variable watchdog_wake_;  ///< with mutex_: stopping_
-  std::thread watchdog_;
   std::thread recovery_;  ///< RunIndexRecorder::recover, at the start
-  bool queue_changed_ = false;           ///< run_queue's state is not published yet
-  bool queue_publisher_stops_ = false;   ///< the queue publisher ends once the state is out
-  std::condition_variable queue_wake_;   ///< with mutex_: queue_changed_ or queue_publisher_stops_
-  std::thread queue_publisher_;
 
   ros::CallbackQueue service_queue_;
   ros::AsyncSpinner service_spinner_;

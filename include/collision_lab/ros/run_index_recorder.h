@@ -141,6 +141,17 @@ class RunIndexRecorder {
   void finished(const collision_lab::RunSummary& summary);
   void rejected(const collision_lab::Rejected& rejected);
 
+  /// run_id's row as committed; none when the index does not list it or cannot be read
+  /// (logged).
+  std::optional<collision_lab::service::IndexedRun> find(const std::string& run_id) const;
+  /// True when a run of the index holds run_id: it has not ended (a dead node's queued run,
+  /// which recovery serves again under its id, or a live node's), or its bag is on disk
+  /// (recorded by any node: a lab that records no bags must not take it over). An ended
+  /// run without a bag holds nothing: the index then keeps the newest run under it.
+  bool holds(const std::string& run_id) const;
+  /// [bytes] of the student's bags on disk, as the index lists them (0 when it cannot be read).
+  std::uint64_t studentBagBytes(const std::string& student) const;
+
   /// ~list_runs: every run of the index (every node process that wrote bag_directory),
   /// oldest first, student's only when student is not empty; in ServedRun's format. Empty
   /// (and logged) when the index cannot be read.

@@ -1,4 +1,4 @@
-#include "node_text.h"
+#include "lab_node_shared.h"
 
 #include <ctime>
 #include <sstream>
@@ -26,6 +26,25 @@ std::string predictedText(const collision_lab::RunSummary& summary) {
   }
   if (summary.collapsed) text << ", collapsed at t = " << summary.collapse_time << " s";
   return text.str();
+}
+
+ros::Time stampNow() {
+  const ros::Time now = ros::Time::now();
+  if (now >= ros::TIME_MIN) return now;
+  const ros::WallTime wall = ros::WallTime::now();
+  return ros::Time(wall.sec, wall.nsec);
+}
+
+collision_lab::core::SceneRunOptions sceneRunOptions(collision_lab::core::RunMode mode, std::uint64_t max_collisions,
+                                                     bool simulate_to_cap) {
+  namespace core = collision_lab::core;
+  core::SceneRunOptions options;
+  options.lab.max_collisions = max_collisions;
+  options.lab.events = mode == core::RunMode::kFull ? core::EventPolicy::all() : core::EventPolicy::none();
+  options.lab.mode = mode;
+  options.simulate_to_cap = simulate_to_cap;
+  options.keep_events = false;
+  return options;
 }
 
 }  // namespace collision_lab_ros
