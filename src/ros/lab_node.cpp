@@ -12,9 +12,7 @@
 #include "collision_lab/ros/node_constants.h"
 #include "collision_lab/ros/run_index_recorder.h"
 #include "collision_lab/ros/run_recorder.h"
-#include "collision_lab/ros/run_timeline.h"
 #include "lab_node_shared.h"
-#include "run_writer.h"
 
 namespace collision_lab_ros {
 namespace {

@@ -6,7 +6,6 @@
 
 #include "collision_lab/ros/lab_node.h"
 #include "collision_lab/ros/msg_conversion.h"
-#include "collision_lab/ros/node_constants.h"
 #include "collision_lab/ros/run_index_recorder.h"
 #include "collision_lab/ros/run_recorder.h"
 #include "collision_lab/ros/run_timeline.h"
@@ -29,14 +28,16 @@ void logRun(const collision_lab::RunSummary& summary, bool at_info) {
                         << (summary.bag_path.empty() ? std::string() : ", bag " + summary.bag_path));
 }
 
-/// The settings a run is served with (run_id and stamp are the RunWriter's).
-collision_lab::RunParameters runParameters(const LabNodeParams& params, std::uint64_t max_collisions) {
+/// The settings a run is served with, under its limits (run_id and stamp are the RunWriter's).
+collision_lab::RunParameters runParameters(const LabNodeParams& params, const collision_lab::service::RunLimits& limits) {
   collision_lab::RunParameters msg;
   msg.package_version = COLLISION_LAB_VERSION;
   msg.node_name = ros::this_node::getName();
-  msg.max_collisions = max_collisions;
+  msg.max_collisions = limits.max_collisions;
   msg.max_published_events = params.max_published_events;
   msg.max_bodies = params.max_bodies;
+  msg.max_run_seconds = limits.max_run_seconds;
+  msg.max_bag_bytes = limits.max_bag_bytes;
   return msg;
 }
 
@@ -87,10 +88,7 @@ void LabNode::run(Worker& worker, Job& job, RunWriter& out, RunSoFar& progress) 
   publishStart(worker, out, input, plan);  // the prediction goes out before the simulation starts
 
   core::SceneRunOptions options = sceneRunOptions(mode, job.limits.max_collisions, params_.simulate_to_cap);
-  collision_lab::RunParameters parameters = runParameters(params_, options.lab.max_collisions);
-  parameters.max_run_seconds = job.limits.max_run_seconds;
-  parameters.max_bag_bytes = job.limits.max_bag_bytes;
-  out.record(std::move(parameters));
+  out.record(runParameters(params_, job.limits));
   options.cancel = &worker.cancel;
   const bool fail = !params_.fail_runs_of_student.empty() && input.student == params_.fail_runs_of_student;
   const PublishLimits limits{params_.max_published_events, params_.progress_period, params_.progress_every_events};
@@ -114,7 +112,7 @@ void LabNode::run(Worker& worker, Job& job, RunWriter& out, RunSoFar& progress) 
 void LabNode::applyStopCause(Worker& worker, const Job& job, collision_lab::RunSummary& summary) {
   const StopCause cause = worker.stopCause();
   collision_lab::service::StopContext context;
-  if (cause == StopCause::kCancel) {  // the node's mutex only for a cancelled run
+  if (cause == StopCause::kCancel) {  // the pool's lock only for a cancelled run
     const auto lock = pool_->lock();
     context.stopped_by = worker.current.stopped_by;
   }
@@ -170,10 +168,7 @@ void LabNode::dropWaiting(Job job, const std::string& by) {
                 dropped_bags_.get(), job.claim_error, RunWriter::RecordLimits{}, {});
   job.input.header.stamp = start;
   out.record(job.input);
-  collision_lab::RunParameters parameters = runParameters(params_, job.limits.max_collisions);
-  parameters.max_run_seconds = job.limits.max_run_seconds;
-  parameters.max_bag_bytes = job.limits.max_bag_bytes;
-  out.record(std::move(parameters));
+  out.record(runParameters(params_, job.limits));
   // As every run: its prediction, then its summary; every bag holds parameters, input,
   // prediction and summary.
   collision_lab::Prediction prediction;

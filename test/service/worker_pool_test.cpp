@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <condition_variable>
 #include <mutex>
 #include <string>
@@ -12,6 +13,10 @@
 
 namespace collision_lab::service {
 namespace {
+
+/// How long a wait for the workers may take before the test fails (generous: no timing is
+/// asserted, only that the event comes).
+constexpr std::chrono::seconds kPatience{30};
 
 /// A test's run: its name, whether it waits for the gate or for a stop.
 struct TestJob {
@@ -41,13 +46,14 @@ class Log {
     started_.push_back(run_id);
     changed_.notify_all();
   }
+  // A regression fails the test after kPatience instead of hanging it.
   void waitServed(std::size_t runs) {
     std::unique_lock<std::mutex> lock(mutex_);
-    changed_.wait(lock, [&] { return order_.size() >= runs; });
+    ASSERT_TRUE(changed_.wait_for(lock, kPatience, [&] { return order_.size() >= runs; })) << runs << " runs served";
   }
   void waitStarted(std::size_t runs) {
     std::unique_lock<std::mutex> lock(mutex_);
-    changed_.wait(lock, [&] { return started_.size() >= runs; });
+    ASSERT_TRUE(changed_.wait_for(lock, kPatience, [&] { return started_.size() >= runs; })) << runs << " runs started";
   }
   void open() {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -85,7 +91,7 @@ Pool::Hooks hooksFor(Pool& pool, Log& log) {
   hooks.serve = [&pool, &log](Pool::Worker& worker, Pool::Entry& entry) {
     log.started(entry.run_id);
     if (entry.job.wait_for_gate) log.waitGate();
-    while (entry.job.wait_for_stop && !worker.cancel) std::this_thread::yield();
+    while (entry.job.wait_for_stop && !worker.cancel) std::this_thread::sleep_for(std::chrono::milliseconds(1));
     ++worker.slot.runs;
     std::string stopped_by;
     {
@@ -102,8 +108,8 @@ Pool::Entry entry(const std::string& run_id, const std::string& student, Lane la
 }
 
 TEST(WorkerPool, ServesEveryStudentInTurn) {
+  Log log;  // outlives the pool, whose runs report to it
   Pool pool({1, 0});
-  Log log;
   pool.start(hooksFor(pool, log));
   {
     const auto lock = pool.lock();
@@ -130,8 +136,8 @@ TEST(WorkerPool, ServesEveryStudentInTurn) {
 }
 
 TEST(WorkerPool, AShortLaneWorkerServesShortRunsWhileALongOneRuns) {
+  Log log;  // outlives the pool, whose runs report to it
   Pool pool({2, 1});  // worker 0 takes short runs only
-  Log log;
   pool.start(hooksFor(pool, log));
   TestJob gate;
   gate.wait_for_gate = true;
@@ -155,8 +161,8 @@ TEST(WorkerPool, AShortLaneWorkerServesShortRunsWhileALongOneRuns) {
 }
 
 TEST(WorkerPool, TheWatchdogStopsARunAtItsDeadline) {
+  Log log;  // outlives the pool, whose runs report to it
   Pool pool({1, 0, 0.001});
-  Log log;
   pool.start(hooksFor(pool, log));
   TestJob endless;
   endless.wait_for_stop = true;
@@ -172,8 +178,8 @@ TEST(WorkerPool, TheWatchdogStopsARunAtItsDeadline) {
 }
 
 TEST(WorkerPool, CancelStopsOnlyTheRunAskedForAndKeepsTheFirstCause) {
+  Log log;  // outlives the pool, whose runs report to it
   Pool pool({2, 0});
-  Log log;
   pool.start(hooksFor(pool, log));
   TestJob endless;
   endless.wait_for_stop = true;
@@ -201,8 +207,8 @@ TEST(WorkerPool, CancelStopsOnlyTheRunAskedForAndKeepsTheFirstCause) {
 }
 
 TEST(WorkerPool, StopHandsBackTheWaitingRunsAndTakesNoMore) {
+  Log log;  // outlives the pool, whose runs report to it
   Pool pool({1, 0});
-  Log log;
   pool.start(hooksFor(pool, log));
   TestJob endless;
   endless.wait_for_stop = true;
@@ -234,18 +240,18 @@ TEST(WorkerPool, StopHandsBackTheWaitingRunsAndTakesNoMore) {
 }
 
 TEST(WorkerPool, TheLastNoticeIsTheNewestState) {
-  Pool pool({1, 0, 0.1, 0.0, 2});
-  Log log;
+  Log log;  // with the notices, outlives the pool, whose threads report to them
   std::mutex notices_mutex;
   std::condition_variable noticed;
   std::vector<std::vector<QueuedRunState>> notices;
+  int idle = 0;
+  Pool pool({1, 0, 0.1, 0.0, 2});
   Pool::Hooks hooks = hooksFor(pool, log);
   hooks.changed = [&](const std::vector<QueuedRunState>& runs) {
     std::lock_guard<std::mutex> lock(notices_mutex);
     notices.push_back(runs);
     noticed.notify_all();
   };
-  int idle = 0;
   hooks.idle = [&] { ++idle; };
   pool.start(std::move(hooks));
   TestJob gate;
@@ -262,7 +268,7 @@ TEST(WorkerPool, TheLastNoticeIsTheNewestState) {
   {
     // r1 holds the worker until the gate opens: the state after r4's push is noticed.
     std::unique_lock<std::mutex> lock(notices_mutex);
-    noticed.wait(lock, [&] { return !notices.empty() && notices.back().size() == 3; });
+    ASSERT_TRUE(noticed.wait_for(lock, kPatience, [&] { return !notices.empty() && notices.back().size() == 3; }));
   }
   log.open();
   log.waitServed(4);

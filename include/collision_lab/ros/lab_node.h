@@ -228,7 +228,6 @@ class LabNode {
   diagnostic_updater::Updater diagnostics_;
   ros::WallTimer diagnostics_timer_;
   std::unique_ptr<RunObserver> marker_view_;
-  std::vector<std::string> recorded_latched_topics_;
 
   // Counters, read by the diagnostics timer.
   std::atomic<std::uint64_t> runs_accepted_{0};
@@ -240,9 +239,6 @@ class LabNode {
   /// Writes the bags of runs that never started (dropWaiting); null when not recording.
   std::unique_ptr<RunBagWriter> dropped_bags_;
 
-  /// The scheduler, the workers, the watchdog and the queue's notices. Its lock guards
-  /// run_ids_ and view_busy_ too.
-  std::unique_ptr<Pool> pool_;
   /// The run_ids this node serves under: remembered, and held in the index and the bag
   /// folder (its Ledger); recording, a claimed run_id's .bag.active file is this node's.
   std::unique_ptr<collision_lab::service::RunIdClaims> run_ids_;
@@ -256,6 +252,10 @@ class LabNode {
   ros::CallbackQueue cancel_queue_;
   ros::AsyncSpinner cancel_spinner_;
   ros::ServiceServer cancel_srv_, list_runs_srv_;
+
+  /// The scheduler, the workers, the watchdog and the queue's notices. Its lock guards
+  /// run_ids_ and view_busy_ too. Last: its threads use the members above, so it goes first.
+  std::unique_ptr<Pool> pool_;
 };
 
 }  // namespace collision_lab_ros

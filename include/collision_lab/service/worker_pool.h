@@ -89,7 +89,7 @@ class WorkerPool {
   };
 
   struct Hooks {
-    std::function<RunFacts(const Job&)> facts;
+    std::function<RunFacts(const Job&)> facts;            ///< lock held (the queue's notices list up to `listed`)
     std::function<void(Worker&, Entry&)> serve;           ///< the run, on the worker, no lock
     std::function<void(Worker&, const Entry&)> taken;     ///< lock held; may be empty
     std::function<void(Worker&)> ended;                   ///< lock held; may be empty
@@ -186,6 +186,7 @@ class WorkerPool {
       noteChange();
     }
     wake_.notify_all();
+    watchdog_wake_.notify_all();
     return waiting;
   }
 
@@ -238,10 +239,11 @@ class WorkerPool {
   }
 
   RunningRun runningOf(const Entry& entry) const {
+    const RunFacts facts = hooks_.facts(entry.job);
     RunningRun running;
-    running.run = stateOf(entry);
+    running.run = stateOf(entry, facts);
     running.run.running = true;
-    const double seconds = hooks_.facts(entry.job).max_run_seconds;
+    const double seconds = facts.max_run_seconds;
     if (seconds > 0) {
       running.deadline = std::chrono::steady_clock::now() +
                          std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(seconds));
@@ -249,15 +251,14 @@ class WorkerPool {
     return running;
   }
 
-  QueuedRunState stateOf(const Entry& entry) const {
-    const RunFacts facts = hooks_.facts(entry.job);
+  static QueuedRunState stateOf(const Entry& entry, const RunFacts& facts) {
     return QueuedRunState{entry.run_id, entry.student, entry.lane, false, facts.predicted_collisions, facts.body_count};
   }
 
   void watchdogLoop() {
     std::unique_lock<std::mutex> guard(mutex_);
     while (!stopping_) {
-      wake_.wait_for(guard, std::chrono::duration<double>(options_.watchdog_period_s));
+      watchdog_wake_.wait_for(guard, std::chrono::duration<double>(options_.watchdog_period_s));
       const auto now = std::chrono::steady_clock::now();
       for (auto& worker : workers_) {
         const RunningRun& current = worker->current;
@@ -274,7 +275,7 @@ class WorkerPool {
     for (const auto& worker : workers_) {
       if (!worker->current.run.run_id.empty()) runs.push_back(worker->current.run);
     }
-    for (const Entry* entry : scheduler_.order(options_.listed)) runs.push_back(stateOf(*entry));
+    for (const Entry* entry : scheduler_.order(options_.listed)) runs.push_back(stateOf(*entry, hooks_.facts(entry->job)));
     return runs;
   }
 
@@ -296,7 +297,8 @@ class WorkerPool {
   const Options options_;
   Hooks hooks_;
   std::mutex mutex_;
-  std::condition_variable wake_;  ///< a run waits, or stopping_ (the workers, the watchdog)
+  std::condition_variable wake_;           ///< a run waits, or stopping_ (the workers)
+  std::condition_variable watchdog_wake_;  ///< stopping_
   Scheduler scheduler_;
   std::vector<std::unique_ptr<Worker>> workers_;
   bool stopping_ = false;
