@@ -41,6 +41,7 @@ collision_lab_service_test(worker_pool_test)
 catkin_add_gtest(run_index_recorder_test test/ros/run_index_recorder_test.cpp)
 if(TARGET run_index_recorder_test)
   target_link_libraries(run_index_recorder_test collision_lab_ros GTest::gtest_main)
+  target_compile_definitions(run_index_recorder_test PRIVATE COLLISION_LAB_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
 endif()
 
 # The real nodes (rostest): a lab node killed with SIGKILL and respawned by roslaunch

@@ -27,6 +27,7 @@
 #include <rosbag/view.h>
 
 #include "collision_lab/CollisionEvent.h"
+#include "collision_lab/core/nbody/scene.h"
 #include "collision_lab/ros/bag_reading.h"
 #include "collision_lab/ros/run_recorder.h"
 
@@ -53,6 +54,20 @@ double wallNow() {
 
 /// JSON has no inf or NaN: null.
 json finite(double x) { return std::isfinite(x) ? json(x) : json(nullptr); }
+
+/// InitialConditions.restitution_model from its name or its number (inputFields).
+std::uint8_t restitutionModelOf(const json& j) {
+  namespace core = collision_lab::core;
+  const json& model = j.contains("restitution_model") ? j["restitution_model"] : json();
+  if (model.is_number_unsigned() && model.get<std::uint64_t>() <= 255) return static_cast<std::uint8_t>(model.get<std::uint64_t>());
+  for (const auto kind : {core::RestitutionModelKind::kConstant, core::RestitutionModelKind::kTc,
+                          core::RestitutionModelKind::kViscoelastic, core::RestitutionModelKind::kThreshold}) {
+    if (model.is_string() && model.get<std::string>() == core::restitutionModelName(kind)) {
+      return static_cast<std::uint8_t>(kind);
+    }
+  }
+  throw std::invalid_argument("its stored input has no restitution_model");
+}
 
 json finiteArray(const std::vector<double>& values) {
   json out = json::array();
@@ -202,9 +217,11 @@ std::string interruptedJson(const std::string& bag_path, const BagContents& cont
 
 }  // namespace
 
-std::string inputJson(const collision_lab::InitialConditions& in) {
+json inputFields(const collision_lab::InitialConditions& in) {
   json masses = json::array();
   for (double m : in.masses) masses.push_back(std::isinf(m) && m > 0 ? json("inf") : finite(m));
+  const auto model = static_cast<collision_lab::core::RestitutionModelKind>(in.restitution_model);
+  const std::string model_name = collision_lab::core::restitutionModelName(model);
   return json{{"run_id", in.run_id},
               {"student", in.student},
               {"mode", in.mode},
@@ -212,19 +229,23 @@ std::string inputJson(const collision_lab::InitialConditions& in) {
               {"positions", finiteArray(in.positions)},
               {"velocities", finiteArray(in.velocities)},
               {"restitution", finiteArray(in.restitution)},
-              {"restitution_model", in.restitution_model},
+              {"restitution_model", model_name == "unknown" ? json(in.restitution_model) : json(model_name)},
               {"tc", finite(in.tc)},
               {"elastic_below", finite(in.elastic_below)},
               {"viscoelastic_speed", finite(in.viscoelastic_speed)},
               {"ring", finite(in.ring)},
               {"max_collisions", in.max_collisions},
               {"max_run_seconds", finite(in.max_run_seconds)},
-              {"max_bag_bytes", in.max_bag_bytes}}
-      .dump();
+              {"max_bag_bytes", in.max_bag_bytes}};
 }
 
+std::string inputJson(const collision_lab::InitialConditions& in) { return inputFields(in).dump(); }
+
 collision_lab::InitialConditions inputFromJson(const std::string& text) {
-  const json j = json::parse(text, nullptr, false);
+  return inputFromFields(json::parse(text, nullptr, false));  // not JSON: a discarded value, refused
+}
+
+collision_lab::InitialConditions inputFromFields(const json& j) {
   if (!j.is_object()) throw std::invalid_argument("its stored input is not a JSON object");
   const auto numbers = [&](const char* key, bool walls) {
     std::vector<double> values;
@@ -259,7 +280,7 @@ collision_lab::InitialConditions inputFromJson(const std::string& text) {
   in.positions = numbers("positions", false);
   in.velocities = numbers("velocities", false);
   in.restitution = numbers("restitution", false);
-  in.restitution_model = static_cast<std::uint8_t>(whole("restitution_model"));
+  in.restitution_model = restitutionModelOf(j);
   in.tc = number("tc");
   in.elastic_below = number("elastic_below");
   in.viscoelastic_speed = number("viscoelastic_speed");

@@ -53,29 +53,10 @@ json numbers(const std::vector<double>& values) {
   return out;
 }
 
-/// Masses keep "inf" (a wall) readable.
-json masses(const std::vector<double>& values) {
-  json out = json::array();
-  for (double m : values) out.push_back(std::isinf(m) ? json("inf") : exactNumber(m));
-  return out;
-}
-
 json points(const Envelope& envelope) {
   json out = json::array();
   for (const auto& v : envelope.polyline()) out.push_back(json::array({number(v.x), number(v.y)}));
   return out;
-}
-
-json sceneJson(const collision_lab::InitialConditions& in) {
-  return {{"masses", masses(in.masses)},
-          {"positions", numbers(in.positions)},
-          {"velocities", numbers(in.velocities)},
-          {"restitution", numbers(in.restitution)},
-          {"restitution_model", collision_lab::core::restitutionModelName(
-                                    static_cast<collision_lab::core::RestitutionModelKind>(in.restitution_model))},
-          {"ring", number(in.ring)},
-          {"max_collisions", in.max_collisions},
-          {"mode", in.mode}};
 }
 
 json predictionJson(const collision_lab::Prediction& p) {
@@ -882,7 +863,7 @@ std::optional<std::pair<std::string, std::uint64_t>> RunBook::json(const std::st
                           {"collisions", run.record ? run.record->collisions() : 0},
                           {"newest_time", run.record ? run.record->newestTime() : 0.0}};
     if (run.record) {
-      out["scene"] = sceneJson(run.record->input());
+      out["scene"] = collision_lab_ros::inputFields(run.record->input());
       if (run.record->prediction) out["prediction"] = predictionJson(*run.record->prediction);
       out["plots"] = plotsJson(*run.record, run.predicted);
       const auto view = collision_lab_ros::makeRunView(*run.record);

@@ -17,6 +17,7 @@
 #include <memory>
 #include <fstream>
 #include <limits>
+#include <set>
 #include <string>
 #include <thread>
 
@@ -26,6 +27,8 @@
 #include <rosbag/view.h>
 
 #include "collision_lab/CollisionEvent.h"
+#include "collision_lab/io/scenario_file.h"
+#include "collision_lab/ros/msg_conversion.h"
 #include "collision_lab/ros/run_index_recorder.h"
 #include "collision_lab/ros/run_recorder.h"
 
@@ -117,6 +120,80 @@ class RunIndexRecorderTest : public ::testing::Test {
 
   std::string dir_;
 };
+
+/// Every field of InitialConditions, compared exactly (an infinite mass equals itself).
+void expectSameInput(const collision_lab::InitialConditions& a, const collision_lab::InitialConditions& b,
+                     const std::string& name) {
+  EXPECT_EQ(a.run_id, b.run_id) << name;
+  EXPECT_EQ(a.student, b.student) << name;
+  EXPECT_EQ(a.mode, b.mode) << name;
+  EXPECT_EQ(a.masses, b.masses) << name;
+  EXPECT_EQ(a.positions, b.positions) << name;
+  EXPECT_EQ(a.velocities, b.velocities) << name;
+  EXPECT_EQ(a.restitution, b.restitution) << name;
+  EXPECT_EQ(a.restitution_model, b.restitution_model) << name;
+  EXPECT_EQ(a.tc, b.tc) << name;
+  EXPECT_EQ(a.elastic_below, b.elastic_below) << name;
+  EXPECT_EQ(a.viscoelastic_speed, b.viscoelastic_speed) << name;
+  EXPECT_EQ(a.ring, b.ring) << name;
+  EXPECT_EQ(a.max_collisions, b.max_collisions) << name;
+  EXPECT_EQ(a.max_run_seconds, b.max_run_seconds) << name;
+  EXPECT_EQ(a.max_bag_bytes, b.max_bag_bytes) << name;
+}
+
+TEST(InputJson, EverySceneKindReadsBackAsServed) {
+  // The one input JSON, which the index stores and the web serves as a run's scene: every
+  // preset (walls, a ring, per-pair e, the TC model, gases), and the other restitution
+  // models, come back field for field, bit for bit.
+  using Model = collision_lab::core::RestitutionModelKind;
+  std::vector<collision_lab::InitialConditions> inputs;
+  for (const auto& entry : collision_lab::io::loadScenes(COLLISION_LAB_SOURCE_DIR "/config/scenarios.yaml")) {
+    collision_lab::InitialConditions in =
+        toInitialConditions(entry.scene, collision_lab::core::RunMode::kFull, entry.max_collisions);
+    in.run_id = entry.name;
+    in.student = "ana";
+    in.max_run_seconds = 2.5;
+    in.max_bag_bytes = 1'000'000;
+    inputs.push_back(in);
+  }
+  collision_lab::InitialConditions threshold = inputs.front();
+  threshold.restitution_model = static_cast<std::uint8_t>(Model::kThreshold);
+  threshold.elastic_below = 0.1;
+  threshold.mode = collision_lab::InitialConditions::MODE_SUMMARY_ONLY;
+  collision_lab::InitialConditions viscoelastic = inputs.front();
+  viscoelastic.restitution_model = static_cast<std::uint8_t>(Model::kViscoelastic);
+  viscoelastic.viscoelastic_speed = 1.0 / 3.0;
+  inputs.push_back(threshold);
+  inputs.push_back(viscoelastic);
+  std::set<std::string> kinds;
+  for (const auto& in : inputs) {
+    const nlohmann::json fields = inputFields(in);
+    kinds.insert(fields["restitution_model"].get<std::string>());
+    if (in.ring > 0) kinds.insert("ring");
+    if (std::isinf(in.masses.front()) || std::isinf(in.masses.back())) kinds.insert("wall");
+    if (in.masses.size() > 100) kinds.insert("gas");
+    expectSameInput(inputFromJson(inputJson(in)), in, in.run_id);
+  }
+  EXPECT_EQ(kinds, (std::set<std::string>{"constant", "tc", "threshold", "viscoelastic", "ring", "wall", "gas"}));
+}
+
+TEST(InputJson, RowsOfEarlierVersionsStillReadAndBadOnesAreRefused) {
+  // Before 0.8 the index stored restitution_model as its number.
+  const collision_lab::InitialConditions in = inputFromJson(
+      R"({"mode":0,"masses":[1,"inf"],"positions":[1,0],"velocities":[-1,0],"restitution":[],)"
+      R"("restitution_model":1,"tc":0.5,"elastic_below":0,"viscoelastic_speed":0,"ring":null,)"
+      R"("max_collisions":10,"max_run_seconds":0,"max_bag_bytes":0})");
+  EXPECT_EQ(in.restitution_model, static_cast<std::uint8_t>(collision_lab::core::RestitutionModelKind::kTc));
+  EXPECT_EQ(in.tc, 0.5);
+  EXPECT_EQ(in.ring, 0.0);
+  EXPECT_TRUE(std::isinf(in.masses[1]));
+  EXPECT_EQ(inputFields(in)["restitution_model"], "tc");
+  EXPECT_THROW(inputFromJson("not json"), std::invalid_argument);
+  EXPECT_THROW(inputFromJson(R"({"mode":0,"masses":[1],"positions":[0],"velocities":[0],"restitution":[],)"
+                             R"("restitution_model":"sticky","tc":0,"elastic_below":0,"viscoelastic_speed":0,)"
+                             R"("ring":0,"max_collisions":1,"max_run_seconds":0,"max_bag_bytes":0})"),
+               std::invalid_argument);
+}
 
 TEST(SummaryJson, EveryFieldItWritesReadsBack) {
   // The one summary JSON, which the index stores and the web serves and reads back: each

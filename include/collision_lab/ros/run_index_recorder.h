@@ -29,14 +29,21 @@
 
 namespace collision_lab_ros {
 
-/// The index's JSON of a served input (IndexedRun::scene_json): masses ("inf" for a wall),
-/// positions, velocities, restitution (null for a non-finite value), max_collisions, mode,
-/// student, run_id.
+/// The one JSON of a served input (InitialConditions), which the run index stores
+/// (IndexedRun::scene_json) and the web serves as a run's "scene": InitialConditions' field
+/// names, masses with "inf" for a wall, restitution_model by its name ("constant", "tc",
+/// "viscoelastic", "threshold"; a number no model has, as that number); a value that is not
+/// finite is null.
+nlohmann::json inputFields(const collision_lab::InitialConditions& input);
+/// inputFields as text.
 std::string inputJson(const collision_lab::InitialConditions& input);
-/// The served input back from inputJson's text (a run to serve again). A scalar stored as
-/// null (not finite: tc, elastic_below, viscoelastic_speed, ring, max_run_seconds, which
-/// the node ignores unless in use) reads back as 0. Throws std::invalid_argument when the
-/// text is not such JSON, or a per-body value is null.
+/// The served input back from inputFields (a run to serve again). restitution_model reads
+/// as a name or a number (as the index stored it before 0.8). A scalar stored as null (not
+/// finite: tc, elastic_below, viscoelastic_speed, ring, max_run_seconds, which the node
+/// ignores unless in use) reads back as 0. Throws std::invalid_argument when it is not such
+/// JSON, or a per-body value is null.
+collision_lab::InitialConditions inputFromFields(const nlohmann::json& fields);
+/// inputFromFields of inputJson's text.
 collision_lab::InitialConditions inputFromJson(const std::string& text);
 /// The one JSON of a RunSummary, which the run index stores (IndexedRun::summary_json) and
 /// the web serves: the fields the class pages show, under RunSummary's field names but
