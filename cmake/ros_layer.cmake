@@ -1,10 +1,11 @@
 # Thin ROS layer in four libraries, as grid_map does, over the ROS-free core:
 #   collision_lab_ros    the node: message <-> core conversion, the lab node, per-run bags
+#                        and their exports (bag_csv: the events CSV, the class table)
 #   collision_lab_view_model  a run kept for drawing and its view description, which rviz
 #                        and the web page share (no marker types)
 #   collision_lab_views  the rviz markers over the view model (links the node library for
 #                        RunObserver, the node's hook for an in-process view)
-#   collision_lab_tools  bag_to_csv and the scenario publisher
+#   collision_lab_tools  the scenario publisher
 # Each executable links the library it runs.
 # ROS headers for this layer and everything built after it (nodes, ROS tests, the node
 # benchmarks); the core, built before, never sees them.
@@ -12,6 +13,7 @@ include_directories(SYSTEM ${catkin_INCLUDE_DIRS})
 add_library(collision_lab_ros
   src/ros/msg_conversion.cpp
   src/ros/bag_reading.cpp
+  src/ros/bag_csv.cpp
   src/ros/run_recorder.cpp
   src/ros/run_timeline.cpp
   src/ros/run_index_recorder.cpp
@@ -60,7 +62,6 @@ add_library(collision_lab_views
 target_link_libraries(collision_lab_views PUBLIC collision_lab_view_model)
 
 add_library(collision_lab_tools
-  src/ros/bag_csv.cpp
   src/ros/scenario_publisher.cpp)
 # collision_lab_io: the scenario files the publisher reads.
 target_link_libraries(collision_lab_tools PUBLIC collision_lab_ros collision_lab_io)
@@ -76,7 +77,7 @@ target_link_libraries(collision_lab_markers PRIVATE collision_lab_views)
 add_executable(scenario_publisher src/ros/scenario_publisher_main.cpp)
 target_link_libraries(scenario_publisher PRIVATE collision_lab_tools)
 add_executable(bag_to_csv src/ros/bag_to_csv_main.cpp)
-target_link_libraries(bag_to_csv PRIVATE collision_lab_tools)
+target_link_libraries(bag_to_csv PRIVATE collision_lab_ros)
 set_target_properties(${collision_lab_ROS_EXECUTABLES} PROPERTIES
   RUNTIME_OUTPUT_DIRECTORY ${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_BIN_DESTINATION})
 

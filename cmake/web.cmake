@@ -19,7 +19,7 @@ add_library(collision_lab_web_lib
   src/web/web_stream.cpp
   src/web/window_worldlines.cpp)
 target_include_directories(collision_lab_web_lib PUBLIC include)
-target_link_libraries(collision_lab_web_lib PUBLIC collision_lab_ros collision_lab_view_model collision_lab_tools collision_lab_service Threads::Threads)
+target_link_libraries(collision_lab_web_lib PUBLIC collision_lab_ros collision_lab_view_model collision_lab_service Threads::Threads)
 add_executable(collision_lab_web src/web/web_node_main.cpp)
 target_link_libraries(collision_lab_web PRIVATE collision_lab_web_lib)
 set_target_properties(collision_lab_web PROPERTIES

@@ -7,7 +7,6 @@
 #include "collision_lab/core/nbody/scene.h"
 #include "collision_lab/core/nbody/temperature.h"
 #include "collision_lab/ros/view_style.h"
-#include "collision_lab/ros/markers/layout.h"
 
 namespace collision_lab_ros {
 

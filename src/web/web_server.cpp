@@ -30,9 +30,9 @@
 #include "collision_lab/ros/bag_csv.h"
 #include "collision_lab/ros/bag_reading.h"
 #include "collision_lab/ros/msg_conversion.h"
-#include "collision_lab/ros/markers/layout.h"
 #include "collision_lab/ros/node_constants.h"
 #include "collision_lab/ros/run_view.h"
+#include "collision_lab/ros/view_style.h"
 #include "http_server.h"
 #include "web_parts.h"
 

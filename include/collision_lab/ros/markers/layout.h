@@ -6,6 +6,7 @@
 
 #include <cstddef>
 
+#include "collision_lab/ros/view_style.h"
 
 namespace collision_lab_ros::markers {
 
@@ -14,11 +15,6 @@ struct Box {
   double left, right, bottom, top;
   constexpr double midX() const { return (left + right) / 2; }
   constexpr double midY() const { return (bottom + top) / 2; }
-};
-
-/// A colour, 0..1 per channel.
-struct Rgba {
-  double r, g, b, a = 1.0;
 };
 
 namespace layout {
@@ -47,36 +43,7 @@ constexpr double kBoldDy = 0.022;  ///< about one pixel at the config's 46 px pe
 constexpr double kTextZ = 0.2;  ///< texts over everything
 constexpr double kDotZ = 0.05;  ///< dots over lines
 
-// ---- colours ----
-/// Bodies' colours: A, B, C as always, then more for up to kMaxPlottedBodies bodies.
-constexpr std::size_t kPaletteSize = 10;
-/// Each keeps a contrast of at least 3:1 (WCAG, relative luminance 0.23 to 0.28) on the
-/// page's white and on rviz's dark grey background alike.
-constexpr Rgba kParticleRgb[kPaletteSize] = {
-    {0.95, 0.25, 0.25}, {0.19, 0.63, 0.23}, {0.3, 0.55, 1.0},   {0.7, 0.52, 0.13},  {0.7, 0.42, 0.93},
-    {0.13, 0.61, 0.61}, {0.82, 0.41, 0.62}, {0.47, 0.59, 0.17}, {0.82, 0.45, 0.24}, {0.52, 0.52, 0.82}};
-/// The diverging colour map of velocity: its ends, and purple at rest, seen on rviz's dark
-/// background and on the page's white one alike (white at rest vanished on the page).
-constexpr Rgba kSlowBlue{0.2, 0.4, 1.0};
-constexpr Rgba kFastRed{1.0, 0.2, 0.15};
-constexpr Rgba kRestPurple{0.62, 0.42, 0.72};
-constexpr Rgba kWhite{0.95, 0.95, 0.95};
-constexpr Rgba kGrey{0.6, 0.6, 0.6};
-/// Small grey text lighter than lines: rviz draws a minus sign one pixel thin.
-constexpr Rgba kLabelGrey{0.8, 0.8, 0.8};
-constexpr Rgba kAmber{1.0, 0.75, 0.2};
-constexpr Rgba kPaper{1.0, 0.55, 0.9};
-constexpr Rgba kPredicted{0.8, 0.5, 1.0};
-constexpr Rgba kCursorWhite{1, 1, 1, 0.5};
-constexpr Rgba kConeFill{1.0, 0.85, 0.2, 0.3};
-constexpr Rgba kConeYellow{1.0, 0.85, 0.2};
-constexpr Rgba kPathOrange{1.0, 0.55, 0.1, 0.8};
-constexpr Rgba kSimulatedOrange{1.0, 0.55, 0.1};
-constexpr Rgba kBannerRed{1.0, 0.35, 0.35};
-/// How much lighter than its body a body's text is (0: same, 1: white).
-constexpr double kTagLighten = 0.3;
-/// How much lighter than its series a closed form's dot is.
-constexpr double kDotLighten = 0.6;
+// ---- colours: the view model's (view_style.h) ----
 
 // ---- line widths ----
 constexpr double kFrameWidth = 0.025, kAxisWidth = 0.03, kSeriesWidth = 0.035, kConservedWidth = 0.03;
