@@ -68,6 +68,9 @@ shoot_views() {
   wait_finished "$run"; shoot "/runs/$run" web_view_not_simulated.png 1250
   run=$(send eve collapse_equal); wait_finished "$run"; shoot "/runs/$run" web_view_collapse.png 1250
   run=$(send eve near_collapse); wait_finished "$run"; shoot "/runs/$run" web_view_near_collapse.png 1250
+  # collapse_equal a billion times smaller: the view's small numbers in the page's style (×10⁻⁹).
+  run=$(send_body '{"student":"eve","masses":[1,1,1],"positions":[2e-9,1e-9,0],"velocities":[-1,0,0],"restitution":0.05}')
+  wait_finished "$run"; shoot "/runs/$run" web_view_small_numbers.png 1250
   run=$(send eve two_carts); wait_finished "$run"; shoot "/runs/$run" web_view_two_carts.png 1250
   # The state after the last collision: each plot goes on one past it (the heat of an
   # inelastic pair, equal_masses' A at +1 m/s), and a run without collisions.

@@ -46,6 +46,11 @@ function fmt(x, digits) {
   return m[1] + '×10' + superscript(Number(m[2]));
 }
 
+// The view's texts (rviz's, which writes "4.68×10^11") in the page's style: "4.68×10¹¹".
+function pageText(text) {
+  return text.replace(/×10\^(-?\d+)/g, (all, n) => '×10' + superscript(Number(n)));
+}
+
 function superscript(n) {
   const sup = {'-': '⁻', '0': '⁰', '1': '¹', '2': '²', '3': '³', '4': '⁴', '5': '⁵', '6': '⁶', '7': '⁷', '8': '⁸', '9': '⁹'};
   return String(n).split('').map((c) => sup[c]).join('');
@@ -412,7 +417,7 @@ function summaryRows(run) {
     if (s.recorded === false) {
       rows.push(['recorded', 'no: this run has no bag to download or replay' + (s.recording_error ? ' (' + s.recording_error + ')' : ''), null, null]);
     }
-    rows.push(['stop reason', s.stop_reason + (view.truncated ? ': ' + view.truncated : ''), null, null]);
+    rows.push(['stop reason', s.stop_reason + (view.truncated ? ': ' + pageText(view.truncated) : ''), null, null]);
   }
   return rows;
 }
@@ -491,7 +496,7 @@ function drawTemperature(view) {
   c.options.scales.y.ticks = {autoSkip: false, callback: (value) => logTickLabel(value, spanY)};
   c.update('none');
   document.getElementById('temperature_legend').textContent =
-    view.temperature_legend + (view.temperature_fit_note ? '. ' + view.temperature_fit_note : '');
+    pageText(view.temperature_legend + (view.temperature_fit_note ? '. ' + view.temperature_fit_note : ''));
   document.body.dataset.temperaturePoints = String(points.length);
   // For tests: the labels drawn on each axis, '|'-separated.
   const labels = (axis) => c.scales[axis].ticks.map((t) => t.label).filter((l) => l !== '').join('|');
@@ -520,7 +525,7 @@ function showNotSimulated(run, view) {
   const named = finals.map((v, i) => (v === null || v === undefined ? null : bodyName(i) + ' ' + fmt(v, 9) + ' m/s')).filter((t) => t);
   if (named.length > 0 && named.length <= 10) answer += '; final velocities ' + named.join(', ');
   document.getElementById('not_simulated_reason').textContent =
-    'Nothing to plot, since this run was not simulated: ' + view.not_simulated.replace(/^not simulated: /, '') + '.';
+    'Nothing to plot, since this run was not simulated: ' + pageText(view.not_simulated.replace(/^not simulated: /, '')) + '.';
   document.getElementById('model_answer').textContent = answer + '. The summary below has its numbers.';
   document.body.dataset.plotsHidden = 'velocity energy xt';
   return true;
@@ -532,11 +537,11 @@ function showFacts(view) {
   const facts = document.getElementById('view_facts');
   // The note repeats a cut's sentence when there is one: said once.
   const items = view ? [view.title, view.not_simulated, view.note ? '' : view.truncated, view.collapse, view.spiral, view.ring, view.box, view.moving_wall, view.note] : [];
-  facts.replaceChildren(...items.filter((text) => text).map((text) => el('li', text)));
-  document.getElementById('velocity_legend').textContent = view ? 'Bodies shown: ' + view.velocity_legend + '.' : '';
-  document.getElementById('xt_legend').textContent = view ? 'Bodies shown: ' + view.worldline_legend + '.' : '';
+  facts.replaceChildren(...items.filter((text) => text).map((text) => el('li', pageText(text))));
+  document.getElementById('velocity_legend').textContent = view ? 'Bodies shown: ' + pageText(view.velocity_legend) + '.' : '';
+  document.getElementById('xt_legend').textContent = view ? 'Bodies shown: ' + pageText(view.worldline_legend) + '.' : '';
   // Many bodies: what their colours mean (few: each is named in its colour).
-  document.getElementById('colour_legend').textContent = view && view.colour_legend ? view.colour_legend[0].toUpperCase() + view.colour_legend.slice(1) + '.' : '';
+  document.getElementById('colour_legend').textContent = view && view.colour_legend ? pageText(view.colour_legend[0].toUpperCase() + view.colour_legend.slice(1)) + '.' : '';
 }
 
 function nonBackgroundPixels(canvas) {
@@ -559,7 +564,7 @@ function render(run) {
     view.worldline_bodies.concat(view.velocity_bodies).forEach((b) => viewBodies.set(b.index, b));
     viewColours = view.body_colours || [];
     // The counter and state word are the view's (rviz's) own.
-    status.textContent = run.state + who + ': ' + view.counter;
+    status.textContent = run.state + who + ': ' + pageText(view.counter);
   } else {
     const count = run.summary ? run.summary.collision_count : run.collisions;
     status.textContent = run.state + who + ': ' + plural(count, 'collision');

@@ -415,6 +415,18 @@ TEST_F(RunPageViewTest, CollapseIsNamed) {
   EXPECT_NE(dom.find("collapse at t = "), std::string::npos) << dom.substr(0, 2000);
 }
 
+// collapse_equal a billion times smaller collapses at t = 3.5 ns: the view's text (rviz's
+// "3.5×10^-9") is in the page's number style. (Failed before: the facts read "×10^-9".)
+TEST_F(RunPageViewTest, TheViewsNumbersAreInThePagesStyle) {
+  const std::string dom = finalPage({{"student", "view"},
+                                     {"masses", {1, 1, 1}},
+                                     {"positions", {2e-9, 1e-9, 0}},
+                                     {"velocities", {-1, 0, 0}},
+                                     {"restitution", 0.05}});
+  EXPECT_NE(dom.find("collapse at t = 3.5×10⁻⁹ s"), std::string::npos) << dom.substr(0, 3000);
+  EXPECT_EQ(dom.find("×10^"), std::string::npos) << dom.substr(dom.find("×10^") == std::string::npos ? 0 : dom.find("×10^") - 200, 400);
+}
+
 // The two carts part after their impact at t = 0.5 s: every x-t line reaches the run's end.
 TEST_F(RunPageViewTest, WorldlinesReachTheRunsEnd) {
   const std::string dom = finalPage({{"student", "view"}, {"preset", "two_carts"}});
