@@ -274,6 +274,20 @@ bool ended(collision_lab::service::RunState state) {
 
 /// The summary an index row gives when the run's bag has none (an interrupted run): its
 /// stop reason, count and bag, and what its summary_json holds of RunSummary's fields.
+/// The run read back from its bag, else why not in `error` ("the run was not recorded"
+/// without a bag); the memory the bag took is given back either way.
+std::optional<BagRun> readBack(const std::string& bag_path, std::size_t envelope_vertices, std::string& error) {
+  std::optional<BagRun> rebuilt;
+  try {
+    if (bag_path.empty()) throw std::runtime_error("the run was not recorded");
+    rebuilt = readRunFromBag(existingBag(bag_path), envelope_vertices);
+  } catch (const std::exception& e) {
+    error = e.what();
+  }
+  collision_lab_ros::releaseMemoryAfterBag(bag_path);
+  return rebuilt;
+}
+
 collision_lab::RunSummary summaryFromRow(const collision_lab::service::IndexedRun& row) {
   collision_lab::RunSummary s;
   const json fields = json::parse(row.summary_json, nullptr, false);
@@ -501,15 +515,8 @@ void RunBook::rebuildLoop() {
 
 void RunBook::completeFromBag(const std::string& run_id, const std::string& bag_path,
                               const std::optional<Completion>& how) {
-  std::optional<BagRun> rebuilt;
   std::string error;
-  try {
-    if (bag_path.empty()) throw std::runtime_error("the run was not recorded");
-    rebuilt = readRunFromBag(existingBag(bag_path), options_.envelope_vertices);
-  } catch (const std::exception& e) {
-    error = e.what();
-  }
-  collision_lab_ros::releaseMemoryAfterBag(bag_path);
+  std::optional<BagRun> rebuilt = readBack(bag_path, options_.envelope_vertices, error);
   std::lock_guard<std::mutex> lock(mutex_);
   auto it = runs_.find(run_id);
   if (it == runs_.end() || it->second.finished) return;  // a rebuilding run is never evicted
@@ -606,17 +613,8 @@ bool RunBook::load(const std::string& run_id) {
   if (stub) bag = stub->bag_path;  // only runs with a bag are evicted
   if (row && ended(row->state)) bag = row->bag_path;
   std::optional<BagRun> rebuilt;
-  std::string error;
-  if (!bag.empty()) {
-    try {
-      rebuilt = readRunFromBag(existingBag(bag), options_.envelope_vertices);
-    } catch (const std::exception& e) {
-      error = e.what();
-    }
-    collision_lab_ros::releaseMemoryAfterBag(bag);
-  } else if (stub || (row && ended(row->state))) {
-    error = "the run was not recorded";
-  }
+  std::string error;  // a run known to have ended: read back from its bag, or why not
+  if (stub || (row && ended(row->state))) rebuilt = readBack(bag, options_.envelope_vertices, error);
 
   lock.lock();
   loading_.erase(run_id);
@@ -634,32 +632,9 @@ bool RunBook::load(const std::string& run_id) {
     run.bag_error = error.empty() ? "the bag has no InitialConditions" : error;
   }
   if (stub) {
-    run.student = stub->student;
-    run.requested_run_id = stub->requested_run_id;
-    run.accepted_stamp = stub->accepted_stamp;
-    run.interrupted = stub->interrupted;
-    run.sequence = stub->sequence;
-    if (run.record && run.record->summary && !run.interrupted) {
-      run.summary = *run.record->summary;
-    } else {
-      run.summary = summaryOfStub(run_id, *stub);
-    }
-    run.finished = true;
-    evicted_.erase(run_id);
+    fillFromStubLocked(run, *stub);
   } else {
-    run.student = row->student;
-    run.requested_run_id = row->requested_run_id;
-    run.accepted_stamp = row->accepted_at;
-    run.sequence = next_sequence_++;
-    run.started = row->state == collision_lab::service::RunState::kRunning;
-    if (ended(row->state)) {
-      run.interrupted = row->state == collision_lab::service::RunState::kInterrupted;
-      run.summary = run.record && run.record->summary && !run.interrupted ? *run.record->summary : summaryFromRow(*row);
-      if (run.interrupted && run.record) {
-        run.summary->collision_count = std::max<std::uint64_t>(run.summary->collision_count, run.record->collisions());
-      }
-      run.finished = true;
-    }
+    fillFromRowLocked(run, *row);
   }
   if (run.record && run.summary) run.record->summary = run.summary;
   order_[run.sequence] = run_id;
@@ -667,6 +642,36 @@ bool RunBook::load(const std::string& run_id) {
   countLocked(run);
   enforceBudgetLocked(run_id);
   return true;
+}
+
+void RunBook::fillFromStubLocked(WebRun& run, const EvictedRun& stub) {
+  run.student = stub.student;
+  run.requested_run_id = stub.requested_run_id;
+  run.accepted_stamp = stub.accepted_stamp;
+  run.interrupted = stub.interrupted;
+  run.sequence = stub.sequence;
+  if (run.record && run.record->summary && !run.interrupted) {
+    run.summary = *run.record->summary;
+  } else {
+    run.summary = summaryOfStub(run.run_id, stub);
+  }
+  run.finished = true;
+  evicted_.erase(run.run_id);
+}
+
+void RunBook::fillFromRowLocked(WebRun& run, const collision_lab::service::IndexedRun& row) {
+  run.student = row.student;
+  run.requested_run_id = row.requested_run_id;
+  run.accepted_stamp = row.accepted_at;
+  run.sequence = next_sequence_++;
+  run.started = row.state == collision_lab::service::RunState::kRunning;
+  if (!ended(row.state)) return;
+  run.interrupted = row.state == collision_lab::service::RunState::kInterrupted;
+  run.summary = run.record && run.record->summary && !run.interrupted ? *run.record->summary : summaryFromRow(row);
+  if (run.interrupted && run.record) {
+    run.summary->collision_count = std::max<std::uint64_t>(run.summary->collision_count, run.record->collisions());
+  }
+  run.finished = true;
 }
 
 std::size_t RunBook::reconcile() {

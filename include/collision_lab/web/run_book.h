@@ -218,6 +218,10 @@ class RunBook {
   void completeFromBag(const std::string& run_id, const std::string& bag_path, const std::optional<Completion>& how);
   /// Makes the run resident (from a stub or the RunSource); false when unknown.
   bool load(const std::string& run_id);
+  /// A loaded run's fields from its stub (evicted: it ended), which is then dropped.
+  void fillFromStubLocked(WebRun& run, const EvictedRun& stub);
+  /// A loaded run's fields from its index row: waiting, running or ended.
+  void fillFromRowLocked(WebRun& run, const collision_lab::service::IndexedRun& row);
   void touchLocked(WebRun& run);
   void countLocked(WebRun& run);
   /// The RunSource has the run, finished or interrupted (so an evicted run needs no stub).
