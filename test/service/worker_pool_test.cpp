@@ -107,6 +107,12 @@ Pool::Entry entry(const std::string& run_id, const std::string& student, Lane la
   return Pool::Entry{run_id, student, lane, job};
 }
 
+/// Queues the entries in order, under one lock, as the lab node's intake does.
+void push(Pool& pool, std::initializer_list<Pool::Entry> entries) {
+  const auto lock = pool.lock();
+  for (const Pool::Entry& e : entries) pool.push(e);
+}
+
 TEST(WorkerPool, ServesEveryStudentInTurn) {
   Log log;  // outlives the pool, whose runs report to it
   Pool pool({1, 0});
@@ -141,15 +147,9 @@ TEST(WorkerPool, AShortLaneWorkerServesShortRunsWhileALongOneRuns) {
   pool.start(hooksFor(pool, log));
   TestJob gate;
   gate.wait_for_gate = true;
-  {
-    const auto lock = pool.lock();
-    pool.push(entry("long", "ana", Lane::kLong, gate));
-  }
+  push(pool, {entry("long", "ana", Lane::kLong, gate)});
   log.waitStarted(1);
-  {
-    const auto lock = pool.lock();
-    pool.push(entry("short", "ben", Lane::kShort));
-  }
+  push(pool, {entry("short", "ben", Lane::kShort)});
   log.waitServed(1);  // while "long" still waits for the gate
   EXPECT_EQ(log.order(), std::vector<std::string>{"short"});
   log.open();
@@ -167,10 +167,7 @@ TEST(WorkerPool, TheWatchdogStopsARunAtItsDeadline) {
   TestJob endless;
   endless.wait_for_stop = true;
   endless.max_run_seconds = 0.01;
-  {
-    const auto lock = pool.lock();
-    pool.push(entry("endless", "ana", Lane::kLong, endless));
-  }
+  push(pool, {entry("endless", "ana", Lane::kLong, endless)});
   log.waitServed(1);
   EXPECT_EQ(log.causes(), std::vector<StopCause>{StopCause::kTimeLimit});
   pool.stop("the test");
@@ -183,11 +180,7 @@ TEST(WorkerPool, CancelStopsOnlyTheRunAskedForAndKeepsTheFirstCause) {
   pool.start(hooksFor(pool, log));
   TestJob endless;
   endless.wait_for_stop = true;
-  {
-    const auto lock = pool.lock();
-    pool.push(entry("a", "ana", Lane::kLong, endless));
-    pool.push(entry("b", "ben", Lane::kLong, endless));
-  }
+  push(pool, {entry("a", "ana", Lane::kLong, endless), entry("b", "ben", Lane::kLong, endless)});
   log.waitStarted(2);
   {
     const auto lock = pool.lock();
@@ -212,10 +205,7 @@ TEST(WorkerPool, StopHandsBackTheWaitingRunsAndTakesNoMore) {
   pool.start(hooksFor(pool, log));
   TestJob endless;
   endless.wait_for_stop = true;
-  {
-    const auto lock = pool.lock();
-    pool.push(entry("running", "ana", Lane::kLong, endless));
-  }
+  push(pool, {entry("running", "ana", Lane::kLong, endless)});
   log.waitStarted(1);
   {
     const auto lock = pool.lock();
@@ -256,10 +246,7 @@ TEST(WorkerPool, TheLastNoticeIsTheNewestState) {
   pool.start(std::move(hooks));
   TestJob gate;
   gate.wait_for_gate = true;
-  {
-    const auto lock = pool.lock();
-    pool.push(entry("r1", "ana", Lane::kLong, gate));
-  }
+  push(pool, {entry("r1", "ana", Lane::kLong, gate)});
   log.waitStarted(1);
   {
     const auto lock = pool.lock();
