@@ -348,20 +348,6 @@ TEST_F(WebAccessTest, WrongCodesAre429ThenALockoutThatEnds) {
                         "the lockout to end", 60.0));
 }
 
-TEST_F(WebAccessTest, RunsPerAddressAreLimitedWhateverTheName) {
-  std::vector<int> statuses;
-  for (int i = 0; i < 13; ++i) {  // runs_per_minute_per_address = 12, a new name each time
-    const std::string body = piScene("alias" + std::to_string(i)).dump();
-    statuses.push_back(statusOf(rawRequest(
-        "127.0.5.1", std::string("POST /api/runs HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\n"
-                                 "X-Class-Code: ") +
-                         kCode + "\r\nConnection: close\r\nContent-Length: " + std::to_string(body.size()) + "\r\n\r\n" + body)));
-  }
-    std::vector<int> expected(12, 202);
-  expected.push_back(429);
-  EXPECT_EQ(statuses, expected);
-}
-
 /// POST /api/runs of scene from `source`: the status and the JSON body (null when none).
 std::pair<int, json> postFrom(const std::string& source, const json& scene) {
   const std::string body = scene.dump();
@@ -390,6 +376,22 @@ TEST_F(WebAccessTest, SendingAsAClassmateFromElsewhereSpendsNoneOfTheirRuns) {
   EXPECT_EQ(impostor, expected) << "the impostor's address spends its own runs of zoe";
   EXPECT_NE(refusal.find("at most 8 runs per student per hour"), std::string::npos) << refusal;
   EXPECT_EQ(postFrom("127.0.9.2", piScene("zoe")).first, 202) << "zoe, at her own machine";
+}
+
+// runs_per_minute_per_address = 12: the 13th send of an address is refused, whatever name
+// it types. Each run is waited for, so that no unfinished run holds the address's share
+// (unfinished_runs_per_address, another limit). (Failed now and then before, on a loaded
+// machine: the slow runs' share refused the 11th send.)
+TEST_F(WebAccessTest, RunsPerAddressAreLimitedWhateverTheName) {
+  std::vector<int> statuses;
+  for (int i = 0; i < 13; ++i) {
+    const auto [status, body] = postFrom("127.0.5.1", piScene("alias" + std::to_string(i)));
+    statuses.push_back(status);
+    if (status == 202) finishedRun(body.at("run_id"));
+  }
+  std::vector<int> expected(12, 202);
+  expected.push_back(429);
+  EXPECT_EQ(statuses, expected);
 }
 
 TEST_F(WebAccessTest, OneAddressUnderManyNamesHoldsABoundedShare) {
