@@ -1,13 +1,10 @@
 # collision_lab_cli: no ROS master needed. Placed in the devel space's package bin
 # folder so that `rosrun collision_lab collision_lab_cli` finds it.
-# The CLI's parser and runner, shared with the Python module (cmake/python.cmake), which
-# makes the same report in process: position-independent for its shared object.
+# The CLI's parser and runner (a library of their own for test/cli).
 add_library(collision_lab_cli_runner STATIC
   src/cli/command_line.cpp
   src/cli/progress.cpp
-  src/cli/scene_runner.cpp
-  src/cli/temperature_csv.cpp)
-set_target_properties(collision_lab_cli_runner PROPERTIES POSITION_INDEPENDENT_CODE ON)
+  src/cli/scene_runner.cpp)
 target_link_libraries(collision_lab_cli_runner PUBLIC collision_lab_io CLI11::CLI11)
 add_executable(collision_lab_cli src/cli/main.cpp)
 target_link_libraries(collision_lab_cli PRIVATE collision_lab_cli_runner)

@@ -1,7 +1,7 @@
 # Tests of collision_lab_io (test/io) and collision_lab_cli (test/cli) (gtest, no master).
 # The CLI tests run the built binary as a child process, from the source folder.
 catkin_add_gtest(collision_lab_io_test test/io/scenario_file_test.cpp test/io/scene_run_test.cpp
-  test/io/number_format_test.cpp test/io/report_stream_test.cpp)
+  test/io/number_format_test.cpp test/io/report_stream_test.cpp test/io/report_values_test.cpp)
 if(TARGET collision_lab_io_test)
   target_link_libraries(collision_lab_io_test collision_lab_io GTest::gtest_main)
   target_include_directories(collision_lab_io_test PRIVATE src/io)  # the report stream's cache, tested directly

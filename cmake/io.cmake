@@ -5,7 +5,8 @@ add_library(collision_lab_io
   src/io/scenario_file.cpp
   src/io/bodies_csv.cpp
   src/io/scene_report.cpp
-  src/io/report.cpp)
+  src/io/report.cpp
+  src/io/temperature_csv.cpp)
 target_link_libraries(collision_lab_io PUBLIC collision_lab_core yaml-cpp nlohmann_json::nlohmann_json)
 
 install(TARGETS collision_lab_io

@@ -1,14 +1,12 @@
 # The Python module collision_lab (python/collision_lab, catkin_python_setup in
-# CMakeLists.txt) and its C++ part collision_lab._core (pybind11): the CLI's parser, the
-# core's run and io's JSON report, in process. Built beside the package's generated
-# messages (collision_lab.msg) in the devel space, installed beside them.
+# CMakeLists.txt) and its C++ part collision_lab._core (pybind11): the core's run and io's
+# report as Python values, in process (only public headers). Built beside the package's
+# generated messages (collision_lab.msg) in the devel space, installed beside them.
 # pybind11 takes the Python that catkin found (Python3_FOUND: its new tools), with its headers.
 find_package(Python3 REQUIRED COMPONENTS Interpreter Development)
 find_package(pybind11 REQUIRED)
-pybind11_add_module(collision_lab_python_core MODULE
-  src/python/core_module.cpp
-  src/python/scene_driver.cpp)
-target_link_libraries(collision_lab_python_core PRIVATE collision_lab_cli_runner)
+pybind11_add_module(collision_lab_python_core MODULE src/python/core_module.cpp)
+target_link_libraries(collision_lab_python_core PRIVATE collision_lab_io)
 target_compile_definitions(collision_lab_python_core PRIVATE COLLISION_LAB_VERSION="${collision_lab_VERSION}")
 set_target_properties(collision_lab_python_core PROPERTIES
   OUTPUT_NAME _core

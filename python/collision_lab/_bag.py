@@ -3,7 +3,7 @@ the Run that collision_lab.run gives: the scene as run()'s keyword arguments, th
 under run()'s keys, the prediction, and every CollisionEvent as numpy arrays."""
 import math
 
-from ._run import ESCALATION_KEYS, SUMMARY_KEYS, Run, body_name
+from ._run import ESCALATION_KEYS, SUMMARY_KEYS, Run, body_name, events_from_records
 
 _MODES = {0: 'full', 1: 'predict', 2: 'summary'}
 _KINDS = {0: 'impact', 1: 'collapse'}
@@ -186,6 +186,6 @@ def read_bag(path):
                           'mode': scene['mode']},
               'units': {'mass': 'kg', 'position': 'm', 'velocity': 'm/s', 'time': 's', 'energy': 'J',
                         'momentum': 'kg m/s'},
-              'events': [_event(msg) for msg in events],
               'summary': _summary(summary, prediction) if summary is not None else {}}
-    return Run(report, scene, report['summary'])
+    return Run(report, scene, report['summary'], events_from_records([_event(msg) for msg in events],
+                                                                       len(scene['masses'])))

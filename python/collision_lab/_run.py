@@ -1,11 +1,12 @@
 """One scene run in process: collision_lab.run, predict, SceneError and the Run object.
 
-The C++ part (collision_lab._core) is collision_lab_cli's own parser, core run and JSON
-report writer: a Run's report, options and events are the CLI's JSON, key for key and value
-for value; its summary is the CLI's completed to one set of keys for every model
-(SUMMARY_KEYS), and its scene is run()'s keyword arguments (SCENE_KEYS).
+The C++ part (collision_lab._core) takes the scene's numbers straight into the core and runs
+it as collision_lab_cli does; it hands back the CLI's JSON report as Python values (no
+arguments or JSON text on the way): a Run's report and options are the CLI's JSON, key for
+key and value for value, its events numpy columns of the same values; its summary is the
+CLI's completed to one set of keys for every model (SUMMARY_KEYS), and its scene is run()'s
+keyword arguments (SCENE_KEYS).
 """
-import json
 import math
 import warnings
 
@@ -153,71 +154,95 @@ _USAGE = ('USAGE', 100)
 _INVALID_OPTION = ('INVALID_OPTION', 104)
 
 
+_MODES = ('full', 'predict', 'summary')
+_RESTITUTION_MODELS = {'constant': None, 'tc': 'tc', 'threshold': 'elastic_below',
+                       'viscoelastic': 'viscoelastic_speed'}
+
+
+def _whole_number(key, value, least):
+    """value as an int >= least; a bool, a float or a string is refused, not rounded."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+        raise TypeError('%s must be a whole number, not %r' % (key, value))
+    if value < least:
+        raise SceneError(*_INVALID_OPTION, key, '%s must be >= %d, not %d' % (key, least, value))
+    return int(value)
+
+
+def _check_events(events):
+    """events: 'all', 'none' or 'first:N' (N a whole number >= 0)."""
+    text = str(events)
+    count = text[len('first:'):] if text.startswith('first:') else None
+    if text not in ('all', 'none') and not (count and count.isdigit() and count.isascii()):
+        raise SceneError(*_INVALID_OPTION, 'events', "events must be 'all', 'none' or 'first:N' with N a whole "
+                         "number >= 0, not %r" % (events,))
+    return text
+
+
 def _check_options(restitution, restitution_model, tc, elastic_below, viscoelastic_speed,
-                   max_collisions):
+                   max_collisions, mode='full', events='all', full_state_every=1, temperature_csv=None):
     """The options' mistakes in run()'s words (its keywords, not the command line's options)."""
-    if isinstance(max_collisions, (bool, np.bool_)) or not isinstance(max_collisions, (int, np.integer)):
-        raise TypeError('max_collisions must be a whole number, not %r' % (max_collisions,))
-    if max_collisions < 0:
-        raise SceneError(*_INVALID_OPTION, 'max_collisions',
-                         'max_collisions must be >= 0, not %d' % max_collisions)
+    _whole_number('max_collisions', max_collisions, 0)
+    _whole_number('full_state_every', full_state_every, 1)
     if np.ndim(restitution) != 0 and np.size(restitution) == 0:
         raise SceneError(*_USAGE, 'restitution', 'restitution is empty: give one e for every pair, '
                          'one per pair, or leave it out (elastic)')
+    if restitution_model not in _RESTITUTION_MODELS:
+        raise SceneError(*_INVALID_OPTION, 'restitution_model', "restitution_model must be 'constant', 'tc', "
+                         "'threshold' or 'viscoelastic', not %r" % (restitution_model,))
     for key, value, model in (('tc', tc, 'tc'), ('elastic_below', elastic_below, 'threshold'),
                               ('viscoelastic_speed', viscoelastic_speed, 'viscoelastic')):
         if value is not None and restitution_model != model:
             raise SceneError(*_USAGE, key, "%s= belongs to restitution_model='%s' (it is %r)"
                              % (key, model, restitution_model))
+    if mode not in _MODES:
+        raise SceneError(*_INVALID_OPTION, 'mode', "mode must be 'full', 'predict' or 'summary', not %r" % (mode,))
+    _check_events(events)
+    if temperature_csv is not None and mode != 'full':
+        raise SceneError(*_INVALID_OPTION, 'temperature_csv',
+                         "T(t) needs the simulation's impacts: mode='full' (the default), not %r" % (mode,))
 
 
-def _number_list(values):
-    """Numbers as the CLI's comma list; repr round-trips every double (inf, -inf, nan too)."""
-    if np.ndim(values) == 0:
-        values = [values]
-    return ','.join(repr(float(v)) for v in values)
+def _one_number(key, value):
+    """A scalar option (ring, tc, ...) as a float; None stays None."""
+    if value is None:
+        return None
+    if isinstance(value, (bool, np.bool_)) or np.ndim(value) != 0:
+        raise TypeError('%s must be one number, not %r' % (key, value))
+    return float(value)
 
 
-def scene_arguments(masses, positions, velocities, restitution=1.0, *, ring=None,
-                    restitution_model='constant', tc=None, elastic_below=None,
-                    viscoelastic_speed=None, max_collisions=10_000_000, simulate_to_cap=False,
-                    events='all', mode='full', temperature_csv=None, full_state_every=1):
-    """collision_lab_cli's arguments for these keyword arguments (see run())."""
-    masses, positions, velocities = (_body_values(name, values) for name, values in
+def core_job(masses, positions, velocities, restitution=1.0, *, ring=None,
+             restitution_model='constant', tc=None, elastic_below=None,
+             viscoelastic_speed=None, max_collisions=10_000_000, simulate_to_cap=False,
+             events='all', mode='full', temperature_csv=None, full_state_every=1, name=''):
+    """The checked keyword arguments of run() as the dict that collision_lab._core runs."""
+    masses, positions, velocities = (np.asarray(_body_values(key, values), dtype=float) for key, values in
                                      (('masses', masses), ('positions', positions),
                                       ('velocities', velocities)))
-    if np.ndim(restitution) != 0:
-        _body_values('restitution', restitution)
     _check_options(restitution, restitution_model, tc, elastic_below, viscoelastic_speed,
-                   max_collisions)
-    args = ['--masses', _number_list(masses), '--positions', _number_list(positions),
-            '--velocities', _number_list(velocities),
-            '--max-collisions', str(int(max_collisions)), '--events', str(events), '--mode', str(mode)]
-    # The defaults are the CLI's without the option (its report then shows no restitution list).
-    if np.ndim(restitution) != 0 or float(restitution) != 1.0:
-        args += ['--restitution', _number_list(restitution)]
-    if restitution_model != 'constant':
-        args += ['--restitution-model', str(restitution_model)]
-    for option, value in (('--ring', ring), ('--tc', tc), ('--elastic-below', elastic_below),
-                          ('--viscoelastic-speed', viscoelastic_speed)):
-        if value is not None:
-            args += [option, _number_list(value)]
-    if temperature_csv is not None:
-        args += ['--temperature-csv', str(temperature_csv)]
-    if simulate_to_cap:
-        args.append('--simulate-to-cap')
-    if int(full_state_every) != 1:
-        args += ['--full-state-every', str(int(full_state_every))]
-    return args
+                   max_collisions, mode, events, full_state_every, temperature_csv)
+    if np.ndim(restitution) != 0:
+        restitution = np.asarray(_body_values('restitution', restitution), dtype=float)
+    else:
+        e = _one_number('restitution', restitution)
+        # The default, elastic, as the CLI without --restitution: its report shows no list.
+        restitution = np.empty(0) if e == 1.0 else np.asarray([e])
+    parameter_key = _RESTITUTION_MODELS[restitution_model]
+    parameters = {'tc': tc, 'elastic_below': elastic_below, 'viscoelastic_speed': viscoelastic_speed}
+    return {'masses': masses, 'positions': positions, 'velocities': velocities, 'restitution': restitution,
+            'ring': _one_number('ring', ring), 'restitution_model': str(restitution_model),
+            'model_parameter': _one_number(parameter_key, parameters[parameter_key]) if parameter_key else None,
+            'max_collisions': int(max_collisions), 'simulate_to_cap': bool(simulate_to_cap),
+            'events': str(events), 'mode': str(mode), 'full_state_every': int(full_state_every),
+            'name': str(name), 'temperature_csv': None if temperature_csv is None else str(temperature_csv)}
 
 
-def parse_report(text):
-    """The JSON report as a dict; raises SceneError for the CLI's JSON error document."""
-    report = json.loads(text)
-    if 'error' in report:
-        error = report['error']
+def result_of(result):
+    """(report, events) of collision_lab._core's result; raises SceneError for its error."""
+    if 'error' in result:
+        error = result['error']
         raise SceneError(error['reason'], error['code'], error['field'], error['message'])
-    return report
+    return result['report'], result['events']
 
 
 def _float_rows(rows, bodies):
@@ -233,7 +258,17 @@ def _float_rows(rows, bodies):
     return out
 
 
-def _events_arrays(events, bodies):
+def _uncertified_column(names):
+    """Per event, the names of its values not certified correctly rounded (a tuple each)."""
+    column = np.empty(len(names), dtype=object)
+    for i, value in enumerate(names):
+        column[i] = tuple(value)
+    return column
+
+
+def events_from_records(events, bodies):
+    """The event columns of a list of event dicts (the CLI's JSON events, a bag's messages):
+    NaN where a record has null."""
     arrays = {'kind': np.array([e['kind'] for e in events], dtype=str),
               'pair': np.array([e['pair'] for e in events], dtype=str)}
     for key, dtype in _SCALARS:
@@ -249,10 +284,24 @@ def _events_arrays(events, bodies):
         rows = [e.get(key) for e in events]
         if any(row is not None for row in rows):
             arrays[key] = _float_rows(rows, bodies)
-    # Per event, the names of its values not certified correctly rounded (a tuple each).
-    uncertified = np.empty(len(events), dtype=object)
-    uncertified[:] = [tuple(e.get('uncertified', ())) for e in events]
-    arrays['uncertified'] = uncertified
+    arrays['uncertified'] = _uncertified_column([e.get('uncertified', ()) for e in events])
+    return arrays
+
+
+def _events_from_core(columns, bodies):
+    """The event columns that collision_lab._core filled, in events_from_records' layout.
+    The per-body arrays that the records do not carry (more than 64 bodies) are a read-only
+    view of one NaN, which holds no events x bodies memory: Run.state_at rebuilds states."""
+    columns = dict(columns)
+    count = len(columns['time'])
+    arrays = {'kind': np.where(columns.pop('collapse'), 'collapse', 'impact').astype(str),
+              'pair': np.array(columns.pop('pair'), dtype=str)}
+    arrays.update((key, columns.pop(key)) for key, _ in _SCALARS)
+    for key in _BODY_ARRAYS:
+        given = columns.pop(key)
+        arrays[key] = given if given is not None else np.broadcast_to(np.float64(np.nan), (count, bodies))
+    arrays['uncertified'] = _uncertified_column(columns.pop('uncertified'))
+    arrays.update(columns)
     return arrays
 
 
@@ -271,7 +320,7 @@ class Run:
     [m/s]: numpy arrays.
     """
 
-    def __init__(self, report, scene, summary=None):
+    def __init__(self, report, scene, summary=None, events=None):
         self.report = report
         self.scene = scene
         self.summary = complete_summary(report.get('summary', {})) if summary is None else summary
@@ -285,7 +334,7 @@ class Run:
         self.initial_velocities = np.asarray(scene['velocities'], dtype=float)
         self.names = [body_name(i) for i in range(len(self.masses))]
         self.walls = [name for name, mass in zip(self.names, self.masses) if math.isinf(mass)]
-        self.events = _events_arrays(report.get('events', []), len(self.masses))
+        self.events = events if events is not None else events_from_records([], len(self.masses))
 
     def state_at(self, k=None, *, t=None):
         """The bodies' state (positions [m], velocities [m/s]), each an array of one value per
@@ -493,17 +542,18 @@ def run(masses, positions, velocities, restitution=1.0, *, ring=None, restitutio
     cap left the run unsimulated (the model answered) or cut it short.
     The Run's scene holds these arguments (but temperature_csv): run(**r.scene) runs r again.
     """
-    args = scene_arguments(masses, positions, velocities, restitution, ring=ring,
-                           restitution_model=restitution_model, tc=tc, elastic_below=elastic_below,
-                           viscoelastic_speed=viscoelastic_speed, max_collisions=max_collisions,
-                           simulate_to_cap=simulate_to_cap, events=events, mode=mode,
-                           temperature_csv=temperature_csv, full_state_every=full_state_every)
+    job = core_job(masses, positions, velocities, restitution, ring=ring,
+                   restitution_model=restitution_model, tc=tc, elastic_below=elastic_below,
+                   viscoelastic_speed=viscoelastic_speed, max_collisions=max_collisions,
+                   simulate_to_cap=simulate_to_cap, events=events, mode=mode,
+                   temperature_csv=temperature_csv, full_state_every=full_state_every, name=name)
     scene = scene_of(masses, positions, velocities, restitution, ring=ring, restitution_model=restitution_model,
                      tc=tc, elastic_below=elastic_below, viscoelastic_speed=viscoelastic_speed,
                      max_collisions=max_collisions, simulate_to_cap=simulate_to_cap, events=events, mode=mode,
                      name=name, full_state_every=full_state_every)
-    text, interrupted = _core.run_json(args, name)
-    result = Run(parse_report(text), scene)
+    outcome, interrupted = _core.run(job)
+    report, columns = result_of(outcome)
+    result = Run(report, scene, events=_events_from_core(columns, len(job['masses'])))
     if interrupted:
         raise RunInterrupted(result) from None
     _warn_about_cap(result, max_collisions, simulate_to_cap, mode)

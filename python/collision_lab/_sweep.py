@@ -1,12 +1,11 @@
 """collision_lab.sweep: many scenes' summaries as one pandas DataFrame, on every core (C++
 threads, without the GIL) or over a Dask cluster, with the same table either way."""
 import itertools
-import json
 import math
 import os
 
 from . import _core
-from ._run import ESCALATION_KEYS, SUMMARY_KEYS, SUMMARY_UNITS, complete_summary, scene_arguments
+from ._run import ESCALATION_KEYS, SUMMARY_KEYS, SUMMARY_UNITS, complete_summary, core_job
 
 # A scene dict's keys besides the run() keyword arguments.
 _SCENE_KEYS = ('masses', 'positions', 'velocities', 'restitution', 'name')
@@ -32,7 +31,7 @@ def scene_list(scenes=None, grid=None, base=None):
 
 
 def scene_job(scene, options):
-    """(CLI arguments, name) of one scene dict, with `options` as its defaults."""
+    """The collision_lab._core job (core_job) of one scene dict, with `options` as its defaults."""
     merged = dict(options, **scene)
     unknown = set(merged) - set(_SCENE_KEYS) - set(RUN_OPTIONS)
     if unknown:
@@ -40,20 +39,19 @@ def scene_job(scene, options):
     missing = [key for key in ('masses', 'positions', 'velocities') if key not in merged]
     if missing:
         raise ValueError('a scene needs masses, positions and velocities; missing: %s' % ', '.join(missing))
-    name = str(merged.pop('name', ''))
-    return scene_arguments(**merged), name
+    return core_job(**merged)
 
 
 RUN_OPTIONS = ('ring', 'restitution_model', 'tc', 'elastic_below', 'viscoelastic_speed',
                'max_collisions', 'simulate_to_cap', 'events', 'mode', 'full_state_every')
 
 
-def summary_row(text):
-    """One table row of a report: the summary (complete_summary: every key of SUMMARY_KEYS,
-    None for a rejected scene), its dict values flattened to 'key.subkey' columns (lists kept
-    as lists), then the error columns."""
-    report = json.loads(text)
-    if 'error' in report:
+def summary_row(result):
+    """One table row of a collision_lab._core result: the summary (complete_summary: every
+    key of SUMMARY_KEYS, None for a rejected scene), its dict values flattened to
+    'key.subkey' columns (lists kept as lists), then the error columns."""
+    report = result.get('report', result)
+    if 'error' in result:
         summary = dict({key: None for key in SUMMARY_KEYS}, escalation=dict.fromkeys(ESCALATION_KEYS))
     else:
         summary = complete_summary(report['summary'])
@@ -63,16 +61,16 @@ def summary_row(text):
             row.update(('%s.%s' % (key, sub), v) for sub, v in value.items())
         else:
             row[key] = value
-    error = report.get('error', {})
+    error = result.get('error', {})
     for column in ERROR_COLUMNS:
         row[column] = error.get(column[len('error_'):])
     return row
 
 
 def run_chunk(jobs, workers=1):
-    """The JSON reports of (arguments, name) jobs, run on `workers` C++ threads: the function
-    that every Dask task runs."""
-    return _core.run_many_json(jobs, workers)
+    """The table rows (summary_row) of core_job jobs, run on `workers` C++ threads: the
+    function that every Dask task runs."""
+    return [summary_row(result) for result in _core.run_many(jobs, workers)]
 
 
 def sweep_table(rows, parameter_names):
@@ -113,15 +111,14 @@ def sweep(scenes=None, *, grid=None, base=None, client=None, workers=None, chunk
     parameters, made = scene_list(scenes, grid, base)
     jobs = [scene_job(scene, options) for scene in made]
     if client is None:
-        reports = run_chunk(jobs, workers or os.cpu_count() or 1)
+        rows = run_chunk(jobs, workers or os.cpu_count() or 1)
     else:
         if chunk_size is None:
             threads = sum(client.nthreads().values()) or 1
             chunk_size = max(1, math.ceil(len(jobs) / (4 * threads)))
         chunks = [jobs[i:i + chunk_size] for i in range(0, len(jobs), chunk_size)]
         futures = client.map(run_chunk, chunks, pure=False)
-        reports = [report for chunk in client.gather(futures) for report in chunk]
-    rows = [summary_row(text) for text in reports]
+        rows = [row for chunk in client.gather(futures) for row in chunk]
     for name, values in parameters:
         for row, value in zip(rows, values):
             row[name] = value

@@ -19,7 +19,7 @@ import json
 
 import yaml
 
-from ._sweep import run_chunk, scene_job, scene_list, summary_row, sweep_table
+from ._sweep import run_chunk, scene_job, scene_list, sweep_table
 
 
 def substitute(template, point):
@@ -64,9 +64,9 @@ def run_shard(args):
     begin, end = shard_range(args.shard, len(scenes)) if args.shard else (0, len(scenes))
     jobs = [scene_job(scene, options) for _, scene in scenes[begin:end]]
     with open(args.output, 'w') as out:
-        for number, ((point, _), report) in enumerate(zip(scenes[begin:end], run_chunk(jobs, args.workers)),
-                                                      start=begin):
-            out.write(json.dumps(dict({'scene': number}, **point, **summary_row(report))) + '\n')
+        for number, ((point, _), row) in enumerate(zip(scenes[begin:end], run_chunk(jobs, args.workers)),
+                                                   start=begin):
+            out.write(json.dumps(dict({'scene': number}, **point, **row)) + '\n')
 
 
 def merge(args):

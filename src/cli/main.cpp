@@ -12,9 +12,9 @@
 
 #include "collision_lab/io/report.h"
 #include "collision_lab/io/scenario_file.h"
+#include "collision_lab/io/temperature_csv.h"
 #include "command_line.h"
 #include "scene_runner.h"
-#include "temperature_csv.h"
 
 namespace collision_lab {
 namespace cli {
@@ -138,7 +138,7 @@ int main(int argc, char** argv) {
   } catch (const cli::CliError& error) {
     cli::reportBadInput(error, cli::requestedFormat(args));
     return cli::kExitBadInput;
-  } catch (const cli::OutputFailed& e) {
+  } catch (const io::OutputFailed& e) {
     std::cerr << "collision_lab_cli: " << e.what() << std::endl;
     return cli::kExitOutputFailed;
   } catch (const std::exception& e) {

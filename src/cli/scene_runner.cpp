@@ -10,8 +10,8 @@
 
 #include "collision_lab/core/scene_run.h"
 #include "collision_lab/io/scene_report.h"
+#include "collision_lab/io/temperature_csv.h"
 #include "progress.h"
-#include "temperature_csv.h"
 
 namespace collision_lab {
 namespace cli {
@@ -66,78 +66,32 @@ core::RunOptions optionsFor(const CliRequest& request, const io::SceneEntry& ent
   return options;
 }
 
-/// Runs a validated scene, stopped when `cancel` is set. With `progress_line`, a progress
-/// line on a terminal (stderr): it only watches (visitors.progress), so in a terminal or a
-/// pipe the run takes the same path. `visitors` see the shown events; the run keeps none.
-core::SceneRunResult runShown(const core::ScenePlan& plan, const core::RunOptions& shown, bool simulate_to_cap,
-                              core::SceneVisitors visitors, const std::atomic<bool>* cancel, bool progress_line) {
-  core::SceneRunOptions options;
-  options.lab = shown;
-  options.simulate_to_cap = simulate_to_cap;
-  options.keep_events = false;  // streamed to the report, not kept
-  options.cancel = cancel;
-  std::optional<ProgressLine> progress;
-  if (progress_line && shown.mode != core::RunMode::kPredictOnly && isatty(STDERR_FILENO)) {
-    const std::uint64_t predicted = plan.prediction && plan.prediction->impact_count ? *plan.prediction->impact_count : 0;
-    progress.emplace(stderr, std::min(predicted, shown.max_collisions));
-    options.progress_interval = std::uint64_t{1} << 16;
-    visitors.progress = [&](const core::EngineProgress& p) { progress->onEngineProgress(p.impacts, p.time); };
-  }
-  return core::runScene(plan, options, visitors);
-}
-
-/// The visitors that hand the shown events to the report.
-core::SceneVisitors showEvents(const core::RunOptions& shown, io::SceneReportWriter& report) {
-  core::SceneVisitors visitors;
-  if (shown.events.kind == core::EventPolicy::Kind::kNone) return visitors;
-  const core::EventPolicy policy = shown.events;
-  visitors.impact = [&report, policy](const core::ImpactRecord& impact) {
-    if (policy.keeps(impact.index)) report.impact(impact);
-  };
-  visitors.collapse = [&report, policy](const core::Collapse& collapse) {
-    if (policy.keepsAfter(collapse.impacts_before)) report.collapse(collapse);
-  };
-  // The event engine runs to the end even when only the first N impacts are shown.
-  return visitors;
-}
-
 }  // namespace
 
-namespace {
-
-/// runEntry and reportEntry: the report of one scene to `out`.
-void writeEntry(const CliRequest& request, const io::SceneEntry& given, std::ostream& out,
-                const std::atomic<bool>* cancel, bool progress_line) {
+void runEntry(const CliRequest& request, const io::SceneEntry& given) {
+  const InterruptGuard interrupt_guard;  // from the first byte out, so Ctrl-C never cuts a report
   const io::SceneEntry entry = withRequestRestitution(request, given);
   const core::ScenePlan plan = planOrThrow(entry);
-  std::optional<TemperatureCsv> temperature;  // opened before any report: a bad path is bad input
-  if (request.temperature_csv) temperature.emplace(*request.temperature_csv, entry.scene);
-  const core::RunOptions shown = optionsFor(request, entry);
-  const auto report = io::makeSceneReportWriter(request.format, out);
-  report->begin(entry, shown, plan.model, plan.prediction);
-  core::SceneVisitors visitors = showEvents(shown, *report);
-  core::RunOptions run = shown;
-  if (temperature) {
-    // T(t) needs every impact: the run is simulated even where the closed form alone would
-    // answer, and the visitors see every event (the report still shows those asked for).
-    visitors = temperature->feeding(std::move(visitors));
-    run.events = core::EventPolicy::all();
+  io::ReportedRun run;
+  run.options = optionsFor(request, entry);
+  run.simulate_to_cap = request.simulate_to_cap;
+  run.cancel = &g_cancel;
+  run.temperature_csv = request.temperature_csv;
+  std::optional<ProgressLine> progress;
+  // A progress line on a terminal (stderr): it only watches, so in a terminal or a pipe
+  // the run takes the same path.
+  if (run.options.mode != core::RunMode::kPredictOnly && isatty(STDERR_FILENO)) {
+    const std::uint64_t predicted = plan.prediction && plan.prediction->impact_count ? *plan.prediction->impact_count : 0;
+    progress.emplace(stderr, std::min(predicted, run.options.max_collisions));
+    run.progress_interval = std::uint64_t{1} << 16;
+    run.progress = [&](const core::EngineProgress& p) { progress->onEngineProgress(p.impacts, p.time); };
   }
-  const core::SceneRunResult result = runShown(plan, run, request.simulate_to_cap, visitors, cancel, progress_line);
-  if (temperature) temperature->finish();
-  report->end(result);
-}
-
-}  // namespace
-
-void runEntry(const CliRequest& request, const io::SceneEntry& entry) {
-  const InterruptGuard interrupt_guard;  // from the first byte out, so Ctrl-C never cuts a report
-  writeEntry(request, entry, std::cout, &g_cancel, true);
-}
-
-void reportEntry(const CliRequest& request, const io::SceneEntry& entry, std::ostream& out,
-                 const std::atomic<bool>* cancel) {
-  writeEntry(request, entry, out, cancel, false);
+  const auto report = io::makeSceneReportWriter(request.format, std::cout);
+  try {
+    io::runReported(entry, plan, run, *report);
+  } catch (const io::CannotOpenFile& e) {
+    throw makeCliError(CliReason::kInvalidOption, "temperature-csv", e.what());
+  }
 }
 
 void runEntries(const CliRequest& request, const std::vector<io::SceneEntry>& given) {

@@ -4,7 +4,6 @@
 #pragma once
 
 #include <atomic>
-#include <ostream>
 #include <vector>
 
 #include "collision_lab/io/scenario_file.h"
@@ -17,11 +16,6 @@ namespace cli {
 /// (SIGINT) during an event-engine run stops it, and the partial summary is printed.
 /// Throws CliError for an invalid scene.
 void runEntry(const CliRequest& request, const io::SceneEntry& entry);
-
-/// The same report in process (the Python module): written to `out`, the run stopped
-/// when `cancel` (may be null) is set; no signal handler and no progress line.
-void reportEntry(const CliRequest& request, const io::SceneEntry& entry, std::ostream& out,
-                 const std::atomic<bool>* cancel);
 
 /// Every scene of a file: all are validated before any runs, then one batch report.
 void runEntries(const CliRequest& request, const std::vector<io::SceneEntry>& entries);

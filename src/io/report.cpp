@@ -371,6 +371,12 @@ Json eventJson(const core::ImpactRecord& impact) {
   return Json::parse(text.str());
 }
 
+std::string eventPairName(const EventRecord& r) {
+  // Only an impact across a ring's seam has last_moved below its pair_index (namedBodies).
+  if (r.collapse || r.last_moved >= r.pair_index) return core::pairName(r.pair_index);
+  return core::bodyName(r.pair_index) + (r.pair_index < 26 ? "" : "-") + core::bodyName(0);
+}
+
 namespace report_text {
 
 EventRecord eventRecord(const core::ImpactRecord& impact) {
@@ -459,13 +465,6 @@ std::vector<std::size_t> namedBodies(const EventRecord& r) {
   return bodies;
 }
 
-/// pairName, or for a ring's seam the two bodies' names ("CA", "#30-A").
-std::string recordPairName(const EventRecord& r) {
-  const std::size_t left = namedBodies(r)[1];
-  if (r.collapse || left == r.pair_index + 1) return core::pairName(r.pair_index);
-  return core::bodyName(r.pair_index) + (r.pair_index < 26 ? "" : "-") + core::bodyName(left);
-}
-
 /// core::bodyName(body), written without building a string.
 void putBodyName(TextSink& sink, std::size_t body) {
   if (body < 26) return sink.put(static_cast<char>('A' + body));
@@ -473,7 +472,7 @@ void putBodyName(TextSink& sink, std::size_t body) {
   sink.count(body);
 }
 
-/// The CSV cells pair (recordPairName), pair_index and bodies (namedBodies, separated by
+/// The CSV cells pair (eventPairName), pair_index and bodies (namedBodies, separated by
 /// ';') of a record, written without building strings.
 void putCsvPairAndBodies(TextSink& sink, const EventRecord& r) {
   const std::size_t first = r.pair_index;
@@ -510,7 +509,7 @@ void writeEventRecordJson(TextSink& sink, const EventRecord& r) {
   sink.put(r.collapse ? "{\"kind\":\"collapse\",\"index\":" : "{\"kind\":\"impact\",\"index\":");
   sink.count(r.index);
   sink.put(",\"pair\":\"");
-  sink.put(recordPairName(r));
+  sink.put(eventPairName(r));
   sink.put("\",\"pair_index\":");
   sink.count(r.pair_index);
   sink.put(",\"bodies\":[");

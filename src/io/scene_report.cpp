@@ -8,6 +8,7 @@
 #include <optional>
 #include <sstream>
 
+#include "collision_lab/io/temperature_csv.h"
 #include "event_pipeline.h"
 #include "report_text.h"
 
@@ -400,7 +401,8 @@ class SceneTableWriter : public SceneLayout {
 // JSON: one document, one impact per line; the bodies' lists are streamed.
 
 /// The restitution model and the ring, only when the scene has them (older outputs unchanged).
-void writeSceneOptionsJson(std::ostream& out, const core::Scene& s) {
+Json sceneOptionsJson(const core::Scene& s) {
+  Json json = Json::object();
   const core::RestitutionModel& model = s.restitution_model;
   if (model.kind != core::RestitutionModelKind::kConstant) {
     const double parameter = model.kind == core::RestitutionModelKind::kTc
@@ -410,10 +412,11 @@ void writeSceneOptionsJson(std::ostream& out, const core::Scene& s) {
     const char* key = model.kind == core::RestitutionModelKind::kTc
                           ? "tc"
                           : (model.kind == core::RestitutionModelKind::kThreshold ? "elastic_below" : "viscoelastic_speed");
-    out << ",\"restitution_model\":\"" << core::restitutionModelName(model.kind) << "\",\"" << key
-        << "\":" << jsonText(number(parameter));
+    json["restitution_model"] = core::restitutionModelName(model.kind);
+    json[key] = number(parameter);
   }
-  if (s.isRing()) out << ",\"ring\":" << jsonText(number(s.ring));
+  if (s.isRing()) json["ring"] = number(s.ring);
+  return json;
 }
 
 void writeSceneJson(std::ostream& out, const SceneEntry& entry) {
@@ -427,7 +430,8 @@ void writeSceneJson(std::ostream& out, const SceneEntry& entry) {
   writeJsonNumbers(out, s.velocities);
   out << ",\"restitution\":";
   writeJsonNumbers(out, s.restitution);
-  writeSceneOptionsJson(out, s);
+  const Json options = sceneOptionsJson(s);
+  for (const auto& [key, value] : options.items()) out << "," << jsonText(Json(key)) << ":" << jsonText(value);
   out << "}";
 }
 
@@ -610,6 +614,15 @@ class SceneCsvWriter : public SceneLayout {
 // summary gets "model" and "model_reason", CSV two "# summary.model..." lines, the table a
 // "model:" line.
 
+/// The summary of a run with the rotation model's values (summaryJson) and the model that
+/// answered.
+Json rotationSummaryJson(const core::SceneRunResult& result, const core::ModelChoice& model) {
+  Json summary = summaryJson(result);
+  summary["model"] = core::modelKindName(model.kind);
+  summary["model_reason"] = model.reason;
+  return summary;
+}
+
 class ThreeBodyModelWriter : public RunReportWriter {
  public:
   ThreeBodyModelWriter(ReportFormat format, std::ostream& out, const core::ModelChoice& model)
@@ -637,10 +650,7 @@ class ThreeBodyModelWriter : public RunReportWriter {
   void end(const core::SceneRunResult& result) override {
     if (format_ == ReportFormat::kJson) {
       events_->finish();
-      Json summary = summaryJson(result);
-      summary["model"] = core::modelKindName(model_.kind);
-      summary["model_reason"] = model_.reason;
-      out_ << (any_event_ ? "\n]" : "]") << ",\n\"summary\": " << jsonText(summary) << "}\n";
+      out_ << (any_event_ ? "\n]" : "]") << ",\n\"summary\": " << jsonText(rotationSummaryJson(result, model_)) << "}\n";
       return;
     }
     inner_->end(result);
@@ -850,6 +860,94 @@ class SceneReport : public SceneReportWriter {
 
 std::unique_ptr<SceneReportWriter> makeSceneReportWriter(ReportFormat format, std::ostream& out) {
   return std::make_unique<SceneReport>(format, out);
+}
+
+namespace {
+
+/// The JSON report's values (ReportValues), in its layouts: the rotation model's when the
+/// plan's prediction has its values, every scene's otherwise.
+class SceneReportValues : public SceneReportWriter {
+ public:
+  explicit SceneReportValues(ReportValues& values) : values_(values) {}
+
+  void begin(const SceneEntry& entry, const core::RunOptions& options, const core::ModelChoice& model,
+             const std::optional<core::Prediction>& prediction) override {
+    model_ = model;
+    policy_ = options.events;
+    if (prediction && core::hasRotationValues(*prediction)) {
+      return values_.head(sceneJson(entry), optionsJson(options), unitsJson());
+    }
+    state_.emplace(entry.scene, options.events);
+    Json scene = sceneEntryJson(entry);
+    scene.update(sceneOptionsJson(entry.scene));
+    values_.head(scene, optionsJson(options), unitsJson());
+  }
+  void impact(const core::ImpactRecord& impact) override {
+    if (state_) return values_.event(state_->impact(impact));
+    const core::ImpactRecord shown = report_text::shownImpact(impact, policy_);
+    values_.event(report_text::eventRecord(shown));
+  }
+  void collapse(const core::Collapse& collapse) override {
+    if (state_) values_.event(state_->collapse(collapse));  // elastic runs (the rotation's) have none
+  }
+  void end(const core::SceneRunResult& result) override {
+    values_.summary(state_ ? sceneSummaryJson(result) : rotationSummaryJson(result, model_));
+  }
+
+ private:
+  ReportValues& values_;
+  core::ModelChoice model_;
+  core::EventPolicy policy_;
+  std::optional<SceneEventState> state_;  ///< from begin(), without the rotation model's values
+};
+
+}  // namespace
+
+std::unique_ptr<SceneReportWriter> makeSceneReportValues(ReportValues& values) {
+  return std::make_unique<SceneReportValues>(values);
+}
+
+namespace {
+
+/// The visitors that hand the events that `shown` asks for to the report.
+core::SceneVisitors showEvents(const core::RunOptions& shown, SceneReportWriter& report) {
+  core::SceneVisitors visitors;
+  if (shown.events.kind == core::EventPolicy::Kind::kNone) return visitors;
+  const core::EventPolicy policy = shown.events;
+  visitors.impact = [&report, policy](const core::ImpactRecord& impact) {
+    if (policy.keeps(impact.index)) report.impact(impact);
+  };
+  visitors.collapse = [&report, policy](const core::Collapse& collapse) {
+    if (policy.keepsAfter(collapse.impacts_before)) report.collapse(collapse);
+  };
+  // The event engine runs to the end even when only the first N impacts are shown.
+  return visitors;
+}
+
+}  // namespace
+
+core::SceneRunResult runReported(const SceneEntry& entry, const core::ScenePlan& plan, const ReportedRun& run,
+                                 SceneReportWriter& report) {
+  std::optional<TemperatureCsv> temperature;  // opened before any report: a bad path is bad input
+  if (run.temperature_csv) temperature.emplace(*run.temperature_csv, entry.scene);
+  report.begin(entry, run.options, plan.model, plan.prediction);
+  core::SceneVisitors visitors = showEvents(run.options, report);
+  visitors.progress = run.progress;
+  core::SceneRunOptions options;
+  options.lab = run.options;
+  options.simulate_to_cap = run.simulate_to_cap;
+  options.keep_events = false;  // handed to the report, not kept
+  options.cancel = run.cancel;
+  options.progress_interval = run.progress_interval;
+  if (temperature) {
+    // T(t) needs every impact: the visitors see every event (the report those it shows).
+    visitors = temperature->feeding(std::move(visitors));
+    options.lab.events = core::EventPolicy::all();
+  }
+  const core::SceneRunResult result = core::runScene(plan, options, visitors);
+  if (temperature) temperature->finish();
+  report.end(result);
+  return result;
 }
 
 void writeSceneBatchReport(ReportFormat format, const std::vector<SceneBatchOutcome>& outcomes, std::ostream& out) {

@@ -16,8 +16,6 @@ BAD = [
      '--masses 1,1,1 --positions 2,1,0 --velocities -1,0,1', 'TRIPLE_COLLISION', None),
     (dict(masses=[1, 1], positions=[1, 0], velocities=[0, 0], restitution=1.5),
      '--masses 1,1 --positions 1,0 --velocities 0,0 --restitution 1.5', None, None),
-    (dict(masses=[1, 1], positions=[1, 0], velocities=[0, 0], events='sometimes'),
-     '--masses 1,1 --positions 1,0 --velocities 0,0 --events sometimes', 'INVALID_OPTION', 'events'),
 ]
 
 
@@ -47,6 +45,14 @@ OPTIONS = [
     (dict(tc=1e-3), '--tc 0.001', 'tc', "tc= belongs to restitution_model='tc'"),
     (dict(max_collisions=-1), '--max-collisions -1', 'max_collisions', 'max_collisions must be >= 0'),
     (dict(restitution=[]), '--restitution 0.5,0.5,0.5', 'restitution', 'restitution is empty'),
+    (dict(events='sometimes'), '--events sometimes', 'events', "events must be 'all', 'none' or 'first:N'"),
+    (dict(events='first:-1'), '--events first:-1', 'events', "events must be 'all', 'none' or 'first:N'"),
+    (dict(mode='fast'), '--mode fast', 'mode', "mode must be 'full', 'predict' or 'summary'"),
+    (dict(full_state_every=0), '--full-state-every 0', 'full_state_every', 'full_state_every must be >= 1'),
+    (dict(restitution_model='sticky'), '--restitution-model sticky', 'restitution_model',
+     "restitution_model must be 'constant', 'tc', 'threshold' or 'viscoelastic'"),
+    (dict(temperature_csv='t.csv', mode='predict'), '--temperature-csv t.csv --mode predict', 'temperature_csv',
+     "T(t) needs the simulation's impacts: mode='full'"),
 ]
 
 

@@ -6,6 +6,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "collision_lab/core/events.h"
@@ -50,6 +51,10 @@ struct EventRecord {
   /// "uncertified": their names; the CSV has no such column).
   std::uint32_t uncertified = 0;
 };
+
+/// The record's pair as the reports name it: core::pairName ("AB"), or across a ring's seam
+/// the two bodies' names ("CA", "#30-A").
+std::string eventPairName(const EventRecord& record);
 
 /// The record's full state, pair energy transfers and model values from an impact's model
 /// block (core::ImpactModelValues, as the run computed them); the record refers to `values`.

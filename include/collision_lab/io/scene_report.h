@@ -9,7 +9,9 @@
 // bodies and says how many it leaves out; JSON and CSV carry every body.
 #pragma once
 
+#include <atomic>
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <ostream>
@@ -17,6 +19,7 @@
 #include <vector>
 
 #include "collision_lab/core/scene_run.h"
+#include "collision_lab/io/event_record.h"
 #include "collision_lab/io/report.h"
 #include "collision_lab/io/scenario_file.h"
 
@@ -42,6 +45,43 @@ class SceneReportWriter {
 };
 
 std::unique_ptr<SceneReportWriter> makeSceneReportWriter(ReportFormat format, std::ostream& out);
+
+/// The JSON report of one run as values, for a front end that keeps it in its own types
+/// (the Python module): the scene, options, units, events and summary that the JSON report
+/// (makeSceneReportWriter(kJson)) writes, key for key and value for value.
+class ReportValues {
+ public:
+  virtual ~ReportValues() = default;
+  /// The report's "scene", "options" and "units", before any event.
+  virtual void head(const Json& scene, const Json& options, const Json& units) = 0;
+  /// One event of "events" (the record is valid during the call; eventPairName names its pair).
+  virtual void event(const EventRecord& record) = 0;
+  /// The report's "summary", after the last event.
+  virtual void summary(const Json& summary) = 0;
+};
+
+/// A report writer that hands its values to `values`, which must outlive it.
+std::unique_ptr<SceneReportWriter> makeSceneReportValues(ReportValues& values);
+
+/// How runReported runs a scene: the one path from a plan to its report of the CLI and the
+/// Python module.
+struct ReportedRun {
+  core::RunOptions options;                   ///< as shown: the events the report gets
+  bool simulate_to_cap = false;               ///< core::SceneRunOptions::simulate_to_cap
+  const std::atomic<bool>* cancel = nullptr;  ///< set: the run stops, marked cancelled
+  /// T(t) [J] written to this file (TemperatureCsv): the run is then simulated impact by
+  /// impact even where the closed form answers (the report still shows what options ask).
+  std::optional<std::string> temperature_csv;
+  core::ProgressCallback progress;            ///< watches only: the run takes the same path
+  std::uint64_t progress_interval = std::uint64_t{1} << 20;
+};
+
+/// Runs the planned scene (core::planScene, valid) and hands `report` its begin, the events
+/// to show in order as they happen, and its end; nothing is kept per event. Throws
+/// CannotOpenFile before anything is reported when the temperature file cannot be opened,
+/// OutputFailed when it lost any of what was written.
+core::SceneRunResult runReported(const SceneEntry& entry, const core::ScenePlan& plan, const ReportedRun& run,
+                                 SceneReportWriter& report);
 
 /// name, description, bodies (N), masses, positions, velocities, restitution, walls (names).
 Json sceneEntryJson(const SceneEntry& entry);

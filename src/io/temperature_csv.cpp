@@ -1,23 +1,22 @@
-#include "temperature_csv.h"
+#include "collision_lab/io/temperature_csv.h"
 
 #include <vector>
 
 #include "collision_lab/io/number_text.h"
-#include "command_line.h"
 
 namespace collision_lab {
-namespace cli {
+namespace io {
 
 namespace {
 
 std::string csvNumber(double value) {
-  char text[io::kNumberTextMax];
-  return std::string(text, io::writeCsvNumber(text, value));
+  char text[kNumberTextMax];
+  return std::string(text, writeCsvNumber(text, value));
 }
 
 std::ofstream openForWriting(const std::string& path) {
   std::ofstream out(path);
-  if (!out) throw makeCliError(CliReason::kInvalidOption, "temperature-csv", "cannot open '" + path + "' for writing");
+  if (!out) throw CannotOpenFile("cannot open '" + path + "' for writing");
   return out;
 }
 
@@ -77,5 +76,5 @@ void TemperatureCsv::finish() {
   if (!out_) throw OutputFailed("cannot write to '" + path_ + "'; T(t) is incomplete");
 }
 
-}  // namespace cli
+}  // namespace io
 }  // namespace collision_lab

@@ -1,5 +1,6 @@
-// collision_lab_cli --temperature-csv FILE: the granular temperature T(t) of one run
-// (core/nbody/temperature.h), written while the run goes on.
+// The granular temperature T(t) of one run (core/nbody/temperature.h) as a CSV file,
+// written while the run goes on: collision_lab_cli --temperature-csv FILE and
+// collision_lab.run(temperature_csv=...). ROS-free.
 #pragma once
 
 #include <fstream>
@@ -10,9 +11,14 @@
 #include "collision_lab/core/scene_run.h"
 
 namespace collision_lab {
-namespace cli {
+namespace io {
 
-/// A file the CLI was asked to write lost some of what was written to it (exit code 3).
+/// The file cannot be opened for writing (bad input: the path).
+struct CannotOpenFile : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// A file asked for lost some of what was written to it (the CLI's exit code 3).
 struct OutputFailed : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
@@ -23,7 +29,7 @@ struct OutputFailed : std::runtime_error {
 /// rows thinned to LogTimeSamples (50 per decade of time).
 class TemperatureCsv {
  public:
-  /// Opens `path`. Throws CliError (INVALID_OPTION, field temperature-csv) when it cannot.
+  /// Opens `path`. Throws CannotOpenFile when it cannot.
   TemperatureCsv(const std::string& path, const core::Scene& scene);
   TemperatureCsv(const TemperatureCsv&) = delete;  // its sampler writes through `this`
   TemperatureCsv& operator=(const TemperatureCsv&) = delete;
@@ -47,5 +53,5 @@ class TemperatureCsv {
   core::TemperatureSampler sampler_;  ///< last: it writes the start's row when constructed
 };
 
-}  // namespace cli
+}  // namespace io
 }  // namespace collision_lab
