@@ -238,7 +238,10 @@ def core_job(masses, positions, velocities, restitution=1.0, *, ring=None,
 
 
 def result_of(result):
-    """(report, events) of collision_lab._core's result; raises SceneError for its error."""
+    """(report, events) of collision_lab._core's result; raises SceneError for its error and
+    MemoryError when the events would not fit in memory."""
+    if 'memory' in result:
+        raise MemoryError(result['memory'])
     if 'error' in result:
         error = result['error']
         raise SceneError(error['reason'], error['code'], error['field'], error['message'])
@@ -277,8 +280,9 @@ def events_from_records(events, bodies):
                        else np.array([np.nan if v is None else v for v in values], dtype=float))
     for key in _BODY_ARRAYS:
         arrays[key] = _float_rows([e[key] for e in events], bodies)
-    # What every event carries, whatever its record: the colliding pair's velocities [m/s].
-    for key in ('pair_velocities_before', 'pair_velocities_after'):
+    # What every event carries, whatever its record: the colliding pair's velocities [m/s]
+    # and energy transfers [J].
+    for key in ('pair_velocities_before', 'pair_velocities_after', 'pair_energy_transfer'):
         arrays[key] = _float_rows([e.get(key) for e in events], 2)
     for key in _MODEL_ARRAYS:
         rows = [e.get(key) for e in events]

@@ -15,9 +15,11 @@
 #include <cstdint>
 #include <cstring>
 #include <exception>
+#include <fstream>
 #include <future>
 #include <limits>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <utility>
@@ -42,6 +44,7 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 struct Job {
   io::SceneEntry entry;
   io::ReportedRun run;
+  std::optional<std::uint64_t> events_memory;  ///< the events' budget [bytes]; default half the available
   std::string problem_field, problem;  ///< an option the engine cannot take (run() checks them first)
 };
 
@@ -53,7 +56,8 @@ std::vector<double> numbers(const py::handle& values) {
 
 /// run()'s keywords: masses, positions, velocities, restitution (a list: [] elastic),
 /// ring (None or L), restitution_model (a name), model_parameter (None or its value),
-/// max_collisions, simulate_to_cap, events, full_state_every, mode, name, temperature_csv.
+/// max_collisions, simulate_to_cap, events, full_state_every, mode, name, temperature_csv;
+/// optionally events_memory (bytes the events' columns may take).
 Job readJob(const py::dict& kwargs) {
   Job job;
   core::Scene& scene = job.entry.scene;
@@ -90,6 +94,7 @@ Job readJob(const py::dict& kwargs) {
   if (events) options.events = *events;
   options.events.full_state_every = kwargs["full_state_every"].cast<std::uint64_t>();
   if (!kwargs["temperature_csv"].is_none()) job.run.temperature_csv = kwargs["temperature_csv"].cast<std::string>();
+  if (kwargs.contains("events_memory")) job.events_memory = kwargs["events_memory"].cast<std::uint64_t>();
   return job;
 }
 
@@ -119,11 +124,34 @@ py::object toPython(const io::Json& json) {
   }
 }
 
+/// The memory [bytes] the system can still give without swapping (MemAvailable), or
+/// nothing where it does not say.
+std::optional<std::uint64_t> availableMemory() {
+  std::ifstream meminfo("/proc/meminfo");
+  std::string key;
+  std::uint64_t kib = 0;
+  std::string unit;
+  while (meminfo >> key >> kib >> unit) {
+    if (key == "MemAvailable:") return kib * 1024;
+  }
+  return std::nullopt;
+}
+
+/// The events' columns grew past what memory can hold (ReportColumns' budget): the run is
+/// stopped and refused, with what to ask for instead.
+struct ColumnsTooLarge : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
 /// The report as values: the JSON's objects, and its events as columns (one entry per
 /// event; the per-body arrays as events x bodies rows, NaN where a record has no full state,
-/// kept only for scenes of at most io::kFullStateMaxBodies bodies).
+/// kept only for scenes of at most io::kFullStateMaxBodies bodies). The columns may take at
+/// most `budget` bytes (they are copied once into numpy): past it, event() throws
+/// ColumnsTooLarge, which ends the run.
 class ReportColumns : public io::ReportValues {
  public:
+  explicit ReportColumns(std::uint64_t budget) : budget_(budget) {}
+
   void head(const io::Json& scene, const io::Json& options, const io::Json& units) override {
     scene_ = scene;
     options_ = options;
@@ -132,6 +160,7 @@ class ReportColumns : public io::ReportValues {
   }
 
   void event(const io::EventRecord& r) override {
+    if ((collapse_.size() & 0xffff) == 0xffff) checkBudget();
     collapse_.push_back(r.collapse);
     pair_.push_back(io::eventPairName(r));
     index_.push_back(static_cast<std::int64_t>(r.index));
@@ -139,14 +168,16 @@ class ReportColumns : public io::ReportValues {
     first_moved_.push_back(static_cast<std::int64_t>(r.first_moved));
     last_moved_.push_back(static_cast<std::int64_t>(r.last_moved));
     cluster_impact_.push_back(r.cluster_impact);
+    // The totals belong to the full state: NaN in a lean record, as the JSON's null.
     for (auto [column, value] : {std::pair{&time_, r.time}, std::pair{&position_, r.position},
                                  std::pair{&restitution_, r.restitution}, std::pair{&energy_lost_, r.energy_lost},
-                                 std::pair{&total_energy_, r.total_energy},
-                                 std::pair{&total_momentum_, r.total_momentum}}) {
+                                 std::pair{&total_energy_, r.full_state ? r.total_energy : kNaN},
+                                 std::pair{&total_momentum_, r.full_state ? r.total_momentum : kNaN}}) {
       column->push_back(value);
     }
     pair_before_.insert(pair_before_.end(), r.pair_velocities_before.begin(), r.pair_velocities_before.end());
     pair_after_.insert(pair_after_.end(), r.pair_velocities_after.begin(), r.pair_velocities_after.end());
+    pair_energy_.insert(pair_energy_.end(), r.pair_energy_transfer.begin(), r.pair_energy_transfer.end());
     const bool full = r.full_state && r.bodies == bodies_ && bodies_ <= io::kFullStateMaxBodies;
     const double* body_values[] = {r.positions, r.velocities_before, r.velocities_after, r.energy_transfer,
                                    r.kinetic_energy_after};
@@ -162,6 +193,16 @@ class ReportColumns : public io::ReportValues {
   }
 
   void summary(const io::Json& summary) override { summary_ = summary; }
+
+  /// The bytes the columns hold now.
+  std::uint64_t bytes() const {
+    std::uint64_t total = collapse_.size() * (sizeof(std::string) + 4 * sizeof(std::int64_t) + 6 * sizeof(double) +
+                                              2 + sizeof(std::uint32_t));
+    for (const auto* rows : {&pair_before_, &pair_after_, &pair_energy_}) total += rows->size() * sizeof(double);
+    for (const auto& rows : body_) total += rows.size() * sizeof(double);
+    for (const auto& rows : model_) total += rows.size() * sizeof(double);
+    return total;
+  }
 
   /// {"report": {scene, options, units, summary}, "events": {column: array}}. Needs the GIL.
   py::dict toPython() const {
@@ -189,6 +230,7 @@ class ReportColumns : public io::ReportValues {
     events["cluster_impact"] = column(cluster_impact_);
     events["pair_velocities_before"] = rows(pair_before_, 2);
     events["pair_velocities_after"] = rows(pair_after_, 2);
+    events["pair_energy_transfer"] = rows(pair_energy_, 2);
     const char* body_names[] = {"positions", "velocities_before", "velocities_after", "energy_transfer",
                                 "kinetic_energy_after"};
     for (std::size_t k = 0; k < kBodyArrays; ++k) {
@@ -222,6 +264,17 @@ class ReportColumns : public io::ReportValues {
  private:
   static constexpr std::size_t kBodyArrays = 5, kModelArrays = 4;
 
+  void checkBudget() const {
+    const std::uint64_t held = bytes();
+    if (held <= budget_) return;
+    const auto mib = [](std::uint64_t b) { return std::to_string(b / (std::uint64_t{1} << 20)) + " MiB"; };
+    throw ColumnsTooLarge("the events of this run outgrew the memory that can hold them: " +
+                          std::to_string(collapse_.size()) + " events of " + std::to_string(bodies_) + " bodies took " +
+                          mib(held) + " of the " + mib(budget_) +
+                          " the run may use. Ask for fewer: events='first:N' "
+                          "or 'none' (the summary and state_at still work), full_state_every=K, or a lower max_collisions");
+  }
+
   /// Appends one row of `width` values, NaN for a null `values`, while the rows are kept.
   void addRow(std::vector<double>& to, const double* values, std::size_t width) const {
     if (bodies_ > io::kFullStateMaxBodies && width == bodies_) return;
@@ -247,13 +300,14 @@ class ReportColumns : public io::ReportValues {
     return std::move(array);
   }
 
+  std::uint64_t budget_;
   io::Json scene_, options_, units_, summary_;
   std::size_t bodies_ = 0;
   std::vector<char> collapse_, cluster_impact_;
   std::vector<std::string> pair_;
   std::vector<std::int64_t> index_, pair_index_, first_moved_, last_moved_;
   std::vector<double> time_, position_, restitution_, energy_lost_, total_energy_, total_momentum_;
-  std::vector<double> pair_before_, pair_after_;
+  std::vector<double> pair_before_, pair_after_, pair_energy_;
   std::array<std::vector<double>, kBodyArrays> body_;
   bool any_full_state_ = false;
   std::array<std::vector<double>, kModelArrays> model_;
@@ -267,9 +321,15 @@ struct Outcome {
   std::optional<ReportColumns> report;
   std::string reason, field, message;
   int code = 0;
+  std::string too_large;  ///< ColumnsTooLarge's message: {"memory": it}, Python's MemoryError
 
   py::dict toPython() const {
     if (report) return report->toPython();
+    if (!too_large.empty()) {
+      py::dict out;
+      out["memory"] = too_large;
+      return out;
+    }
     py::dict error;
     error["reason"] = reason;
     error["code"] = code;
@@ -298,12 +358,17 @@ Outcome runJob(const Job& job, const std::atomic<bool>* cancel) {
   }
   io::ReportedRun run = job.run;
   run.cancel = cancel;
-  ReportColumns columns;
+  const std::optional<std::uint64_t> available = job.events_memory ? job.events_memory : availableMemory();
+  ReportColumns columns(!available ? std::numeric_limits<std::uint64_t>::max()
+                                   : job.events_memory ? *available : *available / 2);
   const auto writer = io::makeSceneReportValues(columns);
   try {
     io::runReported(job.entry, plan, run, *writer);
   } catch (const io::CannotOpenFile& e) {
     outcome = {std::nullopt, "INVALID_OPTION", "temperature_csv", e.what(), kInvalidOption};
+    return outcome;
+  } catch (const ColumnsTooLarge& e) {
+    outcome.too_large = e.what();
     return outcome;
   }
   outcome.report.emplace(std::move(columns));
@@ -413,8 +478,8 @@ PYBIND11_MODULE(_core, m) {
   m.attr("version") = COLLISION_LAB_VERSION;  // package.xml's, as the node's RunParameters
   m.def("run", &collision_lab::python::run, py::arg("kwargs"),
         "(result, interrupted): one scene given as run()'s checked keywords (a dict), run as the CLI runs it. "
-        "result: {'report': the JSON report's scene, options, units and summary, 'events': numpy columns} or "
-        "{'error': {reason, code, field, message}}; interrupted: Ctrl-C cancelled it (the report is then of "
+        "result: {'report': the JSON report's scene, options, units and summary, 'events': numpy columns}, "
+        "{'error': {reason, code, field, message}} or {'memory': why the events were refused}; interrupted: Ctrl-C cancelled it (the report is then of "
         "the run as far as it went). Runs without the GIL.");
   m.def("run_many", &collision_lab::python::runMany, py::arg("jobs"), py::arg("workers"),
         "run() of every job (a list of dicts) on `workers` C++ threads, without the GIL; the results in order.");

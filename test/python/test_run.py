@@ -73,6 +73,21 @@ def same_as_json(ours, theirs):
     return ours.item() == theirs
 
 
+def _many_bodies(n):
+    """A scene of n > 64 bodies (beyond the records' full state) and the CLI's arguments for it."""
+    kwargs = dict(masses=[1.0 + (i % 3) for i in range(n)], positions=[float(n - i) for i in range(n)],
+                  velocities=[-1.0] + [0.0] * (n - 2) + [1.0], events='first:200')
+    lists = ' '.join('--%s %s' % (key, ','.join(repr(v) for v in kwargs[key]))
+                     for key in ('masses', 'positions', 'velocities'))
+    return kwargs, lists + ' --events first:200'
+
+
+SCENES.append(('event_engine',) + _many_bodies(70))
+SCENES.append(('event_engine', dict(masses=[1, 2, 3, 1.5, 1], positions=[4, 3, 2, 1, 0],
+                                    velocities=[-1, 0.5, 0, 0.2, 1], full_state_every=3),
+               '--masses 1,2,3,1.5,1 --positions 4,3,2,1,0 --velocities -1,0.5,0,0.2,1 --full-state-every 3'))
+
+
 @pytest.mark.parametrize('model,kwargs,cli_args', SCENES, ids=[s[0] for s in SCENES])
 def test_run_equals_cli_json(cli, model, kwargs, cli_args):
     expected = cli(cli_args.split())
@@ -95,7 +110,7 @@ def test_run_equals_cli_json(cli, model, kwargs, cli_args):
         assert run.events[key].tolist() == [e[key] for e in events], key
     assert [list(u) for u in run.events['uncertified']] == [e.get('uncertified', []) for e in events]
     for key in ('time', 'position', 'restitution', 'energy_lost', 'total_energy', 'total_momentum',
-                'pair_velocities_before', 'pair_velocities_after'):
+                'pair_velocities_before', 'pair_velocities_after', 'pair_energy_transfer'):
         assert all(same_as_json(ours, e[key]) for ours, e in zip(run.events[key], events)), key
     for key in ('positions', 'velocities_before', 'velocities_after', 'energy_transfer', 'kinetic_energy_after'):
         assert run.events[key].shape == (len(events), len(kwargs['masses']))
@@ -111,8 +126,8 @@ def test_run_equals_cli_json(cli, model, kwargs, cli_args):
     names = [collision_lab.body_name(i) for i in range(len(kwargs['masses']))]
     assert run.names == names
     for i, name in enumerate(names):
-        assert table['v_' + name].tolist() == run.events['velocities_after'][:, i].tolist()
-        assert table['x_' + name].tolist() == run.events['positions'][:, i].tolist()
+        np.testing.assert_array_equal(table['v_' + name], run.events['velocities_after'][:, i])
+        np.testing.assert_array_equal(table['x_' + name], run.events['positions'][:, i])
     np.testing.assert_array_equal(run.masses, np.array(kwargs['masses'], dtype=float))
 
 
@@ -205,3 +220,15 @@ def test_a_run_shows_itself_in_a_notebook():
     assert '<th style="text-align:left">collisions</th><td>31</td>' in html
     big = collision_lab.run(np.ones(20), np.arange(20)[::-1] * 1.0, np.zeros(20))._repr_html_()
     assert '20 bodies in all' in big and big.count('<tr><td>') == 12
+
+
+def test_events_that_outgrow_memory_stop_the_run_and_say_what_to_ask_for():
+    # The pi billiard at M/m = 1e10: 314,159 impacts, its events more than a 1 MiB budget.
+    from collision_lab import _core, _run
+    job = _run.core_job([1e10, 1, INF], [2, 1, 0], [-1, 0, 0])
+    job['events_memory'] = 1 << 20
+    with pytest.raises(MemoryError, match="events='first:N' or 'none'"):
+        _run.result_of(_core.run(job)[0])
+    job.update(events='none')
+    report, events = _run.result_of(_core.run(job)[0])
+    assert report['summary']['collision_count'] == 314159 and len(events['time']) == 0
