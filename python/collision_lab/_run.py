@@ -551,7 +551,8 @@ def run(masses, positions, velocities, restitution=1.0, *, ring=None, restitutio
                    viscoelastic_speed=viscoelastic_speed, max_collisions=max_collisions,
                    simulate_to_cap=simulate_to_cap, events=events, mode=mode,
                    temperature_csv=temperature_csv, full_state_every=full_state_every, name=name)
-    scene = scene_of(masses, positions, velocities, restitution, ring=ring, restitution_model=restitution_model,
+    scene = scene_of(job['masses'], job['positions'], job['velocities'], restitution, ring=ring,
+                     restitution_model=restitution_model,
                      tc=tc, elastic_below=elastic_below, viscoelastic_speed=viscoelastic_speed,
                      max_collisions=max_collisions, simulate_to_cap=simulate_to_cap, events=events, mode=mode,
                      name=name, full_state_every=full_state_every)

@@ -146,11 +146,12 @@ struct ColumnsTooLarge : std::runtime_error {
 /// The report as values: the JSON's objects, and its events as columns (one entry per
 /// event; the per-body arrays as events x bodies rows, NaN where a record has no full state,
 /// kept only for scenes of at most io::kFullStateMaxBodies bodies). The columns may take at
-/// most `budget` bytes (they are copied once into numpy): past it, event() throws
-/// ColumnsTooLarge, which ends the run.
+/// most `budget` bytes (they are copied once into numpy; default: half the memory available
+/// when they first reach 2^16 events): past it, event() throws ColumnsTooLarge, which ends
+/// the run.
 class ReportColumns : public io::ReportValues {
  public:
-  explicit ReportColumns(std::uint64_t budget) : budget_(budget) {}
+  explicit ReportColumns(std::optional<std::uint64_t> budget) : budget_(budget) {}
 
   void head(const io::Json& scene, const io::Json& options, const io::Json& units) override {
     scene_ = scene;
@@ -234,7 +235,7 @@ class ReportColumns : public io::ReportValues {
     const char* body_names[] = {"positions", "velocities_before", "velocities_after", "energy_transfer",
                                 "kinetic_energy_after"};
     for (std::size_t k = 0; k < kBodyArrays; ++k) {
-      events[body_names[k]] = any_full_state_ ? rows(body_[k], bodies_) : py::object(py::none());
+      events[body_names[k]] = any_full_state_ || n == 0 ? rows(body_[k], bodies_) : py::object(py::none());
     }
     const char* model_names[] = {"predicted_velocities_after", "paper_velocities_after", "predicted_energy_transfer",
                                  "paper_energy_transfer"};
@@ -264,13 +265,17 @@ class ReportColumns : public io::ReportValues {
  private:
   static constexpr std::size_t kBodyArrays = 5, kModelArrays = 4;
 
-  void checkBudget() const {
+  void checkBudget() {
+    if (!budget_) {
+      const std::optional<std::uint64_t> available = availableMemory();
+      budget_ = available ? *available / 2 : std::numeric_limits<std::uint64_t>::max();
+    }
     const std::uint64_t held = bytes();
-    if (held <= budget_) return;
+    if (held <= *budget_) return;
     const auto mib = [](std::uint64_t b) { return std::to_string(b / (std::uint64_t{1} << 20)) + " MiB"; };
     throw ColumnsTooLarge("the events of this run outgrew the memory that can hold them: " +
                           std::to_string(collapse_.size()) + " events of " + std::to_string(bodies_) + " bodies took " +
-                          mib(held) + " of the " + mib(budget_) +
+                          mib(held) + " of the " + mib(*budget_) +
                           " the run may use. Ask for fewer: events='first:N' "
                           "or 'none' (the summary and state_at still work), full_state_every=K, or a lower max_collisions");
   }
@@ -300,7 +305,7 @@ class ReportColumns : public io::ReportValues {
     return std::move(array);
   }
 
-  std::uint64_t budget_;
+  std::optional<std::uint64_t> budget_;
   io::Json scene_, options_, units_, summary_;
   std::size_t bodies_ = 0;
   std::vector<char> collapse_, cluster_impact_;
@@ -343,24 +348,34 @@ struct Outcome {
 
 constexpr int kInvalidOption = 104;  // the CLI's INVALID_OPTION (docs/cli.md)
 
-/// Runs one job, stopped when `cancel` is set. Needs no GIL.
-Outcome runJob(const Job& job, const std::atomic<bool>* cancel) {
-  Outcome outcome;
+/// A job's plan, or the outcome that refuses it. Needs no GIL.
+struct PlannedJob {
+  std::optional<core::ScenePlan> plan;
+  Outcome refused;
+};
+
+PlannedJob planJob(const Job& job) {
+  PlannedJob planned;
   if (!job.problem_field.empty()) {
-    outcome = {std::nullopt, "INVALID_OPTION", job.problem_field, job.problem, kInvalidOption};
-    return outcome;
+    planned.refused = {std::nullopt, "INVALID_OPTION", job.problem_field, job.problem, kInvalidOption};
+    return planned;
   }
-  const core::ScenePlan plan = core::planScene(job.entry.scene);
+  core::ScenePlan plan = core::planScene(job.entry.scene);
   if (const auto& error = plan.error) {
-    outcome = {std::nullopt, core::reasonName(error->reason), error->field, error->message,
-               static_cast<int>(error->reason)};
-    return outcome;
+    planned.refused = {std::nullopt, core::reasonName(error->reason), error->field, error->message,
+                       static_cast<int>(error->reason)};
+    return planned;
   }
+  planned.plan = std::move(plan);
+  return planned;
+}
+
+/// Runs a planned job, stopped when `cancel` is set. Needs no GIL.
+Outcome runPlanned(const Job& job, const core::ScenePlan& plan, const std::atomic<bool>* cancel) {
+  Outcome outcome;
   io::ReportedRun run = job.run;
   run.cancel = cancel;
-  const std::optional<std::uint64_t> available = job.events_memory ? job.events_memory : availableMemory();
-  ReportColumns columns(!available ? std::numeric_limits<std::uint64_t>::max()
-                                   : job.events_memory ? *available : *available / 2);
+  ReportColumns columns(job.events_memory);
   const auto writer = io::makeSceneReportValues(columns);
   try {
     io::runReported(job.entry, plan, run, *writer);
@@ -373,6 +388,25 @@ Outcome runJob(const Job& job, const std::atomic<bool>* cancel) {
   }
   outcome.report.emplace(std::move(columns));
   return outcome;
+}
+
+/// planJob, then runPlanned (run_many's workers). Needs no GIL.
+Outcome runJob(const Job& job, const std::atomic<bool>* cancel) {
+  PlannedJob planned = planJob(job);
+  return planned.plan ? runPlanned(job, *planned.plan, cancel) : std::move(planned.refused);
+}
+
+/// Impacts at most of a run that the calling thread runs itself (at most tens of ms).
+constexpr std::uint64_t kShortRunImpacts = std::uint64_t{1} << 14;
+
+/// Does the plan know the run to be short (no T(t) file, at most kShortRunImpacts impacts)?
+bool isShort(const Job& job, const core::ScenePlan& plan) {
+  if (job.run.temperature_csv) return false;
+  core::SceneRunOptions options;
+  options.lab = job.run.options;
+  options.simulate_to_cap = job.run.simulate_to_cap;
+  const std::optional<std::uint64_t> impacts = core::plannedImpacts(plan, options);
+  return impacts && *impacts <= kShortRunImpacts;
 }
 
 /// Runs `work` on its own thread while the calling thread, without the GIL, checks for
@@ -418,11 +452,26 @@ bool runWatchingSignals(std::atomic<bool>& cancel, Work work) {
 std::pair<py::dict, bool> run(const py::dict& kwargs) {
   const Job job = readJob(kwargs);
   std::atomic<bool> cancel{false};
+  PlannedJob planned;
+  {
+    py::gil_scoped_release release;
+    planned = planJob(job);
+  }
+  if (!planned.plan) return {planned.refused.toPython(), false};
   Outcome outcome;
+  if (isShort(job, *planned.plan)) {
+    // On this thread, without a watcher (a thread per call would cost more than the run):
+    // Ctrl-C is taken when the run has ended, within milliseconds.
+    {
+      py::gil_scoped_release release;
+      outcome = runPlanned(job, *planned.plan, &cancel);
+    }
+    return {outcome.toPython(), false};
+  }
   std::exception_ptr failure;
   const bool interrupted = runWatchingSignals(cancel, [&] {
     try {
-      outcome = runJob(job, &cancel);
+      outcome = runPlanned(job, *planned.plan, &cancel);
     } catch (...) {
       failure = std::current_exception();
     }
