@@ -47,16 +47,15 @@ RUN_OPTIONS = ('ring', 'restitution_model', 'tc', 'elastic_below', 'viscoelastic
 
 
 def summary_row(result):
-    """One table row of a collision_lab._core result: the summary (complete_summary: every
+    """One table row of a collision_lab._core.run_many result: the summary (complete_summary: every
     key of SUMMARY_KEYS, None for a rejected scene), its dict values flattened to
     'key.subkey' columns (lists kept as lists), then the error columns."""
     if 'memory' in result:
         raise MemoryError(result['memory'])
-    report = result.get('report', result)
     if 'error' in result:
         summary = dict({key: None for key in SUMMARY_KEYS}, escalation=dict.fromkeys(ESCALATION_KEYS))
     else:
-        summary = complete_summary(report['summary'])
+        summary = complete_summary(result['summary'])
     row = {}
     for key, value in summary.items():
         if isinstance(value, dict):

@@ -205,6 +205,8 @@ class ReportColumns : public io::ReportValues {
     return total;
   }
 
+  py::object summaryToPython() const { return python::toPython(summary_); }
+
   /// {"report": {scene, options, units, summary}, "events": {column: array}}. Needs the GIL.
   py::dict toPython() const {
     py::dict report;
@@ -328,7 +330,13 @@ struct Outcome {
   int code = 0;
   std::string too_large;  ///< ColumnsTooLarge's message: {"memory": it}, Python's MemoryError
 
-  py::dict toPython() const {
+  /// `summary_only`: the report's summary alone, {"summary": ...} (a sweep's row).
+  py::dict toPython(bool summary_only = false) const {
+    if (report && summary_only) {
+      py::dict out;
+      out["summary"] = report->summaryToPython();
+      return out;
+    }
     if (report) return report->toPython();
     if (!too_large.empty()) {
       py::dict out;
@@ -487,7 +495,8 @@ std::pair<py::dict, bool> run(const py::dict& kwargs) {
 }
 
 /// Every job on `workers` threads (each takes the next job not yet taken); the results in
-/// the jobs' order. Ctrl-C cancels every run that has not finished.
+/// the jobs' order, each {"summary": ...} or a refusal as run() gives it (a sweep's rows:
+/// no events). Ctrl-C cancels every run that has not finished.
 py::list runMany(const py::list& jobs_given, unsigned workers) {
   std::vector<Job> jobs;
   for (const py::handle& kwargs : jobs_given) jobs.push_back(readJob(kwargs.cast<py::dict>()));
@@ -514,7 +523,7 @@ py::list runMany(const py::list& jobs_given, unsigned workers) {
   });
   if (interrupted) throw py::error_already_set();
   py::list results;
-  for (const Outcome& outcome : outcomes) results.append(outcome.toPython());
+  for (const Outcome& outcome : outcomes) results.append(outcome.toPython(true));
   return results;
 }
 
@@ -531,5 +540,6 @@ PYBIND11_MODULE(_core, m) {
         "{'error': {reason, code, field, message}} or {'memory': why the events were refused}; interrupted: Ctrl-C cancelled it (the report is then of "
         "the run as far as it went). Runs without the GIL.");
   m.def("run_many", &collision_lab::python::runMany, py::arg("jobs"), py::arg("workers"),
-        "run() of every job (a list of dicts) on `workers` C++ threads, without the GIL; the results in order.");
+        "run() of every job (a list of dicts) on `workers` C++ threads, without the GIL; in order, each "
+        "{'summary': the report's summary} or run()'s refusal.");
 }
