@@ -35,16 +35,22 @@ def _values(xs):
     return [_value(float(x)) for x in xs]
 
 
-def _pair_name(index):
-    """The core's pairName: 'AB', ..., 'YZ', then 'Z-#26', '#26-#27', ..."""
+def _pair_name(index, seam=False):
+    """The core's pairName: 'AB', ..., 'YZ', then 'Z-#26', '#26-#27', ...; across a ring's
+    seam (seam) the last body's name and A's: 'EA', '#30-A' (io::eventPairName)."""
+    if seam:
+        return body_name(index) + ('' if index < 26 else '-') + body_name(0)
     return body_name(index) + ('' if index + 1 < 26 else '-') + body_name(index + 1)
 
 
 def _event(msg):
     """A CollisionEvent as the CLI's JSON event (per-body arrays empty beyond the message's
     FULL_STATE_MAX_BODIES: None)."""
-    event = {'kind': _KINDS.get(msg.kind, str(msg.kind)), 'index': msg.index,
-             'pair': _pair_name(msg.pair_index), 'pair_index': msg.pair_index,
+    kind = _KINDS.get(msg.kind, str(msg.kind))
+    # Only an impact across a ring's seam has last_moved below its pair_index.
+    seam = kind == 'impact' and msg.last_moved < msg.pair_index
+    event = {'kind': kind, 'index': msg.index,
+             'pair': _pair_name(msg.pair_index, seam), 'pair_index': msg.pair_index,
              'time': msg.time, 'position': msg.position, 'restitution': _value(msg.restitution),
              'first_moved': msg.first_moved, 'last_moved': msg.last_moved,
              'cluster_impact': msg.cluster_impact,

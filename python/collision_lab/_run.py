@@ -160,11 +160,14 @@ _RESTITUTION_MODELS = {'constant': None, 'tc': 'tc', 'threshold': 'elastic_below
 
 
 def _whole_number(key, value, least):
-    """value as an int >= least; a bool, a float or a string is refused, not rounded."""
+    """value as an int from least to 2^64 - 1 (the engine's counts); a bool, a float or a
+    string is refused, not rounded."""
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
         raise TypeError('%s must be a whole number, not %r' % (key, value))
     if value < least:
         raise SceneError(*_INVALID_OPTION, key, '%s must be >= %d, not %d' % (key, least, value))
+    if value >= 2 ** 64:
+        raise SceneError(*_INVALID_OPTION, key, '%s is too large: at most 2^64 - 1, not %d' % (key, value))
     return int(value)
 
 
@@ -238,8 +241,8 @@ def core_job(masses, positions, velocities, restitution=1.0, *, ring=None,
 
 
 def result_of(result):
-    """(report, events) of collision_lab._core's result; raises SceneError for its error and
-    MemoryError when the events would not fit in memory."""
+    """(report, events) of collision_lab._core.run's result; raises SceneError for its error
+    and MemoryError when the events would not fit in memory."""
     if 'memory' in result:
         raise MemoryError(result['memory'])
     if 'error' in result:
@@ -310,13 +313,13 @@ def _events_from_core(columns, bodies):
 
 
 class Run:
-    """One scene's run: the CLI's JSON report, with the events as numpy arrays.
+    """One scene's run: the CLI's JSON report as Python values, its events as numpy arrays.
 
     scene: run()'s keyword arguments for this run (SCENE_KEYS): run(**r.scene) runs it again
     (the same count and final velocities, bit for bit). summary: the CLI's summary under
     every key of SUMMARY_KEYS, for every model (complete_summary). options, units: the
-    report's objects as dicts (null -> None); report: the whole JSON document (its 'scene'
-    has the CLI's description, bodies and walls). model, model_reason: the model that
+    report's objects as dicts (null -> None); report: the JSON document but its events (its
+    'scene' has the CLI's description, bodies and walls). model, model_reason: the model that
     answered, and why. prediction: the model's answer (the summary's predicted_* and model
     fields; equal to predict()). events: dict of numpy arrays, one entry per event in order
     (see docs/python.md for the keys and units). names: the bodies' names; walls: the names
@@ -541,7 +544,9 @@ def run(masses, positions, velocities, restitution=1.0, *, ring=None, restitutio
     full_state_every: K > 1 gives the lean record of long runs: every body's state (the
     per-body event arrays) at impact 1 and every K-th impact only, NaN in the others.
     The GIL is released while it runs; Ctrl-C stops it and raises RunInterrupted (a
-    KeyboardInterrupt) whose .run is the run as far as it went.
+    KeyboardInterrupt) whose .run is the run as far as it went (a run the plan knows to be
+    short, at most 16,384 impacts, ends first: then a plain KeyboardInterrupt). Raises
+    MemoryError when the events outgrow the memory that can hold them.
     Raises SceneError for a scene or option the CLI rejects. Warns (CapWarning) when the
     cap left the run unsimulated (the model answered) or cut it short.
     The Run's scene holds these arguments (but temperature_csv): run(**r.scene) runs r again.

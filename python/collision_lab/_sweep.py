@@ -50,8 +50,6 @@ def summary_row(result):
     """One table row of a collision_lab._core.run_many result: the summary (complete_summary: every
     key of SUMMARY_KEYS, None for a rejected scene), its dict values flattened to
     'key.subkey' columns (lists kept as lists), then the error columns."""
-    if 'memory' in result:
-        raise MemoryError(result['memory'])
     if 'error' in result:
         summary = dict({key: None for key in SUMMARY_KEYS}, escalation=dict.fromkeys(ESCALATION_KEYS))
     else:

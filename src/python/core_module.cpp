@@ -2,8 +2,9 @@
 // straight into core::Scene and the run options; the run is the CLI's (io::runReported), and
 // its report comes back as Python values: the JSON report's scene, options, units and
 // summary as dicts (io::ReportValues, key for key), its events as numpy columns filled from
-// the event records. No argument strings and no JSON text on the way. Runs without the GIL,
-// and turns Ctrl-C (a pending KeyboardInterrupt) into the engine's cancel flag.
+// the event records. No argument strings and no JSON text on the way. Runs without the GIL;
+// a run longer than the plan's short ones goes on a watched thread, which turns Ctrl-C (a
+// pending KeyboardInterrupt) into the engine's cancel flag.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -44,7 +45,7 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 struct Job {
   io::SceneEntry entry;
   io::ReportedRun run;
-  std::optional<std::uint64_t> events_memory;  ///< the events' budget [bytes]; default half the available
+  std::optional<std::uint64_t> events_memory;  ///< the events' budget [bytes]; default a third of the available
   std::string problem_field, problem;  ///< an option the engine cannot take (run() checks them first)
 };
 
@@ -124,17 +125,24 @@ py::object toPython(const io::Json& json) {
   }
 }
 
-/// The memory [bytes] the system can still give without swapping (MemAvailable), or
-/// nothing where it does not say.
+/// The memory [bytes] this process can still take without swapping or being killed: the
+/// system's MemAvailable, or less where the container's cgroup (v2) limit leaves less;
+/// nothing where neither says.
 std::optional<std::uint64_t> availableMemory() {
+  std::optional<std::uint64_t> available;
   std::ifstream meminfo("/proc/meminfo");
-  std::string key;
+  std::string key, unit;
   std::uint64_t kib = 0;
-  std::string unit;
   while (meminfo >> key >> kib >> unit) {
-    if (key == "MemAvailable:") return kib * 1024;
+    if (key == "MemAvailable:") available = kib * 1024;
   }
-  return std::nullopt;
+  std::uint64_t limit = 0, used = 0;
+  std::ifstream max("/sys/fs/cgroup/memory.max"), current("/sys/fs/cgroup/memory.current");
+  if (max >> limit && current >> used) {  // "max" (no limit) does not read as a number
+    const std::uint64_t left = limit > used ? limit - used : 0;
+    if (!available || left < *available) available = left;
+  }
+  return available;
 }
 
 /// The events' columns grew past what memory can hold (ReportColumns' budget): the run is
@@ -145,13 +153,13 @@ struct ColumnsTooLarge : std::runtime_error {
 
 /// The report as values: the JSON's objects, and its events as columns (one entry per
 /// event; the per-body arrays as events x bodies rows, NaN where a record has no full state,
-/// kept only for scenes of at most io::kFullStateMaxBodies bodies). The columns may take at
-/// most `budget` bytes (they are copied once into numpy; default: half the memory available
-/// when they first reach 2^16 events): past it, event() throws ColumnsTooLarge, which ends
-/// the run.
+/// kept only for scenes of at most io::kFullStateMaxBodies bodies), or none of them
+/// (`keep_events` false: the summary alone). The columns may take at most `budget` bytes
+/// (default: a third of the memory available when they first reach 2^16 events, since numpy
+/// copies them once): past it, event() throws ColumnsTooLarge, which ends the run.
 class ReportColumns : public io::ReportValues {
  public:
-  explicit ReportColumns(std::optional<std::uint64_t> budget) : budget_(budget) {}
+  ReportColumns(std::optional<std::uint64_t> budget, bool keep_events) : budget_(budget), keep_events_(keep_events) {}
 
   void head(const io::Json& scene, const io::Json& options, const io::Json& units) override {
     scene_ = scene;
@@ -161,6 +169,7 @@ class ReportColumns : public io::ReportValues {
   }
 
   void event(const io::EventRecord& r) override {
+    if (!keep_events_) return;
     if ((collapse_.size() & 0xffff) == 0xffff) checkBudget();
     collapse_.push_back(r.collapse);
     pair_.push_back(io::eventPairName(r));
@@ -195,13 +204,19 @@ class ReportColumns : public io::ReportValues {
 
   void summary(const io::Json& summary) override { summary_ = summary; }
 
-  /// The bytes the columns hold now.
+  /// The bytes the columns hold now, their vectors' spare capacity included.
   std::uint64_t bytes() const {
-    std::uint64_t total = collapse_.size() * (sizeof(std::string) + 4 * sizeof(std::int64_t) + 6 * sizeof(double) +
-                                              2 + sizeof(std::uint32_t));
-    for (const auto* rows : {&pair_before_, &pair_after_, &pair_energy_}) total += rows->size() * sizeof(double);
-    for (const auto& rows : body_) total += rows.size() * sizeof(double);
-    for (const auto& rows : model_) total += rows.size() * sizeof(double);
+    std::uint64_t total = pair_.capacity() * sizeof(std::string) + uncertified_.capacity() * sizeof(std::uint32_t) +
+                          collapse_.capacity() + cluster_impact_.capacity();
+    for (const auto* column : {&index_, &pair_index_, &first_moved_, &last_moved_}) {
+      total += column->capacity() * sizeof(std::int64_t);
+    }
+    for (const auto* column : {&time_, &position_, &restitution_, &energy_lost_, &total_energy_, &total_momentum_,
+                               &pair_before_, &pair_after_, &pair_energy_}) {
+      total += column->capacity() * sizeof(double);
+    }
+    for (const auto& rows : body_) total += rows.capacity() * sizeof(double);
+    for (const auto& rows : model_) total += rows.capacity() * sizeof(double);
     return total;
   }
 
@@ -270,7 +285,7 @@ class ReportColumns : public io::ReportValues {
   void checkBudget() {
     if (!budget_) {
       const std::optional<std::uint64_t> available = availableMemory();
-      budget_ = available ? *available / 2 : std::numeric_limits<std::uint64_t>::max();
+      budget_ = available ? *available / 3 : std::numeric_limits<std::uint64_t>::max();
     }
     const std::uint64_t held = bytes();
     if (held <= *budget_) return;
@@ -308,6 +323,7 @@ class ReportColumns : public io::ReportValues {
   }
 
   std::optional<std::uint64_t> budget_;
+  bool keep_events_;
   io::Json scene_, options_, units_, summary_;
   std::size_t bodies_ = 0;
   std::vector<char> collapse_, cluster_impact_;
@@ -378,12 +394,14 @@ PlannedJob planJob(const Job& job) {
   return planned;
 }
 
-/// Runs a planned job, stopped when `cancel` is set. Needs no GIL.
-Outcome runPlanned(const Job& job, const core::ScenePlan& plan, const std::atomic<bool>* cancel) {
+/// Runs a planned job, stopped when `cancel` is set; `summary_only`: its events are not kept.
+/// Needs no GIL.
+Outcome runPlanned(const Job& job, const core::ScenePlan& plan, const std::atomic<bool>* cancel,
+                   bool summary_only = false) {
   Outcome outcome;
   io::ReportedRun run = job.run;
   run.cancel = cancel;
-  ReportColumns columns(job.events_memory);
+  ReportColumns columns(job.events_memory, !summary_only);
   const auto writer = io::makeSceneReportValues(columns);
   try {
     io::runReported(job.entry, plan, run, *writer);
@@ -392,16 +410,17 @@ Outcome runPlanned(const Job& job, const core::ScenePlan& plan, const std::atomi
     return outcome;
   } catch (const ColumnsTooLarge& e) {
     outcome.too_large = e.what();
+    if (run.temperature_csv) outcome.too_large += " (the T(t) file ends where the run stopped, without its fit)";
     return outcome;
   }
   outcome.report.emplace(std::move(columns));
   return outcome;
 }
 
-/// planJob, then runPlanned (run_many's workers). Needs no GIL.
-Outcome runJob(const Job& job, const std::atomic<bool>* cancel) {
+/// planJob, then runPlanned keeping the summary alone (run_many's workers). Needs no GIL.
+Outcome runSummary(const Job& job, const std::atomic<bool>* cancel) {
   PlannedJob planned = planJob(job);
-  return planned.plan ? runPlanned(job, *planned.plan, cancel) : std::move(planned.refused);
+  return planned.plan ? runPlanned(job, *planned.plan, cancel, true) : std::move(planned.refused);
 }
 
 /// Impacts at most of a run that the calling thread runs itself (at most tens of ms).
@@ -507,7 +526,7 @@ py::list runMany(const py::list& jobs_given, unsigned workers) {
     std::vector<std::exception_ptr> failures(std::max(1u, workers));
     const auto drain = [&](std::exception_ptr& failure) {
       try {
-        for (std::size_t i = next++; i < jobs.size(); i = next++) outcomes[i] = runJob(jobs[i], &cancel);
+        for (std::size_t i = next++; i < jobs.size(); i = next++) outcomes[i] = runSummary(jobs[i], &cancel);
       } catch (...) {
         failure = std::current_exception();
         next = jobs.size();  // the others stop after their current job

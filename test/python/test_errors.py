@@ -49,6 +49,8 @@ OPTIONS = [
     (dict(events='first:-1'), '--events first:-1', 'events', "events must be 'all', 'none' or 'first:N'"),
     (dict(mode='fast'), '--mode fast', 'mode', "mode must be 'full', 'predict' or 'summary'"),
     (dict(full_state_every=0), '--full-state-every 0', 'full_state_every', 'full_state_every must be >= 1'),
+    (dict(max_collisions=2 ** 64), '--max-collisions 18446744073709551616', 'max_collisions',
+     'max_collisions is too large'),
     (dict(restitution_model='sticky'), '--restitution-model sticky', 'restitution_model',
      "restitution_model must be 'constant', 'tc', 'threshold' or 'viscoelastic'"),
     (dict(temperature_csv='t.csv', mode='predict'), '--temperature-csv t.csv --mode predict', 'temperature_csv',

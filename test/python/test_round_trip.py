@@ -236,3 +236,28 @@ def test_the_models_share_one_key_set_and_fills_say_what_the_model_decides():
     assert engine.summary['truncation_reason'] == engine.summary['stop_message'] != ''
     assert engine.summary['theta'] is None
     assert list(rotation.summary) == list(engine.summary)
+
+
+def test_a_bags_events_name_a_ring_seams_pair_as_run_does():
+    # read_bag names each CollisionEvent's pair; across a ring's seam (last_moved below
+    # pair_index) the pair is the last body and A ('EA'), as run() names it.
+    from types import SimpleNamespace
+    from collision_lab._bag import _event
+    run = collision_lab.run([1, 2, 3, 1.5, 1], [4, 3, 2, 1, 0], [-1, 0.5, 0, 0.2, 1], ring=10, max_collisions=100)
+    e = run.events
+    seams = [j for j in range(len(e['time'])) if e['kind'][j] == 'impact' and e['last_moved'][j] < e['pair_index'][j]]
+    assert seams and e['pair'][seams[0]] == 'EA'
+    for j in range(len(e['time'])):
+        empty = []
+        msg = SimpleNamespace(kind=0 if e['kind'][j] == 'impact' else 1, index=int(e['index'][j]),
+                              pair_index=int(e['pair_index'][j]), time=float(e['time'][j]),
+                              position=float(e['position'][j]), restitution=float(e['restitution'][j]),
+                              first_moved=int(e['first_moved'][j]), last_moved=int(e['last_moved'][j]),
+                              cluster_impact=bool(e['cluster_impact'][j]),
+                              pair_velocities_before=e['pair_velocities_before'][j],
+                              pair_velocities_after=e['pair_velocities_after'][j],
+                              pair_energy_transfer=e['pair_energy_transfer'][j], energy_lost=0.0, total_energy=0.0,
+                              total_momentum=0.0, positions=empty, velocities_before=empty, velocities_after=empty,
+                              energy_transfer=empty, kinetic_energy_after=empty, predicted_velocities_after=empty,
+                              paper_velocities_after=empty, predicted_energy_transfer=empty, paper_energy_transfer=empty)
+        assert _event(msg)['pair'] == e['pair'][j], j
