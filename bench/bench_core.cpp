@@ -349,14 +349,12 @@ void printCountOnlyGoals(const char* scene, const SceneFigures& f) {
               scene, f.summary_ns, f.lean_ns, ratio, ratio <= 1.5 ? "under it by" : "over it by",
               ratio <= 1.5 ? 1.5 / ratio : ratio / 1.5, pathName(), ratio <= 1.5 ? "met" : "missed");
   if (ratio > 1.5) {
-    std::printf("why: count-only: the run is the engine's known-count pass (double-double velocities by the "
-                "engine's impact map, the intercepts in double with bounds on their distance from the engine's, its "
-                "rounding bounds, precision guard and range checks: the engine's bits without its queue, the final "
-                "velocities then certified correctly rounded, 0.1 ms where the product of the impact maps gives "
-                "them); that pass "
-                "alone takes %.1f ns per impact portable (%.2fx the lean loop) and %.1f ns with FMA (0: no FMA here); "
-                "the double-double velocity map (three dependent additions of six double operations each) and the "
-                "bounds of both maps are most of it\n",
+    std::printf("why: count-only: the run is the filtered pass (velocities and intercepts walked in double as the "
+                "lean loop walks them, each velocity with a componentwise bound on its distance from the exact one, "
+                "every decision taken in double where the bound takes it, the final velocities certified once by "
+                "the product of the impact maps, 0.1 ms); where the bound does not decide, the double-double "
+                "known-count pass runs, "
+                "alone %.1f ns per impact portable (%.2fx the lean loop) and %.1f ns with FMA (0: no FMA here)\n",
                 f.pass_portable_ns, f.pass_portable_ns / f.lean_ns, f.pass_fma_ns);
   }
   if (f.pass_fma_ns > 0) {

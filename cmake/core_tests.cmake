@@ -18,6 +18,7 @@ catkin_add_gtest(collision_lab_core_tests
   test/core/test_wedge_cycle.cpp
   test/core/test_three_body_rounding.cpp
   test/core/test_long_run_rounding.cpp
+  test/core/test_filtered_pass.cpp
   test/core/test_published_rounding.cpp
   test/core/test_totals.cpp)
 if(TARGET collision_lab_core_tests)

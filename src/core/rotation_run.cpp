@@ -449,18 +449,21 @@ struct SimulationOptions {
 };
 
 /// The run of three elastic bodies whose count the closed form gives (`count`), without the
-/// engine's queue or any decision (nbody/elastic_triple.h), the summary of every run that
-/// can be had so: its count, final velocities (certified correctly rounded, or where no
-/// certificate can be had, an exact zero or tie, the engine's bit for bit) and drifts, as
-/// simulateByEngine gives them; no final time or positions. An impact that may come after the largest double [s] declines it. restart() is called before
-/// each pass over the impacts (at most two); after each impact n, visit(n, v) sees the
-/// velocities [m/s] that simulateByEngine's event would carry. Returns nothing when the run
-/// cannot be taken this way (then the engine runs it). `progress` (RunOptions) sees every
+/// engine's queue (nbody/elastic_triple.h; a long run's decisions filtered in double), the
+/// summary of every run that can be had so: its count, final velocities (certified correctly
+/// rounded, or where no certificate can be had, an exact zero or tie, the engine's bit for
+/// bit) and drifts, as simulateByEngine gives them; no final time or positions. An impact
+/// that may come after the largest double [s] declines it. restart() is called before each
+/// pass over the impacts (at most three); after each impact n, visit(n, v) sees the
+/// velocities [m/s] (runElasticTriple: the engine's, or the filtered pass's double walk);
+/// accept() says whether a filtered pass may stand. Returns nothing when the run cannot be
+/// taken this way (then the engine runs it). `progress` (RunOptions) sees every
 /// progress_interval-th impact, with no time (NaN).
-template <class Restart, class Visit>
+template <class Restart, class Visit, class Accept>
 std::optional<SceneSimulation> simulateKnownCount(const Scene& scene, std::uint64_t count,
                                                    const SimulationOptions& options, const ProgressCallback& progress,
-                                                   std::uint64_t progress_interval, Restart&& restart, Visit&& visit) {
+                                                   std::uint64_t progress_interval, Restart&& restart, Visit&& visit,
+                                                   Accept&& accept) {
   if (scene.isWall(0) && scene.isWall(2)) return std::nullopt;
   const std::optional<Pair> first = firstPair(scene);
   if (count > 0 && !first) return std::nullopt;
@@ -486,7 +489,8 @@ std::optional<SceneSimulation> simulateKnownCount(const Scene& scene, std::uint6
       [&](std::uint64_t n, const std::array<double, 3>& v) {
         visit(n, std::array<double, 3>{si(v[0]), si(v[1]), si(v[2])});
         if (every != 0 && n % every == 0) progress(EngineProgress{n, std::numeric_limits<double>::quiet_NaN()});
-      });
+      },
+      accept);
   if (!run) return std::nullopt;
   SceneSimulation result;
   result.simulated = true;
@@ -806,10 +810,15 @@ SceneSimulation simulateRotationScene(const Scene& scene, const Prediction& pred
         },
         [&](std::uint64_t n, const std::array<double, 3>& v) {
           known_error_sq = std::max(known_error_sq, disagreement(v, predicted->velocitiesAfter(n)));
-        });
+        },
+        // The filtered pass's double walk stands for the run where it too agrees with the
+        // closed form within kClosedFormAgreement at every impact; else the double-double
+        // passes measure the disagreement.
+        [&] { return known_error_sq == 0.0; });
   } else {
-    known = simulateKnownCount(scene, predicted_count, simulation_options, known_progress, progress_interval, [] {},
-                               [](std::uint64_t, const std::array<double, 3>&) {});
+    known = simulateKnownCount(
+        scene, predicted_count, simulation_options, known_progress, progress_interval, [] {},
+        [](std::uint64_t, const std::array<double, 3>&) {}, [] { return true; });
   }
   std::optional<SceneSimulation> by_engine;
   if (publishes || !known) {

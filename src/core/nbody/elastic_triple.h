@@ -31,6 +31,12 @@
 // checked against the engine's own mass-weighted bound (eu / sqrt(m_k)); where that does not
 // certify them, the product of the run's impact maps (certifiedVelocitiesAfter) gives them
 // certified, and only where neither can (an exact zero or tie) do the engine's bits stand.
+//
+// A long run is taken first by the filtered pass (issue 48, filteredTriplePass): the same
+// impacts walked in double with a rigorous bound, its decisions checked (each impact's pair
+// approaches, none after the last), the final state certified once by the product. Where the
+// bound does not decide, the passes above run; since a certified value is the correctly
+// rounded one, the answer is the same bits whichever pass gives it.
 #pragma once
 
 #include <array>
@@ -39,6 +45,8 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <type_traits>
+#include <utility>
 
 #include "collision_lab/core/nbody/engine.h"
 #include "collision_lab/core/nbody/impact_rule.h"
@@ -260,6 +268,173 @@ CL_DD_INLINE std::optional<ElasticTripleRun> elasticTriplePass(const Scene& scen
   return run;
 }
 
+#if defined(__GNUC__)
+#define CL_ALWAYS_INLINE __attribute__((always_inline))  // on a lambda: its body inlined where called
+#else
+#define CL_ALWAYS_INLINE
+#endif
+
+/// What the filtered pass found (filteredTriplePass).
+enum class FilterVerdict {
+  kDecided,      ///< every decision certified in double: the closed form's count holds
+  kUndecided,    ///< a decision, the range or the time check needs the double-double passes
+  kContradicted  ///< certified in double: the exact run departs from the closed form's count
+};
+
+struct FilteredTripleRun {
+  FilterVerdict verdict = FilterVerdict::kUndecided;
+  /// kDecided: count, capped, cancelled and the double walk's final velocities (not certified).
+  ElasticTripleRun run;
+};
+
+/// The filtered pass (issue 48): the impacts walked in double, as a lean loop walks them,
+/// each velocity carrying a rigorous componentwise bound E_k on its distance from the exact
+/// one, and every decision taken from the double values where the bound decides it: impact
+/// n's pair approaches (v_j - v_i > 0), and after the last impact neither pair does. A
+/// decision the bound does not take (a grazing end, an exact tie), a value out of range, or
+/// an impact time near time_limit leaves the run kUndecided: the double-double passes take it.
+/// A decision the bound takes against the closed form's count is kContradicted: the engine,
+/// whose decisions are exact, runs the scene. The final velocities are the double walk's;
+/// runElasticTriple certifies them once, by the product of the impact maps.
+///
+/// The bound. Each operation of the walk rounds by at most kU = 2u of its result (u = 2^-53;
+/// below the normal range, by tiny): for d = v_j - v_i, E_d = E_i + E_j + kU |d|; for the
+/// heavy body's increment g d (g within kU of the exact gain G), E_inc = |g| (1 + kU) E_d +
+/// 3 kU |g d|; then E_h' = E_h + E_inc + kU |h'| and E_l' = E_h' + E_d + kU |l'| (l' = h' -+ d;
+/// a wall's velocity is exact, a swap rounds nothing). The bounds are sums and products of
+/// nonnegative doubles, each rounded to nearest, at most 8 roundings per impact deep, so the
+/// computed E is at least (1 - u)^(8 n) of the true one: a decision uses kDecisionMargin E,
+/// which covers that for n <= 2^40 (a longer run is not filtered). watch(n, v, e) sees the
+/// velocities after impact n and their bounds (times kDecisionMargin) [the scene's units].
+template <class Watch>
+FilteredTripleRun filteredTriplePass(const Scene& scene, std::uint64_t count, std::size_t first_pair,
+                                                std::uint64_t cap, double time_limit,
+                                                const std::atomic<bool>* cancel, Watch& watch) {
+  constexpr double kU = 0x1p-52;
+  constexpr double kTiny = 0x1p-1060;  // covers an operation's underflow (2^-1075) several times over
+  constexpr double kDecisionMargin = 1.0 + 0x1p-7;
+  constexpr double kRange = 0x1p890;  // as the certified pass: far from overflow in any product here
+  constexpr std::uint64_t kMaxFiltered = std::uint64_t{1} << 40;
+  FilteredTripleRun result;
+  const std::uint64_t target = count < cap ? count : cap;
+  if (target > kMaxFiltered) return result;
+  const double time_bound = time_limit * (1 - 0x1p-20);  // as the certified pass: it only declines
+  struct PairTables {
+    ImpactMap<double> map;
+    double gain_up;  // |g| (1 + kU), rounded up; 0 for a wall
+    bool wall;       // the heavy body is a wall: its velocity is exact
+  };
+  std::array<PairTables, 2> pairs;
+  for (int p = 0; p < 2; ++p) {
+    pairs[p].map = makeImpactMap<double>(scene.masses[p], scene.masses[p + 1], 1.0);
+    pairs[p].gain_up = std::fabs(pairs[p].map.heavy_gain) * (1 + 0x1p-50);
+    pairs[p].wall = scene.isWall(p) || scene.isWall(p + 1);
+  }
+  std::array<double, 3> v = {scene.velocities[0], scene.velocities[1], scene.velocities[2]};
+  std::array<double, 3> b = {scene.positions[0], scene.positions[1], scene.positions[2]};
+  std::array<double, 3> e{};  // E_k [the scene's units]; the inputs are exact
+  const auto margin = [](std::array<double, 3> bound) {
+    for (double& x : bound) x *= kDecisionMargin;
+    return bound;
+  };
+  // One impact of pair P (0: AB, 1: BC) of kind K (kHeavyI, kHeavyJ, kExchange); false when
+  // the run leaves the filter (result says why). The pairs alternate, so the loop below takes
+  // them two at a time, every index and kind constant: the state stays in registers.
+  enum Kind { kHeavyI, kHeavyJ, kExchange };
+  const auto kind_of = [](const ImpactMap<double>& map) {
+    return map.exchange ? kExchange : map.heavy_is_i ? kHeavyI : kHeavyJ;
+  };
+  std::uint64_t n = 0;
+  const auto impact = [&](auto pair_index, auto pair_kind) CL_ALWAYS_INLINE {
+    constexpr int p = decltype(pair_index)::value;
+    constexpr Kind kind = decltype(pair_kind)::value;
+    constexpr bool heavy_is_i = kind == kHeavyI;
+    const PairTables& pair = pairs[p];
+    double& vi = v[p];
+    double& vj = v[p + 1];
+    double& ei = e[p];
+    double& ej = e[p + 1];
+    const double d = vj - vi;
+    const double ed = ei + ej + (kU * std::fabs(d) + kTiny);
+    if (!(d > kDecisionMargin * ed)) {  // the pair may not approach
+      result.verdict = -d >= kDecisionMargin * ed ? FilterVerdict::kContradicted : FilterVerdict::kUndecided;
+      return false;
+    }
+    const double db = b[p + 1] - b[p];
+    if (!(std::fabs(db) < time_bound * d)) return false;  // the impact time may pass the largest double
+    if constexpr (kind == kExchange) {
+      std::swap(vi, vj);
+      std::swap(ei, ej);
+      std::swap(b[p], b[p + 1]);
+    } else {
+      double& h = heavy_is_i ? vi : vj;
+      double& l = heavy_is_i ? vj : vi;
+      double& eh = heavy_is_i ? ei : ej;
+      double& el = heavy_is_i ? ej : ei;
+      double& bh = heavy_is_i ? b[p] : b[p + 1];
+      double& bl = heavy_is_i ? b[p + 1] : b[p];
+      const double gain = pair.map.heavy_gain;  // l' = h' - d when the heavy body is i, h' + d when j
+      const double increment = gain * d;
+      h += increment;
+      l = heavy_is_i ? h - d : h + d;
+      if (!pair.wall) eh += pair.gain_up * ed + (3 * kU * std::fabs(increment) + kU * std::fabs(h) + 2 * kTiny);
+      el = eh + (ed + (kU * std::fabs(l) + kTiny));
+      bh += gain * db;
+      bl = heavy_is_i ? bh - db : bh + db;
+    }
+    if (!(std::fabs(b[p]) + std::fabs(b[p + 1]) + std::fabs(vi) + std::fabs(vj) < kRange)) return false;
+    ++n;
+    watch(n, v, margin(e));
+    return true;
+  };
+  const auto cancelled = [&] {
+    if (!cancel || n % 1024 > 1 || !cancel->load(std::memory_order_relaxed)) return false;
+    result.run.cancelled = true;
+    return true;
+  };
+  const auto walk = [&](auto kind_ab, auto kind_bc) {
+    using AB = std::integral_constant<int, 0>;
+    using BC = std::integral_constant<int, 1>;
+    bool walking = true;
+    if (first_pair == 1 && n < target) walking = impact(BC{}, kind_bc);
+    while (walking && n + 2 <= target) {
+      if (cancelled()) break;
+      walking = impact(AB{}, kind_ab) && impact(BC{}, kind_bc);
+    }
+    if (walking && n < target && !result.run.cancelled) walking = impact(AB{}, kind_ab);
+    return walking;
+  };
+  // Nine instances of the loop, one per pair of kinds.
+  const auto walk_bc = [&](auto kind_ab) {
+    switch (kind_of(pairs[1].map)) {
+      case kHeavyI: return walk(kind_ab, std::integral_constant<Kind, kHeavyI>{});
+      case kHeavyJ: return walk(kind_ab, std::integral_constant<Kind, kHeavyJ>{});
+      default: return walk(kind_ab, std::integral_constant<Kind, kExchange>{});
+    }
+  };
+  bool walking = false;
+  switch (kind_of(pairs[0].map)) {
+    case kHeavyI: walking = walk_bc(std::integral_constant<Kind, kHeavyI>{}); break;
+    case kHeavyJ: walking = walk_bc(std::integral_constant<Kind, kHeavyJ>{}); break;
+    default: walking = walk_bc(std::integral_constant<Kind, kExchange>{}); break;
+  }
+  if (!walking) return result;
+  if (!result.run.cancelled && n == count) {  // the end: neither pair approaches
+    for (int q = 0; q < 2; ++q) {
+      const double d = v[q + 1] - v[q];
+      const double ed = e[q] + e[q + 1] + (kU * std::fabs(d) + kTiny);
+      if (-d >= kDecisionMargin * ed) continue;
+      result.verdict = d > kDecisionMargin * ed ? FilterVerdict::kContradicted : FilterVerdict::kUndecided;
+      return result;
+    }
+  }
+  result.verdict = FilterVerdict::kDecided;
+  result.run.impact_count = n;
+  result.run.capped = !result.run.cancelled && count > cap;
+  result.run.final_velocities = v;
+  return result;
+}
+
 /// elasticTriplePass, portable: the impact maps and the bounds inline into the loop.
 template <ElasticTriplePass kPass, class Visit>
 CL_FLATTEN std::optional<ElasticTripleRun> runElasticTriplePass(const Scene& scene, std::uint64_t count,
@@ -293,20 +468,57 @@ std::optional<ElasticTripleRun> runElasticTriplePassOnPath(const Scene& scene, s
   return runElasticTriplePass<kPass>(scene, count, first_pair, cap, time_limit, cancel, visit);
 }
 
+/// Which passes runElasticTriple may take.
+enum class KnownCountPath {
+  kAuto,          ///< filtered where the run is long enough to repay its certificate, else double-double
+  kFiltered,      ///< the filtered pass first at any length (tests)
+  kDoubleDouble,  ///< the double-double passes only (tests, benchmarks)
+};
+
+/// Impacts from which kAuto takes the filtered pass: its certificate of the final state (the
+/// product of the impact maps, about 0.1 ms) costs what double-double costs over some 5,000
+/// impacts.
+constexpr std::uint64_t kFilterFromImpacts = 8192;
+
 /// Runs scene (three bodies, every e = 1, no ring; at most one wall), whose exact count is
 /// `count` with first pair `first_pair` (0: AB, 1: BC), up to `cap` impacts, every impact
 /// before `time_limit` [the scene's units of time; inf: any] (else it declines); the cancel flag
-/// (may be null) is read every 1024 impacts, as the engine does. First as the engine's
-/// replica, which stops where the engine's precision guard may fire; then, if it stopped,
-/// certified. The final velocities are certified wherever they can be (the header comment):
-/// where the replica's are not, they come from certifiedVelocitiesAfter. restart() is called
-/// before each pass; after impact n, visit(n, v) sees the velocities rounded to double (the
-/// engine's record values in the replica). Returns nothing when the engine must run it (then
-/// visit has seen an unfinished pass).
-template <class Restart, class Visit>
+/// (may be null) is read every 1024 impacts, as the engine does.
+/// A long run (KnownCountPath) is first taken by the filtered pass, in double: where it
+/// decides every impact, its final velocities are certified by the product of the impact
+/// maps, and accept() (called then) keeps it; where the bound contradicts the count, the run
+/// declines (the engine decides). Otherwise, as the engine's replica, which stops where the
+/// engine's precision guard may fire; then, if it stopped, certified. The final velocities
+/// are certified wherever they can be (the header comment): where the replica's are not,
+/// they come from certifiedVelocitiesAfter. restart() is called before each pass; after
+/// impact n, visit(n, v) sees the velocities rounded to double (the engine's record values
+/// in the replica; the double walk's in the filtered pass). Returns nothing when the engine
+/// must run it (then visit has seen an unfinished pass). A certified final state is the same
+/// whichever pass answers: the correctly rounded one.
+template <class Restart, class Visit, class Accept>
 std::optional<ElasticTripleRun> runElasticTriple(const Scene& scene, std::uint64_t count, std::size_t first_pair,
                                                  std::uint64_t cap, double time_limit, const std::atomic<bool>* cancel,
-                                                 Restart&& restart, Visit&& visit) {
+                                                 Restart&& restart, Visit&& visit, Accept&& accept,
+                                                 KnownCountPath path = KnownCountPath::kAuto) {
+  const std::uint64_t target = count < cap ? count : cap;
+  if (path == KnownCountPath::kFiltered || (path == KnownCountPath::kAuto && target >= kFilterFromImpacts)) {
+    restart();
+    auto watch = [&visit](std::uint64_t n, const std::array<double, 3>& v, const std::array<double, 3>&) {
+      visit(n, v);
+    };
+    FilteredTripleRun filtered = filteredTriplePass(scene, count, first_pair, cap, time_limit, cancel, watch);
+    if (filtered.verdict == FilterVerdict::kContradicted) return std::nullopt;
+    if (filtered.verdict == FilterVerdict::kDecided) {
+      ElasticTripleRun& run = filtered.run;
+      if (const auto exact = certifiedVelocitiesAfter(scene, run.impact_count, first_pair)) {
+        for (int k = 0; k < 3; ++k) {
+          if (!scene.isWall(k)) run.final_velocities[k] = (*exact)[k];  // a wall's is exact
+        }
+        run.certified = true;
+        if (accept()) return run;
+      }
+    }
+  }
   restart();
   if (auto run = runElasticTriplePassOnPath<ElasticTriplePass::kReplica>(scene, count, first_pair, cap, time_limit,
                                                                          cancel, visit)) {
