@@ -293,6 +293,7 @@ struct FilteredTripleRun {
 /// n's pair approaches (v_j - v_i > 0), and after the last impact neither pair does. A
 /// decision the bound does not take (a grazing end, an exact tie), a value out of range, or
 /// an impact time near time_limit leaves the run kUndecided: the double-double passes take it.
+/// Where the bound grows too wide, the walk is re-anchored at the certified state (reanchor).
 /// A decision the bound takes against the closed form's count is kContradicted: the engine,
 /// whose decisions are exact, runs the scene. The final velocities are the double walk's;
 /// runElasticTriple certifies them once, by the product of the impact maps.
@@ -345,6 +346,23 @@ FilteredTripleRun filteredTriplePass(const Scene& scene, std::uint64_t count, st
     return map.exchange ? kExchange : map.heavy_is_i ? kHeavyI : kHeavyJ;
   };
   std::uint64_t n = 0;
+  // Where the bound grows too wide to decide (a long run's error is its whole past's), the
+  // walk starts again from the certified state after impact n (the product of the impact
+  // maps, each velocity within half an ulp of the exact one), at most kMaxAnchors times.
+  constexpr int kMaxAnchors = 64;
+  int anchors = 0;
+  const auto reanchor = [&]() {
+    if (anchors == kMaxAnchors) return false;
+    ++anchors;
+    const std::array<std::optional<double>, 3> exact = certifiedVelocityComponentsAfter(scene, n, first_pair);
+    for (int k = 0; k < 3; ++k) {
+      if (scene.isWall(k)) continue;  // exact throughout
+      if (!exact[k]) return false;
+      v[k] = *exact[k];
+      e[k] = std::nextafter(std::fabs(v[k]), HUGE_VAL) - std::fabs(v[k]);  // an ulp: twice the rounding
+    }
+    return true;
+  };
   const auto impact = [&](auto pair_index, auto pair_kind) CL_ALWAYS_INLINE {
     constexpr int p = decltype(pair_index)::value;
     constexpr Kind kind = decltype(pair_kind)::value;
@@ -354,11 +372,19 @@ FilteredTripleRun filteredTriplePass(const Scene& scene, std::uint64_t count, st
     double& vj = v[p + 1];
     double& ei = e[p];
     double& ej = e[p + 1];
-    const double d = vj - vi;
-    const double ed = ei + ej + (kU * std::fabs(d) + kTiny);
-    if (!(d > kDecisionMargin * ed)) {  // the pair may not approach
-      result.verdict = -d >= kDecisionMargin * ed ? FilterVerdict::kContradicted : FilterVerdict::kUndecided;
-      return false;
+    double d = vj - vi;
+    double ed = ei + ej + (kU * std::fabs(d) + kTiny);
+    if (!(d > kDecisionMargin * ed)) [[unlikely]] {  // the pair may not approach
+      if (-d >= kDecisionMargin * ed || !reanchor()) {
+        result.verdict = -d >= kDecisionMargin * ed ? FilterVerdict::kContradicted : FilterVerdict::kUndecided;
+        return false;
+      }
+      d = vj - vi;
+      ed = ei + ej + (kU * std::fabs(d) + kTiny);
+      if (!(d > kDecisionMargin * ed)) {
+        result.verdict = -d >= kDecisionMargin * ed ? FilterVerdict::kContradicted : FilterVerdict::kUndecided;
+        return false;
+      }
     }
     const double db = b[p + 1] - b[p];
     if (!(std::fabs(db) < time_bound * d)) return false;  // the impact time may pass the largest double
@@ -421,11 +447,15 @@ FilteredTripleRun filteredTriplePass(const Scene& scene, std::uint64_t count, st
   if (!walking) return result;
   if (!result.run.cancelled && n == count) {  // the end: neither pair approaches
     for (int q = 0; q < 2; ++q) {
-      const double d = v[q + 1] - v[q];
-      const double ed = e[q] + e[q + 1] + (kU * std::fabs(d) + kTiny);
-      if (-d >= kDecisionMargin * ed) continue;
-      result.verdict = d > kDecisionMargin * ed ? FilterVerdict::kContradicted : FilterVerdict::kUndecided;
-      return result;
+      for (int attempt = 0; attempt < 2; ++attempt) {
+        const double d = v[q + 1] - v[q];
+        const double ed = e[q] + e[q + 1] + (kU * std::fabs(d) + kTiny);
+        if (-d >= kDecisionMargin * ed) break;
+        if (d > kDecisionMargin * ed || attempt == 1 || !reanchor()) {
+          result.verdict = d > kDecisionMargin * ed ? FilterVerdict::kContradicted : FilterVerdict::kUndecided;
+          return result;
+        }
+      }
     }
   }
   result.verdict = FilterVerdict::kDecided;
