@@ -292,7 +292,8 @@ struct FilteredTripleRun {
 /// one, and every decision taken from the double values where the bound decides it: impact
 /// n's pair approaches (v_j - v_i > 0), and after the last impact neither pair does. A
 /// decision the bound does not take (a grazing end, an exact tie), a value out of range, or
-/// an impact time near time_limit leaves the run kUndecided: the double-double passes take it.
+/// an impact time that may pass time_limit (the intercepts carry bounds by the same rules)
+/// leaves the run kUndecided: the double-double passes take it.
 /// Where the bound grows too wide, the walk is re-anchored at the certified state (reanchor).
 /// A decision the bound takes against the closed form's count is kContradicted: the engine,
 /// whose decisions are exact, runs the scene. The final velocities are the double walk's;
@@ -319,7 +320,7 @@ FilteredTripleRun filteredTriplePass(const Scene& scene, std::uint64_t count, st
   FilteredTripleRun result;
   const std::uint64_t target = count < cap ? count : cap;
   if (target > kMaxFiltered) return result;
-  const double time_bound = time_limit * (1 - 0x1p-20);  // as the certified pass: it only declines
+  const double time_bound = time_limit * (1 - 0x1p-20);  // covers the rounding of the check
   struct PairTables {
     ImpactMap<double> map;
     double gain_up;  // |g| (1 + kU), rounded up; 0 for a wall
@@ -334,6 +335,7 @@ FilteredTripleRun filteredTriplePass(const Scene& scene, std::uint64_t count, st
   std::array<double, 3> v = {scene.velocities[0], scene.velocities[1], scene.velocities[2]};
   std::array<double, 3> b = {scene.positions[0], scene.positions[1], scene.positions[2]};
   std::array<double, 3> e{};  // E_k [the scene's units]; the inputs are exact
+  std::array<double, 3> eb{};  // the intercepts' bounds, by the same rules (never re-anchored)
   const auto margin = [](std::array<double, 3> bound) {
     for (double& x : bound) x *= kDecisionMargin;
     return bound;
@@ -386,12 +388,16 @@ FilteredTripleRun filteredTriplePass(const Scene& scene, std::uint64_t count, st
         return false;
       }
     }
+    // The impact time, |B_j - B_i| / D, at most (|db| + E_db) / (d - E_d): it may not pass
+    // the largest double.
     const double db = b[p + 1] - b[p];
-    if (!(std::fabs(db) < time_bound * d)) return false;  // the impact time may pass the largest double
+    const double edb = eb[p] + eb[p + 1] + (kU * std::fabs(db) + kTiny);
+    if (!(std::fabs(db) + kDecisionMargin * edb < time_bound * (d - kDecisionMargin * ed))) return false;
     if constexpr (kind == kExchange) {
       std::swap(vi, vj);
       std::swap(ei, ej);
       std::swap(b[p], b[p + 1]);
+      std::swap(eb[p], eb[p + 1]);
     } else {
       double& h = heavy_is_i ? vi : vj;
       double& l = heavy_is_i ? vj : vi;
@@ -405,14 +411,23 @@ FilteredTripleRun filteredTriplePass(const Scene& scene, std::uint64_t count, st
       l = heavy_is_i ? h - d : h + d;
       if (!pair.wall) eh += pair.gain_up * ed + (3 * kU * std::fabs(increment) + kU * std::fabs(h) + 2 * kTiny);
       el = eh + (ed + (kU * std::fabs(l) + kTiny));
-      bh += gain * db;
+      double& ebh = heavy_is_i ? eb[p] : eb[p + 1];
+      double& ebl = heavy_is_i ? eb[p + 1] : eb[p];
+      const double intercept_increment = gain * db;
+      bh += intercept_increment;
       bl = heavy_is_i ? bh - db : bh + db;
+      if (!pair.wall) {
+        ebh += pair.gain_up * edb + (3 * kU * std::fabs(intercept_increment) + kU * std::fabs(bh) + 2 * kTiny);
+      }
+      ebl = ebh + (edb + (kU * std::fabs(bl) + kTiny));
     }
     if (!(std::fabs(b[p]) + std::fabs(b[p + 1]) + std::fabs(vi) + std::fabs(vj) < kRange)) return false;
     ++n;
     watch(n, v, margin(e));
     return true;
   };
+  // The cancel flag, read every 1024 impacts (one impact later than the engine reads it when
+  // the run starts with BC: n is odd at every check).
   const auto cancelled = [&] {
     if (!cancel || n % 1024 > 1 || !cancel->load(std::memory_order_relaxed)) return false;
     result.run.cancelled = true;
