@@ -7,6 +7,7 @@
 #include <limits>
 #include <random>
 #include <string>
+#include <vector>
 
 #include <boost/multiprecision/cpp_int.hpp>
 
@@ -27,6 +28,21 @@ inline SceneRunResult runInMode(const Scene& scene, RunMode mode,
   options.lab.mode = mode;
   options.lab.max_collisions = max_collisions;
   return runScene(planScene(scene), options);
+}
+
+/// Heavy, light, heavy (a wall in every third): long runs, 10^(decades / 2) to 10^decades.
+inline std::vector<Scene> heavyLightHeavy(std::mt19937_64& rng, double decades) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<Scene> scenes;
+  for (int k = 0; k < 12; ++k) {
+    const double heavy = std::pow(10.0, decades * (0.5 + 0.5 * unit(rng)));
+    Scene scene = threeBodies();
+    scene.masses = {heavy * (1 + unit(rng)), 1 + unit(rng), k % 3 == 0 ? kInf : heavy * (1 + unit(rng))};
+    scene.positions = {1 + unit(rng), 0.0, -1 - unit(rng)};
+    scene.velocities = {-unit(rng), 2 * unit(rng) - 1, k % 3 == 0 ? 0.0 : unit(rng)};
+    if (!validate(scene) && firstPair(scene)) scenes.push_back(scene);
+  }
+  return scenes;
 }
 
 /// The scene's masses, positions and velocities on one line, for failure messages.

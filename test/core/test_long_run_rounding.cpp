@@ -28,6 +28,7 @@ namespace {
 using nbody_detail::certifiedVelocitiesAfter;
 using reference::correctlyRounded;
 using testing_support::describe;
+using testing_support::heavyLightHeavy;
 using testing_support::kInf;
 
 /// The double nearest to x, when x is not within 2^-200 of a tie (else empty).
@@ -40,21 +41,6 @@ std::optional<double> nearestClearOfTies(const DeepPrecision& x) {
 }
 
 std::size_t firstPairIndex(const Scene& scene) { return firstPair(scene) == Pair::BC ? 1 : 0; }
-
-/// Heavy, light, heavy (a wall in every third): long runs, 10^(decades / 2) to 10^decades.
-std::vector<Scene> heavyLightHeavy(std::mt19937_64& rng, double decades) {
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  std::vector<Scene> scenes;
-  for (int k = 0; k < 12; ++k) {
-    const double heavy = std::pow(10.0, decades * (0.5 + 0.5 * unit(rng)));
-    Scene scene = threeBodies();
-    scene.masses = {heavy * (1 + unit(rng)), 1 + unit(rng), k % 3 == 0 ? kInf : heavy * (1 + unit(rng))};
-    scene.positions = {1 + unit(rng), 0.0, -1 - unit(rng)};
-    scene.velocities = {-unit(rng), 2 * unit(rng) - 1, k % 3 == 0 ? 0.0 : unit(rng)};
-    if (!validate(scene) && firstPair(scene)) scenes.push_back(scene);
-  }
-  return scenes;
-}
 
 TEST(ImpactMapProduct, IsTheCorrectlyRoundedExactStateAfterEveryCountChecked) {
   std::vector<Scene> scenes = {

@@ -545,6 +545,17 @@ std::optional<ElasticTripleRun> runElasticTriple(const Scene& scene, std::uint64
                                                  std::uint64_t cap, double time_limit, const std::atomic<bool>* cancel,
                                                  Restart&& restart, Visit&& visit, Accept&& accept,
                                                  KnownCountPath path = KnownCountPath::kAuto) {
+  // The run's final velocities from the product, where it certifies them (a wall's is exact
+  // and keeps the pass's zero sign).
+  const auto certify = [&](ElasticTripleRun& run) {
+    const auto exact = certifiedVelocitiesAfter(scene, run.impact_count, first_pair);
+    if (!exact) return false;
+    for (int k = 0; k < 3; ++k) {
+      if (!scene.isWall(k)) run.final_velocities[k] = (*exact)[k];
+    }
+    run.certified = true;
+    return true;
+  };
   const std::uint64_t target = count < cap ? count : cap;
   if (path == KnownCountPath::kFiltered || (path == KnownCountPath::kAuto && target >= kFilterFromImpacts)) {
     restart();
@@ -553,28 +564,12 @@ std::optional<ElasticTripleRun> runElasticTriple(const Scene& scene, std::uint64
     };
     FilteredTripleRun filtered = filteredTriplePass(scene, count, first_pair, cap, time_limit, cancel, watch);
     if (filtered.verdict == FilterVerdict::kContradicted) return std::nullopt;
-    if (filtered.verdict == FilterVerdict::kDecided) {
-      ElasticTripleRun& run = filtered.run;
-      if (const auto exact = certifiedVelocitiesAfter(scene, run.impact_count, first_pair)) {
-        for (int k = 0; k < 3; ++k) {
-          if (!scene.isWall(k)) run.final_velocities[k] = (*exact)[k];  // a wall's is exact
-        }
-        run.certified = true;
-        if (accept()) return run;
-      }
-    }
+    if (filtered.verdict == FilterVerdict::kDecided && certify(filtered.run) && accept()) return filtered.run;
   }
   restart();
   if (auto run = runElasticTriplePassOnPath<ElasticTriplePass::kReplica>(scene, count, first_pair, cap, time_limit,
                                                                          cancel, visit)) {
-    if (!run->certified) {
-      if (const auto exact = certifiedVelocitiesAfter(scene, run->impact_count, first_pair)) {
-        for (int k = 0; k < 3; ++k) {
-          if (!scene.isWall(k)) run->final_velocities[k] = (*exact)[k];  // a wall's keeps the engine's zero sign
-        }
-        run->certified = true;
-      }
-    }
+    if (!run->certified) certify(*run);
     return run;
   }
   restart();
