@@ -217,6 +217,41 @@ ClosedFormSequence::ClosedFormSequence(const AnalyticModel<double>& model)
   sin_part_[1] = map * sin_part_[0];
 }
 
+double ClosedFormSequence::largestSquaredError(std::uint64_t first, const std::array<double, 3>* v,
+                                               std::size_t count, const std::array<double, 3>& weight) {
+  using Triple = std::array<double, 3>;
+  const auto parts = [](const Eigen::Vector3d& x) { return Triple{x(0), x(1), x(2)}; };
+  const Triple centre = parts(centre_), cos_even = parts(cos_part_[0]), cos_odd = parts(cos_part_[1]),
+               sin_even = parts(sin_part_[0]), sin_odd = parts(sin_part_[1]), w = weight;
+  const auto error = [&](const Triple& run, const Triple& cos_part, const Triple& sin_part) {
+    const double c = rotation_.cos();
+    const double s = rotation_.sin();
+    double norm_sq = 0.0;
+    for (int j = 0; j < 3; ++j) {
+      const double d = run[j] - (centre[j] + c * cos_part[j] + s * sin_part[j]);
+      norm_sq += w[j] * d * d;
+    }
+    return norm_sq;
+  };
+  double largest = 0.0;
+  std::size_t i = 0;
+  std::uint64_t n = first;
+  if (n % 2 == 1 && i < count) {
+    rotation_.moveTo(n / 2);
+    largest = error(v[i++], cos_odd, sin_odd);
+    ++n;
+  }
+  for (; i + 2 <= count; i += 2, n += 2) {  // n even, then n + 1 odd: one rotation step
+    rotation_.moveTo(n / 2);
+    largest = std::max(largest, std::max(error(v[i], cos_even, sin_even), error(v[i + 1], cos_odd, sin_odd)));
+  }
+  if (i < count) {
+    rotation_.moveTo(n / 2);
+    largest = std::max(largest, error(v[i], cos_even, sin_even));
+  }
+  return largest;
+}
+
 // The scalars analytic.h promises.
 template class AnalyticModel<double>;
 template class AnalyticModel<long double>;

@@ -7,6 +7,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <type_traits>
 
 #include "collision_lab/core/count_text.h"
 #include "collision_lab/core/analytic.h"
@@ -266,6 +267,21 @@ class ClosedFormInTurn {
     return sequence_ ? toArray(sequence_->velocitiesAfter(n)) : model_.velocitiesAfter(n);
   }
 
+  /// The largest over i < count of sum_j weight_j (v[i]_j - velocitiesAfter(first + i)_j)^2
+  /// (0 when count is 0); first, first + count, ... in turn, as velocitiesAfter.
+  double largestSquaredError(std::uint64_t first, const std::array<double, 3>* v, std::size_t count,
+                             const std::array<double, 3>& weight) {
+    if (sequence_ && !exact_) return sequence_->largestSquaredError(first, v, count, weight);
+    double largest = 0.0;
+    for (std::size_t i = 0; i < count; ++i) {
+      const std::array<double, 3> model = velocitiesAfter(first + i);
+      double norm_sq = 0.0;
+      for (int j = 0; j < 3; ++j) norm_sq += weight[j] * (v[i][j] - model[j]) * (v[i][j] - model[j]);
+      largest = std::max(largest, norm_sq);
+    }
+    return largest;
+  }
+
   /// A short run's exact state around impact n (ExactInTurn::fillState): false, and nothing
   /// filled, for a longer run.
   bool fillExactState(std::uint64_t n, ImpactModelValues& state) {
@@ -380,6 +396,8 @@ class EnergyNormError {
     }
     return norm_sq;
   }
+  /// squared(a, b) = sum_i weights()_i (a_i - b_i)^2.
+  const std::array<double, 3>& weights() const { return weight_; }
   double fromSquared(double norm_sq) const { return std::sqrt(norm_sq) / initial_norm_; }
   /// The squared norm whose relative error is `relative`: a comparison per impact without a
   /// square root or a division.
@@ -460,11 +478,18 @@ struct SimulationOptions {
 /// rounded, or where no certificate can be had, an exact zero or tie, the engine's bit for
 /// bit) and drifts, as simulateByEngine gives them; no final time or positions. An impact
 /// that may come after the largest double [s] declines it. restart() is called before each
-/// pass over the impacts (at most three); after each impact n, visit(n, v) sees the
-/// velocities [m/s] (runElasticTriple: the engine's, or the filtered pass's double walk);
-/// accept() says whether a filtered pass may stand. Returns nothing when the run cannot be
-/// taken this way (then the engine runs it). `progress` (RunOptions) sees every
-/// progress_interval-th impact, with no time (NaN).
+/// pass over the impacts (at most three); visit(first, v, count) sees the velocities [m/s]
+/// after impacts first, ..., first + count - 1 in v[0 .. count) (runElasticTriple: the
+/// engine's, or the filtered pass's double walk), in batches after the walk has taken them,
+/// so that a visitor's work does not crowd the walk's registers: every impact of a pass
+/// before accept() is called, and of a run before this returns (a pass that stops
+/// unfinished drops its last batch: restart() follows). accept() says whether a filtered
+/// pass may stand. Returns nothing when the run cannot be taken this way (then the engine
+/// runs it). `progress` (RunOptions) sees every progress_interval-th impact, with no time
+/// (NaN): with a visitor, as its batch is visited; with NoVisit, as the walk takes it.
+struct NoVisit {};
+constexpr std::size_t kVisitBatch = 256;
+
 template <class Restart, class Visit, class Accept>
 std::optional<SceneSimulation> simulateKnownCount(const Scene& scene, std::uint64_t count,
                                                    const SimulationOptions& options, const ProgressCallback& progress,
@@ -490,13 +515,57 @@ std::optional<SceneSimulation> simulateKnownCount(const Scene& scene, std::uint6
   // The largest working time whose SI value a double holds (as runEngine bounds it).
   const double time_limit = static_cast<double>(
       std::ldexp(static_cast<long double>(std::numeric_limits<double>::max()), units.timeShift()));
-  const std::optional<nbody_detail::ElasticTripleRun> run = nbody_detail::runElasticTriple(
-      units.scene, count, first == Pair::BC ? 1 : 0, options.max_collisions, time_limit, options.cancel, restart,
-      [&](std::uint64_t n, const std::array<double, 3>& v) {
-        visit(n, std::array<double, 3>{si(v[0]), si(v[1]), si(v[2])});
-        if (every != 0 && n % every == 0) progress(EngineProgress{n, std::numeric_limits<double>::quiet_NaN()});
-      },
-      accept);
+  const std::size_t first_pair = first == Pair::BC ? 1 : 0;
+  std::optional<nbody_detail::ElasticTripleRun> run;
+  if constexpr (std::is_same_v<std::decay_t<Visit>, NoVisit>) {
+    run = nbody_detail::runElasticTriple(
+        units.scene, count, first_pair, options.max_collisions, time_limit, options.cancel, restart,
+        [&](std::uint64_t n, const std::array<double, 3>&) {
+          if (every != 0 && n % every == 0) progress(EngineProgress{n, std::numeric_limits<double>::quiet_NaN()});
+        },
+        accept);
+  } else {
+    std::array<std::array<double, 3>, kVisitBatch> batch, si_batch;  // working units, SI
+    std::size_t batched = 0;
+    std::uint64_t batch_end = 0;  // the impact after the batch's last
+    const auto flush = [&] {
+      const std::uint64_t batch_start = batch_end - batched;
+      // Scaled by a power of two, exact unless a result is below the normal range; that
+      // rare batch is converted again through velocity_si, from the working values.
+      bool below_normal = false;
+      for (std::size_t i = 0; i < batched; ++i) {
+        for (int k = 0; k < 3; ++k) {
+          const double x = batch[i][k] * to_si;
+          below_normal |= std::fabs(x) < std::numeric_limits<double>::min() && x != 0.0;
+          si_batch[i][k] = x;
+        }
+      }
+      for (std::size_t i = 0; below_normal && i < batched; ++i) {
+        for (int k = 0; k < 3; ++k) si_batch[i][k] = si(batch[i][k]);
+      }
+      visit(batch_start, si_batch.data(), batched);
+      for (std::uint64_t n = batch_start; every != 0 && n < batch_end; ++n) {
+        if (n % every == 0) progress(EngineProgress{n, std::numeric_limits<double>::quiet_NaN()});
+      }
+      batched = 0;
+    };
+    run = nbody_detail::runElasticTriple(
+        units.scene, count, first_pair, options.max_collisions, time_limit, options.cancel,
+        [&] {
+          batched = 0;
+          restart();
+        },
+        [&](std::uint64_t n, const std::array<double, 3>& v) {
+          batch[batched++] = v;
+          batch_end = n + 1;
+          if (batched == kVisitBatch) flush();
+        },
+        [&] {
+          flush();
+          return accept();
+        });
+    flush();
+  }
   if (!run) return std::nullopt;
   SceneSimulation result;
   result.simulated = true;
@@ -816,8 +885,9 @@ SceneSimulation simulateRotationScene(const Scene& scene, const Prediction& pred
           predicted.emplace(model);
           known_error_sq = 0.0;
         },
-        [&](std::uint64_t n, const std::array<double, 3>& v) {
-          known_error_sq = std::max(known_error_sq, disagreement(v, predicted->velocitiesAfter(n)));
+        [&](std::uint64_t first, const std::array<double, 3>* v, std::size_t count) {
+          const double error_sq = predicted->largestSquaredError(first, v, count, relative_error.weights());
+          if (error_sq > agreement_sq) known_error_sq = std::max(known_error_sq, error_sq);
         },
         // The filtered pass's double walk stands for the run where it too agrees with the
         // closed form within kClosedFormAgreement at every impact; else the double-double
@@ -825,8 +895,8 @@ SceneSimulation simulateRotationScene(const Scene& scene, const Prediction& pred
         [&] { return known_error_sq == 0.0; });
   } else {
     known = simulateKnownCount(
-        scene, predicted_count, simulation_options, known_progress, progress_interval, [] {},
-        [](std::uint64_t, const std::array<double, 3>&) {}, [] { return true; });
+        scene, predicted_count, simulation_options, known_progress, progress_interval, [] {}, NoVisit{},
+        [] { return true; });
   }
   std::optional<SceneSimulation> by_engine;
   if (publishes || !known) {
