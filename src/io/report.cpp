@@ -533,18 +533,23 @@ void writeEventRecordJson(TextSink& sink, const EventRecord& r) {
   sink.jsonArray(",\"pair_velocities_after\":", r.pair_velocities_after);
   sink.jsonArray(",\"pair_energy_transfer\":", r.pair_energy_transfer);
   sink.jsonField(",\"energy_lost\":", r.energy_lost);
-  const std::size_t n = r.full_state ? r.bodies : 0;
-  jsonValues(sink, ",\"positions\":", r.full_state ? r.positions : nullptr, n);
-  jsonValues(sink, ",\"velocities_before\":", r.full_state ? r.velocities_before : nullptr, n);
-  jsonValues(sink, ",\"velocities_after\":", r.full_state ? r.velocities_after : nullptr, n);
-  jsonValues(sink, ",\"energy_transfer\":", r.full_state ? r.energy_transfer : nullptr, n);
-  jsonValues(sink, ",\"kinetic_energy_after\":", r.full_state ? r.kinetic_energy_after : nullptr, n);
-  sink.jsonField(",\"total_energy\":", r.full_state ? r.total_energy : std::nan(""));
-  sink.jsonField(",\"total_momentum\":", r.full_state ? r.total_momentum : std::nan(""));
-  jsonModel(sink, ",\"predicted_velocities_after\":", r.predicted_velocities_after);
-  jsonModel(sink, ",\"predicted_energy_transfer\":", r.predicted_energy_transfer);
-  jsonModel(sink, ",\"paper_velocities_after\":", r.paper_velocities_after);
-  jsonModel(sink, ",\"paper_energy_transfer\":", r.paper_energy_transfer);
+  // An event without the full state (the lean record, or a scene of more than
+  // kFullStateMaxBodies bodies) leaves out the per-body, total and model keys: absent, not
+  // null, so that the lean record is the pair's values alone.
+  if (r.full_state) {
+    const std::size_t n = r.bodies;
+    jsonValues(sink, ",\"positions\":", r.positions, n);
+    jsonValues(sink, ",\"velocities_before\":", r.velocities_before, n);
+    jsonValues(sink, ",\"velocities_after\":", r.velocities_after, n);
+    jsonValues(sink, ",\"energy_transfer\":", r.energy_transfer, n);
+    jsonValues(sink, ",\"kinetic_energy_after\":", r.kinetic_energy_after, n);
+    sink.jsonField(",\"total_energy\":", r.total_energy);
+    sink.jsonField(",\"total_momentum\":", r.total_momentum);
+    jsonModel(sink, ",\"predicted_velocities_after\":", r.predicted_velocities_after);
+    jsonModel(sink, ",\"predicted_energy_transfer\":", r.predicted_energy_transfer);
+    jsonModel(sink, ",\"paper_velocities_after\":", r.paper_velocities_after);
+    jsonModel(sink, ",\"paper_energy_transfer\":", r.paper_energy_transfer);
+  }
   sink.put(",\"uncertified\":[");
   putUncertified(sink, r.uncertified);
   sink.put("]}");
