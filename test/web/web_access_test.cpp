@@ -11,9 +11,10 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <atomic>
+#include <condition_variable>
 #include <fstream>
 #include <iterator>
+#include <mutex>
 #include <string>
 #include <thread>
 #include <utility>
@@ -166,12 +167,16 @@ TEST_F(WebAccessTest, SlowClientsHoldNothingAndAreClosedAfterTheHeaderDeadline) 
     ASSERT_TRUE(sendAll(fd, "G"));
     slow.push_back(fd);
   }
-  std::atomic<bool> done{false};
+  // The trickle's pace is the workload (a byte a second); it stops as soon as it is told.
+  std::mutex trickle_mutex;
+  std::condition_variable trickle_stop;
+  bool done = false;
   std::thread trickle([&] {
     const std::string header = "ET / HTTP/1.1\r\nHost: 127.0.0.1\r\nX-Padding: ";
+    std::unique_lock<std::mutex> lock(trickle_mutex);
     for (std::size_t k = 0; !done; ++k) {
       for (int fd : slow) send(fd, header.data() + std::min(k, header.size() - 1), 1, MSG_NOSIGNAL);
-      std::this_thread::sleep_for(std::chrono::seconds(1));
+      trickle_stop.wait_for(lock, std::chrono::seconds(1), [&] { return done; });
     }
   });
   // Meanwhile a page and a POST are answered.
@@ -189,7 +194,11 @@ TEST_F(WebAccessTest, SlowClientsHoldNothingAndAreClosedAfterTheHeaderDeadline) 
     closed += poll(&p, 1, 0) == 1 && recv(fd, nullptr, 0, MSG_DONTWAIT) <= 0;
     EXPECT_EQ(answer.find("200 OK"), std::string::npos) << "a header that never ends is never answered";
   }
-  done = true;
+  {
+    const std::lock_guard<std::mutex> lock(trickle_mutex);
+    done = true;
+  }
+  trickle_stop.notify_one();
   trickle.join();
   for (int fd : slow) close(fd);
   EXPECT_EQ(closed, kSlow) << "the server closes every connection whose header is late";
