@@ -36,10 +36,12 @@ Eigen::Matrix<T, 3, 1> cross(const Eigen::Matrix<T, 3, 1>& a, const Eigen::Matri
   return Eigen::Matrix<T, 3, 1>(a(1) * b(2) - a(2) * b(1), a(2) * b(0) - a(0) * b(2), a(0) * b(1) - a(1) * b(0));
 }
 
-/// The wedge of one set of masses in precision T. S is scaled by 1/sqrt(m_max) (m_max the
-/// largest finite mass) so that no mass overflows; directions do not depend on that scale.
+/// The mirrors of the impact maps in mass-weighted velocity space, in precision T: what an
+/// impact's reflection needs, without the cone's angle (whose arctangent costs, at 100
+/// digits, more than the rest). S is scaled by 1/sqrt(m_max) (m_max the largest finite
+/// mass) so that no mass overflows; directions do not depend on that scale.
 template <class T>
-struct Wedge {
+struct Mirrors {
   using Vec3 = Eigen::Matrix<T, 3, 1>;
 
   Vec3 sqrt_mass;  ///< sqrt(m_i / m_max); 0 for a wall
@@ -47,6 +49,13 @@ struct Wedge {
   Vec3 s_hat;      ///< unit s = S 1; with a wall its limit, the wall's axis
   Vec3 n_ab;       ///< unit normal of the AB plane, along (1/sqrt m_A, -1/sqrt m_B, 0)
   Vec3 n_bc;       ///< unit normal of the BC plane, along (0, 1/sqrt m_B, -1/sqrt m_C)
+};
+
+/// The wedge of one set of masses in precision T: its mirrors and the cone they bound.
+template <class T>
+struct Wedge : Mirrors<T> {
+  using Vec3 = typename Mirrors<T>::Vec3;
+
   /// The cone's boundary ray on L_BC (in s-perp, orthogonal to n_BC), on the side
   /// n_AB . r_bc >= 0. With n_bc it is a basis of s-perp in which the other ray, r_AB,
   /// lies at the angle +alpha.
@@ -55,37 +64,45 @@ struct Wedge {
 
   /// Coordinates of a vector of s-perp in the basis (r_bc, n_bc): atan2 of them is its
   /// angle psi from r_BC towards r_AB.
-  std::array<T, 2> coordinates(const Vec3& u_perp) const { return {T(u_perp.dot(r_bc)), T(u_perp.dot(n_bc))}; }
+  std::array<T, 2> coordinates(const Vec3& u_perp) const { return {T(u_perp.dot(r_bc)), T(u_perp.dot(this->n_bc))}; }
 };
 
 template <class T>
-Wedge<T> wedgeOf(const std::array<double, 3>& masses) {
+Mirrors<T> mirrorsOf(const std::array<double, 3>& masses) {
   using std::sqrt;
-  using Vec3 = typename Wedge<T>::Vec3;
-  Wedge<T> wedge;
+  using Vec3 = typename Mirrors<T>::Vec3;
+  Mirrors<T> mirrors;
   const double mass_max = largestFiniteMass(masses);
   int wall = -1;
   for (int i = 0; i < 3; ++i) {
     if (std::isinf(masses[i])) {
       wall = i;
-      wedge.sqrt_mass(i) = 0;
+      mirrors.sqrt_mass(i) = 0;
       continue;
     }
     const T scaled = T(masses[i]) / T(mass_max);
-    wedge.sqrt_mass(i) = sqrt(scaled);
-    wedge.mass_sum += scaled;
+    mirrors.sqrt_mass(i) = sqrt(scaled);
+    mirrors.mass_sum += scaled;
   }
   if (wall >= 0) {
-    wedge.s_hat = Vec3::Zero();
-    wedge.s_hat(wall) = 1;
+    mirrors.s_hat = Vec3::Zero();
+    mirrors.s_hat(wall) = 1;
   } else {
-    wedge.s_hat = wedge.sqrt_mass / sqrt(wedge.mass_sum);
+    mirrors.s_hat = mirrors.sqrt_mass / sqrt(mirrors.mass_sum);
   }
-  auto inverse_sqrt = [&](int i) { return i == wall ? T(0) : T(1) / wedge.sqrt_mass(i); };
-  wedge.n_ab = Vec3(inverse_sqrt(kA), -inverse_sqrt(kB), T(0));
-  wedge.n_bc = Vec3(T(0), inverse_sqrt(kB), -inverse_sqrt(kC));
-  wedge.n_ab /= sqrt(wedge.n_ab.squaredNorm());
-  wedge.n_bc /= sqrt(wedge.n_bc.squaredNorm());
+  auto inverse_sqrt = [&](int i) { return i == wall ? T(0) : T(1) / mirrors.sqrt_mass(i); };
+  mirrors.n_ab = Vec3(inverse_sqrt(kA), -inverse_sqrt(kB), T(0));
+  mirrors.n_bc = Vec3(T(0), inverse_sqrt(kB), -inverse_sqrt(kC));
+  mirrors.n_ab /= sqrt(mirrors.n_ab.squaredNorm());
+  mirrors.n_bc /= sqrt(mirrors.n_bc.squaredNorm());
+  return mirrors;
+}
+
+template <class T>
+Wedge<T> wedgeOf(const std::array<double, 3>& masses) {
+  using std::sqrt;
+  Wedge<T> wedge;
+  static_cast<Mirrors<T>&>(wedge) = mirrorsOf<T>(masses);
   wedge.r_bc = cross<T>(wedge.s_hat, wedge.n_bc);
   wedge.r_bc /= sqrt(wedge.r_bc.squaredNorm());
   if (wedge.n_ab.dot(wedge.r_bc) < 0) wedge.r_bc = -wedge.r_bc;

@@ -74,20 +74,20 @@ std::array<std::optional<double>, 3> certifiedVelocityComponentsAfter(const Scen
   if (impacts == 0 || (scene.isWall(0) && scene.isWall(2))) return result;
   const int wall = scene.isWall(0) ? 0 : scene.isWall(2) ? 2 : -1;
   const std::array<double, 3> masses = triple(scene.masses);
-  const Wedge<Float100> wedge = wedgeOf<Float100>(masses);
+  const Mirrors<Float100> mirrors = mirrorsOf<Float100>(masses);
   const double mass_max = largestFiniteMass(masses);
   const double reference = wall >= 0 ? scene.velocities[wall] : 0.0;  // the wall's frame
   // The start, weighted: each component within 8 units of its own size (the difference, the
   // square root, the product).
   Vec3 u = Vec3::Zero();
   for (int k = 0; k < 3; ++k) {
-    if (k != wall) u(k) = wedge.sqrt_mass(k) * (Float100(scene.velocities[k]) - reference);
+    if (k != wall) u(k) = mirrors.sqrt_mass(k) * (Float100(scene.velocities[k]) - reference);
   }
   const double start_norm = upperNorm(u);
   const double start_error = 8 * kUnit * start_norm;
   const double exact_norm = (start_norm + start_error) * kUp;  // conserved by every impact
-  const Product reflections[2] = {{Mat3::Identity() - 2 * wedge.n_ab * wedge.n_ab.transpose(), kReflectionError},
-                                  {Mat3::Identity() - 2 * wedge.n_bc * wedge.n_bc.transpose(), kReflectionError}};
+  const Product reflections[2] = {{Mat3::Identity() - 2 * mirrors.n_ab * mirrors.n_ab.transpose(), kReflectionError},
+                                  {Mat3::Identity() - 2 * mirrors.n_bc * mirrors.n_bc.transpose(), kReflectionError}};
   const Product& first = reflections[first_pair];
   Product all = power(multiply(reflections[first_pair ^ 1], first), impacts / 2);
   if (impacts % 2 == 1) all = multiply(first, all);
@@ -100,7 +100,7 @@ std::array<std::optional<double>, 3> certifiedVelocityComponentsAfter(const Scen
       result[k] = scene.velocities[k];
       continue;
     }
-    const Float100 relative = end(k) / wedge.sqrt_mass(k);
+    const Float100 relative = end(k) / mirrors.sqrt_mass(k);
     const Float100 v = relative + reference;
     // S's entry sqrt(m_k / m_max) from below, in double: the quotient and root with margin.
     const double sqrt_mass_below = std::sqrt(scene.masses[k] / mass_max) * (1 - 0x1p-40);
