@@ -470,6 +470,11 @@ struct SimulationOptions {
   std::uint64_t max_collisions = 10'000'000;  ///< stops the run cleanly; marks it truncated
   /// When set, the run stops within 1024 impacts, marked truncated and cancelled.
   const std::atomic<bool>* cancel = nullptr;
+  /// The caller holds the certified velocities after the predicted count (a short run's
+  /// exact walk): simulateKnownCount does not certify a replica that reaches it again
+  /// (runElasticTriple's end_known); the caller's values stand where the run's are within
+  /// ulps of them.
+  bool end_known = false;
 };
 
 /// The run of three elastic bodies whose count the closed form gives (`count`), without the
@@ -523,7 +528,7 @@ std::optional<SceneSimulation> simulateKnownCount(const Scene& scene, std::uint6
         [&](std::uint64_t n, const std::array<double, 3>&) {
           if (every != 0 && n % every == 0) progress(EngineProgress{n, std::numeric_limits<double>::quiet_NaN()});
         },
-        accept);
+        accept, nbody_detail::KnownCountPath::kAuto, options.end_known);
   } else {
     std::array<std::array<double, 3>, kVisitBatch> batch, si_batch;  // working units, SI
     std::size_t batched = 0;
@@ -563,7 +568,8 @@ std::optional<SceneSimulation> simulateKnownCount(const Scene& scene, std::uint6
         [&] {
           flush();
           return accept();
-        });
+        },
+        nbody_detail::KnownCountPath::kAuto, options.end_known);
     flush();
   }
   if (!run) return std::nullopt;
@@ -833,6 +839,12 @@ SceneSimulation simulateRotationScene(const Scene& scene, const Prediction& pred
   SimulationOptions simulation_options;
   simulation_options.max_collisions = lab.max_collisions;
   simulation_options.cancel = options.cancel;
+  // The prediction's certified final velocities are the run's at the predicted count: the
+  // run need not certify them a second time (see below, where they stand for it).
+  const bool prediction_certified =
+      std::find(prediction.uncertified.begin(), prediction.uncertified.end(), "predicted_final_velocities") ==
+      prediction.uncertified.end();
+  simulation_options.end_known = prediction_certified;
   const EventPolicy events = options.keep_events ? lab.events : EventPolicy::none();
   const ProgressCallback& progress = visitors.progress;
   const std::uint64_t progress_interval = progress ? options.progress_interval : 0;
@@ -933,9 +945,7 @@ SceneSimulation simulateRotationScene(const Scene& scene, const Prediction& pred
   simulation.uncertified = run.uncertified;
   // At the model's count the model's certified velocities name the same exact values: an
   // uncertified run value within a few ulps of them gives way to them.
-  if (!simulation.uncertified.empty() && run.impact_count == predicted_count &&
-      std::find(prediction.uncertified.begin(), prediction.uncertified.end(), "predicted_final_velocities") ==
-          prediction.uncertified.end()) {
+  if (!simulation.uncertified.empty() && run.impact_count == predicted_count && prediction_certified) {
     if (detail::withinUlps(run.final_velocities, prediction.final_velocities)) {
       simulation.final_velocities = prediction.final_velocities;
       simulation.uncertified.clear();

@@ -539,12 +539,14 @@ constexpr std::uint64_t kFilterFromImpacts = 8192;
 /// impact n, visit(n, v) sees the velocities rounded to double (the engine's record values
 /// in the replica; the double walk's in the filtered pass). Returns nothing when the engine
 /// must run it (then visit has seen an unfinished pass). A certified final state is the same
-/// whichever pass answers: the correctly rounded one.
+/// whichever pass answers: the correctly rounded one. `end_known`: the caller holds the
+/// certified state after all `count` impacts (a short run's exact walk), so that a replica
+/// which reaches it is not certified again here (it stays uncertified for the caller).
 template <class Restart, class Visit, class Accept>
 std::optional<ElasticTripleRun> runElasticTriple(const Scene& scene, std::uint64_t count, std::size_t first_pair,
                                                  std::uint64_t cap, double time_limit, const std::atomic<bool>* cancel,
                                                  Restart&& restart, Visit&& visit, Accept&& accept,
-                                                 KnownCountPath path = KnownCountPath::kAuto) {
+                                                 KnownCountPath path = KnownCountPath::kAuto, bool end_known = false) {
   // The run's final velocities from the product, where it certifies them (a wall's is exact
   // and keeps the pass's zero sign).
   const auto certify = [&](ElasticTripleRun& run) {
@@ -569,7 +571,7 @@ std::optional<ElasticTripleRun> runElasticTriple(const Scene& scene, std::uint64
   restart();
   if (auto run = runElasticTriplePassOnPath<ElasticTriplePass::kReplica>(scene, count, first_pair, cap, time_limit,
                                                                          cancel, visit)) {
-    if (!run->certified) certify(*run);
+    if (!run->certified && !(end_known && run->impact_count == count)) certify(*run);
     return run;
   }
   restart();
