@@ -1,9 +1,15 @@
 """collision_lab.read_bag: a run that collision_lab_node recorded (docs/ros.md, Bags), as
 the Run that collision_lab.run gives: the scene as run()'s keyword arguments, the summary
-under run()'s keys, the prediction, and every CollisionEvent as numpy arrays."""
+under run()'s keys, the prediction, and every CollisionEvent as numpy arrays, streamed
+into columns (no message or per-event record kept)."""
 import math
+from array import array
+from operator import attrgetter
 
-from ._run import ESCALATION_KEYS, SUMMARY_KEYS, Run, body_name, events_from_records
+import numpy as np
+
+from ._run import (_BODY_ARRAYS, _MODEL_ARRAYS, _SCALARS, ESCALATION_KEYS, FULL_STATE_MAX_BODIES, SUMMARY_KEYS,
+                   Run, body_name, events_from_records)
 
 _MODES = {0: 'full', 1: 'predict', 2: 'summary'}
 _KINDS = {0: 'impact', 1: 'collapse'}
@@ -43,29 +49,145 @@ def _pair_name(index, seam=False):
     return body_name(index) + ('' if index + 1 < 26 else '-') + body_name(index + 1)
 
 
-def _event(msg):
-    """A CollisionEvent as the CLI's JSON event (per-body arrays empty beyond the message's
-    FULL_STATE_MAX_BODIES: None)."""
-    kind = _KINDS.get(msg.kind, str(msg.kind))
-    # Only an impact across a ring's seam has last_moved below its pair_index.
-    seam = kind == 'impact' and msg.last_moved < msg.pair_index
-    event = {'kind': kind, 'index': msg.index,
-             'pair': _pair_name(msg.pair_index, seam), 'pair_index': msg.pair_index,
-             'time': msg.time, 'position': msg.position, 'restitution': _value(msg.restitution),
-             'first_moved': msg.first_moved, 'last_moved': msg.last_moved,
-             'cluster_impact': msg.cluster_impact,
-             'pair_velocities_before': _values(msg.pair_velocities_before),
-             'pair_velocities_after': _values(msg.pair_velocities_after),
-             'pair_energy_transfer': _values(msg.pair_energy_transfer),
-             'energy_lost': _value(msg.energy_lost), 'total_energy': _value(msg.total_energy),
-             'total_momentum': _value(msg.total_momentum),
-             'uncertified': list(getattr(msg, 'uncertified', []))}
-    for key in ('positions', 'velocities_before', 'velocities_after', 'energy_transfer',
-                'kinetic_energy_after', 'predicted_velocities_after', 'paper_velocities_after',
-                'predicted_energy_transfer', 'paper_energy_transfer'):
-        values = getattr(msg, key)
-        event[key] = _values(values) if len(values) else None
-    return event
+_PAIR_ARRAYS = ('pair_velocities_before', 'pair_velocities_after', 'pair_energy_transfer')
+_INT_SCALARS = ('index', 'pair_index', 'first_moved', 'last_moved')
+# The float fields that _event writes as the CLI's JSON does (a non-finite value null, so NaN
+# in the columns); time and position keep their value (an inf time stays inf).
+_NULLED_FLOATS = ('restitution', 'energy_lost', 'total_energy', 'total_momentum')
+_FLOATS = ('time', 'position') + _NULLED_FLOATS
+_get_ints = attrgetter(*_INT_SCALARS)
+_get_floats = attrgetter(*_FLOATS)
+
+
+def _is_event(datatype):
+    return datatype.split('/')[-1] == 'CollisionEvent'
+
+
+def _nulled(values):
+    """values with every non-finite value NaN (the JSON's null), in place."""
+    np.copyto(values, np.nan, where=~np.isfinite(values))
+    return values
+
+
+class _EventColumns:
+    """The event columns of a run's CollisionEvent messages, filled one message at a time
+    (add) and handed over in events_from_records' layout (arrays), the same keys, dtypes and
+    values: the scalars and the pair's fields in growing arrays of 8 bytes a value; the
+    per-body arrays (and the three-body model's) in events x bodies arrays only for a scene
+    of at most FULL_STATE_MAX_BODIES bodies, whose messages carry them. Above that the
+    messages' arrays are empty and not read, and those columns are run()'s read-only view of
+    one NaN (no events x bodies memory): Run.state_at rebuilds every body's state."""
+
+    def __init__(self, bodies):
+        self.bodies = bodies
+        self.full_state = bodies <= FULL_STATE_MAX_BODIES
+        self.count = 0
+        # kind and pair: each event's number of its name (the names are few).
+        self.kind_names, self.pair_names = {}, {}
+        self.kinds, self.pairs = array('q'), array('q')
+        # One row per event, interleaved: _INT_SCALARS; cluster_impact; _FLOATS; the pair's
+        # fields (_PAIR_ARRAYS, two values each).
+        self.ints, self.cluster, self.floats, self.pair = array('q'), array('B'), array('d'), array('d')
+        self.uncertified = []  # per event, the names of its values not certified correctly rounded
+        self.uncertified_names = {}
+        # key -> the events' rows of `bodies` values, one after another (NaN where a message's
+        # array is empty), from the first event whose message has that array.
+        self.per_body = {}
+        self.nan_row = array('d', [math.nan] * bodies)
+
+    def add(self, msg):
+        kind = self.kind_names.get(msg.kind)
+        if kind is None:
+            kind = self.kind_names[msg.kind] = len(self.kind_names)
+        # Only an impact across a ring's seam has last_moved below its pair_index.
+        seam = msg.kind == 0 and msg.last_moved < msg.pair_index
+        pair = self.pair_names.get((msg.pair_index, seam))
+        if pair is None:
+            pair = self.pair_names[(msg.pair_index, seam)] = len(self.pair_names)
+        self.kinds.append(kind)
+        self.pairs.append(pair)
+        self.ints.extend(_get_ints(msg))
+        self.cluster.append(bool(msg.cluster_impact))
+        self.floats.extend(_get_floats(msg))
+        values = self.pair
+        values.extend(msg.pair_velocities_before)
+        values.extend(msg.pair_velocities_after)
+        values.extend(msg.pair_energy_transfer)
+        uncertified = getattr(msg, 'uncertified', ())
+        if len(uncertified):
+            # One tuple for every event with the same names (a long run's events share a few).
+            names = tuple(uncertified)
+            self.uncertified.append(self.uncertified_names.setdefault(names, names))
+        else:
+            self.uncertified.append(())
+        if self.full_state:
+            bodies, per_body = self.bodies, self.per_body
+            for key in _BODY_ARRAYS + _MODEL_ARRAYS:
+                values = getattr(msg, key)
+                rows = per_body.get(key)
+                if len(values):
+                    if rows is None:  # NaN in the events before
+                        rows = per_body[key] = self.nan_row * self.count
+                    if len(values) > bodies:
+                        raise ValueError('CollisionEvent %d: %s has %d values for %d bodies'
+                                         % (msg.index, key, len(values), bodies))
+                    rows.extend(values)
+                    if len(values) < bodies:  # NaN after a short row, as events_from_records
+                        rows.extend(self.nan_row[len(values):])
+                elif rows is not None:
+                    rows.extend(self.nan_row)
+        self.count += 1
+
+    def _rows(self, key):
+        """The events x bodies array of key (NaN where an event had none), or None when no
+        event had one."""
+        rows = self.per_body.pop(key, None)
+        if rows is None:
+            return None
+        return _nulled(np.frombuffer(rows, dtype=float).reshape(self.count, self.bodies))
+
+    def arrays(self):
+        """The columns, as events_from_records gives them for the same events."""
+        n, bodies = self.count, self.bodies
+        if n == 0:
+            return events_from_records([], bodies)
+        kinds = np.array([_KINDS.get(kind, str(kind)) for kind in self.kind_names], dtype=str)
+        pairs = np.array([_pair_name(index, seam) for index, seam in self.pair_names], dtype=str)
+        arrays = {'kind': kinds[np.frombuffer(self.kinds, dtype=np.int64)],
+                  'pair': pairs[np.frombuffer(self.pairs, dtype=np.int64)]}
+        self.kinds = self.pairs = None
+        ints = np.frombuffer(self.ints, dtype=np.int64).reshape(n, len(_INT_SCALARS))
+        floats = np.frombuffer(self.floats, dtype=float).reshape(n, len(_FLOATS))
+        for key, dtype in _SCALARS:
+            if key in _INT_SCALARS:
+                column = ints[:, _INT_SCALARS.index(key)].copy()
+            elif key == 'cluster_impact':
+                column = np.frombuffer(self.cluster, dtype=np.uint8).astype(bool)
+            else:
+                column = floats[:, _FLOATS.index(key)].copy()
+                if key in _NULLED_FLOATS:
+                    _nulled(column)
+            arrays[key] = column.astype(dtype, copy=False)
+        del ints, floats
+        self.ints = self.cluster = self.floats = None
+        for key in _BODY_ARRAYS:
+            rows = self._rows(key)
+            arrays[key] = rows if rows is not None else np.broadcast_to(np.float64(np.nan), (n, bodies))
+        pair = np.frombuffer(self.pair, dtype=float).reshape(n, len(_PAIR_ARRAYS), 2)
+        for i, key in enumerate(_PAIR_ARRAYS):
+            arrays[key] = _nulled(pair[:, i].copy())
+        del pair
+        self.pair = None
+        for key in _MODEL_ARRAYS:
+            rows = self._rows(key)
+            if rows is not None:
+                arrays[key] = rows
+        uncertified = np.empty(n, dtype=object)
+        for j, names in enumerate(self.uncertified):
+            uncertified[j] = names
+        self.uncertified = None
+        arrays['uncertified'] = uncertified
+        return arrays
 
 
 def _scene(initial):
@@ -167,12 +289,21 @@ def read_bag(path):
     summary: exactly run()'s keys (SUMMARY_KEYS) plus run_id, student and bag_path, from
     RunSummary and Prediction; the keys the bag does not hold (not in BAG_SUMMARY_KEYS) are
     None. events: every CollisionEvent, the arrays of run(). options: as run()'s.
+
+    The events are streamed: one pass over the CollisionEvent messages fills the columns
+    (8 bytes a value), keeping no message. Above CollisionEvent.FULL_STATE_MAX_BODIES (64)
+    bodies the messages carry the pair's fields only: the per-body arrays (positions,
+    velocities_after, ...) are then run()'s read-only view of one NaN (no events x bodies
+    memory), and state_at(k) or state_at(t=...) gives every body's position and velocity,
+    rebuilt from the pair fields as for run()'s runs; to_pandas() then leaves out the
+    v_/x_ columns, and to_pandas(bodies=[...]) gives those of the bodies named.
     """
     import rosbag
     initial = prediction = summary = parameters = None
-    events = []
     with rosbag.Bag(path) as bag:
-        for _, msg, _ in bag.read_messages():
+        # The run's few messages first (the scene decides the events' layout), then the
+        # events in one pass.
+        for _, msg, _ in bag.read_messages(connection_filter=lambda topic, datatype, *_: not _is_event(datatype)):
             kind = msg._type.split('/')[-1]
             if kind == 'InitialConditions':
                 initial = msg
@@ -182,10 +313,11 @@ def read_bag(path):
                 summary = msg
             elif kind == 'RunParameters':
                 parameters = msg
-            elif kind == 'CollisionEvent':
-                events.append(msg)
-    if initial is None:
-        raise ValueError('%s: no InitialConditions: not a bag of collision_lab_node' % path)
+        if initial is None:
+            raise ValueError('%s: no InitialConditions: not a bag of collision_lab_node' % path)
+        events = _EventColumns(len(initial.masses))
+        for _, msg, _ in bag.read_messages(connection_filter=lambda topic, datatype, *_: _is_event(datatype)):
+            events.add(msg)
     scene = _run_scene(initial, parameters, summary)
     report = {'scene': _scene(initial),
               'options': {'max_collisions': scene['max_collisions'], 'events': scene['events'],
@@ -193,5 +325,4 @@ def read_bag(path):
               'units': {'mass': 'kg', 'position': 'm', 'velocity': 'm/s', 'time': 's', 'energy': 'J',
                         'momentum': 'kg m/s'},
               'summary': _summary(summary, prediction) if summary is not None else {}}
-    return Run(report, scene, report['summary'], events_from_records([_event(msg) for msg in events],
-                                                                       len(scene['masses'])))
+    return Run(report, scene, report['summary'], events.arrays())

@@ -48,6 +48,9 @@ EVENT_UNITS = {'time': 's', 'position': 'm', 'energy_lost': 'J', 'total_energy':
 SCENE_KEYS = ('name', 'masses', 'positions', 'velocities', 'restitution', 'ring', 'restitution_model',
               'tc', 'elastic_below', 'viscoelastic_speed', 'max_collisions', 'simulate_to_cap', 'mode',
               'events', 'full_state_every')
+# CollisionEvent.FULL_STATE_MAX_BODIES: above this many bodies a record carries the pair's
+# fields only (run()'s, as the node's messages): the per-body arrays are a view of one NaN.
+FULL_STATE_MAX_BODIES = 64
 # Per-event values with one number per body ([m], [m/s], [J]).
 _BODY_ARRAYS = ('positions', 'velocities_before', 'velocities_after', 'energy_transfer',
                 'kinetic_energy_after')
@@ -427,22 +430,76 @@ class Run:
         ring = self.scene.get('ring')
         return np.mod(flown, ring) if ring else flown
 
-    def to_pandas(self):
-        """One row per event: the scalar fields, then v_A, v_B, ... (velocities after [m/s])
-        and x_A, x_B, ... (positions at the event [m]). table.attrs['units']: column -> unit
-        of every column that has one."""
+    def to_pandas(self, bodies=None):
+        """One row per event: kind, pair and the scalar fields, then v_A, v_B, ... (velocities
+        after the event [m/s]) and x_A, x_B, ... (positions at the event [m]).
+        table.attrs['units']: column -> unit of every column that has one.
+
+        bodies: whose v_/x_ columns. None (the default): every body's, from the per-body
+        arrays, for a scene of at most 64 bodies (FULL_STATE_MAX_BODIES; NaN in an event
+        that carries no full state, full_state_every); above 64 bodies none, since the
+        record has no per-body arrays and the table would take events x bodies x 16 bytes
+        (1.6 GB for 100,000 events of 1,000 bodies): use state_at(k) / state_at(t=...) for
+        every body's state, or ask for the bodies you want here. A list of bodies (names
+        'A', '#70', or 0-based indices) or 'all': those bodies' columns rebuilt from the
+        pair fields in one pass over the events, as state_at gives them (velocities exact,
+        positions flown from each body's last contact), for any number of bodies and for
+        every event of a lean record too; they take events x len(bodies) x 16 bytes. The
+        same for run()'s and read_bag()'s runs."""
         import pandas as pd
         columns = {key: self.events[key] for key in ('kind', 'pair') + tuple(k for k, _ in _SCALARS)}
-        for i, name in enumerate(self.names):
-            columns['v_' + name] = self.events['velocities_after'][:, i]
-        for i, name in enumerate(self.names):
-            columns['x_' + name] = self.events['positions'][:, i]
+        if bodies is None:
+            shown = list(range(len(self.names))) if len(self.names) <= FULL_STATE_MAX_BODIES else []
+            velocities = {i: self.events['velocities_after'][:, i] for i in shown}
+            positions = {i: self.events['positions'][:, i] for i in shown}
+        else:
+            shown = self._body_indices(bodies)
+            rebuilt_x, rebuilt_v = self._states_at_events(shown)
+            velocities = {i: rebuilt_v[:, c] for c, i in enumerate(shown)}
+            positions = {i: rebuilt_x[:, c] for c, i in enumerate(shown)}
+        for i in shown:
+            columns['v_' + self.names[i]] = velocities[i]
+        for i in shown:
+            columns['x_' + self.names[i]] = positions[i]
         table = pd.DataFrame(columns)
         units = dict(EVENT_UNITS)
-        units.update(('v_' + name, 'm/s') for name in self.names)
-        units.update(('x_' + name, 'm') for name in self.names)
+        units.update(('v_' + self.names[i], 'm/s') for i in shown)
+        units.update(('x_' + self.names[i], 'm') for i in shown)
         table.attrs['units'] = units
         return table
+
+    def _body_indices(self, bodies):
+        """to_pandas' bodies (names, 0-based indices or 'all') as indices, in the order given."""
+        if isinstance(bodies, str) and bodies == 'all':
+            return list(range(len(self.names)))
+        if isinstance(bodies, (str, int, np.integer)):
+            bodies = [bodies]
+        indices = []
+        for body in bodies:
+            if isinstance(body, str) and body in self.names:
+                indices.append(self.names.index(body))
+            elif (isinstance(body, (int, np.integer)) and not isinstance(body, bool)
+                  and 0 <= body < len(self.names)):
+                indices.append(int(body))
+            else:
+                raise ValueError("bodies: %r is not a body of this run (names %s .. %s, or indices 0 .. %d, or 'all')"
+                                 % (body, self.names[0], self.names[-1], len(self.names) - 1))
+        return indices
+
+    def _states_at_events(self, indices):
+        """(positions [m], velocities [m/s]) of the bodies `indices` after each event, arrays
+        of shape (events, len(indices)): state_at(k) for k = 1 .. events in one replay."""
+        e = self.events
+        count = len(e['time'])
+        indices = np.asarray(indices, dtype=np.intp)
+        positions = np.empty((count, len(indices)))
+        velocities = np.empty_like(positions)
+        replay = self._replay()
+        next(replay)  # the start
+        for j, (x, v, since) in enumerate(replay):
+            positions[j] = self._flown(x[indices], v[indices], since[indices], e['time'][j])
+            velocities[j] = v[indices]
+        return positions, velocities
 
     def __repr__(self):
         return '<collision_lab.Run %d bodies, model %s, %s collisions>' % (

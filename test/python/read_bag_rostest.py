@@ -90,7 +90,9 @@ class ReadBag(unittest.TestCase):
 
     def test_many_bodies_beyond_the_full_state(self):
         # CollisionEvent carries per-body arrays up to FULL_STATE_MAX_BODIES (64) bodies:
-        # beyond, read_bag's per-body arrays are NaN, the scalars still the run's.
+        # beyond, read_bag's per-body arrays are run()'s read-only view of one NaN (no events
+        # x bodies memory), the scalars and pair fields still the run's, and state_at gives
+        # every body's state, as run()'s does.
         n = 70
         scene = dict(masses=[1.0 + (i % 3) for i in range(n)], positions=[float(n - i) for i in range(n)],
                      velocities=[-1.0] + [0.0] * (n - 2) + [1.0])
@@ -101,9 +103,22 @@ class ReadBag(unittest.TestCase):
         self.assertGreater(events, 0)
         self.assertEqual(bag.events['positions'].shape, (events, n))
         self.assertTrue(np.isnan(bag.events['velocities_after']).all())
-        for key in ('index', 'pair_index', 'time', 'position', 'total_energy'):
+        self.assertEqual(bag.events['velocities_after'].strides, (0, 0))
+        for key in ('index', 'pair_index', 'time', 'position', 'total_energy', 'pair_velocities_after'):
             np.testing.assert_array_equal(bag.events[key], run.events[key], err_msg=key)
         self.assertEqual(bag.names[-1], '#69')
+        masses = np.array(scene['masses'])
+        momentum = float(np.sum(masses * np.array(scene['velocities'])))
+        for k in (1, events // 2, events):
+            x, v = bag.state_at(k)
+            x_run, v_run = run.state_at(k)
+            np.testing.assert_array_equal(v, v_run, err_msg=str(k))
+            np.testing.assert_array_equal(x, x_run, err_msg=str(k))
+            # Elastic, no walls: the momentum is the start's, to rounding.
+            self.assertLessEqual(abs(float(np.sum(masses * v)) - momentum), 1e-12 * float(np.sum(masses)))
+        # After the last impact: RunSummary's final velocities, recorded from the engine's state.
+        self.assertEqual(bag.state_at(events)[1].tolist(), list(summary.final_velocities))
+        self.assertFalse([c for c in bag.to_pandas().columns if c.startswith(('v_', 'x_'))])
 
 
 if __name__ == '__main__':

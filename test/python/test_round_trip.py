@@ -242,11 +242,12 @@ def test_a_bags_events_name_a_ring_seams_pair_as_run_does():
     # read_bag names each CollisionEvent's pair; across a ring's seam (last_moved below
     # pair_index) the pair is the last body and A ('EA'), as run() names it.
     from types import SimpleNamespace
-    from collision_lab._bag import _event
+    from collision_lab._bag import _EventColumns
     run = collision_lab.run([1, 2, 3, 1.5, 1], [4, 3, 2, 1, 0], [-1, 0.5, 0, 0.2, 1], ring=10, max_collisions=100)
     e = run.events
     seams = [j for j in range(len(e['time'])) if e['kind'][j] == 'impact' and e['last_moved'][j] < e['pair_index'][j]]
     assert seams and e['pair'][seams[0]] == 'EA'
+    columns = _EventColumns(5)
     for j in range(len(e['time'])):
         empty = []
         msg = SimpleNamespace(kind=0 if e['kind'][j] == 'impact' else 1, index=int(e['index'][j]),
@@ -260,4 +261,5 @@ def test_a_bags_events_name_a_ring_seams_pair_as_run_does():
                               total_momentum=0.0, positions=empty, velocities_before=empty, velocities_after=empty,
                               energy_transfer=empty, kinetic_energy_after=empty, predicted_velocities_after=empty,
                               paper_velocities_after=empty, predicted_energy_transfer=empty, paper_energy_transfer=empty)
-        assert _event(msg)['pair'] == e['pair'][j], j
+        columns.add(msg)
+    assert columns.arrays()['pair'].tolist() == e['pair'].tolist()

@@ -126,9 +126,12 @@ def test_run_equals_cli_json(cli, model, kwargs, cli_args):
     assert len(table) == len(events)
     names = [collision_lab.body_name(i) for i in range(len(kwargs['masses']))]
     assert run.names == names
-    for i, name in enumerate(names):
-        np.testing.assert_array_equal(table['v_' + name], run.events['velocities_after'][:, i])
-        np.testing.assert_array_equal(table['x_' + name], run.events['positions'][:, i])
+    if len(names) <= 64:
+        for i, name in enumerate(names):
+            np.testing.assert_array_equal(table['v_' + name], run.events['velocities_after'][:, i])
+            np.testing.assert_array_equal(table['x_' + name], run.events['positions'][:, i])
+    else:  # no per-body arrays: no all-NaN columns; state_at gives the states
+        assert not [c for c in table.columns if c.startswith(('v_', 'x_'))]
     np.testing.assert_array_equal(run.masses, np.array(kwargs['masses'], dtype=float))
 
 

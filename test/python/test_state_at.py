@@ -96,3 +96,33 @@ def test_times_in_any_order_are_the_states_at_each():
     for row, time in enumerate(times):
         x, v = run.state_at(t=float(time))
         assert list(xs[row]) == list(x) and list(vs[row]) == list(v), time
+
+
+def test_a_tables_asked_for_bodies_are_state_at_for_every_event():
+    # to_pandas(bodies=...) rebuilds the columns of the bodies named, in one pass: after
+    # event k they are state_at(k); of a lean record, the full record's velocities bit for
+    # bit at every event, as state_at's.
+    full, lean = pi_run(), pi_run(full_state_every=10)
+    table = lean.to_pandas(bodies='all')
+    assert [c for c in table.columns if c[:2] in ('v_', 'x_')] == ['v_A', 'v_B', 'v_C', 'x_A', 'x_B', 'x_C']
+    for i, name in enumerate(lean.names):
+        assert table['v_' + name].to_numpy().tobytes() == full.events['velocities_after'][:, i].tobytes(), name
+        np.testing.assert_allclose(table['x_' + name], full.events['positions'][:, i], rtol=0, atol=4e-15)
+    # Above 64 bodies: none by default, and those asked for by name or index.
+    n = 200
+    v0 = np.where(np.arange(n) % 2 == 0, -1.0, 1.0)
+    many = collision_lab.run([1.0] * n, [float(x) for x in range(n, 0, -1)], v0)
+    assert not [c for c in many.to_pandas().columns if c[:2] in ('v_', 'x_')]
+    chosen = many.to_pandas(bodies=['#199', 0])
+    assert list(chosen.columns[-4:]) == ['v_#199', 'v_A', 'x_#199', 'x_A']
+    for k in (1, len(chosen) // 2, len(chosen)):
+        x, v = many.state_at(k)
+        assert (chosen['v_#199'][k - 1], chosen['v_A'][k - 1]) == (v[199], v[0]), k
+        assert (chosen['x_#199'][k - 1], chosen['x_A'][k - 1]) == (x[199], x[0]), k
+    # Equal masses exchange velocities: A (rightmost, -1 m/s first) ends with the fastest
+    # rightward velocity, +1 m/s; the leftmost body with -1 m/s.
+    assert (chosen['v_A'].iloc[-1], chosen['v_#199'].iloc[-1]) == (1.0, -1.0)
+    with pytest.raises(ValueError, match='not a body'):
+        many.to_pandas(bodies=[200])
+    with pytest.raises(ValueError, match='not a body'):
+        many.to_pandas(bodies=[True])
