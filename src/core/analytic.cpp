@@ -236,14 +236,15 @@ double ClosedFormSequence::largestSquaredError(std::uint64_t first, const std::a
   double largest = 0.0;
   std::size_t i = 0;
   std::uint64_t n = first;
+  // std::max(largest, e) keeps largest where e is NaN, as one impact at a time would.
   if (n % 2 == 1 && i < count) {
     rotation_.moveTo(n / 2);
-    largest = error(v[i++], cos_odd, sin_odd);
+    largest = std::max(largest, error(v[i++], cos_odd, sin_odd));
     ++n;
   }
   for (; i + 2 <= count; i += 2, n += 2) {  // n even, then n + 1 odd: one rotation step
     rotation_.moveTo(n / 2);
-    largest = std::max(largest, std::max(error(v[i], cos_even, sin_even), error(v[i + 1], cos_odd, sin_odd)));
+    largest = std::max(std::max(largest, error(v[i], cos_even, sin_even)), error(v[i + 1], cos_odd, sin_odd));
   }
   if (i < count) {
     rotation_.moveTo(n / 2);

@@ -470,11 +470,10 @@ struct SimulationOptions {
   std::uint64_t max_collisions = 10'000'000;  ///< stops the run cleanly; marks it truncated
   /// When set, the run stops within 1024 impacts, marked truncated and cancelled.
   const std::atomic<bool>* cancel = nullptr;
-  /// The caller holds the certified velocities after the predicted count (a short run's
-  /// exact walk): simulateKnownCount does not certify a replica that reaches it again
-  /// (runElasticTriple's end_known); the caller's values stand where the run's are within
-  /// ulps of them.
-  bool end_known = false;
+  /// The certified velocities after the predicted count [m/s], where the caller holds them
+  /// (the prediction's): a replica that reaches the count without certifying its own takes
+  /// them (runElasticTriple's end_state) instead of building the product again.
+  std::optional<std::array<double, 3>> end_state;
 };
 
 /// The run of three elastic bodies whose count the closed form gives (`count`), without the
@@ -521,6 +520,13 @@ std::optional<SceneSimulation> simulateKnownCount(const Scene& scene, std::uint6
   const double time_limit = static_cast<double>(
       std::ldexp(static_cast<long double>(std::numeric_limits<double>::max()), units.timeShift()));
   const std::size_t first_pair = first == Pair::BC ? 1 : 0;
+  // The caller's certified end state in the working units, where they hold it exactly.
+  std::optional<std::array<double, 3>> end_state;
+  if (options.end_state && detail::scalesExactly(*options.end_state, shift)) {
+    end_state.emplace();
+    for (int k = 0; k < 3; ++k) (*end_state)[k] = std::ldexp((*options.end_state)[k], shift);
+  }
+  const std::array<double, 3>* known_end = end_state ? &*end_state : nullptr;
   std::optional<nbody_detail::ElasticTripleRun> run;
   if constexpr (std::is_same_v<std::decay_t<Visit>, NoVisit>) {
     run = nbody_detail::runElasticTriple(
@@ -528,7 +534,7 @@ std::optional<SceneSimulation> simulateKnownCount(const Scene& scene, std::uint6
         [&](std::uint64_t n, const std::array<double, 3>&) {
           if (every != 0 && n % every == 0) progress(EngineProgress{n, std::numeric_limits<double>::quiet_NaN()});
         },
-        accept, nbody_detail::KnownCountPath::kAuto, options.end_known);
+        accept, nbody_detail::KnownCountPath::kAuto, known_end);
   } else {
     std::array<std::array<double, 3>, kVisitBatch> batch, si_batch;  // working units, SI
     std::size_t batched = 0;
@@ -569,7 +575,7 @@ std::optional<SceneSimulation> simulateKnownCount(const Scene& scene, std::uint6
           flush();
           return accept();
         },
-        nbody_detail::KnownCountPath::kAuto, options.end_known);
+        nbody_detail::KnownCountPath::kAuto, known_end);
     flush();
   }
   if (!run) return std::nullopt;
@@ -839,12 +845,14 @@ SceneSimulation simulateRotationScene(const Scene& scene, const Prediction& pred
   SimulationOptions simulation_options;
   simulation_options.max_collisions = lab.max_collisions;
   simulation_options.cancel = options.cancel;
-  // The prediction's certified final velocities are the run's at the predicted count: the
-  // run need not certify them a second time (see below, where they stand for it).
+  // The prediction's certified final velocities are the exact state after the predicted
+  // count, correctly rounded: the run takes them there rather than certify that state again.
   const bool prediction_certified =
       std::find(prediction.uncertified.begin(), prediction.uncertified.end(), "predicted_final_velocities") ==
       prediction.uncertified.end();
-  simulation_options.end_known = prediction_certified;
+  if (prediction_certified && prediction.final_velocities.size() == 3) {
+    simulation_options.end_state = triple(prediction.final_velocities);
+  }
   const EventPolicy events = options.keep_events ? lab.events : EventPolicy::none();
   const ProgressCallback& progress = visitors.progress;
   const std::uint64_t progress_interval = progress ? options.progress_interval : 0;

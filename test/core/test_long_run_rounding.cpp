@@ -134,6 +134,46 @@ TEST(LongRunRounding, SummaryAndFullRunsEndAtTheCorrectlyRoundedVelocities) {
   EXPECT_GE(checked, 40);
 }
 
+TEST(LongRunRounding, ShortRunsEndAtTheCorrectlyRoundedVelocitiesCertified) {
+  // Runs below the filtered pass's length (kFilterFromImpacts): the double-double replica,
+  // which takes the prediction's certified end state where its own bound does not certify
+  // its values. Seeded heavy-light-heavy scenes of 10^3 to 10^6 (about 100 to 3,000
+  // impacts), summary and full mode: every velocity the correctly rounded exact one, and
+  // none flagged uncertified.
+  std::mt19937_64 rng(61);
+  std::vector<Scene> scenes = heavyLightHeavy(rng, 6.0);
+  scenes.push_back({{3, 1, 2}, {2, 1, 0}, {-1, 0.25, 0.5}});
+  // Equal masses: velocities exchanged, exact zeros among them (the replica's bound cannot
+  // certify a zero; the prediction's exact walk does).
+  scenes.push_back({{1, 1, 1}, {2, 1, -1}, {-1, 0, 1}});
+  scenes.push_back({{2, 2, 2}, {3, 2, 1}, {-1, 0, 0}});
+  scenes.push_back({{1, 1, 1}, {2, 1, 0}, {-1, 0.5, 0.25}});
+  int checked = 0;
+  for (const Scene& scene : scenes) {
+    const std::uint64_t count = predictedImpactCount(scene);
+    ASSERT_LT(count, nbody_detail::kFilterFromImpacts) << describe(scene);
+    for (const RunMode mode : {RunMode::kSummaryOnly, RunMode::kFull}) {
+      SceneRunOptions options;
+      options.lab.mode = mode;
+      options.lab.events = EventPolicy::none();
+      const SceneSimulation run = runScene(planScene(Scene(scene)), options).simulation;
+      ASSERT_EQ(run.impact_count, count) << describe(scene);
+      const auto exact = AnalyticModel<DeepPrecision>(scene).velocitiesAfter(count);
+      bool all_clear = true;
+      for (int k = 0; k < 3; ++k) {
+        if (scene.isWall(k)) continue;
+        const std::optional<double> nearest = nearestClearOfTies(exact(k));
+        all_clear = all_clear && nearest.has_value();
+        if (!nearest) continue;
+        ++checked;
+        EXPECT_EQ(run.final_velocities[k], *nearest) << describe(scene) << " body " << k;
+      }
+      if (all_clear) EXPECT_TRUE(run.uncertified.empty()) << describe(scene);
+    }
+  }
+  EXPECT_GE(checked, 40);
+}
+
 TEST(LongRunRounding, TheLastEventCarriesTheSummarysFinalVelocities) {
   // The run whose engine value is 2 ulps off: every event published, none kept.
   const Scene scene = {{1e14, 1, 1e14}, {1, 0, -1}, {-1, 0, 0}};

@@ -539,14 +539,16 @@ constexpr std::uint64_t kFilterFromImpacts = 8192;
 /// impact n, visit(n, v) sees the velocities rounded to double (the engine's record values
 /// in the replica; the double walk's in the filtered pass). Returns nothing when the engine
 /// must run it (then visit has seen an unfinished pass). A certified final state is the same
-/// whichever pass answers: the correctly rounded one. `end_known`: the caller holds the
-/// certified state after all `count` impacts (a short run's exact walk), so that a replica
-/// which reaches it is not certified again here (it stays uncertified for the caller).
+/// whichever pass answers: the correctly rounded one. `end_state` (may be null): the
+/// certified velocities after all `count` impacts, which the caller holds (the prediction's:
+/// the same exact state, correctly rounded), so that a replica which reaches the count
+/// without certifying its own takes them instead of building the product again.
 template <class Restart, class Visit, class Accept>
 std::optional<ElasticTripleRun> runElasticTriple(const Scene& scene, std::uint64_t count, std::size_t first_pair,
                                                  std::uint64_t cap, double time_limit, const std::atomic<bool>* cancel,
                                                  Restart&& restart, Visit&& visit, Accept&& accept,
-                                                 KnownCountPath path = KnownCountPath::kAuto, bool end_known = false) {
+                                                 KnownCountPath path = KnownCountPath::kAuto,
+                                                 const std::array<double, 3>* end_state = nullptr) {
   // The run's final velocities from the product, where it certifies them (a wall's is exact
   // and keeps the pass's zero sign).
   const auto certify = [&](ElasticTripleRun& run) {
@@ -571,7 +573,14 @@ std::optional<ElasticTripleRun> runElasticTriple(const Scene& scene, std::uint64
   restart();
   if (auto run = runElasticTriplePassOnPath<ElasticTriplePass::kReplica>(scene, count, first_pair, cap, time_limit,
                                                                          cancel, visit)) {
-    if (!run->certified && !(end_known && run->impact_count == count)) certify(*run);
+    if (!run->certified && end_state && run->impact_count == count) {
+      for (int k = 0; k < 3; ++k) {
+        if (!scene.isWall(k)) run->final_velocities[k] = (*end_state)[k];
+      }
+      run->certified = true;
+    } else if (!run->certified) {
+      certify(*run);
+    }
     return run;
   }
   restart();
