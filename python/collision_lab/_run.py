@@ -277,15 +277,16 @@ def _uncertified_column(names):
 
 def events_from_records(events, bodies):
     """The event columns of a list of event dicts (the CLI's JSON events, a bag's messages):
-    NaN where a record has null."""
+    NaN where a record has null, or leaves a key out (the full state of a lean event, or of
+    a scene of more than 64 bodies)."""
     arrays = {'kind': np.array([e['kind'] for e in events], dtype=str),
               'pair': np.array([e['pair'] for e in events], dtype=str)}
     for key, dtype in _SCALARS:
-        values = [e[key] for e in events]
+        values = [e.get(key) for e in events]
         arrays[key] = (np.array(values, dtype=dtype) if dtype is not float
                        else np.array([np.nan if v is None else v for v in values], dtype=float))
     for key in _BODY_ARRAYS:
-        arrays[key] = _float_rows([e[key] for e in events], bodies)
+        arrays[key] = _float_rows([e.get(key) for e in events], bodies)
     # What every event carries, whatever its record: the colliding pair's velocities [m/s]
     # and energy transfers [J].
     for key in ('pair_velocities_before', 'pair_velocities_after', 'pair_energy_transfer'):

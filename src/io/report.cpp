@@ -372,9 +372,7 @@ Json eventJson(const core::ImpactRecord& impact) {
 }
 
 std::string eventPairName(const EventRecord& r) {
-  // Only an impact across a ring's seam has last_moved below its pair_index (namedBodies).
-  if (r.collapse || r.last_moved >= r.pair_index) return core::pairName(r.pair_index);
-  return core::bodyName(r.pair_index) + (r.pair_index < 26 ? "" : "-") + core::bodyName(0);
+  return r.collapse ? core::pairName(r.pair_index) : core::impactPairName(r.pair_index, r.last_moved);
 }
 
 namespace report_text {

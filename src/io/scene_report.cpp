@@ -185,17 +185,6 @@ std::string csvField(const std::string& text) {
   return quoted + "\"";
 }
 
-/// The left body of an impact: pair_index + 1, or body 0 across a ring's seam (the only
-/// record whose last_moved is below its pair_index; a ring has no clusters).
-std::size_t leftBody(const core::ImpactRecord& r) { return r.last_moved < r.pair_index ? 0 : r.pair_index + 1; }
-
-/// pairName, or for a ring's seam the two bodies' names ("CA", "#30-A").
-std::string impactPairName(const core::ImpactRecord& r) {
-  const std::size_t left = leftBody(r);
-  if (left == r.pair_index + 1) return core::pairName(r.pair_index);
-  return core::bodyName(r.pair_index) + (r.pair_index < 26 ? "" : "-") + core::bodyName(left);
-}
-
 Json wallNames(const core::Scene& scene) {
   Json walls = Json::array();
   for (std::size_t i = 0; i < scene.size(); ++i) {
@@ -295,7 +284,7 @@ class SceneTableWriter : public SceneLayout {
 
   void impact(const core::ImpactRecord& r) override {
     if (!header_written_) writeImpactHeader();
-    out_ << padLeft(std::to_string(r.index), 9) << padLeft(impactPairName(r), 8);
+    out_ << padLeft(std::to_string(r.index), 9) << padLeft(core::impactPairName(r.pair_index, r.last_moved), 8);
     for (double value : {r.time, r.position, r.velocities_after[0], r.velocities_after[1], r.energy_lost}) {
       out_ << padLeft(humanText(value, kEventDigits), 15);
     }

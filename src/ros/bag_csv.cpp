@@ -835,7 +835,7 @@ ClassTable bagToClassTable(const std::string& bag_path, const std::string& csv_p
       const bool collapse = event->kind == CollisionEvent::KIND_COLLAPSE;
       if (!collapse) impacts = event->index;
       const std::string pair = collapse ? core::bodyName(event->first_moved) + ".." + core::bodyName(event->last_moved)
-                                        : core::pairName(event->pair_index);
+                                        : core::impactPairName(event->pair_index, event->last_moved);
       const bool every_body = event->positions.size() == state->size();
       writeClassTableRow(out, event->time, impacts, collapse ? "collapse" : "impact", pair,
                          every_body ? std::vector<double>(event->positions.begin(), event->positions.end())

@@ -697,6 +697,37 @@ TEST_F(BagCsvTest, ClassTableIsTheExactRunAtTheStartAndAfterEveryImpact) {
   }
 }
 
+// A ring's impact across its seam (bodies D and A of four) is named as the reports name it,
+// "DA", never after a fifth body; every other impact after its two neighbours. The bodies
+// of each row's pair are the two whose velocities the row changes.
+TEST_F(BagCsvTest, ClassTableNamesARingsSeamPairAsTheReportsDo) {
+  using namespace class_table;
+  core::Scene scene;
+  scene.masses = {1, 2, 3, 4};
+  scene.positions = {3.5, 2.5, 1.5, 0.5};
+  scene.velocities = {1, -1, 0.5, -0.5};
+  scene.ring = 4;
+  recordRun(bag_path_, scene);
+  const auto table = bagToClassTable(bag_path_, dir_ + "/ring.csv", 64);
+  ASSERT_GT(table.rows, 20u);
+  const Table csv = readCsv(dir_ + "/ring.csv");
+  const std::set<std::string> pairs = {"AB", "BC", "CD", "DA"};
+  const char* const names[] = {"A", "B", "C", "D"};
+  int seams = 0;
+  for (std::size_t row = 2; row < csv.size(); ++row) {
+    SCOPED_TRACE("row " + std::to_string(row));
+    const std::string pair = cell(csv, row, "pair");
+    ASSERT_EQ(pairs.count(pair), 1u) << pair;
+    seams += pair == "DA";
+    for (int i = 0; i < 4; ++i) {  // the row changes the velocities of its pair's bodies only
+      const std::string v = "v_" + std::string(names[i]) + "_m_s";
+      const bool in_pair = pair.find(names[i]) != std::string::npos;
+      EXPECT_EQ(number(csv, row, v) != number(csv, row - 1, v), in_pair) << v;
+    }
+  }
+  EXPECT_GT(seams, 0);
+}
+
 // A table with a column per body is refused past max_bodies, and a bag whose summary counts
 // impacts it has no events for says so; neither writes anything.
 TEST_F(BagCsvTest, ClassTableRefusesTooManyBodiesAndSaysWhenEventsAreMissing) {

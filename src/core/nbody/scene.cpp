@@ -384,9 +384,19 @@ std::string bodyName(std::size_t body) {
   return "#" + std::to_string(body);
 }
 
-std::string pairName(std::size_t pair) {
-  if (pair + 1 < 26) return bodyName(pair) + bodyName(pair + 1);
-  return bodyName(pair) + "-" + bodyName(pair + 1);
+namespace {
+
+/// Bodies `right` and `left` as a pair: their names, joined by '-' unless both are letters.
+std::string namesOfPair(std::size_t right, std::size_t left) {
+  return bodyName(right) + (right < 26 && left < 26 ? "" : "-") + bodyName(left);
+}
+
+}  // namespace
+
+std::string pairName(std::size_t pair) { return namesOfPair(pair, pair + 1); }
+
+std::string impactPairName(std::size_t pair_index, std::size_t last_moved) {
+  return last_moved < pair_index ? namesOfPair(pair_index, 0) : pairName(pair_index);
 }
 
 const char* reasonName(Reason reason) {

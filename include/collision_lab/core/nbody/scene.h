@@ -74,6 +74,9 @@ struct Scene {
 std::string bodyName(std::size_t body);
 /// "AB", "BC", ... while both bodies have letters, then "Z-#26", "#26-#27", ...
 std::string pairName(std::size_t pair);
+/// The pair of an impact: pairName(pair_index), or across a ring's seam (the only impact
+/// whose last_moved is below its pair_index) the last body and A: "EA", "#30-A".
+std::string impactPairName(std::size_t pair_index, std::size_t last_moved);
 
 /// Why a scene was rejected. Values are stable (published and printed): append only.
 /// Values 0..8 keep the meaning they have for the three-body scene.
