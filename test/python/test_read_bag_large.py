@@ -6,12 +6,12 @@ The bags come from the record_bag fixture (conftest.py: two nodes under roslaunc
 import os
 import shutil
 import tracemalloc
-import warnings
 
 import numpy as np
 import pytest
 
 import collision_lab
+from bag_reference import event_record, run_quietly
 
 PER_BODY = ('positions', 'velocities_before', 'velocities_after', 'energy_transfer', 'kinetic_energy_after')
 PAIR = ('pair_velocities_before', 'pair_velocities_after', 'pair_energy_transfer')
@@ -31,12 +31,6 @@ MANY = ring(400, 800.0, [1.0 + 0.5 * (i % 3) for i in range(400)])
 FEW = ring(40, 80.0, [1.0 + 0.25 * (i % 5) for i in range(40)], restitution=0.9, cap=3000,
            restitution_model='tc', tc=1e-3, seed=2)
 
-
-def run_quietly(**scene):
-    """run(**scene), its CapWarning (both rings stop at their cap) not shown."""
-    with warnings.catch_warnings():
-        warnings.simplefilter('ignore', collision_lab.CapWarning)
-        return collision_lab.run(**scene)
 
 
 @pytest.fixture(scope='module')
@@ -58,7 +52,6 @@ def as_before(path):
     """The event columns as read_bag built them before it streamed (issue 47): every message
     kept, each made the CLI's JSON event, then events_from_records."""
     import rosbag
-    from bag_reference import event_record
     from collision_lab._run import events_from_records
     with rosbag.Bag(path) as bag:
         masses = [m for _, m, _ in bag.read_messages() if m._type.endswith('/InitialConditions')][0].masses

@@ -5,14 +5,13 @@ at most 64 bodies; above 64 bodies the per-body arrays are run()'s read-only vie
 No node is needed here: the messages are made from run()'s events, field for field as
 collision_lab_node fills CollisionEvent (docs/messages.md). The bags the node records are
 read in test_read_bag_large.py and read_bag_rostest.py."""
-import warnings
 from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
 import collision_lab
-from bag_reference import event_record
+from bag_reference import event_record, run_quietly
 from collision_lab._bag import _EventColumns
 from collision_lab._run import events_from_records
 
@@ -82,19 +81,13 @@ SCENES = {
 
 @pytest.mark.parametrize('name', list(SCENES))
 def test_streamed_columns_are_the_records_columns(name):
-    run = run_quietly(SCENES[name])
+    run = run_quietly(**SCENES[name])
     msgs = messages(run)
     bodies = len(run.masses)
     reference = events_from_records([event_record(m) for m in msgs], bodies)
     ours = streamed(msgs, bodies)
     assert_same_columns(ours, reference)
 
-
-def run_quietly(scene):
-    """run(**scene), its CapWarning (the ring stops at its cap) not shown."""
-    with warnings.catch_warnings():
-        warnings.simplefilter('ignore', collision_lab.CapWarning)
-        return collision_lab.run(**scene)
 
 
 def test_non_finite_values_are_nan_as_in_the_json_and_an_inf_time_stays_and_short_rows_are_padded():

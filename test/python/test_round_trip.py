@@ -2,12 +2,12 @@
 for run() and for read_bag() of the bags collision_lab_node records; and run(), sweep()
 and read_bag() give one set of summary keys for every model (read_bag adds exactly run_id,
 student and bag_path)."""
-import warnings
 
 import numpy as np
 import pytest
 
 import collision_lab
+from bag_reference import run_quietly
 
 INF = float('inf')
 
@@ -72,12 +72,6 @@ def bits(values):
     """Each double's bits (-0.0 and 0.0 differ), None kept."""
     return None if values is None else [None if v is None else float(v).hex() for v in values]
 
-
-def run_quietly(**scene):
-    """run(**scene), its CapWarning (a scene over its cap says so) not shown."""
-    with warnings.catch_warnings():
-        warnings.simplefilter('ignore', collision_lab.CapWarning)
-        return collision_lab.run(**scene)
 
 
 @pytest.fixture(scope='module')
