@@ -174,6 +174,42 @@ TEST(LongRunRounding, ShortRunsEndAtTheCorrectlyRoundedVelocitiesCertified) {
   EXPECT_GE(checked, 40);
 }
 
+TEST(LongRunRounding, ShortRunsAndTheirPredictionsAreTheExactRationalRunRounded) {
+  // The same paths against exact rationals (rational_reference.h, which shares no code with
+  // the core): the summary's final velocities and the prediction's, in summary and full
+  // mode, each within half an ulp of the exact run's (correctlyRounded).
+  std::mt19937_64 rng(4861);
+  std::vector<Scene> scenes = heavyLightHeavy(rng, 4.0);  // up to about 600 impacts
+  scenes.push_back({{1, 1, 1}, {2, 1, -1}, {-1, 0, 1}});
+  scenes.push_back({{2, 2, 2}, {3, 2, 1}, {-1, 0, 0}});
+  scenes.push_back({{3, 1, 2}, {2, 1, 0}, {-1, 0.25, 0.5}});
+  scenes.push_back({{1e4, 1, kInf}, {2, 1, 0}, {-1, 0, 0}});
+  int checked = 0;
+  for (const Scene& scene : scenes) {
+    const reference::Run truth = reference::simulateVelocities(scene, 100000);
+    ASSERT_FALSE(truth.truncated) << describe(scene);
+    ASSERT_FALSE(truth.impacts.empty()) << describe(scene);
+    const auto& exact = truth.impacts.back().velocities;
+    for (const RunMode mode : {RunMode::kSummaryOnly, RunMode::kFull}) {
+      SceneRunOptions options;
+      options.lab.mode = mode;
+      options.lab.events = EventPolicy::none();
+      const SceneRunResult result = runScene(planScene(Scene(scene)), options);
+      ASSERT_EQ(result.simulation.impact_count, truth.impacts.size()) << describe(scene);
+      ASSERT_TRUE(result.prediction) << describe(scene);
+      for (int k = 0; k < 3; ++k) {
+        ++checked;
+        EXPECT_TRUE(correctlyRounded(result.simulation.final_velocities[k], exact[k]))
+            << describe(scene) << " run, body " << k;
+        EXPECT_TRUE(correctlyRounded(result.prediction->final_velocities[k], exact[k]))
+            << describe(scene) << " prediction, body " << k;
+      }
+      EXPECT_TRUE(uncertifiedValues(result).empty()) << describe(scene);
+    }
+  }
+  EXPECT_GE(checked, 60);
+}
+
 TEST(LongRunRounding, TheLastEventCarriesTheSummarysFinalVelocities) {
   // The run whose engine value is 2 ulps off: every event published, none kept.
   const Scene scene = {{1e14, 1, 1e14}, {1, 0, -1}, {-1, 0, 0}};
