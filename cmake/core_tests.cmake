@@ -6,8 +6,22 @@ add_library(collision_lab_test_support STATIC EXCLUDE_FROM_ALL test/core/nbody/r
 target_include_directories(collision_lab_test_support PUBLIC test/core test/core/nbody)
 target_link_libraries(collision_lab_test_support PUBLIC collision_lab_core)
 
+# The long physics test binaries run one process per test, as many at a time as there are
+# cores (test/gtest_parallel.py), so that their minutes do not hold CI on one core; the
+# result file is gtest's, under gtest's name.
+function(collision_lab_add_parallel_gtest target)
+  catkin_add_executable_with_gtest(${target} ${ARGN} EXCLUDE_FROM_ALL)
+  if(TARGET ${target})
+    add_dependencies(tests ${target})
+    get_target_property(binary_folder ${target} RUNTIME_OUTPUT_DIRECTORY)
+    catkin_run_tests_target("gtest" ${target} "gtest-${target}.xml"
+      COMMAND "/usr/bin/python3 ${PROJECT_SOURCE_DIR}/test/gtest_parallel.py ${binary_folder}/${target} --gtest_output=xml:${CATKIN_TEST_RESULTS_DIR}/${PROJECT_NAME}/gtest-${target}.xml"
+      DEPENDENCIES ${target})
+  endif()
+endfunction()
+
 # Pure core tests: gtest, no ROS master.
-catkin_add_gtest(collision_lab_core_tests
+collision_lab_add_parallel_gtest(collision_lab_core_tests
   test/core/test_validation.cpp
   test/core/test_exact_agreement.cpp
   test/core/test_analytic.cpp
@@ -29,7 +43,7 @@ endif()
 
 # N-body core (issue 10): scene, models, exact event engine, against the exact rational
 # reference of the test support.
-catkin_add_gtest(collision_lab_nbody_tests
+collision_lab_add_parallel_gtest(collision_lab_nbody_tests
   test/core/nbody/test_scene.cpp
   test/core/nbody/test_models.cpp
   test/core/nbody/test_engine_hard.cpp
