@@ -7,7 +7,8 @@ most --jobs at a time, in the binary's listing order. Each test's output is prin
 finishes; the closing lines are gtest's ("[  PASSED  ] N tests.", "[  FAILED  ] Suite.Name").
 The XML file has gtest's layout (a testsuites root with the totals, one testsuite per suite),
 so catkin_test_results counts it as it counted the serial run. A test whose process ends
-without its XML (a crash, an abort) is a failure with its exit status and its output's tail.
+with a non-zero status and no failure in its XML (a crash, an abort) is a failure
+with that status and its output's tail.
 
 Usage: gtest_parallel.py BINARY --gtest_output=xml:FILE [--jobs N]
 Exit status: 0 when every test passed, 1 otherwise.
@@ -44,16 +45,16 @@ def run_one(binary, test, folder, index):
 
 
 def testcases(test, returncode, output, xml):
-    """The test's <testcase> elements: from its XML, or one failure when it wrote none."""
-    if os.path.exists(xml):
-        cases = list(ET.parse(xml).getroot().iter("testcase"))
-        if cases:
-            return cases
-    suite, name = test.split(".", 1)
-    case = ET.Element("testcase", name=name, classname=suite, status="run", time="0")
-    failure = ET.SubElement(case, "failure", message="the test process ended with status %d and no result" % returncode)
-    failure.text = output[-4000:]
-    return [case]
+    """The test's <testcase> elements from its XML; a failure added when the process failed
+    without saying so (a crash before or after the test wrote its result)."""
+    cases = list(ET.parse(xml).getroot().iter("testcase")) if os.path.exists(xml) else []
+    if not cases:
+        suite, name = test.split(".", 1)
+        cases = [ET.Element("testcase", name=name, classname=suite, status="run", time="0")]
+    if returncode != 0 and not any(failed(case) for case in cases):
+        failure = ET.SubElement(cases[-1], "failure", message="the test process ended with status %d" % returncode)
+        failure.text = output[-4000:]
+    return cases
 
 
 def failed(case):
