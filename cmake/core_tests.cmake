@@ -33,12 +33,14 @@ collision_lab_add_parallel_gtest(collision_lab_core_tests
   test/core/test_three_body_rounding.cpp
   test/core/test_long_run_rounding.cpp
   test/core/test_filtered_pass.cpp
+  test/core/test_filtered_arithmetic.cpp
   test/core/test_published_rounding.cpp
   test/core/test_totals.cpp)
 if(TARGET collision_lab_core_tests)
   target_link_libraries(collision_lab_core_tests collision_lab_test_support GTest::gtest_main)
-  # test_long_run_rounding.cpp tests the known-count pass (src/core/nbody/elastic_triple.h).
-  target_include_directories(collision_lab_core_tests PRIVATE src/core/nbody)
+  # test_long_run_rounding.cpp tests the known-count pass (src/core/nbody/elastic_triple.h),
+  # test_filtered_arithmetic.cpp the filter of the published angles (src/core/correct_rounding.h).
+  target_include_directories(collision_lab_core_tests PRIVATE src/core/nbody src/core)
 endif()
 
 # N-body core (issue 10): scene, models, exact event engine, against the exact rational

@@ -1,5 +1,6 @@
 #include "correct_rounding.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -56,6 +57,106 @@ std::optional<double> quickNearest(long double x, long double relative) {
     return std::nullopt;
   }
   return low;
+}
+
+namespace {
+
+constexpr long double kInfinity = std::numeric_limits<long double>::infinity();
+
+/// A bound computed in long double, rounded up: a few roundings of 2^-64 each, and an
+/// underflow, covered.
+long double roundedUp(long double bound) {
+  return bound * (1 + 0x1p-60L) + std::numeric_limits<long double>::denorm_min();
+}
+
+/// The result of one rounded operation whose operands' errors propagate to `propagated`.
+Filtered rounded(long double value, long double propagated) {
+  if (!std::isfinite(value)) return {value, kInfinity};
+  return {value, roundedUp(propagated + std::fabs(value) * 0x1p-64L)};
+}
+
+}  // namespace
+
+Filtered operator+(const Filtered& a, const Filtered& b) { return rounded(a.value + b.value, a.error + b.error); }
+
+Filtered operator-(const Filtered& a, const Filtered& b) { return rounded(a.value - b.value, a.error + b.error); }
+
+Filtered operator-(const Filtered& a) { return {-a.value, a.error}; }
+
+Filtered operator*(const Filtered& a, const Filtered& b) {
+  return rounded(a.value * b.value, std::fabs(a.value) * b.error + std::fabs(b.value) * a.error + a.error * b.error);
+}
+
+Filtered operator/(const Filtered& a, const Filtered& b) {
+  // |A/B - a/b| = |(A - a) b - a (B - b)| / |B b| <= (e_a |b| + |a| e_b) / ((|b| - e_b) |b|).
+  const long double size = std::fabs(b.value);
+  if (!(b.error < size)) return {a.value / b.value, kInfinity};
+  const long double room = size - roundedUp(b.error);
+  if (!(room > 0)) return {a.value / b.value, kInfinity};
+  return rounded(a.value / b.value, (a.error * size + std::fabs(a.value) * b.error) / (room * size));
+}
+
+Filtered sqrt(const Filtered& a) {
+  // |sqrt(A) - sqrt(a)| = |A - a| / (sqrt(A) + sqrt(a)) <= e_a / sqrt(a) for A >= 0.
+  if (a.error == 0) return rounded(std::sqrt(a.value), 0);
+  if (!(a.value > 0)) return {std::sqrt(std::fabs(a.value)), kInfinity};
+  const long double root = std::sqrt(a.value);
+  return rounded(root, a.error / root);
+}
+
+Filtered atan2(const Filtered& y, const Filtered& x) {
+  const bool y_exact_zero = y.value == 0 && y.error == 0;
+  // atan2l: within 2 ulps (glibc); an exact 0 as +0, so that the angle is in (-pi, pi].
+  const long double angle = std::atan2(y_exact_zero ? 0.0L : y.value, x.value);
+  const long double own = std::fabs(angle) * 0x1p-61L;
+  // The exact point lies within `spread` of (x, y), so its direction within
+  // asin(spread / radius) <= (pi / 2) spread / radius of (x, y)'s.
+  const long double radius = std::hypot(x.value, y.value) * (1 - 0x1p-60L);
+  const long double spread = roundedUp(x.error + y.error);
+  if (!(spread < radius / 2) || (x.value < 0 && !(y.error < std::fabs(y.value)) && !y_exact_zero)) {
+    return {angle, kInfinity};
+  }
+  long double bound = roundedUp(1.5707963267948966193L * (1 + 0x1p-60L) * spread / radius);
+  // Relatively: scaling y by 1 + a and x by 1 + b moves the angle by at most
+  // |ln((1 + a) / (1 + b))| times |sin 2 xi| / 2 <= min(1/2, |xi|), xi between the two
+  // angles; |ln(1 + a)| <= |a| / (1 - |a|). Tight for small angles, where the first is not.
+  if (x.value != 0 && y.value != 0) {
+    const long double r_x = x.error / std::fabs(x.value), r_y = y.error / std::fabs(y.value);
+    if (r_x < 0.5L && r_y < 0.5L) {
+      const long double log_spread = roundedUp((r_x + r_y) / (1 - std::max(r_x, r_y)));
+      bound = std::min(bound, roundedUp(log_spread * std::min(0.5L, roundedUp(std::fabs(angle) + bound + own))));
+    }
+  }
+  return {angle, roundedUp(bound + own)};
+}
+
+Filtered atan2Sqrt(const Filtered& y, const Filtered& x, const Filtered& scale) {
+  const Filtered size = sqrt(x * x * scale);
+  return atan2(y, x.value < 0 ? -size : size);
+}
+
+std::optional<double> filteredNearest(const Filtered& x) {
+  if (!kFilterable || !std::isfinite(x.value) || !std::isfinite(x.error)) return std::nullopt;
+  if (x.value == 0 && x.error == 0) return 0.0;
+  // Widened so that the rounded ends still enclose [value - error, value + error].
+  const long double margin = x.error * (1 + 0x1p-62L) + std::fabs(x.value) * 0x1p-62L;
+  const double low = static_cast<double>(x.value - margin), high = static_cast<double>(x.value + margin);
+  if (low != high || !std::isfinite(low) || !(std::fabs(low) >= std::numeric_limits<double>::min())) {
+    return std::nullopt;
+  }
+  return low;
+}
+
+std::optional<double> filteredAtan2Sqrt(const Filtered& y, const Filtered& x, const Filtered& scale,
+                                        bool from_zero) {
+  const bool y_exact_zero = y.value == 0 && y.error == 0;
+  if (y_exact_zero && (x.value >= x.error || (scale.value == 0 && scale.error == 0))) return 0.0;  // exactly
+  Filtered angle = atan2Sqrt(y, x, scale);
+  if (from_zero && angle.value < 0) {  // in [0, 2 pi): only an angle that is surely negative
+    if (!(angle.error < -angle.value)) return std::nullopt;
+    angle = angle + Filtered(2 * 3.14159265358979323846264338327950288L, 0x1p-60L);
+  }
+  return filteredNearest(angle);
 }
 
 long double approximate(const ExactRational& q) {

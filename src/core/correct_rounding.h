@@ -8,6 +8,7 @@
 #pragma once
 
 #include <array>
+#include <limits>
 #include <optional>
 
 #include <boost/multiprecision/cpp_bin_float.hpp>
@@ -51,6 +52,44 @@ Certifying certifyingAtan2Sqrt(const ExactRational& y, const ExactRational& x, c
 /// certifies it.
 std::optional<double> roundedAtan2Sqrt(const ExactRational& y, const ExactRational& x, const ExactRational& scale,
                                        bool from_zero = false);
+
+/// A long double with a rigorous bound on its distance from the exact value it stands for:
+/// a floating-point filter's running error bound (as CGAL's filtered predicates). An exact
+/// input has error 0; each operation adds its operands' errors, propagated, and its own
+/// rounding, every bound rounded up. A rounding or a decision that the bound settles needs
+/// no exact arithmetic; one it does not settle goes to the exact path. The bounds assume
+/// long double's 64-bit significand (kFilterable) and values inside its exponent range
+/// (products and quotients of a few doubles are: 2^+-16382 against the doubles' 2^+-1074).
+struct Filtered {
+  Filtered(long double exact = 0) : value(exact) {}  // NOLINT(google-explicit-constructor): exact inputs
+  Filtered(long double value_, long double error_) : value(value_), error(error_) {}
+  long double value = 0;  ///< the computed value
+  long double error = 0;  ///< |exact - value| <= error (infinite: nothing known)
+};
+
+/// Long double has the 64-bit significand that Filtered's bounds assume.
+constexpr bool kFilterable = std::numeric_limits<long double>::digits >= 64;
+
+Filtered operator+(const Filtered& a, const Filtered& b);
+Filtered operator-(const Filtered& a, const Filtered& b);
+Filtered operator-(const Filtered& a);
+Filtered operator*(const Filtered& a, const Filtered& b);
+/// Infinite error where b's bound does not keep it from 0.
+Filtered operator/(const Filtered& a, const Filtered& b);
+/// For an exact value known to be >= 0.
+Filtered sqrt(const Filtered& a);
+/// The angle of (x, y) [rad], in (-pi, pi]; infinite error where the bounds let the exact
+/// point reach the origin or cross the branch cut (x < 0, y of either sign).
+Filtered atan2(const Filtered& y, const Filtered& x);
+/// atan2(y, x sqrt(scale)), for an exact scale >= 0.
+Filtered atan2Sqrt(const Filtered& y, const Filtered& x, const Filtered& scale);
+/// The double nearest the exact value when every value within the bound rounds to it, in the
+/// normal range (an exact 0 as +0); else empty.
+std::optional<double> filteredNearest(const Filtered& x);
+/// roundedAtan2Sqrt's first step, on filtered arguments: the same correctly rounded angle
+/// where the bounds certify it; else empty (the caller takes roundedAtan2Sqrt).
+std::optional<double> filteredAtan2Sqrt(const Filtered& y, const Filtered& x, const Filtered& scale,
+                                        bool from_zero = false);
 
 /// sqrt(q) when it is rational (numerator and denominator perfect squares); else empty.
 std::optional<ExactRational> rationalSqrt(const ExactRational& q);

@@ -69,25 +69,26 @@ std::optional<std::int64_t> impactCountInDouble(const Scene& scene) {
 }
 
 
-using detail::approximate;
 using detail::Certifying;
 using Rational = detail::ExactRational;
 using Integer = boost::multiprecision::cpp_int;
 
 Certifying toCertifying(const Rational& q) { return Certifying(numerator(q)) / Certifying(denominator(q)); }
 
-/// The exact arguments of the printed angles of a scene without a wall. With u1 after the
+/// The arguments of the printed angles of a scene without a wall, exact (T = Rational) or
+/// with a filter's bound (T = detail::Filtered). With u1 after the
 /// first AB impact, u1.n_BC and u1.l_BC of eq. (3.21) are, up to one positive factor,
 /// Y = v_B1 - v_C1 and X sqrt(m_A / (m_B m_C M)) with X = m_B v_B1 + m_C v_C1 - (m_B + m_C) v_A1;
 /// Omega = arccos(n_AB . n_BC) has cos^2 = m_A m_C / q and sin^2 = m_B M / q (cos < 0), and
 /// theta = arg lambda_+ = atan2(2 sqrt(D), a) (eq. 2.2), q = m_A m_C + m_B M, a = m_A m_C - m_B M.
+template <class T>
 struct PrintedAngleArguments {
   explicit PrintedAngleArguments(const Scene& scene)
       : m_a(scene.masses[kA]), m_b(scene.masses[kB]), m_c(scene.masses[kC]), total(m_a + m_b + m_c) {
-    const Rational v_a(scene.velocities[kA]), v_b(scene.velocities[kB]), v_c(scene.velocities[kC]);
-    const Rational m_ab = m_a + m_b;
-    const Rational v_a1 = ((m_a - m_b) * v_a + 2 * m_b * v_b) / m_ab;
-    const Rational v_b1 = (2 * m_a * v_a + (m_b - m_a) * v_b) / m_ab;
+    const T v_a(scene.velocities[kA]), v_b(scene.velocities[kB]), v_c(scene.velocities[kC]);
+    const T m_ab = m_a + m_b;
+    const T v_a1 = ((m_a - m_b) * v_a + T(2) * m_b * v_b) / m_ab;
+    const T v_b1 = (T(2) * m_a * v_a + (m_b - m_a) * v_b) / m_ab;
     x = m_b * v_b1 + m_c * v_c - (m_b + m_c) * v_a1;
     y = v_b1 - v_c;
     x_scale = m_a / (m_b * m_c * total);
@@ -97,15 +98,12 @@ struct PrintedAngleArguments {
     theta_d = m_a * m_b * m_c * total;
     theta_a = m_a * m_c - m_b * total;
   }
-  Rational m_a, m_b, m_c, total;       // the masses [kg] and M
-  Rational x, y, x_scale;              // X, Y and m_A / (m_B m_C M): phi_BC = atan2(Y, X sqrt(x_scale))
-  Rational q;
-  Rational omega_cos_sq, omega_sin_sq;
-  Rational theta_d, theta_a;           // D and a
+  T m_a, m_b, m_c, total;       // the masses [kg] and M
+  T x, y, x_scale;              // X, Y and m_A / (m_B m_C M): phi_BC = atan2(Y, X sqrt(x_scale))
+  T q;
+  T omega_cos_sq, omega_sin_sq;
+  T theta_d, theta_a;           // D and a
 };
-
-/// Long double with a 64-bit significand, where the cheap first step's bounds hold.
-constexpr bool kCheapStep = std::numeric_limits<long double>::digits >= 64;
 
 /// 1 + floor(x) + ceil(x) of eq. (3.22) when every value within `error` of x gives the same.
 std::optional<std::int64_t> decidedCount(const Certifying& x, const Certifying& error) {
@@ -120,7 +118,7 @@ std::optional<std::int64_t> decidedCount(const Certifying& x, const Certifying& 
 /// q = m_A m_C + m_B M; lambda_+^j = c_j + i sqrt(D) s_j with rationals c_j, s_j. Equal unit
 /// vectors: the signs agree and the cosines' squares are equal. (Equal modulo 2 pi: the caller
 /// knows the two angles to be within far less than 2 pi.)
-bool isMultipleOfTheta(const PrintedAngleArguments& a, std::int64_t j) {
+bool isMultipleOfTheta(const PrintedAngleArguments<Rational>& a, std::int64_t j) {
   const Rational &m_a = a.m_a, &m_b = a.m_b, &m_c = a.m_c, &total = a.total, &q = a.q, &x = a.x, &y = a.y;
   // lambda_+^|j| by squaring, (c, s) for c + i sqrt(D) s; a negative j conjugates.
   using Complex = std::pair<Rational, Rational>;
@@ -233,7 +231,11 @@ std::array<double, 3> ExactPrintedClosedForm::velocitiesAfter(std::uint64_t n) {
 
 double phiBC(const Scene& scene, bool* certified) {
   if (wallIndex(scene) >= 0) return kNaN;  // as printed, s = (sqrt m_i) unscaled: inf / inf
-  const PrintedAngleArguments a(scene);
+  if (detail::kFilterable) {
+    const PrintedAngleArguments<detail::Filtered> f(scene);
+    if (const auto rounded = detail::filteredAtan2Sqrt(f.y, f.x, f.x_scale)) return *rounded;
+  }
+  const PrintedAngleArguments<Rational> a(scene);
   if (const auto rounded = detail::roundedAtan2Sqrt(a.y, a.x, a.x_scale)) return *rounded;
   if (certified) *certified = false;
   return phiBCInDouble(scene);
@@ -241,17 +243,17 @@ double phiBC(const Scene& scene, bool* certified) {
 
 std::optional<std::int64_t> impactCount(const Scene& scene, bool* certified) {
   if (wallIndex(scene) >= 0) return std::nullopt;  // phi_BC is inf / inf as printed
-  const PrintedAngleArguments a(scene);
-  if (kCheapStep) {  // each angle within 2^-59 relatively (cheapAtan2Sqrt)
-    const long double omega = std::atan2(std::sqrt(approximate(a.omega_sin_sq)), -std::sqrt(approximate(a.omega_cos_sq)));
-    const long double theta = std::atan2(2 * std::sqrt(approximate(a.theta_d)), approximate(a.theta_a));
-    const long double phi = detail::cheapAtan2Sqrt(a.y, a.x, a.x_scale);
-    const long double x = (omega - phi) / theta;
-    const long double error = 0x1p-57L * ((omega + std::fabs(phi)) / theta + std::fabs(x));
-    if (std::isfinite(x) && std::isfinite(error) && std::fabs(x) + error < 4e18L) {
-      if (const auto count = decidedCount(Certifying(x), Certifying(error))) return count;
+  if (detail::kFilterable) {  // the filter first: the arguments with their bounds, no rationals
+    using detail::Filtered;
+    const PrintedAngleArguments<Filtered> f(scene);
+    const Filtered omega = atan2(sqrt(f.omega_sin_sq), -sqrt(f.omega_cos_sq));
+    const Filtered theta = atan2(Filtered(2) * sqrt(f.theta_d), f.theta_a);
+    const Filtered x = (omega - detail::atan2Sqrt(f.y, f.x, f.x_scale)) / theta;
+    if (std::isfinite(x.value) && std::isfinite(x.error) && std::fabs(x.value) + x.error < 4e18L) {
+      if (const auto count = decidedCount(Certifying(x.value), Certifying(x.error))) return count;
     }
   }
+  const PrintedAngleArguments<Rational> a(scene);
   const Certifying omega = atan2(sqrt(toCertifying(a.omega_sin_sq)), -sqrt(toCertifying(a.omega_cos_sq)));
   const Certifying theta = atan2(2 * sqrt(toCertifying(a.theta_d)), toCertifying(a.theta_a));
   const Certifying x = (omega - detail::certifyingAtan2Sqrt(a.y, a.x, a.x_scale)) / theta;

@@ -48,6 +48,10 @@ constexpr std::uint64_t kExactWalkBits = 16384;
 /// walk, within its budget; longer runs keep the closed form in double per impact.
 constexpr std::uint64_t kExactEventLimit = 64;
 
+/// The longest run whose final velocities the filtered walk (filteredVelocitiesAfter) tries
+/// first: its bound grows with the count, and past this it would seldom decide.
+constexpr std::uint64_t kFilteredWalkLimit = 256;
+
 /// Does the exact walk of `count` impacts of these masses stay within kExactWalkBits?
 bool exactWalkAffordable(const std::array<double, 3>& masses, std::uint64_t count) {
   std::uint64_t bits_per_impact = 0;
@@ -710,6 +714,12 @@ std::array<double, 3> roundedVelocitiesAfter(const Scene& scene, std::uint64_t c
   }
   const auto exactly = [&] { return ExactInTurn(scene).velocitiesAfter(count); };
   const std::array<double, 3> masses = triple(scene.masses);
+  if (detail::kFilterable && count <= kFilteredWalkLimit) {
+    const std::array<detail::Filtered, 3> walked = filteredVelocitiesAfter(scene, *first, count);
+    std::array<std::optional<double>, 3> nearest;
+    for (int k = 0; k < 3; ++k) nearest[k] = detail::filteredNearest(walked[k]);
+    if (nearest[0] && nearest[1] && nearest[2]) return {*nearest[0], *nearest[1], *nearest[2]};
+  }
   if (exactWalkAffordable(masses, count)) return exactly();
   std::array<std::optional<double>, 3> product;
   if (productInRange(masses)) {
@@ -731,23 +741,67 @@ std::array<double, 3> roundedVelocitiesAfter(const Scene& scene, std::uint64_t c
 /// 1 / (m_B m_C); a wall C: X = v_A - v_C, scale = m_A / m_B; in [0, 2 pi). Empty where it
 /// is not certified.
 std::optional<double> roundedPsi(const Scene& scene) {
-  using R = detail::ExactRational;
   if (scene.isWall(kA) && scene.isWall(kC)) return std::nullopt;
-  const R v_a(scene.velocities[kA]), v_b(scene.velocities[kB]), v_c(scene.velocities[kC]);
-  const R m_b(scene.masses[kB]);
-  const R y = v_b - v_c;
-  if (scene.isWall(kA)) {
-    const R m_c(scene.masses[kC]);
-    return detail::roundedAtan2Sqrt(y, -(m_b * (v_b - v_a) + m_c * (v_c - v_a)), 1 / (m_b * m_c), true);
+  // Y, X and scale, exact (detail::ExactRational) or with a filter's bound (detail::Filtered).
+  const auto arguments = [&scene](auto exact) {
+    using T = decltype(exact);
+    const T v_a(scene.velocities[kA]), v_b(scene.velocities[kB]), v_c(scene.velocities[kC]);
+    const T m_b(scene.masses[kB]);
+    const T y = v_b - v_c;
+    if (scene.isWall(kA)) {
+      const T m_c(scene.masses[kC]);
+      return std::array<T, 3>{y, -(m_b * (v_b - v_a) + m_c * (v_c - v_a)), T(1) / (m_b * m_c)};
+    }
+    const T m_a(scene.masses[kA]);
+    if (scene.isWall(kC)) return std::array<T, 3>{y, v_a - v_c, m_a / m_b};
+    const T m_c(scene.masses[kC]);
+    return std::array<T, 3>{y, (m_b + m_c) * v_a - m_b * v_b - m_c * v_c, m_a / (m_b * m_c * (m_a + m_b + m_c))};
+  };
+  if (detail::kFilterable) {
+    const auto f = arguments(detail::Filtered());
+    if (const auto rounded = detail::filteredAtan2Sqrt(f[0], f[1], f[2], true)) return rounded;
   }
-  const R m_a(scene.masses[kA]);
-  if (scene.isWall(kC)) return detail::roundedAtan2Sqrt(y, v_a - v_c, m_a / m_b, true);
-  const R m_c(scene.masses[kC]);
-  return detail::roundedAtan2Sqrt(y, (m_b + m_c) * v_a - m_b * v_b - m_c * v_c, m_a / (m_b * m_c * (m_a + m_b + m_c)),
-                                  true);
+  const auto a = arguments(detail::ExactRational());
+  return detail::roundedAtan2Sqrt(a[0], a[1], a[2], true);
 }
 
 }  // namespace
+
+std::array<detail::Filtered, 3> filteredVelocitiesAfter(const Scene& scene, Pair first, std::uint64_t count) {
+  constexpr long double kUnit = 0x1p-64L;  // long double's unit roundoff
+  constexpr long double kInfinite = std::numeric_limits<long double>::infinity();
+  std::array<long double, 3> v{}, m{};
+  for (int k = 0; k < 3; ++k) v[k] = scene.velocities[k], m[k] = scene.masses[k];
+  long double error = 0;  // in the energy norm
+  Pair pair = first;
+  for (std::uint64_t n = 0; n < count; ++n, pair = otherPair(pair)) {
+    const int i = pairIndex(pair), j = i + 1;
+    if (scene.isWall(i) || scene.isWall(j)) {  // the finite body reflects off the wall's velocity
+      const int body = scene.isWall(i) ? j : i, wall = i + j - body;
+      v[body] = 2 * v[wall] - v[body];
+      error += std::sqrt(m[body]) * std::fabs(v[body]) * kUnit;
+    } else {
+      // The centre velocity within 6 roundings of size (5 suffice) of the exact one of the
+      // walked values, then v' = 2 V - v within one rounding more.
+      const long double size = (m[i] * std::fabs(v[i]) + m[j] * std::fabs(v[j])) / (m[i] + m[j]);
+      const long double centre = (m[i] * v[i] + m[j] * v[j]) / (m[i] + m[j]);
+      v[i] = 2 * centre - v[i];
+      v[j] = 2 * centre - v[j];
+      const long double centre_error = 6 * kUnit * size;
+      error += std::sqrt(m[i]) * (2 * centre_error + kUnit * std::fabs(v[i])) +
+               std::sqrt(m[j]) * (2 * centre_error + kUnit * std::fabs(v[j]));
+    }
+  }
+  error *= 1 + 0x1p-50L;  // the bound's own roundings (a sum of up to 2^13 terms, square roots)
+  std::array<detail::Filtered, 3> walked;
+  for (int k = 0; k < 3; ++k) {
+    const bool finite = std::isfinite(v[k]) && std::isfinite(error);
+    walked[k] = scene.isWall(k) ? detail::Filtered(scene.velocities[k])
+                : finite        ? detail::Filtered(v[k], error / (std::sqrt(m[k]) * (1 - 0x1p-60L)))
+                                : detail::Filtered(v[k], kInfinite);
+  }
+  return walked;
+}
 
 void fillRotationPrediction(const Scene& scene, Prediction& prediction) {
   const std::array<double, 3> masses = triple(scene.masses);

@@ -6,6 +6,7 @@
 
 #include "collision_lab/core/nbody/models.h"
 #include "collision_lab/core/scene_run.h"
+#include "correct_rounding.h"
 
 namespace collision_lab {
 namespace core {
@@ -14,6 +15,15 @@ namespace core {
 /// velocities, angles, psi, first pair and the paper's printed values. Precondition:
 /// validate(scene) passed and scene.size() == 3.
 void fillRotationPrediction(const Scene& scene, Prediction& prediction);
+
+/// The filter of the final velocities (issue 48): the velocities after `count` impacts
+/// (`first` first, then alternating) walked in long double, each with a rigorous bound on its
+/// distance from the exact value; a wall's exact. From a bound in the energy norm
+/// |x|^2 = sum m_k x_k^2 (walls left out): each impact map is an isometry of it (a wall's, a
+/// reflection of the other body), so the walk is within the sum of each impact's own
+/// rounding, and body k within that over sqrt(m_k). Infinite bounds where a value leaves
+/// the range.
+std::array<detail::Filtered, 3> filteredVelocitiesAfter(const Scene& scene, Pair first, std::uint64_t count);
 
 /// Simulates a scene whose prediction has the rotation model's values (hasRotationValues),
 /// in full or summary mode, up to options.lab.max_collisions. The summary is the same with

@@ -331,6 +331,45 @@ TEST(PublishedRounding, ThePapersPrintedFormulasArePublishedAsTheirExactValuesRo
   EXPECT_TRUE(p.uncertified.empty());
 }
 
+TEST(PublishedRounding, TheFiltersAnglesAreTheExactOnesRoundedAcrossTheDoubleRange) {
+  // psi, phi_BC and the paper's count come from the filter (long double with a running error
+  // bound, no rationals) wherever its bound decides, and from exact rationals elsewhere:
+  // either way the exact value rounded. Seeded scenes across the double range, with exact
+  // ties (v_B = v_C, v_A = v_B), exact zeros and walls; against 500 bits.
+  std::mt19937_64 rng(4810);
+  std::uniform_real_distribution<double> unit(0.0, 1.0), mass_decade(-15.0, 15.0), speed_decade(-30.0, 30.0);
+  const auto speed = [&] { return (unit(rng) < 0.5 ? -1 : 1) * std::pow(10.0, speed_decade(rng)); };
+  int counts_checked = 0;
+  for (int k = 0; k < 400; ++k) {
+    Scene scene{{std::pow(10.0, mass_decade(rng)), std::pow(10.0, mass_decade(rng)), std::pow(10.0, mass_decade(rng))},
+                {2, 1, 0},
+                {speed(), speed(), speed()}};
+    if (k % 5 == 0) scene.velocities[2] = scene.velocities[1];  // on the BC mirror
+    if (k % 5 == 1) scene.velocities[0] = scene.velocities[1];  // on the AB mirror
+    if (k % 5 == 2) scene.velocities[k % 3] = 0.0;
+    if (k % 7 == 3) scene.masses[0] = kInf;
+    if (k % 7 == 4) scene.masses[2] = kInf;
+    if (scene.velocities[0] == scene.velocities[1] && scene.velocities[1] == scene.velocities[2]) continue;
+    const ScenePlan plan = planScene(scene);
+    if (plan.error) continue;  // beyond the lab's envelope (the count's range)
+    const Prediction& p = *plan.prediction;
+    SCOPED_TRACE(describe(scene));
+    ASSERT_TRUE(p.psi);
+    EXPECT_TRUE(nearestTo(*p.psi, AnalyticModel<DeepPrecision>(scene).psi())) << "psi " << *p.psi;
+    EXPECT_TRUE(p.uncertified.empty()) << p.uncertified.front();
+    if (scene.isWall(0) || scene.isWall(2)) continue;  // the printed angles are inf / inf
+    const PrintedAngles printed = printedAnglesAt500Bits(scene);
+    ASSERT_TRUE(p.phi_bc);
+    EXPECT_TRUE(nearestTo(*p.phi_bc, printed.phi_bc)) << "phi_BC " << *p.phi_bc;
+    const DeepPrecision& x = printed.count_argument;
+    if (abs(x - round(x)) < 1e-100) continue;  // a grazing start: decided exactly (the test above)
+    ASSERT_TRUE(p.paper_impact_count);
+    EXPECT_EQ(*p.paper_impact_count, 1 + static_cast<std::int64_t>(floor(x)) + static_cast<std::int64_t>(ceil(x)));
+    ++counts_checked;
+  }
+  EXPECT_GT(counts_checked, 150);
+}
+
 }  // namespace
 }  // namespace core
 }  // namespace collision_lab
