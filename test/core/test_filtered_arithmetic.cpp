@@ -52,7 +52,7 @@ D toDeep(long double x) { return D(x); }  // exact
 
 /// |exact - value| / error, from an exact value to 500 bits (relative slack 2^-480).
 double ratio(const D& exact, const Filtered& result) {
-  EXPECT_TRUE(std::isfinite(static_cast<double>(result.error)));
+  EXPECT_TRUE(std::isfinite(result.error));
   const D distance = abs(exact - toDeep(result.value));
   const D slack = abs(exact) * ldexp(D(1), -480);
   EXPECT_LE(distance, toDeep(result.error) + slack) << "value " << static_cast<double>(result.value) << ", error "
@@ -74,15 +74,15 @@ TEST(FilteredArithmetic, EveryOperationsBoundHoldsAndAFourTimesTighterOneFails) 
     note("-", ratio(da - db, a.filtered - b.filtered));
     note("*", ratio(da * db, a.filtered * b.filtered));
     const Filtered quotient = a.filtered / b.filtered;
-    if (std::isfinite(static_cast<double>(quotient.error))) note("/", ratio(da / db, quotient));
+    if (std::isfinite(quotient.error)) note("/", ratio(da / db, quotient));
     const Operand p = operand(rng, low, high, true);
     note("sqrt", ratio(sqrt(toDeep(p.exact)), sqrt(p.filtered)));
     // Angles: the branch cut and the origin are left undecided (infinite error), never wrong.
     const Filtered angle = detail::atan2(a.filtered, b.filtered);
-    if (std::isfinite(static_cast<double>(angle.error))) note("atan2", ratio(atan2(da, db), angle));
+    if (std::isfinite(angle.error)) note("atan2", ratio(atan2(da, db), angle));
     const Operand s = operand(rng, -60, 60, true);
     const Filtered scaled = detail::atan2Sqrt(a.filtered, b.filtered, s.filtered);
-    if (std::isfinite(static_cast<double>(scaled.error))) {
+    if (std::isfinite(scaled.error)) {
       note("atan2Sqrt", ratio(atan2(da, db * sqrt(toDeep(s.exact))), scaled));
     }
   }
@@ -95,15 +95,15 @@ TEST(FilteredArithmetic, EveryOperationsBoundHoldsAndAFourTimesTighterOneFails) 
 
 TEST(FilteredArithmetic, TheBranchCutAndTheOriginAreLeftUndecided) {
   // y straddles 0 left of the origin: the angle may be near +pi or near -pi.
-  EXPECT_TRUE(std::isinf(static_cast<double>(detail::atan2(Filtered(1e-30L, 1e-29L), Filtered(-1)).error)));
+  EXPECT_TRUE(std::isinf(detail::atan2(Filtered(1e-30L, 1e-29L), Filtered(-1)).error));
   // An exact 0 left of the origin is +pi, as the exact path says.
   const Filtered pi = detail::atan2(Filtered(0), Filtered(-1, 1e-20L));
   EXPECT_GT(pi.value, 3.14L);
   EXPECT_EQ(detail::filteredNearest(pi), M_PI);
   // The origin within the bounds.
-  EXPECT_TRUE(std::isinf(static_cast<double>(detail::atan2(Filtered(1e-10L, 1e-9L), Filtered(1e-10L, 1e-9L)).error)));
+  EXPECT_TRUE(std::isinf(detail::atan2(Filtered(1e-10L, 1e-9L), Filtered(1e-10L, 1e-9L)).error));
   // A quotient whose divisor's bound reaches 0.
-  EXPECT_TRUE(std::isinf(static_cast<double>((Filtered(1) / Filtered(1e-5L, 2e-5L)).error)));
+  EXPECT_TRUE(std::isinf((Filtered(1) / Filtered(1e-5L, 2e-5L)).error));
   // Rounding: a value within its bound of a rounding boundary between two doubles is not rounded.
   const long double boundary = 1.0L + 0x1p-53L;  // halfway between 1 and its successor
   EXPECT_FALSE(detail::filteredNearest(Filtered(boundary + 0x1p-62L, 0x1p-61L)));
