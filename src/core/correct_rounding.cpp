@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <utility>
 
 #include <boost/math/constants/constants.hpp>
 
@@ -64,44 +65,89 @@ namespace {
 constexpr long double kInfinity = std::numeric_limits<long double>::infinity();
 
 /// A bound computed in long double, rounded up: a few roundings of 2^-64 each, and an
-/// underflow, covered.
+/// underflow, covered. 0 stays 0, so that exact operations stay exact.
 long double roundedUp(long double bound) {
-  return bound * (1 + 0x1p-60L) + std::numeric_limits<long double>::denorm_min();
+  return bound == 0 ? 0 : bound * (1 + 0x1p-60L) + std::numeric_limits<long double>::denorm_min();
 }
 
-/// The result of one rounded operation whose operands' errors propagate to `propagated`.
-Filtered rounded(long double value, long double propagated) {
-  if (!std::isfinite(value)) return {value, kInfinity};
-  return {value, roundedUp(propagated + std::fabs(value) * 0x1p-64L)};
+/// Error-free transformations (Knuth's TwoSum, Dekker's TwoProduct with Veltkamp's split at
+/// 32 of the 64 bits): the exact rounding error of a + b and of a b, so that an operation
+/// whose result is exact adds no error, and one that is not adds its true rounding.
+long double sumError(long double a, long double b, long double sum) {
+  const long double b_virtual = sum - a;
+  return (a - (sum - b_virtual)) + (b - b_virtual);
+}
+
+std::pair<long double, long double> split(long double a) {
+  const long double c = (0x1p32L + 1) * a;
+  const long double high = c - (c - a);
+  return {high, a - high};
+}
+
+long double productError(long double a, long double b, long double product) {
+  // Exact away from the ends of the exponent range; near them, a bound on the rounding.
+  constexpr long double kLarge = 0x1p16000L, kSmall = 0x1p-16000L;
+  if (!(std::fabs(a) < kLarge && std::fabs(b) < kLarge && (product == 0 || std::fabs(product) > kSmall))) {
+    return std::fabs(product) * 0x1p-63L + std::numeric_limits<long double>::denorm_min();
+  }
+  const auto [a_high, a_low] = split(a);
+  const auto [b_high, b_low] = split(b);
+  return ((a_high * b_high - product) + a_high * b_low + a_low * b_high) + a_low * b_low;
+}
+
+/// The result of one operation: its operands' errors propagated, and its own rounding.
+Filtered rounded(long double value, long double propagated, long double own) {
+  if (!std::isfinite(value) || !std::isfinite(own)) return {value, kInfinity};
+  return {value, roundedUp(propagated + std::fabs(own))};
+}
+
+/// |a - product(b, c)|, exact but for one rounding of the result: the residual of a
+/// quotient or a square root.
+long double residual(long double a, long double b, long double c) {
+  const long double product = b * c;
+  return (a - product) - productError(b, c, product);
 }
 
 }  // namespace
 
-Filtered operator+(const Filtered& a, const Filtered& b) { return rounded(a.value + b.value, a.error + b.error); }
+Filtered operator+(const Filtered& a, const Filtered& b) {
+  const long double sum = a.value + b.value;
+  return rounded(sum, a.error + b.error, sumError(a.value, b.value, sum));
+}
 
-Filtered operator-(const Filtered& a, const Filtered& b) { return rounded(a.value - b.value, a.error + b.error); }
+Filtered operator-(const Filtered& a, const Filtered& b) { return a + (-b); }
 
 Filtered operator-(const Filtered& a) { return {-a.value, a.error}; }
 
 Filtered operator*(const Filtered& a, const Filtered& b) {
-  return rounded(a.value * b.value, std::fabs(a.value) * b.error + std::fabs(b.value) * a.error + a.error * b.error);
+  const long double product = a.value * b.value;
+  return rounded(product, std::fabs(a.value) * b.error + std::fabs(b.value) * a.error + a.error * b.error,
+                 productError(a.value, b.value, product));
 }
 
 Filtered operator/(const Filtered& a, const Filtered& b) {
-  // |A/B - a/b| = |(A - a) b - a (B - b)| / |B b| <= (e_a |b| + |a| e_b) / ((|b| - e_b) |b|).
+  // |A/B - a/b| = |(A - a) b - a (B - b)| / |B b| <= (e_a |b| + |a| e_b) / ((|b| - e_b) |b|);
+  // the quotient's own rounding is its residual over b.
   const long double size = std::fabs(b.value);
-  if (!(b.error < size)) return {a.value / b.value, kInfinity};
+  const long double quotient = a.value / b.value;
+  if (!(b.error < size)) return {quotient, kInfinity};
   const long double room = size - roundedUp(b.error);
-  if (!(room > 0)) return {a.value / b.value, kInfinity};
-  return rounded(a.value / b.value, (a.error * size + std::fabs(a.value) * b.error) / (room * size));
+  if (!(room > 0)) return {quotient, kInfinity};
+  const long double own = residual(a.value, quotient, b.value) / size * (1 + 0x1p-60L);
+  return rounded(quotient, (a.error * size + std::fabs(a.value) * b.error) / (room * size), own);
 }
 
 Filtered sqrt(const Filtered& a) {
-  // |sqrt(A) - sqrt(a)| = |A - a| / (sqrt(A) + sqrt(a)) <= e_a / sqrt(a) for A >= 0.
-  if (a.error == 0) return rounded(std::sqrt(a.value), 0);
-  if (!(a.value > 0)) return {std::sqrt(std::fabs(a.value)), kInfinity};
+  // |sqrt(A) - sqrt(a)| = |A - a| / (sqrt(A) + sqrt(a)) <= e_a / sqrt(a) for A >= 0; where
+  // a <= 0, sqrt(A) <= sqrt(a + e_a). The root's own rounding is its residual over it.
+  if (!(a.value > 0)) {
+    if (a.value == 0 && a.error == 0) return Filtered(0);
+    const long double top = roundedUp(a.value + a.error);
+    if (!(top >= 0)) return {0, kInfinity};  // no A >= 0 within the bound: nothing known
+    return {0, roundedUp(std::sqrt(top))};
+  }
   const long double root = std::sqrt(a.value);
-  return rounded(root, a.error / root);
+  return rounded(root, a.error / root, residual(a.value, root, root) / root * (1 + 0x1p-60L));
 }
 
 Filtered atan2(const Filtered& y, const Filtered& x) {

@@ -56,7 +56,8 @@ std::optional<double> roundedAtan2Sqrt(const ExactRational& y, const ExactRation
 /// A long double with a rigorous bound on its distance from the exact value it stands for:
 /// a floating-point filter's running error bound (as CGAL's filtered predicates). An exact
 /// input has error 0; each operation adds its operands' errors, propagated, and its own
-/// rounding, every bound rounded up. A rounding or a decision that the bound settles needs
+/// rounding: the exact one for + and * (error-free transformations, so an exact operation
+/// adds nothing), the residual's for / and sqrt; every bound rounded up. A rounding or a decision that the bound settles needs
 /// no exact arithmetic; one it does not settle goes to the exact path. The bounds assume
 /// long double's 64-bit significand (kFilterable) and values inside its exponent range
 /// (products and quotients of a few doubles are: 2^+-16382 against the doubles' 2^+-1074).
