@@ -64,10 +64,10 @@ namespace {
 
 constexpr long double kInfinity = std::numeric_limits<long double>::infinity();
 
-/// A bound computed in long double, rounded up: a few roundings of 2^-64 each, and an
-/// underflow, covered. 0 stays 0, so that exact operations stay exact.
+/// A bound computed in long double, rounded up: up to 16 roundings of 2^-64 each, and up to
+/// four below the normal range, covered. 0 stays 0, so that exact operations stay exact.
 long double roundedUp(long double bound) {
-  return bound == 0 ? 0 : bound * (1 + 0x1p-60L) + std::numeric_limits<long double>::denorm_min();
+  return bound == 0 ? 0 : bound * (1 + 0x1p-60L) + 4 * std::numeric_limits<long double>::denorm_min();
 }
 
 /// Error-free transformations (Knuth's TwoSum, Dekker's TwoProduct with Veltkamp's split at
@@ -85,17 +85,20 @@ std::pair<long double, long double> split(long double a) {
 }
 
 long double productError(long double a, long double b, long double product) {
-  // Exact away from the ends of the exponent range; near them, a bound on the rounding.
+  // Exact away from the ends of the exponent range; near them (never with the doubles'
+  // products here) unknown: NaN, which makes the operation's error infinite.
+  if (a == 0 || b == 0) return 0;
   constexpr long double kLarge = 0x1p16000L, kSmall = 0x1p-16000L;
-  if (!(std::fabs(a) < kLarge && std::fabs(b) < kLarge && (product == 0 || std::fabs(product) > kSmall))) {
-    return std::fabs(product) * 0x1p-63L + std::numeric_limits<long double>::denorm_min();
+  if (!(std::fabs(a) < kLarge && std::fabs(b) < kLarge && std::fabs(product) > kSmall)) {
+    return std::numeric_limits<long double>::quiet_NaN();
   }
   const auto [a_high, a_low] = split(a);
   const auto [b_high, b_low] = split(b);
   return ((a_high * b_high - product) + a_high * b_low + a_low * b_high) + a_low * b_low;
 }
 
-/// The result of one operation: its operands' errors propagated, and its own rounding.
+/// The result of one operation: its operands' errors propagated, and its own rounding (not
+/// finite: nothing known).
 Filtered rounded(long double value, long double propagated, long double own) {
   if (!std::isfinite(value) || !std::isfinite(own)) return {value, kInfinity};
   return {value, roundedUp(propagated + std::fabs(own))};
@@ -177,6 +180,8 @@ Filtered atan2(const Filtered& y, const Filtered& x) {
 }
 
 Filtered atan2Sqrt(const Filtered& y, const Filtered& x, const Filtered& scale) {
+  // Where X's sign is uncertain (|x| <= its error), size's bound is at least e sqrt(scale),
+  // which covers X sqrt(scale) of either sign; atan2 then finds the origin within its reach.
   const Filtered size = sqrt(x * x * scale);
   return atan2(y, x.value < 0 ? -size : size);
 }

@@ -68,8 +68,10 @@ struct Filtered {
   long double error = 0;  ///< |exact - value| <= error (infinite: nothing known)
 };
 
-/// Long double has the 64-bit significand that Filtered's bounds assume.
-constexpr bool kFilterable = std::numeric_limits<long double>::digits >= 64;
+/// Long double has exactly the binary 64-bit significand that Filtered's bounds and its
+/// error-free transformations (a split at 32 bits) assume: x86's. Elsewhere the exact path
+/// answers alone.
+constexpr bool kFilterable = std::numeric_limits<long double>::digits == 64 && std::numeric_limits<long double>::radix == 2;
 
 Filtered operator+(const Filtered& a, const Filtered& b);
 Filtered operator-(const Filtered& a, const Filtered& b);

@@ -792,7 +792,8 @@ std::array<detail::Filtered, 3> filteredVelocitiesAfter(const Scene& scene, Pair
                std::sqrt(m[j]) * (2 * centre_error + kUnit * std::fabs(v[j]));
     }
   }
-  error *= 1 + 0x1p-50L;  // the bound's own roundings (a sum of up to 2^13 terms, square roots)
+  // The bound's own roundings: a sum of 2 count terms, each of a few roundings.
+  error *= 1 + (2 * static_cast<long double>(count) + 16) * 0x1p-63L;
   std::array<detail::Filtered, 3> walked;
   for (int k = 0; k < 3; ++k) {
     const bool finite = std::isfinite(v[k]) && std::isfinite(error);
