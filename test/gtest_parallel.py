@@ -6,9 +6,10 @@ otherwise hold CI on one core. Each test runs alone in its own process (--gtest_
 most --jobs at a time, in the binary's listing order. Each test's output is printed as it
 finishes; the closing lines are gtest's ("[  PASSED  ] N tests.", "[  FAILED  ] Suite.Name").
 The XML file has gtest's layout (a testsuites root with the totals, one testsuite per suite),
-so catkin_test_results counts it as it counted the serial run. A test whose process ends
-with a non-zero status and no failure in its XML (a crash, an abort) is a failure
-with that status and its output's tail.
+so catkin_test_results counts it as it counted the serial run (skipped tests as skipped;
+the binaries have no disabled ones). A test without a result (no XML, none in it, or one
+that does not parse) or whose process ends with a non-zero status and no failure in its
+XML (a crash, an abort) is a failure, with its output's tail.
 
 Usage: gtest_parallel.py BINARY --gtest_output=xml:FILE [--jobs N]
 Exit status: 0 when every test passed, 1 otherwise.
@@ -39,26 +40,40 @@ def listed_tests(binary):
 
 def run_one(binary, test, folder, index):
     xml = os.path.join(folder, "%05d.xml" % index)
-    done = subprocess.run([binary, "--gtest_filter=" + test, "--gtest_output=xml:" + xml],
+    # Each test in full: gtest's own sharding would leave some processes without their test.
+    environment = {k: v for k, v in os.environ.items() if k not in ("GTEST_SHARD_INDEX", "GTEST_TOTAL_SHARDS")}
+    done = subprocess.run([binary, "--gtest_filter=" + test, "--gtest_output=xml:" + xml], env=environment,
                           stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, errors="replace")
     return test, done.returncode, done.stdout, xml
 
 
 def testcases(test, returncode, output, xml):
-    """The test's <testcase> elements from its XML; a failure added when the process failed
-    without saying so (a crash before or after the test wrote its result)."""
-    cases = list(ET.parse(xml).getroot().iter("testcase")) if os.path.exists(xml) else []
+    """The test's <testcase> elements from its XML. A failure when there is no result (no
+    file, no test case in it, a file that does not parse: the test did not run, whatever
+    the status) or when the process failed without saying so (a crash after the result)."""
+    try:
+        cases = list(ET.parse(xml).getroot().iter("testcase")) if os.path.exists(xml) else []
+    except ET.ParseError:
+        cases = []
+    problem = None
     if not cases:
         suite, name = test.split(".", 1)
         cases = [ET.Element("testcase", name=name, classname=suite, status="run", time="0")]
-    if returncode != 0 and not any(failed(case) for case in cases):
-        failure = ET.SubElement(cases[-1], "failure", message="the test process ended with status %d" % returncode)
+        problem = "no result from the test process (status %d)" % returncode
+    elif returncode != 0 and not any(failed(case) for case in cases):
+        problem = "the test process ended with status %d" % returncode
+    if problem:
+        failure = ET.SubElement(cases[-1], "failure", message=problem)
         failure.text = output[-4000:]
     return cases
 
 
 def failed(case):
     return case.find("failure") is not None or case.find("error") is not None
+
+
+def skipped(case):
+    return case.find("skipped") is not None
 
 
 def merged(results):
@@ -68,10 +83,11 @@ def merged(results):
         for case in testcases(test, returncode, output, xml):
             suites.setdefault(case.get("classname"), []).append(case)
     root = ET.Element("testsuites", name="AllTests")
-    totals = {"tests": 0, "failures": 0, "errors": 0, "disabled": 0, "time": 0.0}
+    totals = {"tests": 0, "failures": 0, "errors": 0, "skipped": 0, "disabled": 0, "time": 0.0}
     for name, cases in suites.items():
         suite = ET.SubElement(root, "testsuite", name=name)
-        counts = {"tests": len(cases), "failures": sum(failed(c) for c in cases), "errors": 0, "disabled": 0,
+        counts = {"tests": len(cases), "failures": sum(failed(c) for c in cases), "errors": 0,
+                  "skipped": sum(skipped(c) for c in cases), "disabled": 0,
                   "time": sum(float(c.get("time", "0")) for c in cases)}
         for key, value in counts.items():
             suite.set(key, "%.3f" % value if key == "time" else str(value))
