@@ -768,40 +768,33 @@ std::optional<double> roundedPsi(const Scene& scene) {
 }  // namespace
 
 std::array<detail::Filtered, 3> filteredVelocitiesAfter(const Scene& scene, Pair first, std::uint64_t count) {
-  constexpr long double kUnit = 0x1p-64L;  // long double's unit roundoff
-  constexpr long double kInfinite = std::numeric_limits<long double>::infinity();
-  std::array<long double, 3> v{}, m{};
-  for (int k = 0; k < 3; ++k) v[k] = scene.velocities[k], m[k] = scene.masses[k];
-  long double error = 0;  // in the energy norm
+  using detail::Filtered;
+  std::array<Filtered, 3> v;
+  for (int k = 0; k < 3; ++k) v[k] = Filtered(scene.velocities[k]);
+  // Each pair's coefficients, once: v_i' = ((m_i - m_j) v_i + 2 m_j v_j) / (m_i + m_j).
+  struct Coefficients {
+    Filtered difference, twice_right, twice_left, total;
+  };
+  std::array<Coefficients, 2> pair_coefficients;
+  for (int i = 0; i < 2; ++i) {
+    if (scene.isWall(i) || scene.isWall(i + 1)) continue;
+    const Filtered m_i(scene.masses[i]), m_j(scene.masses[i + 1]);
+    pair_coefficients[i] = {m_i - m_j, Filtered(2) * m_j, Filtered(2) * m_i, m_i + m_j};
+  }
   Pair pair = first;
   for (std::uint64_t n = 0; n < count; ++n, pair = otherPair(pair)) {
     const int i = pairIndex(pair), j = i + 1;
     if (scene.isWall(i) || scene.isWall(j)) {  // the finite body reflects off the wall's velocity
       const int body = scene.isWall(i) ? j : i, wall = i + j - body;
-      v[body] = 2 * v[wall] - v[body];
-      error += std::sqrt(m[body]) * std::fabs(v[body]) * kUnit;
-    } else {
-      // The centre velocity within 6 roundings of size (5 suffice) of the exact one of the
-      // walked values, then v' = 2 V - v within one rounding more.
-      const long double size = (m[i] * std::fabs(v[i]) + m[j] * std::fabs(v[j])) / (m[i] + m[j]);
-      const long double centre = (m[i] * v[i] + m[j] * v[j]) / (m[i] + m[j]);
-      v[i] = 2 * centre - v[i];
-      v[j] = 2 * centre - v[j];
-      const long double centre_error = 6 * kUnit * size;
-      error += std::sqrt(m[i]) * (2 * centre_error + kUnit * std::fabs(v[i])) +
-               std::sqrt(m[j]) * (2 * centre_error + kUnit * std::fabs(v[j]));
+      v[body] = Filtered(2) * v[wall] - v[body];
+      continue;
     }
+    const Coefficients& c = pair_coefficients[i];
+    const Filtered left = (c.difference * v[i] + c.twice_right * v[j]) / c.total;
+    v[j] = (c.twice_left * v[i] - c.difference * v[j]) / c.total;
+    v[i] = left;
   }
-  // The bound's own roundings: a sum of 2 count terms, each of a few roundings.
-  error *= 1 + (2 * static_cast<long double>(count) + 16) * 0x1p-63L;
-  std::array<detail::Filtered, 3> walked;
-  for (int k = 0; k < 3; ++k) {
-    const bool finite = std::isfinite(v[k]) && std::isfinite(error);
-    walked[k] = scene.isWall(k) ? detail::Filtered(scene.velocities[k])
-                : finite        ? detail::Filtered(v[k], error / (std::sqrt(m[k]) * (1 - 0x1p-60L)))
-                                : detail::Filtered(v[k], kInfinite);
-  }
-  return walked;
+  return v;
 }
 
 void fillRotationPrediction(const Scene& scene, Prediction& prediction) {

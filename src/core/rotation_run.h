@@ -17,12 +17,10 @@ namespace core {
 void fillRotationPrediction(const Scene& scene, Prediction& prediction);
 
 /// The filter of the final velocities (issue 48): the velocities after `count` impacts
-/// (`first` first, then alternating) walked in long double, each with a rigorous bound on its
-/// distance from the exact value; a wall's exact. From a bound in the energy norm
-/// |x|^2 = sum m_k x_k^2 (walls left out): each impact map is an isometry of it (a wall's, a
-/// reflection of the other body), so the walk is within the sum of each impact's own
-/// rounding, and body k within that over sqrt(m_k). Infinite bounds where a value leaves
-/// the range.
+/// (`first` first, then alternating) walked in detail::Filtered arithmetic, each with a
+/// rigorous bound on its distance from the exact value (a wall's exact). The impact rule in
+/// the form v_i' = ((m_i - m_j) v_i + 2 m_j v_j) / (m_i + m_j), whose bound does not grow
+/// with the mass ratio: a body's error moves by its partner's times 2 m_j / M.
 std::array<detail::Filtered, 3> filteredVelocitiesAfter(const Scene& scene, Pair first, std::uint64_t count);
 
 /// Simulates a scene whose prediction has the rotation model's values (hasRotationValues),
