@@ -49,8 +49,9 @@ constexpr std::uint64_t kExactWalkBits = 16384;
 constexpr std::uint64_t kExactEventLimit = 64;
 
 /// The longest run whose final velocities the filtered walk (filteredVelocitiesAfter) tries
-/// first: its bound grows with the count, and past this it would seldom decide.
-constexpr std::uint64_t kFilteredWalkLimit = 256;
+/// first: its bound grows with the count (on seeded scenes it decides 99% of runs of up to 4
+/// impacts, 90% up to 16, a third up to 64, none longer).
+constexpr std::uint64_t kFilteredWalkLimit = 64;
 
 /// Does the exact walk of `count` impacts of these masses stay within kExactWalkBits?
 bool exactWalkAffordable(const std::array<double, 3>& masses, std::uint64_t count) {
