@@ -907,7 +907,9 @@ SceneSimulation simulateRotationScene(const Scene& scene, const Prediction& pred
   const std::uint64_t progress_interval = progress ? options.progress_interval : 0;
   SceneSimulation simulation;
   std::function<void(ImpactRecord&)> enrich;
-  ModelBesideImpacts beside(scene, model);
+  // Built at the first impact the engine publishes: a summary from the known count needs
+  // none of it, and its paper's exact closed form was most of a short summary run's cost.
+  std::optional<ModelBesideImpacts> beside;
   double max_error_sq = 0.0;
   // The closed form and the run name the same exact state after every impact: a difference
   // within the closed form's rounding (kClosedFormAgreement) is none; a larger one, a fault.
@@ -921,7 +923,8 @@ SceneSimulation simulateRotationScene(const Scene& scene, const Prediction& pred
   if (lab.mode == RunMode::kFull) {
     enrich = [&](ImpactRecord& event) {
       ImpactModelValues& values = *event.model;
-      const bool exact_walk = beside.describe(event.index, event.pair_index == 0 ? Pair::AB : Pair::BC, values);
+      if (!beside) beside.emplace(scene, model);
+      const bool exact_walk = beside->describe(event.index, event.pair_index == 0 ? Pair::AB : Pair::BC, values);
       if (exact_walk) {
         for (std::size_t side = 0; side < 2; ++side) {  // the pair's entries of the record too
           const std::size_t body = event.pair_index + side;
